@@ -1,0 +1,21 @@
+"""daeclear: dynamics of planar mechanisms with clearance joints.
+
+Scene --assemble--> DAEModel --simulate--> Result --> analysis | plot | io
+"""
+
+from __future__ import annotations
+
+from . import mechanisms
+from .assemble import DAEModel, assemble
+from .errors import AssemblyError, DaeclearError, DaeclearWarning, SceneError, SolveError
+from .result import ContactEvent, Result, load
+from .scene import Body, Driver, Revolute, Scene, Translational
+from .solve import simulate
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "Driver",
+    "Result", "Revolute", "Scene", "SceneError", "SolveError", "Translational", "assemble", "load",
+    "mechanisms", "simulate",
+]

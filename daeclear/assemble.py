@@ -1,0 +1,549 @@
+"""Scene -> DAEModel: the symbolic equations of motion, built once with CasADi.
+
+Coordinates: each moving body k has ``q_k = (x_k, y_k, phi_k)`` of its centre of
+mass; the state is ``y = [q, v, lam]`` (``index1``) or ``y = [q, v, lam, mu]``
+(``ggl``). Ideal joints and drivers are constraints ``Phi(q, t) = 0``; contact
+elements (clearance joints) add no constraint but *terms*: generalized forces that
+the solver switches on and off between integration segments.
+
+Formulations
+------------
+``index1`` (the chapter's, default)::
+
+    q' - v                                   = 0
+    M v' + Phi_q^T lam - Q(q, v, t)          = 0
+    Phi_q v' - gamma + 2 alpha Phi' + beta^2 Phi = 0     (Baumgarte)
+
+``ggl`` (stabilised index 2, Gear-Gupta-Leimkuhler; drift-free)::
+
+    q' - v + Phi_q^T mu                      = 0
+    M v' + Phi_q^T lam - Q(q, v, t)          = 0
+    Phi_q v + Phi_t                          = 0
+    Phi(q, t)                                = 0
+
+where ``Phi' = Phi_q v + Phi_t`` and ``gamma = -(d Phi'/dq) v - d Phi'/dt``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Literal, Sequence
+
+import casadi as ca
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import AssemblyError, SceneError
+from .ida_session import DAEFunctions
+from .scene import GROUND, Body, Driver, Revolute, Scene, Translational
+
+Formulation = Literal["index1", "ggl"]
+FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
+
+# State kinds: how each state variable is treated by the solver's error test.
+KIND_POSITION, KIND_VELOCITY, KIND_MULTIPLIER = "q", "v", "lambda"
+
+
+def rotation(phi: Any) -> Any:
+    """Planar rotation matrix A(phi) as a CasADi expression."""
+    c, s = ca.cos(phi), ca.sin(phi)
+    return ca.vertcat(ca.horzcat(c, -s), ca.horzcat(s, c))
+
+
+def perpendicular(u: Any) -> Any:
+    """Vector ``u`` rotated by +90 degrees."""
+    return ca.vertcat(-u[1], u[0])
+
+
+@dataclass(frozen=True)
+class BodyFrame:
+    """Symbolic kinematics of one body (or of the ground) inside an assembly."""
+
+    name: str
+    index: int | None  # position in the body list; None for the ground
+    r: Any  # centre of mass (2x1)
+    phi: Any
+    v: Any  # velocity of the centre of mass (2x1)
+    omega: Any
+
+    def point(self, s_local: Any) -> Any:
+        """World position of the body-fixed point ``s_local``."""
+        return self.r + ca.mtimes(rotation(self.phi), s_local)
+
+    def point_velocity(self, s_local: Any) -> Any:
+        """World velocity of the body-fixed point ``s_local`` (material point)."""
+        return self.v + self.omega * perpendicular(ca.mtimes(rotation(self.phi), s_local))
+
+
+@dataclass(frozen=True)
+class Term:
+    """A switchable generalized force (e.g. one contact pair), added to the equations of motion.
+
+    ``force`` maps ``(t, q, v, p)`` to the generalized force vector (length n_q);
+    ``n_params`` is the size of ``p`` (e.g. the approach speed latched at onset).
+    """
+
+    name: str
+    force: ca.Function
+    n_params: int
+
+
+@dataclass(frozen=True)
+class Channel:
+    """A named output quantity with its unit and symbolic expression in (t, y, yp)."""
+
+    name: str
+    unit: str
+    expr: Any
+
+
+@dataclass
+class AssemblyContext:
+    """Symbols and per-body kinematics handed to element builders during assembly."""
+
+    t: Any
+    q: Any
+    v: Any
+    a: Any  # accelerations (v')
+    frames: dict[str, BodyFrame]
+    reference: dict[str, tuple[tuple[float, float], float]]  # body -> (position, angle)
+
+    def local_point(self, body: str, world: Sequence[float]) -> NDArray[np.float64]:
+        """Body-fixed coordinates of a world point of the reference configuration."""
+        (x0, y0), phi0 = self.reference[body]
+        c, s = math.cos(phi0), math.sin(phi0)
+        dx, dy = world[0] - x0, world[1] - y0
+        return np.array([c * dx + s * dy, -s * dx + c * dy])
+
+
+@dataclass(frozen=True)
+class DAEModel:
+    """An assembled mechanism: CasADi functions for the solver plus everything to interpret them.
+
+    Build it with :func:`assemble`; it is frozen and independent of the scene object.
+    ``print(model)`` summarises its sizes.
+    """
+
+    scene_name: str
+    formulation: str
+    alpha: float
+    beta: float
+    body_names: tuple[str, ...]
+    constraint_names: tuple[str, ...]
+    state_names: tuple[str, ...]
+    state_kinds: tuple[str, ...]
+    functions: DAEFunctions
+    terms: tuple[Term, ...]
+    gap_names: tuple[str, ...]
+    channel_names: tuple[str, ...]
+    channel_units: dict[str, str]
+    outputs: ca.Function  # (t, y, yp) -> channel values
+    q_guess: NDArray[np.float64]
+    v_guess: NDArray[np.float64]
+    mass_diagonal: NDArray[np.float64]
+    kinematics: ca.Function  # (q, v, t) -> (Phi, Phi_q, Phi_dot, gamma)
+    base_force: ca.Function  # (t, q, v) -> Q (gravity and applied loads)
+    parameters: dict[str, Any] = field(default_factory=dict)
+    contacts: tuple[Any, ...] = ()  # contact elements' event logic (clearance joints)
+
+    @property
+    def n_q(self) -> int:
+        return len(self.body_names) * 3
+
+    @property
+    def n_constraints(self) -> int:
+        return len(self.constraint_names)
+
+    @property
+    def n_states(self) -> int:
+        return len(self.state_names)
+
+    @property
+    def differential(self) -> NDArray[np.bool_]:
+        """True for differential states (q, v), False for algebraic ones (multipliers)."""
+        return np.array([k != KIND_MULTIPLIER for k in self.state_kinds])
+
+    def __str__(self) -> str:
+        n_q, m = self.n_q, self.n_constraints
+        extra = self.n_states - 2 * n_q - m
+        parts = f"q {n_q} + v {n_q} + lambda {m}" + (f" + mu {extra}" if extra else "")
+        lines = [
+            f"DAEModel '{self.scene_name}' ({self.formulation}"
+            + (f", alpha={self.alpha:g}, beta={self.beta:g})" if self.formulation == "index1" else ")"),
+            f"  bodies:      {len(self.body_names)} ({', '.join(self.body_names)})",
+            f"  states:      {self.n_states} = {parts}",
+            f"  constraints: {m} ({', '.join(self.constraint_names)})",
+            f"  terms:       {len(self.terms)}" + (f" ({', '.join(t.name for t in self.terms)})" if self.terms else ""),
+            f"  gaps:        {len(self.gap_names)}" + (f" ({', '.join(self.gap_names)})" if self.gap_names else ""),
+            f"  channels:    {len(self.channel_names)}",
+        ]
+        return "\n".join(lines)
+
+    def summary(self) -> dict[str, int]:
+        """Sizes of the assembled DAE (what ``print(model)`` shows), for tests and logs."""
+        return {
+            "bodies": len(self.body_names),
+            "states": self.n_states,
+            "constraints": self.n_constraints,
+            "terms": len(self.terms),
+            "gaps": len(self.gap_names),
+            "channels": len(self.channel_names),
+        }
+
+    # ---- consistent states -------------------------------------------------------------
+    def assemble_positions(self, q_guess: NDArray[np.float64], t: float = 0.0, tol: float = 1e-13,
+                           max_iter: int = 50) -> NDArray[np.float64]:
+        """Newton (least-norm) on Phi(q, t) = 0 from ``q_guess``; raises AssemblyError if it cannot close."""
+        q = np.array(q_guess, dtype=float)
+        if self.n_constraints == 0:
+            return q
+        scale = max(1.0, float(np.max(np.abs(q))))
+        zero_v = np.zeros(self.n_q)
+        for _ in range(max_iter):
+            Phi, Phi_q, _, _ = (np.array(x) for x in self.kinematics(q, zero_v, t))
+            Phi = Phi.ravel()
+            if np.max(np.abs(Phi)) < tol * scale:
+                return q
+            dq, *_ = np.linalg.lstsq(Phi_q, -Phi, rcond=None)
+            q = q + dq
+        Phi = np.array(self.kinematics(q, zero_v, t)[0]).ravel()
+        worst = np.argsort(-np.abs(Phi))[:3]
+        detail = ", ".join(f"'{self.constraint_names[i]}' = {Phi[i]:.3g}" for i in worst)
+        raise AssemblyError(
+            f"scene '{self.scene_name}': cannot assemble the initial positions; after {max_iter} Newton "
+            f"iterations the largest constraint residuals are {detail}. Check the joint points and "
+            "initial positions: the joints cannot all close."
+        )
+
+    def assemble_velocities(self, q: NDArray[np.float64], v_guess: NDArray[np.float64],
+                            t: float = 0.0) -> NDArray[np.float64]:
+        """Least-norm correction of ``v_guess`` so that Phi_q v + Phi_t = 0."""
+        v = np.array(v_guess, dtype=float)
+        if self.n_constraints == 0:
+            return v
+        _, Phi_q, Phi_dot, _ = (np.array(x) for x in self.kinematics(q, v, t))
+        dv, *_ = np.linalg.lstsq(Phi_q, -Phi_dot.ravel(), rcond=None)
+        return v + dv
+
+    def accelerations(self, t: ArrayLike, q: NDArray[np.float64], v: NDArray[np.float64],
+                      generalized_force: NDArray[np.float64] | None = None
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Solve [M Phi_q^T; Phi_q 0] [v'; lam] = [Q; gamma - 2 alpha Phi' - beta^2 Phi] for v' and lam.
+
+        Works on one state (``q``, ``v`` of shape (n,)) or on many at once (shape (N, n), with
+        ``t`` of shape (N,)). ``generalized_force`` adds contact forces to the base forces.
+        """
+        single = np.ndim(q) == 1
+        t_arr = np.atleast_1d(np.asarray(t, dtype=float))
+        q2, v2 = np.atleast_2d(q), np.atleast_2d(v)
+        N, n, m = q2.shape[0], self.n_q, self.n_constraints
+        if t_arr.size == 1 and N > 1:
+            t_arr = np.full(N, t_arr[0])
+        Q = np.array(self.base_force.map(N)(t_arr[None, :], q2.T, v2.T)).T
+        if generalized_force is not None:
+            Q = Q + np.atleast_2d(generalized_force)
+        if m == 0:
+            a, lam = Q / self.mass_diagonal, np.zeros((N, 0))
+        else:
+            Phi, Phi_q, Phi_dot, gamma = (np.array(x) for x in self.kinematics.map(N)(q2.T, v2.T, t_arr[None, :]))
+            Phi_q = Phi_q.reshape(m, N, n).transpose(1, 0, 2)  # map stacks the (m, n) blocks side by side
+            rhs_c = gamma.T
+            if self.formulation == "index1":
+                rhs_c = rhs_c - 2.0 * self.alpha * Phi_dot.T - self.beta**2 * Phi.T
+            K = np.zeros((N, n + m, n + m))
+            K[:, :n, :n] = np.diag(self.mass_diagonal)
+            K[:, :n, n:] = Phi_q.transpose(0, 2, 1)
+            K[:, n:, :n] = Phi_q
+            sol = np.linalg.solve(K, np.concatenate([Q, rhs_c], axis=1)[..., None])[..., 0]
+            a, lam = sol[:, :n], sol[:, n:]
+        return (a[0], lam[0]) if single else (a, lam)
+
+    def consistent_state(self, t: ArrayLike, y: NDArray[np.float64],
+                         generalized_force: NDArray[np.float64] | None = None
+                         ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Keep q and v of ``y``; recompute multipliers and derivatives so that F(t, y, y') = 0.
+
+        ``y`` is one state (n_states,) or many (N, n_states) with ``t`` of shape (N,).
+        """
+        n, m = self.n_q, self.n_constraints
+        y = np.array(y, dtype=float)
+        single = y.ndim == 1
+        y2 = np.atleast_2d(y)
+        q, v = y2[:, :n], y2[:, n:2 * n]
+        a, lam = self.accelerations(t, q, v, generalized_force)
+        yp = np.zeros_like(y2)
+        yp[:, :n] = v
+        yp[:, n:2 * n] = a
+        y2[:, 2 * n:2 * n + m] = lam
+        if self.formulation == "ggl" and m:
+            mu = y2[:, 2 * n + m:]
+            N = y2.shape[0]
+            t_arr = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,))
+            Phi_q = np.array(self.kinematics.map(N)(q.T, v.T, t_arr[None, :])[1]).reshape(m, N, n).transpose(1, 0, 2)
+            yp[:, :n] = v - np.einsum("kmn,km->kn", Phi_q, mu)
+        return (y2[0], yp[0]) if single else (y2, yp)
+
+    def initial_state(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Consistent (y0, yp0) at t = 0: assembled positions and velocities, then v' and lam."""
+        q = self.assemble_positions(self.q_guess)
+        v = self.assemble_velocities(q, self.v_guess)
+        y = np.zeros(self.n_states)
+        y[: self.n_q] = q
+        y[self.n_q: 2 * self.n_q] = v
+        return self.consistent_state(0.0, y)
+
+    def channels(self, t: NDArray[np.float64], y: NDArray[np.float64], yp: NDArray[np.float64]
+                 ) -> dict[str, NDArray[np.float64]]:
+        """Evaluate every output channel at the rows of ``y`` and ``yp`` (time first)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        if t.size == 0:
+            return {name: np.zeros(0) for name in self.channel_names}
+        values = np.array(self.outputs.map(t.size)(t[None, :], np.asarray(y).T, np.asarray(yp).T))
+        return {name: values[i].copy() for i, name in enumerate(self.channel_names)}
+
+
+# ---- element builders --------------------------------------------------------------------
+
+def _joint_points(ctx: AssemblyContext, joint: Revolute | Translational) -> tuple[NDArray, NDArray]:
+    """Body-fixed joint points of body i and j (from ``at`` in the reference configuration)."""
+    s_i = np.asarray(joint.point_i) if joint.point_i is not None else ctx.local_point(joint.body_i, joint.at)
+    s_j = np.asarray(joint.point_j) if joint.point_j is not None else ctx.local_point(joint.body_j, joint.at)
+    return s_i, s_j
+
+
+def _revolute(ctx: AssemblyContext, joint: Revolute) -> tuple[list[Any], list[str]]:
+    s_i, s_j = _joint_points(ctx, joint)
+    bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
+    d = bi.point(ca.DM(s_i)) - bj.point(ca.DM(s_j))
+    return [d[0], d[1]], [f"{joint.name}.x", f"{joint.name}.y"]
+
+
+def _translational(ctx: AssemblyContext, joint: Translational) -> tuple[list[Any], list[str]]:
+    s_i, s_j = _joint_points(ctx, joint)
+    bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
+    _, phi_i0 = ctx.reference[joint.body_i]
+    _, phi_j0 = ctx.reference[joint.body_j]
+    ux, uy = joint.axis
+    norm = math.hypot(ux, uy)
+    c, s = math.cos(phi_i0), math.sin(phi_i0)
+    u_local = np.array([c * ux + s * uy, -s * ux + c * uy]) / norm  # axis in body i's frame
+    n_world = ca.mtimes(rotation(bi.phi), ca.DM([-u_local[1], u_local[0]]))
+    d = bj.point(ca.DM(s_j)) - bi.point(ca.DM(s_i))
+    lateral = ca.dot(n_world, d)
+    relative_angle = bj.phi - bi.phi - (phi_j0 - phi_i0)
+    return [lateral, relative_angle], [f"{joint.name}.lateral", f"{joint.name}.angle"]
+
+
+def _driver(ctx: AssemblyContext, driver: Driver, joint: Revolute) -> Any:
+    bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
+    theta0 = driver.initial_angle
+    if theta0 is None:
+        theta0 = ctx.reference[joint.body_j][1] - ctx.reference[joint.body_i][1]
+    return bj.phi - bi.phi - theta0 - driver.speed * ctx.t
+
+
+ElementBuilder = Callable[..., Any]
+# Contact elements (clearance joints) register a builder here: (ctx, element, scene) -> ContactBuild.
+CONTACT_BUILDERS: dict[type, ElementBuilder] = {}
+
+
+def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, beta: float = 5.0) -> DAEModel:
+    """Assemble a validated scene into a :class:`DAEModel`.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism; validated first (all problems reported at once).
+    formulation : {"index1", "ggl"}
+        ``index1``: acceleration-level constraints with Baumgarte stabilisation (the
+        chapter's); ``ggl``: stabilised index-2, drift-free in positions and velocities.
+    alpha, beta : float
+        Baumgarte parameters of ``index1`` (1/s), 5 and 5 by default (Table 4.2).
+
+    Returns
+    -------
+    DAEModel
+
+    Raises
+    ------
+    SceneError
+        Invalid scene or argument.
+    AssemblyError
+        Redundant constraints, unsupported elements or joints that cannot close.
+    """
+    formulation = str(formulation).lower()
+    if formulation not in FORMULATIONS:
+        raise SceneError(f"formulation={formulation!r}, must be one of {', '.join(FORMULATIONS)}.")
+    for label, value in (("alpha", alpha), ("beta", beta)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+            raise SceneError(f"{label}={value!r} 1/s, must be a finite number >= 0.")
+    scene.validate()
+
+    bodies = scene.bodies
+    nb = len(bodies)
+    n = 3 * nb
+    t = ca.SX.sym("t")
+    q = ca.SX.sym("q", n)
+    v = ca.SX.sym("v", n)
+    a = ca.SX.sym("a", n)
+
+    frames: dict[str, BodyFrame] = {
+        GROUND: BodyFrame(GROUND, None, ca.DM.zeros(2), ca.DM(0.0), ca.DM.zeros(2), ca.DM(0.0))
+    }
+    reference: dict[str, tuple[tuple[float, float], float]] = {GROUND: ((0.0, 0.0), 0.0)}
+    for k, body in enumerate(bodies):
+        frames[body.name] = BodyFrame(body.name, k, q[3 * k:3 * k + 2], q[3 * k + 2], v[3 * k:3 * k + 2], v[3 * k + 2])
+        reference[body.name] = (body.position, body.angle)
+    ctx = AssemblyContext(t, q, v, a, frames, reference)
+
+    # ---- constraints ----
+    phi_list: list[Any] = []
+    names: list[str] = []
+    revolutes = {j.name: j for j in scene.joints if isinstance(j, Revolute)}
+    driver_rows: dict[str, int] = {}
+    contact_builds: list[Any] = []
+    for element in scene.elements:
+        if isinstance(element, Body):
+            continue
+        if isinstance(element, Revolute):
+            eqs, labels = _revolute(ctx, element)
+        elif isinstance(element, Translational):
+            eqs, labels = _translational(ctx, element)
+        elif isinstance(element, Driver):
+            driver_rows[element.name] = len(phi_list)
+            eqs, labels = [_driver(ctx, element, revolutes[element.joint])], [element.name]
+        elif type(element) in CONTACT_BUILDERS:
+            contact_builds.append(CONTACT_BUILDERS[type(element)](ctx, element, scene))
+            continue
+        else:
+            raise AssemblyError(f"{element.kind} '{element.name}': element type not supported by assemble().")
+        phi_list.extend(eqs)
+        names.extend(labels)
+
+    m = len(phi_list)
+    Phi = ca.vertcat(*phi_list) if m else ca.SX(0, 1)
+    Phi_q = ca.jacobian(Phi, q)
+    Phi_t = ca.jacobian(Phi, t)
+    Phi_dot = ca.mtimes(Phi_q, v) + Phi_t
+    gamma = -(ca.mtimes(ca.jacobian(Phi_dot, q), v) + ca.jacobian(Phi_dot, t))
+    kinematics = ca.Function("kinematics", [q, v, t], [Phi, ca.densify(Phi_q), Phi_dot, gamma],
+                             ["q", "v", "t"], ["Phi", "Phi_q", "Phi_dot", "gamma"])
+
+    # ---- masses and applied forces ----
+    gx, gy = scene.gravity
+    mass_diag = np.concatenate([[b.mass, b.mass, b.inertia] for b in bodies])
+    M = ca.diag(ca.DM(mass_diag))
+    Q = ca.vertcat(*[ca.vertcat(b.mass * gx, b.mass * gy, 0.0) for b in bodies])
+    Q = Q + 0 * t  # keep Q symbolic in t for a uniform signature
+    base_force = ca.Function("base_force", [t, q, v], [Q], ["t", "q", "v"], ["Q"])
+
+    # ---- state vector ----
+    lam = ca.SX.sym("lam", m)
+    lam_p = ca.SX.sym("lam_p", m)
+    q_p = ca.SX.sym("q_p", n)
+    body_state = [f"{b.name}.{c}" for b in bodies for c in ("x", "y", "phi")]
+    body_rate = [f"{b.name}.{c}" for b in bodies for c in ("vx", "vy", "omega")]
+    state_names = body_state + body_rate + [f"lambda.{c}" for c in names]
+    kinds = [KIND_POSITION] * n + [KIND_VELOCITY] * n + [KIND_MULTIPLIER] * m
+    eom = ca.mtimes(M, a) + ca.mtimes(Phi_q.T, lam) - Q
+    if formulation == "index1":
+        y = ca.vertcat(q, v, lam)
+        yp = ca.vertcat(q_p, a, lam_p)
+        res = ca.vertcat(q_p - v, eom, ca.mtimes(Phi_q, a) - gamma + 2 * alpha * Phi_dot + beta**2 * Phi)
+    else:
+        mu = ca.SX.sym("mu", m)
+        mu_p = ca.SX.sym("mu_p", m)
+        y = ca.vertcat(q, v, lam, mu)
+        yp = ca.vertcat(q_p, a, lam_p, mu_p)
+        res = ca.vertcat(q_p - v + ca.mtimes(Phi_q.T, mu), eom, Phi_dot, Phi)
+        state_names += [f"mu.{c}" for c in names]
+        kinds += [KIND_MULTIPLIER] * m
+    n_y = y.numel()
+    cj = ca.SX.sym("cj")
+    residual = ca.Function("residual", [t, y, yp], [res], ["t", "y", "yp"], ["r"])
+    jac = ca.densify(ca.jacobian(res, y) + cj * ca.jacobian(res, yp))
+    jacobian = ca.Function("jacobian", [t, y, yp, cj], [jac], ["t", "y", "yp", "cj"], ["J"])
+
+    # ---- contact terms: generalized forces added to the equations of motion rows ----
+    terms: list[Term] = []
+    term_res: list[ca.Function] = []
+    term_jac: list[ca.Function] = []
+    gaps: list[Any] = []
+    gap_names: list[str] = []
+    contact_channels: list[Channel] = []
+    contacts: list[Any] = []
+    for build in contact_builds:
+        for term in build.terms:
+            p = ca.SX.sym("p", term.n_params)
+            Qk = term.force(t, q, v, p)
+            r_k = ca.vertcat(ca.SX.zeros(n), -Qk, ca.SX.zeros(n_y - 2 * n))
+            term_res.append(ca.Function(f"{term.name}_res", [t, y, yp, p], [r_k], ["t", "y", "yp", "p"], ["r"]))
+            j_k = ca.densify(ca.jacobian(r_k, y) + cj * ca.jacobian(r_k, yp))
+            term_jac.append(ca.Function(f"{term.name}_jac", [t, y, yp, p, cj], [j_k],
+                                        ["t", "y", "yp", "p", "cj"], ["J"]))
+            terms.append(term)
+        gaps.extend(build.gaps)
+        gap_names.extend(build.gap_names)
+        contact_channels.extend(build.channels(t, y, yp))
+        contacts.append(build.logic)
+    roots = None
+    if gaps:
+        roots = ca.Function("roots", [t, y, yp], [ca.vertcat(*gaps)], ["t", "y", "yp"], ["g"])
+
+    functions = DAEFunctions(
+        n=n_y, residual=residual, jacobian=jacobian, term_residuals=tuple(term_res),
+        term_jacobians=tuple(term_jac), roots=roots, name=_c_identifier(scene.name),
+    )
+
+    # ---- output channels ----
+    channels: list[Channel] = []
+    for k, b in enumerate(bodies):
+        sl = slice(3 * k, 3 * k + 3)
+        qk, vk, ak = q[sl], v[sl], a[sl]
+        channels += [
+            Channel(f"{b.name}.x", "m", qk[0]), Channel(f"{b.name}.y", "m", qk[1]),
+            Channel(f"{b.name}.phi", "rad", qk[2]),
+            Channel(f"{b.name}.vx", "m/s", vk[0]), Channel(f"{b.name}.vy", "m/s", vk[1]),
+            Channel(f"{b.name}.omega", "rad/s", vk[2]),
+            Channel(f"{b.name}.ax", "m/s^2", ak[0]), Channel(f"{b.name}.ay", "m/s^2", ak[1]),
+            Channel(f"{b.name}.alpha", "rad/s^2", ak[2]),
+        ]
+    for name, row in driver_rows.items():
+        # The driver's constraint enters body j's rotation equation with +lam; the torque it
+        # applies to body j is therefore -lam (positive counter-clockwise).
+        channels.append(Channel(f"{name}.moment", "N m", -lam[row]))
+    kinetic = 0.5 * ca.dot(ca.DM(mass_diag), v * v)
+    potential = -sum(b.mass * (gx * q[3 * k] + gy * q[3 * k + 1]) for k, b in enumerate(bodies))
+    channels += [
+        Channel("energy.kinetic", "J", kinetic),
+        Channel("energy.potential", "J", potential),
+        Channel("energy.mechanical", "J", kinetic + potential),
+    ]
+    if m:
+        channels += [
+            Channel("constraints.position", "m", ca.mmax(ca.fabs(Phi))),
+            Channel("constraints.velocity", "m/s", ca.mmax(ca.fabs(Phi_dot))),
+        ]
+    channels += contact_channels
+    outputs = ca.Function("outputs", [t, y, yp], [ca.vertcat(*[c.expr for c in channels])],
+                          ["t", "y", "yp"], ["channels"])
+
+    q_guess = np.concatenate([[*b.position, b.angle] for b in bodies])
+    v_guess = np.concatenate([[*b.velocity, b.angular_velocity] for b in bodies])
+    return DAEModel(
+        scene_name=scene.name, formulation=formulation, alpha=float(alpha), beta=float(beta),
+        body_names=tuple(b.name for b in bodies), constraint_names=tuple(names),
+        state_names=tuple(state_names), state_kinds=tuple(kinds), functions=functions,
+        terms=tuple(terms), gap_names=tuple(gap_names),
+        channel_names=tuple(c.name for c in channels), channel_units={c.name: c.unit for c in channels},
+        outputs=outputs, q_guess=q_guess, v_guess=v_guess, mass_diagonal=mass_diag,
+        kinematics=kinematics, base_force=base_force,
+        parameters={"scene": scene.to_dict(), "formulation": formulation, "alpha": alpha, "beta": beta},
+        contacts=tuple(contacts),
+    )
+
+
+def _c_identifier(name: str) -> str:
+    ident = "".join(ch if ch.isalnum() else "_" for ch in name)
+    return ident if ident and not ident[0].isdigit() else f"m_{ident}"

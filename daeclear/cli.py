@@ -1,0 +1,118 @@
+"""Command line: ``daeclear run`` a named mechanism or a scene file, writing HDF5 and a figure."""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import logging
+import math
+import sys
+from pathlib import Path
+from typing import Any, Sequence
+
+from .errors import DaeclearError, SolveError
+
+
+def _parse_value(text: str) -> Any:
+    """Parse a ``--set`` value: a Python literal (number, string, list, None, bool) or a bare string."""
+    try:
+        return ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        return text
+
+
+def _parse_sets(items: Sequence[str]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise DaeclearError(f"--set {item!r}: expected KEY=VALUE, e.g. --set clearance=0.5e-3.")
+        out[key.strip()] = _parse_value(value.strip())
+    return out
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="daeclear", description="Planar mechanisms with clearance joints.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="simulate a named mechanism or a scene file (.toml)")
+    run.add_argument("target", help="mechanism name (slider_crank) or path to a .toml scene file")
+    run.add_argument("--joint", help="slider_crank: which joint has clearance (ideal, revolute, translational)")
+    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                     help="mechanism parameter, e.g. --set rpm=3000 (repeatable)")
+    run.add_argument("--t-end", type=float, help="end time, s (default: two crank revolutions)")
+    run.add_argument("--rtol", type=float, help="relative tolerance (default 1e-6)")
+    run.add_argument("--formulation", choices=["index1", "ggl"], help="DAE formulation (default index1)")
+    run.add_argument("--backend", choices=["auto", "c", "python"], default="auto")
+    run.add_argument("--out", type=Path, default=Path("results"), help="output directory (default ./results)")
+    run.add_argument("--name", help="base name of the output files (default: the scene name)")
+    run.add_argument("--no-figure", action="store_true", help="write the HDF5 result only")
+    run.add_argument("--quiet", action="store_true", help="no progress line")
+    return parser
+
+
+def _run(args: argparse.Namespace) -> int:
+    from .scenefile import MECHANISMS, read_scene_file
+    from .solve import simulate
+
+    params = _parse_sets(args.set)
+    sim: dict[str, Any] = {}
+    if args.target.endswith(".toml") or Path(args.target).is_file():
+        spec = read_scene_file(args.target)
+        scene, sim = spec.scene, dict(spec.simulate)
+        if params or args.joint:
+            raise DaeclearError("--set and --joint apply to named mechanisms; edit the scene file instead.")
+    elif args.target in MECHANISMS:
+        if args.joint:
+            params["joint"] = args.joint
+        scene = MECHANISMS[args.target](**params)
+    else:
+        raise DaeclearError(f"run: {args.target!r} is neither a scene file nor a mechanism "
+                            f"({', '.join(MECHANISMS)}).")
+    rpm = float(params.get("rpm", 5000.0))
+    default_t_end = 2 * 60.0 / abs(rpm) if rpm else 0.024  # two crank revolutions
+    t_end = args.t_end or sim.pop("t_end", None) or default_t_end
+    sim.pop("t_end", None)
+    step = sim.pop("t_eval_step", None)
+    options: dict[str, Any] = {"rtol": args.rtol or sim.pop("rtol", 1e-6), "backend": args.backend,
+                               "progress": not args.quiet, "on_failure": "return"}
+    if args.formulation:
+        sim["formulation"] = args.formulation
+    options.update(sim)
+    if step:
+        import numpy as np
+        options["t_eval"] = np.linspace(0.0, t_end, int(math.floor(t_end / step)) + 1)
+    result = simulate(scene, t_end, **options)
+    args.out.mkdir(parents=True, exist_ok=True)
+    base = args.name or scene.name
+    h5 = result.save(args.out / f"{base}.h5")
+    print(result)
+    print(f"wrote {h5}")
+    if not args.no_figure:
+        import matplotlib
+        matplotlib.use("Agg")
+        from .plot import save_response_figure
+        png = save_response_figure(result, args.out / f"{base}.png")
+        print(f"wrote {png}")
+    if not result.success:
+        print(f"daeclear: run failed: {result.message}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    logging.basicConfig(level=logging.WARNING, format="daeclear: %(message)s")
+    args = build_parser().parse_args(argv)
+    try:
+        if args.command == "run":
+            return _run(args)
+    except SolveError as exc:
+        print(f"daeclear: {exc}", file=sys.stderr)
+        return 1
+    except (DaeclearError, ValueError, KeyError) as exc:
+        print(f"daeclear: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,380 @@
+"""C code generation and compilation of a DAE model for the compiled IDA backend.
+
+``build_model_library(funcs)`` turns a :class:`daeclear.ida_session.DAEFunctions` into a shared
+library that holds
+
+* the model's CasADi functions generated as C by ``casadi.CodeGenerator`` (symbols ``dc_res``,
+  ``dc_jac``, ``dc_roots``, ``dc_term<k>_res``, ``dc_term<k>_jac``), every one normalised to dense
+  column-vector inputs and a dense output (``casadi.densify``; the Jacobians column-major, as
+  SUNDIALS' dense matrix stores them);
+* a small generated table (``dc_model``: sizes, parameter counts, function pointers; layout in
+  ``csrc/dc_model.h``);
+* the hand-written driver ``csrc/ida_driver.c`` (IDA loop, callbacks, dense output);
+
+linked against the SUNDIALS libraries shipped inside the scikit-sundae wheel
+(``<site-packages>/scikit_sundae.libs``) by full path, with that directory as rpath. The wheel has
+no SUNDIALS headers; ``csrc/sundials_min.h`` declares the few functions used.
+
+Libraries are cached: the key is the SHA-256 of the generated source, the driver sources, the
+compiler command and version, and the SUNDIALS library paths. The cache directory is
+``$DAECLEAR_CACHE_DIR`` or ``~/.cache/daeclear``. A build compiles into a private temporary
+directory and moves the result into place with ``os.replace`` under a per-key file lock, so
+concurrent processes building the same model neither corrupt nor duplicate each other's work.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import hashlib
+import importlib.util
+import os
+import shlex
+import shutil
+import subprocess
+import sysconfig
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterator
+
+import casadi
+
+from .errors import AssemblyError, DaeclearError
+
+__all__ = [
+    "CompilerUnavailable",
+    "CompileError",
+    "NormalizedModel",
+    "BuildResult",
+    "normalize_model",
+    "generate_source",
+    "compiler_command",
+    "sundials_libraries",
+    "cache_dir",
+    "build_model_library",
+]
+
+CSRC = Path(__file__).resolve().parent / "csrc"
+DRIVER_SOURCES = ("ida_driver.c", "sundials_min.h", "dc_model.h")
+SUNDIALS_LIBS = (
+    "sundials_ida",
+    "sundials_core",
+    "sundials_nvecserial",
+    "sundials_sunmatrixdense",
+    "sundials_sunlinsoldense",
+)
+CFLAGS = ("-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Werror=incompatible-pointer-types",
+          "-Werror=implicit-function-declaration")
+
+
+class CompilerUnavailable(DaeclearError):
+    """No working C compiler (or no SUNDIALS libraries) for the compiled backend."""
+
+
+class CompileError(DaeclearError):
+    """The C compiler failed on the generated model; the message holds its output."""
+
+
+# --------------------------------------------------------------------------- normalisation
+
+
+@dataclass(frozen=True)
+class NormalizedModel:
+    """The model's functions with dense column-vector inputs and one dense output each.
+
+    Signatures (sizes): ``res (1, n, n) -> n``; ``jac (1, n, n, 1) -> n x n``;
+    ``term_res[k] (1, n, n, p_k) -> n``; ``term_jac[k] (1, n, n, p_k, 1) -> n x n``;
+    ``roots (1, n, n) -> n_roots`` or None.
+    """
+
+    n: int
+    name: str
+    res: casadi.Function
+    jac: casadi.Function
+    term_res: tuple[casadi.Function, ...]
+    term_jac: tuple[casadi.Function, ...]
+    roots: casadi.Function | None
+    n_params: tuple[int, ...]
+    n_roots: int
+
+
+def _check(f: Any, what: str, sizes: list[int | None], out_numel: int | None) -> list[int]:
+    if not isinstance(f, casadi.Function):
+        raise AssemblyError(f"{what} must be a casadi.Function, got {type(f).__name__}")
+    if f.n_in() != len(sizes):
+        raise AssemblyError(f"{what} ({f.name()}) must take {len(sizes)} inputs, it takes {f.n_in()}")
+    if f.n_out() < 1:
+        raise AssemblyError(f"{what} ({f.name()}) has no output")
+    got = []
+    for i, want in enumerate(sizes):
+        sz = f.size_in(i)
+        if min(sz) > 1 and want != 0:
+            raise AssemblyError(f"{what} ({f.name()}) input {i} must be a vector, it is {sz[0]}x{sz[1]}")
+        numel = f.numel_in(i)
+        if want is not None and numel != want:
+            raise AssemblyError(f"{what} ({f.name()}) input {i} must have {want} elements, it has {numel}")
+        got.append(numel)
+    if out_numel is not None and f.numel_out(0) != out_numel:
+        raise AssemblyError(
+            f"{what} ({f.name()}) output must have {out_numel} elements, it has {f.numel_out(0)}"
+        )
+    return got
+
+
+def _wrap(f: casadi.Function, name: str, in_sizes: list[int], out_shape: tuple[int, int]) -> casadi.Function:
+    """Same function with dense column-vector inputs and a dense output of out_shape."""
+    sym = casadi.SX if f.is_a("SXFunction") else casadi.MX
+    ins = [sym.sym(f"i{k}", s) for k, s in enumerate(in_sizes)]
+    args = [casadi.reshape(x, f.size_in(k)) for k, x in enumerate(ins)]
+    out = f.call(args)[0]
+    out = casadi.densify(casadi.reshape(out, out_shape[0], out_shape[1]))
+    return casadi.Function(name, ins, [out])
+
+
+def normalize_model(funcs: Any) -> NormalizedModel:
+    """Validate a DAEFunctions and return its dense, uniformly named functions."""
+    n = int(funcs.n)
+    if n < 1:
+        raise AssemblyError(f"DAEFunctions.n must be >= 1, got {n}")
+    _check(funcs.residual, "residual", [1, n, n], n)
+    _check(funcs.jacobian, "jacobian", [1, n, n, 1], n * n)
+    if len(funcs.term_residuals) != len(funcs.term_jacobians):
+        raise AssemblyError(
+            f"{len(funcs.term_residuals)} term residuals but {len(funcs.term_jacobians)} term Jacobians"
+        )
+    res = _wrap(funcs.residual, "dc_res", [1, n, n], (n, 1))
+    jac = _wrap(funcs.jacobian, "dc_jac", [1, n, n, 1], (n, n))
+    tres, tjac, n_params = [], [], []
+    for k, (fr, fj) in enumerate(zip(funcs.term_residuals, funcs.term_jacobians)):
+        p = _check(fr, f"term_residuals[{k}]", [1, n, n, None], n)[3]
+        _check(fj, f"term_jacobians[{k}]", [1, n, n, p, 1], n * n)
+        tres.append(_wrap(fr, f"dc_term{k}_res", [1, n, n, p], (n, 1)))
+        tjac.append(_wrap(fj, f"dc_term{k}_jac", [1, n, n, p, 1], (n, n)))
+        n_params.append(p)
+    roots = None
+    n_roots = 0
+    if funcs.roots is not None:
+        _check(funcs.roots, "roots", [1, n, n], None)
+        n_roots = int(funcs.roots.numel_out(0))
+        if n_roots > 0:
+            roots = _wrap(funcs.roots, "dc_roots", [1, n, n], (n_roots, 1))
+    return NormalizedModel(
+        n=n,
+        name=str(getattr(funcs, "name", "model")),
+        res=res,
+        jac=jac,
+        term_res=tuple(tres),
+        term_jac=tuple(tjac),
+        roots=roots,
+        n_params=tuple(n_params),
+        n_roots=n_roots,
+    )
+
+
+# --------------------------------------------------------------------------- C source
+
+
+def _c_string(s: str) -> str:
+    return '"' + "".join(c if c.isalnum() or c in " _-.:/" else "_" for c in s)[:200] + '"'
+
+
+def _fun_entry(name: str) -> str:
+    return (
+        f"{{{name}, {name}_work, {name}_checkout, {name}_release, {name}_incref, {name}_decref, "
+        f'"{name}"}}'
+    )
+
+
+def generate_source(model: NormalizedModel) -> str:
+    """CasADi-generated C for every function of the model, plus the dc_model table."""
+    cg = casadi.CodeGenerator(
+        "dc_model_gen.c",
+        {"with_header": False, "casadi_int": "long long int", "casadi_real": "double"},
+    )
+    funs = [model.res, model.jac, *model.term_res, *model.term_jac]
+    if model.roots is not None:
+        funs.append(model.roots)
+    for f in funs:
+        cg.add(f)
+    src = cg.dump()
+    nt = len(model.term_res)
+    lines = [
+        "",
+        "/* ---------------------------------------------------------------- daeclear table */",
+        '#include "dc_model.h"',
+    ]
+    if nt:
+        lines.append(f"static const int dc_n_params_tab[{nt}] = {{{', '.join(map(str, model.n_params))}}};")
+        lines.append(f"static const dc_fun_t dc_term_res_tab[{nt}] = {{")
+        lines += [f"  {_fun_entry(f'dc_term{k}_res')}," for k in range(nt)]
+        lines.append("};")
+        lines.append(f"static const dc_fun_t dc_term_jac_tab[{nt}] = {{")
+        lines += [f"  {_fun_entry(f'dc_term{k}_jac')}," for k in range(nt)]
+        lines.append("};")
+    roots_entry = _fun_entry("dc_roots") if model.roots is not None else "{0, 0, 0, 0, 0, 0, 0}"
+    lines += [
+        "const dc_model_t dc_model = {",
+        f"  {model.n}, {nt}, {model.n_roots},",
+        f"  {'dc_n_params_tab' if nt else '0'},",
+        f"  {_fun_entry('dc_res')},",
+        f"  {_fun_entry('dc_jac')},",
+        f"  {roots_entry},",
+        f"  {'dc_term_res_tab' if nt else '0'},",
+        f"  {'dc_term_jac_tab' if nt else '0'},",
+        f"  {_c_string(model.name)}",
+        "};",
+        "",
+    ]
+    return src + "\n".join(lines)
+
+
+# --------------------------------------------------------------------------- toolchain
+
+
+def compiler_command() -> list[str]:
+    """The C compiler command: $CC, else sysconfig's CC, else cc/gcc. Raises CompilerUnavailable."""
+    env_cc = os.environ.get("CC")
+    candidates: list[tuple[str, str]] = []
+    if env_cc is not None and env_cc.strip():
+        candidates.append((env_cc, "$CC"))
+    else:
+        cfg = sysconfig.get_config_var("CC")
+        if cfg:
+            candidates.append((cfg, "sysconfig CC"))
+        candidates += [("cc", "default"), ("gcc", "default")]
+    tried = []
+    for cmd, origin in candidates:
+        parts = shlex.split(cmd)
+        if not parts:
+            continue
+        exe = shutil.which(parts[0])
+        if exe is not None:
+            return [exe, *parts[1:]]
+        tried.append(f"{parts[0]!r} ({origin})")
+        if origin == "$CC":
+            break  # an explicit $CC is not second-guessed
+    raise CompilerUnavailable(f"no C compiler found: tried {', '.join(tried)}")
+
+
+@functools.lru_cache(maxsize=16)
+def _compiler_version(exe: str) -> str:
+    try:
+        out = subprocess.run([exe, "--version"], capture_output=True, text=True, timeout=30)
+        return (out.stdout or out.stderr).strip().splitlines()[0] if (out.stdout or out.stderr) else ""
+    except (OSError, subprocess.SubprocessError) as exc:
+        raise CompilerUnavailable(f"C compiler {exe!r} does not run: {exc}") from exc
+
+
+@functools.lru_cache(maxsize=1)
+def sundials_libraries() -> tuple[Path, dict[str, Path]]:
+    """(directory, {name: path}) of the SUNDIALS shared libraries inside the scikit-sundae wheel."""
+    spec = importlib.util.find_spec("sksundae")
+    if spec is None or spec.origin is None:
+        raise CompilerUnavailable("scikit-sundae (sksundae) is not installed")
+    site = Path(spec.origin).resolve().parent.parent
+    libdir = site / "scikit_sundae.libs"
+    if not libdir.is_dir():
+        raise CompilerUnavailable(f"SUNDIALS libraries not found: {libdir} does not exist")
+    found: dict[str, Path] = {}
+    for name in SUNDIALS_LIBS:
+        hits = sorted(libdir.glob(f"lib{name}-*.so*"))
+        if not hits:
+            raise CompilerUnavailable(f"SUNDIALS library lib{name} not found in {libdir}")
+        found[name] = hits[0]
+    return libdir, found
+
+
+def cache_dir() -> Path:
+    d = os.environ.get("DAECLEAR_CACHE_DIR")
+    return Path(d).expanduser() if d else Path.home() / ".cache" / "daeclear"
+
+
+# --------------------------------------------------------------------------- build
+
+
+@dataclass(frozen=True)
+class BuildResult:
+    path: Path
+    key: str
+    cache_hit: bool
+    compile_time: float   # s spent in the compiler (0 on a cache hit)
+    codegen_time: float   # s spent generating C and hashing
+
+
+@contextlib.contextmanager
+def _file_lock(path: Path) -> Iterator[None]:
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - non-POSIX
+        yield
+        return
+    with open(path, "a+") as fh:
+        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
+
+
+def _driver_text() -> str:
+    return "".join(f"/* {name} */\n" + (CSRC / name).read_text() for name in DRIVER_SOURCES)
+
+
+def build_model_library(funcs: Any, *, model: NormalizedModel | None = None) -> BuildResult:
+    """Generate, compile (or find in the cache) the shared library for a DAEFunctions."""
+    t0 = time.perf_counter()
+    if model is None:
+        model = normalize_model(funcs)
+    cc = compiler_command()
+    version = _compiler_version(cc[0])
+    libdir, libs = sundials_libraries()
+    source = generate_source(model)
+    flags = [*CFLAGS, f"-I{CSRC}"]
+    link = [str(libs[name]) for name in SUNDIALS_LIBS] + [f"-Wl,-rpath,{libdir}", "-lm"]
+    h = hashlib.sha256()
+    for part in (source, _driver_text(), shlex.join(cc + flags + link), version,
+                 "\n".join(str(p) for p in libs.values())):
+        h.update(part.encode())
+        h.update(b"\0")
+    key = h.hexdigest()
+    codegen_time = time.perf_counter() - t0
+
+    root = cache_dir()
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise CompilerUnavailable(f"cache directory {root} cannot be created: {exc}") from exc
+    stem = f"dc_{key[:40]}"
+    target = root / f"{stem}.so"
+    if target.is_file():
+        return BuildResult(target, key, True, 0.0, codegen_time)
+    with _file_lock(root / f"{stem}.lock"):
+        if target.is_file():  # built by another process meanwhile
+            return BuildResult(target, key, True, 0.0, codegen_time)
+        t1 = time.perf_counter()
+        with tempfile.TemporaryDirectory(prefix=f"{stem}-", dir=root) as tmp:
+            tmpd = Path(tmp)
+            model_c = tmpd / "model.c"
+            model_c.write_text(source)
+            out = tmpd / "lib.so"
+            cmd = [*cc, *flags, str(model_c), str(CSRC / "ida_driver.c"), "-o", str(out), *link]
+            try:
+                proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+            except (OSError, subprocess.SubprocessError) as exc:
+                raise CompilerUnavailable(f"running the C compiler {cc[0]!r} failed: {exc}") from exc
+            if proc.returncode != 0 or not out.is_file():
+                msg = (proc.stderr or proc.stdout or "").strip()
+                if len(msg) > 4000:
+                    msg = msg[:2000] + "\n...\n" + msg[-2000:]
+                raise CompileError(
+                    f"compiling the model {model.name!r} failed (exit {proc.returncode}):\n"
+                    f"$ {shlex.join(cmd)}\n{msg}"
+                )
+            # keep the generated source next to the library, for debugging
+            src_tmp = tmpd / "src.c"
+            src_tmp.write_text(source)
+            os.replace(src_tmp, root / f"{stem}.c")
+            os.replace(out, target)
+        return BuildResult(target, key, False, time.perf_counter() - t1, codegen_time)

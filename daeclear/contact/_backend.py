@@ -1,0 +1,101 @@
+"""Tiny math shim so each contact law is written once for floats, numpy and CasADi.
+
+Every function here looks at its arguments: if one of them is a CasADi ``SX``, ``MX``
+or ``DM``, the CasADi operation is used (so the expression stays symbolic and
+differentiable, and generated C code stays branch-free); otherwise the numpy
+operation is used. CasADi is imported lazily, only when a CasADi object is seen,
+so ``daeclear.contact`` can be imported without loading CasADi.
+
+Rules for law implementers (they keep both paths NaN-free, value and derivative):
+
+- guard every operand before a fractional power, a logarithm or a division, e.g.
+  ``fmax(delta, 0.0) ** 1.5`` and never ``delta ** 1.5`` with ``delta`` possibly < 0;
+- ``if_else`` evaluates both branches in both backends, so both must be finite.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "as_numeric", "exp", "fabs", "fmax", "fmin", "if_else", "is_symbolic", "log", "log1p",
+    "sign", "sqrt",
+]
+
+
+def _is_casadi(x: Any) -> bool:
+    return type(x).__module__ == "casadi.casadi"
+
+
+def is_symbolic(*args: Any) -> bool:
+    """Return True if any argument is a CasADi object (``SX``, ``MX`` or ``DM``)."""
+    return any(_is_casadi(a) for a in args)
+
+
+def _ca() -> Any:
+    import casadi
+
+    return casadi
+
+
+def fmax(a: Any, b: Any) -> Any:
+    """Elementwise maximum."""
+    return _ca().fmax(a, b) if is_symbolic(a, b) else np.maximum(a, b)
+
+
+def fmin(a: Any, b: Any) -> Any:
+    """Elementwise minimum."""
+    return _ca().fmin(a, b) if is_symbolic(a, b) else np.minimum(a, b)
+
+
+def if_else(condition: Any, if_true: Any, if_false: Any) -> Any:
+    """``if_true`` where ``condition`` holds, else ``if_false`` (both branches are evaluated)."""
+    if is_symbolic(condition, if_true, if_false):
+        return _ca().if_else(condition, if_true, if_false)
+    return np.where(condition, if_true, if_false)
+
+
+def log(x: Any) -> Any:
+    """Natural logarithm."""
+    return _ca().log(x) if is_symbolic(x) else np.log(x)
+
+
+def log1p(x: Any) -> Any:
+    """``log(1 + x)``, accurate for small ``x``."""
+    return _ca().log1p(x) if is_symbolic(x) else np.log1p(x)
+
+
+def exp(x: Any) -> Any:
+    """Exponential."""
+    return _ca().exp(x) if is_symbolic(x) else np.exp(x)
+
+
+def sqrt(x: Any) -> Any:
+    """Square root."""
+    return _ca().sqrt(x) if is_symbolic(x) else np.sqrt(x)
+
+
+def sign(x: Any) -> Any:
+    """Sign, with ``sign(0) == 0`` in both backends (derivative 0 everywhere in CasADi)."""
+    return _ca().sign(x) if is_symbolic(x) else np.sign(x)
+
+
+def fabs(x: Any) -> Any:
+    """Absolute value."""
+    return _ca().fabs(x) if is_symbolic(x) else np.abs(x)
+
+
+def as_numeric(*args: Any) -> tuple[bool, tuple[Any, ...]]:
+    """Prepare arguments for a law body.
+
+    Returns ``(scalar, converted)``: CasADi objects pass through unchanged; anything
+    else becomes a float numpy array. ``scalar`` is True when every non-None argument
+    is a plain Python/numpy scalar (the caller then returns a ``float``).
+    """
+    if is_symbolic(*args):
+        return False, args
+    converted = tuple(None if a is None else np.asarray(a, dtype=float) for a in args)
+    scalar = all(c is None or c.ndim == 0 for c in converted)
+    return scalar, converted

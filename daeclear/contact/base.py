@@ -1,0 +1,224 @@
+"""Base class of the normal contact laws and the ``resolve`` protocol.
+
+Contract for implementers of a :class:`NormalLaw` subclass (a frozen, keyword-only
+dataclass whose fields are the law's parameters):
+
+- set the class attributes ``name`` (registry name, lower case with hyphens),
+  ``geometry`` (``"sphere"``, ``"cylinder"`` or ``"face"``: what the law needs from a
+  joint to complete itself) and ``supported_kinds`` (the ``resolve`` kinds for which
+  the missing numbers can be computed);
+- override ``is_resolved`` (all numbers set), ``_resolve`` (return a copy with the
+  numbers computed from the joint's geometry) and ``_force`` (the law, written once
+  with the functions of ``daeclear.contact._backend`` so it runs on numpy arrays and
+  CasADi symbols; zero for penetration <= 0, never negative, never NaN, including
+  its CasADi derivatives);
+- override ``dissipative`` / ``needs_approach_speed`` / ``penetration_limit`` when
+  they differ from the defaults (False / False / inf).
+"""
+
+from __future__ import annotations
+
+import abc
+import math
+import warnings
+from dataclasses import dataclass
+from typing import Any, ClassVar, Literal, Self
+
+import numpy as np
+
+from ..errors import DaeclearWarning, SceneError
+from . import _backend as B
+from ._checks import check_number
+from .geometry import (
+    MaterialPair, internal_contact_stiffness, material_pair, plane_face_stiffness, sphere_plane_stiffness,
+)
+
+__all__ = ["KINDS", "Geometry", "Kind", "NormalLaw", "bearing_radii", "computed_stiffness"]
+
+Kind = Literal["internal_cylinder", "sphere_plane", "plane_face"]
+Geometry = Literal["sphere", "cylinder", "face"]
+
+#: The contact kinds a joint can pass to :meth:`NormalLaw.resolve`.
+KINDS: tuple[str, ...] = ("internal_cylinder", "sphere_plane", "plane_face")
+
+
+@dataclass(frozen=True, kw_only=True)
+class NormalLaw(abc.ABC):
+    """A normal contact force law ``F_N(delta, delta_dot, delta_dot_minus)``.
+
+    Sign conventions (chapter 4): penetration ``delta > 0`` in contact; penetration
+    rate ``delta_dot > 0`` while the bodies approach (compression) and < 0 while
+    they separate (restitution); approach speed ``delta_dot_minus > 0`` is the rate
+    latched at contact onset. The returned force is the magnitude along the contact
+    normal, ``>= 0``.
+    """
+
+    name: ClassVar[str]
+    geometry: ClassVar[Geometry]
+    supported_kinds: ClassVar[tuple[str, ...]]
+
+    # ---- metadata -----------------------------------------------------------------
+    @property
+    def dissipative(self) -> bool:
+        """True if the law dissipates energy in an impact (hysteresis or damping)."""
+        return False
+
+    @property
+    def needs_approach_speed(self) -> bool:
+        """True if ``force`` uses the approach speed latched at contact onset."""
+        return False
+
+    @property
+    @abc.abstractmethod
+    def is_resolved(self) -> bool:
+        """True when every number the force needs is set (see :meth:`resolve`)."""
+
+    @property
+    def penetration_limit(self) -> float:
+        """Largest penetration (m) of the law's valid range; beyond it see the class Notes."""
+        return math.inf
+
+    # ---- resolve protocol ---------------------------------------------------------
+    def resolve(self, kind: Kind, *, radii: tuple[float, ...] | float | None = None,
+                materials: MaterialPair | None = None,
+                face_half_width: float | None = None) -> Self:
+        """Return a copy with every number the force needs set from the joint's geometry.
+
+        Values the user set (``stiffness=``, ``length=``...) are never overridden;
+        only fields left ``None`` are computed. Calling it on a resolved law is harmless.
+
+        Parameters
+        ----------
+        kind : {"internal_cylinder", "sphere_plane", "plane_face"}
+            ``"internal_cylinder"``: journal (radius R_j) inside a bearing (R_i), the
+            revolute clearance joint; ``"sphere_plane"``: a rounded slider corner of
+            radius R_c on a guide surface; ``"plane_face"``: a square slider face of
+            side ``2 a`` flat on the guide.
+        radii : tuple of float or float, optional
+            ``(R_i, R_j)`` = (bearing radius, journal radius) in m for
+            ``"internal_cylinder"``; ``(R_c,)`` or ``R_c`` for ``"sphere_plane"``.
+        materials : Material or (Material, Material), optional
+            Materials of bodies i and j; one Material means both.
+        face_half_width : float, optional
+            Half side ``a`` (m) of the square contact area, for ``"plane_face"``.
+
+        Returns
+        -------
+        NormalLaw
+            A resolved law of the same class (``is_resolved`` is True).
+
+        Raises
+        ------
+        SceneError
+            Unknown kind, a kind this law cannot use, or a missing/invalid input.
+        """
+        if kind not in KINDS:
+            raise SceneError(f"{type(self).__name__}.resolve: kind={kind!r} is not a contact kind; "
+                             f"valid kinds: {', '.join(map(repr, KINDS))}.")
+        return self._resolve(kind, radii=radii, materials=materials, face_half_width=face_half_width)
+
+    @abc.abstractmethod
+    def _resolve(self, kind: str, *, radii: Any, materials: Any, face_half_width: Any) -> Self:
+        """Implementation of :meth:`resolve` (kind already validated)."""
+
+    # ---- evaluation ---------------------------------------------------------------
+    def force(self, penetration: Any, penetration_rate: Any = None, approach_speed: Any = None) -> Any:
+        """Normal force magnitude ``F_N >= 0`` (N) on floats, numpy arrays or CasADi symbols.
+
+        Parameters
+        ----------
+        penetration : float, array_like, casadi.SX or casadi.MX
+            ``delta`` in m, > 0 in contact. For ``delta <= 0`` the force is exactly 0.
+        penetration_rate : same types, optional
+            ``delta_dot`` in m/s, > 0 approaching. Required by dissipative laws.
+        approach_speed : same types, optional
+            ``delta_dot_minus`` in m/s (> 0), the rate latched at contact onset.
+            Required when ``needs_approach_speed``; floored at the law's
+            ``min_approach_speed``.
+
+        Returns
+        -------
+        float, numpy.ndarray or CasADi expression
+            A float when every argument is a scalar; arrays broadcast.
+
+        Raises
+        ------
+        SceneError
+            If the law is not resolved (``stiffness=None``...): call :meth:`resolve`.
+        TypeError
+            If a required rate or approach speed is missing.
+        """
+        if not self.is_resolved:
+            raise SceneError(f"{type(self).__name__}: some parameters are None (not resolved); give them "
+                             "explicitly or call .resolve(kind, radii=..., materials=...) first.")
+        if penetration_rate is None and self.dissipative:
+            raise TypeError(f"{type(self).__name__}.force needs penetration_rate (the law is dissipative).")
+        if approach_speed is None and self.needs_approach_speed:
+            raise TypeError(f"{type(self).__name__}.force needs approach_speed (initial impact velocity).")
+        scalar, (delta, delta_dot, v_minus) = B.as_numeric(penetration, penetration_rate, approach_speed)
+        delta_dot = 0.0 if delta_dot is None else delta_dot
+        v_minus = 0.0 if v_minus is None else v_minus
+        out = self._force(delta, delta_dot, v_minus)
+        return float(out) if scalar else out
+
+    @abc.abstractmethod
+    def _force(self, delta: Any, delta_dot: Any, v_minus: Any) -> Any:
+        """The law, written once with ``daeclear.contact._backend`` functions."""
+
+    def check_penetration(self, penetration: Any, *, warn: bool = True) -> bool:
+        """Return True if every (numeric) penetration is inside the law's valid range.
+
+        Inside a simulation the law cannot raise; it continues as documented in the
+        class Notes. Call this on results (e.g. a penetration channel) to be told.
+        With ``warn=True`` a :class:`~daeclear.errors.DaeclearWarning` is issued
+        when some value is outside.
+        """
+        values = np.asarray(penetration, dtype=float)
+        worst = float(np.max(values)) if values.size else -math.inf
+        ok = worst <= self.penetration_limit
+        if not ok and warn:
+            warnings.warn(f"{type(self).__name__}: penetration {worst:.3e} m exceeds the valid range "
+                          f"(penetration_limit {self.penetration_limit:.3e} m); the force there is the "
+                          "documented extension, not the law.", DaeclearWarning, stacklevel=2)
+        return ok
+
+
+# ---- helpers for implementers: turn resolve() inputs into numbers ---------------------
+def bearing_radii(owner: str, radii: Any) -> tuple[float, float]:
+    """``(R_i, R_j)`` for kind ``"internal_cylinder"``, checked ``R_i > R_j > 0``."""
+    if not (isinstance(radii, (tuple, list)) and len(radii) == 2):
+        raise SceneError(f"{owner}.resolve(kind='internal_cylinder'): radii={radii!r}, must be "
+                         "(bearing_radius, journal_radius) in m.")
+    where = f"{owner}.resolve(kind='internal_cylinder')"
+    r_i = check_number(where, "bearing_radius", radii[0], low=0.0, unit="m")
+    r_j = check_number(where, "journal_radius", radii[1], low=0.0, unit="m")
+    if not r_j < r_i:
+        raise SceneError(f"{owner}.resolve(kind='internal_cylinder'): radii=({r_i:g}, {r_j:g}) m, "
+                         "must satisfy bearing_radius > journal_radius > 0.")
+    return r_i, r_j
+
+
+def _corner_radius(owner: str, radii: Any) -> float:
+    value = radii[0] if isinstance(radii, (tuple, list)) and len(radii) == 1 else radii
+    if value is None or isinstance(value, (tuple, list)):
+        raise SceneError(f"{owner}.resolve(kind='sphere_plane'): radii={radii!r}, must be (R_c,) "
+                         "with the corner radius R_c > 0 in m.")
+    return check_number(f"{owner}.resolve(kind='sphere_plane')", "radii", value, low=0.0, unit="m")
+
+
+def computed_stiffness(owner: str, kind: str, *, radii: Any, materials: Any, face_half_width: Any) -> float:
+    """Stiffness from materials and geometry: eq. (3.5) for the two sphere-type kinds
+    (N/m^1.5), eq. (4.27) for ``"plane_face"`` (N/m)."""
+    if materials is None:
+        raise SceneError(f"{owner}.resolve(kind={kind!r}): materials=None; pass materials= or give "
+                         "stiffness= explicitly.")
+    pair = material_pair(materials, owner)
+    if kind == "internal_cylinder":
+        r_i, r_j = bearing_radii(owner, radii)
+        return internal_contact_stiffness(r_i, r_j, pair)
+    if kind == "sphere_plane":
+        return sphere_plane_stiffness(_corner_radius(owner, radii), pair)
+    if face_half_width is None:
+        raise SceneError(f"{owner}.resolve(kind='plane_face'): face_half_width=None; pass the half side "
+                         "a (m) of the square contact area.")
+    return plane_face_stiffness(face_half_width, pair)

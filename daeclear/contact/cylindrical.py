@@ -1,0 +1,303 @@
+"""Cylindrical (line-contact) laws for a journal in a bearing: Dubowsky-Freudenstein,
+Goldsmith and ESDU 78035 (chapter 4, Figs. 4.22c-e).
+
+Each law gives the penetration as an explicit function of the force,
+
+    delta = s F [ln(X / F) + k],        s = sigma_s / L,
+
+with ``sigma_s = sigma_i + sigma_j`` (eq. 3.4, convention below), L the axial contact
+length, X a force scale and k = +1 or -1 (``/work/shared/CONTACT_MODELS.md`` section 8).
+It is implicit in F. ``delta(F)`` rises from 0 to its maximum ``delta_max = s X e^(k-1)``
+at ``F_max = X e^(k-1)`` and falls after it; only ``0 < F < F_max`` is physical.
+
+Solving it (exactly, on floats, numpy and CasADi from one definition)
+--------------------------------------------------------------------
+With ``z = ln(X / F) + k`` the law reads ``z - ln z = 1 + r``, ``r = ln(delta_max / delta)``,
+on the branch ``z > 1``, i.e. ``z = -W_{-1}(-exp(-1 - r))`` (Lambert W). We solve
+``eps - log1p(eps) = r`` for ``eps = z - 1 > 0`` (no cancellation near the branch end)
+with a fixed number of safeguarded Newton steps (Newton in ``eps`` is Newton in
+``u = ln F``; the safeguard ``eps_new >= eps / 2`` keeps the iterate on the physical
+branch) from a starting value that is the series ``t + t^2/3 + t^3/36 - t^4/270``,
+``t = sqrt(2 r)``, for r < 2 and ``r + ln(1 + r + ln(1 + r))`` above. Three steps reach
+round-off (relative 2e-16 in ``z``) over the whole valid range; we take
+:data:`NEWTON_STEPS` = 4 (tested). Then ``F = delta / (s (1 + eps))``: the relative
+error of F is that of ``z``. The graph is branch-free (``if_else`` evaluates both
+starting values), so the generated C code has no data-dependent loops, and CasADi's
+derivative through the converged Newton steps is the implicit-function derivative
+``dF/d delta = 1 / (d delta / dF) = 1 / (s eps)`` (Newton's map has zero slope at its
+root, so the derivative converges with the iterate).
+
+Valid range and fallback
+------------------------
+``dF/d delta = 1/(s eps)`` is infinite at ``delta_max``. The law is used up to
+``penetration_limit = delta_max exp(-(eps_min - log1p(eps_min)))`` with
+``eps_min = 1e-3`` (i.e. 0.99999950 delta_max, force ``F_lim``); beyond it the force is
+continued as ``F_lim (delta / penetration_limit)**1.5`` (Hertz-like, continuous,
+increasing). A simulation cannot raise; call :meth:`~NormalLaw.check_penetration` on
+results to get a warning. For the chapter's steel journal (c = 0.5 mm, L = 10 mm)
+``delta_max`` is 526 um (D-F), 271 um (ESDU) and 0.2 m (Goldsmith), far above the
+micrometre penetrations of the benchmark. Very small penetrations,
+``delta < delta_max e^-200`` (~1e-90 m), are evaluated at ``r = 200`` (the force stays
+proportional to delta, and every derivative stays finite).
+
+sigma convention
+----------------
+``sigma_convention="plain"`` uses ``sigma = (1 - nu^2)/E`` (eq. 3.4 as in Flores et al.);
+``"pi"`` uses ``sigma' = (1 - nu^2)/(pi E)`` (Lankarani-Nikravesh 1990). Which one the
+book used in these laws is not known. Defaults: "plain" for Dubowsky-Freudenstein and
+Goldsmith, "pi" for ESDU 78035, whose formula is written in sigma' (so that it equals
+Johnson's conforming-cylinder solution).
+"""
+
+from __future__ import annotations
+
+import abc
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any, ClassVar, Literal, NamedTuple, Self
+
+from ..errors import SceneError
+from . import _backend as B
+from ._checks import check_number, set_field
+from .base import Geometry, NormalLaw, bearing_radii
+from .geometry import MaterialPair, material_pair
+
+__all__ = ["NEWTON_STEPS", "DubowskyFreudenstein", "ESDU78035", "Goldsmith"]
+
+#: Newton steps of the implicit solve (3 reach round-off over the valid range; 1 spare).
+NEWTON_STEPS = 4
+#: Relative distance of the end of the valid range from the branch maximum, in ``eps = z - 1``.
+EPS_MIN = 1e-3
+#: Largest ``r = ln(delta_max / delta)`` solved; smaller penetrations use it (force ~ linear).
+R_MAX = 200.0
+_R_SWITCH = 2.0
+
+SigmaConvention = Literal["plain", "pi"]
+
+
+class CylinderConstants(NamedTuple):
+    """Numbers of a resolved cylindrical law (SI units)."""
+
+    s: float            # compliance factor sigma_s / L, m/N
+    force_scale: float  # X, N
+    k: float            # +1 or -1
+    delta_max: float    # end of the physical branch, m
+    force_max: float    # force at delta_max, N
+    delta_lim: float    # end of the valid range (penetration_limit), m
+    force_lim: float    # force at delta_lim, N
+    delta_tiny: float   # below it the solve uses r = R_MAX, m
+
+
+def solve_branch(r: Any) -> Any:
+    """Return ``eps > 0`` with ``eps - log1p(eps) = r`` for ``r >= r_min > 0`` (floats, numpy, CasADi).
+
+    ``1 + eps = -W_{-1}(-exp(-1 - r))``. Fixed, unrolled safeguarded Newton steps.
+    """
+    t = B.sqrt(2.0 * r)
+    series = t + t * t / 3.0 + t**3 / 36.0 - t**4 / 270.0
+    asymptotic = r + B.log(1.0 + r + B.log(1.0 + r))
+    eps = B.if_else(r < _R_SWITCH, series, asymptotic)
+    for _ in range(NEWTON_STEPS):
+        step = (1.0 + eps) * (eps - B.log1p(eps) - r) / eps
+        eps = B.fmax(eps - step, 0.5 * eps)  # safeguard: stay on the physical branch eps > 0
+    return eps
+
+
+@dataclass(frozen=True, kw_only=True)
+class _CylindricalLaw(NormalLaw):
+    """``delta = s F [ln(X/F) + k]`` solved for F; see the module docstring."""
+
+    length: float
+    bearing_radius: float | None = None
+    journal_radius: float | None = None
+    materials: MaterialPair | None = None
+    sigma_convention: SigmaConvention = "plain"
+
+    geometry: ClassVar[Geometry] = "cylinder"
+    supported_kinds: ClassVar[tuple[str, ...]] = ("internal_cylinder",)
+    branch_constant: ClassVar[float]
+
+    def __post_init__(self) -> None:
+        owner = type(self).__name__
+        set_field(self, "length", check_number(owner, "length", self.length, low=0.0, unit="m"))
+        for field in ("bearing_radius", "journal_radius"):
+            value = getattr(self, field)
+            if value is not None:
+                set_field(self, field, check_number(owner, field, value, low=0.0, unit="m"))
+        if (self.bearing_radius is not None and self.journal_radius is not None
+                and self.journal_radius >= self.bearing_radius):
+            raise SceneError(f"{owner}: journal_radius={self.journal_radius:g} m, must be < "
+                             f"bearing_radius={self.bearing_radius:g} m.")
+        if self.materials is not None:
+            set_field(self, "materials", material_pair(self.materials, owner))
+        if self.sigma_convention not in ("plain", "pi"):
+            raise SceneError(f"{owner}: sigma_convention={self.sigma_convention!r}, must be 'plain' "
+                             "((1-nu^2)/E) or 'pi' ((1-nu^2)/(pi E)).")
+
+    # ---- resolve ------------------------------------------------------------------
+    @property
+    def is_resolved(self) -> bool:
+        return None not in (self.bearing_radius, self.journal_radius, self.materials)
+
+    def _resolve(self, kind: str, *, radii: Any, materials: Any, face_half_width: Any) -> Self:
+        owner = type(self).__name__
+        if kind != "internal_cylinder":
+            raise SceneError(f"{owner}: a line-contact law for a journal in a bearing; kind={kind!r} is not "
+                             "supported (use 'internal_cylinder').")
+        changes: dict[str, Any] = {}
+        if self.bearing_radius is None or self.journal_radius is None:
+            r_i, r_j = bearing_radii(owner, radii)
+            if self.bearing_radius is None:
+                changes["bearing_radius"] = r_i
+            if self.journal_radius is None:
+                changes["journal_radius"] = r_j
+        if self.materials is None:
+            if materials is None:
+                raise SceneError(f"{owner}.resolve(kind='internal_cylinder'): materials=None; pass "
+                                 "materials=(bearing material, journal material).")
+            changes["materials"] = material_pair(materials, owner)
+        return dataclasses.replace(self, **changes) if changes else self
+
+    # ---- numbers ------------------------------------------------------------------
+    @property
+    def sigma_sum(self) -> float:
+        """``sigma_i + sigma_j`` in the law's ``sigma_convention`` (1/Pa)."""
+        if self.materials is None:
+            raise SceneError(f"{type(self).__name__}: materials=None; call resolve(...) first.")
+        total = self.materials[0].sigma + self.materials[1].sigma
+        return total / math.pi if self.sigma_convention == "pi" else total
+
+    @abc.abstractmethod
+    def _force_scale(self, sigma_s: float, length: float, r_i: float, r_j: float) -> float:
+        """The constant X (N) inside ``ln(X / F)``."""
+
+    def constants(self) -> CylinderConstants:
+        """The law's constants (requires a resolved law)."""
+        if not self.is_resolved:
+            raise SceneError(f"{type(self).__name__}: bearing_radius, journal_radius or materials is None; "
+                             "call resolve(kind='internal_cylinder', radii=..., materials=...) first.")
+        sigma_s = self.sigma_sum
+        s = sigma_s / self.length
+        x = self._force_scale(sigma_s, self.length, self.bearing_radius, self.journal_radius)
+        k = self.branch_constant
+        delta_max = s * x * math.exp(k - 1.0)
+        delta_lim = delta_max * math.exp(-(EPS_MIN - math.log1p(EPS_MIN)))
+        return CylinderConstants(s=s, force_scale=x, k=k, delta_max=delta_max, force_max=x * math.exp(k - 1.0),
+                                 delta_lim=delta_lim, force_lim=delta_lim / (s * (1.0 + EPS_MIN)),
+                                 delta_tiny=delta_max * math.exp(-R_MAX))
+
+    @property
+    def max_penetration(self) -> float:
+        """``delta_max`` (m), where the physical branch ends (dF/d delta infinite)."""
+        return self.constants().delta_max
+
+    @property
+    def penetration_limit(self) -> float:
+        """End of the valid range (m); beyond it the Hertz-like extension is used."""
+        return self.constants().delta_lim
+
+    def penetration_from_force(self, force: Any) -> Any:
+        """The explicit law ``delta(F) = s F [ln(X / F) + k]`` (0 for F <= 0), any backend.
+
+        Meaningful on the physical branch ``0 < F <= F_max``.
+        """
+        c = self.constants()
+        scalar, (f,) = B.as_numeric(force)
+        f_safe = B.fmax(f, c.force_max * math.exp(-R_MAX))
+        delta = c.s * f_safe * (B.log(c.force_scale / f_safe) + c.k)
+        out = B.if_else(f > 0.0, delta, 0.0)
+        return float(out) if scalar else out
+
+    def _force(self, delta: Any, delta_dot: Any, v_minus: Any) -> Any:
+        c = self.constants()
+        delta_pos = B.fmax(delta, 0.0)
+        delta_in = B.fmin(B.fmax(delta, c.delta_tiny), c.delta_lim)  # keeps every operand finite
+        eps = solve_branch(B.log(c.delta_max / delta_in))
+        on_law = B.fmin(delta_pos, c.delta_lim) / (c.s * (1.0 + eps))
+        extension = c.force_lim * (delta_pos / c.delta_lim) ** 1.5
+        return B.if_else(delta > c.delta_lim, extension, on_law)
+
+
+_COMMON = """
+    Parameters
+    ----------
+    length : float
+        Axial contact length L in m, > 0. Required (the chapter does not state the
+        value used in Fig. 4.22); the slider-crank examples state theirs.
+    bearing_radius, journal_radius : float or None
+        R_i > R_j in m; None: set by :meth:`resolve` from the revolute clearance joint.
+    materials : Material or (Material, Material) or None
+        Bearing and journal materials; None: set by :meth:`resolve`.
+    sigma_convention : {"plain", "pi"}
+        sigma = (1-nu^2)/E or (1-nu^2)/(pi E) in the formula (see module docstring).
+
+    Notes
+    -----
+    Elastic: ``dissipative`` and ``needs_approach_speed`` are False. Implicit in F:
+    solved as described in :mod:`daeclear.contact.cylindrical` (round-off accuracy,
+    exact derivative). Valid for ``penetration <= penetration_limit`` (just below
+    ``max_penetration``); beyond it the force is continued as
+    ``F_lim (delta / penetration_limit)**1.5`` and :meth:`check_penetration` warns.
+    Force 0 for ``delta <= 0``; never negative.
+"""
+
+
+@dataclass(frozen=True, kw_only=True)
+class DubowskyFreudenstein(_CylindricalLaw):
+    """Dubowsky-Freudenstein (1971) internal cylinder law.
+
+    ``delta = F sigma_s / L [ln(L^3 (R_i - R_j) / (F sigma_s R_i R_j)) + 1]``,
+    the ``L^3`` reading (the only dimensionless one) of CONTACT_MODELS.md section 8.3.
+    Steel, R_i = 10 mm, c = 0.5 mm, L = 10 mm, sigma "plain": 119 N at 1 um,
+    739 N at 5 um, 1650 N at 10 um.
+    """ + _COMMON
+
+    name: ClassVar[str] = "dubowsky-freudenstein"
+    branch_constant: ClassVar[float] = 1.0
+
+    def _force_scale(self, sigma_s: float, length: float, r_i: float, r_j: float) -> float:
+        return length**3 * (r_i - r_j) / (sigma_s * r_i * r_j)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Goldsmith(_CylindricalLaw):
+    """Goldsmith (1960) internal cylinder law -- form UNCONFIRMED.
+
+    ``delta = F sigma_s / L [ln(L^3 / (F sigma_s (R_i - R_j))) + 1]``.
+
+    Warning: the book's printed form (chapter 3) was not available. The one public
+    implementation found is dimensionally wrong, or identical to Dubowsky-Freudenstein
+    once repaired, yet the chapter plots different curves (Fig. 4.22c-d). This is the
+    plausible reading with the radial clearance in place of ``R_i R_j / (R_i - R_j)``
+    (CONTACT_MODELS.md section 8.4). Steel, c = 0.5 mm, L = 10 mm, sigma "plain":
+    71 N at 1 um, 399 N at 5 um, 842 N at 10 um.
+    """ + _COMMON
+
+    name: ClassVar[str] = "goldsmith"
+    branch_constant: ClassVar[float] = 1.0
+
+    def _force_scale(self, sigma_s: float, length: float, r_i: float, r_j: float) -> float:
+        return length**3 / (sigma_s * (r_i - r_j))
+
+
+@dataclass(frozen=True, kw_only=True)
+class ESDU78035(_CylindricalLaw):
+    """ESDU 78035 internal cylinder law (Johnson-consistent reading).
+
+    ``delta = F sigma'_s / L [ln(4 L (R_i - R_j) / (F sigma'_s)) - 1]`` with
+    ``sigma' = (1 - nu^2)/(pi E)`` by default (``sigma_convention="pi"``); this equals
+    Johnson's conforming-cylinder solution
+    ``delta = F/(pi L E*) [ln(4 pi L E* (R_i - R_j)/F) - 1]`` (CONTACT_MODELS.md 8.5a).
+    The other published reading (``pi`` in front, ``+1``) is not offered.
+    Steel, c = 0.5 mm, L = 10 mm: 407 N at 1 um, 2579 N at 5 um, 5850 N at 10 um
+    (130 / 821 / 1862 N with ``sigma_convention="plain"``).
+    """ + _COMMON
+
+    sigma_convention: SigmaConvention = "pi"
+
+    name: ClassVar[str] = "esdu-78035"
+    branch_constant: ClassVar[float] = -1.0
+
+    def _force_scale(self, sigma_s: float, length: float, r_i: float, r_j: float) -> float:
+        return 4.0 * length * (r_i - r_j) / sigma_s

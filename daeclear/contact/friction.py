@@ -1,0 +1,166 @@
+"""Friction laws: none, Coulomb, and the modified Coulomb law of Ambrosio (eq. 3.16).
+
+Sign convention: ``sliding_velocity`` is the tangential velocity of the body the force
+acts on, relative to the other body (material points, spin included). The returned
+signed force OPPOSES it, so the friction power ``force * sliding_velocity <= 0``.
+For the revolute clearance joint with ``v_T = (r_dot_j^Q - r_dot_i^Q) . t`` (journal j
+relative to bearing i): force on the journal ``friction_force(F_N, v_T) * t``, on the
+bearing the opposite.
+
+Every law runs on floats, numpy arrays and CasADi symbols from one definition and
+never divides by ``|v|``, so nothing is NaN at ``v = 0`` (``sign(0) = 0``, and its
+CasADi derivative is 0).
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from ..errors import SceneError
+from . import _backend as B
+from ._checks import check_number, set_field
+
+__all__ = ["Coulomb", "FrictionLaw", "ModifiedCoulomb", "NoFriction"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class FrictionLaw(abc.ABC):
+    """A tangential force law ``F_T(F_N, v_T)``.
+
+    Contract for implementers: set ``name`` and ``smooth`` (continuous in the sliding
+    velocity), override ``_force(normal_force, sliding_velocity)`` using
+    ``daeclear.contact._backend`` functions; it must oppose the velocity and be finite
+    (with finite CasADi derivatives) everywhere, including ``v = 0``.
+    """
+
+    name: ClassVar[str]
+    smooth: ClassVar[bool]
+
+    @property
+    def frictionless(self) -> bool:
+        """True if the law never produces a force (the assembly may skip it)."""
+        return False
+
+    def friction_force(self, normal_force: Any, sliding_velocity: Any) -> Any:
+        """Signed tangential force (N) opposing ``sliding_velocity``.
+
+        Parameters
+        ----------
+        normal_force : float, array_like, casadi.SX or casadi.MX
+            ``F_N >= 0`` in N.
+        sliding_velocity : same types
+            ``v_T`` in m/s, of the body the force acts on relative to the other.
+
+        Returns
+        -------
+        float, numpy.ndarray or CasADi expression
+            ``F_T`` with ``F_T * v_T <= 0``; a float for scalar inputs.
+        """
+        scalar, (f_n, v_t) = B.as_numeric(normal_force, sliding_velocity)
+        out = self._force(f_n, v_t)
+        return float(out) if scalar else out
+
+    @abc.abstractmethod
+    def _force(self, normal_force: Any, sliding_velocity: Any) -> Any:
+        """The law, written once with ``_backend`` functions."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class NoFriction(FrictionLaw):
+    """Frictionless contact: ``F_T = 0``."""
+
+    name: ClassVar[str] = "none"
+    smooth: ClassVar[bool] = True
+
+    @property
+    def frictionless(self) -> bool:
+        return True
+
+    def _force(self, normal_force: Any, sliding_velocity: Any) -> Any:
+        return 0.0 * normal_force * sliding_velocity
+
+
+def _coefficient(owner: str, value: Any) -> float:
+    return check_number(owner, "coefficient", value, low=0.0, low_open=False)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Coulomb(FrictionLaw):
+    """Plain Coulomb friction, ``F_T = -c_f F_N sign(v_T)``.
+
+    Parameters
+    ----------
+    coefficient : float
+        Friction coefficient c_f >= 0.
+
+    Notes
+    -----
+    Discontinuous at ``v_T = 0`` (``sign(0) = 0``, so the force is 0 exactly there):
+    an integrator chatters across sliding reversals. Prefer :class:`ModifiedCoulomb`.
+    """
+
+    coefficient: float
+
+    name: ClassVar[str] = "coulomb"
+    smooth: ClassVar[bool] = False
+
+    def __post_init__(self) -> None:
+        set_field(self, "coefficient", _coefficient("Coulomb", self.coefficient))
+
+    def _force(self, normal_force: Any, sliding_velocity: Any) -> Any:
+        return -self.coefficient * normal_force * B.sign(sliding_velocity)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ModifiedCoulomb(FrictionLaw):
+    """Modified Coulomb friction of Ambrosio (2002), eq. (3.16).
+
+    ``F_T = -c_f c_d(|v_T|) F_N sign(v_T)`` with the dynamic correction coefficient
+    ``c_d = 0`` for ``|v_T| <= v0``, ``(|v_T| - v0)/(v1 - v0)`` between, 1 for ``|v_T| >= v1``.
+
+    Parameters
+    ----------
+    coefficient : float
+        Friction coefficient c_f >= 0 (chapter 4 sweeps 0.01, 0.03, 0.05, 0.1).
+    v0 : float
+        Speed below which the force is zero, m/s, >= 0. Default 1e-4.
+    v1 : float
+        Speed from which full Coulomb friction acts, m/s, > v0. Default 2e-4.
+
+    Notes
+    -----
+    Continuous in ``v_T`` (piecewise linear ramp), which is what makes it kinder to
+    integrators than :class:`Coulomb`; it has no stiction (zero force below v0).
+    The book's v0, v1 are not known; the defaults are the only Flores-attributed
+    values found (CONTACT_MODELS.md section 11).
+    """
+
+    coefficient: float
+    v0: float = 1e-4
+    v1: float = 2e-4
+
+    name: ClassVar[str] = "modified-coulomb"
+    smooth: ClassVar[bool] = True
+
+    def __post_init__(self) -> None:
+        set_field(self, "coefficient", _coefficient("ModifiedCoulomb", self.coefficient))
+        set_field(self, "v0", check_number("ModifiedCoulomb", "v0", self.v0, low=0.0, low_open=False,
+                                           unit="m/s"))
+        set_field(self, "v1", check_number("ModifiedCoulomb", "v1", self.v1, low=0.0, unit="m/s"))
+        if self.v1 <= self.v0:
+            raise SceneError(f"ModifiedCoulomb: v1={self.v1:g} m/s, must be > v0={self.v0:g} m/s.")
+
+    def correction(self, sliding_velocity: Any) -> Any:
+        """Dynamic correction coefficient ``c_d(|v_T|)`` in [0, 1], any backend."""
+        scalar, (v_t,) = B.as_numeric(sliding_velocity)
+        out = self._correction(v_t)
+        return float(out) if scalar else out
+
+    def _correction(self, v_t: Any) -> Any:
+        ramp = (B.fabs(v_t) - self.v0) / (self.v1 - self.v0)
+        return B.fmin(B.fmax(ramp, 0.0), 1.0)
+
+    def _force(self, normal_force: Any, sliding_velocity: Any) -> Any:
+        return -self.coefficient * self._correction(sliding_velocity) * normal_force * B.sign(sliding_velocity)

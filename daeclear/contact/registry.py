@@ -1,0 +1,119 @@
+"""Look up contact and friction laws by name (scene files, command line, sweeps)."""
+
+from __future__ import annotations
+
+import dataclasses
+import numbers
+import re
+from typing import Any
+
+from ..errors import SceneError
+from .base import NormalLaw
+from .cylindrical import DubowskyFreudenstein, ESDU78035, Goldsmith
+from .friction import Coulomb, FrictionLaw, ModifiedCoulomb, NoFriction
+from .normal import Flores, Hertz, HuntCrossley, KelvinVoigt, LankaraniNikravesh, LankaraniPlane
+
+__all__ = ["FRICTION_LAWS", "NORMAL_LAWS", "friction_law", "normal_law"]
+
+#: Normal laws by registry name.
+NORMAL_LAWS: dict[str, type[NormalLaw]] = {cls.name: cls for cls in (
+    Hertz, KelvinVoigt, HuntCrossley, LankaraniNikravesh, Flores, DubowskyFreudenstein, Goldsmith,
+    ESDU78035, LankaraniPlane)}
+_NORMAL_ALIASES = {"ln": "lankarani-nikravesh", "esdu": "esdu-78035", "kv": "kelvin-voigt",
+                   "hc": "hunt-crossley", "df": "dubowsky-freudenstein", "flores-2011": "flores"}
+
+#: Friction laws by registry name.
+FRICTION_LAWS: dict[str, type[FrictionLaw]] = {cls.name: cls for cls in (NoFriction, Coulomb, ModifiedCoulomb)}
+_FRICTION_ALIASES = {"ambrosio": "modified-coulomb", "frictionless": "none"}
+
+
+def _key(name: str) -> str:
+    """Case-insensitive key ignoring hyphens, underscores and spaces."""
+    return re.sub(r"[-_\s]+", "", name.strip().lower())
+
+
+def _lookup(kind: str, name: Any, table: dict[str, Any], aliases: dict[str, str]) -> Any:
+    if not isinstance(name, str):
+        raise SceneError(f"{kind}: name={name!r} is not a string; valid names: {', '.join(table)}.")
+    keys = {_key(n): n for n in table} | {_key(a): n for a, n in aliases.items()}
+    found = keys.get(_key(name))
+    if found is None:
+        raise SceneError(f"{kind}: unknown name {name!r}; valid names: {', '.join(table)} "
+                         f"(aliases: {', '.join(aliases)}).")
+    return table[found]
+
+
+def _build(cls: type, params: dict[str, Any]) -> Any:
+    fields = [f.name for f in dataclasses.fields(cls)]
+    unknown = sorted(set(params) - set(fields))
+    if unknown:
+        raise SceneError(f"{cls.__name__}: unknown parameter(s) {', '.join(unknown)}; "
+                         f"valid: {', '.join(fields)}.")
+    missing = [f.name for f in dataclasses.fields(cls) if f.name not in params
+               and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING]
+    if missing:
+        raise SceneError(f"{cls.__name__}: missing required parameter(s) {', '.join(missing)}.")
+    return cls(**params)
+
+
+def normal_law(name: str | NormalLaw, **params: Any) -> NormalLaw:
+    """Build a normal contact law from its name.
+
+    Parameters
+    ----------
+    name : str or NormalLaw
+        Case-insensitive; hyphens, underscores and spaces are ignored
+        (``"Lankarani_Nikravesh"`` == ``"lankarani-nikravesh"``). Names:
+        hertz, kelvin-voigt, hunt-crossley, lankarani-nikravesh, flores,
+        dubowsky-freudenstein, goldsmith, esdu-78035, lankarani-plane; aliases ln, esdu,
+        kv, hc, df. A NormalLaw instance is returned as is (no params allowed).
+    **params
+        The law's constructor keywords, e.g. ``restitution=0.9``.
+
+    Raises
+    ------
+    SceneError
+        Unknown name (lists the valid ones), unknown or missing parameter, bad value.
+
+    Example
+    -------
+    >>> normal_law("Lankarani Nikravesh", restitution=0.9).name
+    'lankarani-nikravesh'
+    """
+    if isinstance(name, NormalLaw):
+        if params:
+            raise SceneError(f"normal_law: parameters {sorted(params)} given with a law instance.")
+        return name
+    return _build(_lookup("normal_law", name, NORMAL_LAWS, _NORMAL_ALIASES), params)
+
+
+def friction_law(name_or_coefficient: str | float | FrictionLaw | None, **params: Any) -> FrictionLaw:
+    """Build a friction law.
+
+    Parameters
+    ----------
+    name_or_coefficient : str, float, FrictionLaw or None
+        ``None`` -> :class:`NoFriction`; a number -> :class:`ModifiedCoulomb` with that
+        coefficient (``params`` may set ``v0``, ``v1``); a name ("none"/"frictionless",
+        "coulomb", "modified-coulomb"/"ambrosio", case-insensitive) with ``params``;
+        a FrictionLaw instance is returned as is.
+
+    Raises
+    ------
+    SceneError
+        Unknown name (lists the valid ones), unknown parameter or bad value.
+
+    Example
+    -------
+    >>> friction_law(0.05)
+    ModifiedCoulomb(coefficient=0.05, v0=0.0001, v1=0.0002)
+    """
+    if isinstance(name_or_coefficient, FrictionLaw):
+        if params:
+            raise SceneError(f"friction_law: parameters {sorted(params)} given with a law instance.")
+        return name_or_coefficient
+    if name_or_coefficient is None:
+        return _build(NoFriction, params)
+    if isinstance(name_or_coefficient, numbers.Real) and not isinstance(name_or_coefficient, bool):
+        return _build(ModifiedCoulomb, {"coefficient": float(name_or_coefficient), **params})
+    return _build(_lookup("friction_law", name_or_coefficient, FRICTION_LAWS, _FRICTION_ALIASES), params)

@@ -1,0 +1,756 @@
+/*
+ * ida_driver.c -- daeclear's compiled integrator loop.
+ *
+ * Compiled together with a CasADi-generated model (see daeclear/codegen.py) into one shared
+ * library that links the SUNDIALS libraries of the scikit-sundae wheel. Python drives it with
+ * ctypes a few calls per integration segment; every residual, Jacobian and root evaluation,
+ * every IDA step, the recording of steps and the dense output at requested times happen here,
+ * with no Python in the loop.
+ *
+ * The residual is the base residual plus the active switchable terms (contact forces); an
+ * inactive term is never evaluated. The Jacobian is the base Jacobian plus the active terms'
+ * Jacobians (dense, column-major, as SUNDIALS' dense matrix stores it).
+ */
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sundials_min.h"
+#include "dc_model.h"
+
+#define DC_API __attribute__((visibility("default")))
+
+#define DC_ABI_VERSION 1
+
+/* dc_advance return codes */
+#define DC_CHUNK 0          /* buffer full: call again */
+#define DC_TSTOP 1          /* reached t_stop */
+#define DC_ROOT 2           /* a root was found */
+#define DC_ERR_IDA (-1)     /* IDA returned an error flag */
+#define DC_ERR_MAXSTEPS (-2) /* session step cap reached */
+#define DC_ERR_COLLAPSE (-3) /* step size collapsed */
+#define DC_ERR_USAGE (-4)   /* called in a wrong state / bad arguments */
+
+/* statistics slots (dc_stats) */
+enum {
+  ST_STEPS, ST_RES, ST_JAC, ST_LSETUP, ST_NNI, ST_NCF, ST_NETF, ST_GEVALS, ST_REINITS, ST_N
+};
+
+/* A step is "tiny" when |h| < DC_TINY_REL * max(1, |t|). DC_TINY_MAX tiny steps that did not
+ * grow (|h| <= DC_TINY_GROWTH * previous |h|), with no normal step in between, are a collapse of
+ * the step size: the loop stops instead of creeping on forever. Tiny steps that keep growing
+ * are IDA's start-up doubling after a tiny initial step (0.5 / ||y'||_wrms) and do not count. */
+#define DC_TINY_REL 1e-14
+#define DC_TINY_MAX 20
+#define DC_TINY_GROWTH 1.5
+
+#define MSG_LEN 1024
+
+typedef struct {
+  SUNContext ctx;
+  void* ida;
+  N_Vector yy, yp, atol, dky;
+  SUNMatrix A;
+  SUNLinearSolver LS;
+  int n, n_terms, n_roots;
+  /* CasADi work memory, sized for the largest function */
+  const double** arg;
+  double** res;
+  dc_int* iw;
+  double* w;
+  int mem_res, mem_jac, mem_roots;
+  int* mem_term_res;
+  int* mem_term_jac;
+  /* per-segment state */
+  int* active;
+  double* params;
+  int* param_off;
+  int* rootdir_default;
+  int* rootdir;
+  int* rootsfound;
+  double* tmp_r;   /* n   */
+  double* tmp_J;   /* n*n */
+  double t_now;    /* time of the state in yy/yp (last return) */
+  double t_rec;    /* time of the last recorded step (to skip duplicates) */
+  int ready;       /* reinit was called */
+  int tiny;        /* tiny, non-growing steps since the last normal step */
+  double h_prev;   /* size of the previous step (collapse detection) */
+  long long max_steps;
+  long long base[ST_N]; /* counters accumulated over earlier reinit segments */
+  char msg[MSG_LEN];    /* our own message for the last non-success return */
+  char cb_msg[MSG_LEN]; /* set by a callback that refused its input (NaN, CasADi error) */
+  char ida_msg[MSG_LEN]; /* last message IDA passed to the error handler */
+} dc_session;
+
+static void set_msg(char* buf, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(buf, MSG_LEN, fmt, ap);
+  va_end(ap);
+}
+
+static void err_handler(int line, const char* func, const char* file, const char* msg,
+                        SUNErrCode code, void* data, SUNContext ctx) {
+  dc_session* s = (dc_session*)data;
+  (void)line;
+  (void)file;
+  (void)ctx;
+  if (!s) return;
+  snprintf(s->ida_msg, MSG_LEN, "%s (code %d): %s", func ? func : "?", (int)code,
+           msg ? msg : "");
+}
+
+static int first_nonfinite(const double* v, int m) {
+  for (int i = 0; i < m; ++i)
+    if (!isfinite(v[i])) return i;
+  return -1;
+}
+
+/* ---------------------------------------------------------------- model evaluation ---- */
+
+static int eval_res(dc_session* s, double t, const double* y, const double* yp, double* r) {
+  const dc_model_t* M = &dc_model;
+  s->arg[0] = &t;
+  s->arg[1] = y;
+  s->arg[2] = yp;
+  s->res[0] = r;
+  if (M->res.eval(s->arg, s->res, s->iw, s->w, s->mem_res)) return -1;
+  for (int k = 0; k < s->n_terms; ++k) {
+    if (!s->active[k]) continue;
+    s->arg[0] = &t;
+    s->arg[1] = y;
+    s->arg[2] = yp;
+    s->arg[3] = s->params + s->param_off[k];
+    s->res[0] = s->tmp_r;
+    if (M->term_res[k].eval(s->arg, s->res, s->iw, s->w, s->mem_term_res[k])) return -(k + 2);
+    for (int i = 0; i < s->n; ++i) r[i] += s->tmp_r[i];
+  }
+  return 0;
+}
+
+static int eval_jac(dc_session* s, double t, const double* y, const double* yp, double cj,
+                    double* J) {
+  const dc_model_t* M = &dc_model;
+  const int nn = s->n * s->n;
+  s->arg[0] = &t;
+  s->arg[1] = y;
+  s->arg[2] = yp;
+  s->arg[3] = &cj;
+  s->res[0] = J;
+  if (M->jac.eval(s->arg, s->res, s->iw, s->w, s->mem_jac)) return -1;
+  for (int k = 0; k < s->n_terms; ++k) {
+    if (!s->active[k]) continue;
+    s->arg[0] = &t;
+    s->arg[1] = y;
+    s->arg[2] = yp;
+    s->arg[3] = s->params + s->param_off[k];
+    s->arg[4] = &cj;
+    s->res[0] = s->tmp_J;
+    if (M->term_jac[k].eval(s->arg, s->res, s->iw, s->w, s->mem_term_jac[k])) return -(k + 2);
+    for (int i = 0; i < nn; ++i) J[i] += s->tmp_J[i];
+  }
+  return 0;
+}
+
+static int eval_roots(dc_session* s, double t, const double* y, const double* yp, double* g) {
+  const dc_model_t* M = &dc_model;
+  s->arg[0] = &t;
+  s->arg[1] = y;
+  s->arg[2] = yp;
+  s->res[0] = g;
+  return M->roots.eval(s->arg, s->res, s->iw, s->w, s->mem_roots) ? -1 : 0;
+}
+
+/* ---------------------------------------------------------------- IDA callbacks ---- */
+
+static int res_cb(sunrealtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* data) {
+  dc_session* s = (dc_session*)data;
+  double* r = N_VGetArrayPointer(rr);
+  int rc = eval_res(s, t, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), r);
+  if (rc) {
+    if (rc == -1)
+      set_msg(s->cb_msg, "the generated base residual returned an error at t=%.17g", t);
+    else
+      set_msg(s->cb_msg, "the generated residual of term %d returned an error at t=%.17g",
+              -rc - 2, t);
+    return -1; /* unrecoverable */
+  }
+  int i = first_nonfinite(r, s->n);
+  if (i >= 0) {
+    set_msg(s->cb_msg,
+            "residual component %d is %g at t=%.17g (y[%d]=%g); IDA retried with smaller steps",
+            i, r[i], t, i, N_VGetArrayPointer(yy)[i]);
+    return 1; /* recoverable: IDA cuts the step */
+  }
+  return 0;
+}
+
+static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vector rr,
+                  SUNMatrix J, void* data, N_Vector t1, N_Vector t2, N_Vector t3) {
+  dc_session* s = (dc_session*)data;
+  double* Jd = SUNDenseMatrix_Data(J);
+  (void)rr;
+  (void)t1;
+  (void)t2;
+  (void)t3;
+  int rc = eval_jac(s, t, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), cj, Jd);
+  if (rc) {
+    if (rc == -1)
+      set_msg(s->cb_msg, "the generated base Jacobian returned an error at t=%.17g", t);
+    else
+      set_msg(s->cb_msg, "the generated Jacobian of term %d returned an error at t=%.17g",
+              -rc - 2, t);
+    return -1;
+  }
+  int i = first_nonfinite(Jd, s->n * s->n);
+  if (i >= 0) {
+    set_msg(s->cb_msg, "Jacobian entry (%d, %d) is %g at t=%.17g", i % s->n, i / s->n, Jd[i], t);
+    return 1;
+  }
+  return 0;
+}
+
+static int root_cb(sunrealtype t, N_Vector yy, N_Vector yp, sunrealtype* g, void* data) {
+  dc_session* s = (dc_session*)data;
+  if (eval_roots(s, t, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), g)) {
+    set_msg(s->cb_msg, "the generated root function returned an error at t=%.17g", t);
+    return -1;
+  }
+  int i = first_nonfinite(g, s->n_roots);
+  if (i >= 0) {
+    set_msg(s->cb_msg, "root function %d is %g at t=%.17g", i, g[i], t);
+    return -1;
+  }
+  return 0;
+}
+
+/* ---------------------------------------------------------------- helpers ---- */
+
+static void ida_counters(dc_session* s, long long* out) {
+  long int v = 0;
+  for (int i = 0; i < ST_N; ++i) out[i] = 0;
+  if (!s->ida) return;
+  if (IDAGetNumSteps(s->ida, &v) == 0) out[ST_STEPS] = v;
+  if (IDAGetNumResEvals(s->ida, &v) == 0) out[ST_RES] = v;
+  if (IDAGetNumJacEvals(s->ida, &v) == 0) out[ST_JAC] = v;
+  if (IDAGetNumLinSolvSetups(s->ida, &v) == 0) out[ST_LSETUP] = v;
+  if (IDAGetNumNonlinSolvIters(s->ida, &v) == 0) out[ST_NNI] = v;
+  if (IDAGetNumNonlinSolvConvFails(s->ida, &v) == 0) out[ST_NCF] = v;
+  if (IDAGetNumErrTestFails(s->ida, &v) == 0) out[ST_NETF] = v;
+  if (IDAGetNumGEvals(s->ida, &v) == 0) out[ST_GEVALS] = v;
+}
+
+static void flag_name(long int flag, char* buf, int len) {
+  char* name = IDAGetReturnFlagName(flag);
+  if (name) {
+    snprintf(buf, len, "%s", name);
+    free(name);
+  } else {
+    snprintf(buf, len, "IDA flag %ld", flag);
+  }
+}
+
+static void* xcalloc(size_t n, size_t sz) { return calloc(n ? n : 1, sz); }
+
+/* ---------------------------------------------------------------- API ---- */
+
+DC_API int dc_abi_version(void) { return DC_ABI_VERSION; }
+
+DC_API int dc_sundials_version(char* buf, int len) { return SUNDIALSGetVersion(buf, len); }
+
+DC_API int dc_model_info(int* n, int* n_terms, int* n_roots, int* n_params) {
+  *n = dc_model.n;
+  *n_terms = dc_model.n_terms;
+  *n_roots = dc_model.n_roots;
+  if (n_params)
+    for (int k = 0; k < dc_model.n_terms; ++k) n_params[k] = dc_model.n_params[k];
+  return 0;
+}
+
+DC_API const char* dc_model_name(void) { return dc_model.name; }
+
+DC_API void dc_flag_name(long flag, char* buf, int len) { flag_name(flag, buf, len); }
+
+DC_API const char* dc_message(void* sp) { return sp ? ((dc_session*)sp)->msg : ""; }
+
+static void release_funs(dc_session* s) {
+  const dc_model_t* M = &dc_model;
+  if (s->mem_res >= 0) M->res.release(s->mem_res);
+  if (s->mem_jac >= 0) M->jac.release(s->mem_jac);
+  if (M->n_roots > 0 && s->mem_roots >= 0) M->roots.release(s->mem_roots);
+  for (int k = 0; k < M->n_terms; ++k) {
+    if (s->mem_term_res && s->mem_term_res[k] >= 0) M->term_res[k].release(s->mem_term_res[k]);
+    if (s->mem_term_jac && s->mem_term_jac[k] >= 0) M->term_jac[k].release(s->mem_term_jac[k]);
+  }
+  M->res.decref();
+  M->jac.decref();
+  if (M->n_roots > 0) M->roots.decref();
+  for (int k = 0; k < M->n_terms; ++k) {
+    M->term_res[k].decref();
+    M->term_jac[k].decref();
+  }
+}
+
+DC_API void dc_free(void* sp) {
+  dc_session* s = (dc_session*)sp;
+  if (!s) return;
+  if (s->ida) IDAFree(&s->ida);
+  if (s->LS) SUNLinSolFree(s->LS);
+  if (s->A) SUNMatDestroy(s->A);
+  if (s->yy) N_VDestroy(s->yy);
+  if (s->yp) N_VDestroy(s->yp);
+  if (s->atol) N_VDestroy(s->atol);
+  if (s->dky) N_VDestroy(s->dky);
+  if (s->ctx) SUNContext_Free(&s->ctx);
+  if (s->arg) release_funs(s);
+  free(s->arg);
+  free(s->res);
+  free(s->iw);
+  free(s->w);
+  free(s->mem_term_res);
+  free(s->mem_term_jac);
+  free(s->active);
+  free(s->params);
+  free(s->param_off);
+  free(s->rootdir_default);
+  free(s->rootdir);
+  free(s->rootsfound);
+  free(s->tmp_r);
+  free(s->tmp_J);
+  free(s);
+}
+
+static void work_max(const dc_fun_t* f, dc_int* a, dc_int* r, dc_int* iw, dc_int* w) {
+  dc_int sa = 0, sr = 0, si = 0, sw = 0;
+  f->work(&sa, &sr, &si, &sw);
+  if (sa > *a) *a = sa;
+  if (sr > *r) *r = sr;
+  if (si > *iw) *iw = si;
+  if (sw > *w) *w = sw;
+}
+
+/* Open a session: IDA memory, dense linear solver, tolerances, options and root functions.
+ * IDAInit is called here with a zero state; dc_reinit then (re)starts with IDAReInit.
+ * Returns NULL on failure with a message in err. */
+DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_order,
+                     long long max_steps, const int* rootdir, char* err, int errlen) {
+  const dc_model_t* M = &dc_model;
+  dc_session* s = (dc_session*)calloc(1, sizeof(dc_session));
+  int n = M->n, flag;
+#define FAIL(...)                          \
+  do {                                     \
+    if (err && errlen > 0) snprintf(err, errlen, __VA_ARGS__); \
+    dc_free(s);                            \
+    return NULL;                           \
+  } while (0)
+  if (!s) {
+    if (err && errlen > 0) snprintf(err, errlen, "out of memory");
+    return NULL;
+  }
+  s->n = n;
+  s->n_terms = M->n_terms;
+  s->n_roots = M->n_roots;
+  s->max_steps = max_steps;
+  s->mem_res = s->mem_jac = s->mem_roots = -1;
+
+  /* CasADi work memory */
+  {
+    dc_int sa = 5, sr = 1, si = 0, sw = 0;
+    work_max(&M->res, &sa, &sr, &si, &sw);
+    work_max(&M->jac, &sa, &sr, &si, &sw);
+    if (M->n_roots > 0) work_max(&M->roots, &sa, &sr, &si, &sw);
+    for (int k = 0; k < M->n_terms; ++k) {
+      work_max(&M->term_res[k], &sa, &sr, &si, &sw);
+      work_max(&M->term_jac[k], &sa, &sr, &si, &sw);
+    }
+    s->arg = (const double**)xcalloc((size_t)sa, sizeof(double*));
+    s->res = (double**)xcalloc((size_t)sr, sizeof(double*));
+    s->iw = (dc_int*)xcalloc((size_t)si, sizeof(dc_int));
+    s->w = (double*)xcalloc((size_t)sw, sizeof(double));
+    s->mem_term_res = (int*)xcalloc((size_t)M->n_terms, sizeof(int));
+    s->mem_term_jac = (int*)xcalloc((size_t)M->n_terms, sizeof(int));
+    if (!s->arg || !s->res || !s->iw || !s->w || !s->mem_term_res || !s->mem_term_jac)
+      FAIL("out of memory");
+    for (int k = 0; k < M->n_terms; ++k) s->mem_term_res[k] = s->mem_term_jac[k] = -1;
+    M->res.incref();
+    M->jac.incref();
+    if (M->n_roots > 0) M->roots.incref();
+    for (int k = 0; k < M->n_terms; ++k) {
+      M->term_res[k].incref();
+      M->term_jac[k].incref();
+    }
+    s->mem_res = M->res.checkout();
+    s->mem_jac = M->jac.checkout();
+    if (M->n_roots > 0) s->mem_roots = M->roots.checkout();
+    for (int k = 0; k < M->n_terms; ++k) {
+      s->mem_term_res[k] = M->term_res[k].checkout();
+      s->mem_term_jac[k] = M->term_jac[k].checkout();
+    }
+  }
+
+  /* per-segment state */
+  {
+    int np = 0;
+    s->param_off = (int*)xcalloc((size_t)M->n_terms, sizeof(int));
+    s->active = (int*)xcalloc((size_t)M->n_terms, sizeof(int));
+    if (!s->param_off || !s->active) FAIL("out of memory");
+    for (int k = 0; k < M->n_terms; ++k) {
+      s->param_off[k] = np;
+      np += M->n_params[k];
+    }
+    s->params = (double*)xcalloc((size_t)np, sizeof(double));
+    s->rootdir_default = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
+    s->rootdir = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
+    s->rootsfound = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
+    s->tmp_r = (double*)xcalloc((size_t)n, sizeof(double));
+    s->tmp_J = (double*)xcalloc((size_t)n * (size_t)n, sizeof(double));
+    if (!s->params || !s->rootdir_default || !s->rootdir || !s->rootsfound || !s->tmp_r ||
+        !s->tmp_J)
+      FAIL("out of memory");
+    for (int i = 0; i < M->n_roots; ++i) s->rootdir_default[i] = rootdir ? rootdir[i] : 0;
+  }
+
+  /* SUNDIALS objects */
+  if (SUNContext_Create(SUN_COMM_NULL, &s->ctx) != 0 || !s->ctx)
+    FAIL("SUNContext_Create failed");
+  SUNContext_ClearErrHandlers(s->ctx); /* IDA must not print; we build our own messages */
+  SUNContext_PushErrHandler(s->ctx, err_handler, s);
+  s->yy = N_VNew_Serial(n, s->ctx);
+  s->yp = N_VNew_Serial(n, s->ctx);
+  s->atol = N_VNew_Serial(n, s->ctx);
+  s->dky = N_VNew_Serial(n, s->ctx);
+  if (!s->yy || !s->yp || !s->atol || !s->dky) FAIL("N_VNew_Serial failed");
+  memset(N_VGetArrayPointer(s->yy), 0, sizeof(double) * (size_t)n);
+  memset(N_VGetArrayPointer(s->yp), 0, sizeof(double) * (size_t)n);
+  memcpy(N_VGetArrayPointer(s->atol), atol, sizeof(double) * (size_t)n);
+  s->A = SUNDenseMatrix(n, n, s->ctx);
+  if (!s->A) FAIL("SUNDenseMatrix failed");
+  s->LS = SUNLinSol_Dense(s->yy, s->A, s->ctx);
+  if (!s->LS) FAIL("SUNLinSol_Dense failed");
+  s->ida = IDACreate(s->ctx);
+  if (!s->ida) FAIL("IDACreate failed");
+#define CHECK(call)                                                      \
+  do {                                                                   \
+    flag = (call);                                                       \
+    if (flag < 0) FAIL("%s failed with flag %d: %s", #call, flag, s->ida_msg); \
+  } while (0)
+  CHECK(IDAInit(s->ida, res_cb, 0.0, s->yy, s->yp));
+  CHECK(IDASetUserData(s->ida, s));
+  CHECK(IDASVtolerances(s->ida, rtol, s->atol));
+  CHECK(IDASetLinearSolver(s->ida, s->LS, s->A));
+  CHECK(IDASetJacFn(s->ida, jac_cb));
+  CHECK(IDASetMaxOrd(s->ida, max_order));
+  CHECK(IDASetMaxStep(s->ida, max_step));
+  /* one-step mode: IDA's own per-call step limit never binds; the session cap is ours */
+  CHECK(IDASetMaxNumSteps(s->ida, 0 < max_steps && max_steps < 2000000000LL ? (long)max_steps : 2000000000L));
+  if (M->n_roots > 0) {
+    CHECK(IDARootInit(s->ida, M->n_roots, root_cb));
+    CHECK(IDASetRootDirection(s->ida, s->rootdir_default));
+    CHECK(IDASetNoInactiveRootWarn(s->ida));
+  }
+#undef CHECK
+#undef FAIL
+  return s;
+}
+
+/* Solver hints applied from the next step or restart on: the safety factor of IDA's
+ * Newton convergence test (default 0.33; smaller solves the algebraic equations tighter)
+ * and the first step size after the next (re)start (0: IDA's own estimate). */
+DC_API int dc_set_nonlin_conv_coef(void* sp, double coef) {
+  return IDASetNonlinConvCoef(((dc_session*)sp)->ida, coef);
+}
+
+DC_API int dc_set_init_step(void* sp, double h) {
+  return IDASetInitStep(((dc_session*)sp)->ida, h);
+}
+
+/* (Re)start IDA at (t0, y0, yp0) with fresh BDF history; set active terms, their parameters
+ * (concatenated) and the root directions (NULL: the directions given to dc_open). */
+DC_API int dc_reinit(void* sp, double t0, const double* y0, const double* yp0,
+                     const int* active, const double* params, const int* rootdir) {
+  dc_session* s = (dc_session*)sp;
+  long long cur[ST_N];
+  int flag, np = 0;
+  s->msg[0] = 0;
+  if (s->ready) {
+    ida_counters(s, cur);
+    for (int i = 0; i < ST_N; ++i) s->base[i] += cur[i];
+  }
+  memcpy(N_VGetArrayPointer(s->yy), y0, sizeof(double) * (size_t)s->n);
+  memcpy(N_VGetArrayPointer(s->yp), yp0, sizeof(double) * (size_t)s->n);
+  flag = IDAReInit(s->ida, t0, s->yy, s->yp);
+  if (flag < 0) {
+    s->ready = 0;
+    set_msg(s->msg, "IDAReInit failed with flag %d: %s", flag, s->ida_msg);
+    return flag;
+  }
+  for (int k = 0; k < s->n_terms; ++k) {
+    s->active[k] = active ? (active[k] != 0) : 0;
+    np += dc_model.n_params[k];
+  }
+  if (np > 0 && params) memcpy(s->params, params, sizeof(double) * (size_t)np);
+  if (s->n_roots > 0) {
+    for (int i = 0; i < s->n_roots; ++i)
+      s->rootdir[i] = rootdir ? rootdir[i] : s->rootdir_default[i];
+    flag = IDASetRootDirection(s->ida, s->rootdir);
+    if (flag < 0) {
+      s->ready = 0;
+      set_msg(s->msg, "IDASetRootDirection failed with flag %d: %s", flag, s->ida_msg);
+      return flag;
+    }
+  }
+  s->t_now = t0;
+  s->t_rec = t0;
+  s->tiny = 0;
+  s->h_prev = 0.0;
+  s->ready = 1;
+  s->base[ST_REINITS] += 1;
+  return 0;
+}
+
+static void copy_state(dc_session* s, double* y_out, double* yp_out) {
+  memcpy(y_out, N_VGetArrayPointer(s->yy), sizeof(double) * (size_t)s->n);
+  memcpy(yp_out, N_VGetArrayPointer(s->yp), sizeof(double) * (size_t)s->n);
+}
+
+/*
+ * Integrate from the current time towards t_stop (hard stop) in one-step mode.
+ *
+ * t_eval[*i_eval .. n_eval) are the requested output times, sorted, all > current time; each
+ * one reached is written (y via IDAGetDky k=0, yp via k=1) to eval_y/eval_yp row *i_eval and
+ * *i_eval advances. If store_steps, every return point of IDA (the end of each internal step;
+ * on a root return the root point; duplicates skipped) is written to the step buffers, at most
+ * cap rows; *n_stored rows were written.
+ *
+ * Returns DC_CHUNK when cap rows were written (store_steps) or cap IDA calls were made
+ * (otherwise): call again. DC_TSTOP / DC_ROOT / errors < 0 otherwise; *t_out, y_out, yp_out
+ * hold the state reached, roots_out the root info (DC_ROOT), *flag_out IDA's flag (DC_ERR_IDA).
+ */
+DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval, int* i_eval,
+                      double* eval_y, double* eval_yp, int store_steps, int cap, double* st,
+                      double* sy, double* syp, double* sh, int* sord, int* n_stored,
+                      double* t_out, double* y_out, double* yp_out, int* roots_out,
+                      int* flag_out) {
+  dc_session* s = (dc_session*)sp;
+  const int n = s->n;
+  int k = 0, calls = 0;
+  long int nst = 0, nst_prev = 0;
+  *n_stored = 0;
+  *flag_out = 0;
+  s->msg[0] = 0;
+  *t_out = s->t_now;
+  if (!s->ready) {
+    set_msg(s->msg, "advance called before reinit (or after a failed reinit)");
+    copy_state(s, y_out, yp_out);
+    return DC_ERR_USAGE;
+  }
+  /* Nothing to integrate: IDA would refuse an interval below roundoff. */
+  if (t_stop - s->t_now <= 4.0 * DBL_EPSILON * fmax(fabs(t_stop), fabs(s->t_now))) {
+    copy_state(s, y_out, yp_out);
+    return DC_TSTOP;
+  }
+  /* After a root return IDA's internal time tn lies beyond the returned time. A t_stop inside
+   * (t_now, tn) needs no new step: IDA_NORMAL mode checks that interval for further roots and
+   * interpolates y(t_stop). (IDASetStopTime would refuse a stop time behind tn.) */
+  double tn = s->t_now;
+  IDAGetCurrentTime(s->ida, &tn);
+  if (t_stop < tn) {
+    double tret = s->t_now, h = 0.0, t_prev = s->t_now;
+    int order = 0;
+    s->cb_msg[0] = 0;
+    s->ida_msg[0] = 0;
+    int fl = IDASolve(s->ida, t_stop, &tret, s->yy, s->yp, IDA_NORMAL);
+    if (fl < 0) {
+      char name[64];
+      flag_name(fl, name, sizeof name);
+      *flag_out = fl;
+      *t_out = s->t_now;
+      copy_state(s, y_out, yp_out);
+      set_msg(s->msg, "%s at t=%.17g (interpolating inside the last step): %s%s%s", name, s->t_now,
+              s->ida_msg, s->cb_msg[0] ? "; last model error: " : "", s->cb_msg);
+      return DC_ERR_IDA;
+    }
+    s->t_now = tret;
+    IDAGetLastStep(s->ida, &h);
+    IDAGetLastOrder(s->ida, &order);
+    while (*i_eval < n_eval && t_eval[*i_eval] <= tret) {
+      double te = t_eval[*i_eval];
+      if (te > t_prev) {
+        if (IDAGetDky(s->ida, te, 0, s->dky) == 0)
+          memcpy(eval_y + (size_t)(*i_eval) * n, N_VGetArrayPointer(s->dky), sizeof(double) * (size_t)n);
+        if (IDAGetDky(s->ida, te, 1, s->dky) == 0)
+          memcpy(eval_yp + (size_t)(*i_eval) * n, N_VGetArrayPointer(s->dky), sizeof(double) * (size_t)n);
+      }
+      ++(*i_eval);
+    }
+    if (store_steps && tret > s->t_rec) {
+      st[0] = tret;
+      memcpy(sy, N_VGetArrayPointer(s->yy), sizeof(double) * (size_t)n);
+      memcpy(syp, N_VGetArrayPointer(s->yp), sizeof(double) * (size_t)n);
+      sh[0] = h;
+      sord[0] = order;
+      *n_stored = 1;
+    }
+    if (tret > s->t_rec) s->t_rec = tret;
+    *t_out = tret;
+    copy_state(s, y_out, yp_out);
+    if (fl == IDA_ROOT_RETURN) {
+      IDAGetRootInfo(s->ida, s->rootsfound);
+      memcpy(roots_out, s->rootsfound, sizeof(int) * (size_t)s->n_roots);
+      return DC_ROOT;
+    }
+    s->t_now = t_stop; /* IDA_NORMAL returned y(tout) with tret == tout */
+    *t_out = t_stop;
+    return DC_TSTOP;
+  }
+  int flag = IDASetStopTime(s->ida, t_stop);
+  if (flag < 0) {
+    *flag_out = flag;
+    set_msg(s->msg, "IDASetStopTime(%.17g) failed: %s", t_stop, s->ida_msg);
+    copy_state(s, y_out, yp_out);
+    return DC_ERR_IDA;
+  }
+  IDAGetNumSteps(s->ida, &nst_prev);
+
+  for (;;) {
+    double tret = s->t_now, h = 0.0;
+    int order = 0;
+    if (s->base[ST_STEPS] + (long long)nst_prev >= s->max_steps) {
+      set_msg(s->msg,
+              "step cap reached: %lld IDA steps in this session (max_steps=%lld) at t=%.17g",
+              s->base[ST_STEPS] + (long long)nst_prev, s->max_steps, s->t_now);
+      copy_state(s, y_out, yp_out);
+      *t_out = s->t_now;
+      return DC_ERR_MAXSTEPS;
+    }
+    s->cb_msg[0] = 0;
+    s->ida_msg[0] = 0;
+    flag = IDASolve(s->ida, t_stop, &tret, s->yy, s->yp, IDA_ONE_STEP);
+    ++calls;
+    if (flag < 0) {
+      char name[64];
+      flag_name(flag, name, sizeof name);
+      *flag_out = flag;
+      s->t_now = tret;
+      *t_out = tret;
+      copy_state(s, y_out, yp_out);
+      set_msg(s->msg, "%s at t=%.17g%s%s%s%s", name, tret, s->ida_msg[0] ? ": " : "",
+              s->ida_msg, s->cb_msg[0] ? "; last model error: " : "", s->cb_msg);
+      return DC_ERR_IDA;
+    }
+    double t_prev = s->t_now;
+    s->t_now = tret;
+    IDAGetNumSteps(s->ida, &nst);
+    IDAGetLastStep(s->ida, &h);
+    IDAGetLastOrder(s->ida, &order);
+
+    /* dense output at requested times in (t_prev, tret] */
+    while (*i_eval < n_eval && t_eval[*i_eval] <= tret) {
+      double te = t_eval[*i_eval];
+      if (te > t_prev) {
+        int f0 = IDAGetDky(s->ida, te, 0, s->dky);
+        if (f0 == 0) memcpy(eval_y + (size_t)(*i_eval) * n, N_VGetArrayPointer(s->dky), sizeof(double) * (size_t)n);
+        int f1 = f0 == 0 ? IDAGetDky(s->ida, te, 1, s->dky) : f0;
+        if (f1 == 0) memcpy(eval_yp + (size_t)(*i_eval) * n, N_VGetArrayPointer(s->dky), sizeof(double) * (size_t)n);
+        if (f0 || f1) {
+          *flag_out = f0 ? f0 : f1;
+          set_msg(s->msg, "IDAGetDky failed at t=%.17g (flag %d): %s", te, *flag_out, s->ida_msg);
+          *t_out = tret;
+          copy_state(s, y_out, yp_out);
+          return DC_ERR_IDA;
+        }
+      }
+      ++(*i_eval);
+    }
+
+    /* record the return point */
+    if (store_steps && tret > s->t_rec) {
+      st[k] = tret;
+      memcpy(sy + (size_t)k * n, N_VGetArrayPointer(s->yy), sizeof(double) * (size_t)n);
+      memcpy(syp + (size_t)k * n, N_VGetArrayPointer(s->yp), sizeof(double) * (size_t)n);
+      sh[k] = h;
+      sord[k] = order;
+      ++k;
+      *n_stored = k;
+    }
+    if (tret > s->t_rec) s->t_rec = tret;
+
+    /* step-size collapse: only for genuinely new steps that did not end at t_stop */
+    if (nst > nst_prev && flag != IDA_TSTOP_RETURN) {
+      if (fabs(h) >= DC_TINY_REL * fmax(1.0, fabs(tret)))
+        s->tiny = 0;
+      else if (!(fabs(h) > DC_TINY_GROWTH * fabs(s->h_prev)))
+        ++s->tiny;
+      s->h_prev = h;
+      if (s->tiny >= DC_TINY_MAX) {
+        *t_out = tret;
+        copy_state(s, y_out, yp_out);
+        set_msg(s->msg,
+                "step size collapsed: %d steps with |h| < %g*max(1,|t|) that did not grow "
+                "(last h=%.3g) at t=%.17g%s%s",
+                s->tiny, DC_TINY_REL, h, tret, s->cb_msg[0] ? "; last model error: " : "",
+                s->cb_msg);
+        return DC_ERR_COLLAPSE;
+      }
+    }
+    nst_prev = nst;
+
+    if (flag == IDA_ROOT_RETURN) {
+      IDAGetRootInfo(s->ida, s->rootsfound);
+      memcpy(roots_out, s->rootsfound, sizeof(int) * (size_t)s->n_roots);
+      *t_out = tret;
+      copy_state(s, y_out, yp_out);
+      return DC_ROOT;
+    }
+    if (flag == IDA_TSTOP_RETURN) {
+      *t_out = tret;
+      copy_state(s, y_out, yp_out);
+      return DC_TSTOP;
+    }
+    if ((store_steps && k >= cap) || (!store_steps && calls >= cap)) {
+      *t_out = tret;
+      copy_state(s, y_out, yp_out);
+      return DC_CHUNK;
+    }
+  }
+}
+
+/* Cumulative statistics: earlier segments plus the current one. */
+DC_API void dc_stats(void* sp, long long* out) {
+  dc_session* s = (dc_session*)sp;
+  long long cur[ST_N];
+  ida_counters(s, cur);
+  if (!s->ready)
+    for (int i = 0; i < ST_N; ++i) cur[i] = 0;
+  for (int i = 0; i < ST_N; ++i) out[i] = s->base[i] + (i == ST_REINITS ? 0 : cur[i]);
+}
+
+/* Model evaluation with the current active terms and parameters (tests, consistency). */
+DC_API int dc_eval_residual(void* sp, double t, const double* y, const double* yp, double* r) {
+  return eval_res((dc_session*)sp, t, y, yp, r);
+}
+
+DC_API int dc_eval_jacobian(void* sp, double t, const double* y, const double* yp, double cj,
+                            double* J) {
+  return eval_jac((dc_session*)sp, t, y, yp, cj, J);
+}
+
+DC_API int dc_eval_roots(void* sp, double t, const double* y, const double* yp, double* g) {
+  dc_session* s = (dc_session*)sp;
+  if (s->n_roots == 0) return 0;
+  return eval_roots(s, t, y, yp, g);
+}
+
+/* Set active terms and parameters without restarting IDA (for residual/jacobian checks). */
+DC_API void dc_set_terms(void* sp, const int* active, const double* params) {
+  dc_session* s = (dc_session*)sp;
+  int np = 0;
+  for (int k = 0; k < s->n_terms; ++k) {
+    s->active[k] = active ? (active[k] != 0) : 0;
+    np += dc_model.n_params[k];
+  }
+  if (np > 0 && params) memcpy(s->params, params, sizeof(double) * (size_t)np);
+}

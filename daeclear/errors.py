@@ -1,0 +1,29 @@
+"""Exceptions and warnings of daeclear, one hierarchy for the whole package."""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+class DaeclearError(Exception):
+    """Base class of every daeclear error."""
+
+
+class SceneError(DaeclearError, ValueError):
+    """A scene, a scene element or a user argument is invalid."""
+
+
+class AssemblyError(DaeclearError, ValueError):
+    """The scene is valid but its equations cannot be assembled (e.g. joints that cannot close)."""
+
+
+class SolveError(DaeclearError, RuntimeError):
+    """The integrator failed; ``.result`` holds everything computed up to the failure."""
+
+    def __init__(self, message: str, result: Any = None) -> None:
+        super().__init__(message)
+        self.result = result
+
+
+class DaeclearWarning(UserWarning):
+    """A daeclear warning: something was changed or a slower path was taken."""

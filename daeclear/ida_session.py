@@ -1,0 +1,1092 @@
+"""The integrator backend: SUNDIALS IDA on a CasADi model, restartable between events.
+
+``open_session(funcs, ...)`` returns a :class:`Session` that integrates ``F(t, y, y') = 0`` with
+IDA in one-step mode and stops at roots of the model's root functions, at a hard stop time, or
+at an error. The event logic above it switches the model's *terms* (contact-force
+contributions) on and off between segments with :meth:`Session.reinit`; an inactive term is
+never evaluated.
+
+Two backends share one interface:
+
+``"c"``
+    The model is generated as C with CasADi, compiled with a hand-written IDA driver
+    (``csrc/ida_driver.c``) into a shared library linked against the SUNDIALS libraries of the
+    scikit-sundae wheel (see :mod:`daeclear.codegen`), and driven through ctypes a few calls per
+    segment. No Python runs per step or per model evaluation.
+``"python"``
+    scikit-sundae's ``IDA`` with callbacks that evaluate the CasADi functions through
+    ``casadi.FunctionBuffer``. Differences: ``t_eval`` values are cubic Hermite interpolants
+    between stored steps (IDA's own interpolant is not exposed by scikit-sundae; the two
+    differ by far less than the integration error), statistics that scikit-sundae does not
+    expose are ``-1``, step orders are ``-1``, and a non-finite residual ends the advance with
+    ``IDA_RES_FAIL`` at once (the C backend lets IDA retry with smaller steps first).
+``"auto"``
+    ``"c"`` when a C compiler works, else ``"python"`` with one :class:`DaeclearWarning` naming
+    the reason.
+
+Behaviour at a restart (measured with SUNDIALS 7.9, see tests/test_ida_session.py): IDA
+returns a root at the end of the final bracket, so the state at a root already lies on the
+far side of the crossing (``g`` has changed sign, ``|g|`` tiny). Restarting there does not
+report the same crossing again. A root function exactly ``0`` at the restart point is made
+inactive until it moves away from zero, so no root is reported at ``t0``. A root function
+that is tiny but still on the *near* side at ``t0`` and heading for zero is reported again
+within a few ulps of ``t0``: restart from the state IDA returned (or mask the direction with
+``root_directions``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import io
+import math
+import time
+import warnings
+import weakref
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol, Sequence, runtime_checkable
+
+import casadi
+import numpy as np
+
+from .codegen import (
+    BuildResult,
+    CompileError,
+    CompilerUnavailable,
+    NormalizedModel,
+    build_model_library,
+    normalize_model,
+)
+from .errors import DaeclearError, DaeclearWarning
+
+__all__ = [
+    "DAEFunctions",
+    "Advance",
+    "Session",
+    "open_session",
+    "BACKENDS",
+    "FLAG_MAX_STEPS",
+    "FLAG_STEP_COLLAPSE",
+]
+
+BACKENDS = ("auto", "c", "python")
+
+#: flag of an Advance that stopped because the session's step cap (max_steps) was reached
+FLAG_MAX_STEPS = -1001
+#: flag of an Advance that stopped because the step size collapsed (see TINY_STEP_REL)
+FLAG_STEP_COLLAPSE = -1002
+#: a step is tiny when |h| < TINY_STEP_REL * max(1, |t|); TINY_STEP_COUNT tiny steps that did not
+#: grow by more than TINY_STEP_GROWTH over the previous one, with no normal step in between, stop
+#: the advance (step-size collapse). Growing tiny steps (IDA's start-up doubling) do not count.
+TINY_STEP_REL = 1e-14
+TINY_STEP_COUNT = 20
+TINY_STEP_GROWTH = 1.5
+
+_OWN_FLAG_NAMES = {FLAG_MAX_STEPS: "DC_MAX_STEPS", FLAG_STEP_COLLAPSE: "DC_STEP_COLLAPSE"}
+
+_STAT_KEYS = (
+    "n_steps",
+    "n_res_evals",
+    "n_jac_evals",
+    "n_lin_setups",
+    "n_nonlin_iters",
+    "n_nonlin_conv_fails",
+    "n_err_test_fails",
+    "n_root_evals",
+    "n_reinits",
+)
+
+
+@dataclass(frozen=True)
+class DAEFunctions:
+    """A DAE F(t, y, y') = 0 with switchable terms, as CasADi functions.
+
+    residual: (t[1], y[n], yp[n]) -> r[n], always active.
+    jacobian: (t, y, yp, cj[1]) -> J[n x n] = dr/dy + cj dr/dyp (dense or sparse output).
+    term_residuals[k]: (t, y, yp, p_k[n_params_k]) -> r_k[n], added to r while term k is active.
+    term_jacobians[k]: (t, y, yp, p_k, cj) -> J_k[n x n], added to J while term k is active.
+    roots: (t, y, yp) -> g[n_roots], or None when the model has no events.
+    """
+
+    n: int
+    residual: casadi.Function
+    jacobian: casadi.Function
+    term_residuals: tuple[casadi.Function, ...]
+    term_jacobians: tuple[casadi.Function, ...]
+    roots: casadi.Function | None
+    name: str = "model"
+
+
+@dataclass
+class Advance:
+    """What one :meth:`Session.advance` call did.
+
+    ``step_*`` hold every point where IDA returned in one-step mode during the call: the end of
+    each internal step, and on a root return the root point itself (which lies inside IDA's last
+    internal step). Times strictly increase; the start point of the call is not included.
+    ``step_h`` is the size of the internal step the point belongs to, ``step_order`` the BDF
+    order used for it (-1 when unknown: python backend).
+    ``eval_*`` hold the requested ``t_eval`` points reached in this call, in (t_start, t].
+    """
+
+    status: str  # "tstop" | "root" | "error"
+    t: float
+    y: np.ndarray
+    yp: np.ndarray
+    step_t: np.ndarray
+    step_y: np.ndarray
+    step_yp: np.ndarray
+    step_h: np.ndarray
+    step_order: np.ndarray
+    eval_t: np.ndarray
+    eval_y: np.ndarray
+    eval_yp: np.ndarray
+    roots_found: np.ndarray | None = None
+    flag: int = 0
+    flag_name: str = ""
+    message: str = ""
+
+    @property
+    def success(self) -> bool:
+        return self.status != "error"
+
+
+@runtime_checkable
+class Session(Protocol):
+    backend: str
+
+    def reinit(self, t0: float, y0: np.ndarray, yp0: np.ndarray, active: Sequence[bool],
+               params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None: ...
+
+    def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
+                store_steps: bool = True) -> Advance: ...
+
+    def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
+
+    def jacobian(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray: ...
+
+    def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
+
+    def stats(self) -> dict[str, int | float]: ...
+
+    def close(self) -> None: ...
+
+
+# =========================================================================== options
+
+
+@dataclass
+class _Options:
+    rtol: float
+    atol: np.ndarray
+    max_step: float
+    max_order: int
+    max_steps: int
+    root_directions: np.ndarray  # int32 (n_roots,)
+    buffer_steps: int
+
+
+def _root_dirs(model: NormalizedModel, rd: Any, what: str = "root_directions") -> np.ndarray:
+    if rd is None:
+        return np.zeros(model.n_roots, dtype=np.int32)
+    arr = np.asarray(rd)
+    if arr.shape != (model.n_roots,):
+        raise ValueError(f"{what} must have shape ({model.n_roots},), got {arr.shape}")
+    if not np.all(np.isin(arr, (-1, 0, 1))):
+        raise ValueError(f"{what} values must be -1, 0 or +1, got {arr.tolist()}")
+    return np.ascontiguousarray(arr, dtype=np.int32)
+
+
+def _options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, max_order: Any,
+             max_steps: Any, root_directions: Any, buffer_steps: Any) -> _Options:
+    rtol = float(rtol)
+    if not (math.isfinite(rtol) and rtol > 0):
+        raise ValueError(f"rtol must be a positive number, got {rtol}")
+    a = np.asarray(atol, dtype=float)
+    if a.ndim == 0:
+        a = np.full(model.n, float(a))
+    if a.shape != (model.n,):
+        raise ValueError(f"atol must be a scalar or have shape ({model.n},), got {a.shape}")
+    if not np.all(np.isfinite(a) & (a > 0)):
+        raise ValueError(f"atol must be positive and finite, got {a.tolist()}")
+    max_step = float(max_step)
+    if not (max_step >= 0 and math.isfinite(max_step)):
+        raise ValueError(f"max_step must be >= 0 (0: unbounded), got {max_step}")
+    if int(max_order) != max_order or not 1 <= int(max_order) <= 5:
+        raise ValueError(f"max_order must be an integer in [1, 5], got {max_order}")
+    if int(max_steps) != max_steps or int(max_steps) < 1:
+        raise ValueError(f"max_steps must be a positive integer, got {max_steps}")
+    if int(buffer_steps) != buffer_steps or int(buffer_steps) < 1:
+        raise ValueError(f"buffer_steps must be a positive integer, got {buffer_steps}")
+    return _Options(rtol, np.ascontiguousarray(a), max_step, int(max_order), int(max_steps),
+                    _root_dirs(model, root_directions), int(buffer_steps))
+
+
+# =========================================================================== common base
+
+
+_EMPTY = np.empty(0)
+_EMPTY.flags.writeable = False
+
+
+def _empty_advance_arrays(n: int) -> dict[str, np.ndarray]:
+    return dict(
+        step_t=np.empty(0), step_y=np.empty((0, n)), step_yp=np.empty((0, n)),
+        step_h=np.empty(0), step_order=np.empty(0, dtype=np.int32),
+    )
+
+
+class _SessionBase:
+    backend = "?"
+
+    def __init__(self, model: NormalizedModel, opts: _Options) -> None:
+        self._model = model
+        self._opts = opts
+        self._n = model.n
+        self._nt = len(model.term_res)
+        self._ready = False
+        self._closed = False
+        self._t = 0.0
+        self._y = np.zeros(model.n)
+        self._yp = np.zeros(model.n)
+        self._active = np.zeros(self._nt, dtype=np.int32)
+        self._params = [np.zeros(p) for p in model.n_params]
+        self._solve_time = 0.0
+        self._extra_stats: dict[str, int | float] = {}
+
+    # ---------------------------------------------------------------- properties
+    @property
+    def n(self) -> int:
+        return self._n
+
+    @property
+    def n_terms(self) -> int:
+        return self._nt
+
+    @property
+    def n_roots(self) -> int:
+        return self._model.n_roots
+
+    @property
+    def n_params(self) -> tuple[int, ...]:
+        return self._model.n_params
+
+    @property
+    def t(self) -> float:
+        """Time of the current state (last reinit or last advance)."""
+        return self._t
+
+    # ---------------------------------------------------------------- validation
+    def _vec(self, v: Any, what: str) -> np.ndarray:
+        a = np.ascontiguousarray(v, dtype=float)
+        if a.shape != (self._n,):
+            raise ValueError(f"{what} must have shape ({self._n},), got {a.shape}")
+        return a
+
+    def set_hints(self, *, nonlin_conv_coef: float | None = None, init_step: float | None = None) -> bool:
+        """Solver hints (see CSession.set_hints); scikit-sundae exposes neither, so the python
+        backend ignores them and returns False."""
+        return False
+
+    def _check_reinit(self, t0: Any, y0: Any, yp0: Any, active: Any, params: Any,
+                      root_directions: Any) -> tuple[float, np.ndarray, np.ndarray, np.ndarray,
+                                                     list[np.ndarray], np.ndarray]:
+        """Validate reinit arguments (kept lean: it runs at every event)."""
+        if self._closed:
+            raise DaeclearError("the session is closed")
+        t0 = float(t0)
+        n, nt = self._n, self._nt
+        y0 = np.asarray(y0, dtype=float)
+        yp0 = np.asarray(yp0, dtype=float)
+        if y0.shape != (n,):
+            raise ValueError(f"y0 must have shape ({n},), got {y0.shape}")
+        if yp0.shape != (n,):
+            raise ValueError(f"yp0 must have shape ({n},), got {yp0.shape}")
+        if not (math.isfinite(t0) and math.isfinite(y0.sum()) and math.isfinite(yp0.sum())):
+            raise ValueError(f"t0, y0 and yp0 must be finite (t0={t0}, y0={y0.tolist()}, yp0={yp0.tolist()})")
+        if active is None:
+            active = ()
+        if len(active) != nt:
+            raise ValueError(f"active must have {nt} entries (one per term), got {len(active)}")
+        act = np.array([1 if a else 0 for a in active], dtype=np.int32)
+        if params is None:
+            params = (None,) * nt
+        if len(params) != nt:
+            raise ValueError(f"params must have {nt} entries (one per term), got {len(params)}")
+        plist = []
+        n_params = self._model.n_params
+        for k in range(nt):
+            p, npk = params[k], n_params[k]
+            pa = np.zeros(npk) if p is None else np.asarray(p, dtype=float).reshape(-1)
+            if pa.size != npk:
+                raise ValueError(f"params[{k}] must have {npk} entries, got {pa.size}")
+            if act[k] and npk and not math.isfinite(pa.sum()):
+                raise ValueError(f"params[{k}] of active term {k} must be finite, got {pa.tolist()}")
+            plist.append(pa)
+        rd = (self._opts.root_directions if root_directions is None
+              else _root_dirs(self._model, root_directions))
+        return t0, y0, yp0, act, plist, rd
+
+    def _select_eval(self, t_eval: Any, t_stop: float) -> np.ndarray:
+        if t_eval is None:
+            return _EMPTY
+        te = np.asarray(t_eval, dtype=float).reshape(-1)
+        lo = int(np.searchsorted(te, self._t, side="right"))
+        hi = int(np.searchsorted(te, t_stop, side="right"))
+        sel = np.ascontiguousarray(te[lo:hi])
+        if sel.size > 1 and np.any(np.diff(sel) < 0):
+            raise ValueError("t_eval must be sorted in increasing order")
+        return sel
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise DaeclearError("the session is closed")
+
+    def _check_advance(self, t_stop: Any) -> float:
+        self._check_open()
+        if not self._ready:
+            raise DaeclearError("advance() called before reinit()")
+        t_stop = float(t_stop)
+        if math.isnan(t_stop) or t_stop < self._t:
+            raise ValueError(f"t_stop={t_stop!r} is behind the current time {self._t!r}")
+        if math.isinf(t_stop):
+            raise ValueError("t_stop must be finite")
+        return t_stop
+
+    # ---------------------------------------------------------------- context manager
+    def __enter__(self) -> "_SessionBase":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return (f"<{type(self).__name__} backend={self.backend!r} model={self._model.name!r} "
+                f"n={self._n} terms={self._nt} roots={self._model.n_roots} t={self._t!r}>")
+
+
+# =========================================================================== compiled backend
+
+
+class _CLib:
+    """ctypes view of one compiled model library (shared by all its sessions)."""
+
+    _cache: dict[str, "_CLib"] = {}
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        lib = ctypes.CDLL(str(path))
+        P = ctypes.c_void_p
+        I = ctypes.c_int
+        D = ctypes.c_double
+        lib.dc_abi_version.restype = I
+        lib.dc_abi_version.argtypes = []
+        lib.dc_sundials_version.restype = I
+        lib.dc_sundials_version.argtypes = [ctypes.c_char_p, I]
+        lib.dc_model_info.restype = I
+        lib.dc_model_info.argtypes = [P, P, P, P]
+        lib.dc_model_name.restype = ctypes.c_char_p
+        lib.dc_model_name.argtypes = []
+        lib.dc_message.restype = ctypes.c_char_p
+        lib.dc_message.argtypes = [P]
+        lib.dc_open.restype = P
+        lib.dc_open.argtypes = [D, P, D, I, ctypes.c_longlong, P, ctypes.c_char_p, I]
+        lib.dc_set_nonlin_conv_coef.restype = I
+        lib.dc_set_nonlin_conv_coef.argtypes = [P, D]
+        lib.dc_set_init_step.restype = I
+        lib.dc_set_init_step.argtypes = [P, D]
+        lib.dc_free.restype = None
+        lib.dc_free.argtypes = [P]
+        lib.dc_reinit.restype = I
+        lib.dc_reinit.argtypes = [P, D, P, P, P, P, P]
+        lib.dc_advance.restype = I
+        lib.dc_advance.argtypes = [P, D, P, I, P, P, P, I, I, P, P, P, P, P, P, P, P, P, P, P]
+        lib.dc_stats.restype = None
+        lib.dc_stats.argtypes = [P, P]
+        lib.dc_eval_residual.restype = I
+        lib.dc_eval_residual.argtypes = [P, D, P, P, P]
+        lib.dc_eval_jacobian.restype = I
+        lib.dc_eval_jacobian.argtypes = [P, D, P, P, D, P]
+        lib.dc_eval_roots.restype = I
+        lib.dc_eval_roots.argtypes = [P, D, P, P, P]
+        lib.dc_set_terms.restype = None
+        lib.dc_set_terms.argtypes = [P, P, P]
+        lib.dc_flag_name.restype = None
+        lib.dc_flag_name.argtypes = [ctypes.c_long, ctypes.c_char_p, I]
+        self.lib = lib
+        if lib.dc_abi_version() != 1:
+            raise DaeclearError(f"{path}: driver ABI version {lib.dc_abi_version()} != 1")
+        buf = ctypes.create_string_buffer(64)
+        lib.dc_sundials_version(buf, 64)
+        self.sundials_version = buf.value.decode()
+
+    @classmethod
+    def load(cls, path: Path) -> "_CLib":
+        key = str(path)
+        if key not in cls._cache:
+            cls._cache[key] = cls(path)
+        return cls._cache[key]
+
+    def model_info(self, n_terms: int) -> tuple[int, int, int, list[int]]:
+        n, nt, nr = ctypes.c_int(), ctypes.c_int(), ctypes.c_int()
+        np_ = (ctypes.c_int * max(n_terms, 1))()
+        self.lib.dc_model_info(ctypes.addressof(n), ctypes.addressof(nt), ctypes.addressof(nr),
+                               ctypes.addressof(np_))
+        return n.value, nt.value, nr.value, list(np_)[: nt.value]
+
+    def flag_name(self, flag: int) -> str:
+        buf = ctypes.create_string_buffer(64)
+        self.lib.dc_flag_name(flag, buf, 64)
+        return buf.value.decode()
+
+
+def _free_c_session(lib: Any, handle: int) -> None:
+    lib.dc_free(handle)
+
+
+def _ptr(a: np.ndarray | None) -> int | None:
+    return None if a is None or a.size == 0 else a.ctypes.data
+
+
+class CSession(_SessionBase):
+    """Compiled backend: IDA, callbacks and the step loop in C (see module docstring)."""
+
+    backend = "c"
+
+    def __init__(self, model: NormalizedModel, opts: _Options, clib: _CLib, build: BuildResult) -> None:
+        super().__init__(model, opts)
+        n, nt, nr, npar = clib.model_info(self._nt)
+        if (n, nt, nr, tuple(npar)) != (model.n, self._nt, model.n_roots, model.n_params):
+            raise DaeclearError(
+                f"compiled library {clib.path} does not match the model: (n, terms, roots, params) = "
+                f"{(n, nt, nr, npar)} != {(model.n, self._nt, model.n_roots, list(model.n_params))}"
+            )
+        self._clib = clib
+        self._lib = clib.lib
+        self._build = build
+        err = ctypes.create_string_buffer(1024)
+        h = self._lib.dc_open(opts.rtol, opts.atol.ctypes.data, opts.max_step, opts.max_order,
+                              opts.max_steps, _ptr(opts.root_directions), err, 1024)
+        if not h:
+            raise DaeclearError(f"opening the compiled IDA session failed: {err.value.decode()}")
+        self._h = h
+        self._finalizer = weakref.finalize(self, _free_c_session, self._lib, h)
+        cap = opts.buffer_steps
+        self._cap = cap
+        # persistent buffers (addresses cached: ctypes calls stay cheap)
+        self._st = np.empty(cap)
+        self._sy = np.empty((cap, n))
+        self._syp = np.empty((cap, n))
+        self._sh = np.empty(cap)
+        self._sord = np.empty(cap, dtype=np.int32)
+        self._yout = np.empty(n)
+        self._ypout = np.empty(n)
+        self._roots = np.zeros(max(nr, 1), dtype=np.int32)
+        self._i_eval = ctypes.c_int()
+        self._n_stored = ctypes.c_int()
+        self._t_out = ctypes.c_double()
+        self._flag = ctypes.c_int()
+        self._addr = dict(
+            st=self._st.ctypes.data, sy=self._sy.ctypes.data, syp=self._syp.ctypes.data,
+            sh=self._sh.ctypes.data, sord=self._sord.ctypes.data, yout=self._yout.ctypes.data,
+            ypout=self._ypout.ctypes.data, roots=self._roots.ctypes.data,
+            i_eval=ctypes.addressof(self._i_eval), n_stored=ctypes.addressof(self._n_stored),
+            t_out=ctypes.addressof(self._t_out), flag=ctypes.addressof(self._flag),
+        )
+        self._statbuf = np.zeros(len(_STAT_KEYS), dtype=np.int64)
+        # reinit inputs: copied into fixed arrays whose addresses are known
+        self._y0b = np.zeros(n)
+        self._yp0b = np.zeros(n)
+        self._actb = np.zeros(max(self._nt, 1), dtype=np.int32)
+        self._rdb = np.zeros(max(nr, 1), dtype=np.int32)
+        self._pcat = np.zeros(max(sum(model.n_params), 1))
+        self._poff = np.concatenate([[0], np.cumsum(model.n_params)]).astype(int).tolist()
+        for name in ("y0b", "yp0b", "actb", "rdb", "pcat"):
+            self._addr[name] = getattr(self, "_" + name).ctypes.data
+
+    def set_hints(self, *, nonlin_conv_coef: float | None = None, init_step: float | None = None) -> bool:
+        """Solver hints: Newton convergence factor (IDA default 0.33) and the first step of the
+        next restart (0: IDA's estimate). Returns True (the compiled backend applies them)."""
+        if nonlin_conv_coef is not None and self._lib.dc_set_nonlin_conv_coef(self._h, nonlin_conv_coef) < 0:
+            raise DaeclearError(f"nonlin_conv_coef={nonlin_conv_coef!r} rejected by IDA; must be > 0.")
+        if init_step is not None and self._lib.dc_set_init_step(self._h, init_step) < 0:
+            raise DaeclearError(f"init_step={init_step!r} rejected by IDA.")
+        return True
+
+    # ---------------------------------------------------------------- core
+    def _load_terms(self, act: np.ndarray, plist: list[np.ndarray]) -> None:
+        nt = self._nt
+        if nt:
+            self._actb[:nt] = act
+            off = self._poff
+            for k in range(nt):
+                if off[k + 1] > off[k]:
+                    self._pcat[off[k]:off[k + 1]] = plist[k]
+
+    def reinit(self, t0: float, y0: np.ndarray, yp0: np.ndarray, active: Sequence[bool],
+               params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None:
+        t0, y0, yp0, act, plist, rd = self._check_reinit(t0, y0, yp0, active, params, root_directions)
+        A = self._addr
+        self._y0b[:] = y0
+        self._yp0b[:] = yp0
+        self._load_terms(act, plist)
+        if self.n_roots:
+            self._rdb[:] = rd
+        rc = self._lib.dc_reinit(self._h, t0, A["y0b"], A["yp0b"], A["actb"], A["pcat"], A["rdb"])
+        if rc != 0:
+            self._ready = False
+            raise DaeclearError(f"IDA reinit failed: {self._lib.dc_message(self._h).decode()}")
+        self._t, self._y, self._yp = t0, self._y0b.copy(), self._yp0b.copy()
+        self._active = act
+        self._params = plist
+        self._ready = True
+
+    def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
+                store_steps: bool = True) -> Advance:
+        t_stop = self._check_advance(t_stop)
+        n = self._n
+        te = self._select_eval(t_eval, t_stop)
+        m = te.size
+        ev_y = np.empty((m, n))
+        ev_yp = np.empty((m, n))
+        te_p, evy_p, evyp_p = (te.ctypes.data, ev_y.ctypes.data, ev_yp.ctypes.data) if m else (None, None, None)
+        A = self._addr
+        self._i_eval.value = 0
+        chunks: list[tuple[np.ndarray, ...]] = []
+        store = 1 if store_steps else 0
+        lib, h = self._lib, self._h
+        tic = time.perf_counter()
+        try:
+            while True:
+                rc = lib.dc_advance(h, t_stop, te_p, m, A["i_eval"], evy_p, evyp_p,
+                                    store, self._cap, A["st"], A["sy"], A["syp"], A["sh"], A["sord"],
+                                    A["n_stored"], A["t_out"], A["yout"], A["ypout"], A["roots"],
+                                    A["flag"])
+                k = self._n_stored.value
+                if k:
+                    chunks.append((self._st[:k].copy(), self._sy[:k].copy(), self._syp[:k].copy(),
+                                   self._sh[:k].copy(), self._sord[:k].copy()))
+                if rc != 0:
+                    break
+                # buffer full: back in Python between chunks, so Ctrl-C works here
+        finally:
+            self._solve_time += time.perf_counter() - tic
+            # also after an interrupt between chunks: the C side stopped at a valid state
+            self._t = self._t_out.value
+            self._y = self._yout.copy()  # shared with the Advance: the session only reads it
+            self._yp = self._ypout.copy()
+        if len(chunks) == 1:
+            st, sy, syp, sh, so = chunks[0]
+        elif chunks:
+            st, sy, syp, sh, so = (np.concatenate(c) for c in zip(*chunks))
+        else:
+            e = _empty_advance_arrays(n)
+            st, sy, syp, sh, so = e["step_t"], e["step_y"], e["step_yp"], e["step_h"], e["step_order"]
+        ne = self._i_eval.value
+        adv = Advance(status="tstop", t=self._t, y=self._y, yp=self._yp, step_t=st,
+                      step_y=sy, step_yp=syp, step_h=sh, step_order=so, eval_t=te[:ne].copy(),
+                      eval_y=ev_y[:ne], eval_yp=ev_yp[:ne])
+        if rc == 1:
+            return adv
+        if rc == 2:
+            adv.status = "root"
+            adv.roots_found = self._roots[: self.n_roots].copy()
+            return adv
+        adv.status = "error"
+        msg = self._lib.dc_message(h).decode()
+        if rc == -2:
+            adv.flag, adv.flag_name = FLAG_MAX_STEPS, _OWN_FLAG_NAMES[FLAG_MAX_STEPS]
+        elif rc == -3:
+            adv.flag, adv.flag_name = FLAG_STEP_COLLAPSE, _OWN_FLAG_NAMES[FLAG_STEP_COLLAPSE]
+        else:
+            adv.flag = self._flag.value
+            adv.flag_name = self._clib.flag_name(adv.flag) if adv.flag else "DC_USAGE"
+        adv.message = msg
+        return adv
+
+    # ---------------------------------------------------------------- model evaluation
+    def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._check_open()
+        y, yp = self._vec(y, "y"), self._vec(yp, "yp")
+        out = np.empty(self._n)
+        self._sync_terms()
+        if self._lib.dc_eval_residual(self._h, float(t), y.ctypes.data, yp.ctypes.data, out.ctypes.data):
+            raise DaeclearError(f"the generated residual failed at t={t}")
+        return out
+
+    def jacobian(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray:
+        self._check_open()
+        y, yp = self._vec(y, "y"), self._vec(yp, "yp")
+        out = np.empty((self._n, self._n), order="F")
+        self._sync_terms()
+        if self._lib.dc_eval_jacobian(self._h, float(t), y.ctypes.data, yp.ctypes.data, float(cj),
+                                      out.ctypes.data):
+            raise DaeclearError(f"the generated Jacobian failed at t={t}")
+        return np.ascontiguousarray(out)
+
+    def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._check_open()
+        y, yp = self._vec(y, "y"), self._vec(yp, "yp")
+        out = np.empty(self.n_roots)
+        if self.n_roots and self._lib.dc_eval_roots(self._h, float(t), y.ctypes.data, yp.ctypes.data,
+                                                    out.ctypes.data):
+            raise DaeclearError(f"the generated root function failed at t={t}")
+        return out
+
+    def set_terms(self, active: Sequence[bool], params: Sequence[np.ndarray]) -> None:
+        """Set active terms and parameters without restarting IDA (for residual/jacobian checks).
+
+        The next advance() without reinit() integrates with them; prefer reinit() in event logic.
+        """
+        _, _, _, act, plist, _ = self._check_reinit(self._t, self._y, self._yp, active, params, None)
+        self._active, self._params = act, plist
+        self._sync_terms()
+
+    def _sync_terms(self) -> None:
+        self._load_terms(self._active, self._params)
+        self._lib.dc_set_terms(self._h, self._addr["actb"], self._addr["pcat"])
+
+    # ---------------------------------------------------------------- stats and lifetime
+    def stats(self) -> dict[str, int | float]:
+        self._check_open()
+        self._lib.dc_stats(self._h, self._statbuf.ctypes.data)
+        out: dict[str, int | float] = {k: int(v) for k, v in zip(_STAT_KEYS, self._statbuf)}
+        out["solve_time"] = self._solve_time
+        out["compile_time"] = self._build.compile_time
+        out["codegen_time"] = self._build.codegen_time
+        out["cache_hit"] = bool(self._build.cache_hit)
+        return out
+
+    @property
+    def library_path(self) -> Path:
+        return self._build.path
+
+    @property
+    def cache_hit(self) -> bool:
+        return self._build.cache_hit
+
+    @property
+    def sundials_version(self) -> str:
+        return self._clib.sundials_version
+
+    def close(self) -> None:
+        if not self._closed:
+            self._closed = True
+            self._finalizer()
+
+
+# =========================================================================== python backend
+
+
+class _ModelError(Exception):
+    """Raised inside a scikit-sundae callback; ends the advance with a clear message."""
+
+
+class _Buffered:
+    """A CasADi function evaluated through FunctionBuffer on fixed numpy arrays."""
+
+    def __init__(self, f: casadi.Function, args: list[np.ndarray]) -> None:
+        self.buf, self.call = f.buffer()
+        self.args = args  # kept alive: the buffer points into them
+        for i, a in enumerate(args):
+            self.buf.set_arg(i, memoryview(a))
+        self.out = np.zeros(f.nnz_out(0))
+        self.buf.set_res(0, memoryview(self.out))
+
+
+def _hermite(t0: float, y0: np.ndarray, yp0: np.ndarray, t1: float, y1: np.ndarray,
+             yp1: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    h = t1 - t0
+    s = ((t - t0) / h)[:, None]
+    h00 = 2 * s**3 - 3 * s**2 + 1
+    h10 = s**3 - 2 * s**2 + s
+    h01 = -2 * s**3 + 3 * s**2
+    h11 = s**3 - s**2
+    y = h00 * y0 + h10 * h * yp0 + h01 * y1 + h11 * h * yp1
+    d00 = (6 * s**2 - 6 * s) / h
+    d10 = 3 * s**2 - 4 * s + 1
+    d01 = (-6 * s**2 + 6 * s) / h
+    d11 = 3 * s**2 - 2 * s
+    yp = d00 * y0 + d10 * yp0 + d01 * y1 + d11 * yp1
+    return y, yp
+
+
+class PythonSession(_SessionBase):
+    """scikit-sundae IDA with FunctionBuffer callbacks (see module docstring)."""
+
+    backend = "python"
+
+    def __init__(self, model: NormalizedModel, opts: _Options, fallback_reason: str | None = None) -> None:
+        super().__init__(model, opts)
+        import sksundae  # noqa: F401  (fail early if missing)
+
+        n = model.n
+        self.fallback_reason = fallback_reason
+        # shared input arrays: every function reads t, y, yp, cj from the same memory
+        self._a_t = np.zeros(1)
+        self._a_y = np.zeros(n)
+        self._a_yp = np.zeros(n)
+        self._a_cj = np.zeros(1)
+        self._a_p = [np.zeros(p) for p in model.n_params]
+        base = [self._a_t, self._a_y, self._a_yp]
+        self._res = _Buffered(model.res, base)
+        self._jac = _Buffered(model.jac, base + [self._a_cj])
+        self._tres = [_Buffered(f, base + [p]) for f, p in zip(model.term_res, self._a_p)]
+        self._tjac = [_Buffered(f, base + [p, self._a_cj]) for f, p in zip(model.term_jac, self._a_p)]
+        self._roots_fn = _Buffered(model.roots, base) if model.roots is not None else None
+        self._active_idx: list[int] = []
+        self._solver: Any = None
+        self._solver_dirs: np.ndarray | None = None
+        self._count = dict(res=0, jac=0, roots=0, steps=0, reinits=0)
+        self._pending_tn = False
+        self._t_internal = 0.0
+        self._tiny = 0
+        self._h_prev = 0.0
+
+    # ---------------------------------------------------------------- evaluation
+    def _eval_res(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._a_t[0] = t
+        self._a_y[:] = y
+        self._a_yp[:] = yp
+        self._res.call()
+        r = self._res.out
+        if self._active_idx:
+            r = r.copy()
+            for k in self._active_idx:
+                self._tres[k].call()
+                r += self._tres[k].out
+        return r
+
+    def _eval_jac(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray:
+        self._a_t[0] = t
+        self._a_y[:] = y
+        self._a_yp[:] = yp
+        self._a_cj[0] = cj
+        self._jac.call()
+        J = self._jac.out
+        if self._active_idx:
+            J = J.copy()
+            for k in self._active_idx:
+                self._tjac[k].call()
+                J += self._tjac[k].out
+        return J.reshape(self._n, self._n, order="F")
+
+    def _eval_roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._a_t[0] = t
+        self._a_y[:] = y
+        self._a_yp[:] = yp
+        self._roots_fn.call()
+        return self._roots_fn.out
+
+    def _make_solver(self, rd: np.ndarray) -> Any:
+        from sksundae.ida import IDA
+
+        count = self._count
+        eval_res, eval_jac, eval_roots = self._eval_res, self._eval_jac, self._eval_roots
+        isfinite = math.isfinite
+
+        def resfn(t, y, yp, res):
+            count["res"] += 1
+            r = eval_res(t, y, yp)
+            if not isfinite(float(r.sum())):
+                i = int(np.flatnonzero(~np.isfinite(r))[0])
+                raise _ModelError(f"residual component {i} is {r[i]} at t={t!r} (y[{i}]={y[i]})")
+            res[:] = r
+
+        def jacfn(t, y, yp, res, cj, JJ):
+            count["jac"] += 1
+            J = eval_jac(t, y, yp, cj)
+            if not isfinite(float(J.sum())):
+                raise _ModelError(f"the Jacobian has non-finite entries at t={t!r}")
+            JJ[:, :] = J
+
+        options: dict[str, Any] = dict(
+            rtol=self._opts.rtol, atol=self._opts.atol.copy(), max_step=self._opts.max_step,
+            max_order=self._opts.max_order, max_num_steps=500, jacfn=jacfn, linsolver="dense",
+        )
+        if self.n_roots:
+            def events(t, y, yp, out):
+                count["roots"] += 1
+                g = eval_roots(t, y, yp)
+                if not isfinite(float(g.sum())):
+                    raise _ModelError(f"a root function is non-finite at t={t!r}: {g.tolist()}")
+                out[:] = g
+
+            events.terminal = [True] * self.n_roots
+            events.direction = [int(d) for d in rd]
+            options.update(eventsfn=events, num_events=self.n_roots)
+            self._events = events
+        return IDA(resfn, **options)
+
+    # ---------------------------------------------------------------- core
+    def reinit(self, t0: float, y0: np.ndarray, yp0: np.ndarray, active: Sequence[bool],
+               params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None:
+        t0, y0, yp0, act, plist, rd = self._check_reinit(t0, y0, yp0, active, params, root_directions)
+        self._apply_terms(act, plist)
+        if self._solver is None or (self.n_roots and not np.array_equal(rd, self._solver_dirs)):
+            # scikit-sundae sets root directions only when it builds its IDA memory
+            self._solver = self._make_solver(rd)
+            self._solver_dirs = rd.copy()
+        try:
+            self._solver.init_step(t0, y0, yp0)
+        except _ModelError as exc:
+            self._ready = False
+            raise DaeclearError(f"IDA reinit failed: {exc}") from exc
+        except RuntimeError as exc:
+            self._ready = False
+            raise DaeclearError(f"IDA reinit failed: {exc}") from exc
+        self._count["reinits"] += 1
+        self._t, self._y, self._yp = t0, y0.copy(), yp0.copy()
+        self._t_internal = t0
+        self._pending_tn = False
+        self._tiny = 0
+        self._h_prev = 0.0
+        self._ready = True
+
+    def _apply_terms(self, act: np.ndarray, plist: list[np.ndarray]) -> None:
+        self._active = act
+        self._params = plist
+        for k, p in enumerate(plist):
+            self._a_p[k][:] = p
+        self._active_idx = [k for k in range(self._nt) if act[k]]
+
+    def set_terms(self, active: Sequence[bool], params: Sequence[np.ndarray]) -> None:
+        """Set active terms and parameters without restarting IDA (see CSession.set_terms)."""
+        _, _, _, act, plist, _ = self._check_reinit(self._t, self._y, self._yp, active, params, None)
+        self._apply_terms(act, plist)
+
+    def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
+                store_steps: bool = True) -> Advance:
+        t_stop = self._check_advance(t_stop)
+        n = self._n
+        te = self._select_eval(t_eval, t_stop)
+        ev_y = np.empty((te.size, n))
+        ev_yp = np.empty((te.size, n))
+        ie = 0
+        st: list[float] = []
+        sy: list[np.ndarray] = []
+        syp: list[np.ndarray] = []
+        sh: list[float] = []
+        t_rec = self._t
+        status, flag, flag_name, message, roots = "tstop", 0, "", "", None
+        solver = self._solver
+        max_steps = self._opts.max_steps
+        tic = time.perf_counter()
+        try:
+            if t_stop - self._t <= 4.0 * np.finfo(float).eps * max(abs(t_stop), abs(self._t)):
+                status = "tstop"
+            else:
+                while True:
+                    if self._count["steps"] >= max_steps:
+                        status, flag = "error", FLAG_MAX_STEPS
+                        flag_name = _OWN_FLAG_NAMES[flag]
+                        message = (f"step cap reached: {self._count['steps']} IDA steps in this session "
+                                   f"(max_steps={max_steps}) at t={self._t!r}")
+                        break
+                    interpolated = False
+                    try:
+                        if self._pending_tn:
+                            # after a root return IDA's internal time tn is beyond self._t; a
+                            # t_stop inside (self._t, tn) makes IDASetStopTime fail (scikit-sundae
+                            # prints that error): then IDA_NORMAL mode interpolates, as in C
+                            try:
+                                with contextlib.redirect_stdout(io.StringIO()):
+                                    r = solver.step(t_stop, method="onestep", tstop=t_stop)
+                            except RuntimeError as exc:
+                                if "IDASetStopTime" not in str(exc):
+                                    raise
+                                r = solver.step(t_stop, method="normal", tstop=None)
+                                interpolated = True
+                        else:
+                            r = solver.step(t_stop, method="onestep", tstop=t_stop)
+                    except _ModelError as exc:
+                        status, flag, flag_name = "error", -8, "IDA_RES_FAIL"
+                        message = f"IDA_RES_FAIL at t={self._t!r}: {exc}"
+                        break
+                    fl = int(r.status)
+                    if fl < 0:
+                        status, flag = "error", fl
+                        flag_name = _IDA_FLAG_NAMES.get(fl, f"IDA flag {fl}")
+                        message = f"{flag_name} at t={float(r.t)!r}: {r.message}"
+                        self._t, self._y, self._yp = float(r.t), np.array(r.y, float), np.array(r.yp, float)
+                        break
+                    t_prev, y_prev, yp_prev = self._t, self._y, self._yp
+                    t_new = float(r.t)
+                    y_new = np.array(r.y, dtype=float).reshape(-1)
+                    yp_new = np.array(r.yp, dtype=float).reshape(-1)
+                    # was a new internal step taken in this call?
+                    new_step = False
+                    h = float("nan")
+                    if interpolated:  # no step taken; IDA still holds tn for the next call
+                        if fl == 0:
+                            fl = 1  # y(t_stop) returned: this advance is done
+                    elif fl == 2:  # root
+                        if not self._pending_tn:
+                            new_step = True
+                            self._count["steps"] += 1
+                        self._pending_tn = True
+                    elif self._pending_tn:  # y(tn) returned after a root: no new step
+                        self._pending_tn = False
+                        h = t_new - self._t_internal
+                        self._t_internal = t_new
+                    elif t_new > t_prev:
+                        new_step = True
+                        self._count["steps"] += 1
+                        h = t_new - self._t_internal
+                        self._t_internal = t_new
+                    self._t, self._y, self._yp = t_new, y_new, yp_new
+                    # t_eval points in (t_prev, t_new]: cubic Hermite on the two return points
+                    if ie < te.size and te[ie] <= t_new:
+                        j = int(np.searchsorted(te, t_new, side="right"))
+                        yy, yyp = _hermite(t_prev, y_prev, yp_prev, t_new, y_new, yp_new, te[ie:j])
+                        ev_y[ie:j], ev_yp[ie:j] = yy, yyp
+                        ie = j
+                    if store_steps and t_new > t_rec:
+                        st.append(t_new)
+                        sy.append(y_new)
+                        syp.append(yp_new)
+                        sh.append(h)
+                        t_rec = t_new
+                    if new_step and fl != 1 and not math.isnan(h):
+                        if abs(h) >= TINY_STEP_REL * max(1.0, abs(t_new)):
+                            self._tiny = 0
+                        elif not abs(h) > TINY_STEP_GROWTH * abs(self._h_prev):
+                            self._tiny += 1
+                        self._h_prev = h
+                        if self._tiny >= TINY_STEP_COUNT:
+                            status, flag = "error", FLAG_STEP_COLLAPSE
+                            flag_name = _OWN_FLAG_NAMES[flag]
+                            message = (f"step size collapsed: {self._tiny} steps with |h| < "
+                                       f"{TINY_STEP_REL}*max(1,|t|) that did not grow (last h={h:.3g}) "
+                                       f"at t={t_new!r}")
+                            break
+                    if fl == 2:
+                        status = "root"
+                        roots = np.asarray(r.i_events[-1], dtype=np.int32).copy()
+                        ev = getattr(self, "_events", None)
+                        if ev is not None:  # keep scikit-sundae's event log from growing
+                            for name in ("_i", "_t", "_y", "_yp"):
+                                getattr(ev, name).clear()
+                        break
+                    if fl == 1:
+                        status = "tstop"
+                        break
+        finally:
+            self._solve_time += time.perf_counter() - tic
+        k = len(st)
+        adv = Advance(
+            status=status, t=self._t, y=self._y.copy(), yp=self._yp.copy(),
+            step_t=np.array(st, dtype=float), step_y=np.array(sy, dtype=float).reshape(k, n),
+            step_yp=np.array(syp, dtype=float).reshape(k, n), step_h=np.array(sh, dtype=float),
+            step_order=np.full(k, -1, dtype=np.int32), eval_t=te[:ie].copy(), eval_y=ev_y[:ie],
+            eval_yp=ev_yp[:ie], roots_found=roots, flag=flag, flag_name=flag_name, message=message,
+        )
+        return adv
+
+    def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._check_open()
+        return self._eval_res(float(t), self._vec(y, "y"), self._vec(yp, "yp")).copy()
+
+    def jacobian(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray:
+        self._check_open()
+        return np.ascontiguousarray(self._eval_jac(float(t), self._vec(y, "y"), self._vec(yp, "yp"), float(cj)))
+
+    def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._check_open()
+        if self._roots_fn is None:
+            return np.empty(0)
+        return self._eval_roots(float(t), self._vec(y, "y"), self._vec(yp, "yp")).copy()
+
+    def stats(self) -> dict[str, int | float]:
+        c = self._count
+        return {
+            "n_steps": c["steps"],
+            "n_res_evals": c["res"],
+            "n_jac_evals": c["jac"],
+            "n_lin_setups": -1,
+            "n_nonlin_iters": -1,
+            "n_nonlin_conv_fails": -1,
+            "n_err_test_fails": -1,
+            "n_root_evals": c["roots"],
+            "n_reinits": c["reinits"],
+            "solve_time": self._solve_time,
+            "compile_time": 0.0,
+            "codegen_time": 0.0,
+            "cache_hit": False,
+        }
+
+    def close(self) -> None:
+        self._closed = True
+        self._solver = None
+
+
+_IDA_FLAG_NAMES = {
+    -1: "IDA_TOO_MUCH_WORK", -2: "IDA_TOO_MUCH_ACC", -3: "IDA_ERR_FAIL", -4: "IDA_CONV_FAIL",
+    -5: "IDA_LINIT_FAIL", -6: "IDA_LSETUP_FAIL", -7: "IDA_LSOLVE_FAIL", -8: "IDA_RES_FAIL",
+    -9: "IDA_REP_RES_ERR", -10: "IDA_RTFUNC_FAIL", -11: "IDA_CONSTR_FAIL",
+    -12: "IDA_FIRST_RES_FAIL", -13: "IDA_LINESEARCH_FAIL", -14: "IDA_NO_RECOVERY",
+    -15: "IDA_NLS_INIT_FAIL", -16: "IDA_NLS_SETUP_FAIL", -17: "IDA_NLS_FAIL",
+    -20: "IDA_MEM_NULL", -21: "IDA_MEM_FAIL", -22: "IDA_ILL_INPUT", -23: "IDA_NO_MALLOC",
+    -24: "IDA_BAD_EWT", -25: "IDA_BAD_K", -26: "IDA_BAD_T", -27: "IDA_BAD_DKY",
+    -28: "IDA_VECTOROP_ERR", -29: "IDA_CONTEXT_ERR", -99: "IDA_UNRECOGNIZED_ERROR",
+}
+
+
+# =========================================================================== factory
+
+_warned: set[str] = set()
+
+
+def _warn_once(reason: str) -> None:
+    if reason in _warned:
+        return
+    _warned.add(reason)
+    warnings.warn(
+        "daeclear: the compiled IDA backend is unavailable, using the pure-Python backend "
+        f"(scikit-sundae with CasADi FunctionBuffer callbacks), typically 10-30x slower. Reason: {reason}",
+        DaeclearWarning,
+        stacklevel=3,
+    )
+
+
+def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, atol: np.ndarray | float,
+                 max_step: float = 0.0, max_order: int = 5, max_steps: int = 5_000_000,
+                 root_directions: np.ndarray | None = None, buffer_steps: int = 4096) -> Session:
+    """Open an IDA session on a model; see the module docstring.
+
+    backend: "auto" (compiled if a C compiler works, else python with one DaeclearWarning),
+    "c" (DaeclearError if it cannot be built) or "python"; case-insensitive.
+    atol: per-variable absolute tolerances (a scalar is broadcast). max_step 0: unbounded.
+    max_steps: cap on the IDA steps of the whole session (all segments). root_directions:
+    default directions (-1, 0, +1 per root function; reinit may override them per segment).
+    buffer_steps: rows of the step buffers the C loop fills before returning to Python.
+    Call reinit() before the first advance().
+    """
+    if not isinstance(backend, str) or backend.lower() not in BACKENDS:
+        raise ValueError(f"unknown backend {backend!r}: valid backends are {', '.join(map(repr, BACKENDS))}")
+    b = backend.lower()
+    model = normalize_model(funcs)
+    opts = _options(model, rtol, atol, max_step, max_order, max_steps, root_directions, buffer_steps)
+    if b == "python":
+        return PythonSession(model, opts)
+    try:
+        build = build_model_library(funcs, model=model)
+        try:
+            clib = _CLib.load(build.path)
+        except OSError:
+            # a damaged cache entry: remove it and build once more
+            build.path.unlink(missing_ok=True)
+            build = build_model_library(funcs, model=model)
+            clib = _CLib.load(build.path)
+        return CSession(model, opts, clib, build)
+    except (CompilerUnavailable, CompileError, OSError) as exc:
+        if b == "c":
+            if isinstance(exc, DaeclearError):
+                raise
+            raise DaeclearError(f"the compiled backend cannot be loaded: {exc}") from exc
+        reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        if isinstance(exc, CompileError):
+            reason = str(exc).strip()[:2000]
+        _warn_once(reason)
+        return PythonSession(model, opts, fallback_reason=str(exc))

@@ -1,0 +1,107 @@
+"""Ready-made scenes: the chapter's slider-crank (Tables 4.1-4.3) and its variants."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .errors import SceneError
+from .scene import Body, Driver, Revolute, Scene, Translational
+
+# Table 4.1: link lengths (m), masses (kg), moments of inertia (kg m^2)
+CRANK_LENGTH, CRANK_MASS, CRANK_INERTIA = 0.05, 0.30, 1.0e-4
+ROD_LENGTH, ROD_MASS, ROD_INERTIA = 0.12, 0.21, 2.5e-4
+SLIDER_MASS, SLIDER_INERTIA = 0.14, 1.0e-4
+
+JOINT_KINDS = ("ideal",)
+
+
+def rpm_to_rad_s(rpm: float) -> float:
+    """Convert revolutions per minute to rad/s."""
+    return rpm * 2.0 * math.pi / 60.0
+
+
+def ideal_slider_crank_state(theta: float, omega: float, crank: float = CRANK_LENGTH,
+                             rod: float = ROD_LENGTH) -> dict[str, tuple[float, float, float, float, float, float]]:
+    """Positions and velocities (x, y, phi, vx, vy, omega) of the ideal slider-crank's bodies.
+
+    Crank pinned at the origin at angle ``theta`` turning at ``omega``; rod from the
+    crank pin to the slider on the X axis; centres of mass at link mid-lengths.
+    """
+    s, c = math.sin(theta), math.cos(theta)
+    beta = math.asin(-crank * s / rod)  # rod angle (slider on the X axis)
+    beta_dot = -crank * c * omega / (rod * math.cos(beta))
+    bx, by = crank * c, crank * s
+    bvx, bvy = -crank * s * omega, crank * c * omega
+    slider_x = bx + rod * math.cos(beta)
+    slider_vx = bvx - rod * math.sin(beta) * beta_dot
+    return {
+        "crank": (0.5 * bx, 0.5 * by, theta, 0.5 * bvx, 0.5 * bvy, omega),
+        "rod": (bx + 0.5 * rod * math.cos(beta), by + 0.5 * rod * math.sin(beta), beta,
+                bvx - 0.5 * rod * math.sin(beta) * beta_dot, bvy + 0.5 * rod * math.cos(beta) * beta_dot, beta_dot),
+        "slider": (slider_x, 0.0, 0.0, slider_vx, 0.0, 0.0),
+    }
+
+
+def _check(name: str, value: Any, rule: str, ok: bool) -> None:
+    if not ok:
+        raise SceneError(f"slider_crank: {name}={value!r}, {rule}.")
+
+
+def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 5000.0,
+                 crank_angle: float = 0.0, name: str | None = None, **options: Any) -> Scene:
+    """The chapter's slider-crank mechanism (Fig. 4.14, Table 4.1).
+
+    Crank (body ``crank``) pinned to the ground at the origin by revolute ``A`` and driven
+    at constant speed by driver ``drive``; connecting rod ``rod`` joined to the crank by
+    revolute ``B`` and to the slider by joint ``C``; slider ``slider`` on the X axis by
+    translational joint ``D``. The crank turns counter-clockwise from the collinear
+    position (crank angle 0, slider at x = 0.17 m). Centres of mass at link mid-lengths.
+
+    Parameters
+    ----------
+    joint : {"ideal"}
+        Which joint has clearance; "ideal" has none.
+    gravity : float
+        Magnitude of gravity along -Y, m/s^2 (0 to switch it off).
+    rpm : float
+        Crank speed, rev/min (5000 in the chapter); counter-clockwise.
+    crank_angle : float
+        Initial crank angle, rad.
+    name : str or None
+        Scene name; defaults to ``"slider_crank"`` (+ the joint kind).
+
+    Returns
+    -------
+    Scene
+    """
+    joint = str(joint).lower()
+    _check("joint", joint, f"must be one of {', '.join(JOINT_KINDS)}", joint in JOINT_KINDS)
+    _check("gravity", gravity, "must be a finite number >= 0 m/s^2",
+           isinstance(gravity, (int, float)) and math.isfinite(gravity) and gravity >= 0)
+    _check("rpm", rpm, "must be a finite number (rev/min)", isinstance(rpm, (int, float)) and math.isfinite(rpm))
+    _check("crank_angle", crank_angle, "must be a finite number (rad)",
+           isinstance(crank_angle, (int, float)) and math.isfinite(crank_angle))
+    if options:
+        raise SceneError(f"slider_crank(joint={joint!r}): unknown option(s) {', '.join(sorted(options))}.")
+
+    omega = rpm_to_rad_s(rpm)
+    state = ideal_slider_crank_state(crank_angle, omega)
+    scene = Scene(name or ("slider_crank" if joint == "ideal" else f"slider_crank_{joint}"), gravity=(0.0, -gravity))
+
+    def body(body_name: str, mass: float, inertia: float) -> Body:
+        x, y, phi, vx, vy, w = state[body_name]
+        return scene.add(Body(body_name, mass=mass, inertia=inertia, position=(x, y), angle=phi,
+                              velocity=(vx, vy), angular_velocity=w))
+
+    crank = body("crank", CRANK_MASS, CRANK_INERTIA)
+    rod = body("rod", ROD_MASS, ROD_INERTIA)
+    slider = body("slider", SLIDER_MASS, SLIDER_INERTIA)
+    pin_b = (CRANK_LENGTH * math.cos(crank_angle), CRANK_LENGTH * math.sin(crank_angle))
+    pin_c = (state["slider"][0], 0.0)
+    scene.add(Revolute("A", scene.ground, crank, at=(0.0, 0.0)))
+    scene.add(Revolute("B", crank, rod, at=pin_b))
+    scene.add(Revolute("C", rod, slider, at=pin_c))
+    scene.add(Translational("D", scene.ground, slider, at=pin_c, axis=(1.0, 0.0)))
+    scene.add(Driver("drive", joint="A", speed=omega))
+    return scene

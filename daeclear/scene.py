@@ -1,0 +1,382 @@
+"""Scene description: bodies, joints, drivers and gravity of a planar mechanism.
+
+A scene is plain data (frozen dataclasses, SI units, planar 2-vectors); it knows
+nothing of CasADi or of the solver. ``Scene.validate()`` collects every problem of
+the scene and raises one :class:`~daeclear.errors.SceneError` listing them all.
+
+Conventions
+-----------
+* Every body has generalized coordinates ``(x, y, phi)`` of its centre of mass.
+* Joints join two bodies at a world point ``at`` given in the *reference
+  configuration*, i.e. with the bodies at their declared ``position`` and
+  ``angle``. The body-fixed attachment points are taken from that configuration.
+  Alternatively give them directly in body coordinates with ``point_i`` and
+  ``point_j``; then the declared positions are only guesses that assembly corrects.
+* The ground is the body named ``"ground"``: fixed at the origin, angle zero.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass, field, fields
+from typing import Any, Iterator, Sequence, Union
+
+from .errors import SceneError
+
+GROUND = "ground"
+
+Vector2 = tuple[float, float]
+
+
+def _is_finite_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _as_vector2(value: Any) -> Vector2 | None:
+    """Return ``value`` as a tuple of two finite floats, or None if it is not one."""
+    try:
+        items = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        return None
+    if len(items) != 2 or not all(math.isfinite(v) for v in items):
+        return None
+    return items  # type: ignore[return-value]
+
+
+class Element:
+    """Base class of every scene element: a name, and a list of own problems."""
+
+    name: str
+
+    @property
+    def kind(self) -> str:
+        return type(self).__name__
+
+    def problems(self) -> list[str]:
+        """Problems of this element alone (empty when valid)."""
+        if not isinstance(self.name, str) or not self.name.strip():
+            return [f"{self.kind}: name={self.name!r}, must be a non-empty string."]
+        if "." in self.name or "/" in self.name:
+            return [f"{self.kind} '{self.name}': name must not contain '.' or '/' (used in channel names)."]
+        return []
+
+    def _check_positive(self, out: list[str], field_name: str, unit: str) -> None:
+        value = getattr(self, field_name)
+        if not _is_finite_number(value) or value <= 0:
+            out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number > 0.")
+
+    def _check_vector(self, out: list[str], field_name: str, unit: str, optional: bool = False) -> None:
+        value = getattr(self, field_name)
+        if optional and value is None:
+            return
+        if _as_vector2(value) is None:
+            out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be two finite numbers (x, y).")
+
+    def _check_number(self, out: list[str], field_name: str, unit: str) -> None:
+        value = getattr(self, field_name)
+        if not _is_finite_number(value):
+            out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number.")
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data description (element kind and fields) for files and HDF5 attributes."""
+        out: dict[str, Any] = {"kind": self.kind}
+        for f in fields(self):  # type: ignore[arg-type]
+            value = getattr(self, f.name)
+            if hasattr(value, "to_dict"):
+                value = value.to_dict()
+            elif isinstance(value, tuple):
+                value = list(value)
+            out[f.name] = value
+        return out
+
+
+def _body_name(body: Union[str, "Body", "Ground"]) -> str:
+    return body if isinstance(body, str) else getattr(body, "name", body)
+
+
+@dataclass(frozen=True)
+class Body(Element):
+    """A rigid body moving in the plane.
+
+    Parameters
+    ----------
+    name : str
+        Unique name in the scene (used by joints, channels and errors).
+    mass : float
+        Mass, kg (> 0).
+    inertia : float
+        Moment of inertia about the centre of mass, kg m^2 (> 0).
+    position : (float, float)
+        Initial position of the centre of mass, m (a guess when constrained).
+    angle : float
+        Initial angle of the body frame, rad.
+    velocity : (float, float)
+        Initial velocity of the centre of mass, m/s (a guess when constrained).
+    angular_velocity : float
+        Initial angular velocity, rad/s (a guess when constrained).
+    """
+
+    name: str
+    mass: float
+    inertia: float
+    position: Vector2 = (0.0, 0.0)
+    angle: float = 0.0
+    velocity: Vector2 = (0.0, 0.0)
+    angular_velocity: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("position", "velocity"):
+            vec = _as_vector2(getattr(self, name))
+            if vec is not None:
+                object.__setattr__(self, name, vec)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        if self.name == GROUND:
+            out.append(f"Body '{GROUND}': the name is reserved for the fixed ground; use scene.ground.")
+        self._check_positive(out, "mass", "kg")
+        self._check_positive(out, "inertia", "kg m^2")
+        self._check_vector(out, "position", "m")
+        self._check_number(out, "angle", "rad")
+        self._check_vector(out, "velocity", "m/s")
+        self._check_number(out, "angular_velocity", "rad/s")
+        return out
+
+
+@dataclass(frozen=True)
+class Ground:
+    """The fixed ground: the body named ``"ground"`` at the origin with angle zero."""
+
+    name: str = GROUND
+
+
+@dataclass(frozen=True)
+class Joint(Element):
+    """Base class of joints between two bodies ``body_i`` and ``body_j``."""
+
+    name: str
+    body_i: str
+    body_j: str
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "body_i", _body_name(self.body_i))
+        object.__setattr__(self, "body_j", _body_name(self.body_j))
+
+    @property
+    def bodies(self) -> tuple[str, str]:
+        return (self.body_i, self.body_j)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        if self.body_i == self.body_j:
+            out.append(f"{self.kind} '{self.name}': joins body '{self.body_i}' to itself; give two different bodies.")
+        return out
+
+
+@dataclass(frozen=True)
+class _PointJoint(Joint):
+    """A joint located by a world point ``at`` or by body-fixed points ``point_i``/``point_j``."""
+
+    at: Vector2 | None = None
+    point_i: Vector2 | None = None
+    point_j: Vector2 | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        for name in ("at", "point_i", "point_j"):
+            vec = _as_vector2(getattr(self, name)) if getattr(self, name) is not None else None
+            if vec is not None:
+                object.__setattr__(self, name, vec)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        self._check_vector(out, "at", "m", optional=True)
+        self._check_vector(out, "point_i", "m", optional=True)
+        self._check_vector(out, "point_j", "m", optional=True)
+        local = (self.point_i is not None, self.point_j is not None)
+        if self.at is None and not all(local):
+            out.append(
+                f"{self.kind} '{self.name}': give the world point at=(x, y), "
+                "or both body-fixed points point_i and point_j."
+            )
+        return out
+
+
+@dataclass(frozen=True)
+class Revolute(_PointJoint):
+    """Ideal revolute (pin) joint: point P of body i coincides with point P of body j.
+
+    Adds two constraint equations, ``r_i + A_i s_i - r_j - A_j s_j = 0``.
+    """
+
+
+@dataclass(frozen=True)
+class Translational(_PointJoint):
+    """Ideal translational (prismatic) joint: body j slides on body i along ``axis``.
+
+    ``axis`` is a world direction in the reference configuration (fixed to body i);
+    the two constraints keep the joint point of body j on the line through the joint
+    point of body i along ``axis``, and keep the relative angle constant.
+    """
+
+    axis: Vector2 = (1.0, 0.0)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        vec = _as_vector2(self.axis)
+        if vec is not None:
+            object.__setattr__(self, "axis", vec)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        vec = _as_vector2(self.axis)
+        if vec is None or math.hypot(*vec) < 1e-12:
+            out.append(f"{self.kind} '{self.name}': axis={self.axis!r}, must be a non-zero 2-vector.")
+        return out
+
+
+@dataclass(frozen=True)
+class Driver(Element):
+    """Constant-speed rotational driver on a revolute joint.
+
+    Imposes ``phi_j - phi_i = theta0 + speed * t`` on the bodies of revolute ``joint``,
+    where ``theta0`` is the relative angle of the reference configuration unless
+    ``initial_angle`` is given. The driving moment is the torque the driver applies
+    to body j (positive counter-clockwise), channel ``<name>.moment``.
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    joint : str
+        Name of a :class:`Revolute` joint of the scene.
+    speed : float
+        Angular speed, rad/s (counter-clockwise positive).
+    initial_angle : float or None
+        Relative angle ``phi_j - phi_i`` at t = 0, rad; None keeps the reference one.
+    """
+
+    name: str
+    joint: str
+    speed: float
+    initial_angle: float | None = None
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        self._check_number(out, "speed", "rad/s")
+        if self.initial_angle is not None:
+            self._check_number(out, "initial_angle", "rad")
+        return out
+
+
+@dataclass
+class Scene:
+    """A planar mechanism: bodies, joints and drivers, a fixed ground and gravity.
+
+    Parameters
+    ----------
+    name : str
+        Scene name (results and files carry it).
+    gravity : (float, float)
+        Gravitational acceleration vector, m/s^2; ``(0, -9.81)`` by default.
+
+    Examples
+    --------
+    >>> scene = Scene("pendulum")
+    >>> link = scene.add(Body("link", mass=1.0, inertia=0.01, position=(0.5, 0.0)))
+    >>> _ = scene.add(Revolute("A", scene.ground, link, at=(0.0, 0.0)))
+    >>> scene.validate()
+    """
+
+    name: str
+    gravity: Vector2 = (0.0, -9.81)
+    elements: list[Element] = field(default_factory=list)
+    ground: Ground = field(default_factory=Ground)
+
+    def add(self, element: Element) -> Any:
+        """Add an element and return it (so ``crank = scene.add(Body(...))`` reads well)."""
+        if not isinstance(element, Element):
+            raise SceneError(
+                f"scene '{self.name}': cannot add {element!r}; expected a Body, joint or Driver."
+            )
+        self.elements.append(element)
+        return element
+
+    def __iter__(self) -> Iterator[Element]:
+        return iter(self.elements)
+
+    @property
+    def bodies(self) -> list[Body]:
+        return [e for e in self.elements if isinstance(e, Body)]
+
+    @property
+    def joints(self) -> list[Joint]:
+        return [e for e in self.elements if isinstance(e, Joint)]
+
+    @property
+    def drivers(self) -> list[Driver]:
+        return [e for e in self.elements if isinstance(e, Driver)]
+
+    def of_type(self, cls: type) -> list[Any]:
+        return [e for e in self.elements if isinstance(e, cls)]
+
+    def __getitem__(self, name: str) -> Element:
+        for element in self.elements:
+            if element.name == name:
+                return element
+        names = [e.name for e in self.elements]
+        close = difflib.get_close_matches(name, names, n=3)
+        hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+        raise KeyError(f"no element '{name}' in scene '{self.name}'.{hint}")
+
+    def problems(self) -> list[str]:
+        """Every problem of the scene (empty when valid)."""
+        out: list[str] = []
+        if _as_vector2(self.gravity) is None:
+            out.append(f"scene '{self.name}': gravity={self.gravity!r} m/s^2, must be two finite numbers.")
+        seen: set[str] = set()
+        for element in self.elements:
+            out.extend(element.problems())
+            if element.name in seen:
+                out.append(f"{element.kind} '{element.name}': duplicate name; every name in a scene must be unique.")
+            seen.add(element.name)
+        body_names = [b.name for b in self.bodies]
+        known = set(body_names) | {GROUND}
+        for joint in self.joints:
+            for role, body in (("body_i", joint.body_i), ("body_j", joint.body_j)):
+                if body not in known:
+                    close = difflib.get_close_matches(str(body), sorted(known), n=1)
+                    hint = f" Did you mean '{close[0]}'?" if close else ""
+                    out.append(
+                        f"{joint.kind} '{joint.name}': {role} refers to body '{body}', "
+                        f"not in scene '{self.name}'.{hint}"
+                    )
+        revolutes = {j.name: j for j in self.joints if isinstance(j, Revolute)}
+        driven: set[str] = set()
+        for driver in self.drivers:
+            if driver.joint not in revolutes:
+                out.append(f"Driver '{driver.name}': '{driver.joint}' is not a revolute joint of this scene.")
+            elif driver.joint in driven:
+                out.append(f"Driver '{driver.name}': joint '{driver.joint}' already has a driver.")
+            driven.add(driver.joint)
+        if not self.bodies:
+            out.append(f"scene '{self.name}': has no moving body; add a Body.")
+        return out
+
+    def validate(self) -> None:
+        """Raise one :class:`SceneError` listing every problem of the scene."""
+        problems = self.problems()
+        if len(problems) == 1:
+            raise SceneError(problems[0])
+        if problems:
+            lines = "\n".join(f"  - {p}" for p in problems)
+            raise SceneError(f"scene '{self.name}' has {len(problems)} problems:\n{lines}")
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data description of the scene (for result files)."""
+        return {
+            "name": self.name,
+            "gravity": list(self.gravity),
+            "elements": {e.name: e.to_dict() for e in self.elements},
+        }

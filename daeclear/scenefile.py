@@ -1,0 +1,111 @@
+"""Scene files (TOML): a named mechanism with its parameters, or a scene element by element.
+
+A mechanism file::
+
+    [mechanism]
+    name = "slider_crank"
+    joint = "ideal"
+    rpm = 5000.0
+
+    [simulate]
+    t_end = 0.024
+    rtol = 1e-6
+
+A scene file (tables map key for key onto the Python classes)::
+
+    [scene]
+    name = "pendulum"
+    gravity = [0.0, -9.81]
+
+    [[body]]
+    name = "link"
+    mass = 1.0
+    inertia = 0.01
+    position = [0.5, 0.0]
+
+    [[revolute]]
+    name = "A"
+    body_i = "ground"
+    body_j = "link"
+    at = [0.0, 0.0]
+
+Unknown tables or keys are errors that name the file, the table and the key.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from pathlib import Path
+from typing import Any, Callable
+
+from . import mechanisms
+from .errors import SceneError
+from .scene import Body, Driver, Revolute, Scene, Translational
+
+MECHANISMS: dict[str, Callable[..., Scene]] = {"slider_crank": mechanisms.slider_crank}
+ELEMENT_TABLES: dict[str, type] = {
+    "body": Body, "revolute": Revolute, "translational": Translational, "driver": Driver,
+}
+SIMULATE_KEYS = ("t_end", "rtol", "atol", "formulation", "method", "backend", "max_step", "t_eval_step")
+
+
+@dataclasses.dataclass(frozen=True)
+class SceneFile:
+    """What a scene file declares: the scene, and the simulation options it asks for."""
+
+    scene: Scene
+    simulate: dict[str, Any]
+    source: dict[str, Any]
+
+
+def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any]) -> Any:
+    allowed = [f.name for f in dataclasses.fields(cls)]
+    unknown = sorted(set(entry) - set(allowed))
+    if unknown:
+        raise SceneError(f"{path}: [[{table}]] #{index + 1}: unknown key(s) {', '.join(unknown)}; "
+                         f"allowed: {', '.join(allowed)}.")
+    try:
+        return cls(**entry)
+    except TypeError as exc:
+        raise SceneError(f"{path}: [[{table}]] #{index + 1}: {exc}") from None
+
+
+def read_scene_file(path: str | Path) -> SceneFile:
+    """Read and validate a TOML scene file; raise SceneError naming the file, table and key."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise SceneError(f"scene file {path} does not exist.") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: not valid TOML ({exc}).") from None
+    simulate = dict(data.get("simulate", {}))
+    unknown_sim = sorted(set(simulate) - set(SIMULATE_KEYS))
+    if unknown_sim:
+        raise SceneError(f"{path}: [simulate]: unknown key(s) {', '.join(unknown_sim)}; "
+                         f"allowed: {', '.join(SIMULATE_KEYS)}.")
+    if "mechanism" in data:
+        extra = sorted(set(data) - {"mechanism", "simulate"})
+        if extra:
+            raise SceneError(f"{path}: a [mechanism] file takes only [mechanism] and [simulate]; "
+                             f"found {', '.join(extra)}.")
+        params = dict(data["mechanism"])
+        name = str(params.pop("name", ""))
+        if name not in MECHANISMS:
+            raise SceneError(f"{path}: [mechanism] name={name!r}, must be one of {', '.join(MECHANISMS)}.")
+        return SceneFile(MECHANISMS[name](**params), simulate, data)
+    allowed_tables = {"scene", "simulate", *ELEMENT_TABLES}
+    extra = sorted(set(data) - allowed_tables)
+    if extra:
+        raise SceneError(f"{path}: unknown table(s) {', '.join(extra)}; allowed: {', '.join(sorted(allowed_tables))}.")
+    head = dict(data.get("scene", {}))
+    unknown_head = sorted(set(head) - {"name", "gravity"})
+    if unknown_head:
+        raise SceneError(f"{path}: [scene]: unknown key(s) {', '.join(unknown_head)}; allowed: name, gravity.")
+    scene = Scene(str(head.get("name", path.stem)), gravity=tuple(head.get("gravity", (0.0, -9.81))))
+    for table, cls in ELEMENT_TABLES.items():
+        for i, entry in enumerate(data.get(table, [])):
+            scene.add(_element(path, table, i, cls, entry))
+    scene.validate()
+    return SceneFile(scene, simulate, data)

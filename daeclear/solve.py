@@ -1,0 +1,305 @@
+"""simulate(): IDA with root finding, contact-mode switches and consistent restarts.
+
+The solver knows nothing of slider-cranks: it integrates a :class:`DAEModel` segment
+by segment. Between two roots of the gap functions the set of active contact terms
+is fixed; at a root each contact element's event logic decides the new modes (and
+latches the approach speed), the multipliers and derivatives are made consistent
+again, and IDA restarts with fresh BDF history.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import sys
+import time
+from typing import Any, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .assemble import KIND_MULTIPLIER, DAEModel, assemble
+from .errors import SceneError, SolveError
+from .ida_session import open_session
+from .result import ContactEvent, Result
+from .scene import Scene
+
+log = logging.getLogger("daeclear")
+
+METHODS: tuple[str, ...] = ("ida",)
+ON_FAILURE: tuple[str, ...] = ("raise", "return")
+# Multipliers are kept out of IDA's error test by a huge absolute tolerance (scikit-sundae has
+# no IDASetSuppressAlg): atol = MULTIPLIER_ATOL_FACTOR * rtol, see PERFORMANCE.md item 1.
+MULTIPLIER_ATOL_FACTOR = 1e12
+# Default absolute tolerance of positions and velocities, relative to rtol: contact runs resolve
+# micrometre penetrations, so positions need an absolute floor well below the clearance.
+DEFAULT_ATOL_FACTOR = 1e-3
+# GGL holds Phi = 0 only as tightly as IDA's Newton test (safety factor 0.33 by default). 1e-3
+# keeps the pendulum's constraint residual at 1e-12 instead of 3e-11 (rtol 1e-10) and, measured,
+# halves the steps; index1 is better off with IDA's default. The python backend cannot set it.
+GGL_NEWTON_COEF = 1e-3
+
+
+def _positive(name: str, value: Any, unit: str, allow_zero: bool = False) -> float:
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    ok = ok and (value >= 0 if allow_zero else value > 0)
+    if not ok:
+        rule = ">= 0" if allow_zero else "> 0"
+        raise SceneError(f"simulate: {name}={value!r} {unit}, must be a finite number {rule}.")
+    return float(value)
+
+
+def _choice(name: str, value: Any, allowed: Sequence[str]) -> str:
+    text = str(value).lower()
+    if text not in allowed:
+        raise SceneError(f"simulate: {name}={value!r}, must be one of {', '.join(allowed)} (case-insensitive).")
+    return text
+
+
+def tolerance_vector(model: DAEModel, rtol: float, atol: float | ArrayLike | None) -> NDArray[np.float64]:
+    """Absolute tolerances per state: q and v from ``atol``; multipliers out of the error test."""
+    kinds = np.array(model.state_kinds)
+    if atol is None:
+        vec = np.full(model.n_states, DEFAULT_ATOL_FACTOR * rtol)
+    elif np.ndim(atol) == 0:
+        vec = np.full(model.n_states, _positive("atol", float(atol), ""))  # type: ignore[arg-type]
+    else:
+        vec = np.asarray(atol, dtype=float).copy()
+        if vec.shape != (model.n_states,) or not np.all(np.isfinite(vec)) or np.any(vec <= 0):
+            raise SceneError(
+                f"simulate: atol has shape {vec.shape}; give a positive number or {model.n_states} "
+                f"positive values (one per state: {', '.join(model.state_names[:4])}, ...)."
+            )
+        return vec
+    vec[kinds == KIND_MULTIPLIER] = MULTIPLIER_ATOL_FACTOR * rtol
+    return vec
+
+
+class _Progress:
+    """A one-line progress display on stderr for long runs (only when asked for)."""
+
+    def __init__(self, enabled: bool, t_end: float) -> None:
+        self.enabled, self.t_end, self.last = enabled, t_end, -1.0
+
+    def update(self, t: float, n_events: int) -> None:
+        if not self.enabled:
+            return
+        frac = min(1.0, t / self.t_end) if self.t_end > 0 else 1.0
+        if frac - self.last >= 0.01 or frac >= 1.0:
+            self.last = frac
+            sys.stderr.write(f"\r  t = {t:.6g} s  {100 * frac:5.1f} %  events {n_events}")
+            if frac >= 1.0:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+def simulate(
+    scene: Scene | DAEModel,
+    t_end: float,
+    *,
+    t_eval: ArrayLike | None = None,
+    rtol: float = 1e-6,
+    atol: float | ArrayLike | None = None,
+    method: str = "ida",
+    formulation: str = "index1",
+    backend: str = "auto",
+    max_step: float = 0.0,
+    max_steps: int = 5_000_000,
+    store_steps: bool = True,
+    on_failure: str = "raise",
+    progress: bool = False,
+) -> Result:
+    """Integrate a scene (or an assembled model) from t = 0 to ``t_end``.
+
+    Parameters
+    ----------
+    scene : Scene or DAEModel
+        The mechanism; a Scene is assembled with ``formulation`` first.
+    t_end : float
+        End time, s (> 0).
+    t_eval : array_like or None
+        Output times in [0, t_end] (increasing). None: every internal IDA step.
+    rtol : float
+        Relative tolerance (1e-6; the chapter's "integration tolerance").
+    atol : float, array or None
+        Absolute tolerance of positions and velocities (default ``1e-3 * rtol``) or one
+        value per state. Multipliers are always kept out of the error test.
+    method : {"ida"}
+        Integrator (case-insensitive).
+    formulation : {"index1", "ggl"}
+        Used when ``scene`` is a Scene.
+    backend : {"auto", "c", "python"}
+        "c": generated C and an IDA loop in C (fast); "python": scikit-sundae with CasADi
+        callbacks; "auto": C when a compiler works, else python with a warning.
+    max_step : float
+        Largest step, s (0: unbounded).
+    max_steps : int
+        Cap on the total number of steps; the run fails cleanly beyond it.
+    store_steps : bool
+        Keep every internal step (step sizes are reported in ``result.stats``/steps).
+    on_failure : {"raise", "return"}
+        On an integrator failure raise :class:`SolveError` (its ``.result`` holds the
+        partial result) or return the partial result with ``success=False``.
+    progress : bool
+        Show a progress line on stderr.
+
+    Returns
+    -------
+    Result
+    """
+    method = _choice("method", method, METHODS)
+    on_failure = _choice("on_failure", on_failure, ON_FAILURE)
+    t_end = _positive("t_end", t_end, "s")
+    rtol = _positive("rtol", rtol, "")
+    max_step = _positive("max_step", max_step, "s", allow_zero=True)
+    if not isinstance(max_steps, int) or max_steps < 1:
+        raise SceneError(f"simulate: max_steps={max_steps!r}, must be an integer >= 1.")
+    if rtol < 1e-14 or rtol > 1e-2:
+        raise SceneError(f"simulate: rtol={rtol!r}, must be in [1e-14, 1e-2].")
+
+    setup_start = time.perf_counter()
+    model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation)
+    eval_times = None
+    if t_eval is not None:
+        eval_times = np.asarray(t_eval, dtype=float).ravel()
+        if eval_times.size == 0 or np.any(np.diff(eval_times) <= 0) or eval_times[0] < 0 or eval_times[-1] > t_end:
+            raise SceneError(f"simulate: t_eval must be increasing values in [0, t_end={t_end}].")
+    atol_vec = tolerance_vector(model, rtol, atol)
+    y0, yp0 = model.initial_state()
+    session = open_session(model.functions, backend=backend, rtol=rtol, atol=atol_vec, max_step=max_step,
+                           max_steps=max_steps)
+    if model.formulation == "ggl":
+        session.set_hints(nonlin_conv_coef=GGL_NEWTON_COEF)
+    setup_time = time.perf_counter() - setup_start
+    return _run(model, session, y0, yp0, t_end, eval_times, store_steps, on_failure, progress,
+                setup_time, {"method": method, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
+                             "max_step": max_step, "t_end": t_end, "backend": session.backend})
+
+
+def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float, eval_times: NDArray | None,
+         store_steps: bool, on_failure: str, progress: bool, setup_time: float,
+         sim_params: dict[str, Any]) -> Result:
+    """The segment loop: advance, handle roots, restart; always returns what was computed."""
+    progress_line = _Progress(progress, t_end)
+    n_terms = len(model.terms)
+    active = [False] * n_terms
+    params = [np.zeros(term.n_params) for term in model.terms]
+    modes: dict[str, str] = {}
+    for logic in model.contacts:
+        modes.update(logic.initial_modes(0.0, y0, active, params))
+    y, yp = y0, yp0
+    if any(active):
+        y, yp = model.consistent_state(0.0, y0, _term_forces(model, 0.0, y0, active, params))
+
+    steps_t: list[NDArray] = [np.array([0.0])]
+    steps_y: list[NDArray] = [y[None, :]]
+    steps_yp: list[NDArray] = [yp[None, :]]
+    steps_h: list[NDArray] = [np.array([0.0])]
+    steps_order: list[NDArray] = [np.array([0])]
+    ev_t: list[NDArray] = []
+    ev_y: list[NDArray] = []
+    ev_yp: list[NDArray] = []
+    if eval_times is not None and eval_times[0] == 0.0:
+        ev_t.append(np.array([0.0]))
+        ev_y.append(y[None, :])
+        ev_yp.append(yp[None, :])
+        pending = eval_times[1:]
+    else:
+        pending = eval_times
+    events: list[ContactEvent] = []
+    segments: list[tuple[float, float, dict[str, str]]] = []
+    t = 0.0
+    success, status, message = True, 0, "end of the time span reached"
+    n_restarts = 0
+    try:
+        session.reinit(t, y, yp, active, params)
+        while True:
+            seg_start = t
+            adv = session.advance(t_end, pending, store_steps)
+            if store_steps and adv.step_t.size:
+                steps_t.append(adv.step_t)
+                steps_y.append(adv.step_y)
+                steps_yp.append(adv.step_yp)
+                steps_h.append(adv.step_h)
+                steps_order.append(adv.step_order)
+            if adv.eval_t.size:
+                # IDA's interpolant of the multipliers is not error-controlled: recompute the
+                # multipliers and accelerations of output points from their q and v.
+                y_eval, yp_eval = model.consistent_state(
+                    adv.eval_t, adv.eval_y, _term_forces(model, adv.eval_t, adv.eval_y, active, params))
+                ev_t.append(adv.eval_t)
+                ev_y.append(y_eval)
+                ev_yp.append(yp_eval)
+                if pending is not None:
+                    pending = pending[pending > adv.eval_t[-1]]
+            t, y, yp = adv.t, adv.y, adv.yp
+            segments.append((seg_start, t, dict(modes)))
+            progress_line.update(t, len(events))
+            if adv.status == "error":
+                success, status = False, -1
+                message = _failure_message(model, adv, modes)
+                break
+            if adv.status == "tstop" or t >= t_end:
+                break
+            # a root: let every contact element decide its new modes
+            for logic in model.contacts:
+                new_events = logic.on_roots(t, y, yp, adv.roots_found, active, params)
+                events.extend(new_events)
+                for event in new_events:
+                    modes[event.pair] = "contact" if event.kind == "onset" else "free"
+            y, yp = model.consistent_state(t, y, _term_forces(model, t, y, active, params))
+            session.reinit(t, y, yp, active, params)
+            n_restarts += 1
+    except KeyboardInterrupt:
+        success, status, message = False, -1, f"interrupted by the user at t={t:.6g} s"
+    finally:
+        stats = dict(session.stats())
+        session.close()
+
+    progress_line.update(t_end if success else t, len(events))
+    step_t = np.concatenate(steps_t)
+    if eval_times is not None:
+        out_t = np.concatenate(ev_t) if ev_t else np.zeros(0)
+        out_y = np.concatenate(ev_y) if ev_y else np.zeros((0, model.n_states))
+        out_yp = np.concatenate(ev_yp) if ev_yp else np.zeros((0, model.n_states))
+    else:
+        out_t, out_y, out_yp = step_t, np.concatenate(steps_y), np.concatenate(steps_yp)
+    stats.update(n_events=len(events), n_restarts=n_restarts, setup_time=setup_time)
+    result = Result(
+        t=out_t, y=out_y, yp=out_yp, state_names=list(model.state_names),
+        channels=model.channels(out_t, out_y, out_yp), units=dict(model.channel_units),
+        events=events, segments=segments, step_t=step_t, step_h=np.concatenate(steps_h),
+        step_order=np.concatenate(steps_order), stats=stats, success=success, status=status, message=message,
+        parameters={**model.parameters, "simulate": sim_params}, scene_name=model.scene_name,
+        method=sim_params["method"], formulation=model.formulation,
+    )
+    if not success and on_failure == "raise":
+        raise SolveError(message + " Partial result in .result.", result)
+    return result
+
+
+def _term_forces(model: DAEModel, t: ArrayLike, y: NDArray, active: Sequence[bool],
+                 params: Sequence[NDArray]) -> NDArray | None:
+    """Sum of the generalized forces of the active terms at one state (n,) or many (N, n)."""
+    if not any(active):
+        return None
+    n = model.n_q
+    y2 = np.atleast_2d(y)
+    N = y2.shape[0]
+    t_row = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,))[None, :]
+    total = np.zeros((N, n))
+    for term, on, p in zip(model.terms, active, params):
+        if on:
+            p_cols = np.repeat(np.asarray(p, dtype=float).reshape(-1, 1), N, axis=1)
+            total += np.array(term.force.map(N)(t_row, y2[:, :n].T, y2[:, n:2 * n].T, p_cols)).T
+    return total[0] if np.ndim(y) == 1 else total
+
+
+def _failure_message(model: DAEModel, adv: Any, modes: dict[str, str]) -> str:
+    """Say when, where (contact modes) and why IDA failed, and what to try."""
+    in_contact = [pair for pair, mode in modes.items() if mode == "contact"]
+    where = f" with {', '.join(repr(p) for p in in_contact)} in contact" if in_contact else ""
+    flag = f" ({adv.flag_name})" if adv.flag_name else ""
+    detail = f": {adv.message}" if adv.message else ""
+    return (f"IDA failed at t={adv.t:.6g} s{flag}{where}{detail}. "
+            "Try a smaller max_step, a tighter rtol, or formulation='ggl'.")
