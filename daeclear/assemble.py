@@ -37,84 +37,14 @@ from numpy.typing import ArrayLike, NDArray
 from .errors import AssemblyError, SceneError
 from .ida_session import DAEFunctions
 from .scene import GROUND, Body, Driver, Revolute, Scene, Translational
+from .clearance import CONTACT_BUILDERS
+from .symbolic import AssemblyContext, BodyFrame, Channel, Term, rotation
 
 Formulation = Literal["index1", "ggl"]
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
 
 # State kinds: how each state variable is treated by the solver's error test.
 KIND_POSITION, KIND_VELOCITY, KIND_MULTIPLIER = "q", "v", "lambda"
-
-
-def rotation(phi: Any) -> Any:
-    """Planar rotation matrix A(phi) as a CasADi expression."""
-    c, s = ca.cos(phi), ca.sin(phi)
-    return ca.vertcat(ca.horzcat(c, -s), ca.horzcat(s, c))
-
-
-def perpendicular(u: Any) -> Any:
-    """Vector ``u`` rotated by +90 degrees."""
-    return ca.vertcat(-u[1], u[0])
-
-
-@dataclass(frozen=True)
-class BodyFrame:
-    """Symbolic kinematics of one body (or of the ground) inside an assembly."""
-
-    name: str
-    index: int | None  # position in the body list; None for the ground
-    r: Any  # centre of mass (2x1)
-    phi: Any
-    v: Any  # velocity of the centre of mass (2x1)
-    omega: Any
-
-    def point(self, s_local: Any) -> Any:
-        """World position of the body-fixed point ``s_local``."""
-        return self.r + ca.mtimes(rotation(self.phi), s_local)
-
-    def point_velocity(self, s_local: Any) -> Any:
-        """World velocity of the body-fixed point ``s_local`` (material point)."""
-        return self.v + self.omega * perpendicular(ca.mtimes(rotation(self.phi), s_local))
-
-
-@dataclass(frozen=True)
-class Term:
-    """A switchable generalized force (e.g. one contact pair), added to the equations of motion.
-
-    ``force`` maps ``(t, q, v, p)`` to the generalized force vector (length n_q);
-    ``n_params`` is the size of ``p`` (e.g. the approach speed latched at onset).
-    """
-
-    name: str
-    force: ca.Function
-    n_params: int
-
-
-@dataclass(frozen=True)
-class Channel:
-    """A named output quantity with its unit and symbolic expression in (t, y, yp)."""
-
-    name: str
-    unit: str
-    expr: Any
-
-
-@dataclass
-class AssemblyContext:
-    """Symbols and per-body kinematics handed to element builders during assembly."""
-
-    t: Any
-    q: Any
-    v: Any
-    a: Any  # accelerations (v')
-    frames: dict[str, BodyFrame]
-    reference: dict[str, tuple[tuple[float, float], float]]  # body -> (position, angle)
-
-    def local_point(self, body: str, world: Sequence[float]) -> NDArray[np.float64]:
-        """Body-fixed coordinates of a world point of the reference configuration."""
-        (x0, y0), phi0 = self.reference[body]
-        c, s = math.cos(phi0), math.sin(phi0)
-        dx, dy = world[0] - x0, world[1] - y0
-        return np.array([c * dx + s * dy, -s * dx + c * dy])
 
 
 @dataclass(frozen=True)
@@ -138,7 +68,7 @@ class DAEModel:
     gap_names: tuple[str, ...]
     channel_names: tuple[str, ...]
     channel_units: dict[str, str]
-    outputs: ca.Function  # (t, y, yp) -> channel values
+    outputs: ca.Function  # (t, y, yp, switch) -> channel values; switch: see switch_vector
     q_guess: NDArray[np.float64]
     v_guess: NDArray[np.float64]
     mass_diagonal: NDArray[np.float64]
@@ -293,13 +223,25 @@ class DAEModel:
         y[self.n_q: 2 * self.n_q] = v
         return self.consistent_state(0.0, y)
 
-    def channels(self, t: NDArray[np.float64], y: NDArray[np.float64], yp: NDArray[np.float64]
-                 ) -> dict[str, NDArray[np.float64]]:
-        """Evaluate every output channel at the rows of ``y`` and ``yp`` (time first)."""
+    def switch_vector(self, active: Sequence[bool], params: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
+        """The contact terms' on/off flags and parameters as the outputs' ``switch`` input."""
+        parts: list[NDArray[np.float64]] = []
+        for on, p in zip(active, params):
+            parts += [np.array([1.0 if on else 0.0]), np.asarray(p, dtype=float).ravel()]
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+    def channels(self, t: NDArray[np.float64], y: NDArray[np.float64], yp: NDArray[np.float64],
+                 switch: NDArray[np.float64] | None = None) -> dict[str, NDArray[np.float64]]:
+        """Evaluate every output channel at the rows of ``y`` and ``yp`` (time first).
+
+        ``switch`` holds one row per time of :meth:`switch_vector` (contact terms' modes).
+        """
         t = np.atleast_1d(np.asarray(t, dtype=float))
         if t.size == 0:
             return {name: np.zeros(0) for name in self.channel_names}
-        values = np.array(self.outputs.map(t.size)(t[None, :], np.asarray(y).T, np.asarray(yp).T))
+        n_s = self.outputs.size1_in(3)
+        S = np.zeros((t.size, n_s)) if switch is None else np.asarray(switch, dtype=float).reshape(t.size, n_s)
+        values = np.array(self.outputs.map(t.size)(t[None, :], np.asarray(y).T, np.asarray(yp).T, S.T))
         return {name: values[i].copy() for i, name in enumerate(self.channel_names)}
 
 
@@ -341,11 +283,6 @@ def _driver(ctx: AssemblyContext, driver: Driver, joint: Revolute) -> Any:
     if theta0 is None:
         theta0 = ctx.reference[joint.body_j][1] - ctx.reference[joint.body_i][1]
     return bj.phi - bi.phi - theta0 - driver.speed * ctx.t
-
-
-ElementBuilder = Callable[..., Any]
-# Contact elements (clearance joints) register a builder here: (ctx, element, scene) -> ContactBuild.
-CONTACT_BUILDERS: dict[type, ElementBuilder] = {}
 
 
 def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, beta: float = 5.0) -> DAEModel:
@@ -414,7 +351,9 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
             driver_rows[element.name] = len(phi_list)
             eqs, labels = [_driver(ctx, element, revolutes[element.joint])], [element.name]
         elif type(element) in CONTACT_BUILDERS:
-            contact_builds.append(CONTACT_BUILDERS[type(element)](ctx, element, scene))
+            first_term = sum(len(b.terms) for b in contact_builds)
+            first_root = sum(len(b.gaps) for b in contact_builds)
+            contact_builds.append(CONTACT_BUILDERS[type(element)](ctx, element, scene, first_term, first_root))
             continue
         else:
             raise AssemblyError(f"{element.kind} '{element.name}': element type not supported by assemble().")
@@ -473,7 +412,14 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     gap_names: list[str] = []
     contact_channels: list[Channel] = []
     contacts: list[Any] = []
+    switch_syms: list[Any] = []  # per term: on/off flag and parameters, inputs of the outputs
     for build in contact_builds:
+        switches = []
+        for term in build.terms:
+            on_k, p_k = ca.SX.sym(f"{term.name}_on"), ca.SX.sym(f"{term.name}_p", term.n_params)
+            switches.append((on_k, p_k))
+            switch_syms += [on_k, p_k]
+        contact_channels.extend(build.channels(switches))
         for term in build.terms:
             p = ca.SX.sym("p", term.n_params)
             Qk = term.force(t, q, v, p)
@@ -485,8 +431,7 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
             terms.append(term)
         gaps.extend(build.gaps)
         gap_names.extend(build.gap_names)
-        contact_channels.extend(build.channels(t, y, yp))
-        contacts.append(build.logic)
+        contacts.extend(build.logic)
     roots = None
     if gaps:
         roots = ca.Function("roots", [t, y, yp], [ca.vertcat(*gaps)], ["t", "y", "yp"], ["g"])
@@ -526,8 +471,9 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
             Channel("constraints.velocity", "m/s", ca.mmax(ca.fabs(Phi_dot))),
         ]
     channels += contact_channels
-    outputs = ca.Function("outputs", [t, y, yp], [ca.vertcat(*[c.expr for c in channels])],
-                          ["t", "y", "yp"], ["channels"])
+    switch = ca.vertcat(*switch_syms) if switch_syms else ca.SX(0, 1)
+    outputs = ca.Function("outputs", [t, y, yp, switch], [ca.vertcat(*[c.expr for c in channels])],
+                          ["t", "y", "yp", "switch"], ["channels"])
 
     q_guess = np.concatenate([[*b.position, b.angle] for b in bodies])
     v_guess = np.concatenate([[*b.velocity, b.angular_velocity] for b in bodies])

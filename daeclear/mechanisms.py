@@ -5,15 +5,21 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from .contact import Material, friction_law, normal_law
+from .contact.base import NormalLaw
 from .errors import SceneError
-from .scene import Body, Driver, Revolute, Scene, Translational
+from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational
 
 # Table 4.1: link lengths (m), masses (kg), moments of inertia (kg m^2)
 CRANK_LENGTH, CRANK_MASS, CRANK_INERTIA = 0.05, 0.30, 1.0e-4
 ROD_LENGTH, ROD_MASS, ROD_INERTIA = 0.12, 0.21, 2.5e-4
 SLIDER_MASS, SLIDER_INERTIA = 0.14, 1.0e-4
 
-JOINT_KINDS = ("ideal",)
+# Table 4.2: revolute clearance joint
+BEARING_RADIUS = 10.0e-3
+STEEL = Material(young=207e9, poisson=0.3)
+
+JOINT_KINDS = ("ideal", "revolute")
 
 
 def rpm_to_rad_s(rpm: float) -> float:
@@ -48,8 +54,23 @@ def _check(name: str, value: Any, rule: str, ok: bool) -> None:
         raise SceneError(f"slider_crank: {name}={value!r}, {rule}.")
 
 
+def _contact_law(law: Any, restitution: float, length: float | None) -> NormalLaw:
+    """A law object from a law or a name; ``restitution``/``length`` fill the fields the law has."""
+    if isinstance(law, NormalLaw):
+        return law
+    fields = {"restitution": restitution, "length": length}
+    from .contact.registry import NORMAL_LAWS, _NORMAL_ALIASES, _lookup  # one source of names
+
+    cls = _lookup("law", str(law), NORMAL_LAWS, _NORMAL_ALIASES)
+    accepted = set(getattr(cls, "__dataclass_fields__", {}))
+    return normal_law(str(law), **{k: v for k, v in fields.items() if k in accepted and v is not None})
+
+
 def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 5000.0,
-                 crank_angle: float = 0.0, name: str | None = None, **options: Any) -> Scene:
+                 crank_angle: float = 0.0, name: str | None = None, clearance: float = 0.5e-3,
+                 law: Any = "lankarani-nikravesh", restitution: float = 0.9, friction: Any = None,
+                 bearing_radius: float = BEARING_RADIUS, material: Material = STEEL,
+                 length: float | None = None, **options: Any) -> Scene:
     """The chapter's slider-crank mechanism (Fig. 4.14, Table 4.1).
 
     Crank (body ``crank``) pinned to the ground at the origin by revolute ``A`` and driven
@@ -60,8 +81,10 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
 
     Parameters
     ----------
-    joint : {"ideal"}
-        Which joint has clearance; "ideal" has none.
+    joint : {"ideal", "revolute"}
+        Which joint has clearance; "ideal" has none. "revolute": joint ``C`` becomes the
+        revolute clearance joint ``clearance`` (bearing on the slider, journal on the rod,
+        Table 4.2), journal and bearing centres coincident at the start.
     gravity : float
         Magnitude of gravity along -Y, m/s^2 (0 to switch it off).
     rpm : float
@@ -70,6 +93,21 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
         Initial crank angle, rad.
     name : str or None
         Scene name; defaults to ``"slider_crank"`` (+ the joint kind).
+    clearance : float
+        Radial clearance of the clearance joint, m (0.5 mm in Fig. 4.15).
+    law : str or NormalLaw
+        Normal contact law (name or object; stiffness computed from radii and material
+        when not given). Default Lankarani-Nikravesh (3.9).
+    restitution : float
+        Coefficient of restitution c_e for laws that take one (0.9, Table 4.2).
+    friction : None, float, str or FrictionLaw
+        None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
+    bearing_radius : float
+        Bearing radius, m (10 mm, Table 4.2).
+    material : Material
+        Material of bearing and journal (steel, 207 GPa, 0.3).
+    length : float or None
+        Axial contact length L, m, required by the cylindrical laws.
 
     Returns
     -------
@@ -101,7 +139,14 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     pin_c = (state["slider"][0], 0.0)
     scene.add(Revolute("A", scene.ground, crank, at=(0.0, 0.0)))
     scene.add(Revolute("B", crank, rod, at=pin_b))
-    scene.add(Revolute("C", rod, slider, at=pin_c))
+    if joint == "revolute":
+        _check("clearance", clearance, "must be a number in (0, bearing_radius) m",
+               isinstance(clearance, (int, float)) and 0 < clearance < bearing_radius)
+        scene.add(RevoluteClearance(
+            "clearance", slider, rod, at=pin_c, bearing_radius=bearing_radius, clearance=clearance,
+            material=material, law=_contact_law(law, restitution, length), friction=friction_law(friction)))
+    else:
+        scene.add(Revolute("C", rod, slider, at=pin_c))
     scene.add(Translational("D", scene.ground, slider, at=pin_c, axis=(1.0, 0.0)))
     scene.add(Driver("drive", joint="A", speed=omega))
     return scene

@@ -22,6 +22,7 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import Any, Iterator, Sequence, Union
 
+from .contact.geometry import Material
 from .errors import SceneError
 
 GROUND = "ground"
@@ -380,3 +381,115 @@ class Scene:
             "gravity": list(self.gravity),
             "elements": {e.name: e.to_dict() for e in self.elements},
         }
+
+
+def _default_law() -> Any:
+    from .contact import LankaraniNikravesh
+
+    return LankaraniNikravesh(restitution=0.9)
+
+
+def _law_problems(element: "RevoluteClearance") -> list[str]:
+    """Resolve the joint's contact and friction laws once, reporting what is wrong."""
+    from .contact import friction_law, normal_law
+    from .contact.base import NormalLaw
+
+    out: list[str] = []
+    law = element.law
+    try:
+        if isinstance(law, str):
+            law = normal_law(law)
+        if not isinstance(law, NormalLaw):
+            out.append(f"{element.kind} '{element.name}': law={law!r}, must be a daeclear.contact law or a law name.")
+        else:
+            element.resolved_law()
+    except (SceneError, TypeError) as exc:
+        out.append(f"{element.kind} '{element.name}': {exc}")
+    try:
+        friction_law(element.friction)
+    except (SceneError, TypeError) as exc:
+        out.append(f"{element.kind} '{element.name}': friction: {exc}")
+    return out
+
+
+@dataclass(frozen=True)
+class RevoluteClearance(_PointJoint):
+    """Revolute joint with radial clearance: a journal (body j) inside a bearing (body i).
+
+    The joint adds no constraint; the journal moves freely inside the bearing and a
+    contact-impact force acts when the eccentricity exceeds the clearance (section 4.2,
+    eqs. 4.1-4.13). ``at`` is the common centre of bearing and journal in the reference
+    configuration (or give ``point_i``/``point_j`` in body coordinates).
+
+    Parameters
+    ----------
+    name : str
+        Unique name; channels ``<name>.ex``, ``<name>.penetration``, ... and events use it.
+    body_i, body_j : str or Body
+        Bearing body and journal body.
+    bearing_radius : float
+        Bearing radius R_i, m.
+    clearance : float or None
+        Radial clearance c = R_i - R_j, m (give this or ``journal_radius``).
+    journal_radius : float or None
+        Journal radius R_j, m.
+    material : Material or (Material, Material) or None
+        Materials of bearing and journal (one for both); needed when the law's stiffness
+        is computed (``stiffness=None``).
+    law : NormalLaw or str
+        Normal contact law (default Lankarani-Nikravesh with c_e = 0.9, eq. 3.9).
+    friction : None, float, str or FrictionLaw
+        None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
+    """
+
+    bearing_radius: float = 0.0
+    clearance: float | None = None
+    journal_radius: float | None = None
+    material: Any = None
+    law: Any = field(default_factory=lambda: _default_law())
+    friction: Any = None
+
+    @property
+    def radial_clearance(self) -> float:
+        if self.clearance is not None:
+            return float(self.clearance)
+        return float(self.bearing_radius) - float(self.journal_radius or 0.0)
+
+    @property
+    def journal(self) -> float:
+        return float(self.bearing_radius) - self.radial_clearance
+
+    def resolved_law(self) -> Any:
+        """The normal law with its stiffness (or cylinder geometry) set from radii and materials."""
+        from .contact import normal_law
+
+        law = normal_law(self.law) if isinstance(self.law, str) else self.law
+        if law.is_resolved:
+            return law
+        return law.resolve("internal_cylinder", radii=(float(self.bearing_radius), self.journal),
+                           materials=self.material)
+
+    def resolved_friction(self) -> Any:
+        from .contact import friction_law
+
+        return friction_law(self.friction)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        self._check_positive(out, "bearing_radius", "m")
+        given = [self.clearance is not None, self.journal_radius is not None]
+        if given[0] == given[1]:
+            out.append(f"{self.kind} '{self.name}': give exactly one of clearance= or journal_radius= "
+                       f"(got clearance={self.clearance!r}, journal_radius={self.journal_radius!r}).")
+        elif given[0]:
+            self._check_positive(out, "clearance", "m")
+        else:
+            self._check_positive(out, "journal_radius", "m")
+        if not out:
+            c, R = self.radial_clearance, float(self.bearing_radius)
+            if not 0.0 < c < R:
+                out.append(f"{self.kind} '{self.name}': journal radius {self.journal!r} m must be in "
+                           f"(0, bearing_radius={R!r} m): clearance {c!r} m, must be in (0, {R!r}).")
+            else:
+                out.extend(_law_problems(self))
+        return out

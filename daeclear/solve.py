@@ -190,19 +190,23 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     y, yp = y0, yp0
     if any(active):
         y, yp = model.consistent_state(0.0, y0, _term_forces(model, 0.0, y0, active, params))
+    switch = model.switch_vector(active, params)
 
     steps_t: list[NDArray] = [np.array([0.0])]
     steps_y: list[NDArray] = [y[None, :]]
     steps_yp: list[NDArray] = [yp[None, :]]
     steps_h: list[NDArray] = [np.array([0.0])]
     steps_order: list[NDArray] = [np.array([0])]
+    steps_switch: list[NDArray] = [switch[None, :]]
     ev_t: list[NDArray] = []
     ev_y: list[NDArray] = []
     ev_yp: list[NDArray] = []
+    ev_switch: list[NDArray] = []
     if eval_times is not None and eval_times[0] == 0.0:
         ev_t.append(np.array([0.0]))
         ev_y.append(y[None, :])
         ev_yp.append(yp[None, :])
+        ev_switch.append(switch[None, :])
         pending = eval_times[1:]
     else:
         pending = eval_times
@@ -212,7 +216,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     success, status, message = True, 0, "end of the time span reached"
     n_restarts = 0
     try:
-        session.reinit(t, y, yp, active, params)
+        session.reinit(t, y, yp, active, params, _root_directions(model, active))
         while True:
             seg_start = t
             adv = session.advance(t_end, pending, store_steps)
@@ -222,6 +226,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 steps_yp.append(adv.step_yp)
                 steps_h.append(adv.step_h)
                 steps_order.append(adv.step_order)
+                steps_switch.append(np.repeat(switch[None, :], adv.step_t.size, axis=0))
             if adv.eval_t.size:
                 # IDA's interpolant of the multipliers is not error-controlled: recompute the
                 # multipliers and accelerations of output points from their q and v.
@@ -230,6 +235,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 ev_t.append(adv.eval_t)
                 ev_y.append(y_eval)
                 ev_yp.append(yp_eval)
+                ev_switch.append(np.repeat(switch[None, :], adv.eval_t.size, axis=0))
                 if pending is not None:
                     pending = pending[pending > adv.eval_t[-1]]
             t, y, yp = adv.t, adv.y, adv.yp
@@ -248,7 +254,8 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 for event in new_events:
                     modes[event.pair] = "contact" if event.kind == "onset" else "free"
             y, yp = model.consistent_state(t, y, _term_forces(model, t, y, active, params))
-            session.reinit(t, y, yp, active, params)
+            switch = model.switch_vector(active, params)
+            session.reinit(t, y, yp, active, params, _root_directions(model, active))
             n_restarts += 1
     except KeyboardInterrupt:
         success, status, message = False, -1, f"interrupted by the user at t={t:.6g} s"
@@ -258,16 +265,19 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
 
     progress_line.update(t_end if success else t, len(events))
     step_t = np.concatenate(steps_t)
+    n_switch = switch.size
     if eval_times is not None:
         out_t = np.concatenate(ev_t) if ev_t else np.zeros(0)
         out_y = np.concatenate(ev_y) if ev_y else np.zeros((0, model.n_states))
         out_yp = np.concatenate(ev_yp) if ev_yp else np.zeros((0, model.n_states))
+        out_switch = np.concatenate(ev_switch) if ev_switch else np.zeros((0, n_switch))
     else:
         out_t, out_y, out_yp = step_t, np.concatenate(steps_y), np.concatenate(steps_yp)
+        out_switch = np.concatenate(steps_switch)
     stats.update(n_events=len(events), n_restarts=n_restarts, setup_time=setup_time)
     result = Result(
         t=out_t, y=out_y, yp=out_yp, state_names=list(model.state_names),
-        channels=model.channels(out_t, out_y, out_yp), units=dict(model.channel_units),
+        channels=model.channels(out_t, out_y, out_yp, out_switch), units=dict(model.channel_units),
         events=events, segments=segments, step_t=step_t, step_h=np.concatenate(steps_h),
         step_order=np.concatenate(steps_order), stats=stats, success=success, status=status, message=message,
         parameters={**model.parameters, "simulate": sim_params}, scene_name=model.scene_name,
@@ -276,6 +286,17 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     if not success and on_failure == "raise":
         raise SolveError(message + " Partial result in .result.", result)
     return result
+
+
+def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:
+    """Root directions for the next segment: each contact pair watches only its next switch."""
+    if not model.gap_names:
+        return None
+    directions = np.zeros(len(model.gap_names), dtype=np.int32)
+    for logic in model.contacts:
+        for index, direction in logic.root_directions(active):
+            directions[index] = direction
+    return directions
 
 
 def _term_forces(model: DAEModel, t: ArrayLike, y: NDArray, active: Sequence[bool],

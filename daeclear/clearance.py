@@ -1,0 +1,188 @@
+"""Clearance joints as contact elements: symbolic forces, gap functions, channels, event logic.
+
+A clearance joint adds no constraint. It brings
+
+* *terms*: generalized contact forces that the solver switches on only while the pair is
+  in contact (inactive terms are never evaluated);
+* *gaps*: root functions watched by IDA, positive in penetration;
+* *channels*: output quantities (eccentricity, penetration, forces);
+* *logic*: what happens at a root (mode switch, approach speed latched at onset).
+
+Event rule (documented in docs/user_guide.md, "Contact events")
+---------------------------------------------------------------
+A pair is *free* or in *contact*. While free, only upward crossings of its gap are
+watched (onset); while in contact only downward ones (separation). At an onset the
+approach speed (the penetration rate at the located root) is latched, floored at the
+law's ``min_approach_speed`` so the damping term stays bounded for grazing contacts,
+and the term is switched on; at a separation it is switched off. Every switch restarts
+IDA from a consistent state. The contact force is exactly zero with a zero derivative
+at zero penetration for every continuous law, so a switch never jumps the force; and
+because IDA returns a root just past the crossing, a restart never reports the same
+crossing twice. Following (continuous) contact keeps the pair in contact mode with no
+events at all; a Zeno-like cascade of ever shorter bounces is cut by the storm guard
+of :class:`PairLogic` (see ``STORM_EVENTS``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from .result import ContactEvent
+from .scene import RevoluteClearance, Scene
+from .symbolic import AssemblyContext, Channel, Term, perpendicular
+
+# Storm guard: when a pair switches STORM_EVENTS times within STORM_WINDOW seconds, its term
+# stays on through the next separations until the pair has been free for STORM_WINDOW. The
+# law's force is zero (with zero derivative) for a non-positive penetration, so this changes
+# nothing physical; it only stops restarting IDA for micro-bounces.
+STORM_EVENTS = 20
+STORM_WINDOW = 1e-6
+
+
+@dataclass
+class PairLogic:
+    """Mode switching of one contact pair: one gap (root) and one term.
+
+    ``rate`` evaluates ``(gap, penetration_rate)`` from ``(q, v)``; ``needs_approach`` says
+    whether the term's parameter is the approach speed latched at onset.
+    """
+
+    pair: str
+    root_index: int
+    term_index: int
+    rate: ca.Function
+    n_q: int
+    needs_approach: bool
+    min_approach_speed: float
+    recent: list[float] = field(default_factory=list)
+    held_since: float | None = None
+
+    def _gap_rate(self, y: NDArray) -> tuple[float, float]:
+        q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
+        gap, rate = self.rate(q, v)
+        return float(gap), float(rate)
+
+    def _params(self, rate: float) -> NDArray:
+        return np.array([max(rate, self.min_approach_speed)]) if self.needs_approach else np.zeros(0)
+
+    def initial_modes(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> dict[str, str]:
+        gap, rate = self._gap_rate(y)
+        in_contact = gap > 0.0
+        active[self.term_index] = in_contact
+        params[self.term_index] = self._params(rate)
+        return {self.pair: "contact" if in_contact else "free"}
+
+    def root_directions(self, active: Sequence[bool]) -> list[tuple[int, int]]:
+        """While free watch onsets (+1), while in contact separations (-1)."""
+        return [(self.root_index, -1 if active[self.term_index] else +1)]
+
+    def on_roots(self, t: float, y: NDArray, yp: NDArray, roots_found: NDArray | None,
+                 active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+        if roots_found is None or roots_found[self.root_index] == 0:
+            return []
+        direction = int(roots_found[self.root_index])
+        gap, rate = self._gap_rate(y)
+        k = self.term_index
+        if direction > 0 and not active[k]:
+            self._count(t)
+            active[k] = True
+            params[k] = self._params(rate)
+            self.held_since = None
+            return [ContactEvent(t=t, pair=self.pair, kind="onset", approach_speed=rate, y=y.copy())]
+        if direction < 0 and active[k]:
+            self._count(t)
+            event = ContactEvent(t=t, pair=self.pair, kind="separation", approach_speed=rate, y=y.copy())
+            if len(self.recent) >= STORM_EVENTS:
+                self.held_since = t  # storm: keep the (zero) force term on, see STORM_EVENTS
+            else:
+                active[k] = False
+            return [event]
+        return []
+
+    def _count(self, t: float) -> None:
+        self.recent = [s for s in self.recent if t - s < STORM_WINDOW] + [t]
+
+
+@dataclass(frozen=True)
+class ContactBuild:
+    """What a clearance joint contributes to the assembled model."""
+
+    terms: list[Term]
+    gaps: list[Any]
+    gap_names: list[str]
+    channels: Callable[[Sequence[tuple[Any, Any]]], list[Channel]]
+    logic: list[Any]
+
+
+def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, scene: Scene,
+                             first_term: int, first_root: int) -> ContactBuild:
+    """Journal-bearing contact (section 4.2): eqs. (4.1)-(4.13) with the joint's laws.
+
+    Body i carries the bearing (radius R_i), body j the journal (R_j); c = R_i - R_j.
+    """
+    law = joint.resolved_law()
+    friction = joint.resolved_friction()
+    c = joint.radial_clearance
+    R_i, R_j = float(joint.bearing_radius), joint.journal
+    if joint.at is not None:
+        s_i = ctx.local_point(joint.body_i, joint.at) if joint.point_i is None else np.asarray(joint.point_i)
+        s_j = ctx.local_point(joint.body_j, joint.at) if joint.point_j is None else np.asarray(joint.point_j)
+    else:
+        s_i, s_j = np.asarray(joint.point_i), np.asarray(joint.point_j)
+    bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
+    P_i, P_j = bi.point(ca.DM(s_i)), bj.point(ca.DM(s_j))  # (4.2)
+    e = P_j - P_i  # (4.1) eccentricity
+    e_dot = bj.point_velocity(ca.DM(s_j)) - bi.point_velocity(ca.DM(s_i))
+    ee = ca.dot(e, e)
+    gap = (ee - c * c) / (2.0 * c)  # smooth at e = 0; equals delta (1 + delta / 2c) near contact
+
+    # in contact |e| >= c > 0: the normal and everything below are regular there
+    e_norm = ca.sqrt(ee)
+    n = e / e_norm  # (4.4)
+    delta = e_norm - c  # (4.5)
+    delta_dot = ca.dot(e_dot, n)  # (4.8): v_N = d|e|/dt
+    t_vec = perpendicular(n)
+    Q_i = P_i + R_i * n  # (4.6) contact points
+    Q_j = P_j + R_j * n
+    # (4.9) with the velocities of the material points at the contact (spin included)
+    v_T = ca.dot(bj.world_point_velocity(Q_j) - bi.world_point_velocity(Q_i), t_vec)
+
+    n_params = 1 if law.needs_approach_speed else 0
+    p = ca.SX.sym("p", n_params)
+    F_N = law.force(delta, delta_dot, p[0] if n_params else None)
+    F_T = 0.0 if friction.frictionless else friction.friction_force(F_N, v_T)
+    f_journal = -F_N * n + F_T * t_vec  # force on the journal (body j); the bearing gets the opposite
+    Q = ctx.generalized_force([(joint.body_j, f_journal, Q_j), (joint.body_i, -f_journal, Q_i)])
+    force = ca.Function(f"{joint.name}_force", [ctx.t, ctx.q, ctx.v, p], [Q], ["t", "q", "v", "p"], ["Q"])
+    rate = ca.Function(f"{joint.name}_rate", [ctx.q, ctx.v], [gap, ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
+    logic = PairLogic(joint.name, first_root, first_term, rate, ctx.n_q, law.needs_approach_speed,
+                      float(getattr(law, "min_approach_speed", 0.0)))
+
+    def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
+        on, p_sym = switches[0]
+        F_N_out = on * ca.substitute(F_N, p, p_sym) if n_params else on * F_N
+        out = [
+            Channel(f"{joint.name}.ex", "m", e[0]),
+            Channel(f"{joint.name}.ey", "m", e[1]),
+            Channel(f"{joint.name}.eccentricity", "m", e_norm),
+            Channel(f"{joint.name}.penetration", "m", e_norm - c),
+            Channel(f"{joint.name}.penetration_rate", "m/s", ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)),
+            Channel(f"{joint.name}.normal_force", "N", F_N_out),
+            Channel(f"{joint.name}.in_contact", "", on),
+        ]
+        if not friction.frictionless:
+            F_T_out = on * (ca.substitute(F_T, p, p_sym) if n_params else F_T)
+            out += [Channel(f"{joint.name}.friction_force", "N", F_T_out),
+                    Channel(f"{joint.name}.sliding_velocity", "m/s", v_T)]
+        return out
+
+    return ContactBuild(terms=[Term(joint.name, force, n_params)], gaps=[gap], gap_names=[joint.name],
+                        channels=channels, logic=[logic])
+
+
+CONTACT_BUILDERS: dict[type, Callable[..., ContactBuild]] = {RevoluteClearance: build_revolute_clearance}
