@@ -56,6 +56,7 @@ def _run(args: argparse.Namespace) -> int:
 
     params = _parse_sets(args.set)
     sim: dict[str, Any] = {}
+    reference_scene = None
     if args.target.endswith(".toml") or Path(args.target).is_file():
         spec = read_scene_file(args.target)
         scene, sim = spec.scene, dict(spec.simulate)
@@ -65,6 +66,8 @@ def _run(args: argparse.Namespace) -> int:
         if args.joint:
             params["joint"] = args.joint
         scene = MECHANISMS[args.target](**params)
+        if params.get("joint", "ideal") != "ideal":  # the chapter plots against the ideal joint
+            reference_scene = MECHANISMS[args.target](**{**params, "joint": "ideal"})
     else:
         raise DaeclearError(f"run: {args.target!r} is neither a scene file nor a mechanism "
                             f"({', '.join(MECHANISMS)}).")
@@ -91,7 +94,11 @@ def _run(args: argparse.Namespace) -> int:
         import matplotlib
         matplotlib.use("Agg")
         from .plot import save_response_figure
-        png = save_response_figure(result, args.out / f"{base}.png")
+        reference = None
+        if reference_scene is not None:
+            reference = simulate(reference_scene, t_end, rtol=options["rtol"], backend=args.backend,
+                                 on_failure="return")
+        png = save_response_figure(result, args.out / f"{base}.png", reference=reference)
         print(f"wrote {png}")
     if not result.success:
         print(f"daeclear: run failed: {result.message}", file=sys.stderr)

@@ -312,7 +312,7 @@ def _term_forces(model: DAEModel, t: ArrayLike, y: NDArray, active: Sequence[boo
     for term, on, p in zip(model.terms, active, params):
         if on:
             p_cols = np.repeat(np.asarray(p, dtype=float).reshape(-1, 1), N, axis=1)
-            total += np.array(term.force.map(N)(t_row, y2[:, :n].T, y2[:, n:2 * n].T, p_cols)).T
+            total += np.array((term.force if N == 1 else term.force.map(N))(t_row, y2[:, :n].T, y2[:, n:2 * n].T, p_cols)).T
     return total[0] if np.ndim(y) == 1 else total
 
 
