@@ -9,13 +9,14 @@ from . import mechanisms
 from .assemble import DAEModel, assemble
 from .errors import AssemblyError, DaeclearError, DaeclearWarning, SceneError, SolveError
 from .result import ContactEvent, Result, load
-from .scene import Body, Driver, Revolute, Scene, Translational
+from .contact import Material
+from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
 from .solve import simulate
 
 __version__ = "0.1.0"
 
 __all__ = [
     "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "Driver",
-    "Result", "Revolute", "Scene", "SceneError", "SolveError", "Translational", "assemble", "load",
-    "mechanisms", "simulate",
+    "Material", "Result", "Revolute", "RevoluteClearance", "Scene", "SceneError", "SolveError", "Translational",
+    "TranslationalClearance", "assemble", "load", "mechanisms", "simulate",
 ]

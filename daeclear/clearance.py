@@ -59,6 +59,7 @@ class PairLogic:
     n_q: int
     needs_approach: bool
     min_approach_speed: float
+    discontinuous_friction: bool = False
     recent: list[float] = field(default_factory=list)
     held_since: float | None = None
 
@@ -161,7 +162,8 @@ def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, sce
     force = ca.Function(f"{joint.name}_force", [ctx.t, ctx.q, ctx.v, p], [Q], ["t", "q", "v", "p"], ["Q"])
     rate = ca.Function(f"{joint.name}_rate", [ctx.q, ctx.v], [gap, ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
     logic = PairLogic(joint.name, first_root, first_term, rate, ctx.n_q, law.needs_approach_speed,
-                      float(getattr(law, "min_approach_speed", 0.0)))
+                      float(getattr(law, "min_approach_speed", 0.0)),
+                      discontinuous_friction=not friction.frictionless and not friction.smooth)
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
         on, p_sym = switches[0]
@@ -186,3 +188,7 @@ def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, sce
 
 
 CONTACT_BUILDERS: dict[type, Callable[..., ContactBuild]] = {RevoluteClearance: build_revolute_clearance}
+
+from .slider_guide import TranslationalClearance, build_translational_clearance  # noqa: E402  (imports ContactBuild)
+
+CONTACT_BUILDERS[TranslationalClearance] = build_translational_clearance

@@ -378,3 +378,182 @@ def build_model_library(funcs: Any, *, model: NormalizedModel | None = None) -> 
             os.replace(src_tmp, root / f"{stem}.c")
             os.replace(out, target)
         return BuildResult(target, key, False, time.perf_counter() - t1, codegen_time)
+
+
+# --------------------------------------------------------------------------- ODE libraries
+# (for the explicit and scipy integrators of daeclear.integrators; no SUNDIALS involved)
+
+ODE_DRIVER_SOURCES = ("ode_driver.c", "dco_model.h", "dc_model.h")
+__all__ += ["OdeSpec", "generate_ode_source", "build_ode_library"]
+
+
+@dataclass(frozen=True)
+class OdeSpec:
+    """An index-1 mechanism as an ODE in x = (q, v), as CasADi functions for ``csrc/ode_driver.c``.
+
+    Sizes: n coordinates, m constraints. Every function has dense column-vector inputs; matrix
+    outputs are dense (stored column-major in C):
+
+    * ``sys``: (t[1], q[n], v[n]) -> (Q[n], Phi_q[m x n], c[m]), c the Baumgarte right-hand side;
+    * ``sys_jac``: (t, q, v, a[n], lam[m]) -> d[Phi_q^T lam - Q; Phi_q a - c]/d(q, v), (n+m) x 2n;
+    * ``gaps``: (t, q, v) -> (g[n_gaps], dg/dt[n_gaps]) or None;
+    * ``term_force[k]``: (t, q, v, p_k) -> F_k[n]; ``term_jac[k]``: same inputs -> dF_k/d(q, v), n x 2n.
+    """
+
+    n: int
+    m: int
+    mass: tuple[float, ...]
+    sys: casadi.Function
+    sys_jac: casadi.Function
+    gaps: casadi.Function | None
+    term_force: tuple[casadi.Function, ...]
+    term_jac: tuple[casadi.Function, ...]
+    n_params: tuple[int, ...]
+    name: str = "model"
+
+    @property
+    def n_gaps(self) -> int:
+        return 0 if self.gaps is None else int(self.gaps.numel_out(0))
+
+
+def _check_ode_spec(spec: OdeSpec) -> None:
+    n, m = spec.n, spec.m
+
+    def check(f: Any, what: str, ins: list[int], outs: list[int]) -> None:
+        if not isinstance(f, casadi.Function):
+            raise AssemblyError(f"OdeSpec.{what} must be a casadi.Function, got {type(f).__name__}")
+        got_in = [f.numel_in(i) for i in range(f.n_in())]
+        got_out = [f.numel_out(i) for i in range(f.n_out())]
+        if got_in != ins or got_out != outs:
+            raise AssemblyError(f"OdeSpec.{what} ({f.name()}): input sizes {got_in} and output sizes "
+                                f"{got_out}, expected {ins} and {outs}")
+        for i in range(f.n_out()):
+            if not f.sparsity_out(i).is_dense():
+                raise AssemblyError(f"OdeSpec.{what} ({f.name()}): output {i} must be dense")
+
+    if len(spec.mass) != n or not all(mk > 0 for mk in spec.mass):
+        raise AssemblyError(f"OdeSpec.mass must hold {n} positive values, got {list(spec.mass)}")
+    check(spec.sys, "sys", [1, n, n], [n, m * n, m])
+    check(spec.sys_jac, "sys_jac", [1, n, n, n, m], [(n + m) * 2 * n])
+    if spec.gaps is not None:
+        check(spec.gaps, "gaps", [1, n, n], [spec.n_gaps, spec.n_gaps])
+    if not (len(spec.term_force) == len(spec.term_jac) == len(spec.n_params)):
+        raise AssemblyError("OdeSpec: term_force, term_jac and n_params must have the same length")
+    for k, (ff, fj, p) in enumerate(zip(spec.term_force, spec.term_jac, spec.n_params)):
+        check(ff, f"term_force[{k}]", [1, n, n, p], [n])
+        check(fj, f"term_jac[{k}]", [1, n, n, p], [n * 2 * n])
+
+
+def generate_ode_source(spec: OdeSpec) -> str:
+    """CasADi-generated C for every function of an OdeSpec, plus the dco_model table."""
+    _check_ode_spec(spec)
+    cg = casadi.CodeGenerator(
+        "dco_model_gen.c",
+        {"with_header": False, "casadi_int": "long long int", "casadi_real": "double"},
+    )
+    nt = len(spec.term_force)
+    funs = {"dco_sys": spec.sys, "dco_sys_jac": spec.sys_jac}
+    if spec.gaps is not None:
+        funs["dco_gaps"] = spec.gaps
+    for k in range(nt):
+        funs[f"dco_term{k}_force"] = spec.term_force[k]
+        funs[f"dco_term{k}_jac"] = spec.term_jac[k]
+    for name, f in funs.items():
+        # re-wrap under the C symbol name the table refers to
+        ins = [casadi.SX.sym(f"i{i}", f.numel_in(i)) if f.is_a("SXFunction") else
+               casadi.MX.sym(f"i{i}", f.numel_in(i)) for i in range(f.n_in())]
+        args = [casadi.reshape(x, f.size_in(i)) for i, x in enumerate(ins)]
+        outs = [casadi.densify(o) for o in f.call(args)]
+        cg.add(casadi.Function(name, ins, outs))
+    src = cg.dump()
+    mass = ", ".join(repr(float(mk)) for mk in spec.mass)
+    lines = [
+        "",
+        "/* ---------------------------------------------------------------- daeclear ODE table */",
+        '#include "dco_model.h"',
+        f"static const double dco_mass_tab[{spec.n}] = {{{mass}}};",
+    ]
+    if nt:
+        lines.append(f"static const int dco_n_params_tab[{nt}] = {{{', '.join(map(str, spec.n_params))}}};")
+        lines.append(f"static const dc_fun_t dco_term_force_tab[{nt}] = {{")
+        lines += [f"  {_fun_entry(f'dco_term{k}_force')}," for k in range(nt)]
+        lines.append("};")
+        lines.append(f"static const dc_fun_t dco_term_jac_tab[{nt}] = {{")
+        lines += [f"  {_fun_entry(f'dco_term{k}_jac')}," for k in range(nt)]
+        lines.append("};")
+    gaps_entry = _fun_entry("dco_gaps") if spec.gaps is not None else "{0, 0, 0, 0, 0, 0, 0}"
+    lines += [
+        "const dco_model_t dco_model = {",
+        f"  {spec.n}, {spec.m}, {nt}, {spec.n_gaps},",
+        f"  {'dco_n_params_tab' if nt else '0'},",
+        "  dco_mass_tab,",
+        f"  {_fun_entry('dco_sys')},",
+        f"  {_fun_entry('dco_sys_jac')},",
+        f"  {gaps_entry},",
+        f"  {'dco_term_force_tab' if nt else '0'},",
+        f"  {'dco_term_jac_tab' if nt else '0'},",
+        f"  {_c_string(spec.name)}",
+        "};",
+        "",
+    ]
+    return src + "\n".join(lines)
+
+
+def build_ode_library(spec: OdeSpec) -> BuildResult:
+    """Generate, compile (or find in the cache) the shared library of an OdeSpec.
+
+    Same cache directory, key scheme and locking as :func:`build_model_library`; the library
+    holds the generated functions and ``csrc/ode_driver.c`` (symbols ``dco_*``), and links
+    nothing but libm.
+    """
+    t0 = time.perf_counter()
+    cc = compiler_command()
+    version = _compiler_version(cc[0])
+    source = generate_ode_source(spec)
+    flags = ["-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Werror=incompatible-pointer-types",
+             "-Werror=implicit-function-declaration", f"-I{CSRC}"]
+    link = ["-lm"]
+    driver = "".join(f"/* {name} */\n" + (CSRC / name).read_text() for name in ODE_DRIVER_SOURCES)
+    h = hashlib.sha256()
+    for part in ("ode", source, driver, shlex.join(cc + flags + link), version):
+        h.update(part.encode())
+        h.update(b"\0")
+    key = h.hexdigest()
+    codegen_time = time.perf_counter() - t0
+
+    root = cache_dir()
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise CompilerUnavailable(f"cache directory {root} cannot be created: {exc}") from exc
+    stem = f"dco_{key[:40]}"
+    target = root / f"{stem}.so"
+    if target.is_file():
+        return BuildResult(target, key, True, 0.0, codegen_time)
+    with _file_lock(root / f"{stem}.lock"):
+        if target.is_file():
+            return BuildResult(target, key, True, 0.0, codegen_time)
+        t1 = time.perf_counter()
+        with tempfile.TemporaryDirectory(prefix=f"{stem}-", dir=root) as tmp:
+            tmpd = Path(tmp)
+            model_c = tmpd / "model.c"
+            model_c.write_text(source)
+            out = tmpd / "lib.so"
+            cmd = [*cc, *flags, str(model_c), str(CSRC / "ode_driver.c"), "-o", str(out), *link]
+            try:
+                proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+            except (OSError, subprocess.SubprocessError) as exc:
+                raise CompilerUnavailable(f"running the C compiler {cc[0]!r} failed: {exc}") from exc
+            if proc.returncode != 0 or not out.is_file():
+                msg = (proc.stderr or proc.stdout or "").strip()
+                if len(msg) > 4000:
+                    msg = msg[:2000] + "\n...\n" + msg[-2000:]
+                raise CompileError(
+                    f"compiling the ODE model {spec.name!r} failed (exit {proc.returncode}):\n"
+                    f"$ {shlex.join(cmd)}\n{msg}"
+                )
+            src_tmp = tmpd / "src.c"
+            src_tmp.write_text(source)
+            os.replace(src_tmp, root / f"{stem}.c")
+            os.replace(out, target)
+        return BuildResult(target, key, False, time.perf_counter() - t1, codegen_time)

@@ -252,6 +252,7 @@ class _SessionBase:
         self._yp = np.zeros(model.n)
         self._active = np.zeros(self._nt, dtype=np.int32)
         self._params = [np.zeros(p) for p in model.n_params]
+        self._stall_step, self._stall_count = 0.0, TINY_STEP_COUNT
         self._solve_time = 0.0
         self._extra_stats: dict[str, int | float] = {}
 
@@ -288,6 +289,15 @@ class _SessionBase:
         """Solver hints (see CSession.set_hints); scikit-sundae exposes neither, so the python
         backend ignores them and returns False."""
         return False
+
+    def set_stall(self, stall_step: float, count: int) -> None:
+        """Stall detection: ``count`` tiny steps (below ``stall_step`` s and not growing, with no
+        step 100x larger in between) end an advance with DC_STEP_COLLAPSE. Both backends."""
+        if not (stall_step >= 0.0) or count < 1:
+            raise ValueError(f"set_stall: stall_step={stall_step!r} must be >= 0 and count={count!r} >= 1")
+        self._stall_step, self._stall_count = float(stall_step), int(count)
+        if self.backend == "c":
+            self._lib.dc_set_stall(self._h, self._stall_step, self._stall_count)
 
     def _check_reinit(self, t0: Any, y0: Any, yp0: Any, active: Any, params: Any,
                       root_directions: Any) -> tuple[float, np.ndarray, np.ndarray, np.ndarray,
@@ -394,6 +404,8 @@ class _CLib:
         lib.dc_open.argtypes = [D, P, D, I, ctypes.c_longlong, P, ctypes.c_char_p, I]
         lib.dc_set_nonlin_conv_coef.restype = I
         lib.dc_set_nonlin_conv_coef.argtypes = [P, D]
+        lib.dc_set_stall.restype = I
+        lib.dc_set_stall.argtypes = [P, D, I]
         lib.dc_set_init_step.restype = I
         lib.dc_set_init_step.argtypes = [P, D]
         lib.dc_free.restype = None
@@ -949,16 +961,18 @@ class PythonSession(_SessionBase):
                         sh.append(h)
                         t_rec = t_new
                     if new_step and fl != 1 and not math.isnan(h):
-                        if abs(h) >= TINY_STEP_REL * max(1.0, abs(t_new)):
+                        thr = max(TINY_STEP_REL * max(1.0, abs(t_new)), self._stall_step)
+                        if abs(h) >= (100.0 * thr if self._stall_step > 0 else thr):
                             self._tiny = 0
-                        elif not abs(h) > TINY_STEP_GROWTH * abs(self._h_prev):
+                        elif abs(h) < thr and not abs(h) > TINY_STEP_GROWTH * abs(self._h_prev):
                             self._tiny += 1
                         self._h_prev = h
-                        if self._tiny >= TINY_STEP_COUNT:
+                        if self._tiny >= self._stall_count:
                             status, flag = "error", FLAG_STEP_COLLAPSE
                             flag_name = _OWN_FLAG_NAMES[flag]
                             message = (f"step size collapsed: {self._tiny} steps with |h| < "
-                                       f"{TINY_STEP_REL}*max(1,|t|) that did not grow (last h={h:.3g}) "
+                                       f"max({TINY_STEP_REL}*max(1,|t|), {self._stall_step} s) that did "
+                                       f"not grow (last h={h:.3g}) "
                                        f"at t={t_new!r}")
                             break
                     if fl == 2:

@@ -8,7 +8,7 @@ from typing import Any
 from .contact import Material, friction_law, normal_law
 from .contact.base import NormalLaw
 from .errors import SceneError
-from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational
+from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
 
 # Table 4.1: link lengths (m), masses (kg), moments of inertia (kg m^2)
 CRANK_LENGTH, CRANK_MASS, CRANK_INERTIA = 0.05, 0.30, 1.0e-4
@@ -19,7 +19,13 @@ SLIDER_MASS, SLIDER_INERTIA = 0.14, 1.0e-4
 BEARING_RADIUS = 10.0e-3
 STEEL = Material(young=207e9, poisson=0.3)
 
-JOINT_KINDS = ("ideal", "revolute")
+# Table 4.3: translational clearance joint (slider length x width x thickness, corner radius)
+SLIDER_LENGTH = SLIDER_WIDTH = SLIDER_THICKNESS = 50.0e-3
+CORNER_RADIUS = 1.0e-3
+# Guide contact segment: the slider's corners stay 5 mm inside it over the whole stroke.
+GUIDE_MARGIN = 5.0e-3
+
+JOINT_KINDS = ("ideal", "revolute", "translational")
 
 
 def rpm_to_rad_s(rpm: float) -> float:
@@ -70,7 +76,8 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
                  crank_angle: float = 0.0, name: str | None = None, clearance: float = 0.5e-3,
                  law: Any = "lankarani-nikravesh", restitution: float = 0.9, friction: Any = None,
                  bearing_radius: float = BEARING_RADIUS, material: Material = STEEL,
-                 length: float | None = None, **options: Any) -> Scene:
+                 length: float | None = None, contact_model: str = "corners",
+                 face_law: Any = "lankarani-plane", **options: Any) -> Scene:
     """The chapter's slider-crank mechanism (Fig. 4.14, Table 4.1).
 
     Crank (body ``crank``) pinned to the ground at the origin by revolute ``A`` and driven
@@ -81,10 +88,17 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
 
     Parameters
     ----------
-    joint : {"ideal", "revolute"}
+    joint : {"ideal", "revolute", "translational"}
         Which joint has clearance; "ideal" has none. "revolute": joint ``C`` becomes the
         revolute clearance joint ``clearance`` (bearing on the slider, journal on the rod,
-        Table 4.2), journal and bearing centres coincident at the start.
+        Table 4.2), journal and bearing centres coincident at the start. "translational":
+        joint ``D`` becomes the translational clearance joint ``clearance`` (Fig. 4.27,
+        Table 4.3): a 50 x 50 x 50 mm slider with 1 mm corner radius, its centre at the
+        rod-slider pin ``C`` (ideal), inside a guide on the ground whose mid-line is the X
+        axis, with contact segment x in [l - r - L/2 - 5 mm, l + r + L/2 + 5 mm] =
+        [0.04, 0.20] m on both surfaces (the slider never reaches its ends) and the
+        dimensionless stroke xi = 0 at x = l - r = 0.07 m, 1 at x = l + r = 0.17 m. The
+        slider starts midway between the surfaces and parallel to them.
     gravity : float
         Magnitude of gravity along -Y, m/s^2 (0 to switch it off).
     rpm : float
@@ -94,7 +108,8 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     name : str or None
         Scene name; defaults to ``"slider_crank"`` (+ the joint kind).
     clearance : float
-        Radial clearance of the clearance joint, m (0.5 mm in Fig. 4.15).
+        Radial clearance of the clearance joint, m (0.5 mm in Figs. 4.15 and 4.28); for
+        the translational joint c = (H - W)/2.
     law : str or NormalLaw
         Normal contact law (name or object; stiffness computed from radii and material
         when not given). Default Lankarani-Nikravesh (3.9).
@@ -108,6 +123,13 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
         Material of bearing and journal (steel, 207 GPa, 0.3).
     length : float or None
         Axial contact length L, m, required by the cylindrical laws.
+    contact_model : {"corners", "section-4.3"}
+        Translational joint only: every touching corner a sphere on a plane
+        ("corners", Figs. 4.28-4.34), or a face in contact on ``face_law``
+        ("section-4.3", Fig. 4.35b). See :class:`~daeclear.scene.TranslationalClearance`.
+    face_law : str or NormalLaw
+        Translational joint, "section-4.3" only: the law of a face in contact, default
+        Lankarani's linear law (4.26) with the stiffness (4.27).
 
     Returns
     -------
@@ -147,6 +169,19 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
             material=material, law=_contact_law(law, restitution, length), friction=friction_law(friction)))
     else:
         scene.add(Revolute("C", rod, slider, at=pin_c))
-    scene.add(Translational("D", scene.ground, slider, at=pin_c, axis=(1.0, 0.0)))
+    if joint == "translational":
+        _check("clearance", clearance, "must be a number in (0, slider length) m",
+               isinstance(clearance, (int, float)) and 0 < clearance < SLIDER_LENGTH)
+        inner, outer = ROD_LENGTH - CRANK_LENGTH, ROD_LENGTH + CRANK_LENGTH  # slider centre: x range
+        reach = 0.5 * SLIDER_LENGTH + GUIDE_MARGIN
+        scene.add(TranslationalClearance(
+            "clearance", scene.ground, slider, point_i=(0.0, 0.0), point_j=(0.0, 0.0), axis=(1.0, 0.0),
+            length=SLIDER_LENGTH, width=SLIDER_WIDTH, thickness=SLIDER_THICKNESS, corner_radius=CORNER_RADIUS,
+            clearance=clearance, upper_limits=(inner - reach, outer + reach),
+            lower_limits=(inner - reach, outer + reach), stroke=(inner, outer), material=material,
+            law=_contact_law(law, restitution, length), face_law=_contact_law(face_law, restitution, length),
+            friction=friction_law(friction), model=contact_model))
+    else:
+        scene.add(Translational("D", scene.ground, slider, at=pin_c, axis=(1.0, 0.0)))
     scene.add(Driver("drive", joint="A", speed=omega))
     return scene

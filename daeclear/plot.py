@@ -143,3 +143,276 @@ def save_response_figure(result: Result, path: Any, *, reference: Result | None 
     plt.close(fig)
     tmp.replace(path)
     return path
+
+
+# --------------------------------------------------------------------------- revolute clearance joint (section 4.4)
+
+_LENGTH_SCALE = {"m": 1.0, "mm": 1e3, "um": 1e6}
+_LENGTH_LABEL = {"m": "m", "mm": "mm", "um": "µm"}
+
+
+def _contact_intervals(result: Result, pair: str | None = None) -> list[tuple[float, float]]:
+    """Time intervals [t_onset, t_separation] in which ``pair`` (every pair when None) is in contact.
+
+    Built from ``result.events``. A result that starts in contact (its first event of the
+    pair is a separation, or, without events, its first segment has the pair in contact)
+    gets an interval from ``result.t[0]``; one that ends in contact, an interval up to
+    ``result.t[-1]``.
+    """
+    if result.n_times == 0:
+        return []
+    t_first, t_last = float(result.t[0]), float(result.t[-1])
+    events = result.events.of(pair)
+    if len(events):
+        in_contact = events[0].kind == "separation"
+    else:
+        modes = result.segments[0][2] if result.segments else {}
+        in_contact = any(mode == "contact" for name, mode in modes.items()
+                         if pair is None or name == pair or name.startswith(pair + "."))
+    intervals: list[tuple[float, float]] = []
+    start = t_first if in_contact else None
+    for event in events:
+        if event.kind == "onset" and start is None:
+            start = event.t
+        elif event.kind == "separation" and start is not None:
+            intervals.append((start, event.t))
+            start = None
+    if start is not None:
+        intervals.append((start, max(start, t_last)))
+    return intervals
+
+
+def _clearance_of(result: Result, joint: str) -> float | None:
+    """Radial clearance (m) of clearance joint ``joint`` from the result's scene parameters."""
+    element = result.parameters.get("scene", {}).get("elements", {}).get(joint, {})
+    value = element.get("clearance") if isinstance(element, dict) else None
+    return float(value) if isinstance(value, (int, float)) else None
+
+
+def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | None = None, markers: bool = True,
+                       clearance: float | None = None, unit: str = "um", **line_kw: Any) -> Axes:
+    """Journal centre relative to the bearing centre, with the clearance circle (Figs. 4.15d, 4.17, 4.20, 4.24).
+
+    Parameters
+    ----------
+    result : Result
+        A run with the channels ``<joint>.ex`` and ``<joint>.ey`` (eccentricity vector
+        e = r_journal - r_bearing, eq. 4.1).
+    joint : str
+        Name of the revolute clearance joint (``"clearance"`` in ``slider_crank``).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    markers : bool
+        Put a marker on every output point. For one marker per IDA step, as in the
+        chapter, pass a result simulated without ``t_eval`` (its output times are
+        the steps): the markers crowd where the steps are small (contact) and thin out
+        in free flight. Points outside the circle show the penetration.
+    clearance : float, optional
+        Radial clearance c (m) of the dashed circle; read from the result's scene
+        parameters when None (no circle if it cannot be found).
+    unit : {"um", "mm", "m"}
+        Length unit of both axes.
+    **line_kw
+        Passed to ``ax.plot`` for the orbit.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax.lines[0]`` is the orbit (x: e_x, y: e_y in ``unit``), ``ax.lines[1]`` the
+        clearance circle |e| = c (dashed), when drawn. Equal aspect ratio.
+    """
+    if unit not in _LENGTH_SCALE:
+        raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTH_SCALE)}.")
+    import numpy as np
+
+    ax = _axes(ax)
+    scale = _LENGTH_SCALE[unit]
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0"}
+    if markers:
+        kw.update(marker=".", ms=2.5)
+    kw.update(line_kw)
+    ax.plot(np.asarray(result[f"{joint}.ex"]) * scale, np.asarray(result[f"{joint}.ey"]) * scale, **kw)
+    c = clearance if clearance is not None else _clearance_of(result, joint)
+    if c is not None:
+        angle = np.linspace(0.0, 2.0 * np.pi, 361)
+        ax.plot(c * scale * np.cos(angle), c * scale * np.sin(angle), "k--", lw=0.8)
+    ax.set_aspect("equal", adjustable="datalim")
+    label = _LENGTH_LABEL[unit]
+    ax.set_xlabel(f"journal x rel. to bearing ({label})")
+    ax.set_ylabel(f"journal y rel. to bearing ({label})")
+    return ax
+
+
+def plot_phase_portrait(result: Result, x: str = "slider.vx", y: str = "slider.ax", *, ax: Axes | None = None,
+                        reference: Result | None = None, **line_kw: Any) -> Axes:
+    """One channel against another over the whole result (Figs. 4.18, 4.21: slider acceleration against velocity).
+
+    The chapter calls these plots Poincaré maps: a closed curve traced again and again
+    is a periodic response, a band filled by curves that never repeat a chaotic one.
+
+    Parameters
+    ----------
+    result : Result
+        The run; a dense ``t_eval`` gives a smooth curve.
+    x, y : str
+        Channel names (default slider velocity on x, slider acceleration on y).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    reference : Result, optional
+        Drawn first, black dashed (e.g. the ideal joint, whose portrait is one closed curve).
+    **line_kw
+        Passed to ``ax.plot`` for the result's curve.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax.lines[0]`` is the reference curve when given, then the result's curve.
+    """
+    ax = _axes(ax)
+    if reference is not None:
+        ax.plot(reference[x], reference[y], "k--", lw=0.8, label="ideal joint")
+    kw: dict[str, Any] = {"lw": 0.5, "color": "C0"}
+    kw.update(line_kw)
+    ax.plot(result[x], result[y], **kw)
+    for axis_label, name in ((ax.set_xlabel, x), (ax.set_ylabel, y)):
+        unit = result.units.get(name, "")
+        axis_label(f"{name} ({unit})" if unit else name)
+    return ax
+
+
+def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None = None, shade: bool = True,
+                    **line_kw: Any) -> Axes:
+    """IDA's step size against time, log scale, contact intervals shaded (section 4.4, Figs. 4.15d, 4.24).
+
+    Parameters
+    ----------
+    result : Result
+        A run with recorded steps (``result.step_t``, ``result.step_h``; ``simulate``
+        records them by default, whatever ``t_eval``).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    pair : str, optional
+        Contact pair whose contact intervals are shaded (every pair when None).
+    shade : bool
+        Shade the contact intervals (from ``result.events``) in grey.
+    **line_kw
+        Passed to ``ax.plot`` for the step sizes.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax.lines[0]``: step size h (s) against the time reached by the step (s); the
+        zero-size placeholder of the initial point is left out. One patch per contact
+        interval.
+
+    Raises
+    ------
+    ValueError
+        If the result has no recorded steps.
+    """
+    import numpy as np
+
+    if result.step_t is None or result.step_h is None:
+        raise ValueError(f"plot_step_sizes: result of scene {result.scene_name!r} has no recorded steps "
+                         f"(simulate(..., store_steps=True) records them).")
+    ax = _axes(ax)
+    h = np.asarray(result.step_h)
+    keep = h > 0
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0", "marker": ".", "ms": 1.5}
+    kw.update(line_kw)
+    ax.plot(np.asarray(result.step_t)[keep], h[keep], **kw)
+    ax.set_yscale("log")
+    if shade:
+        for k, (t0, t1) in enumerate(_contact_intervals(result, pair)):
+            ax.axvspan(t0, t1, color="0.85", lw=0, zorder=0, label="contact" if k == 0 else None)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("IDA step size (s)")
+    return ax
+
+
+def plot_cases(results: Mapping[str, Result], draw: Any, *, ncols: int = 2, sharex: bool = False,
+               sharey: bool = False, panel_size: tuple[float, float] = (3.8, 2.9), suptitle: str | None = None,
+               **kwargs: Any) -> Any:
+    """One panel per labelled result, each drawn by a figure function (Figs. 4.16-4.25).
+
+    Parameters
+    ----------
+    results : mapping of str to Result
+        Panel title -> result, in panel order; titles get the chapter's "(a)", "(b)", ...
+    draw : callable
+        A figure function called as ``draw(result, ax=ax, **kwargs)``, e.g.
+        ``plot_journal_orbit``, ``plot_phase_portrait``, ``plot_step_sizes`` or
+        ``functools.partial(plot_channel, channel="drive.moment")``.
+    ncols : int
+        Panels per row.
+    sharex, sharey : bool
+        Share axes between panels (as ``plt.subplots``).
+    panel_size : (float, float)
+        Width and height of one panel, inches.
+    suptitle : str, optional
+        Figure title.
+    **kwargs
+        Passed to every ``draw`` call (e.g. ``reference=ideal``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Its first ``len(results)`` axes hold the panels; unused grid cells are hidden.
+    """
+    import matplotlib.pyplot as plt
+
+    n = len(results)
+    if n == 0:
+        raise ValueError("plot_cases: no results to draw.")
+    ncols = max(1, min(int(ncols), n))
+    nrows = -(-n // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(panel_size[0] * ncols, panel_size[1] * nrows + 0.4),
+                             sharex=sharex, sharey=sharey, squeeze=False)
+    flat = list(axes.ravel())
+    for k, (label, result) in enumerate(results.items()):
+        draw(result, ax=flat[k], **kwargs)
+        flat[k].set_title(f"({chr(ord('a') + k)}) {label}", fontsize="medium")
+    for extra in flat[n:]:
+        extra.set_visible(False)
+    if suptitle:
+        fig.suptitle(suptitle, fontsize="medium")
+    fig.tight_layout()
+    return fig
+
+
+def plot_revolute_response(result: Result, *, reference: Result | None = None, orbit: Result | None = None,
+                           joint: str = "clearance") -> Any:
+    """Fig. 4.15 in four panels: slider velocity, slider acceleration, crank moment, journal orbit.
+
+    Parameters
+    ----------
+    result : Result
+        The clearance-joint run (a dense ``t_eval`` for panels a-c).
+    reference : Result, optional
+        The ideal-joint run over the same times, dashed in panels a-c.
+    orbit : Result, optional
+        Run whose output times are IDA's steps (``t_eval=None``), for panel d's
+        one-marker-per-step orbit; ``result`` when None.
+    joint : str
+        Name of the revolute clearance joint.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Axes in order (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) orbit.
+    """
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(10.0, 7.0))
+    (a, b), (c, d) = axes
+    titles = ("(a) slider velocity", "(b) slider acceleration", "(c) crank moment")
+    for ax, name, title in zip((a, b, c), RESPONSE_CHANNELS, titles):
+        plot_channel(result, name, ax=ax, reference=reference, label="clearance joint")
+        ax.set_title(title, fontsize="medium")
+    plot_journal_orbit(orbit if orbit is not None else result, joint, ax=d)
+    d.set_title("(d) journal trajectory relative to the bearing", fontsize="medium")
+    fig.tight_layout()
+    return fig
+
+
+__all__ += ["plot_cases", "plot_journal_orbit", "plot_phase_portrait", "plot_revolute_response", "plot_step_sizes"]

@@ -493,3 +493,223 @@ class RevoluteClearance(_PointJoint):
             else:
                 out.extend(_law_problems(self))
         return out
+
+
+def _default_face_law() -> Any:
+    from .contact import LankaraniPlane
+
+    return LankaraniPlane()
+
+
+#: Contact models of :class:`TranslationalClearance` (see its docstring).
+SLIDER_MODELS: tuple[str, ...] = ("corners", "section-4.3")
+
+
+@dataclass(frozen=True)
+class TranslationalClearance(_PointJoint):
+    """Translational joint with clearance: a rectangular slider (body j) free inside a guide (body i).
+
+    The joint adds no constraint; each slider corner that reaches a guide surface is
+    pushed back by a contact-impact force (section 4.3, eqs. 4.14-4.27). The guide is two
+    parallel surfaces a distance ``H`` apart, symmetric about the guide's *mid-line*; the
+    slider is an ``L x W`` rectangle (``thickness`` out of plane) with rounded corners.
+
+    Geometry and names. ``at`` is, in the reference configuration (bodies at their
+    declared positions and angles), both a point of the guide's mid-line and the slider's
+    centre, the slider parallel to the guide; or give ``point_i`` (a mid-line point, guide
+    coordinates) and ``point_j`` (the slider centre, slider coordinates). ``axis`` is the
+    guide direction (world, reference configuration), fixed to the guide, and the slider's
+    length direction in the reference configuration. Coordinates along the guide, ``s``,
+    are measured from the mid-line point along ``axis``; "upper" is the surface on the
+    left of ``axis`` (+90 degrees). Corners, counter-clockwise from the front upper one
+    (front = +axis): ``A`` (+L/2, +W/2), ``B`` (-L/2, +W/2), ``C`` (-L/2, -W/2),
+    ``D`` (+L/2, -W/2). Contact pairs are named ``<name>.A_upper``, ``<name>.B_upper``,
+    ``<name>.C_lower``, ``<name>.D_lower``; faces ``<name>.upper_face`` (A, B) and
+    ``<name>.lower_face`` (C, D). The chapter calls the slider body i and the guide
+    body j; here, as for :class:`Translational` and :class:`RevoluteClearance`, the
+    outer part is body i.
+
+    Parameters
+    ----------
+    name : str
+        Unique name; channels and events use it.
+    body_i, body_j : str or Body
+        Guide body and slider body.
+    axis : (float, float)
+        Guide direction, world frame, reference configuration (need not be unit).
+    length, width : float
+        Slider length L (along the guide) and width W (across), m.
+    corner_radius : float
+        Corner radius R_c, m, in (0, min(L, W)/2): the stiffness of a corner contact
+        (sphere on a plane, eq. 3.5). The penetration is measured at the sharp corner
+        of the L x W rectangle, as in eqs. (4.16)-(4.20).
+    clearance : float or None
+        c = (H - W)/2, m (give this or ``guide_height``).
+    guide_height : float or None
+        Distance H between the guide surfaces, m.
+    thickness : float or None
+        Slider thickness (out of plane), m; None means ``length``. A face in contact
+        is ``length x thickness``; eq. (4.27) takes the half side of the square of the
+        same area, ``a = sqrt(length * thickness) / 2`` (25 mm for Table 4.3).
+    upper_limits, lower_limits : (float, float) or None
+        Segment limits (P, Q) of the upper and (R, S) of the lower surface, as ``s``
+        coordinates, m: a corner can touch a surface only while its projection lies
+        between them. None: unbounded.
+    stroke : (float, float) or None
+        ``s`` coordinates of the slider centre mapped to xi = 0 and xi = 1 in the
+        dimensionless path (channel ``<name>.xi``); None: ``upper_limits`` if given,
+        else no ``xi`` channel.
+    material : Material or (Material, Material) or None
+        Materials of guide and slider; needed when a stiffness is computed.
+    law : NormalLaw or str
+        Corner law (sphere of radius R_c on a plane), default Lankarani-Nikravesh with
+        c_e = 0.9 (eq. 3.9), stiffness from (3.5) when not given.
+    face_law : NormalLaw or str
+        Law of a face in contact in the ``section-4.3`` model, on the average
+        penetration of its two corners; default Lankarani's linear law (4.26) with the
+        stiffness (4.27). A Hertz-type law given here is resolved with n = 1 (the
+        "unified" damped model). Unused by the ``corners`` model.
+    friction : None, float, str or FrictionLaw
+        None: frictionless; a float: modified Coulomb (3.16) with that coefficient, at
+        every active contact.
+    model : {"corners", "section-4.3"}
+        ``"corners"``: every touching corner is a sphere on a plane, whatever the
+        scenario of Fig. 4.9. ``"section-4.3"``: two adjacent corners on the same surface
+        (a face) use ``face_law`` at the geometric centre of the penetrated area; one
+        corner or two opposite corners use ``law``.
+
+    Notes
+    -----
+    The slider must not be able to turn over in the guide (``sqrt(L^2 + W^2) > H``):
+    then the upper corners can only ever touch the upper surface and the lower corners
+    the lower one, and these four pairs are all the contacts there are.
+    """
+
+    axis: Vector2 = (1.0, 0.0)
+    length: float = 0.0
+    width: float = 0.0
+    corner_radius: float = 0.0
+    clearance: float | None = None
+    guide_height: float | None = None
+    thickness: float | None = None
+    upper_limits: Vector2 | None = None
+    lower_limits: Vector2 | None = None
+    stroke: Vector2 | None = None
+    material: Any = None
+    law: Any = field(default_factory=lambda: _default_law())
+    face_law: Any = field(default_factory=lambda: _default_face_law())
+    friction: Any = None
+    model: str = "corners"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        for name in ("axis", "upper_limits", "lower_limits", "stroke"):
+            value = getattr(self, name)
+            vec = _as_vector2(value) if value is not None else None
+            if vec is not None:
+                object.__setattr__(self, name, vec)
+        if isinstance(self.model, str):
+            object.__setattr__(self, "model", self.model.strip().lower())
+
+    # ---- derived geometry ----------------------------------------------------------
+    @property
+    def radial_clearance(self) -> float:
+        """c = (H - W) / 2, m."""
+        if self.clearance is not None:
+            return float(self.clearance)
+        return 0.5 * (float(self.guide_height or 0.0) - float(self.width))
+
+    @property
+    def height(self) -> float:
+        """Distance between the guide surfaces H = W + 2c, m."""
+        return float(self.width) + 2.0 * self.radial_clearance
+
+    @property
+    def face_half_width(self) -> float:
+        """Half side a of the square with the area of a slider face, m (eq. 4.27)."""
+        thickness = float(self.length if self.thickness is None else self.thickness)
+        return 0.5 * math.sqrt(float(self.length) * thickness)
+
+    def resolved_law(self) -> Any:
+        """The corner law with its stiffness set (kind ``"sphere_plane"``, radius R_c)."""
+        from .contact import normal_law
+
+        law = normal_law(self.law) if isinstance(self.law, str) else self.law
+        if law.is_resolved:
+            return law
+        return law.resolve("sphere_plane", radii=(float(self.corner_radius),), materials=self.material)
+
+    def resolved_face_law(self) -> Any:
+        """The face law with its stiffness set (kind ``"plane_face"``, half side a)."""
+        from .contact import normal_law
+
+        law = normal_law(self.face_law) if isinstance(self.face_law, str) else self.face_law
+        return law.resolve("plane_face", face_half_width=self.face_half_width, materials=self.material)
+
+    def resolved_friction(self) -> Any:
+        from .contact import friction_law
+
+        return friction_law(self.friction)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        vec = _as_vector2(self.axis)
+        if vec is None or math.hypot(*vec) < 1e-12:
+            out.append(f"{self.kind} '{self.name}': axis={self.axis!r}, must be a non-zero 2-vector.")
+        for name in ("length", "width", "corner_radius"):
+            self._check_positive(out, name, "m")
+        if self.thickness is not None:
+            self._check_positive(out, "thickness", "m")
+        given = [self.clearance is not None, self.guide_height is not None]
+        if given[0] == given[1]:
+            out.append(f"{self.kind} '{self.name}': give exactly one of clearance= or guide_height= "
+                       f"(got clearance={self.clearance!r}, guide_height={self.guide_height!r}).")
+        elif given[0]:
+            self._check_positive(out, "clearance", "m")
+        else:
+            self._check_positive(out, "guide_height", "m")
+        for name in ("upper_limits", "lower_limits", "stroke"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            pair = _as_vector2(value)
+            if pair is None or not pair[0] < pair[1]:
+                out.append(f"{self.kind} '{self.name}': {name}={value!r} m, must be two finite numbers "
+                           "(start, end) with start < end.")
+        if self.model not in SLIDER_MODELS:
+            out.append(f"{self.kind} '{self.name}': model={self.model!r}, must be one of "
+                       f"{', '.join(map(repr, SLIDER_MODELS))}.")
+        if out:
+            return out
+        L, W, R_c, c = float(self.length), float(self.width), float(self.corner_radius), self.radial_clearance
+        if c <= 0:
+            out.append(f"{self.kind} '{self.name}': guide_height={self.guide_height!r} m must exceed the slider "
+                       f"width {W!r} m: clearance (H - W)/2 = {c!r} m, must be > 0.")
+        elif math.hypot(L, W) <= self.height:
+            out.append(f"{self.kind} '{self.name}': the slider ({L!r} x {W!r} m, diagonal {math.hypot(L, W):.6g} m) "
+                       f"can turn over in a guide {self.height:.6g} m high; the diagonal must exceed the guide "
+                       "height (reduce the clearance or lengthen the slider).")
+        if R_c >= 0.5 * min(L, W):
+            out.append(f"{self.kind} '{self.name}': corner_radius={R_c!r} m, must be < min(length, width)/2 "
+                       f"= {0.5 * min(L, W)!r} m.")
+        out.extend(_law_problems(self))
+        if self.model == "section-4.3":
+            out.extend(_face_law_problems(self))
+        return out
+
+
+def _face_law_problems(element: TranslationalClearance) -> list[str]:
+    from .contact import normal_law
+    from .contact.base import NormalLaw
+
+    law = element.face_law
+    try:
+        if isinstance(law, str):
+            law = normal_law(law)
+        if not isinstance(law, NormalLaw):
+            return [f"{element.kind} '{element.name}': face_law={law!r}, must be a daeclear.contact law or a "
+                    "law name."]
+        element.resolved_face_law()
+    except (SceneError, TypeError) as exc:
+        return [f"{element.kind} '{element.name}': face_law: {exc}"]
+    return []

@@ -38,6 +38,12 @@ DEFAULT_ATOL_FACTOR = 1e-3
 # keeps the pendulum's constraint residual at 1e-12 instead of 3e-11 (rtol 1e-10) and, measured,
 # halves the steps; index1 is better off with IDA's default. The python backend cannot set it.
 GGL_NEWTON_COEF = 1e-3
+# Stall guard: STALL_COUNT steps shorter than STALL_STEP_FACTOR * t_end that do not grow (and no
+# step a hundred times longer in between) end the run with a clear message instead of creeping on
+# (e.g. plain Coulomb friction chattering at zero sliding speed takes ~1e-12 s order-1 steps).
+# Contact steps of the chapter's runs are 1e-9..1e-6 s; restarts' start-up steps grow and do not count.
+STALL_STEP_FACTOR = 1e-10
+STALL_COUNT = 2000
 
 
 def _positive(name: str, value: Any, unit: str, allow_zero: bool = False) -> float:
@@ -170,6 +176,7 @@ def simulate(
                            max_steps=max_steps)
     if model.formulation == "ggl":
         session.set_hints(nonlin_conv_coef=GGL_NEWTON_COEF)
+    session.set_stall(STALL_STEP_FACTOR * t_end, STALL_COUNT)
     setup_time = time.perf_counter() - setup_start
     return _run(model, session, y0, yp0, t_end, eval_times, store_steps, on_failure, progress,
                 setup_time, {"method": method, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
@@ -322,5 +329,10 @@ def _failure_message(model: DAEModel, adv: Any, modes: dict[str, str]) -> str:
     where = f" with {', '.join(repr(p) for p in in_contact)} in contact" if in_contact else ""
     flag = f" ({adv.flag_name})" if adv.flag_name else ""
     detail = f": {adv.message}" if adv.message else ""
-    return (f"IDA failed at t={adv.t:.6g} s{flag}{where}{detail}. "
-            "Try a smaller max_step, a tighter rtol, or formulation='ggl'.")
+    advice = "Try a smaller max_step, a tighter rtol, or formulation='ggl'."
+    if adv.flag_name == "DC_STEP_COLLAPSE" and in_contact and any(
+            getattr(logic, "discontinuous_friction", False) for logic in model.contacts):
+        advice = ("The friction law is discontinuous at zero sliding speed (plain Coulomb) and the "
+                  "contact is sticking: use the modified Coulomb law (friction=<coefficient> or "
+                  "daeclear.contact.ModifiedCoulomb), which is continuous.")
+    return f"IDA failed at t={adv.t:.6g} s{flag}{where}{detail}. {advice}"

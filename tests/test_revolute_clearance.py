@@ -134,3 +134,20 @@ def test_joint_needs_material_or_stiffness():
     scene.add(RevoluteClearance("c", scene.ground, a, at=(0, 0), bearing_radius=0.01, clearance=1e-4))
     with pytest.raises(SceneError, match="RevoluteClearance 'c'.*materials"):
         scene.validate()
+
+
+def test_sticking_with_plain_coulomb_fails_fast_with_advice():
+    """Plain Coulomb is discontinuous at zero sliding speed: a sticking contact chatters with ~1e-12 s
+    steps. The stall guard ends the run within a few thousand steps and says what to use instead."""
+    import daeclear.contact as dcc
+
+    scene = dc.mechanisms.slider_crank("revolute", friction=dcc.Coulomb(coefficient=0.5))
+    result = dc.simulate(scene, 0.024, on_failure="return")
+    assert not result.success and result.status == -1
+    assert "DC_STEP_COLLAPSE" in result.message and "'clearance' in contact" in result.message
+    assert "modified Coulomb" in result.message
+    assert result.stats["n_steps"] < 20_000
+    assert np.all(np.isfinite(result.y))  # the partial result is kept
+    with pytest.raises(dc.SolveError, match="modified Coulomb") as info:
+        dc.simulate(scene, 0.024)
+    assert info.value.result.t[-1] == pytest.approx(result.t[-1])

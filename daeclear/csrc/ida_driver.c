@@ -77,6 +77,8 @@ typedef struct {
   double t_rec;    /* time of the last recorded step (to skip duplicates) */
   int ready;       /* reinit was called */
   int tiny;        /* tiny, non-growing steps since the last normal step */
+  double stall_step; /* absolute tiny-step threshold (0: relative test only), see dc_set_stall */
+  int stall_count;   /* tiny steps that end the advance (default DC_TINY_MAX) */
   double h_prev;   /* size of the previous step (collapse detection) */
   long long max_steps;
   long long base[ST_N]; /* counters accumulated over earlier reinit segments */
@@ -402,7 +404,8 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
       np += M->n_params[k];
     }
     s->params = (double*)xcalloc((size_t)np, sizeof(double));
-    s->rootdir_default = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
+    s->stall_count = DC_TINY_MAX;
+  s->rootdir_default = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
     s->rootdir = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
     s->rootsfound = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
     s->tmp_r = (double*)xcalloc((size_t)n, sizeof(double));
@@ -461,6 +464,16 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
  * and the first step size after the next (re)start (0: IDA's own estimate). */
 DC_API int dc_set_nonlin_conv_coef(void* sp, double coef) {
   return IDASetNonlinConvCoef(((dc_session*)sp)->ida, coef);
+}
+
+/* Stall detection: steps below stall_step seconds (0: only the relative collapse test) that do
+ * not grow; count of them that ends the advance. */
+DC_API int dc_set_stall(void* sp, double stall_step, int count) {
+  dc_session* s = (dc_session*)sp;
+  if (!(stall_step >= 0.0) || count < 1) return -1;
+  s->stall_step = stall_step;
+  s->stall_count = count;
+  return 0;
 }
 
 DC_API int dc_set_init_step(void* sp, double h) {
@@ -678,20 +691,24 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
     }
     if (tret > s->t_rec) s->t_rec = tret;
 
-    /* step-size collapse: only for genuinely new steps that did not end at t_stop */
+    /* step-size collapse or stall: only for genuinely new steps that did not end at t_stop.
+     * A step is tiny below max(DC_TINY_REL*max(1,|t|), stall_step); the count restarts at a
+     * clearly normal step (100x that threshold), so a chattering run whose steps hover around
+     * the threshold is still caught. */
     if (nst > nst_prev && flag != IDA_TSTOP_RETURN) {
-      if (fabs(h) >= DC_TINY_REL * fmax(1.0, fabs(tret)))
+      double thr = fmax(DC_TINY_REL * fmax(1.0, fabs(tret)), s->stall_step);
+      if (fabs(h) >= (s->stall_step > 0.0 ? 100.0 * thr : thr))
         s->tiny = 0;
-      else if (!(fabs(h) > DC_TINY_GROWTH * fabs(s->h_prev)))
+      else if (fabs(h) < thr && !(fabs(h) > DC_TINY_GROWTH * fabs(s->h_prev)))
         ++s->tiny;
       s->h_prev = h;
-      if (s->tiny >= DC_TINY_MAX) {
+      if (s->tiny >= s->stall_count) {
         *t_out = tret;
         copy_state(s, y_out, yp_out);
         set_msg(s->msg,
-                "step size collapsed: %d steps with |h| < %g*max(1,|t|) that did not grow "
-                "(last h=%.3g) at t=%.17g%s%s",
-                s->tiny, DC_TINY_REL, h, tret, s->cb_msg[0] ? "; last model error: " : "",
+                "step size collapsed: %d steps with |h| < max(%g*max(1,|t|), %g s) that did not "
+                "grow (last h=%.3g) at t=%.17g%s%s",
+                s->tiny, DC_TINY_REL, s->stall_step, h, tret, s->cb_msg[0] ? "; last model error: " : "",
                 s->cb_msg);
         return DC_ERR_COLLAPSE;
       }
