@@ -36,10 +36,7 @@ from .result import ContactEvent
 from .scene import RevoluteClearance, Scene
 from .symbolic import AssemblyContext, Channel, Term, perpendicular
 
-# Storm guard: when a pair switches STORM_EVENTS times within STORM_WINDOW seconds, its term
-# stays on through the next separations until the pair has been free for STORM_WINDOW. The
-# law's force is zero (with zero derivative) for a non-positive penetration, so this changes
-# nothing physical; it only stops restarting IDA for micro-bounces.
+# Storm guard (see PairLogic): STORM_EVENTS switches within STORM_WINDOW seconds hold the term on.
 STORM_EVENTS = 20
 STORM_WINDOW = 1e-6
 
@@ -50,6 +47,12 @@ class PairLogic:
 
     ``rate`` evaluates ``(gap, penetration_rate)`` from ``(q, v)``; ``needs_approach`` says
     whether the term's parameter is the approach speed latched at onset.
+
+    Storm guard: when the pair has switched ``STORM_EVENTS`` times within ``STORM_WINDOW``
+    seconds, a separation leaves the term on (*held*): the force is zero with a zero derivative
+    while the gap is open, so nothing physical changes. A held pair watches both crossings but
+    changes nothing (the solver continues without a restart) until it re-contacts after being
+    free for longer than ``STORM_WINDOW``, which is a genuine new impact.
     """
 
     pair: str
@@ -61,7 +64,8 @@ class PairLogic:
     min_approach_speed: float
     discontinuous_friction: bool = False
     recent: list[float] = field(default_factory=list)
-    held_since: float | None = None
+    held: bool = False
+    free_since: float = 0.0
 
     def _gap_rate(self, y: NDArray) -> tuple[float, float]:
         q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
@@ -79,30 +83,39 @@ class PairLogic:
         return {self.pair: "contact" if in_contact else "free"}
 
     def root_directions(self, active: Sequence[bool]) -> list[tuple[int, int]]:
-        """While free watch onsets (+1), while in contact separations (-1)."""
+        """While free watch onsets (+1), in contact separations (-1), held both (0)."""
+        if self.held:
+            return [(self.root_index, 0)]
         return [(self.root_index, -1 if active[self.term_index] else +1)]
 
     def on_roots(self, t: float, y: NDArray, yp: NDArray, roots_found: NDArray | None,
                  active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+        """Switch the pair's mode at a root of its gap; return the events it records."""
         if roots_found is None or roots_found[self.root_index] == 0:
             return []
         direction = int(roots_found[self.root_index])
-        gap, rate = self._gap_rate(y)
         k = self.term_index
+        if self.held:
+            if direction < 0:
+                self.free_since = t
+                return []
+            if t - self.free_since <= STORM_WINDOW:
+                return []  # a re-contact inside the storm: keep the held term as it is
+            self.held = False
+            active[k] = False  # fall through: a genuine onset after a real flight
+        gap, rate = self._gap_rate(y)
         if direction > 0 and not active[k]:
             self._count(t)
             active[k] = True
             params[k] = self._params(rate)
-            self.held_since = None
             return [ContactEvent(t=t, pair=self.pair, kind="onset", approach_speed=rate, y=y.copy())]
         if direction < 0 and active[k]:
             self._count(t)
-            event = ContactEvent(t=t, pair=self.pair, kind="separation", approach_speed=rate, y=y.copy())
             if len(self.recent) >= STORM_EVENTS:
-                self.held_since = t  # storm: keep the (zero) force term on, see STORM_EVENTS
+                self.held, self.free_since = True, t
             else:
                 active[k] = False
-            return [event]
+            return [ContactEvent(t=t, pair=self.pair, kind="separation", approach_speed=rate, y=y.copy())]
         return []
 
     def _count(self, t: float) -> None:

@@ -255,11 +255,15 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
             if adv.status == "tstop" or t >= t_end:
                 break
             # a root: let every contact element decide its new modes
+            before = (list(active), [p.copy() for p in params], _root_directions(model, active))
             for logic in model.contacts:
                 new_events = logic.on_roots(t, y, yp, adv.roots_found, active, params)
                 events.extend(new_events)
                 for event in new_events:
                     modes[event.pair] = "contact" if event.kind == "onset" else "free"
+            if (before[0] == active and all(np.array_equal(a, b) for a, b in zip(before[1], params))
+                    and np.array_equal(before[2], _root_directions(model, active))):
+                continue  # nothing switched: IDA goes on from the root without a restart
             y, yp = model.consistent_state(t, y, _term_forces(model, t, y, active, params))
             switch = model.switch_vector(active, params)
             session.reinit(t, y, yp, active, params, _root_directions(model, active))
