@@ -43,6 +43,9 @@ from .symbolic import AssemblyContext, BodyFrame, Channel, Term, rotation
 Formulation = Literal["index1", "ggl"]
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
 
+# Extra functions compiled with the model (DAEFunctions.extras), evaluated over many points.
+EXTRA_OUTPUTS, EXTRA_KKT, EXTRA_TERM0 = 0, 1, 2  # term k's generalized force: EXTRA_TERM0 + k
+
 # State kinds: how each state variable is treated by the solver's error test.
 KIND_POSITION, KIND_VELOCITY, KIND_MULTIPLIER = "q", "v", "lambda"
 
@@ -156,41 +159,59 @@ class DAEModel:
         dv, *_ = np.linalg.lstsq(Phi_q, -Phi_dot.ravel(), rcond=None)
         return v + dv
 
-    def accelerations(self, t: ArrayLike, q: NDArray[np.float64], v: NDArray[np.float64],
-                      generalized_force: NDArray[np.float64] | None = None
-                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Solve [M Phi_q^T; Phi_q 0] [v'; lam] = [Q; gamma - 2 alpha Phi' - beta^2 Phi] for v' and lam.
+    def evaluate(self, k: int, inputs: Sequence[Any], n_points: int, session: Any = None) -> NDArray[np.float64]:
+        """Evaluate ``functions.extras[k]`` at ``n_points`` points (inputs (n_points, size) or (size,)).
 
-        Works on one state (``q``, ``v`` of shape (n,)) or on many at once (shape (N, n), with
-        ``t`` of shape (N,)). ``generalized_force`` adds contact forces to the base forces.
+        With an open compiled ``session`` the loop runs in C (~1 us a point); otherwise CasADi.
+        """
+        if session is not None:
+            return session.eval_extra(k, inputs, n_points)
+        f = self.functions.extras[k]
+        cols = [np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, f.numel_in(j)),
+                                (n_points, f.numel_in(j))).T for j, x in enumerate(inputs)]
+        return np.array(_mapped(f, n_points)(*cols)).reshape(-1, n_points).T
+
+    def term_forces(self, t: ArrayLike, y: NDArray[np.float64], active: Sequence[bool],
+                    params: Sequence[NDArray[np.float64]], session: Any = None) -> NDArray[np.float64] | None:
+        """Sum of the generalized forces of the active terms at one state (n_states,) or many (N, n_states)."""
+        if not any(active):
+            return None
+        n = self.n_q
+        y2 = np.atleast_2d(y)
+        N = y2.shape[0]
+        t_col = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,)).reshape(N, 1)
+        total = np.zeros((N, n))
+        for k, (on, p) in enumerate(zip(active, params)):
+            if on:
+                total += self.evaluate(EXTRA_TERM0 + k, [t_col, y2[:, :n], y2[:, n:2 * n], np.asarray(p, dtype=float)],
+                                       N, session)
+        return total[0] if np.ndim(y) == 1 else total
+
+    def accelerations(self, t: ArrayLike, q: NDArray[np.float64], v: NDArray[np.float64],
+                      generalized_force: NDArray[np.float64] | None = None, session: Any = None
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Solve [M Phi_q^T; Phi_q 0] [v'; lam] = [Q; c] for v' and lam.
+
+        ``c = gamma - 2 alpha Phi' - beta^2 Phi`` (index1) or ``gamma`` (ggl). Works on one state
+        (``q``, ``v`` of shape (n,)) or on many (N, n) with ``t`` of shape (N,).
+        ``generalized_force`` adds contact forces to the base forces (gravity).
         """
         single = np.ndim(q) == 1
-        t_arr = np.atleast_1d(np.asarray(t, dtype=float))
         q2, v2 = np.atleast_2d(q), np.atleast_2d(v)
         N, n, m = q2.shape[0], self.n_q, self.n_constraints
-        if t_arr.size == 1 and N > 1:
-            t_arr = np.full(N, t_arr[0])
-        Q = np.array(_mapped(self.base_force, N)(t_arr[None, :], q2.T, v2.T)).T
+        t_col = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,)).reshape(N, 1)
+        size = n + m
+        out = self.evaluate(EXTRA_KKT, [t_col, q2, v2], N, session)
+        K = out[:, :size * size].reshape(N, size, size).transpose(0, 2, 1)  # column-major blocks
+        rhs = out[:, size * size:].copy()
         if generalized_force is not None:
-            Q = Q + np.atleast_2d(generalized_force)
-        if m == 0:
-            a, lam = Q / self.mass_diagonal, np.zeros((N, 0))
-        else:
-            Phi, Phi_q, Phi_dot, gamma = (np.array(x) for x in _mapped(self.kinematics, N)(q2.T, v2.T, t_arr[None, :]))
-            Phi_q = Phi_q.reshape(m, N, n).transpose(1, 0, 2)  # map stacks the (m, n) blocks side by side
-            rhs_c = gamma.T
-            if self.formulation == "index1":
-                rhs_c = rhs_c - 2.0 * self.alpha * Phi_dot.T - self.beta**2 * Phi.T
-            K = np.zeros((N, n + m, n + m))
-            K[:, :n, :n] = np.diag(self.mass_diagonal)
-            K[:, :n, n:] = Phi_q.transpose(0, 2, 1)
-            K[:, n:, :n] = Phi_q
-            sol = np.linalg.solve(K, np.concatenate([Q, rhs_c], axis=1)[..., None])[..., 0]
-            a, lam = sol[:, :n], sol[:, n:]
+            rhs[:, :n] += np.atleast_2d(generalized_force)
+        sol = np.linalg.solve(K, rhs[..., None])[..., 0]
+        a, lam = sol[:, :n], sol[:, n:]
         return (a[0], lam[0]) if single else (a, lam)
 
     def consistent_state(self, t: ArrayLike, y: NDArray[np.float64],
-                         generalized_force: NDArray[np.float64] | None = None
+                         generalized_force: NDArray[np.float64] | None = None, session: Any = None
                          ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Keep q and v of ``y``; recompute multipliers and derivatives so that F(t, y, y') = 0.
 
@@ -201,7 +222,7 @@ class DAEModel:
         single = y.ndim == 1
         y2 = np.atleast_2d(y)
         q, v = y2[:, :n], y2[:, n:2 * n]
-        a, lam = self.accelerations(t, q, v, generalized_force)
+        a, lam = self.accelerations(t, q, v, generalized_force, session)
         yp = np.zeros_like(y2)
         yp[:, :n] = v
         yp[:, n:2 * n] = a
@@ -231,7 +252,7 @@ class DAEModel:
         return np.concatenate(parts) if parts else np.zeros(0)
 
     def channels(self, t: NDArray[np.float64], y: NDArray[np.float64], yp: NDArray[np.float64],
-                 switch: NDArray[np.float64] | None = None) -> dict[str, NDArray[np.float64]]:
+                 switch: NDArray[np.float64] | None = None, session: Any = None) -> dict[str, NDArray[np.float64]]:
         """Evaluate every output channel at the rows of ``y`` and ``yp`` (time first).
 
         ``switch`` holds one row per time of :meth:`switch_vector` (contact terms' modes).
@@ -241,8 +262,8 @@ class DAEModel:
             return {name: np.zeros(0) for name in self.channel_names}
         n_s = self.outputs.size1_in(3)
         S = np.zeros((t.size, n_s)) if switch is None else np.asarray(switch, dtype=float).reshape(t.size, n_s)
-        values = np.array(_mapped(self.outputs, t.size)(t[None, :], np.asarray(y).T, np.asarray(yp).T, S.T))
-        return {name: values[i].copy() for i, name in enumerate(self.channel_names)}
+        values = self.evaluate(EXTRA_OUTPUTS, [t.reshape(-1, 1), np.asarray(y), np.asarray(yp), S], t.size, session)
+        return {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(self.channel_names)}
 
 
 # ---- element builders --------------------------------------------------------------------
@@ -436,10 +457,6 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     if gaps:
         roots = ca.Function("roots", [t, y, yp], [ca.vertcat(*gaps)], ["t", "y", "yp"], ["g"])
 
-    functions = DAEFunctions(
-        n=n_y, residual=residual, jacobian=jacobian, term_residuals=tuple(term_res),
-        term_jacobians=tuple(term_jac), roots=roots, name=_c_identifier(scene.name),
-    )
 
     # ---- output channels ----
     channels: list[Channel] = []
@@ -474,6 +491,15 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     switch = ca.vertcat(*switch_syms) if switch_syms else ca.SX(0, 1)
     outputs = ca.Function("outputs", [t, y, yp, switch], [ca.vertcat(*[c.expr for c in channels])],
                           ["t", "y", "yp", "switch"], ["channels"])
+    # KKT system of the accelerations and multipliers (consistent states at restarts and outputs)
+    rhs_c = gamma - 2 * alpha * Phi_dot - beta**2 * Phi if formulation == "index1" else gamma
+    K = ca.vertcat(ca.horzcat(M, Phi_q.T), ca.horzcat(Phi_q, ca.SX.zeros(m, m)))
+    kkt = ca.Function("kkt", [t, q, v], [ca.densify(ca.vertcat(ca.vec(K), Q, rhs_c))], ["t", "q", "v"], ["kkt"])
+    extras = [outputs, kkt] + [term.force for term in terms]
+    functions = DAEFunctions(
+        n=n_y, residual=residual, jacobian=jacobian, term_residuals=tuple(term_res),
+        term_jacobians=tuple(term_jac), roots=roots, name=_c_identifier(scene.name), extras=tuple(extras),
+    )
 
     q_guess = np.concatenate([[*b.position, b.angle] for b in bodies])
     v_guess = np.concatenate([[*b.velocity, b.angular_velocity] for b in bodies])

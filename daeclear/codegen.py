@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import dataclasses
 import hashlib
 import importlib.util
 import os
@@ -35,6 +36,7 @@ import subprocess
 import sysconfig
 import tempfile
 import time
+import weakref
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterator
@@ -98,6 +100,7 @@ class NormalizedModel:
     roots: casadi.Function | None
     n_params: tuple[int, ...]
     n_roots: int
+    extras: tuple[casadi.Function, ...] = ()
 
 
 def _check(f: Any, what: str, sizes: list[int | None], out_numel: int | None) -> list[int]:
@@ -160,7 +163,12 @@ def normalize_model(funcs: Any) -> NormalizedModel:
         n_roots = int(funcs.roots.numel_out(0))
         if n_roots > 0:
             roots = _wrap(funcs.roots, "dc_roots", [1, n, n], (n_roots, 1))
+    extras = []
+    for k, f in enumerate(getattr(funcs, "extras", ())):
+        sizes = _check(f, f"extras[{k}]", [None] * f.n_in(), None)
+        extras.append(_wrap(f, f"dc_extra{k}", sizes, (f.numel_out(0), 1)))
     return NormalizedModel(
+        extras=tuple(extras),
         n=n,
         name=str(getattr(funcs, "name", "model")),
         res=res,
@@ -193,7 +201,7 @@ def generate_source(model: NormalizedModel) -> str:
         "dc_model_gen.c",
         {"with_header": False, "casadi_int": "long long int", "casadi_real": "double"},
     )
-    funs = [model.res, model.jac, *model.term_res, *model.term_jac]
+    funs = [model.res, model.jac, *model.term_res, *model.term_jac, *model.extras]
     if model.roots is not None:
         funs.append(model.roots)
     for f in funs:
@@ -214,6 +222,11 @@ def generate_source(model: NormalizedModel) -> str:
         lines += [f"  {_fun_entry(f'dc_term{k}_jac')}," for k in range(nt)]
         lines.append("};")
     roots_entry = _fun_entry("dc_roots") if model.roots is not None else "{0, 0, 0, 0, 0, 0, 0}"
+    ne = len(model.extras)
+    lines.append(f"const int dc_n_extras = {ne};")
+    lines.append(f"const dc_fun_t dc_extra_tab[{max(ne, 1)}] = {{")
+    lines += [f"  {_fun_entry(f'dc_extra{k}')}," for k in range(ne)] or ["  {0, 0, 0, 0, 0, 0, 0},"]
+    lines.append("};")
     lines += [
         "const dc_model_t dc_model = {",
         f"  {model.n}, {nt}, {model.n_roots},",
@@ -322,8 +335,36 @@ def _driver_text() -> str:
     return "".join(f"/* {name} */\n" + (CSRC / name).read_text() for name in DRIVER_SOURCES)
 
 
+# Libraries already built in this process, by DAEFunctions identity: simulating the same model
+# again skips code generation (tens of ms) as well as compilation.
+_BUILT: dict[int, tuple[Any, BuildResult]] = {}
+
+
+def memo_get(table: dict[int, tuple[Any, Any]], obj: Any) -> Any:
+    """The value memoised for this very object (identity, kept only while the object lives)."""
+    entry = table.get(id(obj))
+    return entry[1] if entry is not None and entry[0]() is obj else None
+
+
+def memo_put(table: dict[int, tuple[Any, Any]], obj: Any, value: Any) -> None:
+    try:
+        ref = weakref.ref(obj, lambda _r, key=id(obj): table.pop(key, None))
+    except TypeError:
+        return
+    table[id(obj)] = (ref, value)
+
+
 def build_model_library(funcs: Any, *, model: NormalizedModel | None = None) -> BuildResult:
     """Generate, compile (or find in the cache) the shared library for a DAEFunctions."""
+    known = memo_get(_BUILT, funcs)
+    if known is not None and known.path.exists():
+        return dataclasses.replace(known, cache_hit=True, compile_time=0.0, codegen_time=0.0)
+    result = _build_model_library(funcs, model=model)
+    memo_put(_BUILT, funcs, result)
+    return result
+
+
+def _build_model_library(funcs: Any, *, model: NormalizedModel | None = None) -> BuildResult:
     t0 = time.perf_counter()
     if model is None:
         model = normalize_model(funcs)
@@ -452,12 +493,12 @@ def generate_ode_source(spec: OdeSpec) -> str:
         {"with_header": False, "casadi_int": "long long int", "casadi_real": "double"},
     )
     nt = len(spec.term_force)
-    funs = {"dco_sys": spec.sys, "dco_sys_jac": spec.sys_jac}
+    funs = {"dcog_sys": spec.sys, "dcog_sys_jac": spec.sys_jac}
     if spec.gaps is not None:
-        funs["dco_gaps"] = spec.gaps
+        funs["dcog_gaps"] = spec.gaps
     for k in range(nt):
-        funs[f"dco_term{k}_force"] = spec.term_force[k]
-        funs[f"dco_term{k}_jac"] = spec.term_jac[k]
+        funs[f"dcog_term{k}_force"] = spec.term_force[k]
+        funs[f"dcog_term{k}_jac"] = spec.term_jac[k]
     for name, f in funs.items():
         # re-wrap under the C symbol name the table refers to
         ins = [casadi.SX.sym(f"i{i}", f.numel_in(i)) if f.is_a("SXFunction") else
@@ -476,19 +517,19 @@ def generate_ode_source(spec: OdeSpec) -> str:
     if nt:
         lines.append(f"static const int dco_n_params_tab[{nt}] = {{{', '.join(map(str, spec.n_params))}}};")
         lines.append(f"static const dc_fun_t dco_term_force_tab[{nt}] = {{")
-        lines += [f"  {_fun_entry(f'dco_term{k}_force')}," for k in range(nt)]
+        lines += [f"  {_fun_entry(f'dcog_term{k}_force')}," for k in range(nt)]
         lines.append("};")
         lines.append(f"static const dc_fun_t dco_term_jac_tab[{nt}] = {{")
-        lines += [f"  {_fun_entry(f'dco_term{k}_jac')}," for k in range(nt)]
+        lines += [f"  {_fun_entry(f'dcog_term{k}_jac')}," for k in range(nt)]
         lines.append("};")
-    gaps_entry = _fun_entry("dco_gaps") if spec.gaps is not None else "{0, 0, 0, 0, 0, 0, 0}"
+    gaps_entry = _fun_entry("dcog_gaps") if spec.gaps is not None else "{0, 0, 0, 0, 0, 0, 0}"
     lines += [
         "const dco_model_t dco_model = {",
         f"  {spec.n}, {spec.m}, {nt}, {spec.n_gaps},",
         f"  {'dco_n_params_tab' if nt else '0'},",
         "  dco_mass_tab,",
-        f"  {_fun_entry('dco_sys')},",
-        f"  {_fun_entry('dco_sys_jac')},",
+        f"  {_fun_entry('dcog_sys')},",
+        f"  {_fun_entry('dcog_sys_jac')},",
         f"  {gaps_entry},",
         f"  {'dco_term_force_tab' if nt else '0'},",
         f"  {'dco_term_jac_tab' if nt else '0'},",

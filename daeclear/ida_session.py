@@ -51,6 +51,8 @@ import casadi
 import numpy as np
 
 from .codegen import (
+    memo_get,
+    memo_put,
     BuildResult,
     CompileError,
     CompilerUnavailable,
@@ -71,6 +73,7 @@ __all__ = [
 ]
 
 BACKENDS = ("auto", "c", "python")
+_NORMALIZED: dict[int, tuple[Any, Any]] = {}  # normalize_model results by DAEFunctions identity
 
 #: flag of an Advance that stopped because the session's step cap (max_steps) was reached
 FLAG_MAX_STEPS = -1001
@@ -107,6 +110,9 @@ class DAEFunctions:
     term_residuals[k]: (t, y, yp, p_k[n_params_k]) -> r_k[n], added to r while term k is active.
     term_jacobians[k]: (t, y, yp, p_k, cj) -> J_k[n x n], added to J while term k is active.
     roots: (t, y, yp) -> g[n_roots], or None when the model has no events.
+    extras[k]: any functions with vector inputs and one output, compiled into the same library
+    and evaluated over many points at once by :meth:`Session.eval_extra` (post-processing:
+    output channels, consistent restarts); never called by IDA.
     """
 
     n: int
@@ -116,6 +122,7 @@ class DAEFunctions:
     term_jacobians: tuple[casadi.Function, ...]
     roots: casadi.Function | None
     name: str = "model"
+    extras: tuple[casadi.Function, ...] = ()
 
 
 @dataclass
@@ -193,7 +200,7 @@ def _root_dirs(model: NormalizedModel, rd: Any, what: str = "root_directions") -
     arr = np.asarray(rd)
     if arr.shape != (model.n_roots,):
         raise ValueError(f"{what} must have shape ({model.n_roots},), got {arr.shape}")
-    if not np.all(np.isin(arr, (-1, 0, 1))):
+    if arr.size and (arr.min() < -1 or arr.max() > 1 or not np.array_equal(arr, np.round(arr))):
         raise ValueError(f"{what} values must be -1, 0 or +1, got {arr.tolist()}")
     return np.ascontiguousarray(arr, dtype=np.int32)
 
@@ -289,6 +296,16 @@ class _SessionBase:
         """Solver hints (see CSession.set_hints); scikit-sundae exposes neither, so the python
         backend ignores them and returns False."""
         return False
+
+    def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
+        """Evaluate ``DAEFunctions.extras[k]`` at ``n_points`` points: each input is an array of
+        shape (n_points, size) or (size,) (the same for every point); returns (n_points, n_out).
+        The compiled backend loops in C; the python backend maps the CasADi function."""
+        f = self._model.extras[k]
+        cols = [np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, f.numel_in(j)),
+                                (n_points, f.numel_in(j))).T for j, x in enumerate(inputs)]
+        fm = f if n_points == 1 else f.map(n_points)
+        return np.array(fm(*cols)).reshape(-1, n_points).T.copy()
 
     def set_stall(self, stall_step: float, count: int) -> None:
         """Stall detection: ``count`` tiny steps (below ``stall_step`` s and not growing, with no
@@ -404,6 +421,10 @@ class _CLib:
         lib.dc_open.argtypes = [D, P, D, I, ctypes.c_longlong, P, ctypes.c_char_p, I]
         lib.dc_set_nonlin_conv_coef.restype = I
         lib.dc_set_nonlin_conv_coef.argtypes = [P, D]
+        lib.dc_n_extra.restype = I
+        lib.dc_n_extra.argtypes = []
+        lib.dc_eval_extra.restype = I
+        lib.dc_eval_extra.argtypes = [I, I, I, P, P, P, I]
         lib.dc_set_stall.restype = I
         lib.dc_set_stall.argtypes = [P, D, I]
         lib.dc_set_init_step.restype = I
@@ -525,6 +546,30 @@ class CSession(_SessionBase):
         if init_step is not None and self._lib.dc_set_init_step(self._h, init_step) < 0:
             raise DaeclearError(f"init_step={init_step!r} rejected by IDA.")
         return True
+
+    def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
+        f = self._model.extras[k]
+        arrays, strides = [], []
+        for j, x in enumerate(inputs):
+            a = np.ascontiguousarray(x, dtype=float)
+            size = f.numel_in(j)
+            if a.size == size:
+                arrays.append(a.ravel())
+                strides.append(0)
+            elif a.shape == (n_points, size):
+                arrays.append(a)
+                strides.append(size)
+            else:
+                raise ValueError(f"eval_extra({k}): input {j} has shape {a.shape}, expected ({n_points}, {size}) or ({size},)")
+        n_out = f.numel_out(0)
+        out = np.empty((n_points, n_out))
+        ptrs = (ctypes.c_void_p * max(len(arrays), 1))(*[a.__array_interface__["data"][0] for a in arrays])
+        stride_arr = (ctypes.c_int * max(len(strides), 1))(*strides)
+        rc = self._lib.dc_eval_extra(k, n_points, len(arrays), ptrs, stride_arr,
+                                     out.__array_interface__["data"][0], n_out)
+        if rc != 0:
+            raise DaeclearError(f"evaluating {f.name()} in the compiled model failed (status {rc}).")
+        return out
 
     # ---------------------------------------------------------------- core
     def _load_terms(self, act: np.ndarray, plist: list[np.ndarray]) -> None:
@@ -1080,7 +1125,10 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
     if not isinstance(backend, str) or backend.lower() not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}: valid backends are {', '.join(map(repr, BACKENDS))}")
     b = backend.lower()
-    model = normalize_model(funcs)
+    model = memo_get(_NORMALIZED, funcs)
+    if model is None:
+        model = normalize_model(funcs)
+        memo_put(_NORMALIZED, funcs, model)
     opts = _options(model, rtol, atol, max_step, max_order, max_steps, root_directions, buffer_steps)
     if b == "python":
         return PythonSession(model, opts)

@@ -26,7 +26,7 @@ from .scene import Scene
 
 log = logging.getLogger("daeclear")
 
-METHODS: tuple[str, ...] = ("ida",)
+METHODS: tuple[str, ...] = ("ida", "rk45", "dop853", "radau", "bdf", "lsoda", "rk4", "euler")
 ON_FAILURE: tuple[str, ...] = ("raise", "return")
 # Multipliers are kept out of IDA's error test by a huge absolute tolerance (scikit-sundae has
 # no IDASetSuppressAlg): atol = MULTIPLIER_ATOL_FACTOR * rtol, see PERFORMANCE.md item 1.
@@ -114,6 +114,7 @@ def simulate(
     store_steps: bool = True,
     on_failure: str = "raise",
     progress: bool = False,
+    step: float | None = None,
 ) -> Result:
     """Integrate a scene (or an assembled model) from t = 0 to ``t_end``.
 
@@ -130,15 +131,18 @@ def simulate(
     atol : float, array or None
         Absolute tolerance of positions and velocities (default ``1e-3 * rtol``) or one
         value per state. Multipliers are always kept out of the error test.
-    method : {"ida"}
-        Integrator (case-insensitive).
+    method : {"ida", "RK45", "DOP853", "Radau", "BDF", "LSODA", "rk4", "euler"}
+        Integrator (case-insensitive). "ida": SUNDIALS IDA on the DAE. The others integrate the
+        same model as an ODE in (q, v) (index-1 formulation only) with the same contact events
+        (see :mod:`daeclear.integrators`): scipy's explicit RK45/DOP853 and implicit
+        Radau/BDF/LSODA, fixed-step classical Runge-Kutta "rk4" and explicit "euler".
     formulation : {"index1", "ggl"}
         Used when ``scene`` is a Scene.
     backend : {"auto", "c", "python"}
         "c": generated C and an IDA loop in C (fast); "python": scikit-sundae with CasADi
         callbacks; "auto": C when a compiler works, else python with a warning.
     max_step : float
-        Largest step, s (0: unbounded).
+        Largest step, s (0: unbounded); IDA and the scipy methods.
     max_steps : int
         Cap on the total number of steps; the run fails cleanly beyond it.
     store_steps : bool
@@ -148,6 +152,9 @@ def simulate(
         partial result) or return the partial result with ``success=False``.
     progress : bool
         Show a progress line on stderr.
+    step : float or None
+        Step size, s, of the fixed-step methods "rk4" and "euler" (required there, e.g. the
+        chapter's 1e-5); rejected by the other methods.
 
     Returns
     -------
@@ -162,6 +169,13 @@ def simulate(
         raise SceneError(f"simulate: max_steps={max_steps!r}, must be an integer >= 1.")
     if rtol < 1e-14 or rtol > 1e-2:
         raise SceneError(f"simulate: rtol={rtol!r}, must be in [1e-14, 1e-2].")
+    from .integrators import check_step, integrate  # the non-IDA methods
+
+    check_step(method, step)
+    if method != "ida":
+        return integrate(scene, t_end, method=method, t_eval=t_eval, rtol=rtol, atol=atol, formulation=formulation,
+                         backend=backend, max_step=max_step, max_steps=max_steps, step=step,
+                         store_steps=store_steps, on_failure=on_failure, progress=progress)
 
     setup_start = time.perf_counter()
     model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation)
@@ -196,7 +210,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         modes.update(logic.initial_modes(0.0, y0, active, params))
     y, yp = y0, yp0
     if any(active):
-        y, yp = model.consistent_state(0.0, y0, _term_forces(model, 0.0, y0, active, params))
+        y, yp = model.consistent_state(0.0, y0, model.term_forces(0.0, y0, active, params, session), session)
     switch = model.switch_vector(active, params)
 
     steps_t: list[NDArray] = [np.array([0.0])]
@@ -238,7 +252,8 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 # IDA's interpolant of the multipliers is not error-controlled: recompute the
                 # multipliers and accelerations of output points from their q and v.
                 y_eval, yp_eval = model.consistent_state(
-                    adv.eval_t, adv.eval_y, _term_forces(model, adv.eval_t, adv.eval_y, active, params))
+                    adv.eval_t, adv.eval_y, model.term_forces(adv.eval_t, adv.eval_y, active, params, session),
+                    session)
                 ev_t.append(adv.eval_t)
                 ev_y.append(y_eval)
                 ev_yp.append(yp_eval)
@@ -264,7 +279,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
             if (before[0] == active and all(np.array_equal(a, b) for a, b in zip(before[1], params))
                     and np.array_equal(before[2], _root_directions(model, active))):
                 continue  # nothing switched: IDA goes on from the root without a restart
-            y, yp = model.consistent_state(t, y, _term_forces(model, t, y, active, params))
+            y, yp = model.consistent_state(t, y, model.term_forces(t, y, active, params, session), session)
             switch = model.switch_vector(active, params)
             session.reinit(t, y, yp, active, params, _root_directions(model, active))
             n_restarts += 1
@@ -272,7 +287,6 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         success, status, message = False, -1, f"interrupted by the user at t={t:.6g} s"
     finally:
         stats = dict(session.stats())
-        session.close()
 
     progress_line.update(t_end if success else t, len(events))
     step_t = np.concatenate(steps_t)
@@ -285,10 +299,16 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     else:
         out_t, out_y, out_yp = step_t, np.concatenate(steps_y), np.concatenate(steps_yp)
         out_switch = np.concatenate(steps_switch)
-    stats.update(n_events=len(events), n_restarts=n_restarts, setup_time=setup_time)
+    post_start = time.perf_counter()
+    try:
+        channels = model.channels(out_t, out_y, out_yp, out_switch, session)
+    finally:
+        session.close()
+    stats.update(n_events=len(events), n_restarts=n_restarts, setup_time=setup_time,
+                 output_time=time.perf_counter() - post_start)
     result = Result(
         t=out_t, y=out_y, yp=out_yp, state_names=list(model.state_names),
-        channels=model.channels(out_t, out_y, out_yp, out_switch), units=dict(model.channel_units),
+        channels=channels, units=dict(model.channel_units),
         events=events, segments=segments, step_t=step_t, step_h=np.concatenate(steps_h),
         step_order=np.concatenate(steps_order), stats=stats, success=success, status=status, message=message,
         parameters={**model.parameters, "simulate": sim_params}, scene_name=model.scene_name,
@@ -308,23 +328,6 @@ def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:
         for index, direction in logic.root_directions(active):
             directions[index] = direction
     return directions
-
-
-def _term_forces(model: DAEModel, t: ArrayLike, y: NDArray, active: Sequence[bool],
-                 params: Sequence[NDArray]) -> NDArray | None:
-    """Sum of the generalized forces of the active terms at one state (n,) or many (N, n)."""
-    if not any(active):
-        return None
-    n = model.n_q
-    y2 = np.atleast_2d(y)
-    N = y2.shape[0]
-    t_row = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,))[None, :]
-    total = np.zeros((N, n))
-    for term, on, p in zip(model.terms, active, params):
-        if on:
-            p_cols = np.repeat(np.asarray(p, dtype=float).reshape(-1, 1), N, axis=1)
-            total += np.array((term.force if N == 1 else term.force.map(N))(t_row, y2[:, :n].T, y2[:, n:2 * n].T, p_cols)).T
-    return total[0] if np.ndim(y) == 1 else total
 
 
 def _failure_message(model: DAEModel, adv: Any, modes: dict[str, str]) -> str:

@@ -579,3 +579,26 @@ def test_tiny_initial_step_is_not_a_collapse(backend):
     assert a.status == "tstop", a.message
     assert a.step_h[0] < 1e-22 and np.sum(a.step_h < 1e-14) > TINY_STEP_COUNT  # the start-up doubling
     assert a.y[0] == pytest.approx(1e4, rel=1e-9)
+
+
+def test_extras_evaluate_over_points_like_casadi():
+    """DAEFunctions.extras run in C over many points (stride 0 broadcasts) and match CasADi."""
+    import casadi as ca
+    import numpy as np
+
+    from daeclear.ida_session import DAEFunctions, open_session
+
+    t, y, yp, c = ca.SX.sym("t"), ca.SX.sym("y", 2), ca.SX.sym("yp", 2), ca.SX.sym("cj")
+    res = ca.vertcat(yp[0] - y[1], yp[1] + y[0])
+    a, b = ca.SX.sym("a", 2), ca.SX.sym("b")
+    extra = ca.Function("extra", [a, b], [ca.vertcat(ca.sin(a[0]) * b, a[1] ** 2, a[0] + a[1])])
+    funcs = DAEFunctions(n=2, residual=ca.Function("r", [t, y, yp], [res]),
+                         jacobian=ca.Function("j", [t, y, yp, c], [ca.densify(ca.jacobian(res, y) + c * ca.jacobian(res, yp))]),
+                         term_residuals=(), term_jacobians=(), roots=None, name="extras_test", extras=(extra,))
+    A = np.random.default_rng(1).normal(size=(50, 2))
+    expected = np.array(extra.map(50)(A.T, 3.0)).T
+    for backend in ("c", "python"):
+        session = open_session(funcs, backend=backend, rtol=1e-8, atol=1e-10)
+        got = session.eval_extra(0, [A, np.array([3.0])], 50)
+        np.testing.assert_allclose(got, expected, rtol=1e-14, atol=1e-14)
+        session.close()

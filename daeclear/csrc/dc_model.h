@@ -41,4 +41,8 @@ typedef struct {
 
 extern const dc_model_t dc_model;
 
+/* post-processing functions (DAEFunctions.extras), evaluated point by point by dc_eval_extra */
+extern const int dc_n_extras;
+extern const dc_fun_t dc_extra_tab[];
+
 #endif

@@ -274,6 +274,41 @@ DC_API int dc_model_info(int* n, int* n_terms, int* n_roots, int* n_params) {
 
 DC_API const char* dc_model_name(void) { return dc_model.name; }
 
+DC_API int dc_n_extra(void) { return dc_n_extras; }
+
+/* Evaluate extra function k at n_points points. Input j of point i is read from
+ * inputs[j] + i * in_strides[j] (stride 0: the same values for every point); the output of
+ * point i is written to out + i * out_stride. Returns 0, or -1 (bad k / out of memory) or the
+ * function's nonzero status. No session needed: the functions are pure. */
+DC_API int dc_eval_extra(int k, int n_points, int n_in, const double* const* inputs,
+                         const int* in_strides, double* out, int out_stride) {
+  if (k < 0 || k >= dc_n_extras || n_points < 0) return -1;
+  const dc_fun_t* f = &dc_extra_tab[k];
+  dc_int sz_arg = 0, sz_res = 0, sz_iw = 0, sz_w = 0;
+  if (f->work(&sz_arg, &sz_res, &sz_iw, &sz_w)) return -1;
+  const double** arg = (const double**)calloc((size_t)sz_arg + 1, sizeof(double*));
+  double** res = (double**)calloc((size_t)sz_res + 1, sizeof(double*));
+  dc_int* iw = (dc_int*)calloc((size_t)sz_iw + 1, sizeof(dc_int));
+  double* w = (double*)calloc((size_t)sz_w + 1, sizeof(double));
+  int status = (arg && res && iw && w && n_in <= sz_arg) ? 0 : -1;
+  if (status == 0) {
+    f->incref();
+    int mem = f->checkout();
+    for (int i = 0; i < n_points && status == 0; ++i) {
+      for (int j = 0; j < n_in; ++j) arg[j] = inputs[j] ? inputs[j] + (size_t)i * (size_t)in_strides[j] : 0;
+      res[0] = out + (size_t)i * (size_t)out_stride;
+      status = f->eval(arg, res, iw, w, mem);
+    }
+    f->release(mem);
+    f->decref();
+  }
+  free(arg);
+  free(res);
+  free(iw);
+  free(w);
+  return status;
+}
+
 DC_API void dc_flag_name(long flag, char* buf, int len) { flag_name(flag, buf, len); }
 
 DC_API const char* dc_message(void* sp) { return sp ? ((dc_session*)sp)->msg : ""; }
