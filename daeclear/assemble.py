@@ -206,21 +206,32 @@ class DAEModel:
         rhs = out[:, size * size:].copy()
         if generalized_force is not None:
             rhs[:, :n] += np.atleast_2d(generalized_force)
-        sol = np.linalg.solve(K, rhs[..., None])[..., 0]
+        if N == 1:  # the per-event path: a plain 2-D solve avoids numpy's batched overhead
+            sol = np.linalg.solve(K[0], rhs[0])[None, :]
+        else:
+            sol = np.linalg.solve(K, rhs[..., None])[..., 0]
         a, lam = sol[:, :n], sol[:, n:]
         return (a[0], lam[0]) if single else (a, lam)
 
     def consistent_state(self, t: ArrayLike, y: NDArray[np.float64],
-                         generalized_force: NDArray[np.float64] | None = None, session: Any = None
-                         ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+                         generalized_force: NDArray[np.float64] | None = None, session: Any = None,
+                         project: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Keep q and v of ``y``; recompute multipliers and derivatives so that F(t, y, y') = 0.
 
         ``y`` is one state (n_states,) or many (N, n_states) with ``t`` of shape (N,).
+        ``project`` (GGL restarts): first put q and v exactly on the constraint manifold, mu = 0.
         """
         n, m = self.n_q, self.n_constraints
         y = np.array(y, dtype=float)
         single = y.ndim == 1
         y2 = np.atleast_2d(y)
+        if self.formulation == "ggl" and m and single and project:
+            # restart on the constraint manifold with mu = 0, its exact value: GGL holds Phi and
+            # Phi' only to Newton's tolerance, and a restart at a tight rtol must not inherit that
+            t0 = float(np.ravel(t)[0])
+            y2[0, :n] = self.assemble_positions(y2[0, :n], t0)
+            y2[0, n:2 * n] = self.assemble_velocities(y2[0, :n], y2[0, n:2 * n], t0)
+            y2[0, 2 * n + m:] = 0.0
         q, v = y2[:, :n], y2[:, n:2 * n]
         a, lam = self.accelerations(t, q, v, generalized_force, session)
         yp = np.zeros_like(y2)

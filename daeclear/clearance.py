@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 
 from .result import ContactEvent
 from .scene import RevoluteClearance, Scene
-from .symbolic import AssemblyContext, Channel, Term, perpendicular
+from .symbolic import AssemblyContext, BufferedFunction, Channel, Term, perpendicular
 
 # Storm guard (see PairLogic): STORM_EVENTS switches within STORM_WINDOW seconds hold the term on.
 STORM_EVENTS = 20
@@ -58,7 +58,7 @@ class PairLogic:
     pair: str
     root_index: int
     term_index: int
-    rate: ca.Function
+    rate: Callable[..., tuple[NDArray, NDArray]]  # (q, v) -> (gap, penetration rate)
     n_q: int
     needs_approach: bool
     min_approach_speed: float
@@ -70,7 +70,7 @@ class PairLogic:
     def _gap_rate(self, y: NDArray) -> tuple[float, float]:
         q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
         gap, rate = self.rate(q, v)
-        return float(gap), float(rate)
+        return float(gap[0]), float(rate[0])
 
     def _params(self, rate: float) -> NDArray:
         return np.array([max(rate, self.min_approach_speed)]) if self.needs_approach else np.zeros(0)
@@ -174,7 +174,7 @@ def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, sce
     Q = ctx.generalized_force([(joint.body_j, f_journal, Q_j), (joint.body_i, -f_journal, Q_i)])
     force = ca.Function(f"{joint.name}_force", [ctx.t, ctx.q, ctx.v, p], [Q], ["t", "q", "v", "p"], ["Q"])
     rate = ca.Function(f"{joint.name}_rate", [ctx.q, ctx.v], [gap, ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
-    logic = PairLogic(joint.name, first_root, first_term, rate, ctx.n_q, law.needs_approach_speed,
+    logic = PairLogic(joint.name, first_root, first_term, BufferedFunction(rate), ctx.n_q, law.needs_approach_speed,
                       float(getattr(law, "min_approach_speed", 0.0)),
                       discontinuous_friction=not friction.frictionless and not friction.smooth)
 

@@ -47,6 +47,19 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--name", help="base name of the output files (default: the scene name)")
     run.add_argument("--no-figure", action="store_true", help="write the HDF5 result only")
     run.add_argument("--quiet", action="store_true", help="no progress line")
+
+    study = sub.add_parser("study", help="work-precision study: error against run time per method and tolerance")
+    study.add_argument("target", help="mechanism name (slider_crank)")
+    study.add_argument("--joint", default="revolute", help="slider_crank: which joint has clearance (default revolute)")
+    study.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="mechanism parameter")
+    study.add_argument("--t-end", type=float, default=0.012, help="end time, s (default one revolution at 5000 rpm)")
+    study.add_argument("--methods", default="ida,DOP853,LSODA,rk4",
+                       help="comma-separated methods (ida, RK45, DOP853, Radau, BDF, LSODA, rk4, euler)")
+    study.add_argument("--rtols", default="1e-4,1e-6,1e-8", help="tolerances of the adaptive methods")
+    study.add_argument("--steps", default="1e-5,5e-6", help="steps of the fixed-step methods, s")
+    study.add_argument("--channels", default="slider.vx,drive.moment", help="channels whose error is measured")
+    study.add_argument("--repeats", type=int, default=3, help="timed repeats per run (best kept)")
+    study.add_argument("--out", type=Path, default=Path("results/study"), help="output directory")
     return parser
 
 
@@ -106,12 +119,56 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _floats(text: str, what: str) -> list[float]:
+    try:
+        return [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise DaeclearError(f"--{what} {text!r}: expected comma-separated numbers, e.g. 1e-4,1e-6.") from None
+
+
+def _study(args: argparse.Namespace) -> int:
+    from .accuracy import work_precision
+    from .scenefile import MECHANISMS
+
+    if args.target not in MECHANISMS:
+        raise DaeclearError(f"study: {args.target!r} is not a mechanism ({', '.join(MECHANISMS)}).")
+    params = _parse_sets(args.set)
+    params.setdefault("joint", args.joint)
+    scene = MECHANISMS[args.target](**params)
+    methods = {m.strip(): {"method": m.strip()} for m in args.methods.split(",") if m.strip()}
+    study = work_precision(scene, args.t_end, channels=[c.strip() for c in args.channels.split(",") if c.strip()],
+                           methods=methods, rtols=_floats(args.rtols, "rtols"), steps=_floats(args.steps, "steps"),
+                           repeats=args.repeats, progress=True)
+    args.out.mkdir(parents=True, exist_ok=True)
+    study.to_csv(args.out / "work_precision.csv")
+    text = study.to_markdown(args.out / "work_precision.md")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .plot import plot_work_precision
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    plot_work_precision(study, ax=ax)
+    fig.tight_layout()
+    fig.savefig(args.out / "work_precision.png", dpi=120)
+    plt.close(fig)
+    print(text)
+    others = [label for label in methods if label.lower() != "ida"]
+    for row in study.speed_ratio("ida", others) if "ida" in methods else []:
+        print(f"ida rtol {row['tolerance']:g}: error {row['error']:.3g}, {row['wall_time']:.4f} s; fastest other at "
+              f"equal or better accuracy: {row['rival']} ({row['rival_wall_time']:.4f} s): ratio {row['ratio']:.1f}")
+    print(f"wrote {args.out / 'work_precision.csv'}, .md and .png")
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="daeclear: %(message)s")
     args = build_parser().parse_args(argv)
     try:
         if args.command == "run":
             return _run(args)
+        if args.command == "study":
+            return _study(args)
     except SolveError as exc:
         print(f"daeclear: {exc}", file=sys.stderr)
         return 1

@@ -416,3 +416,110 @@ def plot_revolute_response(result: Result, *, reference: Result | None = None, o
 
 
 __all__ += ["plot_cases", "plot_journal_orbit", "plot_phase_portrait", "plot_revolute_response", "plot_step_sizes"]
+
+
+def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | None = None, limits: bool = True,
+                     reference: Result | None = None, **line_kw: Any) -> Axes:
+    """Dimensionless path of the slider centre inside the guide (Figs. 4.28d, 4.30, 4.33).
+
+    Parameters
+    ----------
+    result : Result
+        A run with a translational clearance joint (channels ``<joint>.xi`` and
+        ``<joint>.eta``: xi from 0 to 1 along the stroke, eta the offset of the slider
+        centre from the guide's mid-line over 2c, +-0.5 where a parallel slider touches
+        a surface).
+    joint : str
+        Name of the translational clearance joint (``"clearance"`` in ``slider_crank``).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    limits : bool
+        Draw the geometric contact limits, eta = +-0.5 (dashed): beyond them the slider
+        and the guide are in contact (the chapter's horizontal lines).
+    reference : Result, optional
+        Drawn first, black dotted (e.g. the ideal joint: eta = 0 along the stroke).
+    **line_kw
+        Passed to ``ax.plot`` for the path.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax.lines[0]`` is the reference path when given, then the slider path, then the
+        two limit lines.
+    """
+    ax = _axes(ax)
+    if reference is not None:
+        ax.plot(reference[f"{joint}.xi"], reference[f"{joint}.eta"], "k:", lw=0.8, label="ideal joint")
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0"}
+    kw.update(line_kw)
+    ax.plot(result[f"{joint}.xi"], result[f"{joint}.eta"], **kw)
+    if limits:
+        for level in (0.5, -0.5):
+            ax.axhline(level, color="k", ls="--", lw=0.8)
+    ax.set_xlabel("dimensionless slider position along the stroke, ξ")
+    ax.set_ylabel("dimensionless slider offset, η")
+    return ax
+
+
+def plot_translational_response(result: Result, *, reference: Result | None = None,
+                                joint: str = "clearance") -> Any:
+    """Fig. 4.28 in four panels: slider velocity, slider acceleration, crank moment, slider path.
+
+    Parameters
+    ----------
+    result : Result
+        The clearance-joint run (a dense ``t_eval``).
+    reference : Result, optional
+        The ideal-joint run over the same times, dashed in panels a-c.
+    joint : str
+        Name of the translational clearance joint.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Axes in order (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) path.
+    """
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(10.0, 7.0))
+    (a, b), (c, d) = axes
+    titles = ("(a) slider velocity", "(b) slider acceleration", "(c) crank moment")
+    for ax, name, title in zip((a, b, c), RESPONSE_CHANNELS, titles):
+        plot_channel(result, name, ax=ax, reference=reference, label="clearance joint")
+        ax.set_title(title, fontsize="medium")
+    plot_slider_path(result, joint, ax=d)
+    d.set_title("(d) dimensionless slider path inside the guide", fontsize="medium")
+    fig.tight_layout()
+    return fig
+
+
+__all__ += ["plot_slider_path", "plot_translational_response"]
+
+
+def plot_work_precision(study: Any, *, ax: Axes | None = None) -> Axes:
+    """Error against wall time (log-log), one line per method, failed runs marked with x at the top.
+
+    ``study`` is a :class:`daeclear.accuracy.WorkPrecision`.
+    """
+    import math
+
+    ax = _axes(ax)
+    labels = list(dict.fromkeys(r["label"] for r in study.rows))
+    ok_errors = [r["error"] for r in study.rows if r["status"] == 0 and math.isfinite(r["error"])]
+    top = max(ok_errors) * 3 if ok_errors else 1.0
+    for label in labels:
+        rows = [r for r in study.rows if r["label"] == label]
+        good = [r for r in rows if r["status"] == 0 and math.isfinite(r["error"]) and r["error"] > 0]
+        line = ax.loglog([r["wall_time"] for r in good], [r["error"] for r in good], "o-", label=label)[0]
+        for r in good:
+            ax.annotate(f"{r['tolerance']:g}", (r["wall_time"], r["error"]), fontsize=6,
+                        textcoords="offset points", xytext=(3, 3))
+        bad = [r for r in rows if r not in good and math.isfinite(r.get("wall_time", math.nan))]
+        if bad:
+            ax.loglog([r["wall_time"] for r in bad], [top] * len(bad), "x", color=line.get_color())
+    ax.set_xlabel("wall time (s)")
+    ax.set_ylabel(f"max error / range ({', '.join(study.channels)})")
+    ax.set_title(f"error over t in [{study.window[0]:.3g}, {study.window[1]:.3g}] s", fontsize="small")
+    ax.legend(fontsize="small")
+    ax.grid(True, which="both", lw=0.3)
+    return ax

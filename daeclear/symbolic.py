@@ -114,3 +114,30 @@ class AssemblyContext:
         return np.array([c * dx + s * dy, -s * dx + c * dy])
 
 
+
+
+class BufferedFunction:
+    """A CasADi Function called through a FunctionBuffer on fixed numpy arrays (~1 us a call
+    instead of ~50-100 us for a plain call): for small functions on the per-event path."""
+
+    def __init__(self, function: ca.Function) -> None:
+        self.function = function
+        self._inputs = [np.zeros(function.numel_in(i)) for i in range(function.n_in())]
+        self._outputs = [np.zeros(function.numel_out(i)) for i in range(function.n_out())]
+        self._buffer, self._eval = function.buffer()
+        for i, a in enumerate(self._inputs):
+            self._buffer.set_arg(i, memoryview(a))
+        for i, r in enumerate(self._outputs):
+            self._buffer.set_res(i, memoryview(r))
+
+    def __call__(self, *args: Any) -> tuple[NDArray[np.float64], ...]:
+        for a, x in zip(self._inputs, args):
+            a[:] = np.ravel(x)
+        self._eval()
+        return tuple(r.copy() for r in self._outputs)
+
+    def __getstate__(self) -> dict[str, Any]:  # picklable for process pools: rebuild the buffer
+        return {"function": self.function}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(state["function"])  # type: ignore[misc]

@@ -68,3 +68,14 @@ def test_scene_file_unknown_key(tmp_path, capsys):
     assert main(["run", str(path), "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert "[[body]] #1: unknown key(s) mas" in err
+
+
+def test_study_writes_table_and_figure(tmp_path, capsys):
+    code = main(["study", "slider_crank", "--joint", "ideal", "--t-end", "0.002", "--methods", "ida,rk4",
+                 "--rtols", "1e-5", "--steps", "1e-5", "--repeats", "0", "--channels", "slider.vx",
+                 "--out", str(tmp_path)])
+    assert code == 0
+    lines = (tmp_path / "work_precision.csv").read_text().strip().splitlines()
+    assert len(lines) == 3 and lines[1].startswith("ida,ida,1e-05")
+    assert (tmp_path / "work_precision.png").stat().st_size > 10_000
+    assert "Window: t in [0, 0.002]" in capsys.readouterr().out
