@@ -289,3 +289,21 @@ def work_precision(
             })
     return WorkPrecision(rows=rows, channels=list(channels), window=window, window_reason=reason, reference=ref,
                          reference_options=ref_options, assembly_time=assembly_time, notes=notes)
+
+
+def energy_balance(result: Result) -> dict[str, float]:
+    """How well the run keeps dE/dt = input power (drivers and contact forces; gravity is in E).
+
+    Integrates ``energy.input_power`` over the output times (cumulative trapezoid) and compares
+    it with the change of ``energy.mechanical``. Returns the largest and the final residual,
+    relative to the energy scale (the larger of the energy's range and the integrated work).
+    Accuracy is limited by the quadrature as much as by the integration: use dense outputs.
+    """
+    t = np.asarray(result.t)
+    energy = np.asarray(result["energy.mechanical"])
+    power = np.asarray(result["energy.input_power"]) if "energy.input_power" in result else np.zeros_like(t)
+    work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
+    residual = (energy - energy[0]) - work
+    scale = max(float(np.ptp(energy)), float(np.max(np.abs(work))), 1e-300)
+    return {"max_residual": float(np.max(np.abs(residual))) / scale,
+            "final_residual": float(abs(residual[-1])) / scale, "scale": scale}

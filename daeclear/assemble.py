@@ -44,7 +44,7 @@ Formulation = Literal["index1", "ggl"]
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
 
 # Extra functions compiled with the model (DAEFunctions.extras), evaluated over many points.
-EXTRA_OUTPUTS, EXTRA_KKT, EXTRA_TERM0 = 0, 1, 2  # term k's generalized force: EXTRA_TERM0 + k
+EXTRA_OUTPUTS, EXTRA_ACCEL, EXTRA_TERM0 = 0, 1, 2  # term k's generalized force: EXTRA_TERM0 + k
 
 # State kinds: how each state variable is treated by the solver's error test.
 KIND_POSITION, KIND_VELOCITY, KIND_MULTIPLIER = "q", "v", "lambda"
@@ -190,7 +190,7 @@ class DAEModel:
     def accelerations(self, t: ArrayLike, q: NDArray[np.float64], v: NDArray[np.float64],
                       generalized_force: NDArray[np.float64] | None = None, session: Any = None
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Solve [M Phi_q^T; Phi_q 0] [v'; lam] = [Q; c] for v' and lam.
+        """Solve [M Phi_q^T; Phi_q 0] [v'; lam] = [Q; c] for v' and lam (generated code, see assemble).
 
         ``c = gamma - 2 alpha Phi' - beta^2 Phi`` (index1) or ``gamma`` (ggl). Works on one state
         (``q``, ``v`` of shape (n,)) or on many (N, n) with ``t`` of shape (N,).
@@ -200,16 +200,8 @@ class DAEModel:
         q2, v2 = np.atleast_2d(q), np.atleast_2d(v)
         N, n, m = q2.shape[0], self.n_q, self.n_constraints
         t_col = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,)).reshape(N, 1)
-        size = n + m
-        out = self.evaluate(EXTRA_KKT, [t_col, q2, v2], N, session)
-        K = out[:, :size * size].reshape(N, size, size).transpose(0, 2, 1)  # column-major blocks
-        rhs = out[:, size * size:].copy()
-        if generalized_force is not None:
-            rhs[:, :n] += np.atleast_2d(generalized_force)
-        if N == 1:  # the per-event path: a plain 2-D solve avoids numpy's batched overhead
-            sol = np.linalg.solve(K[0], rhs[0])[None, :]
-        else:
-            sol = np.linalg.solve(K, rhs[..., None])[..., 0]
+        Qc = np.zeros((1, n)) if generalized_force is None else np.atleast_2d(generalized_force)
+        sol = self.evaluate(EXTRA_ACCEL, [t_col, q2, v2, Qc], N, session)
         a, lam = sol[:, :n], sol[:, n:]
         return (a[0], lam[0]) if single else (a, lam)
 
@@ -445,6 +437,7 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     contact_channels: list[Channel] = []
     contacts: list[Any] = []
     switch_syms: list[Any] = []  # per term: on/off flag and parameters, inputs of the outputs
+    power_channels: list[Any] = []
     for build in contact_builds:
         switches = []
         for term in build.terms:
@@ -452,6 +445,11 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
             switches.append((on_k, p_k))
             switch_syms += [on_k, p_k]
         contact_channels.extend(build.channels(switches))
+        for term, (on_k, p_k) in zip(build.terms, switches):
+            # power of the contact force on the mechanism (energy balance: dE/dt = sum of powers)
+            power = ca.if_else(on_k > 0, ca.dot(term.force(t, q, v, p_k), v), 0.0)  # 0 (not NaN) when off
+            contact_channels.append(Channel(f"{term.name}.power", "W", power))
+            power_channels.append(power)
         for term in build.terms:
             p = ca.SX.sym("p", term.n_params)
             Qk = term.force(t, q, v, p)
@@ -486,6 +484,9 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         # The driver's constraint enters body j's rotation equation with +lam; the torque it
         # applies to body j is therefore -lam (positive counter-clockwise).
         channels.append(Channel(f"{name}.moment", "N m", -lam[row]))
+        drive_power = -lam[row] * ca.mtimes(Phi_q[row, :], v)  # moment times relative angular speed
+        channels.append(Channel(f"{name}.power", "W", drive_power))
+        power_channels.append(drive_power)
     kinetic = 0.5 * ca.dot(ca.DM(mass_diag), v * v)
     potential = -sum(b.mass * (gx * q[3 * k] + gy * q[3 * k + 1]) for k, b in enumerate(bodies))
     channels += [
@@ -493,6 +494,8 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         Channel("energy.potential", "J", potential),
         Channel("energy.mechanical", "J", kinetic + potential),
     ]
+    if power_channels:  # drivers and contact forces: the rate of change of the mechanical energy
+        channels.append(Channel("energy.input_power", "W", sum(power_channels)))
     if m:
         channels += [
             Channel("constraints.position", "m", ca.mmax(ca.fabs(Phi))),
@@ -502,11 +505,21 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     switch = ca.vertcat(*switch_syms) if switch_syms else ca.SX(0, 1)
     outputs = ca.Function("outputs", [t, y, yp, switch], [ca.vertcat(*[c.expr for c in channels])],
                           ["t", "y", "yp", "switch"], ["channels"])
-    # KKT system of the accelerations and multipliers (consistent states at restarts and outputs)
+    # Accelerations and multipliers from (t, q, v) and the contact forces Qc: the KKT system
+    # [M Phi_q^T; Phi_q 0][a; lam] = [Q + Qc; c] solved by its Schur complement (M is diagonal),
+    # generated as C: consistent states at restarts and at every reported point cost ~1 us.
     rhs_c = gamma - 2 * alpha * Phi_dot - beta**2 * Phi if formulation == "index1" else gamma
-    K = ca.vertcat(ca.horzcat(M, Phi_q.T), ca.horzcat(Phi_q, ca.SX.zeros(m, m)))
-    kkt = ca.Function("kkt", [t, q, v], [ca.densify(ca.vertcat(ca.vec(K), Q, rhs_c))], ["t", "q", "v"], ["kkt"])
-    extras = [outputs, kkt] + [term.force for term in terms]
+    Qc = ca.SX.sym("Qc", n)
+    Minv = ca.DM(1.0 / mass_diag)
+    F = Q + Qc
+    if m:
+        PMinv = Phi_q * ca.repmat(Minv.T, m, 1)  # Phi_q M^-1
+        lam_sol = ca.solve(ca.mtimes(PMinv, Phi_q.T), ca.mtimes(PMinv, F) - rhs_c)
+        a_sol = Minv * (F - ca.mtimes(Phi_q.T, lam_sol))
+    else:
+        lam_sol, a_sol = ca.SX(0, 1), Minv * F
+    accel = ca.Function("accel", [t, q, v, Qc], [ca.densify(ca.vertcat(a_sol, lam_sol))], ["t", "q", "v", "Qc"], ["a_lam"])
+    extras = [outputs, accel] + [term.force for term in terms]
     functions = DAEFunctions(
         n=n_y, residual=residual, jacobian=jacobian, term_residuals=tuple(term_res),
         term_jacobians=tuple(term_jac), roots=roots, name=_c_identifier(scene.name), extras=tuple(extras),

@@ -246,15 +246,19 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
             seg_start = t
             adv = session.advance(t_end, pending, store_steps)
             if store_steps and adv.step_t.size:
+                # IDA does not converge the multipliers (they are out of its error test): report
+                # multipliers and accelerations recomputed from each step's q and v
+                step_y, step_yp = model.consistent_state(
+                    adv.step_t, adv.step_y, model.term_forces(adv.step_t, adv.step_y, active, params, session),
+                    session)
                 steps_t.append(adv.step_t)
-                steps_y.append(adv.step_y)
-                steps_yp.append(adv.step_yp)
+                steps_y.append(step_y)
+                steps_yp.append(step_yp)
                 steps_h.append(adv.step_h)
                 steps_order.append(adv.step_order)
                 steps_switch.append(np.repeat(switch[None, :], adv.step_t.size, axis=0))
             if adv.eval_t.size:
-                # IDA's interpolant of the multipliers is not error-controlled: recompute the
-                # multipliers and accelerations of output points from their q and v.
+                # likewise for output times (IDA's interpolant of the multipliers is not controlled)
                 y_eval, yp_eval = model.consistent_state(
                     adv.eval_t, adv.eval_y, model.term_forces(adv.eval_t, adv.eval_y, active, params, session),
                     session)
