@@ -47,7 +47,7 @@ FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
 EXTRA_OUTPUTS, EXTRA_ACCEL, EXTRA_TERM0 = 0, 1, 2  # term k's generalized force: EXTRA_TERM0 + k
 
 # State kinds: how each state variable is treated by the solver's error test.
-KIND_POSITION, KIND_VELOCITY, KIND_MULTIPLIER = "q", "v", "lambda"
+KIND_POSITION, KIND_VELOCITY, KIND_MULTIPLIER, KIND_WORK = "q", "v", "lambda", "work"
 
 
 @dataclass(frozen=True)
@@ -79,6 +79,7 @@ class DAEModel:
     base_force: ca.Function  # (t, q, v) -> Q (gravity and applied loads)
     parameters: dict[str, Any] = field(default_factory=dict)
     contacts: tuple[Any, ...] = ()  # contact elements' event logic (clearance joints)
+    track_work: bool = False
 
     @property
     def n_q(self) -> int:
@@ -99,8 +100,9 @@ class DAEModel:
 
     def __str__(self) -> str:
         n_q, m = self.n_q, self.n_constraints
-        extra = self.n_states - 2 * n_q - m
-        parts = f"q {n_q} + v {n_q} + lambda {m}" + (f" + mu {extra}" if extra else "")
+        extra = self.n_states - 2 * n_q - m - int(self.track_work)
+        parts = (f"q {n_q} + v {n_q} + lambda {m}" + (f" + mu {extra}" if extra else "")
+                 + (" + work 1" if self.track_work else ""))
         lines = [
             f"DAEModel '{self.scene_name}' ({self.formulation}"
             + (f", alpha={self.alpha:g}, beta={self.beta:g})" if self.formulation == "index1" else ")"),
@@ -167,8 +169,9 @@ class DAEModel:
         if session is not None:
             return session.eval_extra(k, inputs, n_points)
         f = self.functions.extras[k]
-        cols = [np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, f.numel_in(j)),
-                                (n_points, f.numel_in(j))).T for j, x in enumerate(inputs)]
+        cols = [np.zeros((0, n_points)) if f.numel_in(j) == 0 else
+                np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, f.numel_in(j)), (n_points, f.numel_in(j))).T
+                for j, x in enumerate(inputs)]
         return np.array(_mapped(f, n_points)(*cols)).reshape(-1, n_points).T
 
     def term_forces(self, t: ArrayLike, y: NDArray[np.float64], active: Sequence[bool],
@@ -202,8 +205,16 @@ class DAEModel:
         t_col = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,)).reshape(N, 1)
         Qc = np.zeros((1, n)) if generalized_force is None else np.atleast_2d(generalized_force)
         sol = self.evaluate(EXTRA_ACCEL, [t_col, q2, v2, Qc], N, session)
-        a, lam = sol[:, :n], sol[:, n:]
+        a, lam = sol[:, :n], sol[:, n:n + m]
         return (a[0], lam[0]) if single else (a, lam)
+
+    def _accel_solution(self, t: ArrayLike, q: NDArray, v: NDArray, generalized_force: NDArray | None,
+                        session: Any) -> NDArray[np.float64]:
+        """[a, lam(, work rate)] per row, from the generated Schur-complement solve."""
+        N, n = q.shape[0], self.n_q
+        t_col = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,)).reshape(N, 1)
+        Qc = np.zeros((1, n)) if generalized_force is None else np.atleast_2d(generalized_force)
+        return self.evaluate(EXTRA_ACCEL, [t_col, q, v, Qc], N, session)
 
     def consistent_state(self, t: ArrayLike, y: NDArray[np.float64],
                          generalized_force: NDArray[np.float64] | None = None, session: Any = None,
@@ -223,15 +234,17 @@ class DAEModel:
             t0 = float(np.ravel(t)[0])
             y2[0, :n] = self.assemble_positions(y2[0, :n], t0)
             y2[0, n:2 * n] = self.assemble_velocities(y2[0, :n], y2[0, n:2 * n], t0)
-            y2[0, 2 * n + m:] = 0.0
+            y2[0, 2 * n + m:2 * n + 2 * m] = 0.0
         q, v = y2[:, :n], y2[:, n:2 * n]
-        a, lam = self.accelerations(t, q, v, generalized_force, session)
+        sol = self._accel_solution(t, q, v, generalized_force, session)
         yp = np.zeros_like(y2)
         yp[:, :n] = v
-        yp[:, n:2 * n] = a
-        y2[:, 2 * n:2 * n + m] = lam
+        yp[:, n:2 * n] = sol[:, :n]
+        y2[:, 2 * n:2 * n + m] = sol[:, n:n + m]
+        if self.track_work:
+            yp[:, -1] = sol[:, n + m]
         if self.formulation == "ggl" and m:
-            mu = y2[:, 2 * n + m:]
+            mu = y2[:, 2 * n + m:2 * n + 2 * m]
             N = y2.shape[0]
             t_arr = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,))
             Phi_q = np.array(_mapped(self.kinematics, N)(q.T, v.T, t_arr[None, :])[1]).reshape(m, N, n).transpose(1, 0, 2)
@@ -309,7 +322,8 @@ def _driver(ctx: AssemblyContext, driver: Driver, joint: Revolute) -> Any:
     return bj.phi - bi.phi - theta0 - driver.speed * ctx.t
 
 
-def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, beta: float = 5.0) -> DAEModel:
+def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, beta: float = 5.0,
+             track_work: bool = False) -> DAEModel:
     """Assemble a validated scene into a :class:`DAEModel`.
 
     Parameters
@@ -321,6 +335,11 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         chapter's); ``ggl``: stabilised index-2, drift-free in positions and velocities.
     alpha, beta : float
         Baumgarte parameters of ``index1`` (1/s), 5 and 5 by default (Table 4.2).
+    track_work : bool
+        Add the state ``work.input``: the work done on the mechanism by drivers and contact
+        forces, W' = driver power + contact power, integrated with the equations (kept out of
+        the error test, so it does not change the solution). ``energy.mechanical - work`` is then
+        conserved up to the integration error: channel ``energy.work``.
 
     Returns
     -------
@@ -422,6 +441,27 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         res = ca.vertcat(q_p - v + ca.mtimes(Phi_q.T, mu), eom, Phi_dot, Phi)
         state_names += [f"mu.{c}" for c in names]
         kinds += [KIND_MULTIPLIER] * m
+    drive_power = sum((-lam[row] * ca.mtimes(Phi_q[row, :], v) for row in driver_rows.values()), ca.SX(0.0))
+    # Multipliers from (t, q, v) and extra generalized forces Fc, by the Schur complement of the
+    # KKT system [M Phi_q^T; Phi_q 0][a; lam] = [Q + Fc; c] (M is diagonal). Used for consistent
+    # states and for the work rate, which must not depend on IDA's unconverged multipliers.
+    Minv = ca.DM(1.0 / mass_diag)
+    rhs_c = gamma - 2 * alpha * Phi_dot - beta**2 * Phi if formulation == "index1" else gamma
+    Fc = ca.SX.sym("Fc", n)
+    if m:
+        PMinv = Phi_q * ca.repmat(Minv.T, m, 1)  # Phi_q M^-1
+        lam_sol = ca.solve(ca.mtimes(PMinv, Phi_q.T), ca.mtimes(PMinv, Q + Fc) - rhs_c)
+    else:
+        lam_sol = ca.SX(0, 1)
+    a_sol = Minv * (Q + Fc - ca.mtimes(Phi_q.T, lam_sol))
+    drive_power_of = ca.substitute(drive_power, lam, lam_sol) if m else ca.SX(0.0)  # linear in Fc
+    drive_power_base = ca.substitute(drive_power_of, Fc, ca.SX.zeros(n))
+    if track_work:
+        W, W_p = ca.SX.sym("W"), ca.SX.sym("W_p")
+        y, yp = ca.vertcat(y, W), ca.vertcat(yp, W_p)
+        res = ca.vertcat(res, W_p - drive_power_base)
+        state_names.append("work.input")
+        kinds.append(KIND_WORK)
     n_y = y.numel()
     cj = ca.SX.sym("cj")
     residual = ca.Function("residual", [t, y, yp], [res], ["t", "y", "yp"], ["r"])
@@ -453,7 +493,9 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         for term in build.terms:
             p = ca.SX.sym("p", term.n_params)
             Qk = term.force(t, q, v, p)
-            r_k = ca.vertcat(ca.SX.zeros(n), -Qk, ca.SX.zeros(n_y - 2 * n))
+            # the term's share of the work rate: its own power and the driver power it causes
+            work_row = [-(ca.dot(Qk, v) + ca.substitute(drive_power_of, Fc, Qk) - drive_power_base)] if track_work else []
+            r_k = ca.vertcat(ca.SX.zeros(n), -Qk, ca.SX.zeros(n_y - 2 * n - len(work_row)), *work_row)
             term_res.append(ca.Function(f"{term.name}_res", [t, y, yp, p], [r_k], ["t", "y", "yp", "p"], ["r"]))
             j_k = ca.densify(ca.jacobian(r_k, y) + cj * ca.jacobian(r_k, yp))
             term_jac.append(ca.Function(f"{term.name}_jac", [t, y, yp, p, cj], [j_k],
@@ -484,9 +526,9 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         # The driver's constraint enters body j's rotation equation with +lam; the torque it
         # applies to body j is therefore -lam (positive counter-clockwise).
         channels.append(Channel(f"{name}.moment", "N m", -lam[row]))
-        drive_power = -lam[row] * ca.mtimes(Phi_q[row, :], v)  # moment times relative angular speed
-        channels.append(Channel(f"{name}.power", "W", drive_power))
-        power_channels.append(drive_power)
+        power_d = -lam[row] * ca.mtimes(Phi_q[row, :], v)  # moment times relative angular speed
+        channels.append(Channel(f"{name}.power", "W", power_d))
+        power_channels.append(power_d)
     kinetic = 0.5 * ca.dot(ca.DM(mass_diag), v * v)
     potential = -sum(b.mass * (gx * q[3 * k] + gy * q[3 * k + 1]) for k, b in enumerate(bodies))
     channels += [
@@ -496,6 +538,8 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     ]
     if power_channels:  # drivers and contact forces: the rate of change of the mechanical energy
         channels.append(Channel("energy.input_power", "W", sum(power_channels)))
+    if track_work:
+        channels.append(Channel("energy.work", "J", y[n_y - 1]))
     if m:
         channels += [
             Channel("constraints.position", "m", ca.mmax(ca.fabs(Phi))),
@@ -505,20 +549,11 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     switch = ca.vertcat(*switch_syms) if switch_syms else ca.SX(0, 1)
     outputs = ca.Function("outputs", [t, y, yp, switch], [ca.vertcat(*[c.expr for c in channels])],
                           ["t", "y", "yp", "switch"], ["channels"])
-    # Accelerations and multipliers from (t, q, v) and the contact forces Qc: the KKT system
-    # [M Phi_q^T; Phi_q 0][a; lam] = [Q + Qc; c] solved by its Schur complement (M is diagonal),
-    # generated as C: consistent states at restarts and at every reported point cost ~1 us.
-    rhs_c = gamma - 2 * alpha * Phi_dot - beta**2 * Phi if formulation == "index1" else gamma
-    Qc = ca.SX.sym("Qc", n)
-    Minv = ca.DM(1.0 / mass_diag)
-    F = Q + Qc
-    if m:
-        PMinv = Phi_q * ca.repmat(Minv.T, m, 1)  # Phi_q M^-1
-        lam_sol = ca.solve(ca.mtimes(PMinv, Phi_q.T), ca.mtimes(PMinv, F) - rhs_c)
-        a_sol = Minv * (F - ca.mtimes(Phi_q.T, lam_sol))
-    else:
-        lam_sol, a_sol = ca.SX(0, 1), Minv * F
-    accel = ca.Function("accel", [t, q, v, Qc], [ca.densify(ca.vertcat(a_sol, lam_sol))], ["t", "q", "v", "Qc"], ["a_lam"])
+    # accelerations, multipliers (and work rate) from (t, q, v, contact forces) as generated code:
+    # consistent states at restarts and at every reported point cost ~1 us
+    work_rate = [drive_power_of + ca.dot(Fc, v)] if track_work else []
+    accel = ca.Function("accel", [t, q, v, Fc], [ca.densify(ca.vertcat(a_sol, lam_sol, *work_rate))],
+                        ["t", "q", "v", "Qc"], ["a_lam"])
     extras = [outputs, accel] + [term.force for term in terms]
     functions = DAEFunctions(
         n=n_y, residual=residual, jacobian=jacobian, term_residuals=tuple(term_res),
@@ -535,8 +570,9 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         channel_names=tuple(c.name for c in channels), channel_units={c.name: c.unit for c in channels},
         outputs=outputs, q_guess=q_guess, v_guess=v_guess, mass_diagonal=mass_diag,
         kinematics=kinematics, base_force=base_force,
-        parameters={"scene": scene.to_dict(), "formulation": formulation, "alpha": alpha, "beta": beta},
-        contacts=tuple(contacts),
+        parameters={"scene": scene.to_dict(), "formulation": formulation, "alpha": alpha, "beta": beta,
+                    "track_work": bool(track_work)},
+        contacts=tuple(contacts), track_work=bool(track_work),
     )
 
 

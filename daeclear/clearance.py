@@ -76,6 +76,7 @@ class PairLogic:
         return np.array([max(rate, self.min_approach_speed)]) if self.needs_approach else np.zeros(0)
 
     def initial_modes(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> dict[str, str]:
+        self.recent, self.held, self.free_since = [], False, 0.0  # a new run starts without history
         gap, rate = self._gap_rate(y)
         in_contact = gap > 0.0
         active[self.term_index] = in_contact

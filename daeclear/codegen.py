@@ -438,7 +438,9 @@ class OdeSpec:
     * ``sys``: (t[1], q[n], v[n]) -> (Q[n], Phi_q[m x n], c[m]), c the Baumgarte right-hand side;
     * ``sys_jac``: (t, q, v, a[n], lam[m]) -> d[Phi_q^T lam - Q; Phi_q a - c]/d(q, v), (n+m) x 2n;
     * ``gaps``: (t, q, v) -> (g[n_gaps], dg/dt[n_gaps]) or None;
-    * ``term_force[k]``: (t, q, v, p_k) -> F_k[n]; ``term_jac[k]``: same inputs -> dF_k/d(q, v), n x 2n.
+    * ``term_force[k]``: (t, q, v, p_k) -> F_k[n]; ``term_jac[k]``: same inputs -> dF_k/d(q, v), n x 2n;
+    * ``outputs`` (optional): (t, y, yp, switch) -> channel values, evaluated point by point by
+      ``dco_outputs`` (the model's output channels without a CasADi map over many points).
     """
 
     n: int
@@ -451,6 +453,7 @@ class OdeSpec:
     term_jac: tuple[casadi.Function, ...]
     n_params: tuple[int, ...]
     name: str = "model"
+    outputs: casadi.Function | None = None
 
     @property
     def n_gaps(self) -> int:
@@ -483,6 +486,11 @@ def _check_ode_spec(spec: OdeSpec) -> None:
     for k, (ff, fj, p) in enumerate(zip(spec.term_force, spec.term_jac, spec.n_params)):
         check(ff, f"term_force[{k}]", [1, n, n, p], [n])
         check(fj, f"term_jac[{k}]", [1, n, n, p], [n * 2 * n])
+    if spec.outputs is not None:
+        f = spec.outputs
+        if not isinstance(f, casadi.Function) or f.n_in() != 4 or f.n_out() != 1 or f.numel_in(0) != 1 \
+                or f.numel_in(1) != f.numel_in(2):
+            raise AssemblyError("OdeSpec.outputs must be a casadi.Function (t[1], y[n_y], yp[n_y], switch) -> channels")
 
 
 def generate_ode_source(spec: OdeSpec) -> str:
@@ -499,6 +507,8 @@ def generate_ode_source(spec: OdeSpec) -> str:
     for k in range(nt):
         funs[f"dcog_term{k}_force"] = spec.term_force[k]
         funs[f"dcog_term{k}_jac"] = spec.term_jac[k]
+    if spec.outputs is not None:
+        funs["dcog_outputs"] = spec.outputs
     for name, f in funs.items():
         # re-wrap under the C symbol name the table refers to
         ins = [casadi.SX.sym(f"i{i}", f.numel_in(i)) if f.is_a("SXFunction") else
@@ -533,6 +543,8 @@ def generate_ode_source(spec: OdeSpec) -> str:
         f"  {gaps_entry},",
         f"  {'dco_term_force_tab' if nt else '0'},",
         f"  {'dco_term_jac_tab' if nt else '0'},",
+        (f"  {spec.outputs.numel_in(1)}, {spec.outputs.numel_in(3)}, {spec.outputs.numel_out(0)}, "
+         f"{_fun_entry('dcog_outputs')}," if spec.outputs is not None else "  0, 0, 0, {0, 0, 0, 0, 0, 0, 0},"),
         f"  {_c_string(spec.name)}",
         "};",
         "",

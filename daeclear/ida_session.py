@@ -302,8 +302,9 @@ class _SessionBase:
         shape (n_points, size) or (size,) (the same for every point); returns (n_points, n_out).
         The compiled backend loops in C; the python backend maps the CasADi function."""
         f = self._model.extras[k]
-        cols = [np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, f.numel_in(j)),
-                                (n_points, f.numel_in(j))).T for j, x in enumerate(inputs)]
+        cols = [np.zeros((0, n_points)) if f.numel_in(j) == 0 else
+                np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, f.numel_in(j)), (n_points, f.numel_in(j))).T
+                for j, x in enumerate(inputs)]
         fm = f if n_points == 1 else f.map(n_points)
         return np.array(fm(*cols)).reshape(-1, n_points).T.copy()
 

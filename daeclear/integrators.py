@@ -25,19 +25,31 @@ compiler) evaluates the same functions through ``casadi.FunctionBuffer`` and num
 
 Events
 ------
-The same contact logic objects as IDA (``model.contacts``): each segment watches the gaps in
-the directions ``logic.root_directions(active)`` gives, and at an event ``logic.on_roots`` switches
-the modes; the ODE state (q, v) is kept at a restart (it is consistent by construction), and the
-integrator restarts from the event time with fresh history (scipy: a new solver object and its
-own initial step selection).
+The same contact logic objects as IDA (``model.contacts``): each segment watches every gap in the
+direction ``logic.root_directions(active)`` gives (+1 increasing, -1 decreasing, 0 both, as IDA),
+and at an event ``logic.on_roots`` gets ``roots_found`` with the direction of the crossing (+1/-1)
+and switches the modes. The ODE state (q, v) is kept at a restart (it is consistent by
+construction) and the integrator restarts from the event time with fresh history (scipy: a new
+solver object with its own initial step selection; passing the last step size instead was
+measured and gained nothing).
 
-A step may contain a crossing of a watched gap G = direction * g (from <= 0 to > 0) when G has
+A step may contain a crossing of a watched gap, G = direction * g from <= 0 to > 0, when G has
 changed sign over the step, *or* when the cubic Hermite interpolant of G built from G and dG/dt
 at the two ends of the step has an interior maximum above zero. The second test is what keeps
 quick re-contacts (a contact that closes and opens again within one step, PERFORMANCE.md item 4)
 from being stepped over: such a predicted excursion is checked on the scheme's own state at the
 predicted maximum and becomes an event when it is confirmed. Residual risk: an excursion that the
 cubic does not predict (a gap with large higher derivatives over the step) is still missed.
+Measured on the chapter's slider-crank (benchmarks/bench_methods.py): its contacts last 40 us or
+more, so over two revolutions the naive end-of-step test finds the same events as the Hermite test
+with rk4 at 1e-5 and 4e-5 s, and 87 instead of 91 with DOP853 at rtol 1e-6 (72 against 74 with
+RK45 at 1e-4); the test costs no measurable time.
+
+Just after an event the newly watched G is at rounding level (|g| ~ 1e-19 m) and moving away from
+zero; the error of an interpolant (or of a tiny re-step) could then fake a crossing right at the
+start of the next step, which DOP853 did when one long free-flight step ended inside the bearing
+wall. When G starts downwards, the bracket therefore starts where the state confirms G < 0 (at the
+cubic's first minimum, or at 1/4, 1/16, ... of it).
 
 The crossing is located by the Illinois variant of regula falsi on a bracket whose far end is
 always past the crossing, down to ``100 eps (|t| + |h|)`` (IDA's root tolerance). The state at the
@@ -71,6 +83,7 @@ from __future__ import annotations
 
 import ctypes
 import math
+import re
 import sys
 import time
 import warnings
@@ -114,6 +127,9 @@ TINY_STEP_REL = 1e-14
 TINY_STEP_COUNT = 20
 # an event loop that produces STALL_EVENTS events without the time advancing is a failure
 STALL_EVENTS = 50
+# Look for gap crossings inside a step from the cubic Hermite interpolant of the gap (True), or
+# only from sign changes at the step ends (False: the naive check, kept for measurements).
+HERMITE_GAP_CHECK = True
 # rows of the fixed-step C loop's step buffer per call
 FIXED_CHUNK = 8192
 _EPS = float(np.finfo(float).eps)
@@ -153,6 +169,9 @@ def ode_spec(model: DAEModel) -> OdeSpec:
     if model.formulation != "index1":
         raise SceneError(f"simulate: formulation={model.formulation!r} is integrated by IDA only; the other "
                          "methods integrate the chapter's index-1 formulation (formulation='index1').")
+    if getattr(model, "track_work", False) or model.n_states != 2 * model.n_q + model.n_constraints:
+        raise SceneError(f"simulate: model '{model.scene_name}' has states besides q, v and the multipliers "
+                         "(track_work); only method='ida' integrates it.")
     n, m = model.n_q, model.n_constraints
     t = ca.SX.sym("t")
     q = ca.SX.sym("q", n)
@@ -187,10 +206,10 @@ def ode_spec(model: DAEModel) -> OdeSpec:
         gaps = ca.Function("gaps", [t, q, v], [ca.densify(g), ca.densify(g_dot)])
     return OdeSpec(n=n, m=m, mass=tuple(float(mk) for mk in model.mass_diagonal), sys=sys_f, sys_jac=sys_jac,
                    gaps=gaps, term_force=tuple(forces), term_jac=tuple(jacs), n_params=tuple(n_params),
-                   name=model.functions.name)
+                   name=model.functions.name, outputs=model.outputs)
 
 
-def _candidate(G0: float, Gd0: float, G1: float, Gd1: float, h: float) -> float:
+def _candidate(G0: float, Gd0: float, G1: float, Gd1: float, h: float, hermite: bool = True) -> float:
     """Far-side point s* in (0, h] of a possible crossing of G from <= 0 to > 0 within a step.
 
     h when G1 > 0, or the first interior maximum of the cubic Hermite interpolant of G that lies
@@ -200,7 +219,7 @@ def _candidate(G0: float, Gd0: float, G1: float, Gd1: float, h: float) -> float:
     if G0 > 0.0:
         return -1.0
     best = h if G1 > 0.0 else -1.0
-    if max(G0, G1) + 0.15 * h * (abs(Gd0) + abs(Gd1)) <= 0.0:
+    if not hermite or max(G0, G1) + 0.15 * h * (abs(Gd0) + abs(Gd1)) <= 0.0:
         return best
     for u, is_max, p in _cubic_extrema(G0, Gd0, G1, Gd1, h):
         if is_max and p > 0.0 and (best < 0.0 or u * h < best):
@@ -234,30 +253,6 @@ def _cubic_extrema(G0: float, Gd0: float, G1: float, Gd1: float, h: float) -> li
             p = (2 * u3 - 3 * u2 + 1) * G0 + (u3 - 2 * u2 + u) * a0 + (-2 * u3 + 3 * u2) * G1 + (u3 - u2) * a1
             out.append((u, 2.0 * A * u + B < 0.0, p))
     return out
-    a0, a1 = h * Gd0, h * Gd1
-    A = 6.0 * G0 + 3.0 * a0 - 6.0 * G1 + 3.0 * a1
-    B = -6.0 * G0 - 4.0 * a0 + 6.0 * G1 - 2.0 * a1
-    C = a0
-    us: list[float] = []
-    if abs(A) <= 1e-12 * (abs(B) + abs(C)):
-        if B != 0.0:
-            us.append(-C / B)
-    else:
-        disc = B * B - 4.0 * A * C
-        if disc >= 0.0:
-            sq = math.sqrt(disc)
-            qq = -0.5 * (B + (sq if B >= 0.0 else -sq))
-            us.append(qq / A)
-            if qq != 0.0:
-                us.append(C / qq)
-    for u in us:
-        if not 0.0 < u < 1.0 or 2.0 * A * u + B >= 0.0:
-            continue
-        u2, u3 = u * u, u * u * u
-        p = (2 * u3 - 3 * u2 + 1) * G0 + (u3 - 2 * u2 + u) * a0 + (-2 * u3 + 3 * u2) * G1 + (u3 - u2) * a1
-        if p > 0.0 and (best < 0.0 or u * h < best):
-            best = u * h
-    return best
 
 
 # =========================================================================== evaluators
@@ -285,6 +280,9 @@ class _CLib:
             "dco_batch": (I, [P, I, P, P, P, P]),
             "dco_fixed": (I, [P, I, D, P, D, D, LL, P, I, P, P, P, P, P, P, P, P]),
             "dco_counters": (None, [P, P]),
+            "dco_set_hermite": (None, [P, I]),
+            "dco_outputs": (I, [P, I, P, P, P, P, P]),
+            "dco_output_sizes": (None, [P, P, P]),
         }
         for name, (res, args) in sig.items():
             fn = getattr(lib, name)
@@ -358,7 +356,7 @@ class _CEvaluator(_Evaluator):
         self._sx = np.zeros((FIXED_CHUNK, nx))
         self._xa = np.zeros(nx)
         self._xb = np.zeros(nx)
-        self._sstar = np.zeros(ng)
+        self._sstar = np.zeros(2 * ng)
         self._rd = np.zeros(ng, dtype=np.int32)
         self._nst = ctypes.c_int()
         self._ta = ctypes.c_double()
@@ -417,6 +415,7 @@ class _CEvaluator(_Evaluator):
     def fixed(self, scheme: int, t0: float, x0: NDArray, step: float, t_stop: float, max_steps: int,
               rootdir: NDArray | None) -> dict[str, Any]:
         A = self._a
+        self.lib.dco_set_hermite(self.h, 1 if HERMITE_GAP_CHECK else 0)
         self._xin[:] = x0
         if self.ng:
             self._rd[:] = 0 if rootdir is None else rootdir
@@ -426,9 +425,27 @@ class _CEvaluator(_Evaluator):
         out: dict[str, Any] = dict(status=rc, st=self._st[:k].copy(), sx=self._sx[:k].copy(),
                                    ta=self._ta.value, xa=self._xa.copy())
         if rc == _FX_CANDIDATE:
-            out.update(tb=self._tb.value, xb=self._xb.copy(), sstar=self._sstar[:self.ng].copy())
+            out.update(tb=self._tb.value, xb=self._xb.copy(), sstar=self._sstar[:2 * self.ng].reshape(self.ng, 2).copy())
         if rc == _FX_ERR:
             self.last_message = self.message()
+        return out
+
+    def channels(self, model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> NDArray:
+        """Output channels (N, n_channels) at N points with one switch vector, in C."""
+        sizes = [ctypes.c_int() for _ in range(3)]
+        self.lib.dco_output_sizes(*(ctypes.addressof(c) for c in sizes))
+        n_y, n_sw, n_ch = (c.value for c in sizes)
+        t = np.ascontiguousarray(t, dtype=float)
+        y = np.ascontiguousarray(y, dtype=float)
+        yp = np.ascontiguousarray(yp, dtype=float)
+        sw = np.zeros(max(n_sw, 1))
+        sw[:switch.size] = switch
+        out = np.empty((t.size, n_ch))
+        if n_ch == 0 or y.shape[1] != n_y or switch.size != n_sw:
+            return _model_channels(model, t, y, yp, switch)
+        if t.size and self.lib.dco_outputs(self.h, t.size, t.ctypes.data, y.ctypes.data, yp.ctypes.data,
+                                           sw.ctypes.data, out.ctypes.data):
+            return _model_channels(model, t, y, yp, switch)
         return out
 
     def counters(self) -> dict[str, int]:
@@ -577,7 +594,7 @@ class _PyEvaluator(_Evaluator):
     def fixed(self, scheme: int, t0: float, x0: NDArray, step: float, t_stop: float, max_steps: int,
               rootdir: NDArray | None) -> dict[str, Any]:
         """The loop of dco_fixed (csrc/ode_driver.c) in Python."""
-        watch = rootdir is not None and self.ng > 0 and bool(np.any(rootdir))
+        watch = rootdir is not None and self.ng > 0
         ta, xa = t0, np.array(x0, dtype=float)
         st: list[float] = []
         sx: list[NDArray] = []
@@ -613,11 +630,12 @@ class _PyEvaluator(_Evaluator):
                 if gg is None:
                     return done(_FX_ERR)
                 g1, gd1 = gg
-                sstar = np.full(self.ng, -1.0)
+                sstar = np.full((self.ng, 2), -1.0)
                 for i in range(self.ng):
-                    d = float(rootdir[i])  # type: ignore[index]
-                    if d:
-                        sstar[i] = _candidate(d * g0[i], d * gd0[i], d * g1[i], d * gd1[i], h)
+                    for j, d in enumerate((1.0, -1.0)):
+                        if rootdir[i] * d >= 0:  # type: ignore[index]
+                            sstar[i, j] = _candidate(d * g0[i], d * gd0[i], d * g1[i], d * gd1[i], h,
+                                                     HERMITE_GAP_CHECK)
                 if np.any(sstar > 0):
                     return done(_FX_CANDIDATE, tb=tn, xb=xb, sstar=sstar)
                 g0, gd0 = g1, gd1
@@ -625,8 +643,23 @@ class _PyEvaluator(_Evaluator):
             sx.append(xb)
             ta, xa = tn, xb
 
+    def channels(self, model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> NDArray:
+        return _model_channels(model, t, y, yp, switch)
+
     def counters(self) -> dict[str, int]:
         return dict(self.cnt)
+
+
+def _model_channels(model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> NDArray:
+    """Output channels (N, n_channels) through CasADi (no compiled library)."""
+    N = t.size
+    n_ch = model.outputs.numel_out(0)
+    if N == 0:
+        return np.zeros((0, n_ch))
+    f = model.outputs if N == 1 else model.outputs.map(N)
+    S = np.repeat(np.asarray(switch, dtype=float).reshape(-1, 1), N, axis=1)
+    out = f(np.asarray(t, dtype=float)[None, :], np.asarray(y).T, np.asarray(yp).T, S)
+    return np.array(out).reshape(n_ch, N).T
 
 
 _warned: set[str] = set()
@@ -684,6 +717,8 @@ class _Segment:
     include_start: bool  # the first segment also outputs its start point
     st: list[NDArray] = field(default_factory=list)  # chunks of step times
     sx: list[NDArray] = field(default_factory=list)  # chunks of step states
+    pt: list[float] = field(default_factory=list)  # single step times (scipy methods)
+    px: list[NDArray] = field(default_factory=list)
     et: list[NDArray] = field(default_factory=list)  # chunks of t_eval times (scipy: dense output)
     ex: list[NDArray] = field(default_factory=list)
     t1: float = 0.0
@@ -718,7 +753,7 @@ class _Run:
         self.out_t: list[NDArray] = []
         self.out_y: list[NDArray] = []
         self.out_yp: list[NDArray] = []
-        self.out_sw: list[NDArray] = []
+        self.out_ch: list[NDArray] = []
         self.step_t: list[NDArray] = []
         self.step_h: list[NDArray] = []
         self.step_order: list[NDArray] = []
@@ -781,6 +816,10 @@ class _Run:
         self.seg = None
         ev, n, m = self.ev, self.n, self.m
         ev.set_terms(seg.active, seg.params)
+        if seg.pt:
+            seg.st.append(np.array(seg.pt))
+            seg.sx.append(np.array(seg.px).reshape(len(seg.px), 2 * n))
+            seg.pt, seg.px = [], []
         st = np.concatenate(seg.st) if seg.st else np.zeros(0)
         sx = np.concatenate(seg.sx) if seg.sx else np.zeros((0, 2 * n))
         T = np.concatenate([[seg.t0], st])
@@ -821,7 +860,7 @@ class _Run:
             self.out_y.append(y)
             self.out_yp.append(yp)
             sw = self.model.switch_vector(seg.active, seg.params)
-            self.out_sw.append(np.repeat(sw[None, :], N, axis=0))
+            self.out_ch.append(ev.channels(self.model, ot, y, yp, sw))
         ev.set_terms(self.active, self.params)
 
     # ---------------------------------------------------------------- events
@@ -848,6 +887,16 @@ class _Run:
         self.last_event_t = t
 
     def fail(self, t: float, why: str, hint: str) -> None:
+        names = self.model.state_names
+
+        def name(match: "re.Match[str]") -> str:
+            i = int(match.group(2))
+            if i >= 2 * self.n:
+                return match.group(0)
+            label = f"d({names[i]})/dt" if match.group(1).startswith("right") else names[i]
+            return f"{match.group(1)} {i} ({label})"
+
+        why = re.sub(r"(right-hand side component|state component) (\d+)", name, why).replace("-nan", "nan")
         in_contact = [pair for pair, mode in self.modes.items() if mode == "contact"]
         where = f" with {', '.join(repr(p) for p in in_contact)} in contact" if in_contact else ""
         self.success, self.status = False, -1
@@ -869,7 +918,7 @@ class _Run:
 
     def _progress(self, t: float) -> None:
         frac = min(1.0, t / self.t_end)
-        if frac - self._last_frac >= 0.01 or frac >= 1.0:
+        if frac - self._last_frac >= 0.01 or (frac >= 1.0 > self._last_frac):
             self._last_frac = frac
             sys.stderr.write(f"\r  t = {t:.6g} s  {100 * frac:5.1f} %  events {len(self.events)}")
             if frac >= 1.0:
@@ -879,11 +928,11 @@ class _Run:
     # ---------------------------------------------------------------- result
     def result(self, setup_time: float, solve_time: float, sim_params: dict[str, Any]) -> Result:
         n_states = self.model.n_states
-        n_sw = self.model.switch_vector(self.active, self.params).size
         t = np.concatenate(self.out_t) if self.out_t else np.zeros(0)
         y = np.concatenate(self.out_y) if self.out_y else np.zeros((0, n_states))
         yp = np.concatenate(self.out_yp) if self.out_yp else np.zeros((0, n_states))
-        sw = np.concatenate(self.out_sw) if self.out_sw else np.zeros((0, n_sw))
+        ch = np.concatenate(self.out_ch) if self.out_ch else np.zeros((0, len(self.model.channel_names)))
+        channels = {name: np.ascontiguousarray(ch[:, i]) for i, name in enumerate(self.model.channel_names)}
         stats: dict[str, Any] = {"n_steps": self.n_steps}
         stats.update(self.ev.counters())
         stats.pop("n_fixed_steps", None)
@@ -900,7 +949,7 @@ class _Run:
         segments = [(s.t0, s.t1, s.modes) for s in self.segments]
         return Result(
             t=t, y=y, yp=yp, state_names=list(self.model.state_names),
-            channels=self.model.channels(t, y, yp, sw), units=dict(self.model.channel_units),
+            channels=channels, units=dict(self.model.channel_units),
             events=self.events, segments=segments,
             step_t=np.concatenate(self.step_t) if self.step_t else np.zeros(0),
             step_h=np.concatenate(self.step_h) if self.step_h else np.zeros(0),
@@ -925,19 +974,20 @@ def _hermite(T: NDArray, X: NDArray, Xd: NDArray, te: NDArray) -> NDArray:
 
 
 def _locate(ev: _Evaluator, X_of: Callable[[float], NDArray | None], ta0: float, g_a: tuple[NDArray, NDArray],
-            tb_end: float, x_end: NDArray, g_end: tuple[NDArray, NDArray], cands: list[tuple[int, float]],
-            dirs: NDArray) -> tuple[float, NDArray, NDArray] | None | str:
+            tb_end: float, x_end: NDArray, g_end: tuple[NDArray, NDArray], cands: list[tuple[int, int, float]],
+            n_gaps: int) -> tuple[float, NDArray, NDArray] | None | str:
     """Locate the earliest confirmed crossing among the candidates of one step [ta0, tb_end].
 
-    ``g_a`` and ``g_end`` are (gaps, rates) at the ends of the step. Returns (t_event, x_event,
+    ``g_a`` and ``g_end`` are (gaps, rates) at the ends of the step; ``cands`` (gap, direction,
+    far-side point) from _candidate. Returns (t_event, x_event,
     roots_found), None when no candidate is confirmed, or an error message when the model could
     not be evaluated.
     """
     h = tb_end - ta0
     ttol = 100.0 * _EPS * (abs(ta0) + abs(h))
-    best: tuple[float, NDArray, list[int]] | None = None
-    for i, s in cands:
-        d = float(dirs[i])
+    best: tuple[float, NDArray, list[tuple[int, int]]] | None = None
+    for i, direction, s in cands:
+        d = float(direction)
         G0, Gd0, G1, Gd1 = d * g_a[0][i], d * g_a[1][i], d * g_end[0][i], d * g_end[1][i]
         tb = ta0 + s
         if tb >= tb_end or s >= tb_end - ta0:
@@ -954,17 +1004,19 @@ def _locate(ev: _Evaluator, X_of: Callable[[float], NDArray | None], ta0: float,
             continue  # a predicted excursion that the scheme's state does not confirm
         ta, Ga = ta0, G0
         if Gd0 < 0.0:
-            # G starts by moving away from zero (typically just after the opposite event, where
-            # |G| is at rounding level and an interpolant's error could fake a crossing): start
-            # the bracket at the cubic's first minimum when the state confirms G <= 0 there.
-            for u, is_max, _ in _cubic_extrema(G0, Gd0, G1, Gd1, h):
-                if is_max or ta0 + u * h >= tb:
-                    break
+            # G starts by moving away from zero: typically just after the opposite event, where
+            # |G| is at rounding level and the error of an interpolant (or of a tiny re-step) can
+            # fake a crossing right at the start. Start the bracket where the state confirms G < 0
+            # on the way down: at the cubic's first minimum, or closer to the start (1/4, 1/16, ...).
+            ext = [u for u, is_max, _ in _cubic_extrema(G0, Gd0, G1, Gd1, h)[:1] if not is_max]
+            u = min(ext[0] if ext else 0.5, (tb - ta0) / h)
+            while u * h > 1e3 * ttol:
                 xm = X_of(ta0 + u * h)
                 gg = None if xm is None else ev.gaps(ta0 + u * h, xm)
-                if gg is not None and d * gg[0][i] <= 0.0:
+                if gg is not None and d * gg[0][i] < 0.0:
                     ta, Ga = ta0 + u * h, d * gg[0][i]
-                break
+                    break
+                u *= 0.25
         side = 0
         for _ in range(200):
             if tb - ta <= ttol:
@@ -990,14 +1042,14 @@ def _locate(ev: _Evaluator, X_of: Callable[[float], NDArray | None], ta0: float,
                     Gb *= 0.5
                 side = -1
         if best is None or tb < best[0] - ttol:
-            best = (tb, xb, [i])
+            best = (tb, xb, [(i, direction)])
         elif abs(tb - best[0]) <= ttol:
-            best[2].append(i)
+            best[2].append((i, direction))
     if best is None:
         return None
-    roots = np.zeros(len(dirs), dtype=np.int32)
-    for i in best[2]:
-        roots[i] = dirs[i]
+    roots = np.zeros(n_gaps, dtype=np.int32)
+    for i, direction in best[2]:
+        roots[i] = direction
     return best[0], np.array(best[1], dtype=float), roots
 
 
@@ -1014,7 +1066,7 @@ def _run_scipy(run: _Run, x0: NDArray, rtol: float, atol: NDArray, max_step: flo
     while True:
         run.open_segment(t, x)
         dirs = run.directions()
-        watch = dirs is not None and bool(np.any(dirs))
+        watch = dirs is not None  # every gap, in its direction (0: both, as IDA)
         g0 = gd0 = None
         if watch:
             gg = ev.gaps(t, x)
@@ -1028,14 +1080,21 @@ def _run_scipy(run: _Run, x0: NDArray, rtol: float, atol: NDArray, max_step: flo
             run.fail(t, f"the solver could not start: {exc}", hint)
             return
         lu0 = getattr(solver, "nlu", 0)
-        t_prev, x_prev = t, x
+        seg = run.seg
+        assert seg is not None
+        add_t, add_x = seg.pt.append, seg.px.append
+        solver_step = solver.step
+        n_gaps = 0 if dirs is None else len(dirs)
+        watched = [(i, d) for i in range(n_gaps) for d in (1, -1) if dirs[i] * d >= 0]  # type: ignore[index]
+        next_eval = run.pending[0] if run.pending is not None and run.pending.size else math.inf
+        t_prev = t
         restart = None
         while True:
             if run.n_steps >= run.max_steps:
                 run.fail(t_prev, f"max_steps={run.max_steps} steps reached", "Raise max_steps or loosen rtol.")
                 break
             try:
-                msg = solver.step()
+                msg = solver_step()
             except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
                 msg = f"{type(exc).__name__}: {exc}"
                 solver.status = "failed"
@@ -1045,13 +1104,18 @@ def _run_scipy(run: _Run, x0: NDArray, rtol: float, atol: NDArray, max_step: flo
                     why += f" (last model error: {ev.last_message})"
                 run.fail(t_prev, why, hint)
                 break
-            t1, x1 = float(solver.t), np.array(solver.y, dtype=float)
-            if not np.all(np.isfinite(x1)):
+            t1, x1 = float(solver.t), solver.y.copy()
+            if not math.isfinite(x1.sum()):
                 bad = int(np.flatnonzero(~np.isfinite(x1))[0])
                 run.fail(t_prev, f"the state became non-finite ({run.model.state_names[bad]} = {x1[bad]})", hint)
                 break
-            if not run.count_step(t_prev, t1):
-                break
+            run.n_steps += 1
+            if t1 - t_prev < TINY_STEP_REL * max(1.0, abs(t1)):
+                run.n_steps -= 1
+                if not run.count_step(t_prev, t1):
+                    break
+            else:
+                run.tiny = 0
             sol = None
             if watch:
                 gg = ev.gaps(t1, x1)
@@ -1061,15 +1125,14 @@ def _run_scipy(run: _Run, x0: NDArray, rtol: float, atol: NDArray, max_step: flo
                 g1, gd1 = gg
                 h = t1 - t_prev
                 cands = []
-                for i in np.flatnonzero(dirs):
-                    d = float(dirs[i])
-                    s = _candidate(d * g0[i], d * gd0[i], d * g1[i], d * gd1[i], h)
+                for i, d in watched:
+                    s = _candidate(d * g0[i], d * gd0[i], d * g1[i], d * gd1[i], h, HERMITE_GAP_CHECK)
                     if s > 0.0:
-                        cands.append((int(i), s))
+                        cands.append((i, d, s))
                 if cands:
                     sol = solver.dense_output()
                     found = _locate(ev, lambda tt: np.array(sol(tt), dtype=float), t_prev, (g0, gd0), t1, x1,
-                                    (g1, gd1), cands, dirs)
+                                    (g1, gd1), cands, n_gaps)
                     if isinstance(found, str):
                         run.fail(t_prev, found, hint)
                         break
@@ -1078,19 +1141,26 @@ def _run_scipy(run: _Run, x0: NDArray, rtol: float, atol: NDArray, max_step: flo
                         te = run.pending_upto(t_ev)
                         if te.size:
                             run.add_evals(te, np.atleast_2d(np.array(sol(te), dtype=float).T))
-                        run.add_steps(np.array([t_ev]), x_ev[None, :])
+                        add_t(t_ev)
+                        add_x(x_ev)
                         restart = (t_ev, x_ev, roots)
                         break
                 g0, gd0 = g1, gd1
-            te = run.pending_upto(t1)
-            if te.size:
+            if next_eval <= t1:
+                te = run.pending_upto(t1)
                 if sol is None:
                     sol = solver.dense_output()
                 run.add_evals(te, np.atleast_2d(np.array(sol(te), dtype=float).T))
-            run.add_steps(np.array([t1]), x1[None, :])
-            t_prev, x_prev = t1, x1
+                next_eval = run.pending[0] if run.pending is not None and run.pending.size else math.inf
+            add_t(t1)
+            add_x(x1)
+            if run.progress:
+                run._progress(t1)
+            t_prev = t1
             if solver.status == "finished":
                 break
+        seg.t1 = t_prev if restart is None else restart[0]
+        run.t_last = seg.t1
         run.n_lu += getattr(solver, "nlu", 0) - lu0
         if restart is None or not run.success:
             run.close_segment(hermite=False)
@@ -1138,14 +1208,14 @@ def _run_fixed(run: _Run, x0: NDArray, step: float) -> None:
             # a step that may hold a crossing: confirm and locate it on re-steps from its start
             run.n_steps += 1
             tb, xb, sstar = out["tb"], out["xb"], out["sstar"]
-            cands = [(int(i), float(sstar[i])) for i in np.flatnonzero(sstar > 0)]
+            cands = [(int(i), 1 - 2 * int(j), float(sstar[i, j])) for i, j in zip(*np.nonzero(sstar > 0))]
             gg_a, gg_b = ev.gaps(t, x), ev.gaps(tb, xb)
             if gg_a is None or gg_b is None:
                 run.fail(t, ev.last_message, hint)
                 break
             ta, xa = t, x
             found = _locate(ev, lambda tt: ev.step(scheme, ta, xa, tt - ta), ta, gg_a, tb, xb, gg_b,
-                            cands, dirs)  # type: ignore[arg-type]
+                            cands, ev.ng)  # type: ignore[arg-type]
             if isinstance(found, str):
                 run.fail(t, found, hint)
                 break
@@ -1194,6 +1264,7 @@ def integrate(
     store_steps: bool = True,
     on_failure: str = "raise",
     progress: bool = False,
+    track_work: bool = False,
 ) -> Result:
     """Integrate with a non-IDA method; the arguments are those of :func:`daeclear.simulate`.
 
@@ -1223,16 +1294,18 @@ def integrate(
     if rtol < 1e-14 or rtol > 1e-2:
         raise SceneError(f"simulate: rtol={rtol!r}, must be in [1e-14, 1e-2].")
     name = METHOD_NAMES[method_l]
+    if track_work:
+        raise SceneError(f"simulate: track_work=True is supported by method='ida' only, not by method={name!r}.")
     if isinstance(scene, DAEModel):
         model = scene
     else:
-        if str(formulation).lower() != "index1":
+        if str(formulation).lower() == "ggl":
             raise SceneError(f"simulate: formulation={formulation!r} is integrated by IDA only; method={name!r} "
                              "integrates the chapter's index-1 formulation (formulation='index1').")
         model = None
     setup_start = time.perf_counter()
     if model is None:
-        model = assemble(scene, "index1")  # type: ignore[arg-type]
+        model = assemble(scene, formulation)  # type: ignore[arg-type]  # validates the name
     if model.formulation != "index1":
         raise SceneError(f"simulate: formulation={model.formulation!r} is integrated by IDA only; method={name!r} "
                          "integrates the chapter's index-1 formulation (formulation='index1').")

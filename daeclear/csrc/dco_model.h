@@ -22,6 +22,8 @@ typedef struct {
   dc_fun_t gaps;             /* (t, q, v) -> g[n_gaps], dg/dt[n_gaps]; eval == 0 when n_gaps == 0 */
   const dc_fun_t* term_force; /* [n_terms] (t, q, v, p) -> F_k[n] */
   const dc_fun_t* term_jac;   /* [n_terms] (t, q, v, p) -> dF_k/dx, n x 2n */
+  int n_y, n_switch, n_channels; /* sizes of the outputs function (n_channels 0: none) */
+  dc_fun_t outputs;          /* (t, y[n_y], yp[n_y], switch[n_switch]) -> channels[n_channels] */
   const char* name;
 } dco_model_t;
 

@@ -56,8 +56,9 @@ typedef struct {
   double** res;
   dc_int* iw;
   double* w;
-  int mem_sys, mem_sysj, mem_gaps;
+  int mem_sys, mem_sysj, mem_gaps, mem_out;
   int refd; /* the generated functions were incref'ed */
+  int hermite; /* 1: also look for interior maxima of the gaps within a step (default) */
   int* mem_tf;
   int* mem_tj;
   int* active;
@@ -183,7 +184,8 @@ static int accel(dco_session* s, double t, const double* x, double* xdot) {
     }
     int i = first_nonfinite(xdot, s->nx);
     if (i >= 0) {
-      set_msg(s, "the right-hand side component %d is %g at t=%.17g", i, xdot[i], t);
+      set_msg(s, "the right-hand side component %d is %g at t=%.17g (the state has diverged or "
+              "is outside the model's domain)", i, xdot[i], t);
       return DCO_NONFINITE;
     }
   }
@@ -292,9 +294,10 @@ static int scheme_step(dco_session* s, int scheme, double t, const double* x, do
  * step, from G and dG/dt at both ends: h when G1 > 0, or the first interior maximum of the cubic
  * Hermite interpolant that lies above zero (if earlier). -1: no crossing expected. Must match
  * integrators._candidate. */
-static double candidate(double G0, double Gd0, double G1, double Gd1, double h) {
+static double candidate(double G0, double Gd0, double G1, double Gd1, double h, int hermite) {
   if (G0 > 0.0) return -1.0;
   double best = G1 > 0.0 ? h : -1.0;
+  if (!hermite) return best;
   double hi = (G0 > G1 ? G0 : G1) + 0.15 * h * (fabs(Gd0) + fabs(Gd1));
   if (hi <= 0.0) return best;
   const double a0 = h * Gd0, a1 = h * Gd1;
@@ -359,6 +362,7 @@ DCO_API void dco_free(void* sp) {
     if (s->mem_sys >= 0) M->sys.release(s->mem_sys);
     if (s->mem_sysj >= 0) M->sys_jac.release(s->mem_sysj);
     if (M->n_gaps > 0 && s->mem_gaps >= 0) M->gaps.release(s->mem_gaps);
+    if (M->n_channels > 0 && s->mem_out >= 0) M->outputs.release(s->mem_out);
     for (int k = 0; k < M->n_terms; ++k) {
       if (s->mem_tf && s->mem_tf[k] >= 0) M->term_force[k].release(s->mem_tf[k]);
       if (s->mem_tj && s->mem_tj[k] >= 0) M->term_jac[k].release(s->mem_tj[k]);
@@ -366,6 +370,7 @@ DCO_API void dco_free(void* sp) {
     M->sys.decref();
     M->sys_jac.decref();
     if (M->n_gaps > 0) M->gaps.decref();
+    if (M->n_channels > 0) M->outputs.decref();
     for (int k = 0; k < M->n_terms; ++k) {
       M->term_force[k].decref();
       M->term_jac[k].decref();
@@ -398,11 +403,13 @@ DCO_API void* dco_open(char* err, int errlen) {
   s->nx = nx;
   s->nt = nt;
   s->ng = ng;
-  s->mem_sys = s->mem_sysj = s->mem_gaps = -1;
+  s->mem_sys = s->mem_sysj = s->mem_gaps = s->mem_out = -1;
+  s->hermite = 1;
   dc_int sa = 5, sr = 3, si = 0, sw = 0;
   work_max(&M->sys, &sa, &sr, &si, &sw);
   work_max(&M->sys_jac, &sa, &sr, &si, &sw);
   if (ng > 0) work_max(&M->gaps, &sa, &sr, &si, &sw);
+  if (M->n_channels > 0) work_max(&M->outputs, &sa, &sr, &si, &sw);
   for (int k = 0; k < nt; ++k) {
     work_max(&M->term_force[k], &sa, &sr, &si, &sw);
     work_max(&M->term_jac[k], &sa, &sr, &si, &sw);
@@ -468,6 +475,7 @@ DCO_API void* dco_open(char* err, int errlen) {
   M->sys.incref();
   M->sys_jac.incref();
   if (ng > 0) M->gaps.incref();
+  if (M->n_channels > 0) M->outputs.incref();
   for (int k = 0; k < nt; ++k) {
     M->term_force[k].incref();
     M->term_jac[k].incref();
@@ -475,6 +483,7 @@ DCO_API void* dco_open(char* err, int errlen) {
   s->mem_sys = M->sys.checkout();
   s->mem_sysj = M->sys_jac.checkout();
   if (ng > 0) s->mem_gaps = M->gaps.checkout();
+  if (M->n_channels > 0) s->mem_out = M->outputs.checkout();
   for (int k = 0; k < nt; ++k) {
     s->mem_tf[k] = M->term_force[k].checkout();
     s->mem_tj[k] = M->term_jac[k].checkout();
@@ -489,6 +498,10 @@ DCO_API void dco_set_terms(void* sp, const int* active, const double* params) {
   int np = s->nt ? s->poff[s->nt] : 0;
   if (np) memcpy(s->params, params, sizeof(double) * np);
 }
+
+/* 1 (default): a step may hold a crossing when the cubic Hermite interpolant of a gap has an
+ * interior maximum above zero; 0: sign changes at the step ends only (for measurements). */
+DCO_API void dco_set_hermite(void* sp, int on) { ((dco_session*)sp)->hermite = on ? 1 : 0; }
 
 /* x' at (t, x): 0 on success, else a DCO_* code (message in dco_message; xdot may hold NaN). */
 DCO_API int dco_rhs(void* sp, double t, const double* x, double* xdot) {
@@ -538,19 +551,18 @@ DCO_API int dco_batch(void* sp, int N, const double* t, const double* X, double*
 }
 
 /* Fixed-step loop from (t0, x0) with step hstep towards t_stop (the last step lands on t_stop).
- * Records every step end in st/sx (at most cap). Watches the gaps whose rootdir is non-zero.
- * On return (ta, xa) is the current state; on FX_CANDIDATE (ta, xa) is the start and (tb, xb)
- * the end of the step that may hold a crossing, sstar[i] the far-side point (step-relative) of
- * gap i or -1. */
+ * Records every step end in st/sx (at most cap). Watches every gap in the direction rootdir[i]
+ * (+1 increasing, -1 decreasing, 0 both, as IDA). On return (ta, xa) is the current state; on
+ * FX_CANDIDATE (ta, xa) is the start and (tb, xb) the end of the step that may hold a crossing,
+ * sstar[2i] (increasing) and sstar[2i+1] (decreasing) the far-side points (step-relative) of
+ * gap i, or -1. */
 DCO_API int dco_fixed(void* sp, int scheme, double t0, const double* x0, double hstep,
                       double t_stop, long long max_steps, const int* rootdir, int cap, double* st,
                       double* sx, int* n_stored, double* ta, double* xa, double* tb, double* xb,
                       double* sstar) {
   dco_session* s = (dco_session*)sp;
   const int nx = s->nx, ng = s->ng;
-  int watch = 0;
-  for (int i = 0; i < ng; ++i)
-    if (rootdir[i]) watch = 1;
+  const int watch = ng > 0;
   *n_stored = 0;
   *ta = t0;
   memcpy(xa, x0, sizeof(double) * nx);
@@ -572,11 +584,14 @@ DCO_API int dco_fixed(void* sp, int scheme, double t0, const double* x0, double 
       }
       int found = 0;
       for (int i = 0; i < ng; ++i) {
-        sstar[i] = -1.0;
-        const double d = (double)rootdir[i];
-        if (d == 0.0) continue;
-        sstar[i] = candidate(d * s->g0[i], d * s->gd0[i], d * s->g1[i], d * s->gd1[i], h);
-        if (sstar[i] > 0.0) found = 1;
+        for (int j = 0; j < 2; ++j) {
+          const double d = j == 0 ? 1.0 : -1.0;
+          double* out = sstar + 2 * i + j;
+          *out = -1.0;
+          if (rootdir[i] * d < 0) continue; /* the other direction only */
+          *out = candidate(d * s->g0[i], d * s->gd0[i], d * s->g1[i], d * s->gd1[i], h, s->hermite);
+          if (*out > 0.0) found = 1;
+        }
       }
       if (found) {
         *tb = tn;
@@ -595,6 +610,28 @@ DCO_API int dco_fixed(void* sp, int scheme, double t0, const double* x0, double 
     *ta = tn;
     memcpy(xa, xb, sizeof(double) * nx);
   }
+}
+
+/* Output channels at N points: Y, YP row-major (N x n_y), one switch vector for all points,
+ * out row-major (N x n_channels). Returns 0, -1 without an outputs function, or 1 + the index of
+ * the first point that failed. */
+DCO_API int dco_outputs(void* sp, int N, const double* t, const double* Y, const double* YP,
+                        const double* sw, double* out) {
+  dco_session* s = (dco_session*)sp;
+  const dco_model_t* M = &dco_model;
+  if (M->n_channels <= 0) return -1;
+  for (int p = 0; p < N; ++p) {
+    const double* in[4] = {t + p, Y + (size_t)p * M->n_y, YP + (size_t)p * M->n_y, sw};
+    double* o[1] = {out + (size_t)p * M->n_channels};
+    if (call(s, &M->outputs, s->mem_out, 4, in, 1, o)) return 1 + p;
+  }
+  return 0;
+}
+
+DCO_API void dco_output_sizes(int* n_y, int* n_switch, int* n_channels) {
+  *n_y = dco_model.n_y;
+  *n_switch = dco_model.n_switch;
+  *n_channels = dco_model.n_channels;
 }
 
 /* counters: rhs evaluations, Jacobians, gap evaluations, fixed steps */
