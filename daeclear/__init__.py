@@ -5,18 +5,19 @@ Scene --assemble--> DAEModel --simulate--> Result --> analysis | plot | io
 
 from __future__ import annotations
 
-from . import mechanisms
+from . import analysis, mechanisms
 from .assemble import DAEModel, assemble
 from .errors import AssemblyError, DaeclearError, DaeclearWarning, SceneError, SolveError
 from .result import ContactEvent, Result, load
 from .contact import Material
 from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
 from .solve import simulate
+from .sweep import load_sweep, sweep  # the function `sweep` shadows the module: import names from daeclear.sweep
 
 __version__ = "0.1.0"
 
 __all__ = [
     "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "Driver",
     "Material", "Result", "Revolute", "RevoluteClearance", "Scene", "SceneError", "SolveError", "Translational",
-    "TranslationalClearance", "assemble", "load", "mechanisms", "simulate",
+    "TranslationalClearance", "analysis", "assemble", "load", "load_sweep", "mechanisms", "simulate", "sweep",
 ]

@@ -481,7 +481,8 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     for build in contact_builds:
         switches = []
         for term in build.terms:
-            on_k, p_k = ca.SX.sym(f"{term.name}_on"), ca.SX.sym(f"{term.name}_p", term.n_params)
+            ident = _c_identifier(term.name)
+            on_k, p_k = ca.SX.sym(f"{ident}_on"), ca.SX.sym(f"{ident}_p", term.n_params)
             switches.append((on_k, p_k))
             switch_syms += [on_k, p_k]
         contact_channels.extend(build.channels(switches))
@@ -496,9 +497,10 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
             # the term's share of the work rate: its own power and the driver power it causes
             work_row = [-(ca.dot(Qk, v) + ca.substitute(drive_power_of, Fc, Qk) - drive_power_base)] if track_work else []
             r_k = ca.vertcat(ca.SX.zeros(n), -Qk, ca.SX.zeros(n_y - 2 * n - len(work_row)), *work_row)
-            term_res.append(ca.Function(f"{term.name}_res", [t, y, yp, p], [r_k], ["t", "y", "yp", "p"], ["r"]))
+            ident = _c_identifier(term.name)  # term names may hold dots (channel names); C may not
+            term_res.append(ca.Function(f"{ident}_res", [t, y, yp, p], [r_k], ["t", "y", "yp", "p"], ["r"]))
             j_k = ca.densify(ca.jacobian(r_k, y) + cj * ca.jacobian(r_k, yp))
-            term_jac.append(ca.Function(f"{term.name}_jac", [t, y, yp, p, cj], [j_k],
+            term_jac.append(ca.Function(f"{ident}_jac", [t, y, yp, p, cj], [j_k],
                                         ["t", "y", "yp", "p", "cj"], ["J"]))
             terms.append(term)
         gaps.extend(build.gaps)

@@ -456,8 +456,8 @@ def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | Non
     if limits:
         for level in (0.5, -0.5):
             ax.axhline(level, color="k", ls="--", lw=0.8)
-    ax.set_xlabel("dimensionless slider position along the stroke, ξ")
-    ax.set_ylabel("dimensionless slider offset, η")
+    ax.set_xlabel("ξ, slider position along the stroke (-)")
+    ax.set_ylabel("η, offset across the guide (-)")
     return ax
 
 
@@ -523,3 +523,216 @@ def plot_work_precision(study: Any, *, ax: Axes | None = None) -> Axes:
     ax.legend(fontsize="small")
     ax.grid(True, which="both", lw=0.3)
     return ax
+
+
+# --------------------------------------------------------------------------- Poincaré sections and sweeps
+
+MOTION_COLORS = {"periodic": "#2ca02c", "quasi-periodic": "#1f77b4", "chaotic": "#d62728",
+                 "non-periodic": "#ff7f0e", "undetermined": "#7f7f7f", "failed": "#000000"}
+"""Colour of each motion class (:data:`daeclear.analysis.MOTION_LABELS`) in the sweep figures."""
+
+
+def _channel_label(name: str, unit: str) -> str:
+    return f"{name} ({unit})" if unit else name
+
+
+def plot_poincare_section(section: Any, *, ax: Axes | None = None, portrait: Any = None, label: str | None = None,
+                          **marker_kw: Any) -> Axes:
+    """Stroboscopic Poincaré section (one point per crank revolution), over the phase portrait.
+
+    Parameters
+    ----------
+    section : daeclear.analysis.PoincareSection
+        Its first two channels are drawn (x, y); with one channel, the value against the
+        revolution number.
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    portrait : PhasePortrait or Result, optional
+        Drawn first as a thin grey curve (the chapter's "Poincaré map"): a
+        :class:`~daeclear.analysis.PhasePortrait`, or a Result whose same two channels are
+        plotted from the section's first time on.
+    label : str, optional
+        Legend label of the points (default "once per revolution (n points)").
+    **marker_kw
+        Passed to ``ax.plot`` for the points.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax.lines[-1]`` holds the section points.
+    """
+    import numpy as np
+
+    ax = _axes(ax)
+    points = np.asarray(section.points)
+    if points.shape[1] >= 2 and portrait is not None:
+        if hasattr(portrait, "x") and hasattr(portrait, "y"):
+            px, py = portrait.x, portrait.y
+        else:
+            t0 = section.t[0] if len(section) else None
+            mask = portrait.window_mask(t0, None)
+            px = np.asarray(portrait[section.channels[0]])[mask]
+            py = np.asarray(portrait[section.channels[1]])[mask]
+        ax.plot(px, py, color="0.6", lw=0.4, label="phase portrait")
+    kw: dict[str, Any] = {"ls": "none", "marker": "o", "ms": 3.5, "color": "C3"}
+    kw.update(marker_kw)
+    text = label or f"once per revolution ({len(points)} points)"
+    if points.shape[1] >= 2:
+        ax.plot(points[:, 0], points[:, 1], label=text, **kw)
+        ax.set_xlabel(_channel_label(section.channels[0], section.units[0]))
+        ax.set_ylabel(_channel_label(section.channels[1], section.units[1]))
+    else:
+        ax.plot(np.arange(len(points)), points[:, 0], label=text, **kw)
+        ax.set_xlabel("revolution after the transient")
+        ax.set_ylabel(_channel_label(section.channels[0], section.units[0]))
+    ax.legend(loc="best", fontsize="x-small")
+    return ax
+
+
+def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: Axes | None = None,
+                     scale: float = 1.0, unit: str | None = None, color_by_motion: bool = True,
+                     **marker_kw: Any) -> Axes:
+    """Bifurcation diagram: the Poincaré-section values of one channel against a swept parameter.
+
+    Parameters
+    ----------
+    sweep : daeclear.sweep.SweepResult or mapping of float to PoincareSection
+        A sweep over ``parameter`` (other parameters fixed), or parameter value -> section.
+    parameter : str
+        The swept parameter (x axis), e.g. ``"clearance"``.
+    channel : str or int
+        Section channel on the y axis (name or column; default the first, slider velocity).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    scale : float
+        Factor applied to the parameter values (e.g. 1e3 for a clearance in mm).
+    unit : str, optional
+        Unit of the scaled parameter, shown in the x label.
+    color_by_motion : bool
+        Colour each run's points by its motion class (:data:`MOTION_COLORS`), with a legend.
+    **marker_kw
+        Passed to ``ax.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        One line (markers only) per motion class present, or a single one.
+    """
+    import numpy as np
+
+    ax = _axes(ax)
+    if isinstance(sweep, Mapping):
+        xs, ys, labels = [], [], []
+        for value, sec in sweep.items():
+            col = sec.channels.index(channel) if isinstance(channel, str) else int(channel)
+            xs.append(np.full(len(sec), float(value)))
+            ys.append(np.asarray(sec.points)[:, col])
+            labels += ["" for _ in range(len(sec))]
+        x = np.concatenate(xs) if xs else np.zeros(0)
+        y = np.concatenate(ys) if ys else np.zeros(0)
+        name = channel if isinstance(channel, str) else next(iter(sweep.values())).channels[int(channel)]
+        units = next(iter(sweep.values())).units if sweep else ()
+        y_unit = units[next(iter(sweep.values())).channels.index(name)] if units else ""
+        color_by_motion = False
+    else:
+        x, y, labels = sweep.bifurcation_data(parameter, channel)
+        ok = [r for r in sweep.runs if r.ok]
+        sec = sweep.section(ok[0]) if ok else None
+        name = channel if isinstance(channel, str) else (sec.channels[int(channel)] if sec else str(channel))
+        y_unit = sec.units[sec.channels.index(name)] if sec else ""
+    kw: dict[str, Any] = {"ls": "none", "marker": ".", "ms": 3.0}
+    kw.update(marker_kw)
+    x = x * scale
+    if color_by_motion:
+        labels_arr = np.array(labels)
+        for motion, color in MOTION_COLORS.items():
+            sel = labels_arr == motion
+            if np.any(sel):
+                ax.plot(x[sel], y[sel], label=motion, **{**kw, "color": color})
+        ax.legend(loc="best", fontsize="x-small", title="motion", title_fontsize="x-small")
+    else:
+        kw.setdefault("color", "k")
+        ax.plot(x, y, **kw)
+    ax.set_xlabel(f"{parameter} ({unit})" if unit else parameter)
+    ax.set_ylabel(f"{_channel_label(name, y_unit)} once per revolution")
+    return ax
+
+
+def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_scale: float = 1.0,
+                    y_scale: float = 1.0, x_unit: str | None = None, y_unit: str | None = None,
+                    annotate: bool = True) -> Axes:
+    """Map of the motion class over two swept parameters (one cell per run).
+
+    Parameters
+    ----------
+    sweep : daeclear.sweep.SweepResult
+        A sweep over a grid of ``x`` and ``y`` (other parameters fixed).
+    x, y : str
+        Parameter names of the horizontal and vertical axes.
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    x_scale, y_scale : float
+        Factors applied to the parameter values in the tick labels (e.g. 1e3 for mm).
+    x_unit, y_unit : str, optional
+        Units of the scaled values, in the axis labels.
+    annotate : bool
+        Write the period k in periodic cells ("P1", "P2", ...), "C" chaotic, "Q"
+        quasi-periodic, "N" non-periodic, "?" undetermined, "x" failed.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        Cells on an index grid (ticks labelled with the values), coloured by
+        :data:`MOTION_COLORS`; one legend entry per class present.
+
+    Raises
+    ------
+    ValueError
+        If two runs share the same (x, y) cell.
+    """
+    import numpy as np
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    ax = _axes(ax)
+    runs = [r for r in sweep.runs if x in r.parameters and y in r.parameters]
+
+    def key(v: Any) -> tuple[int, Any]:  # numbers in order, then anything else by its text
+        return (0, float(v)) if isinstance(v, (int, float)) and not isinstance(v, bool) else (1, str(v))
+
+    xs = sorted({r.parameters[x] for r in runs}, key=key)
+    ys = sorted({r.parameters[y] for r in runs}, key=key)
+    classes = list(MOTION_COLORS)
+    grid = np.full((len(ys), len(xs)), np.nan)
+    text: dict[tuple[int, int], str] = {}
+    short = {"chaotic": "C", "quasi-periodic": "Q", "non-periodic": "N", "undetermined": "?", "failed": "x"}
+    for r in runs:
+        i, j = ys.index(r.parameters[y]), xs.index(r.parameters[x])
+        if not np.isnan(grid[i, j]):
+            raise ValueError(f"plot_motion_map: two runs at {x}={r.parameters[x]!r}, {y}={r.parameters[y]!r}; "
+                             "fix the other parameters.")
+        motion = r.motion if r.ok else "failed"
+        grid[i, j] = classes.index(motion)
+        text[(i, j)] = f"P{r.period}" if motion == "periodic" else short.get(motion, "")
+    cmap = ListedColormap([MOTION_COLORS[c] for c in classes])
+    ax.pcolormesh(np.arange(len(xs) + 1) - 0.5, np.arange(len(ys) + 1) - 0.5, np.ma.masked_invalid(grid), cmap=cmap,
+                  vmin=-0.5, vmax=len(classes) - 0.5, edgecolors="w", linewidth=0.5)
+    if annotate:
+        for (i, j), label in text.items():
+            ax.text(j, i, label, ha="center", va="center", fontsize="x-small", color="w")
+
+    def fmt(v: Any, scale: float) -> str:
+        return f"{float(v) * scale:g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
+
+    ax.set_xticks(range(len(xs)), [fmt(v, x_scale) for v in xs], rotation=45 if len(xs) > 8 else 0)
+    ax.set_yticks(range(len(ys)), [fmt(v, y_scale) for v in ys])
+    ax.set_xlabel(f"{x} ({x_unit})" if x_unit else x)
+    ax.set_ylabel(f"{y} ({y_unit})" if y_unit else y)
+    present = sorted({int(v) for v in grid[np.isfinite(grid)]})
+    ax.legend(handles=[Patch(color=MOTION_COLORS[classes[k]], label=classes[k]) for k in present],
+              loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="x-small", title="motion",
+              title_fontsize="x-small")
+    return ax
+
+
+__all__ += ["MOTION_COLORS", "plot_bifurcation", "plot_motion_map", "plot_poincare_section"]

@@ -537,6 +537,10 @@ class TranslationalClearance(_PointJoint):
         Guide body and slider body.
     axis : (float, float)
         Guide direction, world frame, reference configuration (need not be unit).
+    slider_axis : (float, float) or None
+        The slider's length direction in slider body coordinates; None: ``axis`` in the
+        reference configuration (the slider starts parallel to the guide). Give it to
+        start tilted: e.g. ``(1, 0)`` with the slider body at ``angle=tilt``.
     length, width : float
         Slider length L (along the guide) and width W (across), m.
     corner_radius : float
@@ -583,9 +587,28 @@ class TranslationalClearance(_PointJoint):
     The slider must not be able to turn over in the guide (``sqrt(L^2 + W^2) > H``):
     then the upper corners can only ever touch the upper surface and the lower corners
     the lower one, and these four pairs are all the contacts there are.
+
+    The ``section-4.3`` model switches between two laws of very different stiffness: when
+    a face forms under a corner that is already deep (a tilted slider), the stored elastic
+    energy jumps up (channel ``<name>.elastic_energy``; docs/validation.md, section 4.5). It
+    is the chapter's model for a slider that lands flat (frictionless, pin at the slider's
+    centre, Fig. 4.35b); for tilting sliders (friction) use ``corners``.
+
+    Example
+    -------
+    >>> import daeclear as dc
+    >>> scene = dc.Scene("guide", gravity=(0.0, -9.81))
+    >>> slider = scene.add(dc.Body("slider", mass=0.14, inertia=1e-4))
+    >>> joint = scene.add(dc.TranslationalClearance(
+    ...     "g", scene.ground, slider, at=(0.0, 0.0), length=0.05, width=0.05, corner_radius=1e-3,
+    ...     clearance=0.5e-3, material=dc.Material(young=207e9, poisson=0.3)))
+    >>> scene.validate()
+    >>> round(joint.resolved_law().stiffness / 1e9, 2)  # sphere of R_c on a plane, eq. (3.5)
+    4.8
     """
 
     axis: Vector2 = (1.0, 0.0)
+    slider_axis: Vector2 | None = None
     length: float = 0.0
     width: float = 0.0
     corner_radius: float = 0.0
@@ -603,7 +626,7 @@ class TranslationalClearance(_PointJoint):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        for name in ("axis", "upper_limits", "lower_limits", "stroke"):
+        for name in ("axis", "slider_axis", "upper_limits", "lower_limits", "stroke"):
             value = getattr(self, name)
             vec = _as_vector2(value) if value is not None else None
             if vec is not None:
@@ -653,9 +676,11 @@ class TranslationalClearance(_PointJoint):
 
     def problems(self) -> list[str]:
         out = super().problems()
-        vec = _as_vector2(self.axis)
-        if vec is None or math.hypot(*vec) < 1e-12:
-            out.append(f"{self.kind} '{self.name}': axis={self.axis!r}, must be a non-zero 2-vector.")
+        for name in ("axis", "slider_axis"):
+            value = getattr(self, name)
+            vec = _as_vector2(value) if value is not None or name == "axis" else (1.0, 0.0)
+            if vec is None or math.hypot(*vec) < 1e-12:
+                out.append(f"{self.kind} '{self.name}': {name}={value!r}, must be a non-zero 2-vector.")
         for name in ("length", "width", "corner_radius"):
             self._check_positive(out, name, "m")
         if self.thickness is not None:

@@ -9,9 +9,9 @@ at ``+H/2``, the lower one is at ``-H/2``. For a slider corner ``r_k`` (4.15)
     A_j = O + s_k t +- (H/2) n     closest guide point (4.16), on the surface
     d_k = +-n . (r_k - O) - H/2    signed penetration, > 0 in contact
 
-``d_k = -n_k . delta`` with ``delta = A_j - r_k`` (4.17) and ``n_k`` the surface normal
-pointing into the guide, so ``d_k > 0`` is the chapter's condition (4.19) and
-``d_k = |delta|`` (4.20) in contact. The penetration is measured at the sharp corner of
+``d_k = -n_k . delta`` with ``delta = A_j - r_k`` (4.17) and ``n_k`` the surface's normal
+pointing out of the guide (the chapter's ``n`` of (4.18)), so ``d_k > 0`` is the chapter's
+condition (4.19) and ``d_k = |delta|`` (4.20) in contact. The penetration is measured at the sharp corner of
 the ``L x W`` rectangle as in the chapter; the corner radius R_c only sets the stiffness
 of the corner contact (a sphere of radius R_c on a plane, eq. 3.5). The penetration rate
 is ``(d d_k / dq) v`` (4.21). The force on the slider acts at the corner, the opposite
@@ -54,6 +54,21 @@ Events follow the rule of :mod:`daeclear.clearance` (onset watched while free, s
 while in contact, approach speed latched at the located onset and floored, the same
 storm guard per corner). A face's switches are reported as events of the pair
 ``<name>.upper_face`` / ``<name>.lower_face``, after the corner events that caused them.
+
+Channels (``<name>`` the joint's name, ``<pair>`` ``<name>.A_upper`` ... ``<name>.D_lower``)
+---------------------------------------------------------------------------------------
+``<name>.s``, ``<name>.y`` (m): slider centre along the guide and its offset from the
+mid-line; ``<name>.tilt`` (rad): angle from the guide to the slider; ``<name>.eta`` =
+y / (2c) (+-0.5 where a parallel slider touches a surface); ``<name>.xi`` = 0..1 along the
+joint's ``stroke`` (dimensionless path of Fig. 4.28d); per pair ``<pair>.penetration``,
+``.penetration_rate``, ``.normal_force``, ``.in_contact`` (1 also while its face carries
+it), with friction ``.friction_force`` and ``.sliding_velocity``; per face (``section-4.3``)
+``<name>.upper_face.penetration`` (the average), ``.normal_force``, ``.in_contact`` and the
+friction channels; ``<name>.penetration`` (largest corner penetration),
+``<name>.normal_force`` (sum over pairs and faces), ``<name>.in_contact`` (any), and
+``<name>.elastic_energy`` (J): the energy stored in the elastic part of the active laws
+(K d^(n+1)/(n+1) per corner, the Winkler potential per face), so that mechanical plus
+elastic energy is conserved by elastic laws.
 """
 
 from __future__ import annotations
@@ -61,7 +76,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import casadi as ca
 import numpy as np
@@ -70,7 +85,7 @@ from numpy.typing import NDArray
 from .clearance import STORM_EVENTS, STORM_WINDOW, ContactBuild
 from .result import ContactEvent
 from .scene import Scene, TranslationalClearance
-from .symbolic import AssemblyContext, Channel, Term, perpendicular, rotation
+from .symbolic import AssemblyContext, BufferedFunction, Channel, Term, perpendicular, rotation
 
 #: Corners: name, sign along the slider length, sign across it, surface it can touch.
 CORNERS: tuple[tuple[str, int, int, str], ...] = (
@@ -116,8 +131,8 @@ class SliderGuideLogic:
 
     A corner is *free* or in *contact* (its gap's root); the terms follow from the modes:
     a face term is on while both its corners are in contact, a corner term while its
-    corner is in contact and its face is not on. ``rate`` maps ``(q, v)`` to the four gaps,
-    the four penetration rates and the faces' mean penetration rates.
+    corner is in contact and its face is not on (or while it is *held* by the storm guard).
+    ``rate`` maps ``(q, v)`` to the four gaps and the four penetration rates.
     """
 
     name: str
@@ -127,7 +142,7 @@ class SliderGuideLogic:
     face_names: list[str]
     face_terms: list[int]
     face_corners: list[tuple[int, int]]
-    rate: ca.Function
+    rate: Callable[..., tuple[NDArray, NDArray]]  # (q, v) -> (gaps, penetration rates)
     n_q: int
     needs_approach: bool
     min_approach_speed: float
@@ -135,6 +150,7 @@ class SliderGuideLogic:
     face_min_approach_speed: float
     contact: list[bool] = field(default_factory=list)
     held: list[bool] = field(default_factory=list)
+    free_since: list[float] = field(default_factory=list)
     latched: list[float] = field(default_factory=list)
     face_on: list[bool] = field(default_factory=list)
     recent: list[list[float]] = field(default_factory=list)
@@ -146,7 +162,7 @@ class SliderGuideLogic:
 
     def _reset(self) -> None:
         n = len(self.pairs)
-        self.contact, self.held, self.latched = [False] * n, [False] * n, [0.0] * n
+        self.contact, self.held, self.latched, self.free_since = [False] * n, [False] * n, [0.0] * n, [0.0] * n
         self.recent = [[] for _ in range(n)]
         self.face_on = [False] * len(self.face_names)
 
@@ -189,8 +205,8 @@ class SliderGuideLogic:
         return modes
 
     def root_directions(self, active: Sequence[bool]) -> list[tuple[int, int]]:
-        """While a corner is free watch its onsets (+1), while in contact (or held) separations (-1)."""
-        return [(self.first_root + i, -1 if (self.contact[i] or self.held[i]) else +1)
+        """While a corner is free watch its onsets (+1), in contact separations (-1), held both (0)."""
+        return [(self.first_root + i, 0 if self.held[i] else -1 if self.contact[i] else +1)
                 for i in range(len(self.pairs))]
 
     def on_roots(self, t: float, y: NDArray, yp: NDArray, roots_found: NDArray | None,
@@ -203,21 +219,29 @@ class SliderGuideLogic:
         gaps, rates = self._evaluate(y)
         events: list[ContactEvent] = []
         for i, direction in enumerate(int(d) for d in found):
+            if direction == 0:
+                continue
+            if self.held[i]:  # the storm rule of clearance.PairLogic
+                if direction < 0:
+                    self.free_since[i] = t
+                    continue
+                if t - self.free_since[i] <= STORM_WINDOW:
+                    continue  # a re-contact inside the storm: the held term stays as it is
+                self.held[i] = False  # a genuine onset after a real flight
             rate = float(rates[i])
             if direction > 0 and not self.contact[i]:
                 self._count(i, t)
-                self.contact[i], self.held[i] = True, False
+                self.contact[i] = True
                 params[self.corner_terms[i]] = self._corner_params(i, rate)
                 events.append(ContactEvent(t=t, pair=self.pairs[i], kind="onset", approach_speed=rate,
                                            y=y.copy()))
-            elif direction < 0 and (self.contact[i] or self.held[i]):
+            elif direction < 0 and self.contact[i]:
                 self._count(i, t)
-                if self.contact[i]:
-                    events.append(ContactEvent(t=t, pair=self.pairs[i], kind="separation",
-                                               approach_speed=rate, y=y.copy()))
                 self.contact[i] = False
-                # storm: keep the (zero) corner force term on, see clearance.STORM_EVENTS
-                self.held[i] = len(self.recent[i]) >= STORM_EVENTS
+                if len(self.recent[i]) >= STORM_EVENTS:
+                    self.held[i], self.free_since[i] = True, t  # the corner term stays on (zero force)
+                events.append(ContactEvent(t=t, pair=self.pairs[i], kind="separation", approach_speed=rate,
+                                           y=y.copy()))
         events += self._apply(t, y, active, params)
         return events
 
@@ -250,7 +274,9 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
     s_i, s_j = _points(ctx, joint)
     axis = _unit(joint.axis)
     t_guide = _to_local(ctx.reference[joint.body_i][1], axis)  # (4.14): t in guide coordinates
-    e_slider = _to_local(ctx.reference[joint.body_j][1], axis)  # slider length direction, slider coordinates
+    # slider length direction, slider coordinates
+    e_slider = (_to_local(ctx.reference[joint.body_j][1], axis) if joint.slider_axis is None
+                else _unit(joint.slider_axis))
     w_slider = np.array([-e_slider[1], e_slider[0]])
 
     O = guide.point(ca.DM(s_i))  # a point of the mid-line
@@ -303,7 +329,7 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         p = ca.SX.sym("p", n_params)
         F_N = law.force(d_k, d_dot, p[0] if n_params else None)
         Q, F_T, v_T = contact_force(F_N, r_k, surface_point(s_k, surface), surface)
-        terms.append(Term(f"{ident}_{pair}", ca.Function(f"{ident}_{pair}_force", [ctx.t, ctx.q, ctx.v, p], [Q],
+        terms.append(Term(f"{name}.{pair}", ca.Function(f"{ident}_{pair}_force", [ctx.t, ctx.q, ctx.v, p], [Q],
                                                          ["t", "q", "v", "p"], ["Q"]), n_params))
         forces.append((F_N, F_T, v_T, p))
         energies.append(_elastic_energy(law, d_k))
@@ -325,7 +351,7 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
             p = ca.SX.sym("p", face_params)
             F_N = face_law.force(d_mean, d_mean_dot, p[0] if face_params else None)
             Q, F_T, v_T = contact_force(F_N, point, point, surface)
-            terms.append(Term(f"{ident}_{face}", ca.Function(f"{ident}_{face}_force", [ctx.t, ctx.q, ctx.v, p],
+            terms.append(Term(f"{name}.{face}", ca.Function(f"{ident}_{face}_force", [ctx.t, ctx.q, ctx.v, p],
                                                              [Q], ["t", "q", "v", "p"], ["Q"]), face_params))
             forces.append((F_N, F_T, v_T, p))
             # Winkler potential of the linear law at the trapezoid's centroid (see module docstring)
@@ -340,7 +366,7 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         name=name, pairs=pair_names, first_root=first_root,
         corner_terms=[first_term + i for i in range(n_corners)],
         face_names=face_names, face_terms=[first_term + n_corners + f for f in range(len(face_names))],
-        face_corners=face_corners, rate=rate, n_q=ctx.n_q,
+        face_corners=face_corners, rate=BufferedFunction(rate), n_q=ctx.n_q,
         needs_approach=law.needs_approach_speed,
         min_approach_speed=float(getattr(law, "min_approach_speed", 0.0)),
         face_needs_approach=bool(face_law is not None and face_law.needs_approach_speed),
@@ -349,9 +375,8 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
 
     y_centre = ca.dot(n_vec, rel_centre)
     s_centre = ca.dot(t_vec, rel_centre)
-    _, phi_i0 = ctx.reference[joint.body_i]
-    _, phi_j0 = ctx.reference[joint.body_j]
-    tilt = slider.phi - guide.phi - (phi_j0 - phi_i0)
+    # angle from the guide's direction to the slider's length direction
+    tilt = (slider.phi + math.atan2(e_slider[1], e_slider[0])) - (guide.phi + math.atan2(t_guide[1], t_guide[0]))
     stroke = joint.stroke if joint.stroke is not None else joint.upper_limits
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
