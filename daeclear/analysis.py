@@ -18,7 +18,9 @@ of the motion with the evidence behind it:
    (decorrelation >= ``decorrelation``, 0.3 by default) and their separation grows
    (largest Lyapunov exponent estimated by a straight-line fit of ln(distance) against
    time over the growth window, with its R^2), the motion is chaotic; a non-periodic
-   section whose twins stay together is quasi-periodic.
+   section whose twins stay together is quasi-periodic. Twins restarted in free flight
+   that grow 1000-fold and decorrelate also overrule a recurring section: chaos that is
+   small in the section's channels (the translational joint's lateral impacts).
 
 Only numpy here (no plotting); figures are in :mod:`daeclear.plot`.
 ``docs/nonlinear_dynamics.md`` states the method, thresholds, limits and the measured
@@ -656,6 +658,12 @@ class MotionClass:
         return f"{head}: {self.reason}"
 
 
+def _grows(divergence: Divergence) -> bool:
+    """Sensitive dependence beyond doubt: the twin separation grew SENSITIVE_AMPLIFICATION-fold, exponentially."""
+    return (math.isfinite(divergence.amplification) and divergence.amplification >= SENSITIVE_AMPLIFICATION
+            and math.isfinite(divergence.lyapunov) and divergence.lyapunov > 0)
+
+
 def classify_section(section: PoincareSection, divergence: Divergence | None = None, *, tol: float = DEFAULT_TOL,
                      max_period: int = DEFAULT_MAX_PERIOD, decorrelation: float = DEFAULT_DECORRELATION,
                      min_points: int = MIN_POINTS) -> MotionClass:
@@ -666,13 +674,14 @@ def classify_section(section: PoincareSection, divergence: Divergence | None = N
     1. fewer than ``min_points`` section points, or unknown attractor size: "undetermined";
     2. smallest k <= ``max_period`` whose recurrence defect
        max_j max_channel |p[j+k] - p[j]| / size <= ``tol``: "periodic", period k -- unless
-       the twins separate at least SENSITIVE_AMPLIFICATION (1000) times, decorrelate and have
-       a positive exponent: then "chaotic" (sensitive dependence, small in these channels);
+       the twins, restarted in free flight, *grow* (separation amplified >=
+       SENSITIVE_AMPLIFICATION = 1000 times with a positive exponent) and decorrelate: then
+       "chaotic" (small in these channels);
     3. without ``divergence``: "non-periodic";
-    4. twins decorrelated (>= ``decorrelation``) and Lyapunov estimate > 0 or not resolved:
-       "chaotic";
-    5. twins not decorrelated: "quasi-periodic";
-    6. otherwise (decorrelated but a non-positive exponent): "non-periodic".
+    4. twins decorrelated (>= ``decorrelation``) or growing, and no negative Lyapunov
+       estimate: "chaotic";
+    5. twins neither decorrelated nor growing: "quasi-periodic";
+    6. otherwise (a non-positive exponent against decorrelation): "non-periodic".
 
     Parameters
     ----------
@@ -720,8 +729,14 @@ def classify_section(section: PoincareSection, divergence: Divergence | None = N
         recurs = (f"every section point is within {defects[k]:.3g} of the point {k} revolution"
                   f"{'s' if k > 1 else ''} later (<= tol {tol:g} of the attractor size), "
                   f"{n} points, {evidence['n_clusters']} cluster(s)")
-        if (divergence is not None and divergence.amplification >= SENSITIVE_AMPLIFICATION
-                and divergence.decorrelation >= decorrelation and divergence.lyapunov > 0):
+        sensitive = divergence is not None and _grows(divergence) and divergence.decorrelation >= decorrelation
+        if sensitive and divergence is not None and divergence.restart_in_contact:
+            # twins restarted in contact are not faithful copies (the latched impact speed of the
+            # ongoing contact is replaced): their growth cannot overrule a recurring section
+            return MotionClass("periodic", k, evidence,
+                               f"{recurs}; the twins grew {divergence.amplification:.3g}-fold but were restarted "
+                               "in contact (no free flight at any section time), so they do not count.")
+        if sensitive and divergence is not None:
             return MotionClass("chaotic", 0, evidence,
                                f"{recurs}, but twins separate {divergence.amplification:.3g}-fold and decorrelate "
                                f"({divergence.decorrelation:.3g} >= {decorrelation:g}; Lyapunov estimate "
@@ -733,13 +748,15 @@ def classify_section(section: PoincareSection, divergence: Divergence | None = N
     if divergence is None:
         return MotionClass("non-periodic", 0, evidence, not_periodic + "; no twin run to test sensitivity.")
     D, lam = divergence.decorrelation, divergence.lyapunov
-    lam_text = (f"Lyapunov estimate {lam:.3g} 1/s ({lam * section.period:.3g} per revolution, R^2 "
-                f"{divergence.r_squared:.2f})" if math.isfinite(lam)
-                else f"separation grew {divergence.amplification:.3g}x, too little for a Lyapunov fit")
-    if math.isfinite(D) and D >= decorrelation and not (math.isfinite(lam) and lam <= 0):
-        return MotionClass("chaotic", 0, evidence,
-                           f"{not_periodic}; twins decorrelate ({D:.3g} >= {decorrelation:g}); {lam_text}.")
-    if math.isfinite(D) and D < decorrelation:
+    lam_text = (f"twins separate {divergence.amplification:.3g}-fold, Lyapunov estimate {lam:.3g} 1/s "
+                f"({lam * section.period:.3g} per revolution, R^2 {divergence.r_squared:.2f})" if math.isfinite(lam)
+                else f"separation grew {divergence.amplification:.3g}-fold, too little for a Lyapunov fit")
+    decorrelated = math.isfinite(D) and D >= decorrelation
+    if (decorrelated or _grows(divergence)) and not (math.isfinite(lam) and lam <= 0):
+        how = f"twins decorrelate ({D:.3g} >= {decorrelation:g})" if decorrelated else \
+            f"twins stay correlated ({D:.3g}) but diverge exponentially"
+        return MotionClass("chaotic", 0, evidence, f"{not_periodic}; {how}; {lam_text}.")
+    if math.isfinite(D) and not decorrelated:
         return MotionClass("quasi-periodic", 0, evidence,
                            f"{not_periodic}; twins stay together (decorrelation {D:.3g} < {decorrelation:g}); "
                            f"{lam_text}.")

@@ -60,6 +60,7 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("--channels", default="slider.vx,drive.moment", help="channels whose error is measured")
     study.add_argument("--repeats", type=int, default=3, help="timed repeats per run (best kept)")
     study.add_argument("--out", type=Path, default=Path("results/study"), help="output directory")
+    _add_sweep_parser(sub)
     return parser
 
 
@@ -161,6 +162,154 @@ def _study(args: argparse.Namespace) -> int:
     return 0
 
 
+# --------------------------------------------------------------------------- daeclear sweep
+
+
+def _add_sweep_parser(sub: Any) -> None:
+    sweep = sub.add_parser("sweep", help="classify the motion over a grid of parameters into one HDF5 file",
+                           description="Run and classify (periodic, quasi-periodic, chaotic) one scene per parameter "
+                                       "point, in parallel, into one HDF5 file; an interrupted sweep resumes where it "
+                                       "stopped when the same command is run again.")
+    sweep.add_argument("target", help="mechanism name (slider_crank)")
+    sweep.add_argument("out", type=Path, help="sweep file (.h5), created or resumed")
+    sweep.add_argument("--joint", help="slider_crank: which joint has clearance (ideal, revolute, translational)")
+    sweep.add_argument("--grid", action="append", default=[], metavar="NAME=VALUES",
+                       help="swept parameter: NAME=v1,v2,... or NAME=lin:START:STOP:N or NAME=geom:START:STOP:N "
+                            "(repeatable: every combination is run)")
+    sweep.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help="fixed mechanism parameter, e.g. --set rpm=3000 (repeatable)")
+    sweep.add_argument("--points", type=Path, help="JSON file with a list of parameter points (dicts) to run")
+    sweep.add_argument("--revolutions", type=int, default=30, help="revolutions analysed (default 30)")
+    sweep.add_argument("--transient", type=int, default=10, help="revolutions discarded first (default 10)")
+    sweep.add_argument("--per-revolution", type=int, default=32, help="output samples per revolution (default 32)")
+    sweep.add_argument("--channels", default="slider.vx,slider.ax", help="Poincaré-section channels")
+    sweep.add_argument("--twin", choices=["always", "auto", "never"], default="always",
+                       help="twin runs for the chaos test: always (default), only when the section does not "
+                            "recur (auto), or never")
+    sweep.add_argument("--rtol", type=float, default=1e-6, help="IDA relative tolerance (default 1e-6)")
+    sweep.add_argument("--keep", choices=["section", "channels", "full"], default="channels",
+                       help="what each run stores besides its class and section (default channels)")
+    sweep.add_argument("--workers", type=int, help="worker processes (default: the CPU count)")
+    sweep.add_argument("--dask", metavar="ADDRESS",
+                       help="run on a Dask cluster: a scheduler address (tcp://host:8786) or 'local'")
+    sweep.add_argument("--restart", action="store_true", help="discard the file's runs and start over")
+    sweep.add_argument("--retry-failed", action="store_true", help="run the recorded failed runs again")
+    sweep.add_argument("--no-figure", action="store_true", help="no bifurcation diagram / motion map")
+    sweep.add_argument("--quiet", action="store_true", help="no progress line")
+
+
+def _grid_values(item: str) -> tuple[str, list[Any]]:
+    """``NAME=v1,v2``, ``NAME=lin:a:b:n`` or ``NAME=geom:a:b:n`` -> (name, values)."""
+    import numpy as np
+
+    name, sep, text = item.partition("=")
+    name, text = name.strip(), text.strip()
+    if not sep or not name or not text:
+        raise DaeclearError(f"--grid {item!r}: expected NAME=v1,v2,... or NAME=lin:START:STOP:N, "
+                            "e.g. --grid clearance=0.01e-3,0.1e-3,0.5e-3.")
+    kind, _, spec = text.partition(":")
+    if kind in ("lin", "geom") and spec:
+        try:
+            a, b, n = spec.split(":")
+            start, stop, count = float(a), float(b), int(n)
+        except ValueError:
+            raise DaeclearError(f"--grid {item!r}: expected {kind}:START:STOP:N, e.g. {kind}:1e-5:5e-4:10.") from None
+        if count < 1 or (kind == "geom" and (start <= 0 or stop <= 0)):
+            rule = " and START, STOP > 0." if kind == "geom" else "."
+            raise DaeclearError(f"--grid {item!r}: N must be >= 1{rule}")
+        values = np.linspace(start, stop, count) if kind == "lin" else np.geomspace(start, stop, count)
+        return name, [float(v) for v in values]
+    return name, [_parse_value(v.strip()) for v in text.split(",") if v.strip()]
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    import json
+
+    from .sweep import sweep
+
+    fixed = _parse_sets(args.set)
+    if args.joint:
+        fixed["joint"] = args.joint
+    grid = dict(_grid_values(item) for item in args.grid)
+    points = None
+    if args.points:
+        try:
+            points = json.loads(args.points.read_text())
+        except (OSError, ValueError) as exc:
+            raise DaeclearError(f"--points {args.points}: cannot read a JSON list of points ({exc}).") from None
+        if not isinstance(points, list) or not all(isinstance(p, dict) for p in points):
+            raise DaeclearError(f"--points {args.points}: expected a JSON list of objects, e.g. "
+                                '[{"clearance": 1e-4}, {"clearance": 5e-4, "friction": 0.1}].')
+    if not grid and not points:
+        raise DaeclearError("sweep: give --grid NAME=VALUES (repeatable) and/or --points FILE.json.")
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    client = cluster = None
+    executor = None
+    if args.dask:
+        try:
+            from dask.distributed import Client, LocalCluster
+        except ImportError:
+            raise DaeclearError("--dask needs Dask: pip install 'daeclear[dask]' (dask[distributed]).") from None
+        if args.dask == "local":
+            cluster = LocalCluster(n_workers=args.workers or 2, threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
+            client = Client(cluster)
+        else:
+            client = Client(args.dask)
+        executor = client.get_executor()
+    twin = {"auto": "auto", "always": True, "never": False}[args.twin]
+    try:
+        result = sweep(args.out, grid or None, runs=points, mechanism=args.target, fixed=fixed,
+                       channels=[c.strip() for c in args.channels.split(",") if c.strip()], keep=args.keep,
+                       revolutions=args.revolutions, transient=args.transient, per_revolution=args.per_revolution,
+                       twin=twin, rtol=args.rtol, executor=executor, max_workers=args.workers,
+                       resume=not args.restart, retry_failed=args.retry_failed, progress=not args.quiet)
+    except KeyboardInterrupt:
+        print(f"daeclear: sweep interrupted; finished runs are saved in {args.out}. Run the same command again to "
+              "resume.", file=sys.stderr)
+        return 130
+    finally:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    names = result.parameter_names()
+    print(f"{result}  ({result.n_computed} computed now, {result.n_skipped} already done)")
+    for run in result.runs:
+        values = " ".join(f"{n}={run.parameters.get(n)!r}" for n in names)
+        if run.ok:
+            e = run.evidence
+            print(f"  {values}: {run.motion}" + (f" (period {run.period})" if run.motion == "periodic" else "")
+                  + f"  defect {e.get('periodicity_defect', float('nan')):.3g}"
+                  + (f", decorrelation {e['decorrelation']:.3g}" if "decorrelation" in e else "")
+                  + (f", Lyapunov {e['lyapunov']:.3g} 1/s" if "lyapunov" in e else ""))
+        else:
+            print(f"  {values}: FAILED {run.error}")
+    numeric = [n for n in names if all(isinstance(r.parameters.get(n), (int, float))
+                                       and not isinstance(r.parameters.get(n), bool) for r in result.runs)]
+    if not args.no_figure and result.runs and 1 <= len(names) <= 2:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from .plot import plot_bifurcation, plot_motion_map
+        fig, ax = plt.subplots(figsize=(7.0, 4.5))
+        if len(names) == 1 and numeric:
+            plot_bifurcation(result, names[0], ax=ax)
+            png = args.out.with_name(args.out.stem + "_bifurcation.png")
+        else:
+            plot_motion_map(result, names[0], names[-1], ax=ax)
+            png = args.out.with_name(args.out.stem + "_motion_map.png")
+        fig.tight_layout()
+        fig.savefig(png, dpi=120)
+        plt.close(fig)
+        print(f"wrote {png}")
+    if result.failed:
+        print(f"daeclear: {len(result.failed)} run(s) failed (recorded in {args.out}; --retry-failed runs them "
+              "again).", file=sys.stderr)
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="daeclear: %(message)s")
     args = build_parser().parse_args(argv)
@@ -169,6 +318,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _run(args)
         if args.command == "study":
             return _study(args)
+        if args.command == "sweep":
+            return _sweep(args)
     except SolveError as exc:
         print(f"daeclear: {exc}", file=sys.stderr)
         return 1

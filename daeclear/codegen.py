@@ -368,15 +368,27 @@ def _build_model_library(funcs: Any, *, model: NormalizedModel | None = None) ->
     t0 = time.perf_counter()
     if model is None:
         model = normalize_model(funcs)
-    cc = compiler_command()
-    version = _compiler_version(cc[0])
     libdir, libs = sundials_libraries()
     source = generate_source(model)
-    flags = [*CFLAGS, f"-I{CSRC}"]
     link = [str(libs[name]) for name in SUNDIALS_LIBS] + [f"-Wl,-rpath,{libdir}", "-lm"]
+    return compile_cached("dc", f"the model {model.name!r}", source, "ida_driver.c", _driver_text(), [*CFLAGS],
+                          link, ["\n".join(str(p) for p in libs.values())], t0)
+
+
+def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text: str, flags: list[str],
+                   link: list[str], extra_key: list[str], t0: float) -> BuildResult:
+    """Compile ``source`` with the driver ``csrc/<driver>`` into a cached shared library.
+
+    The cache key hashes the generated source, the driver sources, the compiler command and
+    version and ``extra_key``; the library is built in a temporary directory under a file lock
+    and moved into place atomically, so concurrent processes never see a half-written file.
+    ``t0`` is when code generation started (reported as ``codegen_time``).
+    """
+    cc = compiler_command()
+    version = _compiler_version(cc[0])
+    flags = [*flags, f"-I{CSRC}"]
     h = hashlib.sha256()
-    for part in (source, _driver_text(), shlex.join(cc + flags + link), version,
-                 "\n".join(str(p) for p in libs.values())):
+    for part in (prefix, source, driver_text, shlex.join(cc + flags + link), version, *extra_key):
         h.update(part.encode())
         h.update(b"\0")
     key = h.hexdigest()
@@ -387,7 +399,7 @@ def _build_model_library(funcs: Any, *, model: NormalizedModel | None = None) ->
         root.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise CompilerUnavailable(f"cache directory {root} cannot be created: {exc}") from exc
-    stem = f"dc_{key[:40]}"
+    stem = f"{prefix}_{key[:40]}"
     target = root / f"{stem}.so"
     if target.is_file():
         return BuildResult(target, key, True, 0.0, codegen_time)
@@ -400,7 +412,7 @@ def _build_model_library(funcs: Any, *, model: NormalizedModel | None = None) ->
             model_c = tmpd / "model.c"
             model_c.write_text(source)
             out = tmpd / "lib.so"
-            cmd = [*cc, *flags, str(model_c), str(CSRC / "ida_driver.c"), "-o", str(out), *link]
+            cmd = [*cc, *flags, str(model_c), str(CSRC / driver), "-o", str(out), *link]
             try:
                 proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
             except (OSError, subprocess.SubprocessError) as exc:
@@ -409,10 +421,7 @@ def _build_model_library(funcs: Any, *, model: NormalizedModel | None = None) ->
                 msg = (proc.stderr or proc.stdout or "").strip()
                 if len(msg) > 4000:
                     msg = msg[:2000] + "\n...\n" + msg[-2000:]
-                raise CompileError(
-                    f"compiling the model {model.name!r} failed (exit {proc.returncode}):\n"
-                    f"$ {shlex.join(cmd)}\n{msg}"
-                )
+                raise CompileError(f"compiling {what} failed (exit {proc.returncode}):\n$ {shlex.join(cmd)}\n{msg}")
             # keep the generated source next to the library, for debugging
             src_tmp = tmpd / "src.c"
             src_tmp.write_text(source)
@@ -560,53 +569,9 @@ def build_ode_library(spec: OdeSpec) -> BuildResult:
     nothing but libm.
     """
     t0 = time.perf_counter()
-    cc = compiler_command()
-    version = _compiler_version(cc[0])
     source = generate_ode_source(spec)
     flags = ["-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Werror=incompatible-pointer-types",
-             "-Werror=implicit-function-declaration", f"-I{CSRC}"]
-    link = ["-lm"]
+             "-Werror=implicit-function-declaration"]
     driver = "".join(f"/* {name} */\n" + (CSRC / name).read_text() for name in ODE_DRIVER_SOURCES)
-    h = hashlib.sha256()
-    for part in ("ode", source, driver, shlex.join(cc + flags + link), version):
-        h.update(part.encode())
-        h.update(b"\0")
-    key = h.hexdigest()
-    codegen_time = time.perf_counter() - t0
-
-    root = cache_dir()
-    try:
-        root.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise CompilerUnavailable(f"cache directory {root} cannot be created: {exc}") from exc
-    stem = f"dco_{key[:40]}"
-    target = root / f"{stem}.so"
-    if target.is_file():
-        return BuildResult(target, key, True, 0.0, codegen_time)
-    with _file_lock(root / f"{stem}.lock"):
-        if target.is_file():
-            return BuildResult(target, key, True, 0.0, codegen_time)
-        t1 = time.perf_counter()
-        with tempfile.TemporaryDirectory(prefix=f"{stem}-", dir=root) as tmp:
-            tmpd = Path(tmp)
-            model_c = tmpd / "model.c"
-            model_c.write_text(source)
-            out = tmpd / "lib.so"
-            cmd = [*cc, *flags, str(model_c), str(CSRC / "ode_driver.c"), "-o", str(out), *link]
-            try:
-                proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
-            except (OSError, subprocess.SubprocessError) as exc:
-                raise CompilerUnavailable(f"running the C compiler {cc[0]!r} failed: {exc}") from exc
-            if proc.returncode != 0 or not out.is_file():
-                msg = (proc.stderr or proc.stdout or "").strip()
-                if len(msg) > 4000:
-                    msg = msg[:2000] + "\n...\n" + msg[-2000:]
-                raise CompileError(
-                    f"compiling the ODE model {spec.name!r} failed (exit {proc.returncode}):\n"
-                    f"$ {shlex.join(cmd)}\n{msg}"
-                )
-            src_tmp = tmpd / "src.c"
-            src_tmp.write_text(source)
-            os.replace(src_tmp, root / f"{stem}.c")
-            os.replace(out, target)
-        return BuildResult(target, key, False, time.perf_counter() - t1, codegen_time)
+    return compile_cached("dco", f"the ODE model {spec.name!r}", source, "ode_driver.c", driver, flags, ["-lm"],
+                          [], t0)

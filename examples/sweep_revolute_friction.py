@@ -1,0 +1,28 @@
+"""Section 4.4, Figs. 4.19-4.21: the revolute friction study as a sweep (c_f = 0.01, 0.03, 0.05, 0.1; c = 0.5 mm).
+
+Every value is one run classified by :func:`daeclear.analysis.classify_motion` (periodic of
+period k, quasi-periodic or chaotic, with the evidence), run in parallel by :func:`daeclear.sweep`
+and gathered in ``results/sweep_revolute_friction/revolute_friction.h5``; running the script again resumes
+the sweep and recomputes nothing that is finished. Outputs and options: ``sweep_studies.py``.
+
+Run: ``python examples/sweep_revolute_friction.py`` (``--quick`` for a smoke run, ``--dask local``
+for a local Dask cluster).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Sequence
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import sweep_studies  # noqa: E402
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    return sweep_studies.main("revolute_friction", argv)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
