@@ -182,7 +182,8 @@ class DAEModel:
         n = self.n_q
         y2 = np.atleast_2d(y)
         N = y2.shape[0]
-        t_col = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,)).reshape(N, 1)
+        t_arr = np.asarray(t, dtype=float)
+        t_col = t_arr.reshape(N, 1) if t_arr.size == N else np.full((N, 1), float(t_arr.ravel()[0]))
         total = np.zeros((N, n))
         for k, (on, p) in enumerate(zip(active, params)):
             if on:
@@ -212,9 +213,14 @@ class DAEModel:
                         session: Any) -> NDArray[np.float64]:
         """[a, lam(, work rate)] per row, from the generated Schur-complement solve."""
         N, n = q.shape[0], self.n_q
-        t_col = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,)).reshape(N, 1)
-        Qc = np.zeros((1, n)) if generalized_force is None else np.atleast_2d(generalized_force)
+        t_arr = np.asarray(t, dtype=float)
+        t_col = t_arr.reshape(N, 1) if t_arr.size == N else np.full((N, 1), float(t_arr.ravel()[0]))
+        Qc = self._zero_force if generalized_force is None else generalized_force
         return self.evaluate(EXTRA_ACCEL, [t_col, q, v, Qc], N, session)
+
+    @property
+    def _zero_force(self) -> NDArray[np.float64]:
+        return np.zeros(self.n_q)
 
     def consistent_state(self, t: ArrayLike, y: NDArray[np.float64],
                          generalized_force: NDArray[np.float64] | None = None, session: Any = None,

@@ -529,6 +529,7 @@ class CSession(_SessionBase):
             t_out=ctypes.addressof(self._t_out), flag=ctypes.addressof(self._flag),
         )
         self._statbuf = np.zeros(len(_STAT_KEYS), dtype=np.int64)
+        self._extra_meta: dict[int, tuple[Any, ...]] = {}
         # reinit inputs: copied into fixed arrays whose addresses are known
         self._y0b = np.zeros(n)
         self._yp0b = np.zeros(n)
@@ -549,27 +550,31 @@ class CSession(_SessionBase):
         return True
 
     def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
-        f = self._model.extras[k]
-        arrays, strides = [], []
+        meta = self._extra_meta.get(k)
+        if meta is None:  # input sizes, output size and reusable ctypes arrays, once per function
+            f = self._model.extras[k]
+            sizes = [f.numel_in(j) for j in range(f.n_in())]
+            meta = (sizes, f.numel_out(0), (ctypes.c_void_p * max(len(sizes), 1))(),
+                    (ctypes.c_int * max(len(sizes), 1))())
+            self._extra_meta[k] = meta
+        sizes, n_out, ptrs, strides = meta
+        keep = []
         for j, x in enumerate(inputs):
-            a = np.ascontiguousarray(x, dtype=float)
-            size = f.numel_in(j)
+            a = x if (type(x) is np.ndarray and x.dtype == np.float64 and x.flags.c_contiguous) \
+                else np.ascontiguousarray(x, dtype=float)
+            size = sizes[j]
             if a.size == size:
-                arrays.append(a.ravel())
-                strides.append(0)
-            elif a.shape == (n_points, size):
-                arrays.append(a)
-                strides.append(size)
+                strides[j] = 0
+            elif a.size == n_points * size:
+                strides[j] = size
             else:
                 raise ValueError(f"eval_extra({k}): input {j} has shape {a.shape}, expected ({n_points}, {size}) or ({size},)")
-        n_out = f.numel_out(0)
+            ptrs[j] = a.__array_interface__["data"][0]
+            keep.append(a)
         out = np.empty((n_points, n_out))
-        ptrs = (ctypes.c_void_p * max(len(arrays), 1))(*[a.__array_interface__["data"][0] for a in arrays])
-        stride_arr = (ctypes.c_int * max(len(strides), 1))(*strides)
-        rc = self._lib.dc_eval_extra(k, n_points, len(arrays), ptrs, stride_arr,
-                                     out.__array_interface__["data"][0], n_out)
+        rc = self._lib.dc_eval_extra(k, n_points, len(sizes), ptrs, strides, out.__array_interface__["data"][0], n_out)
         if rc != 0:
-            raise DaeclearError(f"evaluating {f.name()} in the compiled model failed (status {rc}).")
+            raise DaeclearError(f"evaluating {self._model.extras[k].name()} in the compiled model failed (status {rc}).")
         return out
 
     # ---------------------------------------------------------------- core
