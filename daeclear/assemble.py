@@ -80,6 +80,8 @@ class DAEModel:
     parameters: dict[str, Any] = field(default_factory=dict)
     contacts: tuple[Any, ...] = ()  # contact elements' event logic (clearance joints)
     track_work: bool = False
+    # (root, term, gap-rate extra, needs approach speed, min approach speed) of simple pairs
+    auto_pairs: tuple[tuple[int, int, int, bool, float], ...] = ()
 
     @property
     def n_q(self) -> int:
@@ -190,6 +192,24 @@ class DAEModel:
                 total += self.evaluate(EXTRA_TERM0 + k, [t_col, y2[:, :n], y2[:, n:2 * n], np.asarray(p, dtype=float)],
                                        N, session)
         return total[0] if np.ndim(y) == 1 else total
+
+    def term_forces_rows(self, t: NDArray[np.float64], y: NDArray[np.float64], switch: NDArray[np.float64],
+                         session: Any = None) -> NDArray[np.float64] | None:
+        """Generalized contact forces at many rows, each with its own modes: ``switch`` holds one
+        :meth:`switch_vector` per row (on/off flag and parameters of every term)."""
+        if not self.terms:
+            return None
+        N, n = y.shape[0], self.n_q
+        total = np.zeros((N, n))
+        off = 0
+        for k, term in enumerate(self.terms):
+            rows = np.nonzero(switch[:, off] > 0)[0]
+            if rows.size:
+                P = np.ascontiguousarray(switch[rows, off + 1:off + 1 + term.n_params])
+                total[rows] += self.evaluate(EXTRA_TERM0 + k, [t[rows].reshape(-1, 1), y[rows, :n], y[rows, n:2 * n], P],
+                                             rows.size, session)
+            off += 1 + term.n_params
+        return total
 
     def accelerations(self, t: ArrayLike, q: NDArray[np.float64], v: NDArray[np.float64],
                       generalized_force: NDArray[np.float64] | None = None, session: Any = None
@@ -563,6 +583,15 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     accel = ca.Function("accel", [t, q, v, Fc], [ca.densify(ca.vertcat(a_sol, lam_sol, *work_rate))],
                         ["t", "q", "v", "Qc"], ["a_lam"])
     extras = [outputs, accel] + [term.force for term in terms]
+    # simple contact pairs whose switches the compiled loop may handle itself (see ida_driver.c)
+    auto_pairs = []
+    if formulation == "index1" and contacts and all(type(logic).__name__ == "PairLogic" for logic in contacts):
+        qs, vs = ca.SX.sym("q", n), ca.SX.sym("v", n)
+        for logic in contacts:
+            gap_k, rate_k = logic.rate.function(qs, vs)
+            extras.append(ca.Function(f"{_c_identifier(logic.pair)}_gap_rate", [qs, vs], [ca.vertcat(gap_k, rate_k)]))
+            auto_pairs.append((logic.root_index, logic.term_index, len(extras) - 1, bool(logic.needs_approach),
+                               float(logic.min_approach_speed)))
     functions = DAEFunctions(
         n=n_y, residual=residual, jacobian=jacobian, term_residuals=tuple(term_res),
         term_jacobians=tuple(term_jac), roots=roots, name=_c_identifier(scene.name), extras=tuple(extras),
@@ -580,7 +609,7 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         kinematics=kinematics, base_force=base_force,
         parameters={"scene": scene.to_dict(), "formulation": formulation, "alpha": alpha, "beta": beta,
                     "track_work": bool(track_work)},
-        contacts=tuple(contacts), track_work=bool(track_work),
+        contacts=tuple(contacts), track_work=bool(track_work), auto_pairs=tuple(auto_pairs),
     )
 
 

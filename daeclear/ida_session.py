@@ -43,7 +43,7 @@ import math
 import time
 import warnings
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol, Sequence, runtime_checkable
 
@@ -153,6 +153,9 @@ class Advance:
     flag: int = 0
     flag_name: str = ""
     message: str = ""
+    # contact switches the compiled loop handled itself (see CSession.set_auto_events):
+    # (t, pair index, +1 onset / -1 separation, penetration rate, state) in time order
+    auto_events: list = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -308,6 +311,10 @@ class _SessionBase:
         fm = f if n_points == 1 else f.map(n_points)
         return np.array(fm(*cols)).reshape(-1, n_points).T.copy()
 
+    def set_auto_events(self, pairs: Sequence[Any], **kwargs: Any) -> bool:
+        """Only the compiled backend switches contact pairs in C; returns False here."""
+        return False
+
     def set_stall(self, stall_step: float, count: int) -> None:
         """Stall detection: ``count`` tiny steps (below ``stall_step`` s and not growing, with no
         step 100x larger in between) end an advance with DC_STEP_COLLAPSE. Both backends."""
@@ -426,6 +433,12 @@ class _CLib:
         lib.dc_n_extra.argtypes = []
         lib.dc_eval_extra.restype = I
         lib.dc_eval_extra.argtypes = [I, I, I, P, P, P, I]
+        lib.dc_set_auto.restype = I
+        lib.dc_set_auto.argtypes = [P, I, P, P, P, P, P, I, I, I, I, I, I, D, I]
+        lib.dc_take_events.restype = I
+        lib.dc_take_events.argtypes = [P, I, P, P, P, P, P]
+        lib.dc_get_active.restype = None
+        lib.dc_get_active.argtypes = [P, P, P]
         lib.dc_set_stall.restype = I
         lib.dc_set_stall.argtypes = [P, D, I]
         lib.dc_set_init_step.restype = I
@@ -549,6 +562,45 @@ class CSession(_SessionBase):
             raise DaeclearError(f"init_step={init_step!r} rejected by IDA.")
         return True
 
+    def set_auto_events(self, pairs: Sequence[tuple[int, int, int, bool, float]], *, n_q: int, n_constraints: int,
+                        track_work: bool, accel_extra: int, force_extra0: int, storm_events: int,
+                        storm_window: float, capacity: int = 256) -> bool:
+        """Let the C loop switch simple contact pairs itself (index-1 layout, see ida_driver.c).
+
+        ``pairs``: (root index, term index, gap-rate extra, needs approach speed, min speed).
+        Each advance then returns the switches it made in ``Advance.auto_events``.
+        """
+        np_ = len(pairs)
+        arr = lambda col, dt: np.ascontiguousarray([p[col] for p in pairs] or [0], dtype=dt)  # noqa: E731
+        self._auto_arrays = [arr(0, np.int32), arr(1, np.int32), arr(2, np.int32), arr(3, np.int32),
+                             arr(4, np.float64)]
+        ptr = [a.ctypes.data for a in self._auto_arrays]
+        rc = self._lib.dc_set_auto(self._h, np_, *ptr, n_q, n_constraints, int(track_work), accel_extra,
+                                   force_extra0, storm_events, float(storm_window), capacity)
+        if rc != 0:
+            raise DaeclearError("configuring the events handled in C failed")
+        self._auto_cap = capacity
+        self._auto_buf = (np.empty(capacity), np.empty(capacity, dtype=np.int32), np.empty(capacity, dtype=np.int32),
+                          np.empty(capacity), np.empty((capacity, self._n)))
+        return True
+
+    def _take_auto_events(self) -> list[tuple[float, int, int, float, np.ndarray]]:
+        buf = getattr(self, "_auto_buf", None)
+        if buf is None:
+            return []
+        t, pair, kind, speed, y = buf
+        k = self._lib.dc_take_events(self._h, self._auto_cap, t.ctypes.data, pair.ctypes.data, kind.ctypes.data,
+                                     speed.ctypes.data, y.ctypes.data)
+        return [(float(t[i]), int(pair[i]), int(kind[i]), float(speed[i]), y[i].copy()) for i in range(k)]
+
+    def active_terms(self) -> tuple[list[bool], list[np.ndarray]]:
+        """The active flags and parameters the C loop integrates with now."""
+        act = np.zeros(max(self._nt, 1), dtype=np.int32)
+        par = np.zeros(max(sum(self._model.n_params), 1))
+        self._lib.dc_get_active(self._h, act.ctypes.data, par.ctypes.data)
+        off = self._poff
+        return [bool(a) for a in act[:self._nt]], [par[off[k]:off[k + 1]].copy() for k in range(self._nt)]
+
     def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
         meta = self._extra_meta.get(k)
         if meta is None:  # input sizes, output size and reusable ctypes arrays, once per function
@@ -649,7 +701,7 @@ class CSession(_SessionBase):
         ne = self._i_eval.value
         adv = Advance(status="tstop", t=self._t, y=self._y, yp=self._yp, step_t=st,
                       step_y=sy, step_yp=syp, step_h=sh, step_order=so, eval_t=te[:ne].copy(),
-                      eval_y=ev_y[:ne], eval_yp=ev_yp[:ne])
+                      eval_y=ev_y[:ne], eval_yp=ev_yp[:ne], auto_events=self._take_auto_events())
         if rc == 1:
             return adv
         if rc == 2:

@@ -18,7 +18,8 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
+from .assemble import EXTRA_ACCEL, EXTRA_TERM0, KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
+from .clearance import STORM_EVENTS, STORM_WINDOW
 from .errors import SceneError, SolveError
 from .ida_session import open_session
 from .result import ContactEvent, Result
@@ -248,32 +249,54 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     n_restarts = 0
     try:
         session.reinit(t, y, yp, active, params, _root_directions(model, active))
+        if model.auto_pairs:
+            session.set_auto_events(model.auto_pairs, n_q=model.n_q, n_constraints=model.n_constraints,
+                                    track_work=model.track_work, accel_extra=EXTRA_ACCEL, force_extra0=EXTRA_TERM0,
+                                    storm_events=STORM_EVENTS, storm_window=STORM_WINDOW)
+
+        def record(adv: Any, steps: slice, evals: slice, switch: NDArray) -> None:
+            """Keep IDA's points as they are; they are made consistent in one pass at the end."""
+            if store_steps and adv.step_t[steps].size:
+                k = adv.step_t[steps].size
+                steps_t.append(adv.step_t[steps])
+                steps_y.append(adv.step_y[steps])
+                steps_yp.append(adv.step_yp[steps])
+                steps_h.append(adv.step_h[steps])
+                steps_order.append(adv.step_order[steps])
+                steps_switch.append(np.repeat(switch[None, :], k, axis=0))
+            if adv.eval_t[evals].size:
+                k = adv.eval_t[evals].size
+                ev_t.append(adv.eval_t[evals])
+                ev_y.append(adv.eval_y[evals])
+                ev_yp.append(adv.eval_yp[evals])
+                ev_switch.append(np.repeat(switch[None, :], k, axis=0))
+
         while True:
             seg_start = t
             adv = session.advance(t_end, pending, store_steps)
-            if store_steps and adv.step_t.size:
-                # IDA does not converge the multipliers (they are out of its error test): report
-                # multipliers and accelerations recomputed from each step's q and v
-                step_y, step_yp = model.consistent_state(
-                    adv.step_t, adv.step_y, model.term_forces(adv.step_t, adv.step_y, active, params, session),
-                    session)
-                steps_t.append(adv.step_t)
-                steps_y.append(step_y)
-                steps_yp.append(step_yp)
-                steps_h.append(adv.step_h)
-                steps_order.append(adv.step_order)
-                steps_switch.append(np.repeat(switch[None, :], adv.step_t.size, axis=0))
-            if adv.eval_t.size:
-                # likewise for output times (IDA's interpolant of the multipliers is not controlled)
-                y_eval, yp_eval = model.consistent_state(
-                    adv.eval_t, adv.eval_y, model.term_forces(adv.eval_t, adv.eval_y, active, params, session),
-                    session)
-                ev_t.append(adv.eval_t)
-                ev_y.append(y_eval)
-                ev_yp.append(yp_eval)
-                ev_switch.append(np.repeat(switch[None, :], adv.eval_t.size, axis=0))
-                if pending is not None:
-                    pending = pending[pending > adv.eval_t[-1]]
+            if pending is not None and adv.eval_t.size:
+                pending = pending[pending > adv.eval_t[-1]]
+            # the C loop may have switched simple contact pairs itself: split the advance there
+            # and replay each switch through the same pair logic (modes, storm counters, events)
+            s0 = e0 = 0
+            for t_ev, pair_index, kind, _speed, y_ev in adv.auto_events:
+                s1 = int(np.searchsorted(adv.step_t, t_ev, side="right"))
+                e1 = int(np.searchsorted(adv.eval_t, t_ev, side="right"))
+                record(adv, slice(s0, s1), slice(e0, e1), switch)
+                segments.append((seg_start, t_ev, dict(modes)))
+                roots = np.zeros(len(model.gap_names), dtype=np.int32)
+                roots[model.auto_pairs[pair_index][0]] = kind
+                for logic in model.contacts:
+                    for event in logic.on_roots(t_ev, y_ev, None, roots, active, params):
+                        events.append(event)
+                        modes[event.pair] = "contact" if event.kind == "onset" else "free"
+                switch = model.switch_vector(active, params)
+                seg_start, s0, e0 = t_ev, s1, e1
+                n_restarts += 1
+            record(adv, slice(s0, None), slice(e0, None), switch)
+            if adv.auto_events and session.active_terms()[0] != list(active):
+                adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
+                adv.message = "internal: the compiled event loop and the pair logic disagree on the contact modes"
             t, y, yp = adv.t, adv.y, adv.yp
             segments.append((seg_start, t, dict(modes)))
             progress_line.update(t, len(events))
@@ -316,6 +339,12 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         out_switch = np.concatenate(steps_switch)
     post_start = time.perf_counter()
     try:
+        # IDA does not converge the multipliers (out of its error test) and its interpolant of
+        # them is not controlled: report multipliers, accelerations (and the work rate)
+        # recomputed from every point's q and v with that point's contact modes
+        if out_t.size:
+            out_y, out_yp = model.consistent_state(
+                out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)
         channels = model.channels(out_t, out_y, out_yp, out_switch, session)
     finally:
         session.close()

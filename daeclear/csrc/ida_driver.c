@@ -85,6 +85,26 @@ typedef struct {
   char msg[MSG_LEN];    /* our own message for the last non-success return */
   char cb_msg[MSG_LEN]; /* set by a callback that refused its input (NaN, CasADi error) */
   char ida_msg[MSG_LEN]; /* last message IDA passed to the error handler */
+  /* contact events handled in C (dc_set_auto): simple pairs of one root and one term */
+  int n_auto;
+  int* auto_root;     /* [n_auto] root index of the pair */
+  int* auto_term;     /* [n_auto] term index of the pair */
+  int* auto_rate;     /* [n_auto] extra: (q, v) -> [gap; penetration rate] */
+  int* auto_needs;    /* [n_auto] the term's parameter is the latched approach speed */
+  double* auto_vmin;  /* [n_auto] floor of the approach speed */
+  int* root_to_auto;  /* [n_roots] pair of a root, -1 if the root is not a simple pair's */
+  int auto_nq, auto_m, auto_track, auto_accel, auto_force0;
+  int storm_events;   /* a separation completing this many switches within storm_window... */
+  double storm_window; /* ...is left to Python (held pairs) */
+  double* recent;     /* [n_auto * storm_events] ring of switch times */
+  int* recent_n;      /* [n_auto] */
+  double* auto_buf;   /* scratch, 4 * (auto_nq + auto_m + 2) */
+  int ev_cap, ev_n;   /* events recorded in C, taken by dc_take_events */
+  double* ev_t;
+  int* ev_pair;
+  int* ev_kind;       /* +1 onset, -1 separation */
+  double* ev_speed;
+  double* ev_y;       /* [ev_cap * n] state at the event */
 } dc_session;
 
 static void set_msg(char* buf, const char* fmt, ...) {
@@ -357,6 +377,20 @@ DC_API void dc_free(void* sp) {
   free(s->rootsfound);
   free(s->tmp_r);
   free(s->tmp_J);
+  free(s->auto_root);
+  free(s->auto_term);
+  free(s->auto_rate);
+  free(s->auto_needs);
+  free(s->auto_vmin);
+  free(s->root_to_auto);
+  free(s->recent);
+  free(s->recent_n);
+  free(s->auto_buf);
+  free(s->ev_t);
+  free(s->ev_pair);
+  free(s->ev_kind);
+  free(s->ev_speed);
+  free(s->ev_y);
   free(s);
 }
 
@@ -564,6 +598,195 @@ static void copy_state(dc_session* s, double* y_out, double* yp_out) {
   memcpy(yp_out, N_VGetArrayPointer(s->yp), sizeof(double) * (size_t)s->n);
 }
 
+/* ------------------------------------------------------------------ events handled in C
+ * Simple contact pairs (one root function, one term; index-1 layout y = [q, v, lam(, W)]) can
+ * switch without returning to Python: at a root the C loop flips the pair's term, latches the
+ * approach speed (floored), recomputes the multipliers and derivatives with the generated
+ * functions (extras: term forces and the accelerations' Schur-complement solve), restarts IDA
+ * and records the event for Python, which replays it through the same pair logic afterwards.
+ * Anything else (a root of another element, an unexpected direction, a separation that would
+ * complete an event storm, a full event buffer) returns DC_ROOT as before. */
+DC_API int dc_set_auto(void* sp, int n_auto, const int* root, const int* term, const int* rate,
+                       const int* needs, const double* vmin, int nq, int m, int track_work,
+                       int accel_extra, int force_extra0, int storm_events, double storm_window,
+                       int ev_cap) {
+  dc_session* s = (dc_session*)sp;
+  if (n_auto < 0 || storm_events < 1 || ev_cap < 1) return -1;
+  s->n_auto = 0;
+  free(s->auto_root); free(s->auto_term); free(s->auto_rate); free(s->auto_needs);
+  free(s->auto_vmin); free(s->root_to_auto); free(s->recent); free(s->recent_n);
+  free(s->auto_buf); free(s->ev_t); free(s->ev_pair); free(s->ev_kind); free(s->ev_speed);
+  free(s->ev_y);
+  s->auto_root = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
+  s->auto_term = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
+  s->auto_rate = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
+  s->auto_needs = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
+  s->auto_vmin = (double*)xcalloc((size_t)n_auto + 1, sizeof(double));
+  s->root_to_auto = (int*)xcalloc((size_t)s->n_roots + 1, sizeof(int));
+  s->recent = (double*)xcalloc((size_t)(n_auto + 1) * (size_t)storm_events, sizeof(double));
+  s->recent_n = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
+  s->auto_buf = (double*)xcalloc(4 * ((size_t)nq + (size_t)m + 2), sizeof(double));
+  s->ev_t = (double*)xcalloc((size_t)ev_cap, sizeof(double));
+  s->ev_pair = (int*)xcalloc((size_t)ev_cap, sizeof(int));
+  s->ev_kind = (int*)xcalloc((size_t)ev_cap, sizeof(int));
+  s->ev_speed = (double*)xcalloc((size_t)ev_cap, sizeof(double));
+  s->ev_y = (double*)xcalloc((size_t)ev_cap * (size_t)s->n, sizeof(double));
+  if (!s->auto_root || !s->auto_term || !s->auto_rate || !s->auto_needs || !s->auto_vmin ||
+      !s->root_to_auto || !s->recent || !s->recent_n || !s->auto_buf || !s->ev_t || !s->ev_pair ||
+      !s->ev_kind || !s->ev_speed || !s->ev_y)
+    return -1;
+  for (int i = 0; i < s->n_roots; ++i) s->root_to_auto[i] = -1;
+  for (int p = 0; p < n_auto; ++p) {
+    if (root[p] < 0 || root[p] >= s->n_roots || term[p] < 0 || term[p] >= s->n_terms) return -1;
+    if (needs[p] && dc_model.n_params[term[p]] < 1) return -1;
+    s->auto_root[p] = root[p];
+    s->auto_term[p] = term[p];
+    s->auto_rate[p] = rate[p];
+    s->auto_needs[p] = needs[p];
+    s->auto_vmin[p] = vmin[p];
+    s->root_to_auto[root[p]] = p;
+  }
+  s->auto_nq = nq;
+  s->auto_m = m;
+  s->auto_track = track_work;
+  s->auto_accel = accel_extra;
+  s->auto_force0 = force_extra0;
+  s->storm_events = storm_events;
+  s->storm_window = storm_window;
+  s->ev_cap = ev_cap;
+  s->ev_n = 0;
+  s->n_auto = n_auto;
+  return 0;
+}
+
+/* Move the events recorded in C to the caller's buffers (at most cap); returns their count. */
+DC_API int dc_take_events(void* sp, int cap, double* t, int* pair, int* kind, double* speed, double* y) {
+  dc_session* s = (dc_session*)sp;
+  int k = s->ev_n < cap ? s->ev_n : cap;
+  memcpy(t, s->ev_t, sizeof(double) * (size_t)k);
+  memcpy(pair, s->ev_pair, sizeof(int) * (size_t)k);
+  memcpy(kind, s->ev_kind, sizeof(int) * (size_t)k);
+  memcpy(speed, s->ev_speed, sizeof(double) * (size_t)k);
+  memcpy(y, s->ev_y, sizeof(double) * (size_t)k * (size_t)s->n);
+  s->ev_n = 0;
+  return k;
+}
+
+DC_API void dc_get_active(void* sp, int* active, double* params) {
+  dc_session* s = (dc_session*)sp;
+  int np = 0;
+  for (int k = 0; k < s->n_terms; ++k) {
+    active[k] = s->active[k];
+    np += dc_model.n_params[k];
+  }
+  memcpy(params, s->params, sizeof(double) * (size_t)np);
+}
+
+static int storm_count(const dc_session* s, int p, double t) {
+  int c = 0;
+  const double* r = s->recent + (size_t)p * (size_t)s->storm_events;
+  for (int i = 0; i < s->recent_n[p]; ++i)
+    if (t - r[i] < s->storm_window) ++c;
+  return c;
+}
+
+static void storm_push(dc_session* s, int p, double t) {
+  double* r = s->recent + (size_t)p * (size_t)s->storm_events;
+  if (s->recent_n[p] < s->storm_events) {
+    r[s->recent_n[p]++] = t;
+  } else {
+    memmove(r, r + 1, sizeof(double) * (size_t)(s->storm_events - 1));
+    r[s->storm_events - 1] = t;
+  }
+}
+
+/* Handle the root at (t, yy) in C if every found root is a simple pair's plain switch; restart
+ * IDA consistently and return 1, or return 0 (nothing changed) for Python to handle it. */
+static int auto_handle_root(dc_session* s, double t, double t_stop) {
+  if (s->n_auto == 0) return 0;
+  int count = 0;
+  for (int i = 0; i < s->n_roots; ++i) {
+    int dir = s->rootsfound[i];
+    if (!dir) continue;
+    int p = s->root_to_auto[i];
+    if (p < 0) return 0;
+    int act = s->active[s->auto_term[p]];
+    if ((dir > 0 && act) || (dir < 0 && !act)) return 0;
+    if (dir < 0 && storm_count(s, p, t) + 1 >= s->storm_events) return 0;
+    ++count;
+  }
+  if (count == 0 || s->ev_n + count > s->ev_cap) return 0;
+  const int n = s->n, nq = s->auto_nq, m = s->auto_m;
+  double* y = N_VGetArrayPointer(s->yy);
+  double* yp = N_VGetArrayPointer(s->yp);
+  const double* q = y;
+  const double* v = y + nq;
+  double* gr = s->auto_buf;            /* [2] */
+  double* Qc = gr + 2;                 /* [nq] */
+  double* Fk = Qc + nq;                /* [nq] */
+  double* sol = Fk + nq;               /* [nq + m + 1] */
+  const int zeros2[2] = {0, 0};
+  for (int i = 0; i < s->n_roots; ++i) {
+    int dir = s->rootsfound[i];
+    if (!dir) continue;
+    int p = s->root_to_auto[i], k = s->auto_term[p];
+    const double* in_rate[2] = {q, v};
+    if (dc_eval_extra(s->auto_rate[p], 1, 2, in_rate, zeros2, gr, 2) != 0) goto eval_failed;
+    s->ev_t[s->ev_n] = t;
+    s->ev_pair[s->ev_n] = p;
+    s->ev_kind[s->ev_n] = dir > 0 ? 1 : -1;
+    s->ev_speed[s->ev_n] = gr[1];
+    memcpy(s->ev_y + (size_t)s->ev_n * (size_t)n, y, sizeof(double) * (size_t)n);
+    ++s->ev_n;
+    storm_push(s, p, t);
+    if (dir > 0) {
+      s->active[k] = 1;
+      if (s->auto_needs[p]) s->params[s->param_off[k]] = fmax(gr[1], s->auto_vmin[p]);
+    } else {
+      s->active[k] = 0;
+    }
+    s->rootdir[i] = s->active[k] ? -1 : 1;
+  }
+  /* consistent restart: keep q and v; multipliers, accelerations (and work rate) from the
+   * generated Schur-complement solve with the new set of contact forces */
+  memset(Qc, 0, sizeof(double) * (size_t)nq);
+  double tt = t;
+  for (int k = 0; k < s->n_terms; ++k) {
+    if (!s->active[k]) continue;
+    const double* in_f[4] = {&tt, q, v, s->params + s->param_off[k]};
+    int strides[4] = {0, 0, 0, 0};
+    if (dc_eval_extra(s->auto_force0 + k, 1, 4, in_f, strides, Fk, nq) != 0) goto eval_failed;
+    for (int j = 0; j < nq; ++j) Qc[j] += Fk[j];
+  }
+  const double* in_a[4] = {&tt, q, v, Qc};
+  int strides_a[4] = {0, 0, 0, 0};
+  if (dc_eval_extra(s->auto_accel, 1, 4, in_a, strides_a, sol, nq + m + 1) != 0) goto eval_failed;
+  memcpy(y + 2 * nq, sol + nq, sizeof(double) * (size_t)m);
+  memcpy(yp, v, sizeof(double) * (size_t)nq);
+  memcpy(yp + nq, sol, sizeof(double) * (size_t)nq);
+  memset(yp + 2 * nq, 0, sizeof(double) * (size_t)(n - 2 * nq));
+  if (s->auto_track) yp[n - 1] = sol[nq + m];
+  long long cur[ST_N];
+  ida_counters(s, cur);
+  for (int i = 0; i < ST_N; ++i) s->base[i] += cur[i];
+  if (IDAReInit(s->ida, t, s->yy, s->yp) < 0 || IDASetRootDirection(s->ida, s->rootdir) < 0 ||
+      IDASetStopTime(s->ida, t_stop) < 0) {
+    s->ready = 0;
+    set_msg(s->msg, "restarting IDA after a contact event at t=%.17g failed: %s", t, s->ida_msg);
+    return -1;
+  }
+  s->t_now = t;
+  s->t_rec = t;
+  s->tiny = 0;
+  s->h_prev = 0.0;
+  s->base[ST_REINITS] += 1;
+  return 1;
+eval_failed:
+  s->ready = 0;
+  set_msg(s->msg, "evaluating the generated contact functions at t=%.17g failed", t);
+  return -1;
+}
+
 /*
  * Integrate from the current time towards t_stop (hard stop) in one-step mode.
  *
@@ -752,6 +975,16 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
 
     if (flag == IDA_ROOT_RETURN) {
       IDAGetRootInfo(s->ida, s->rootsfound);
+      int handled = auto_handle_root(s, tret, t_stop);
+      if (handled < 0) {
+        *t_out = tret;
+        copy_state(s, y_out, yp_out);
+        return DC_ERR_IDA;
+      }
+      if (handled) {
+        IDAGetNumSteps(s->ida, &nst_prev); /* counters restarted with IDA */
+        continue;
+      }
       memcpy(roots_out, s->rootsfound, sizeof(int) * (size_t)s->n_roots);
       *t_out = tret;
       copy_state(s, y_out, yp_out);
