@@ -170,7 +170,7 @@ class Session(Protocol):
                params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None: ...
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True) -> Advance: ...
+                store_steps: bool = True, on_chunk: Any = None) -> Advance: ...
 
     def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
 
@@ -658,7 +658,7 @@ class CSession(_SessionBase):
         self._ready = True
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True) -> Advance:
+                store_steps: bool = True, on_chunk: Any = None) -> Advance:
         t_stop = self._check_advance(t_stop)
         n = self._n
         te = self._select_eval(t_eval, t_stop)
@@ -685,6 +685,8 @@ class CSession(_SessionBase):
                 if rc != 0:
                     break
                 # buffer full: back in Python between chunks, so Ctrl-C works here
+                if on_chunk is not None:
+                    on_chunk(self._t_out.value)
         finally:
             self._solve_time += time.perf_counter() - tic
             # also after an interrupt between chunks: the C side stopped at a valid state
@@ -972,7 +974,7 @@ class PythonSession(_SessionBase):
         self._apply_terms(act, plist)
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True) -> Advance:
+                store_steps: bool = True, on_chunk: Any = None) -> Advance:
         t_stop = self._check_advance(t_stop)
         n = self._n
         te = self._select_eval(t_eval, t_stop)

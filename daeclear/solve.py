@@ -271,9 +271,11 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 ev_yp.append(adv.eval_yp[evals])
                 ev_switch.append(np.repeat(switch[None, :], k, axis=0))
 
+        # progress between the compiled loop's buffer chunks: the steps taken are not changed
+        on_chunk = (lambda t_now: progress_line.update(t_now, len(events))) if progress else None
+        seg_start = t
         while True:
-            seg_start = t
-            adv = session.advance(t_end, pending, store_steps)
+            adv = session.advance(t_end, pending, store_steps, on_chunk=on_chunk)
             if pending is not None and adv.eval_t.size:
                 pending = pending[pending > adv.eval_t[-1]]
             # the C loop may have switched simple contact pairs itself: split the advance there
@@ -298,8 +300,9 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
                 adv.message = "internal: the compiled event loop and the pair logic disagree on the contact modes"
             t, y, yp = adv.t, adv.y, adv.yp
-            segments.append((seg_start, t, dict(modes)))
             progress_line.update(t, len(events))
+            segments.append((seg_start, t, dict(modes)))
+            seg_start = t
             if adv.status == "error":
                 success, status = False, -1
                 message = _failure_message(model, adv, modes)
