@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Callable, Literal, Sequence
+from typing import Any, Literal, Sequence
 
 import casadi as ca
 import numpy as np
@@ -221,18 +221,15 @@ class DAEModel:
         ``generalized_force`` adds contact forces to the base forces (gravity).
         """
         single = np.ndim(q) == 1
-        q2, v2 = np.atleast_2d(q), np.atleast_2d(v)
-        N, n, m = q2.shape[0], self.n_q, self.n_constraints
-        t_col = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,)).reshape(N, 1)
-        Qc = np.zeros((1, n)) if generalized_force is None else np.atleast_2d(generalized_force)
-        sol = self.evaluate(EXTRA_ACCEL, [t_col, q2, v2, Qc], N, session)
+        n, m = self.n_q, self.n_constraints
+        sol = self._accel_solution(t, np.atleast_2d(q), np.atleast_2d(v), generalized_force, session)
         a, lam = sol[:, :n], sol[:, n:n + m]
         return (a[0], lam[0]) if single else (a, lam)
 
     def _accel_solution(self, t: ArrayLike, q: NDArray, v: NDArray, generalized_force: NDArray | None,
                         session: Any) -> NDArray[np.float64]:
         """[a, lam(, work rate)] per row, from the generated Schur-complement solve."""
-        N, n = q.shape[0], self.n_q
+        N = q.shape[0]
         t_arr = np.asarray(t, dtype=float)
         t_col = t_arr.reshape(N, 1) if t_arr.size == N else np.full((N, 1), float(t_arr.ravel()[0]))
         Qc = self._zero_force if generalized_force is None else generalized_force

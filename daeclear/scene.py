@@ -20,9 +20,8 @@ from __future__ import annotations
 import difflib
 import math
 from dataclasses import dataclass, field, fields
-from typing import Any, Iterator, Sequence, Union
+from typing import Any, Iterator, Union
 
-from .contact.geometry import Material
 from .errors import SceneError
 
 GROUND = "ground"

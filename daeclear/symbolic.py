@@ -7,7 +7,7 @@ element builders. Nothing here knows a particular joint.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Sequence
 
 import casadi as ca

@@ -44,7 +44,7 @@ def generalized_inertia(theta):
 
 def potential_slope(theta, g):
     """dV/dtheta for gravity g along -Y (crank and rod centres of mass rise with theta)."""
-    s, c = np.sin(theta), np.cos(theta)
+    c = np.cos(theta)
     # y_crank = R s / 2, y_rod = R s / 2 (mid-point between B at R s and C at 0)
     return g * (CRANK_MASS * R * c / 2 + ROD_MASS * R * c / 2)
 
