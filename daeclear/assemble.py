@@ -582,13 +582,12 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     extras = [outputs, accel] + [term.force for term in terms]
     # simple contact pairs whose switches the compiled loop may handle itself (see ida_driver.c)
     auto_pairs = []
-    if formulation == "index1" and contacts and all(type(logic).__name__ == "PairLogic" for logic in contacts):
-        qs, vs = ca.SX.sym("q", n), ca.SX.sym("v", n)
-        for logic in contacts:
-            gap_k, rate_k = logic.rate.function(qs, vs)
-            extras.append(ca.Function(f"{_c_identifier(logic.pair)}_gap_rate", [qs, vs], [ca.vertcat(gap_k, rate_k)]))
-            auto_pairs.append((logic.root_index, logic.term_index, len(extras) - 1, bool(logic.needs_approach),
-                               float(logic.min_approach_speed)))
+    simple = [getattr(logic, "simple_pairs", lambda: None)() for logic in contacts]
+    if formulation == "index1" and contacts and all(pairs is not None for pairs in simple):
+        for pairs in simple:
+            for root, term_index, gap_rate, needs, floor in pairs:
+                extras.append(gap_rate)
+                auto_pairs.append((root, term_index, len(extras) - 1, needs, floor))
     functions = DAEFunctions(
         n=n_y, residual=residual, jacobian=jacobian, term_residuals=tuple(term_res),
         term_jacobians=tuple(term_jac), roots=roots, name=_c_identifier(scene.name), extras=tuple(extras),

@@ -122,6 +122,15 @@ class PairLogic:
     def _count(self, t: float) -> None:
         self.recent = [s for s in self.recent if t - s < STORM_WINDOW] + [t]
 
+    def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]]:
+        """(root, term, (q, v) -> [gap; rate], needs approach speed, floor): the switches the
+        compiled IDA loop may make itself, with exactly this class's rules (see ida_driver.c)."""
+        q = ca.SX.sym("q", self.n_q)
+        v = ca.SX.sym("v", self.n_q)
+        gap, rate = self.rate.function(q, v)
+        f = ca.Function(f"{self.pair.replace('.', '_')}_gap_rate", [q, v], [ca.vertcat(gap, rate)])
+        return [(self.root_index, self.term_index, f, bool(self.needs_approach), float(self.min_approach_speed))]
+
 
 @dataclass(frozen=True)
 class ContactBuild:

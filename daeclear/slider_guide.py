@@ -248,6 +248,24 @@ class SliderGuideLogic:
     def _count(self, i: int, t: float) -> None:
         self.recent[i] = [s for s in self.recent[i] if t - s < STORM_WINDOW] + [t]
 
+    def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
+        """Without faces (model ``corners``) every corner pair switches by PairLogic's rules, so
+        the compiled IDA loop may switch it itself; with faces the terms depend on two corners."""
+        if self.face_names:
+            return None
+        fn = getattr(self.rate, "function", None)
+        if fn is None:
+            return None
+        q = ca.SX.sym("q", self.n_q)
+        v = ca.SX.sym("v", self.n_q)
+        gaps, rates = fn(q, v)
+        out = []
+        for i, pair in enumerate(self.pairs):
+            f = ca.Function(f"{pair.replace('.', '_')}_gap_rate", [q, v], [ca.vertcat(gaps[i], rates[i])])
+            out.append((self.first_root + i, self.corner_terms[i], f, bool(self.needs_approach),
+                        float(self.min_approach_speed)))
+        return out
+
 
 def _points(ctx: AssemblyContext, joint: TranslationalClearance) -> tuple[NDArray, NDArray]:
     if joint.at is not None:

@@ -234,3 +234,24 @@ def test_compiled_event_loop_matches_python_event_handling():
     assert [m for *_, m in fast.segments] == [m for *_, m in slow.segments]
     for name in ("drive.moment", "clearance.normal_force", "slider.ax"):
         np.testing.assert_allclose(fast[name], slow[name], rtol=1e-9, atol=1e-9 * np.max(np.abs(slow[name])))
+
+
+def test_compiled_events_with_tiny_step_buffers(monkeypatch):
+    """Chunk boundaries of the C loop's step buffer falling on contact events (buffers of 3 steps)
+    change nothing: same steps, same events (a regression test for a buffer overrun)."""
+    import functools
+
+    import daeclear.solve as solve_module
+    from daeclear.ida_session import open_session
+
+    for scene in (dc.mechanisms.slider_crank("revolute", gravity=0.0), dc.mechanisms.slider_crank("translational")):
+        model = dc.assemble(scene)
+        assert model.auto_pairs  # the compiled loop switches these pairs itself
+        normal = dc.simulate(model, 0.006, rtol=1e-8)
+        monkeypatch.setattr(solve_module, "open_session", functools.partial(open_session, buffer_steps=3))
+        chunked = dc.simulate(model, 0.006, rtol=1e-8)
+        monkeypatch.undo()
+        assert chunked.stats["n_steps"] == normal.stats["n_steps"]
+        assert chunked.events.kind == normal.events.kind and len(normal.events) > 5
+        np.testing.assert_array_equal(chunked.events.t, normal.events.t)
+        np.testing.assert_array_equal(chunked.t, normal.t)

@@ -710,6 +710,7 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
     if (!dir) continue;
     int p = s->root_to_auto[i];
     if (p < 0) return 0;
+    if (s->rootdir[i] == 0) return 0; /* a held pair (storm guard) watches both ways: Python's */
     int act = s->active[s->auto_term[p]];
     if ((dir > 0 && act) || (dir < 0 && !act)) return 0;
     if (dir < 0 && storm_count(s, p, t) + 1 >= s->storm_events) return 0;
@@ -983,6 +984,11 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
       }
       if (handled) {
         IDAGetNumSteps(s->ida, &nst_prev); /* counters restarted with IDA */
+        if ((store_steps && k >= cap) || (!store_steps && calls >= cap)) { /* buffer full */
+          *t_out = tret;
+          copy_state(s, y_out, yp_out);
+          return DC_CHUNK;
+        }
         continue;
       }
       memcpy(roots_out, s->rootsfound, sizeof(int) * (size_t)s->n_roots);
