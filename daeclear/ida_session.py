@@ -437,6 +437,8 @@ class _CLib:
         lib.dc_set_auto.argtypes = [P, I, P, P, P, P, P, I, I, I, I, I, I, D, I]
         lib.dc_take_events.restype = I
         lib.dc_take_events.argtypes = [P, I, P, P, P, P, P]
+        lib.dc_pending_events.restype = I
+        lib.dc_pending_events.argtypes = [P]
         lib.dc_get_active.restype = None
         lib.dc_get_active.argtypes = [P, P, P]
         lib.dc_set_stall.restype = I
@@ -685,8 +687,8 @@ class CSession(_SessionBase):
                 if rc != 0:
                     break
                 # buffer full: back in Python between chunks, so Ctrl-C works here
-                if on_chunk is not None:
-                    on_chunk(self._t_out.value)
+                if on_chunk is not None:  # time reached, and contact switches made in C so far
+                    on_chunk(self._t_out.value, self._lib.dc_pending_events(h))
         finally:
             self._solve_time += time.perf_counter() - tic
             # also after an interrupt between chunks: the C side stopped at a valid state

@@ -272,7 +272,8 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 ev_switch.append(np.repeat(switch[None, :], k, axis=0))
 
         # progress between the compiled loop's buffer chunks: the steps taken are not changed
-        on_chunk = (lambda t_now: progress_line.update(t_now, len(events))) if progress else None
+        on_chunk = ((lambda t_now, in_c=0: progress_line.update(t_now, len(events) + in_c)) if progress
+                    else None)
         seg_start = t
         while True:
             adv = session.advance(t_end, pending, store_steps, on_chunk=on_chunk)

@@ -672,6 +672,8 @@ DC_API int dc_take_events(void* sp, int cap, double* t, int* pair, int* kind, do
   return k;
 }
 
+DC_API int dc_pending_events(void* sp) { return ((dc_session*)sp)->ev_n; }
+
 DC_API void dc_get_active(void* sp, int* active, double* params) {
   dc_session* s = (dc_session*)sp;
   int np = 0;
