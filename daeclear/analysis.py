@@ -45,6 +45,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from .accuracy import energy_balance, work_precision  # re-exported: daeclear.analysis.work_precision
 from .assemble import DAEModel
 from .errors import DaeclearError, SceneError
 
@@ -63,6 +64,8 @@ __all__ = [
     "classify_motion",
     "classify_section",
     "crank_period",
+    "energy_balance",
+    "work_precision",
     "phase_portrait",
     "poincare_section",
     "restart_model",

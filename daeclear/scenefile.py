@@ -29,6 +29,20 @@ A scene file (tables map key for key onto the Python classes)::
     body_j = "link"
     at = [0.0, 0.0]
 
+Clearance joints (tables ``[[revolute_clearance]]`` and ``[[translational_clearance]]``) take
+their materials and laws as tables::
+
+    [[revolute_clearance]]
+    name = "clearance"
+    body_i = "slider"
+    body_j = "rod"
+    at = [0.17, 0.0]
+    bearing_radius = 0.01
+    clearance = 0.5e-3
+    material = { young = 207e9, poisson = 0.3 }
+    law = { name = "lankarani-nikravesh", restitution = 0.9 }
+    friction = 0.05          # or "coulomb", or { name = "modified-coulomb", coefficient = 0.1 }
+
 Unknown tables or keys are errors that name the file, the table and the key.
 """
 
@@ -41,11 +55,13 @@ from typing import Any, Callable
 
 from . import mechanisms
 from .errors import SceneError
-from .scene import Body, Driver, Revolute, Scene, Translational
+from .contact import Material, friction_law, normal_law
+from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
 
 MECHANISMS: dict[str, Callable[..., Scene]] = {"slider_crank": mechanisms.slider_crank}
 ELEMENT_TABLES: dict[str, type] = {
     "body": Body, "revolute": Revolute, "translational": Translational, "driver": Driver,
+    "revolute_clearance": RevoluteClearance, "translational_clearance": TranslationalClearance,
 }
 SIMULATE_KEYS = ("t_end", "rtol", "atol", "formulation", "method", "backend", "max_step", "t_eval_step")
 
@@ -59,6 +75,30 @@ class SceneFile:
     source: dict[str, Any]
 
 
+def _law(value: Any, build: Any) -> Any:
+    """A law given as a name, a number (friction coefficient) or a table {name = ..., parameters}."""
+    if isinstance(value, dict):
+        params = dict(value)
+        return build(params.pop("name", None), **params)
+    return value
+
+
+def _contact_fields(entry: dict[str, Any]) -> dict[str, Any]:
+    """Clearance joints: material tables -> Material, law tables -> law objects."""
+    out = dict(entry)
+    material = out.get("material")
+    if isinstance(material, dict):
+        out["material"] = Material(**material)
+    elif isinstance(material, list):
+        out["material"] = tuple(Material(**m) for m in material)
+    for key in ("law", "face_law"):
+        if key in out:
+            out[key] = _law(out[key], normal_law)
+    if isinstance(out.get("friction"), dict):
+        out["friction"] = _law(out["friction"], friction_law)
+    return out
+
+
 def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any]) -> Any:
     allowed = [f.name for f in dataclasses.fields(cls)]
     unknown = sorted(set(entry) - set(allowed))
@@ -66,8 +106,10 @@ def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any
         raise SceneError(f"{path}: [[{table}]] #{index + 1}: unknown key(s) {', '.join(unknown)}; "
                          f"allowed: {', '.join(allowed)}.")
     try:
+        if cls in (RevoluteClearance, TranslationalClearance):
+            entry = _contact_fields(entry)
         return cls(**entry)
-    except TypeError as exc:
+    except (TypeError, SceneError) as exc:
         raise SceneError(f"{path}: [[{table}]] #{index + 1}: {exc}") from None
 
 

@@ -212,6 +212,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
          store_steps: bool, on_failure: str, progress: bool, setup_time: float,
          sim_params: dict[str, Any]) -> Result:
     """The segment loop: advance, handle roots, restart; always returns what was computed."""
+    run_start = time.perf_counter()
     progress_line = _Progress(progress, t_end)
     n_terms = len(model.terms)
     active = [False] * n_terms
@@ -353,6 +354,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     finally:
         session.close()
     stats.update(n_events=len(events), n_restarts=n_restarts, setup_time=setup_time,
+                 wall_time=setup_time + time.perf_counter() - run_start,
                  output_time=time.perf_counter() - post_start)
     result = Result(
         t=out_t, y=out_y, yp=out_yp, state_names=list(model.state_names),

@@ -36,9 +36,9 @@ import multiprocessing
 import os
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -58,8 +58,14 @@ GRAVITY = 9.81  # m/s^2 along -Y (slider_crank's default), stated in every summa
 PAIR = "clearance"  # name of the revolute clearance joint in slider_crank("revolute")
 
 
-def parse_args(script: str, description: str, argv: Sequence[str] | None = None) -> argparse.Namespace:
-    """Common options: ``--quick``, ``--out``, ``--transient``, ``--revolutions``, ``--dt``, ``--rtol``, ``--jobs``."""
+def parse_args(script: str, description: str, argv: Sequence[str] | None = None, *,
+               revolutions: int = DEFAULT_REVOLUTIONS, window_text: str = "figures",
+               jobs: bool = True) -> argparse.Namespace:
+    """Common options: ``--quick``, ``--out``, ``--transient``, ``--revolutions``, ``--dt``, ``--rtol``, ``--jobs``.
+
+    ``revolutions`` is the default of ``--revolutions``, ``window_text`` what shows the last two
+    revolutions (help text), ``jobs=False`` leaves ``--jobs`` out (the cases then run one by one).
+    """
     name = Path(script).stem
     parser = argparse.ArgumentParser(prog=Path(script).name, description=description)
     parser.add_argument("--quick", action="store_true",
@@ -68,14 +74,15 @@ def parse_args(script: str, description: str, argv: Sequence[str] | None = None)
                         help=f"output directory (default results/{name}/)")
     parser.add_argument("--transient", type=int, default=DEFAULT_TRANSIENT,
                         help=f"crank revolutions simulated and discarded (default {DEFAULT_TRANSIENT})")
-    parser.add_argument("--revolutions", type=int, default=DEFAULT_REVOLUTIONS,
-                        help=f"revolutions analysed after the transient, >= 2 (default {DEFAULT_REVOLUTIONS}); "
-                             "figures show the last two")
+    parser.add_argument("--revolutions", type=int, default=revolutions,
+                        help=f"revolutions analysed after the transient, >= 2 (default {revolutions}); "
+                             f"{window_text} show the last two")
     parser.add_argument("--dt", type=float, default=DEFAULT_DT,
                         help=f"spacing of the dense output, s (default {DEFAULT_DT:g})")
     parser.add_argument("--rtol", type=float, default=RTOL, help=f"IDA relative tolerance (default {RTOL:g})")
-    parser.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1),
-                        help="cases run at once, one process each (default: 2, or 1 on a one-core machine)")
+    if jobs:
+        parser.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1),
+                            help="cases run at once, one process each (default: 2, or 1 on a one-core machine)")
     args = parser.parse_args(argv)
     if args.transient < 0 or args.revolutions < WINDOW_REVOLUTIONS:
         parser.error(f"--transient must be >= 0 and --revolutions >= {WINDOW_REVOLUTIONS}.")
@@ -98,6 +105,7 @@ class Span:
     t_eval: np.ndarray
     revolution_times: np.ndarray  # Poincaré section times (crank angle 0), empty with --quick
     quick: bool
+    window_label: str = "figures"  # what shows the window, in describe()
 
     def describe(self) -> str:
         if self.quick:
@@ -105,16 +113,16 @@ class Span:
         n_trans = round(self.analysed[0] / PERIOD)
         n_rev = round((self.analysed[1] - self.analysed[0]) / PERIOD)
         return (f"{n_trans} revolutions of transient discarded, {n_rev} analysed "
-                f"({self.analysed[0]:.3f} to {self.analysed[1]:.3f} s), figures over the last two "
+                f"({self.analysed[0]:.3f} to {self.analysed[1]:.3f} s), {self.window_label} over the last two "
                 f"({self.window[0]:.3f} to {self.window[1]:.3f} s)")
 
 
-def make_span(args: argparse.Namespace) -> Span:
+def make_span(args: argparse.Namespace, *, window_label: str = "figures") -> Span:
     """The time span of a run from the parsed options (see the module docstring)."""
     if args.quick:
         n = int(round(QUICK_SPAN / args.dt))
         t_eval = np.linspace(0.0, QUICK_SPAN, n + 1)
-        return Span(QUICK_SPAN, (0.0, QUICK_SPAN), (0.0, QUICK_SPAN), t_eval, np.zeros(0), True)
+        return Span(QUICK_SPAN, (0.0, QUICK_SPAN), (0.0, QUICK_SPAN), t_eval, np.zeros(0), True, window_label)
     t0 = args.transient * PERIOD
     t_end = (args.transient + args.revolutions) * PERIOD
     per_rev = int(round(PERIOD / args.dt))
@@ -122,7 +130,7 @@ def make_span(args: argparse.Namespace) -> Span:
     t_eval = t0 + PERIOD * k / per_rev  # revolution boundaries fall exactly on output points
     t_eval[-1] = t_end
     return Span(t_end, (t0, t_end), (t_end - WINDOW_REVOLUTIONS * PERIOD, t_end), t_eval,
-                t_eval[::per_rev].copy(), False)
+                t_eval[::per_rev].copy(), False, window_label)
 
 
 def _window(result: dc.Result, window: tuple[float, float]) -> dc.Result:
@@ -158,43 +166,59 @@ class Case:
                 f"{self.n_steps} IDA steps (IDA solve {self.solve_time:.3f} s)")
 
 
-def run_case(label: str, scene: dc.Scene, span: Span, args: argparse.Namespace, *, verbose: bool = True) -> Case:
-    """Assemble ``scene`` once, simulate it twice (dense output, per-step output) and cut the windows."""
+Progress = Callable[[Case, float], str]  # (case, t_end) -> progress line
+
+
+def run_case(label: str, scene: dc.Scene, span: Span, args: argparse.Namespace, *, verbose: bool = True,
+             check_events: bool = True, impact_pair: str | None = None, progress: Progress | None = None) -> Case:
+    """Assemble ``scene`` once, simulate it twice (dense output, per-step output) and cut the windows.
+
+    ``check_events``: warn if the two runs found different events; ``impact_pair``: the pair whose
+    onsets ``Case.n_impacts`` counts (None: every pair); ``progress``: the printed line
+    (default :meth:`Case.progress_line`).
+    """
     start = time.perf_counter()
     model = dc.assemble(scene)
     dense = dc.simulate(model, span.t_end, t_eval=span.t_eval, rtol=args.rtol)
     per_step = dc.simulate(model, span.t_end, rtol=args.rtol)
-    if len(dense.events) != len(per_step.events) or not np.array_equal(dense.events.t, per_step.events.t):
+    if check_events and len(dense.events) != len(per_step.events) or not np.array_equal(dense.events.t, per_step.events.t):
         warnings.warn(f"{label}: the dense and per-step runs found different events "
                       f"({len(dense.events)} and {len(per_step.events)}); the orbit figure may not match.",
                       stacklevel=2)
     dense = _window(dense, span.analysed)  # t_eval starts there, but the events of the transient are kept
     steps = _window(per_step, span.analysed)
     case = Case(label, dense, _window(dense, span.window), steps, _window(steps, span.window),
-                time.perf_counter() - start, len(per_step.events.of(kind="onset")),
+                time.perf_counter() - start, len(per_step.events.of(impact_pair, "onset")),
                 int(per_step.stats.get("n_steps", len(per_step.step_t))),
                 float(per_step.stats.get("solve_time", float("nan"))))
     if verbose:
-        print(case.progress_line(span.t_end), flush=True)
+        print(_progress_line(case, span.t_end, progress), flush=True)
     return case
 
 
-def run_cases(scenes: Mapping[str, dc.Scene], span: Span, args: argparse.Namespace) -> list[Case]:
-    """:func:`run_case` for every ``label -> scene``, on ``args.jobs`` processes; in the given order."""
+def _progress_line(case: Case, t_end: float, progress: Progress | None) -> str:
+    return case.progress_line(t_end) if progress is None else progress(case, t_end)
+
+
+def run_cases(scenes: Mapping[str, dc.Scene], span: Span, args: argparse.Namespace, **run_kwargs: Any) -> list[Case]:
+    """:func:`run_case` for every ``label -> scene``, on ``args.jobs`` processes; in the given order.
+
+    ``run_kwargs``: keyword arguments of :func:`run_case` (``check_events``, ``impact_pair``, ``progress``).
+    """
     jobs = max(1, min(int(getattr(args, "jobs", 1)), len(scenes)))
     if jobs == 1:
-        return [run_case(label, scene, span, args) for label, scene in scenes.items()]
+        return [run_case(label, scene, span, args, **run_kwargs) for label, scene in scenes.items()]
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     # fork: the workers inherit the imported modules (this file is not an installed module)
     context = multiprocessing.get_context("fork")
     done: dict[str, Case] = {}
     with ProcessPoolExecutor(jobs, mp_context=context) as pool:
-        futures = {pool.submit(run_case, label, scene, span, args, verbose=False): label
+        futures = {pool.submit(run_case, label, scene, span, args, **{**run_kwargs, "verbose": False}): label
                    for label, scene in scenes.items()}
         for future in as_completed(futures):
             case = future.result()
-            print(case.progress_line(span.t_end), flush=True)
+            print(_progress_line(case, span.t_end, run_kwargs.get("progress")), flush=True)
             done[futures[future]] = case
     return [done[label] for label in scenes]
 
@@ -232,9 +256,9 @@ def ideal_scene() -> dc.Scene:
     return slider_crank("ideal", gravity=GRAVITY, rpm=RPM)
 
 
-def run_ideal(span: Span, args: argparse.Namespace, *, verbose: bool = True) -> Case:
+def run_ideal(span: Span, args: argparse.Namespace, *, verbose: bool = True, **run_kwargs: Any) -> Case:
     """The ideal-joint slider-crank over the same span (comparison curves)."""
-    return run_case("ideal joint", ideal_scene(), span, args, verbose=verbose)
+    return run_case("ideal joint", ideal_scene(), span, args, verbose=verbose, **run_kwargs)
 
 
 # --------------------------------------------------------------------------- measures
@@ -441,15 +465,24 @@ def markdown_table(rows: Sequence[Mapping[str, Any]], columns: Sequence[tuple[st
     return "\n".join(lines)
 
 
-def write_metrics(rows: Sequence[Mapping[str, Any]], out: Path, span: Span, header: str, rtol: float = RTOL) -> None:
-    """Write ``metrics.json`` and ``metrics.md`` and print the summary tables."""
+# tables of metrics.md: (title, columns, also with --quick)
+Section = tuple[str, Sequence[tuple[str, str, str]], bool]
+SECTIONS: tuple[Section, ...] = (
+    ("Last two revolutions:", SUMMARY_COLUMNS, True),
+    ("Whole analysed span:", SPAN_COLUMNS, False),
+    ("IDA step sizes by phase (impact: first 0.1 ms of a contact):", STEP_COLUMNS, True),
+)
+
+
+def write_metrics(rows: Sequence[Mapping[str, Any]], out: Path, span: Span, header: str, rtol: float = RTOL, *,
+                  sections: Sequence[Section] = SECTIONS) -> None:
+    """Write ``metrics.json`` and ``metrics.md`` (one table per section) and print the summary tables."""
     meta = {"span": span.describe(), "rtol": rtol, "gravity_m_s2": GRAVITY, "rpm": RPM}
     (out / "metrics.json").write_text(json.dumps({"about": header, **meta, "cases": list(rows)}, indent=1))
-    text = [f"# {header}", "", span.describe() + f"; rtol {rtol:g}, gravity {GRAVITY} m/s², {RPM:g} rpm.", "",
-            "Last two revolutions:", "", markdown_table(rows, SUMMARY_COLUMNS)]
-    if not span.quick:
-        text += ["", "Whole analysed span:", "", markdown_table(rows, SPAN_COLUMNS)]
-    text += ["", "IDA step sizes by phase (impact: first 0.1 ms of a contact):", "", markdown_table(rows, STEP_COLUMNS)]
+    text = [f"# {header}", "", span.describe() + f"; rtol {rtol:g}, gravity {GRAVITY} m/s², {RPM:g} rpm."]
+    for title, columns, with_quick in sections:
+        if with_quick or not span.quick:
+            text += ["", title, "", markdown_table(rows, columns)]
     (out / "metrics.md").write_text("\n".join(text) + "\n")
     print("\n".join(text[2:]))
 
@@ -471,26 +504,33 @@ class Study:
     ideal: Case
     cases: list[Case]
     rows: list[dict[str, Any]]
-    files: dict[str, str]  # case label -> HDF5 file stem
+    files: dict[str, str] = field(default_factory=dict)  # case label -> HDF5 file stem
 
 
-def run_study(header: str, scenes: Mapping[str, tuple[str, dc.Scene]], args: argparse.Namespace) -> Study:
-    """Run the ideal joint and every case ``label -> (file stem, scene)``, print progress, measure them."""
-    span = make_span(args)
+def run_study(header: str, scenes: Mapping[str, tuple[str, dc.Scene]], args: argparse.Namespace, *,
+              span: Span | None = None, measure_case: Callable[[Case, Case, Span], dict[str, Any]] | None = None,
+              **run_kwargs: Any) -> Study:
+    """Run the ideal joint and every case ``label -> (file stem, scene)``, print progress, measure them.
+
+    ``span`` defaults to ``make_span(args)``, ``measure_case`` to :func:`measure`; ``run_kwargs`` go
+    to :func:`run_case`.
+    """
+    span = make_span(args) if span is None else span
+    measure_case = measure if measure_case is None else measure_case
     print(f"{header}\n{span.describe()}; rtol {args.rtol:g}, gravity {GRAVITY} m/s^2, {RPM:g} rpm", flush=True)
     all_cases = run_cases({"ideal joint": ideal_scene(), **{label: scene for label, (_, scene) in scenes.items()}},
-                          span, args)
+                          span, args, **run_kwargs)
     ideal, cases = all_cases[0], all_cases[1:]
-    rows = [measure(case, ideal, span) for case in cases]
+    rows = [measure_case(case, ideal, span) for case in cases]
     return Study(header, span, ideal, cases, rows, {label: stem for label, (stem, _) in scenes.items()})
 
 
-def save_study(study: Study, out: Path, rtol: float) -> None:
+def save_study(study: Study, out: Path, rtol: float, *, sections: Sequence[Section] = SECTIONS) -> None:
     """HDF5 of every case and of the ideal joint over the plotted window, and the metrics."""
     for case in study.cases:
         save_result(case.window, out, study.files[case.label])
     save_result(study.ideal.window, out, "ideal")
-    write_metrics(study.rows, out, study.span, study.header, rtol)
+    write_metrics(study.rows, out, study.span, study.header, rtol, sections=sections)
 
 
 def channel_figure(study: Study, channel: str, title: str, *, reference: bool = True) -> Any:

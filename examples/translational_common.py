@@ -27,130 +27,55 @@ every IDA step (contact forces and penetrations at their peaks: a face impact of
 from __future__ import annotations
 
 import argparse
-import json
-import math
-import time
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+import _common
 import daeclear as dc
+from _common import (  # noqa: F401  (re-exported: the translational scripts use them as tc.*)
+    DEFAULT_DT, DEFAULT_TRANSIENT, GRAVITY, PERIOD, QUICK_SPAN, RPM, RTOL, WINDOW_REVOLUTIONS, Case, Span, Study,
+    distinct_points, markdown_table, poincare_points, print_written, save_figure, save_result,
+)
 from daeclear.mechanisms import slider_crank
 
-RPM = 5000.0
-PERIOD = 60.0 / RPM  # s per crank revolution
-DEFAULT_TRANSIENT = 4
-DEFAULT_REVOLUTIONS = 10
-WINDOW_REVOLUTIONS = 2  # as in the chapter
-DEFAULT_DT = 5e-6  # s
-QUICK_SPAN = 0.005  # s
-RTOL = 1e-6  # Table 4.3's "integration tolerance"
-GRAVITY = 9.81  # m/s^2 along -Y
+DEFAULT_REVOLUTIONS = 10  # revolutions analysed after the transient (section 4.4's examples: 20)
+WINDOW_LABEL = "time histories"  # what shows the last two revolutions (Span.describe, --help)
 JOINT = "clearance"  # name of the translational clearance joint in slider_crank("translational")
 PAIRS = ("A_upper", "B_upper", "C_lower", "D_lower")
+
+_cut = _common._window
 
 
 def parse_args(script: str, description: str, argv: Sequence[str] | None = None) -> argparse.Namespace:
     """Common options: ``--quick``, ``--out``, ``--transient``, ``--revolutions``, ``--dt``, ``--rtol``."""
-    name = Path(script).stem
-    parser = argparse.ArgumentParser(prog=Path(script).name, description=description)
-    parser.add_argument("--quick", action="store_true",
-                        help=f"simulate only {QUICK_SPAN * 1e3:g} ms from t = 0 (smoke test)")
-    parser.add_argument("--out", type=Path, default=Path("results") / name,
-                        help=f"output directory (default results/{name}/)")
-    parser.add_argument("--transient", type=int, default=DEFAULT_TRANSIENT,
-                        help=f"crank revolutions simulated and discarded (default {DEFAULT_TRANSIENT})")
-    parser.add_argument("--revolutions", type=int, default=DEFAULT_REVOLUTIONS,
-                        help=f"revolutions analysed after the transient, >= 2 (default {DEFAULT_REVOLUTIONS}); "
-                             "time histories show the last two")
-    parser.add_argument("--dt", type=float, default=DEFAULT_DT,
-                        help=f"spacing of the dense output, s (default {DEFAULT_DT:g})")
-    parser.add_argument("--rtol", type=float, default=RTOL, help=f"IDA relative tolerance (default {RTOL:g})")
-    args = parser.parse_args(argv)
-    if args.transient < 0 or args.revolutions < WINDOW_REVOLUTIONS:
-        parser.error(f"--transient must be >= 0 and --revolutions >= {WINDOW_REVOLUTIONS}.")
-    if not 0 < args.dt <= PERIOD / 100:
-        parser.error(f"--dt must be in (0, {PERIOD / 100:g}] s.")
-    args.out.mkdir(parents=True, exist_ok=True)
-    return args
-
-
-@dataclass(frozen=True)
-class Span:
-    """Where a run ends, which part is analysed and which part is plotted (s)."""
-
-    t_end: float
-    analysed: tuple[float, float]
-    window: tuple[float, float]
-    t_eval: np.ndarray
-    revolution_times: np.ndarray  # Poincaré section times (crank angle 0); empty with --quick
-    quick: bool
-
-    def describe(self) -> str:
-        if self.quick:
-            return f"quick run: 0 to {self.t_end * 1e3:g} ms, no transient removed"
-        n_trans = round(self.analysed[0] / PERIOD)
-        n_rev = round((self.analysed[1] - self.analysed[0]) / PERIOD)
-        return (f"{n_trans} revolutions of transient discarded, {n_rev} analysed "
-                f"({self.analysed[0]:.3f} to {self.analysed[1]:.3f} s), time histories over the last two "
-                f"({self.window[0]:.3f} to {self.window[1]:.3f} s)")
+    return _common.parse_args(script, description, argv, revolutions=DEFAULT_REVOLUTIONS, window_text=WINDOW_LABEL,
+                              jobs=False)
 
 
 def make_span(args: argparse.Namespace) -> Span:
     """The time span of a run from the parsed options (see the module docstring)."""
-    if args.quick:
-        n = int(round(QUICK_SPAN / args.dt))
-        return Span(QUICK_SPAN, (0.0, QUICK_SPAN), (0.0, QUICK_SPAN), np.linspace(0.0, QUICK_SPAN, n + 1),
-                    np.zeros(0), True)
-    t0 = args.transient * PERIOD
-    t_end = (args.transient + args.revolutions) * PERIOD
-    per_rev = int(round(PERIOD / args.dt))
-    t_eval = t0 + PERIOD * np.arange(args.revolutions * per_rev + 1) / per_rev
-    t_eval[-1] = t_end
-    return Span(t_end, (t0, t_end), (t_end - WINDOW_REVOLUTIONS * PERIOD, t_end), t_eval,
-                t_eval[::per_rev].copy(), False)
+    return _common.make_span(args, window_label=WINDOW_LABEL)
 
 
-def _cut(result: dc.Result, window: tuple[float, float]) -> dc.Result:
-    pad = 1e-9 * PERIOD
-    return result.slice(window[0] - pad, window[1] + pad)
+def _progress_line(case: Case, t_end: float) -> str:
+    return (f"  {case.label:<34s} {case.wall_time:6.2f} s   {case.n_impacts:5d} onsets over 0-{t_end:.3f} s, "
+            f"{case.n_steps} IDA steps (IDA solve {case.solve_time:.3f} s)")
 
 
-@dataclass
-class Case:
-    """One simulated case: dense output (``dense``, ``window``) and per-step output (``steps``...)."""
-
-    label: str
-    dense: dc.Result
-    window: dc.Result
-    steps: dc.Result
-    steps_window: dc.Result
-    wall_time: float
+# run_case keywords of the section 4.5 examples: onsets of the clearance joint, no event check
+RUN_KWARGS: dict[str, Any] = {"check_events": False, "impact_pair": JOINT, "progress": _progress_line}
 
 
 def run_case(label: str, scene: dc.Scene, span: Span, args: argparse.Namespace, *, verbose: bool = True) -> Case:
     """Assemble ``scene`` once, simulate it with dense and with per-step output, cut the windows."""
-    start = time.perf_counter()
-    model = dc.assemble(scene)
-    dense = dc.simulate(model, span.t_end, t_eval=span.t_eval, rtol=args.rtol)
-    per_step = dc.simulate(model, span.t_end, rtol=args.rtol)
-    steps = _cut(per_step, span.analysed)
-    dense = _cut(dense, span.analysed)
-    case = Case(label, dense, _cut(dense, span.window), steps, _cut(steps, span.window),
-                time.perf_counter() - start)
-    if verbose:
-        onsets = per_step.events.of(JOINT, "onset")
-        print(f"  {label:<34s} {case.wall_time:6.2f} s   {len(onsets):5d} onsets over 0-{span.t_end:.3f} s, "
-              f"{per_step.stats.get('n_steps', 0)} IDA steps (IDA solve {per_step.stats.get('solve_time', 0.0):.3f} s)",
-              flush=True)
-    return case
+    return _common.run_case(label, scene, span, args, verbose=verbose, **RUN_KWARGS)
 
 
 def run_ideal(span: Span, args: argparse.Namespace, *, verbose: bool = True) -> Case:
     """The ideal-joint slider-crank over the same span (comparison curves)."""
-    return run_case("ideal joint", slider_crank("ideal", gravity=GRAVITY, rpm=RPM), span, args, verbose=verbose)
+    return _common.run_ideal(span, args, verbose=verbose, **RUN_KWARGS)
 
 
 def scene(clearance: float = 0.5e-3, **kwargs: Any) -> dc.Scene:
@@ -165,25 +90,6 @@ def impacts(result: dc.Result) -> int:
     """Number of impacts: onsets of corner pairs, simultaneous ones (a face landing) counted once."""
     t = np.unique(np.round([e.t for e in result.events.of(JOINT, "onset") if not e.pair.endswith("_face")], 15))
     return int(t.size)
-
-
-def poincare_points(dense: dc.Result, span: Span, x: str = "slider.vx", y: str = "slider.ax") -> np.ndarray:
-    """(x, y) once per crank revolution (crank angle 0) over the analysed span, shape (n, 2)."""
-    if span.revolution_times.size == 0:
-        return np.zeros((0, 2))
-    idx = np.searchsorted(dense.t, span.revolution_times - 1e-9 * PERIOD)
-    idx = idx[idx < dense.n_times]
-    return np.column_stack([dense[x][idx], dense[y][idx]])
-
-
-def distinct_points(points: np.ndarray, scale: np.ndarray, tol: float = 0.01) -> int:
-    """Clusters of points (1 for a periodic response, n for chaos): a point is new if it differs
-    from every kept point by more than ``tol * scale`` in some coordinate."""
-    kept: list[np.ndarray] = []
-    for p in points:
-        if not any(np.all(np.abs(p - q) <= tol * scale) for q in kept):
-            kept.append(p)
-    return len(kept)
 
 
 def measure(case: Case, ideal: Case, span: Span) -> dict[str, Any]:
@@ -238,18 +144,6 @@ def measure(case: Case, ideal: Case, span: Span) -> dict[str, Any]:
 # --------------------------------------------------------------------------- output
 
 
-def save_result(result: dc.Result, out: Path, name: str) -> Path:
-    return result.save(out / f"{name}.h5")
-
-
-def save_figure(fig: Any, path: Path) -> Path:
-    import matplotlib.pyplot as plt
-
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
-
-
 SUMMARY_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("case", "case", "{}"),
     ("peak_moment_Nm", "peak moment (N m)", "{:.0f}"),
@@ -276,58 +170,24 @@ SPAN_COLUMNS: tuple[tuple[str, str, str], ...] = (
 )
 
 
-def _fmt(value: Any, fmt: str) -> str:
-    if isinstance(value, float) and not math.isfinite(value):
-        return "-"
-    return fmt.format(value)
-
-
-def markdown_table(rows: Sequence[Mapping[str, Any]], columns: Sequence[tuple[str, str, str]]) -> str:
-    cols = [c for c in columns if all(c[0] in r for r in rows)]
-    lines = ["| " + " | ".join(h for _, h, _ in cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
-    lines += ["| " + " | ".join(_fmt(r[k], f) for k, _, f in cols) + " |" for r in rows]
-    return "\n".join(lines)
+# tables of metrics.md (the span table also with --quick: then only the case column)
+SECTIONS: tuple[_common.Section, ...] = (
+    ("Last two revolutions:", SUMMARY_COLUMNS, True),
+    ("Whole analysed span:", SPAN_COLUMNS, True),
+)
 
 
 def write_metrics(rows: Sequence[Mapping[str, Any]], out: Path, span: Span, header: str, rtol: float) -> None:
     """Write ``metrics.json`` and ``metrics.md`` and print the tables."""
-    meta = {"span": span.describe(), "rtol": rtol, "gravity_m_s2": GRAVITY, "rpm": RPM}
-    (out / "metrics.json").write_text(json.dumps({"about": header, **meta, "cases": list(rows)}, indent=1))
-    text = [f"# {header}", "", span.describe() + f"; rtol {rtol:g}, gravity {GRAVITY} m/s², {RPM:g} rpm.", "",
-            "Last two revolutions:", "", markdown_table(rows, SUMMARY_COLUMNS), "",
-            "Whole analysed span:", "", markdown_table(rows, SPAN_COLUMNS)]
-    (out / "metrics.md").write_text("\n".join(text) + "\n")
-    print("\n".join(text[2:]))
-
-
-def print_written(out: Path) -> None:
-    files = sorted(p.name for p in out.iterdir() if p.is_file())
-    print(f"wrote {len(files)} files to {out}/: {', '.join(files)}")
-
-
-@dataclass
-class Study:
-    """The cases of one figure family, their ideal-joint reference and their measures."""
-
-    header: str
-    span: Span
-    ideal: Case
-    cases: list[Case]
-    rows: list[dict[str, Any]]
+    _common.write_metrics(rows, out, span, header, rtol, sections=SECTIONS)
 
 
 def run_study(header: str, scenes: Mapping[str, dc.Scene], args: argparse.Namespace) -> Study:
     """Run the ideal joint and every case ``label -> scene``, measure them, save HDF5 and metrics."""
-    span = make_span(args)
-    print(f"{header}\n{span.describe()}; rtol {args.rtol:g}, gravity {GRAVITY} m/s^2, {RPM:g} rpm", flush=True)
-    ideal = run_ideal(span, args)
-    cases = [run_case(label, sc, span, args) for label, sc in scenes.items()]
-    rows = [measure(case, ideal, span) for case in cases]
-    for case in cases:
-        save_result(case.window, args.out, _stem(case.label))
-    save_result(ideal.window, args.out, "ideal")
-    write_metrics(rows, args.out, span, header, args.rtol)
-    return Study(header, span, ideal, cases, rows)
+    study = _common.run_study(header, {label: (_stem(label), sc) for label, sc in scenes.items()}, args,
+                              span=make_span(args), measure_case=measure, **RUN_KWARGS)
+    _common.save_study(study, args.out, args.rtol, sections=SECTIONS)
+    return study
 
 
 def _stem(label: str) -> str:

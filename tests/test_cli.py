@@ -79,3 +79,98 @@ def test_study_writes_table_and_figure(tmp_path, capsys):
     assert len(lines) == 3 and lines[1].startswith("ida,ida,1e-05")
     assert (tmp_path / "work_precision.png").stat().st_size > 10_000
     assert "Window: t in [0, 0.002]" in capsys.readouterr().out
+
+
+CLEARANCE_TOML = """
+[scene]
+name = "crank_with_clearance"
+gravity = [0.0, -9.81]
+
+[[body]]
+name = "crank"
+mass = 0.30
+inertia = 1.0e-4
+position = [0.025, 0.0]
+velocity = [0.0, @crank_vy@]
+angular_velocity = @omega@
+
+[[body]]
+name = "rod"
+mass = 0.21
+inertia = 2.5e-4
+position = [0.11, 0.0]
+velocity = [0.0, @rod_vy@]
+angular_velocity = @rod_omega@
+
+[[body]]
+name = "slider"
+mass = 0.14
+inertia = 1.0e-4
+position = [0.17, 0.0]
+
+[[revolute]]
+name = "A"
+body_i = "ground"
+body_j = "crank"
+at = [0.0, 0.0]
+
+[[revolute]]
+name = "B"
+body_i = "crank"
+body_j = "rod"
+at = [0.05, 0.0]
+
+[[revolute_clearance]]
+name = "clearance"
+body_i = "slider"
+body_j = "rod"
+at = [0.17, 0.0]
+bearing_radius = 0.01
+clearance = 0.5e-3
+material = { young = 207e9, poisson = 0.3 }
+law = { name = "lankarani-nikravesh", restitution = 0.9 }
+friction = 0.05
+
+[[translational]]
+name = "D"
+body_i = "ground"
+body_j = "slider"
+at = [0.17, 0.0]
+
+[[driver]]
+name = "drive"
+joint = "A"
+speed = @omega@
+
+[simulate]
+t_end = 0.002
+"""
+
+
+def clearance_toml():
+    """The chapter's mechanism as a scene file, started from the ideal kinematics like slider_crank."""
+    omega = 5000 * 2 * np.pi / 60
+    state = dc.mechanisms.ideal_slider_crank_state(0.0, omega)
+    values = {"omega": omega, "crank_vy": state["crank"][4], "rod_vy": state["rod"][4], "rod_omega": state["rod"][5]}
+    text = CLEARANCE_TOML
+    for key, value in values.items():
+        text = text.replace(f"@{key}@", repr(float(value)))
+    return text
+
+
+def test_scene_file_with_a_clearance_joint_matches_the_mechanism(tmp_path):
+    path = tmp_path / "crank.toml"
+    path.write_text(clearance_toml())
+    assert main(["run", str(path), "--out", str(tmp_path), "--no-figure", "--quiet"]) == 0
+    from_file = dc.load(tmp_path / "crank_with_clearance.h5")
+    reference = dc.simulate(dc.mechanisms.slider_crank("revolute", friction=0.05), 0.002)
+    assert [e.kind for e in from_file.events] == [e.kind for e in reference.events] and len(reference.events) > 2
+    np.testing.assert_allclose(from_file.events.t, reference.events.t, rtol=1e-6)
+    assert "clearance.friction_force" in from_file
+
+
+def test_scene_file_clearance_law_errors_name_the_table(tmp_path, capsys):
+    path = tmp_path / "bad.toml"
+    path.write_text(clearance_toml().replace('name = "lankarani-nikravesh"', 'name = "spring"'))
+    assert main(["run", str(path), "--out", str(tmp_path)]) == 2
+    assert "[[revolute_clearance]] #1" in capsys.readouterr().err
