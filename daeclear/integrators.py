@@ -1162,17 +1162,22 @@ def _run_scipy(run: _Run, x0: NDArray, rtol: float, atol: NDArray, max_step: flo
         seg.t1 = t_prev if restart is None else restart[0]
         run.t_last = seg.t1
         run.n_lu += getattr(solver, "nlu", 0) - lu0
-        if restart is None or not run.success:
-            run.close_segment(hermite=False)
+        if not _end_segment(run, restart, False, t_end):
             return
-        t, x, roots = restart
-        run.close_segment(hermite=False)
-        run.handle_event(t, x, roots)
-        if run.stall >= STALL_EVENTS:
-            run.fail(t, f"{run.stall} events at the same time: the event loop does not advance", "")
-            return
-        if t >= t_end:
-            return
+        t, x, _ = restart  # the next segment starts at the event
+
+
+def _end_segment(run: _Run, restart: Any, hermite: bool, t_end: float) -> bool:
+    """Close the segment; on an event let the logic switch modes. True when the run goes on."""
+    run.close_segment(hermite=hermite)
+    if restart is None or not run.success:
+        return False
+    t, x, roots = restart
+    run.handle_event(t, x, roots)
+    if run.stall >= STALL_EVENTS:
+        run.fail(t, f"{run.stall} events at the same time: the event loop does not advance", "")
+        return False
+    return t < t_end
 
 
 def _run_fixed(run: _Run, x0: NDArray, step: float) -> None:
@@ -1227,17 +1232,9 @@ def _run_fixed(run: _Run, x0: NDArray, step: float) -> None:
             run.add_steps(np.array([t_ev]), x_ev[None, :])
             restart = (t_ev, x_ev, roots)
             break
-        if restart is None or not run.success:
-            run.close_segment(hermite=True)
+        if not _end_segment(run, restart, True, t_end):
             return
-        t, x, roots = restart
-        run.close_segment(hermite=True)
-        run.handle_event(t, x, roots)
-        if run.stall >= STALL_EVENTS:
-            run.fail(t, f"{run.stall} events at the same time: the event loop does not advance", "")
-            return
-        if t >= t_end:
-            return
+        t, x, _ = restart  # the next segment starts at the event
 
 
 def _positive(name: str, value: Any, unit: str, allow_zero: bool = False) -> float:

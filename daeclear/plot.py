@@ -119,6 +119,14 @@ def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, refere
 RESPONSE_CHANNELS = ("slider.vx", "slider.ax", "drive.moment")
 
 
+def _response_panels(result: Result, reference: Result | None, axes: Any) -> None:
+    """Panels (a)-(c) of Figs. 4.15 and 4.28: slider velocity, acceleration, crank moment."""
+    titles = ("(a) slider velocity", "(b) slider acceleration", "(c) crank moment")
+    for ax, name, title in zip(axes, RESPONSE_CHANNELS, titles):
+        plot_channel(result, name, ax=ax, reference=reference, label="clearance joint")
+        ax.set_title(title, fontsize="medium")
+
+
 def save_response_figure(result: Result, path: Any, *, reference: Result | None = None,
                          channels: Iterable[str] = RESPONSE_CHANNELS) -> Any:
     """Write a figure of slider velocity, acceleration and driving moment (Fig. 4.15a-c) to ``path``.
@@ -405,10 +413,7 @@ def plot_revolute_response(result: Result, *, reference: Result | None = None, o
 
     fig, axes = plt.subplots(2, 2, figsize=(10.0, 7.0))
     (a, b), (c, d) = axes
-    titles = ("(a) slider velocity", "(b) slider acceleration", "(c) crank moment")
-    for ax, name, title in zip((a, b, c), RESPONSE_CHANNELS, titles):
-        plot_channel(result, name, ax=ax, reference=reference, label="clearance joint")
-        ax.set_title(title, fontsize="medium")
+    _response_panels(result, reference, (a, b, c))
     plot_journal_orbit(orbit if orbit is not None else result, joint, ax=d)
     d.set_title("(d) journal trajectory relative to the bearing", fontsize="medium")
     fig.tight_layout()
@@ -483,10 +488,7 @@ def plot_translational_response(result: Result, *, reference: Result | None = No
 
     fig, axes = plt.subplots(2, 2, figsize=(10.0, 7.0))
     (a, b), (c, d) = axes
-    titles = ("(a) slider velocity", "(b) slider acceleration", "(c) crank moment")
-    for ax, name, title in zip((a, b, c), RESPONSE_CHANNELS, titles):
-        plot_channel(result, name, ax=ax, reference=reference, label="clearance joint")
-        ax.set_title(title, fontsize="medium")
+    _response_panels(result, reference, (a, b, c))
     plot_slider_path(result, joint, ax=d)
     d.set_title("(d) dimensionless slider path inside the guide", fontsize="medium")
     fig.tight_layout()

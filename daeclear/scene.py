@@ -73,6 +73,15 @@ class Element:
         if _as_vector2(value) is None:
             out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be two finite numbers (x, y).")
 
+    def _check_one_positive(self, out: list[str], first: str, second: str, unit: str) -> None:
+        """Exactly one of two alternative fields is given, and it is > 0."""
+        a, b = getattr(self, first), getattr(self, second)
+        if (a is None) == (b is None):
+            out.append(f"{self.kind} '{self.name}': give exactly one of {first}= or {second}= "
+                       f"(got {first}={a!r}, {second}={b!r}).")
+        else:
+            self._check_positive(out, first if a is not None else second, unit)
+
     def _check_number(self, out: list[str], field_name: str, unit: str) -> None:
         value = getattr(self, field_name)
         if not _is_finite_number(value):
@@ -476,14 +485,7 @@ class RevoluteClearance(_PointJoint):
     def problems(self) -> list[str]:
         out = super().problems()
         self._check_positive(out, "bearing_radius", "m")
-        given = [self.clearance is not None, self.journal_radius is not None]
-        if given[0] == given[1]:
-            out.append(f"{self.kind} '{self.name}': give exactly one of clearance= or journal_radius= "
-                       f"(got clearance={self.clearance!r}, journal_radius={self.journal_radius!r}).")
-        elif given[0]:
-            self._check_positive(out, "clearance", "m")
-        else:
-            self._check_positive(out, "journal_radius", "m")
+        self._check_one_positive(out, "clearance", "journal_radius", "m")
         if not out:
             c, R = self.radial_clearance, float(self.bearing_radius)
             if not 0.0 < c < R:
@@ -684,14 +686,7 @@ class TranslationalClearance(_PointJoint):
             self._check_positive(out, name, "m")
         if self.thickness is not None:
             self._check_positive(out, "thickness", "m")
-        given = [self.clearance is not None, self.guide_height is not None]
-        if given[0] == given[1]:
-            out.append(f"{self.kind} '{self.name}': give exactly one of clearance= or guide_height= "
-                       f"(got clearance={self.clearance!r}, guide_height={self.guide_height!r}).")
-        elif given[0]:
-            self._check_positive(out, "clearance", "m")
-        else:
-            self._check_positive(out, "guide_height", "m")
+        self._check_one_positive(out, "clearance", "guide_height", "m")
         for name in ("upper_limits", "lower_limits", "stroke"):
             value = getattr(self, name)
             if value is None:
