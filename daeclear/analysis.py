@@ -387,10 +387,10 @@ class _RestartModel(DAEModel):
 
     start_state: tuple[float, ...] = ()
 
-    def initial_state(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def initial_state(self, session: Any = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         # No Newton projection: the stored state carries the run's own (Baumgarte-controlled)
         # constraint drift, and projecting it away would move a journal by up to that drift.
-        return self.consistent_state(0.0, np.array(self.start_state, dtype=float))
+        return self.consistent_state(0.0, np.array(self.start_state, dtype=float), session=session)
 
 
 def restart_model(model: DAEModel, result: Result, index: int, *, perturbation: float = 0.0,

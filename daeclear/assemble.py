@@ -46,7 +46,8 @@ Formulation = Literal["index1", "ggl"]
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
 
 # Extra functions compiled with the model (DAEFunctions.extras), evaluated over many points.
-EXTRA_OUTPUTS, EXTRA_ACCEL, EXTRA_TERM0 = 0, 1, 2  # term k's generalized force: EXTRA_TERM0 + k
+# kinematics: (q, v, t) -> [Phi; Phi_q (column-major); Phi_dot]; term k's generalized force: EXTRA_TERM0 + k
+EXTRA_OUTPUTS, EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_TERM0 = 0, 1, 2, 3
 
 # State kinds: how each state variable is treated by the solver's error test.
 KIND_POSITION, KIND_VELOCITY, KIND_MULTIPLIER, KIND_WORK = "q", "v", "lambda", "work"
@@ -147,8 +148,15 @@ class DAEModel:
         }
 
     # ---- consistent states -------------------------------------------------------------
+    def _constraints(self, q: NDArray[np.float64], v: NDArray[np.float64], t: float,
+                     session: Any = None) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """(Phi, Phi_q, Phi_dot) at one state, through the compiled library when a session is open."""
+        m, n = self.n_constraints, self.n_q
+        flat = self.evaluate(EXTRA_KINEMATICS, [q, v, np.array([t])], 1, session)[0]
+        return flat[:m], flat[m:m + m * n].reshape(n, m).T, flat[m + m * n:]
+
     def assemble_positions(self, q_guess: NDArray[np.float64], t: float = 0.0, tol: float = 1e-13,
-                           max_iter: int = 50) -> NDArray[np.float64]:
+                           max_iter: int = 50, session: Any = None) -> NDArray[np.float64]:
         """Newton (least-norm) on Phi(q, t) = 0 from ``q_guess``; raises AssemblyError if it cannot close."""
         q = np.array(q_guess, dtype=float)
         if self.n_constraints == 0:
@@ -156,13 +164,12 @@ class DAEModel:
         scale = max(1.0, float(np.max(np.abs(q))))
         zero_v = np.zeros(self.n_q)
         for _ in range(max_iter):
-            Phi, Phi_q, _, _ = (np.array(x) for x in self.kinematics(q, zero_v, t, self.parameter_values))
-            Phi = Phi.ravel()
+            Phi, Phi_q, _ = self._constraints(q, zero_v, t, session)
             if np.max(np.abs(Phi)) < tol * scale:
                 return q
             dq, *_ = np.linalg.lstsq(Phi_q, -Phi, rcond=None)
             q = q + dq
-        Phi = np.array(self.kinematics(q, zero_v, t, self.parameter_values)[0]).ravel()
+        Phi = self._constraints(q, zero_v, t, session)[0]
         worst = np.argsort(-np.abs(Phi))[:3]
         detail = ", ".join(f"'{self.constraint_names[i]}' = {Phi[i]:.3g}" for i in worst)
         raise AssemblyError(
@@ -172,13 +179,13 @@ class DAEModel:
         )
 
     def assemble_velocities(self, q: NDArray[np.float64], v_guess: NDArray[np.float64],
-                            t: float = 0.0) -> NDArray[np.float64]:
+                            t: float = 0.0, session: Any = None) -> NDArray[np.float64]:
         """Least-norm correction of ``v_guess`` so that Phi_q v + Phi_t = 0."""
         v = np.array(v_guess, dtype=float)
         if self.n_constraints == 0:
             return v
-        _, Phi_q, Phi_dot, _ = (np.array(x) for x in self.kinematics(q, v, t, self.parameter_values))
-        dv, *_ = np.linalg.lstsq(Phi_q, -Phi_dot.ravel(), rcond=None)
+        _, Phi_q, Phi_dot = self._constraints(q, v, t, session)
+        dv, *_ = np.linalg.lstsq(Phi_q, -Phi_dot, rcond=None)
         return v + dv
 
     def evaluate(self, k: int, inputs: Sequence[Any], n_points: int, session: Any = None) -> NDArray[np.float64]:
@@ -275,8 +282,8 @@ class DAEModel:
             # restart on the constraint manifold with mu = 0, its exact value: GGL holds Phi and
             # Phi' only to Newton's tolerance, and a restart at a tight rtol must not inherit that
             t0 = float(np.ravel(t)[0])
-            y2[0, :n] = self.assemble_positions(y2[0, :n], t0)
-            y2[0, n:2 * n] = self.assemble_velocities(y2[0, :n], y2[0, n:2 * n], t0)
+            y2[0, :n] = self.assemble_positions(y2[0, :n], t0, session=session)
+            y2[0, n:2 * n] = self.assemble_velocities(y2[0, :n], y2[0, n:2 * n], t0, session=session)
             y2[0, 2 * n + m:2 * n + 2 * m] = 0.0
         q, v = y2[:, :n], y2[:, n:2 * n]
         sol = self._accel_solution(t, q, v, generalized_force, session)
@@ -290,18 +297,20 @@ class DAEModel:
             mu = y2[:, 2 * n + m:2 * n + 2 * m]
             N = y2.shape[0]
             t_arr = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,))
-            Phi_q = np.array(_mapped(self.kinematics, N)(q.T, v.T, t_arr[None, :], self.parameter_values)[1]).reshape(m, N, n).transpose(1, 0, 2)
+            flat = self.evaluate(EXTRA_KINEMATICS, [q, v, t_arr.reshape(N, 1)], N, session)
+            Phi_q = flat[:, m:m + m * n].reshape(N, n, m).transpose(0, 2, 1)
             yp[:, :n] = v - np.einsum("kmn,km->kn", Phi_q, mu)
         return (y2[0], yp[0]) if single else (y2, yp)
 
-    def initial_state(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Consistent (y0, yp0) at t = 0: assembled positions and velocities, then v' and lam."""
-        q = self.assemble_positions(self.q_guess)
-        v = self.assemble_velocities(q, self.v_guess)
+    def initial_state(self, session: Any = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Consistent (y0, yp0) at t = 0: assembled positions and velocities, then v' and lam.
+        With an open compiled ``session`` every evaluation runs in C."""
+        q = self.assemble_positions(self.q_guess, session=session)
+        v = self.assemble_velocities(q, self.v_guess, session=session)
         y = np.zeros(self.n_states)
         y[: self.n_q] = q
         y[self.n_q: 2 * self.n_q] = v
-        return self.consistent_state(0.0, y)
+        return self.consistent_state(0.0, y, session=session)
 
     def switch_vector(self, active: Sequence[bool], params: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
         """The contact terms' on/off flags and parameters as the outputs' ``switch`` input."""
@@ -707,7 +716,9 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
     work_rate = [drive_power_of + ca.dot(Fc, v)] if track_work else []
     accel = ca.Function("accel", [t, q, v, Fc, P], [ca.densify(ca.vertcat(a_sol, lam_sol, *work_rate))],
                         ["t", "q", "v", "Qc", "P"], ["a_lam"])
-    extras = [outputs, accel] + [term.force for term in terms]
+    kinematics_flat = ca.Function("kinematics_flat", [q, v, t, P],
+                                  [ca.densify(ca.vertcat(Phi, ca.vec(Phi_q), Phi_dot))], ["q", "v", "t", "P"], ["K"])
+    extras = [outputs, accel, kinematics_flat] + [term.force for term in terms]
     # simple contact pairs whose switches the compiled loop may handle itself (see ida_driver.c)
     logic_makers = tuple(build.logic for build in contact_builds)
     sample = [logic for make in logic_makers for logic in make(table.vector)]

@@ -195,10 +195,9 @@ def simulate(
         if eval_times.size == 0 or np.any(np.diff(eval_times) <= 0) or eval_times[0] < 0 or eval_times[-1] > t_end:
             raise SceneError(f"simulate: t_eval must be increasing values in [0, t_end={t_end}].")
     atol_vec = tolerance_vector(model, rtol, atol)
-    y0, yp0 = model.initial_state()
     session = open_session(model.functions, backend=backend, rtol=rtol, atol=atol_vec, max_step=max_step,
-                           parameters=model.parameter_values,
-                           max_steps=max_steps)
+                           parameters=model.parameter_values, max_steps=max_steps)
+    y0, yp0 = model.initial_state(session=session)
     if model.formulation == "ggl":
         # never ask Newton for corrections below round-off: coef * rtol >= 1e-13
         session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / rtol)))

@@ -1,0 +1,79 @@
+"""A clearance sweep of the Fig. 4.15 scene: how much of its wall time is integration.
+
+Runs the chapter's revolute slider-crank (5000 rpm, Lankarani-Nikravesh c_e = 0.9, gravity)
+for ``--points`` clearances spaced geometrically from 0.01 mm to 0.5 mm, each a whole
+``daeclear.simulate(scene, ...)`` call with a new Scene (what a user's loop does), with an
+EMPTY compile cache (a fresh ``DAECLEAR_CACHE_DIR``), so the first point pays for the one
+build of the structure. Prints, side by side: the number of compiles, the build time, the wall
+time of the whole loop and the sum of the runs' own IDA loop times (``stats["solve_time"]``),
+and their ratio against the target (wall within 1.2x of the solve times, build excluded), then
+the same sweep through ``daeclear.sweep`` on one worker process (its file, classification and
+Poincaré section included).
+
+    python benchmarks/bench_sweep.py [--points 50] [--revolutions 2] [--rtol 1e-6]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+REV = 60.0 / 5000.0
+TARGET = 1.2
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--points", type=int, default=50)
+    parser.add_argument("--revolutions", type=float, default=2.0)
+    parser.add_argument("--rtol", type=float, default=1e-6)
+    parser.add_argument("--no-sweep", action="store_true", help="skip the daeclear.sweep part")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory(prefix="bench_sweep-") as tmp:
+        os.environ["DAECLEAR_CACHE_DIR"] = str(Path(tmp) / "cache")  # before daeclear builds anything
+        import daeclear as dc
+        from daeclear.codegen import cache_dir
+
+        clearances = np.geomspace(1e-5, 5e-4, args.points)
+        t_end = args.revolutions * REV
+        compiles, build, solve, setup_times = 0, 0.0, 0.0, []
+        start = time.perf_counter()
+        for c in clearances:
+            scene = dc.mechanisms.slider_crank("revolute", clearance=float(c))
+            result = dc.simulate(scene, t_end=t_end, rtol=args.rtol)
+            compiled = result.stats.get("compile_time", 0.0)
+            compiles += compiled > 0.0
+            build += compiled
+            solve += result.stats["solve_time"]
+            setup_times.append(result.stats.get("setup_time", 0.0) - compiled)
+        wall = time.perf_counter() - start
+        libraries = len(list(cache_dir().glob("*.so")))
+        print(f"Fig. 4.15 scene, {args.points} clearances 0.01-0.5 mm, {args.revolutions:g} revolutions, "
+              f"rtol {args.rtol:g}, simulate(scene) in a loop")
+        print(f"  compiles             {compiles}   (libraries in the fresh cache: {libraries}; target 1)")
+        print(f"  build (compiler)     {build:8.3f} s")
+        print(f"  wall, whole loop     {wall:8.3f} s")
+        print(f"  sum of IDA solves    {solve:8.3f} s")
+        ratio = (wall - build) / solve
+        print(f"  wall - build / solve {ratio:8.2f}     (target <= {TARGET}: {'ok' if ratio <= TARGET else 'MISSED'})")
+        print(f"  per-run setup        {np.median(setup_times) * 1e3:8.2f} ms median (assembly, initial state, "
+              "session), build excluded")
+        if args.no_sweep:
+            return
+        start = time.perf_counter()
+        out = dc.sweep(Path(tmp) / "sweep.h5", {"clearance": [float(c) for c in clearances]},
+                       fixed={"joint": "revolute"}, max_workers=1, revolutions=int(max(args.revolutions, 2)),
+                       transient=0, twin=False, rtol=args.rtol, progress=False)
+        sweep_wall = time.perf_counter() - start
+        print(f"daeclear.sweep, 1 worker process, same points ({len(out)} runs, all ok: "
+              f"{all(r.ok for r in out.runs)}): wall {sweep_wall:.3f} s, "
+              f"libraries in the cache: {len(list(cache_dir().glob('*.so')))}")
+
+
+if __name__ == "__main__":
+    main()
