@@ -13,6 +13,7 @@ import logging
 import math
 import sys
 import time
+import warnings
 from typing import Any, Sequence
 
 import numpy as np
@@ -20,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .assemble import EXTRA_ACCEL, EXTRA_TERM0, KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
 from .clearance import STORM_EVENTS, STORM_WINDOW
-from .errors import SceneError, SolveError
+from .errors import DaeclearWarning, SceneError, SolveError
 from .ida_session import open_session
 from .result import ContactEvent, Result
 from .scene import Scene
@@ -38,6 +39,8 @@ MULTIPLIER_ATOL_FLOOR = 1e4
 # Default absolute tolerance of positions and velocities, relative to rtol: contact runs resolve
 # micrometre penetrations, so positions need an absolute floor well below the clearance.
 DEFAULT_ATOL_FACTOR = 1e-3
+# Constraint drift (largest |Phi| of a run) above this fraction of the smallest clearance is warned of.
+DRIFT_FRACTION = 1e-3
 # GGL holds Phi = 0 only as tightly as IDA's Newton test (safety factor 0.33 by default). 1e-3
 # keeps the pendulum's constraint residual at 1e-12 instead of 3e-11 (rtol 1e-10) and, measured,
 # halves the steps; index1 is better off with IDA's default. The python backend cannot set it.
@@ -356,6 +359,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     stats.update(n_events=len(events), n_restarts=n_restarts, setup_time=setup_time,
                  wall_time=setup_time + time.perf_counter() - run_start,
                  output_time=time.perf_counter() - post_start)
+    _check_drift(model, channels, stats)
     result = Result(
         t=out_t, y=out_y, yp=out_yp, state_names=list(model.state_names),
         channels=channels, units=dict(model.channel_units),
@@ -367,6 +371,29 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     if not success and on_failure == "raise":
         raise SolveError(message + " Partial result in .result.", result)
     return result
+
+
+def smallest_clearance(model: DAEModel) -> float:
+    """The smallest clearance of the model's clearance joints (inf without any), from its parameters."""
+    values = [float(model.parameter(name)[0]) for name in model.parameter_names if name.endswith(".clearance")]
+    return min(values, default=math.inf)
+
+
+def _check_drift(model: DAEModel, channels: dict[str, NDArray], stats: dict[str, Any]) -> None:
+    """Record the largest constraint violation of the run; warn when it reaches DRIFT_FRACTION of the
+    smallest clearance (the journal's position is then uncertain by a visible part of its play)."""
+    drift = channels.get("constraints.position")
+    if drift is None or drift.size == 0:
+        return
+    worst = float(np.max(drift))
+    stats["max_constraint_drift"] = worst
+    clearance = smallest_clearance(model)
+    if worst > DRIFT_FRACTION * clearance:
+        warnings.warn(
+            f"simulate: the constraints drifted by {worst:.2e} m, {worst / clearance:.1%} of the smallest "
+            f"clearance ({clearance:.2e} m) (formulation={model.formulation!r}); contact times and forces are "
+            "uncertain by that much. Use formulation='ggl' (drift-free) or a smaller rtol.",
+            DaeclearWarning, stacklevel=3)
 
 
 def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:
