@@ -439,7 +439,7 @@ def restart_model(model: DAEModel, result: Result, index: int, *, perturbation: 
         u = rng.standard_normal(n_q)
         q, v = y[:n_q], y[n_q:2 * n_q]
         if model.n_constraints:  # along the constraint manifold: project on the null space of Phi_q
-            Phi_q = np.array(model.kinematics(q, v, 0.0)[1], dtype=float).reshape(model.n_constraints, n_q)
+            Phi_q = np.array(model.kinematics(q, v, 0.0, model.parameter_values)[1], dtype=float).reshape(model.n_constraints, n_q)
             _, sv, vt = np.linalg.svd(Phi_q)
             rank = int(np.sum(sv > 1e-10 * sv[0])) if sv.size and sv[0] > 0 else 0
             null = vt[rank:].T

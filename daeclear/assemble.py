@@ -28,17 +28,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Literal, Sequence
+from typing import Any, Callable, Literal, Sequence
 
 import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .codegen import memo_table
 from .errors import AssemblyError, SceneError
 from .ida_session import DAEFunctions
+from .parameters import ParameterTable, structure_key
 from .scene import GROUND, Body, Driver, Revolute, Scene, Translational
 from .clearance import CONTACT_BUILDERS
-from .symbolic import AssemblyContext, BodyFrame, Channel, Term, rotation
+from .symbolic import AssemblyContext, BodyFrame, Channel, Reference, Term, rotation
 
 Formulation = Literal["index1", "ggl"]
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
@@ -82,6 +84,22 @@ class DAEModel:
     track_work: bool = False
     # (root, term, gap-rate extra, needs approach speed, min approach speed) of simple pairs
     auto_pairs: tuple[tuple[int, int, int, bool, float], ...] = ()
+    # run-time parameters: the last input of every function above (see daeclear.parameters)
+    parameter_layout: tuple[tuple[str, int], ...] = ()  # (name, size) of each entry
+    parameter_values: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        return tuple(name for name, _ in self.parameter_layout)
+
+    def parameter(self, name: str) -> NDArray[np.float64]:
+        """The value of one run-time parameter, e.g. ``model.parameter("clearance.clearance")``."""
+        offset = 0
+        for key, size in self.parameter_layout:
+            if key == name:
+                return self.parameter_values[offset:offset + size].copy()
+            offset += size
+        raise KeyError(f"no parameter {name!r}; the model has {', '.join(self.parameter_names)}")
 
     @property
     def n_q(self) -> int:
@@ -138,13 +156,13 @@ class DAEModel:
         scale = max(1.0, float(np.max(np.abs(q))))
         zero_v = np.zeros(self.n_q)
         for _ in range(max_iter):
-            Phi, Phi_q, _, _ = (np.array(x) for x in self.kinematics(q, zero_v, t))
+            Phi, Phi_q, _, _ = (np.array(x) for x in self.kinematics(q, zero_v, t, self.parameter_values))
             Phi = Phi.ravel()
             if np.max(np.abs(Phi)) < tol * scale:
                 return q
             dq, *_ = np.linalg.lstsq(Phi_q, -Phi, rcond=None)
             q = q + dq
-        Phi = np.array(self.kinematics(q, zero_v, t)[0]).ravel()
+        Phi = np.array(self.kinematics(q, zero_v, t, self.parameter_values)[0]).ravel()
         worst = np.argsort(-np.abs(Phi))[:3]
         detail = ", ".join(f"'{self.constraint_names[i]}' = {Phi[i]:.3g}" for i in worst)
         raise AssemblyError(
@@ -159,7 +177,7 @@ class DAEModel:
         v = np.array(v_guess, dtype=float)
         if self.n_constraints == 0:
             return v
-        _, Phi_q, Phi_dot, _ = (np.array(x) for x in self.kinematics(q, v, t))
+        _, Phi_q, Phi_dot, _ = (np.array(x) for x in self.kinematics(q, v, t, self.parameter_values))
         dv, *_ = np.linalg.lstsq(Phi_q, -Phi_dot.ravel(), rcond=None)
         return v + dv
 
@@ -167,10 +185,12 @@ class DAEModel:
         """Evaluate ``functions.extras[k]`` at ``n_points`` points (inputs (n_points, size) or (size,)).
 
         With an open compiled ``session`` the loop runs in C (~1 us a point); otherwise CasADi.
+        Every extra takes the run-time parameters as its last input; they are appended here.
         """
         if session is not None:
             return session.eval_extra(k, inputs, n_points)
         f = self.functions.extras[k]
+        inputs = [*inputs, self.parameter_values]
         cols = [np.zeros((0, n_points)) if f.numel_in(j) == 0 else
                 np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, f.numel_in(j)), (n_points, f.numel_in(j))).T
                 for j, x in enumerate(inputs)]
@@ -270,7 +290,7 @@ class DAEModel:
             mu = y2[:, 2 * n + m:2 * n + 2 * m]
             N = y2.shape[0]
             t_arr = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,))
-            Phi_q = np.array(_mapped(self.kinematics, N)(q.T, v.T, t_arr[None, :])[1]).reshape(m, N, n).transpose(1, 0, 2)
+            Phi_q = np.array(_mapped(self.kinematics, N)(q.T, v.T, t_arr[None, :], self.parameter_values)[1]).reshape(m, N, n).transpose(1, 0, 2)
             yp[:, :n] = v - np.einsum("kmn,km->kn", Phi_q, mu)
         return (y2[0], yp[0]) if single else (y2, yp)
 
@@ -305,49 +325,148 @@ class DAEModel:
         return {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(self.channel_names)}
 
 
-# ---- element builders --------------------------------------------------------------------
+# ---- element parameters (numbers) and builders (structure) --------------------------------
 
-def _joint_points(ctx: AssemblyContext, joint: Revolute | Translational) -> tuple[NDArray, NDArray]:
-    """Body-fixed joint points of body i and j (from ``at`` in the reference configuration)."""
-    s_i = np.asarray(joint.point_i) if joint.point_i is not None else ctx.local_point(joint.body_i, joint.at)
-    s_j = np.asarray(joint.point_j) if joint.point_j is not None else ctx.local_point(joint.body_j, joint.at)
-    return s_i, s_j
+def _revolute_parameters(ref: Reference, joint: Revolute) -> dict[str, Any]:
+    s_i, s_j = ref.joint_points(joint)
+    return {"s_i": s_i, "s_j": s_j}
 
 
 def _revolute(ctx: AssemblyContext, joint: Revolute) -> tuple[list[Any], list[str]]:
-    s_i, s_j = _joint_points(ctx, joint)
     bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
-    d = bi.point(ca.DM(s_i)) - bj.point(ca.DM(s_j))
+    d = bi.point(ctx.p(joint.name, "s_i")) - bj.point(ctx.p(joint.name, "s_j"))
     return [d[0], d[1]], [f"{joint.name}.x", f"{joint.name}.y"]
 
 
+def _translational_parameters(ref: Reference, joint: Translational) -> dict[str, Any]:
+    s_i, s_j = ref.joint_points(joint)
+    u_local = ref.local_vector(joint.body_i, joint.axis)  # axis in body i's frame
+    return {"s_i": s_i, "s_j": s_j, "normal": [-u_local[1], u_local[0]],
+            "angle0": ref.angle(joint.body_j) - ref.angle(joint.body_i)}
+
+
 def _translational(ctx: AssemblyContext, joint: Translational) -> tuple[list[Any], list[str]]:
-    s_i, s_j = _joint_points(ctx, joint)
     bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
-    _, phi_i0 = ctx.reference[joint.body_i]
-    _, phi_j0 = ctx.reference[joint.body_j]
-    ux, uy = joint.axis
-    norm = math.hypot(ux, uy)
-    c, s = math.cos(phi_i0), math.sin(phi_i0)
-    u_local = np.array([c * ux + s * uy, -s * ux + c * uy]) / norm  # axis in body i's frame
-    n_world = ca.mtimes(rotation(bi.phi), ca.DM([-u_local[1], u_local[0]]))
-    d = bj.point(ca.DM(s_j)) - bi.point(ca.DM(s_i))
+    n_world = ca.mtimes(rotation(bi.phi), ctx.p(joint.name, "normal"))
+    d = bj.point(ctx.p(joint.name, "s_j")) - bi.point(ctx.p(joint.name, "s_i"))
     lateral = ca.dot(n_world, d)
-    relative_angle = bj.phi - bi.phi - (phi_j0 - phi_i0)
+    relative_angle = bj.phi - bi.phi - ctx.p(joint.name, "angle0")
     return [lateral, relative_angle], [f"{joint.name}.lateral", f"{joint.name}.angle"]
+
+
+def _driver_parameters(ref: Reference, driver: Driver, joint: Revolute) -> dict[str, Any]:
+    theta0 = driver.initial_angle
+    if theta0 is None:
+        theta0 = ref.angle(joint.body_j) - ref.angle(joint.body_i)
+    return {"angle0": theta0, "speed": driver.speed}
 
 
 def _driver(ctx: AssemblyContext, driver: Driver, joint: Revolute) -> Any:
     bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
-    theta0 = driver.initial_angle
-    if theta0 is None:
-        theta0 = ctx.reference[joint.body_j][1] - ctx.reference[joint.body_i][1]
-    return bj.phi - bi.phi - theta0 - driver.speed * ctx.t
+    return bj.phi - bi.phi - ctx.p(driver.name, "angle0") - ctx.p(driver.name, "speed") * ctx.t
+
+
+def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
+                     track_work: bool) -> tuple[ParameterTable, str]:
+    """The scene's numbers as run-time parameters, and the key of its structure.
+
+    Pure Python (no CasADi): this is all that a scene of a known structure costs to assemble.
+    """
+    ref = Reference(scene.bodies, GROUND)
+    table = ParameterTable()
+    if formulation == "index1":
+        table.add("baumgarte.alpha", alpha)
+        table.add("baumgarte.beta", beta)
+    table.add("gravity", scene.gravity)
+    structure: list[Any] = [formulation, bool(track_work), _ENGINE_VERSION]
+    revolutes = {j.name: j for j in scene.joints if isinstance(j, Revolute)}
+    for element in scene.elements:
+        if isinstance(element, Body):
+            table.update(element.name, {"mass": element.mass, "inertia": element.inertia})
+        elif isinstance(element, Revolute):
+            table.update(element.name, _revolute_parameters(ref, element))
+        elif isinstance(element, Translational):
+            table.update(element.name, _translational_parameters(ref, element))
+        elif isinstance(element, Driver):
+            table.update(element.name, _driver_parameters(ref, element, revolutes[element.joint]))
+        elif type(element) in CONTACT_BUILDERS:
+            values, flags = CONTACT_BUILDERS[type(element)][0](ref, element)
+            table.update(element.name, values)
+            structure.append([element.name, flags])
+        else:
+            raise AssemblyError(f"{element.kind} '{element.name}': element type not supported by assemble().")
+    structure.append(table.layout)
+    described = scene.to_dict()
+    described.pop("name")  # the scene's name is no part of its structure
+    return table, structure_key(described, structure)
+
+
+@dataclass(frozen=True)
+class _Template:
+    """Everything of an assembled model that depends on the structure only (shared by every
+    scene with that structure; numbers are bound by :meth:`bind`)."""
+
+    layout: tuple[tuple[str, int], ...]
+    formulation: str
+    track_work: bool
+    body_names: tuple[str, ...]
+    constraint_names: tuple[str, ...]
+    state_names: tuple[str, ...]
+    state_kinds: tuple[str, ...]
+    functions: DAEFunctions
+    terms: tuple[Term, ...]
+    gap_names: tuple[str, ...]
+    channel_names: tuple[str, ...]
+    channel_units: dict[str, str]
+    outputs: ca.Function
+    kinematics: ca.Function
+    base_force: ca.Function
+    logic: tuple[Callable[[NDArray[np.float64]], list[Any]], ...]
+    # (root, term, gap-rate extra, needs approach speed, index of the contact logic) of simple pairs
+    auto_pairs: tuple[tuple[int, int, int, bool, int], ...]
+
+    def bind(self, scene: Scene, table: ParameterTable, alpha: float, beta: float) -> "DAEModel":
+        if table.layout != self.layout:  # a structure key collision would land here
+            raise AssemblyError(f"scene '{scene.name}': its parameters do not match the cached structure.")
+        P = table.vector
+        P.setflags(write=False)
+        bodies = scene.bodies
+        contacts = tuple(logic for make in self.logic for logic in make(P))
+        auto_pairs = tuple((root, term, extra, needs, float(getattr(contacts[i], "min_approach_speed", 0.0)))
+                           for root, term, extra, needs, i in self.auto_pairs)
+        return DAEModel(
+            scene_name=scene.name, formulation=self.formulation, alpha=float(alpha), beta=float(beta),
+            body_names=self.body_names, constraint_names=self.constraint_names,
+            state_names=self.state_names, state_kinds=self.state_kinds, functions=self.functions,
+            terms=self.terms, gap_names=self.gap_names, channel_names=self.channel_names,
+            channel_units=self.channel_units, outputs=self.outputs,
+            q_guess=np.concatenate([[*b.position, b.angle] for b in bodies]),
+            v_guess=np.concatenate([[*b.velocity, b.angular_velocity] for b in bodies]),
+            mass_diagonal=np.concatenate([[b.mass, b.mass, b.inertia] for b in bodies]),
+            kinematics=self.kinematics, base_force=self.base_force,
+            parameters={"scene": scene.to_dict(), "formulation": self.formulation, "alpha": alpha, "beta": beta,
+                        "track_work": self.track_work},
+            contacts=contacts, track_work=self.track_work, auto_pairs=auto_pairs,
+            parameter_layout=self.layout, parameter_values=P,
+        )
+
+
+# Templates built in this process, by structure key (a scene that differs only in numbers
+# reuses one: no CasADi work, and the same compiled library).
+_TEMPLATES: dict[str, _Template] = memo_table()
+_TEMPLATE_LIMIT = 64
+# Part of every structure key: bump when the generated functions change meaning.
+_ENGINE_VERSION = "engine-2"
 
 
 def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, beta: float = 5.0,
              track_work: bool = False) -> DAEModel:
     """Assemble a validated scene into a :class:`DAEModel`.
+
+    Only the scene's structure (bodies, joints, clearance joints and their laws) is built
+    symbolically, once per process; every number is run-time parameter data
+    (``model.parameter_values``), so scenes that differ only in numbers share the symbolic
+    functions and the compiled library.
 
     Parameters
     ----------
@@ -382,7 +501,19 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
             raise SceneError(f"{label}={value!r} 1/s, must be a finite number >= 0.")
     scene.validate()
+    table, key = scene_parameters(scene, formulation, alpha, beta, track_work)
+    template = _TEMPLATES.get(key)
+    if template is None:
+        template = _build_template(scene, formulation, bool(track_work), table, f"mechanism_{key[:16]}")
+        if len(_TEMPLATES) >= _TEMPLATE_LIMIT:
+            _TEMPLATES.pop(next(iter(_TEMPLATES)))
+        _TEMPLATES[key] = template
+    return template.bind(scene, table, alpha, beta)
 
+
+def _build_template(scene: Scene, formulation: str, track_work: bool, table: ParameterTable,
+                    name: str) -> _Template:
+    """The symbolic DAE of the scene's structure, every number a symbol of the parameter vector P."""
     bodies = scene.bodies
     nb = len(bodies)
     n = 3 * nb
@@ -390,15 +521,15 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     q = ca.SX.sym("q", n)
     v = ca.SX.sym("v", n)
     a = ca.SX.sym("a", n)
+    P = ca.SX.sym("P", table.vector.size)
+    params = table.symbols(P)
 
     frames: dict[str, BodyFrame] = {
         GROUND: BodyFrame(GROUND, None, ca.DM.zeros(2), ca.DM(0.0), ca.DM.zeros(2), ca.DM(0.0))
     }
-    reference: dict[str, tuple[tuple[float, float], float]] = {GROUND: ((0.0, 0.0), 0.0)}
     for k, body in enumerate(bodies):
         frames[body.name] = BodyFrame(body.name, k, q[3 * k:3 * k + 2], q[3 * k + 2], v[3 * k:3 * k + 2], v[3 * k + 2])
-        reference[body.name] = (body.position, body.angle)
-    ctx = AssemblyContext(t, q, v, a, frames, reference)
+    ctx = AssemblyContext(t, q, v, a, P, frames, params, table.offsets())
 
     # ---- constraints ----
     phi_list: list[Any] = []
@@ -416,13 +547,11 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         elif isinstance(element, Driver):
             driver_rows[element.name] = len(phi_list)
             eqs, labels = [_driver(ctx, element, revolutes[element.joint])], [element.name]
-        elif type(element) in CONTACT_BUILDERS:
+        else:  # a clearance joint (scene_parameters rejected anything else)
             first_term = sum(len(b.terms) for b in contact_builds)
             first_root = sum(len(b.gaps) for b in contact_builds)
-            contact_builds.append(CONTACT_BUILDERS[type(element)](ctx, element, scene, first_term, first_root))
+            contact_builds.append(CONTACT_BUILDERS[type(element)][1](ctx, element, first_term, first_root))
             continue
-        else:
-            raise AssemblyError(f"{element.kind} '{element.name}': element type not supported by assemble().")
         phi_list.extend(eqs)
         names.extend(labels)
 
@@ -432,16 +561,17 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     Phi_t = ca.jacobian(Phi, t)
     Phi_dot = ca.mtimes(Phi_q, v) + Phi_t
     gamma = -(ca.mtimes(ca.jacobian(Phi_dot, q), v) + ca.jacobian(Phi_dot, t))
-    kinematics = ca.Function("kinematics", [q, v, t], [Phi, ca.densify(Phi_q), Phi_dot, gamma],
-                             ["q", "v", "t"], ["Phi", "Phi_q", "Phi_dot", "gamma"])
+    kinematics = ca.Function("kinematics", [q, v, t, P], [Phi, ca.densify(Phi_q), Phi_dot, gamma],
+                             ["q", "v", "t", "P"], ["Phi", "Phi_q", "Phi_dot", "gamma"])
 
     # ---- masses and applied forces ----
-    gx, gy = scene.gravity
-    mass_diag = np.concatenate([[b.mass, b.mass, b.inertia] for b in bodies])
-    M = ca.diag(ca.DM(mass_diag))
-    Q = ca.vertcat(*[ca.vertcat(b.mass * gx, b.mass * gy, 0.0) for b in bodies])
+    g_vec = params["gravity"]
+    gx, gy = g_vec[0], g_vec[1]
+    mass_diag = ca.vertcat(*[ca.vertcat(params[f"{b.name}.mass"], params[f"{b.name}.mass"],
+                                        params[f"{b.name}.inertia"]) for b in bodies])
+    Q = ca.vertcat(*[ca.vertcat(params[f"{b.name}.mass"] * gx, params[f"{b.name}.mass"] * gy, 0.0) for b in bodies])
     Q = Q + 0 * t  # keep Q symbolic in t for a uniform signature
-    base_force = ca.Function("base_force", [t, q, v], [Q], ["t", "q", "v"], ["Q"])
+    base_force = ca.Function("base_force", [t, q, v, P], [Q], ["t", "q", "v", "P"], ["Q"])
 
     # ---- state vector ----
     lam = ca.SX.sym("lam", m)
@@ -451,8 +581,9 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     body_rate = [f"{b.name}.{c}" for b in bodies for c in ("vx", "vy", "omega")]
     state_names = body_state + body_rate + [f"lambda.{c}" for c in names]
     kinds = [KIND_POSITION] * n + [KIND_VELOCITY] * n + [KIND_MULTIPLIER] * m
-    eom = ca.mtimes(M, a) + ca.mtimes(Phi_q.T, lam) - Q
+    eom = mass_diag * a + ca.mtimes(Phi_q.T, lam) - Q
     if formulation == "index1":
+        alpha, beta = params["baumgarte.alpha"], params["baumgarte.beta"]
         y = ca.vertcat(q, v, lam)
         yp = ca.vertcat(q_p, a, lam_p)
         res = ca.vertcat(q_p - v, eom, ca.mtimes(Phi_q, a) - gamma + 2 * alpha * Phi_dot + beta**2 * Phi)
@@ -468,7 +599,7 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     # Multipliers from (t, q, v) and extra generalized forces Fc, by the Schur complement of the
     # KKT system [M Phi_q^T; Phi_q 0][a; lam] = [Q + Fc; c] (M is diagonal). Used for consistent
     # states and for the work rate, which must not depend on IDA's unconverged multipliers.
-    Minv = ca.DM(1.0 / mass_diag)
+    Minv = 1.0 / mass_diag
     rhs_c = gamma - 2 * alpha * Phi_dot - beta**2 * Phi if formulation == "index1" else gamma
     Fc = ca.SX.sym("Fc", n)
     if m:
@@ -487,9 +618,9 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         kinds.append(KIND_WORK)
     n_y = y.numel()
     cj = ca.SX.sym("cj")
-    residual = ca.Function("residual", [t, y, yp], [res], ["t", "y", "yp"], ["r"])
-    jac = ca.densify(ca.jacobian(res, y) + cj * ca.jacobian(res, yp))
-    jacobian = ca.Function("jacobian", [t, y, yp, cj], [jac], ["t", "y", "yp", "cj"], ["J"])
+    residual = ca.Function("residual", [t, y, yp, P], [res], ["t", "y", "yp", "P"], ["r"])
+    jac = ca.jacobian(res, y) + cj * ca.jacobian(res, yp)
+    jacobian = ca.Function("jacobian", [t, y, yp, cj, P], [jac], ["t", "y", "yp", "cj", "P"], ["J"])
 
     # ---- contact terms: generalized forces added to the equations of motion rows ----
     terms: list[Term] = []
@@ -498,7 +629,6 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     gaps: list[Any] = []
     gap_names: list[str] = []
     contact_channels: list[Channel] = []
-    contacts: list[Any] = []
     switch_syms: list[Any] = []  # per term: on/off flag and parameters, inputs of the outputs
     power_channels: list[Any] = []
     for build in contact_builds:
@@ -511,28 +641,26 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         contact_channels.extend(build.channels(switches))
         for term, (on_k, p_k) in zip(build.terms, switches):
             # power of the contact force on the mechanism (energy balance: dE/dt = sum of powers)
-            power = ca.if_else(on_k > 0, ca.dot(term.force(t, q, v, p_k), v), 0.0)  # 0 (not NaN) when off
+            power = ca.if_else(on_k > 0, ca.dot(term.force(t, q, v, p_k, P), v), 0.0)  # 0 (not NaN) when off
             contact_channels.append(Channel(f"{term.name}.power", "W", power))
             power_channels.append(power)
         for term in build.terms:
             p = ca.SX.sym("p", term.n_params)
-            Qk = term.force(t, q, v, p)
+            Qk = term.force(t, q, v, p, P)
             # the term's share of the work rate: its own power and the driver power it causes
             work_row = [-(ca.dot(Qk, v) + ca.substitute(drive_power_of, Fc, Qk) - drive_power_base)] if track_work else []
             r_k = ca.vertcat(ca.SX.zeros(n), -Qk, ca.SX.zeros(n_y - 2 * n - len(work_row)), *work_row)
             ident = _c_identifier(term.name)  # term names may hold dots (channel names); C may not
-            term_res.append(ca.Function(f"{ident}_res", [t, y, yp, p], [r_k], ["t", "y", "yp", "p"], ["r"]))
-            j_k = ca.densify(ca.jacobian(r_k, y) + cj * ca.jacobian(r_k, yp))
-            term_jac.append(ca.Function(f"{ident}_jac", [t, y, yp, p, cj], [j_k],
-                                        ["t", "y", "yp", "p", "cj"], ["J"]))
+            term_res.append(ca.Function(f"{ident}_res", [t, y, yp, p, P], [r_k], ["t", "y", "yp", "p", "P"], ["r"]))
+            j_k = ca.jacobian(r_k, y) + cj * ca.jacobian(r_k, yp)
+            term_jac.append(ca.Function(f"{ident}_jac", [t, y, yp, p, cj, P], [j_k],
+                                        ["t", "y", "yp", "p", "cj", "P"], ["J"]))
             terms.append(term)
         gaps.extend(build.gaps)
         gap_names.extend(build.gap_names)
-        contacts.extend(build.logic)
     roots = None
     if gaps:
-        roots = ca.Function("roots", [t, y, yp], [ca.vertcat(*gaps)], ["t", "y", "yp"], ["g"])
-
+        roots = ca.Function("roots", [t, y, yp, P], [ca.vertcat(*gaps)], ["t", "y", "yp", "P"], ["g"])
 
     # ---- output channels ----
     channels: list[Channel] = []
@@ -554,8 +682,8 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         power_d = -lam[row] * ca.mtimes(Phi_q[row, :], v)  # moment times relative angular speed
         channels.append(Channel(f"{name}.power", "W", power_d))
         power_channels.append(power_d)
-    kinetic = 0.5 * ca.dot(ca.DM(mass_diag), v * v)
-    potential = -sum(b.mass * (gx * q[3 * k] + gy * q[3 * k + 1]) for k, b in enumerate(bodies))
+    kinetic = 0.5 * ca.dot(mass_diag, v * v)
+    potential = -sum(params[f"{b.name}.mass"] * (gx * q[3 * k] + gy * q[3 * k + 1]) for k, b in enumerate(bodies))
     channels += [
         Channel("energy.kinetic", "J", kinetic),
         Channel("energy.potential", "J", potential),
@@ -572,40 +700,37 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         ]
     channels += contact_channels
     switch = ca.vertcat(*switch_syms) if switch_syms else ca.SX(0, 1)
-    outputs = ca.Function("outputs", [t, y, yp, switch], [ca.vertcat(*[c.expr for c in channels])],
-                          ["t", "y", "yp", "switch"], ["channels"])
+    outputs = ca.Function("outputs", [t, y, yp, switch, P], [ca.vertcat(*[c.expr for c in channels])],
+                          ["t", "y", "yp", "switch", "P"], ["channels"])
     # accelerations, multipliers (and work rate) from (t, q, v, contact forces) as generated code:
     # consistent states at restarts and at every reported point cost ~1 us
     work_rate = [drive_power_of + ca.dot(Fc, v)] if track_work else []
-    accel = ca.Function("accel", [t, q, v, Fc], [ca.densify(ca.vertcat(a_sol, lam_sol, *work_rate))],
-                        ["t", "q", "v", "Qc"], ["a_lam"])
+    accel = ca.Function("accel", [t, q, v, Fc, P], [ca.densify(ca.vertcat(a_sol, lam_sol, *work_rate))],
+                        ["t", "q", "v", "Qc", "P"], ["a_lam"])
     extras = [outputs, accel] + [term.force for term in terms]
     # simple contact pairs whose switches the compiled loop may handle itself (see ida_driver.c)
+    logic_makers = tuple(build.logic for build in contact_builds)
+    sample = [logic for make in logic_makers for logic in make(table.vector)]
     auto_pairs = []
-    simple = [getattr(logic, "simple_pairs", lambda: None)() for logic in contacts]
-    if formulation == "index1" and contacts and all(pairs is not None for pairs in simple):
-        for pairs in simple:
-            for root, term_index, gap_rate, needs, floor in pairs:
+    simple = [getattr(logic, "simple_pairs", lambda: None)() for logic in sample]
+    if formulation == "index1" and sample and all(pairs is not None for pairs in simple):
+        for index, pairs in enumerate(simple):
+            for root, term_index, gap_rate, needs, _floor in pairs:
                 extras.append(gap_rate)
-                auto_pairs.append((root, term_index, len(extras) - 1, needs, floor))
+                auto_pairs.append((root, term_index, len(extras) - 1, needs, index))
     functions = DAEFunctions(
         n=n_y, residual=residual, jacobian=jacobian, term_residuals=tuple(term_res),
-        term_jacobians=tuple(term_jac), roots=roots, name=_c_identifier(scene.name), extras=tuple(extras),
+        term_jacobians=tuple(term_jac), roots=roots, name=name, extras=tuple(extras),
+        n_parameters=int(P.numel()),
     )
-
-    q_guess = np.concatenate([[*b.position, b.angle] for b in bodies])
-    v_guess = np.concatenate([[*b.velocity, b.angular_velocity] for b in bodies])
-    return DAEModel(
-        scene_name=scene.name, formulation=formulation, alpha=float(alpha), beta=float(beta),
+    return _Template(
+        layout=table.layout, formulation=formulation, track_work=track_work,
         body_names=tuple(b.name for b in bodies), constraint_names=tuple(names),
         state_names=tuple(state_names), state_kinds=tuple(kinds), functions=functions,
         terms=tuple(terms), gap_names=tuple(gap_names),
         channel_names=tuple(c.name for c in channels), channel_units={c.name: c.unit for c in channels},
-        outputs=outputs, q_guess=q_guess, v_guess=v_guess, mass_diagonal=mass_diag,
-        kinematics=kinematics, base_force=base_force,
-        parameters={"scene": scene.to_dict(), "formulation": formulation, "alpha": alpha, "beta": beta,
-                    "track_work": bool(track_work)},
-        contacts=tuple(contacts), track_work=bool(track_work), auto_pairs=tuple(auto_pairs),
+        outputs=outputs, kinematics=kinematics, base_force=base_force, logic=logic_makers,
+        auto_pairs=tuple(auto_pairs),
     )
 
 

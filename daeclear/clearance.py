@@ -34,9 +34,10 @@ from numpy.typing import NDArray
 
 from .automaton import STORM_EVENTS, STORM_WINDOW  # noqa: F401  (re-exported: the storm guard's defaults)
 from .automaton import EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
+from .parameters import law_structure, law_values, symbolic_law
 from .result import ContactEvent
-from .scene import RevoluteClearance, Scene
-from .symbolic import AssemblyContext, BufferedFunction, Channel, Term, perpendicular
+from .scene import RevoluteClearance
+from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
 
 
 @dataclass
@@ -116,45 +117,69 @@ class PairLogic:
         return [ContactEvent(t=t, pair=self.pair, kind=EVENT_KINDS[decision.kind], approach_speed=rate, y=y.copy())]
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]]:
-        """(root, term, (q, v) -> [gap; rate], needs approach speed, floor): the pairs whose
+        """(root, term, (q, v, P) -> [gap; rate], needs approach speed, floor): the pairs whose
         switches the compiled IDA loop decides itself, by the C mirror of the automaton."""
-        q = ca.SX.sym("q", self.n_q)
-        v = ca.SX.sym("v", self.n_q)
-        gap, rate = self.rate.function(q, v)
-        f = ca.Function(f"{self.pair.replace('.', '_')}_gap_rate", [q, v], [ca.vertcat(gap, rate)])
+        fn = self.rate.function
+        q, v, P = (ca.SX.sym(label, fn.numel_in(i)) for i, label in enumerate(("q", "v", "P")))
+        gap, rate = fn(q, v, P)
+        f = ca.Function(f"{self.pair.replace('.', '_')}_gap_rate", [q, v, P], [ca.vertcat(gap, rate)])
         return [(self.root_index, self.term_index, f, bool(self.needs_approach), float(self.min_approach_speed))]
 
 
 @dataclass(frozen=True)
 class ContactBuild:
-    """What a clearance joint contributes to the assembled model."""
+    """What a clearance joint contributes to the assembled model.
+
+    ``logic(P)`` makes the joint's event logic for one parameter vector (the structure is
+    built once; each bound model gets its own logic with its own numbers and run state).
+    """
 
     terms: list[Term]
     gaps: list[Any]
     gap_names: list[str]
     channels: Callable[[Sequence[tuple[Any, Any]]], list[Channel]]
-    logic: list[Any]
+    logic: Callable[[NDArray[np.float64]], list[Any]]
 
 
-def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, scene: Scene,
-                             first_term: int, first_root: int) -> ContactBuild:
+def approach_floor(ctx: AssemblyContext, law: Any, prefix: str) -> Callable[[NDArray[np.float64]], float]:
+    """The law's ``min_approach_speed`` read from a parameter vector (or the baked number)."""
+    name = f"{prefix}.min_approach_speed"
+    if name in ctx.params:
+        index = ctx.offsets[name]
+        return lambda P: float(P[index])
+    floor = float(getattr(law, "min_approach_speed", 0.0))
+    return lambda P: floor
+
+
+def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> tuple[dict[str, Any], list[Any]]:
+    """The joint's numbers (run-time parameters) and what of it is structure."""
+    law, friction = joint.resolved_law(), joint.resolved_friction()
+    s_i, s_j = ref.joint_points(joint)
+    values: dict[str, Any] = {"s_i": s_i, "s_j": s_j, "clearance": joint.radial_clearance,
+                              "bearing_radius": float(joint.bearing_radius), "journal_radius": joint.journal}
+    values.update({f"law.{k}": v for k, v in law_values(law).items()})
+    values.update({f"friction.{k}": v for k, v in law_values(friction).items()})
+    return values, [law_structure(law), law_structure(friction)]
+
+
+def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, first_term: int,
+                             first_root: int) -> ContactBuild:
     """Journal-bearing contact (section 4.2): eqs. (4.1)-(4.13) with the joint's laws.
 
-    Body i carries the bearing (radius R_i), body j the journal (R_j); c = R_i - R_j.
+    Body i carries the bearing (radius R_i), body j the journal (R_j); c = R_i - R_j. Every
+    number comes from the run-time parameters ``<joint>.*`` (see revolute_clearance_parameters).
     """
-    law = joint.resolved_law()
-    friction = joint.resolved_friction()
-    c = joint.radial_clearance
-    R_i, R_j = float(joint.bearing_radius), joint.journal
-    if joint.at is not None:
-        s_i = ctx.local_point(joint.body_i, joint.at) if joint.point_i is None else np.asarray(joint.point_i)
-        s_j = ctx.local_point(joint.body_j, joint.at) if joint.point_j is None else np.asarray(joint.point_j)
-    else:
-        s_i, s_j = np.asarray(joint.point_i), np.asarray(joint.point_j)
+    name = joint.name
+    law_numeric, friction_numeric = joint.resolved_law(), joint.resolved_friction()
+    law = symbolic_law(law_numeric, ctx.params, f"{name}.law")
+    friction = symbolic_law(friction_numeric, ctx.params, f"{name}.friction")
+    c = ctx.p(name, "clearance")
+    R_i, R_j = ctx.p(name, "bearing_radius"), ctx.p(name, "journal_radius")
+    s_i, s_j = ctx.p(name, "s_i"), ctx.p(name, "s_j")
     bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
-    P_i, P_j = bi.point(ca.DM(s_i)), bj.point(ca.DM(s_j))  # (4.2)
+    P_i, P_j = bi.point(s_i), bj.point(s_j)  # (4.2)
     e = P_j - P_i  # (4.1) eccentricity
-    e_dot = bj.point_velocity(ca.DM(s_j)) - bi.point_velocity(ca.DM(s_i))
+    e_dot = bj.point_velocity(s_j) - bi.point_velocity(s_i)
     ee = ca.dot(e, e)
     gap = (ee - c * c) / (2.0 * c)  # smooth at e = 0; equals delta (1 + delta / 2c) near contact
 
@@ -169,42 +194,48 @@ def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, sce
     # (4.9) with the velocities of the material points at the contact (spin included)
     v_T = ca.dot(bj.world_point_velocity(Q_j) - bi.world_point_velocity(Q_i), t_vec)
 
-    n_params = 1 if law.needs_approach_speed else 0
+    n_params = 1 if law_numeric.needs_approach_speed else 0
     p = ca.SX.sym("p", n_params)
     F_N = law.force(delta, delta_dot, p[0] if n_params else None)
-    F_T = 0.0 if friction.frictionless else friction.friction_force(F_N, v_T)
+    F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
     f_journal = -F_N * n + F_T * t_vec  # force on the journal (body j); the bearing gets the opposite
     Q = ctx.generalized_force([(joint.body_j, f_journal, Q_j), (joint.body_i, -f_journal, Q_i)])
-    force = ca.Function(f"{joint.name}_force", [ctx.t, ctx.q, ctx.v, p], [Q], ["t", "q", "v", "p"], ["Q"])
-    rate = ca.Function(f"{joint.name}_rate", [ctx.q, ctx.v], [gap, ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
-    logic = PairLogic(joint.name, first_root, first_term, BufferedFunction(rate), ctx.n_q, law.needs_approach_speed,
-                      float(getattr(law, "min_approach_speed", 0.0)),
-                      discontinuous_friction=not friction.frictionless and not friction.smooth)
+    force = ca.Function(f"{name}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P], [Q], ["t", "q", "v", "p", "P"], ["Q"])
+    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P], [gap, ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
+    floor = approach_floor(ctx, law_numeric, f"{name}.law")
+    discontinuous = not friction_numeric.frictionless and not friction_numeric.smooth
+
+    def logic(P: NDArray[np.float64]) -> list[Any]:
+        return [PairLogic(name, first_root, first_term, BufferedFunction(rate, bound=(P,)), ctx.n_q,
+                          law_numeric.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
         on, p_sym = switches[0]
         F_N_out = on * ca.substitute(F_N, p, p_sym) if n_params else on * F_N
         out = [
-            Channel(f"{joint.name}.ex", "m", e[0]),
-            Channel(f"{joint.name}.ey", "m", e[1]),
-            Channel(f"{joint.name}.eccentricity", "m", e_norm),
-            Channel(f"{joint.name}.penetration", "m", e_norm - c),
-            Channel(f"{joint.name}.penetration_rate", "m/s", ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)),
-            Channel(f"{joint.name}.normal_force", "N", F_N_out),
-            Channel(f"{joint.name}.in_contact", "", on),
+            Channel(f"{name}.ex", "m", e[0]),
+            Channel(f"{name}.ey", "m", e[1]),
+            Channel(f"{name}.eccentricity", "m", e_norm),
+            Channel(f"{name}.penetration", "m", e_norm - c),
+            Channel(f"{name}.penetration_rate", "m/s", ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)),
+            Channel(f"{name}.normal_force", "N", F_N_out),
+            Channel(f"{name}.in_contact", "", on),
         ]
-        if not friction.frictionless:
+        if not friction_numeric.frictionless:
             F_T_out = on * (ca.substitute(F_T, p, p_sym) if n_params else F_T)
-            out += [Channel(f"{joint.name}.friction_force", "N", F_T_out),
-                    Channel(f"{joint.name}.sliding_velocity", "m/s", v_T)]
+            out += [Channel(f"{name}.friction_force", "N", F_T_out),
+                    Channel(f"{name}.sliding_velocity", "m/s", v_T)]
         return out
 
-    return ContactBuild(terms=[Term(joint.name, force, n_params)], gaps=[gap], gap_names=[joint.name],
-                        channels=channels, logic=[logic])
+    return ContactBuild(terms=[Term(name, force, n_params)], gaps=[gap], gap_names=[name],
+                        channels=channels, logic=logic)
 
 
-CONTACT_BUILDERS: dict[type, Callable[..., ContactBuild]] = {RevoluteClearance: build_revolute_clearance}
+#: Clearance joint type -> (parameter function, builder).
+CONTACT_BUILDERS: dict[type, tuple[Callable[..., tuple[dict[str, Any], list[Any]]], Callable[..., ContactBuild]]] = {
+    RevoluteClearance: (revolute_clearance_parameters, build_revolute_clearance)}
 
-from .slider_guide import TranslationalClearance, build_translational_clearance  # noqa: E402  (imports ContactBuild)
+from .slider_guide import (  # noqa: E402  (imports ContactBuild)
+    TranslationalClearance, build_translational_clearance, translational_clearance_parameters)
 
-CONTACT_BUILDERS[TranslationalClearance] = build_translational_clearance
+CONTACT_BUILDERS[TranslationalClearance] = (translational_clearance_parameters, build_translational_clearance)

@@ -35,10 +35,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="daeclear", description="Planar mechanisms with clearance joints.")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="simulate a named mechanism or a scene file (.toml)")
-    run.add_argument("target", help="mechanism name (slider_crank) or path to a .toml scene file")
+    run.add_argument("target", help="mechanism name (slider_crank, chain) or path to a .toml scene file")
     run.add_argument("--joint", help="slider_crank: which joint has clearance (ideal, revolute, translational)")
     run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                     help="mechanism parameter, e.g. --set rpm=3000 (repeatable)")
+                     help="mechanism parameter, e.g. --set rpm=3000 or --set n_links=4 (repeatable)")
     run.add_argument("--t-end", type=float, help="end time, s (default: two crank revolutions)")
     run.add_argument("--rtol", type=float, help="relative tolerance (default 1e-6)")
     run.add_argument("--formulation", choices=["index1", "ggl"], help="DAE formulation (default index1)")
@@ -64,6 +64,14 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _mechanism(mechanisms: dict[str, Any], name: str, params: dict[str, Any]) -> Any:
+    """Build a named mechanism; a missing required parameter (chain's n_links) is a clear error."""
+    try:
+        return mechanisms[name](**params)
+    except TypeError as exc:
+        raise DaeclearError(f"{name}: {exc} (give it with --set KEY=VALUE).") from None
+
+
 def _run(args: argparse.Namespace) -> int:
     from .scenefile import MECHANISMS, read_scene_file
     from .solve import simulate
@@ -79,14 +87,14 @@ def _run(args: argparse.Namespace) -> int:
     elif args.target in MECHANISMS:
         if args.joint:
             params["joint"] = args.joint
-        scene = MECHANISMS[args.target](**params)
+        scene = _mechanism(MECHANISMS, args.target, params)
         if params.get("joint", "ideal") != "ideal":  # the chapter plots against the ideal joint
             reference_scene = MECHANISMS[args.target](**{**params, "joint": "ideal"})
     else:
         raise DaeclearError(f"run: {args.target!r} is neither a scene file nor a mechanism "
                             f"({', '.join(MECHANISMS)}).")
-    rpm = float(params.get("rpm", 5000.0))
-    default_t_end = 2 * 60.0 / abs(rpm) if rpm else 0.024  # two crank revolutions
+    rpm = params.get("rpm", 5000.0)
+    default_t_end = 2 * 60.0 / abs(float(rpm)) if rpm else 0.024  # two crank revolutions
     t_end = args.t_end or sim.pop("t_end", None) or default_t_end
     sim.pop("t_end", None)
     step = sim.pop("t_eval_step", None)
@@ -112,12 +120,24 @@ def _run(args: argparse.Namespace) -> int:
         if reference_scene is not None:
             reference = simulate(reference_scene, t_end, rtol=options["rtol"], backend=args.backend,
                                  on_failure="return")
-        png = save_response_figure(result, args.out / f"{base}.png", reference=reference)
+        png = save_response_figure(result, args.out / f"{base}.png", reference=reference,
+                                   channels=_figure_channels(result, scene))
         print(f"wrote {png}")
     if not result.success:
         print(f"daeclear: run failed: {result.message}", file=sys.stderr)
         return 1
     return 0
+
+
+def _figure_channels(result: Any, scene: Any) -> tuple[str, ...]:
+    """The slider-crank's response channels if the result has any, else the last body's motion and energy
+    (a chain or a scene file without a slider would otherwise get an empty figure)."""
+    from .plot import RESPONSE_CHANNELS
+
+    if any(name in result for name in RESPONSE_CHANNELS):
+        return RESPONSE_CHANNELS
+    last = scene.bodies[-1].name
+    return tuple(c for c in (f"{last}.phi", f"{last}.omega", "drive.moment", "energy.mechanical") if c in result)
 
 
 def _floats(text: str, what: str) -> list[float]:
@@ -135,7 +155,7 @@ def _study(args: argparse.Namespace) -> int:
         raise DaeclearError(f"study: {args.target!r} is not a mechanism ({', '.join(MECHANISMS)}).")
     params = _parse_sets(args.set)
     params.setdefault("joint", args.joint)
-    scene = MECHANISMS[args.target](**params)
+    scene = _mechanism(MECHANISMS, args.target, params)
     methods = {m.strip(): {"method": m.strip()} for m in args.methods.split(",") if m.strip()}
     study = work_precision(scene, args.t_end, channels=[c.strip() for c in args.channels.split(",") if c.strip()],
                            methods=methods, rtols=_floats(args.rtols, "rtols"), steps=_floats(args.steps, "steps"),

@@ -56,6 +56,7 @@ __all__ = [
     "sundials_libraries",
     "cache_dir",
     "build_model_library",
+    "clear_memos",
 ]
 
 CSRC = Path(__file__).resolve().parent / "csrc"
@@ -67,7 +68,12 @@ SUNDIALS_LIBS = (
     "sundials_sunmatrixdense",
     "sundials_sunlinsoldense",
 )
-CFLAGS = ("-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Werror=incompatible-pointer-types",
+#: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
+#: and checked when a library is loaded: bump it when a dc_* signature changes.
+DRIVER_ABI = 2
+#: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
+ODE_DRIVER_ABI = 2
+CFLAGS = (f"-DDC_ABI_VERSION={DRIVER_ABI}", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Werror=incompatible-pointer-types",
           "-Werror=implicit-function-declaration")
 
 
@@ -84,11 +90,13 @@ class CompileError(DaeclearError):
 
 @dataclass(frozen=True)
 class NormalizedModel:
-    """The model's functions with dense column-vector inputs and one dense output each.
+    """The model's functions with column-vector inputs, the run-time parameters ``P`` last.
 
-    Signatures (sizes): ``res (1, n, n) -> n``; ``jac (1, n, n, 1) -> n x n``;
-    ``term_res[k] (1, n, n, p_k) -> n``; ``term_jac[k] (1, n, n, p_k, 1) -> n x n``;
-    ``roots (1, n, n) -> n_roots`` or None.
+    Signatures (sizes): ``res (1, n, n, n_P) -> n``; ``jac (1, n, n, 1, n_P) -> n x n``;
+    ``term_res[k] (1, n, n, p_k, n_P) -> n``; ``term_jac[k] (1, n, n, p_k, 1, n_P) -> n x n``;
+    ``roots (1, n, n, n_P) -> n_roots`` or None; ``extras[k] (..., n_P) -> vector``. Residuals,
+    roots and extras have dense outputs; the Jacobians keep CasADi's sparsity (compressed
+    column storage), so generated code grows with their nonzeros, not with n^2.
     """
 
     n: int
@@ -101,6 +109,12 @@ class NormalizedModel:
     n_params: tuple[int, ...]
     n_roots: int
     extras: tuple[casadi.Function, ...] = ()
+    n_parameters: int = 0
+
+    def dense(self, f: casadi.Function) -> casadi.Function:
+        """``f`` with a dense output (for the Python backend, which adds whole matrices)."""
+        ins = [casadi.MX.sym(f"i{k}", f.sparsity_in(k)) for k in range(f.n_in())]
+        return casadi.Function(f.name() + "_dense", ins, [casadi.densify(f.call(ins)[0])])
 
 
 def _check(f: Any, what: str, sizes: list[int | None], out_numel: int | None) -> list[int]:
@@ -126,46 +140,66 @@ def _check(f: Any, what: str, sizes: list[int | None], out_numel: int | None) ->
     return got
 
 
-def _wrap(f: casadi.Function, name: str, in_sizes: list[int], out_shape: tuple[int, int]) -> casadi.Function:
-    """Same function with dense column-vector inputs and a dense output of out_shape."""
+def _with_parameters(f: Any, n_base: int, n_parameters: int) -> Any:
+    """``f`` with the run-time parameter input last: as it is when it has one, else with an
+    unused input of ``n_parameters`` elements (hand-made models without parameters)."""
+    if not isinstance(f, casadi.Function) or f.n_in() != n_base:
+        return f
+    sym = casadi.SX if f.is_a("SXFunction") else casadi.MX
+    ins = [sym.sym(f"i{k}", f.sparsity_in(k)) for k in range(n_base)] + [sym.sym("P", n_parameters)]
+    return casadi.Function(f.name(), ins, f.call(ins[:n_base]))
+
+
+def _wrap(f: casadi.Function, name: str, in_sizes: list[int], out_shape: tuple[int, int],
+          keep_sparsity: bool = False) -> casadi.Function:
+    """Same function with column-vector inputs and an output of out_shape (dense unless
+    ``keep_sparsity``)."""
     sym = casadi.SX if f.is_a("SXFunction") else casadi.MX
     ins = [sym.sym(f"i{k}", s) for k, s in enumerate(in_sizes)]
     args = [casadi.reshape(x, f.size_in(k)) for k, x in enumerate(ins)]
-    out = f.call(args)[0]
-    out = casadi.densify(casadi.reshape(out, out_shape[0], out_shape[1]))
-    return casadi.Function(name, ins, [out])
+    out = casadi.reshape(f.call(args)[0], out_shape[0], out_shape[1])
+    return casadi.Function(name, ins, [out if keep_sparsity else casadi.densify(out)])
 
 
 def normalize_model(funcs: Any) -> NormalizedModel:
-    """Validate a DAEFunctions and return its dense, uniformly named functions."""
+    """Validate a DAEFunctions and return its uniformly named functions (parameters last)."""
     n = int(funcs.n)
     if n < 1:
         raise AssemblyError(f"DAEFunctions.n must be >= 1, got {n}")
-    _check(funcs.residual, "residual", [1, n, n], n)
-    _check(funcs.jacobian, "jacobian", [1, n, n, 1], n * n)
+    n_P = int(getattr(funcs, "n_parameters", 0))
+    residual = _with_parameters(funcs.residual, 3, n_P)
+    jacobian = _with_parameters(funcs.jacobian, 4, n_P)
+    _check(residual, "residual", [1, n, n, n_P], n)
+    _check(jacobian, "jacobian", [1, n, n, 1, n_P], n * n)
     if len(funcs.term_residuals) != len(funcs.term_jacobians):
         raise AssemblyError(
             f"{len(funcs.term_residuals)} term residuals but {len(funcs.term_jacobians)} term Jacobians"
         )
-    res = _wrap(funcs.residual, "dc_res", [1, n, n], (n, 1))
-    jac = _wrap(funcs.jacobian, "dc_jac", [1, n, n, 1], (n, n))
+    res = _wrap(residual, "dc_res", [1, n, n, n_P], (n, 1))
+    jac = _wrap(jacobian, "dc_jac", [1, n, n, 1, n_P], (n, n), keep_sparsity=True)
     tres, tjac, n_params = [], [], []
     for k, (fr, fj) in enumerate(zip(funcs.term_residuals, funcs.term_jacobians)):
-        p = _check(fr, f"term_residuals[{k}]", [1, n, n, None], n)[3]
-        _check(fj, f"term_jacobians[{k}]", [1, n, n, p, 1], n * n)
-        tres.append(_wrap(fr, f"dc_term{k}_res", [1, n, n, p], (n, 1)))
-        tjac.append(_wrap(fj, f"dc_term{k}_jac", [1, n, n, p, 1], (n, n)))
+        fr, fj = _with_parameters(fr, 4, n_P), _with_parameters(fj, 5, n_P)
+        p = _check(fr, f"term_residuals[{k}]", [1, n, n, None, n_P], n)[3]
+        _check(fj, f"term_jacobians[{k}]", [1, n, n, p, 1, n_P], n * n)
+        tres.append(_wrap(fr, f"dc_term{k}_res", [1, n, n, p, n_P], (n, 1)))
+        tjac.append(_wrap(fj, f"dc_term{k}_jac", [1, n, n, p, 1, n_P], (n, n), keep_sparsity=True))
         n_params.append(p)
     roots = None
     n_roots = 0
     if funcs.roots is not None:
-        _check(funcs.roots, "roots", [1, n, n], None)
-        n_roots = int(funcs.roots.numel_out(0))
+        froots = _with_parameters(funcs.roots, 3, n_P)
+        _check(froots, "roots", [1, n, n, n_P], None)
+        n_roots = int(froots.numel_out(0))
         if n_roots > 0:
-            roots = _wrap(funcs.roots, "dc_roots", [1, n, n], (n_roots, 1))
+            roots = _wrap(froots, "dc_roots", [1, n, n, n_P], (n_roots, 1))
     extras = []
     for k, f in enumerate(getattr(funcs, "extras", ())):
+        if n_P == 0 and (f.n_in() == 0 or f.numel_in(f.n_in() - 1) != 0):
+            f = _with_parameters(f, f.n_in(), 0)
         sizes = _check(f, f"extras[{k}]", [None] * f.n_in(), None)
+        if sizes[-1] != n_P:
+            raise AssemblyError(f"extras[{k}] ({f.name()}) must take the {n_P} run-time parameters as its last input")
         extras.append(_wrap(f, f"dc_extra{k}", sizes, (f.numel_out(0), 1)))
     return NormalizedModel(
         extras=tuple(extras),
@@ -178,6 +212,7 @@ def normalize_model(funcs: Any) -> NormalizedModel:
         roots=roots,
         n_params=tuple(n_params),
         n_roots=n_roots,
+        n_parameters=n_P,
     )
 
 
@@ -191,8 +226,11 @@ def _c_string(s: str) -> str:
 def _fun_entry(name: str) -> str:
     return (
         f"{{{name}, {name}_work, {name}_checkout, {name}_release, {name}_incref, {name}_decref, "
-        f'"{name}"}}'
+        f'{name}_sparsity_out, "{name}"}}'
     )
+
+
+_NO_FUN = "{0, 0, 0, 0, 0, 0, 0, 0}"
 
 
 def generate_source(model: NormalizedModel) -> str:
@@ -221,15 +259,15 @@ def generate_source(model: NormalizedModel) -> str:
         lines.append(f"static const dc_fun_t dc_term_jac_tab[{nt}] = {{")
         lines += [f"  {_fun_entry(f'dc_term{k}_jac')}," for k in range(nt)]
         lines.append("};")
-    roots_entry = _fun_entry("dc_roots") if model.roots is not None else "{0, 0, 0, 0, 0, 0, 0}"
+    roots_entry = _fun_entry("dc_roots") if model.roots is not None else _NO_FUN
     ne = len(model.extras)
     lines.append(f"const int dc_n_extras = {ne};")
     lines.append(f"const dc_fun_t dc_extra_tab[{max(ne, 1)}] = {{")
-    lines += [f"  {_fun_entry(f'dc_extra{k}')}," for k in range(ne)] or ["  {0, 0, 0, 0, 0, 0, 0},"]
+    lines += [f"  {_fun_entry(f'dc_extra{k}')}," for k in range(ne)] or [f"  {_NO_FUN},"]
     lines.append("};")
     lines += [
         "const dc_model_t dc_model = {",
-        f"  {model.n}, {nt}, {model.n_roots},",
+        f"  {model.n}, {nt}, {model.n_roots}, {model.n_parameters},",
         f"  {'dc_n_params_tab' if nt else '0'},",
         f"  {_fun_entry('dc_res')},",
         f"  {_fun_entry('dc_jac')},",
@@ -335,23 +373,42 @@ def _driver_text() -> str:
     return "".join(f"/* {name} */\n" + (CSRC / name).read_text() for name in DRIVER_SOURCES)
 
 
-# Libraries already built in this process, by DAEFunctions identity: simulating the same model
-# again skips code generation (tens of ms) as well as compilation.
-_BUILT: dict[int, tuple[Any, BuildResult]] = {}
+MemoTable = dict[Any, Any]
+_MEMO_TABLES: list[MemoTable] = []
 
 
-def memo_get(table: dict[int, tuple[Any, Any]], obj: Any) -> Any:
+def memo_table() -> MemoTable:
+    """A new in-process memo (by object identity with memo_get/memo_put, or by any key);
+    :func:`clear_memos` empties them all."""
+    table: MemoTable = {}
+    _MEMO_TABLES.append(table)
+    return table
+
+
+def clear_memos() -> None:
+    """Forget every assembled template, normalised model, generated spec and loaded library of
+    this process (the disk cache stays): the next run generates and loads again, e.g. after changing ``$CC``."""
+    for table in _MEMO_TABLES:
+        table.clear()
+
+
+def memo_get(table: MemoTable, obj: Any) -> Any:
     """The value memoised for this very object (identity, kept only while the object lives)."""
     entry = table.get(id(obj))
     return entry[1] if entry is not None and entry[0]() is obj else None
 
 
-def memo_put(table: dict[int, tuple[Any, Any]], obj: Any, value: Any) -> None:
+def memo_put(table: MemoTable, obj: Any, value: Any) -> None:
     try:
         ref = weakref.ref(obj, lambda _r, key=id(obj): table.pop(key, None))
     except TypeError:
         return
     table[id(obj)] = (ref, value)
+
+
+# Libraries already built in this process, by DAEFunctions identity (shared by every model of
+# one structure): simulating again skips code generation (tens of ms) as well as compilation.
+_BUILT = memo_table()
 
 
 def build_model_library(funcs: Any, *, model: NormalizedModel | None = None) -> BuildResult:
@@ -450,6 +507,10 @@ class OdeSpec:
     * ``term_force[k]``: (t, q, v, p_k) -> F_k[n]; ``term_jac[k]``: same inputs -> dF_k/d(q, v), n x 2n;
     * ``outputs`` (optional): (t, y, yp, switch) -> channel values, evaluated point by point by
       ``dco_outputs`` (the model's output channels without a CasADi map over many points).
+
+    Every function also takes the ``n_parameters`` run-time parameters P as its last input;
+    ``mass`` and ``parameters`` are data given to the compiled library when it is opened, so
+    the generated source depends on the structure only.
     """
 
     n: int
@@ -463,6 +524,8 @@ class OdeSpec:
     n_params: tuple[int, ...]
     name: str = "model"
     outputs: casadi.Function | None = None
+    n_parameters: int = 0
+    parameters: tuple[float, ...] = ()
 
     @property
     def n_gaps(self) -> int:
@@ -486,20 +549,23 @@ def _check_ode_spec(spec: OdeSpec) -> None:
 
     if len(spec.mass) != n or not all(mk > 0 for mk in spec.mass):
         raise AssemblyError(f"OdeSpec.mass must hold {n} positive values, got {list(spec.mass)}")
-    check(spec.sys, "sys", [1, n, n], [n, m * n, m])
-    check(spec.sys_jac, "sys_jac", [1, n, n, n, m], [(n + m) * 2 * n])
+    n_P = spec.n_parameters
+    if len(spec.parameters) != n_P:
+        raise AssemblyError(f"OdeSpec.parameters must hold {n_P} values, got {len(spec.parameters)}")
+    check(spec.sys, "sys", [1, n, n, n_P], [n, m * n, m])
+    check(spec.sys_jac, "sys_jac", [1, n, n, n, m, n_P], [(n + m) * 2 * n])
     if spec.gaps is not None:
-        check(spec.gaps, "gaps", [1, n, n], [spec.n_gaps, spec.n_gaps])
+        check(spec.gaps, "gaps", [1, n, n, n_P], [spec.n_gaps, spec.n_gaps])
     if not (len(spec.term_force) == len(spec.term_jac) == len(spec.n_params)):
         raise AssemblyError("OdeSpec: term_force, term_jac and n_params must have the same length")
     for k, (ff, fj, p) in enumerate(zip(spec.term_force, spec.term_jac, spec.n_params)):
-        check(ff, f"term_force[{k}]", [1, n, n, p], [n])
-        check(fj, f"term_jac[{k}]", [1, n, n, p], [n * 2 * n])
+        check(ff, f"term_force[{k}]", [1, n, n, p, n_P], [n])
+        check(fj, f"term_jac[{k}]", [1, n, n, p, n_P], [n * 2 * n])
     if spec.outputs is not None:
         f = spec.outputs
-        if not isinstance(f, casadi.Function) or f.n_in() != 4 or f.n_out() != 1 or f.numel_in(0) != 1 \
-                or f.numel_in(1) != f.numel_in(2):
-            raise AssemblyError("OdeSpec.outputs must be a casadi.Function (t[1], y[n_y], yp[n_y], switch) -> channels")
+        if not isinstance(f, casadi.Function) or f.n_in() != 5 or f.n_out() != 1 or f.numel_in(0) != 1 \
+                or f.numel_in(1) != f.numel_in(2) or f.numel_in(4) != n_P:
+            raise AssemblyError("OdeSpec.outputs must be a casadi.Function (t[1], y[n_y], yp[n_y], switch, P) -> channels")
 
 
 def generate_ode_source(spec: OdeSpec) -> str:
@@ -526,12 +592,10 @@ def generate_ode_source(spec: OdeSpec) -> str:
         outs = [casadi.densify(o) for o in f.call(args)]
         cg.add(casadi.Function(name, ins, outs))
     src = cg.dump()
-    mass = ", ".join(repr(float(mk)) for mk in spec.mass)
     lines = [
         "",
         "/* ---------------------------------------------------------------- daeclear ODE table */",
         '#include "dco_model.h"',
-        f"static const double dco_mass_tab[{spec.n}] = {{{mass}}};",
     ]
     if nt:
         lines.append(f"static const int dco_n_params_tab[{nt}] = {{{', '.join(map(str, spec.n_params))}}};")
@@ -541,19 +605,18 @@ def generate_ode_source(spec: OdeSpec) -> str:
         lines.append(f"static const dc_fun_t dco_term_jac_tab[{nt}] = {{")
         lines += [f"  {_fun_entry(f'dcog_term{k}_jac')}," for k in range(nt)]
         lines.append("};")
-    gaps_entry = _fun_entry("dcog_gaps") if spec.gaps is not None else "{0, 0, 0, 0, 0, 0, 0}"
+    gaps_entry = _fun_entry("dcog_gaps") if spec.gaps is not None else _NO_FUN
     lines += [
         "const dco_model_t dco_model = {",
-        f"  {spec.n}, {spec.m}, {nt}, {spec.n_gaps},",
+        f"  {spec.n}, {spec.m}, {nt}, {spec.n_gaps}, {spec.n_parameters},",
         f"  {'dco_n_params_tab' if nt else '0'},",
-        "  dco_mass_tab,",
         f"  {_fun_entry('dcog_sys')},",
         f"  {_fun_entry('dcog_sys_jac')},",
         f"  {gaps_entry},",
         f"  {'dco_term_force_tab' if nt else '0'},",
         f"  {'dco_term_jac_tab' if nt else '0'},",
         (f"  {spec.outputs.numel_in(1)}, {spec.outputs.numel_in(3)}, {spec.outputs.numel_out(0)}, "
-         f"{_fun_entry('dcog_outputs')}," if spec.outputs is not None else "  0, 0, 0, {0, 0, 0, 0, 0, 0, 0},"),
+         f"{_fun_entry('dcog_outputs')}," if spec.outputs is not None else f"  0, 0, 0, {_NO_FUN},"),
         f"  {_c_string(spec.name)}",
         "};",
         "",
@@ -570,8 +633,8 @@ def build_ode_library(spec: OdeSpec) -> BuildResult:
     """
     t0 = time.perf_counter()
     source = generate_ode_source(spec)
-    flags = ["-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Werror=incompatible-pointer-types",
-             "-Werror=implicit-function-declaration"]
+    flags = [f"-DDCO_ABI_VERSION={ODE_DRIVER_ABI}", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
+             "-Werror=incompatible-pointer-types", "-Werror=implicit-function-declaration"]
     driver = "".join(f"/* {name} */\n" + (CSRC / name).read_text() for name in ODE_DRIVER_SOURCES)
     return compile_cached("dco", f"the ODE model {spec.name!r}", source, "ode_driver.c", driver, flags, ["-lm"],
                           [], t0)

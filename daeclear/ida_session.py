@@ -54,11 +54,13 @@ from .automaton import Decision, PairState, Storm
 from .codegen import (
     memo_get,
     memo_put,
+    memo_table,
     BuildResult,
     CompileError,
     CompilerUnavailable,
     NormalizedModel,
     build_model_library,
+    DRIVER_ABI,
     normalize_model,
 )
 from .errors import DaeclearError, DaeclearWarning
@@ -74,7 +76,7 @@ __all__ = [
 ]
 
 BACKENDS = ("auto", "c", "python")
-_NORMALIZED: dict[int, tuple[Any, Any]] = {}  # normalize_model results by DAEFunctions identity
+_NORMALIZED = memo_table()  # normalize_model results by DAEFunctions identity
 
 #: flag of an Advance that stopped because the session's step cap (max_steps) was reached
 FLAG_MAX_STEPS = -1001
@@ -106,14 +108,17 @@ _STAT_KEYS = (
 class DAEFunctions:
     """A DAE F(t, y, y') = 0 with switchable terms, as CasADi functions.
 
-    residual: (t[1], y[n], yp[n]) -> r[n], always active.
-    jacobian: (t, y, yp, cj[1]) -> J[n x n] = dr/dy + cj dr/dyp (dense or sparse output).
-    term_residuals[k]: (t, y, yp, p_k[n_params_k]) -> r_k[n], added to r while term k is active.
-    term_jacobians[k]: (t, y, yp, p_k, cj) -> J_k[n x n], added to J while term k is active.
-    roots: (t, y, yp) -> g[n_roots], or None when the model has no events.
-    extras[k]: any functions with vector inputs and one output, compiled into the same library
-    and evaluated over many points at once by :meth:`Session.eval_extra` (post-processing:
+    residual: (t[1], y[n], yp[n], P) -> r[n], always active.
+    jacobian: (t, y, yp, cj[1], P) -> J[n x n] = dr/dy + cj dr/dyp (dense or sparse output).
+    term_residuals[k]: (t, y, yp, p_k[n_params_k], P) -> r_k[n], added to r while term k is active.
+    term_jacobians[k]: (t, y, yp, p_k, cj, P) -> J_k[n x n], added to J while term k is active.
+    roots: (t, y, yp, P) -> g[n_roots], or None when the model has no events.
+    extras[k]: any functions with vector inputs, P last, and one output, compiled into the same
+    library and evaluated over many points at once by :meth:`Session.eval_extra` (post-processing:
     output channels, consistent restarts); never called by IDA.
+
+    ``P`` holds the ``n_parameters`` run-time parameters (the values are given to
+    :func:`open_session`); with ``n_parameters == 0`` the functions may leave it out.
     """
 
     n: int
@@ -124,6 +129,7 @@ class DAEFunctions:
     roots: casadi.Function | None
     name: str = "model"
     extras: tuple[casadi.Function, ...] = ()
+    n_parameters: int = 0
 
 
 class AutoEvent(NamedTuple):
@@ -206,6 +212,7 @@ class _Options:
     max_steps: int
     root_directions: np.ndarray  # int32 (n_roots,)
     buffer_steps: int
+    parameters: np.ndarray  # run-time parameters P (n_parameters,)
 
 
 def _root_dirs(model: NormalizedModel, rd: Any, what: str = "root_directions") -> np.ndarray:
@@ -220,7 +227,7 @@ def _root_dirs(model: NormalizedModel, rd: Any, what: str = "root_directions") -
 
 
 def _options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, max_order: Any,
-             max_steps: Any, root_directions: Any, buffer_steps: Any) -> _Options:
+             max_steps: Any, root_directions: Any, buffer_steps: Any, parameters: Any) -> _Options:
     rtol = float(rtol)
     if not (math.isfinite(rtol) and rtol > 0):
         raise ValueError(f"rtol must be a positive number, got {rtol}")
@@ -240,8 +247,12 @@ def _options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, max_or
         raise ValueError(f"max_steps must be a positive integer, got {max_steps}")
     if int(buffer_steps) != buffer_steps or int(buffer_steps) < 1:
         raise ValueError(f"buffer_steps must be a positive integer, got {buffer_steps}")
+    P = np.zeros(0) if parameters is None else np.ascontiguousarray(parameters, dtype=float).ravel()
+    if P.size != model.n_parameters:
+        raise ValueError(f"parameters must have {model.n_parameters} values (the model's run-time parameters), "
+                         f"got {P.size}")
     return _Options(rtol, np.ascontiguousarray(a), max_step, int(max_order), int(max_steps),
-                    _root_dirs(model, root_directions), int(buffer_steps))
+                    _root_dirs(model, root_directions), int(buffer_steps), P)
 
 
 # =========================================================================== common base
@@ -314,8 +325,10 @@ class _SessionBase:
     def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
         """Evaluate ``DAEFunctions.extras[k]`` at ``n_points`` points: each input is an array of
         shape (n_points, size) or (size,) (the same for every point); returns (n_points, n_out).
-        The compiled backend loops in C; the python backend maps the CasADi function."""
+        The compiled backend loops in C; the python backend maps the CasADi function. The
+        run-time parameters are appended as the last input."""
         f = self._model.extras[k]
+        inputs = [*inputs, self._opts.parameters]
         cols = [np.zeros((0, n_points)) if f.numel_in(j) == 0 else
                 np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, f.numel_in(j)), (n_points, f.numel_in(j))).T
                 for j, x in enumerate(inputs)]
@@ -437,7 +450,9 @@ class _CLib:
         lib.dc_message.restype = ctypes.c_char_p
         lib.dc_message.argtypes = [P]
         lib.dc_open.restype = P
-        lib.dc_open.argtypes = [D, P, D, I, ctypes.c_longlong, P, ctypes.c_char_p, I]
+        lib.dc_open.argtypes = [D, P, D, I, ctypes.c_longlong, P, P, ctypes.c_char_p, I]
+        lib.dc_n_parameters.restype = I
+        lib.dc_n_parameters.argtypes = []
         lib.dc_set_nonlin_conv_coef.restype = I
         lib.dc_set_nonlin_conv_coef.argtypes = [P, D]
         lib.dc_n_extra.restype = I
@@ -477,8 +492,8 @@ class _CLib:
         lib.dc_flag_name.restype = None
         lib.dc_flag_name.argtypes = [ctypes.c_long, ctypes.c_char_p, I]
         self.lib = lib
-        if lib.dc_abi_version() != 1:
-            raise DaeclearError(f"{path}: driver ABI version {lib.dc_abi_version()} != 1")
+        if lib.dc_abi_version() != DRIVER_ABI:
+            raise DaeclearError(f"{path}: driver ABI version {lib.dc_abi_version()} != {DRIVER_ABI}")
         buf = ctypes.create_string_buffer(64)
         lib.dc_sundials_version(buf, 64)
         self.sundials_version = buf.value.decode()
@@ -519,7 +534,8 @@ class CSession(_SessionBase):
     def __init__(self, model: NormalizedModel, opts: _Options, clib: _CLib, build: BuildResult) -> None:
         super().__init__(model, opts)
         n, nt, nr, npar = clib.model_info(self._nt)
-        if (n, nt, nr, tuple(npar)) != (model.n, self._nt, model.n_roots, model.n_params):
+        if (n, nt, nr, tuple(npar)) != (model.n, self._nt, model.n_roots, model.n_params) \
+                or clib.lib.dc_n_parameters() != model.n_parameters:
             raise DaeclearError(
                 f"compiled library {clib.path} does not match the model: (n, terms, roots, params) = "
                 f"{(n, nt, nr, npar)} != {(model.n, self._nt, model.n_roots, list(model.n_params))}"
@@ -529,7 +545,7 @@ class CSession(_SessionBase):
         self._build = build
         err = ctypes.create_string_buffer(1024)
         h = self._lib.dc_open(opts.rtol, opts.atol.ctypes.data, opts.max_step, opts.max_order,
-                              opts.max_steps, _ptr(opts.root_directions), err, 1024)
+                              opts.max_steps, _ptr(opts.root_directions), _ptr(opts.parameters), err, 1024)
         if not h:
             raise DaeclearError(f"opening the compiled IDA session failed: {err.value.decode()}")
         self._h = h
@@ -654,6 +670,7 @@ class CSession(_SessionBase):
         return [bool(a) for a in act[:self._nt]], [par[off[k]:off[k + 1]].copy() for k in range(self._nt)]
 
     def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
+        inputs = [*inputs, self._opts.parameters]
         meta = self._extra_meta.get(k)
         if meta is None:  # input sizes, output size and reusable ctypes arrays, once per function
             f = self._model.extras[k]
@@ -900,12 +917,13 @@ class PythonSession(_SessionBase):
         self._a_yp = np.zeros(n)
         self._a_cj = np.zeros(1)
         self._a_p = [np.zeros(p) for p in model.n_params]
+        P = opts.parameters
         base = [self._a_t, self._a_y, self._a_yp]
-        self._res = _Buffered(model.res, base)
-        self._jac = _Buffered(model.jac, base + [self._a_cj])
-        self._tres = [_Buffered(f, base + [p]) for f, p in zip(model.term_res, self._a_p)]
-        self._tjac = [_Buffered(f, base + [p, self._a_cj]) for f, p in zip(model.term_jac, self._a_p)]
-        self._roots_fn = _Buffered(model.roots, base) if model.roots is not None else None
+        self._res = _Buffered(model.res, base + [P])
+        self._jac = _Buffered(model.dense(model.jac), base + [self._a_cj, P])
+        self._tres = [_Buffered(f, base + [p, P]) for f, p in zip(model.term_res, self._a_p)]
+        self._tjac = [_Buffered(model.dense(f), base + [p, self._a_cj, P]) for f, p in zip(model.term_jac, self._a_p)]
+        self._roots_fn = _Buffered(model.roots, base + [P]) if model.roots is not None else None
         self._active_idx: list[int] = []
         self._solver: Any = None
         self._solver_dirs: np.ndarray | None = None
@@ -1225,7 +1243,8 @@ def _warn_once(reason: str) -> None:
 
 def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, atol: np.ndarray | float,
                  max_step: float = 0.0, max_order: int = 5, max_steps: int = 5_000_000,
-                 root_directions: np.ndarray | None = None, buffer_steps: int = 4096) -> Session:
+                 root_directions: np.ndarray | None = None, buffer_steps: int = 4096,
+                 parameters: np.ndarray | None = None) -> Session:
     """Open an IDA session on a model; see the module docstring.
 
     backend: "auto" (compiled if a C compiler works, else python with one DaeclearWarning),
@@ -1234,6 +1253,7 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
     max_steps: cap on the IDA steps of the whole session (all segments). root_directions:
     default directions (-1, 0, +1 per root function; reinit may override them per segment).
     buffer_steps: rows of the step buffers the C loop fills before returning to Python.
+    parameters: the run-time parameters P of the model (``funcs.n_parameters`` values).
     Call reinit() before the first advance().
     """
     if not isinstance(backend, str) or backend.lower() not in BACKENDS:
@@ -1243,7 +1263,7 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
     if model is None:
         model = normalize_model(funcs)
         memo_put(_NORMALIZED, funcs, model)
-    opts = _options(model, rtol, atol, max_step, max_order, max_steps, root_directions, buffer_steps)
+    opts = _options(model, rtol, atol, max_step, max_order, max_steps, root_directions, buffer_steps, parameters)
     if b == "python":
         return PythonSession(model, opts)
     try:

@@ -82,6 +82,7 @@ advance (``STALL_EVENTS`` events at the same time).
 from __future__ import annotations
 
 import ctypes
+import dataclasses
 import math
 import re
 import sys
@@ -97,7 +98,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .assemble import DAEModel, assemble
-from .codegen import BuildResult, CompileError, CompilerUnavailable, OdeSpec, build_ode_library
+from .codegen import (ODE_DRIVER_ABI, BuildResult, CompileError, CompilerUnavailable, OdeSpec, build_ode_library,
+                      memo_get, memo_put, memo_table)
 from .errors import DaeclearError, DaeclearWarning, SceneError, SolveError
 from .result import ContactEvent, Result
 from .scene import Scene
@@ -172,41 +174,57 @@ def ode_spec(model: DAEModel) -> OdeSpec:
     if getattr(model, "track_work", False) or model.n_states != 2 * model.n_q + model.n_constraints:
         raise SceneError(f"simulate: model '{model.scene_name}' has states besides q, v and the multipliers "
                          "(track_work); only method='ida' integrates it.")
+    spec = memo_get(_SPEC_BY_FUNCTIONS, model.functions)
+    if spec is None:  # once per structure: models of the same structure share their functions
+        spec = _symbolic_spec(model)
+        memo_put(_SPEC_BY_FUNCTIONS, model.functions, spec)
+    return dataclasses.replace(spec, mass=tuple(float(mk) for mk in model.mass_diagonal),
+                               parameters=tuple(float(x) for x in model.parameter_values))
+
+
+_SPEC_BY_FUNCTIONS = memo_table()
+
+
+def _symbolic_spec(model: DAEModel) -> OdeSpec:
+    """The functions of :func:`ode_spec`, every number a run-time parameter (P last)."""
     n, m = model.n_q, model.n_constraints
     t = ca.SX.sym("t")
     q = ca.SX.sym("q", n)
     v = ca.SX.sym("v", n)
+    P = ca.SX.sym("P", model.parameter_values.size)
     x = ca.vertcat(q, v)
-    Phi, Phi_q, Phi_dot, gamma = model.kinematics(q, v, t)
-    c = gamma - 2.0 * model.alpha * Phi_dot - model.beta ** 2 * Phi
-    Q = model.base_force(t, q, v)
-    sys_f = ca.Function("sys", [t, q, v], [ca.densify(Q), ca.densify(Phi_q), ca.densify(c)])
+    Phi, Phi_q, Phi_dot, gamma = model.kinematics(q, v, t, P)
+    offsets = dict(zip(model.parameter_names, np.cumsum([0] + [size for _, size in model.parameter_layout])))
+    alpha, beta = P[int(offsets["baumgarte.alpha"])], P[int(offsets["baumgarte.beta"])]
+    c = gamma - 2.0 * alpha * Phi_dot - beta ** 2 * Phi
+    Q = model.base_force(t, q, v, P)
+    sys_f = ca.Function("sys", [t, q, v, P], [ca.densify(Q), ca.densify(Phi_q), ca.densify(c)])
     a = ca.SX.sym("a", n)
     lam = ca.SX.sym("lam", m)
     r = ca.vertcat(ca.mtimes(Phi_q.T, lam) - Q, ca.mtimes(Phi_q, a) - c)
-    sys_jac = ca.Function("sys_jac", [t, q, v, a, lam], [ca.densify(ca.jacobian(r, x))])
+    sys_jac = ca.Function("sys_jac", [t, q, v, a, lam, P], [ca.densify(ca.jacobian(r, x))])
     forces, jacs, n_params = [], [], []
     for k, term in enumerate(model.terms):
         p = ca.SX.sym("p", term.n_params)
-        F = term.force(t, q, v, p)
-        forces.append(ca.Function(f"term{k}", [t, q, v, p], [ca.densify(F)]))
-        jacs.append(ca.Function(f"term{k}_jac", [t, q, v, p], [ca.densify(ca.jacobian(F, x))]))
+        F = term.force(t, q, v, p, P)
+        forces.append(ca.Function(f"term{k}", [t, q, v, p, P], [ca.densify(F)]))
+        jacs.append(ca.Function(f"term{k}_jac", [t, q, v, p, P], [ca.densify(ca.jacobian(F, x))]))
         n_params.append(term.n_params)
     gaps = None
     if model.functions.roots is not None and model.gap_names:
         n_rest = model.n_states - 2 * n
         rest = ca.SX.sym("lam", n_rest)
         yp = ca.SX.sym("yp", model.n_states)
-        g = model.functions.roots(t, ca.vertcat(q, v, rest), yp)
+        g = model.functions.roots(t, ca.vertcat(q, v, rest), yp, P)
         for label, sym in (("velocities", v), ("multipliers", rest), ("derivatives", yp)):
             if sym.numel() and ca.depends_on(g, sym):
                 raise SceneError(f"simulate: the gap functions of model '{model.scene_name}' depend on {label}; "
                                  "only method='ida' integrates such a model.")
         g_dot = ca.mtimes(ca.jacobian(g, q), v) + ca.jacobian(g, t)
-        gaps = ca.Function("gaps", [t, q, v], [ca.densify(g), ca.densify(g_dot)])
+        gaps = ca.Function("gaps", [t, q, v, P], [ca.densify(g), ca.densify(g_dot)])
     return OdeSpec(n=n, m=m, mass=tuple(float(mk) for mk in model.mass_diagonal), sys=sys_f, sys_jac=sys_jac,
                    gaps=gaps, term_force=tuple(forces), term_jac=tuple(jacs), n_params=tuple(n_params),
-                   name=model.functions.name, outputs=model.outputs)
+                   name=model.functions.name, outputs=model.outputs, n_parameters=int(P.numel()))
 
 
 def _candidate(G0: float, Gd0: float, G1: float, Gd1: float, h: float, hermite: bool = True) -> float:
@@ -270,7 +288,7 @@ class _CLib:
             "dco_abi_version": (I, []),
             "dco_info": (I, [P, P, P, P, P]),
             "dco_message": (ctypes.c_char_p, [P]),
-            "dco_open": (P, [ctypes.c_char_p, I]),
+            "dco_open": (P, [P, P, ctypes.c_char_p, I]),
             "dco_free": (None, [P]),
             "dco_set_terms": (None, [P, P, P]),
             "dco_rhs": (I, [P, D, P, P]),
@@ -287,8 +305,8 @@ class _CLib:
         for name, (res, args) in sig.items():
             fn = getattr(lib, name)
             fn.restype, fn.argtypes = res, args
-        if lib.dco_abi_version() != 1:
-            raise DaeclearError(f"{path}: ODE driver ABI version {lib.dco_abi_version()} != 1")
+        if lib.dco_abi_version() != ODE_DRIVER_ABI:
+            raise DaeclearError(f"{path}: ODE driver ABI version {lib.dco_abi_version()} != {ODE_DRIVER_ABI}")
         self.lib = lib
         self.path = path
 
@@ -336,7 +354,9 @@ class _CEvaluator(_Evaluator):
         if got != want:
             raise DaeclearError(f"compiled ODE library {clib.path} does not match the model: {got} != {want}")
         err = ctypes.create_string_buffer(1024)
-        h = lib.dco_open(err, 1024)
+        self._mass = np.ascontiguousarray(spec.mass, dtype=float)
+        self._P = np.ascontiguousarray(spec.parameters, dtype=float)
+        h = lib.dco_open(self._mass.ctypes.data, self._P.ctypes.data if self._P.size else None, err, 1024)
         if not h:
             raise DaeclearError(f"opening the compiled ODE model failed: {err.value.decode()}")
         self.lib, self.h, self.build = lib, h, build
@@ -456,8 +476,9 @@ class _CEvaluator(_Evaluator):
 class _Buffered:
     """A CasADi function with every input and output on fixed numpy arrays (FunctionBuffer)."""
 
-    def __init__(self, f: ca.Function) -> None:
+    def __init__(self, f: ca.Function, parameters: Sequence[float]) -> None:
         self.args = [np.zeros(f.nnz_in(i)) for i in range(f.n_in())]
+        self.args[-1][:] = parameters  # the run-time parameters, the last input of every function
         self.outs = [np.zeros(f.nnz_out(i)) for i in range(f.n_out())]
         self.shapes = [f.size_out(i) for i in range(f.n_out())]
         self.buf, self.call = f.buffer()
@@ -482,11 +503,12 @@ class _PyEvaluator(_Evaluator):
     def __init__(self, spec: OdeSpec) -> None:
         super().__init__(spec)
         self.build = None
-        self._sys = _Buffered(spec.sys)
-        self._sys_jac = _Buffered(spec.sys_jac)
-        self._gaps = _Buffered(spec.gaps) if spec.gaps is not None else None
-        self._tf = [_Buffered(f) for f in spec.term_force]
-        self._tj = [_Buffered(f) for f in spec.term_jac]
+        P = spec.parameters
+        self._sys = _Buffered(spec.sys, P)
+        self._sys_jac = _Buffered(spec.sys_jac, P)
+        self._gaps = _Buffered(spec.gaps, P) if spec.gaps is not None else None
+        self._tf = [_Buffered(f, P) for f in spec.term_force]
+        self._tj = [_Buffered(f, P) for f in spec.term_jac]
         self.minv = 1.0 / np.asarray(spec.mass)
         self.active = [False] * self.nt
         self.params: list[NDArray] = [np.zeros(p) for p in spec.n_params]
@@ -658,21 +680,18 @@ def _model_channels(model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch
         return np.zeros((0, n_ch))
     f = model.outputs if N == 1 else model.outputs.map(N)
     S = np.repeat(np.asarray(switch, dtype=float).reshape(-1, 1), N, axis=1)
-    out = f(np.asarray(t, dtype=float)[None, :], np.asarray(y).T, np.asarray(yp).T, S)
+    out = f(np.asarray(t, dtype=float)[None, :], np.asarray(y).T, np.asarray(yp).T, S, model.parameter_values)
     return np.array(out).reshape(n_ch, N).T
 
 
 _warned: set[str] = set()
-_LIB_BY_MODEL: dict[int, tuple[weakref.ref, OdeSpec, Any]] = {}
+_LIB_BY_FUNCTIONS = memo_table()
 
 
 def _evaluator(model: DAEModel, backend: str) -> _Evaluator:
     """The model's ODE evaluator: compiled (cached per model object and on disk) or python."""
-    entry = _LIB_BY_MODEL.get(id(model))
-    if entry is not None and entry[0]() is model:
-        spec, compiled = entry[1], entry[2]
-    else:
-        spec, compiled = ode_spec(model), None
+    spec = ode_spec(model)
+    compiled = memo_get(_LIB_BY_FUNCTIONS, model.functions)  # one library per structure
     if backend == "python":
         return _PyEvaluator(spec)
     try:
@@ -685,8 +704,7 @@ def _evaluator(model: DAEModel, backend: str) -> _Evaluator:
                 build = build_ode_library(spec)
                 clib = _CLib.load(build.path)
             compiled = (clib, build)
-            _LIB_BY_MODEL[id(model)] = (weakref.ref(model), spec, compiled)
-            weakref.finalize(model, _LIB_BY_MODEL.pop, id(model), None)
+            memo_put(_LIB_BY_FUNCTIONS, model.functions, compiled)
         else:
             clib, build = compiled
             compiled = (clib, BuildResult(build.path, build.key, True, 0.0, 0.0))

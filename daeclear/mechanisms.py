@@ -1,4 +1,4 @@
-"""Ready-made scenes: the chapter's slider-crank (Tables 4.1-4.3) and its variants."""
+"""Ready-made scenes: the chapter's slider-crank (Tables 4.1-4.3) and its variants; a chain of N links."""
 
 from __future__ import annotations
 
@@ -184,4 +184,135 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     else:
         scene.add(Translational("D", scene.ground, slider, at=pin_c, axis=(1.0, 0.0)))
     scene.add(Driver("drive", joint="A", speed=omega))
+    return scene
+
+
+# Chain of links (a multi-link pendulum with a clearance joint at every pin): steel links
+# 0.1 m between pins, 25 x 10 mm section (m = 7850 * 0.1 * 0.025 * 0.010 = 0.196 kg, slender-bar
+# inertia m L^2 / 12), pins with the slider-crank's bearing (10 mm radius, steel).
+CHAIN_LINK_LENGTH = 0.1
+CHAIN_LINK_MASS = 0.196
+CHAIN_LINK_INERTIA = CHAIN_LINK_MASS * CHAIN_LINK_LENGTH ** 2 / 12.0
+
+
+def _finite(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm: float | None = None,
+          angle: float = 0.0, link_length: float = CHAIN_LINK_LENGTH, link_mass: float = CHAIN_LINK_MASS,
+          link_inertia: float | None = None, law: Any = "lankarani-nikravesh", restitution: float = 0.9,
+          friction: Any = None, bearing_radius: float = BEARING_RADIUS, material: Material = STEEL,
+          length: float | None = None, name: str | None = None, **options: Any) -> Scene:
+    """A planar chain of ``n_links`` rigid links with a revolute clearance joint at every pin.
+
+    A multi-link pendulum whose size is one integer: the scalable mechanism of the benchmarks
+    (states, generated code and build time grow with ``n_links``). Links ``link1`` ...
+    ``link<N>`` lie end to end from the origin along the direction ``angle``, centres of mass at
+    mid-length; pin ``pin<k>`` joins link k-1 (the bearing; the ground for k = 1) to link k
+    (the journal) at their common end, journal and bearing centres coincident at the start.
+
+    Two variants:
+
+    * ``rpm=None`` (default): a free chain hanging from the ground and released from rest;
+      every pin, the ground pin too, is a :class:`~daeclear.scene.RevoluteClearance`, so the
+      model has no constraint at all (6 N states: q 3N + v 3N). The whole chain first falls
+      through the ground pin's clearance (about 4.5 ms for 0.1 mm), then swings; every
+      joint sees impacts followed by following contact under the links' weight and the
+      centripetal loads.
+    * ``rpm`` a number: the ground pin ``pin1`` is an ideal :class:`~daeclear.scene.Revolute`
+      driven at constant speed by driver ``drive`` (a crank), pins 2..N are clearance joints
+      (6 N + 3 states: two pin and one driver constraint). The links start as one rigid bar
+      turning at that speed; with ``n_links=1`` there is no clearance joint left.
+
+    Parameters
+    ----------
+    n_links : int
+        Number of links N (>= 1).
+    clearance : float
+        Radial clearance of every clearance joint, m (0.1 mm), in (0, bearing_radius).
+    gravity : float
+        Magnitude of gravity along -Y, m/s^2 (0 to switch it off).
+    rpm : float or None
+        None: free chain, all pins clearance joints. A number: the ground pin is an ideal
+        revolute driven at this speed, rev/min, counter-clockwise.
+    angle : float
+        Initial angle of the (straight) chain from the X axis, rad (0: horizontal, so a free
+        chain swings down; -pi/2: hanging at rest).
+    link_length : float
+        Distance between a link's pins, m (0.1).
+    link_mass : float
+        Mass of a link, kg (0.196: steel, 0.1 m x 25 mm x 10 mm).
+    link_inertia : float or None
+        Moment of inertia of a link about its centre of mass, kg m^2; None: slender bar
+        ``link_mass * link_length**2 / 12``.
+    law : str or NormalLaw
+        Normal contact law of every clearance joint (name or object; stiffness computed from
+        the radii and material when not given). Default Lankarani-Nikravesh (3.9).
+    restitution : float
+        Coefficient of restitution c_e for laws that take one (0.9).
+    friction : None, float, str or FrictionLaw
+        None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
+    bearing_radius : float
+        Bearing radius of every joint, m (10 mm, as the slider-crank's, Table 4.2).
+    material : Material
+        Material of bearings and journals (steel, 207 GPa, 0.3).
+    length : float or None
+        Axial contact length L, m, required by the cylindrical laws.
+    name : str or None
+        Scene name; defaults to ``"chain<N>"``.
+
+    Returns
+    -------
+    Scene
+
+    Examples
+    --------
+    >>> import daeclear as dc
+    >>> dc.assemble(dc.mechanisms.chain(3)).summary()["states"]
+    18
+    """
+
+    def check(field_name: str, value: Any, rule: str, ok: bool) -> None:
+        if not ok:
+            raise SceneError(f"chain: {field_name}={value!r}, {rule}.")
+
+    if options:  # e.g. the command line's --joint, which is the slider-crank's
+        raise SceneError(f"chain: unknown option(s) {', '.join(sorted(options))}.")
+    check("n_links", n_links, "must be an integer >= 1",
+          isinstance(n_links, int) and not isinstance(n_links, bool) and n_links >= 1)
+    check("gravity", gravity, "must be a finite number >= 0 m/s^2", _finite(gravity) and gravity >= 0)
+    check("rpm", rpm, "must be None (free chain) or a finite number (rev/min)", rpm is None or _finite(rpm))
+    check("angle", angle, "must be a finite number (rad)", _finite(angle))
+    check("link_length", link_length, "must be a finite number > 0 m", _finite(link_length) and link_length > 0)
+    check("link_mass", link_mass, "must be a finite number > 0 kg", _finite(link_mass) and link_mass > 0)
+    check("link_inertia", link_inertia, "must be None or a finite number > 0 kg m^2",
+          link_inertia is None or (_finite(link_inertia) and link_inertia > 0))
+    check("bearing_radius", bearing_radius, "must be a finite number > 0 m",
+          _finite(bearing_radius) and bearing_radius > 0)
+    check("clearance", clearance, f"must be a number in (0, bearing_radius={bearing_radius!r}) m",
+          _finite(clearance) and 0 < clearance < bearing_radius)
+    check("bearing_radius", bearing_radius, f"must be smaller than half the link length ({link_length!r} m)",
+          2.0 * bearing_radius < link_length)
+
+    inertia = link_mass * link_length ** 2 / 12.0 if link_inertia is None else float(link_inertia)
+    omega = 0.0 if rpm is None else rpm_to_rad_s(rpm)
+    scene = Scene(name or f"chain{n_links}", gravity=(0.0, -gravity))
+    ux, uy = math.cos(angle), math.sin(angle)
+    contact_law = _contact_law(law, restitution, length)
+    bearing: Any = scene.ground
+    for k in range(1, n_links + 1):
+        r = (k - 0.5) * link_length  # centre of mass: rigid rotation about the origin at omega
+        link = scene.add(Body(f"link{k}", mass=link_mass, inertia=inertia, position=(r * ux, r * uy), angle=angle,
+                              velocity=(-omega * r * uy, omega * r * ux), angular_velocity=omega))
+        pin = ((k - 1) * link_length * ux, (k - 1) * link_length * uy)
+        if k == 1 and rpm is not None:
+            scene.add(Revolute("pin1", bearing, link, at=pin))
+        else:
+            scene.add(RevoluteClearance(f"pin{k}", bearing, link, at=pin, bearing_radius=bearing_radius,
+                                        clearance=clearance, material=material, law=contact_law,
+                                        friction=friction_law(friction)))
+        bearing = link
+    if rpm is not None:
+        scene.add(Driver("drive", joint="pin1", speed=omega))
     return scene

@@ -58,7 +58,7 @@ from .errors import SceneError
 from .contact import Material, friction_law, normal_law
 from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
 
-MECHANISMS: dict[str, Callable[..., Scene]] = {"slider_crank": mechanisms.slider_crank}
+MECHANISMS: dict[str, Callable[..., Scene]] = {"slider_crank": mechanisms.slider_crank, "chain": mechanisms.chain}
 ELEMENT_TABLES: dict[str, type] = {
     "body": Body, "revolute": Revolute, "translational": Translational, "driver": Driver,
     "revolute_clearance": RevoluteClearance, "translational_clearance": TranslationalClearance,
@@ -136,7 +136,11 @@ def read_scene_file(path: str | Path) -> SceneFile:
         name = str(params.pop("name", ""))
         if name not in MECHANISMS:
             raise SceneError(f"{path}: [mechanism] name={name!r}, must be one of {', '.join(MECHANISMS)}.")
-        return SceneFile(MECHANISMS[name](**params), simulate, data)
+        try:
+            scene = MECHANISMS[name](**params)
+        except TypeError as exc:  # a missing required parameter, e.g. chain's n_links
+            raise SceneError(f"{path}: [mechanism] {exc}.") from None
+        return SceneFile(scene, simulate, data)
     allowed_tables = {"scene", "simulate", *ELEMENT_TABLES}
     extra = sorted(set(data) - allowed_tables)
     if extra:

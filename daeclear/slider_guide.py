@@ -83,10 +83,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .automaton import EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
-from .clearance import ContactBuild
+from .clearance import ContactBuild, approach_floor
+from .parameters import law_structure, law_values, symbolic_law
 from .result import ContactEvent
-from .scene import Scene, TranslationalClearance
-from .symbolic import AssemblyContext, BufferedFunction, Channel, Term, perpendicular, rotation
+from .scene import TranslationalClearance
+from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular, rotation
 
 #: Corners: name, sign along the slider length, sign across it, surface it can touch.
 CORNERS: tuple[tuple[str, int, int, str], ...] = (
@@ -104,25 +105,21 @@ def _identifier(name: str) -> str:
     return ident if ident and ident[0].isalpha() else f"j_{ident}"
 
 
-def _elastic_energy(law: Any, d: Any) -> Any | None:
-    """Energy stored by the elastic part ``K d^n`` of a law, ``K d^(n+1)/(n+1)``; None if unknown."""
-    stiffness = getattr(law, "stiffness", None)
-    if stiffness is None:
+def _elastic_energy(numeric: Any, law: Any, d: Any) -> Any | None:
+    """Energy stored by the elastic part ``K d^n`` of a law, ``K d^(n+1)/(n+1)``; None if unknown.
+    ``numeric`` decides (structure), ``law`` (possibly with symbolic numbers) gives the formula."""
+    if getattr(numeric, "stiffness", None) is None:
         return None
-    n = float(getattr(law, "effective_exponent", 1.0 if law.geometry == "face" else math.nan))
-    if not math.isfinite(n):
+    n_value = float(getattr(numeric, "effective_exponent", 1.0 if numeric.geometry == "face" else math.nan))
+    if not math.isfinite(n_value):
         return None
-    return stiffness * ca.fmax(d, 0.0) ** (n + 1.0) / (n + 1.0)
+    n = getattr(law, "effective_exponent", n_value)
+    return law.stiffness * ca.fmax(d, 0.0) ** (n + 1.0) / (n + 1.0)
 
 
 def _unit(v: Sequence[float]) -> NDArray[np.float64]:
     v = np.asarray(v, dtype=float)
     return v / math.hypot(*v)
-
-
-def _to_local(phi0: float, v_world: NDArray[np.float64]) -> NDArray[np.float64]:
-    c, s = math.cos(phi0), math.sin(phi0)
-    return np.array([c * v_world[0] + s * v_world[1], -s * v_world[0] + c * v_world[1]])
 
 
 @dataclass
@@ -257,53 +254,75 @@ class SliderGuideLogic:
         fn = getattr(self.rate, "function", None)
         if fn is None:
             return None
-        q = ca.SX.sym("q", self.n_q)
-        v = ca.SX.sym("v", self.n_q)
-        gaps, rates = fn(q, v)
+        q, v, P = (ca.SX.sym(label, fn.numel_in(i)) for i, label in enumerate(("q", "v", "P")))
+        gaps, rates = fn(q, v, P)
         out = []
         for i, pair in enumerate(self.pairs):
-            f = ca.Function(f"{pair.replace('.', '_')}_gap_rate", [q, v], [ca.vertcat(gaps[i], rates[i])])
+            f = ca.Function(f"{pair.replace('.', '_')}_gap_rate", [q, v, P], [ca.vertcat(gaps[i], rates[i])])
             out.append((self.first_root + i, self.corner_terms[i], f, bool(self.needs_approach),
                         float(self.min_approach_speed)))
         return out
 
 
-def _points(ctx: AssemblyContext, joint: TranslationalClearance) -> tuple[NDArray, NDArray]:
-    if joint.at is not None:
-        s_i = ctx.local_point(joint.body_i, joint.at) if joint.point_i is None else np.asarray(joint.point_i)
-        s_j = ctx.local_point(joint.body_j, joint.at) if joint.point_j is None else np.asarray(joint.point_j)
-    else:
-        s_i, s_j = np.asarray(joint.point_i, dtype=float), np.asarray(joint.point_j, dtype=float)
-    return s_i, s_j
-
-
-def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClearance, scene: Scene,
-                                  first_term: int, first_root: int) -> ContactBuild:
-    """Slider-guide contact (section 4.3): eqs. (4.14)-(4.27) with the joint's laws and model.
-
-    Terms, in order: the corner pairs A_upper, B_upper, C_lower, D_lower, then (model
-    ``section-4.3``) the faces upper_face, lower_face. Gaps: the four corner pairs.
-    """
+def translational_clearance_parameters(ref: Reference, joint: TranslationalClearance) -> tuple[dict[str, Any], list[Any]]:
+    """The joint's numbers (run-time parameters) and what of it is structure."""
     law = joint.resolved_law()
     face_law = joint.resolved_face_law() if joint.model == "section-4.3" else None
     friction = joint.resolved_friction()
-    name, ident = joint.name, _identifier(joint.name)
-    L, W, H, c = float(joint.length), float(joint.width), joint.height, joint.radial_clearance
-    guide, slider = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
-    s_i, s_j = _points(ctx, joint)
-    axis = _unit(joint.axis)
-    t_guide = _to_local(ctx.reference[joint.body_i][1], axis)  # (4.14): t in guide coordinates
+    s_i, s_j = ref.joint_points(joint)
+    t_guide = ref.local_vector(joint.body_i, joint.axis)  # (4.14): t in guide coordinates
     # slider length direction, slider coordinates
-    e_slider = (_to_local(ctx.reference[joint.body_j][1], axis) if joint.slider_axis is None
-                else _unit(joint.slider_axis))
-    w_slider = np.array([-e_slider[1], e_slider[0]])
+    e_slider = ref.local_vector(joint.body_j, joint.axis) if joint.slider_axis is None else _unit(joint.slider_axis)
+    values: dict[str, Any] = {
+        "s_i": s_i, "s_j": s_j, "length": float(joint.length), "width": float(joint.width),
+        "height": joint.height, "clearance": joint.radial_clearance, "t_guide": t_guide, "e_slider": e_slider,
+        # angle from the guide's direction to the slider's length direction, both bodies at angle 0
+        "tilt0": math.atan2(e_slider[1], e_slider[0]) - math.atan2(t_guide[1], t_guide[0]),
+    }
+    for surface, limits in (("upper", joint.upper_limits), ("lower", joint.lower_limits)):
+        if limits is not None:
+            values[f"{surface}_limits"] = limits
+    stroke = joint.stroke if joint.stroke is not None else joint.upper_limits
+    if stroke is not None:
+        values["stroke"] = stroke
+    structure: list[Any] = [law_structure(law), law_structure(friction)]
+    for prefix, each in (("law", law), ("face_law", face_law), ("friction", friction)):
+        if each is not None:
+            values.update({f"{prefix}.{k}": v for k, v in law_values(each).items()})
+    if face_law is not None:
+        structure.append(law_structure(face_law))
+    return values, structure
 
-    O = guide.point(ca.DM(s_i))  # a point of the mid-line
-    t_vec = ca.mtimes(rotation(guide.phi), ca.DM(t_guide))
+
+def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClearance, first_term: int,
+                                  first_root: int) -> ContactBuild:
+    """Slider-guide contact (section 4.3): eqs. (4.14)-(4.27) with the joint's laws and model.
+
+    Terms, in order: the corner pairs A_upper, B_upper, C_lower, D_lower, then (model
+    ``section-4.3``) the faces upper_face, lower_face. Gaps: the four corner pairs. Every
+    number comes from the run-time parameters ``<joint>.*``.
+    """
+    name, ident = joint.name, _identifier(joint.name)
+    law_numeric = joint.resolved_law()
+    face_numeric = joint.resolved_face_law() if joint.model == "section-4.3" else None
+    friction_numeric = joint.resolved_friction()
+    law = symbolic_law(law_numeric, ctx.params, f"{name}.law")
+    face_law = None if face_numeric is None else symbolic_law(face_numeric, ctx.params, f"{name}.face_law")
+    friction = symbolic_law(friction_numeric, ctx.params, f"{name}.friction")
+    L, W = ctx.p(name, "length"), ctx.p(name, "width")
+    H, c = ctx.p(name, "height"), ctx.p(name, "clearance")
+    guide, slider = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
+    s_i, s_j = ctx.p(name, "s_i"), ctx.p(name, "s_j")
+    t_guide, e_slider = ctx.p(name, "t_guide"), ctx.p(name, "e_slider")
+    w_slider = perpendicular(e_slider)
+
+    O = guide.point(s_i)  # a point of the mid-line
+    t_vec = ca.mtimes(rotation(guide.phi), t_guide)
     n_vec = perpendicular(t_vec)  # towards the upper surface
-    centre = slider.point(ca.DM(s_j))
+    centre = slider.point(s_j)
     rel_centre = centre - O
-    limits = {"upper": joint.upper_limits, "lower": joint.lower_limits}
+    limits = {surface: ctx.p(name, f"{surface}_limits") if f"{name}.{surface}_limits" in ctx.params else None
+              for surface in ("upper", "lower")}
     side = {"upper": 1.0, "lower": -1.0}
 
     def surface_point(s: Any, surface: str) -> Any:
@@ -316,7 +335,7 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         """Generalized force of a normal force F_N (and friction) on the slider at ``point_slider``."""
         n_in = -side[surface] * n_vec  # surface normal pointing into the guide
         v_T = sliding_velocity(point_guide)
-        F_T = 0.0 if friction.frictionless else friction.friction_force(F_N, v_T)
+        F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
         f_slider = F_N * n_in + F_T * t_vec  # (4.22)
         Q = ctx.generalized_force([(joint.body_j, f_slider, point_slider),  # (4.23)
                                    (joint.body_i, -f_slider, point_guide)])  # (4.24)-(4.25)
@@ -327,17 +346,17 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
     pair_names: list[str] = []
     forces: list[tuple[Any, Any, Any, Any]] = []  # per term: (F_N, F_T, v_T, p)
     energies: list[Any | None] = []  # per term: elastic energy stored while the term is on
-    n_params = 1 if law.needs_approach_speed else 0
+    n_params = 1 if law_numeric.needs_approach_speed else 0
     for label, sign_l, sign_w, surface in CORNERS:
         local = s_j + sign_l * 0.5 * L * e_slider + sign_w * 0.5 * W * w_slider
-        r_k = slider.point(ca.DM(local))  # (4.15)
+        r_k = slider.point(local)  # (4.15)
         u = r_k - O
         s_k = ca.dot(t_vec, u)
         d_k = side[surface] * ca.dot(n_vec, u) - 0.5 * H  # (4.17)-(4.20): -n^T delta
         d_dot = ca.jtimes(d_k, ctx.q, ctx.v)  # (4.21) along the normal
         gap = d_k
         if limits[surface] is not None:
-            lo, hi = limits[surface]
+            lo, hi = limits[surface][0], limits[surface][1]
             gap = ca.fmin(d_k, ca.fmin(s_k - lo, hi - s_k))
         corner_s.append(s_k)
         corner_d.append(d_k)
@@ -348,16 +367,16 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         p = ca.SX.sym("p", n_params)
         F_N = law.force(d_k, d_dot, p[0] if n_params else None)
         Q, F_T, v_T = contact_force(F_N, r_k, surface_point(s_k, surface), surface)
-        terms.append(Term(f"{name}.{pair}", ca.Function(f"{ident}_{pair}_force", [ctx.t, ctx.q, ctx.v, p], [Q],
-                                                         ["t", "q", "v", "p"], ["Q"]), n_params))
+        terms.append(Term(f"{name}.{pair}", ca.Function(f"{ident}_{pair}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P],
+                                                         [Q], ["t", "q", "v", "p", "P"], ["Q"]), n_params))
         forces.append((F_N, F_T, v_T, p))
-        energies.append(_elastic_energy(law, d_k))
+        energies.append(_elastic_energy(law_numeric, law, d_k))
 
     face_names: list[str] = []
     face_corners: list[tuple[int, int]] = []
     face_params = 0
-    if face_law is not None:
-        face_params = 1 if face_law.needs_approach_speed else 0
+    if face_law is not None and face_numeric is not None:
+        face_params = 1 if face_numeric.needs_approach_speed else 0
         for face, a, b in FACES:
             surface = CORNERS[a][3]
             d_1, d_2, s_1, s_2 = corner_d[a], corner_d[b], corner_s[a], corner_s[b]
@@ -370,33 +389,37 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
             p = ca.SX.sym("p", face_params)
             F_N = face_law.force(d_mean, d_mean_dot, p[0] if face_params else None)
             Q, F_T, v_T = contact_force(F_N, point, point, surface)
-            terms.append(Term(f"{name}.{face}", ca.Function(f"{ident}_{face}_force", [ctx.t, ctx.q, ctx.v, p],
-                                                             [Q], ["t", "q", "v", "p"], ["Q"]), face_params))
+            terms.append(Term(f"{name}.{face}", ca.Function(f"{ident}_{face}_force",
+                                                             [ctx.t, ctx.q, ctx.v, p, ctx.P], [Q],
+                                                             ["t", "q", "v", "p", "P"], ["Q"]), face_params))
             forces.append((F_N, F_T, v_T, p))
             # Winkler potential of the linear law at the trapezoid's centroid (see module docstring)
-            linear = getattr(face_law, "effective_exponent", 1.0) == 1.0 and face_law.stiffness is not None
+            linear = getattr(face_numeric, "effective_exponent", 1.0) == 1.0 and face_numeric.stiffness is not None
             energies.append(face_law.stiffness * (w_1 * w_1 + w_1 * w_2 + w_2 * w_2) / 6.0 if linear else None)
             face_names.append(f"{name}.{face}")
             face_corners.append((a, b))
 
-    rate = ca.Function(f"{ident}_rates", [ctx.q, ctx.v], [ca.vertcat(*corner_gap), ca.vertcat(*corner_rate)])
+    rate = ca.Function(f"{ident}_rates", [ctx.q, ctx.v, ctx.P], [ca.vertcat(*corner_gap), ca.vertcat(*corner_rate)])
     n_corners = len(CORNERS)
-    logic = SliderGuideLogic(
-        name=name, pairs=pair_names, first_root=first_root,
-        corner_terms=[first_term + i for i in range(n_corners)],
-        face_names=face_names, face_terms=[first_term + n_corners + f for f in range(len(face_names))],
-        face_corners=face_corners, rate=BufferedFunction(rate), n_q=ctx.n_q,
-        needs_approach=law.needs_approach_speed,
-        min_approach_speed=float(getattr(law, "min_approach_speed", 0.0)),
-        face_needs_approach=bool(face_law is not None and face_law.needs_approach_speed),
-        face_min_approach_speed=float(getattr(face_law, "min_approach_speed", 0.0)),
-    )
+    floor = approach_floor(ctx, law_numeric, f"{name}.law")
+    face_floor = approach_floor(ctx, face_numeric, f"{name}.face_law") if face_numeric is not None else None
+
+    def logic(P: NDArray[np.float64]) -> list[Any]:
+        return [SliderGuideLogic(
+            name=name, pairs=pair_names, first_root=first_root,
+            corner_terms=[first_term + i for i in range(n_corners)],
+            face_names=face_names, face_terms=[first_term + n_corners + f for f in range(len(face_names))],
+            face_corners=face_corners, rate=BufferedFunction(rate, bound=(P,)), n_q=ctx.n_q,
+            needs_approach=law_numeric.needs_approach_speed, min_approach_speed=floor(P),
+            face_needs_approach=bool(face_numeric is not None and face_numeric.needs_approach_speed),
+            face_min_approach_speed=face_floor(P) if face_floor is not None else 0.0,
+        )]
 
     y_centre = ca.dot(n_vec, rel_centre)
     s_centre = ca.dot(t_vec, rel_centre)
     # angle from the guide's direction to the slider's length direction
-    tilt = (slider.phi + math.atan2(e_slider[1], e_slider[0])) - (guide.phi + math.atan2(t_guide[1], t_guide[0]))
-    stroke = joint.stroke if joint.stroke is not None else joint.upper_limits
+    tilt = slider.phi - guide.phi + ctx.p(name, "tilt0")
+    stroke = ctx.p(name, "stroke") if f"{name}.stroke" in ctx.params else None
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
         def switched(k: int, expr: Any) -> Any:
@@ -456,4 +479,4 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         ]
         return out
 
-    return ContactBuild(terms=terms, gaps=corner_gap, gap_names=pair_names, channels=channels, logic=[logic])
+    return ContactBuild(terms=terms, gaps=corner_gap, gap_names=pair_names, channels=channels, logic=logic)

@@ -197,6 +197,7 @@ def simulate(
     atol_vec = tolerance_vector(model, rtol, atol)
     y0, yp0 = model.initial_state()
     session = open_session(model.functions, backend=backend, rtol=rtol, atol=atol_vec, max_step=max_step,
+                           parameters=model.parameter_values,
                            max_steps=max_steps)
     if model.formulation == "ggl":
         # never ask Newton for corrections below round-off: coef * rtol >= 1e-13

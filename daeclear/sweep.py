@@ -421,6 +421,9 @@ def _consolidate(path: Path, *, mechanism: str, options: Mapping[str, Any], orde
         raise
     for part in merged:
         part.unlink(missing_ok=True)
+    if _parts_dir(path).is_dir():  # half-written parts of a killed sweep (the lock is ours: no writer runs)
+        for stale in _parts_dir(path).glob(".run-*.tmp"):
+            stale.unlink(missing_ok=True)
     try:
         _parts_dir(path).rmdir()
     except OSError:

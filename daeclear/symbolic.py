@@ -72,20 +72,67 @@ class Channel:
     expr: Any
 
 
+class Reference:
+    """The scene's reference configuration (numbers only): where every body and joint point is
+    when the scene is declared. Element parameter functions turn world data into body-fixed
+    parameters with it."""
+
+    def __init__(self, bodies: Sequence[Any], ground: str) -> None:
+        self.pose: dict[str, tuple[tuple[float, float], float]] = {ground: ((0.0, 0.0), 0.0)}
+        for body in bodies:
+            self.pose[body.name] = (tuple(body.position), float(body.angle))
+
+    def angle(self, body: str) -> float:
+        return self.pose[body][1]
+
+    def local_point(self, body: str, world: Sequence[float]) -> NDArray[np.float64]:
+        """Body-fixed coordinates of a world point of the reference configuration."""
+        (x0, y0), phi0 = self.pose[body]
+        c, s = math.cos(phi0), math.sin(phi0)
+        dx, dy = world[0] - x0, world[1] - y0
+        return np.array([c * dx + s * dy, -s * dx + c * dy])
+
+    def local_vector(self, body: str, world: Sequence[float]) -> NDArray[np.float64]:
+        """Body-fixed components of a world direction (unit length) of the reference configuration."""
+        phi0 = self.pose[body][1]
+        v = np.asarray(world, dtype=float) / math.hypot(*world)
+        c, s = math.cos(phi0), math.sin(phi0)
+        return np.array([c * v[0] + s * v[1], -s * v[0] + c * v[1]])
+
+    def joint_points(self, joint: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Body-fixed joint points of bodies i and j: ``point_i``/``point_j`` when given, else
+        the world point ``at`` of the reference configuration."""
+        s_i = np.asarray(joint.point_i, dtype=float) if joint.point_i is not None else self.local_point(joint.body_i, joint.at)
+        s_j = np.asarray(joint.point_j, dtype=float) if joint.point_j is not None else self.local_point(joint.body_j, joint.at)
+        return s_i, s_j
+
+
 @dataclass
 class AssemblyContext:
-    """Symbols and per-body kinematics handed to element builders during assembly."""
+    """Symbols and per-body kinematics handed to element builders during assembly.
+
+    Builders read every number from ``params`` (run-time parameters, see
+    :mod:`daeclear.parameters`), never from the scene: the same build serves every scene of
+    the same structure.
+    """
 
     t: Any
     q: Any
     v: Any
     a: Any  # accelerations (v')
+    P: Any  # the parameter vector, last input of every generated function
     frames: dict[str, BodyFrame]
-    reference: dict[str, tuple[tuple[float, float], float]]  # body -> (position, angle)
+    params: dict[str, Any]  # parameter name -> its slice of P
+    offsets: dict[str, int]  # parameter name -> index of its first element in P
 
     @property
     def n_q(self) -> int:
         return int(self.q.numel())
+
+    def p(self, owner: str, key: str) -> Any:
+        """The parameter ``<owner>.<key>`` (a scalar symbol for one-element entries)."""
+        value = self.params[f"{owner}.{key}"]
+        return value[0] if value.numel() == 1 else value
 
     def generalized_force(self, loads: Sequence[tuple[str, Any, Any]]) -> Any:
         """Generalized force vector (length n_q) of point loads ``(body, force (2x1), point (2x1))``.
@@ -106,22 +153,17 @@ class AssemblyContext:
             Q[k + 2] += arm[0] * force[1] - arm[1] * force[0]
         return Q
 
-    def local_point(self, body: str, world: Sequence[float]) -> NDArray[np.float64]:
-        """Body-fixed coordinates of a world point of the reference configuration."""
-        (x0, y0), phi0 = self.reference[body]
-        c, s = math.cos(phi0), math.sin(phi0)
-        dx, dy = world[0] - x0, world[1] - y0
-        return np.array([c * dx + s * dy, -s * dx + c * dy])
-
-
-
 
 class BufferedFunction:
     """A CasADi Function called through a FunctionBuffer on fixed numpy arrays (~1 us a call
-    instead of ~50-100 us for a plain call): for small functions on the per-event path."""
+    instead of ~50-100 us for a plain call): for small functions on the per-event path.
 
-    def __init__(self, function: ca.Function) -> None:
+    ``bound`` fills the function's last inputs once (the model parameters); calls pass the rest.
+    """
+
+    def __init__(self, function: ca.Function, bound: Sequence[Any] = ()) -> None:
         self.function = function
+        self.bound = tuple(np.asarray(b, dtype=float) for b in bound)
         self._inputs = [np.zeros(function.numel_in(i)) for i in range(function.n_in())]
         self._outputs = [np.zeros(function.numel_out(i)) for i in range(function.n_out())]
         self._buffer, self._eval = function.buffer()
@@ -129,6 +171,8 @@ class BufferedFunction:
             self._buffer.set_arg(i, memoryview(a))
         for i, r in enumerate(self._outputs):
             self._buffer.set_res(i, memoryview(r))
+        for a, x in zip(self._inputs[len(self._inputs) - len(self.bound):], self.bound):
+            a[:] = np.ravel(x)
 
     def __call__(self, *args: Any) -> tuple[NDArray[np.float64], ...]:
         for a, x in zip(self._inputs, args):
@@ -137,7 +181,7 @@ class BufferedFunction:
         return tuple(r.copy() for r in self._outputs)
 
     def __getstate__(self) -> dict[str, Any]:  # picklable for process pools: rebuild the buffer
-        return {"function": self.function}
+        return {"function": self.function, "bound": self.bound}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__init__(state["function"])  # type: ignore[misc]
+        self.__init__(state["function"], state.get("bound", ()))  # type: ignore[misc]

@@ -26,7 +26,7 @@ from daeclear.ida_session import CSession, open_session
 def c_session():
     """A compiled session of the revolute slider-crank: its library carries the C automaton."""
     model = _slider_crank("revolute", None)
-    session = open_session(model.functions, backend="c", rtol=1e-6, atol=1e-8)
+    session = open_session(model.functions, backend="c", rtol=1e-6, atol=1e-8, parameters=model.parameter_values)
     yield session
     session.close()
 

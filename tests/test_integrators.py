@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
+from daeclear.codegen import clear_memos
 from daeclear.integrators import _candidate, _cubic_extrema
 from daeclear.mechanisms import CRANK_LENGTH as R, ROD_LENGTH as L, rpm_to_rad_s
 
@@ -224,6 +225,7 @@ def test_hermite_check_finds_a_crossing_inside_a_step():
 def test_without_a_compiler_falls_back_to_python(monkeypatch, tmp_path):
     monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
     monkeypatch.setenv("DAECLEAR_CACHE_DIR", str(tmp_path))  # nothing cached there
+    clear_memos()  # nor loaded in this process (models of one structure share their library)
     model = dc.assemble(dc.mechanisms.slider_crank("ideal", gravity=0.0))
     with pytest.warns(dc.DaeclearWarning, match="compiled right-hand side is unavailable"):
         result = dc.simulate(model, 1e-3, method="rk4", step=1e-5)

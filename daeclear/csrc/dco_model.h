@@ -3,7 +3,8 @@
  * CasADi-generated functions of an index-1 mechanism written as an ODE in x = (q, v),
  * and that the ODE driver (ode_driver.c) reads.
  *
- * Every function takes dense column vectors and writes dense outputs (matrices column-major).
+ * Every function takes dense column vectors, the run-time parameters P last, and writes dense
+ * outputs (matrices column-major). The mass diagonal and P are given to dco_open.
  */
 #ifndef DAECLEAR_DCO_MODEL_H
 #define DAECLEAR_DCO_MODEL_H
@@ -15,8 +16,8 @@ typedef struct {
   int m;                     /* constraints */
   int n_terms;               /* switchable force terms */
   int n_gaps;                /* gap (root) functions, 0: none */
+  int n_parameters;          /* run-time parameters P, the last input of every function */
   const int* n_params;       /* [n_terms] parameters of each term */
-  const double* mass;        /* [n] diagonal of the mass matrix */
   dc_fun_t sys;              /* (t, q, v) -> Q[n], Phi_q[m x n], c[m] (c: Baumgarte right side) */
   dc_fun_t sys_jac;          /* (t, q, v, a, lam) -> d[Phi_q^T lam - Q; Phi_q a - c]/dx, (n+m) x 2n */
   dc_fun_t gaps;             /* (t, q, v) -> g[n_gaps], dg/dt[n_gaps]; eval == 0 when n_gaps == 0 */

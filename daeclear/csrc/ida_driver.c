@@ -9,7 +9,12 @@
  *
  * The residual is the base residual plus the active switchable terms (contact forces); an
  * inactive term is never evaluated. The Jacobian is the base Jacobian plus the active terms'
- * Jacobians (dense, column-major, as SUNDIALS' dense matrix stores it).
+ * Jacobians: the generated functions return their nonzeros (CasADi's compressed column
+ * storage), scattered here into SUNDIALS' dense column-major matrix.
+ *
+ * Every generated function takes the model's run-time parameters P (masses, joint points,
+ * clearances, law constants, ...) as its last input: one compiled library serves every
+ * scene of the same structure; the numbers arrive with dc_open.
  */
 #include <float.h>
 #include <math.h>
@@ -23,7 +28,9 @@
 
 #define DC_API __attribute__((visibility("default")))
 
-#define DC_ABI_VERSION 1
+#ifndef DC_ABI_VERSION /* given by daeclear.codegen (DRIVER_ABI) */
+#error "compile with -DDC_ABI_VERSION=<daeclear.codegen.DRIVER_ABI>"
+#endif
 
 /* dc_advance return codes */
 #define DC_CHUNK 0          /* buffer full: call again */
@@ -154,7 +161,8 @@ typedef struct {
   int* rootdir;
   int* rootsfound;
   double* tmp_r;   /* n   */
-  double* tmp_J;   /* n*n */
+  double* tmp_J;   /* nonzeros of the largest Jacobian */
+  double* P;       /* run-time parameters, dc_model.n_parameters */
   double t_now;    /* time of the state in yy/yp (last return) */
   double t_rec;    /* time of the last recorded step (to skip duplicates) */
   int ready;       /* reinit was called */
@@ -219,6 +227,7 @@ static int eval_res(dc_session* s, double t, const double* y, const double* yp, 
   s->arg[0] = &t;
   s->arg[1] = y;
   s->arg[2] = yp;
+  s->arg[3] = s->P;
   s->res[0] = r;
   if (M->res.eval(s->arg, s->res, s->iw, s->w, s->mem_res)) return -1;
   for (int k = 0; k < s->n_terms; ++k) {
@@ -227,6 +236,7 @@ static int eval_res(dc_session* s, double t, const double* y, const double* yp, 
     s->arg[1] = y;
     s->arg[2] = yp;
     s->arg[3] = s->params + s->param_off[k];
+    s->arg[4] = s->P;
     s->res[0] = s->tmp_r;
     if (M->term_res[k].eval(s->arg, s->res, s->iw, s->w, s->mem_term_res[k])) return -(k + 2);
     for (int i = 0; i < s->n; ++i) r[i] += s->tmp_r[i];
@@ -234,16 +244,40 @@ static int eval_res(dc_session* s, double t, const double* y, const double* yp, 
   return 0;
 }
 
+/* CasADi's compressed column storage: nrow, ncol, colind[ncol+1], row[nnz]; a dense pattern
+ * is written as just nrow, ncol, 1 (a sparse one always has colind[0] == 0). */
+static int sp_dense(const dc_int* sp) { return sp[2] == 1; }
+
+static dc_int nnz_of(const dc_fun_t* f) {
+  const dc_int* sp = f->sparsity_out(0);
+  return sp_dense(sp) ? sp[0] * sp[1] : sp[2 + sp[1]];
+}
+
+/* Add the nonzeros nz of an n x n matrix with pattern sp to the dense column-major J. */
+static void scatter_add(const dc_int* sp, const double* nz, double* J, int n) {
+  const dc_int ncol = sp[1];
+  if (sp_dense(sp)) {
+    for (dc_int i = 0; i < sp[0] * ncol; ++i) J[i] += nz[i];
+    return;
+  }
+  const dc_int* colind = sp + 2;
+  const dc_int* row = sp + 3 + ncol;
+  for (dc_int c = 0; c < ncol; ++c)
+    for (dc_int k = colind[c]; k < colind[c + 1]; ++k) J[(size_t)c * (size_t)n + (size_t)row[k]] += nz[k];
+}
+
 static int eval_jac(dc_session* s, double t, const double* y, const double* yp, double cj,
                     double* J) {
   const dc_model_t* M = &dc_model;
-  const int nn = s->n * s->n;
+  memset(J, 0, sizeof(double) * (size_t)s->n * (size_t)s->n);
   s->arg[0] = &t;
   s->arg[1] = y;
   s->arg[2] = yp;
   s->arg[3] = &cj;
-  s->res[0] = J;
+  s->arg[4] = s->P;
+  s->res[0] = s->tmp_J;
   if (M->jac.eval(s->arg, s->res, s->iw, s->w, s->mem_jac)) return -1;
+  scatter_add(M->jac.sparsity_out(0), s->tmp_J, J, s->n);
   for (int k = 0; k < s->n_terms; ++k) {
     if (!s->active[k]) continue;
     s->arg[0] = &t;
@@ -251,9 +285,10 @@ static int eval_jac(dc_session* s, double t, const double* y, const double* yp, 
     s->arg[2] = yp;
     s->arg[3] = s->params + s->param_off[k];
     s->arg[4] = &cj;
+    s->arg[5] = s->P;
     s->res[0] = s->tmp_J;
     if (M->term_jac[k].eval(s->arg, s->res, s->iw, s->w, s->mem_term_jac[k])) return -(k + 2);
-    for (int i = 0; i < nn; ++i) J[i] += s->tmp_J[i];
+    scatter_add(M->term_jac[k].sparsity_out(0), s->tmp_J, J, s->n);
   }
   return 0;
 }
@@ -263,6 +298,7 @@ static int eval_roots(dc_session* s, double t, const double* y, const double* yp
   s->arg[0] = &t;
   s->arg[1] = y;
   s->arg[2] = yp;
+  s->arg[3] = s->P;
   s->res[0] = g;
   return M->roots.eval(s->arg, s->res, s->iw, s->w, s->mem_roots) ? -1 : 0;
 }
@@ -364,6 +400,8 @@ DC_API int dc_abi_version(void) { return DC_ABI_VERSION; }
 
 DC_API int dc_sundials_version(char* buf, int len) { return SUNDIALSGetVersion(buf, len); }
 
+DC_API int dc_n_parameters(void) { return dc_model.n_parameters; }
+
 DC_API int dc_model_info(int* n, int* n_terms, int* n_roots, int* n_params) {
   *n = dc_model.n;
   *n_terms = dc_model.n_terms;
@@ -458,6 +496,7 @@ DC_API void dc_free(void* sp) {
   free(s->rootsfound);
   free(s->tmp_r);
   free(s->tmp_J);
+  free(s->P);
   free(s->auto_root);
   free(s->auto_term);
   free(s->auto_rate);
@@ -489,7 +528,8 @@ static void work_max(const dc_fun_t* f, dc_int* a, dc_int* r, dc_int* iw, dc_int
  * IDAInit is called here with a zero state; dc_reinit then (re)starts with IDAReInit.
  * Returns NULL on failure with a message in err. */
 DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_order,
-                     long long max_steps, const int* rootdir, char* err, int errlen) {
+                     long long max_steps, const int* rootdir, const double* P, char* err,
+                     int errlen) {
   const dc_model_t* M = &dc_model;
   dc_session* s = (dc_session*)calloc(1, sizeof(dc_session));
   int n = M->n, flag;
@@ -511,7 +551,7 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
 
   /* CasADi work memory */
   {
-    dc_int sa = 5, sr = 1, si = 0, sw = 0;
+    dc_int sa = 6, sr = 1, si = 0, sw = 0;
     work_max(&M->res, &sa, &sr, &si, &sw);
     work_max(&M->jac, &sa, &sr, &si, &sw);
     if (M->n_roots > 0) work_max(&M->roots, &sa, &sr, &si, &sw);
@@ -560,10 +600,18 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
     s->rootdir = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
     s->rootsfound = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
     s->tmp_r = (double*)xcalloc((size_t)n, sizeof(double));
-    s->tmp_J = (double*)xcalloc((size_t)n * (size_t)n, sizeof(double));
+    dc_int nnz = nnz_of(&M->jac);
+    for (int k = 0; k < M->n_terms; ++k)
+      if (nnz_of(&M->term_jac[k]) > nnz) nnz = nnz_of(&M->term_jac[k]);
+    s->tmp_J = (double*)xcalloc((size_t)nnz, sizeof(double));
+    s->P = (double*)xcalloc((size_t)M->n_parameters, sizeof(double));
     if (!s->params || !s->rootdir_default || !s->rootdir || !s->rootsfound || !s->tmp_r ||
-        !s->tmp_J)
+        !s->tmp_J || !s->P)
       FAIL("out of memory");
+    if (M->n_parameters > 0) {
+      if (!P) FAIL("the model has %d run-time parameters and none were given", M->n_parameters);
+      memcpy(s->P, P, sizeof(double) * (size_t)M->n_parameters);
+    }
     for (int i = 0; i < M->n_roots; ++i) s->rootdir_default[i] = rootdir ? rootdir[i] : 0;
   }
 
@@ -837,14 +885,14 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
   double* Qc = gr + 2;                 /* [nq] */
   double* Fk = Qc + nq;                /* [nq] */
   double* sol = Fk + nq;               /* [nq + m + 1] */
-  const int zeros2[2] = {0, 0};
+  const int zeros3[3] = {0, 0, 0};
   int switched = 0;
   for (int i = 0; i < s->n_roots; ++i) {
     int dir = s->rootsfound[i];
     if (!dir) continue;
     int p = s->root_to_auto[i], k = s->auto_term[p];
-    const double* in_rate[2] = {q, v};
-    if (dc_eval_extra(s->auto_rate[p], 1, 2, in_rate, zeros2, gr, 2) != 0) goto eval_failed;
+    const double* in_rate[3] = {q, v, s->P};
+    if (dc_eval_extra(s->auto_rate[p], 1, 3, in_rate, zeros3, gr, 2) != 0) goto eval_failed;
     dc_decision d = pair_step(&s->pair_rule[p], &s->pair_state[p], t, dir, gr[1]);
     if (d.kind == DC_NONE) continue;
     int* info = s->ev_info + 4 * (size_t)s->ev_n;
@@ -870,14 +918,14 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
   double tt = t;
   for (int k = 0; k < s->n_terms; ++k) {
     if (!s->active[k]) continue;
-    const double* in_f[4] = {&tt, q, v, s->params + s->param_off[k]};
-    int strides[4] = {0, 0, 0, 0};
-    if (dc_eval_extra(s->auto_force0 + k, 1, 4, in_f, strides, Fk, nq) != 0) goto eval_failed;
+    const double* in_f[5] = {&tt, q, v, s->params + s->param_off[k], s->P};
+    int strides[5] = {0, 0, 0, 0, 0};
+    if (dc_eval_extra(s->auto_force0 + k, 1, 5, in_f, strides, Fk, nq) != 0) goto eval_failed;
     for (int j = 0; j < nq; ++j) Qc[j] += Fk[j];
   }
-  const double* in_a[4] = {&tt, q, v, Qc};
-  int strides_a[4] = {0, 0, 0, 0};
-  if (dc_eval_extra(s->auto_accel, 1, 4, in_a, strides_a, sol, nq + m + 1) != 0) goto eval_failed;
+  const double* in_a[5] = {&tt, q, v, Qc, s->P};
+  int strides_a[5] = {0, 0, 0, 0, 0};
+  if (dc_eval_extra(s->auto_accel, 1, 5, in_a, strides_a, sol, nq + m + 1) != 0) goto eval_failed;
   memcpy(y + 2 * nq, sol + nq, sizeof(double) * (size_t)m);
   memcpy(yp, v, sizeof(double) * (size_t)nq);
   memcpy(yp + nq, sol, sizeof(double) * (size_t)nq);

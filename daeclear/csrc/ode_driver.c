@@ -32,7 +32,9 @@
 #include "dco_model.h"
 
 #define DCO_API __attribute__((visibility("default")))
-#define DCO_ABI_VERSION 1
+#ifndef DCO_ABI_VERSION /* given by daeclear.codegen (ODE_DRIVER_ABI) */
+#error "compile with -DDCO_ABI_VERSION=<daeclear.codegen.ODE_DRIVER_ABI>"
+#endif
 #define MSG_LEN 1024
 
 /* model evaluation return codes */
@@ -63,6 +65,7 @@ typedef struct {
   int* mem_tj;
   int* active;
   double* params;
+  double* P; /* run-time parameters, appended to every generated function's inputs */
   int* poff;
   double *minv, *Q, *Pq, *c, *f, *Fk, *S, *Sd, *r, *lam, *D, *Jk, *b, *zl;
   double *k1, *k2, *k3, *k4, *xt, *xcur, *g0, *gd0, *g1, *gd1;
@@ -88,6 +91,7 @@ static int first_nonfinite(const double* v, int k) {
 static int call(dco_session* s, const dc_fun_t* f, int mem, int nin, const double** in, int nout,
                 double** out) {
   for (int i = 0; i < nin; ++i) s->arg[i] = in[i];
+  s->arg[nin] = s->P;
   for (int i = 0; i < nout; ++i) s->res[i] = out[i];
   return f->eval(s->arg, s->res, s->iw, s->w, mem);
 }
@@ -387,10 +391,11 @@ DCO_API void dco_free(void* sp) {
   free(s->mem_tj);
   free(s->active);
   free(s->poff);
+  free(s->P);
   free(s);
 }
 
-DCO_API void* dco_open(char* err, int errlen) {
+DCO_API void* dco_open(const double* mass, const double* P, char* err, int errlen) {
   const dco_model_t* M = &dco_model;
   dco_session* s = (dco_session*)calloc(1, sizeof(dco_session));
   if (!s) {
@@ -405,7 +410,7 @@ DCO_API void* dco_open(char* err, int errlen) {
   s->ng = ng;
   s->mem_sys = s->mem_sysj = s->mem_gaps = s->mem_out = -1;
   s->hermite = 1;
-  dc_int sa = 5, sr = 3, si = 0, sw = 0;
+  dc_int sa = 6, sr = 3, si = 0, sw = 0;
   work_max(&M->sys, &sa, &sr, &si, &sw);
   work_max(&M->sys_jac, &sa, &sr, &si, &sw);
   if (ng > 0) work_max(&M->gaps, &sa, &sr, &si, &sw);
@@ -429,6 +434,8 @@ DCO_API void* dco_open(char* err, int errlen) {
   }
   if (nt) s->poff[nt] = np;
   s->params = (double*)xcalloc((size_t)np, sizeof(double));
+  s->P = (double*)xcalloc((size_t)M->n_parameters, sizeof(double));
+  if (s->P && M->n_parameters > 0) memcpy(s->P, P, sizeof(double) * (size_t)M->n_parameters);
 #define ALLOC(field, count) s->field = (double*)xcalloc((size_t)(count), sizeof(double))
   ALLOC(minv, n);
   ALLOC(Q, n);
@@ -456,19 +463,19 @@ DCO_API void* dco_open(char* err, int errlen) {
   ALLOC(gd1, ng);
 #undef ALLOC
   if (!s->arg || !s->res || !s->iw || !s->w || !s->mem_tf || !s->mem_tj || !s->active ||
-      !s->poff || !s->params || !s->minv || !s->D || !s->Jk || !s->gd1) {
+      !s->poff || !s->params || !s->P || !s->minv || !s->D || !s->Jk || !s->gd1) {
     if (err && errlen > 0) snprintf(err, errlen, "out of memory");
     dco_free(s);
     return NULL;
   }
   for (int k = 0; k < n; ++k) {
-    if (!(M->mass[k] > 0.0)) {
+    if (!(mass[k] > 0.0)) {
       if (err && errlen > 0)
-        snprintf(err, errlen, "mass matrix diagonal entry %d is %g; it must be > 0", k, M->mass[k]);
+        snprintf(err, errlen, "mass matrix diagonal entry %d is %g; it must be > 0", k, mass[k]);
       dco_free(s);
       return NULL;
     }
-    s->minv[k] = 1.0 / M->mass[k];
+    s->minv[k] = 1.0 / mass[k];
   }
   for (int k = 0; k < nt; ++k) s->mem_tf[k] = s->mem_tj[k] = -1;
   s->refd = 1;

@@ -1,0 +1,209 @@
+"""Run-time parameters of an assembled model: what is compiled versus what is data.
+
+The compiled engine depends only on a scene's *structure* (which bodies, joints, clearance
+joints and laws it has, and the switches that change the shape of the equations). Every
+number (masses, inertias, joint points, clearances, radii, law and friction parameters,
+driver speeds, gravity, Baumgarte constants) is a run-time parameter: one entry of the
+vector ``P`` that every generated function takes as its last input. So a sweep, a study or a
+second call with other numbers reuses the compiled library (and, in one process, the
+assembled template) and compiles nothing.
+
+Three pieces live here:
+
+* :class:`ParameterTable`: the named entries of ``P`` (values, and while a template is
+  built, their CasADi symbols);
+* :func:`structure_key`: the hashable description of a scene with every number masked, which
+  picks the template and the compiled library;
+* :func:`law_values` / :func:`symbolic_law`: a contact or friction law's numbers as
+  parameters, and a twin of the law whose numbers are those symbols. A law whose formula
+  cannot run on symbolic numbers (it computes constants with ``math``) is *baked*: its
+  numbers become part of the structure key instead (checked once per law class).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+from typing import Any, Iterable
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["ParameterTable", "structure_key", "law_values", "symbolic_law", "law_structure", "is_parametric"]
+
+
+class ParameterTable:
+    """Ordered named parameters: name -> values (a float or a short vector).
+
+    Built by the element parameter functions; ``layout`` (names and sizes) belongs to the
+    structure, ``vector`` is the run-time data.
+    """
+
+    def __init__(self) -> None:
+        self._values: dict[str, NDArray[np.float64]] = {}
+
+    def add(self, name: str, value: Any) -> None:
+        """Add one entry; ``value`` is a number or a sequence of numbers."""
+        if name in self._values:
+            raise KeyError(f"parameter {name!r} added twice")
+        self._values[name] = np.atleast_1d(np.asarray(value, dtype=float)).ravel()
+
+    def update(self, prefix: str, values: dict[str, Any]) -> None:
+        """Add every ``values`` entry under ``prefix.<key>``."""
+        for key, value in values.items():
+            self.add(f"{prefix}.{key}", value)
+
+    @property
+    def layout(self) -> tuple[tuple[str, int], ...]:
+        return tuple((name, v.size) for name, v in self._values.items())
+
+    @property
+    def vector(self) -> NDArray[np.float64]:
+        return np.concatenate(list(self._values.values())) if self._values else np.zeros(0)
+
+    def value(self, name: str) -> NDArray[np.float64]:
+        return self._values[name]
+
+    def symbols(self, P: Any) -> dict[str, Any]:
+        """Name -> the slice of the symbol vector ``P`` that holds it (scalars as 1x1)."""
+        out, offset = {}, 0
+        for name, size in self.layout:
+            out[name] = P[offset:offset + size]
+            offset += size
+        return out
+
+    def offsets(self) -> dict[str, int]:
+        """Name -> index of the entry's first element in :attr:`vector`."""
+        out, offset = {}, 0
+        for name, size in self.layout:
+            out[name] = offset
+            offset += size
+        return out
+
+
+# ---- structure -------------------------------------------------------------------------
+
+def _mask(value: Any) -> Any:
+    """A plain-data copy of ``value`` with every number replaced by ``'#'``."""
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, (int, float, np.floating, np.integer)):
+        return "#"
+    if isinstance(value, dict):
+        return {str(k): _mask(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_mask(v) for v in value]
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return [type(value).__name__, {f.name: _mask(getattr(value, f.name)) for f in dataclasses.fields(value)}]
+    return repr(value)
+
+
+def structure_key(scene_dict: dict[str, Any], extra: Iterable[Any]) -> str:
+    """SHA-256 of the scene description with numbers masked, plus ``extra`` (formulation,
+    options and the laws' structural flags, see :func:`law_structure`)."""
+    text = json.dumps([_mask(scene_dict), list(extra)], sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+# ---- laws ------------------------------------------------------------------------------
+
+def _numeric_fields(law: Any) -> list[str]:
+    return [f.name for f in dataclasses.fields(law)
+            if isinstance(getattr(law, f.name), (int, float)) and not isinstance(getattr(law, f.name), bool)]
+
+
+_PARAMETRIC: dict[type, bool] = {}
+
+
+def is_parametric(law: Any) -> bool:
+    """True when the law's formula runs with symbolic numbers and agrees with the numeric law
+    (checked once per class, at a few penetrations and rates)."""
+    cls = type(law)
+    if cls not in _PARAMETRIC:
+        _PARAMETRIC[cls] = _check_parametric(law)
+    return _PARAMETRIC[cls]
+
+
+def _evaluate(law: Any, x: Any, y: Any, z: Any) -> Any:
+    if hasattr(law, "friction_force"):
+        return law.friction_force(x, y)
+    return law.force(x, y, z) if law.needs_approach_speed else law.force(x, y)
+
+
+#: Properties the assembly branches on: a twin answers them with the numeric law's values.
+_FLAGS = ("needs_approach_speed", "dissipative", "is_resolved", "frictionless")
+_TWIN_CLASSES: dict[type, type] = {}
+
+
+def _twin_class(cls: type) -> type:
+    """A subclass whose structural flags are fixed numbers, not expressions of its fields."""
+    if cls not in _TWIN_CLASSES:
+        fixed = {flag: property(lambda self, flag=flag: self._fixed_flags[flag]) for flag in _FLAGS if hasattr(cls, flag)}
+        _TWIN_CLASSES[cls] = type(cls.__name__, (cls,), fixed)
+    return _TWIN_CLASSES[cls]
+
+
+def _check_parametric(law: Any) -> bool:
+    names = _numeric_fields(law)
+    if not names:
+        return True
+    P = ca.SX.sym("P", len(names))
+    try:
+        twin = _twin(law, {name: P[i] for i, name in enumerate(names)})
+        a, b, c = ca.SX.sym("a"), ca.SX.sym("b"), ca.SX.sym("c")
+        f = ca.Function("law_check", [a, b, c, P], [_evaluate(twin, a, b, c)])
+        if f.has_free():
+            return False
+    except Exception:  # a formula that needs numbers (math.*, comparisons): bake its numbers
+        return False
+    values = [float(getattr(law, name)) for name in names]
+    for x, y, z in ((1e-6, 0.3, 0.5), (3e-5, -0.2, 1.2), (2e-4, 1.5, 2.0), (-1e-6, 0.1, 0.5)):
+        try:
+            expected = float(_evaluate(law, x, y, z))
+        except Exception:
+            return False
+        got = float(f(x, y, z, values))
+        if not (math.isclose(got, expected, rel_tol=1e-9, abs_tol=1e-12) or (math.isnan(got) and math.isnan(expected))):
+            return False
+    return True
+
+
+def _twin(law: Any, symbols: dict[str, Any]) -> Any:
+    """A copy of ``law`` with some numeric fields replaced by symbols (no validation: the
+    numeric law was validated already; its structural flags are kept as numbers)."""
+    twin = object.__new__(_twin_class(type(law)))
+    object.__setattr__(twin, "_fixed_flags", {flag: getattr(law, flag) for flag in _FLAGS if hasattr(law, flag)})
+    for f in dataclasses.fields(law):
+        object.__setattr__(twin, f.name, symbols.get(f.name, getattr(law, f.name)))
+    return twin
+
+
+def law_values(law: Any) -> dict[str, float]:
+    """The law's numbers as run-time parameters (empty for a baked law)."""
+    if not is_parametric(law):
+        return {}
+    return {name: float(getattr(law, name)) for name in _numeric_fields(law)}
+
+
+def symbolic_law(law: Any, symbols: dict[str, Any], prefix: str) -> Any:
+    """The law with its numbers taken from ``symbols[prefix.<field>]`` (the law itself if baked)."""
+    if not is_parametric(law):
+        return law
+    return _twin(law, {name: symbols[f"{prefix}.{name}"][0] for name in _numeric_fields(law)})
+
+
+def law_structure(law: Any) -> list[Any]:
+    """What of a law decides the equations' shape: its class, the flags the assembly branches
+    on, which fields are set, and all its numbers when it is baked."""
+    flags = [type(law).__name__]
+    for attr in ("needs_approach_speed", "dissipative", "frictionless", "smooth", "geometry"):
+        if hasattr(law, attr):
+            flags.append((attr, getattr(law, attr)))
+    exponent = getattr(law, "effective_exponent", None)
+    if exponent is not None:
+        flags.append(("linear", exponent == 1.0))
+    flags.append(_mask(dataclasses.asdict(law)) if is_parametric(law) else repr(law))
+    return flags

@@ -1,0 +1,146 @@
+"""Structure compiles, numbers do not: run-time parameters of the assembled model.
+
+Every number of a scene enters the generated functions as run-time parameter data. Checked
+here: scenes that differ only in numbers share one symbolic template and one compiled
+library; the shared template bound to new numbers gives the same equations as a template
+built for those numbers from scratch (an independent second computation); structural
+changes get their own template; every contact and friction law either runs with symbolic
+parameters or is baked into the structure.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import daeclear as dc
+from daeclear.codegen import clear_memos
+from daeclear.contact import FRICTION_LAWS, NORMAL_LAWS, Material, friction_law, normal_law
+from daeclear.parameters import is_parametric, law_values, symbolic_law
+
+STEEL = Material(young=207e9, poisson=0.3)
+
+
+def _functions_at(model: dc.DAEModel, seed: int) -> list[np.ndarray]:
+    """Residual (every term on), Jacobian, roots and outputs at a random state."""
+    rng = np.random.default_rng(seed)
+    f = model.functions
+    P = model.parameter_values
+    y = np.concatenate([model.q_guess, model.v_guess, np.zeros(model.n_states - 2 * model.n_q)])
+    y = y + 1e-4 * rng.standard_normal(y.size)
+    yp = rng.standard_normal(y.size)
+    t, cj = 1.3e-3, 2.5e3
+    out = [np.array(f.residual(t, y, yp, P)), np.array(f.jacobian(t, y, yp, cj, P))]
+    for term_res, term in zip(f.term_residuals, model.terms):
+        out.append(np.array(term_res(t, y, yp, np.full(term.n_params, 0.7), P)))
+    if f.roots is not None:
+        out.append(np.array(f.roots(t, y, yp, P)))
+    switch = np.concatenate([np.r_[1.0, np.full(term.n_params, 0.7)] for term in model.terms]) if model.terms \
+        else np.zeros(0)
+    out.append(np.array(model.outputs(t, y, yp, switch, P)))
+    return out
+
+
+# (scene built first, scene with other numbers and the same structure)
+VARIANTS = {
+    "revolute": (dict(joint="revolute", friction=0.2),
+                 dict(joint="revolute", clearance=0.4e-3, rpm=3000.0, gravity=0.0, friction=0.05)),
+    "revolute-hertz": (dict(joint="revolute", law="hertz"),
+                       dict(joint="revolute", clearance=0.2e-3, law="hertz", bearing_radius=12e-3)),
+    "translational": (dict(joint="translational", friction=0.3),
+                      dict(joint="translational", clearance=0.3e-3, rpm=4000.0, friction=0.1)),
+    "section-4.3": (dict(joint="translational", contact_model="section-4.3"),
+                    dict(joint="translational", clearance=0.6e-3, contact_model="section-4.3", restitution=0.8)),
+    "ideal": (dict(joint="ideal"), dict(joint="ideal", rpm=1234.0, gravity=3.0)),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_shared_template_equals_a_fresh_build(variant):
+    base, kwargs = VARIANTS[variant]
+    first = dc.assemble(dc.mechanisms.slider_crank(**base))  # builds (or reuses) the template
+    shared = dc.assemble(dc.mechanisms.slider_crank(**kwargs))
+    assert shared.functions is first.functions, "numbers only: the template must be reused"
+    assert not np.array_equal(shared.parameter_values, first.parameter_values)
+    clear_memos()
+    fresh = dc.assemble(dc.mechanisms.slider_crank(**kwargs))  # built from these numbers
+    assert fresh.functions is not shared.functions
+    for seed in (1, 2):
+        for a, b in zip(_functions_at(shared, seed), _functions_at(fresh, seed)):
+            np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(shared.q_guess, fresh.q_guess)
+    np.testing.assert_array_equal(shared.mass_diagonal, fresh.mass_diagonal)
+
+
+def test_new_numbers_compile_nothing_and_keep_the_physics():
+    runs = []
+    for clearance in (0.5e-3, 0.25e-3):
+        scene = dc.mechanisms.slider_crank("revolute", clearance=clearance, gravity=0.0)
+        runs.append(dc.simulate(scene, t_end=0.003, rtol=1e-7))
+    assert runs[1].stats["compile_time"] == 0.0
+    for run, clearance in zip(runs, (0.5e-3, 0.25e-3)):
+        # the first impact happens at the clearance the run was given
+        onset = run.events.of("clearance", kind="onset")[0]
+        i = int(np.searchsorted(run.t, onset.t))
+        assert run["clearance.eccentricity"][i] == pytest.approx(clearance, rel=1e-3)
+    assert runs[0].events.of("clearance", kind="onset")[0].t > runs[1].events.of("clearance", kind="onset")[0].t
+
+
+def test_structure_changes_get_their_own_template():
+    reference = dc.assemble(dc.mechanisms.slider_crank("revolute")).functions
+    same = [dict(clearance=0.1e-3), dict(rpm=100.0), dict(gravity=0.0), dict(restitution=0.5),
+            dict(bearing_radius=20e-3), dict(name="renamed")]
+    for kwargs in same:
+        assert dc.assemble(dc.mechanisms.slider_crank("revolute", **kwargs)).functions is reference, kwargs
+    different = [dict(friction=0.1), dict(restitution=1.0), dict(law="hertz")]
+    for kwargs in different:
+        assert dc.assemble(dc.mechanisms.slider_crank("revolute", **kwargs)).functions is not reference, kwargs
+    assert dc.assemble(dc.mechanisms.slider_crank("revolute"), formulation="ggl").functions is not reference
+    assert dc.assemble(dc.mechanisms.slider_crank("revolute"), track_work=True).functions is not reference
+
+
+def test_named_parameters():
+    model = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.3e-3, rpm=6000.0), alpha=7.0)
+    assert model.parameter("clearance.clearance")[0] == pytest.approx(0.3e-3)
+    assert model.parameter("drive.speed")[0] == pytest.approx(6000.0 * np.pi / 30.0)
+    assert model.parameter("baumgarte.alpha")[0] == 7.0
+    assert model.parameter("gravity").tolist() == [0.0, -9.81]
+    with pytest.raises(KeyError, match="clearance.clearance"):
+        model.parameter("clearance.nope")
+
+
+def _resolved(law):
+    for kind, radii in (("internal_cylinder", (0.01, 0.0095)), ("sphere_plane", (1e-3,)), ("plane_face", None)):
+        try:
+            return law.resolve(kind, radii=radii, materials=STEEL, face_half_width=0.025)
+        except dc.SceneError:
+            continue
+    raise AssertionError(f"{law!r} resolves for no kind")
+
+
+@pytest.mark.parametrize("name", sorted(NORMAL_LAWS))
+def test_normal_laws_run_with_symbolic_numbers_or_are_baked(name):
+    import casadi as ca
+
+    extra = {"restitution": 0.8} if name in ("lankarani-nikravesh", "hunt-crossley", "flores") else {}
+    if name in ("dubowsky-freudenstein", "esdu-78035", "goldsmith"):
+        extra = {"length": 0.02}
+    law = _resolved(normal_law(name, **extra))
+    values = law_values(law)
+    if not is_parametric(law):
+        assert values == {}  # baked: its numbers are structure (a new value, a new template)
+        return
+    names = sorted(values)
+    P = ca.SX.sym("P", len(names))
+    twin = symbolic_law(law, {f"law.{k}": P[i:i + 1] for i, k in enumerate(names)}, "law")
+    d, r, v = ca.SX.sym("d"), ca.SX.sym("r"), ca.SX.sym("v")
+    f = ca.Function("f", [d, r, v, P], [twin.force(d, r, v) if law.needs_approach_speed else twin.force(d, r)])
+    for delta, rate in ((2e-6, 0.4), (4e-5, -0.3), (-1e-6, 0.2)):
+        expected = law.force(delta, rate, 0.9) if law.needs_approach_speed else law.force(delta, rate)
+        assert float(f(delta, rate, 0.9, [values[k] for k in names])) == pytest.approx(expected, rel=1e-12, abs=1e-12)
+
+
+@pytest.mark.parametrize("name", sorted(FRICTION_LAWS))
+def test_friction_laws_are_parametric(name):
+    law = friction_law(name, **({} if name == "none" else {"coefficient": 0.2}))
+    assert is_parametric(law)
