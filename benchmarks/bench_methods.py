@@ -32,6 +32,7 @@ except ImportError:  # running from a checkout without installing
 
 import daeclear as dc  # noqa: E402
 import daeclear.integrators as integrators  # noqa: E402
+from daeclear.automaton import PairState  # noqa: E402
 
 T_END = 0.024
 WINDOW = 0.005
@@ -56,12 +57,13 @@ CASES_QUICK = [
 
 
 def reset_contact_logic(model):
-    """Start every run with fresh contact logic: the storm guard of PairLogic (recent switches, held
-    flag) is not reset by initial_modes at the time of writing and leaks from one run to the next."""
+    """Start every run with fresh contact logic (initial_modes starts every run without storm
+    history too; this keeps a run from seeing the last one's automaton states even before that)."""
     for logic in model.contacts:
-        for name, value in (("recent", []), ("held", False), ("free_since", 0.0), ("held_since", None)):
-            if hasattr(logic, name):
-                setattr(logic, name, value)
+        if hasattr(logic, "state"):
+            logic.state = PairState()
+        if hasattr(logic, "states"):
+            logic.states = []
 
 
 def run(model, method, kind, value, te, repeat):

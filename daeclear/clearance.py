@@ -19,8 +19,8 @@ IDA from a consistent state. The contact force is exactly zero with a zero deriv
 at zero penetration for every continuous law, so a switch never jumps the force; and
 because IDA returns a root just past the crossing, a restart never reports the same
 crossing twice. Following (continuous) contact keeps the pair in contact mode with no
-events at all; a Zeno-like cascade of ever shorter bounces is cut by the storm guard
-of :class:`PairLogic` (see ``STORM_EVENTS``).
+events at all; a Zeno-like cascade of ever shorter bounces is cut by the storm guard.
+The rule, storm guard included, is defined once in :mod:`daeclear.automaton`.
 """
 
 from __future__ import annotations
@@ -32,14 +32,12 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from .automaton import STORM_EVENTS, STORM_WINDOW  # noqa: F401  (re-exported: the storm guard's defaults)
+from .automaton import EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
 from .parameters import law_structure, law_values, symbolic_law
 from .result import ContactEvent
 from .scene import RevoluteClearance
 from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
-
-# Storm guard (see PairLogic): STORM_EVENTS switches within STORM_WINDOW seconds hold the term on.
-STORM_EVENTS = 20
-STORM_WINDOW = 1e-6
 
 
 @dataclass
@@ -47,13 +45,9 @@ class PairLogic:
     """Mode switching of one contact pair: one gap (root) and one term.
 
     ``rate`` evaluates ``(gap, penetration_rate)`` from ``(q, v)``; ``needs_approach`` says
-    whether the term's parameter is the approach speed latched at onset.
-
-    Storm guard: when the pair has switched ``STORM_EVENTS`` times within ``STORM_WINDOW``
-    seconds, a separation leaves the term on (*held*): the force is zero with a zero derivative
-    while the gap is open, so nothing physical changes. A held pair watches both crossings but
-    changes nothing (the solver continues without a restart) until it re-contacts after being
-    free for longer than ``STORM_WINDOW``, which is a genuine new impact.
+    whether the term's parameter is the approach speed latched at onset. The rule, storm guard
+    included, is :func:`daeclear.automaton.step` with this pair's ``storm`` constants; the term
+    is on while the pair is in contact or held.
     """
 
     pair: str
@@ -64,68 +58,67 @@ class PairLogic:
     needs_approach: bool
     min_approach_speed: float
     discontinuous_friction: bool = False
-    recent: list[float] = field(default_factory=list)
-    held: bool = False
-    free_since: float = 0.0
+    storm: Storm = field(default_factory=Storm)
+    state: PairState = field(default_factory=PairState)
+
+    @property
+    def held(self) -> bool:
+        """The storm guard holds the term on (see :mod:`daeclear.automaton`)."""
+        return self.state.held
+
+    @property
+    def roots(self) -> range:
+        """Indices of the gaps (roots) of this element."""
+        return range(self.root_index, self.root_index + 1)
+
+    def pair_state(self, root: int) -> PairState:
+        """The automaton state of the pair of gap ``root``."""
+        return self.state
 
     def _gap_rate(self, y: NDArray) -> tuple[float, float]:
         q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
         gap, rate = self.rate(q, v)
         return float(gap[0]), float(rate[0])
 
-    def _params(self, rate: float) -> NDArray:
-        return np.array([max(rate, self.min_approach_speed)]) if self.needs_approach else np.zeros(0)
+    def _params(self) -> NDArray:
+        return np.array([self.state.latched]) if self.needs_approach else np.zeros(0)
 
     def initial_modes(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> dict[str, str]:
-        self.recent, self.held, self.free_since = [], False, 0.0  # a new run starts without history
         gap, rate = self._gap_rate(y)
-        in_contact = gap > 0.0
-        active[self.term_index] = in_contact
-        params[self.term_index] = self._params(rate)
-        return {self.pair: "contact" if in_contact else "free"}
+        self.state = start(gap > 0.0, rate, self.min_approach_speed)  # a new run starts without history
+        active[self.term_index] = self.state.term_on
+        params[self.term_index] = self._params()
+        return {self.pair: "contact" if self.state.contact else "free"}
 
     def root_directions(self, active: Sequence[bool]) -> list[tuple[int, int]]:
         """While free watch onsets (+1), in contact separations (-1), held both (0)."""
-        if self.held:
-            return [(self.root_index, 0)]
-        return [(self.root_index, -1 if active[self.term_index] else +1)]
+        return [(self.root_index, self.state.watch)]
 
     def on_roots(self, t: float, y: NDArray, yp: NDArray, roots_found: NDArray | None,
                  active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
-        """Switch the pair's mode at a root of its gap; return the events it records."""
+        """Decide a root of the pair's gap by the automaton; return the events it records."""
         if roots_found is None or roots_found[self.root_index] == 0:
             return []
-        direction = int(roots_found[self.root_index])
-        k = self.term_index
-        if self.held:
-            if direction < 0:
-                self.free_since = t
-                return []
-            if t - self.free_since <= STORM_WINDOW:
-                return []  # a re-contact inside the storm: keep the held term as it is
-            self.held = False
-            active[k] = False  # fall through: a genuine onset after a real flight
-        gap, rate = self._gap_rate(y)
-        if direction > 0 and not active[k]:
-            self._count(t)
-            active[k] = True
-            params[k] = self._params(rate)
-            return [ContactEvent(t=t, pair=self.pair, kind="onset", approach_speed=rate, y=y.copy())]
-        if direction < 0 and active[k]:
-            self._count(t)
-            if len(self.recent) >= STORM_EVENTS:
-                self.held, self.free_since = True, t
-            else:
-                active[k] = False
-            return [ContactEvent(t=t, pair=self.pair, kind="separation", approach_speed=rate, y=y.copy())]
-        return []
+        rate = self._gap_rate(y)[1]
+        self.state, decision = step(self.state, t, int(roots_found[self.root_index]), rate, storm=self.storm,
+                                    min_approach_speed=self.min_approach_speed)
+        return self.record(self.root_index, t, y, rate, decision, active, params)
 
-    def _count(self, t: float) -> None:
-        self.recent = [s for s in self.recent if t - s < STORM_WINDOW] + [t]
+    def record(self, root: int, t: float, y: NDArray, rate: float, decision: Decision,
+               active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+        """Apply a decision taken at a root of gap ``root`` (here or by the compiled loop): the
+        pair's mode, its term and latched speed; return the event it makes, if any."""
+        if decision.kind == NONE:
+            return []
+        self.state = recorded(self.state, decision)
+        active[self.term_index] = decision.term_on
+        if decision.kind == ONSET:
+            params[self.term_index] = self._params()
+        return [ContactEvent(t=t, pair=self.pair, kind=EVENT_KINDS[decision.kind], approach_speed=rate, y=y.copy())]
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]]:
-        """(root, term, (q, v, P) -> [gap; rate], needs approach speed, floor): the switches the
-        compiled IDA loop may make itself, with exactly this class's rules (see ida_driver.c)."""
+        """(root, term, (q, v, P) -> [gap; rate], needs approach speed, floor): the pairs whose
+        switches the compiled IDA loop decides itself, by the C mirror of the automaton."""
         fn = self.rate.function
         q, v, P = (ca.SX.sym(label, fn.numel_in(i)) for i, label in enumerate(("q", "v", "P")))
         gap, rate = fn(q, v, P)

@@ -45,11 +45,12 @@ import warnings
 import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol, Sequence, runtime_checkable
+from typing import Any, NamedTuple, Protocol, Sequence, runtime_checkable
 
 import casadi
 import numpy as np
 
+from .automaton import Decision, PairState, Storm
 from .codegen import (
     memo_get,
     memo_put,
@@ -131,6 +132,17 @@ class DAEFunctions:
     n_parameters: int = 0
 
 
+class AutoEvent(NamedTuple):
+    """A contact switch the compiled loop decided itself: pair index (in the order given to
+    :meth:`CSession.set_auto_events`), the penetration rate there, the decision and the state."""
+
+    t: float
+    pair: int
+    rate: float
+    decision: Decision
+    y: np.ndarray
+
+
 @dataclass
 class Advance:
     """What one :meth:`Session.advance` call did.
@@ -159,9 +171,8 @@ class Advance:
     flag: int = 0
     flag_name: str = ""
     message: str = ""
-    # contact switches the compiled loop handled itself (see CSession.set_auto_events):
-    # (t, pair index, +1 onset / -1 separation, penetration rate, state) in time order
-    auto_events: list = field(default_factory=list)
+    # contact switches the compiled loop decided itself (see CSession.set_auto_events), in time order
+    auto_events: list[AutoEvent] = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -449,9 +460,11 @@ class _CLib:
         lib.dc_eval_extra.restype = I
         lib.dc_eval_extra.argtypes = [I, I, I, P, P, P, I]
         lib.dc_set_auto.restype = I
-        lib.dc_set_auto.argtypes = [P, I, P, P, P, P, P, I, I, I, I, I, I, D, I]
+        lib.dc_set_auto.argtypes = [P, I, P, P, P, P, P, P, P, P, P, P, I, I, I, I, I, I]
         lib.dc_take_events.restype = I
-        lib.dc_take_events.argtypes = [P, I, P, P, P, P, P]
+        lib.dc_take_events.argtypes = [P, I, P, P, P, P, P, P]
+        lib.dc_automaton_run.restype = I
+        lib.dc_automaton_run.argtypes = [I, P, P, P, I, D, D, I, I, D, P, P, P, P, P]
         lib.dc_pending_events.restype = I
         lib.dc_pending_events.argtypes = [P]
         lib.dc_get_active.restype = None
@@ -581,35 +594,72 @@ class CSession(_SessionBase):
         return True
 
     def set_auto_events(self, pairs: Sequence[tuple[int, int, int, bool, float]], *, n_q: int, n_constraints: int,
-                        track_work: bool, accel_extra: int, force_extra0: int, storm_events: int,
-                        storm_window: float, capacity: int = 256) -> bool:
-        """Let the C loop switch simple contact pairs itself (index-1 layout, see ida_driver.c).
+                        track_work: bool, accel_extra: int, force_extra0: int, storms: Sequence[Storm],
+                        states: Sequence[PairState], capacity: int = 256) -> bool:
+        """Let the C loop decide every contact switch itself (index-1 layout, see ida_driver.c).
 
-        ``pairs``: (root index, term index, gap-rate extra, needs approach speed, min speed).
+        ``pairs``: (root index, term index, gap-rate extra, needs approach speed, min speed), one
+        per root function; ``storms``: each pair's storm-guard constants; ``states``: each pair's
+        :class:`daeclear.automaton.PairState` to start from (its history is not carried over).
         Each advance then returns the switches it made in ``Advance.auto_events``.
         """
         np_ = len(pairs)
-        arr = lambda col, dt: np.ascontiguousarray([p[col] for p in pairs] or [0], dtype=dt)  # noqa: E731
-        self._auto_arrays = [arr(0, np.int32), arr(1, np.int32), arr(2, np.int32), arr(3, np.int32),
-                             arr(4, np.float64)]
+        if len(storms) != np_ or len(states) != np_:
+            raise ValueError(f"set_auto_events: {np_} pairs, {len(storms)} storms, {len(states)} states")
+        capacity = max(int(capacity), np_)
+
+        def arr(values: Any, dt: Any) -> np.ndarray:
+            return np.ascontiguousarray(list(values) or [0], dtype=dt)
+
+        self._auto_arrays = [
+            arr((p[0] for p in pairs), np.int32), arr((p[1] for p in pairs), np.int32),
+            arr((p[2] for p in pairs), np.int32), arr((p[3] for p in pairs), np.int32),
+            arr((p[4] for p in pairs), np.float64), arr((st.events for st in storms), np.int32),
+            arr((st.window for st in storms), np.float64), arr((st.contact for st in states), np.int32),
+            arr((st.held for st in states), np.int32), arr((st.latched for st in states), np.float64)]
         ptr = [a.ctypes.data for a in self._auto_arrays]
         rc = self._lib.dc_set_auto(self._h, np_, *ptr, n_q, n_constraints, int(track_work), accel_extra,
-                                   force_extra0, storm_events, float(storm_window), capacity)
+                                   force_extra0, capacity)
         if rc != 0:
-            raise DaeclearError("configuring the events handled in C failed")
+            raise DaeclearError("configuring the events decided in C failed")
         self._auto_cap = capacity
-        self._auto_buf = (np.empty(capacity), np.empty(capacity, dtype=np.int32), np.empty(capacity, dtype=np.int32),
-                          np.empty(capacity), np.empty((capacity, self._n)))
+        self._auto_buf = (np.empty(capacity), np.empty(capacity, dtype=np.int32),
+                          np.empty((capacity, 4), dtype=np.int32), np.empty(capacity), np.empty(capacity),
+                          np.empty((capacity, self._n)))
         return True
 
-    def _take_auto_events(self) -> list[tuple[float, int, int, float, np.ndarray]]:
+    def _take_auto_events(self) -> list[AutoEvent]:
         buf = getattr(self, "_auto_buf", None)
         if buf is None:
             return []
-        t, pair, kind, speed, y = buf
-        k = self._lib.dc_take_events(self._h, self._auto_cap, t.ctypes.data, pair.ctypes.data, kind.ctypes.data,
-                                     speed.ctypes.data, y.ctypes.data)
-        return [(float(t[i]), int(pair[i]), int(kind[i]), float(speed[i]), y[i].copy()) for i in range(k)]
+        t, pair, info, rate, latched, y = buf
+        k = self._lib.dc_take_events(self._h, self._auto_cap, t.ctypes.data, pair.ctypes.data, info.ctypes.data,
+                                     rate.ctypes.data, latched.ctypes.data, y.ctypes.data)
+        return [AutoEvent(float(t[i]), int(pair[i]), float(rate[i]),
+                          Decision(int(info[i, 0]), bool(info[i, 1]), bool(info[i, 2]), float(latched[i]),
+                                   int(info[i, 3])), y[i].copy()) for i in range(k)]
+
+    def automaton_run(self, times: Sequence[float], directions: Sequence[int], rates: Sequence[float], *,
+                      storm: Storm, min_approach_speed: float, contact: bool = False, held: bool = False,
+                      latched: float = 0.0) -> list[Decision]:
+        """Run the compiled loop's pair automaton over a root sequence from the given state with no
+        history (a test hook: the decisions must be those of :func:`daeclear.automaton.step`)."""
+        t = np.ascontiguousarray(times, dtype=np.float64)
+        d = np.ascontiguousarray(directions, dtype=np.int32)
+        r = np.ascontiguousarray(rates, dtype=np.float64)
+        n = t.size
+        if d.size != n or r.size != n:
+            raise ValueError("automaton_run: times, directions and rates differ in length")
+        out_i = np.zeros((4, max(n, 1)), dtype=np.int32)
+        out_l = np.zeros(max(n, 1))
+        rc = self._lib.dc_automaton_run(n, t.ctypes.data, d.ctypes.data, r.ctypes.data, storm.events,
+                                        float(storm.window), float(min_approach_speed), int(contact), int(held),
+                                        float(latched), *(out_i[j].ctypes.data for j in range(4)),
+                                        out_l.ctypes.data)
+        if rc != 0:
+            raise DaeclearError("dc_automaton_run rejected its arguments")
+        return [Decision(int(out_i[0, i]), bool(out_i[1, i]), bool(out_i[2, i]), float(out_l[i]), int(out_i[3, i]))
+                for i in range(n)]
 
     def active_terms(self) -> tuple[list[bool], list[np.ndarray]]:
         """The active flags and parameters the C loop integrates with now."""
@@ -688,6 +738,7 @@ class CSession(_SessionBase):
         A = self._addr
         self._i_eval.value = 0
         chunks: list[tuple[np.ndarray, ...]] = []
+        auto_events: list[AutoEvent] = []
         store = 1 if store_steps else 0
         lib, h = self._lib, self._h
         tic = time.perf_counter()
@@ -701,11 +752,12 @@ class CSession(_SessionBase):
                 if k:
                     chunks.append((self._st[:k].copy(), self._sy[:k].copy(), self._syp[:k].copy(),
                                    self._sh[:k].copy(), self._sord[:k].copy()))
+                auto_events += self._take_auto_events()  # drained at every chunk: the C buffer never overflows
                 if rc != 0:
                     break
                 # buffer full: back in Python between chunks, so Ctrl-C works here
                 if on_chunk is not None:  # time reached, and contact switches made in C so far
-                    on_chunk(self._t_out.value, self._lib.dc_pending_events(h))
+                    on_chunk(self._t_out.value, len(auto_events))
         finally:
             self._solve_time += time.perf_counter() - tic
             # also after an interrupt between chunks: the C side stopped at a valid state
@@ -722,7 +774,7 @@ class CSession(_SessionBase):
         ne = self._i_eval.value
         adv = Advance(status="tstop", t=self._t, y=self._y, yp=self._yp, step_t=st,
                       step_y=sy, step_yp=syp, step_h=sh, step_order=so, eval_t=te[:ne].copy(),
-                      eval_y=ev_y[:ne], eval_yp=ev_yp[:ne], auto_events=self._take_auto_events())
+                      eval_y=ev_y[:ne], eval_yp=ev_yp[:ne], auto_events=auto_events)
         if rc == 1:
             return adv
         if rc == 2:

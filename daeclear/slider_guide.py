@@ -50,7 +50,7 @@ Friction (only when declared): at every active contact, the modified Coulomb law
 joint's law) on the sliding velocity of the slider's material point at the contact
 relative to the guide's, along ``t``.
 
-Events follow the rule of :mod:`daeclear.clearance` (onset watched while free, separation
+Events follow the rule of :mod:`daeclear.automaton` (onset watched while free, separation
 while in contact, approach speed latched at the located onset and floored, the same
 storm guard per corner). A face's switches are reported as events of the pair
 ``<name>.upper_face`` / ``<name>.lower_face``, after the corner events that caused them.
@@ -82,7 +82,8 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from .clearance import STORM_EVENTS, STORM_WINDOW, ContactBuild, approach_floor
+from .automaton import EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
+from .clearance import ContactBuild, approach_floor
 from .parameters import law_structure, law_values, symbolic_law
 from .result import ContactEvent
 from .scene import TranslationalClearance
@@ -126,10 +127,10 @@ class SliderGuideLogic:
     """Mode switching of one translational clearance joint: four corner pairs and, in the
     ``section-4.3`` model, two faces.
 
-    A corner is *free* or in *contact* (its gap's root); the terms follow from the modes:
-    a face term is on while both its corners are in contact, a corner term while its
-    corner is in contact and its face is not on (or while it is *held* by the storm guard).
-    ``rate`` maps ``(q, v)`` to the four gaps and the four penetration rates.
+    Each corner is a pair of :mod:`daeclear.automaton` (free, contact or held, by the root of its
+    gap); the terms follow from the modes: a face term is on while both its corners are in
+    contact, a corner term while its corner's term is on (in contact or held) and its face is
+    not. ``rate`` maps ``(q, v)`` to the four gaps and the four penetration rates.
     """
 
     name: str
@@ -145,33 +146,33 @@ class SliderGuideLogic:
     min_approach_speed: float
     face_needs_approach: bool
     face_min_approach_speed: float
-    contact: list[bool] = field(default_factory=list)
-    held: list[bool] = field(default_factory=list)
-    free_since: list[float] = field(default_factory=list)
-    latched: list[float] = field(default_factory=list)
+    storm: Storm = field(default_factory=Storm)
+    states: list[PairState] = field(default_factory=list)
     face_on: list[bool] = field(default_factory=list)
-    recent: list[list[float]] = field(default_factory=list)
+
+    @property
+    def roots(self) -> range:
+        """Indices of the gaps (roots) of this element: one per corner."""
+        return range(self.first_root, self.first_root + len(self.pairs))
+
+    def pair_state(self, root: int) -> PairState:
+        """The automaton state of the corner of gap ``root``."""
+        return self.states[root - self.first_root]
 
     def _evaluate(self, y: NDArray) -> tuple[NDArray, NDArray]:
         q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
         gaps, rates = self.rate(q, v)
         return np.asarray(gaps, dtype=float).ravel(), np.asarray(rates, dtype=float).ravel()
 
-    def _reset(self) -> None:
-        n = len(self.pairs)
-        self.contact, self.held, self.latched, self.free_since = [False] * n, [False] * n, [0.0] * n, [0.0] * n
-        self.recent = [[] for _ in range(n)]
-        self.face_on = [False] * len(self.face_names)
-
     def _apply(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
         """Set the terms from the modes; return the events of faces that formed or broke."""
         events: list[ContactEvent] = []
         in_face = [False] * len(self.pairs)
         for f, (a, b) in enumerate(self.face_corners):
-            on = self.contact[a] and self.contact[b]
+            on = self.states[a].contact and self.states[b].contact
             k = self.face_terms[f]
             if on and not self.face_on[f]:
-                speed = 0.5 * (self.latched[a] + self.latched[b])
+                speed = 0.5 * (self.states[a].latched + self.states[b].latched)
                 params[k] = (np.array([max(speed, self.face_min_approach_speed)]) if self.face_needs_approach
                              else np.zeros(0))
                 events.append(ContactEvent(t=t, pair=self.face_names[f], kind="onset", approach_speed=speed,
@@ -183,31 +184,31 @@ class SliderGuideLogic:
             active[k] = on
             in_face[a] = in_face[b] = on
         for i, k in enumerate(self.corner_terms):
-            active[k] = (self.contact[i] or self.held[i]) and not in_face[i]
+            active[k] = self.states[i].term_on and not in_face[i]
         return events
 
-    def _corner_params(self, i: int, rate: float) -> NDArray:
-        self.latched[i] = max(rate, self.min_approach_speed)
-        return np.array([self.latched[i]]) if self.needs_approach else np.zeros(0)
+    def _corner_params(self, i: int) -> NDArray:
+        return np.array([self.states[i].latched]) if self.needs_approach else np.zeros(0)
 
     def initial_modes(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> dict[str, str]:
-        self._reset()
         gaps, rates = self._evaluate(y)
+        # a new run starts without history
+        self.states = [start(gaps[i] > 0.0, float(rates[i]), self.min_approach_speed) for i in range(len(self.pairs))]
+        self.face_on = [False] * len(self.face_names)
         for i, k in enumerate(self.corner_terms):
-            self.contact[i] = bool(gaps[i] > 0.0)
-            params[k] = self._corner_params(i, float(rates[i]))
+            params[k] = self._corner_params(i)
         self._apply(t, y, active, params)
-        modes = {p: ("contact" if c else "free") for p, c in zip(self.pairs, self.contact)}
+        modes = {p: ("contact" if st.contact else "free") for p, st in zip(self.pairs, self.states)}
         modes.update({f: ("contact" if on else "free") for f, on in zip(self.face_names, self.face_on)})
         return modes
 
     def root_directions(self, active: Sequence[bool]) -> list[tuple[int, int]]:
         """While a corner is free watch its onsets (+1), in contact separations (-1), held both (0)."""
-        return [(self.first_root + i, 0 if self.held[i] else -1 if self.contact[i] else +1)
-                for i in range(len(self.pairs))]
+        return [(self.first_root + i, st.watch) for i, st in enumerate(self.states)]
 
     def on_roots(self, t: float, y: NDArray, yp: NDArray, roots_found: NDArray | None,
                  active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+        """Decide the roots of the corners' gaps by the automaton; return the events of corners and faces."""
         if roots_found is None:
             return []
         found = roots_found[self.first_root:self.first_root + len(self.pairs)]
@@ -218,36 +219,36 @@ class SliderGuideLogic:
         for i, direction in enumerate(int(d) for d in found):
             if direction == 0:
                 continue
-            if self.held[i]:  # the storm rule of clearance.PairLogic
-                if direction < 0:
-                    self.free_since[i] = t
-                    continue
-                if t - self.free_since[i] <= STORM_WINDOW:
-                    continue  # a re-contact inside the storm: the held term stays as it is
-                self.held[i] = False  # a genuine onset after a real flight
             rate = float(rates[i])
-            if direction > 0 and not self.contact[i]:
-                self._count(i, t)
-                self.contact[i] = True
-                params[self.corner_terms[i]] = self._corner_params(i, rate)
-                events.append(ContactEvent(t=t, pair=self.pairs[i], kind="onset", approach_speed=rate,
-                                           y=y.copy()))
-            elif direction < 0 and self.contact[i]:
-                self._count(i, t)
-                self.contact[i] = False
-                if len(self.recent[i]) >= STORM_EVENTS:
-                    self.held[i], self.free_since[i] = True, t  # the corner term stays on (zero force)
-                events.append(ContactEvent(t=t, pair=self.pairs[i], kind="separation", approach_speed=rate,
-                                           y=y.copy()))
+            self.states[i], decision = step(self.states[i], t, direction, rate, storm=self.storm,
+                                            min_approach_speed=self.min_approach_speed)
+            events += self._record_corner(i, t, y, rate, decision, params)
         events += self._apply(t, y, active, params)
         return events
 
-    def _count(self, i: int, t: float) -> None:
-        self.recent[i] = [s for s in self.recent[i] if t - s < STORM_WINDOW] + [t]
+    def record(self, root: int, t: float, y: NDArray, rate: float, decision: Decision,
+               active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+        """Apply a decision taken at a root of gap ``root`` (here or by the compiled loop) to its
+        corner and the terms; return the events of the corner and of faces that formed or broke."""
+        events = self._record_corner(root - self.first_root, t, y, rate, decision, params)
+        if events:
+            events += self._apply(t, y, active, params)
+        return events
+
+    def _record_corner(self, i: int, t: float, y: NDArray, rate: float, decision: Decision,
+                       params: list[NDArray]) -> list[ContactEvent]:
+        """Set corner i's mode and latched speed from a decision; return its event, if any."""
+        if decision.kind == NONE:
+            return []
+        self.states[i] = recorded(self.states[i], decision)
+        if decision.kind == ONSET:
+            params[self.corner_terms[i]] = self._corner_params(i)
+        return [ContactEvent(t=t, pair=self.pairs[i], kind=EVENT_KINDS[decision.kind], approach_speed=rate,
+                             y=y.copy())]
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
-        """Without faces (model ``corners``) every corner pair switches by PairLogic's rules, so
-        the compiled IDA loop may switch it itself; with faces the terms depend on two corners."""
+        """Without faces (model ``corners``) every corner term follows its own pair, so the compiled
+        IDA loop may decide its switches itself; with faces the terms depend on two corners."""
         if self.face_names:
             return None
         fn = getattr(self.rate, "function", None)

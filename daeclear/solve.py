@@ -9,6 +9,7 @@ again, and IDA restarts with fresh BDF history.
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
 import sys
@@ -20,7 +21,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .assemble import EXTRA_ACCEL, EXTRA_TERM0, KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
-from .clearance import STORM_EVENTS, STORM_WINDOW
 from .errors import DaeclearWarning, SceneError, SolveError
 from .ida_session import open_session
 from .result import ContactEvent, Result
@@ -253,10 +253,17 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     n_restarts = 0
     try:
         session.reinit(t, y, yp, active, params, _root_directions(model, active))
+        # the compiled loop may decide every contact switch itself (simple pairs): the rule and the
+        # starting state of each pair come from its logic object; Python then only records
+        owners: dict[int, Any] = {}
+        c_decides = False
         if model.auto_pairs:
-            session.set_auto_events(model.auto_pairs, n_q=model.n_q, n_constraints=model.n_constraints,
-                                    track_work=model.track_work, accel_extra=EXTRA_ACCEL, force_extra0=EXTRA_TERM0,
-                                    storm_events=STORM_EVENTS, storm_window=STORM_WINDOW)
+            owners = {root: logic for logic in model.contacts for root in logic.roots}
+            roots = [pair[0] for pair in model.auto_pairs]
+            c_decides = session.set_auto_events(
+                model.auto_pairs, n_q=model.n_q, n_constraints=model.n_constraints, track_work=model.track_work,
+                accel_extra=EXTRA_ACCEL, force_extra0=EXTRA_TERM0, storms=[owners[root].storm for root in roots],
+                states=[owners[root].pair_state(root) for root in roots])
 
         def record(adv: Any, steps: slice, evals: slice, switch: NDArray) -> None:
             """Keep IDA's points as they are; they are made consistent in one pass at the end."""
@@ -283,39 +290,41 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
             adv = session.advance(t_end, pending, store_steps, on_chunk=on_chunk)
             if pending is not None and adv.eval_t.size:
                 pending = pending[pending > adv.eval_t[-1]]
-            # the C loop may have switched simple contact pairs itself: split the advance there
-            # and replay each switch through the same pair logic (modes, storm counters, events)
+            # the C loop decided contact switches itself: split the advance at each restart and
+            # record the decisions (modes, terms, latched speeds, events) in the pair logic
             s0 = e0 = 0
-            for t_ev, pair_index, kind, _speed, y_ev in adv.auto_events:
+            for t_ev, decided in itertools.groupby(adv.auto_events, key=lambda ev: ev.t):
                 s1 = int(np.searchsorted(adv.step_t, t_ev, side="right"))
                 e1 = int(np.searchsorted(adv.eval_t, t_ev, side="right"))
                 record(adv, slice(s0, s1), slice(e0, e1), switch)
                 segments.append((seg_start, t_ev, dict(modes)))
-                roots = np.zeros(len(model.gap_names), dtype=np.int32)
-                roots[model.auto_pairs[pair_index][0]] = kind
-                for logic in model.contacts:
-                    for event in logic.on_roots(t_ev, y_ev, None, roots, active, params):
+                for ev in decided:
+                    root = model.auto_pairs[ev.pair][0]
+                    for event in owners[root].record(root, t_ev, ev.y, ev.rate, ev.decision, active, params):
                         events.append(event)
                         modes[event.pair] = "contact" if event.kind == "onset" else "free"
                 switch = model.switch_vector(active, params)
                 seg_start, s0, e0 = t_ev, s1, e1
                 n_restarts += 1
             record(adv, slice(s0, None), slice(e0, None), switch)
-            if adv.auto_events and session.active_terms()[0] != list(active):
+            if adv.auto_events and not _same_terms(session.active_terms(), active, params):
                 adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
-                adv.message = "internal: the compiled event loop and the pair logic disagree on the contact modes"
+                adv.message = "internal: the compiled event loop and the recorded contact modes disagree"
+            elif c_decides and adv.status == "root":
+                adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
+                adv.message = "internal: the compiled event loop left a contact root undecided"
             t, y, yp = adv.t, adv.y, adv.yp
             progress_line.update(t, len(events))
-            segments.append((seg_start, t, dict(modes)))
-            seg_start = t
             if adv.status == "error":
+                segments.append((seg_start, t, dict(modes)))
                 success, status = False, -1
                 message = _failure_message(model, adv, modes)
                 break
             if adv.status == "tstop" or t >= t_end:
+                segments.append((seg_start, t, dict(modes)))
                 break
             # a root: let every contact element decide its new modes
-            before = (list(active), [p.copy() for p in params], _root_directions(model, active))
+            before = (list(active), [p.copy() for p in params], _root_directions(model, active), dict(modes))
             for logic in model.contacts:
                 new_events = logic.on_roots(t, y, yp, adv.roots_found, active, params)
                 events.extend(new_events)
@@ -323,7 +332,9 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                     modes[event.pair] = "contact" if event.kind == "onset" else "free"
             if (before[0] == active and all(np.array_equal(a, b) for a, b in zip(before[1], params))
                     and np.array_equal(before[2], _root_directions(model, active))):
-                continue  # nothing switched: IDA goes on from the root without a restart
+                continue  # nothing switched: IDA goes on from the root without a restart, in the same segment
+            segments.append((seg_start, t, before[3]))
+            seg_start = t
             y, yp = model.consistent_state(t, y, model.term_forces(t, y, active, params, session), session,
                                            project=True)
             switch = model.switch_vector(active, params)
@@ -394,6 +405,11 @@ def _check_drift(model: DAEModel, channels: dict[str, NDArray], stats: dict[str,
             f"clearance ({clearance:.2e} m) (formulation={model.formulation!r}); contact times and forces are "
             "uncertain by that much. Use formulation='ggl' (drift-free) or a smaller rtol.",
             DaeclearWarning, stacklevel=3)
+
+
+def _same_terms(c_terms: tuple[list[bool], list[NDArray]], active: Sequence[bool], params: Sequence[NDArray]) -> bool:
+    """The compiled loop's active terms and parameters are those recorded from its decisions."""
+    return c_terms[0] == list(active) and all(np.array_equal(a, b) for a, b in zip(c_terms[1], params))
 
 
 def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:

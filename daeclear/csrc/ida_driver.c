@@ -56,6 +56,88 @@ enum {
 
 #define MSG_LEN 1024
 
+/* ------------------------------------------------------------------ contact-mode automaton
+ * The C mirror of daeclear/automaton.py (step): the decision of one contact pair at a root of
+ * its gap. Keep the two identical, branch for branch; tests/test_automaton.py drives both
+ * with the same random root sequences through dc_automaton_run. */
+#define DC_NONE 0
+#define DC_ONSET 1
+#define DC_SEPARATION (-1)
+
+typedef struct {
+  int storm_events;    /* this many switches within storm_window s hold the term on (>= 1) */
+  double storm_window;
+  double vmin;         /* floor of the latched approach speed */
+} dc_pair_rule;
+
+typedef struct {
+  int contact, held;
+  double free_since;   /* start of the current flight of a held pair */
+  double latched;      /* approach speed latched at the last onset (floored) */
+  int n_recent;        /* entries of recent, <= storm_events */
+  double* recent;      /* [storm_events] times of the last switches, oldest first */
+} dc_pair_state;
+
+typedef struct {
+  int kind;            /* DC_ONSET, DC_SEPARATION or DC_NONE (nothing changes) */
+  int contact, held;   /* the new mode; the term is on while contact || held */
+  int watch;           /* root direction to watch next */
+  double latched;
+} dc_decision;
+
+static double floor_speed(double rate, double vmin) { return rate > vmin ? rate : vmin; }
+
+static int pair_watch(const dc_pair_state* st) { return st->held ? 0 : st->contact ? -1 : 1; }
+
+static dc_decision decision_of(const dc_pair_state* st, int kind) {
+  dc_decision d = {kind, st->contact, st->held, pair_watch(st), st->latched};
+  return d;
+}
+
+/* keep the last storm_events switch times */
+static void pair_push(const dc_pair_rule* r, dc_pair_state* st, double t) {
+  if (st->n_recent < r->storm_events) {
+    st->recent[st->n_recent++] = t;
+  } else {
+    memmove(st->recent, st->recent + 1, sizeof(double) * (size_t)(r->storm_events - 1));
+    st->recent[r->storm_events - 1] = t;
+  }
+}
+
+/* Decide a root at time t (non-decreasing per pair) crossed in direction dir (+1, -1, 0) with
+ * penetration rate `rate`; update the state and return the decision. */
+static dc_decision pair_step(const dc_pair_rule* r, dc_pair_state* st, double t, int dir,
+                             double rate) {
+  if (dir != 0 && st->held) {
+    if (dir < 0) {
+      st->free_since = t; /* the held pair's flight starts again */
+      dir = 0;
+    } else if (t - st->free_since <= r->storm_window) {
+      dir = 0; /* a re-contact inside the storm: the held term stays as it is */
+    } else {
+      st->held = 0; /* a genuine onset after a real flight */
+    }
+  }
+  if (dir > 0 && !st->contact) {
+    st->contact = 1;
+    st->latched = floor_speed(rate, r->vmin);
+    pair_push(r, st, t);
+    return decision_of(st, DC_ONSET);
+  }
+  if (dir < 0 && st->contact) {
+    int count = 1;
+    for (int i = 0; i < st->n_recent; ++i)
+      if (t - st->recent[i] < r->storm_window) ++count;
+    int hold = count >= r->storm_events;
+    st->contact = 0;
+    st->held = hold;
+    if (hold) st->free_since = t;
+    pair_push(r, st, t);
+    return decision_of(st, DC_SEPARATION);
+  }
+  return decision_of(st, DC_NONE);
+}
+
 typedef struct {
   SUNContext ctx;
   void* ida;
@@ -93,25 +175,24 @@ typedef struct {
   char msg[MSG_LEN];    /* our own message for the last non-success return */
   char cb_msg[MSG_LEN]; /* set by a callback that refused its input (NaN, CasADi error) */
   char ida_msg[MSG_LEN]; /* last message IDA passed to the error handler */
-  /* contact events handled in C (dc_set_auto): simple pairs of one root and one term */
+  /* contact events decided in C (dc_set_auto): simple pairs of one root and one term */
   int n_auto;
   int* auto_root;     /* [n_auto] root index of the pair */
   int* auto_term;     /* [n_auto] term index of the pair */
   int* auto_rate;     /* [n_auto] extra: (q, v) -> [gap; penetration rate] */
   int* auto_needs;    /* [n_auto] the term's parameter is the latched approach speed */
-  double* auto_vmin;  /* [n_auto] floor of the approach speed */
-  int* root_to_auto;  /* [n_roots] pair of a root, -1 if the root is not a simple pair's */
+  int* root_to_auto;  /* [n_roots] pair of a root */
   int auto_nq, auto_m, auto_track, auto_accel, auto_force0;
-  int storm_events;   /* a separation completing this many switches within storm_window... */
-  double storm_window; /* ...is left to Python (held pairs) */
-  double* recent;     /* [n_auto * storm_events] ring of switch times */
-  int* recent_n;      /* [n_auto] */
+  dc_pair_rule* pair_rule;   /* [n_auto] */
+  dc_pair_state* pair_state; /* [n_auto] */
+  double* recent;     /* storage of the pairs' rings of switch times */
   double* auto_buf;   /* scratch, 4 * (auto_nq + auto_m + 2) */
   int ev_cap, ev_n;   /* events recorded in C, taken by dc_take_events */
   double* ev_t;
   int* ev_pair;
-  int* ev_kind;       /* +1 onset, -1 separation */
-  double* ev_speed;
+  int* ev_info;       /* [ev_cap * 4] the decision: kind, contact, held, watch */
+  double* ev_rate;    /* penetration rate at the event */
+  double* ev_latched; /* the pair's latched approach speed after the event */
   double* ev_y;       /* [ev_cap * n] state at the event */
 } dc_session;
 
@@ -420,15 +501,16 @@ DC_API void dc_free(void* sp) {
   free(s->auto_term);
   free(s->auto_rate);
   free(s->auto_needs);
-  free(s->auto_vmin);
   free(s->root_to_auto);
+  free(s->pair_rule);
+  free(s->pair_state);
   free(s->recent);
-  free(s->recent_n);
   free(s->auto_buf);
   free(s->ev_t);
   free(s->ev_pair);
-  free(s->ev_kind);
-  free(s->ev_speed);
+  free(s->ev_info);
+  free(s->ev_rate);
+  free(s->ev_latched);
   free(s->ev_y);
   free(s);
 }
@@ -646,77 +728,105 @@ static void copy_state(dc_session* s, double* y_out, double* yp_out) {
   memcpy(yp_out, N_VGetArrayPointer(s->yp), sizeof(double) * (size_t)s->n);
 }
 
-/* ------------------------------------------------------------------ events handled in C
- * Simple contact pairs (one root function, one term; index-1 layout y = [q, v, lam(, W)]) can
- * switch without returning to Python: at a root the C loop flips the pair's term, latches the
- * approach speed (floored), recomputes the multipliers and derivatives with the generated
- * functions (extras: term forces and the accelerations' Schur-complement solve), restarts IDA
- * and records the event for Python, which replays it through the same pair logic afterwards.
- * Anything else (a root of another element, an unexpected direction, a separation that would
- * complete an event storm, a full event buffer) returns DC_ROOT as before. */
+/* ------------------------------------------------------------------ events decided in C
+ * Simple contact pairs (one root function, one term; index-1 layout y = [q, v, lam(, W)]) are
+ * decided entirely in C once dc_set_auto has configured them (every root must be a pair's): at
+ * a root the loop runs each pair's automaton (pair_step, storm guard and holds included), sets
+ * the pair's term, latched approach speed and root direction from the decision, and, when any
+ * pair switched, recomputes the multipliers and derivatives with the generated functions
+ * (extras: term forces and the accelerations' Schur-complement solve) and restarts IDA; a root
+ * that switched nothing lets IDA go on. Each switch is recorded with its decision for Python,
+ * which only records it (modes, terms, events). dc_advance returns DC_CHUNK before the event
+ * buffer could overflow, so Python drains it between chunks.
+ *
+ * Per pair: root, term, rate (extra), needs (latched speed is the term's parameter), vmin,
+ * storm_events, storm_window (the rule) and contact0, held0, latched0 (the state to start from). */
 DC_API int dc_set_auto(void* sp, int n_auto, const int* root, const int* term, const int* rate,
-                       const int* needs, const double* vmin, int nq, int m, int track_work,
-                       int accel_extra, int force_extra0, int storm_events, double storm_window,
-                       int ev_cap) {
+                       const int* needs, const double* vmin, const int* storm_events,
+                       const double* storm_window, const int* contact0, const int* held0,
+                       const double* latched0, int nq, int m, int track_work, int accel_extra,
+                       int force_extra0, int ev_cap) {
   dc_session* s = (dc_session*)sp;
-  if (n_auto < 0 || storm_events < 1 || ev_cap < 1) return -1;
+  size_t ring = 0;
+  if (n_auto < 0 || (n_auto > 0 && n_auto != s->n_roots) || ev_cap < (n_auto > 0 ? n_auto : 1))
+    return -1;
+  for (int p = 0; p < n_auto; ++p) {
+    if (storm_events[p] < 1 || !(storm_window[p] >= 0.0)) return -1;
+    ring += (size_t)storm_events[p];
+  }
   s->n_auto = 0;
   free(s->auto_root); free(s->auto_term); free(s->auto_rate); free(s->auto_needs);
-  free(s->auto_vmin); free(s->root_to_auto); free(s->recent); free(s->recent_n);
-  free(s->auto_buf); free(s->ev_t); free(s->ev_pair); free(s->ev_kind); free(s->ev_speed);
-  free(s->ev_y);
+  free(s->root_to_auto); free(s->pair_rule); free(s->pair_state); free(s->recent);
+  free(s->auto_buf); free(s->ev_t); free(s->ev_pair); free(s->ev_info); free(s->ev_rate);
+  free(s->ev_latched); free(s->ev_y);
   s->auto_root = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
   s->auto_term = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
   s->auto_rate = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
   s->auto_needs = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
-  s->auto_vmin = (double*)xcalloc((size_t)n_auto + 1, sizeof(double));
   s->root_to_auto = (int*)xcalloc((size_t)s->n_roots + 1, sizeof(int));
-  s->recent = (double*)xcalloc((size_t)(n_auto + 1) * (size_t)storm_events, sizeof(double));
-  s->recent_n = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
+  s->pair_rule = (dc_pair_rule*)xcalloc((size_t)n_auto + 1, sizeof(dc_pair_rule));
+  s->pair_state = (dc_pair_state*)xcalloc((size_t)n_auto + 1, sizeof(dc_pair_state));
+  s->recent = (double*)xcalloc(ring + 1, sizeof(double));
   s->auto_buf = (double*)xcalloc(4 * ((size_t)nq + (size_t)m + 2), sizeof(double));
   s->ev_t = (double*)xcalloc((size_t)ev_cap, sizeof(double));
   s->ev_pair = (int*)xcalloc((size_t)ev_cap, sizeof(int));
-  s->ev_kind = (int*)xcalloc((size_t)ev_cap, sizeof(int));
-  s->ev_speed = (double*)xcalloc((size_t)ev_cap, sizeof(double));
+  s->ev_info = (int*)xcalloc(4 * (size_t)ev_cap, sizeof(int));
+  s->ev_rate = (double*)xcalloc((size_t)ev_cap, sizeof(double));
+  s->ev_latched = (double*)xcalloc((size_t)ev_cap, sizeof(double));
   s->ev_y = (double*)xcalloc((size_t)ev_cap * (size_t)s->n, sizeof(double));
-  if (!s->auto_root || !s->auto_term || !s->auto_rate || !s->auto_needs || !s->auto_vmin ||
-      !s->root_to_auto || !s->recent || !s->recent_n || !s->auto_buf || !s->ev_t || !s->ev_pair ||
-      !s->ev_kind || !s->ev_speed || !s->ev_y)
+  if (!s->auto_root || !s->auto_term || !s->auto_rate || !s->auto_needs || !s->root_to_auto ||
+      !s->pair_rule || !s->pair_state || !s->recent || !s->auto_buf || !s->ev_t || !s->ev_pair ||
+      !s->ev_info || !s->ev_rate || !s->ev_latched || !s->ev_y)
     return -1;
   for (int i = 0; i < s->n_roots; ++i) s->root_to_auto[i] = -1;
+  ring = 0;
   for (int p = 0; p < n_auto; ++p) {
     if (root[p] < 0 || root[p] >= s->n_roots || term[p] < 0 || term[p] >= s->n_terms) return -1;
     if (needs[p] && dc_model.n_params[term[p]] < 1) return -1;
+    if (s->root_to_auto[root[p]] >= 0) return -1;
     s->auto_root[p] = root[p];
     s->auto_term[p] = term[p];
     s->auto_rate[p] = rate[p];
     s->auto_needs[p] = needs[p];
-    s->auto_vmin[p] = vmin[p];
     s->root_to_auto[root[p]] = p;
+    dc_pair_rule r = {storm_events[p], storm_window[p], vmin[p]};
+    dc_pair_state st = {contact0[p] != 0, held0[p] != 0, 0.0, latched0[p], 0, s->recent + ring};
+    s->pair_rule[p] = r;
+    s->pair_state[p] = st;
+    ring += (size_t)storm_events[p];
   }
   s->auto_nq = nq;
   s->auto_m = m;
   s->auto_track = track_work;
   s->auto_accel = accel_extra;
   s->auto_force0 = force_extra0;
-  s->storm_events = storm_events;
-  s->storm_window = storm_window;
   s->ev_cap = ev_cap;
   s->ev_n = 0;
   s->n_auto = n_auto;
   return 0;
 }
 
-/* Move the events recorded in C to the caller's buffers (at most cap); returns their count. */
-DC_API int dc_take_events(void* sp, int cap, double* t, int* pair, int* kind, double* speed, double* y) {
+/* Move the events recorded in C to the caller's buffers (at most cap); returns their count.
+ * info[4 * i ...] = kind, contact, held, watch of event i's decision. */
+DC_API int dc_take_events(void* sp, int cap, double* t, int* pair, int* info, double* rate,
+                          double* latched, double* y) {
   dc_session* s = (dc_session*)sp;
   int k = s->ev_n < cap ? s->ev_n : cap;
   memcpy(t, s->ev_t, sizeof(double) * (size_t)k);
   memcpy(pair, s->ev_pair, sizeof(int) * (size_t)k);
-  memcpy(kind, s->ev_kind, sizeof(int) * (size_t)k);
-  memcpy(speed, s->ev_speed, sizeof(double) * (size_t)k);
+  memcpy(info, s->ev_info, sizeof(int) * 4 * (size_t)k);
+  memcpy(rate, s->ev_rate, sizeof(double) * (size_t)k);
+  memcpy(latched, s->ev_latched, sizeof(double) * (size_t)k);
   memcpy(y, s->ev_y, sizeof(double) * (size_t)k * (size_t)s->n);
-  s->ev_n = 0;
+  s->ev_n -= k;
+  if (s->ev_n > 0) { /* the rest stays, oldest first */
+    memmove(s->ev_t, s->ev_t + k, sizeof(double) * (size_t)s->ev_n);
+    memmove(s->ev_pair, s->ev_pair + k, sizeof(int) * (size_t)s->ev_n);
+    memmove(s->ev_info, s->ev_info + 4 * k, sizeof(int) * 4 * (size_t)s->ev_n);
+    memmove(s->ev_rate, s->ev_rate + k, sizeof(double) * (size_t)s->ev_n);
+    memmove(s->ev_latched, s->ev_latched + k, sizeof(double) * (size_t)s->ev_n);
+    memmove(s->ev_y, s->ev_y + (size_t)k * (size_t)s->n, sizeof(double) * (size_t)s->ev_n * (size_t)s->n);
+  }
   return k;
 }
 
@@ -732,41 +842,40 @@ DC_API void dc_get_active(void* sp, int* active, double* params) {
   memcpy(params, s->params, sizeof(double) * (size_t)np);
 }
 
-static int storm_count(const dc_session* s, int p, double t) {
-  int c = 0;
-  const double* r = s->recent + (size_t)p * (size_t)s->storm_events;
-  for (int i = 0; i < s->recent_n[p]; ++i)
-    if (t - r[i] < s->storm_window) ++c;
-  return c;
-}
-
-static void storm_push(dc_session* s, int p, double t) {
-  double* r = s->recent + (size_t)p * (size_t)s->storm_events;
-  if (s->recent_n[p] < s->storm_events) {
-    r[s->recent_n[p]++] = t;
-  } else {
-    memmove(r, r + 1, sizeof(double) * (size_t)(s->storm_events - 1));
-    r[s->storm_events - 1] = t;
+/* Test hook: run one pair's automaton (pair_step, exactly as the loop does) over a root sequence
+ * t[i], dir[i], rate[i] from the state (contact0, held0, latched0) with no history; write each
+ * decision to kind, contact, held, watch, latched [n]. Returns 0, or -1 for bad arguments. */
+DC_API int dc_automaton_run(int n, const double* t, const int* dir, const double* rate,
+                            int storm_events, double storm_window, double vmin, int contact0,
+                            int held0, double latched0, int* kind, int* contact, int* held,
+                            int* watch, double* latched) {
+  if (n < 0 || storm_events < 1 || !(storm_window >= 0.0)) return -1;
+  double* ring = (double*)xcalloc((size_t)storm_events, sizeof(double));
+  if (!ring) return -1;
+  dc_pair_rule r = {storm_events, storm_window, vmin};
+  dc_pair_state st = {contact0 != 0, held0 != 0, 0.0, latched0, 0, ring};
+  for (int i = 0; i < n; ++i) {
+    dc_decision d = pair_step(&r, &st, t[i], dir[i], rate[i]);
+    kind[i] = d.kind;
+    contact[i] = d.contact;
+    held[i] = d.held;
+    watch[i] = d.watch;
+    latched[i] = d.latched;
   }
+  free(ring);
+  return 0;
 }
 
-/* Handle the root at (t, yy) in C if every found root is a simple pair's plain switch; restart
- * IDA consistently and return 1, or return 0 (nothing changed) for Python to handle it. */
+/* Decide every root found at (t, yy) by the pairs' automata and record the switches. When any
+ * pair switched, restart IDA consistently and return 1; return 2 when nothing switched (IDA
+ * goes on without a restart), 0 without configured pairs (Python decides), -1 on failure. */
 static int auto_handle_root(dc_session* s, double t, double t_stop) {
   if (s->n_auto == 0) return 0;
-  int count = 0;
-  for (int i = 0; i < s->n_roots; ++i) {
-    int dir = s->rootsfound[i];
-    if (!dir) continue;
-    int p = s->root_to_auto[i];
-    if (p < 0) return 0;
-    if (s->rootdir[i] == 0) return 0; /* a held pair (storm guard) watches both ways: Python's */
-    int act = s->active[s->auto_term[p]];
-    if ((dir > 0 && act) || (dir < 0 && !act)) return 0;
-    if (dir < 0 && storm_count(s, p, t) + 1 >= s->storm_events) return 0;
-    ++count;
+  if (s->ev_n + s->n_auto > s->ev_cap) {
+    s->ready = 0;
+    set_msg(s->msg, "internal: the contact event buffer was not drained (t=%.17g)", t);
+    return -1;
   }
-  if (count == 0 || s->ev_n + count > s->ev_cap) return 0;
   const int n = s->n, nq = s->auto_nq, m = s->auto_m;
   double* y = N_VGetArrayPointer(s->yy);
   double* yp = N_VGetArrayPointer(s->yp);
@@ -777,27 +886,32 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
   double* Fk = Qc + nq;                /* [nq] */
   double* sol = Fk + nq;               /* [nq + m + 1] */
   const int zeros3[3] = {0, 0, 0};
+  int switched = 0;
   for (int i = 0; i < s->n_roots; ++i) {
     int dir = s->rootsfound[i];
     if (!dir) continue;
     int p = s->root_to_auto[i], k = s->auto_term[p];
     const double* in_rate[3] = {q, v, s->P};
     if (dc_eval_extra(s->auto_rate[p], 1, 3, in_rate, zeros3, gr, 2) != 0) goto eval_failed;
+    dc_decision d = pair_step(&s->pair_rule[p], &s->pair_state[p], t, dir, gr[1]);
+    if (d.kind == DC_NONE) continue;
+    int* info = s->ev_info + 4 * (size_t)s->ev_n;
     s->ev_t[s->ev_n] = t;
     s->ev_pair[s->ev_n] = p;
-    s->ev_kind[s->ev_n] = dir > 0 ? 1 : -1;
-    s->ev_speed[s->ev_n] = gr[1];
+    info[0] = d.kind;
+    info[1] = d.contact;
+    info[2] = d.held;
+    info[3] = d.watch;
+    s->ev_rate[s->ev_n] = gr[1];
+    s->ev_latched[s->ev_n] = d.latched;
     memcpy(s->ev_y + (size_t)s->ev_n * (size_t)n, y, sizeof(double) * (size_t)n);
     ++s->ev_n;
-    storm_push(s, p, t);
-    if (dir > 0) {
-      s->active[k] = 1;
-      if (s->auto_needs[p]) s->params[s->param_off[k]] = fmax(gr[1], s->auto_vmin[p]);
-    } else {
-      s->active[k] = 0;
-    }
-    s->rootdir[i] = s->active[k] ? -1 : 1;
+    s->active[k] = d.contact || d.held;
+    if (s->auto_needs[p]) s->params[s->param_off[k]] = d.latched;
+    s->rootdir[i] = d.watch;
+    switched = 1;
   }
+  if (!switched) return 2;
   /* consistent restart: keep q and v; multipliers, accelerations (and work rate) from the
    * generated Schur-complement solve with the new set of contact forces */
   memset(Qc, 0, sizeof(double) * (size_t)nq);
@@ -921,6 +1035,12 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
     copy_state(s, y_out, yp_out);
     if (fl == IDA_ROOT_RETURN) {
       IDAGetRootInfo(s->ida, s->rootsfound);
+      int handled = auto_handle_root(s, tret, t_stop);
+      if (handled < 0) return DC_ERR_IDA;
+      if (handled) {
+        copy_state(s, y_out, yp_out);
+        return DC_CHUNK; /* decided in C: call again to go on towards t_stop */
+      }
       memcpy(roots_out, s->rootsfound, sizeof(int) * (size_t)s->n_roots);
       return DC_ROOT;
     }
@@ -1033,8 +1153,9 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
         return DC_ERR_IDA;
       }
       if (handled) {
-        IDAGetNumSteps(s->ida, &nst_prev); /* counters restarted with IDA */
-        if ((store_steps && k >= cap) || (!store_steps && calls >= cap)) { /* buffer full */
+        if (handled == 1) IDAGetNumSteps(s->ida, &nst_prev); /* counters restarted with IDA */
+        if ((store_steps && k >= cap) || (!store_steps && calls >= cap) ||
+            s->ev_n + s->n_auto > s->ev_cap) { /* a buffer full */
           *t_out = tret;
           copy_state(s, y_out, yp_out);
           return DC_CHUNK;
