@@ -49,6 +49,11 @@ FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
 # kinematics: (q, v, t) -> [Phi; Phi_q (column-major); Phi_dot]; term k's generalized force: EXTRA_TERM0 + k
 EXTRA_OUTPUTS, EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_TERM0 = 0, 1, 2, 3
 
+# Projection onto the constraint manifold (initial state and restarts, in Python and in C):
+# |Phi| < POSITION_TOL * max(1, |q|) within NEWTON_STEPS least-norm Newton steps.
+POSITION_TOL = 1e-13
+NEWTON_STEPS = 50
+
 # State kinds: how each state variable is treated by the solver's error test.
 KIND_POSITION, KIND_VELOCITY, KIND_MULTIPLIER, KIND_WORK = "q", "v", "lambda", "work"
 
@@ -155,8 +160,8 @@ class DAEModel:
         flat = self.evaluate(EXTRA_KINEMATICS, [q, v, np.array([t])], 1, session)[0]
         return flat[:m], flat[m:m + m * n].reshape(n, m).T, flat[m + m * n:]
 
-    def assemble_positions(self, q_guess: NDArray[np.float64], t: float = 0.0, tol: float = 1e-13,
-                           max_iter: int = 50, session: Any = None) -> NDArray[np.float64]:
+    def assemble_positions(self, q_guess: NDArray[np.float64], t: float = 0.0, tol: float = POSITION_TOL,
+                           max_iter: int = NEWTON_STEPS, session: Any = None) -> NDArray[np.float64]:
         """Newton (least-norm) on Phi(q, t) = 0 from ``q_guess``; raises AssemblyError if it cannot close."""
         q = np.array(q_guess, dtype=float)
         if self.n_constraints == 0:
@@ -273,6 +278,8 @@ class DAEModel:
 
         ``y`` is one state (n_states,) or many (N, n_states) with ``t`` of shape (N,).
         ``project`` (GGL restarts): first put q and v exactly on the constraint manifold, mu = 0.
+        (index-1 restarts keep their Baumgarte-controlled drift: the chapter's formulation, and
+        restarted twins of a run must follow it; see ``stats["max_constraint_drift"]``.)
         """
         n, m = self.n_q, self.n_constraints
         y = np.array(y, dtype=float)
@@ -521,7 +528,7 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
 
 
 def _build_template(scene: Scene, formulation: str, track_work: bool, table: ParameterTable,
-                    name: str) -> _Template:
+                    library_name: str) -> _Template:
     """The symbolic DAE of the scene's structure, every number a symbol of the parameter vector P."""
     bodies = scene.bodies
     nb = len(bodies)
@@ -724,14 +731,14 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
     sample = [logic for make in logic_makers for logic in make(table.vector)]
     auto_pairs = []
     simple = [getattr(logic, "simple_pairs", lambda: None)() for logic in sample]
-    if formulation == "index1" and sample and all(pairs is not None for pairs in simple):
+    if sample and all(pairs is not None for pairs in simple):
         for index, pairs in enumerate(simple):
             for root, term_index, gap_rate, needs, _floor in pairs:
                 extras.append(gap_rate)
                 auto_pairs.append((root, term_index, len(extras) - 1, needs, index))
     functions = DAEFunctions(
         n=n_y, residual=residual, jacobian=jacobian, term_residuals=tuple(term_res),
-        term_jacobians=tuple(term_jac), roots=roots, name=name, extras=tuple(extras),
+        term_jacobians=tuple(term_jac), roots=roots, name=library_name, extras=tuple(extras),
         n_parameters=int(P.numel()),
     )
     return _Template(

@@ -70,9 +70,9 @@ SUNDIALS_LIBS = (
 )
 #: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
 #: and checked when a library is loaded: bump it when a dc_* signature changes.
-DRIVER_ABI = 2
+DRIVER_ABI = 3
 #: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
-ODE_DRIVER_ABI = 2
+ODE_DRIVER_ABI = 3
 CFLAGS = (f"-DDC_ABI_VERSION={DRIVER_ABI}", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Werror=incompatible-pointer-types",
           "-Werror=implicit-function-declaration")
 

@@ -339,6 +339,10 @@ class _SessionBase:
         """Only the compiled backend switches contact pairs in C; returns False here."""
         return False
 
+    def set_restart(self, **kwargs: Any) -> bool:
+        """Only the compiled backend restarts after its own contact switches; returns False here."""
+        return False
+
     def set_stall(self, stall_step: float, count: int) -> None:
         """Stall detection: ``count`` tiny steps (below ``stall_step`` s and not growing, with no
         step 100x larger in between) end an advance with DC_STEP_COLLAPSE. Both backends."""
@@ -469,6 +473,8 @@ class _CLib:
         lib.dc_pending_events.argtypes = [P]
         lib.dc_get_active.restype = None
         lib.dc_get_active.argtypes = [P, P, P]
+        lib.dc_set_restart.restype = I
+        lib.dc_set_restart.argtypes = [P, I, I, I, I, I, D, I]
         lib.dc_set_stall.restype = I
         lib.dc_set_stall.argtypes = [P, D, I]
         lib.dc_set_init_step.restype = I
@@ -626,6 +632,17 @@ class CSession(_SessionBase):
         self._auto_buf = (np.empty(capacity), np.empty(capacity, dtype=np.int32),
                           np.empty((capacity, 4), dtype=np.int32), np.empty(capacity), np.empty(capacity),
                           np.empty((capacity, self._n)))
+        return True
+
+    def set_restart(self, *, project: bool, ggl: bool, n_q: int, n_constraints: int, kinematics_extra: int,
+                    tol: float, max_iter: int) -> bool:
+        """How the C loop makes a restart after its own contact switches consistent: project q and v
+        onto the constraint manifold (least-norm Newton to ``tol`` * max(1, |q|), at most
+        ``max_iter`` steps) and, for GGL (``ggl``), set the multipliers mu to 0 (see ida_driver.c)."""
+        rc = self._lib.dc_set_restart(self._h, int(project), int(ggl), n_q, n_constraints, kinematics_extra,
+                                      float(tol), int(max_iter))
+        if rc != 0:
+            raise DaeclearError("configuring the restarts made in C failed")
         return True
 
     def _take_auto_events(self) -> list[AutoEvent]:

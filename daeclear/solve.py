@@ -20,7 +20,8 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .assemble import EXTRA_ACCEL, EXTRA_TERM0, KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
+from .assemble import (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_TERM0, KIND_MULTIPLIER, KIND_WORK, NEWTON_STEPS,
+                       POSITION_TOL, DAEModel, assemble)
 from .errors import DaeclearWarning, SceneError, SolveError
 from .ida_session import open_session
 from .result import ContactEvent, Result
@@ -264,6 +265,11 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 model.auto_pairs, n_q=model.n_q, n_constraints=model.n_constraints, track_work=model.track_work,
                 accel_extra=EXTRA_ACCEL, force_extra0=EXTRA_TERM0, storms=[owners[root].storm for root in roots],
                 states=[owners[root].pair_state(root) for root in roots])
+            if c_decides:  # its restarts are made as Python's (GGL: on the constraint manifold, mu = 0)
+                ggl = model.formulation == "ggl"
+                session.set_restart(project=ggl, ggl=ggl, n_q=model.n_q,
+                                    n_constraints=model.n_constraints, kinematics_extra=EXTRA_KINEMATICS,
+                                    tol=POSITION_TOL, max_iter=NEWTON_STEPS)
 
         def record(adv: Any, steps: slice, evals: slice, switch: NDArray) -> None:
             """Keep IDA's points as they are; they are made consistent in one pass at the end."""

@@ -194,6 +194,12 @@ typedef struct {
   double* ev_rate;    /* penetration rate at the event */
   double* ev_latched; /* the pair's latched approach speed after the event */
   double* ev_y;       /* [ev_cap * n] state at the event */
+  /* restarts after a contact switch decided in C (dc_set_restart) */
+  int proj_on;        /* project q and v onto the constraint manifold before restarting */
+  int proj_mu;        /* GGL: also set the velocity-projection multipliers mu to 0 */
+  int proj_nq, proj_m, proj_kin, proj_iter;
+  double proj_tol;    /* |Phi| < proj_tol * max(1, |q|) ends the position Newton */
+  double* proj_buf;   /* [Phi; Phi_q; Phi_dot] (2m + m nq), G (m m), x (m) */
 } dc_session;
 
 static void set_msg(char* buf, const char* fmt, ...) {
@@ -512,6 +518,7 @@ DC_API void dc_free(void* sp) {
   free(s->ev_rate);
   free(s->ev_latched);
   free(s->ev_y);
+  free(s->proj_buf);
   free(s);
 }
 
@@ -869,6 +876,8 @@ DC_API int dc_automaton_run(int n, const double* t, const int* dir, const double
 /* Decide every root found at (t, yy) by the pairs' automata and record the switches. When any
  * pair switched, restart IDA consistently and return 1; return 2 when nothing switched (IDA
  * goes on without a restart), 0 without configured pairs (Python decides), -1 on failure. */
+static int project_state(dc_session* s, double t, double* y); /* below, with dc_set_restart */
+
 static int auto_handle_root(dc_session* s, double t, double t_stop) {
   if (s->n_auto == 0) return 0;
   if (s->ev_n + s->n_auto > s->ev_cap) {
@@ -912,8 +921,16 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
     switched = 1;
   }
   if (!switched) return 2;
-  /* consistent restart: keep q and v; multipliers, accelerations (and work rate) from the
-   * generated Schur-complement solve with the new set of contact forces */
+  /* consistent restart: q and v on the constraint manifold (GGL: mu = 0); multipliers,
+   * accelerations (and work rate) from the generated Schur-complement solve with the new set
+   * of contact forces */
+  if (s->proj_on && project_state(s, t, y) != 0) {
+    s->ready = 0;
+    set_msg(s->msg, "projecting the state onto the constraints after a contact event at t=%.17g failed "
+            "(dependent constraints, or no convergence in %d Newton steps)", t, s->proj_iter);
+    return -1;
+  }
+  if (s->proj_mu) memset(y + 2 * nq + m, 0, sizeof(double) * (size_t)m);
   memset(Qc, 0, sizeof(double) * (size_t)nq);
   double tt = t;
   for (int k = 0; k < s->n_terms; ++k) {
@@ -950,6 +967,91 @@ eval_failed:
   s->ready = 0;
   set_msg(s->msg, "evaluating the generated contact functions at t=%.17g failed", t);
   return -1;
+}
+
+/* x = (J J^T)^-1 b for the m x nq matrix J (column-major) by Cholesky of G = J J^T; -1 when
+ * G is not positive definite (dependent constraints). */
+static int solve_normal(const double* J, const double* b, double* G, double* x, int nq, int m) {
+  for (int i = 0; i < m; ++i)
+    for (int k = 0; k <= i; ++k) {
+      double acc = 0.0;
+      for (int j = 0; j < nq; ++j) acc += J[i + (size_t)j * m] * J[k + (size_t)j * m];
+      G[i * m + k] = acc;
+    }
+  for (int j = 0; j < m; ++j) { /* lower Cholesky factor in place */
+    double d = G[j * m + j];
+    for (int k = 0; k < j; ++k) d -= G[j * m + k] * G[j * m + k];
+    if (!(d > 0.0)) return -1;
+    d = sqrt(d);
+    G[j * m + j] = d;
+    for (int i = j + 1; i < m; ++i) {
+      double acc = G[i * m + j];
+      for (int k = 0; k < j; ++k) acc -= G[i * m + k] * G[j * m + k];
+      G[i * m + j] = acc / d;
+    }
+  }
+  for (int i = 0; i < m; ++i) { /* L z = b */
+    double acc = b[i];
+    for (int k = 0; k < i; ++k) acc -= G[i * m + k] * x[k];
+    x[i] = acc / G[i * m + i];
+  }
+  for (int i = m - 1; i >= 0; --i) { /* L^T x = z */
+    double acc = x[i];
+    for (int k = i + 1; k < m; ++k) acc -= G[k * m + i] * x[k];
+    x[i] = acc / G[i * m + i];
+  }
+  return 0;
+}
+
+/* Put q and v of y back on the constraint manifold: least-norm Newton on Phi(q, t) = 0, then the
+ * least-norm correction of v to Phi_q v + Phi_t = 0 (what DAEModel.assemble_positions and
+ * assemble_velocities do in Python). Removes the drift accumulated since the last restart. */
+static int project_state(dc_session* s, double t, double* y) {
+  const int nq = s->proj_nq, m = s->proj_m;
+  double* q = y;
+  double* v = y + nq;
+  double* K = s->proj_buf;
+  double* Jq = K + m;
+  double* G = K + 2 * m + (size_t)m * nq;
+  double* x = G + (size_t)m * m;
+  double tt = t, scale = 1.0;
+  const double* in[4] = {q, v, &tt, s->P};
+  const int strides[4] = {0, 0, 0, 0};
+  for (int j = 0; j < nq; ++j) scale = fmax(scale, fabs(q[j]));
+  for (int it = 0;; ++it) {
+    if (dc_eval_extra(s->proj_kin, 1, 4, in, strides, K, 2 * m + m * nq) != 0) return -1;
+    double worst = 0.0;
+    for (int i = 0; i < m; ++i) worst = fmax(worst, fabs(K[i]));
+    if (worst < s->proj_tol * scale) break;
+    if (it >= s->proj_iter || solve_normal(Jq, K, G, x, nq, m) != 0) return -2;
+    for (int j = 0; j < nq; ++j)
+      for (int i = 0; i < m; ++i) q[j] -= Jq[i + (size_t)j * m] * x[i];
+  }
+  if (solve_normal(Jq, K + m + (size_t)m * nq, G, x, nq, m) != 0) return -2; /* Phi_dot at the new q */
+  for (int j = 0; j < nq; ++j)
+    for (int i = 0; i < m; ++i) v[j] -= Jq[i + (size_t)j * m] * x[i];
+  return 0;
+}
+
+/* How a restart after a contact switch decided in C is made consistent: project (q, v) onto the
+ * constraint manifold first (project), zero the GGL multipliers mu (ggl; mu follow lambda in y),
+ * with the kinematics extra kin_extra: (q, v, t, P) -> [Phi; Phi_q (column-major); Phi_dot]. */
+DC_API int dc_set_restart(void* sp, int project, int ggl, int nq, int m, int kin_extra, double tol,
+                          int max_iter) {
+  dc_session* s = (dc_session*)sp;
+  if (nq < 1 || m < 0 || 2 * nq + (ggl ? 2 : 1) * m > s->n || tol <= 0.0 || max_iter < 1) return -1;
+  if (project && m > 0 && (kin_extra < 0 || kin_extra >= dc_n_extras)) return -1;
+  free(s->proj_buf);
+  s->proj_buf = (double*)xcalloc((size_t)(2 * m + m * nq + m * m + m), sizeof(double));
+  if (!s->proj_buf) return -1;
+  s->proj_on = project && m > 0;
+  s->proj_mu = ggl;
+  s->proj_nq = nq;
+  s->proj_m = m;
+  s->proj_kin = kin_extra;
+  s->proj_tol = tol;
+  s->proj_iter = max_iter;
+  return 0;
 }
 
 /*
