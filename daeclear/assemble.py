@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .codegen import memo_table
 from .errors import AssemblyError, SceneError
-from .ida_session import DAEFunctions
+from .ida_session import DAEFunctions, StateLayout
 from .parameters import ParameterTable, structure_key
 from .scene import GROUND, Body, Driver, Revolute, Scene, Translational
 from .clearance import CONTACT_BUILDERS
@@ -123,6 +123,14 @@ class DAEModel:
     def differential(self) -> NDArray[np.bool_]:
         """True for differential states (q, v), False for algebraic ones (multipliers)."""
         return np.array([k != KIND_MULTIPLIER for k in self.state_kinds])
+
+    def layout(self, project: bool) -> StateLayout:
+        """Where q, v, the multipliers (and mu, work) are in y and which extras make a state
+        consistent, for the compiled loop; ``project``: restarts on the constraint manifold."""
+        return StateLayout(
+            n_q=self.n_q, n_constraints=self.n_constraints, ggl=self.formulation == "ggl", track_work=self.track_work,
+            accel_extra=EXTRA_ACCEL, force_extra0=EXTRA_TERM0, kinematics_extra=EXTRA_KINEMATICS,
+            outputs_extra=EXTRA_OUTPUTS, project=project, tol=POSITION_TOL, max_iter=NEWTON_STEPS)
 
     def __str__(self) -> str:
         n_q, m = self.n_q, self.n_constraints

@@ -143,6 +143,24 @@ class AutoEvent(NamedTuple):
     y: np.ndarray
 
 
+@dataclass(frozen=True)
+class StateLayout:
+    """Where things are in y = [q, v, lambda, mu (GGL), work (track_work)] and which extras the
+    compiled loop uses to make a state consistent (see ``dc_set_layout`` in ida_driver.c)."""
+
+    n_q: int
+    n_constraints: int
+    ggl: bool
+    track_work: bool
+    accel_extra: int
+    force_extra0: int
+    kinematics_extra: int
+    outputs_extra: int
+    project: bool  # restarts after switches decided in C are projected on the constraint manifold
+    tol: float
+    max_iter: int
+
+
 @dataclass
 class Advance:
     """What one :meth:`Session.advance` call did.
@@ -339,8 +357,8 @@ class _SessionBase:
         """Only the compiled backend switches contact pairs in C; returns False here."""
         return False
 
-    def set_restart(self, **kwargs: Any) -> bool:
-        """Only the compiled backend restarts after its own contact switches; returns False here."""
+    def set_layout(self, layout: "StateLayout") -> bool:
+        """Only the compiled backend makes states consistent in C; returns False here."""
         return False
 
     def set_stall(self, stall_step: float, count: int) -> None:
@@ -464,7 +482,7 @@ class _CLib:
         lib.dc_eval_extra.restype = I
         lib.dc_eval_extra.argtypes = [I, I, I, P, P, P, I]
         lib.dc_set_auto.restype = I
-        lib.dc_set_auto.argtypes = [P, I, P, P, P, P, P, P, P, P, P, P, I, I, I, I, I, I]
+        lib.dc_set_auto.argtypes = [P, I, P, P, P, P, P, P, P, P, P, P, I]
         lib.dc_take_events.restype = I
         lib.dc_take_events.argtypes = [P, I, P, P, P, P, P, P]
         lib.dc_automaton_run.restype = I
@@ -473,8 +491,10 @@ class _CLib:
         lib.dc_pending_events.argtypes = [P]
         lib.dc_get_active.restype = None
         lib.dc_get_active.argtypes = [P, P, P]
-        lib.dc_set_restart.restype = I
-        lib.dc_set_restart.argtypes = [P, I, I, I, I, I, D, I]
+        lib.dc_set_layout.restype = I
+        lib.dc_set_layout.argtypes = [P, I, I, I, I, I, I, I, I, I, D, I]
+        lib.dc_report.restype = I
+        lib.dc_report.argtypes = [P, I, P, P, P, P, P, P]
         lib.dc_set_stall.restype = I
         lib.dc_set_stall.argtypes = [P, D, I]
         lib.dc_set_init_step.restype = I
@@ -599,10 +619,9 @@ class CSession(_SessionBase):
             raise DaeclearError(f"init_step={init_step!r} rejected by IDA.")
         return True
 
-    def set_auto_events(self, pairs: Sequence[tuple[int, int, int, bool, float]], *, n_q: int, n_constraints: int,
-                        track_work: bool, accel_extra: int, force_extra0: int, storms: Sequence[Storm],
+    def set_auto_events(self, pairs: Sequence[tuple[int, int, int, bool, float]], *, storms: Sequence[Storm],
                         states: Sequence[PairState], capacity: int = 256) -> bool:
-        """Let the C loop decide every contact switch itself (index-1 layout, see ida_driver.c).
+        """Let the C loop decide every contact switch itself (after :meth:`set_layout`, see ida_driver.c).
 
         ``pairs``: (root index, term index, gap-rate extra, needs approach speed, min speed), one
         per root function; ``storms``: each pair's storm-guard constants; ``states``: each pair's
@@ -624,8 +643,7 @@ class CSession(_SessionBase):
             arr((st.window for st in storms), np.float64), arr((st.contact for st in states), np.int32),
             arr((st.held for st in states), np.int32), arr((st.latched for st in states), np.float64)]
         ptr = [a.ctypes.data for a in self._auto_arrays]
-        rc = self._lib.dc_set_auto(self._h, np_, *ptr, n_q, n_constraints, int(track_work), accel_extra,
-                                   force_extra0, capacity)
+        rc = self._lib.dc_set_auto(self._h, np_, *ptr, capacity)
         if rc != 0:
             raise DaeclearError("configuring the events decided in C failed")
         self._auto_cap = capacity
@@ -634,16 +652,31 @@ class CSession(_SessionBase):
                           np.empty((capacity, self._n)))
         return True
 
-    def set_restart(self, *, project: bool, ggl: bool, n_q: int, n_constraints: int, kinematics_extra: int,
-                    tol: float, max_iter: int) -> bool:
-        """How the C loop makes a restart after its own contact switches consistent: project q and v
-        onto the constraint manifold (least-norm Newton to ``tol`` * max(1, |q|), at most
-        ``max_iter`` steps) and, for GGL (``ggl``), set the multipliers mu to 0 (see ida_driver.c)."""
-        rc = self._lib.dc_set_restart(self._h, int(project), int(ggl), n_q, n_constraints, kinematics_extra,
-                                      float(tol), int(max_iter))
+    def set_layout(self, layout: StateLayout) -> bool:
+        """The model's state layout and extras, so that C makes states consistent itself: restarts
+        after the switches it decides (GGL: projected on the constraint manifold) and :meth:`report`."""
+        L = layout
+        rc = self._lib.dc_set_layout(self._h, L.n_q, L.n_constraints, int(L.ggl), int(L.track_work), L.accel_extra,
+                                     L.force_extra0, L.kinematics_extra, L.outputs_extra, int(L.project), L.tol,
+                                     L.max_iter)
         if rc != 0:
-            raise DaeclearError("configuring the restarts made in C failed")
+            raise DaeclearError("configuring the state layout of the compiled model failed")
+        self._n_channels = int(self._model.extras[L.outputs_extra].numel_out(0))
         return True
+
+    def report(self, t: np.ndarray, y: np.ndarray, switch: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The reported points made consistent in one C pass: (y with recomputed multipliers, yp,
+        output channels), one row per time (see ``dc_report``); after :meth:`set_layout`."""
+        t = np.ascontiguousarray(t, dtype=float)
+        y = np.ascontiguousarray(y, dtype=float)
+        switch = np.ascontiguousarray(switch, dtype=float)
+        N = t.size
+        y_out, yp_out = np.empty((N, self._n)), np.empty((N, self._n))
+        channels = np.empty((N, self._n_channels))
+        if N and self._lib.dc_report(self._h, N, t.ctypes.data, y.ctypes.data, switch.ctypes.data,
+                                     y_out.ctypes.data, yp_out.ctypes.data, channels.ctypes.data) != 0:
+            raise DaeclearError("making the reported points consistent in the compiled model failed")
+        return y_out, yp_out, channels
 
     def _take_auto_events(self) -> list[AutoEvent]:
         buf = getattr(self, "_auto_buf", None)

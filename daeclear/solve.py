@@ -20,8 +20,7 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .assemble import (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_TERM0, KIND_MULTIPLIER, KIND_WORK, NEWTON_STEPS,
-                       POSITION_TOL, DAEModel, assemble)
+from .assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
 from .errors import DaeclearWarning, SceneError, SolveError
 from .ida_session import open_session
 from .result import ContactEvent, Result
@@ -253,6 +252,9 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     success, status, message = True, 0, "end of the time span reached"
     n_restarts = 0
     try:
+        # the compiled loop makes states consistent itself (restarts after its own switches, the
+        # reported points); the python backend leaves that to the model's Python methods
+        c_layout = session.set_layout(model.layout(project=model.formulation == "ggl"))
         session.reinit(t, y, yp, active, params, _root_directions(model, active))
         # the compiled loop may decide every contact switch itself (simple pairs): the rule and the
         # starting state of each pair come from its logic object; Python then only records
@@ -261,15 +263,9 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         if model.auto_pairs:
             owners = {root: logic for logic in model.contacts for root in logic.roots}
             roots = [pair[0] for pair in model.auto_pairs]
-            c_decides = session.set_auto_events(
-                model.auto_pairs, n_q=model.n_q, n_constraints=model.n_constraints, track_work=model.track_work,
-                accel_extra=EXTRA_ACCEL, force_extra0=EXTRA_TERM0, storms=[owners[root].storm for root in roots],
+            c_decides = c_layout and session.set_auto_events(
+                model.auto_pairs, storms=[owners[root].storm for root in roots],
                 states=[owners[root].pair_state(root) for root in roots])
-            if c_decides:  # its restarts are made as Python's (GGL: on the constraint manifold, mu = 0)
-                ggl = model.formulation == "ggl"
-                session.set_restart(project=ggl, ggl=ggl, n_q=model.n_q,
-                                    n_constraints=model.n_constraints, kinematics_extra=EXTRA_KINEMATICS,
-                                    tol=POSITION_TOL, max_iter=NEWTON_STEPS)
 
         def record(adv: Any, steps: slice, evals: slice, switch: NDArray) -> None:
             """Keep IDA's points as they are; they are made consistent in one pass at the end."""
@@ -367,10 +363,14 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         # IDA does not converge the multipliers (out of its error test) and its interpolant of
         # them is not controlled: report multipliers, accelerations (and the work rate)
         # recomputed from every point's q and v with that point's contact modes
-        if out_t.size:
-            out_y, out_yp = model.consistent_state(
-                out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)
-        channels = model.channels(out_t, out_y, out_yp, out_switch, session)
+        if c_layout:  # one pass in C
+            out_y, out_yp, values = session.report(out_t, out_y, out_switch)
+            channels = {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(model.channel_names)}
+        else:
+            if out_t.size:
+                out_y, out_yp = model.consistent_state(
+                    out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)
+            channels = model.channels(out_t, out_y, out_yp, out_switch, session)
     finally:
         session.close()
     stats.update(n_events=len(events), n_restarts=n_restarts, setup_time=setup_time,

@@ -182,11 +182,10 @@ typedef struct {
   int* auto_rate;     /* [n_auto] extra: (q, v) -> [gap; penetration rate] */
   int* auto_needs;    /* [n_auto] the term's parameter is the latched approach speed */
   int* root_to_auto;  /* [n_roots] pair of a root */
-  int auto_nq, auto_m, auto_track, auto_accel, auto_force0;
   dc_pair_rule* pair_rule;   /* [n_auto] */
   dc_pair_state* pair_state; /* [n_auto] */
   double* recent;     /* storage of the pairs' rings of switch times */
-  double* auto_buf;   /* scratch, 4 * (auto_nq + auto_m + 2) */
+  double auto_gr[2];  /* gap and penetration rate of a pair */
   int ev_cap, ev_n;   /* events recorded in C, taken by dc_take_events */
   double* ev_t;
   int* ev_pair;
@@ -194,12 +193,17 @@ typedef struct {
   double* ev_rate;    /* penetration rate at the event */
   double* ev_latched; /* the pair's latched approach speed after the event */
   double* ev_y;       /* [ev_cap * n] state at the event */
-  /* restarts after a contact switch decided in C (dc_set_restart) */
-  int proj_on;        /* project q and v onto the constraint manifold before restarting */
-  int proj_mu;        /* GGL: also set the velocity-projection multipliers mu to 0 */
-  int proj_nq, proj_m, proj_kin, proj_iter;
+  /* the state layout and the extras that make states consistent in C (dc_set_layout) */
+  int lay_ready;
+  int lay_nq, lay_m;  /* y = [q (nq), v (nq), lambda (m), mu (m, GGL), work (1, track)] */
+  int lay_ggl, lay_track;
+  int lay_accel, lay_force0, lay_kin, lay_outputs; /* extras, see daeclear.assemble EXTRA_* */
+  int lay_n_switch, lay_n_channels;
+  int proj_on;        /* restarts after a switch decided in C: project q and v on the manifold */
+  int proj_iter;
   double proj_tol;    /* |Phi| < proj_tol * max(1, |q|) ends the position Newton */
-  double* proj_buf;   /* [Phi; Phi_q; Phi_dot] (2m + m nq), G (m m), x (m) */
+  double* lay_buf;    /* Qc, Fk (nq each), sol (nq + m + 1), K (2m + m nq), G (m m), x (m), par */
+  int* lay_on;        /* [n_terms] */
 } dc_session;
 
 static void set_msg(char* buf, const char* fmt, ...) {
@@ -511,14 +515,14 @@ DC_API void dc_free(void* sp) {
   free(s->pair_rule);
   free(s->pair_state);
   free(s->recent);
-  free(s->auto_buf);
   free(s->ev_t);
   free(s->ev_pair);
   free(s->ev_info);
   free(s->ev_rate);
   free(s->ev_latched);
   free(s->ev_y);
-  free(s->proj_buf);
+  free(s->lay_buf);
+  free(s->lay_on);
   free(s);
 }
 
@@ -751,8 +755,7 @@ static void copy_state(dc_session* s, double* y_out, double* yp_out) {
 DC_API int dc_set_auto(void* sp, int n_auto, const int* root, const int* term, const int* rate,
                        const int* needs, const double* vmin, const int* storm_events,
                        const double* storm_window, const int* contact0, const int* held0,
-                       const double* latched0, int nq, int m, int track_work, int accel_extra,
-                       int force_extra0, int ev_cap) {
+                       const double* latched0, int ev_cap) {
   dc_session* s = (dc_session*)sp;
   size_t ring = 0;
   if (n_auto < 0 || (n_auto > 0 && n_auto != s->n_roots) || ev_cap < (n_auto > 0 ? n_auto : 1))
@@ -764,7 +767,7 @@ DC_API int dc_set_auto(void* sp, int n_auto, const int* root, const int* term, c
   s->n_auto = 0;
   free(s->auto_root); free(s->auto_term); free(s->auto_rate); free(s->auto_needs);
   free(s->root_to_auto); free(s->pair_rule); free(s->pair_state); free(s->recent);
-  free(s->auto_buf); free(s->ev_t); free(s->ev_pair); free(s->ev_info); free(s->ev_rate);
+  free(s->ev_t); free(s->ev_pair); free(s->ev_info); free(s->ev_rate);
   free(s->ev_latched); free(s->ev_y);
   s->auto_root = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
   s->auto_term = (int*)xcalloc((size_t)n_auto + 1, sizeof(int));
@@ -774,7 +777,6 @@ DC_API int dc_set_auto(void* sp, int n_auto, const int* root, const int* term, c
   s->pair_rule = (dc_pair_rule*)xcalloc((size_t)n_auto + 1, sizeof(dc_pair_rule));
   s->pair_state = (dc_pair_state*)xcalloc((size_t)n_auto + 1, sizeof(dc_pair_state));
   s->recent = (double*)xcalloc(ring + 1, sizeof(double));
-  s->auto_buf = (double*)xcalloc(4 * ((size_t)nq + (size_t)m + 2), sizeof(double));
   s->ev_t = (double*)xcalloc((size_t)ev_cap, sizeof(double));
   s->ev_pair = (int*)xcalloc((size_t)ev_cap, sizeof(int));
   s->ev_info = (int*)xcalloc(4 * (size_t)ev_cap, sizeof(int));
@@ -782,7 +784,7 @@ DC_API int dc_set_auto(void* sp, int n_auto, const int* root, const int* term, c
   s->ev_latched = (double*)xcalloc((size_t)ev_cap, sizeof(double));
   s->ev_y = (double*)xcalloc((size_t)ev_cap * (size_t)s->n, sizeof(double));
   if (!s->auto_root || !s->auto_term || !s->auto_rate || !s->auto_needs || !s->root_to_auto ||
-      !s->pair_rule || !s->pair_state || !s->recent || !s->auto_buf || !s->ev_t || !s->ev_pair ||
+      !s->pair_rule || !s->pair_state || !s->recent || !s->ev_t || !s->ev_pair ||
       !s->ev_info || !s->ev_rate || !s->ev_latched || !s->ev_y)
     return -1;
   for (int i = 0; i < s->n_roots; ++i) s->root_to_auto[i] = -1;
@@ -802,11 +804,6 @@ DC_API int dc_set_auto(void* sp, int n_auto, const int* root, const int* term, c
     s->pair_state[p] = st;
     ring += (size_t)storm_events[p];
   }
-  s->auto_nq = nq;
-  s->auto_m = m;
-  s->auto_track = track_work;
-  s->auto_accel = accel_extra;
-  s->auto_force0 = force_extra0;
   s->ev_cap = ev_cap;
   s->ev_n = 0;
   s->n_auto = n_auto;
@@ -876,24 +873,23 @@ DC_API int dc_automaton_run(int n, const double* t, const int* dir, const double
 /* Decide every root found at (t, yy) by the pairs' automata and record the switches. When any
  * pair switched, restart IDA consistently and return 1; return 2 when nothing switched (IDA
  * goes on without a restart), 0 without configured pairs (Python decides), -1 on failure. */
-static int project_state(dc_session* s, double t, double* y); /* below, with dc_set_restart */
+/* below, with dc_set_layout */
+static int project_state(dc_session* s, double t, double* y);
+static int make_consistent(dc_session* s, double t, double* y, double* yp, const int* on, const double* par);
 
 static int auto_handle_root(dc_session* s, double t, double t_stop) {
   if (s->n_auto == 0) return 0;
-  if (s->ev_n + s->n_auto > s->ev_cap) {
+  if (s->ev_n + s->n_auto > s->ev_cap || !s->lay_ready) {
     s->ready = 0;
-    set_msg(s->msg, "internal: the contact event buffer was not drained (t=%.17g)", t);
+    set_msg(s->msg, "internal: the contact event buffer was not drained or the layout not set (t=%.17g)", t);
     return -1;
   }
-  const int n = s->n, nq = s->auto_nq, m = s->auto_m;
+  const int n = s->n, nq = s->lay_nq, m = s->lay_m;
   double* y = N_VGetArrayPointer(s->yy);
   double* yp = N_VGetArrayPointer(s->yp);
   const double* q = y;
   const double* v = y + nq;
-  double* gr = s->auto_buf;            /* [2] */
-  double* Qc = gr + 2;                 /* [nq] */
-  double* Fk = Qc + nq;                /* [nq] */
-  double* sol = Fk + nq;               /* [nq + m + 1] */
+  double* gr = s->auto_gr;
   const int zeros3[3] = {0, 0, 0};
   int switched = 0;
   for (int i = 0; i < s->n_roots; ++i) {
@@ -921,33 +917,17 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
     switched = 1;
   }
   if (!switched) return 2;
-  /* consistent restart: q and v on the constraint manifold (GGL: mu = 0); multipliers,
-   * accelerations (and work rate) from the generated Schur-complement solve with the new set
-   * of contact forces */
+  /* consistent restart: GGL on the constraint manifold with mu = 0; then multipliers and
+   * derivatives from the generated solve with the new set of contact forces */
   if (s->proj_on && project_state(s, t, y) != 0) {
     s->ready = 0;
     set_msg(s->msg, "projecting the state onto the constraints after a contact event at t=%.17g failed "
             "(dependent constraints, or no convergence in %d Newton steps)", t, s->proj_iter);
     return -1;
   }
-  if (s->proj_mu) memset(y + 2 * nq + m, 0, sizeof(double) * (size_t)m);
-  memset(Qc, 0, sizeof(double) * (size_t)nq);
-  double tt = t;
-  for (int k = 0; k < s->n_terms; ++k) {
-    if (!s->active[k]) continue;
-    const double* in_f[5] = {&tt, q, v, s->params + s->param_off[k], s->P};
-    int strides[5] = {0, 0, 0, 0, 0};
-    if (dc_eval_extra(s->auto_force0 + k, 1, 5, in_f, strides, Fk, nq) != 0) goto eval_failed;
-    for (int j = 0; j < nq; ++j) Qc[j] += Fk[j];
-  }
-  const double* in_a[5] = {&tt, q, v, Qc, s->P};
-  int strides_a[5] = {0, 0, 0, 0, 0};
-  if (dc_eval_extra(s->auto_accel, 1, 5, in_a, strides_a, sol, nq + m + 1) != 0) goto eval_failed;
-  memcpy(y + 2 * nq, sol + nq, sizeof(double) * (size_t)m);
-  memcpy(yp, v, sizeof(double) * (size_t)nq);
-  memcpy(yp + nq, sol, sizeof(double) * (size_t)nq);
-  memset(yp + 2 * nq, 0, sizeof(double) * (size_t)(n - 2 * nq));
-  if (s->auto_track) yp[n - 1] = sol[nq + m];
+  if (s->lay_ggl) memset(y + 2 * nq + m, 0, sizeof(double) * (size_t)m);
+  if (make_consistent(s, t, y, yp, s->active, s->params) != 0) goto eval_failed;
+  (void)n;
   long long cur[ST_N];
   ida_counters(s, cur);
   for (int i = 0; i < ST_N; ++i) s->base[i] += cur[i];
@@ -1007,10 +987,10 @@ static int solve_normal(const double* J, const double* b, double* G, double* x, 
  * least-norm correction of v to Phi_q v + Phi_t = 0 (what DAEModel.assemble_positions and
  * assemble_velocities do in Python). Removes the drift accumulated since the last restart. */
 static int project_state(dc_session* s, double t, double* y) {
-  const int nq = s->proj_nq, m = s->proj_m;
+  const int nq = s->lay_nq, m = s->lay_m;
   double* q = y;
   double* v = y + nq;
-  double* K = s->proj_buf;
+  double* K = s->lay_buf + 3 * nq + m + 1;
   double* Jq = K + m;
   double* G = K + 2 * m + (size_t)m * nq;
   double* x = G + (size_t)m * m;
@@ -1019,7 +999,7 @@ static int project_state(dc_session* s, double t, double* y) {
   const int strides[4] = {0, 0, 0, 0};
   for (int j = 0; j < nq; ++j) scale = fmax(scale, fabs(q[j]));
   for (int it = 0;; ++it) {
-    if (dc_eval_extra(s->proj_kin, 1, 4, in, strides, K, 2 * m + m * nq) != 0) return -1;
+    if (dc_eval_extra(s->lay_kin, 1, 4, in, strides, K, 2 * m + m * nq) != 0) return -1;
     double worst = 0.0;
     for (int i = 0; i < m; ++i) worst = fmax(worst, fabs(K[i]));
     if (worst < s->proj_tol * scale) break;
@@ -1033,24 +1013,112 @@ static int project_state(dc_session* s, double t, double* y) {
   return 0;
 }
 
-/* How a restart after a contact switch decided in C is made consistent: project (q, v) onto the
- * constraint manifold first (project), zero the GGL multipliers mu (ggl; mu follow lambda in y),
- * with the kinematics extra kin_extra: (q, v, t, P) -> [Phi; Phi_q (column-major); Phi_dot]. */
-DC_API int dc_set_restart(void* sp, int project, int ggl, int nq, int m, int kin_extra, double tol,
-                          int max_iter) {
+/* Fill the multipliers lambda of y and all of yp so that the residual vanishes at (t, y): the
+ * generated Schur-complement solve (accel extra) with the contact forces of the terms that are on
+ * (on[k], parameters at par + param_off[k]); GGL: q' = v - Phi_q^T mu. The same as
+ * DAEModel.consistent_state in Python. */
+static int make_consistent(dc_session* s, double t, double* y, double* yp, const int* on, const double* par) {
+  const int n = s->n, nq = s->lay_nq, m = s->lay_m;
+  double* Qc = s->lay_buf;
+  double* Fk = Qc + nq;
+  double* sol = Fk + nq;
+  double* K = sol + nq + m + 1;
+  const double* q = y;
+  const double* v = y + nq;
+  const int strides[5] = {0, 0, 0, 0, 0};
+  double tt = t;
+  memset(Qc, 0, sizeof(double) * (size_t)nq);
+  for (int k = 0; k < s->n_terms; ++k) {
+    if (!on[k]) continue;
+    const double* in_f[5] = {&tt, q, v, par + s->param_off[k], s->P};
+    if (dc_eval_extra(s->lay_force0 + k, 1, 5, in_f, strides, Fk, nq) != 0) return -1;
+    for (int j = 0; j < nq; ++j) Qc[j] += Fk[j];
+  }
+  const double* in_a[5] = {&tt, q, v, Qc, s->P};
+  if (dc_eval_extra(s->lay_accel, 1, 5, in_a, strides, sol, nq + m + (s->lay_track ? 1 : 0)) != 0) return -1;
+  memcpy(y + 2 * nq, sol + nq, sizeof(double) * (size_t)m);
+  memcpy(yp, v, sizeof(double) * (size_t)nq);
+  if (s->lay_ggl && m > 0) {
+    const double* mu = y + 2 * nq + m;
+    const double* in_k[4] = {q, v, &tt, s->P};
+    if (dc_eval_extra(s->lay_kin, 1, 4, in_k, strides, K, 2 * m + m * nq) != 0) return -1;
+    for (int j = 0; j < nq; ++j)
+      for (int i = 0; i < m; ++i) yp[j] -= K[m + i + (size_t)j * m] * mu[i];
+  }
+  memcpy(yp + nq, sol, sizeof(double) * (size_t)nq);
+  memset(yp + 2 * nq, 0, sizeof(double) * (size_t)(n - 2 * nq));
+  if (s->lay_track) yp[n - 1] = sol[nq + m];
+  return 0;
+}
+
+/* The model's state layout and extras (daeclear.assemble: EXTRA_ACCEL, EXTRA_TERM0 + k,
+ * EXTRA_KINEMATICS, EXTRA_OUTPUTS), for consistent states made in C: restarts after the
+ * switches the loop decides (project: GGL restarts on the constraint manifold, Newton to
+ * tol * max(1, |q|) in at most max_iter steps) and dc_report. */
+DC_API int dc_set_layout(void* sp, int nq, int m, int ggl, int track_work, int accel_extra, int force_extra0,
+                         int kin_extra, int outputs_extra, int project, double tol, int max_iter) {
   dc_session* s = (dc_session*)sp;
-  if (nq < 1 || m < 0 || 2 * nq + (ggl ? 2 : 1) * m > s->n || tol <= 0.0 || max_iter < 1) return -1;
-  if (project && m > 0 && (kin_extra < 0 || kin_extra >= dc_n_extras)) return -1;
-  free(s->proj_buf);
-  s->proj_buf = (double*)xcalloc((size_t)(2 * m + m * nq + m * m + m), sizeof(double));
-  if (!s->proj_buf) return -1;
+  const int last = force_extra0 + s->n_terms - 1;
+  if (nq < 1 || m < 0 || 2 * nq + (ggl ? 2 : 1) * m + (track_work ? 1 : 0) != s->n || !(tol > 0.0) ||
+      max_iter < 1 || accel_extra < 0 || accel_extra >= dc_n_extras || kin_extra < 0 ||
+      kin_extra >= dc_n_extras || outputs_extra < 0 || outputs_extra >= dc_n_extras || force_extra0 < 0 ||
+      last >= dc_n_extras)
+    return -1;
+  free(s->lay_buf);
+  free(s->lay_on);
+  int np = 0;
+  for (int k = 0; k < s->n_terms; ++k) np += dc_model.n_params[k];
+  s->lay_buf = (double*)xcalloc((size_t)(3 * nq + m + 1 + 2 * m + m * nq + m * m + m + np), sizeof(double));
+  s->lay_on = (int*)xcalloc((size_t)s->n_terms, sizeof(int));
+  if (!s->lay_buf || !s->lay_on) return -1;
+  s->lay_nq = nq;
+  s->lay_m = m;
+  s->lay_ggl = ggl;
+  s->lay_track = track_work;
+  s->lay_accel = accel_extra;
+  s->lay_force0 = force_extra0;
+  s->lay_kin = kin_extra;
+  s->lay_outputs = outputs_extra;
+  s->lay_n_switch = s->n_terms + np;
   s->proj_on = project && m > 0;
-  s->proj_mu = ggl;
-  s->proj_nq = nq;
-  s->proj_m = m;
-  s->proj_kin = kin_extra;
   s->proj_tol = tol;
   s->proj_iter = max_iter;
+  {
+    dc_int sa = 0, sr = 0, si = 0, sw = 0;
+    const dc_fun_t* f = &dc_extra_tab[outputs_extra];
+    f->work(&sa, &sr, &si, &sw);
+    const dc_int* sp_out = f->sparsity_out(0);
+    s->lay_n_channels = (int)(sp_out[0] * sp_out[1]);
+  }
+  s->lay_ready = 1;
+  return 0;
+}
+
+/* The reported points of a run, made consistent in one pass: for each of the n_points rows of y
+ * (IDA's states) with its switch row (per term: on flag, then its parameters), write the state
+ * with recomputed multipliers to y_out, its derivative to yp_out and the output channels to
+ * channels_out (dc_set_layout first). */
+DC_API int dc_report(void* sp, int n_points, const double* t, const double* y, const double* sw, double* y_out,
+                     double* yp_out, double* channels_out) {
+  dc_session* s = (dc_session*)sp;
+  if (!s->lay_ready || n_points < 0) return -1;
+  const int n = s->n, ns = s->lay_n_switch, nc = s->lay_n_channels;
+  double* par = s->lay_buf + 3 * s->lay_nq + 3 * s->lay_m + 1 + s->lay_m * s->lay_nq + s->lay_m * s->lay_m + s->lay_m;
+  const int strides[5] = {0, 0, 0, 0, 0};
+  for (int i = 0; i < n_points; ++i) {
+    double* yi = y_out + (size_t)i * n;
+    double* ypi = yp_out + (size_t)i * n;
+    const double* si = sw + (size_t)i * ns;
+    memcpy(yi, y + (size_t)i * n, sizeof(double) * (size_t)n);
+    for (int k = 0, off = 0; k < s->n_terms; ++k) {
+      s->lay_on[k] = si[off] > 0.0;
+      memcpy(par + s->param_off[k], si + off + 1, sizeof(double) * (size_t)dc_model.n_params[k]);
+      off += 1 + dc_model.n_params[k];
+    }
+    if (make_consistent(s, t[i], yi, ypi, s->lay_on, par) != 0) return -1;
+    const double* in_o[5] = {t + i, yi, ypi, si, s->P};
+    if (dc_eval_extra(s->lay_outputs, 1, 5, in_o, strides, channels_out + (size_t)i * nc, nc) != 0) return -1;
+  }
   return 0;
 }
 
