@@ -203,6 +203,10 @@ typedef struct {
   int proj_iter;
   double proj_tol;    /* |Phi| < proj_tol * max(1, |q|) ends the position Newton */
   double* lay_buf;    /* Qc, Fk (nq each), sol (nq + m + 1), K (2m + m nq), G (m m), x (m), par */
+  const double** xarg; /* CasADi work memory for the extras, sized for the largest (dc_set_layout) */
+  double** xres;
+  dc_int* xiw;
+  double* xw;
   int* lay_on;        /* [n_terms] */
 } dc_session;
 
@@ -458,6 +462,15 @@ DC_API int dc_eval_extra(int k, int n_points, int n_in, const double* const* inp
   return status;
 }
 
+/* One evaluation of extra k (inputs in order, one output) with the session's preallocated work
+ * memory: the per-point path of restarts and reports (dc_eval_extra allocates per call). The
+ * generated SX functions keep no state between calls (their checkout is a constant). */
+static int eval_extra1(dc_session* s, int k, int n_in, const double* const* in, double* out) {
+  for (int j = 0; j < n_in; ++j) s->xarg[j] = in[j];
+  s->xres[0] = out;
+  return dc_extra_tab[k].eval(s->xarg, s->xres, s->xiw, s->xw, 0);
+}
+
 DC_API void dc_flag_name(long flag, char* buf, int len) { flag_name(flag, buf, len); }
 
 DC_API const char* dc_message(void* sp) { return sp ? ((dc_session*)sp)->msg : ""; }
@@ -523,6 +536,10 @@ DC_API void dc_free(void* sp) {
   free(s->ev_y);
   free(s->lay_buf);
   free(s->lay_on);
+  free(s->xarg);
+  free(s->xres);
+  free(s->xiw);
+  free(s->xw);
   free(s);
 }
 
@@ -890,14 +907,13 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
   const double* q = y;
   const double* v = y + nq;
   double* gr = s->auto_gr;
-  const int zeros3[3] = {0, 0, 0};
   int switched = 0;
   for (int i = 0; i < s->n_roots; ++i) {
     int dir = s->rootsfound[i];
     if (!dir) continue;
     int p = s->root_to_auto[i], k = s->auto_term[p];
     const double* in_rate[3] = {q, v, s->P};
-    if (dc_eval_extra(s->auto_rate[p], 1, 3, in_rate, zeros3, gr, 2) != 0) goto eval_failed;
+    if (eval_extra1(s, s->auto_rate[p], 3, in_rate, gr) != 0) goto eval_failed;
     dc_decision d = pair_step(&s->pair_rule[p], &s->pair_state[p], t, dir, gr[1]);
     if (d.kind == DC_NONE) continue;
     int* info = s->ev_info + 4 * (size_t)s->ev_n;
@@ -996,10 +1012,9 @@ static int project_state(dc_session* s, double t, double* y) {
   double* x = G + (size_t)m * m;
   double tt = t, scale = 1.0;
   const double* in[4] = {q, v, &tt, s->P};
-  const int strides[4] = {0, 0, 0, 0};
   for (int j = 0; j < nq; ++j) scale = fmax(scale, fabs(q[j]));
   for (int it = 0;; ++it) {
-    if (dc_eval_extra(s->lay_kin, 1, 4, in, strides, K, 2 * m + m * nq) != 0) return -1;
+    if (eval_extra1(s, s->lay_kin, 4, in, K) != 0) return -1;
     double worst = 0.0;
     for (int i = 0; i < m; ++i) worst = fmax(worst, fabs(K[i]));
     if (worst < s->proj_tol * scale) break;
@@ -1025,23 +1040,22 @@ static int make_consistent(dc_session* s, double t, double* y, double* yp, const
   double* K = sol + nq + m + 1;
   const double* q = y;
   const double* v = y + nq;
-  const int strides[5] = {0, 0, 0, 0, 0};
   double tt = t;
   memset(Qc, 0, sizeof(double) * (size_t)nq);
   for (int k = 0; k < s->n_terms; ++k) {
     if (!on[k]) continue;
     const double* in_f[5] = {&tt, q, v, par + s->param_off[k], s->P};
-    if (dc_eval_extra(s->lay_force0 + k, 1, 5, in_f, strides, Fk, nq) != 0) return -1;
+    if (eval_extra1(s, s->lay_force0 + k, 5, in_f, Fk) != 0) return -1;
     for (int j = 0; j < nq; ++j) Qc[j] += Fk[j];
   }
   const double* in_a[5] = {&tt, q, v, Qc, s->P};
-  if (dc_eval_extra(s->lay_accel, 1, 5, in_a, strides, sol, nq + m + (s->lay_track ? 1 : 0)) != 0) return -1;
+  if (eval_extra1(s, s->lay_accel, 5, in_a, sol) != 0) return -1;
   memcpy(y + 2 * nq, sol + nq, sizeof(double) * (size_t)m);
   memcpy(yp, v, sizeof(double) * (size_t)nq);
   if (s->lay_ggl && m > 0) {
     const double* mu = y + 2 * nq + m;
     const double* in_k[4] = {q, v, &tt, s->P};
-    if (dc_eval_extra(s->lay_kin, 1, 4, in_k, strides, K, 2 * m + m * nq) != 0) return -1;
+    if (eval_extra1(s, s->lay_kin, 4, in_k, K) != 0) return -1;
     for (int j = 0; j < nq; ++j)
       for (int i = 0; i < m; ++i) yp[j] -= K[m + i + (size_t)j * m] * mu[i];
   }
@@ -1084,10 +1098,18 @@ DC_API int dc_set_layout(void* sp, int nq, int m, int ggl, int track_work, int a
   s->proj_tol = tol;
   s->proj_iter = max_iter;
   {
-    dc_int sa = 0, sr = 0, si = 0, sw = 0;
-    const dc_fun_t* f = &dc_extra_tab[outputs_extra];
-    f->work(&sa, &sr, &si, &sw);
-    const dc_int* sp_out = f->sparsity_out(0);
+    dc_int sa = 5, sr = 1, si = 0, sw = 0;
+    for (int k = 0; k < dc_n_extras; ++k) work_max(&dc_extra_tab[k], &sa, &sr, &si, &sw);
+    free(s->xarg);
+    free(s->xres);
+    free(s->xiw);
+    free(s->xw);
+    s->xarg = (const double**)xcalloc((size_t)sa, sizeof(double*));
+    s->xres = (double**)xcalloc((size_t)sr, sizeof(double*));
+    s->xiw = (dc_int*)xcalloc((size_t)si, sizeof(dc_int));
+    s->xw = (double*)xcalloc((size_t)sw, sizeof(double));
+    if (!s->xarg || !s->xres || !s->xiw || !s->xw) return -1;
+    const dc_int* sp_out = dc_extra_tab[outputs_extra].sparsity_out(0);
     s->lay_n_channels = (int)(sp_out[0] * sp_out[1]);
   }
   s->lay_ready = 1;
@@ -1104,7 +1126,6 @@ DC_API int dc_report(void* sp, int n_points, const double* t, const double* y, c
   if (!s->lay_ready || n_points < 0) return -1;
   const int n = s->n, ns = s->lay_n_switch, nc = s->lay_n_channels;
   double* par = s->lay_buf + 3 * s->lay_nq + 3 * s->lay_m + 1 + s->lay_m * s->lay_nq + s->lay_m * s->lay_m + s->lay_m;
-  const int strides[5] = {0, 0, 0, 0, 0};
   for (int i = 0; i < n_points; ++i) {
     double* yi = y_out + (size_t)i * n;
     double* ypi = yp_out + (size_t)i * n;
@@ -1117,7 +1138,7 @@ DC_API int dc_report(void* sp, int n_points, const double* t, const double* y, c
     }
     if (make_consistent(s, t[i], yi, ypi, s->lay_on, par) != 0) return -1;
     const double* in_o[5] = {t + i, yi, ypi, si, s->P};
-    if (dc_eval_extra(s->lay_outputs, 1, 5, in_o, strides, channels_out + (size_t)i * nc, nc) != 0) return -1;
+    if (eval_extra1(s, s->lay_outputs, 5, in_o, channels_out + (size_t)i * nc) != 0) return -1;
   }
   return 0;
 }
