@@ -486,7 +486,9 @@ _BUILD_TAG = re.compile(rb"daeclear-build:abi=(\d+);sundials=(\d+)\.(\d+)\.(\d+)
 def read_build_tag(path: Path) -> tuple[int, SundialsInfo] | None:
     """(driver ABI, SUNDIALS build) a compiled model library was made for, read from the file's
     bytes (the driver's ``dc_build_tag``) without loading it; None when it has no tag."""
-    m = _BUILD_TAG.search(path.read_bytes())
+    data = path.read_bytes()
+    start = data.find(b"daeclear-build:")
+    m = _BUILD_TAG.match(data, start) if start >= 0 else None
     if m is None:
         return None
     abi, major, minor, patch, index, sparse = (int(x) for x in m.groups())

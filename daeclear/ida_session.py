@@ -96,8 +96,10 @@ __all__ = [
 BACKENDS = ("auto", "c", "python")
 LINEAR_SOLVERS = ("auto", "dense", "sparse")
 #: linear_solver="auto" uses the sparse solver for models with at least this many states. Measured
-#: with benchmarks/bench_linear_solver.py (chains of N links, 6 N states; docs/performance.md).
-SPARSE_MIN_STATES = 48
+#: with benchmarks/bench_linear_solver.py (chains of N links, 6 N states; docs/performance.md):
+#: dense is faster up to 120 states (SuperLU_MT's fixed cost per factorization), sparse from 144
+#: states on (whole simulate calls 1.1x faster at 144 states, 1.3x at 192, 1.8x at 384).
+SPARSE_MIN_STATES = 144
 _NORMALIZED = memo_table()  # normalize_model results by DAEFunctions identity
 _LS_CODES = {"dense": 0, "sparse": 1}  # dc_open's linear_solver argument
 log = logging.getLogger("daeclear")
@@ -209,7 +211,7 @@ class Session(Protocol):
 
     def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
 
-    def stats(self) -> dict[str, int | float]: ...
+    def stats(self) -> dict[str, int | float | str]: ...
 
     def close(self) -> None: ...
 
@@ -305,7 +307,7 @@ class _SessionBase:
         self._params = [np.zeros(p) for p in model.n_params]
         self._stall_step, self._stall_count = 0.0, TINY_STEP_COUNT
         self._solve_time = 0.0
-        self._extra_stats: dict[str, int | float] = {}
+        self._extra_stats: dict[str, int | float | str] = {}
 
     # ---------------------------------------------------------------- properties
     @property
@@ -924,15 +926,15 @@ class CSession(_SessionBase):
         self._lib.dc_set_terms(self._h, self._addr["actb"], self._addr["pcat"])
 
     # ---------------------------------------------------------------- stats and lifetime
-    def stats(self) -> dict[str, int | float]:
+    def stats(self) -> dict[str, int | float | str]:
         self._check_open()
         self._lib.dc_stats(self._h, self._statbuf.ctypes.data)
-        out: dict[str, int | float] = {k: int(v) for k, v in zip(_STAT_KEYS, self._statbuf)}
+        out: dict[str, int | float | str] = {k: int(v) for k, v in zip(_STAT_KEYS, self._statbuf)}
         out["solve_time"] = self._solve_time
         out["compile_time"] = self._build.compile_time
         out["codegen_time"] = self._build.codegen_time
         out["cache_hit"] = bool(self._build.cache_hit)
-        out["linear_solver"] = self._linear_solver
+        out["linear_solver"] = "sparse" if self._lib.dc_linear_solver(self._h) else "dense"
         out["jac_nnz"] = self._jac_nnz
         return out
 
@@ -1284,7 +1286,7 @@ class PythonSession(_SessionBase):
             return np.empty(0)
         return self._eval_roots(float(t), self._vec(y, "y"), self._vec(yp, "yp")).copy()
 
-    def stats(self) -> dict[str, int | float]:
+    def stats(self) -> dict[str, int | float | str]:
         c = self._count
         return {
             "n_steps": c["steps"],
@@ -1354,21 +1356,38 @@ def _resolve_linear_solver(requested: str, n: int, has_sparse: bool) -> str:
     return requested
 
 
+def _file_id(path: Path) -> tuple[int, int] | None:
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return st.st_ino, st.st_mtime_ns
+
+
+def _remove_if_unchanged(path: Path, seen: tuple[int, int] | None) -> None:
+    """Delete a rejected cache entry, unless another process has replaced it meanwhile (by a
+    good build: deleting that would only make it build once more)."""
+    if seen is not None and _file_id(path) == seen:
+        path.unlink(missing_ok=True)
+
+
 def _load_library(funcs: DAEFunctions, model: NormalizedModel) -> tuple[_CLib, BuildResult]:
     """Build (or find in the cache) the model's library and load it. A damaged cache entry, or
     a stale one (other driver ABI, SUNDIALS version or index size), is deleted and built once
     more, never run; SundialsMismatch if even the fresh build does not fit the loaded SUNDIALS."""
     build = build_model_library(funcs, model=model)
+    seen = _file_id(build.path)
     try:
         return _CLib.load(build.path), build
     except (OSError, StaleLibrary) as exc:
         log.info("daeclear: rebuilding the compiled model %r: %s", model.name, exc)
-        build.path.unlink(missing_ok=True)
+        _remove_if_unchanged(build.path, seen)
     build = build_model_library(funcs, model=model)
+    seen = _file_id(build.path)
     try:
         return _CLib.load(build.path), build
     except StaleLibrary as exc:
-        build.path.unlink(missing_ok=True)
+        _remove_if_unchanged(build.path, seen)
         raise SundialsMismatch(f"{exc} (even freshly built: the SUNDIALS libraries the library loads are not "
                                "those of the scikit-sundae wheel)") from exc
 

@@ -91,17 +91,19 @@ sunindextype* SUNSparseMatrix_IndexPointers(SUNMatrix A);
 SUNLinearSolver SUNLinSol_Dense(N_Vector y, SUNMatrix A, SUNContext sunctx);
 SUNLinearSolver SUNLinSol_SuperLUMT(N_Vector y, SUNMatrix A, int num_threads, SUNContext sunctx);
 int SUNLinSolGetType_SuperLUMT(SUNLinearSolver S); /* returns the enum SUNLinearSolver_Type */
+int SUNLinSolGetID_SuperLUMT(SUNLinearSolver S);   /* returns the enum SUNLinearSolver_ID */
 SUNErrCode SUNLinSolInitialize_SuperLUMT(SUNLinearSolver S);
 SUNErrCode SUNLinSolFree_SuperLUMT(SUNLinearSolver S);
 int SUNLinSolSetup(SUNLinearSolver S, SUNMatrix A);
 SUNErrCode SUNLinSolFree(SUNLinearSolver S);
 
-/* A SUNLinearSolver starts with its content pointer, followed (SUNDIALS 7.0-7.5) by the ops
- * table pointer, or (7.9) by one more pointer and then the ops table; the table's own layout
- * also changed within 7.x (setoptions was inserted). The driver therefore assumes no position:
- * it finds both by their values (see find_ops in ida_driver.c). An op is any function pointer. */
+/* A SUNLinearSolver starts with its content pointer, followed (SUNDIALS 7.0-7.5 headers) by the
+ * ops table pointer, or (the wheel's 7.9, observed) by one more pointer and then the ops table;
+ * the table's own layout also changed within 7.x (setoptions was inserted). The driver therefore
+ * assumes no position: it finds both by their values (find_ops in ida_driver.c). The functions
+ * above whose enum results are declared int are only compared by address. An op is any
+ * function pointer: */
 typedef void (*dc_sun_op)(void);
-SUNErrCode SUNLinSolGetID_SuperLUMT(SUNLinearSolver S); /* returns the enum SUNLinearSolver_ID */
 
 /* ida.h */
 #define IDA_NORMAL 1
