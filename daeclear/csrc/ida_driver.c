@@ -436,8 +436,10 @@ static dc_sun_op* find_ops(SUNLinearSolver LS) {
   return NULL;
 }
 
-/* Replace the initialize operation by keep_factorization. Its slot lies between getid and free,
- * the table's last operation; it must be there exactly once. Returns 0, or -1 (left as is). */
+/* Replace the initialize operation by keep_factorization (in this solver's own ops table: every
+ * SUNLinearSolver has one, so no other solver is affected). Its slot lies between getid and
+ * free, the table's last operation; it must be there exactly once. Returns 0, or -1 (left as
+ * is: dc_open then refuses the sparse solver, and "auto" falls back to dense). */
 static int patch_initialize(SUNLinearSolver LS) {
   dc_sun_op* ops = find_ops(LS);
   int slot = -1;
