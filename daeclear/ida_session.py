@@ -24,6 +24,17 @@ Two backends share one interface:
     ``"c"`` when a C compiler works, else ``"python"`` with one :class:`DaeclearWarning` naming
     the reason.
 
+Linear solver of the compiled backend (``linear_solver``): IDA's Newton iteration solves with
+the iteration matrix dF/dy + cj dF/dy' either by dense LU (SUNDIALS' dense matrix) or by sparse
+LU (SuperLU_MT, one thread, on a SUNSparseMatrix whose pattern is the union of the base and all
+term Jacobians' patterns). ``"auto"`` picks sparse from ``SPARSE_MIN_STATES`` states on (measured,
+``benchmarks/bench_linear_solver.py``). The python backend is always dense.
+
+A compiled library is used only if it was built for the SUNDIALS version and index size that
+the wheel has now (its build tag, read from the file before loading, against
+:func:`daeclear.codegen.sundials_info`) and that the loaded SUNDIALS reports (``dc_build_info``
+and ``SUNDIALSGetVersion``); a stale one is deleted and built again, never run.
+
 Behaviour at a restart (measured with SUNDIALS 7.9, see tests/test_ida_session.py): IDA
 returns a root at the end of the final bracket, so the state at a root already lies on the
 far side of the crossing (``g`` has changed sign, ``|g|`` tiny). Restarting there does not
@@ -39,7 +50,9 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import io
+import logging
 import math
+import re
 import time
 import warnings
 import weakref
@@ -50,6 +63,7 @@ from typing import Any, NamedTuple, Protocol, Sequence, runtime_checkable
 import casadi
 import numpy as np
 
+from . import codegen
 from .automaton import Decision, PairState, Storm
 from .codegen import (
     memo_get,
@@ -59,6 +73,8 @@ from .codegen import (
     CompileError,
     CompilerUnavailable,
     NormalizedModel,
+    SundialsInfo,
+    SundialsMismatch,
     build_model_library,
     DRIVER_ABI,
     normalize_model,
@@ -71,12 +87,23 @@ __all__ = [
     "Session",
     "open_session",
     "BACKENDS",
+    "LINEAR_SOLVERS",
+    "SPARSE_MIN_STATES",
+    "StaleLibrary",
     "FLAG_MAX_STEPS",
     "FLAG_STEP_COLLAPSE",
 ]
 
 BACKENDS = ("auto", "c", "python")
+LINEAR_SOLVERS = ("auto", "dense", "sparse")
+#: linear_solver="auto" uses the sparse solver for models with at least this many states. Measured
+#: with benchmarks/bench_linear_solver.py (chains of N links, 6 N states; docs/performance.md):
+#: dense is faster up to 120 states (SuperLU_MT's fixed cost per factorization), sparse from 144
+#: states on (whole simulate calls 1.1x faster at 144 states, 1.3x at 192, 1.8x at 384).
+SPARSE_MIN_STATES = 144
 _NORMALIZED = memo_table()  # normalize_model results by DAEFunctions identity
+_LS_CODES = {"dense": 0, "sparse": 1}  # dc_open's linear_solver argument
+log = logging.getLogger("daeclear")
 
 #: flag of an Advance that stopped because the session's step cap (max_steps) was reached
 FLAG_MAX_STEPS = -1001
@@ -213,7 +240,7 @@ class Session(Protocol):
 
     def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
 
-    def stats(self) -> dict[str, int | float]: ...
+    def stats(self) -> dict[str, int | float | str]: ...
 
     def close(self) -> None: ...
 
@@ -231,6 +258,7 @@ class _Options:
     root_directions: np.ndarray  # int32 (n_roots,)
     buffer_steps: int
     parameters: np.ndarray  # run-time parameters P (n_parameters,)
+    linear_solver: str = "auto"  # one of LINEAR_SOLVERS, as requested
 
 
 def _root_dirs(model: NormalizedModel, rd: Any, what: str = "root_directions") -> np.ndarray:
@@ -245,7 +273,11 @@ def _root_dirs(model: NormalizedModel, rd: Any, what: str = "root_directions") -
 
 
 def _options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, max_order: Any,
-             max_steps: Any, root_directions: Any, buffer_steps: Any, parameters: Any) -> _Options:
+             max_steps: Any, root_directions: Any, buffer_steps: Any, parameters: Any,
+             linear_solver: Any = "auto") -> _Options:
+    if not isinstance(linear_solver, str) or linear_solver.lower() not in LINEAR_SOLVERS:
+        raise ValueError(f"linear_solver={linear_solver!r} is not a linear solver: valid values are "
+                         f"{', '.join(map(repr, LINEAR_SOLVERS))}")
     rtol = float(rtol)
     if not (math.isfinite(rtol) and rtol > 0):
         raise ValueError(f"rtol must be a positive number, got {rtol}")
@@ -270,7 +302,7 @@ def _options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, max_or
         raise ValueError(f"parameters must have {model.n_parameters} values (the model's run-time parameters), "
                          f"got {P.size}")
     return _Options(rtol, np.ascontiguousarray(a), max_step, int(max_order), int(max_steps),
-                    _root_dirs(model, root_directions), int(buffer_steps), P)
+                    _root_dirs(model, root_directions), int(buffer_steps), P, linear_solver.lower())
 
 
 # =========================================================================== common base
@@ -304,7 +336,7 @@ class _SessionBase:
         self._params = [np.zeros(p) for p in model.n_params]
         self._stall_step, self._stall_count = 0.0, TINY_STEP_COUNT
         self._solve_time = 0.0
-        self._extra_stats: dict[str, int | float] = {}
+        self._extra_stats: dict[str, int | float | str] = {}
 
     # ---------------------------------------------------------------- properties
     @property
@@ -450,19 +482,86 @@ class _SessionBase:
 # =========================================================================== compiled backend
 
 
+class StaleLibrary(DaeclearError):
+    """A cached compiled library was built for another driver ABI, SUNDIALS version or index size
+    than the wheel's now (or than the SUNDIALS it loads): it must not run."""
+
+
+def _unload(lib: ctypes.CDLL) -> None:
+    """dlclose a library that must not be used, so that one rebuilt at the same path is really
+    loaded (dlopen of a path that is still open returns the old library)."""
+    import _ctypes
+
+    _ctypes.dlclose(lib._handle)
+
+
+def _version_prefix(text: str) -> str:
+    m = re.match(r"\d+\.\d+\.\d+", text)
+    return m.group(0) if m else text
+
+
+def _staleness(built: SundialsInfo, current: SundialsInfo) -> str | None:
+    """Why a library built for the SUNDIALS ``built`` must not run with the wheel's SUNDIALS
+    ``current``; None if it may."""
+    if (built.version, built.index_size) != (current.version, current.index_size):
+        return (f"built for SUNDIALS {built.version} with {built.index_size}-bit indices, but the wheel has "
+                f"SUNDIALS {current.version} with {current.index_size}-bit indices")
+    if built.has_sparse != current.has_sparse:
+        return (f"built {'with' if built.has_sparse else 'without'} the sparse solver libraries, which the wheel "
+                f"{'has' if current.has_sparse else 'lacks'} now")
+    return None
+
+
+def _check_loaded(lib: ctypes.CDLL, tagged: SundialsInfo) -> tuple[SundialsInfo, str, str | None]:
+    """(build info, SUNDIALSGetVersion, problem or None) of a loaded library: dc_build_info must
+    say what the file's tag said, and the SUNDIALS it resolved must be the version it was built
+    for (another libsundials found first, e.g. through LD_LIBRARY_PATH, would be a silent ABI
+    mismatch)."""
+    buf = ctypes.create_string_buffer(64)
+    lib.dc_sundials_version(buf, 64)
+    loaded = buf.value.decode()
+    raw = (ctypes.c_int * 6)()
+    lib.dc_build_info(raw, 6)
+    info = SundialsInfo(f"{raw[0]}.{raw[1]}.{raw[2]}", raw[3], bool(raw[5]))
+    if info != tagged or raw[4] != info.index_size:
+        return info, loaded, (f"its dc_build_info ({info}, sunindextype {raw[4]} bits) contradicts its build tag "
+                              f"({tagged})")
+    if _version_prefix(loaded) != info.version:
+        return info, loaded, f"built for SUNDIALS {info.version}, but the SUNDIALS it loads reports version {loaded!r}"
+    return info, loaded, None
+
+
 class _CLib:
-    """ctypes view of one compiled model library (shared by all its sessions)."""
+    """ctypes view of one compiled model library (shared by all its sessions).
+
+    Before loading, the build tag in the file must name this daeclear's driver ABI and the
+    wheel's SUNDIALS version, index size and sparse libraries (:func:`_staleness`); once loaded,
+    ``dc_build_info`` must agree and the SUNDIALS it resolved must report that version
+    (:func:`_check_loaded`), else it is unloaded before any call into SUNDIALS. A mismatch
+    raises StaleLibrary.
+    """
 
     _cache: dict[str, "_CLib"] = {}
 
     def __init__(self, path: Path) -> None:
         self.path = path
+        tag = codegen.read_build_tag(path)
+        if tag is None:
+            raise StaleLibrary(f"{path}: no daeclear build tag (built by another daeclear version)")
+        abi, tagged = tag
+        if abi != DRIVER_ABI:
+            raise StaleLibrary(f"{path}: driver ABI version {abi} != {DRIVER_ABI}")
+        why = _staleness(tagged, codegen.sundials_info())
+        if why is not None:
+            raise StaleLibrary(f"{path}: {why}")
         lib = ctypes.CDLL(str(path))
         P = ctypes.c_void_p
         I = ctypes.c_int
         D = ctypes.c_double
         lib.dc_abi_version.restype = I
         lib.dc_abi_version.argtypes = []
+        lib.dc_build_info.restype = I
+        lib.dc_build_info.argtypes = [P, I]
         lib.dc_sundials_version.restype = I
         lib.dc_sundials_version.argtypes = [ctypes.c_char_p, I]
         lib.dc_model_info.restype = I
@@ -472,7 +571,15 @@ class _CLib:
         lib.dc_message.restype = ctypes.c_char_p
         lib.dc_message.argtypes = [P]
         lib.dc_open.restype = P
-        lib.dc_open.argtypes = [D, P, D, I, ctypes.c_longlong, P, P, ctypes.c_char_p, I]
+        lib.dc_open.argtypes = [D, P, D, I, ctypes.c_longlong, P, P, I, ctypes.c_char_p, I]
+        lib.dc_jac_nnz.restype = ctypes.c_longlong
+        lib.dc_jac_nnz.argtypes = [P]
+        lib.dc_linear_solver.restype = I
+        lib.dc_linear_solver.argtypes = [P]
+        lib.dc_jac_pattern.restype = None
+        lib.dc_jac_pattern.argtypes = [P, P, P]
+        lib.dc_eval_jacobian_sparse.restype = I
+        lib.dc_eval_jacobian_sparse.argtypes = [P, D, P, P, D, P]
         lib.dc_n_parameters.restype = I
         lib.dc_n_parameters.argtypes = []
         lib.dc_set_nonlin_conv_coef.restype = I
@@ -519,10 +626,17 @@ class _CLib:
         lib.dc_flag_name.argtypes = [ctypes.c_long, ctypes.c_char_p, I]
         self.lib = lib
         if lib.dc_abi_version() != DRIVER_ABI:
-            raise DaeclearError(f"{path}: driver ABI version {lib.dc_abi_version()} != {DRIVER_ABI}")
-        buf = ctypes.create_string_buffer(64)
-        lib.dc_sundials_version(buf, 64)
-        self.sundials_version = buf.value.decode()
+            abi = lib.dc_abi_version()
+            _unload(lib)
+            raise StaleLibrary(f"{path}: driver ABI version {abi} != {DRIVER_ABI} (build tag said {DRIVER_ABI})")
+        info, loaded, why = _check_loaded(lib, tagged)
+        if why is not None:
+            _unload(lib)
+            raise StaleLibrary(f"{path}: {why}")
+        #: what the library was compiled for (sundials_min.h's -D flags)
+        self.build_info: SundialsInfo = info
+        #: SUNDIALSGetVersion of the SUNDIALS libraries this library loaded
+        self.sundials_version = loaded
 
     @classmethod
     def load(cls, path: Path) -> "_CLib":
@@ -569,13 +683,24 @@ class CSession(_SessionBase):
         self._clib = clib
         self._lib = clib.lib
         self._build = build
+        self._linear_solver = _resolve_linear_solver(opts.linear_solver, n, clib.build_info.has_sparse)
         err = ctypes.create_string_buffer(1024)
-        h = self._lib.dc_open(opts.rtol, opts.atol.ctypes.data, opts.max_step, opts.max_order,
-                              opts.max_steps, _ptr(opts.root_directions), _ptr(opts.parameters), err, 1024)
+
+        def dc_open() -> Any:
+            return self._lib.dc_open(opts.rtol, opts.atol.ctypes.data, opts.max_step, opts.max_order,
+                                     opts.max_steps, _ptr(opts.root_directions), _ptr(opts.parameters),
+                                     _LS_CODES[self._linear_solver], err, 1024)
+
+        h = dc_open()
+        if not h and self._linear_solver == "sparse" and opts.linear_solver == "auto":
+            log.info("daeclear: sparse linear solver unavailable, using dense LU: %s", err.value.decode())
+            self._linear_solver = "dense"
+            h = dc_open()
         if not h:
             raise DaeclearError(f"opening the compiled IDA session failed: {err.value.decode()}")
         self._h = h
         self._finalizer = weakref.finalize(self, _free_c_session, self._lib, h)
+        self._jac_nnz = int(self._lib.dc_jac_nnz(h))
         cap = opts.buffer_steps
         self._cap = cap
         # persistent buffers (addresses cached: ctypes calls stay cheap)
@@ -853,6 +978,23 @@ class CSession(_SessionBase):
             raise DaeclearError(f"the generated residual failed at t={t}")
         return out
 
+    def sparse_jacobian(self, t: float, y: np.ndarray, yp: np.ndarray,
+                        cj: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The iteration matrix as the sparse solver sees it: CSC (data, row indices, column
+        pointers) on the union of the base and all term Jacobians' patterns (explicit zeros for
+        inactive terms), whatever the session's linear solver."""
+        self._check_open()
+        y, yp = self._vec(y, "y"), self._vec(yp, "yp")
+        colptr = np.empty(self._n + 1, dtype=np.int64)
+        rowind = np.empty(max(self._jac_nnz, 1), dtype=np.int64)
+        data = np.empty(max(self._jac_nnz, 1))
+        self._lib.dc_jac_pattern(self._h, colptr.ctypes.data, rowind.ctypes.data)
+        self._sync_terms()
+        if self._lib.dc_eval_jacobian_sparse(self._h, float(t), y.ctypes.data, yp.ctypes.data, float(cj),
+                                             data.ctypes.data):
+            raise DaeclearError(f"the generated Jacobian failed at t={t}")
+        return data[:self._jac_nnz], rowind[:self._jac_nnz], colptr
+
     def jacobian(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray:
         self._check_open()
         y, yp = self._vec(y, "y"), self._vec(yp, "yp")
@@ -886,15 +1028,22 @@ class CSession(_SessionBase):
         self._lib.dc_set_terms(self._h, self._addr["actb"], self._addr["pcat"])
 
     # ---------------------------------------------------------------- stats and lifetime
-    def stats(self) -> dict[str, int | float]:
+    def stats(self) -> dict[str, int | float | str]:
         self._check_open()
         self._lib.dc_stats(self._h, self._statbuf.ctypes.data)
-        out: dict[str, int | float] = {k: int(v) for k, v in zip(_STAT_KEYS, self._statbuf)}
+        out: dict[str, int | float | str] = {k: int(v) for k, v in zip(_STAT_KEYS, self._statbuf)}
         out["solve_time"] = self._solve_time
         out["compile_time"] = self._build.compile_time
         out["codegen_time"] = self._build.codegen_time
         out["cache_hit"] = bool(self._build.cache_hit)
+        out["linear_solver"] = "sparse" if self._lib.dc_linear_solver(self._h) else "dense"
+        out["jac_nnz"] = self._jac_nnz
         return out
+
+    @property
+    def linear_solver(self) -> str:
+        """"dense" or "sparse": the LU IDA's Newton iteration uses in this session."""
+        return self._linear_solver
 
     @property
     def library_path(self) -> Path:
@@ -1239,7 +1388,7 @@ class PythonSession(_SessionBase):
             return np.empty(0)
         return self._eval_roots(float(t), self._vec(y, "y"), self._vec(yp, "yp")).copy()
 
-    def stats(self) -> dict[str, int | float]:
+    def stats(self) -> dict[str, int | float | str]:
         c = self._count
         return {
             "n_steps": c["steps"],
@@ -1255,7 +1404,14 @@ class PythonSession(_SessionBase):
             "compile_time": 0.0,
             "codegen_time": 0.0,
             "cache_hit": False,
+            "linear_solver": "dense",
+            "jac_nnz": self._n * self._n,
         }
+
+    @property
+    def linear_solver(self) -> str:
+        """Always "dense": scikit-sundae is driven with its dense linear solver here."""
+        return "dense"
 
     def close(self) -> None:
         self._closed = True
@@ -1291,10 +1447,57 @@ def _warn_once(reason: str) -> None:
     )
 
 
+def _resolve_linear_solver(requested: str, n: int, has_sparse: bool) -> str:
+    """The linear solver a compiled session uses: "auto" is sparse from SPARSE_MIN_STATES states on
+    (when the library has the sparse solver)."""
+    if requested == "auto":
+        return "sparse" if has_sparse and n >= SPARSE_MIN_STATES else "dense"
+    if requested == "sparse" and not has_sparse:
+        raise DaeclearError("linear_solver='sparse' is not available: the scikit-sundae wheel lacks "
+                            f"lib{codegen.SPARSE_LIBS[0]} or lib{codegen.SPARSE_LIBS[1]}; use 'dense' or 'auto'")
+    return requested
+
+
+def _file_id(path: Path) -> tuple[int, int] | None:
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return st.st_ino, st.st_mtime_ns
+
+
+def _remove_if_unchanged(path: Path, seen: tuple[int, int] | None) -> None:
+    """Delete a rejected cache entry, unless another process has replaced it meanwhile (by a
+    good build: deleting that would only make it build once more)."""
+    if seen is not None and _file_id(path) == seen:
+        path.unlink(missing_ok=True)
+
+
+def _load_library(funcs: DAEFunctions, model: NormalizedModel) -> tuple[_CLib, BuildResult]:
+    """Build (or find in the cache) the model's library and load it. A damaged cache entry, or
+    a stale one (other driver ABI, SUNDIALS version or index size), is deleted and built once
+    more, never run; SundialsMismatch if even the fresh build does not fit the loaded SUNDIALS."""
+    build = build_model_library(funcs, model=model)
+    seen = _file_id(build.path)
+    try:
+        return _CLib.load(build.path), build
+    except (OSError, StaleLibrary) as exc:
+        log.info("daeclear: rebuilding the compiled model %r: %s", model.name, exc)
+        _remove_if_unchanged(build.path, seen)
+    build = build_model_library(funcs, model=model)
+    seen = _file_id(build.path)
+    try:
+        return _CLib.load(build.path), build
+    except StaleLibrary as exc:
+        _remove_if_unchanged(build.path, seen)
+        raise SundialsMismatch(f"{exc} (even freshly built: the SUNDIALS libraries the library loads are not "
+                               "those of the scikit-sundae wheel)") from exc
+
+
 def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, atol: np.ndarray | float,
                  max_step: float = 0.0, max_order: int = 5, max_steps: int = 5_000_000,
                  root_directions: np.ndarray | None = None, buffer_steps: int = 4096,
-                 parameters: np.ndarray | None = None) -> Session:
+                 parameters: np.ndarray | None = None, linear_solver: str = "auto") -> Session:
     """Open an IDA session on a model; see the module docstring.
 
     backend: "auto" (compiled if a C compiler works, else python with one DaeclearWarning),
@@ -1304,6 +1507,9 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
     default directions (-1, 0, +1 per root function; reinit may override them per segment).
     buffer_steps: rows of the step buffers the C loop fills before returning to Python.
     parameters: the run-time parameters P of the model (``funcs.n_parameters`` values).
+    linear_solver: "auto" (sparse from SPARSE_MIN_STATES states on), "dense" or "sparse"
+    (SuperLU_MT on the union of the Jacobians' patterns); case-insensitive. Compiled backend
+    only: the python backend always uses scikit-sundae's dense solver.
     Call reinit() before the first advance().
     """
     if not isinstance(backend, str) or backend.lower() not in BACKENDS:
@@ -1313,18 +1519,12 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
     if model is None:
         model = normalize_model(funcs)
         memo_put(_NORMALIZED, funcs, model)
-    opts = _options(model, rtol, atol, max_step, max_order, max_steps, root_directions, buffer_steps, parameters)
+    opts = _options(model, rtol, atol, max_step, max_order, max_steps, root_directions, buffer_steps, parameters,
+                    linear_solver)
     if b == "python":
         return PythonSession(model, opts)
     try:
-        build = build_model_library(funcs, model=model)
-        try:
-            clib = _CLib.load(build.path)
-        except OSError:
-            # a damaged cache entry: remove it and build once more
-            build.path.unlink(missing_ok=True)
-            build = build_model_library(funcs, model=model)
-            clib = _CLib.load(build.path)
+        clib, build = _load_library(funcs, model)
         return CSession(model, opts, clib, build)
     except (CompilerUnavailable, CompileError, OSError) as exc:
         if b == "c":

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
 from .errors import DaeclearWarning, SceneError, SolveError
-from .ida_session import open_session
+from .ida_session import LINEAR_SOLVERS, open_session
 from .result import ContactEvent, Result
 from .scene import Scene
 
@@ -124,6 +124,7 @@ def simulate(
     progress: bool = False,
     step: float | None = None,
     track_work: bool = False,
+    linear_solver: str = "auto",
 ) -> Result:
     """Integrate a scene (or an assembled model) from t = 0 to ``t_end``.
 
@@ -167,6 +168,10 @@ def simulate(
     step : float or None
         Step size, s, of the fixed-step methods "rk4" and "euler" (required there, e.g. the
         chapter's 1e-5); rejected by the other methods.
+    linear_solver : {"auto", "dense", "sparse"}
+        LU of IDA's Newton iteration in the compiled backend: dense, sparse (SuperLU_MT), or
+        "auto" (sparse for large models, see :data:`daeclear.ida_session.SPARSE_MIN_STATES`).
+        The python backend and the other methods ignore it. Reported in ``result.stats``.
 
     Returns
     -------
@@ -174,6 +179,7 @@ def simulate(
     """
     method = _choice("method", method, METHODS)
     on_failure = _choice("on_failure", on_failure, ON_FAILURE)
+    linear_solver = _choice("linear_solver", linear_solver, LINEAR_SOLVERS)
     t_end = _positive("t_end", t_end, "s")
     rtol = _positive("rtol", rtol, "")
     max_step = _positive("max_step", max_step, "s", allow_zero=True)
@@ -199,7 +205,7 @@ def simulate(
             raise SceneError(f"simulate: t_eval must be increasing values in [0, t_end={t_end}].")
     atol_vec = tolerance_vector(model, rtol, atol)
     session = open_session(model.functions, backend=backend, rtol=rtol, atol=atol_vec, max_step=max_step,
-                           parameters=model.parameter_values, max_steps=max_steps)
+                           parameters=model.parameter_values, max_steps=max_steps, linear_solver=linear_solver)
     y0, yp0 = model.initial_state(session=session)
     if model.formulation == "ggl":
         # never ask Newton for corrections below round-off: coef * rtol >= 1e-13

@@ -10,7 +10,10 @@
  * The residual is the base residual plus the active switchable terms (contact forces); an
  * inactive term is never evaluated. The Jacobian is the base Jacobian plus the active terms'
  * Jacobians: the generated functions return their nonzeros (CasADi's compressed column
- * storage), scattered here into SUNDIALS' dense column-major matrix.
+ * storage), scattered here either into SUNDIALS' dense column-major matrix (dense LU) or into a
+ * SUNSparseMatrix whose fixed pattern is the union of all those patterns (SuperLU_MT), chosen
+ * per session by dc_open. The union is fixed so that switching contact terms on and off never
+ * changes the structure the sparse LU was ordered for (inactive terms leave explicit zeros).
  *
  * Every generated function takes the model's run-time parameters P (masses, joint points,
  * clearances, law constants, ...) as its last input: one compiled library serves every
@@ -30,6 +33,24 @@
 
 #ifndef DC_ABI_VERSION /* given by daeclear.codegen (DRIVER_ABI) */
 #error "compile with -DDC_ABI_VERSION=<daeclear.codegen.DRIVER_ABI>"
+#endif
+#ifndef DC_HAVE_SPARSE /* 1 when the wheel's sparse matrix and SuperLU_MT libraries are linked */
+#define DC_HAVE_SPARSE 0
+#endif
+
+/* linear solvers of dc_open */
+#define DC_LS_DENSE 0
+#define DC_LS_SPARSE 1
+
+#if DC_HAVE_SPARSE && defined(DC_SUPERLUMT_OMP)
+/* SuperLU_MT factors inside an OpenMP parallel loop over its num_threads (1 here) without a
+ * num_threads clause, so libgomp starts a team of omp_get_max_threads() threads, one per core;
+ * the idle ones spin at the barrier (measured: a third of the run time at 48 states). The team
+ * size is a per-thread setting of the wheel's libgomp, set before each factorization. */
+void omp_set_num_threads(int n);
+#define ONE_OMP_THREAD() omp_set_num_threads(1)
+#else
+#define ONE_OMP_THREAD() ((void)0)
 #endif
 
 /* dc_advance return codes */
@@ -162,6 +183,16 @@ typedef struct {
   int* rootsfound;
   double* tmp_r;   /* n   */
   double* tmp_J;   /* nonzeros of the largest Jacobian */
+  /* Jacobian pattern shared by all parts (0: base Jacobian, 1 + k: term k's): the union of
+   * their CSC patterns, built once by build_jac_pattern. Nonzero i of part p lands at
+   * jp_rowind/data position jmap[jmap_off[p] + i]. */
+  int lin_sparse;          /* DC_LS_SPARSE: s->A is that SUNSparseMatrix, s->LS SuperLU_MT */
+  int lu_factored;         /* a Jacobian was handed to the sparse LS (it has factorized) */
+  dc_int jp_nnz;
+  sunindextype* jp_colptr; /* [n + 1] */
+  sunindextype* jp_rowind; /* [jp_nnz], rows sorted within each column */
+  dc_int* jmap;            /* [sum of the parts' nonzeros] */
+  dc_int* jmap_off;        /* [n_terms + 2] */
   double* P;       /* run-time parameters, dc_model.n_parameters */
   double t_now;    /* time of the state in yy/yp (last return) */
   double t_rec;    /* time of the last recorded step (to skip duplicates) */
@@ -267,6 +298,15 @@ static dc_int nnz_of(const dc_fun_t* f) {
   return sp_dense(sp) ? sp[0] * sp[1] : sp[2 + sp[1]];
 }
 
+/* Nonzeros of column c are [col_begin, col_end) of the value array; row_at gives their rows.
+ * A dense pattern stores every entry, column-major. */
+static dc_int col_begin(const dc_int* sp, dc_int c) { return sp_dense(sp) ? c * sp[0] : sp[2 + c]; }
+static dc_int col_end(const dc_int* sp, dc_int c) { return sp_dense(sp) ? (c + 1) * sp[0] : sp[3 + c]; }
+static dc_int row_at(const dc_int* sp, dc_int k) { return sp_dense(sp) ? k % sp[0] : sp[3 + sp[1] + k]; }
+
+/* The generated Jacobian of part p: 0 the base Jacobian, 1 + k term k's. */
+static const dc_fun_t* jac_part(int p) { return p == 0 ? &dc_model.jac : &dc_model.term_jac[p - 1]; }
+
 /* Add the nonzeros nz of an n x n matrix with pattern sp to the dense column-major J. */
 static void scatter_add(const dc_int* sp, const double* nz, double* J, int n) {
   const dc_int ncol = sp[1];
@@ -280,10 +320,28 @@ static void scatter_add(const dc_int* sp, const double* nz, double* J, int n) {
     for (dc_int k = colind[c]; k < colind[c + 1]; ++k) J[(size_t)c * (size_t)n + (size_t)row[k]] += nz[k];
 }
 
+/* Add the nonzeros nz of Jacobian part p to out: the dense column-major n x n matrix, or (sparse)
+ * the data array of the union pattern, through the precomputed positions (no search per entry). */
+static void add_part(const dc_session* s, int p, const double* nz, double* out, int sparse) {
+  if (!sparse) {
+    scatter_add(jac_part(p)->sparsity_out(0), nz, out, s->n);
+    return;
+  }
+  const dc_int* map = s->jmap + s->jmap_off[p];
+  const dc_int m = s->jmap_off[p + 1] - s->jmap_off[p];
+  for (dc_int i = 0; i < m; ++i) out[map[i]] += nz[i];
+}
+
+/* Entries of the Jacobian (out): n * n dense, or jp_nnz in the union pattern. */
+static dc_int jac_len(const dc_session* s, int sparse) {
+  return sparse ? s->jp_nnz : (dc_int)s->n * (dc_int)s->n;
+}
+
+/* J = base Jacobian + active terms' Jacobians, into out (layout: see add_part). */
 static int eval_jac(dc_session* s, double t, const double* y, const double* yp, double cj,
-                    double* J) {
+                    double* J, int sparse) {
   const dc_model_t* M = &dc_model;
-  memset(J, 0, sizeof(double) * (size_t)s->n * (size_t)s->n);
+  memset(J, 0, sizeof(double) * (size_t)jac_len(s, sparse));
   s->arg[0] = &t;
   s->arg[1] = y;
   s->arg[2] = yp;
@@ -291,7 +349,7 @@ static int eval_jac(dc_session* s, double t, const double* y, const double* yp, 
   s->arg[4] = s->P;
   s->res[0] = s->tmp_J;
   if (M->jac.eval(s->arg, s->res, s->iw, s->w, s->mem_jac)) return -1;
-  scatter_add(M->jac.sparsity_out(0), s->tmp_J, J, s->n);
+  add_part(s, 0, s->tmp_J, J, sparse);
   for (int k = 0; k < s->n_terms; ++k) {
     if (!s->active[k]) continue;
     s->arg[0] = &t;
@@ -302,7 +360,7 @@ static int eval_jac(dc_session* s, double t, const double* y, const double* yp, 
     s->arg[5] = s->P;
     s->res[0] = s->tmp_J;
     if (M->term_jac[k].eval(s->arg, s->res, s->iw, s->w, s->mem_term_jac[k])) return -(k + 2);
-    scatter_add(M->term_jac[k].sparsity_out(0), s->tmp_J, J, s->n);
+    add_part(s, k + 1, s->tmp_J, J, sparse);
   }
   return 0;
 }
@@ -341,15 +399,42 @@ static int res_cb(sunrealtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* da
   return 0;
 }
 
+/* Row and column of entry i of the Jacobian's storage (for messages). */
+static void entry_position(const dc_session* s, dc_int i, int sparse, int* row, int* col) {
+  if (!sparse) {
+    *row = (int)(i % s->n);
+    *col = (int)(i / s->n);
+    return;
+  }
+  int c = 0;
+  while (c < s->n && (dc_int)s->jp_colptr[c + 1] <= i) ++c;
+  *row = (int)s->jp_rowind[i];
+  *col = c;
+}
+
+/* The matrix's storage for eval_jac. A sparse matrix gets its pattern back first: IDA zeroes the
+ * matrix before every call (SUNMatZero), and for a SUNSparseMatrix that clears the index arrays
+ * too. */
+static double* jac_storage(dc_session* s, SUNMatrix J) {
+#if DC_HAVE_SPARSE
+  if (s->lin_sparse) {
+    memcpy(SUNSparseMatrix_IndexPointers(J), s->jp_colptr, sizeof(sunindextype) * ((size_t)s->n + 1));
+    memcpy(SUNSparseMatrix_IndexValues(J), s->jp_rowind, sizeof(sunindextype) * (size_t)s->jp_nnz);
+    return SUNSparseMatrix_Data(J);
+  }
+#endif
+  return SUNDenseMatrix_Data(J);
+}
+
 static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vector rr,
                   SUNMatrix J, void* data, N_Vector t1, N_Vector t2, N_Vector t3) {
   dc_session* s = (dc_session*)data;
-  double* Jd = SUNDenseMatrix_Data(J);
+  double* Jd = jac_storage(s, J);
   (void)rr;
   (void)t1;
   (void)t2;
   (void)t3;
-  int rc = eval_jac(s, t, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), cj, Jd);
+  int rc = eval_jac(s, t, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), cj, Jd, s->lin_sparse);
   if (rc) {
     if (rc == -1)
       set_msg(s->cb_msg, "the generated base Jacobian returned an error at t=%.17g", t);
@@ -358,11 +443,19 @@ static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vec
               -rc - 2, t);
     return -1;
   }
-  int i = first_nonfinite(Jd, s->n * s->n);
+  int i = first_nonfinite(Jd, (int)jac_len(s, s->lin_sparse));
   if (i >= 0) {
-    set_msg(s->cb_msg, "Jacobian entry (%d, %d) is %g at t=%.17g", i % s->n, i / s->n, Jd[i], t);
+    int row, col;
+    entry_position(s, i, s->lin_sparse, &row, &col);
+    set_msg(s->cb_msg, "Jacobian entry (%d, %d) is %g at t=%.17g", row, col, Jd[i], t);
     return 1;
   }
+#if DC_HAVE_SPARSE
+  if (s->lin_sparse) {
+    ONE_OMP_THREAD(); /* IDA factors the matrix next, on this thread */
+    s->lu_factored = 1; /* see free_superlumt */
+  }
+#endif
   return 0;
 }
 
@@ -408,11 +501,122 @@ static void flag_name(long int flag, char* buf, int len) {
 
 static void* xcalloc(size_t n, size_t sz) { return calloc(n ? n : 1, sz); }
 
+/* ------------------------------------------------------------------ sparse LU (SuperLU_MT)
+ * SUNDIALS' SuperLU_MT solver starts over whenever it is initialized, which IDA does at the
+ * first step after every IDAReInit, i.e. at every contact event: the next factorization then
+ * recomputes the column ordering and allocates new L and U storage without freeing the old
+ * (measured on a chain of 8 links: resident memory grew by 60 MB over 600 events, and each
+ * event paid a full symbolic factorization). The session's pattern never changes (the union of
+ * all parts), so the ordering and storage of the first factorization stay valid for all later
+ * ones: dc_open initializes the solver once and replaces its initialize operation by a no-op,
+ * so every later factorization takes SuperLU_MT's refactorization path (as within a segment). */
+#if DC_HAVE_SPARSE
+static SUNErrCode keep_factorization(SUNLinearSolver S) {
+  (void)S;
+  return 0;
+}
+
+/* The ops table of a SuperLU_MT solver, found by value: the pointer field right after the
+ * content (7.0-7.5) or the one after that (7.9) that points at a table starting with its
+ * gettype and getid operations. Both fields exist in either layout (the second is the context
+ * pointer in the older one), so nothing beyond the structure is read. */
+static dc_sun_op* find_ops(SUNLinearSolver LS) {
+  void** head = (void**)LS;
+  for (int i = 1; i <= 2; ++i) {
+    dc_sun_op* ops = (dc_sun_op*)head[i];
+    if (ops && ops[0] == (dc_sun_op)SUNLinSolGetType_SuperLUMT &&
+        ops[1] == (dc_sun_op)SUNLinSolGetID_SuperLUMT)
+      return ops;
+  }
+  return NULL;
+}
+
+/* Replace the initialize operation by keep_factorization (in this solver's own ops table: every
+ * SUNLinearSolver has one, so no other solver is affected). Its slot lies between getid and
+ * free, the table's last operation; it must be there exactly once. Returns 0, or -1 (left as
+ * is: dc_open then refuses the sparse solver, and "auto" falls back to dense). */
+static int patch_initialize(SUNLinearSolver LS) {
+  dc_sun_op* ops = find_ops(LS);
+  int slot = -1;
+  if (!ops) return -1;
+  for (int i = 2; i < 64; ++i) {
+    if (ops[i] == (dc_sun_op)SUNLinSolFree_SuperLUMT) {
+      if (slot < 0) return -1;
+      ops[slot] = (dc_sun_op)keep_factorization;
+      return 0;
+    }
+    if (ops[i] == (dc_sun_op)SUNLinSolInitialize_SuperLUMT) {
+      if (slot >= 0) return -1;
+      slot = i;
+    }
+  }
+  return -1;
+}
+
+/* SUNLinSolFree_SuperLUMT reads uninitialized options when the solver never factorized (a
+ * session opened and closed without a step): factor an n x n identity first, so it has. */
+static void free_superlumt(dc_session* s) {
+  if (!s->lu_factored) {
+    SUNMatrix I = SUNSparseMatrix(s->n, s->n, s->n, CSC_MAT, s->ctx);
+    if (!I) return; /* leave the solver allocated rather than crash */
+    SUNLinSolInitialize_SuperLUMT(s->LS); /* the real one: this is a first factorization */
+    sunindextype* cp = SUNSparseMatrix_IndexPointers(I);
+    sunindextype* ri = SUNSparseMatrix_IndexValues(I);
+    double* d = SUNSparseMatrix_Data(I);
+    for (int i = 0; i < s->n; ++i) {
+      cp[i] = i;
+      ri[i] = i;
+      d[i] = 1.0;
+    }
+    cp[s->n] = s->n;
+    ONE_OMP_THREAD();
+    SUNLinSolSetup(s->LS, I);
+    SUNMatDestroy(I);
+  }
+  SUNLinSolFree(s->LS);
+}
+#endif
+
+static void free_linear_solver(dc_session* s) {
+  if (!s->LS) return;
+#if DC_HAVE_SPARSE
+  if (s->lin_sparse) {
+    free_superlumt(s);
+    return;
+  }
+#endif
+  SUNLinSolFree(s->LS);
+}
+
 /* ---------------------------------------------------------------- API ---- */
 
 DC_API int dc_abi_version(void) { return DC_ABI_VERSION; }
 
+/* What this library was compiled for, as text in the file itself: Python reads it from the file
+ * BEFORE loading the library (codegen.read_build_tag), so a library built for other SUNDIALS
+ * headers or another index width is never even loaded. dc_build_info says the same once loaded. */
+#define DC_STR_(x) #x
+#define DC_STR(x) DC_STR_(x)
+DC_API const char dc_build_tag[] = "daeclear-build:abi=" DC_STR(DC_ABI_VERSION)
+                                   ";sundials=" DC_STR(DC_SUNDIALS_MAJOR) "." DC_STR(DC_SUNDIALS_MINOR)
+                                   "." DC_STR(DC_SUNDIALS_PATCH)
+                                   ";index=" DC_STR(DC_INDEX_SIZE)
+                                   ";sparse=" DC_STR(DC_HAVE_SPARSE) ";";
+
+/* SUNDIALSGetVersion of the SUNDIALS library this library actually loaded. */
 DC_API int dc_sundials_version(char* buf, int len) { return SUNDIALSGetVersion(buf, len); }
+
+/* What this library was compiled for, checked by Python before any session is opened: a
+ * library built for other SUNDIALS headers or another index width must never run. out gets
+ * SUNDIALS major, minor, patch, DC_INDEX_SIZE, the bits of sunindextype as compiled, and
+ * DC_HAVE_SPARSE; returns how many values were written. */
+DC_API int dc_build_info(int* out, int len) {
+  const int info[6] = {DC_SUNDIALS_MAJOR, DC_SUNDIALS_MINOR, DC_SUNDIALS_PATCH, DC_INDEX_SIZE,
+                       (int)(8 * sizeof(sunindextype)), DC_HAVE_SPARSE};
+  int k = len < 6 ? len : 6;
+  for (int i = 0; i < k; ++i) out[i] = info[i];
+  return k;
+}
 
 DC_API int dc_n_parameters(void) { return dc_model.n_parameters; }
 
@@ -497,7 +701,7 @@ DC_API void dc_free(void* sp) {
   dc_session* s = (dc_session*)sp;
   if (!s) return;
   if (s->ida) IDAFree(&s->ida);
-  if (s->LS) SUNLinSolFree(s->LS);
+  free_linear_solver(s);
   if (s->A) SUNMatDestroy(s->A);
   if (s->yy) N_VDestroy(s->yy);
   if (s->yp) N_VDestroy(s->yp);
@@ -519,6 +723,10 @@ DC_API void dc_free(void* sp) {
   free(s->rootsfound);
   free(s->tmp_r);
   free(s->tmp_J);
+  free(s->jp_colptr);
+  free(s->jp_rowind);
+  free(s->jmap);
+  free(s->jmap_off);
   free(s->P);
   free(s->auto_root);
   free(s->auto_term);
@@ -552,12 +760,73 @@ static void work_max(const dc_fun_t* f, dc_int* a, dc_int* r, dc_int* iw, dc_int
   if (sw > *w) *w = sw;
 }
 
-/* Open a session: IDA memory, dense linear solver, tolerances, options and root functions.
+static int cmp_index(const void* a, const void* b) {
+  sunindextype x = *(const sunindextype*)a, y = *(const sunindextype*)b;
+  return (x > y) - (x < y);
+}
+
+/* The union of the CSC patterns of all Jacobian parts (base and every term), rows sorted within
+ * each column as SUNSparseMatrix and SuperLU_MT expect, and each part's nonzero -> position map.
+ * Once per session, O(nonzeros log): a row marker per column, no n x n scratch. Returns 0, or -1
+ * out of memory, -2 a pattern that is not n x n, -3 too many nonzeros for sunindextype. */
+static int build_jac_pattern(dc_session* s) {
+  const int n = s->n, parts = s->n_terms + 1;
+  dc_int total = 0;
+  s->jmap_off = (dc_int*)xcalloc((size_t)parts + 1, sizeof(dc_int));
+  if (!s->jmap_off) return -1;
+  for (int p = 0; p < parts; ++p) {
+    const dc_int* sp = jac_part(p)->sparsity_out(0);
+    if (sp[0] != n || sp[1] != n) return -2;
+    s->jmap_off[p] = total;
+    total += nnz_of(jac_part(p));
+  }
+  s->jmap_off[parts] = total;
+  const dc_int cap = total < (dc_int)n * n ? total : (dc_int)n * n; /* the union's size at most */
+  if (sizeof(sunindextype) < sizeof(dc_int) && cap > (dc_int)INT32_MAX) return -3;
+  s->jmap = (dc_int*)xcalloc((size_t)total, sizeof(dc_int));
+  s->jp_colptr = (sunindextype*)xcalloc((size_t)n + 1, sizeof(sunindextype));
+  s->jp_rowind = (sunindextype*)xcalloc((size_t)cap, sizeof(sunindextype));
+  dc_int* pos = (dc_int*)xcalloc((size_t)n, sizeof(dc_int)); /* row -> position, -1: not seen */
+  if (!s->jmap || !s->jp_colptr || !s->jp_rowind || !pos) {
+    free(pos);
+    return -1;
+  }
+  for (int i = 0; i < n; ++i) pos[i] = -1;
+  dc_int nnz = 0;
+  for (dc_int c = 0; c < n; ++c) {
+    const dc_int start = nnz;
+    for (int p = 0; p < parts; ++p) { /* collect the column's distinct rows */
+      const dc_int* sp = jac_part(p)->sparsity_out(0);
+      for (dc_int k = col_begin(sp, c); k < col_end(sp, c); ++k) {
+        dc_int r = row_at(sp, k);
+        if (pos[r] < 0) {
+          pos[r] = 0;
+          s->jp_rowind[nnz++] = (sunindextype)r;
+        }
+      }
+    }
+    qsort(s->jp_rowind + start, (size_t)(nnz - start), sizeof(sunindextype), cmp_index);
+    for (dc_int k = start; k < nnz; ++k) pos[s->jp_rowind[k]] = k;
+    for (int p = 0; p < parts; ++p) { /* where each part's nonzeros of this column go */
+      const dc_int* sp = jac_part(p)->sparsity_out(0);
+      for (dc_int k = col_begin(sp, c); k < col_end(sp, c); ++k)
+        s->jmap[s->jmap_off[p] + k] = pos[row_at(sp, k)];
+    }
+    for (dc_int k = start; k < nnz; ++k) pos[s->jp_rowind[k]] = -1;
+    s->jp_colptr[c + 1] = (sunindextype)nnz;
+  }
+  s->jp_nnz = nnz;
+  free(pos);
+  return 0;
+}
+
+/* Open a session: IDA memory, linear solver (DC_LS_DENSE: dense LU; DC_LS_SPARSE: SuperLU_MT on
+ * the union pattern, one thread), tolerances, options and root functions.
  * IDAInit is called here with a zero state; dc_reinit then (re)starts with IDAReInit.
  * Returns NULL on failure with a message in err. */
 DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_order,
-                     long long max_steps, const int* rootdir, const double* P, char* err,
-                     int errlen) {
+                     long long max_steps, const int* rootdir, const double* P, int linear_solver,
+                     char* err, int errlen) {
   const dc_model_t* M = &dc_model;
   dc_session* s = (dc_session*)calloc(1, sizeof(dc_session));
   int n = M->n, flag;
@@ -643,6 +912,20 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
     for (int i = 0; i < M->n_roots; ++i) s->rootdir_default[i] = rootdir ? rootdir[i] : 0;
   }
 
+  /* Jacobian pattern: always built (small), so dc_eval_jacobian_sparse works in any session */
+  {
+    int rc = build_jac_pattern(s);
+    if (rc == -1) FAIL("out of memory");
+    if (rc == -2) FAIL("a generated Jacobian is not %d x %d", n, n);
+    if (rc == -3) FAIL("the Jacobian has too many nonzeros for the wheel's 32-bit sunindextype");
+  }
+  if (linear_solver != DC_LS_DENSE && linear_solver != DC_LS_SPARSE)
+    FAIL("unknown linear solver %d (0: dense, 1: sparse)", linear_solver);
+  if (linear_solver == DC_LS_SPARSE && !DC_HAVE_SPARSE)
+    FAIL("this library was built without the sparse solver (the wheel lacks "
+         "libsundials_sunmatrixsparse or libsundials_sunlinsolsuperlumt)");
+  s->lin_sparse = linear_solver == DC_LS_SPARSE;
+
   /* SUNDIALS objects */
   if (SUNContext_Create(SUN_COMM_NULL, &s->ctx) != 0 || !s->ctx)
     FAIL("SUNContext_Create failed");
@@ -656,10 +939,25 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
   memset(N_VGetArrayPointer(s->yy), 0, sizeof(double) * (size_t)n);
   memset(N_VGetArrayPointer(s->yp), 0, sizeof(double) * (size_t)n);
   memcpy(N_VGetArrayPointer(s->atol), atol, sizeof(double) * (size_t)n);
-  s->A = SUNDenseMatrix(n, n, s->ctx);
-  if (!s->A) FAIL("SUNDenseMatrix failed");
-  s->LS = SUNLinSol_Dense(s->yy, s->A, s->ctx);
-  if (!s->LS) FAIL("SUNLinSol_Dense failed");
+  if (s->lin_sparse) {
+#if DC_HAVE_SPARSE
+    /* one thread: the factorizations are small and the machine is shared; more threads cost
+     * more in OpenMP start-up than they save */
+    s->A = SUNSparseMatrix(n, n, s->jp_nnz > 0 ? (sunindextype)s->jp_nnz : 1, CSC_MAT, s->ctx);
+    if (!s->A) FAIL("SUNSparseMatrix(%d, %d, nnz=%lld) failed", n, n, (long long)s->jp_nnz);
+    (void)jac_storage(s, s->A); /* a valid pattern from the start */
+    s->LS = SUNLinSol_SuperLUMT(s->yy, s->A, 1, s->ctx);
+    if (!s->LS) FAIL("SUNLinSol_SuperLUMT failed");
+    if (SUNLinSolInitialize_SuperLUMT(s->LS) != 0 || patch_initialize(s->LS) != 0)
+      FAIL("the SuperLU_MT solver of this SUNDIALS build cannot keep its factorization across "
+           "restarts (unexpected operations table); use linear_solver='dense'");
+#endif
+  } else {
+    s->A = SUNDenseMatrix(n, n, s->ctx);
+    if (!s->A) FAIL("SUNDenseMatrix failed");
+    s->LS = SUNLinSol_Dense(s->yy, s->A, s->ctx);
+    if (!s->LS) FAIL("SUNLinSol_Dense failed");
+  }
   s->ida = IDACreate(s->ctx);
   if (!s->ida) FAIL("IDACreate failed");
 #define CHECK(call)                                                      \
@@ -1388,7 +1686,27 @@ DC_API int dc_eval_residual(void* sp, double t, const double* y, const double* y
 
 DC_API int dc_eval_jacobian(void* sp, double t, const double* y, const double* yp, double cj,
                             double* J) {
-  return eval_jac((dc_session*)sp, t, y, yp, cj, J);
+  return eval_jac((dc_session*)sp, t, y, yp, cj, J, 0);
+}
+
+/* The same Jacobian as the nonzeros of the session's union pattern (dc_jac_pattern): what the
+ * sparse solver's callback fills. */
+DC_API int dc_eval_jacobian_sparse(void* sp, double t, const double* y, const double* yp,
+                                   double cj, double* data) {
+  return eval_jac((dc_session*)sp, t, y, yp, cj, data, 1);
+}
+
+/* Nonzeros of the union pattern. */
+DC_API long long dc_jac_nnz(void* sp) { return (long long)((dc_session*)sp)->jp_nnz; }
+
+/* The session's linear solver: DC_LS_DENSE or DC_LS_SPARSE. */
+DC_API int dc_linear_solver(void* sp) { return ((dc_session*)sp)->lin_sparse; }
+
+/* The union pattern as 64-bit CSC arrays: colptr[n + 1], rowind[dc_jac_nnz]. */
+DC_API void dc_jac_pattern(void* sp, long long* colptr, long long* rowind) {
+  dc_session* s = (dc_session*)sp;
+  for (int c = 0; c <= s->n; ++c) colptr[c] = (long long)s->jp_colptr[c];
+  for (dc_int k = 0; k < s->jp_nnz; ++k) rowind[k] = (long long)s->jp_rowind[k];
 }
 
 DC_API int dc_eval_roots(void* sp, double t, const double* y, const double* yp, double* g) {
