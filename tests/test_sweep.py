@@ -266,3 +266,18 @@ def test_sweep_examples_run_quick(script, files, tmp_path):
         assert (tmp_path / name).stat().st_size > 0, name
     table = load_sweep(next(tmp_path.glob("*.h5")))
     assert len(table) == 2 and all(r.ok for r in table.runs)
+
+
+def test_a_sweep_builds_one_library_per_structure(tmp_path, monkeypatch):
+    """Numbers are run-time data: a clearance x friction-coefficient sweep on two worker processes,
+    from an empty compile cache, compiles one library (the friction law is the same structure for
+    every coefficient), and every worker loads it."""
+    from daeclear.codegen import clear_memos
+
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("DAECLEAR_CACHE_DIR", str(cache))
+    clear_memos()
+    out = sweep(tmp_path / "one.h5", {"clearance": [0.1e-3, 0.3e-3, 0.5e-3], "friction": [0.02, 0.1]},
+                fixed=FIXED, max_workers=2, **FAST)
+    assert len(out) == 6 and all(r.ok for r in out.runs)
+    assert len(list(cache.glob("dc_*.so"))) == 1
