@@ -26,6 +26,7 @@ where ``Phi' = Phi_q v + Phi_t`` and ``gamma = -(d Phi'/dq) v - d Phi'/dt``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Literal, Sequence
@@ -427,24 +428,11 @@ def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
 
 @dataclass(frozen=True)
 class _Template:
-    """Everything of an assembled model that depends on the structure only (shared by every
-    scene with that structure; numbers are bound by :meth:`bind`)."""
+    """What of an assembled model depends on the structure only, shared by every scene with that
+    structure: the model built for the first such scene, and how its numbers are bound."""
 
+    model: DAEModel  # the structure, with the numbers of the scene it was built from
     layout: tuple[tuple[str, int], ...]
-    formulation: str
-    track_work: bool
-    body_names: tuple[str, ...]
-    constraint_names: tuple[str, ...]
-    state_names: tuple[str, ...]
-    state_kinds: tuple[str, ...]
-    functions: DAEFunctions
-    terms: tuple[Term, ...]
-    gap_names: tuple[str, ...]
-    channel_names: tuple[str, ...]
-    channel_units: dict[str, str]
-    outputs: ca.Function
-    kinematics: ca.Function
-    base_force: ca.Function
     logic: tuple[Callable[[NDArray[np.float64]], list[Any]], ...]
     # (root, term, gap-rate extra, needs approach speed, index of the contact logic) of simple pairs
     auto_pairs: tuple[tuple[int, int, int, bool, int], ...]
@@ -458,20 +446,15 @@ class _Template:
         contacts = tuple(logic for make in self.logic for logic in make(P))
         auto_pairs = tuple((root, term, extra, needs, float(getattr(contacts[i], "min_approach_speed", 0.0)))
                            for root, term, extra, needs, i in self.auto_pairs)
-        return DAEModel(
-            scene_name=scene.name, formulation=self.formulation, alpha=float(alpha), beta=float(beta),
-            body_names=self.body_names, constraint_names=self.constraint_names,
-            state_names=self.state_names, state_kinds=self.state_kinds, functions=self.functions,
-            terms=self.terms, gap_names=self.gap_names, channel_names=self.channel_names,
-            channel_units=self.channel_units, outputs=self.outputs,
+        formulation, track_work = self.model.formulation, self.model.track_work
+        return dataclasses.replace(
+            self.model, scene_name=scene.name, alpha=float(alpha), beta=float(beta),
             q_guess=np.concatenate([[*b.position, b.angle] for b in bodies]),
             v_guess=np.concatenate([[*b.velocity, b.angular_velocity] for b in bodies]),
             mass_diagonal=np.concatenate([[b.mass, b.mass, b.inertia] for b in bodies]),
-            kinematics=self.kinematics, base_force=self.base_force,
-            parameters={"scene": scene.to_dict(), "formulation": self.formulation, "alpha": alpha, "beta": beta,
-                        "track_work": self.track_work},
-            contacts=contacts, track_work=self.track_work, auto_pairs=auto_pairs,
-            parameter_layout=self.layout, parameter_values=P,
+            parameters={"scene": scene.to_dict(), "formulation": formulation, "alpha": alpha, "beta": beta,
+                        "track_work": track_work},
+            contacts=contacts, auto_pairs=auto_pairs, parameter_layout=self.layout, parameter_values=P,
         )
 
 
@@ -749,15 +732,16 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
         term_jacobians=tuple(term_jac), roots=roots, name=library_name, extras=tuple(extras),
         n_parameters=int(P.numel()),
     )
-    return _Template(
-        layout=table.layout, formulation=formulation, track_work=track_work,
+    model = DAEModel(
+        scene_name=scene.name, formulation=formulation, alpha=0.0, beta=0.0,
         body_names=tuple(b.name for b in bodies), constraint_names=tuple(names),
         state_names=tuple(state_names), state_kinds=tuple(kinds), functions=functions,
         terms=tuple(terms), gap_names=tuple(gap_names),
         channel_names=tuple(c.name for c in channels), channel_units={c.name: c.unit for c in channels},
-        outputs=outputs, kinematics=kinematics, base_force=base_force, logic=logic_makers,
-        auto_pairs=tuple(auto_pairs),
-    )
+        outputs=outputs, q_guess=np.zeros(n), v_guess=np.zeros(n), mass_diagonal=np.ones(n),
+        kinematics=kinematics, base_force=base_force, track_work=track_work,
+    )  # numbers are bound per scene (_Template.bind)
+    return _Template(model=model, layout=table.layout, logic=logic_makers, auto_pairs=tuple(auto_pairs))
 
 
 def _mapped(function: ca.Function, n: int) -> ca.Function:
