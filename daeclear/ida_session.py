@@ -232,7 +232,10 @@ class Session(Protocol):
                params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None: ...
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True, on_chunk: Any = None) -> Advance: ...
+                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True) -> Advance:
+        """Integrate towards ``t_stop``; ``store_steps``: keep every step's time, size and order,
+        with ``store_states`` also its y and yp (else ``step_y``/``step_yp`` have no rows)."""
+        ...
 
     def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
 
@@ -307,6 +310,21 @@ def _options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, max_or
 
 # =========================================================================== common base
 
+
+# dc_advance's store_steps flags (csrc/ida_driver.c DC_STORE_TIMES, DC_STORE_STATES)
+STORE_TIMES, STORE_STATES = 1, 2
+
+
+class _NoRows(dict):
+    """Empty (0, n) arrays by n: the step states of an advance that was not asked to keep them."""
+
+    def __missing__(self, n: int) -> np.ndarray:
+        self[n] = value = np.empty((0, n))
+        value.flags.writeable = False
+        return value
+
+
+_NO_ROWS = _NoRows()
 
 _EMPTY = np.empty(0)
 _EMPTY.flags.writeable = False
@@ -902,7 +920,7 @@ class CSession(_SessionBase):
         self._ready = True
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True, on_chunk: Any = None) -> Advance:
+                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True) -> Advance:
         t_stop = self._check_advance(t_stop)
         n = self._n
         te = self._select_eval(t_eval, t_stop)
@@ -914,7 +932,7 @@ class CSession(_SessionBase):
         self._i_eval.value = 0
         chunks: list[tuple[np.ndarray, ...]] = []
         auto_events: list[AutoEvent] = []
-        store = 1 if store_steps else 0
+        store = (STORE_TIMES | (STORE_STATES if store_states else 0)) if store_steps else 0
         lib, h = self._lib, self._h
         tic = time.perf_counter()
         try:
@@ -925,8 +943,8 @@ class CSession(_SessionBase):
                                     A["flag"])
                 k = self._n_stored.value
                 if k:
-                    chunks.append((self._st[:k].copy(), self._sy[:k].copy(), self._syp[:k].copy(),
-                                   self._sh[:k].copy(), self._sord[:k].copy()))
+                    states = (self._sy[:k].copy(), self._syp[:k].copy()) if store_states else (_NO_ROWS[n],) * 2
+                    chunks.append((self._st[:k].copy(), *states, self._sh[:k].copy(), self._sord[:k].copy()))
                 auto_events += self._take_auto_events()  # drained at every chunk: the C buffer never overflows
                 if rc != 0:
                     break
@@ -1245,7 +1263,7 @@ class PythonSession(_SessionBase):
         self._apply_terms(act, plist)
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True, on_chunk: Any = None) -> Advance:
+                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True) -> Advance:
         t_stop = self._check_advance(t_stop)
         n = self._n
         te = self._select_eval(t_eval, t_stop)

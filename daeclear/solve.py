@@ -278,11 +278,12 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
             if store_steps and adv.step_t[steps].size:
                 k = adv.step_t[steps].size
                 steps_t.append(adv.step_t[steps])
-                steps_y.append(adv.step_y[steps])
-                steps_yp.append(adv.step_yp[steps])
                 steps_h.append(adv.step_h[steps])
                 steps_order.append(adv.step_order[steps])
-                steps_switch.append(np.repeat(switch[None, :], k, axis=0))
+                if eval_times is None:  # the steps are the output points
+                    steps_y.append(adv.step_y[steps])
+                    steps_yp.append(adv.step_yp[steps])
+                    steps_switch.append(np.repeat(switch[None, :], k, axis=0))
             if adv.eval_t[evals].size:
                 k = adv.eval_t[evals].size
                 ev_t.append(adv.eval_t[evals])
@@ -295,7 +296,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                     else None)
         seg_start = t
         while True:
-            adv = session.advance(t_end, pending, store_steps, on_chunk=on_chunk)
+            adv = session.advance(t_end, pending, store_steps, on_chunk=on_chunk, store_states=eval_times is None)
             if pending is not None and adv.eval_t.size:
                 pending = pending[pending > adv.eval_t[-1]]
             # the C loop decided contact switches itself: split the advance at each restart and

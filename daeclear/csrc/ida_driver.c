@@ -53,6 +53,10 @@ void omp_set_num_threads(int n);
 #define ONE_OMP_THREAD() ((void)0)
 #endif
 
+/* dc_advance store_steps flags: step times, sizes and orders; also the states y and yp */
+#define DC_STORE_TIMES 1
+#define DC_STORE_STATES 2
+
 /* dc_advance return codes */
 #define DC_CHUNK 0          /* buffer full: call again */
 #define DC_TSTOP 1          /* reached t_stop */
@@ -1446,7 +1450,8 @@ DC_API int dc_report(void* sp, int n_points, const double* t, const double* y, c
  *
  * t_eval[*i_eval .. n_eval) are the requested output times, sorted, all > current time; each
  * one reached is written (y via IDAGetDky k=0, yp via k=1) to eval_y/eval_yp row *i_eval and
- * *i_eval advances. If store_steps, every return point of IDA (the end of each internal step;
+ * *i_eval advances. If store_steps (DC_STORE_TIMES, with DC_STORE_STATES also y and yp), every
+ * return point of IDA (the end of each internal step;
  * on a root return the root point; duplicates skipped) is written to the step buffers, at most
  * cap rows; *n_stored rows were written.
  *
@@ -1513,8 +1518,10 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
     }
     if (store_steps && tret > s->t_rec) {
       st[0] = tret;
-      memcpy(sy, N_VGetArrayPointer(s->yy), sizeof(double) * (size_t)n);
-      memcpy(syp, N_VGetArrayPointer(s->yp), sizeof(double) * (size_t)n);
+      if (store_steps & DC_STORE_STATES) {
+        memcpy(sy, N_VGetArrayPointer(s->yy), sizeof(double) * (size_t)n);
+        memcpy(syp, N_VGetArrayPointer(s->yp), sizeof(double) * (size_t)n);
+      }
       sh[0] = h;
       sord[0] = order;
       *n_stored = 1;
@@ -1600,8 +1607,10 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
     /* record the return point */
     if (store_steps && tret > s->t_rec) {
       st[k] = tret;
-      memcpy(sy + (size_t)k * n, N_VGetArrayPointer(s->yy), sizeof(double) * (size_t)n);
-      memcpy(syp + (size_t)k * n, N_VGetArrayPointer(s->yp), sizeof(double) * (size_t)n);
+      if (store_steps & DC_STORE_STATES) {
+        memcpy(sy + (size_t)k * n, N_VGetArrayPointer(s->yy), sizeof(double) * (size_t)n);
+        memcpy(syp + (size_t)k * n, N_VGetArrayPointer(s->yp), sizeof(double) * (size_t)n);
+      }
       sh[k] = h;
       sord[k] = order;
       ++k;
