@@ -507,8 +507,7 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     for label, value in (("alpha", alpha), ("beta", beta)):
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
             raise SceneError(f"{label}={value!r} 1/s, must be a finite number >= 0.")
-    scene.validate()
-    table, key = scene_parameters(scene, formulation, alpha, beta, track_work)
+    table, key = _validated_parameters(scene, formulation, alpha, beta, bool(track_work))
     template = _TEMPLATES.get(key)
     if template is None:
         template = _build_template(scene, formulation, bool(track_work), table, f"mechanism_{key[:16]}")
@@ -516,6 +515,31 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
             _TEMPLATES.pop(next(iter(_TEMPLATES)))
         _TEMPLATES[key] = template
     return template.bind(scene, table, alpha, beta)
+
+
+# Scenes assembled before in this process: (elements, name, gravity, ground, options) -> their
+# parameters and structure key. The entry holds the very element objects (frozen dataclasses),
+# so an unchanged scene is recognised by identity and a changed one (an element added, replaced,
+# gravity or name reassigned) is not; validation and parameters are then skipped.
+_SEEN: dict[int, tuple[Any, ...]] = memo_table()
+_SEEN_LIMIT = 32
+
+
+def _validated_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
+                          track_work: bool) -> tuple[ParameterTable, str]:
+    """``scene.validate()`` then :func:`scene_parameters`, skipped for a scene seen unchanged."""
+    elements = tuple(scene.elements)
+    identity = (scene.name, tuple(scene.gravity), scene.ground, formulation, alpha, beta, track_work)
+    seen = _SEEN.get(id(scene))
+    if seen is not None and seen[1] == identity and len(seen[0]) == len(elements) \
+            and all(a is b for a, b in zip(seen[0], elements)):
+        return seen[2], seen[3]
+    scene.validate()
+    table, key = scene_parameters(scene, formulation, alpha, beta, track_work)
+    if len(_SEEN) >= _SEEN_LIMIT:
+        _SEEN.pop(next(iter(_SEEN)))
+    _SEEN[id(scene)] = (elements, identity, table, key)
+    return table, key
 
 
 def _build_template(scene: Scene, formulation: str, track_work: bool, table: ParameterTable,

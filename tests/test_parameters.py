@@ -162,3 +162,24 @@ def test_drift_against_the_smallest_clearance_is_reported():
         chapter = dc.simulate(dc.mechanisms.slider_crank("revolute"), t_end=0.002, rtol=1e-6)
     assert exact.stats["max_constraint_drift"] < 1e-2 * drifting.stats["max_constraint_drift"]
     assert chapter.stats["max_constraint_drift"] < 1e-3 * 0.5e-3
+
+
+def test_a_scene_changed_in_place_is_assembled_anew():
+    """An unchanged scene object skips validation and parameter extraction; replacing an element,
+    reassigning gravity or adding an element is seen (the numbers and the structure follow)."""
+    import dataclasses
+
+    scene = dc.mechanisms.slider_crank("revolute", clearance=0.3e-3)
+    first = dc.assemble(scene)
+    assert dc.assemble(scene).parameter("clearance.clearance")[0] == pytest.approx(0.3e-3)
+    i = next(k for k, e in enumerate(scene.elements) if e.name == "clearance")
+    scene.elements[i] = dataclasses.replace(scene.elements[i], clearance=0.2e-3)
+    assert dc.assemble(scene).parameter("clearance.clearance")[0] == pytest.approx(0.2e-3)
+    scene.gravity = (0.0, -1.0)
+    assert dc.assemble(scene).parameter("gravity").tolist() == [0.0, -1.0]
+    scene.add(dc.Body("extra", mass=1.0, inertia=0.1, position=(1.0, 1.0)))
+    grown = dc.assemble(scene)
+    assert grown.n_q == first.n_q + 3 and grown.functions is not first.functions
+    scene.elements[i] = dataclasses.replace(scene.elements[i], clearance=-1.0)
+    with pytest.raises(dc.SceneError, match="clearance"):
+        dc.assemble(scene)  # validated again
