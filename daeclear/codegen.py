@@ -634,13 +634,28 @@ def _build_model_library(funcs: Any, *, model: NormalizedModel | None = None) ->
                           key, t0)
 
 
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _intact(library: Path, digest: Path) -> bool:
+    """The cached library exists and is byte for byte the one that was built (a truncated or
+    damaged file would crash the interpreter when loaded)."""
+    try:
+        return library.is_file() and digest.read_text().strip() == _sha256(library)
+    except OSError:
+        return False
+
+
 def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text: str, flags: list[str],
                    link: list[str], extra_key: list[str], t0: float) -> BuildResult:
     """Compile ``source`` with the driver ``csrc/<driver>`` into a cached shared library.
 
     The cache key hashes the generated source, the driver sources, the compiler command and
     version and ``extra_key``; the library is built in a temporary directory under a file lock
-    and moved into place atomically, so concurrent processes never see a half-written file.
+    and moved into place atomically, so concurrent processes never see a half-written file. Its
+    SHA-256 is kept beside it (``<stem>.sha256``) and checked before a cached library is used: a
+    truncated or damaged file is built again, never loaded.
     ``t0`` is when code generation started (reported as ``codegen_time``).
     """
     cc = compiler_command()
@@ -660,11 +675,13 @@ def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text
         raise CompilerUnavailable(f"cache directory {root} cannot be created: {exc}") from exc
     stem = f"{prefix}_{key[:40]}"
     target = root / f"{stem}.so"
-    if target.is_file():
+    digest = root / f"{stem}.sha256"
+    if _intact(target, digest):
         return BuildResult(target, key, True, 0.0, codegen_time)
     with _file_lock(root / f"{stem}.lock"):
-        if target.is_file():  # built by another process meanwhile
+        if _intact(target, digest):  # built by another process meanwhile
             return BuildResult(target, key, True, 0.0, codegen_time)
+        target.unlink(missing_ok=True)  # absent, truncated or altered: never loaded, built again
         t1 = time.perf_counter()
         with tempfile.TemporaryDirectory(prefix=f"{stem}-", dir=root) as tmp:
             tmpd = Path(tmp)
@@ -685,6 +702,9 @@ def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text
             src_tmp = tmpd / "src.c"
             src_tmp.write_text(source)
             os.replace(src_tmp, root / f"{stem}.c")
+            digest_tmp = tmpd / "lib.sha256"
+            digest_tmp.write_text(_sha256(out))
+            os.replace(digest_tmp, digest)  # the digest first: a library is never there without it
             os.replace(out, target)
         return BuildResult(target, key, False, time.perf_counter() - t1, codegen_time)
 

@@ -183,3 +183,29 @@ def test_a_scene_changed_in_place_is_assembled_anew():
     scene.elements[i] = dataclasses.replace(scene.elements[i], clearance=-1.0)
     with pytest.raises(dc.SceneError, match="clearance"):
         dc.assemble(scene)  # validated again
+
+
+def test_a_damaged_cached_library_is_built_again(tmp_path):
+    """A cached library truncated after its build (a full disk, a killed copy) is detected by its
+    digest and rebuilt by the next process, never loaded (loading it could crash the interpreter).
+    Each step runs in its own process, as it would in life: a library loaded in this process must
+    not be changed under it."""
+    import os
+    import subprocess
+    import sys
+
+    script = ("import warnings, daeclear as dc; warnings.simplefilter('ignore'); "
+              "r = dc.simulate(dc.mechanisms.slider_crank('revolute'), t_end=5e-4); "
+              "print(r.success, r.stats['compile_time'] > 0)")
+    env = {**os.environ, "DAECLEAR_CACHE_DIR": str(tmp_path)}
+
+    def run() -> str:
+        out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=300)
+        assert out.returncode == 0, out.stderr[-2000:]
+        return out.stdout.split()[-2:]
+
+    assert run() == ["True", "True"]  # built
+    assert run() == ["True", "False"]  # loaded from the cache
+    (library,) = tmp_path.glob("dc_*.so")
+    library.write_bytes(library.read_bytes()[: library.stat().st_size * 9 // 10])  # keeps its build tag
+    assert run() == ["True", "True"]  # built again, not loaded

@@ -134,7 +134,8 @@ def test_stale_library_is_rebuilt_not_loaded(monkeypatch, caplog):
         stale = codegen.build_model_library(decay_model(2.5, "stale"))
     real = codegen.build_model_library(decay_model(2.5, "stale"))
     assert real.path != stale.path and str(real.path) not in _CLib._cache
-    shutil.copyfile(stale.path, real.path)  # the stale library under the current key
+    shutil.copyfile(stale.path, real.path)  # the stale library under the current key,
+    shutil.copyfile(stale.path.with_suffix(".sha256"), real.path.with_suffix(".sha256"))  # intact
     funcs = decay_model(2.5, "stale")
     with caplog.at_level(logging.INFO, logger="daeclear"):
         s = open_session(funcs, backend="c", rtol=1e-9, atol=1e-12)
