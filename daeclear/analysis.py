@@ -387,7 +387,7 @@ class _RestartModel(DAEModel):
 
     start_state: tuple[float, ...] = ()
 
-    def initial_state(self, session: Any = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def initial_state(self, session: Any = None, start: str = "declared") -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         # No Newton projection: the stored state carries the run's own (Baumgarte-controlled)
         # constraint drift, and projecting it away would move a journal by up to that drift.
         return self.consistent_state(0.0, np.array(self.start_state, dtype=float), session=session)

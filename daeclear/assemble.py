@@ -47,8 +47,13 @@ Formulation = Literal["index1", "ggl"]
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
 
 # Extra functions compiled with the model (DAEFunctions.extras), evaluated over many points.
-# kinematics: (q, v, t) -> [Phi; Phi_q (column-major); Phi_dot]; term k's generalized force: EXTRA_TERM0 + k
-EXTRA_OUTPUTS, EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_TERM0 = 0, 1, 2, 3
+# kinematics: (q, v, t) -> [Phi; Phi_q (column-major); Phi_dot]; start kinematics: the same with
+# every clearance joint's ideal joint added (the chapter's start); term k's force: EXTRA_TERM0 + k
+EXTRA_OUTPUTS, EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_START_KINEMATICS, EXTRA_TERM0 = 0, 1, 2, 3, 4
+#: How a run starts: "ideal" (the chapter's: clearance joints centred, positions and velocities
+#: assembled on the mechanism whose clearance joints are ideal) or "declared" (the bodies' own
+#: positions and velocities, corrected only for the ideal joints the scene has).
+STARTS: tuple[str, ...] = ("ideal", "declared")
 
 # Projection onto the constraint manifold (initial state and restarts, in Python and in C):
 # |Phi| < POSITION_TOL * max(1, |q|) within NEWTON_STEPS least-norm Newton steps.
@@ -91,6 +96,8 @@ class DAEModel:
     track_work: bool = False
     # (root, term, gap-rate extra, needs approach speed, min approach speed) of simple pairs
     auto_pairs: tuple[tuple[int, int, int, bool, float], ...] = ()
+    # constraints of the chapter's start: the ideal joints, then each clearance joint's ideal joint
+    start_constraint_names: tuple[str, ...] = ()
     # run-time parameters: the last input of every function above (see daeclear.parameters)
     parameter_layout: tuple[tuple[str, int], ...] = ()  # (name, size) of each entry
     parameter_values: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
@@ -162,30 +169,35 @@ class DAEModel:
         }
 
     # ---- consistent states -------------------------------------------------------------
-    def _constraints(self, q: NDArray[np.float64], v: NDArray[np.float64], t: float,
-                     session: Any = None) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """(Phi, Phi_q, Phi_dot) at one state, through the compiled library when a session is open."""
-        m, n = self.n_constraints, self.n_q
-        flat = self.evaluate(EXTRA_KINEMATICS, [q, v, np.array([t])], 1, session)[0]
+    def _constraints(self, q: NDArray[np.float64], v: NDArray[np.float64], t: float, session: Any = None,
+                     ideal: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """(Phi, Phi_q, Phi_dot) at one state, through the compiled library when a session is open;
+        ``ideal``: with the ideal joints of the clearance joints added (the chapter's start)."""
+        m, n = (len(self.start_constraint_names), self.n_q) if ideal else (self.n_constraints, self.n_q)
+        flat = self.evaluate(EXTRA_START_KINEMATICS if ideal else EXTRA_KINEMATICS, [q, v, np.array([t])], 1,
+                             session)[0]
         return flat[:m], flat[m:m + m * n].reshape(n, m).T, flat[m + m * n:]
 
     def assemble_positions(self, q_guess: NDArray[np.float64], t: float = 0.0, tol: float = POSITION_TOL,
-                           max_iter: int = NEWTON_STEPS, session: Any = None) -> NDArray[np.float64]:
-        """Newton (least-norm) on Phi(q, t) = 0 from ``q_guess``; raises AssemblyError if it cannot close."""
+                           max_iter: int = NEWTON_STEPS, session: Any = None, ideal: bool = False
+                           ) -> NDArray[np.float64]:
+        """Newton (least-norm) on Phi(q, t) = 0 from ``q_guess`` (``ideal``: the clearance joints'
+        ideal joints too); raises AssemblyError if it cannot close."""
         q = np.array(q_guess, dtype=float)
-        if self.n_constraints == 0:
+        names = self.start_constraint_names if ideal else self.constraint_names
+        if not names:
             return q
         scale = max(1.0, float(np.max(np.abs(q))))
         zero_v = np.zeros(self.n_q)
         for _ in range(max_iter):
-            Phi, Phi_q, _ = self._constraints(q, zero_v, t, session)
+            Phi, Phi_q, _ = self._constraints(q, zero_v, t, session, ideal)
             if np.max(np.abs(Phi)) < tol * scale:
                 return q
             dq, *_ = np.linalg.lstsq(Phi_q, -Phi, rcond=None)
             q = q + dq
-        Phi = self._constraints(q, zero_v, t, session)[0]
+        Phi = self._constraints(q, zero_v, t, session, ideal)[0]
         worst = np.argsort(-np.abs(Phi))[:3]
-        detail = ", ".join(f"'{self.constraint_names[i]}' = {Phi[i]:.3g}" for i in worst)
+        detail = ", ".join(f"'{names[i]}' = {Phi[i]:.3g}" for i in worst)
         raise AssemblyError(
             f"scene '{self.scene_name}': cannot assemble the initial positions; after {max_iter} Newton "
             f"iterations the largest constraint residuals are {detail}. Check the joint points and "
@@ -193,12 +205,12 @@ class DAEModel:
         )
 
     def assemble_velocities(self, q: NDArray[np.float64], v_guess: NDArray[np.float64],
-                            t: float = 0.0, session: Any = None) -> NDArray[np.float64]:
-        """Least-norm correction of ``v_guess`` so that Phi_q v + Phi_t = 0."""
+                            t: float = 0.0, session: Any = None, ideal: bool = False) -> NDArray[np.float64]:
+        """Least-norm correction of ``v_guess`` so that Phi_q v + Phi_t = 0 (``ideal``: as above)."""
         v = np.array(v_guess, dtype=float)
-        if self.n_constraints == 0:
+        if not (self.start_constraint_names if ideal else self.constraint_names):
             return v
-        _, Phi_q, Phi_dot = self._constraints(q, v, t, session)
+        _, Phi_q, Phi_dot = self._constraints(q, v, t, session, ideal)
         dv, *_ = np.linalg.lstsq(Phi_q, -Phi_dot, rcond=None)
         return v + dv
 
@@ -318,11 +330,17 @@ class DAEModel:
             yp[:, :n] = v - np.einsum("kmn,km->kn", Phi_q, mu)
         return (y2[0], yp[0]) if single else (y2, yp)
 
-    def initial_state(self, session: Any = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def initial_state(self, session: Any = None, start: str = "ideal") -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Consistent (y0, yp0) at t = 0: assembled positions and velocities, then v' and lam.
+
+        ``start="ideal"`` (the chapter's, section 4.4): positions and velocities assembled on the
+        mechanism whose clearance joints are ideal (journals centred in their bearings, sliders
+        on their guides' mid-lines, every velocity from the kinematics of that mechanism);
+        ``"declared"``: the bodies' declared state, corrected only for the scene's ideal joints.
         With an open compiled ``session`` every evaluation runs in C."""
-        q = self.assemble_positions(self.q_guess, session=session)
-        v = self.assemble_velocities(q, self.v_guess, session=session)
+        ideal = start == "ideal"
+        q = self.assemble_positions(self.q_guess, session=session, ideal=ideal)
+        v = self.assemble_velocities(q, self.v_guess, session=session, ideal=ideal)
         y = np.zeros(self.n_states)
         y[: self.n_q] = q
         y[self.n_q: 2 * self.n_q] = v
@@ -740,7 +758,14 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
                         ["t", "q", "v", "Qc", "P"], ["a_lam"])
     kinematics_flat = ca.Function("kinematics_flat", [q, v, t, P],
                                   [ca.densify(ca.vertcat(Phi, ca.vec(Phi_q), Phi_dot))], ["q", "v", "t", "P"], ["K"])
-    extras = [outputs, accel, kinematics_flat] + [term.force for term in terms]
+    start_list = phi_list + [c for build in contact_builds for c in build.ideal]
+    start_names = tuple(names) + tuple(label for build in contact_builds for label in build.ideal_names)
+    Phi_s = ca.vertcat(*start_list) if start_list else ca.SX(0, 1)
+    Phi_s_q = ca.jacobian(Phi_s, q)
+    Phi_s_dot = ca.mtimes(Phi_s_q, v) + ca.jacobian(Phi_s, t)
+    start_flat = ca.Function("start_kinematics_flat", [q, v, t, P],
+                             [ca.densify(ca.vertcat(Phi_s, ca.vec(Phi_s_q), Phi_s_dot))], ["q", "v", "t", "P"], ["K"])
+    extras = [outputs, accel, kinematics_flat, start_flat] + [term.force for term in terms]
     # simple contact pairs whose switches the compiled loop may handle itself (see ida_driver.c)
     logic_makers = tuple(build.logic for build in contact_builds)
     sample = [logic for make in logic_makers for logic in make(table.vector)]
@@ -763,7 +788,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
         terms=tuple(terms), gap_names=tuple(gap_names),
         channel_names=tuple(c.name for c in channels), channel_units={c.name: c.unit for c in channels},
         outputs=outputs, q_guess=np.zeros(n), v_guess=np.zeros(n), mass_diagonal=np.ones(n),
-        kinematics=kinematics, base_force=base_force, track_work=track_work,
+        kinematics=kinematics, base_force=base_force, track_work=track_work, start_constraint_names=start_names,
     )  # numbers are bound per scene (_Template.bind)
     return _Template(model=model, layout=table.layout, logic=logic_makers, auto_pairs=tuple(auto_pairs))
 

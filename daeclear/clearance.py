@@ -139,6 +139,10 @@ class ContactBuild:
     gap_names: list[str]
     channels: Callable[[Sequence[tuple[Any, Any]]], list[Channel]]
     logic: Callable[[NDArray[np.float64]], list[Any]]
+    # the constraints of the ideal joint the clearance joint replaces (the chapter's start:
+    # clearance joints centred, the mechanism assembled as if they were ideal), with their names
+    ideal: list[Any]
+    ideal_names: list[str]
 
 
 def approach_floor(ctx: AssemblyContext, law: Any, prefix: str) -> Callable[[NDArray[np.float64]], float]:
@@ -228,7 +232,7 @@ def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, fir
         return out
 
     return ContactBuild(terms=[Term(name, force, n_params)], gaps=[gap], gap_names=[name],
-                        channels=channels, logic=logic)
+                        channels=channels, logic=logic, ideal=[e[0], e[1]], ideal_names=[f"{name}.x", f"{name}.y"])
 
 
 #: Clearance joint type -> (parameter function, builder).

@@ -1280,6 +1280,7 @@ def integrate(
     on_failure: str = "raise",
     progress: bool = False,
     track_work: bool = False,
+    start: str = "ideal",
 ) -> Result:
     """Integrate with a non-IDA method; the arguments are those of :func:`daeclear.simulate`.
 
@@ -1332,7 +1333,7 @@ def integrate(
     n = model.n_q
     atol_x = tolerance_vector(model, rtol, atol)[:2 * n]
     ev = _evaluator(model, backend)
-    y0, _ = model.initial_state()
+    y0, _ = model.initial_state(start=start)
     x0 = np.array(y0[:2 * n])
     run = _Run(model, ev, method_l, t_end, eval_times, store_steps, progress, max_steps)
     for logic in model.contacts:

@@ -479,4 +479,5 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         ]
         return out
 
-    return ContactBuild(terms=terms, gaps=corner_gap, gap_names=pair_names, channels=channels, logic=logic)
+    return ContactBuild(terms=terms, gaps=corner_gap, gap_names=pair_names, channels=channels, logic=logic,
+                        ideal=[y_centre, tilt], ideal_names=[f"{name}.lateral", f"{name}.angle"])

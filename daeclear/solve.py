@@ -20,7 +20,7 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
+from .assemble import KIND_MULTIPLIER, KIND_WORK, STARTS, DAEModel, assemble
 from .errors import DaeclearWarning, SceneError, SolveError
 from .ida_session import LINEAR_SOLVERS, open_session
 from .result import ContactEvent, Result
@@ -125,6 +125,7 @@ def simulate(
     step: float | None = None,
     track_work: bool = False,
     linear_solver: str = "auto",
+    start: str = "ideal",
 ) -> Result:
     """Integrate a scene (or an assembled model) from t = 0 to ``t_end``.
 
@@ -172,6 +173,11 @@ def simulate(
         LU of IDA's Newton iteration in the compiled backend: dense, sparse (SuperLU_MT), or
         "auto" (sparse for large models, see :data:`daeclear.ida_session.SPARSE_MIN_STATES`).
         The python backend and the other methods ignore it. Reported in ``result.stats``.
+    start : {"ideal", "declared"}
+        How the run starts. "ideal" (the chapter's, section 4.4): every clearance joint centred
+        and every position and velocity assembled on the mechanism whose clearance joints are
+        ideal, from the declared state as a guess; "declared": the bodies' declared positions and
+        velocities, corrected only for the scene's ideal joints.
 
     Returns
     -------
@@ -180,6 +186,7 @@ def simulate(
     method = _choice("method", method, METHODS)
     on_failure = _choice("on_failure", on_failure, ON_FAILURE)
     linear_solver = _choice("linear_solver", linear_solver, LINEAR_SOLVERS)
+    start = _choice("start", start, STARTS)
     t_end = _positive("t_end", t_end, "s")
     rtol = _positive("rtol", rtol, "")
     max_step = _positive("max_step", max_step, "s", allow_zero=True)
@@ -194,7 +201,7 @@ def simulate(
         return integrate(scene, t_end, method=method, t_eval=t_eval, rtol=rtol, atol=atol, formulation=formulation,
                          backend=backend, max_step=max_step, max_steps=max_steps, step=step,
                          store_steps=store_steps, on_failure=on_failure, progress=progress,
-                         track_work=track_work)
+                         track_work=track_work, start=start)
 
     setup_start = time.perf_counter()
     model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation, track_work=track_work)
@@ -206,14 +213,14 @@ def simulate(
     atol_vec = tolerance_vector(model, rtol, atol)
     session = open_session(model.functions, backend=backend, rtol=rtol, atol=atol_vec, max_step=max_step,
                            parameters=model.parameter_values, max_steps=max_steps, linear_solver=linear_solver)
-    y0, yp0 = model.initial_state(session=session)
+    y0, yp0 = model.initial_state(session=session, start=start)
     if model.formulation == "ggl":
         # never ask Newton for corrections below round-off: coef * rtol >= 1e-13
         session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / rtol)))
     session.set_stall(STALL_STEP_FACTOR * t_end, STALL_COUNT)
     setup_time = time.perf_counter() - setup_start
     return _run(model, session, y0, yp0, t_end, eval_times, store_steps, on_failure, progress,
-                setup_time, {"method": method, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
+                setup_time, {"method": method, "start": start, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
                              "max_step": max_step, "t_end": t_end, "backend": session.backend})
 
 

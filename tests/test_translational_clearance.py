@@ -78,7 +78,7 @@ def test_model_holds_only_what_the_scene_declares():
 
 def test_flat_drop_on_a_face_matches_the_linear_law():
     """section-4.3: both lower corners touch at once (a simultaneous root), the face takes over."""
-    result = dc.simulate(flat_drop("section-4.3"), 5e-5, rtol=1e-10)
+    result = dc.simulate(flat_drop("section-4.3"), 5e-5, start="declared", rtol=1e-10)
     kinds = [(e.pair, e.kind) for e in result.events]
     assert kinds == [("g.C_lower", "onset"), ("g.D_lower", "onset"), ("g.lower_face", "onset"),
                      ("g.C_lower", "separation"), ("g.D_lower", "separation"), ("g.lower_face", "separation")]
@@ -91,7 +91,7 @@ def test_flat_drop_on_a_face_matches_the_linear_law():
 
 
 def test_flat_drop_on_corners_matches_two_hertz_contacts():
-    result = dc.simulate(flat_drop("corners"), 3e-4, rtol=1e-10)
+    result = dc.simulate(flat_drop("corners"), 3e-4, start="declared", rtol=1e-10)
     assert [e.pair for e in result.events.of(kind="onset")] == ["g.C_lower", "g.D_lower"]
     d_max = (5.0 * M * 0.1**2 / (8.0 * K_CORNER)) ** 0.4
     duration = 2.0 * d_max / 0.1 * math.gamma(0.4) * math.gamma(0.5) / (2.5 * math.gamma(0.9))
@@ -103,7 +103,7 @@ def test_flat_drop_on_corners_matches_two_hertz_contacts():
 
 def test_flat_drop_with_dissipation_matches_a_single_impact():
     """c_e = 0.9: the drop is one impact of m on the law with 2 K_c (its approach speed latched at onset)."""
-    result = dc.simulate(flat_drop("corners", restitution=0.9), 3e-4, rtol=1e-10)
+    result = dc.simulate(flat_drop("corners", restitution=0.9), 3e-4, start="declared", rtol=1e-10)
     law = dcc.LankaraniNikravesh(restitution=0.9, stiffness=2 * K_CORNER)
     impact = dcc.simulate_impact(law, mass=M, speed=0.1)
     t_on, t_off = contact_of(result, "g.D_lower")
@@ -117,7 +117,7 @@ def test_flat_drop_with_dissipation_matches_a_single_impact():
 def test_tilted_drop_hits_one_corner_then_the_face(model):
     tilt = 1e-4  # rad: the rear lower corner C is 5 um below the front one, D
     result = dc.simulate(guide_scene(model, tilt=tilt, y0=-C + 1e-6 + 0.5 * L * tilt, velocity=(0.0, -0.1)),
-                         1e-4, rtol=1e-10)
+                         1e-4, start="declared", rtol=1e-10)
     onsets = result.events.of(kind="onset")
     expected = ["g.C_lower", "g.D_lower"] + (["g.lower_face"] if model == "section-4.3" else [])
     assert [e.pair for e in onsets] == expected
@@ -135,7 +135,7 @@ def test_face_switch_of_the_section_4_3_model_changes_the_stored_energy():
     and is conserved in between (this is why `corners` is the model for tilted, rough runs)."""
     tilt = 1e-4
     result = dc.simulate(guide_scene("section-4.3", tilt=tilt, y0=-C + 1e-6 + 0.5 * L * tilt,
-                                     velocity=(0.0, -0.1)), 1e-4, rtol=1e-10)
+                                     velocity=(0.0, -0.1)), 1e-4, start="declared", rtol=1e-10)
     total = result["energy.mechanical"] + result["g.elastic_energy"]
     t_face = result.events.of("g.lower_face", "onset")[0].t
     before, after = total[result.t < t_face], total[result.t > t_face]
@@ -150,7 +150,7 @@ def test_energy_conserved_through_many_elastic_corner_impacts():
     """A spinning slider rattling in its guide (corners model): single corners, two corners of a
     side, and two opposite corners when it wedges at its largest tilt (0.0202 rad)."""
     scene = guide_scene("corners", velocity=(0.0, 0.5), spin=5.0)
-    result = dc.simulate(scene, 0.2, rtol=1e-10)
+    result = dc.simulate(scene, 0.2, start="declared", rtol=1e-10)
     onsets = result.events.of(kind="onset")
     assert len(onsets) > 150
     assert {e.pair for e in onsets} == {"g.A_upper", "g.B_upper", "g.C_lower", "g.D_lower"}
@@ -177,7 +177,7 @@ def test_moving_tilted_guide_conserves_momentum(friction):
     scene.add(TranslationalClearance("g", guide, slider, at=(0.0, 0.0), axis=u, length=L, width=W, corner_radius=R_C,
                                      clearance=C, material=STEEL, law=dcc.LankaraniNikravesh(restitution=1.0),
                                      friction=friction))
-    r = dc.simulate(scene, 0.05, rtol=1e-10)
+    r = dc.simulate(scene, 0.05, start="declared", rtol=1e-10)
     assert len(r.events.of(kind="onset")) > 20
     momentum, spin = np.zeros((r.n_times, 2)), np.zeros(r.n_times)
     for body, mass, inertia in (("guide", 1.0, 1e-3), ("slider", M, 1e-4)):
@@ -195,14 +195,14 @@ def test_moving_tilted_guide_conserves_momentum(friction):
 def test_energy_conserved_in_the_free_slider_crank():
     scene = dc.mechanisms.slider_crank("translational", gravity=0.0, restitution=1.0)
     scene.elements = [e for e in scene.elements if not isinstance(e, Driver)]
-    result = dc.simulate(scene, 0.05, rtol=1e-8)
+    result = dc.simulate(scene, 0.05, start="declared", rtol=1e-8)
     assert len(result.events.of(kind="onset")) > 50
     total = result["energy.mechanical"] + result["clearance.elastic_energy"]
     assert np.ptp(total) / total[0] < 2e-6
 
 
 def test_resting_slider_settles_at_the_static_penetration():
-    result = dc.simulate(guide_scene("corners", restitution=0.9, gravity=9.81, y0=-C + 2e-6), 0.05, rtol=1e-8)
+    result = dc.simulate(guide_scene("corners", restitution=0.9, gravity=9.81, y0=-C + 2e-6), 0.05, start="declared", rtol=1e-8)
     static = (M * 9.81 / (2 * K_CORNER)) ** (2 / 3)  # two corners carry m g
     assert result["g.C_lower.penetration"][-1] == pytest.approx(static, rel=1e-4)
     assert result["g.D_lower.in_contact"][-1] == 1 and result["g.A_upper.in_contact"][-1] == 0
@@ -275,7 +275,7 @@ def test_corners_outside_the_contact_segment_do_not_touch():
     for x0, expected in ((-0.1, []), (0.0, ["g.D_lower"])):
         scene = guide_scene(lower_limits=(0.0, 0.3), y0=-C + 1e-6, velocity=(0.0, -0.1))
         scene.elements[0] = dataclasses.replace(scene.elements[0], position=(x0, -C + 1e-6))
-        result = dc.simulate(scene, 2e-4, rtol=1e-8)
+        result = dc.simulate(scene, 2e-4, start="declared", rtol=1e-8)
         assert [e.pair for e in result.events.of(kind="onset")] == expected
 
 
