@@ -301,7 +301,8 @@ def _plain(value: Any, where: str) -> Any:
     """``value`` as plain JSON-able Python.
 
     numpy scalars and arrays, tuples and paths are converted; a dataclass instance (e.g. a
-    Material) becomes the dict of its fields. Anything else is stored as its ``repr`` with a
+    Material) becomes the dict of its fields, headed by ``"name"`` when its class has a name
+    (a contact or friction law: figures and readers of the file need to know which law). Anything else is stored as its ``repr`` with a
     DaeclearWarning naming ``where``: a finished run is never lost to an odd parameter.
     Non-string dict keys raise TypeError.
     """
@@ -327,7 +328,11 @@ def _plain(value: Any, where: str) -> Any:
     if isinstance(value, (list, tuple)):
         return [_plain(item, f"{where}[{i}]") for i, item in enumerate(value)]
     if is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _plain(getattr(value, f.name), f"{where}[{f.name!r}]") for f in fields(value)}
+        out = {f.name: _plain(getattr(value, f.name), f"{where}[{f.name!r}]") for f in fields(value)}
+        kind = getattr(type(value), "name", None)  # a contact law's registered name, e.g. "hunt-crossley"
+        if isinstance(kind, str) and "name" not in out:
+            out = {"name": kind, **out}
+        return out
     text = repr(value)
     warnings.warn(
         f"{where}: a {type(value).__name__} is not a number, string, bool, None, list or dict; "
