@@ -883,7 +883,7 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
             ax.text(x_centres[j], y_centres[i], label, ha="center", va="center", fontsize="x-small", color="w")
 
     def fmt(v: Any, scale: float) -> str:
-        return f"{float(v) * scale:g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
+        return f"{float(v) * scale:.3g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
 
     from matplotlib.ticker import NullLocator
 

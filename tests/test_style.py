@@ -268,7 +268,7 @@ def test_motion_map_log_axis_for_a_geometric_grid() -> None:
     ax = plot_motion_map(FakeSweep(runs), "clearance", "friction")
     assert ax.get_xscale() == "log" and ax.get_yscale() == "linear"
     assert ax.get_xlabel() == "clearance (mm)" and ax.get_ylabel() == "friction (-)"
-    assert [t.get_text() for t in ax.get_xticklabels()] == [f"{c * 1e3:g}" for c in clearances]
+    assert [t.get_text() for t in ax.get_xticklabels()] == [f"{c * 1e3:.3g}" for c in clearances]
     np.testing.assert_allclose(ax.get_xticks(), np.array(clearances) * 1e3)
     xs = sorted({round(math.log10(t.get_position()[0]), 9) for t in ax.texts})
     np.testing.assert_allclose(xs, np.log10(np.array(clearances) * 1e3))  # labels centred on the values
