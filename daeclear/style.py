@@ -11,7 +11,7 @@ matplotlib is imported only when an Axes is made.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -31,11 +31,15 @@ __all__ = [
     "is_geometric",
     "new_axes",
     "parameter_axis",
+    "parameter_display",
     "parameter_label",
+    "quantity_label",
     "run_parameters",
     "select_times",
     "set_title",
+    "stride",
     "sweep_caption",
+    "window_index",
 ]
 
 TITLE_SIZE = "medium"
@@ -289,9 +293,10 @@ def window_index(t: ArrayLike, window: tuple[float | None, float | None] | None)
     times = np.asarray(t, dtype=np.float64)
     if window is None:
         return np.arange(times.shape[0])
-    if not isinstance(window, Sequence) or len(window) != 2:
-        raise ValueError(f"window={window!r}, must be a pair (t0, t1) in s (either may be None).")
-    t0, t1 = window
+    try:
+        t0, t1 = window
+    except (TypeError, ValueError):
+        raise ValueError(f"window={window!r}, must be a pair (t0, t1) in s (either may be None).") from None
     lo = -math.inf if t0 is None else float(t0)
     hi = math.inf if t1 is None else float(t1)
     if lo > hi:

@@ -497,6 +497,32 @@ def test_to_xarray_writes_netcdf(tmp_path: Path) -> None:
         assert list(back["event_kind"].to_numpy()) == result.events.kind
 
 
+
+def test_hand_off_of_a_loaded_file_equals_hand_off_of_the_result(tmp_path: Path) -> None:
+    """Save, load, convert: the same frame and Dataset as converting the result directly."""
+    pd = pytest.importorskip("pandas")
+    pytest.importorskip("xarray")
+    result = make_result()
+    loaded = load(result.save(tmp_path / "run.h5"))
+    pd.testing.assert_frame_equal(loaded.to_pandas(states=True), result.to_pandas(states=True))
+    pd.testing.assert_frame_equal(loaded.events_frame(), result.events_frame())
+    assert loaded.to_xarray().identical(result.to_xarray())
+
+
+def test_hand_off_keeps_a_repeated_event_time() -> None:
+    """A restart repeats its time (state before and after): both rows survive, in order."""
+    pytest.importorskip("pandas")
+    pytest.importorskip("xarray")
+    t = np.linspace(0.0, 0.04, 41)
+    t[10] = t[9]
+    result = make_result(t=t)
+    df = result.to_pandas()
+    assert len(df) == 41 and not df.index.is_unique
+    np.testing.assert_array_equal(df["slider.vx"].to_numpy()[9:11], result["slider.vx"][9:11])
+    ds = result.to_xarray()
+    assert ds.sizes["t"] == 41
+    np.testing.assert_array_equal(ds["slider.vx"].isel(t=[9, 10]).to_numpy(), result["slider.vx"][9:11])
+
 @pytest.mark.parametrize(("method", "module"), [("to_pandas", "pandas"), ("events_frame", "pandas"),
                                                 ("to_xarray", "xarray")])
 def test_missing_optional_dependency_names_the_extra(monkeypatch: pytest.MonkeyPatch, method: str,
