@@ -27,3 +27,7 @@ class SolveError(DaeclearError, RuntimeError):
 
 class DaeclearWarning(UserWarning):
     """A daeclear warning: something was changed or a slower path was taken."""
+
+
+class MissingDependencyError(DaeclearError, ImportError):
+    """An optional dependency is not installed; the message names the pip extra that brings it."""

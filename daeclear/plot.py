@@ -2,13 +2,20 @@
 
 Each function takes data and an optional ``ax``, draws on it (a new figure when
 ``ax`` is None) and returns the Axes; none calls ``plt.show()``. Units on the axes are
-stated in the labels.
+stated in the labels. Every function draws through :mod:`daeclear.style`: figures of a
+run are titled with its parameters (clearance, crank speed, contact law, restitution,
+friction; ``title=``), the functions that draw a run over time take a time
+``window=(t0, t1)`` and ``max_points`` (min-max decimation, so a long run does not plot
+as a solid band), and sweep figures show the swept parameter with its unit, on a log
+axis when the grid is geometric.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
+
+from . import style
 
 if TYPE_CHECKING:  # matplotlib is imported only when a figure is drawn
     from typing import TypeAlias
@@ -22,13 +29,38 @@ if TYPE_CHECKING:  # matplotlib is imported only when a figure is drawn
 
 __all__ = ["plot_channel", "plot_force_penetration", "plot_force_time", "save_response_figure"]
 
+Window = tuple[float | None, float | None] | None
+"""A closed time window ``(t0, t1)`` in s; None (or a None side) leaves it open."""
+
 
 def _axes(ax: Axes | None) -> Axes:
-    if ax is not None:
-        return ax
-    import matplotlib.pyplot as plt
+    return style.new_axes(ax)
 
-    return plt.figure().add_subplot()
+
+def _title(target: Any, result: Result, title: str | bool | None, created: bool) -> None:
+    """Title ``target`` (Axes or Figure): the run's caption when ``title`` is True, or None and the
+    function made the figure itself; the text when a str; nothing when False."""
+    if isinstance(title, str):
+        style.set_title(target, title)
+    elif title or (title is None and created):
+        style.set_title(target, style.caption(result))
+
+
+def _series(result: Result, name: str, window: Window, max_points: int | None) -> tuple[Any, Any]:
+    """Time and values of a channel inside ``window``, min-max decimated to ``max_points``."""
+    import numpy as np
+
+    values = np.asarray(result[name])
+    index = style.select_times(result.t, values, window=window, max_points=max_points)
+    return np.asarray(result.t)[index], values[index]
+
+
+def _curve(result: Result, x: str, y: str, window: Window, max_points: int | None) -> tuple[Any, Any]:
+    """Two channels of an x-y curve inside ``window``, evenly thinned to ``max_points``."""
+    import numpy as np
+
+    index = style.select_times(result.t, window=window, max_points=max_points)
+    return np.asarray(result[x])[index], np.asarray(result[y])[index]
 
 
 def _label(impact: ImpactResult) -> str:
@@ -102,36 +134,72 @@ def plot_force_time(impacts: Impacts, *, ax: Axes | None = None, **line_kw: Any)
 
 
 def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, reference: Result | None = None,
-                 label: str | None = None, **line_kw: Any) -> Axes:
-    """A channel against time, with the same channel of a reference run (e.g. the ideal joint) dashed."""
+                 label: str | None = None, window: Window = None, max_points: int | None = None,
+                 title: str | bool | None = None, **line_kw: Any) -> Axes:
+    """A channel against time, with the same channel of a reference run (e.g. the ideal joint) dashed.
+
+    Parameters
+    ----------
+    result : Result
+        The run.
+    channel : str
+        Channel (or state) name.
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    reference : Result, optional
+        Drawn first, black dashed, over the same window.
+    label : str, optional
+        Legend label of the run (default its scene name).
+    window : (t0, t1), optional
+        Time window in s; only output times inside it are drawn.
+    max_points : int, optional
+        Draw at most this many points per line, keeping the lowest and highest value of each
+        stretch (min-max decimation): peaks survive, a long run does not fill the axes.
+    title : str or bool, optional
+        Axes title: True for the run's caption (clearance, speed, law, restitution, friction),
+        a str for that text, False for none; None gives the caption only on a new figure.
+    **line_kw
+        Passed to ``ax.plot`` for the run's line.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax.lines[0]`` is the reference when given, then the run.
+    """
+    created = ax is None
     ax = _axes(ax)
     unit = result.units.get(channel, "")
     if reference is not None:
-        ax.plot(reference.t, reference[channel], "k--", lw=0.8, label="ideal joint")
-    ax.plot(result.t, result[channel], lw=0.9, label=label or result.scene_name, **line_kw)
+        ax.plot(*_series(reference, channel, window, max_points), "k--", lw=0.8, label="ideal joint")
+    ax.plot(*_series(result, channel, window, max_points), lw=0.9, label=label or result.scene_name, **line_kw)
     ax.set_xlabel("time (s)")
-    ax.set_ylabel(f"{channel} ({unit})" if unit else channel)
+    ax.set_ylabel(style.quantity_label(channel, unit))
     if reference is not None:
         ax.legend(loc="best", fontsize="small")
+    _title(ax, result, title, created)
     return ax
 
 
 RESPONSE_CHANNELS = ("slider.vx", "slider.ax", "drive.moment")
 
 
-def _response_panels(result: Result, reference: Result | None, axes: Any) -> None:
+def _response_panels(result: Result, reference: Result | None, axes: Any, window: Window = None,
+                     max_points: int | None = None) -> None:
     """Panels (a)-(c) of Figs. 4.15 and 4.28: slider velocity, acceleration, crank moment."""
     titles = ("(a) slider velocity", "(b) slider acceleration", "(c) crank moment")
     for ax, name, title in zip(axes, RESPONSE_CHANNELS, titles):
-        plot_channel(result, name, ax=ax, reference=reference, label="clearance joint")
-        ax.set_title(title, fontsize="medium")
+        plot_channel(result, name, ax=ax, reference=reference, label="clearance joint", window=window,
+                     max_points=max_points, title=title)
 
 
 def save_response_figure(result: Result, path: Any, *, reference: Result | None = None,
-                         channels: Iterable[str] = RESPONSE_CHANNELS) -> Any:
+                         channels: Iterable[str] = RESPONSE_CHANNELS, window: Window = None,
+                         max_points: int | None = None, title: str | bool = True) -> Any:
     """Write a figure of slider velocity, acceleration and driving moment (Fig. 4.15a-c) to ``path``.
 
-    Channels missing from the result are skipped; returns the path written.
+    Channels missing from the result are skipped; ``window`` and ``max_points`` as in
+    :func:`plot_channel`; titled with the run's caption (scene, clearance, speed, law,
+    restitution, friction) unless ``title`` is False or a text. Returns the path written.
     """
     import matplotlib.pyplot as plt
     from pathlib import Path
@@ -139,11 +207,10 @@ def save_response_figure(result: Result, path: Any, *, reference: Result | None 
     names = [c for c in channels if c in result]
     fig, axes = plt.subplots(len(names), 1, figsize=(7.0, 2.2 * len(names) + 0.6), sharex=True, squeeze=False)
     for ax, name in zip(axes[:, 0], names):
-        plot_channel(result, name, ax=ax, reference=reference)
+        plot_channel(result, name, ax=ax, reference=reference, window=window, max_points=max_points, title=False)
         if ax is not axes[-1, 0]:
             ax.set_xlabel("")
-    status = "" if result.success else "  (FAILED: partial result)"
-    fig.suptitle(f"{result.scene_name}{status}", fontsize="medium")
+    _title(fig, result, title, True)
     fig.tight_layout()
     path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp{path.suffix}")
@@ -198,7 +265,8 @@ def _clearance_of(result: Result, joint: str) -> float | None:
 
 
 def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | None = None, markers: bool = True,
-                       clearance: float | None = None, unit: str = "um", **line_kw: Any) -> Axes:
+                       clearance: float | None = None, unit: str = "um", window: Window = None,
+                       max_points: int | None = None, title: str | bool | None = None, **line_kw: Any) -> Axes:
     """Journal centre relative to the bearing centre, with the clearance circle (Figs. 4.15d, 4.17, 4.20, 4.24).
 
     Parameters
@@ -220,6 +288,12 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
         parameters when None (no circle if it cannot be found).
     unit : {"um", "mm", "m"}
         Length unit of both axes.
+    window : (t0, t1), optional
+        Time window in s; only the orbit inside it is drawn.
+    max_points : int, optional
+        Draw at most this many points, evenly spaced in the output times.
+    title : str or bool, optional
+        As in :func:`plot_channel` (the run's caption on a new figure).
     **line_kw
         Passed to ``ax.plot`` for the orbit.
 
@@ -233,13 +307,15 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
         raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTH_SCALE)}.")
     import numpy as np
 
+    created = ax is None
     ax = _axes(ax)
     scale = _LENGTH_SCALE[unit]
     kw: dict[str, Any] = {"lw": 0.6, "color": "C0"}
     if markers:
         kw.update(marker=".", ms=2.5)
     kw.update(line_kw)
-    ax.plot(np.asarray(result[f"{joint}.ex"]) * scale, np.asarray(result[f"{joint}.ey"]) * scale, **kw)
+    ex, ey = _curve(result, f"{joint}.ex", f"{joint}.ey", window, max_points)
+    ax.plot(ex * scale, ey * scale, **kw)
     c = clearance if clearance is not None else _clearance_of(result, joint)
     if c is not None:
         angle = np.linspace(0.0, 2.0 * np.pi, 361)
@@ -248,11 +324,13 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
     label = _LENGTH_LABEL[unit]
     ax.set_xlabel(f"journal x rel. to bearing ({label})")
     ax.set_ylabel(f"journal y rel. to bearing ({label})")
+    _title(ax, result, title, created)
     return ax
 
 
 def plot_phase_portrait(result: Result, x: str = "slider.vx", y: str = "slider.ax", *, ax: Axes | None = None,
-                        reference: Result | None = None, **line_kw: Any) -> Axes:
+                        reference: Result | None = None, window: Window = None, max_points: int | None = None,
+                        title: str | bool | None = None, **line_kw: Any) -> Axes:
     """One channel against another over the whole result (Figs. 4.18, 4.21: slider acceleration against velocity).
 
     The chapter calls these plots Poincaré maps: a closed curve traced again and again
@@ -268,6 +346,12 @@ def plot_phase_portrait(result: Result, x: str = "slider.vx", y: str = "slider.a
         Where to draw; a new figure when None.
     reference : Result, optional
         Drawn first, black dashed (e.g. the ideal joint, whose portrait is one closed curve).
+    window : (t0, t1), optional
+        Time window in s (e.g. the steady state after the transient).
+    max_points : int, optional
+        Draw at most this many points per curve, evenly spaced in the output times.
+    title : str or bool, optional
+        As in :func:`plot_channel` (the run's caption on a new figure).
     **line_kw
         Passed to ``ax.plot`` for the result's curve.
 
@@ -276,19 +360,21 @@ def plot_phase_portrait(result: Result, x: str = "slider.vx", y: str = "slider.a
     matplotlib.axes.Axes
         ``ax.lines[0]`` is the reference curve when given, then the result's curve.
     """
+    created = ax is None
     ax = _axes(ax)
     if reference is not None:
-        ax.plot(reference[x], reference[y], "k--", lw=0.8, label="ideal joint")
+        ax.plot(*_curve(reference, x, y, window, max_points), "k--", lw=0.8, label="ideal joint")
     kw: dict[str, Any] = {"lw": 0.5, "color": "C0"}
     kw.update(line_kw)
-    ax.plot(result[x], result[y], **kw)
+    ax.plot(*_curve(result, x, y, window, max_points), **kw)
     for axis_label, name in ((ax.set_xlabel, x), (ax.set_ylabel, y)):
-        unit = result.units.get(name, "")
-        axis_label(f"{name} ({unit})" if unit else name)
+        axis_label(style.quantity_label(name, result.units.get(name, "")))
+    _title(ax, result, title, created)
     return ax
 
 
 def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None = None, shade: bool = True,
+                    window: Window = None, max_points: int | None = None, title: str | bool | None = None,
                     **line_kw: Any) -> Axes:
     """IDA's step size against time, log scale, contact intervals shaded (section 4.4, Figs. 4.15d, 4.24).
 
@@ -303,6 +389,13 @@ def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None 
         Contact pair whose contact intervals are shaded (every pair when None).
     shade : bool
         Shade the contact intervals (from ``result.events``) in grey.
+    window : (t0, t1), optional
+        Time window in s: steps reaching a time inside it are drawn, contact intervals are
+        clipped to it.
+    max_points : int, optional
+        Draw at most this many steps (min-max decimation of the step size).
+    title : str or bool, optional
+        As in :func:`plot_channel` (the run's caption on a new figure).
     **line_kw
         Passed to ``ax.plot`` for the step sizes.
 
@@ -323,18 +416,26 @@ def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None 
     if result.step_t is None or result.step_h is None:
         raise ValueError(f"plot_step_sizes: result of scene {result.scene_name!r} has no recorded steps "
                          f"(simulate(..., store_steps=True) records them).")
+    created = ax is None
     ax = _axes(ax)
     h = np.asarray(result.step_h)
-    keep = h > 0
+    t = np.asarray(result.step_t)
+    inside = style.window_index(t, window)
+    index = style.decimate(h, max_points, inside[h[inside] > 0])
     kw: dict[str, Any] = {"lw": 0.6, "color": "C0", "marker": ".", "ms": 1.5}
     kw.update(line_kw)
-    ax.plot(np.asarray(result.step_t)[keep], h[keep], **kw)
+    ax.plot(t[index], h[index], **kw)
     ax.set_yscale("log")
     if shade:
-        for k, (t0, t1) in enumerate(_contact_intervals(result, pair)):
+        lo, hi = (None, None) if window is None else window
+        lo = -np.inf if lo is None else float(lo)
+        hi = np.inf if hi is None else float(hi)
+        spans = [(max(a, lo), min(b, hi)) for a, b in _contact_intervals(result, pair) if b >= lo and a <= hi]
+        for k, (t0, t1) in enumerate(spans):
             ax.axvspan(t0, t1, color="0.85", lw=0, zorder=0, label="contact" if k == 0 else None)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("IDA step size (s)")
+    _title(ax, result, title, created)
     return ax
 
 
@@ -360,7 +461,8 @@ def plot_cases(results: Mapping[str, Result], draw: Any, *, ncols: int = 2, shar
     suptitle : str, optional
         Figure title.
     **kwargs
-        Passed to every ``draw`` call (e.g. ``reference=ideal``).
+        Passed to every ``draw`` call (e.g. ``reference=ideal``, ``window=(t0, t1)``,
+        ``max_points=4000``).
 
     Returns
     -------
@@ -379,17 +481,18 @@ def plot_cases(results: Mapping[str, Result], draw: Any, *, ncols: int = 2, shar
     flat = list(axes.ravel())
     for k, (label, result) in enumerate(results.items()):
         draw(result, ax=flat[k], **kwargs)
-        flat[k].set_title(f"({chr(ord('a') + k)}) {label}", fontsize="medium")
+        style.set_title(flat[k], f"({chr(ord('a') + k)}) {label}")
     for extra in flat[n:]:
         extra.set_visible(False)
     if suptitle:
-        fig.suptitle(suptitle, fontsize="medium")
+        style.set_title(fig, suptitle)
     fig.tight_layout()
     return fig
 
 
 def plot_revolute_response(result: Result, *, reference: Result | None = None, orbit: Result | None = None,
-                           joint: str = "clearance") -> Any:
+                           joint: str = "clearance", window: Window = None, max_points: int | None = None,
+                           title: str | bool = True) -> Any:
     """Fig. 4.15 in four panels: slider velocity, slider acceleration, crank moment, journal orbit.
 
     Parameters
@@ -403,6 +506,14 @@ def plot_revolute_response(result: Result, *, reference: Result | None = None, o
         one-marker-per-step orbit; ``result`` when None.
     joint : str
         Name of the revolute clearance joint.
+    window : (t0, t1), optional
+        Time window in s of every panel.
+    max_points : int, optional
+        At most this many points per line (min-max decimation in panels a-c, even spacing
+        in the orbit).
+    title : str or bool
+        Figure title: True for the run's caption (clearance, speed, law, restitution,
+        friction), a str for that text, False for none.
 
     Returns
     -------
@@ -413,9 +524,10 @@ def plot_revolute_response(result: Result, *, reference: Result | None = None, o
 
     fig, axes = plt.subplots(2, 2, figsize=(10.0, 7.0))
     (a, b), (c, d) = axes
-    _response_panels(result, reference, (a, b, c))
-    plot_journal_orbit(orbit if orbit is not None else result, joint, ax=d)
-    d.set_title("(d) journal trajectory relative to the bearing", fontsize="medium")
+    _response_panels(result, reference, (a, b, c), window, max_points)
+    plot_journal_orbit(orbit if orbit is not None else result, joint, ax=d, window=window, max_points=max_points,
+                       title="(d) journal trajectory relative to the bearing")
+    _title(fig, result, title, True)
     fig.tight_layout()
     return fig
 
@@ -424,7 +536,8 @@ __all__ += ["plot_cases", "plot_journal_orbit", "plot_phase_portrait", "plot_rev
 
 
 def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | None = None, limits: bool = True,
-                     reference: Result | None = None, **line_kw: Any) -> Axes:
+                     reference: Result | None = None, window: Window = None, max_points: int | None = None,
+                     title: str | bool | None = None, **line_kw: Any) -> Axes:
     """Dimensionless path of the slider centre inside the guide (Figs. 4.28d, 4.30, 4.33).
 
     Parameters
@@ -443,6 +556,12 @@ def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | Non
         and the guide are in contact (the chapter's horizontal lines).
     reference : Result, optional
         Drawn first, black dotted (e.g. the ideal joint: eta = 0 along the stroke).
+    window : (t0, t1), optional
+        Time window in s; only the path inside it is drawn.
+    max_points : int, optional
+        Draw at most this many points per path, evenly spaced in the output times.
+    title : str or bool, optional
+        As in :func:`plot_channel` (the run's caption on a new figure).
     **line_kw
         Passed to ``ax.plot`` for the path.
 
@@ -452,22 +571,26 @@ def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | Non
         ``ax.lines[0]`` is the reference path when given, then the slider path, then the
         two limit lines.
     """
+    created = ax is None
     ax = _axes(ax)
+    xi, eta = f"{joint}.xi", f"{joint}.eta"
     if reference is not None:
-        ax.plot(reference[f"{joint}.xi"], reference[f"{joint}.eta"], "k:", lw=0.8, label="ideal joint")
+        ax.plot(*_curve(reference, xi, eta, window, max_points), "k:", lw=0.8, label="ideal joint")
     kw: dict[str, Any] = {"lw": 0.6, "color": "C0"}
     kw.update(line_kw)
-    ax.plot(result[f"{joint}.xi"], result[f"{joint}.eta"], **kw)
+    ax.plot(*_curve(result, xi, eta, window, max_points), **kw)
     if limits:
         for level in (0.5, -0.5):
             ax.axhline(level, color="k", ls="--", lw=0.8)
     ax.set_xlabel("ξ, slider position along the stroke (-)")
     ax.set_ylabel("η, offset across the guide (-)")
+    _title(ax, result, title, created)
     return ax
 
 
 def plot_translational_response(result: Result, *, reference: Result | None = None,
-                                joint: str = "clearance") -> Any:
+                                joint: str = "clearance", window: Window = None, max_points: int | None = None,
+                                title: str | bool = True) -> Any:
     """Fig. 4.28 in four panels: slider velocity, slider acceleration, crank moment, slider path.
 
     Parameters
@@ -478,6 +601,8 @@ def plot_translational_response(result: Result, *, reference: Result | None = No
         The ideal-joint run over the same times, dashed in panels a-c.
     joint : str
         Name of the translational clearance joint.
+    window, max_points, title
+        As in :func:`plot_revolute_response`.
 
     Returns
     -------
@@ -488,9 +613,10 @@ def plot_translational_response(result: Result, *, reference: Result | None = No
 
     fig, axes = plt.subplots(2, 2, figsize=(10.0, 7.0))
     (a, b), (c, d) = axes
-    _response_panels(result, reference, (a, b, c))
-    plot_slider_path(result, joint, ax=d)
-    d.set_title("(d) dimensionless slider path inside the guide", fontsize="medium")
+    _response_panels(result, reference, (a, b, c), window, max_points)
+    plot_slider_path(result, joint, ax=d, window=window, max_points=max_points,
+                     title="(d) dimensionless slider path inside the guide")
+    _title(fig, result, title, True)
     fig.tight_layout()
     return fig
 
@@ -521,7 +647,7 @@ def plot_work_precision(study: Any, *, ax: Axes | None = None) -> Axes:
             ax.loglog([r["wall_time"] for r in bad], [top] * len(bad), "x", color=line.get_color())
     ax.set_xlabel("wall time (s)")
     ax.set_ylabel(f"max error / range ({', '.join(study.channels)})")
-    ax.set_title(f"error over t in [{study.window[0]:.3g}, {study.window[1]:.3g}] s", fontsize="small")
+    style.set_title(ax, f"error over t in [{study.window[0]:.3g}, {study.window[1]:.3g}] s")
     ax.legend(fontsize="small")
     ax.grid(True, which="both", lw=0.3)
     return ax
@@ -535,7 +661,7 @@ MOTION_COLORS = {"periodic": "#2ca02c", "quasi-periodic": "#1f77b4", "chaotic": 
 
 
 def _channel_label(name: str, unit: str) -> str:
-    return f"{name} ({unit})" if unit else name
+    return style.quantity_label(name, unit)
 
 
 def plot_poincare_section(section: Any, *, ax: Axes | None = None, portrait: Any = None, label: str | None = None,
@@ -592,8 +718,8 @@ def plot_poincare_section(section: Any, *, ax: Axes | None = None, portrait: Any
 
 
 def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: Axes | None = None,
-                     scale: float = 1.0, unit: str | None = None, color_by_motion: bool = True,
-                     **marker_kw: Any) -> Axes:
+                     scale: float | None = None, unit: str | None = None, log: bool | None = None,
+                     color_by_motion: bool = True, title: str | bool | None = None, **marker_kw: Any) -> Axes:
     """Bifurcation diagram: the Poincaré-section values of one channel against a swept parameter.
 
     Parameters
@@ -606,12 +732,20 @@ def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: 
         Section channel on the y axis (name or column; default the first, slider velocity).
     ax : matplotlib Axes, optional
         Where to draw; a new figure when None.
-    scale : float
+    scale : float, optional
         Factor applied to the parameter values (e.g. 1e3 for a clearance in mm).
     unit : str, optional
-        Unit of the scaled parameter, shown in the x label.
+        Unit of the scaled parameter, shown in the x label. With neither `scale` nor
+        `unit`, both come from :data:`daeclear.style.PARAMETER_AXES` (clearance in mm,
+        rpm, restitution and friction dimensionless).
+    log : bool, optional
+        Logarithmic x axis; None: when the parameter values form a geometric grid
+        (``numpy.geomspace``, three values or more).
     color_by_motion : bool
         Colour each run's points by its motion class (:data:`MOTION_COLORS`), with a legend.
+    title : str or bool, optional
+        Axes title: True for the mechanism and the parameters every run shares, a str for
+        that text, False for none; None gives the caption only on a new figure.
     **marker_kw
         Passed to ``ax.plot``.
 
@@ -622,7 +756,9 @@ def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: 
     """
     import numpy as np
 
+    created = ax is None
     ax = _axes(ax)
+    scale, unit = style.parameter_display(parameter, scale, unit)
     if isinstance(sweep, Mapping):
         xs, ys, labels = [], [], []
         for value, sec in sweep.items():
@@ -655,14 +791,20 @@ def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: 
     else:
         kw.setdefault("color", "k")
         ax.plot(x, y, **kw)
-    ax.set_xlabel(f"{parameter} ({unit})" if unit else parameter)
+    values = list(sweep) if isinstance(sweep, Mapping) else [r.parameters.get(parameter) for r in sweep.runs]
+    style.parameter_axis(ax, "x", parameter, values, unit, log)
     ax.set_ylabel(f"{_channel_label(name, y_unit)} once per revolution")
+    if isinstance(title, str):
+        style.set_title(ax, title)
+    elif (title or (title is None and created)) and not isinstance(sweep, Mapping):
+        style.set_title(ax, style.sweep_caption(sweep, exclude=(parameter,)))
     return ax
 
 
-def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_scale: float = 1.0,
-                    y_scale: float = 1.0, x_unit: str | None = None, y_unit: str | None = None,
-                    annotate: bool = True) -> Axes:
+def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_scale: float | None = None,
+                    y_scale: float | None = None, x_unit: str | None = None, y_unit: str | None = None,
+                    x_log: bool | None = None, y_log: bool | None = None, annotate: bool = True,
+                    title: str | bool | None = None) -> Axes:
     """Map of the motion class over two swept parameters (one cell per run).
 
     Parameters
@@ -673,19 +815,25 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
         Parameter names of the horizontal and vertical axes.
     ax : matplotlib Axes, optional
         Where to draw; a new figure when None.
-    x_scale, y_scale : float
-        Factors applied to the parameter values in the tick labels (e.g. 1e3 for mm).
+    x_scale, y_scale : float, optional
+        Factors applied to the parameter values (e.g. 1e3 for mm).
     x_unit, y_unit : str, optional
-        Units of the scaled values, in the axis labels.
+        Units of the scaled values, in the axis labels. Without scale and unit, both come
+        from :data:`daeclear.style.PARAMETER_AXES`.
+    x_log, y_log : bool, optional
+        Logarithmic axis (cells centred on the values, edges at geometric midpoints);
+        None: when the values of that axis form a geometric grid (three or more).
     annotate : bool
         Write the period k in periodic cells ("P1", "P2", ...), "C" chaotic, "Q"
         quasi-periodic, "N" non-periodic, "?" undetermined, "x" failed.
+    title : str or bool, optional
+        As in :func:`plot_bifurcation` (the parameters every run shares).
 
     Returns
     -------
     matplotlib.axes.Axes
-        Cells on an index grid (ticks labelled with the values), coloured by
-        :data:`MOTION_COLORS`; one legend entry per class present.
+        Cells coloured by :data:`MOTION_COLORS`, ticks labelled with the values; on an index
+        grid, or on the values themselves along a log axis; one legend entry per class present.
 
     Raises
     ------
@@ -696,7 +844,10 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
+    created = ax is None
     ax = _axes(ax)
+    x_scale, x_unit = style.parameter_display(x, x_scale, x_unit)
+    y_scale, y_unit = style.parameter_display(y, y_scale, y_unit)
     runs = [r for r in sweep.runs if x in r.parameters and y in r.parameters]
 
     def key(v: Any) -> tuple[int, Any]:  # numbers in order, then anything else by its text
@@ -717,24 +868,62 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
         grid[i, j] = classes.index(motion)
         text[(i, j)] = f"P{r.period}" if motion == "periodic" else short.get(motion, "")
     cmap = ListedColormap([MOTION_COLORS[c] for c in classes])
-    ax.pcolormesh(np.arange(len(xs) + 1) - 0.5, np.arange(len(ys) + 1) - 0.5, np.ma.masked_invalid(grid), cmap=cmap,
+
+    def positive(values: list[Any]) -> bool:  # a log axis needs numbers > 0 only
+        return bool(values) and all(key(v)[0] == 0 and float(v) > 0 for v in values)
+
+    x_log = style.is_geometric(xs) if x_log is None else bool(x_log) and positive(xs)
+    y_log = style.is_geometric(ys) if y_log is None else bool(y_log) and positive(ys)
+    x_centres, x_edges = _cells(xs, x_scale, x_log)
+    y_centres, y_edges = _cells(ys, y_scale, y_log)
+    ax.pcolormesh(x_edges, y_edges, np.ma.masked_invalid(grid), cmap=cmap,
                   vmin=-0.5, vmax=len(classes) - 0.5, edgecolors="w", linewidth=0.5)
     if annotate:
         for (i, j), label in text.items():
-            ax.text(j, i, label, ha="center", va="center", fontsize="x-small", color="w")
+            ax.text(x_centres[j], y_centres[i], label, ha="center", va="center", fontsize="x-small", color="w")
 
     def fmt(v: Any, scale: float) -> str:
-        return f"{float(v) * scale:g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
+        return f"{float(v) * scale:.3g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
 
-    ax.set_xticks(range(len(xs)), [fmt(v, x_scale) for v in xs], rotation=45 if len(xs) > 8 else 0)
-    ax.set_yticks(range(len(ys)), [fmt(v, y_scale) for v in ys])
-    ax.set_xlabel(f"{x} ({x_unit})" if x_unit else x)
-    ax.set_ylabel(f"{y} ({y_unit})" if y_unit else y)
+    from matplotlib.ticker import NullLocator
+
+    if x_log:
+        ax.set_xscale("log")
+        ax.xaxis.set_minor_locator(NullLocator())
+    if y_log:
+        ax.set_yscale("log")
+        ax.yaxis.set_minor_locator(NullLocator())
+    ax.set_xticks(x_centres, [fmt(v, x_scale) for v in xs], rotation=45 if len(xs) > 8 else 0)
+    ax.set_yticks(y_centres, [fmt(v, y_scale) for v in ys])
+    ax.set_xlim(x_edges[0], x_edges[-1])
+    ax.set_ylim(y_edges[0], y_edges[-1])
+    ax.set_xlabel(style.parameter_label(x, x_unit))
+    ax.set_ylabel(style.parameter_label(y, y_unit))
+    if isinstance(title, str):
+        style.set_title(ax, title)
+    elif title or (title is None and created):
+        style.set_title(ax, style.sweep_caption(sweep, exclude=(x, y)))
     present = sorted({int(v) for v in grid[np.isfinite(grid)]})
     ax.legend(handles=[Patch(color=MOTION_COLORS[classes[k]], label=classes[k]) for k in present],
               loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="x-small", title="motion",
               title_fontsize="x-small")
     return ax
+
+
+def _cells(values: list[Any], scale: float, log: bool) -> tuple[Any, Any]:
+    """Cell centres and edges of one motion-map axis: an index grid, or the scaled values on a log axis
+    (edges at the geometric midpoints, the outer cells as wide as their neighbours in ratio)."""
+    import numpy as np
+
+    if not log:
+        return np.arange(len(values), dtype=float), np.arange(len(values) + 1) - 0.5
+    centres = np.array([float(v) * scale for v in values])
+    if centres.size == 1:
+        return centres, centres * np.array([10 ** -0.5, 10 ** 0.5])
+    inner = np.sqrt(centres[1:] * centres[:-1])
+    first = centres[0] ** 2 / inner[0]
+    last = centres[-1] ** 2 / inner[-1]
+    return centres, np.concatenate([[first], inner, [last]])
 
 
 __all__ += ["MOTION_COLORS", "plot_bifurcation", "plot_motion_map", "plot_poincare_section"]

@@ -2,8 +2,13 @@
 
 A `Result` is a pure data container filled by the solver (`solve.py`,
 `integrators.py`); it computes nothing about mechanics. It also owns the HDF5
-round trip: `Result.save` and `load`. h5py is imported here and nowhere else in
-daeclear, and only when a file is written or read.
+round trip: `Result.save` and `load`, and the hand-off to pandas and xarray
+(`Result.to_pandas`, `Result.events_frame`, `Result.to_xarray`; optional
+dependencies, the ``data`` extra). h5py is imported here and nowhere else in
+daeclear, and only when a file is written or read; pandas and xarray only when asked for.
+
+docs/hdf5_layout.md documents the file item by item for readers without daeclear
+(a test keeps it in step with `_write`).
 
 HDF5 layout (root attributes ``format="daeclear-result"``, ``version=1``)::
 
@@ -56,10 +61,12 @@ from typing import TYPE_CHECKING, Any, Literal, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import DaeclearError, DaeclearWarning
+from .errors import DaeclearError, DaeclearWarning, MissingDependencyError
 
-if TYPE_CHECKING:  # h5py is imported lazily, only by save() and load()
+if TYPE_CHECKING:  # h5py, pandas and xarray are imported lazily, only where they are used
     import h5py
+    import pandas as pd
+    import xarray as xr
 
 __all__ = [
     "FORMAT_NAME",
@@ -294,7 +301,8 @@ def _plain(value: Any, where: str) -> Any:
     """``value`` as plain JSON-able Python.
 
     numpy scalars and arrays, tuples and paths are converted; a dataclass instance (e.g. a
-    Material) becomes the dict of its fields. Anything else is stored as its ``repr`` with a
+    Material) becomes the dict of its fields, headed by ``"name"`` when its class has a name
+    (a contact or friction law: figures and readers of the file need to know which law). Anything else is stored as its ``repr`` with a
     DaeclearWarning naming ``where``: a finished run is never lost to an odd parameter.
     Non-string dict keys raise TypeError.
     """
@@ -320,7 +328,11 @@ def _plain(value: Any, where: str) -> Any:
     if isinstance(value, (list, tuple)):
         return [_plain(item, f"{where}[{i}]") for i, item in enumerate(value)]
     if is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _plain(getattr(value, f.name), f"{where}[{f.name!r}]") for f in fields(value)}
+        out = {f.name: _plain(getattr(value, f.name), f"{where}[{f.name!r}]") for f in fields(value)}
+        kind = getattr(type(value), "name", None)  # a contact law's registered name, e.g. "hunt-crossley"
+        if isinstance(kind, str) and "name" not in out:
+            out = {"name": kind, **out}
+        return out
     text = repr(value)
     warnings.warn(
         f"{where}: a {type(value).__name__} is not a number, string, bool, None, list or dict; "
@@ -725,6 +737,160 @@ class Result:
             "formulation": self.formulation,
         }
 
+    # ------------------------------------------------------------------ hand-off to pandas and xarray
+
+    def _columns(self, states: bool) -> tuple[dict[str, np.ndarray], dict[str, str]]:
+        """One-dimensional columns (multi-dimensional channels split as ``name[i]``) and their units."""
+        cols: dict[str, np.ndarray] = {}
+        units: dict[str, str] = {}
+        for name in self.channel_names:
+            arr = self._channels[name]
+            if arr.ndim == 1:
+                cols[name], units[name] = arr, self.units[name]
+                continue
+            flat = arr.reshape(arr.shape[0], -1)
+            for k, index in enumerate(np.ndindex(*arr.shape[1:])):
+                col = f"{name}[{','.join(str(i) for i in index)}]"
+                cols[col], units[col] = flat[:, k], self.units[name]
+        if states:
+            for j, name in enumerate(self.state_names):
+                if name not in cols:  # a channel of the same name wins, as in result[name]
+                    cols[name], units[name] = self.y[:, j], self.units[name]
+        return cols, units
+
+    def _metadata(self) -> dict[str, Any]:
+        return {"scene_name": self.scene_name, "method": self.method, "formulation": self.formulation,
+                "success": self.success, "status": self.status, "message": self.message}
+
+    def to_pandas(self, *, states: bool = False) -> pd.DataFrame:
+        """The channels as a pandas DataFrame, one column per channel, indexed by time.
+
+        The hand-off to pandas-based tools: the index is named ``"t"`` (s) and may hold an
+        event time twice (before and after a restart). A channel with more than one value per
+        time (shape (n_times, k)) becomes the columns ``"name[0]"`` ... ``"name[k-1]"``.
+        Dtypes are kept; values are copies.
+
+        Parameters
+        ----------
+        states : bool
+            Also add one column per state (``y``) whose name is not already a channel.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``df.attrs["units"]`` maps every column and ``"t"`` to its unit (``""`` when
+            unknown); ``df.attrs`` also holds scene_name, method, formulation, success,
+            status and message. Events are in `events_frame`.
+
+        Raises
+        ------
+        MissingDependencyError
+            (an ImportError) if pandas is not installed: ``pip install "daeclear[data]"``.
+        """
+        pd = _optional("pandas", "Result.to_pandas")
+        cols, units = self._columns(states)
+        index = pd.Index(np.array(self.t), name="t")
+        df = pd.DataFrame({name: np.array(arr) for name, arr in cols.items()}, index=index)
+        df.attrs["units"] = {"t": "s", **units}
+        df.attrs.update(self._metadata())
+        return df
+
+    def events_frame(self, *, states: bool = False) -> pd.DataFrame:
+        """The contact events as a pandas DataFrame, one row per event, in time order.
+
+        Columns ``t`` (s), ``pair``, ``kind`` (``"onset"`` or ``"separation"``) and
+        ``approach_speed`` (m/s, nan where meaningless); with ``states=True`` also the state
+        at each event, one column per state name. ``df.attrs["units"]`` gives the units.
+
+        Raises
+        ------
+        MissingDependencyError
+            (an ImportError) if pandas is not installed: ``pip install "daeclear[data]"``.
+        """
+        pd = _optional("pandas", "Result.events_frame")
+        data: dict[str, Any] = {
+            "t": self._events.t,
+            "pair": pd.Series(self._events.pair, dtype=object),
+            "kind": pd.Series(self._events.kind, dtype=object),
+            "approach_speed": self._events.approach_speed,
+        }
+        units = {"t": "s", "pair": "", "kind": "", "approach_speed": "m/s"}
+        if states:
+            y = np.array([e.y for e in self._events], dtype=np.float64).reshape(len(self._events), self.n_states)
+            for j, name in enumerate(self.state_names):
+                data[f"y:{name}"] = y[:, j]
+                units[f"y:{name}"] = self.units[name]
+        df = pd.DataFrame(data)
+        df.index.name = "event"
+        df.attrs["units"] = units
+        return df
+
+    def to_xarray(self, *, states: bool = True) -> xr.Dataset:
+        """The result as an xarray Dataset: channels over ``t``, events over ``event``.
+
+        Every channel is a variable over the dimension ``t`` (extra dimensions of a
+        multi-dimensional channel are named ``"<channel>_dim_1"``, ...) with its unit in
+        ``attrs["units"]``; the coordinate ``t`` has ``units="s"`` and may hold an event time
+        twice (select by position, ``ds.isel``). The events are the variables
+        ``event_t``, ``event_pair``, ``event_kind``, ``event_approach_speed`` (and
+        ``event_y`` with states) over the dimension ``event``; the segments are
+        ``segment_t_start``, ``segment_t_end``, ``segment_modes`` (JSON) over ``segment``.
+        Attributes are netCDF-safe: scene_name, method, formulation, success (0/1),
+        status, message, every scalar statistic as ``stats.<name>``, and the full
+        statistics and parameters as JSON strings ``stats_json``, ``parameters_json``.
+
+        Parameters
+        ----------
+        states : bool
+            Include ``y`` and ``yp`` over (``t``, ``state``), with the coordinates
+            ``state`` (names) and ``state_units``.
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Raises
+        ------
+        MissingDependencyError
+            (an ImportError) if xarray is not installed: ``pip install "daeclear[data]"``.
+        """
+        xr = _optional("xarray", "Result.to_xarray")
+        variables: dict[str, Any] = {}
+        for name in self.channel_names:
+            arr = np.array(self._channels[name])
+            dims = ("t", *(f"{name}_dim_{k}" for k in range(1, arr.ndim)))
+            variables[name] = xr.Variable(dims, arr, attrs={"units": self.units[name]})
+        coords: dict[str, Any] = {"t": xr.Variable("t", np.array(self.t), attrs={"units": "s"})}
+        if states:
+            coords["state"] = xr.Variable("state", np.array(self.state_names, dtype=object))
+            coords["state_units"] = xr.Variable("state", np.array([self.units[n] for n in self.state_names],
+                                                                  dtype=object))
+            variables["y"] = xr.Variable(("t", "state"), np.array(self.y))
+            variables["yp"] = xr.Variable(("t", "state"), np.array(self.yp))
+        ev = self._events
+        variables["event_t"] = xr.Variable("event", ev.t, attrs={"units": "s"})
+        variables["event_pair"] = xr.Variable("event", np.array(ev.pair, dtype=object))
+        variables["event_kind"] = xr.Variable("event", np.array(ev.kind, dtype=object))
+        variables["event_approach_speed"] = xr.Variable("event", ev.approach_speed, attrs={"units": "m/s"})
+        if states:
+            y_events = np.array([e.y for e in ev], dtype=np.float64).reshape(len(ev), self.n_states)
+            variables["event_y"] = xr.Variable(("event", "state"), y_events)
+        variables["segment_t_start"] = xr.Variable(
+            "segment", np.array([s[0] for s in self.segments], dtype=np.float64), attrs={"units": "s"})
+        variables["segment_t_end"] = xr.Variable(
+            "segment", np.array([s[1] for s in self.segments], dtype=np.float64), attrs={"units": "s"})
+        variables["segment_modes"] = xr.Variable(
+            "segment", np.array([json.dumps(s[2], ensure_ascii=False) for s in self.segments], dtype=object))
+        attrs: dict[str, Any] = {**self._metadata(), "success": int(self.success)}
+        for key, value in self.stats.items():
+            if isinstance(value, bool):
+                attrs[f"stats.{key}"] = int(value)
+            elif isinstance(value, (int, float, str)):
+                attrs[f"stats.{key}"] = value
+        attrs["stats_json"] = json.dumps(self.stats, ensure_ascii=False)
+        attrs["parameters_json"] = json.dumps(self.parameters, ensure_ascii=False)
+        return xr.Dataset(variables, coords=coords, attrs=attrs)
+
     # ------------------------------------------------------------------ HDF5
 
     def save(self, path: str | os.PathLike[str]) -> Path:
@@ -769,6 +935,19 @@ class Result:
             tmp.unlink(missing_ok=True)
             raise
         return path
+
+
+def _optional(module: str, what: str) -> Any:
+    """Import an optional dependency, or raise MissingDependencyError naming the extra that installs it."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        raise MissingDependencyError(
+            f"{what} needs {module}, which is not installed. Install daeclear's data extra: "
+            f'pip install "daeclear[data]" (or pip install {module}).'
+        ) from exc
 
 
 def _close_matches(name: str, candidates: Iterable[str], n: int = 5) -> list[str]:

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import json
 import math
+import re
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -10,7 +13,7 @@ import h5py
 import numpy as np
 import pytest
 
-from daeclear.errors import DaeclearError, DaeclearWarning
+from daeclear.errors import DaeclearError, DaeclearWarning, MissingDependencyError
 from daeclear.result import FORMAT_NAME, FORMAT_VERSION, ContactEvent, EventList, Result, load
 
 STATE_NAMES = ["crank.x", "crank.vx", "slider.x", "slider.vx", "lambda.A.x"]
@@ -402,3 +405,209 @@ def test_summary() -> None:
     assert repr(make_result()) == text
     failed = str(make_result(success=False, status=-1, message="IDA_CONV_FAIL", events=[]))
     assert "success: False" in failed and "0 events" in failed and "IDA_CONV_FAIL" in failed
+
+
+# ----------------------------------------------------------------------------- hand-off: pandas, xarray
+
+
+def test_to_pandas_keeps_values_units_and_dtypes() -> None:
+    pytest.importorskip("pandas")
+    result = make_result()
+    df = result.to_pandas()
+    assert df.index.name == "t"
+    np.testing.assert_array_equal(df.index.to_numpy(), result.t)
+    one_dim = [n for n in result.channel_names if result[n].ndim == 1]
+    assert set(df.columns) == {*one_dim, "C.point[0]", "C.point[1]"}
+    for name in one_dim:
+        np.testing.assert_array_equal(df[name].to_numpy(), result[name])
+        assert df[name].dtype == result[name].dtype, name
+        assert df.attrs["units"][name] == result.units[name]
+    np.testing.assert_array_equal(df["C.point[1]"].to_numpy(), result["C.point"][:, 1])
+    assert df.attrs["units"]["C.point[0]"] == "m" and df.attrs["units"]["t"] == "s"
+    assert df.attrs["scene_name"] == "slider_crank" and df.attrs["method"] == "ida"
+    # a copy: editing the frame leaves the result alone
+    df.iloc[0, 0] = not df.iloc[0, 0] if df.dtypes.iloc[0] == bool else df.iloc[0, 0] + 1
+    assert result[df.columns[0]][0] != df.iloc[0, 0]
+
+
+def test_to_pandas_with_states_adds_state_columns() -> None:
+    pytest.importorskip("pandas")
+    result = make_result(channels={"slider.vx": np.arange(41.0)}, units={"slider.vx": "m/s", "crank.x": "m"})
+    df = result.to_pandas(states=True)
+    assert list(df.columns) == ["slider.vx", "crank.x", "crank.vx", "slider.x", "lambda.A.x"]
+    np.testing.assert_array_equal(df["slider.vx"].to_numpy(), np.arange(41.0))  # the channel wins
+    np.testing.assert_array_equal(df["lambda.A.x"].to_numpy(), result["lambda.A.x"])
+    assert df.attrs["units"]["crank.x"] == "m"
+
+
+def test_events_frame_matches_events() -> None:
+    pytest.importorskip("pandas")
+    result = make_result()
+    ev = result.events_frame(states=True)
+    assert list(ev.columns[:4]) == ["t", "pair", "kind", "approach_speed"]
+    np.testing.assert_array_equal(ev["t"].to_numpy(), result.events.t)
+    assert list(ev["pair"]) == result.events.pair and list(ev["kind"]) == result.events.kind
+    np.testing.assert_array_equal(ev["approach_speed"].to_numpy(), result.events.approach_speed)
+    np.testing.assert_array_equal(ev[[f"y:{n}" for n in STATE_NAMES]].to_numpy(), [e.y for e in result.events])
+    assert ev.attrs["units"]["approach_speed"] == "m/s"
+    empty = make_result(events=[]).events_frame()
+    assert len(empty) == 0 and list(empty.columns) == ["t", "pair", "kind", "approach_speed"]
+
+
+def test_to_xarray_keeps_values_units_events_and_attributes() -> None:
+    pytest.importorskip("xarray")
+    result = make_result()
+    ds = result.to_xarray()
+    np.testing.assert_array_equal(ds["t"].to_numpy(), result.t)
+    assert ds["t"].attrs["units"] == "s"
+    for name in result.channel_names:
+        np.testing.assert_array_equal(ds[name].to_numpy(), result[name])
+        assert ds[name].dtype == result[name].dtype
+        assert ds[name].attrs["units"] == result.units[name]
+        assert ds[name].dims[0] == "t"
+    assert ds["C.point"].dims == ("t", "C.point_dim_1")
+    np.testing.assert_array_equal(ds["y"].to_numpy(), result.y)
+    assert list(ds["state"].to_numpy()) == STATE_NAMES
+    assert list(ds["state_units"].to_numpy()) == [result.units[n] for n in STATE_NAMES]
+    assert ds.sizes["event"] == 2
+    np.testing.assert_array_equal(ds["event_t"].to_numpy(), result.events.t)
+    assert list(ds["event_pair"].to_numpy()) == result.events.pair
+    assert list(ds["event_kind"].to_numpy()) == result.events.kind
+    np.testing.assert_array_equal(ds["event_approach_speed"].to_numpy(), result.events.approach_speed)
+    np.testing.assert_array_equal(ds["event_y"].to_numpy(), [e.y for e in result.events])
+    assert [json.loads(m) for m in ds["segment_modes"].to_numpy()] == [s[2] for s in result.segments]
+    assert ds.attrs["scene_name"] == "slider_crank" and ds.attrs["formulation"] == "index1"
+    assert ds.attrs["success"] == 1 and ds.attrs["stats.n_steps"] == 57
+    assert json.loads(ds.attrs["parameters_json"]) == result.parameters
+    assert json.loads(ds.attrs["stats_json"]) == result.stats
+    assert "y" not in result.to_xarray(states=False)
+
+
+def test_to_xarray_writes_netcdf(tmp_path: Path) -> None:
+    """The Dataset's attributes are netCDF-safe: it writes and reads back with units and events."""
+    xr = pytest.importorskip("xarray")
+    result = make_result(channels={"slider.vx": np.linspace(0.0, 1.0, 41)}, units={"slider.vx": "m/s"})
+    try:
+        result.to_xarray().to_netcdf(tmp_path / "run.nc")
+    except (ImportError, ValueError) as exc:  # no netCDF backend installed
+        pytest.skip(f"no netCDF backend: {exc}")
+    with xr.open_dataset(tmp_path / "run.nc") as back:
+        np.testing.assert_array_equal(back["slider.vx"].to_numpy(), result["slider.vx"])
+        assert back["slider.vx"].attrs["units"] == "m/s"
+        assert list(back["event_kind"].to_numpy()) == result.events.kind
+
+
+
+def test_hand_off_of_a_loaded_file_equals_hand_off_of_the_result(tmp_path: Path) -> None:
+    """Save, load, convert: the same frame and Dataset as converting the result directly."""
+    pd = pytest.importorskip("pandas")
+    pytest.importorskip("xarray")
+    result = make_result()
+    loaded = load(result.save(tmp_path / "run.h5"))
+    pd.testing.assert_frame_equal(loaded.to_pandas(states=True), result.to_pandas(states=True))
+    pd.testing.assert_frame_equal(loaded.events_frame(), result.events_frame())
+    assert loaded.to_xarray().identical(result.to_xarray())
+
+
+def test_hand_off_keeps_a_repeated_event_time() -> None:
+    """A restart repeats its time (state before and after): both rows survive, in order."""
+    pytest.importorskip("pandas")
+    pytest.importorskip("xarray")
+    t = np.linspace(0.0, 0.04, 41)
+    t[10] = t[9]
+    result = make_result(t=t)
+    df = result.to_pandas()
+    assert len(df) == 41 and not df.index.is_unique
+    np.testing.assert_array_equal(df["slider.vx"].to_numpy()[9:11], result["slider.vx"][9:11])
+    ds = result.to_xarray()
+    assert ds.sizes["t"] == 41
+    np.testing.assert_array_equal(ds["slider.vx"].isel(t=[9, 10]).to_numpy(), result["slider.vx"][9:11])
+
+@pytest.mark.parametrize(("method", "module"), [("to_pandas", "pandas"), ("events_frame", "pandas"),
+                                                ("to_xarray", "xarray")])
+def test_missing_optional_dependency_names_the_extra(monkeypatch: pytest.MonkeyPatch, method: str,
+                                                     module: str) -> None:
+    monkeypatch.setitem(sys.modules, module, None)  # makes `import module` raise ImportError
+    with pytest.raises(ImportError, match=r'daeclear\[data\]') as info:
+        getattr(make_result(), method)()
+    assert isinstance(info.value, MissingDependencyError)
+    assert module in str(info.value) and f"Result.{method}" in str(info.value)
+
+
+# ----------------------------------------------------------------------------- the documented HDF5 layout
+
+LAYOUT_DOC = Path(__file__).resolve().parents[1] / "docs" / "hdf5_layout.md"
+
+
+def _documented_items() -> list[tuple[str, bool]]:
+    """(item, optional) for every table row of docs/hdf5_layout.md whose first cell is `/...`."""
+    items = []
+    for line in LAYOUT_DOC.read_text(encoding="utf-8").splitlines():
+        m = re.match(r"\|\s*`(/[^`]*)`\s*\|([^|]*)\|", line)
+        if m:
+            items.append((m.group(1), "optional" in m.group(2)))
+    return items
+
+
+def _item_pattern(item: str) -> re.Pattern[str]:
+    text = re.escape(item).replace(re.escape("<name>"), r"[^/@]+").replace(re.escape("/**"), r"(?:[/@].*)?")
+    return re.compile(text + r"\Z")
+
+
+def _file_items(f: h5py.File) -> list[str]:
+    """Every object ("/t") and attribute ("/t@units", "/@format") of an HDF5 file."""
+    items = [f"/@{a}" for a in f.attrs]
+
+    def visit(name: str, obj: h5py.HLObject) -> None:
+        items.append(f"/{name}")
+        items.extend(f"/{name}@{a}" for a in obj.attrs)
+
+    f.visititems(visit)
+    return items
+
+
+def test_hdf5_layout_document_lists_every_item_and_only_those(tmp_path: Path) -> None:
+    documented = _documented_items()
+    assert len(documented) > 30
+    patterns = [(_item_pattern(item), item, optional) for item, optional in documented]
+    path = make_result().save(tmp_path / "run.h5")
+    with h5py.File(path, "r") as f:
+        in_file = _file_items(f)
+    undocumented = [i for i in in_file if not any(p.match(i) for p, _, _ in patterns)]
+    assert not undocumented, f"items written by Result.save but missing from {LAYOUT_DOC.name}: {undocumented}"
+    absent = [item for p, item, _ in patterns if not any(p.match(i) for i in in_file)]
+    assert not absent, f"items in {LAYOUT_DOC.name} that Result.save does not write: {absent}"
+    # the optional items are the steps, which a result without recorded steps lacks
+    path = make_result(step_t=None, step_h=None, step_order=None).save(tmp_path / "no_steps.h5")
+    with h5py.File(path, "r") as f:
+        in_file = _file_items(f)
+    absent = {item for p, item, _ in patterns if not any(p.match(i) for i in in_file)}
+    assert absent == {"/steps", "/steps/t", "/steps/h", "/steps/order"}
+    assert {item for item, optional in documented if optional} == {"/steps"}
+
+
+def test_hdf5_layout_document_snippet_reads_a_file_with_plain_h5py(tmp_path: Path,
+                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    text = LAYOUT_DOC.read_text(encoding="utf-8")
+    snippet = re.search(r"## Reading with h5py\s+```python\n(.*?)```", text, re.S)
+    assert snippet, "the h5py snippet of docs/hdf5_layout.md was not found"
+    result = make_result()
+    result.save(tmp_path / "run.h5")
+    monkeypatch.chdir(tmp_path)
+    ns: dict[str, object] = {}
+    exec(compile(snippet.group(1), str(LAYOUT_DOC), "exec"), ns)  # the document's code, as written
+    np.testing.assert_array_equal(ns["t"], result.t)
+    np.testing.assert_array_equal(ns["y"], result.y)
+    assert ns["state_names"] == result.state_names
+    channels = ns["channels"]
+    assert isinstance(channels, dict) and sorted(channels) == result.channel_names
+    for name in result.channel_names:
+        np.testing.assert_array_equal(channels[name], result[name])
+        assert ns["units"][name] == result.units[name]  # type: ignore[index]
+    events = ns["events"]
+    assert isinstance(events, list) and len(events) == len(result.events)
+    for (t, pair, kind, speed), e in zip(events, result.events):
+        assert (t, pair, kind) == (e.t, e.pair, e.kind)
+        assert speed == e.approach_speed or (math.isnan(speed) and math.isnan(e.approach_speed))
+    assert ns["parameters"] == result.parameters and ns["stats"] == result.stats
+    assert [e[0] for e in ns["onsets"]] == list(result.events.of(kind="onset").t)  # type: ignore[attr-defined]
