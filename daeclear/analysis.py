@@ -95,6 +95,7 @@ MIN_POINTS = 8  # fewer section points: "undetermined"
 SIZE_QUANTILES = (0.01, 0.99)  # attractor size: this quantile range of the samples
 MIN_AMPLIFICATION = 100.0  # the twin separation must grow two decades for a Lyapunov fit
 SENSITIVE_AMPLIFICATION = 1e3  # growth that no stable periodic orbit gives: overrides a recurring section
+MIN_FIT_R2 = 0.2  # a Lyapunov fit explaining less of ln(distance) than this resolves no exponent
 SATURATION_FRACTION = 0.1  # the growth window ends where the separation reaches this x saturation
 _TIME_MATCH = 1e-9  # output times match section times to this fraction of the period
 
@@ -744,8 +745,8 @@ class TwinReading:
         Amplification and decorrelation (and, for a recurring section, the section gap) are
         numbers; otherwise the twin test is *missing* and can neither confirm nor contradict.
     exponent : bool
-        A positive exponent resolved by a fit: amplification >= MIN_AMPLIFICATION (100) and
-        Lyapunov estimate > 0 (a finite slope; nan is never positive).
+        A positive exponent resolved by a usable fit: amplification >= MIN_AMPLIFICATION (100),
+        Lyapunov estimate > 0 (a finite slope; nan is never positive) and R^2 >= MIN_FIT_R2 (0.2).
     sensitive : bool
         Sensitive dependence beyond doubt: amplification >= SENSITIVE_AMPLIFICATION (1000) and a
         positive exponent.
@@ -770,9 +771,11 @@ def read_twins(divergence: Divergence, *, tol: float = DEFAULT_TOL,
                decorrelation: float = DEFAULT_DECORRELATION) -> TwinReading:
     """The twin test's verdicts (thresholds of docs/nonlinear_dynamics.md) and its numbers as text."""
     A, lam, D, gap = divergence.amplification, divergence.lyapunov, divergence.decorrelation, divergence.section_gap
-    exponent = math.isfinite(A) and A >= MIN_AMPLIFICATION and math.isfinite(lam) and lam > 0
+    r2 = divergence.r_squared
+    usable = math.isfinite(r2) and r2 >= MIN_FIT_R2
+    exponent = math.isfinite(A) and A >= MIN_AMPLIFICATION and math.isfinite(lam) and lam > 0 and usable
     lam_text = (f"Lyapunov {lam:.3g} 1/s ({lam * divergence.period:.3g} per revolution, R^2 "
-                f"{_num(divergence.r_squared, '.2f')})" if math.isfinite(lam)
+                f"{_num(r2, '.2f')}{'' if usable else f' < {MIN_FIT_R2:g}: fit unusable'})" if math.isfinite(lam)
                 else f"Lyapunov missing (growth < {MIN_AMPLIFICATION:g}-fold: no fit)" if math.isfinite(A)
                 else "Lyapunov missing")
     numbers = (f"twins: separation grew {_num(A)}-fold, {lam_text}, decorrelation {_num(D)}, "
@@ -792,7 +795,7 @@ def classify_section(section: PoincareSection, divergence: Divergence | None = N
     contradicts its own evidence, and missing (nan) twin numbers are reported as missing,
     never counted as agreement. Rules, in order (docs/nonlinear_dynamics.md, with the checks
     behind each threshold); "exponent" means amplification >= 100 with a positive Lyapunov
-    fit, "sensitive" an exponent with amplification >= 1000 (:func:`read_twins`):
+    fit (R^2 >= 0.2), "sensitive" an exponent with amplification >= 1000 (:func:`read_twins`):
 
     1. fewer than ``min_points`` section points, or unknown attractor size: "undetermined";
     2. the section recurs: smallest k <= ``max_period`` whose defect
@@ -872,7 +875,8 @@ def classify_section(section: PoincareSection, divergence: Divergence | None = N
         if twins.sensitive or twins.exponent or twins.apart:
             why = []
             if twins.exponent:
-                why.append(f"a positive exponent resolved over >= {MIN_AMPLIFICATION:g}-fold growth")
+                why.append(f"a positive exponent resolved over >= {MIN_AMPLIFICATION:g}-fold growth "
+                           f"(R^2 >= {MIN_FIT_R2:g})")
             if twins.apart:
                 why.append(f"section gap > tol {tol:g}")
             if twins.sensitive and twins.decorrelated:

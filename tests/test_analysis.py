@@ -283,7 +283,8 @@ def _agrees_with_its_evidence(motion, tol=0.05, decorrelation=0.3):
         return True
     A, lam, D = e["twin_amplification"], e["lyapunov"], e["decorrelation"]
     gap = e["twin_section_gap"]
-    exponent = math.isfinite(A) and A >= 100 and math.isfinite(lam) and lam > 0
+    r2 = e["fit_r2"]
+    exponent = math.isfinite(A) and A >= 100 and math.isfinite(lam) and lam > 0 and math.isfinite(r2) and r2 >= 0.2
     sensitive = exponent and A >= 1000
     recurs = e.get("periodicity_defect", math.inf) <= tol
     if motion.label == "periodic":
@@ -422,10 +423,11 @@ def test_hidden_chaos_the_two_tests_disagree():
         assert _agrees_with_its_evidence(motion), motion
 
 
-def _twins(amplification, lyapunov, decorrelation, gap, in_contact=False):
+def _twins(amplification, lyapunov, decorrelation, gap, in_contact=False, r2=0.9):
     """Twin evidence with the given numbers (section gap in attractor units)."""
     return dataclasses.replace(_divergence(decorrelation, lyapunov), amplification=amplification,
-                               section_gap=gap, restart_in_contact=in_contact)
+                               section_gap=gap, restart_in_contact=in_contact,
+                               r_squared=r2 if math.isfinite(lyapunov) else math.nan)
 
 
 @pytest.mark.parametrize("twins, label", [
@@ -433,6 +435,7 @@ def _twins(amplification, lyapunov, decorrelation, gap, in_contact=False):
     ((546.0, 960.0, 742.0, 0.144), "uncertain"),         # c = 0.0148 mm: exponent and gap > tol
     ((145.0, 581.0, 2.17, 0.027), "uncertain"),          # c = 0.0707 mm: exponent, gap within tol
     ((30.0, math.nan, 0.5, 0.2), "uncertain"),           # no growth, but the twins end apart
+    ((130.0, 261.0, 1.5, 0.0007, False, 0.10), "periodic"),  # c = 0.0118 mm: R^2 0.10, no usable fit
     ((3e3, 300.0, 1.0, 0.03), "chaotic"),                # free restart: chaos small in the section
     ((3e3, 300.0, 1.0, 0.03, True), "uncertain"),        # the same twins restarted in contact
     ((math.nan, math.nan, math.nan, math.nan), "periodic"),  # evidence missing: said so, not "agree"
@@ -450,8 +453,8 @@ def test_recurring_section_against_each_kind_of_twin_evidence(twins, label):
         assert f"{twins[0]:.3g}-fold" in motion.reason
     if math.isnan(twins[0]):
         assert "missing" in motion.reason and "agree" not in motion.reason
-    if label == "periodic" and not math.isnan(twins[0]):
-        assert "Lyapunov missing" in motion.reason  # nan Lyapunov reported as missing, not as a number
+    if label == "periodic" and not math.isnan(twins[0]):  # nan or unusable Lyapunov fit said so, not a number
+        assert "Lyapunov missing" in motion.reason or "fit unusable" in motion.reason
 
 
 def test_nan_lyapunov_is_not_agreement_for_a_spread_section():
