@@ -377,12 +377,15 @@ XV = {"s.x": lambda y: y[:, 0], "s.v": lambda y: y[:, 1]}
 
 
 def test_odes_with_known_answers():
-    """Forced Duffing: gamma = 0.2 period 1, gamma = 0.5 chaotic; an undamped linear oscillator forced at
+    """Forced Duffing: gamma = 0.2 period 1, 0.28 period 2, 0.5 chaotic; an undamped linear oscillator forced at
     the golden ratio times its natural frequency (two incommensurate frequencies): quasi-periodic."""
     sec, div = _classify_ode(_duffing(0.2), [1.0, 0.0], ("s.q", "s.dq"), XV)
     periodic = classify_section(sec, div)
     assert (periodic.label, periodic.period) == ("periodic", 1), periodic
     assert "twins agree" in periodic.reason and div.amplification < 1  # a stable orbit contracts perturbations
+    sec, div = _classify_ode(_duffing(0.28), [1.0, 0.0], ("s.q", "s.dq"), XV)
+    doubled = classify_section(sec, div)
+    assert (doubled.label, doubled.period) == ("periodic", 2), doubled
 
     sec, div = _classify_ode(_duffing(0.5), [1.0, 0.0], ("s.q", "s.dq"), XV, twin_revolutions=80)
     chaotic = classify_section(sec, div)
@@ -395,13 +398,13 @@ def test_odes_with_known_answers():
     quasi = classify_section(sec, div)
     assert quasi.label == "quasi-periodic", quasi
     assert div.amplification < 10 and math.isnan(div.lyapunov)
-    for motion in (periodic, chaotic, quasi):
+    for motion in (periodic, doubled, chaotic, quasi):
         assert _agrees_with_its_evidence(motion), motion
 
 
 def test_hidden_chaos_the_two_tests_disagree():
-    """A forced linear oscillator u (the section channels) plus a chaotic Duffing x that leaks into them at
-    2 %: the section recurs (defect ~0.014 < tol) while the twins separate a million-fold and decorrelate.
+    """A forced linear oscillator u (the section channels) plus a chaotic Duffing x added to them at 20 %
+    of its x: the section recurs (defect ~0.014 < tol) while the twins separate a million-fold and decorrelate.
     Restarted in free flight this is the documented "chaotic, small in the section"; with twins that are not
     faithful copies (flagged restarted in contact) the verdict is "uncertain" with both tests' numbers."""
     def rhs(t, y):
