@@ -65,6 +65,7 @@ __all__ = [
     "MotionClass",
     "PhasePortrait",
     "PoincareSection",
+    "TwinReading",
     "classify_motion",
     "classify_section",
     "crank_period",
@@ -73,9 +74,8 @@ __all__ = [
     "phase_portrait",
     "poincare_section",
     "restart_model",
-    "sampling_times",
-    "TwinReading",
     "read_twins",
+    "sampling_times",
     "twin_divergence",
     "twin_evidence",
 ]
@@ -778,7 +778,9 @@ def read_twins(divergence: Divergence, *, tol: float = DEFAULT_TOL,
                 f"{_num(r2, '.2f')}{'' if usable else f' < {MIN_FIT_R2:g}: fit unusable'})" if math.isfinite(lam)
                 else f"Lyapunov missing (growth < {MIN_AMPLIFICATION:g}-fold: no fit)" if math.isfinite(A)
                 else "Lyapunov missing")
-    numbers = (f"twins: separation grew {_num(A)}-fold, {lam_text}, decorrelation {_num(D)}, "
+    span = float(divergence.t[-1]) / divergence.period if divergence.t.size and divergence.period > 0 else 0.0
+    over = f" over {span:.0f} revolutions" if span > 0 else ""
+    numbers = (f"twins{over}: separation grew {_num(A)}-fold, {lam_text}, decorrelation {_num(D)}, "
                f"section gap {_num(gap)}" + (", restarted in contact" if divergence.restart_in_contact else ""))
     return TwinReading(complete=math.isfinite(A) and math.isfinite(D),
                        exponent=exponent, sensitive=exponent and A >= SENSITIVE_AMPLIFICATION,
