@@ -11,16 +11,20 @@ of the motion with the evidence behind it:
    tested for recurrence: the motion is periodic of period k when every point is within
    ``tol`` (5 % by default) of the point k revolutions later, for the smallest
    k <= ``max_period``.
-2. **Sensitivity** (:func:`twin_divergence`): for a non-periodic section, twin
-   trajectories are restarted on the attractor from the same state, one of them
-   perturbed by ``perturbation`` (1e-8 m by default) along the constraint manifold. If
-   their late section points are as far apart as two unrelated points of the attractor
-   (decorrelation >= ``decorrelation``, 0.3 by default) and their separation grows
-   (largest Lyapunov exponent estimated by a straight-line fit of ln(distance) against
-   time over the growth window, with its R^2), the motion is chaotic; a non-periodic
-   section whose twins stay together is quasi-periodic. Twins restarted in free flight
-   that grow 1000-fold and decorrelate also overrule a recurring section: chaos that is
-   small in the section's channels (the translational joint's lateral impacts).
+2. **Sensitivity** (:func:`twin_divergence`, :func:`twin_evidence` from arrays): twin
+   trajectories are restarted on the attractor from the same state, one of them perturbed
+   by ``perturbation`` (1e-8 m by default) along the constraint manifold. Their separation
+   gives a largest Lyapunov exponent estimate (a straight-line fit of ln(distance) against
+   time over the growth window, with its R^2, when it grew at least 100-fold), the
+   amplification, and the distance of their late section points (gap, and decorrelation: the
+   gap over the section's spread).
+3. **Agreement** (:func:`classify_section`, the one place both tests meet): a recurring
+   section whose twins show a resolved positive exponent or end apart at the section is
+   "uncertain" with both numbers -- except growth >= 1000-fold with decorrelation from a
+   free-flight restart, documented as chaos small in the section's channels (the
+   translational joint's lateral impacts). A non-recurring section is chaotic when the twins
+   decorrelate with a positive exponent, quasi-periodic when they stay together without one.
+   Missing (nan) twin numbers are reported as missing, never counted as agreement.
 
 Only numpy here (no plotting); figures are in :mod:`daeclear.plot`.
 ``docs/nonlinear_dynamics.md`` states the method, thresholds, limits and the measured
@@ -43,7 +47,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .accuracy import energy_balance, work_precision  # re-exported: daeclear.analysis.work_precision
 from .assemble import DAEModel
@@ -61,6 +65,7 @@ __all__ = [
     "MotionClass",
     "PhasePortrait",
     "PoincareSection",
+    "TwinReading",
     "classify_motion",
     "classify_section",
     "crank_period",
@@ -69,15 +74,17 @@ __all__ = [
     "phase_portrait",
     "poincare_section",
     "restart_model",
+    "read_twins",
     "sampling_times",
     "twin_divergence",
+    "twin_evidence",
 ]
 
 CHANNELS: tuple[str, str] = ("slider.vx", "slider.ax")
 """Default channel pair: the chapter's "Poincaré maps" plot slider acceleration against velocity."""
 
-MotionLabel = Literal["periodic", "quasi-periodic", "chaotic", "non-periodic", "undetermined"]
-MOTION_LABELS: tuple[str, ...] = ("periodic", "quasi-periodic", "chaotic", "non-periodic", "undetermined")
+MotionLabel = Literal["periodic", "quasi-periodic", "chaotic", "non-periodic", "uncertain", "undetermined"]
+MOTION_LABELS: tuple[str, ...] = ("periodic", "quasi-periodic", "chaotic", "non-periodic", "uncertain", "undetermined")
 
 # Defaults of the classification (docs/nonlinear_dynamics.md gives the reasons and the checks).
 DEFAULT_TOL = 0.05  # recurrence tolerance, fraction of the attractor size per channel
@@ -88,6 +95,7 @@ MIN_POINTS = 8  # fewer section points: "undetermined"
 SIZE_QUANTILES = (0.01, 0.99)  # attractor size: this quantile range of the samples
 MIN_AMPLIFICATION = 100.0  # the twin separation must grow two decades for a Lyapunov fit
 SENSITIVE_AMPLIFICATION = 1e3  # growth that no stable periodic orbit gives: overrides a recurring section
+MIN_FIT_R2 = 0.2  # a Lyapunov fit explaining less of ln(distance) than this resolves no exponent
 SATURATION_FRACTION = 0.1  # the growth window ends where the separation reaches this x saturation
 _TIME_MATCH = 1e-9  # output times match section times to this fraction of the period
 
@@ -502,6 +510,14 @@ class Divergence:
         they stay together.
     period : float
         T, s.
+    section_gap : float
+        The numerator of the decorrelation alone: RMS distance between the twins' late section
+        points in units of the attractor size, the recurrence test's own yardstick (a periodic
+        section's spread is integration noise, so its decorrelation is a ratio to noise; the gap
+        is compared with ``tol`` instead). nan when not measured.
+    twin_recurrence : float
+        Recurrence defect of the unperturbed twin's late section points (smallest over k, attractor
+        units): a faithful restart of a periodic run recurs as the reference does. nan when not measured.
     """
 
     t: NDArray[np.float64]
@@ -518,6 +534,8 @@ class Divergence:
     fit_window: tuple[float, float]
     decorrelation: float
     period: float
+    section_gap: float = float("nan")
+    twin_recurrence: float = float("nan")
 
     @property
     def lyapunov_per_revolution(self) -> float:
@@ -538,15 +556,92 @@ class Divergence:
             "twin_d_saturation": self.d_saturation,
             "twin_amplification": self.amplification,
             "twin_perturbation": self.perturbation,
+            "twin_section_gap": self.section_gap,
+            "twin_recurrence": self.twin_recurrence,
             "restart_time": self.restart_time,
             "restart_in_contact": self.restart_in_contact,
         }
+
+
+def twin_evidence(t: ArrayLike, distance: ArrayLike, points_a: ArrayLike, points_b: ArrayLike,
+                  section: PoincareSection, *, restart_time: float = 0.0, restart_in_contact: bool = False,
+                  perturbation: float = float("nan"), max_period: int = DEFAULT_MAX_PERIOD) -> Divergence:
+    """Twin evidence from arrays: Lyapunov fit, amplification, decorrelation and section gap.
+
+    The array-level half of :func:`twin_divergence`, public so that any pair of trajectories
+    (a small ODE, a map, measured data) is judged by exactly the numbers a mechanism's twins are.
+
+    Parameters
+    ----------
+    t : array_like (m,)
+        Times since the restart, s (t[0] = 0: the restart).
+    distance : array_like (m,)
+        Normalised separation of the twins at those times (e.g. RMS over the states of
+        |a - b| / attractor range); distance[0] is the perturbation.
+    points_a, points_b : array_like (n, d)
+        The twins' section points (one row per revolution from the restart), in the units of
+        ``section.points``.
+    section : PoincareSection
+        Section of the reference run: attractor size, centre and spread.
+    restart_time, restart_in_contact, perturbation : float, bool, float
+        Recorded as evidence.
+    max_period : int
+        Longest period of the unperturbed twin's recurrence check.
+
+    Returns
+    -------
+    Divergence
+    """
+    t = np.asarray(t, dtype=float)
+    distance = np.asarray(distance, dtype=float)
+    d0 = float(distance[0]) if distance.size else float("nan")
+    d_start = float(distance[1]) if distance.size > 1 else float("nan")
+    late = t >= 0.5 * t[-1] if t.size else np.zeros(0, dtype=bool)
+    d_sat = float(np.median(distance[late])) if np.any(late) else float("nan")
+    floor = max(d_start, d0) if math.isfinite(d0) else d_start
+    amplification = d_sat / floor if floor > 0 else float("nan")
+    lyapunov, r2, window = float("nan"), float("nan"), (float("nan"), float("nan"))
+    if math.isfinite(amplification) and amplification >= MIN_AMPLIFICATION:
+        above = np.nonzero(distance[1:] >= SATURATION_FRACTION * d_sat)[0]
+        end = int(above[0]) + 1 if above.size else distance.size - 1
+        end = min(max(end, 4), distance.size - 1)
+        tt, ld = t[1:end + 1], np.log(np.maximum(distance[1:end + 1], np.finfo(float).tiny))
+        A = np.column_stack([tt, np.ones_like(tt)])
+        coef, *_ = np.linalg.lstsq(A, ld, rcond=None)
+        resid = ld - A @ coef
+        total = float(np.sum((ld - ld.mean()) ** 2))
+        lyapunov = float(coef[0])
+        r2 = 1.0 - float(np.sum(resid**2)) / total if total > 0 else float("nan")
+        window = (float(tt[0]), float(tt[-1]))
+
+    # decorrelation and gap of the twins' late section points, in the reference section's units
+    pa = np.asarray(points_a, dtype=float).reshape(-1, len(section.channels))
+    pb = np.asarray(points_b, dtype=float).reshape(-1, len(section.channels))
+    decorrelation = gap = recurrence = float("nan")
+    if pa.shape == pb.shape and pa.shape[0] >= 2 and len(section) >= 2 and np.all(np.isfinite(section.size)):
+        size = np.where(section.size > 0, section.size, np.inf)
+        half = pa.shape[0] // 2
+        na, nb = (pa[half:] - section.center) / size, (pb[half:] - section.center) / size
+        gap = float(np.sqrt(np.mean(np.sum((na - nb) ** 2, axis=1))))
+        p = section.normalized()
+        spread = float(np.sqrt(np.mean(np.sum((p - p.mean(axis=0)) ** 2, axis=1))))
+        decorrelation = gap / (math.sqrt(2.0) * spread) if spread > 0 else float("nan")
+        defects = _recurrence_defects(na, max_period) if na.shape[0] >= 2 else {}
+        recurrence = min(defects.values()) if defects else float("nan")
+    return Divergence(t=t, distance=distance, restart_time=float(restart_time),
+                      restart_in_contact=bool(restart_in_contact), perturbation=float(perturbation), d0=d0,
+                      d_start=d_start, d_saturation=d_sat, amplification=float(amplification), lyapunov=lyapunov,
+                      r_squared=r2, fit_window=window, decorrelation=decorrelation, period=section.period,
+                      section_gap=gap, twin_recurrence=recurrence)
 
 
 def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *, reference: Result,
                     restart_time: float = 0.0, restart_in_contact: bool = False, perturbation: float = float("nan"),
                     offset: float = 0.0) -> Divergence:
     """Separation, Lyapunov estimate and decorrelation of two twin runs.
+
+    Measures the separation of the states and the twins' section points, then hands them to
+    :func:`twin_evidence` (the same numbers for any pair of trajectories).
 
     Parameters
     ----------
@@ -585,44 +680,16 @@ def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *,
     distance = np.sqrt(np.mean(diff**2, axis=1)) if idx else np.zeros(twin_a.n_times)
     t = np.asarray(twin_a.t) - float(twin_a.t[0])
 
-    d0 = float(distance[0]) if distance.size else float("nan")
-    d_start = float(distance[1]) if distance.size > 1 else float("nan")
-    late = t >= 0.5 * t[-1] if t.size else np.zeros(0, dtype=bool)
-    d_sat = float(np.median(distance[late])) if np.any(late) else float("nan")
-    floor = max(d_start, d0) if math.isfinite(d0) else d_start
-    amplification = d_sat / floor if floor > 0 else float("nan")
-    lyapunov, r2, window = float("nan"), float("nan"), (float("nan"), float("nan"))
-    if math.isfinite(amplification) and amplification >= MIN_AMPLIFICATION:
-        above = np.nonzero(distance[1:] >= SATURATION_FRACTION * d_sat)[0]
-        end = int(above[0]) + 1 if above.size else distance.size - 1
-        end = min(max(end, 4), distance.size - 1)
-        tt, ld = t[1:end + 1], np.log(np.maximum(distance[1:end + 1], np.finfo(float).tiny))
-        A = np.column_stack([tt, np.ones_like(tt)])
-        coef, *_ = np.linalg.lstsq(A, ld, rcond=None)
-        resid = ld - A @ coef
-        total = float(np.sum((ld - ld.mean()) ** 2))
-        lyapunov = float(coef[0])
-        r2 = 1.0 - float(np.sum(resid**2)) / total if total > 0 else float("nan")
-        window = (float(tt[0]), float(tt[-1]))
-
-    # decorrelation of the twins' late section points, in the reference section's units
-    n_sec = int(math.floor((float(twin_a.t[-1]) - offset) / T + _TIME_MATCH)) + 1
-    times = float(twin_a.t[0]) + offset + T * np.arange(max(n_sec, 0))
-    decorrelation = float("nan")
-    if times.size >= 2 and len(section) >= 2 and np.all(np.isfinite(section.size)):
+    n_sec = int(math.floor((float(twin_a.t[-1]) - offset) / T + _TIME_MATCH)) + 1 if twin_a.n_times else 0
+    times = (float(twin_a.t[0]) if twin_a.n_times else 0.0) + offset + T * np.arange(max(n_sec, 0))
+    d = len(section.channels)
+    pa = pb = np.zeros((0, d))
+    if times.size >= 2:
         ia, ib = _match_times(twin_a, times, T), _match_times(twin_b, times, T)
-        size = np.where(section.size > 0, section.size, np.inf)
-        pa = np.column_stack([np.asarray(twin_a[c], dtype=float)[ia] for c in section.channels]) / size
-        pb = np.column_stack([np.asarray(twin_b[c], dtype=float)[ib] for c in section.channels]) / size
-        half = pa.shape[0] // 2
-        gap = float(np.sqrt(np.mean(np.sum((pa[half:] - pb[half:]) ** 2, axis=1))))
-        p = section.normalized()
-        spread = float(np.sqrt(np.mean(np.sum((p - p.mean(axis=0)) ** 2, axis=1))))
-        decorrelation = gap / (math.sqrt(2.0) * spread) if spread > 0 else float("nan")
-    return Divergence(t=t, distance=distance, restart_time=float(restart_time),
-                      restart_in_contact=bool(restart_in_contact), perturbation=float(perturbation), d0=d0,
-                      d_start=d_start, d_saturation=d_sat, amplification=float(amplification), lyapunov=lyapunov,
-                      r_squared=r2, fit_window=window, decorrelation=decorrelation, period=T)
+        pa = np.column_stack([np.asarray(twin_a[c], dtype=float)[ia] for c in section.channels])
+        pb = np.column_stack([np.asarray(twin_b[c], dtype=float)[ib] for c in section.channels])
+    return twin_evidence(t, distance, pa, pb, section, restart_time=restart_time,
+                         restart_in_contact=restart_in_contact, perturbation=perturbation)
 
 
 # --------------------------------------------------------------------------- classification
@@ -634,10 +701,12 @@ class MotionClass:
 
     Attributes
     ----------
-    label : {"periodic", "quasi-periodic", "chaotic", "non-periodic", "undetermined"}
-        "non-periodic": not periodic, and no twin evidence (or contradictory evidence) to
-        tell quasi-periodic from chaotic. "undetermined": too few section points or no
-        attractor size.
+    label : {"periodic", "quasi-periodic", "chaotic", "non-periodic", "uncertain", "undetermined"}
+        "non-periodic": the section does not recur, and no twin evidence (or missing or
+        contradictory twin evidence) to tell quasi-periodic from chaotic. "uncertain": the
+        section recurs but the twin test contradicts it (a positive exponent, growth beyond
+        1000-fold, or twins ending apart at the section); the reason gives both tests'
+        numbers. "undetermined": too few section points or no attractor size.
     period : int
         k for "periodic" (revolutions), else 0.
     evidence : dict
@@ -661,10 +730,62 @@ class MotionClass:
         return f"{head}: {self.reason}"
 
 
-def _grows(divergence: Divergence) -> bool:
-    """Sensitive dependence beyond doubt: the twin separation grew SENSITIVE_AMPLIFICATION-fold, exponentially."""
-    return (math.isfinite(divergence.amplification) and divergence.amplification >= SENSITIVE_AMPLIFICATION
-            and math.isfinite(divergence.lyapunov) and divergence.lyapunov > 0)
+def _num(x: float, fmt: str = ".3g") -> str:
+    """A number for a reason sentence; nan is written as "missing", never as a value."""
+    return format(x, fmt) if math.isfinite(x) else "missing"
+
+
+@dataclass(frozen=True)
+class TwinReading:
+    """What the twin evidence says, decided once for every rule of :func:`classify_section`.
+
+    Attributes
+    ----------
+    complete : bool
+        Amplification and decorrelation (and, for a recurring section, the section gap) are
+        numbers; otherwise the twin test is *missing* and can neither confirm nor contradict.
+    exponent : bool
+        A positive exponent resolved by a usable fit: amplification >= MIN_AMPLIFICATION (100),
+        Lyapunov estimate > 0 (a finite slope; nan is never positive) and R^2 >= MIN_FIT_R2 (0.2).
+    sensitive : bool
+        Sensitive dependence beyond doubt: amplification >= SENSITIVE_AMPLIFICATION (1000) and a
+        positive exponent.
+    decorrelated : bool
+        Decorrelation >= the threshold (0.3).
+    apart : bool
+        The twins' late section points are farther apart than ``tol`` (attractor units): they do
+        not recur onto each other at the recurrence test's own resolution.
+    numbers : str
+        The twin numbers as one clause (nan written as "missing").
+    """
+
+    complete: bool
+    exponent: bool
+    sensitive: bool
+    decorrelated: bool
+    apart: bool
+    numbers: str
+
+
+def read_twins(divergence: Divergence, *, tol: float = DEFAULT_TOL,
+               decorrelation: float = DEFAULT_DECORRELATION) -> TwinReading:
+    """The twin test's verdicts (thresholds of docs/nonlinear_dynamics.md) and its numbers as text."""
+    A, lam, D, gap = divergence.amplification, divergence.lyapunov, divergence.decorrelation, divergence.section_gap
+    r2 = divergence.r_squared
+    usable = math.isfinite(r2) and r2 >= MIN_FIT_R2
+    exponent = math.isfinite(A) and A >= MIN_AMPLIFICATION and math.isfinite(lam) and lam > 0 and usable
+    lam_text = (f"Lyapunov {lam:.3g} 1/s ({lam * divergence.period:.3g} per revolution, R^2 "
+                f"{_num(r2, '.2f')}{'' if usable else f' < {MIN_FIT_R2:g}: fit unusable'})" if math.isfinite(lam)
+                else f"Lyapunov missing (growth < {MIN_AMPLIFICATION:g}-fold: no fit)" if math.isfinite(A)
+                else "Lyapunov missing")
+    span = float(divergence.t[-1]) / divergence.period if divergence.t.size and divergence.period > 0 else 0.0
+    over = f" over {span:.0f} revolutions" if span > 0 else ""
+    numbers = (f"twins{over}: separation grew {_num(A)}-fold, {lam_text}, decorrelation {_num(D)}, "
+               f"section gap {_num(gap)}" + (", restarted in contact" if divergence.restart_in_contact else ""))
+    return TwinReading(complete=math.isfinite(A) and math.isfinite(D),
+                       exponent=exponent, sensitive=exponent and A >= SENSITIVE_AMPLIFICATION,
+                       decorrelated=math.isfinite(D) and D >= decorrelation,
+                       apart=math.isfinite(gap) and gap > tol, numbers=numbers)
 
 
 def classify_section(section: PoincareSection, divergence: Divergence | None = None, *, tol: float = DEFAULT_TOL,
@@ -672,28 +793,38 @@ def classify_section(section: PoincareSection, divergence: Divergence | None = N
                      min_points: int = MIN_POINTS) -> MotionClass:
     """Classify the motion from a Poincaré section and, optionally, twin-trajectory evidence.
 
-    Rules, in order (docs/nonlinear_dynamics.md):
+    The one place where the section test and the twin test are combined: a label never
+    contradicts its own evidence, and missing (nan) twin numbers are reported as missing,
+    never counted as agreement. Rules, in order (docs/nonlinear_dynamics.md, with the checks
+    behind each threshold); "exponent" means amplification >= 100 with a positive Lyapunov
+    fit (R^2 >= 0.2), "sensitive" an exponent with amplification >= 1000 (:func:`read_twins`):
 
     1. fewer than ``min_points`` section points, or unknown attractor size: "undetermined";
-    2. smallest k <= ``max_period`` whose recurrence defect
-       max_j max_channel |p[j+k] - p[j]| / size <= ``tol``: "periodic", period k -- unless
-       the twins, restarted in free flight, *grow* (separation amplified >=
-       SENSITIVE_AMPLIFICATION = 1000 times with a positive exponent) and decorrelate: then
-       "chaotic" (small in these channels);
-    3. without ``divergence``: "non-periodic";
-    4. twins decorrelated (>= ``decorrelation``) or growing, and no negative Lyapunov
-       estimate: "chaotic";
-    5. twins neither decorrelated nor growing: "quasi-periodic";
-    6. otherwise (a non-positive exponent against decorrelation): "non-periodic".
+    2. the section recurs: smallest k <= ``max_period`` whose defect
+       max_j max_channel |p[j+k] - p[j]| / size <= ``tol``. Then
+       a. no twins, or twin numbers missing: "periodic" (k), the reason saying the
+          sensitivity was not tested or its evidence is missing;
+       b. twins sensitive and decorrelated (>= ``decorrelation``), restarted in free flight:
+          "chaotic" -- chaos small in the section's channels (the translational joint);
+       c. twins sensitive, or with an exponent, or ending apart at the section (gap > ``tol``):
+          "uncertain", with both tests' numbers;
+       d. otherwise (no resolved growth, twins within ``tol``): "periodic" (k);
+    3. without twins: "non-periodic";
+    4. twin numbers missing: "non-periodic" (missing evidence named);
+    5. twins decorrelated with an exponent, or sensitive: "chaotic";
+    6. twins not decorrelated and no exponent: "quasi-periodic";
+    7. otherwise (decorrelated without resolved growth, or together with a positive
+       exponent): "non-periodic", both numbers given.
 
     Parameters
     ----------
     section : PoincareSection
         With a finite `size` (a densely sampled run).
     divergence : Divergence, optional
-        From :func:`twin_divergence`.
+        From :func:`twin_divergence` or :func:`twin_evidence`.
     tol : float
-        Recurrence tolerance, fraction of the attractor size (0.05).
+        Recurrence tolerance, fraction of the attractor size (0.05); also the largest section
+        gap of twins that agree with a recurring section.
     max_period : int
         Longest period looked for, revolutions (8).
     decorrelation : float
@@ -725,6 +856,7 @@ def classify_section(section: PoincareSection, divergence: Divergence | None = N
     spread = float(np.sqrt(np.mean(np.sum((p - p.mean(axis=0)) ** 2, axis=1))))
     evidence.update({"periodicity_defect": defect, "best_period": int(best_k), "n_clusters": _clusters(p, tol),
                      "spread": spread, **{f"defect_k{k}": v for k, v in defects.items()}})
+    twins = read_twins(divergence, tol=tol, decorrelation=decorrelation) if divergence is not None else None
     periodic = [k for k, v in defects.items() if v <= tol]
     if periodic:
         k = periodic[0]
@@ -732,39 +864,55 @@ def classify_section(section: PoincareSection, divergence: Divergence | None = N
         recurs = (f"every section point is within {defects[k]:.3g} of the point {k} revolution"
                   f"{'s' if k > 1 else ''} later (<= tol {tol:g} of the attractor size), "
                   f"{n} points, {evidence['n_clusters']} cluster(s)")
-        sensitive = divergence is not None and _grows(divergence) and divergence.decorrelation >= decorrelation
-        if sensitive and divergence is not None and divergence.restart_in_contact:
-            # twins restarted in contact are not faithful copies (the latched impact speed of the
-            # ongoing contact is replaced): their growth cannot overrule a recurring section
+        if divergence is None or twins is None:
+            return MotionClass("periodic", k, evidence, recurs + "; sensitivity not tested (no twin run).")
+        if not (twins.complete and math.isfinite(divergence.section_gap)):
             return MotionClass("periodic", k, evidence,
-                               f"{recurs}; the twins grew {divergence.amplification:.3g}-fold but were restarted "
-                               "in contact (no free flight at any section time), so they do not count.")
-        if sensitive and divergence is not None:
+                               f"{recurs}; twin evidence missing, sensitivity not tested ({twins.numbers}).")
+        if twins.sensitive and twins.decorrelated and not divergence.restart_in_contact:
             return MotionClass("chaotic", 0, evidence,
-                               f"{recurs}, but twins separate {divergence.amplification:.3g}-fold and decorrelate "
-                               f"({divergence.decorrelation:.3g} >= {decorrelation:g}; Lyapunov estimate "
-                               f"{divergence.lyapunov:.3g} 1/s, R^2 {divergence.r_squared:.2f}): chaotic motion "
+                               f"{recurs}, but {twins.numbers} (>= {SENSITIVE_AMPLIFICATION:g}-fold, "
+                               f"decorrelated >= {decorrelation:g}, restarted in free flight): chaotic motion "
                                f"that is small in {', '.join(section.channels)}.")
-        return MotionClass("periodic", k, evidence, recurs + ".")
+        if twins.sensitive or twins.exponent or twins.apart:
+            why = []
+            if twins.exponent:
+                why.append(f"a positive exponent resolved over >= {MIN_AMPLIFICATION:g}-fold growth "
+                           f"(R^2 >= {MIN_FIT_R2:g})")
+            if twins.apart:
+                why.append(f"section gap > tol {tol:g}")
+            if twins.sensitive and twins.decorrelated:
+                why.append("growth that would mark chaos small in the section, but the twins were restarted "
+                           "in contact (not faithful copies)")
+            return MotionClass("uncertain", 0, evidence,
+                               f"section test says period {k} ({recurs}); twin test disagrees ({'; '.join(why)}): "
+                               f"{twins.numbers}; unperturbed twin's own recurrence defect "
+                               f"{_num(divergence.twin_recurrence)}.")
+        return MotionClass("periodic", k, evidence,
+                           f"{recurs}; twins agree: no exponent resolved and section gap <= tol {tol:g} "
+                           f"({twins.numbers}).")
     not_periodic = (f"no period <= {max(defects)} revolutions recurs (smallest defect {defect:.3g} at k = {best_k} "
                     f"> tol {tol:g}; spread {spread:.3g}, {evidence['n_clusters']} clusters of {n} points)")
-    if divergence is None:
+    if divergence is None or twins is None:
         return MotionClass("non-periodic", 0, evidence, not_periodic + "; no twin run to test sensitivity.")
-    D, lam = divergence.decorrelation, divergence.lyapunov
-    lam_text = (f"twins separate {divergence.amplification:.3g}-fold, Lyapunov estimate {lam:.3g} 1/s "
-                f"({lam * section.period:.3g} per revolution, R^2 {divergence.r_squared:.2f})" if math.isfinite(lam)
-                else f"separation grew {divergence.amplification:.3g}-fold, too little for a Lyapunov fit")
-    decorrelated = math.isfinite(D) and D >= decorrelation
-    if (decorrelated or _grows(divergence)) and not (math.isfinite(lam) and lam <= 0):
-        how = f"twins decorrelate ({D:.3g} >= {decorrelation:g})" if decorrelated else \
-            f"twins stay correlated ({D:.3g}) but diverge exponentially"
-        return MotionClass("chaotic", 0, evidence, f"{not_periodic}; {how}; {lam_text}.")
-    if math.isfinite(D) and not decorrelated:
+    if not twins.complete:
+        return MotionClass("non-periodic", 0, evidence,
+                           f"{not_periodic}; twin evidence missing, cannot tell quasi-periodic from chaotic "
+                           f"({twins.numbers}).")
+    D = divergence.decorrelation
+    if (twins.decorrelated and twins.exponent) or twins.sensitive:
+        how = (f"twins decorrelate ({D:.3g} >= {decorrelation:g})" if twins.decorrelated else
+               f"twins stay correlated ({D:.3g}) but diverge exponentially "
+               f"(>= {SENSITIVE_AMPLIFICATION:g}-fold)")
+        return MotionClass("chaotic", 0, evidence, f"{not_periodic}; {how}; {twins.numbers}.")
+    if not twins.decorrelated and not twins.exponent:
         return MotionClass("quasi-periodic", 0, evidence,
-                           f"{not_periodic}; twins stay together (decorrelation {D:.3g} < {decorrelation:g}); "
-                           f"{lam_text}.")
+                           f"{not_periodic}; twins stay together (decorrelation {D:.3g} < {decorrelation:g}, "
+                           f"no positive exponent resolved); {twins.numbers}.")
     return MotionClass("non-periodic", 0, evidence,
-                       f"{not_periodic}; twin evidence inconclusive (decorrelation {D:.3g}; {lam_text}).")
+                       f"{not_periodic}; twin evidence inconclusive ("
+                       + ("decorrelated without a resolved positive exponent" if twins.decorrelated
+                          else "together but with a positive exponent") + f"): {twins.numbers}.")
 
 
 # --------------------------------------------------------------------------- the whole pipeline

@@ -656,7 +656,8 @@ def plot_work_precision(study: Any, *, ax: Axes | None = None) -> Axes:
 # --------------------------------------------------------------------------- Poincaré sections and sweeps
 
 MOTION_COLORS = {"periodic": "#2ca02c", "quasi-periodic": "#1f77b4", "chaotic": "#d62728",
-                 "non-periodic": "#ff7f0e", "undetermined": "#7f7f7f", "failed": "#000000"}
+                 "non-periodic": "#ff7f0e", "uncertain": "#9467bd", "undetermined": "#7f7f7f",
+                 "failed": "#000000"}
 """Colour of each motion class (:data:`daeclear.analysis.MOTION_LABELS`) in the sweep figures."""
 
 
@@ -825,7 +826,7 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
         None: when the values of that axis form a geometric grid (three or more).
     annotate : bool
         Write the period k in periodic cells ("P1", "P2", ...), "C" chaotic, "Q"
-        quasi-periodic, "N" non-periodic, "?" undetermined, "x" failed.
+        quasi-periodic, "N" non-periodic, "U" uncertain, "?" undetermined, "x" failed.
     title : str or bool, optional
         As in :func:`plot_bifurcation` (the parameters every run shares).
 
@@ -858,7 +859,8 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
     classes = list(MOTION_COLORS)
     grid = np.full((len(ys), len(xs)), np.nan)
     text: dict[tuple[int, int], str] = {}
-    short = {"chaotic": "C", "quasi-periodic": "Q", "non-periodic": "N", "undetermined": "?", "failed": "x"}
+    short = {"chaotic": "C", "quasi-periodic": "Q", "non-periodic": "N", "uncertain": "U", "undetermined": "?",
+             "failed": "x"}
     for r in runs:
         i, j = ys.index(r.parameters[y]), xs.index(r.parameters[x])
         if not np.isnan(grid[i, j]):
