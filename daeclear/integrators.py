@@ -100,7 +100,8 @@ from numpy.typing import ArrayLike, NDArray
 from .assemble import DAEModel, assemble
 from .codegen import (ODE_DRIVER_ABI, BuildResult, CompileError, CompilerUnavailable, OdeSpec, build_ode_library,
                       memo_get, memo_put, memo_table)
-from .errors import DaeclearError, DaeclearWarning, SceneError, SolveError
+from . import options
+from .errors import DaeclearError, DaeclearWarning, Interrupted, SceneError, SolveError
 from .result import ContactEvent, Result
 from .scene import Scene
 
@@ -1295,19 +1296,14 @@ def integrate(
         valid = ", ".join(["ida", *METHOD_NAMES.values()])
         raise SceneError(f"simulate: method={method!r}, must be one of {valid} (case-insensitive).")
     step = check_step(method_l, step)
-    on_failure = str(on_failure).lower()
-    if on_failure not in ("raise", "return"):
-        raise SceneError(f"simulate: on_failure={on_failure!r}, must be one of raise, return (case-insensitive).")
-    backend = str(backend).lower()
-    if backend not in ("auto", "c", "python"):
-        raise SceneError(f"simulate: backend={backend!r}, must be one of auto, c, python (case-insensitive).")
-    t_end = _positive("t_end", t_end, "s")
-    rtol = _positive("rtol", rtol, "")
-    max_step = _positive("max_step", max_step, "s", allow_zero=True)
-    if not isinstance(max_steps, int) or isinstance(max_steps, bool) or max_steps < 1:
-        raise SceneError(f"simulate: max_steps={max_steps!r}, must be an integer >= 1.")
-    if rtol < 1e-14 or rtol > 1e-2:
-        raise SceneError(f"simulate: rtol={rtol!r}, must be in [1e-14, 1e-2].")
+    on_failure = options.on_failure(on_failure)
+    backend = options.backend(backend)
+    t_end = options.t_end(t_end)
+    rtol = options.rtol(rtol)
+    options.atol(atol)
+    max_step = options.max_step(max_step)
+    max_steps = options.max_steps(max_steps)
+    t_eval = options.t_eval(t_eval, t_end)
     name = METHOD_NAMES[method_l]
     if track_work:
         raise SceneError(f"simulate: track_work=True is supported by method='ida' only, not by method={name!r}.")
@@ -1326,9 +1322,7 @@ def integrate(
                          "integrates the chapter's index-1 formulation (formulation='index1').")
     eval_times = None
     if t_eval is not None:
-        eval_times = np.asarray(t_eval, dtype=float).ravel()
-        if eval_times.size == 0 or np.any(np.diff(eval_times) <= 0) or eval_times[0] < 0 or eval_times[-1] > t_end:
-            raise SceneError(f"simulate: t_eval must be increasing values in [0, t_end={t_end}].")
+        eval_times = np.asarray(t_eval, dtype=float).ravel()  # checked by options.t_eval
     n = model.n_q
     atol_x = tolerance_vector(model, rtol, atol)[:2 * n]
     ev = _evaluator(model, backend)
@@ -1347,14 +1341,19 @@ def integrate(
                 _run_fixed(run, x0, step)  # type: ignore[arg-type]
             else:
                 _run_scipy(run, x0, rtol, atol_x, max_step)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # Ctrl-C: keep what was computed, then stop the caller too (Interrupted)
         run.success, run.status = False, -1
         run.message = f"interrupted by the user at t={run.t_last:.6g} s"
         run.close_segment(hermite=method_l in FIXED_STEP_METHODS)
+        interrupted = True
+    else:
+        interrupted = False
     solve_time = time.perf_counter() - tic
     if run.progress:
         run._progress(t_end if run.success else run.t_last)
     result = run.result(setup_time, solve_time, sim_params)
+    if interrupted:
+        raise Interrupted(f"simulate: {result.message}; partial result in .result.", result)
     if not result.success and on_failure == "raise":
         raise SolveError(result.message + " Partial result in .result.", result)
     return result
