@@ -340,7 +340,7 @@ def _sweep(args: argparse.Namespace) -> int:
     options.names([c.strip() for c in args.channels.split(",") if c.strip()], where=where, field="--channels")
     if not args.out.parent.exists():
         check_directory(args.out.parent, "daeclear sweep OUT (its directory)")
-    check_file(args.out, "daeclear sweep OUT", what="a sweep file (.h5)")  # before any work
+    check_file(args.out, "daeclear sweep OUT", what="a sweep file (.h5)", example="sweep.h5")  # before any work
     client = cluster = None
     executor = None
     if args.dask:

@@ -35,7 +35,8 @@ def _probe(directory: Path, option: str, path: Path) -> None:
     os.unlink(name)
 
 
-def check_file(path: str | os.PathLike[str], option: str, *, what: str = "an HDF5 file (.h5)") -> Path:
+def check_file(path: str | os.PathLike[str], option: str, *, what: str = "an HDF5 file (.h5)",
+               example: str = "result.h5") -> Path:
     """Check that ``path`` can become (or replace) a file: not a directory, in an existing writable directory.
 
     Parameters
@@ -46,6 +47,8 @@ def check_file(path: str | os.PathLike[str], option: str, *, what: str = "an HDF
         How the user named it (``--out``, ``Result.save(path)``, ``sweep(path)``), for the message.
     what : str
         What is allowed there, for the message.
+    example : str
+        A file name suggested when ``path`` is a directory.
 
     Returns
     -------
@@ -62,7 +65,7 @@ def check_file(path: str | os.PathLike[str], option: str, *, what: str = "an HDF
     if str(path) == "":
         raise OutputError(f"{option} '': an empty path; must be {what}.")
     if p.is_dir():
-        raise OutputError(f"{option} '{p}': is a directory; must be {what}, e.g. '{p / 'result.h5'}'.")
+        raise OutputError(f"{option} '{p}': is a directory; must be {what}, e.g. '{p / example}'.")
     if p.exists() and not p.is_file():
         raise OutputError(f"{option} '{p}': exists and is not a regular file; must be {what}.")
     parent = p.parent

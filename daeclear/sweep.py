@@ -894,7 +894,7 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     """
     from . import options as check
 
-    path = check_file(path, "sweep(path)", what="a sweep file (.h5)")  # before any work
+    path = check_file(path, "sweep(path)", what="a sweep file (.h5)", example="sweep.h5")  # before any work
     if _parts_dir(path).exists() and not _parts_dir(path).is_dir():
         raise OutputError(f"sweep(path) '{path}': its journal '{_parts_dir(path)}' is a file; it must be a "
                           "directory (move the file away).")
