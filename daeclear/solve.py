@@ -323,6 +323,10 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
                 adv.message = "internal: the compiled event loop left a contact root undecided"
             t, y, yp = adv.t, adv.y, adv.yp
+            if adv.status == "interrupted":  # Ctrl-C between the compiled loop's chunks: its steps are kept
+                segments.append((seg_start, t, dict(modes)))
+                seg_start = t
+                raise KeyboardInterrupt
             progress_line.update(t, len(events))
             if adv.status == "error":
                 segments.append((seg_start, t, dict(modes)))
