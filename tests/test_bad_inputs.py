@@ -12,7 +12,6 @@ import math
 from pathlib import Path
 from typing import Any, Callable
 
-import numpy as np
 import pytest
 
 import daeclear as dc
@@ -180,7 +179,8 @@ def _places(tmp_path: Path) -> dict[str, tuple[Path, type]]:
     folder.mkdir()
     a_file = tmp_path / "a_file"
     a_file.write_text("x")
-    return {"a folder": (folder, OutputError), "missing folder": (tmp_path / "missing" / "x.h5", OutputDirectoryMissing),
+    return {"a folder": (folder, OutputError),
+            "missing folder": (tmp_path / "missing" / "x.h5", OutputDirectoryMissing),
             "under a file": (a_file / "x.h5", OutputError), "unwritable": (Path("/proc/daeclear-x.h5"), OutputError)}
 
 
