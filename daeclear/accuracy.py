@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 from .assemble import DAEModel, assemble
 from . import options
 from .errors import Interrupted, SceneError
+from .outputs import atomic_write_text, check_file
 from .result import Result
 from .scene import Scene
 from .solve import simulate
@@ -61,7 +62,8 @@ class WorkPrecision:
             writer.writerow({k: _fmt(v) for k, v in row.items()})
         text = buf.getvalue()
         if path is not None:
-            Path(path).write_text(text)
+            atomic_write_text(check_file(path, "WorkPrecision.to_csv(path)", what="a CSV file", example="table.csv"),
+                              text)
         return text
 
     def to_markdown(self, path: str | Path | None = None) -> str:
@@ -86,7 +88,8 @@ class WorkPrecision:
                          f"{_fmt(r['wall_time'])} | {r['n_steps']} | {r['n_res_evals']} | {status} |")
         text = "\n".join(head + lines + [""] + [f"- {n}" for n in self.notes]) + "\n"
         if path is not None:
-            Path(path).write_text(text)
+            atomic_write_text(check_file(path, "WorkPrecision.to_markdown(path)", what="a markdown file",
+                                         example="table.md"), text)
         return text
 
     def best(self, label: str, max_error: float) -> dict[str, Any] | None:

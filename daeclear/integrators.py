@@ -149,10 +149,7 @@ def check_step(method: str, step: Any) -> float | None:
         if step is None:
             raise SceneError(f"simulate: method={METHOD_NAMES[method]!r} is a fixed-step scheme and needs "
                              "step=<step size in s> (the chapter uses 1e-5 s).")
-        ok = isinstance(step, (int, float)) and not isinstance(step, bool) and math.isfinite(step) and step > 0
-        if not ok:
-            raise SceneError(f"simulate: step={step!r} s, must be a finite number > 0.")
-        return float(step)
+        return options.step(step)
     if step is not None:
         name = METHOD_NAMES.get(method, method)
         raise SceneError(f"simulate: step={step!r} is only for the fixed-step methods "

@@ -200,6 +200,19 @@ def test_sweep_refuses_place(place, tmp_path):
     assert "sweep(path)" in str(info.value) and str(path) in str(info.value)
 
 
+@pytest.mark.parametrize("writer", ["to_csv", "to_markdown"])
+@pytest.mark.parametrize("place", ["a folder", "under a file"])
+def test_study_tables_refuse_place(writer, place, tmp_path):
+    from daeclear.accuracy import WorkPrecision
+
+    study = WorkPrecision(rows=[], channels=["slider.vx"], window=(0.0, 1.0), window_reason="given",
+                          reference=None, reference_options={}, assembly_time=0.0)  # type: ignore[arg-type]
+    path, exc = _places(tmp_path)[place]
+    with pytest.raises(exc) as info:
+        getattr(study, writer)(path)
+    assert f"WorkPrecision.{writer}(path)" in str(info.value) and str(path) in str(info.value)
+
+
 def test_sweep_refuses_a_journal_that_is_a_file(tmp_path):
     (tmp_path / "s.h5.parts").write_text("x")
     with pytest.raises(OutputError, match=r"s\.h5\.parts"):
@@ -433,6 +446,6 @@ def test_same_rule_and_message_everywhere(tmp_path, capsys):
 
 
 def test_there_are_at_least_100_cases():
-    n = (len(API_SIMULATE) + len(API_MECHANISMS) + len(API_STUDY) + len(API_SWEEP) + 4 + 4 + 1 + len(CLI_RUN) + 5
+    n = (len(API_SIMULATE) + len(API_MECHANISMS) + len(API_STUDY) + len(API_SWEEP) + 4 + 4 + 4 + 1 + len(CLI_RUN) + 5
          + len(CLI_STUDY) + 2 + len(CLI_SWEEP) + 4 + 2 * len(SCENE_FILE) + len(MECHANISM_FILE) + 2)
     assert n >= 100, n
