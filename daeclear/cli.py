@@ -127,24 +127,39 @@ def _run(args: argparse.Namespace) -> int:
         result = simulate(scene, t_end, **run_options)
     except Interrupted as exc:
         return _save_interrupted(exc.result, h5)
-    result.save(h5)
+    try:
+        result.save(h5)  # atomic; a Ctrl-C during the write is held back until the file is complete
+    except KeyboardInterrupt:
+        print(f"daeclear: interrupted, result saved to {h5} (no figure)", file=sys.stderr)
+        return EXIT_INTERRUPTED
     print(result)
     print(f"wrote {h5}")
+    try:
+        _run_figure(args, result, scene, reference_scene, t_end, run_options["rtol"], base)
+    except KeyboardInterrupt:  # the result is saved already; only the figure is missing
+        print(f"daeclear: interrupted, result saved to {h5} (no figure)", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    if not result.success:
+        print(f"daeclear: run failed: {result.message}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_scene: Any, t_end: float, rtol: float,
+                base: str) -> None:
+    """The response figure of ``daeclear run`` (against the ideal joint when there is one)."""
+    from .solve import simulate
+
     if not args.no_figure:
         import matplotlib
         matplotlib.use("Agg")
         from .plot import save_response_figure
         reference = None
         if reference_scene is not None:
-            reference = simulate(reference_scene, t_end, rtol=run_options["rtol"], backend=args.backend,
-                                 on_failure="return")
+            reference = simulate(reference_scene, t_end, rtol=rtol, backend=args.backend, on_failure="return")
         png = save_response_figure(result, args.out / f"{base}.png", reference=reference,
                                    channels=_figure_channels(result, scene))
         print(f"wrote {png}")
-    if not result.success:
-        print(f"daeclear: run failed: {result.message}", file=sys.stderr)
-        return 1
-    return 0
 
 
 def _save_interrupted(result: Any, h5: Path) -> int:
