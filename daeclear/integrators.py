@@ -1301,6 +1301,9 @@ def integrate(
     max_step = options.max_step(max_step)
     max_steps = options.max_steps(max_steps)
     t_eval = options.t_eval(t_eval, t_end)
+    store_steps = options.flag(store_steps, field="store_steps")
+    progress = options.flag(progress, field="progress")
+    track_work = options.flag(track_work, field="track_work")
     name = METHOD_NAMES[method_l]
     if track_work:
         raise SceneError(f"simulate: track_work=True is supported by method='ida' only, not by method={name!r}.")

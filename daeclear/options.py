@@ -67,6 +67,13 @@ def integer(value: Any, *, where: str, field: str, low: int) -> int:
     return int(value)
 
 
+def flag(value: Any, *, where: str = "simulate", field: str) -> bool:
+    """A switch: True or False (a string such as "no" would otherwise count as True)."""
+    if not isinstance(value, (bool, np.bool_)):
+        fail(where, field, value, "True or False")
+    return bool(value)
+
+
 def choice(value: Any, allowed: Sequence[str], *, where: str, field: str) -> str:
     """One of ``allowed`` (case-insensitive), returned in lower case."""
     text = value.lower() if isinstance(value, str) else None

@@ -188,6 +188,9 @@ def simulate(
     max_step = options.max_step(max_step)
     max_steps = options.max_steps(max_steps)
     t_eval = options.t_eval(t_eval, t_end)
+    store_steps = options.flag(store_steps, field="store_steps")
+    progress = options.flag(progress, field="progress")
+    track_work = options.flag(track_work, field="track_work")
     from .integrators import check_step, integrate  # the non-IDA methods
 
     check_step(method, step)

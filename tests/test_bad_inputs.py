@@ -98,6 +98,10 @@ API_SIMULATE: list[tuple[str, dict[str, Any], str, str]] = [
     ("DOP853 t_eval nan", {"method": "DOP853", "t_eval": [0.0, NAN]}, "t_eval", "nan"),
     ("DOP853 rtol=0", {"method": "DOP853", "rtol": 0.0}, "rtol", "0.0"),
     ("DOP853 t_end=0", {"method": "DOP853", "t_end": 0.0}, "t_end", "0.0"),
+    ("progress text", {"progress": "no"}, "progress", "'no'"),
+    ("store_steps None", {"store_steps": None}, "store_steps", "None"),
+    ("track_work 1", {"track_work": 1}, "track_work", "1"),
+    ("DOP853 progress text", {"method": "DOP853", "progress": "yes"}, "progress", "'yes'"),
 ]
 
 
