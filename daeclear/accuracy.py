@@ -22,7 +22,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .assemble import DAEModel, assemble
-from .errors import SceneError
+from . import options
+from .errors import Interrupted, SceneError
+from .outputs import atomic_write_text, check_file
 from .result import Result
 from .scene import Scene
 from .solve import simulate
@@ -60,7 +62,8 @@ class WorkPrecision:
             writer.writerow({k: _fmt(v) for k, v in row.items()})
         text = buf.getvalue()
         if path is not None:
-            Path(path).write_text(text)
+            atomic_write_text(check_file(path, "WorkPrecision.to_csv(path)", what="a CSV file", example="table.csv"),
+                              text)
         return text
 
     def to_markdown(self, path: str | Path | None = None) -> str:
@@ -85,7 +88,8 @@ class WorkPrecision:
                          f"{_fmt(r['wall_time'])} | {r['n_steps']} | {r['n_res_evals']} | {status} |")
         text = "\n".join(head + lines + [""] + [f"- {n}" for n in self.notes]) + "\n"
         if path is not None:
-            Path(path).write_text(text)
+            atomic_write_text(check_file(path, "WorkPrecision.to_markdown(path)", what="a markdown file",
+                                         example="table.md"), text)
         return text
 
     def best(self, label: str, max_error: float) -> dict[str, Any] | None:
@@ -236,6 +240,13 @@ def work_precision(
                    "RK4": {"method": "rk4"}}
     if not channels:
         raise SceneError("work_precision: give at least one channel.")
+    t_end = options.t_end(t_end, where="work_precision")
+    rtols = options.rtols(rtols)
+    steps = options.steps(steps, t_end)
+    repeats = options.repeats(repeats)
+    n_eval = options.n_eval(n_eval)
+    for label, opts in methods.items():
+        options.method(opts.get("method", "ida"), where="work_precision", field=f"methods[{label!r}]['method']")
     start = time.perf_counter()
     model = scene if isinstance(scene, DAEModel) else assemble(scene)
     assembly_time = time.perf_counter() - start
@@ -261,12 +272,31 @@ def work_precision(
     else:
         reason = "given"
     rows: list[dict[str, Any]] = []
-    for label, options in methods.items():
-        method = str(options.get("method", "ida")).lower()
+    try:
+        _measure(rows, scene_for_ref, ref, methods, rtols, steps, t_end, t_eval, channels, window, repeats, progress)
+    except KeyboardInterrupt as exc:  # Ctrl-C: stop, with the finished rows in .result (never a "failed" row)
+        partial = WorkPrecision(rows=rows, channels=list(channels), window=window, window_reason=reason,
+                                reference=ref, reference_options=ref_options, assembly_time=assembly_time,
+                                notes=notes + [f"Interrupted by the user after {len(rows)} runs; the table is "
+                                               "incomplete."], timed_with_scene=isinstance(scene, Scene))
+        raise Interrupted(f"work_precision: interrupted by the user after {len(rows)} runs; the finished rows "
+                          "are in .result.", partial) from exc
+    return WorkPrecision(rows=rows, channels=list(channels), window=window, window_reason=reason, reference=ref,
+                         reference_options=ref_options, assembly_time=assembly_time, notes=notes,
+                         timed_with_scene=isinstance(scene, Scene))
+
+
+def _measure(rows: list[dict[str, Any]], scene_for_ref: Scene | DAEModel, ref: Result,
+             methods: Mapping[str, Mapping[str, Any]], rtols: Sequence[float], steps: Sequence[float], t_end: float,
+             t_eval: NDArray, channels: Sequence[str], window: tuple[float, float], repeats: int,
+             progress: bool) -> None:
+    """The timed runs of every method and tolerance, appended to ``rows`` as each finishes."""
+    for label, method_options in methods.items():
+        method = str(method_options.get("method", "ida")).lower()
         fixed = method in FIXED_STEP_METHODS
         values = steps if fixed else rtols
         for value in values:
-            opts = {k: v for k, v in options.items() if k not in ("rtol", "step")}
+            opts = {k: v for k, v in method_options.items() if k not in ("rtol", "step")}
             opts["step" if fixed else "rtol"] = value
             if progress:
                 print(f"  {label} {'step' if fixed else 'rtol'}={value:g} ...", flush=True)
@@ -291,9 +321,6 @@ def work_precision(
                 "n_steps": int(result.stats.get("n_steps", 0)), "n_res_evals": int(result.stats.get("n_res_evals", 0)),
                 "status": 0 if result.success else -1, "message": result.message,
             })
-    return WorkPrecision(rows=rows, channels=list(channels), window=window, window_reason=reason, reference=ref,
-                         reference_options=ref_options, assembly_time=assembly_time, notes=notes,
-                         timed_with_scene=isinstance(scene, Scene))
 
 
 def energy_balance(result: Result) -> dict[str, float]:

@@ -5,12 +5,13 @@ from __future__ import annotations
 import argparse
 import ast
 import logging
-import math
 import sys
 from pathlib import Path
 from typing import Any, Sequence
 
-from .errors import DaeclearError, SolveError
+from .errors import DaeclearError, Interrupted, SolveError
+
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by Ctrl-C
 
 
 def _parse_value(text: str) -> Any:
@@ -73,14 +74,17 @@ def _mechanism(mechanisms: dict[str, Any], name: str, params: dict[str, Any]) ->
 
 
 def _run(args: argparse.Namespace) -> int:
+    from . import options
+    from .outputs import check_directory
     from .scenefile import MECHANISMS, read_scene_file
     from .solve import simulate
 
+    where = "daeclear run"
     params = _parse_sets(args.set)
     sim: dict[str, Any] = {}
     reference_scene = None
     if args.target.endswith(".toml") or Path(args.target).is_file():
-        spec = read_scene_file(args.target)
+        spec = read_scene_file(args.target)  # checks its [simulate] options by the shared rules
         scene, sim = spec.scene, dict(spec.simulate)
         if params or args.joint:
             raise DaeclearError("--set and --joint apply to named mechanisms; edit the scene file instead.")
@@ -93,40 +97,82 @@ def _run(args: argparse.Namespace) -> int:
     else:
         raise DaeclearError(f"run: {args.target!r} is neither a scene file nor a mechanism "
                             f"({', '.join(MECHANISMS)}).")
-    rpm = params.get("rpm", 5000.0)
-    default_t_end = 2 * 60.0 / abs(float(rpm)) if rpm else 0.024  # two crank revolutions
-    t_end = args.t_end or sim.pop("t_end", None) or default_t_end
-    sim.pop("t_end", None)
+    # an option given is checked, never replaced by a default (--t-end 0 is an error, not "two revolutions")
+    if args.t_end is not None:
+        t_end = options.t_end(args.t_end, where=where, field="--t-end")
+        sim.pop("t_end", None)
+    elif "t_end" in sim:
+        t_end = sim.pop("t_end")
+    else:
+        rpm = params.get("rpm", 5000.0)
+        t_end = 2 * 60.0 / abs(float(rpm)) if rpm else 0.024  # two crank revolutions
+    rtol = options.rtol(args.rtol, where=where, field="--rtol") if args.rtol is not None else sim.pop("rtol", 1e-6)
+    sim.pop("rtol", None)
     step = sim.pop("t_eval_step", None)
-    options: dict[str, Any] = {"rtol": args.rtol or sim.pop("rtol", 1e-6), "backend": args.backend,
-                               "progress": not args.quiet, "on_failure": "return"}
+    if step is not None:  # the file's spacing, against the end time actually run
+        step = options.t_eval_step(step, t_end, where=where + f" {args.target}: [simulate]")
+    base = args.name if args.name is not None else scene.name
+    if not base or Path(base).name != base or base in (".", ".."):
+        options.fail(where, "--name", args.name, "a plain file name without a directory (e.g. run1)")
+    check_directory(args.out, "--out", files=[f"{base}.h5", f"{base}.png"])  # before any work
+    run_options: dict[str, Any] = {"rtol": rtol, "backend": args.backend, "progress": not args.quiet,
+                                   "on_failure": "return"}
     if args.formulation:
         sim["formulation"] = args.formulation
-    options.update(sim)
-    if step:
-        import numpy as np
-        options["t_eval"] = np.linspace(0.0, t_end, int(math.floor(t_end / step)) + 1)
-    result = simulate(scene, t_end, **options)
-    args.out.mkdir(parents=True, exist_ok=True)
-    base = args.name or scene.name
-    h5 = result.save(args.out / f"{base}.h5")
+    run_options.update(sim)
+    if step is not None:
+        run_options["t_eval"] = options.uniform_times(step, t_end)
+    h5 = args.out / f"{base}.h5"
+    try:
+        result = simulate(scene, t_end, **run_options)
+    except Interrupted as exc:
+        return _save_interrupted(exc.result, h5)
+    try:
+        result.save(h5)  # atomic; a Ctrl-C during the write is held back until the file is complete
+    except KeyboardInterrupt:
+        print(f"daeclear: interrupted, result saved to {h5} (no figure)", file=sys.stderr)
+        return EXIT_INTERRUPTED
     print(result)
     print(f"wrote {h5}")
+    try:
+        _run_figure(args, result, scene, reference_scene, t_end, run_options["rtol"], base)
+    except KeyboardInterrupt:  # the result is saved already; only the figure is missing
+        print(f"daeclear: interrupted, result saved to {h5} (no figure)", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    if not result.success:
+        print(f"daeclear: run failed: {result.message}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_scene: Any, t_end: float, rtol: float,
+                base: str) -> None:
+    """The response figure of ``daeclear run`` (against the ideal joint when there is one)."""
+    from .solve import simulate
+
     if not args.no_figure:
         import matplotlib
         matplotlib.use("Agg")
         from .plot import save_response_figure
         reference = None
         if reference_scene is not None:
-            reference = simulate(reference_scene, t_end, rtol=options["rtol"], backend=args.backend,
-                                 on_failure="return")
+            reference = simulate(reference_scene, t_end, rtol=rtol, backend=args.backend, on_failure="return")
         png = save_response_figure(result, args.out / f"{base}.png", reference=reference,
                                    channels=_figure_channels(result, scene))
         print(f"wrote {png}")
-    if not result.success:
-        print(f"daeclear: run failed: {result.message}", file=sys.stderr)
-        return 1
-    return 0
+
+
+def _save_interrupted(result: Any, h5: Path) -> int:
+    """Ctrl-C during a run: save its partial result once (a second Ctrl-C waits for the file), exit 130."""
+    if result is None:
+        print("daeclear: interrupted, nothing computed yet", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    try:
+        result.save(h5)  # atomic, SIGINT deferred during the write
+    except KeyboardInterrupt:  # a Ctrl-C held back during the write: the file is complete
+        pass
+    print(f"daeclear: interrupted, partial result saved to {h5} ({result.message})", file=sys.stderr)
+    return EXIT_INTERRUPTED
 
 
 def _figure_channels(result: Any, scene: Any) -> tuple[str, ...]:
@@ -148,21 +194,45 @@ def _floats(text: str, what: str) -> list[float]:
 
 
 def _study(args: argparse.Namespace) -> int:
-    from .accuracy import work_precision
+    from . import options
+    from .accuracy import WorkPrecision, work_precision
+    from .outputs import check_directory
     from .scenefile import MECHANISMS
 
+    where = "daeclear study"
     if args.target not in MECHANISMS:
         raise DaeclearError(f"study: {args.target!r} is not a mechanism ({', '.join(MECHANISMS)}).")
+    t_end = options.t_end(args.t_end, where=where, field="--t-end")
+    repeats = options.repeats(args.repeats, where=where, field="--repeats")
+    names = [m.strip() for m in args.methods.split(",") if m.strip()]
+    options.names(names, where=where, field="--methods")
+    for i, name in enumerate(names):
+        options.method(name, where=where, field=f"--methods[{i}]")
+    methods = {m: {"method": m} for m in names}
+    channels = options.names([c.strip() for c in args.channels.split(",") if c.strip()], where=where,
+                             field="--channels")
+    rtols = options.rtols(_floats(args.rtols, "rtols"), where=where, field="--rtols")
+    steps = options.steps(_floats(args.steps, "steps"), t_end, where=where, field="--steps")
     params = _parse_sets(args.set)
     params.setdefault("joint", args.joint)
     scene = _mechanism(MECHANISMS, args.target, params)
-    methods = {m.strip(): {"method": m.strip()} for m in args.methods.split(",") if m.strip()}
-    study = work_precision(scene, args.t_end, channels=[c.strip() for c in args.channels.split(",") if c.strip()],
-                           methods=methods, rtols=_floats(args.rtols, "rtols"), steps=_floats(args.steps, "steps"),
-                           repeats=args.repeats, progress=True)
-    args.out.mkdir(parents=True, exist_ok=True)
-    study.to_csv(args.out / "work_precision.csv")
-    text = study.to_markdown(args.out / "work_precision.md")
+    files = ("work_precision.csv", "work_precision.md", "work_precision.png")
+    check_directory(args.out, "--out", files=files)  # before any work
+    try:
+        study = work_precision(scene, t_end, channels=channels, methods=methods, rtols=rtols, steps=steps,
+                               repeats=repeats, progress=True)
+    except Interrupted as exc:
+        if isinstance(exc.result, WorkPrecision) and exc.result.rows:
+            try:
+                _write_study_tables(exc.result, args.out)
+            except KeyboardInterrupt:  # a Ctrl-C held back during the write: the tables are complete
+                pass
+            print(f"daeclear: interrupted, partial result saved to {args.out / files[0]} and .md "
+                  f"({len(exc.result.rows)} finished runs)", file=sys.stderr)
+        else:
+            print("daeclear: interrupted before the first study run finished; nothing saved", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    text = _write_study_tables(study, args.out)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -180,6 +250,17 @@ def _study(args: argparse.Namespace) -> int:
               f"equal or better accuracy: {row['rival']} ({row['rival_wall_time']:.4f} s): ratio {row['ratio']:.1f}")
     print(f"wrote {args.out / 'work_precision.csv'}, .md and .png")
     return 0
+
+
+def _write_study_tables(study: Any, out: Path) -> str:
+    """The study's CSV and markdown tables, each written whole (atomic, Ctrl-C deferred); the markdown text."""
+    from .outputs import atomic_write_text, deferred_sigint
+
+    text = study.to_markdown()
+    with deferred_sigint():  # both tables, or a second Ctrl-C waits until both are written
+        atomic_write_text(out / "work_precision.csv", study.to_csv())
+        atomic_write_text(out / "work_precision.md", text)
+    return text
 
 
 # --------------------------------------------------------------------------- daeclear sweep
@@ -245,6 +326,8 @@ def _grid_values(item: str) -> tuple[str, list[Any]]:
 def _sweep(args: argparse.Namespace) -> int:
     import json
 
+    from . import options
+    from .outputs import check_directory, check_file
     from .sweep import sweep
 
     fixed = _parse_sets(args.set)
@@ -262,7 +345,16 @@ def _sweep(args: argparse.Namespace) -> int:
                                 '[{"clearance": 1e-4}, {"clearance": 5e-4, "friction": 0.1}].')
     if not grid and not points:
         raise DaeclearError("sweep: give --grid NAME=VALUES (repeatable) and/or --points FILE.json.")
-    args.out.parent.mkdir(parents=True, exist_ok=True)
+    where = "daeclear sweep"
+    options.revolutions(args.revolutions, where=where, field="--revolutions")
+    options.transient(args.transient, where=where, field="--transient")
+    options.per_revolution(args.per_revolution, where=where, field="--per-revolution")
+    options.rtol(args.rtol, where=where, field="--rtol")
+    options.workers(args.workers, where=where, field="--workers")
+    options.names([c.strip() for c in args.channels.split(",") if c.strip()], where=where, field="--channels")
+    if not args.out.parent.exists():
+        check_directory(args.out.parent, "daeclear sweep OUT (its directory)")
+    check_file(args.out, "daeclear sweep OUT", what="a sweep file (.h5)", example="sweep.h5")  # before any work
     client = cluster = None
     executor = None
     if args.dask:
@@ -285,9 +377,9 @@ def _sweep(args: argparse.Namespace) -> int:
                        twin=twin, rtol=args.rtol, executor=executor, max_workers=args.workers,
                        resume=not args.restart, retry_failed=args.retry_failed, progress=not args.quiet)
     except KeyboardInterrupt:
-        print(f"daeclear: sweep interrupted; finished runs are saved in {args.out}. Run the same command again to "
-              "resume.", file=sys.stderr)
-        return 130
+        print(f"daeclear: interrupted, partial result saved to {args.out} (the finished runs). Run the same command "
+              "again to resume.", file=sys.stderr)
+        return EXIT_INTERRUPTED
     finally:
         if client is not None:
             client.close()
@@ -346,6 +438,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (DaeclearError, ValueError, KeyError) as exc:
         print(f"daeclear: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # Ctrl-C outside a run (assembly, compiling, a figure): nothing to save
+        print("daeclear: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except OSError as exc:  # a write that failed after the checks (disk full, ...): a message, no traceback
+        print(f"daeclear: error: {exc}", file=sys.stderr)
+        return 1
     return 0
 
 

@@ -31,3 +31,23 @@ class DaeclearWarning(UserWarning):
 
 class MissingDependencyError(DaeclearError, ImportError):
     """An optional dependency is not installed; the message names the pip extra that brings it."""
+
+
+class OutputError(DaeclearError, OSError):
+    """An output place (file or directory) cannot be written; found before any work starts."""
+
+
+class OutputDirectoryMissing(OutputError, FileNotFoundError):
+    """The directory an output file should go into does not exist."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C (KeyboardInterrupt) during a run or a study; ``.result`` holds what was computed.
+
+    A KeyboardInterrupt, so it stops every loop that catches only errors (``except Exception``,
+    ``except SolveError``), and ``except KeyboardInterrupt`` still catches it.
+    """
+
+    def __init__(self, message: str, result: Any = None) -> None:
+        super().__init__(message)
+        self.result = result

@@ -200,7 +200,7 @@ class Advance:
     ``eval_*`` hold the requested ``t_eval`` points reached in this call, in (t_start, t].
     """
 
-    status: str  # "tstop" | "root" | "error"
+    status: str  # "tstop" | "root" | "error" | "interrupted" (Ctrl-C between chunks: the steps so far)
     t: float
     y: np.ndarray
     yp: np.ndarray
@@ -935,6 +935,7 @@ class CSession(_SessionBase):
         store = (STORE_TIMES | (STORE_STATES if store_states else 0)) if store_steps else 0
         lib, h = self._lib, self._h
         tic = time.perf_counter()
+        interrupted = False
         try:
             while True:
                 rc = lib.dc_advance(h, t_stop, te_p, m, A["i_eval"], evy_p, evyp_p,
@@ -951,6 +952,8 @@ class CSession(_SessionBase):
                 # buffer full: back in Python between chunks, so Ctrl-C works here
                 if on_chunk is not None:  # time reached, and contact switches made in C so far
                     on_chunk(self._t_out.value, len(auto_events))
+        except KeyboardInterrupt:  # between chunks: return the steps taken so far, marked "interrupted"
+            interrupted, rc = True, 1
         finally:
             self._solve_time += time.perf_counter() - tic
             # also after an interrupt between chunks: the C side stopped at a valid state
@@ -968,6 +971,9 @@ class CSession(_SessionBase):
         adv = Advance(status="tstop", t=self._t, y=self._y, yp=self._yp, step_t=st,
                       step_y=sy, step_yp=syp, step_h=sh, step_order=so, eval_t=te[:ne].copy(),
                       eval_y=ev_y[:ne], eval_yp=ev_yp[:ne], auto_events=auto_events)
+        if interrupted:
+            adv.status = "interrupted"
+            return adv
         if rc == 1:
             return adv
         if rc == 2:

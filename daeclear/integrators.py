@@ -100,7 +100,8 @@ from numpy.typing import ArrayLike, NDArray
 from .assemble import DAEModel, assemble
 from .codegen import (ODE_DRIVER_ABI, BuildResult, CompileError, CompilerUnavailable, OdeSpec, build_ode_library,
                       memo_get, memo_put, memo_table)
-from .errors import DaeclearError, DaeclearWarning, SceneError, SolveError
+from . import options
+from .errors import DaeclearError, DaeclearWarning, Interrupted, SceneError, SolveError
 from .result import ContactEvent, Result
 from .scene import Scene
 
@@ -148,10 +149,7 @@ def check_step(method: str, step: Any) -> float | None:
         if step is None:
             raise SceneError(f"simulate: method={METHOD_NAMES[method]!r} is a fixed-step scheme and needs "
                              "step=<step size in s> (the chapter uses 1e-5 s).")
-        ok = isinstance(step, (int, float)) and not isinstance(step, bool) and math.isfinite(step) and step > 0
-        if not ok:
-            raise SceneError(f"simulate: step={step!r} s, must be a finite number > 0.")
-        return float(step)
+        return options.step(step)
     if step is not None:
         name = METHOD_NAMES.get(method, method)
         raise SceneError(f"simulate: step={step!r} is only for the fixed-step methods "
@@ -1296,19 +1294,17 @@ def integrate(
         valid = ", ".join(["ida", *METHOD_NAMES.values()])
         raise SceneError(f"simulate: method={method!r}, must be one of {valid} (case-insensitive).")
     step = check_step(method_l, step)
-    on_failure = str(on_failure).lower()
-    if on_failure not in ("raise", "return"):
-        raise SceneError(f"simulate: on_failure={on_failure!r}, must be one of raise, return (case-insensitive).")
-    backend = str(backend).lower()
-    if backend not in ("auto", "c", "python"):
-        raise SceneError(f"simulate: backend={backend!r}, must be one of auto, c, python (case-insensitive).")
-    t_end = _positive("t_end", t_end, "s")
-    rtol = _positive("rtol", rtol, "")
-    max_step = _positive("max_step", max_step, "s", allow_zero=True)
-    if not isinstance(max_steps, int) or isinstance(max_steps, bool) or max_steps < 1:
-        raise SceneError(f"simulate: max_steps={max_steps!r}, must be an integer >= 1.")
-    if rtol < 1e-14 or rtol > 1e-2:
-        raise SceneError(f"simulate: rtol={rtol!r}, must be in [1e-14, 1e-2].")
+    on_failure = options.on_failure(on_failure)
+    backend = options.backend(backend)
+    t_end = options.t_end(t_end)
+    rtol = options.rtol(rtol)
+    options.atol(atol)
+    max_step = options.max_step(max_step)
+    max_steps = options.max_steps(max_steps)
+    t_eval = options.t_eval(t_eval, t_end)
+    store_steps = options.flag(store_steps, field="store_steps")
+    progress = options.flag(progress, field="progress")
+    track_work = options.flag(track_work, field="track_work")
     name = METHOD_NAMES[method_l]
     if track_work:
         raise SceneError(f"simulate: track_work=True is supported by method='ida' only, not by method={name!r}.")
@@ -1327,9 +1323,7 @@ def integrate(
                          "integrates the chapter's index-1 formulation (formulation='index1').")
     eval_times = None
     if t_eval is not None:
-        eval_times = np.asarray(t_eval, dtype=float).ravel()
-        if eval_times.size == 0 or np.any(np.diff(eval_times) <= 0) or eval_times[0] < 0 or eval_times[-1] > t_end:
-            raise SceneError(f"simulate: t_eval must be increasing values in [0, t_end={t_end}].")
+        eval_times = np.asarray(t_eval, dtype=float).ravel()  # checked by options.t_eval
     n = model.n_q
     atol_x = tolerance_vector(model, rtol, atol)[:2 * n]
     ev = _evaluator(model, backend)
@@ -1348,14 +1342,19 @@ def integrate(
                 _run_fixed(run, x0, step)  # type: ignore[arg-type]
             else:
                 _run_scipy(run, x0, rtol, atol_x, max_step)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # Ctrl-C: keep what was computed, then stop the caller too (Interrupted)
         run.success, run.status = False, -1
         run.message = f"interrupted by the user at t={run.t_last:.6g} s"
         run.close_segment(hermite=method_l in FIXED_STEP_METHODS)
+        interrupted = True
+    else:
+        interrupted = False
     solve_time = time.perf_counter() - tic
     if run.progress:
         run._progress(t_end if run.success else run.t_last)
     result = run.result(setup_time, solve_time, sim_params)
+    if interrupted:
+        raise Interrupted(f"simulate: {result.message}; partial result in .result.", result)
     if not result.success and on_failure == "raise":
         raise SolveError(result.message + " Partial result in .result.", result)
     return result

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from . import options as rules
 from .contact import Material, friction_law, normal_law
 from .contact.base import NormalLaw
 from .errors import SceneError
@@ -60,11 +61,14 @@ def _check(name: str, value: Any, rule: str, ok: bool) -> None:
         raise SceneError(f"slider_crank: {name}={value!r}, {rule}.")
 
 
-def _contact_law(law: Any, restitution: float, length: float | None) -> NormalLaw:
+DEFAULT_RESTITUTION = 0.9  # Table 4.2, for the laws that take a coefficient of restitution
+
+
+def _contact_law(law: Any, restitution: float | None, length: float | None) -> NormalLaw:
     """A law object from a law or a name; ``restitution``/``length`` fill the fields the law has."""
     if isinstance(law, NormalLaw):
         return law
-    fields = {"restitution": restitution, "length": length}
+    fields = {"restitution": DEFAULT_RESTITUTION if restitution is None else restitution, "length": length}
     from .contact.registry import NORMAL_LAWS, _NORMAL_ALIASES, _lookup  # one source of names
 
     cls = _lookup("law", str(law), NORMAL_LAWS, _NORMAL_ALIASES)
@@ -74,7 +78,7 @@ def _contact_law(law: Any, restitution: float, length: float | None) -> NormalLa
 
 def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 5000.0,
                  crank_angle: float = 0.0, name: str | None = None, clearance: float = 0.5e-3,
-                 law: Any = "lankarani-nikravesh", restitution: float = 0.9, friction: Any = None,
+                 law: Any = "lankarani-nikravesh", restitution: float | None = None, friction: Any = None,
                  bearing_radius: float = BEARING_RADIUS, material: Material = STEEL,
                  length: float | None = None, contact_model: str = "corners",
                  face_law: Any = "lankarani-plane", **options: Any) -> Scene:
@@ -113,8 +117,9 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     law : str or NormalLaw
         Normal contact law (name or object; stiffness computed from radii and material
         when not given). Default Lankarani-Nikravesh (3.9).
-    restitution : float
-        Coefficient of restitution c_e for laws that take one (0.9, Table 4.2).
+    restitution : float or None
+        Coefficient of restitution c_e for laws that take one (None: 0.9, Table 4.2). Given with a
+        law that has none (e.g. law="hertz"), it is an error, not ignored.
     friction : None, float, str or FrictionLaw
         None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
     bearing_radius : float
@@ -161,6 +166,8 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     pin_c = (state["slider"][0], 0.0)
     scene.add(Revolute("A", scene.ground, crank, at=(0.0, 0.0)))
     scene.add(Revolute("B", crank, rod, at=pin_b))
+    if joint != "ideal":  # given for a law without one (or for a law object), it would be silently dropped
+        rules.restitution(restitution, law, where="slider_crank")
     if joint == "revolute":
         _check("clearance", clearance, "must be a number in (0, bearing_radius) m",
                isinstance(clearance, (int, float)) and 0 < clearance < bearing_radius)
@@ -201,7 +208,8 @@ def _finite(value: Any) -> bool:
 
 def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm: float | None = None,
           angle: float = 0.0, link_length: float = CHAIN_LINK_LENGTH, link_mass: float = CHAIN_LINK_MASS,
-          link_inertia: float | None = None, law: Any = "lankarani-nikravesh", restitution: float = 0.9,
+          link_inertia: float | None = None, law: Any = "lankarani-nikravesh",
+          restitution: float | None = None,
           friction: Any = None, bearing_radius: float = BEARING_RADIUS, material: Material = STEEL,
           length: float | None = None, name: str | None = None, **options: Any) -> Scene:
     """A planar chain of ``n_links`` rigid links with a revolute clearance joint at every pin.
@@ -249,8 +257,9 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
     law : str or NormalLaw
         Normal contact law of every clearance joint (name or object; stiffness computed from
         the radii and material when not given). Default Lankarani-Nikravesh (3.9).
-    restitution : float
-        Coefficient of restitution c_e for laws that take one (0.9).
+    restitution : float or None
+        Coefficient of restitution c_e for laws that take one (None: 0.9); an error with a law
+        that has none.
     friction : None, float, str or FrictionLaw
         None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
     bearing_radius : float
@@ -299,6 +308,7 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
     omega = 0.0 if rpm is None else rpm_to_rad_s(rpm)
     scene = Scene(name or f"chain{n_links}", gravity=(0.0, -gravity))
     ux, uy = math.cos(angle), math.sin(angle)
+    rules.restitution(restitution, law, where="chain")
     contact_law = _contact_law(law, restitution, length)
     bearing: Any = scene.ground
     for k in range(1, n_links + 1):

@@ -915,25 +915,27 @@ class Result:
         Raises
         ------
         FileNotFoundError
-            If the directory of `path` does not exist.
+            If the directory of `path` does not exist (an ``OutputDirectoryMissing``).
         OSError
-            If the file cannot be written.
+            If `path` is a directory or its directory cannot be written (an ``OutputError``,
+            checked before writing), or the write fails.
         """
         import h5py
 
-        path = Path(path)
-        if not path.parent.is_dir():
-            raise FileNotFoundError(f"cannot save result to '{path}': directory '{path.parent}' does not exist.")
+        from .outputs import check_file, deferred_sigint
+
+        path = check_file(path, "Result.save(path)")  # the one output-place rule (daeclear.outputs)
         tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:12]}.tmp")
-        try:
-            with h5py.File(tmp, "x") as f:
-                _write(f, self)
-            with open(tmp, "rb+") as fh:  # data on disk before the rename makes it visible
-                os.fsync(fh.fileno())
-            os.replace(tmp, path)
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
+        with deferred_sigint():  # a Ctrl-C during the write arrives once the file is complete
+            try:
+                with h5py.File(tmp, "x") as f:
+                    _write(f, self)
+                with open(tmp, "rb+") as fh:  # data on disk before the rename makes it visible
+                    os.fsync(fh.fileno())
+                os.replace(tmp, path)
+            except BaseException:
+                tmp.unlink(missing_ok=True)
+                raise
         return path
 
 

@@ -49,11 +49,12 @@ Unknown tables or keys are errors that name the file, the table and the key.
 from __future__ import annotations
 
 import dataclasses
+import math
 import tomllib
 from pathlib import Path
 from typing import Any, Callable
 
-from . import mechanisms
+from . import mechanisms, options
 from .errors import SceneError
 from .contact import Material, friction_law, normal_law
 from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
@@ -113,6 +114,31 @@ def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any
         raise SceneError(f"{path}: [[{table}]] #{index + 1}: {exc}") from None
 
 
+def check_simulate(simulate: dict[str, Any], *, where: str) -> dict[str, Any]:
+    """The [simulate] table checked by the rules simulate() applies (daeclear.options), none ignored:
+    ``t_end = 0`` or ``t_eval_step = 0`` are errors, not "use the default"."""
+    out = dict(simulate)
+    if "t_end" in out:
+        out["t_end"] = options.t_end(out["t_end"], where=where)
+    if "rtol" in out:
+        out["rtol"] = options.rtol(out["rtol"], where=where)
+    if "atol" in out:
+        atol = options.atol(out["atol"], where=where)
+        out["atol"] = atol.tolist() if hasattr(atol, "tolist") else atol
+    if "max_step" in out:
+        out["max_step"] = options.max_step(out["max_step"], where=where)
+    for key, rule in (("method", options.method), ("formulation", options.formulation),
+                      ("backend", options.backend)):
+        if key in out:
+            out[key] = rule(out[key], where=where)
+    if "t_eval_step" in out:
+        # against the file's t_end when it has one (the command line checks it again against the end it runs)
+        end = out.get("t_end", math.inf)
+        out["t_eval_step"] = options.number(out["t_eval_step"], where=where, field="t_eval_step", unit="s", low=0.0,
+                                            high=None if math.isinf(end) else end)
+    return out
+
+
 def read_scene_file(path: str | Path) -> SceneFile:
     """Read and validate a TOML scene file; raise SceneError naming the file, table and key."""
     path = Path(path)
@@ -127,6 +153,7 @@ def read_scene_file(path: str | Path) -> SceneFile:
     if unknown_sim:
         raise SceneError(f"{path}: [simulate]: unknown key(s) {', '.join(unknown_sim)}; "
                          f"allowed: {', '.join(SIMULATE_KEYS)}.")
+    simulate = check_simulate(simulate, where=f"{path}: [simulate]")
     if "mechanism" in data:
         extra = sorted(set(data) - {"mechanism", "simulate"})
         if extra:

@@ -20,16 +20,17 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import options
 from .assemble import KIND_MULTIPLIER, KIND_WORK, STARTS, DAEModel, assemble
-from .errors import DaeclearWarning, SceneError, SolveError
+from .errors import DaeclearWarning, Interrupted, SceneError, SolveError
 from .ida_session import LINEAR_SOLVERS, open_session
 from .result import ContactEvent, Result
 from .scene import Scene
 
 log = logging.getLogger("daeclear")
 
-METHODS: tuple[str, ...] = ("ida", "rk45", "dop853", "radau", "bdf", "lsoda", "rk4", "euler")
-ON_FAILURE: tuple[str, ...] = ("raise", "return")
+METHODS: tuple[str, ...] = options.METHODS
+ON_FAILURE: tuple[str, ...] = options.ON_FAILURE
 # Multipliers are kept out of IDA's error test by a huge absolute tolerance (scikit-sundae has
 # no IDASetSuppressAlg): atol = MULTIPLIER_ATOL_FACTOR * rtol, see PERFORMANCE.md item 1.
 MULTIPLIER_ATOL_FACTOR = 1e12
@@ -183,17 +184,20 @@ def simulate(
     -------
     Result
     """
-    method = _choice("method", method, METHODS)
-    on_failure = _choice("on_failure", on_failure, ON_FAILURE)
+    method = options.method(method)
+    on_failure = options.on_failure(on_failure)
     linear_solver = _choice("linear_solver", linear_solver, LINEAR_SOLVERS)
     start = _choice("start", start, STARTS)
-    t_end = _positive("t_end", t_end, "s")
-    rtol = _positive("rtol", rtol, "")
-    max_step = _positive("max_step", max_step, "s", allow_zero=True)
-    if not isinstance(max_steps, int) or max_steps < 1:
-        raise SceneError(f"simulate: max_steps={max_steps!r}, must be an integer >= 1.")
-    if rtol < 1e-14 or rtol > 1e-2:
-        raise SceneError(f"simulate: rtol={rtol!r}, must be in [1e-14, 1e-2].")
+    backend = options.backend(backend)
+    t_end = options.t_end(t_end)
+    rtol = options.rtol(rtol)
+    options.atol(atol)
+    max_step = options.max_step(max_step)
+    max_steps = options.max_steps(max_steps)
+    t_eval = options.t_eval(t_eval, t_end)
+    store_steps = options.flag(store_steps, field="store_steps")
+    progress = options.flag(progress, field="progress")
+    track_work = options.flag(track_work, field="track_work")
     from .integrators import check_step, integrate  # the non-IDA methods
 
     check_step(method, step)
@@ -207,9 +211,7 @@ def simulate(
     model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation, track_work=track_work)
     eval_times = None
     if t_eval is not None:
-        eval_times = np.asarray(t_eval, dtype=float).ravel()
-        if eval_times.size == 0 or np.any(np.diff(eval_times) <= 0) or eval_times[0] < 0 or eval_times[-1] > t_end:
-            raise SceneError(f"simulate: t_eval must be increasing values in [0, t_end={t_end}].")
+        eval_times = np.asarray(t_eval, dtype=float).ravel()  # checked by options.t_eval
     atol_vec = tolerance_vector(model, rtol, atol)
     session = open_session(model.functions, backend=backend, rtol=rtol, atol=atol_vec, max_step=max_step,
                            parameters=model.parameter_values, max_steps=max_steps, linear_solver=linear_solver)
@@ -264,6 +266,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     t = 0.0
     success, status, message = True, 0, "end of the time span reached"
     n_restarts = 0
+    interrupted = False
     try:
         # the compiled loop makes states consistent itself (restarts after its own switches, the
         # reported points); the python backend leaves that to the model's Python methods
@@ -330,6 +333,10 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
                 adv.message = "internal: the compiled event loop left a contact root undecided"
             t, y, yp = adv.t, adv.y, adv.yp
+            if adv.status == "interrupted":  # Ctrl-C between the compiled loop's chunks: its steps are kept
+                segments.append((seg_start, t, dict(modes)))
+                seg_start = t
+                raise KeyboardInterrupt
             progress_line.update(t, len(events))
             if adv.status == "error":
                 segments.append((seg_start, t, dict(modes)))
@@ -356,8 +363,9 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
             switch = model.switch_vector(active, params)
             session.reinit(t, y, yp, active, params, _root_directions(model, active))
             n_restarts += 1
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # Ctrl-C: keep what was computed, then stop the caller too (Interrupted)
         success, status, message = False, -1, f"interrupted by the user at t={t:.6g} s"
+        interrupted = True
     finally:
         stats = dict(session.stats())
 
@@ -399,6 +407,8 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         parameters={**model.parameters, "simulate": sim_params}, scene_name=model.scene_name,
         method=sim_params["method"], formulation=model.formulation,
     )
+    if interrupted:
+        raise Interrupted(f"simulate: {message}; partial result in .result.", result)
     if not success and on_failure == "raise":
         raise SolveError(message + " Partial result in .result.", result)
     return result

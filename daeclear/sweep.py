@@ -72,7 +72,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .analysis import CHANNELS, PhasePortrait, PoincareSection
-from .errors import DaeclearError, DaeclearWarning, SceneError
+from .errors import DaeclearError, DaeclearWarning, OutputError, SceneError
+from .outputs import check_file, deferred_sigint
 
 if TYPE_CHECKING:
     import h5py
@@ -224,9 +225,20 @@ def _build_scene(mechanism: str | Callable[..., Any], parameters: Mapping[str, A
     return MECHANISMS[mechanism](**parameters)
 
 
-def _ignore_sigint() -> None:
-    """Process-pool initializer: Ctrl-C goes to the sweep's own process, which stops the workers."""
+def _ignore_sigint(parent: int | None = None) -> None:
+    """Process-pool initializer: Ctrl-C goes to the sweep's own process, which stops the workers; and
+    on Linux a worker dies with the sweep's process (killed hard, no cleanup) instead of lingering."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):  # pragma: no cover - no prctl: workers end with their queue
+            return
+        if parent is not None and os.getppid() != parent:  # the parent died before prctl took effect
+            os._exit(1)
 
 
 def _run_task(task: Mapping[str, Any]) -> dict[str, Any]:
@@ -680,7 +692,12 @@ def load_sweep(path: str | os.PathLike[str]) -> SweepResult:
     records: dict[str, RunRecord] = {}
     mechanism, options = "", {}
     if path.is_file():
-        with h5py.File(path, "r") as f:
+        try:
+            f = h5py.File(path, "r")
+        except OSError as exc:
+            raise DaeclearError(f"'{path}' cannot be opened as HDF5 ({exc}); it is not a daeclear sweep file. "
+                                "Give another path (or delete it to start over).") from None
+        with f:
             _check_format(f, path)
             mechanism = _text(f.attrs["mechanism"])
             options = json.loads(_text(f.attrs["options_json"]))
@@ -875,11 +892,24 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     KeyboardInterrupt
         Re-raised after the finished runs are saved.
     """
-    path = Path(path)
-    if not path.parent.is_dir():
-        raise FileNotFoundError(f"sweep: directory '{path.parent}' of '{path}' does not exist.")
+    from . import options as check
+
+    path = check_file(path, "sweep(path)", what="a sweep file (.h5)", example="sweep.h5")  # before any work
+    if _parts_dir(path).exists() and not _parts_dir(path).is_dir():
+        raise OutputError(f"sweep(path) '{path}': its journal '{_parts_dir(path)}' is a file; it must be a "
+                          "directory (move the file away).")
+    if _lock_path(path).is_dir():
+        raise OutputError(f"sweep(path) '{path}': its lock '{_lock_path(path)}' is a directory; remove it.")
     if keep not in KEEP:
         raise SceneError(f"sweep: keep={keep!r}, must be one of {', '.join(KEEP)}.")
+    check.revolutions(revolutions)
+    check.transient(transient)
+    check.per_revolution(per_revolution)
+    check.rtol(rtol, where="sweep")
+    check.workers(max_workers)
+    check.names(list(channels) if not isinstance(channels, str) else channels, where="sweep", field="channels")
+    if not isinstance(twin, bool) and twin != "auto":
+        check.fail("sweep", "twin", twin, "True, False or 'auto'")
     extra = dict(analysis or {})
     unknown = sorted(set(extra) - set(ANALYSIS_OPTIONS))
     if unknown:
@@ -943,7 +973,8 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     finally:
         try:
             if checked and (path.is_file() or _part_files(path)):
-                _consolidate(path, mechanism=mech_name, options=file_options, order=order)
+                with deferred_sigint():  # a second Ctrl-C waits for the merge (atomic anyway: the journal stays)
+                    _consolidate(path, mechanism=mech_name, options=file_options, order=order)
         finally:
             lock.unlink(missing_ok=True)
     out = load_sweep(path) if path.is_file() else SweepResult(path, [], mech_name, file_options)
@@ -963,7 +994,7 @@ def _execute(path: Path, todo: list[dict[str, Any]], executor: cf.Executor | Non
     own = executor is None
     if own:  # the platform's start method: fork on Linux (scripts need no __main__ guard), spawn elsewhere
         workers = max(1, min(max_workers or os.cpu_count() or 1, len(todo)))
-        executor = cf.ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint)
+        executor = cf.ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint, initargs=(os.getpid(),))
     assert executor is not None
     parts = _parts_dir(path)
     done = failed = 0

@@ -1,0 +1,264 @@
+"""One validation rule per run option, shared by every entry (Python API, command line, scene files).
+
+Each function checks one option and returns its normalised value, or raises :class:`SceneError`
+with one message shape everywhere: ``<where>: <field>=<value> [unit], must be <rule>.``. ``where``
+names the entry (``simulate``, ``daeclear run``, ``<file>: [simulate]``) and ``field`` the option
+as the user wrote it there (``t_end``, ``--t-end``), so the same mistake gets the same rule
+wherever it is made. Nothing is silently replaced: a zero, a NaN or a value of the wrong type is
+an error, never "use the default".
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, NoReturn, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import SceneError
+
+METHODS: tuple[str, ...] = ("ida", "rk45", "dop853", "radau", "bdf", "lsoda", "rk4", "euler")
+FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
+BACKENDS: tuple[str, ...] = ("auto", "c", "python")
+ON_FAILURE: tuple[str, ...] = ("raise", "return")
+RTOL_RANGE: tuple[float, float] = (1e-14, 1e-2)
+
+
+def fail(where: str, field: str, value: Any, rule: str, unit: str = "", *, shown: str | None = None) -> NoReturn:
+    """Raise the one error shape of a bad option: where, field, value (unit) and the rule.
+
+    ``shown`` replaces ``repr(value)`` for values too long to repeat (arrays).
+    """
+    if isinstance(value, (np.floating, np.integer)):
+        value = value.item()
+    shown = shown if shown is not None else repr(value)
+    shown = f"{shown} {unit}" if unit else shown
+    raise SceneError(f"{where}: {field}={shown}, must be {rule}.")
+
+
+def _real(value: Any) -> bool:
+    """A real number (numpy scalars included), not a bool."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def number(value: Any, *, where: str, field: str, unit: str = "", low: float | None = None,
+           low_open: bool = True, high: float | None = None) -> float:
+    """A finite real number in (low, high] (or [low, high] when ``low_open`` is False)."""
+    ok = _real(value) and math.isfinite(float(value))
+    if ok and low is not None:
+        ok = float(value) > low if low_open else float(value) >= low
+    if ok and high is not None:
+        ok = float(value) <= high
+    if not ok:
+        parts = []
+        if low is not None:
+            parts.append(f"{'>' if low_open else '>='} {low:g}")
+        if high is not None:
+            parts.append(f"<= {high:g}")
+        fail(where, field, value, "a finite number" + (" " + " and ".join(parts) if parts else ""), unit)
+    return float(value)
+
+
+def integer(value: Any, *, where: str, field: str, low: int) -> int:
+    """An integer >= low (a float with an integer value, e.g. 3.0 from a scene file, is not one)."""
+    if not isinstance(value, (int, np.integer)) or isinstance(value, (bool, np.bool_)) or int(value) < low:
+        fail(where, field, value, f"an integer >= {low}")
+    return int(value)
+
+
+def flag(value: Any, *, where: str = "simulate", field: str) -> bool:
+    """A switch: True or False (a string such as "no" would otherwise count as True)."""
+    if not isinstance(value, (bool, np.bool_)):
+        fail(where, field, value, "True or False")
+    return bool(value)
+
+
+def choice(value: Any, allowed: Sequence[str], *, where: str, field: str) -> str:
+    """One of ``allowed`` (case-insensitive), returned in lower case."""
+    text = value.lower() if isinstance(value, str) else None
+    if text not in allowed:
+        fail(where, field, value, f"one of {', '.join(allowed)} (case-insensitive)")
+    return text  # type: ignore[return-value]
+
+
+# --------------------------------------------------------------------------- the run options
+
+
+def t_end(value: Any, *, where: str = "simulate", field: str = "t_end") -> float:
+    """End time of a run: a finite number > 0, s."""
+    return number(value, where=where, field=field, unit="s", low=0.0)
+
+
+def rtol(value: Any, *, where: str = "simulate", field: str = "rtol") -> float:
+    """Relative tolerance: a finite number in [1e-14, 1e-2]."""
+    lo, hi = RTOL_RANGE
+    ok = _real(value) and math.isfinite(float(value)) and lo <= float(value) <= hi
+    if not ok:
+        fail(where, field, value, f"a finite number in [{lo:g}, {hi:g}]")
+    return float(value)
+
+
+def atol(value: Any, *, where: str = "simulate", field: str = "atol") -> float | NDArray[np.float64] | None:
+    """Absolute tolerance: None (default), a finite number > 0, or finite values > 0 (one per state)."""
+    if value is None:
+        return None
+    if _real(value):
+        return number(value, where=where, field=field, low=0.0)
+    try:
+        values = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        fail(where, field, value, "a finite number > 0 or a list of them (one per state)")
+    if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)) or np.any(values <= 0):
+        fail(where, field, value, "a finite number > 0 or a list of them (one per state)")
+    return values.copy()
+
+
+def max_step(value: Any, *, where: str = "simulate", field: str = "max_step") -> float:
+    """Largest step: a finite number >= 0, s (0: unbounded)."""
+    return number(value, where=where, field=field, unit="s", low=0.0, low_open=False)
+
+
+def max_steps(value: Any, *, where: str = "simulate", field: str = "max_steps") -> int:
+    """Cap on the number of steps: an integer >= 1."""
+    return integer(value, where=where, field=field, low=1)
+
+
+def step(value: Any, *, where: str = "simulate", field: str = "step") -> float:
+    """Step size of a fixed-step method: a finite number > 0, s."""
+    return number(value, where=where, field=field, unit="s", low=0.0)
+
+
+def t_eval(value: ArrayLike | None, end: float, *, where: str = "simulate",
+           field: str = "t_eval") -> NDArray[np.float64] | None:
+    """Output times: None, or finite, strictly increasing values in [0, t_end] (NaN is an error, not a cut)."""
+    if value is None:
+        return None
+    rule = f"finite, strictly increasing values in [0, t_end={end:g}]"
+    try:
+        times = np.asarray(value, dtype=float).ravel()
+    except (TypeError, ValueError):
+        fail(where, field, value, rule)
+    if times.size == 0:
+        fail(where, field, value, "at least one time: " + rule)
+    bad = ~np.isfinite(times)
+    if bad.any():
+        index = int(np.argmax(bad))
+        fail(where, field, value, rule + f" ({float(times[index])!r} at index {index})", shown=_show(times))
+    if np.any(np.diff(times) <= 0) or times[0] < 0 or times[-1] > end:
+        fail(where, field, value, rule, shown=_show(times))
+    return times
+
+
+def _show(times: NDArray[np.float64]) -> str:
+    """A short text of an array of times for a message."""
+    if times.size <= 6:
+        return "[" + ", ".join(repr(float(x)) for x in times) + "]"
+    return f"array of {times.size} times from {float(times[0])!r} to {float(times[-1])!r}"
+
+
+def t_eval_step(value: Any, end: float, *, where: str, field: str = "t_eval_step") -> float:
+    """Spacing of uniform output times: a finite number in (0, t_end], s."""
+    return number(value, where=where, field=field, unit="s", low=0.0, high=end)
+
+
+def uniform_times(spacing: float, end: float) -> NDArray[np.float64]:
+    """Output times from 0 to ``end`` (both included), ``end / floor(end / spacing)`` apart."""
+    return np.linspace(0.0, end, int(math.floor(end / spacing)) + 1)
+
+
+def method(value: Any, *, where: str = "simulate", field: str = "method") -> str:
+    """Integrator name (case-insensitive)."""
+    return choice(value, METHODS, where=where, field=field)
+
+
+def formulation(value: Any, *, where: str = "simulate", field: str = "formulation") -> str:
+    """DAE formulation (case-insensitive)."""
+    return choice(value, FORMULATIONS, where=where, field=field)
+
+
+def backend(value: Any, *, where: str = "simulate", field: str = "backend") -> str:
+    """Where the model is evaluated (case-insensitive)."""
+    return choice(value, BACKENDS, where=where, field=field)
+
+
+def on_failure(value: Any, *, where: str = "simulate", field: str = "on_failure") -> str:
+    """What a failed run does (case-insensitive)."""
+    return choice(value, ON_FAILURE, where=where, field=field)
+
+
+# --------------------------------------------------------------------------- studies and sweeps
+
+
+def repeats(value: Any, *, where: str = "work_precision", field: str = "repeats") -> int:
+    """Timed repeats per run: an integer >= 0 (0: one untimed-warm-up-free run)."""
+    return integer(value, where=where, field=field, low=0)
+
+
+def n_eval(value: Any, *, where: str = "work_precision", field: str = "n_eval") -> int:
+    """Number of comparison times: an integer >= 2."""
+    return integer(value, where=where, field=field, low=2)
+
+
+def rtols(values: Any, *, where: str = "work_precision", field: str = "rtols") -> list[float]:
+    """A non-empty list of relative tolerances, each by :func:`rtol`."""
+    items = _list(values, where=where, field=field)
+    return [rtol(v, where=where, field=f"{field}[{i}]") for i, v in enumerate(items)]
+
+
+def steps(values: Any, end: float, *, where: str = "work_precision", field: str = "steps") -> list[float]:
+    """A non-empty list of fixed steps, each a finite number in (0, t_end], s."""
+    items = _list(values, where=where, field=field)
+    return [number(v, where=where, field=f"{field}[{i}]", unit="s", low=0.0, high=end) for i, v in enumerate(items)]
+
+
+def names(values: Any, *, where: str, field: str) -> list[str]:
+    """A non-empty list of non-empty names (channels, methods)."""
+    items = _list(values, where=where, field=field)
+    for i, v in enumerate(items):
+        if not isinstance(v, str) or not v.strip():
+            fail(where, f"{field}[{i}]", v, "a non-empty name")
+    return [v.strip() for v in items]
+
+
+def _list(values: Any, *, where: str, field: str) -> list[Any]:
+    if isinstance(values, (str, bytes)) or not isinstance(values, (list, tuple, np.ndarray)) or len(values) == 0:
+        fail(where, field, values, "a non-empty list")
+    return list(values)
+
+
+def revolutions(value: Any, *, where: str = "sweep", field: str = "revolutions") -> int:
+    """Revolutions analysed: an integer >= 1."""
+    return integer(value, where=where, field=field, low=1)
+
+
+def transient(value: Any, *, where: str = "sweep", field: str = "transient") -> int:
+    """Revolutions discarded first: an integer >= 0."""
+    return integer(value, where=where, field=field, low=0)
+
+
+def per_revolution(value: Any, *, where: str = "sweep", field: str = "per_revolution") -> int:
+    """Output samples per revolution: an integer >= 1."""
+    return integer(value, where=where, field=field, low=1)
+
+
+def workers(value: Any, *, where: str = "sweep", field: str = "max_workers") -> int | None:
+    """Worker processes: None (the CPU count) or an integer >= 1."""
+    return None if value is None else integer(value, where=where, field=field, low=1)
+
+
+def restitution(value: Any, law: Any, *, where: str, field: str = "restitution") -> None:
+    """A restitution given explicitly must reach a law that has one (it is never dropped silently)."""
+    if value is None:
+        return
+    from .contact.base import NormalLaw
+    from .contact.registry import NORMAL_LAWS, _NORMAL_ALIASES, _lookup
+
+    if isinstance(law, NormalLaw):
+        fail(where, field, value, f"left out when law is a law object ({type(law).__name__}); set it on the "
+             "law object instead")
+    cls = _lookup("law", str(law), NORMAL_LAWS, _NORMAL_ALIASES)
+    if "restitution" not in getattr(cls, "__dataclass_fields__", {}):
+        takes = [n for n, c in NORMAL_LAWS.items() if "restitution" in getattr(c, "__dataclass_fields__", {})]
+        fail(where, field, value, f"left out with law={law!r}, which has no coefficient of restitution "
+             f"(laws with one: {', '.join(takes)})")

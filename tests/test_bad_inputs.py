@@ -1,0 +1,455 @@
+"""Bad inputs through every entry (Python API, command line, scene files), one table.
+
+Each case asserts the error class (or the command line's exit code 2, one line, no traceback)
+and that the message names the field and the value. Nothing is computed: ``simulate`` (for
+the command line, studies and sweeps) and the sweep's executor are replaced by a guard that
+fails the test if a bad input got that far.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any, Callable
+
+import pytest
+
+import daeclear as dc
+from daeclear.accuracy import work_precision
+from daeclear.cli import main
+from daeclear.errors import OutputDirectoryMissing, OutputError, SceneError
+from daeclear.scenefile import read_scene_file
+
+SCENE = dc.mechanisms.slider_crank("ideal")
+TINY = 1e-4  # s
+
+
+@pytest.fixture(autouse=True)
+def no_work(monkeypatch):
+    """A bad input must be refused before any run: the runs of the CLI, studies and sweeps are guarded."""
+    import sys
+
+    import daeclear.accuracy
+    import daeclear.solve
+
+    sweep_module = sys.modules["daeclear.sweep"]  # daeclear.sweep is the function
+
+    def guard(*args: Any, **kwargs: Any) -> Any:
+        raise AssertionError("a bad input reached the computation")
+
+    monkeypatch.setattr(daeclear.solve, "simulate", guard)
+    monkeypatch.setattr(daeclear.accuracy, "simulate", guard)
+    monkeypatch.setattr(sweep_module, "_execute", guard)
+
+
+@pytest.fixture(scope="module")
+def tiny_result():
+    return dc.simulate(SCENE, TINY)
+
+
+# --------------------------------------------------------------------------- the Python API
+
+NAN, INF = math.nan, math.inf
+
+API_SIMULATE: list[tuple[str, dict[str, Any], str, str]] = [
+    # (id, keywords of simulate(SCENE, ...), field, value as shown)
+    ("t_end=0", {"t_end": 0}, "t_end", "t_end=0"),
+    ("t_end<0", {"t_end": -1.0}, "t_end", "-1.0"),
+    ("t_end=nan", {"t_end": NAN}, "t_end", "nan"),
+    ("t_end=inf", {"t_end": INF}, "t_end", "inf"),
+    ("t_end=str", {"t_end": "0.01"}, "t_end", "'0.01'"),
+    ("t_end=None", {"t_end": None}, "t_end", "None"),
+    ("t_end=bool", {"t_end": True}, "t_end", "True"),
+    ("rtol=0", {"rtol": 0}, "rtol", "rtol=0"),
+    ("rtol<0", {"rtol": -1e-6}, "rtol", "-1e-06"),
+    ("rtol=1", {"rtol": 1.0}, "rtol", "1.0"),
+    ("rtol=nan", {"rtol": NAN}, "rtol", "nan"),
+    ("rtol tiny", {"rtol": 1e-20}, "rtol", "1e-20"),
+    ("rtol=str", {"rtol": "1e-6"}, "rtol", "'1e-6'"),
+    ("atol=0", {"atol": 0.0}, "atol", "0.0"),
+    ("atol<0", {"atol": -1e-9}, "atol", "-1e-09"),
+    ("atol=nan", {"atol": NAN}, "atol", "nan"),
+    ("atol list<0", {"atol": [1e-9, -1e-9]}, "atol", "-1e-09"),
+    ("atol=str", {"atol": "small"}, "atol", "'small'"),
+    ("max_step<0", {"max_step": -1e-3}, "max_step", "-0.001"),
+    ("max_step=nan", {"max_step": NAN}, "max_step", "nan"),
+    ("max_step=inf", {"max_step": INF}, "max_step", "inf"),
+    ("max_steps=0", {"max_steps": 0}, "max_steps", "max_steps=0"),
+    ("max_steps<0", {"max_steps": -5}, "max_steps", "-5"),
+    ("max_steps float", {"max_steps": 1.5}, "max_steps", "1.5"),
+    ("t_eval nan", {"t_eval": [0.0, NAN, TINY]}, "t_eval", "nan"),
+    ("t_eval inf", {"t_eval": [0.0, INF]}, "t_eval", "inf"),
+    ("t_eval empty", {"t_eval": []}, "t_eval", "[]"),
+    ("t_eval decreasing", {"t_eval": [TINY, 0.0]}, "t_eval", "0.0001"),
+    ("t_eval repeated", {"t_eval": [0.0, 0.0]}, "t_eval", "[0.0, 0.0]"),
+    ("t_eval negative", {"t_eval": [-1.0, 0.0]}, "t_eval", "-1.0"),
+    ("t_eval beyond t_end", {"t_eval": [0.0, 1.0]}, "t_eval", "1.0"),
+    ("t_eval str", {"t_eval": "0.0,0.01"}, "t_eval", "'0.0,0.01'"),
+    ("method", {"method": "rk5"}, "method", "'rk5'"),
+    ("method int", {"method": 4}, "method", "4"),
+    ("formulation", {"formulation": "index3"}, "formulation", "'index3'"),
+    ("backend", {"backend": "gpu"}, "backend", "'gpu'"),
+    ("on_failure", {"on_failure": "ignore"}, "on_failure", "'ignore'"),
+    ("linear_solver", {"linear_solver": "lu"}, "linear_solver", "'lu'"),
+    ("rk4 step=0", {"method": "rk4", "step": 0.0}, "step", "0.0"),
+    ("rk4 step<0", {"method": "rk4", "step": -1e-5}, "step", "-1e-05"),
+    ("rk4 step=nan", {"method": "rk4", "step": NAN}, "step", "nan"),
+    ("ida with step", {"step": 1e-5}, "step", "1e-05"),
+    ("DOP853 t_eval nan", {"method": "DOP853", "t_eval": [0.0, NAN]}, "t_eval", "nan"),
+    ("DOP853 rtol=0", {"method": "DOP853", "rtol": 0.0}, "rtol", "0.0"),
+    ("DOP853 t_end=0", {"method": "DOP853", "t_end": 0.0}, "t_end", "0.0"),
+    ("progress text", {"progress": "no"}, "progress", "'no'"),
+    ("store_steps None", {"store_steps": None}, "store_steps", "None"),
+    ("track_work 1", {"track_work": 1}, "track_work", "1"),
+    ("DOP853 progress text", {"method": "DOP853", "progress": "yes"}, "progress", "'yes'"),
+]
+
+
+@pytest.mark.parametrize("case, kwargs, field, shown", API_SIMULATE, ids=[c[0] for c in API_SIMULATE])
+def test_simulate_refuses(case, kwargs, field, shown):
+    kwargs = {"t_end": TINY, **kwargs}
+    with pytest.raises(SceneError) as info:
+        dc.simulate(SCENE, kwargs.pop("t_end"), **kwargs)
+    assert field in str(info.value) and shown in str(info.value)
+
+
+API_MECHANISMS: list[tuple[str, Callable[[], Any], str, str]] = [
+    ("restitution with hertz", lambda: dc.mechanisms.slider_crank("revolute", law="hertz", restitution=0.5),
+     "restitution", "0.5"),
+    ("restitution with kelvin-voigt", lambda: dc.mechanisms.slider_crank("translational", law="kelvin-voigt",
+                                                                         restitution=0.7), "restitution", "0.7"),
+    ("restitution with a law object", lambda: dc.mechanisms.slider_crank(
+        "revolute", law=dc.contact.LankaraniNikravesh(restitution=0.9), restitution=0.5), "restitution", "0.5"),
+    ("chain restitution with hertz", lambda: dc.mechanisms.chain(2, law="hertz", restitution=0.3),
+     "restitution", "0.3"),
+    ("restitution > 1", lambda: dc.mechanisms.slider_crank("revolute", restitution=1.5), "restitution", "1.5"),
+    ("rpm nan", lambda: dc.mechanisms.slider_crank("ideal", rpm=NAN), "rpm", "nan"),
+    ("clearance 0", lambda: dc.mechanisms.slider_crank("revolute", clearance=0.0), "clearance", "0.0"),
+    ("gravity < 0", lambda: dc.mechanisms.slider_crank("ideal", gravity=-9.81), "gravity", "-9.81"),
+    ("joint", lambda: dc.mechanisms.slider_crank("cylindrical"), "joint", "'cylindrical'"),
+]
+
+
+@pytest.mark.parametrize("case, build, field, shown", API_MECHANISMS, ids=[c[0] for c in API_MECHANISMS])
+def test_mechanisms_refuse(case, build, field, shown):
+    with pytest.raises(SceneError) as info:
+        build()
+    assert field in str(info.value) and shown in str(info.value)
+
+
+API_STUDY: list[tuple[str, dict[str, Any], str, str]] = [
+    ("t_end=0", {"t_end": 0.0}, "t_end", "0.0"),
+    ("rtols empty", {"rtols": []}, "rtols", "[]"),
+    ("rtols zero", {"rtols": [1e-6, 0.0]}, "rtols[1]", "0.0"),
+    ("steps negative", {"steps": [-1e-5]}, "steps[0]", "-1e-05"),
+    ("steps > t_end", {"steps": [1.0]}, "steps[0]", "1.0"),
+    ("repeats < 0", {"repeats": -1}, "repeats", "-1"),
+    ("n_eval 1", {"n_eval": 1}, "n_eval", "1"),
+    ("method", {"methods": {"X": {"method": "rk5"}}}, "method", "'rk5'"),
+]
+
+
+@pytest.mark.parametrize("case, kwargs, field, shown", API_STUDY, ids=[c[0] for c in API_STUDY])
+def test_work_precision_refuses(case, kwargs, field, shown):
+    kwargs = {"t_end": 0.002, **kwargs}
+    with pytest.raises(SceneError) as info:
+        work_precision(SCENE, kwargs.pop("t_end"), **kwargs)
+    assert field in str(info.value) and shown in str(info.value)
+
+
+API_SWEEP: list[tuple[str, dict[str, Any], type, str, str]] = [
+    ("keep", {"keep": "all"}, SceneError, "keep", "'all'"),
+    ("revolutions 0", {"revolutions": 0}, SceneError, "revolutions", "0"),
+    ("transient < 0", {"transient": -1}, SceneError, "transient", "-1"),
+    ("per_revolution 0", {"per_revolution": 0}, SceneError, "per_revolution", "0"),
+    ("rtol 0", {"rtol": 0.0}, SceneError, "rtol", "0.0"),
+    ("max_workers 0", {"max_workers": 0}, SceneError, "max_workers", "0"),
+    ("twin", {"twin": "maybe"}, SceneError, "twin", "'maybe'"),
+    ("channels empty", {"channels": []}, SceneError, "channels", "[]"),
+]
+
+
+@pytest.mark.parametrize("case, kwargs, exc, field, shown", API_SWEEP, ids=[c[0] for c in API_SWEEP])
+def test_sweep_refuses_options(case, kwargs, exc, field, shown, tmp_path):
+    with pytest.raises(exc) as info:
+        dc.sweep(tmp_path / "s.h5", {"clearance": [1e-4]}, fixed={"joint": "revolute"}, progress=False, **kwargs)
+    assert field in str(info.value) and shown in str(info.value)
+    assert list(tmp_path.iterdir()) == []  # nothing written
+
+
+def _places(tmp_path: Path) -> dict[str, tuple[Path, type]]:
+    """Bad output places: (path, error class) by case."""
+    folder = tmp_path / "folder"
+    folder.mkdir()
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    return {"a folder": (folder, OutputError),
+            "missing folder": (tmp_path / "missing" / "x.h5", OutputDirectoryMissing),
+            "under a file": (a_file / "x.h5", OutputError), "unwritable": (Path("/proc/daeclear-x.h5"), OutputError)}
+
+
+@pytest.mark.parametrize("place", ["a folder", "missing folder", "under a file", "unwritable"])
+def test_result_save_refuses_place(place, tmp_path, tiny_result):
+    path, exc = _places(tmp_path)[place]
+    with pytest.raises(exc) as info:
+        tiny_result.save(path)
+    assert "Result.save(path)" in str(info.value) and str(path) in str(info.value)
+
+
+@pytest.mark.parametrize("place", ["a folder", "missing folder", "under a file", "unwritable"])
+def test_sweep_refuses_place(place, tmp_path):
+    path, exc = _places(tmp_path)[place]
+    with pytest.raises(exc) as info:
+        dc.sweep(path, {"clearance": [1e-4]}, fixed={"joint": "revolute"}, progress=False)
+    assert "sweep(path)" in str(info.value) and str(path) in str(info.value)
+
+
+@pytest.mark.parametrize("writer", ["to_csv", "to_markdown"])
+@pytest.mark.parametrize("place", ["a folder", "under a file"])
+def test_study_tables_refuse_place(writer, place, tmp_path):
+    from daeclear.accuracy import WorkPrecision
+
+    study = WorkPrecision(rows=[], channels=["slider.vx"], window=(0.0, 1.0), window_reason="given",
+                          reference=None, reference_options={}, assembly_time=0.0)  # type: ignore[arg-type]
+    path, exc = _places(tmp_path)[place]
+    with pytest.raises(exc) as info:
+        getattr(study, writer)(path)
+    assert f"WorkPrecision.{writer}(path)" in str(info.value) and str(path) in str(info.value)
+
+
+def test_sweep_refuses_a_journal_that_is_a_file(tmp_path):
+    (tmp_path / "s.h5.parts").write_text("x")
+    with pytest.raises(OutputError, match=r"s\.h5\.parts"):
+        dc.sweep(tmp_path / "s.h5", {"clearance": [1e-4]}, fixed={"joint": "revolute"}, progress=False)
+
+
+# --------------------------------------------------------------------------- the command line
+
+
+def _cli(argv: list[str], capsys) -> str:
+    """Run the command line; it must exit 2 with one line on stderr and no traceback."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and err.count("\n") == 1, err
+    return err
+
+
+CLI_RUN: list[tuple[str, list[str], str, str]] = [
+    ("--t-end 0", ["--t-end", "0"], "--t-end", "0.0"),
+    ("--t-end -1", ["--t-end", "-1"], "--t-end", "-1.0"),
+    ("--t-end nan", ["--t-end", "nan"], "--t-end", "nan"),
+    ("--t-end inf", ["--t-end", "inf"], "--t-end", "inf"),
+    ("--rtol 0", ["--rtol", "0"], "--rtol", "0.0"),
+    ("--rtol 1", ["--rtol", "1"], "--rtol", "1.0"),
+    ("--rtol nan", ["--rtol", "nan"], "--rtol", "nan"),
+    ("--rtol -1e-6", ["--rtol=-1e-6"], "--rtol", "-1e-06"),
+    ("--rtol 1e-20", ["--rtol", "1e-20"], "--rtol", "1e-20"),
+    ("--name with a folder", ["--name", "a/b"], "--name", "'a/b'"),
+    ("--name empty", ["--name", ""], "--name", "''"),
+    ("--set rpm nan", ["--set", "rpm=nan"], "rpm", "'nan'"),
+    ("--set clearance 0", ["--joint", "revolute", "--set", "clearance=0"], "clearance", "0"),
+    ("--set restitution with hertz", ["--joint", "revolute", "--set", "law='hertz'", "--set", "restitution=0.5"],
+     "restitution", "0.5"),
+    ("--set restitution 2", ["--joint", "revolute", "--set", "restitution=2.0"], "restitution", "restitution=2"),
+    ("--set gravity -1", ["--set", "gravity=-1"], "gravity", "-1"),
+    ("--set unknown", ["--set", "rpmm=1"], "rpmm", "rpmm"),
+    ("--joint", ["--joint", "cylindrical"], "joint", "'cylindrical'"),
+]
+
+
+@pytest.mark.parametrize("case, args, field, shown", CLI_RUN, ids=[c[0] for c in CLI_RUN])
+def test_cli_run_refuses(case, args, field, shown, tmp_path, capsys):
+    err = _cli(["run", "slider_crank", "--out", str(tmp_path / "out"), "--quiet", *args], capsys)
+    assert field in err and shown in err
+
+
+@pytest.mark.parametrize("place", ["a file", "under a file", "unwritable", "h5 is a folder", "png is a folder"])
+def test_cli_run_refuses_out_before_work(place, tmp_path, capsys):
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    out = {"a file": a_file, "under a file": a_file / "sub", "unwritable": Path("/proc/daeclear-out"),
+           "h5 is a folder": tmp_path / "o1", "png is a folder": tmp_path / "o2"}[place]
+    if place == "h5 is a folder":
+        (out / "slider_crank.h5").mkdir(parents=True)
+    if place == "png is a folder":
+        (out / "slider_crank.png").mkdir(parents=True)
+    err = _cli(["run", "slider_crank", "--out", str(out), "--quiet"], capsys)
+    assert "--out" in err and str(out) in err
+
+
+CLI_STUDY: list[tuple[str, list[str], str, str]] = [
+    ("--t-end 0", ["--t-end", "0"], "--t-end", "0.0"),
+    ("--t-end nan", ["--t-end", "nan"], "--t-end", "nan"),
+    ("--repeats -1", ["--repeats", "-1"], "--repeats", "-1"),
+    ("--methods unknown", ["--methods", "ida,rk5"], "--methods[1]", "'rk5'"),
+    ("--methods empty", ["--methods", ","], "--methods", "[]"),
+    ("--rtols 0", ["--rtols", "1e-6,0"], "--rtols[1]", "0.0"),
+    ("--rtols 1", ["--rtols", "1"], "--rtols[0]", "1.0"),
+    ("--rtols text", ["--rtols", "tight"], "--rtols", "'tight'"),
+    ("--steps 0", ["--steps", "0"], "--steps[0]", "0.0"),
+    ("--steps > t_end", ["--steps", "1"], "--steps[0]", "1.0"),
+    ("--channels empty", ["--channels", ""], "--channels", "[]"),
+    ("--set restitution with hertz", ["--set", "law='hertz'", "--set", "restitution=0.5"], "restitution", "0.5"),
+]
+
+
+@pytest.mark.parametrize("case, args, field, shown", CLI_STUDY, ids=[c[0] for c in CLI_STUDY])
+def test_cli_study_refuses(case, args, field, shown, tmp_path, capsys):
+    err = _cli(["study", "slider_crank", "--out", str(tmp_path / "out"), *args], capsys)
+    assert field in err and shown in err
+
+
+@pytest.mark.parametrize("place", ["a file", "csv is a folder"])
+def test_cli_study_refuses_out_before_work(place, tmp_path, capsys):
+    out = tmp_path / "o"
+    if place == "a file":
+        out.write_text("x")
+    else:
+        (out / "work_precision.csv").mkdir(parents=True)
+    err = _cli(["study", "slider_crank", "--out", str(out)], capsys)
+    assert "--out" in err and str(out) in err
+
+
+CLI_SWEEP: list[tuple[str, list[str], str, str]] = [
+    ("--revolutions 0", ["--revolutions", "0"], "--revolutions", "0"),
+    ("--transient -1", ["--transient", "-1"], "--transient", "-1"),
+    ("--per-revolution 0", ["--per-revolution", "0"], "--per-revolution", "0"),
+    ("--rtol 0", ["--rtol", "0"], "--rtol", "0.0"),
+    ("--rtol nan", ["--rtol", "nan"], "--rtol", "nan"),
+    ("--workers 0", ["--workers", "0"], "--workers", "0"),
+    ("--channels empty", ["--channels", ","], "--channels", "[]"),
+    ("--grid geom 0", ["--grid", "friction=geom:0:1:3"], "--grid", "geom:0:1:3"),
+    ("--grid lin N", ["--grid", "friction=lin:0:1:0"], "--grid", "lin:0:1:0"),
+]
+
+
+@pytest.mark.parametrize("case, args, field, shown", CLI_SWEEP, ids=[c[0] for c in CLI_SWEEP])
+def test_cli_sweep_refuses(case, args, field, shown, tmp_path, capsys):
+    grid = [] if any(a == "--grid" for a in args) else ["--grid", "clearance=1e-4"]
+    err = _cli(["sweep", "slider_crank", str(tmp_path / "s.h5"), "--joint", "revolute", *grid, *args], capsys)
+    assert field in err and shown in err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("place", ["a folder", "under a file", "unwritable", "not a sweep file"])
+def test_cli_sweep_refuses_out_before_work(place, tmp_path, capsys):
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    folder = tmp_path / "folder"
+    folder.mkdir()
+    out = {"a folder": folder, "under a file": a_file / "s.h5", "unwritable": Path("/proc/daeclear-s.h5"),
+           "not a sweep file": a_file}[place]
+    err = _cli(["sweep", "slider_crank", str(out), "--joint", "revolute", "--grid", "clearance=1e-4", "--quiet"],
+               capsys)
+    assert str(out) in err
+    assert ("OUT" in err) or ("not a daeclear sweep" in err)
+
+
+# --------------------------------------------------------------------------- scene files
+
+PENDULUM = """
+[scene]
+name = "pendulum"
+
+[[body]]
+name = "link"
+mass = 1.0
+inertia = 0.01
+position = [0.5, 0.0]
+
+[[revolute]]
+name = "A"
+body_i = "ground"
+body_j = "link"
+at = [0.0, 0.0]
+"""
+
+SCENE_FILE: list[tuple[str, str, str, str]] = [
+    # (id, [simulate] lines (or a whole [mechanism] file), field, value as shown)
+    ("t_end = 0", "t_end = 0", "t_end", "t_end=0"),
+    ("t_end = 0.0", "t_end = 0.0", "t_end", "0.0"),
+    ("t_end < 0", "t_end = -1.0", "t_end", "-1.0"),
+    ("t_end = nan", "t_end = nan", "t_end", "nan"),
+    ("t_end = inf", "t_end = inf", "t_end", "inf"),
+    ("t_end text", 't_end = "1"', "t_end", "'1'"),
+    ("rtol = 0", "rtol = 0.0", "rtol", "0.0"),
+    ("rtol = 1", "rtol = 1.0", "rtol", "1.0"),
+    ("rtol text", 'rtol = "tight"', "rtol", "'tight'"),
+    ("atol = 0", "atol = 0.0", "atol", "0.0"),
+    ("atol < 0", "atol = -1e-9", "atol", "-1e-09"),
+    ("max_step < 0", "max_step = -1e-3", "max_step", "-0.001"),
+    ("t_eval_step = 0", "t_end = 0.1\nt_eval_step = 0.0", "t_eval_step", "0.0"),
+    ("t_eval_step < 0", "t_eval_step = -0.01", "t_eval_step", "-0.01"),
+    ("t_eval_step > t_end", "t_end = 0.1\nt_eval_step = 0.5", "t_eval_step", "0.5"),
+    ("t_eval_step = nan", "t_eval_step = nan", "t_eval_step", "nan"),
+    ("method", 'method = "rk5"', "method", "'rk5'"),
+    ("formulation", 'formulation = "index3"', "formulation", "'index3'"),
+    ("backend", 'backend = "gpu"', "backend", "'gpu'"),
+]
+
+MECHANISM_FILE: list[tuple[str, str, str, str]] = [
+    ("restitution with hertz", 'joint = "revolute"\nlaw = "hertz"\nrestitution = 0.5', "restitution", "0.5"),
+    ("rpm nan", "rpm = nan", "rpm", "nan"),
+    ("clearance 0", 'joint = "revolute"\nclearance = 0.0', "clearance", "0.0"),
+]
+
+
+def _scene_file(tmp_path: Path, simulate: str) -> Path:
+    path = tmp_path / "scene.toml"
+    path.write_text(PENDULUM + "\n[simulate]\n" + simulate + "\n")
+    return path
+
+
+def _mechanism_file(tmp_path: Path, lines: str) -> Path:
+    path = tmp_path / "mechanism.toml"
+    path.write_text('[mechanism]\nname = "slider_crank"\n' + lines + "\n")
+    return path
+
+
+@pytest.mark.parametrize("case, lines, field, shown", SCENE_FILE, ids=[c[0] for c in SCENE_FILE])
+def test_scene_file_refuses(case, lines, field, shown, tmp_path):
+    path = _scene_file(tmp_path, lines)
+    with pytest.raises(SceneError) as info:
+        read_scene_file(path)
+    text = str(info.value)
+    assert str(path) in text and "[simulate]" in text and field in text and shown in text
+
+
+@pytest.mark.parametrize("case, lines, field, shown", SCENE_FILE, ids=[c[0] for c in SCENE_FILE])
+def test_scene_file_refused_by_the_cli(case, lines, field, shown, tmp_path, capsys):
+    path = _scene_file(tmp_path, lines)
+    err = _cli(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"], capsys)
+    assert field in err and shown in err
+
+
+@pytest.mark.parametrize("case, lines, field, shown", MECHANISM_FILE, ids=[c[0] for c in MECHANISM_FILE])
+def test_mechanism_file_refuses(case, lines, field, shown, tmp_path, capsys):
+    path = _mechanism_file(tmp_path, lines)
+    with pytest.raises(SceneError) as info:
+        read_scene_file(path)
+    assert field in str(info.value) and shown in str(info.value)
+    err = _cli(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"], capsys)
+    assert field in err and shown in err
+
+
+def test_cli_t_end_overrides_the_file_and_t_eval_step_is_checked_against_it(tmp_path, capsys):
+    """The file's spacing fits its own t_end but not the end asked for on the command line."""
+    path = _scene_file(tmp_path, "t_end = 0.5\nt_eval_step = 0.1")
+    err = _cli(["run", str(path), "--t-end", "0.05", "--out", str(tmp_path / "out"), "--quiet"], capsys)
+    assert "t_eval_step" in err and "0.1" in err
+
+
+def test_same_rule_and_message_everywhere(tmp_path, capsys):
+    """t_end = 0 gets the same rule through the API, the command line and a scene file."""
+    rule = "must be a finite number > 0."
+    with pytest.raises(SceneError, match="t_end=0 s, " + rule.replace(".", r"\.")):
+        dc.simulate(SCENE, 0)
+    assert rule in _cli(["run", "slider_crank", "--t-end", "0", "--out", str(tmp_path / "o")], capsys)
+    with pytest.raises(SceneError, match=rule.replace(".", r"\.")):
+        read_scene_file(_scene_file(tmp_path, "t_end = 0"))
+
+
+def test_there_are_at_least_100_cases():
+    n = (len(API_SIMULATE) + len(API_MECHANISMS) + len(API_STUDY) + len(API_SWEEP) + 4 + 4 + 4 + 1 + len(CLI_RUN) + 5
+         + len(CLI_STUDY) + 2 + len(CLI_SWEEP) + 4 + 2 * len(SCENE_FILE) + len(MECHANISM_FILE) + 2)
+    assert n >= 100, n
