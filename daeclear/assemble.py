@@ -38,22 +38,19 @@ from numpy.typing import ArrayLike, NDArray
 from .codegen import memo_table
 from .errors import AssemblyError, SceneError
 from .ida_session import DAEFunctions, StateLayout
+from .options import FORMULATIONS
 from .parameters import ParameterTable, structure_key
 from .scene import GROUND, Body, Driver, Revolute, Scene, Translational
 from .clearance import CONTACT_BUILDERS
 from .symbolic import AssemblyContext, BodyFrame, Channel, Reference, Term, rotation
 
 Formulation = Literal["index1", "ggl"]
-FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
 
 # Extra functions compiled with the model (DAEFunctions.extras), evaluated over many points.
 # kinematics: (q, v, t) -> [Phi; Phi_q (column-major); Phi_dot]; start kinematics: the same with
 # every clearance joint's ideal joint added (the chapter's start); term k's force: EXTRA_TERM0 + k
 EXTRA_OUTPUTS, EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_START_KINEMATICS, EXTRA_TERM0 = 0, 1, 2, 3, 4
-#: How a run starts: "ideal" (the chapter's: clearance joints centred, positions and velocities
-#: assembled on the mechanism whose clearance joints are ideal) or "declared" (the bodies' own
-#: positions and velocities, corrected only for the ideal joints the scene has).
-STARTS: tuple[str, ...] = ("ideal", "declared")
+
 
 # Projection onto the constraint manifold (initial state and restarts, in Python and in C):
 # |Phi| < POSITION_TOL * max(1, |q|) within NEWTON_STEPS least-norm Newton steps.

@@ -65,6 +65,7 @@ import numpy as np
 
 from . import codegen
 from .automaton import Decision, PairState, Storm
+from .options import BACKENDS, LINEAR_SOLVERS
 from .codegen import (
     memo_get,
     memo_put,
@@ -94,8 +95,7 @@ __all__ = [
     "FLAG_STEP_COLLAPSE",
 ]
 
-BACKENDS = ("auto", "c", "python")
-LINEAR_SOLVERS = ("auto", "dense", "sparse")
+
 #: linear_solver="auto" uses the sparse solver for models with at least this many states. Measured
 #: with benchmarks/bench_linear_solver.py (chains of N links, 6 N states; docs/performance.md):
 #: dense is faster up to 120 states (SuperLU_MT's fixed cost per factorization), sparse from 144

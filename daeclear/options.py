@@ -22,6 +22,11 @@ METHODS: tuple[str, ...] = ("ida", "rk45", "dop853", "radau", "bdf", "lsoda", "r
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
 BACKENDS: tuple[str, ...] = ("auto", "c", "python")
 ON_FAILURE: tuple[str, ...] = ("raise", "return")
+LINEAR_SOLVERS: tuple[str, ...] = ("auto", "dense", "sparse")
+#: How a run starts: "ideal" (the chapter's: clearance joints centred, positions and velocities
+#: assembled on the mechanism whose clearance joints are ideal) or "declared" (the bodies' own
+#: positions and velocities, corrected only for the ideal joints the scene has).
+STARTS: tuple[str, ...] = ("ideal", "declared")
 RTOL_RANGE: tuple[float, float] = (1e-14, 1e-2)
 
 
@@ -185,6 +190,16 @@ def backend(value: Any, *, where: str = "simulate", field: str = "backend") -> s
 def on_failure(value: Any, *, where: str = "simulate", field: str = "on_failure") -> str:
     """What a failed run does (case-insensitive)."""
     return choice(value, ON_FAILURE, where=where, field=field)
+
+
+def linear_solver(value: Any, *, where: str = "simulate", field: str = "linear_solver") -> str:
+    """LU of IDA's Newton iteration (case-insensitive)."""
+    return choice(value, LINEAR_SOLVERS, where=where, field=field)
+
+
+def start(value: Any, *, where: str = "simulate", field: str = "start") -> str:
+    """How a run starts (case-insensitive), see :data:`STARTS`."""
+    return choice(value, STARTS, where=where, field=field)
 
 
 # --------------------------------------------------------------------------- studies and sweeps

@@ -21,9 +21,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import options
-from .assemble import KIND_MULTIPLIER, KIND_WORK, STARTS, DAEModel, assemble
+from .assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
 from .errors import DaeclearWarning, Interrupted, SceneError, SolveError
-from .ida_session import LINEAR_SOLVERS, open_session
+from .ida_session import open_session
 from .result import ContactEvent, Result
 from .scene import Scene
 
@@ -61,13 +61,6 @@ def _positive(name: str, value: Any, unit: str, allow_zero: bool = False) -> flo
         rule = ">= 0" if allow_zero else "> 0"
         raise SceneError(f"simulate: {name}={value!r} {unit}, must be a finite number {rule}.")
     return float(value)
-
-
-def _choice(name: str, value: Any, allowed: Sequence[str]) -> str:
-    text = str(value).lower()
-    if text not in allowed:
-        raise SceneError(f"simulate: {name}={value!r}, must be one of {', '.join(allowed)} (case-insensitive).")
-    return text
 
 
 def tolerance_vector(model: DAEModel, rtol: float, atol: float | ArrayLike | None) -> NDArray[np.float64]:
@@ -186,8 +179,8 @@ def simulate(
     """
     method = options.method(method)
     on_failure = options.on_failure(on_failure)
-    linear_solver = _choice("linear_solver", linear_solver, LINEAR_SOLVERS)
-    start = _choice("start", start, STARTS)
+    linear_solver = options.linear_solver(linear_solver)
+    start = options.start(start)
     backend = options.backend(backend)
     t_end = options.t_end(t_end)
     rtol = options.rtol(rtol)
