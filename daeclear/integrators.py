@@ -1294,17 +1294,9 @@ def integrate(
         valid = ", ".join(["ida", *METHOD_NAMES.values()])
         raise SceneError(f"simulate: method={method!r}, must be one of {valid} (case-insensitive).")
     step = check_step(method_l, step)
-    on_failure = options.on_failure(on_failure)
-    backend = options.backend(backend)
-    t_end = options.t_end(t_end)
-    rtol = options.rtol(rtol)
-    options.atol(atol)
-    max_step = options.max_step(max_step)
-    max_steps = options.max_steps(max_steps)
-    t_eval = options.t_eval(t_eval, t_end)
-    store_steps = options.flag(store_steps, field="store_steps")
-    progress = options.flag(progress, field="progress")
-    track_work = options.flag(track_work, field="track_work")
+    t_end, rtol, max_step, max_steps, t_eval, backend, on_failure, store_steps, progress, track_work = options.run(
+        t_end=t_end, rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, t_eval=t_eval, backend=backend,
+        on_failure=on_failure, store_steps=store_steps, progress=progress, track_work=track_work)
     name = METHOD_NAMES[method_l]
     if track_work:
         raise SceneError(f"simulate: track_work=True is supported by method='ida' only, not by method={name!r}.")

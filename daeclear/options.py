@@ -11,7 +11,7 @@ an error, never "use the default".
 from __future__ import annotations
 
 import math
-from typing import Any, NoReturn, Sequence
+from typing import Any, NamedTuple, NoReturn, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -202,6 +202,35 @@ def start(value: Any, *, where: str = "simulate", field: str = "start") -> str:
     return choice(value, STARTS, where=where, field=field)
 
 
+class RunOptions(NamedTuple):
+    """The options every integrator shares, checked and normalised (see :func:`run`)."""
+
+    t_end: float
+    rtol: float
+    max_step: float
+    max_steps: int
+    t_eval: NDArray[np.float64] | None
+    backend: str
+    on_failure: str
+    store_steps: bool
+    progress: bool
+    track_work: bool
+
+
+def run(**values: Any) -> RunOptions:
+    """Check the options shared by :func:`daeclear.simulate` and every integrator (the fields of
+    :class:`RunOptions`, plus ``atol``, checked here and converted per model by the solver)."""
+    end = t_end(values["t_end"])
+    atol(values["atol"])
+    return RunOptions(
+        t_end=end, rtol=rtol(values["rtol"]), max_step=max_step(values["max_step"]),
+        max_steps=max_steps(values["max_steps"]), t_eval=t_eval(values["t_eval"], end),
+        backend=backend(values["backend"]), on_failure=on_failure(values["on_failure"]),
+        store_steps=flag(values["store_steps"], field="store_steps"),
+        progress=flag(values["progress"], field="progress"),
+        track_work=flag(values["track_work"], field="track_work"))
+
+
 # --------------------------------------------------------------------------- studies and sweeps
 
 
@@ -277,3 +306,4 @@ def restitution(value: Any, law: Any, *, where: str, field: str = "restitution")
         takes = [n for n, c in NORMAL_LAWS.items() if "restitution" in getattr(c, "__dataclass_fields__", {})]
         fail(where, field, value, f"left out with law={law!r}, which has no coefficient of restitution "
              f"(laws with one: {', '.join(takes)})")
+

@@ -178,19 +178,11 @@ def simulate(
     Result
     """
     method = options.method(method)
-    on_failure = options.on_failure(on_failure)
     linear_solver = options.linear_solver(linear_solver)
     start = options.start(start)
-    backend = options.backend(backend)
-    t_end = options.t_end(t_end)
-    rtol = options.rtol(rtol)
-    options.atol(atol)
-    max_step = options.max_step(max_step)
-    max_steps = options.max_steps(max_steps)
-    t_eval = options.t_eval(t_eval, t_end)
-    store_steps = options.flag(store_steps, field="store_steps")
-    progress = options.flag(progress, field="progress")
-    track_work = options.flag(track_work, field="track_work")
+    t_end, rtol, max_step, max_steps, t_eval, backend, on_failure, store_steps, progress, track_work = options.run(
+        t_end=t_end, rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, t_eval=t_eval, backend=backend,
+        on_failure=on_failure, store_steps=store_steps, progress=progress, track_work=track_work)
     from .integrators import check_step, integrate  # the non-IDA methods
 
     check_step(method, step)
