@@ -13,7 +13,7 @@ DOP853 at rtol 1e-12). Then the speed ratio: for each IDA run, the fastest other
 error is at most IDA's (IDA at equal or worse accuracy), and how much slower it is.
 
 Last, the gap check of daeclear.integrators with and without its cubic Hermite test for crossings
-inside a step (PERFORMANCE.md item 4): event counts over the first 5 ms and the two revolutions.
+inside a step (docs/performance.md): event counts over the first 5 ms and the two revolutions.
 """
 
 from __future__ import annotations

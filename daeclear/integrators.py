@@ -36,7 +36,7 @@ measured and gained nothing).
 A step may contain a crossing of a watched gap, G = direction * g from <= 0 to > 0, when G has
 changed sign over the step, *or* when the cubic Hermite interpolant of G built from G and dG/dt
 at the two ends of the step has an interior maximum above zero. The second test is what keeps
-quick re-contacts (a contact that closes and opens again within one step, PERFORMANCE.md item 4)
+quick re-contacts (a contact that closes and opens again within one step, docs/performance.md)
 from being stepped over: such a predicted excursion is checked on the scheme's own state at the
 predicted maximum and becomes an event when it is confirmed. Residual risk: an excursion that the
 cubic does not predict (a gap with large higher derivatives over the step) is still missed.

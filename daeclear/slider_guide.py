@@ -44,7 +44,7 @@ to the local penetration, so the face force derives from the potential
 law. When a face forms or breaks, the force switches between the two laws (the
 chapter's model: not continuous, not energy-conserving at the switch). A face law that
 needs an approach speed gets the mean of the approach speeds latched by its two corners
-(CONTACT_MODELS.md, uncertain item 9).
+(docs/contact_laws.md).
 
 Friction (only when declared): at every active contact, the modified Coulomb law (or the
 joint's law) on the sliding velocity of the slider's material point at the contact

@@ -32,7 +32,7 @@ log = logging.getLogger("daeclear")
 METHODS: tuple[str, ...] = options.METHODS
 ON_FAILURE: tuple[str, ...] = options.ON_FAILURE
 # Multipliers are kept out of IDA's error test by a huge absolute tolerance (scikit-sundae has
-# no IDASetSuppressAlg): atol = MULTIPLIER_ATOL_FACTOR * rtol, see PERFORMANCE.md item 1.
+# no IDASetSuppressAlg): atol = MULTIPLIER_ATOL_FACTOR * rtol, see docs/performance.md.
 MULTIPLIER_ATOL_FACTOR = 1e12
 # ... and never below this floor (N or N m): at rtol 1e-11, 1e12 * rtol = 10 N would put impact
 # multipliers of 1e3..1e5 N back into the error test, which breaks the index-2 GGL runs.

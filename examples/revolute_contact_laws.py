@@ -6,12 +6,12 @@ rtol 1e-6. Transient and windows as in ``_common.py``.
 - Hertz: F = K delta^1.5, K = 6.61e10 N/m^1.5 from eq. (3.5) (elastic);
 - Lankarani-Nikravesh (3.9): same K, c_e = 0.9 (the only dissipative law here);
 - Dubowsky-Freudenstein, Goldsmith, ESDU 78035: the implicit cylindrical laws of
-  CONTACT_MODELS.md section 8 (elastic), with axial contact length L = 10 mm (``--length``).
+  docs/contact_laws.md (elastic), with axial contact length L = 10 mm (``--length``).
   The chapter does not give L; section 8.7 shows that L = 10-20 mm makes the cylindrical
   laws "reasonably close" to Hertz, as the chapter's summary says; we take the short end.
   sigma convention: daeclear's defaults, (1 - nu^2)/E for Dubowsky-Freudenstein and Goldsmith,
   (1 - nu^2)/(pi E) for ESDU 78035 (its Johnson-consistent reading). Goldsmith's form is
-  unconfirmed (CONTACT_MODELS.md section 8.4).
+  unconfirmed (docs/contact_laws.md).
 
 Writes into ``--out`` (default ``results/revolute_contact_laws/``):
 

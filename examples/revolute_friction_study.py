@@ -2,7 +2,7 @@
 
 Section 4.4's friction study: c = 0.5 mm, Lankarani-Nikravesh law (3.9) with c_e = 0.9 and the
 modified Coulomb law (3.16) with daeclear's default thresholds v0 = 1e-4 m/s, v1 = 2e-4 m/s
-(CONTACT_MODELS.md section 11; the book's values are not known), sliding velocity from the
+(docs/contact_laws.md; the book's values are not known), sliding velocity from the
 material points of journal and bearing, 5000 rpm, gravity 9.81 m/s^2, IDA at rtol 1e-6.
 Transient and windows as in ``_common.py``.
 

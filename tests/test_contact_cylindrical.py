@@ -10,7 +10,7 @@ law's convention, "plain" (1-nu^2)/E or "pi" (1-nu^2)/(pi E); dR = R_i - R_j):
   identical to ESDU with sigma "pi".
 
 The independent reference force solves delta(F) = delta with scipy's brentq on the physical
-branch 0 < F < F_max. Anchors: CONTACT_MODELS.md section 8.7 (steel, R_i = 10 mm, c = 0.5 mm),
+branch 0 < F < F_max. Anchors: docs/contact_laws.md (steel, R_i = 10 mm, c = 0.5 mm),
 values rounded to 1 N there.
 """
 
@@ -59,7 +59,7 @@ def make(cls: type, length: float = 0.01, **kw) -> object:
 
 CLASSES = [DubowskyFreudenstein, Goldsmith, ESDU78035]
 
-# CONTACT_MODELS.md section 8.7: (L, sigma convention) -> {class: forces at 1, 5, 10 um}
+# docs/contact_laws.md: (L, sigma convention) -> {class: forces at 1, 5, 10 um}
 ANCHORS = {
     (0.01, "plain"): {DubowskyFreudenstein: (119, 739, 1650), ESDU78035: (130, 821, 1862), Goldsmith: (71, 399, 842)},
     (0.01, "pi"): {DubowskyFreudenstein: (375, 2321, 5183), ESDU78035: (407, 2579, 5850),

@@ -69,7 +69,7 @@ def test_one_revolution_matches_closed_form(formulation, gravity):
     for name, ref in (("slider.x", x), ("slider.vx", vx), ("slider.ax", ax), ("drive.moment", moment)):
         err = np.max(np.abs(result[name] - ref)) / np.ptp(ref)
         assert err < 1e-5, f"{name}: relative error {err:.2e}"
-    # the extreme values of CONTACT_MODELS.md (computed independently there)
+    # the extreme values of docs/contact_laws.md (computed independently there)
     assert ax[0] == pytest.approx(-19419.36, abs=0.05)
     if gravity == 0.0:
         assert np.max(result["drive.moment"]) == pytest.approx(138.5, abs=0.1)

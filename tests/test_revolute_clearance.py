@@ -112,7 +112,7 @@ def test_first_impact_matches_kinematic_estimate():
     """The slider is at rest at t = 0 while the journal accelerates at -r w^2 (1 + r/l)."""
     result = dc.simulate(dc.mechanisms.slider_crank("revolute", gravity=0.0), 0.4e-3, rtol=1e-10)
     onset = result.events.of(kind="onset")[0]
-    a0 = 19419.36  # |slider acceleration| of the ideal mechanism at t = 0 (CONTACT_MODELS.md)
+    a0 = 19419.36  # |slider acceleration| of the ideal mechanism at t = 0 (docs/contact_laws.md)
     assert onset.t == pytest.approx(np.sqrt(2 * 0.5e-3 / a0), rel=2e-2)
     assert onset.approach_speed == pytest.approx(a0 * onset.t, rel=2e-2)
 

@@ -6,7 +6,7 @@ Each law gives the penetration as an explicit function of the force,
     delta = s F [ln(X / F) + k],        s = sigma_s / L,
 
 with ``sigma_s = sigma_i + sigma_j`` (eq. 3.4, convention below), L the axial contact
-length, X a force scale and k = +1 or -1 (``/work/shared/CONTACT_MODELS.md`` section 8).
+length, X a force scale and k = +1 or -1 (docs/contact_laws.md section 8).
 It is implicit in F. ``delta(F)`` rises from 0 to its maximum ``delta_max = s X e^(k-1)``
 at ``F_max = X e^(k-1)`` and falls after it; only ``0 < F < F_max`` is physical.
 
@@ -248,7 +248,7 @@ class DubowskyFreudenstein(_CylindricalLaw):
     """Dubowsky-Freudenstein (1971) internal cylinder law.
 
     ``delta = F sigma_s / L [ln(L^3 (R_i - R_j) / (F sigma_s R_i R_j)) + 1]``,
-    the ``L^3`` reading (the only dimensionless one) of CONTACT_MODELS.md section 8.3.
+    the ``L^3`` reading (the only dimensionless one) of docs/contact_laws.md
     Steel, R_i = 10 mm, c = 0.5 mm, L = 10 mm, sigma "plain": 119 N at 1 um,
     739 N at 5 um, 1650 N at 10 um.
     """ + _COMMON
@@ -270,7 +270,7 @@ class Goldsmith(_CylindricalLaw):
     implementation found is dimensionally wrong, or identical to Dubowsky-Freudenstein
     once repaired, yet the chapter plots different curves (Fig. 4.22c-d). This is the
     plausible reading with the radial clearance in place of ``R_i R_j / (R_i - R_j)``
-    (CONTACT_MODELS.md section 8.4). Steel, c = 0.5 mm, L = 10 mm, sigma "plain":
+    (docs/contact_laws.md). Steel, c = 0.5 mm, L = 10 mm, sigma "plain":
     71 N at 1 um, 399 N at 5 um, 842 N at 10 um.
     """ + _COMMON
 
@@ -288,7 +288,7 @@ class ESDU78035(_CylindricalLaw):
     ``delta = F sigma'_s / L [ln(4 L (R_i - R_j) / (F sigma'_s)) - 1]`` with
     ``sigma' = (1 - nu^2)/(pi E)`` by default (``sigma_convention="pi"``); this equals
     Johnson's conforming-cylinder solution
-    ``delta = F/(pi L E*) [ln(4 pi L E* (R_i - R_j)/F) - 1]`` (CONTACT_MODELS.md 8.5a).
+    ``delta = F/(pi L E*) [ln(4 pi L E* (R_i - R_j)/F) - 1]`` (docs/contact_laws.md 8.5a).
     The other published reading (``pi`` in front, ``+1``) is not offered.
     Steel, c = 0.5 mm, L = 10 mm: 407 N at 1 um, 2579 N at 5 um, 5850 N at 10 um
     (130 / 821 / 1862 N with ``sigma_convention="plain"``).

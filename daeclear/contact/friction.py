@@ -134,7 +134,7 @@ class ModifiedCoulomb(FrictionLaw):
     Continuous in ``v_T`` (piecewise linear ramp), which is what makes it kinder to
     integrators than :class:`Coulomb`; it has no stiction (zero force below v0).
     The book's v0, v1 are not known; the defaults are the only Flores-attributed
-    values found (CONTACT_MODELS.md section 11).
+    values found (docs/contact_laws.md).
     """
 
     coefficient: float

@@ -1,6 +1,6 @@
 """Materials and contact stiffness from materials and geometry (eqs. 3.4, 3.5, 4.27).
 
-Conventions (``/work/shared/CONTACT_MODELS.md``, decisions): the material parameter is
+Conventions (docs/contact_laws.md, decisions): the material parameter is
 ``sigma = (1 - nu**2) / E`` without pi (eq. 3.4 as Flores et al. use it; the 0.475 of
 eq. 4.27 only works with this convention), and the internal journal-bearing pair uses
 the sphere formula (3.5) with ``R_i - R_j``.
