@@ -6,7 +6,7 @@ Each law gives the penetration as an explicit function of the force,
     delta = s F [ln(X / F) + k],        s = sigma_s / L,
 
 with ``sigma_s = sigma_i + sigma_j`` (eq. 3.4, convention below), L the axial contact
-length, X a force scale and k = +1 or -1 (docs/contact_laws.md section 8).
+length, X a force scale and k = +1 or -1 (docs/contact_laws.md).
 It is implicit in F. ``delta(F)`` rises from 0 to its maximum ``delta_max = s X e^(k-1)``
 at ``F_max = X e^(k-1)`` and falls after it; only ``0 < F < F_max`` is physical.
 
