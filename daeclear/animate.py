@@ -131,7 +131,8 @@ def _window(result: Result, window: Window, f: _Fields) -> tuple[float, float]:
     slack = 1e-9 * max(abs(start), abs(end), end - start)
     lo_f, hi_f = float(lo), float(hi)
     if not (start - slack <= lo_f < hi_f <= end + slack):
-        options.fail(f.where, f.window, (t0, t1), rule, "s")
+        shown = ", ".join("None" if v is None else repr(float(v)) for v in (t0, t1))
+        options.fail(f.where, f.window, (t0, t1), rule, "s", shown=f"({shown})")
     return max(lo_f, start), min(hi_f, end)
 
 
@@ -489,7 +490,7 @@ class _Scene:
                     continue
                 u = geo.local_vector(joint.body_i, axis)
                 travel = _world(pj, joint.s_j) - _world(pi, joint.s_i)
-                along = travel @ (axis / math.hypot(*axis))
+                along = np.sum(travel * _direction(pi, u), axis=1)
                 reach = (float(along.min()), float(along.max()))
                 guide = _pen(ax, _GROUND, lw=1.0, ls="--", zorder=1)
                 self.updates.append(self._guide_update(guide, pi, joint.s_i, u, [reach], 0.0))
@@ -598,7 +599,9 @@ def _status(ax: Axes) -> Any:
 
 
 def _contact_text(in_contact: bool, depth: float) -> str:
-    return f"contact, δ = {depth * 1e6:.3g} µm" if in_contact else "free flight"
+    if not in_contact:
+        return "free flight"
+    return f"contact, δ = {depth * 1e6:.3g} µm" if math.isfinite(depth) else "contact"
 
 
 class _RevoluteInset:

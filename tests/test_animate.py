@@ -212,3 +212,18 @@ def test_cli_bad_input_exits_2(translational, tmp_path, capsys, monkeypatch, arg
 def test_cli_missing_result_file(tmp_path, capsys):
     assert main(["animate", str(tmp_path / "nope.h5")]) == 2
     assert "no result file" in capsys.readouterr().err
+
+
+@pytest.mark.filterwarnings("ignore::daeclear.DaeclearWarning")  # the run's drift note, not the animation's
+def test_fig4_15_example_script(tmp_path):
+    import importlib.util
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parent.parent / "examples" / "animate_fig4_15.py"
+    spec = importlib.util.spec_from_file_location("animate_fig4_15", script)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    out = tmp_path / "fig.gif"
+    assert module.main(["--out", str(out), "--revolutions", "1", "--span", "2", "--slow-motion", "100",
+                        "--fps", "10", "--size", "200", "160"]) == 0
+    assert _frames(out) == (2, 100)
