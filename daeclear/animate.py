@@ -26,9 +26,10 @@ A frame shows
 
 Frames. The window [t0, t1] of duration D plays at ``slow_motion`` times slower than real
 time at ``fps`` frames per second: ``n_frames = max(2, round(D * slow_motion * fps))``,
-evenly spaced from t0 to t1 inclusive, so the animation lasts ``n_frames / fps`` s. Contact
-shown in a frame is any contact since the previous frame, so an impact shorter than the
-frame spacing still lights up.
+evenly spaced from t0 to t1 inclusive, so the animation lasts ``n_frames / fps`` s. A joint
+is red in a frame when it is in contact then or was since the previous frame ("impact since
+last frame", with the deepest penetration), so an impact shorter than the frame spacing still
+lights up.
 
 matplotlib (and pillow, which it requires) is imported only when an animation is made.
 """
@@ -295,16 +296,15 @@ class _Sampler:
         return v[self.last] + self.weight * (v[self.next] - v[self.last])
 
     def since_previous(self, name: str, reduce: Callable[[NDArray[np.float64]], float]) -> NDArray[np.float64]:
-        """``reduce`` of the samples since the previous frame (just after it up to the next sample),
-        so a contact shorter than the frame spacing is not missed."""
+        """``reduce`` of the samples after the previous frame's time up to this frame's (the sample at
+        or before it when there is none in between), so a contact shorter than the frame spacing is
+        not missed."""
         v = np.asarray(self.result[name], dtype=np.float64)
         out = np.empty(self.times.size)
-        previous = self.last[0]
         for k in range(self.times.size):
-            lo = previous + 1 if k else self.last[0]
-            hi = max(self.next[k], lo)
-            out[k] = reduce(v[min(lo, hi):hi + 1])
-            previous = self.last[k]
+            hi = int(self.last[k])
+            lo = min(int(self.last[k - 1]) + 1, hi) if k else hi
+            out[k] = reduce(v[lo:hi + 1])
         return out
 
 
@@ -598,10 +598,32 @@ def _status(ax: Axes) -> Any:
     return ax.text(0.03, 0.96, "", transform=ax.transAxes, va="top", ha="left", fontsize="small", zorder=10)
 
 
-def _contact_text(in_contact: bool, depth: float) -> str:
-    if not in_contact:
-        return "free flight"
-    return f"contact, δ = {depth * 1e6:.3g} µm" if math.isfinite(depth) else "contact"
+FREE, IMPACT, CONTACT = 0.0, 1.0, 2.0  # contact state of a clearance joint in a frame
+
+
+def _contact_state(sampler: _Sampler, joint: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per frame: CONTACT (in contact at the frame's time), IMPACT (a contact since the previous frame,
+    over by now) or FREE; and the penetration to show (the current one, or the deepest of the impact)."""
+    n = sampler.times.size
+    flag, pen = f"{joint}.in_contact", f"{joint}.penetration"
+    if flag not in sampler.result:
+        return np.zeros(n), np.full(n, np.nan)
+    now = np.asarray(sampler.result[flag], dtype=np.float64)[sampler.last] > 0
+    since = sampler.since_previous(flag, np.max) > 0
+    state = np.where(now, CONTACT, np.where(since, IMPACT, FREE))
+    if pen not in sampler.result:
+        return state, np.full(n, np.nan)
+    return state, np.where(now, sampler.at(pen), sampler.since_previous(pen, np.max))
+
+
+def _contact_text(state: float, depth: float) -> str:
+    """What a panel says about its joint in this frame."""
+    known = math.isfinite(depth)
+    if state == CONTACT:
+        return f"contact, δ = {depth * 1e6:.3g} µm" if known else "contact"
+    if state == IMPACT:
+        return f"impact since last frame, δ max {depth * 1e6:.3g} µm" if known else "impact since last frame"
+    return "free flight"
 
 
 class _RevoluteInset:
@@ -650,7 +672,8 @@ class _RevoluteInset:
         self.dot.set_data([self.x[k]], [self.y[k]])
         self.dot.set_color(colour)
         self.arm.set_data([0.0, self.x[k]], [0.0, self.y[k]])
-        self.status.set_text(_contact_text(hit, float(self.depth[k]) if self.depth is not None else math.nan))
+        state = float(self.contact[k]) if self.contact is not None else FREE
+        self.status.set_text(_contact_text(state, float(self.depth[k]) if self.depth is not None else math.nan))
         self.status.set_color(colour)
 
 
@@ -721,7 +744,8 @@ class _TranslationalInset:
         self.trail.set_data(np.append(self.ss[idx], self.centre[k, 0]), np.append(self.yy[idx], self.centre[k, 1]))
         touching = [i for i, on in enumerate(self.corner_contact) if on is not None and on[k] > 0]
         self.hits.set_data(self.quad[k, touching, 0], self.quad[k, touching, 1])
-        self.status.set_text(_contact_text(hit, float(self.depth[k]) if self.depth is not None else math.nan))
+        state = float(self.contact[k]) if self.contact is not None else FREE
+        self.status.set_text(_contact_text(state, float(self.depth[k]) if self.depth is not None else math.nan))
         self.status.set_color(colour)
 
 
@@ -891,10 +915,10 @@ def _animate(result: Result, path: Any, *, fps: Any, window: Window, slow_motion
     sampler = _Sampler(result, times, t0, t1)
     for body in geo.bodies:
         _pose(sampler, body, geo, f.where)  # every body's channels exist, before a figure is made
-    contact = {j.name: sampler.since_previous(f"{j.name}.in_contact", np.max)
-               for j in clearance if f"{j.name}.in_contact" in result}
-    depth = {j.name: sampler.since_previous(f"{j.name}.penetration", np.max)
-             for j in clearance if f"{j.name}.penetration" in result}
+    contact: dict[str, NDArray[np.float64]] = {}
+    depth: dict[str, NDArray[np.float64]] = {}
+    for j in clearance:
+        contact[j.name], depth[j.name] = _contact_state(sampler, j.name)
     shown = clearance[:MAX_INSETS]
 
     scale, unit = (1e3, "ms") if max(abs(t0), abs(t1)) < 1.0 else (1.0, "s")

@@ -227,3 +227,20 @@ def test_fig4_15_example_script(tmp_path):
     assert module.main(["--out", str(out), "--revolutions", "1", "--span", "2", "--slow-motion", "100",
                         "--fps", "10", "--size", "200", "160"]) == 0
     assert _frames(out) == (2, 100)
+
+
+def test_contact_state_of_a_frame():
+    """In contact at the frame's time, an impact since the previous frame (over by now), or free."""
+    from daeclear.animate import CONTACT, FREE, IMPACT, _contact_state, _Sampler
+
+    t = np.arange(5.0)
+    result = dc.Result(t=t, y=np.zeros((5, 0)), yp=np.zeros((5, 0)), state_names=[], units={},
+                       channels={"j.in_contact": [0, 0, 1, 0, 0], "j.penetration": [-1e-4, -1e-4, 2e-6, -1e-4, -1e-4]})
+    times = np.array([0.0, 1.5, 2.0, 4.0])
+    state, depth = _contact_state(_Sampler(result, times, 0.0, 4.0), "j")
+    assert list(state) == [FREE, FREE, CONTACT, FREE]
+    assert depth[2] == pytest.approx(2e-6)
+    times = np.array([0.0, 1.5, 3.5])  # the contact at t = 2 falls between two frames
+    state, depth = _contact_state(_Sampler(result, times, 0.0, 4.0), "j")
+    assert list(state) == [FREE, FREE, IMPACT]
+    assert depth[2] == pytest.approx(2e-6)
