@@ -116,7 +116,8 @@ def _window(result: Result, window: Window, f: _Fields) -> tuple[float, float]:
         raise SceneError(f"{f.where}: the result has {t.size} output time(s) spanning no time; "
                          "an animation needs a run of nonzero duration.")
     start, end = float(t[0]), float(t[-1])
-    rule = f"(t0, t1) in s with {start:g} <= t0 < t1 <= {end:g} (the run; None for its start or end)"
+    sides = "" if f.window.startswith("--") else "; None for its start or end"
+    rule = f"(t0, t1) in s with {start:g} <= t0 < t1 <= {end:g} (the run{sides})"
     if window is None:
         return start, end
     try:
