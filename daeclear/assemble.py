@@ -98,6 +98,10 @@ class DAEModel:
     # run-time parameters: the last input of every function above (see daeclear.parameters)
     parameter_layout: tuple[tuple[str, int], ...] = ()  # (name, size) of each entry
     parameter_values: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    # the scene element (joint or driver name) of each constraint row, for messages
+    constraint_elements: tuple[str, ...] = ()
+    # (name, clearance m, corner radius m or 0) of each clearance joint: the limits of the physics checks
+    clearance_joints: tuple[tuple[str, float, float], ...] = ()
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -470,6 +474,8 @@ class _Template:
             parameters={"scene": scene.to_dict(), "formulation": formulation, "alpha": alpha, "beta": beta,
                         "track_work": track_work},
             contacts=contacts, auto_pairs=auto_pairs, parameter_layout=self.layout, parameter_values=P,
+            clearance_joints=tuple((e.name, float(e.radial_clearance), float(getattr(e, "corner_radius", 0.0)))
+                                   for e in scene.elements if type(e) in CONTACT_BUILDERS),
         )
 
 
@@ -529,7 +535,49 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         if len(_TEMPLATES) >= _TEMPLATE_LIMIT:
             _TEMPLATES.pop(next(iter(_TEMPLATES)))
         _TEMPLATES[key] = template
-    return template.bind(scene, table, alpha, beta)
+    model = template.bind(scene, table, alpha, beta)
+    check_independent(model)
+    return model
+
+
+# Constraint rows are dependent when the constraint Jacobian's singular value falls below RANK_TOL
+# times its largest one (its entries are 1 and lever arms of 1 mm..1 m; round-off is ~1e-16).
+RANK_TOL = 1e-9
+# a row takes part in a dependency when its weight in a left null vector of the Jacobian is above this
+NULL_WEIGHT = 1e-6
+
+
+def check_independent(model: DAEModel) -> None:
+    """Raise AssemblyError when the constraint Jacobian is rank deficient at the declared positions.
+
+    Redundant constraints (a joint that repeats what others already impose, two drivers on one
+    joint) make the multipliers undetermined: IDA would fail at t = 0 with a singular matrix and
+    unrelated advice. The message names the joints and drivers whose rows are dependent.
+    """
+    m, n = model.n_constraints, model.n_q
+    if not m:
+        return
+    Phi_q = np.array(model.kinematics(model.q_guess, model.v_guess, 0.0, model.parameter_values)[1], dtype=float)
+    if not np.all(np.isfinite(Phi_q)):
+        return  # not a rank question: the positions themselves are unusable (reported when they are assembled)
+    U, sigma, _ = np.linalg.svd(Phi_q)
+    scale = float(sigma[0]) if sigma.size else 0.0
+    rank = int(np.sum(sigma > RANK_TOL * scale))
+    if rank >= m:
+        return
+    null = U[:, rank:]
+    rows = [i for i in range(m) if np.linalg.norm(null[i]) > NULL_WEIGHT]
+    owners = model.constraint_elements or tuple(name.rsplit(".", 1)[0] for name in model.constraint_names)
+    involved = list(dict.fromkeys(owners[i] for i in rows))
+    equations = ", ".join(model.constraint_names[i] for i in rows)
+    more = f" ({m} equations for {n} coordinates)" if m > n else ""
+    raise AssemblyError(
+        f"scene '{model.scene_name}': redundant constraints: {', '.join(repr(e) for e in involved)} impose "
+        f"dependent conditions (equations {equations}); the constraint Jacobian at the declared positions has "
+        f"rank {rank} for {m} equations{more}, so their reaction forces are undetermined and the run cannot "
+        f"start. Remove one of these joints or drivers (or replace a revolute by a clearance joint). If the "
+        f"mechanism is not over-constrained, the declared positions are a singular configuration (e.g. two "
+        f"links aligned): start it from another position.")
 
 
 # Scenes assembled before in this process: (elements, name, gravity, ground, options) -> their
@@ -580,6 +628,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
     # ---- constraints ----
     phi_list: list[Any] = []
     names: list[str] = []
+    owners: list[str] = []  # the element of each constraint row
     revolutes = {j.name: j for j in scene.joints if isinstance(j, Revolute)}
     driver_rows: dict[str, int] = {}
     contact_builds: list[Any] = []
@@ -600,6 +649,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
             continue
         phi_list.extend(eqs)
         names.extend(labels)
+        owners.extend([element.name] * len(eqs))
 
     m = len(phi_list)
     Phi = ca.vertcat(*phi_list) if m else ca.SX(0, 1)
@@ -786,6 +836,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
         channel_names=tuple(c.name for c in channels), channel_units={c.name: c.unit for c in channels},
         outputs=outputs, q_guess=np.zeros(n), v_guess=np.zeros(n), mass_diagonal=np.ones(n),
         kinematics=kinematics, base_force=base_force, track_work=track_work, start_constraint_names=start_names,
+        constraint_elements=tuple(owners),
     )  # numbers are bound per scene (_Template.bind)
     return _Template(model=model, layout=table.layout, logic=logic_makers, auto_pairs=tuple(auto_pairs))
 
