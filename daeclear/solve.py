@@ -387,6 +387,12 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                  output_time=time.perf_counter() - post_start)
     found = physics.check_run(model, out_t, out_y, channels, y0, stats)
     physics.issue(found, stacklevel=4)  # issue <- _run <- simulate <- the caller
+    deep = [w for w in found if w["kind"] == "penetration" and w["t"] <= t]
+    if not success and not interrupted and deep:  # the advice must fit the cause: not a tolerance problem
+        w = deep[0]
+        message += (f" Before it, '{w['where']}' penetrated {w['value']:.3g} m at t={w['t']:.6g} s, more than its "
+                    f"limit {w['limit']:.3g} m: the contact carries more than the joint can (friction, speed or "
+                    "load); tolerances will not fix that.")
     result = Result(
         t=out_t, y=out_y, yp=out_yp, state_names=list(model.state_names),
         channels=channels, units=dict(model.channel_units),
