@@ -341,6 +341,7 @@ class DAEModel:
         With an open compiled ``session`` every evaluation runs in C."""
         ideal = start == "ideal"
         q = self.assemble_positions(self.q_guess, session=session, ideal=ideal)
+        check_independent(self, q, session)
         v = self.assemble_velocities(q, self.v_guess, session=session, ideal=ideal)
         y = np.zeros(self.n_states)
         y[: self.n_q] = q
@@ -535,9 +536,7 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
         if len(_TEMPLATES) >= _TEMPLATE_LIMIT:
             _TEMPLATES.pop(next(iter(_TEMPLATES)))
         _TEMPLATES[key] = template
-    model = template.bind(scene, table, alpha, beta)
-    check_independent(model)
-    return model
+    return template.bind(scene, table, alpha, beta)
 
 
 # Constraint rows are dependent when the constraint Jacobian's singular value falls below RANK_TOL
@@ -547,17 +546,18 @@ RANK_TOL = 1e-9
 NULL_WEIGHT = 1e-6
 
 
-def check_independent(model: DAEModel) -> None:
-    """Raise AssemblyError when the constraint Jacobian is rank deficient at the declared positions.
+def check_independent(model: DAEModel, q: NDArray[np.float64], session: Any = None) -> None:
+    """Raise AssemblyError when the constraint Jacobian is rank deficient at the initial positions ``q``.
 
-    Redundant constraints (a joint that repeats what others already impose, two drivers on one
-    joint) make the multipliers undetermined: IDA would fail at t = 0 with a singular matrix and
-    unrelated advice. The message names the joints and drivers whose rows are dependent.
+    Redundant constraints (a joint that repeats what others already impose, a second driver of a
+    one-degree-of-freedom mechanism) make the multipliers undetermined: IDA would fail at t = 0 with
+    a singular matrix and unrelated advice. The message names the joints and drivers whose rows are
+    dependent. Called by :meth:`DAEModel.initial_state` once the positions are assembled.
     """
     m, n = model.n_constraints, model.n_q
     if not m:
         return
-    Phi_q = np.array(model.kinematics(model.q_guess, model.v_guess, 0.0, model.parameter_values)[1], dtype=float)
+    Phi_q = model._constraints(np.asarray(q, dtype=float), np.zeros(n), 0.0, session)[1]
     if not np.all(np.isfinite(Phi_q)):
         return  # not a rank question: the positions themselves are unusable (reported when they are assembled)
     U, sigma, _ = np.linalg.svd(Phi_q)
@@ -569,15 +569,25 @@ def check_independent(model: DAEModel) -> None:
     rows = [i for i in range(m) if np.linalg.norm(null[i]) > NULL_WEIGHT]
     owners = model.constraint_elements or tuple(name.rsplit(".", 1)[0] for name in model.constraint_names)
     involved = list(dict.fromkeys(owners[i] for i in rows))
+
+    def independent_without(element: str) -> bool:
+        keep = [i for i in range(m) if owners[i] != element]
+        if not keep:
+            return True
+        s_keep = np.linalg.svd(Phi_q[keep], compute_uv=False)
+        return int(np.sum(s_keep > RANK_TOL * scale)) == len(keep)
+
+    fixes = [e for e in involved if independent_without(e)]
     equations = ", ".join(model.constraint_names[i] for i in rows)
-    more = f" ({m} equations for {n} coordinates)" if m > n else ""
+    advice = (f"Removing any one of {', '.join(repr(e) for e in fixes)} leaves independent constraints."
+              if fixes else "Remove the joints or drivers that repeat what the others impose.")
     raise AssemblyError(
         f"scene '{model.scene_name}': redundant constraints: {', '.join(repr(e) for e in involved)} impose "
-        f"dependent conditions (equations {equations}); the constraint Jacobian at the declared positions has "
-        f"rank {rank} for {m} equations{more}, so their reaction forces are undetermined and the run cannot "
-        f"start. Remove one of these joints or drivers (or replace a revolute by a clearance joint). If the "
-        f"mechanism is not over-constrained, the declared positions are a singular configuration (e.g. two "
-        f"links aligned): start it from another position.")
+        f"dependent conditions (equations {equations}); the constraint Jacobian at the initial positions has "
+        f"rank {rank} for {m} equations on {n} coordinates, so their reaction forces are undetermined and the run "
+        f"cannot start. {advice} (A joint meant to have play can be a clearance joint.) If the mechanism is not "
+        "over-constrained, the initial positions are a singular configuration (e.g. two links aligned): start it "
+        "from another position.")
 
 
 # Scenes assembled before in this process: (elements, name, gravity, ground, options) -> their

@@ -154,8 +154,7 @@ def _toml_type(value: Any) -> str:
 def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any]) -> Any:
     fields = dataclasses.fields(cls)
     allowed = [f.name for f in fields]
-    label = f"{path}: [[{table}]] #{index + 1}" + (f" (name={entry['name']!r})" if isinstance(entry.get("name"), str)
-                                                   else "")
+    label = f"{path}: [[{table}]] #{index + 1}"
     unknown = sorted(set(entry) - set(allowed))
     if unknown:
         raise SceneError(f"{label}: unknown key(s) {', '.join(unknown)}; allowed: {', '.join(allowed)}.")
