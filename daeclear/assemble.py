@@ -29,7 +29,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Any, Callable, Literal, Sequence
+from typing import Any, Callable, ClassVar, Literal, Sequence
 
 import casadi as ca
 import numpy as np
@@ -102,6 +102,9 @@ class DAEModel:
     constraint_elements: tuple[str, ...] = ()
     # (name, clearance m, corner radius m or 0) of each clearance joint: the limits of the physics checks
     clearance_joints: tuple[tuple[str, float, float], ...] = ()
+    driver_names: tuple[str, ...] = ()
+    # False for a model that starts from a computed state (a restart), whose start is not checked
+    start_is_declared: ClassVar[bool] = True
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -846,7 +849,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
         channel_names=tuple(c.name for c in channels), channel_units={c.name: c.unit for c in channels},
         outputs=outputs, q_guess=np.zeros(n), v_guess=np.zeros(n), mass_diagonal=np.ones(n),
         kinematics=kinematics, base_force=base_force, track_work=track_work, start_constraint_names=start_names,
-        constraint_elements=tuple(owners),
+        constraint_elements=tuple(owners), driver_names=tuple(driver_rows),
     )  # numbers are bound per scene (_Template.bind)
     return _Template(model=model, layout=table.layout, logic=logic_makers, auto_pairs=tuple(auto_pairs))
 

@@ -38,9 +38,10 @@ KINDS: tuple[str, ...] = ("penetration", "initial_penetration", "initial_velocit
 PENETRATION_FRACTION = 1.0
 # A run that starts with a penetration above this fraction of the clearance starts inside the wall.
 INITIAL_PENETRATION_FRACTION = 1e-2
-# A clearance joint whose two sides move apart at t = 0 faster than this fraction of the fastest body
-# (and at least INITIAL_VELOCITY_FLOOR) starts with velocities inconsistent with the joint: the
-# journal flies across its play and its first impact is an artefact of the start.
+# A clearance joint of a driven mechanism whose two sides move apart at t = 0 faster than this
+# fraction of the fastest body (and at least INITIAL_VELOCITY_FLOOR) starts with velocities
+# inconsistent with the joint: the journal flies across its play and its first impact is an
+# artefact of the start.
 INITIAL_VELOCITY_FRACTION = 1e-2
 INITIAL_VELOCITY_FLOOR = 1e-3  # m/s
 # Constraint drift (largest |Phi| of a run) above this fraction of the smallest clearance.
@@ -79,17 +80,18 @@ def check_run(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channe
 
     Sets ``stats["max_constraint_drift"]``. Returns the warning records (not issued)."""
     out: list[dict[str, Any]] = []
+    declared = getattr(model, "start_is_declared", True)  # a restart from a run's state may start in contact
     for name, clearance, corner in model.clearance_joints:
-        out += _penetration(model, name, clearance, corner, t, channels)
-    if y0 is not None:
+        out += _penetration(model, name, clearance, corner, t, channels, declared)
+    if y0 is not None and declared and model.driver_names:
         out += _initial_velocity(model, y0)
     out += _drift(model, t, y, channels, stats)
     return out
 
 
 def _penetration(model: Any, joint: str, clearance: float, corner: float, t: NDArray[np.float64],
-                 channels: dict[str, NDArray[np.float64]]) -> list[dict[str, Any]]:
-    """Worst penetration of the joint over the run, and at t = 0."""
+                 channels: dict[str, NDArray[np.float64]], declared: bool) -> list[dict[str, Any]]:
+    """Worst penetration of the joint over the run, and at t = 0 (``declared``: the start is the scene's)."""
     limit = PENETRATION_FRACTION * (min(clearance, corner) if corner > 0 else clearance)
     basis = ("the corner radius" if 0 < corner < clearance else "the clearance") if corner > 0 else "the clearance"
     out: list[dict[str, Any]] = []
@@ -105,7 +107,7 @@ def _penetration(model: Any, joint: str, clearance: float, corner: float, t: NDA
             worst = (float(values[i]), float(t[i]), pair)
         if t[0] == 0.0 and (start is None or values[0] > start[0]):
             start = (float(values[0]), pair)
-    if start is not None and start[0] > INITIAL_PENETRATION_FRACTION * clearance:
+    if declared and start is not None and start[0] > INITIAL_PENETRATION_FRACTION * clearance:
         value, pair = start
         out.append(record(
             "initial_penetration", "penetration", value, INITIAL_PENETRATION_FRACTION * clearance, "m", pair, 0.0,
@@ -116,14 +118,19 @@ def _penetration(model: Any, joint: str, clearance: float, corner: float, t: NDA
         value, when, pair = worst
         out.append(record(
             "penetration", "penetration", value, limit, "m", pair, when,
-            f"'{pair}' penetrates {value:.3g} m at t={when:.6g} s, more than {basis} ({limit:.3g} m): no contact "
-            "law holds there and the result is not physical. Check the contact stiffness, the friction "
-            "coefficient and the speed (a load the joint cannot carry), or a tighter rtol."))
+            f"'{pair}' penetrates {value:.3g} m at t={when:.6g} s, more than {basis} ({limit:.3g} m): the contact "
+            "deforms by more than the joint's geometry allows, beyond what its contact law describes, and the "
+            "result is not physical. Check the contact stiffness, the friction coefficient and the speed (a load "
+            "the joint cannot carry), or a tighter rtol."))
     return out
 
 
 def _initial_velocity(model: Any, y0: NDArray[np.float64]) -> list[dict[str, Any]]:
-    """Speed at which each clearance joint's two sides move apart at t = 0 (0 for an ideal start)."""
+    """Speed at which each clearance joint's two sides move apart at t = 0 (0 for an ideal start).
+
+    Checked for driven mechanisms only: their velocities follow from the driver, so a joint whose
+    sides fly apart was declared inconsistently. Without a driver (a drop test, a free chain) a
+    relative velocity is the experiment's initial condition."""
     if not model.clearance_joints:
         return []
     n = model.n_q

@@ -178,6 +178,15 @@ def simulate(
     Returns
     -------
     Result
+        ``result.warnings`` lists what the physics checks found (penetration beyond the
+        clearance, an impossible start, constraint drift, contacts stepped over by a fixed step);
+        each is also issued as a :class:`daeclear.PhysicsWarning`. See :mod:`daeclear.physics`.
+
+    Raises
+    ------
+    AssemblyError
+        The initial positions cannot be assembled, or the constraints are redundant (the
+        message names the joints and drivers).
     """
     method = options.method(method)
     linear_solver = options.linear_solver(linear_solver)

@@ -157,6 +157,28 @@ def test_velocities_inconsistent_with_the_joint():
     assert not {"initial_velocity", "initial_penetration"} & set(kinds(declared))
 
 
+def test_a_restart_from_a_computed_state_may_start_in_contact():
+    """analysis.restart_model starts from a run's own state (twin runs): its start is not a declaration."""
+    from daeclear.analysis import restart_model
+
+    model = dc.assemble(journal_inside_the_wall())
+    declared = quiet_simulate(model, 0.002, start="declared", t_eval=np.linspace(0.0, 0.002, 21))
+    assert "initial_penetration" in kinds(declared)
+    again = quiet_simulate(restart_model(model, declared, 0), 0.002)
+    assert again["clearance.penetration"][0] == pytest.approx(0.2e-3, rel=1e-6)
+    assert not {"initial_penetration", "initial_velocity"} & set(kinds(again))
+
+
+def test_an_undriven_drop_is_an_experiment_not_an_inconsistent_start():
+    """Without a driver a journal thrown across its bearing is the run's initial condition: no warning."""
+    scene = dc.Scene("drop", gravity=(0.0, -9.81))
+    link = scene.add(dc.Body("link", mass=1.0, inertia=0.01, position=(0.0, -0.1), velocity=(0.0, -0.2)))
+    scene.add(dc.RevoluteClearance("pin", scene.ground, link, at=(0.0, 0.0), bearing_radius=0.01,
+                                   clearance=CLEARANCE, material=dc.mechanisms.STEEL))
+    result = quiet_simulate(scene, 0.01, start="declared")
+    assert result.events and "initial_velocity" not in kinds(result)
+
+
 def test_warnings_are_saved_and_loaded(tmp_path: Path):
     result = quiet_simulate(dc.mechanisms.slider_crank("revolute", rpm=50000), 0.0024)
     assert result.warnings
