@@ -93,7 +93,7 @@ def _penetration(model: Any, joint: str, clearance: float, corner: float, t: NDA
                  channels: dict[str, NDArray[np.float64]], declared: bool) -> list[dict[str, Any]]:
     """Worst penetration of the joint over the run, and at t = 0 (``declared``: the start is the scene's)."""
     limit = PENETRATION_FRACTION * (min(clearance, corner) if corner > 0 else clearance)
-    basis = ("the corner radius" if 0 < corner < clearance else "the clearance") if corner > 0 else "the clearance"
+    basis = "the corner radius" if 0 < corner < clearance else "the clearance"
     out: list[dict[str, Any]] = []
     worst: tuple[float, float, str] | None = None
     start: tuple[float, str] | None = None

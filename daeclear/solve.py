@@ -14,7 +14,6 @@ import logging
 import math
 import sys
 import time
-import warnings
 from typing import Any, Sequence
 
 import numpy as np
@@ -22,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import options, physics
 from .assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
-from .errors import DaeclearWarning, Interrupted, SceneError, SolveError
+from .errors import Interrupted, SceneError, SolveError
 from .ida_session import open_session
 from .result import ContactEvent, Result
 from .scene import Scene
