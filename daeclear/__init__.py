@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from . import analysis, mechanisms
 from .assemble import DAEModel, assemble
-from .errors import AssemblyError, DaeclearError, DaeclearWarning, Interrupted, OutputError, SceneError, SolveError
+from .errors import (AssemblyError, DaeclearError, DaeclearWarning, Interrupted, OutputError, PhysicsWarning, SceneError,
+                     SolveError)
 from .result import ContactEvent, Result, load
 from .contact import Material
 from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
@@ -18,6 +19,6 @@ __version__ = "0.1.0"
 
 __all__ = [
     "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "Driver",
-    "Interrupted", "Material", "OutputError", "Result", "Revolute", "RevoluteClearance", "Scene", "SceneError", "SolveError", "Translational",
+    "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "Scene", "SceneError", "SolveError", "Translational",
     "TranslationalClearance", "analysis", "assemble", "load", "load_sweep", "mechanisms", "simulate", "sweep",
 ]

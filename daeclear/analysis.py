@@ -394,6 +394,7 @@ class _RestartModel(DAEModel):
     """A DAEModel whose run starts from a given state (positions and velocities kept as given)."""
 
     start_state: tuple[float, ...] = ()
+    start_is_declared = False  # a state of a run: starting in contact is no declaration error (daeclear.physics)
 
     def initial_state(self, session: Any = None, start: str = "declared") -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         # No Newton projection: the stored state carries the run's own (Baumgarte-controlled)

@@ -881,12 +881,12 @@ def animate(result: Result, path: str | os.PathLike[str], *, fps: float = 25.0, 
     OutputError
         ``path`` cannot be written (checked before rendering).
     """
-    return _animate(result, path, fps=fps, window=window, slow_motion=slow_motion, size=size, channel=channel,
+    return render(result, path, fps=fps, window=window, slow_motion=slow_motion, size=size, channel=channel,
                     magnify=magnify, progress=progress)
 
 
-def _animate(result: Result, path: Any, *, fps: Any, window: Window, slow_motion: Any, size: Any,
-             channel: Any, magnify: Any, progress: Any, fields: _Fields = _Fields()) -> Path:
+def render(result: Result, path: Any, *, fps: Any, window: Window, slow_motion: Any, size: Any,
+           channel: Any, magnify: Any, progress: Any, fields: _Fields = _Fields()) -> Path:
     """:func:`animate` with the option names of the caller (``fields``) in its messages."""
     f = fields
     fps_v = options.number(fps, where=f.where, field=f.fps, low=0.0, high=MAX_FPS)

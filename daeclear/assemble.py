@@ -29,7 +29,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Any, Callable, Literal, Sequence
+from typing import Any, Callable, ClassVar, Literal, Sequence
 
 import casadi as ca
 import numpy as np
@@ -98,6 +98,13 @@ class DAEModel:
     # run-time parameters: the last input of every function above (see daeclear.parameters)
     parameter_layout: tuple[tuple[str, int], ...] = ()  # (name, size) of each entry
     parameter_values: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    # the scene element (joint or driver name) of each constraint row, for messages
+    constraint_elements: tuple[str, ...] = ()
+    # (name, clearance m, corner radius m or 0) of each clearance joint: the limits of the physics checks
+    clearance_joints: tuple[tuple[str, float, float], ...] = ()
+    driver_names: tuple[str, ...] = ()
+    # False for a model that starts from a computed state (a restart), whose start is not checked
+    start_is_declared: ClassVar[bool] = True
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -337,6 +344,7 @@ class DAEModel:
         With an open compiled ``session`` every evaluation runs in C."""
         ideal = start == "ideal"
         q = self.assemble_positions(self.q_guess, session=session, ideal=ideal)
+        check_independent(self, q, session)
         v = self.assemble_velocities(q, self.v_guess, session=session, ideal=ideal)
         y = np.zeros(self.n_states)
         y[: self.n_q] = q
@@ -470,6 +478,8 @@ class _Template:
             parameters={"scene": scene.to_dict(), "formulation": formulation, "alpha": alpha, "beta": beta,
                         "track_work": track_work},
             contacts=contacts, auto_pairs=auto_pairs, parameter_layout=self.layout, parameter_values=P,
+            clearance_joints=tuple((e.name, float(e.radial_clearance), float(getattr(e, "corner_radius", 0.0)))
+                                   for e in scene.elements if type(e) in CONTACT_BUILDERS),
         )
 
 
@@ -532,6 +542,57 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     return template.bind(scene, table, alpha, beta)
 
 
+# Constraint rows are dependent when the constraint Jacobian's singular value falls below RANK_TOL
+# times its largest one (its entries are 1 and lever arms of 1 mm..1 m; round-off is ~1e-16).
+RANK_TOL = 1e-9
+# a row takes part in a dependency when its weight in a left null vector of the Jacobian is above this
+NULL_WEIGHT = 1e-6
+
+
+def check_independent(model: DAEModel, q: NDArray[np.float64], session: Any = None) -> None:
+    """Raise AssemblyError when the constraint Jacobian is rank deficient at the initial positions ``q``.
+
+    Redundant constraints (a joint that repeats what others already impose, a second driver of a
+    one-degree-of-freedom mechanism) make the multipliers undetermined: IDA would fail at t = 0 with
+    a singular matrix and unrelated advice. The message names the joints and drivers whose rows are
+    dependent. Called by :meth:`DAEModel.initial_state` once the positions are assembled.
+    """
+    m, n = model.n_constraints, model.n_q
+    if not m:
+        return
+    Phi_q = model._constraints(np.asarray(q, dtype=float), np.zeros(n), 0.0, session)[1]
+    if not np.all(np.isfinite(Phi_q)):
+        return  # not a rank question: the positions themselves are unusable (reported when they are assembled)
+    U, sigma, _ = np.linalg.svd(Phi_q)
+    scale = float(sigma[0]) if sigma.size else 0.0
+    rank = int(np.sum(sigma > RANK_TOL * scale))
+    if rank >= m:
+        return
+    null = U[:, rank:]
+    rows = [i for i in range(m) if np.linalg.norm(null[i]) > NULL_WEIGHT]
+    owners = model.constraint_elements or tuple(name.rsplit(".", 1)[0] for name in model.constraint_names)
+    involved = list(dict.fromkeys(owners[i] for i in rows))
+
+    def independent_without(element: str) -> bool:
+        keep = [i for i in range(m) if owners[i] != element]
+        if not keep:
+            return True
+        s_keep = np.linalg.svd(Phi_q[keep], compute_uv=False)
+        return int(np.sum(s_keep > RANK_TOL * scale)) == len(keep)
+
+    fixes = [e for e in involved if independent_without(e)]
+    equations = ", ".join(model.constraint_names[i] for i in rows)
+    advice = (f"Removing any one of {', '.join(repr(e) for e in fixes)} leaves independent constraints."
+              if fixes else "Remove the joints or drivers that repeat what the others impose.")
+    raise AssemblyError(
+        f"scene '{model.scene_name}': redundant constraints: {', '.join(repr(e) for e in involved)} impose "
+        f"dependent conditions (equations {equations}); the constraint Jacobian at the initial positions has "
+        f"rank {rank} for {m} equations on {n} coordinates, so their reaction forces are undetermined and the run "
+        f"cannot start. {advice} (A joint meant to have play can be a clearance joint.) If the mechanism is not "
+        "over-constrained, the initial positions are a singular configuration (e.g. two links aligned): start it "
+        "from another position.")
+
+
 # Scenes assembled before in this process: (elements, name, gravity, ground, options) -> their
 # parameters and structure key. The entry holds the very element objects (frozen dataclasses),
 # so an unchanged scene is recognised by identity and a changed one (an element added, replaced,
@@ -580,6 +641,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
     # ---- constraints ----
     phi_list: list[Any] = []
     names: list[str] = []
+    owners: list[str] = []  # the element of each constraint row
     revolutes = {j.name: j for j in scene.joints if isinstance(j, Revolute)}
     driver_rows: dict[str, int] = {}
     contact_builds: list[Any] = []
@@ -600,6 +662,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
             continue
         phi_list.extend(eqs)
         names.extend(labels)
+        owners.extend([element.name] * len(eqs))
 
     m = len(phi_list)
     Phi = ca.vertcat(*phi_list) if m else ca.SX(0, 1)
@@ -786,6 +849,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
         channel_names=tuple(c.name for c in channels), channel_units={c.name: c.unit for c in channels},
         outputs=outputs, q_guess=np.zeros(n), v_guess=np.zeros(n), mass_diagonal=np.ones(n),
         kinematics=kinematics, base_force=base_force, track_work=track_work, start_constraint_names=start_names,
+        constraint_elements=tuple(owners), driver_names=tuple(driver_rows),
     )  # numbers are bound per scene (_Template.bind)
     return _Template(model=model, layout=table.layout, logic=logic_makers, auto_pairs=tuple(auto_pairs))
 

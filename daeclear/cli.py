@@ -6,10 +6,11 @@ import argparse
 import ast
 import logging
 import sys
+import warnings
 from pathlib import Path
 from typing import Any, Sequence
 
-from .errors import DaeclearError, Interrupted, SolveError
+from .errors import DaeclearError, Interrupted, PhysicsWarning, SolveError
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by Ctrl-C
 
@@ -125,7 +126,9 @@ def _run(args: argparse.Namespace) -> int:
         run_options["t_eval"] = options.uniform_times(step, t_end)
     h5 = args.out / f"{base}.h5"
     try:
-        result = simulate(scene, t_end, **run_options)
+        with warnings.catch_warnings():  # shown once, from the result, after the run
+            warnings.simplefilter("ignore", PhysicsWarning)
+            result = simulate(scene, t_end, **run_options)
     except Interrupted as exc:
         return _save_interrupted(exc.result, h5)
     try:
@@ -135,6 +138,7 @@ def _run(args: argparse.Namespace) -> int:
         return EXIT_INTERRUPTED
     print(result)
     print(f"wrote {h5}")
+    _print_physics_warnings(result)
     try:
         _run_figure(args, result, scene, reference_scene, t_end, run_options["rtol"], base)
     except KeyboardInterrupt:  # the result is saved already; only the figure is missing
@@ -423,6 +427,12 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _print_physics_warnings(result: Any) -> None:
+    """The run's physics warnings (``result.warnings``, also in its HDF5 file), one line each on stderr."""
+    for rec in result.warnings:
+        print(f"daeclear: warning: {rec['kind']}: {rec['message']}", file=sys.stderr)
+
+
 # --------------------------------------------------------------------------- daeclear animate
 
 
@@ -447,7 +457,7 @@ def _add_animate_parser(sub: Any) -> None:
 
 
 def _animate(args: argparse.Namespace) -> int:
-    from .animate import CLI_FIELDS, _animate as render
+    from .animate import CLI_FIELDS, render
     from .result import load
 
     if not args.result.is_file():

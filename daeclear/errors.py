@@ -29,6 +29,11 @@ class DaeclearWarning(UserWarning):
     """A daeclear warning: something was changed or a slower path was taken."""
 
 
+class PhysicsWarning(DaeclearWarning):
+    """A finished run is not physical (penetration beyond the clearance, drift, a contact stepped
+    over, an impossible start); the same finding is recorded in ``Result.warnings``."""
+
+
 class MissingDependencyError(DaeclearError, ImportError):
     """An optional dependency is not installed; the message names the pip extra that brings it."""
 

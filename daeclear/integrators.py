@@ -100,7 +100,7 @@ from numpy.typing import ArrayLike, NDArray
 from .assemble import DAEModel, assemble
 from .codegen import (ODE_DRIVER_ABI, BuildResult, CompileError, CompilerUnavailable, OdeSpec, build_ode_library,
                       memo_get, memo_put, memo_table)
-from . import options
+from . import options, physics
 from .errors import DaeclearError, DaeclearWarning, Interrupted, SceneError, SolveError
 from .result import ContactEvent, Result
 from .scene import Scene
@@ -776,6 +776,9 @@ class _Run:
         self.seg: _Segment | None = None
         self.t_last = 0.0
         self.success, self.status, self.message = True, 0, "end of the time span reached"
+        self.y0: NDArray | None = None  # the state at t = 0, for the physics checks
+        self.step: float | None = None  # the fixed step (rk4, euler)
+        self.missed: list[tuple[float, float, str]] = []  # steps over which a gap changed sign, no event
 
     # ---------------------------------------------------------------- segments
     def directions(self) -> NDArray | None:
@@ -840,6 +843,8 @@ class _Run:
         sx = np.concatenate(seg.sx) if seg.sx else np.zeros((0, 2 * n))
         T = np.concatenate([[seg.t0], st])
         X = np.concatenate([seg.x0[None, :], sx])
+        if hermite and self.model.gap_names:  # fixed step: a gap that changed sign inside a segment has no event
+            self.missed += physics.sign_changes(self.model, T, X)
         if hermite and self.eval_times is not None:
             # fixed step: t_eval by cubic Hermite interpolation between the segment's steps
             te = self.pending_upto(seg.t1)
@@ -963,6 +968,10 @@ class _Run:
                      codegen_time=build.codegen_time if build else 0.0,
                      cache_hit=bool(build.cache_hit) if build else False)
         segments = [(s.t0, s.t1, s.modes) for s in self.segments]
+        found = physics.check_run(self.model, t, y, channels, self.y0, stats)
+        if self.step is not None:
+            found += physics.check_fixed_steps(self.model, self.events, self.step, self.missed)
+        physics.issue(found, stacklevel=5)  # issue <- result <- integrate <- simulate <- the caller
         return Result(
             t=t, y=y, yp=yp, state_names=list(self.model.state_names),
             channels=channels, units=dict(self.model.channel_units),
@@ -972,7 +981,7 @@ class _Run:
             step_order=np.concatenate(self.step_order) if self.step_order else np.zeros(0, dtype=np.int64),
             stats=stats, success=self.success, status=self.status, message=self.message,
             parameters={**self.model.parameters, "simulate": sim_params}, scene_name=self.model.scene_name,
-            method=METHOD_NAMES[self.method], formulation=self.model.formulation,
+            method=METHOD_NAMES[self.method], formulation=self.model.formulation, warnings=found,
         )
 
 
@@ -1322,6 +1331,7 @@ def integrate(
     y0, _ = model.initial_state(start=start)
     x0 = np.array(y0[:2 * n])
     run = _Run(model, ev, method_l, t_end, eval_times, store_steps, progress, max_steps)
+    run.y0, run.step = y0, step
     for logic in model.contacts:
         run.modes.update(logic.initial_modes(0.0, y0, run.active, run.params))
     setup_time = time.perf_counter() - setup_start

@@ -31,6 +31,7 @@ HDF5 layout (root attributes ``format="daeclear-result"``, ``version=1``)::
     /stats_json           scalar string: the statistics as JSON (what `load` reads)
     /parameters           groups and attributes mirroring the nested parameters
     /parameters_json      scalar string: the parameters as JSON (what `load` reads)
+    /warnings_json        scalar string: the physics warnings as a JSON list (absent in older files)
 
 Channel names keep their dots (``/channels/slider.vx``): a "." is an ordinary
 character in an HDF5 name. The ``/stats`` and ``/parameters`` groups are a
@@ -395,6 +396,9 @@ class Result:
     scene_name, method, formulation : str, default ""
         Where the result came from: the scene's name, the integrator
         (``"ida"``, ``"DOP853"``, ...) and the DAE formulation (``"index1"``, ``"ggl"``).
+    warnings : sequence of dict, optional
+        What the run's physics checks found (see :mod:`daeclear.physics`): each a dict with
+        ``kind``, ``quantity``, ``value``, ``limit``, ``unit``, ``where``, ``t``, ``message``.
 
     Raises
     ------
@@ -440,6 +444,7 @@ class Result:
         scene_name: str = "",
         method: str = "",
         formulation: str = "",
+        warnings: Iterable[Mapping[str, Any]] = (),
     ) -> None:
         t_arr = np.asarray(t, dtype=np.float64)
         if t_arr.ndim != 1:
@@ -536,6 +541,7 @@ class Result:
         self.scene_name: str = str(scene_name)
         self.method: str = str(method)
         self.formulation: str = str(formulation)
+        self.warnings: list[dict[str, Any]] = _plain([dict(w) for w in warnings], "warnings")
 
     # ------------------------------------------------------------------ access
 
@@ -641,6 +647,9 @@ class Result:
         names = self.channel_names
         shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
         lines.append(f"  channels ({len(names)}): {shown or '-'}")
+        if self.warnings:
+            kinds = ", ".join(dict.fromkeys(str(w.get("kind", "?")) for w in self.warnings))
+            lines.append(f"  warnings: {len(self.warnings)} ({kinds}); see result.warnings")
         return "\n".join(lines)
 
     # ------------------------------------------------------------------ windows
@@ -735,6 +744,7 @@ class Result:
             "scene_name": self.scene_name,
             "method": self.method,
             "formulation": self.formulation,
+            "warnings": json.loads(json.dumps(self.warnings)),
         }
 
     # ------------------------------------------------------------------ hand-off to pandas and xarray
@@ -1097,6 +1107,7 @@ def _write(f: h5py.File, r: Result) -> None:
     _json_dataset(f, "stats_json", r.stats)
     _mirror(f.create_group("parameters"), r.parameters)
     _json_dataset(f, "parameters_json", r.parameters)
+    _json_dataset(f, "warnings_json", r.warnings)
 
 
 # --------------------------------------------------------------------------- reading
@@ -1242,5 +1253,6 @@ def _read(r: _Reader) -> Result:
         scene_name=str(r.attr("scene_name")),
         method=str(r.attr("method")),
         formulation=str(r.attr("formulation")),
+        warnings=r.json("warnings_json") if r.has("warnings_json") else [],  # older files: no warnings
         **steps,
     )

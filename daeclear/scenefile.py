@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import tomllib
 from pathlib import Path
 from typing import Any, Callable
@@ -85,33 +86,100 @@ def _law(value: Any, build: Any) -> Any:
 
 
 def _contact_fields(entry: dict[str, Any]) -> dict[str, Any]:
-    """Clearance joints: material tables -> Material, law tables -> law objects."""
+    """Clearance joints: material tables -> Material, law tables -> law objects; an error names its key."""
     out = dict(entry)
-    material = out.get("material")
-    if isinstance(material, dict):
-        out["material"] = Material(**material)
-    elif isinstance(material, list):
-        out["material"] = tuple(Material(**m) for m in material)
-    for key in ("law", "face_law"):
-        if key in out:
-            out[key] = _law(out[key], normal_law)
-    if isinstance(out.get("friction"), dict):
-        out["friction"] = _law(out["friction"], friction_law)
+    key = "material"
+    try:
+        material = out.get("material")
+        if isinstance(material, dict):
+            out["material"] = Material(**material)
+        elif isinstance(material, list):
+            out["material"] = tuple(Material(**m) if isinstance(m, dict) else m for m in material)
+        for key in ("law", "face_law"):
+            if key in out:
+                out[key] = _law(out[key], normal_law)
+        key = "friction"
+        if isinstance(out.get("friction"), dict):
+            out["friction"] = _law(out["friction"], friction_law)
+    except (TypeError, ValueError, SceneError) as exc:
+        raise SceneError(f"key {key}: {exc}") from None
     return out
 
 
+def _single_table(path: Path, data: dict[str, Any], table: str) -> dict[str, Any]:
+    """``[table]``: one table; ``[[table]]`` or ``table = ...`` written instead is named as such."""
+    value = data.get(table, {})
+    if isinstance(value, dict):
+        return dict(value)
+    if isinstance(value, list):
+        raise SceneError(f"{path}: [[{table}]] is an array of tables; {table} is a single table: write "
+                         f"[{table}] (one pair of brackets), once.")
+    raise SceneError(f"{path}: {table} = {value!r} is {_a(value)}; {table} is a table: write [{table}] "
+                     "on its own line with its keys below it.")
+
+
+def _array_of_tables(path: Path, data: dict[str, Any], table: str) -> list[dict[str, Any]]:
+    """``[[table]]`` entries; a single ``[table]`` (or a value) written instead is named as such."""
+    value = data.get(table, [])
+    if isinstance(value, dict):
+        raise SceneError(f"{path}: [{table}] is a single table; scene elements are arrays of tables: write "
+                         f"[[{table}]] (two pairs of brackets) before each {table}.")
+    if not isinstance(value, list) or not all(isinstance(entry, dict) for entry in value):
+        raise SceneError(f"{path}: {table} = {value!r} is {_a(value)}; write each {table} as a table "
+                         f"[[{table}]] with its keys below it.")
+    return value
+
+
+def _a(value: Any) -> str:
+    """'a number', 'an array', ...: the TOML type of a value with its article."""
+    kind = _toml_type(value)
+    return f"an {kind}" if kind[0] in "aeiou" else f"a {kind}"
+
+
+def _toml_type(value: Any) -> str:
+    """The TOML name of a value's type, for messages."""
+    if isinstance(value, bool):
+        return "boolean"
+    if isinstance(value, (int, float)):
+        return "number"
+    if isinstance(value, str):
+        return "string"
+    if isinstance(value, list):
+        return "array"
+    if isinstance(value, dict):
+        return "table"
+    return type(value).__name__
+
+
 def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any]) -> Any:
-    allowed = [f.name for f in dataclasses.fields(cls)]
+    fields = dataclasses.fields(cls)
+    allowed = [f.name for f in fields]
+    label = f"{path}: [[{table}]] #{index + 1}"
     unknown = sorted(set(entry) - set(allowed))
     if unknown:
-        raise SceneError(f"{path}: [[{table}]] #{index + 1}: unknown key(s) {', '.join(unknown)}; "
-                         f"allowed: {', '.join(allowed)}.")
+        raise SceneError(f"{label}: unknown key(s) {', '.join(unknown)}; allowed: {', '.join(allowed)}.")
+    for f in fields:  # names of the element and of the bodies and joints it refers to
+        if f.type in ("str", str) and f.name in entry and not isinstance(entry[f.name], str):
+            value = entry[f.name]
+            raise SceneError(f"{label}: key {f.name} = {value!r} is {_a(value)}, must be a string "
+                             f"(in quotes: {f.name} = \"{value}\").")
     try:
         if cls in (RevoluteClearance, TranslationalClearance):
             entry = _contact_fields(entry)
-        return cls(**entry)
-    except (TypeError, SceneError) as exc:
-        raise SceneError(f"{path}: [[{table}]] #{index + 1}: {exc}") from None
+        element = cls(**entry)
+    except (TypeError, ValueError, SceneError) as exc:
+        text = str(exc)
+        raise SceneError(f"{label}: {text if text.startswith('key ') else _with_key(text, entry)}") from None
+    problems = element.problems()
+    if problems:
+        raise SceneError(f"{label}: " + " ".join(_with_key(p, entry) for p in problems))
+    return element
+
+
+def _with_key(problem: str, entry: dict[str, Any]) -> str:
+    """A problem message that names the key it is about (the message names the field as ``key=``)."""
+    keys = [key for key in entry if re.search(rf"\b{re.escape(key)}s?=", problem)]
+    return f"key {keys[0]}: {problem}" if keys else problem
 
 
 def check_simulate(simulate: dict[str, Any], *, where: str) -> dict[str, Any]:
@@ -148,7 +216,7 @@ def read_scene_file(path: str | Path) -> SceneFile:
         raise SceneError(f"scene file {path} does not exist.") from None
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML ({exc}).") from None
-    simulate = dict(data.get("simulate", {}))
+    simulate = _single_table(path, data, "simulate")
     unknown_sim = sorted(set(simulate) - set(SIMULATE_KEYS))
     if unknown_sim:
         raise SceneError(f"{path}: [simulate]: unknown key(s) {', '.join(unknown_sim)}; "
@@ -159,26 +227,45 @@ def read_scene_file(path: str | Path) -> SceneFile:
         if extra:
             raise SceneError(f"{path}: a [mechanism] file takes only [mechanism] and [simulate]; "
                              f"found {', '.join(extra)}.")
-        params = dict(data["mechanism"])
-        name = str(params.pop("name", ""))
+        params = _single_table(path, data, "mechanism")
+        name = params.pop("name", "")
         if name not in MECHANISMS:
-            raise SceneError(f"{path}: [mechanism] name={name!r}, must be one of {', '.join(MECHANISMS)}.")
+            raise SceneError(f"{path}: [mechanism]: key name = {name!r}, must be one of {', '.join(MECHANISMS)}.")
         try:
             scene = MECHANISMS[name](**params)
         except TypeError as exc:  # a missing required parameter, e.g. chain's n_links
             raise SceneError(f"{path}: [mechanism] {exc}.") from None
+        except SceneError as exc:  # a parameter's value: the rule, with the file and the table
+            raise SceneError(f"{path}: [mechanism]: {_with_key(str(exc), params)}") from None
         return SceneFile(scene, simulate, data)
     allowed_tables = {"scene", "simulate", *ELEMENT_TABLES}
     extra = sorted(set(data) - allowed_tables)
     if extra:
         raise SceneError(f"{path}: unknown table(s) {', '.join(extra)}; allowed: {', '.join(sorted(allowed_tables))}.")
-    head = dict(data.get("scene", {}))
+    head = _single_table(path, data, "scene")
     unknown_head = sorted(set(head) - {"name", "gravity"})
     if unknown_head:
         raise SceneError(f"{path}: [scene]: unknown key(s) {', '.join(unknown_head)}; allowed: name, gravity.")
-    scene = Scene(str(head.get("name", path.stem)), gravity=tuple(head.get("gravity", (0.0, -9.81))))
-    for table, cls in ELEMENT_TABLES.items():
-        for i, entry in enumerate(data.get(table, [])):
-            scene.add(_element(path, table, i, cls, entry))
-    scene.validate()
+    name = head.get("name", path.stem)
+    if not isinstance(name, str):
+        raise SceneError(f"{path}: [scene]: key name = {name!r} is {_a(name)}, must be a string "
+                         f"(in quotes: name = \"{name}\").")
+    gravity = head.get("gravity", [0.0, -9.81])
+    if not isinstance(gravity, list):
+        raise SceneError(f"{path}: [scene]: key gravity = {gravity!r} is {_a(gravity)}, must be an array "
+                         "of two numbers (m/s^2), e.g. gravity = [0.0, -9.81].")
+    try:
+        scene = Scene(name, gravity=tuple(gravity))
+    except SceneError as exc:
+        raise SceneError(f"{path}: [scene]: key gravity: {exc}") from None
+    try:
+        for table, cls in ELEMENT_TABLES.items():
+            for i, entry in enumerate(_array_of_tables(path, data, table)):
+                scene.add(_element(path, table, i, cls, entry))
+        scene.validate()
+    except SceneError as exc:  # the scene as a whole (names, references): the file, then the rule
+        text = str(exc)
+        if text.startswith(f"scene {name!r}: gravity="):
+            text = f"[scene]: key gravity: {text}"
+        raise SceneError(text if text.startswith(str(path)) else f"{path}: {text}") from None
     return SceneFile(scene, simulate, data)

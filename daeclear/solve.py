@@ -14,15 +14,14 @@ import logging
 import math
 import sys
 import time
-import warnings
 from typing import Any, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import options
+from . import options, physics
 from .assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
-from .errors import DaeclearWarning, Interrupted, SceneError, SolveError
+from .errors import Interrupted, SceneError, SolveError
 from .ida_session import open_session
 from .result import ContactEvent, Result
 from .scene import Scene
@@ -41,16 +40,18 @@ MULTIPLIER_ATOL_FLOOR = 1e4
 # micrometre penetrations, so positions need an absolute floor well below the clearance.
 DEFAULT_ATOL_FACTOR = 1e-3
 # Constraint drift (largest |Phi| of a run) above this fraction of the smallest clearance is warned of.
-DRIFT_FRACTION = 1e-3
+DRIFT_FRACTION = physics.DRIFT_FRACTION
 # GGL holds Phi = 0 only as tightly as IDA's Newton test (safety factor 0.33 by default). 1e-3
 # keeps the pendulum's constraint residual at 1e-12 instead of 3e-11 (rtol 1e-10) and, measured,
 # halves the steps; index1 is better off with IDA's default. The python backend cannot set it.
 GGL_NEWTON_COEF = 1e-3
-# Stall guard: STALL_COUNT steps shorter than STALL_STEP_FACTOR * t_end that do not grow (and no
-# step a hundred times longer in between) end the run with a clear message instead of creeping on
+# Stall guard: STALL_COUNT steps shorter than STALL_STEP seconds that do not grow (and no step a
+# hundred times longer in between) end the run with a clear message instead of creeping on
 # (e.g. plain Coulomb friction chattering at zero sliding speed takes ~1e-12 s order-1 steps).
 # Contact steps of the chapter's runs are 1e-9..1e-6 s; restarts' start-up steps grow and do not count.
-STALL_STEP_FACTOR = 1e-10
+# The threshold is absolute: it used to be 1e-10 * t_end, which at t_end = 100 s (1e-8 s) called
+# ordinary contact steps a stall. 2.4e-12 s is what it was for the chapter's 0.024 s runs.
+STALL_STEP = 2.4e-12
 STALL_COUNT = 2000
 
 
@@ -176,6 +177,15 @@ def simulate(
     Returns
     -------
     Result
+        ``result.warnings`` lists what the physics checks found (penetration beyond the
+        clearance, an impossible start, constraint drift, contacts stepped over by a fixed step);
+        each is also issued as a :class:`daeclear.PhysicsWarning`. See :mod:`daeclear.physics`.
+
+    Raises
+    ------
+    AssemblyError
+        The initial positions cannot be assembled, or the constraints are redundant (the
+        message names the joints and drivers).
     """
     method = options.method(method)
     linear_solver = options.linear_solver(linear_solver)
@@ -204,7 +214,7 @@ def simulate(
     if model.formulation == "ggl":
         # never ask Newton for corrections below round-off: coef * rtol >= 1e-13
         session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / rtol)))
-    session.set_stall(STALL_STEP_FACTOR * t_end, STALL_COUNT)
+    session.set_stall(STALL_STEP, STALL_COUNT)
     setup_time = time.perf_counter() - setup_start
     return _run(model, session, y0, yp0, t_end, eval_times, store_steps, on_failure, progress,
                 setup_time, {"method": method, "start": start, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
@@ -383,14 +393,21 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     stats.update(n_events=len(events), n_restarts=n_restarts, setup_time=setup_time,
                  wall_time=setup_time + time.perf_counter() - run_start,
                  output_time=time.perf_counter() - post_start)
-    _check_drift(model, channels, stats)
+    found = physics.check_run(model, out_t, out_y, channels, y0, stats)
+    physics.issue(found, stacklevel=4)  # issue <- _run <- simulate <- the caller
+    deep = [w for w in found if w["kind"] == "penetration" and w["t"] <= t]
+    if not success and not interrupted and deep:  # the advice must fit the cause: not a tolerance problem
+        w = deep[0]
+        message += (f" Before it, '{w['where']}' penetrated {w['value']:.3g} m at t={w['t']:.6g} s, more than its "
+                    f"limit {w['limit']:.3g} m: the contact carries more than the joint can (friction, speed or "
+                    "load); tolerances will not fix that.")
     result = Result(
         t=out_t, y=out_y, yp=out_yp, state_names=list(model.state_names),
         channels=channels, units=dict(model.channel_units),
         events=events, segments=segments, step_t=step_t, step_h=np.concatenate(steps_h),
         step_order=np.concatenate(steps_order), stats=stats, success=success, status=status, message=message,
         parameters={**model.parameters, "simulate": sim_params}, scene_name=model.scene_name,
-        method=sim_params["method"], formulation=model.formulation,
+        method=sim_params["method"], formulation=model.formulation, warnings=found,
     )
     if interrupted:
         raise Interrupted(f"simulate: {message}; partial result in .result.", result)
@@ -400,26 +417,8 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
 
 
 def smallest_clearance(model: DAEModel) -> float:
-    """The smallest clearance of the model's clearance joints (inf without any), from its parameters."""
-    values = [float(model.parameter(name)[0]) for name in model.parameter_names if name.endswith(".clearance")]
-    return min(values, default=math.inf)
-
-
-def _check_drift(model: DAEModel, channels: dict[str, NDArray], stats: dict[str, Any]) -> None:
-    """Record the largest constraint violation of the run; warn when it reaches DRIFT_FRACTION of the
-    smallest clearance (the journal's position is then uncertain by a visible part of its play)."""
-    drift = channels.get("constraints.position")
-    if drift is None or drift.size == 0:
-        return
-    worst = float(np.max(drift))
-    stats["max_constraint_drift"] = worst
-    clearance = smallest_clearance(model)
-    if worst > DRIFT_FRACTION * clearance:
-        warnings.warn(
-            f"simulate: the constraints drifted by {worst:.2e} m, {worst / clearance:.1%} of the smallest "
-            f"clearance ({clearance:.2e} m) (formulation={model.formulation!r}); contact times and forces are "
-            "uncertain by that much. Use formulation='ggl' (drift-free) or a smaller rtol.",
-            DaeclearWarning, stacklevel=3)
+    """The smallest clearance of the model's clearance joints (inf without any)."""
+    return physics.smallest_clearance(model)
 
 
 def _same_terms(c_terms: tuple[list[bool], list[NDArray]], active: Sequence[bool], params: Sequence[NDArray]) -> bool:

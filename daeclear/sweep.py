@@ -676,6 +676,21 @@ class SweepResult:
         return (np.concatenate(xs) if xs else np.zeros(0), np.concatenate(ys) if ys else np.zeros(0), labels)
 
 
+def _unreadable(path: Path, exc: OSError) -> DaeclearError:
+    """The error for a sweep file HDF5 cannot open, with the recovery that fits: a truncated file (a
+    copy or a write cut short) is a damaged sweep, anything else is not a sweep file."""
+    if "truncated file" not in str(exc):
+        return DaeclearError(f"'{path}' cannot be opened as HDF5 ({exc}); it is not a daeclear sweep file. "
+                             "Give another path (or delete it to start over).")
+    journal = _parts_dir(path)
+    kept = len(_part_files(path))
+    return DaeclearError(
+        f"'{path}' is a truncated daeclear sweep file ({path.stat().st_size} bytes; HDF5: {exc}): a copy or a write "
+        "that was cut short, whose runs cannot be read. To recover: restore the file from a copy if you have one; "
+        f"otherwise move it aside (e.g. rename it to '{path.name}.damaged') and run the same sweep again: the "
+        f"{kept} run(s) in its journal '{journal}' are kept, the others are computed again.")
+
+
 def load_sweep(path: str | os.PathLike[str]) -> SweepResult:
     """Read a sweep file, with the runs of its journal that are not merged yet.
 
@@ -695,8 +710,7 @@ def load_sweep(path: str | os.PathLike[str]) -> SweepResult:
         try:
             f = h5py.File(path, "r")
         except OSError as exc:
-            raise DaeclearError(f"'{path}' cannot be opened as HDF5 ({exc}); it is not a daeclear sweep file. "
-                                "Give another path (or delete it to start over).") from None
+            raise _unreadable(path, exc) from None
         with f:
             _check_format(f, path)
             mechanism = _text(f.attrs["mechanism"])
