@@ -412,10 +412,10 @@ def _sweep(args: argparse.Namespace) -> int:
         from .plot import plot_bifurcation, plot_motion_map
         fig, ax = plt.subplots(figsize=(7.0, 4.5))
         if len(names) == 1 and numeric:
-            plot_bifurcation(result, names[0], ax=ax)
+            plot_bifurcation(result, names[0], ax=ax, title=True)
             png = args.out.with_name(args.out.stem + "_bifurcation.png")
         else:
-            plot_motion_map(result, names[0], names[-1], ax=ax)
+            plot_motion_map(result, names[0], names[-1], ax=ax, title=True)
             png = args.out.with_name(args.out.stem + "_motion_map.png")
         fig.tight_layout()
         fig.savefig(png, dpi=120)
