@@ -449,6 +449,12 @@ def title_of(what: str, results: Sequence[dc.Result] | dc.Result) -> str:
     return f"{what}\n{shared_caption(results)}"
 
 
+def caption_runs(scenes: Sequence[dc.Scene]) -> list[dc.Result]:
+    """A 1 µs run of every scene: Results that record the scenes' parameters, for the titles of figures
+    drawn from data that carry none (a sweep's sections)."""
+    return [dc.simulate(scene, 1e-6) for scene in scenes]
+
+
 def study_title(study: Study, what: str) -> str:
     """:func:`title_of` the cases of ``study`` (the ideal joint left out)."""
     return title_of(what, [case.window for case in study.cases])
