@@ -11,6 +11,7 @@ from __future__ import annotations
 import importlib.util
 import re
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
 
@@ -35,7 +36,7 @@ def _load() -> ModuleType:
 
 
 @pytest.fixture()
-def gallery(monkeypatch: pytest.MonkeyPatch) -> ModuleType:
+def gallery(monkeypatch: pytest.MonkeyPatch) -> Iterator[ModuleType]:
     monkeypatch.syspath_prepend(str(EXAMPLES))
     yield _load()
     import matplotlib.pyplot as plt
