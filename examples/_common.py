@@ -43,6 +43,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 import daeclear as dc
+from daeclear import style
 from daeclear.mechanisms import slider_crank
 from daeclear.plot import _contact_intervals as contact_intervals
 
@@ -402,13 +403,71 @@ def save_result(result: dc.Result, out: Path, name: str) -> Path:
     return result.save(out / f"{name}.h5")
 
 
-def save_figure(fig: Any, path: Path) -> Path:
-    """Write a figure as PNG and close it."""
+def save_figure(fig: Any, path: Path, *, dpi: int = 110) -> Path:
+    """Write a figure as PNG, its title in the PNG's ``Title`` text (readable without drawing it), and close it."""
     import matplotlib.pyplot as plt
 
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=dpi, metadata={"Title": figure_title(fig)})
     plt.close(fig)
     return path
+
+
+# --------------------------------------------------------------------------- titles
+
+
+def shared_caption(results: Sequence[dc.Result]) -> str:
+    """The parameters every run of ``results`` shares, from :func:`daeclear.style.caption`.
+
+    For the title of a figure that compares cases: the parameter that varies is in the panel
+    titles or the legend, the others once in the figure title. A part that differs only in its
+    value keeps its name (``Lankarani-Nikravesh $c_e$ = 1`` and ``... = 0.9`` give
+    ``Lankarani-Nikravesh``); the scene name leads when every run has the same.
+    """
+    if not results:
+        return ""
+    captions = [style.caption(r, name=False).split(", ") for r in results]
+    shared: list[str] = []
+    for part in captions[0]:
+        if all(part in other for other in captions[1:]):
+            shared.append(part)
+            continue
+        name, dollar, _ = part.partition(" $")
+        if dollar and all(any(p.startswith(name + " $") for p in other) for other in captions[1:]):
+            shared.append(name)
+    text = ", ".join(shared)
+    names = {r.scene_name for r in results}
+    if len(names) == 1 and (scene := names.pop()):
+        text = f"{scene}: {text}" if text else scene
+    return text
+
+
+def title_of(what: str, results: Sequence[dc.Result] | dc.Result) -> str:
+    """Figure title: what it shows, then on a second line the run's parameters (:func:`daeclear.style.caption`)
+    or, for several runs, the ones they share (:func:`shared_caption`)."""
+    if isinstance(results, dc.Result):
+        return f"{what}\n{style.caption(results)}"
+    return f"{what}\n{shared_caption(results)}"
+
+
+def caption_runs(scenes: Sequence[dc.Scene]) -> list[dc.Result]:
+    """A 1 µs run of every scene: Results that record the scenes' parameters, for the titles of figures
+    drawn from data that carry none (a sweep's sections)."""
+    return [dc.simulate(scene, 1e-6) for scene in scenes]
+
+
+def study_title(study: Study, what: str) -> str:
+    """:func:`title_of` the cases of ``study`` (the ideal joint left out)."""
+    return title_of(what, [case.window for case in study.cases])
+
+
+def figure_title(fig: Any) -> str:
+    """The text of a figure's title: its suptitle, else the title of its first Axes ("" when none)."""
+    if fig.get_suptitle():
+        return str(fig.get_suptitle())
+    for ax in fig.axes:
+        if ax.get_title():
+            return str(ax.get_title())
+    return ""
 
 
 # columns of the printed summary: (key, header, format)
@@ -534,22 +593,26 @@ def save_study(study: Study, out: Path, rtol: float, *, sections: Sequence[Secti
 
 
 def channel_figure(study: Study, channel: str, title: str, *, reference: bool = True) -> Any:
-    """One panel per case: ``channel`` over the plotted window, the ideal joint dashed."""
+    """One panel per case: ``channel`` over the plotted window, the ideal joint dashed.
+
+    ``title`` says what the figure shows; the parameters the cases share are added (:func:`study_title`),
+    the case labels (the varied parameter) title the panels. The same for the figures below.
+    """
     from functools import partial
 
     from daeclear.plot import plot_cases, plot_channel
 
     kw: dict[str, Any] = {"reference": study.ideal.window} if reference else {}
     return plot_cases({c.label: c.window for c in study.cases}, partial(plot_channel, channel=channel),
-                      sharey=True, suptitle=title, label="clearance joint", **kw)
+                      sharey=True, suptitle=study_title(study, title), label="clearance joint", **kw)
 
 
 def orbit_figure(study: Study, title: str) -> Any:
     """One panel per case: journal centre relative to the bearing, one marker per IDA step."""
     from daeclear.plot import plot_cases, plot_journal_orbit
 
-    return plot_cases({c.label: c.steps_window for c in study.cases}, plot_journal_orbit, suptitle=title,
-                      panel_size=(3.8, 3.6))
+    return plot_cases({c.label: c.steps_window for c in study.cases}, plot_journal_orbit,
+                      suptitle=study_title(study, title), panel_size=(3.8, 3.6))
 
 
 def phase_figure(study: Study, title: str) -> Any:
@@ -558,7 +621,7 @@ def phase_figure(study: Study, title: str) -> Any:
     from daeclear.plot import plot_cases, plot_phase_portrait
 
     fig = plot_cases({c.label: c.dense for c in study.cases}, plot_phase_portrait, reference=study.ideal.window,
-                     sharex=True, sharey=True, suptitle=title)
+                     sharex=True, sharey=True, suptitle=study_title(study, title))
     for ax, case in zip(fig.axes, study.cases):
         pts = poincare_points(case.dense, study.span)
         if len(pts):
@@ -572,4 +635,4 @@ def step_figure(study: Study, title: str) -> Any:
     from daeclear.plot import plot_cases, plot_step_sizes
 
     return plot_cases({c.label: c.steps_window for c in study.cases}, plot_step_sizes, sharey=True,
-                      suptitle=title, pair=PAIR)
+                      suptitle=study_title(study, title), pair=PAIR)

@@ -34,6 +34,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import _common as cm  # noqa: E402
 import daeclear as dc  # noqa: E402
 import sweep_studies  # noqa: E402
 
@@ -62,6 +63,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parse_args(argv)
     import matplotlib.pyplot as plt
 
+    from daeclear import style
     from daeclear.plot import plot_bifurcation
 
     clearances = [float(c) for c in np.geomspace(C_MIN, C_MAX, 2 if args.quick else args.points)]
@@ -95,7 +97,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         ax.set_xscale("log")
     for ax in axes[:2]:
         ax.set_xlabel("")
-    fig.suptitle("Revolute clearance joint: Poincaré section against clearance (5000 rpm)", fontsize="medium")
+    scenes = [dc.mechanisms.slider_crank(**r.parameters) for r in done]  # the shared parameters, from 1 µs runs
+    style.set_title(fig, cm.title_of("Revolute clearance joint: Poincaré section against clearance",
+                                     cm.caption_runs(scenes)))
     fig.tight_layout()
     png = args.out / "bifurcation.png"
     fig.savefig(png, dpi=120)

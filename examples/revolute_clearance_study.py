@@ -20,9 +20,10 @@ Run: ``python examples/revolute_clearance_study.py`` (``--quick`` for a 5 ms smo
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Callable, Sequence
 
 import matplotlib
 
@@ -37,21 +38,39 @@ CLEARANCES = (0.5e-3, 0.2e-3, 0.1e-3, 0.01e-3)  # m (Figs. 4.16-4.18 a-d)
 RESTITUTION = 0.9
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    args = cm.parse_args(__file__, __doc__.splitlines()[0], argv)
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The common options of ``_common.parse_args``."""
+    return cm.parse_args(__file__, __doc__.splitlines()[0], argv)
+
+
+def run(args: argparse.Namespace) -> cm.Study:
+    """Simulate the ideal joint and the four clearances."""
     scenes = {f"c = {c * 1e3:g} mm": (f"c{c * 1e3:g}mm",
                                       slider_crank("revolute", clearance=c, restitution=RESTITUTION,
                                                    gravity=cm.GRAVITY, rpm=cm.RPM))
               for c in CLEARANCES}
-    study = cm.run_study("Figs. 4.16-4.18: clearance size, Lankarani-Nikravesh c_e = 0.9, frictionless",
-                         scenes, args)
-    cm.save_figure(cm.channel_figure(study, "drive.moment", "Fig. 4.16: crank moment for different clearances"),
-                   args.out / "fig4_16_crank_moment.png")
-    cm.save_figure(cm.orbit_figure(study, "Fig. 4.17: journal centre trajectory relative to the bearing"),
-                   args.out / "fig4_17_journal_orbits.png")
-    cm.save_figure(cm.phase_figure(study, "Fig. 4.18: slider acceleration against velocity"),
-                   args.out / "fig4_18_phase_portraits.png")
-    cm.save_figure(cm.step_figure(study, "IDA step size, contact shaded"), args.out / "step_sizes.png")
+    return cm.run_study("Figs. 4.16-4.18: clearance size, Lankarani-Nikravesh c_e = 0.9, frictionless",
+                        scenes, args)
+
+
+def figures(study: cm.Study) -> dict[str, Callable[[], Any]]:
+    """File name -> function drawing that figure (titles: what it shows and the shared parameters)."""
+    return {
+        "fig4_16_crank_moment.png": lambda: cm.channel_figure(study, "drive.moment",
+                                                              "Fig. 4.16: crank moment for different clearances"),
+        "fig4_17_journal_orbits.png": lambda: cm.orbit_figure(
+            study, "Fig. 4.17: journal centre trajectory relative to the bearing"),
+        "fig4_18_phase_portraits.png": lambda: cm.phase_figure(study,
+                                                               "Fig. 4.18: slider acceleration against velocity"),
+        "step_sizes.png": lambda: cm.step_figure(study, "IDA step size, contact shaded"),
+    }
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = parse_args(argv)
+    study = run(args)
+    for name, draw in figures(study).items():
+        cm.save_figure(draw(), args.out / name)
     cm.save_study(study, args.out, args.rtol)
     cm.print_written(args.out)
     return 0

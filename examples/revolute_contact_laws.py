@@ -29,9 +29,10 @@ Run: ``python examples/revolute_contact_laws.py`` (``--quick`` for a 5 ms smoke 
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Callable, Sequence
 
 import matplotlib
 
@@ -47,6 +48,7 @@ from daeclear.contact import (  # noqa: E402
     Hertz,
     LankaraniNikravesh,
 )
+from daeclear import style  # noqa: E402
 from daeclear.mechanisms import BEARING_RADIUS, STEEL, slider_crank  # noqa: E402
 
 CLEARANCE = 0.5e-3  # m
@@ -68,26 +70,42 @@ def laws(length: float) -> dict[str, tuple[str, object]]:
     }
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    import argparse
-
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The common options of ``_common.parse_args`` and ``--length`` (m, axial length of the cylindrical laws)."""
     pre = argparse.ArgumentParser(add_help=False)
     pre.add_argument("--length", type=float, default=LENGTH)
     known, rest = pre.parse_known_args(argv)
     args = cm.parse_args(__file__, __doc__.splitlines()[0] + f" [--length L, m, default {LENGTH:g}]", rest)
-    chosen = laws(known.length)
+    args.length = known.length
+    return args
+
+
+def run(args: argparse.Namespace) -> cm.Study:
+    """Simulate the ideal joint and the five laws."""
     scenes = {label: (stem, slider_crank("revolute", clearance=CLEARANCE, law=law, gravity=cm.GRAVITY, rpm=cm.RPM))
-              for label, (stem, law) in chosen.items()}
-    study = cm.run_study(f"Figs. 4.22-4.24: contact laws, c = 0.5 mm, frictionless, cylindrical laws with "
-                         f"L = {known.length * 1e3:g} mm", scenes, args)
-    cm.save_figure(cm.channel_figure(study, "clearance.normal_force", "Fig. 4.22: contact force", reference=False),
-                   args.out / "fig4_22_contact_force.png")
-    cm.save_figure(cm.channel_figure(study, "drive.moment", "Fig. 4.23: crank moment"),
-                   args.out / "fig4_23_crank_moment.png")
-    cm.save_figure(cm.orbit_figure(study, "Fig. 4.24: journal centre trajectory (one marker per IDA step)"),
-                   args.out / "fig4_24_journal_orbits.png")
-    cm.save_figure(_law_curves(chosen), args.out / "law_curves.png")
-    cm.save_figure(cm.step_figure(study, "IDA step size, contact shaded"), args.out / "step_sizes.png")
+              for label, (stem, law) in laws(args.length).items()}
+    return cm.run_study(f"Figs. 4.22-4.24: contact laws, c = 0.5 mm, frictionless, cylindrical laws with "
+                        f"L = {args.length * 1e3:g} mm", scenes, args)
+
+
+def figures(study: cm.Study, length: float = LENGTH) -> dict[str, Callable[[], Any]]:
+    """File name -> function drawing that figure (titles: what it shows and the shared parameters)."""
+    return {
+        "fig4_22_contact_force.png": lambda: cm.channel_figure(study, "clearance.normal_force",
+                                                               "Fig. 4.22: contact force", reference=False),
+        "fig4_23_crank_moment.png": lambda: cm.channel_figure(study, "drive.moment", "Fig. 4.23: crank moment"),
+        "fig4_24_journal_orbits.png": lambda: cm.orbit_figure(
+            study, "Fig. 4.24: journal centre trajectory (one marker per IDA step)"),
+        "law_curves.png": lambda: _law_curves(laws(length)),
+        "step_sizes.png": lambda: cm.step_figure(study, "IDA step size, contact shaded"),
+    }
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = parse_args(argv)
+    study = run(args)
+    for name, draw in figures(study, args.length).items():
+        cm.save_figure(draw(), args.out / name)
     cm.save_study(study, args.out, args.rtol)
     cm.print_written(args.out)
     return 0
@@ -106,7 +124,8 @@ def _law_curves(chosen: dict[str, tuple[str, object]]):
         ax.plot(delta * 1e6, resolved.force(delta, np.zeros_like(delta), np.ones_like(delta)) / 1e3, label=label)
     ax.set_xlabel("penetration (µm)")
     ax.set_ylabel("contact force at zero rate (kN)")
-    ax.set_title("Normal laws for the journal in the bearing (c = 0.5 mm, steel)", fontsize="medium")
+    clearance = style.format_parameter("clearance", CLEARANCE)
+    style.set_title(ax, f"Normal laws for the journal in the bearing\n{clearance}, steel, penetration rate 0")
     ax.legend(fontsize="small")
     fig.tight_layout()
     return fig

@@ -21,10 +21,12 @@ Run: ``python examples/revolute_first_impact.py`` (``--quick`` runs the same: it
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Callable, Sequence
 
 import matplotlib
 
@@ -36,6 +38,7 @@ import numpy as np  # noqa: E402
 
 import _common as cm  # noqa: E402
 import daeclear as dc  # noqa: E402
+from daeclear import style  # noqa: E402
 from daeclear.contact import ImpactResult  # noqa: E402
 from daeclear.mechanisms import slider_crank  # noqa: E402
 from daeclear.plot import plot_force_penetration, plot_force_time  # noqa: E402
@@ -67,35 +70,66 @@ def first_impacts(restitutions: Sequence[float], rtol: float, jobs: int) -> list
     return out
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    import matplotlib.pyplot as plt
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The common options of ``_common.parse_args`` (``--quick`` changes nothing: the run is short)."""
+    return cm.parse_args(__file__, __doc__.splitlines()[0], argv)
 
-    args = cm.parse_args(__file__, __doc__.splitlines()[0], argv)
+
+@dataclass
+class Impacts:
+    """The first impact of every c_e: label -> fine Result, label -> ImpactResult, and the measured rows."""
+
+    results: dict[str, dc.Result]
+    impacts: dict[str, ImpactResult]
+    rows: list[dict[str, Any]]
+
+
+def run(args: argparse.Namespace) -> Impacts:
+    """Simulate the first impact for every c_e and measure it."""
     print(f"Fig. 4.26: first impact, c = {CLEARANCE * 1e3:g} mm, Lankarani-Nikravesh, frictionless, "
           f"gravity {cm.GRAVITY} m/s^2, rtol {args.rtol:g}", flush=True)
-    impacts: dict[str, ImpactResult] = {}
-    rows = []
+    out = Impacts({}, {}, [])
     for ce, (result, imp) in zip(RESTITUTIONS, first_impacts(RESTITUTIONS, args.rtol, args.jobs)):
         label = f"$c_e$ = {ce:.2f}"
-        impacts[label] = imp
-        cm.save_result(result, args.out, f"first_impact_ce{ce:.2f}")
+        out.results[label], out.impacts[label] = result, imp
         loop = float(np.trapezoid(imp.force, imp.penetration))  # J: area of the loop = energy dissipated
-        rows.append({"case": label, "onset_ms": float(result.t[0] * 1e3), "entry_speed_m_s": imp.entry_speed,
-                     "exit_speed_m_s": imp.exit_speed, "effective_restitution": imp.restitution,
-                     "peak_force_N": imp.peak_force, "max_penetration_um": imp.max_penetration * 1e6,
-                     "duration_us": imp.duration * 1e6, "dissipated_J": loop})
+        out.rows.append({"case": label, "onset_ms": float(result.t[0] * 1e3), "entry_speed_m_s": imp.entry_speed,
+                         "exit_speed_m_s": imp.exit_speed, "effective_restitution": imp.restitution,
+                         "peak_force_N": imp.peak_force, "max_penetration_um": imp.max_penetration * 1e6,
+                         "duration_us": imp.duration * 1e6, "dissipated_J": loop})
         print(f"  {label:<16s} onset {result.t[0] * 1e3:.4f} ms, {imp.entry_speed:.3f} -> {imp.exit_speed:.3f} m/s "
               f"(ratio {imp.restitution:.4f}), peak {imp.peak_force:.0f} N, max penetration "
               f"{imp.max_penetration * 1e6:.2f} um, {imp.duration * 1e6:.1f} us, loop {loop:.4f} J", flush=True)
+    return out
 
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11.0, 4.3))
-    plot_force_time(impacts, ax=left)
-    left.set_title("(a) contact force against time", fontsize="medium")
-    plot_force_penetration(impacts, ax=right)
-    right.set_title("(b) force against penetration", fontsize="medium")
-    fig.suptitle("Fig. 4.26: first impact of the slider-crank, c = 0.5 mm, Lankarani-Nikravesh", fontsize="medium")
+
+def impact_figure(data: Impacts) -> Any:
+    """Fig. 4.26 (a) force against time, (b) force against penetration; c_e in the legend, the rest in the title."""
+    import matplotlib.pyplot as plt
+
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11.0, 4.6))
+    plot_force_time(data.impacts, ax=left)
+    style.set_title(left, "(a) contact force against time")
+    plot_force_penetration(data.impacts, ax=right)
+    style.set_title(right, "(b) force against penetration")
+    style.set_title(fig, cm.title_of("Fig. 4.26: first impact of the slider-crank", list(data.results.values())))
     fig.tight_layout()
-    cm.save_figure(fig, args.out / "fig4_26_first_impact.png")
+    return fig
+
+
+def figures(data: Impacts) -> dict[str, Callable[[], Any]]:
+    """File name -> function drawing that figure."""
+    return {"fig4_26_first_impact.png": lambda: impact_figure(data)}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = parse_args(argv)
+    data = run(args)
+    for ce, result in zip(RESTITUTIONS, data.results.values()):
+        cm.save_result(result, args.out, f"first_impact_ce{ce:.2f}")
+    for name, draw in figures(data).items():
+        cm.save_figure(draw(), args.out / name)
+    rows = data.rows
 
     columns = (("case", "case", "{}"), ("entry_speed_m_s", "approach speed (m/s)", "{:.3f}"),
                ("exit_speed_m_s", "separation speed (m/s)", "{:.3f}"),

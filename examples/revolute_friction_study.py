@@ -22,9 +22,10 @@ Run: ``python examples/revolute_friction_study.py`` (``--quick`` for a 5 ms smok
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Callable, Sequence
 
 import matplotlib
 
@@ -42,22 +43,40 @@ RESTITUTION = 0.9
 V0, V1 = 1e-4, 2e-4  # m/s, thresholds of the modified Coulomb law (3.16)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    args = cm.parse_args(__file__, __doc__.splitlines()[0], argv)
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The common options of ``_common.parse_args``."""
+    return cm.parse_args(__file__, __doc__.splitlines()[0], argv)
+
+
+def run(args: argparse.Namespace) -> cm.Study:
+    """Simulate the ideal joint and the four friction coefficients."""
     scenes = {f"$c_f$ = {cf:g}": (f"cf{cf:g}",
                                   slider_crank("revolute", clearance=CLEARANCE, restitution=RESTITUTION,
                                                friction=ModifiedCoulomb(coefficient=cf, v0=V0, v1=V1),
                                                gravity=cm.GRAVITY, rpm=cm.RPM))
               for cf in FRICTION}
-    study = cm.run_study("Figs. 4.19-4.21: friction, c = 0.5 mm, Lankarani-Nikravesh c_e = 0.9 + modified Coulomb",
-                         scenes, args)
-    cm.save_figure(cm.channel_figure(study, "drive.moment", "Fig. 4.19: crank moment for different friction "
-                                     "coefficients"), args.out / "fig4_19_crank_moment.png")
-    cm.save_figure(cm.orbit_figure(study, "Fig. 4.20: journal centre trajectory relative to the bearing"),
-                   args.out / "fig4_20_journal_orbits.png")
-    cm.save_figure(cm.phase_figure(study, "Fig. 4.21: slider acceleration against velocity"),
-                   args.out / "fig4_21_phase_portraits.png")
-    cm.save_figure(cm.step_figure(study, "IDA step size, contact shaded"), args.out / "step_sizes.png")
+    return cm.run_study("Figs. 4.19-4.21: friction, c = 0.5 mm, Lankarani-Nikravesh c_e = 0.9 + modified Coulomb",
+                        scenes, args)
+
+
+def figures(study: cm.Study) -> dict[str, Callable[[], Any]]:
+    """File name -> function drawing that figure (titles: what it shows and the shared parameters)."""
+    return {
+        "fig4_19_crank_moment.png": lambda: cm.channel_figure(
+            study, "drive.moment", "Fig. 4.19: crank moment for different friction coefficients"),
+        "fig4_20_journal_orbits.png": lambda: cm.orbit_figure(
+            study, "Fig. 4.20: journal centre trajectory relative to the bearing"),
+        "fig4_21_phase_portraits.png": lambda: cm.phase_figure(study,
+                                                               "Fig. 4.21: slider acceleration against velocity"),
+        "step_sizes.png": lambda: cm.step_figure(study, "IDA step size, contact shaded"),
+    }
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = parse_args(argv)
+    study = run(args)
+    for name, draw in figures(study).items():
+        cm.save_figure(draw(), args.out / name)
     cm.save_study(study, args.out, args.rtol)
     cm.print_written(args.out)
     return 0

@@ -18,9 +18,10 @@ Run: ``python examples/revolute_restitution.py`` (``--quick`` for a 5 ms smoke r
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Callable, Sequence
 
 import matplotlib
 
@@ -35,20 +36,38 @@ RESTITUTIONS = (1.00, 0.99, 0.95, 0.90)  # c_e (Fig. 4.25 a-d)
 CLEARANCE = 0.5e-3  # m
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    args = cm.parse_args(__file__, __doc__.splitlines()[0], argv)
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The common options of ``_common.parse_args``."""
+    return cm.parse_args(__file__, __doc__.splitlines()[0], argv)
+
+
+def run(args: argparse.Namespace) -> cm.Study:
+    """Simulate the ideal joint and the four coefficients of restitution."""
     scenes = {f"$c_e$ = {ce:.2f}": (f"ce{ce:.2f}",
                                     slider_crank("revolute", clearance=CLEARANCE, restitution=ce,
                                                  gravity=cm.GRAVITY, rpm=cm.RPM))
               for ce in RESTITUTIONS}
-    study = cm.run_study("Fig. 4.25: restitution, c = 0.5 mm, Lankarani-Nikravesh, frictionless", scenes, args)
-    cm.save_figure(cm.channel_figure(study, "drive.moment", "Fig. 4.25: crank moment for different coefficients "
-                                     "of restitution"), args.out / "fig4_25_crank_moment.png")
-    cm.save_figure(cm.channel_figure(study, "clearance.normal_force", "Contact force for different coefficients "
-                                     "of restitution", reference=False), args.out / "fig4_25_contact_force.png")
-    cm.save_figure(cm.orbit_figure(study, "Journal centre trajectory relative to the bearing"),
-                   args.out / "journal_orbits.png")
-    cm.save_figure(cm.step_figure(study, "IDA step size, contact shaded"), args.out / "step_sizes.png")
+    return cm.run_study("Fig. 4.25: restitution, c = 0.5 mm, Lankarani-Nikravesh, frictionless", scenes, args)
+
+
+def figures(study: cm.Study) -> dict[str, Callable[[], Any]]:
+    """File name -> function drawing that figure (titles: what it shows and the shared parameters)."""
+    return {
+        "fig4_25_crank_moment.png": lambda: cm.channel_figure(
+            study, "drive.moment", "Fig. 4.25: crank moment for different coefficients of restitution"),
+        "fig4_25_contact_force.png": lambda: cm.channel_figure(
+            study, "clearance.normal_force", "Contact force for different coefficients of restitution",
+            reference=False),
+        "journal_orbits.png": lambda: cm.orbit_figure(study, "Journal centre trajectory relative to the bearing"),
+        "step_sizes.png": lambda: cm.step_figure(study, "IDA step size, contact shaded"),
+    }
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = parse_args(argv)
+    study = run(args)
+    for name, draw in figures(study).items():
+        cm.save_figure(draw(), args.out / name)
     cm.save_study(study, args.out, args.rtol)
     cm.print_written(args.out)
     return 0

@@ -29,7 +29,9 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+import _common as cm  # noqa: E402
 import daeclear as dc  # noqa: E402
+from daeclear.mechanisms import slider_crank  # noqa: E402
 from daeclear.sweep import SweepResult  # noqa: E402
 
 CLEARANCES = [0.5e-3, 0.2e-3, 0.1e-3, 0.01e-3]  # m (Figs. 4.16-4.18 and 4.29-4.31)
@@ -40,22 +42,26 @@ STUDIES: dict[str, dict[str, Any]] = {
         "title": "Section 4.4, Figs. 4.16-4.18: revolute clearance size (Lankarani-Nikravesh, c_e = 0.9)",
         "fixed": {"joint": "revolute"}, "parameter": "clearance", "values": CLEARANCES, "scale": 1e3, "unit": "mm",
         "chapter": {0.5e-3: "chaotic", 0.2e-3: "chaotic", 0.1e-3: "quasi-periodic", 0.01e-3: "periodic"},
+        "figure": "Section 4.4, Figs. 4.16-4.18: revolute clearance size",
     },
     "revolute_friction": {
         "title": "Section 4.4, Figs. 4.19-4.21: friction in the revolute joint, c = 0.5 mm",
         "fixed": {"joint": "revolute", "clearance": 0.5e-3}, "parameter": "friction", "values": FRICTIONS,
         "scale": 1.0, "unit": "",
         "chapter": {0.01: "chaotic", 0.1: "tends to periodic (closer to the ideal joint)"},
+        "figure": "Section 4.4, Figs. 4.19-4.21: friction in the revolute joint",
     },
     "translational_clearance": {
         "title": "Section 4.5, Figs. 4.29-4.31: translational clearance size",
         "fixed": {"joint": "translational"}, "parameter": "clearance", "values": CLEARANCES, "scale": 1e3,
         "unit": "mm", "chapter": {0.5e-3: "chaotic", 0.01e-3: "periodic or regular"},
+        "figure": "Section 4.5, Figs. 4.29-4.31: translational clearance size",
     },
     "translational_friction": {
         "title": "Section 4.5, Figs. 4.32-4.34: friction in the translational joint, c = 0.5 mm",
         "fixed": {"joint": "translational", "clearance": 0.5e-3}, "parameter": "friction", "values": FRICTIONS,
         "scale": 1.0, "unit": "", "chapter": {v: "friction has no significant influence" for v in FRICTIONS},
+        "figure": "Section 4.5, Figs. 4.32-4.34: friction in the translational joint",
     },
 }
 
@@ -156,6 +162,7 @@ def markdown(table: list[dict[str, Any]]) -> str:
 def figures(name: str, result: SweepResult, out: Path) -> list[Path]:
     import matplotlib.pyplot as plt
 
+    from daeclear import style
     from daeclear.plot import plot_poincare_section
 
     study = STUDIES[name]
@@ -170,7 +177,9 @@ def figures(name: str, result: SweepResult, out: Path) -> list[Path]:
                      fontsize="small")
     for ax in axes.ravel()[len(done):]:
         ax.set_visible(False)
-    fig.suptitle(study["title"], fontsize="medium")
+    # the shared parameters of the runs (the varied one titles the panels), from 1 µs runs of their scenes
+    title = cm.title_of(study["figure"], cm.caption_runs([slider_crank(**run.parameters) for run in done]))
+    style.set_title(fig, title)
     fig.tight_layout()
     sections = out / "sections.png"
     fig.savefig(sections, dpi=110)
@@ -188,6 +197,7 @@ def figures(name: str, result: SweepResult, out: Path) -> list[Path]:
     b.legend(fontsize="x-small")
     for ax in (a, b):
         ax.set_xlabel(f"{study['parameter']} ({study['unit']})" if study["unit"] else study["parameter"])
+    style.set_title(fig, title)
     fig.tight_layout()
     evidence = out / "evidence.png"
     fig.savefig(evidence, dpi=110)

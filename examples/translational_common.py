@@ -36,7 +36,8 @@ import _common
 import daeclear as dc
 from _common import (  # noqa: F401  (re-exported: the translational scripts use them as tc.*)
     DEFAULT_DT, DEFAULT_TRANSIENT, GRAVITY, PERIOD, QUICK_SPAN, RPM, RTOL, WINDOW_REVOLUTIONS, Case, Span, Study,
-    distinct_points, markdown_table, poincare_points, print_written, save_figure, save_result,
+    distinct_points, figure_title, markdown_table, poincare_points, print_written, save_figure, save_result,
+    study_title, title_of,
 )
 from daeclear.mechanisms import slider_crank
 
@@ -183,11 +184,20 @@ def write_metrics(rows: Sequence[Mapping[str, Any]], out: Path, span: Span, head
 
 
 def run_study(header: str, scenes: Mapping[str, dc.Scene], args: argparse.Namespace) -> Study:
-    """Run the ideal joint and every case ``label -> scene``, measure them, save HDF5 and metrics."""
-    study = _common.run_study(header, {label: (_stem(label), sc) for label, sc in scenes.items()}, args,
-                              span=make_span(args), measure_case=measure, **RUN_KWARGS)
+    """Run the ideal joint and every case ``label -> scene`` and measure them (:func:`save_study` writes them)."""
+    return _common.run_study(header, {label: (_stem(label), sc) for label, sc in scenes.items()}, args,
+                             span=make_span(args), measure_case=measure, **RUN_KWARGS)
+
+
+def save_study(study: Study, args: argparse.Namespace) -> None:
+    """HDF5 of every case and of the ideal joint over the plotted window, and the metrics, into ``args.out``."""
     _common.save_study(study, args.out, args.rtol, sections=SECTIONS)
-    return study
+
+
+def save_figures(figures: Mapping[str, Any], out: Path) -> None:
+    """Draw and write every figure of ``file name -> function drawing it``."""
+    for name, draw in figures.items():
+        save_figure(draw(), out / name)
 
 
 def _stem(label: str) -> str:
@@ -195,9 +205,15 @@ def _stem(label: str) -> str:
     return "_".join(part for part in keep.split("_") if part)
 
 
-def panels(study: Study, draw: Any, title: str, *, dense: bool = True, **kwargs: Any) -> Any:
-    """One panel per case (the chapter's (a)-(d)), drawn by ``draw(result, ax=ax, **kwargs)``."""
+def panels(study: Study, draw: Any, title: str, *, dense: bool = True, span: bool = False, **kwargs: Any) -> Any:
+    """One panel per case (the chapter's (a)-(d)), drawn by ``draw(result, ax=ax, **kwargs)``.
+
+    ``title`` says what the figure shows; the parameters the cases share are added on a second
+    line, the case labels (the varied parameter) title the panels. ``dense``: the dense output
+    (else the per-step one) over the last two revolutions, or with ``span`` over the analysed span.
+    """
     from daeclear.plot import plot_cases
 
-    results = {case.label: (case.window if dense else case.steps_window) for case in study.cases}
-    return plot_cases(results, draw, suptitle=title, **kwargs)
+    results = {case.label: (case.dense if span else case.window if dense else case.steps_window)
+               for case in study.cases}
+    return plot_cases(results, draw, suptitle=study_title(study, title), **kwargs)

@@ -10,9 +10,10 @@ Run ``python examples/translational_fig4_28.py`` (``--quick`` for a 5 ms smoke r
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Callable, Sequence
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
@@ -23,19 +24,45 @@ CLEARANCE = 0.5e-3  # m, Table 4.3
 RESTITUTION = 0.9
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    args = tc.parse_args(__file__, __doc__.splitlines()[0], argv)
-    study = tc.run_study(
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The common options of ``translational_common.parse_args``."""
+    return tc.parse_args(__file__, __doc__.splitlines()[0], argv)
+
+
+def run(args: argparse.Namespace) -> tc.Study:
+    """Simulate the ideal joint and the clearance joint."""
+    return tc.run_study(
         "Fig. 4.28: translational clearance joint, c = 0.5 mm, corners model, L-N c_e = 0.9, frictionless",
         {"c = 0.5 mm": tc.scene(CLEARANCE, restitution=RESTITUTION)}, args)
-    case, ideal = study.cases[0], study.ideal
-    fig = plot_translational_response(case.window, reference=ideal.window)
-    fig.suptitle("Fig. 4.28: translational clearance joint, c = 0.5 mm, L-N $c_e$ = 0.9", fontsize="medium")
+
+
+def _response_figure(study: tc.Study) -> Any:
+    case = study.cases[0]
+    fig = plot_translational_response(case.window, reference=study.ideal.window,
+                                      title=tc.title_of("Fig. 4.28: slider-crank against the ideal joint",
+                                                        case.window))
     fig.tight_layout()
-    tc.save_figure(fig, args.out / "fig4_28.png")
-    ax = plot_phase_portrait(case.dense, reference=ideal.window)
-    ax.set_title("slider acceleration against velocity, analysed span", fontsize="medium")
-    tc.save_figure(ax.figure, args.out / "phase_portrait.png")
+    return fig
+
+
+def _phase_figure(study: tc.Study) -> Any:
+    case = study.cases[0]
+    ax = plot_phase_portrait(case.dense, reference=study.ideal.window,
+                             title=tc.title_of("Slider acceleration against velocity, analysed span", case.dense))
+    ax.figure.tight_layout()
+    return ax.figure
+
+
+def figures(study: tc.Study) -> dict[str, Callable[[], Any]]:
+    """File name -> function drawing that figure (titled with the run's parameters)."""
+    return {"fig4_28.png": lambda: _response_figure(study), "phase_portrait.png": lambda: _phase_figure(study)}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = parse_args(argv)
+    study = run(args)
+    tc.save_study(study, args)
+    tc.save_figures(figures(study), args.out)
     tc.print_written(args.out)
     return 0
 

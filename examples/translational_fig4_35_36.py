@@ -12,10 +12,11 @@ Run ``python examples/translational_fig4_35_36.py`` (``--quick`` for a 5 ms smok
 
 from __future__ import annotations
 
+import argparse
 import sys
 from functools import partial
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Callable, Sequence
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
@@ -25,19 +26,38 @@ from daeclear.plot import plot_channel  # noqa: E402
 CLEARANCE = 0.5e-3  # m
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    args = tc.parse_args(__file__, __doc__.splitlines()[0], argv)
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The common options of ``translational_common.parse_args``."""
+    return tc.parse_args(__file__, __doc__.splitlines()[0], argv)
+
+
+def run(args: argparse.Namespace) -> tc.Study:
+    """Simulate the ideal joint and the two contact models."""
     scenes = {
         "Lankarani-Nikravesh (corners)": tc.scene(CLEARANCE, restitution=0.9, contact_model="corners"),
         "linear plane law (section-4.3)": tc.scene(CLEARANCE, restitution=0.9, contact_model="section-4.3",
                                                    face_law="lankarani-plane"),
     }
-    study = tc.run_study("Figs. 4.35-4.36: contact force model, c = 0.5 mm, frictionless", scenes, args)
-    tc.save_figure(tc.panels(study, partial(plot_channel, channel=f"{tc.JOINT}.normal_force"),
-                             "Fig. 4.35: contact force between slider and guide (every IDA step)", dense=False,
-                             ncols=1, panel_size=(8.0, 2.6)), args.out / "fig4_35.png")
-    tc.save_figure(tc.panels(study, partial(plot_channel, channel="drive.moment"), "Fig. 4.36: driving crank moment",
-                             reference=study.ideal.window, ncols=1, panel_size=(8.0, 2.6)), args.out / "fig4_36.png")
+    return tc.run_study("Figs. 4.35-4.36: contact force model, c = 0.5 mm, frictionless", scenes, args)
+
+
+def figures(study: tc.Study) -> dict[str, Callable[[], Any]]:
+    """File name -> function drawing that figure (titles: what it shows and the shared parameters)."""
+    moment = partial(plot_channel, channel="drive.moment", label="clearance joint")
+    return {
+        "fig4_35.png": lambda: tc.panels(study, partial(plot_channel, channel=f"{tc.JOINT}.normal_force"),
+                                         "Fig. 4.35: contact force between slider and guide (every IDA step)",
+                                         dense=False, ncols=1, panel_size=(8.0, 2.6)),
+        "fig4_36.png": lambda: tc.panels(study, moment, "Fig. 4.36: driving crank moment",
+                                         reference=study.ideal.window, ncols=1, panel_size=(8.0, 2.6)),
+    }
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = parse_args(argv)
+    study = run(args)
+    tc.save_study(study, args)
+    tc.save_figures(figures(study), args.out)
     tc.print_written(args.out)
     return 0
 
