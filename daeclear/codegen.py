@@ -72,7 +72,7 @@ __all__ = [
 ]
 
 CSRC = Path(__file__).resolve().parent / "csrc"
-DRIVER_SOURCES = ("ida_driver.c", "sundials_min.h", "dc_model.h")
+DRIVER_SOURCES = ("ida_driver.c", "sundials_min.h", "dc_model.h", "dc_linalg.h")
 SUNDIALS_LIBS = (
     "sundials_ida",
     "sundials_core",
@@ -712,7 +712,7 @@ def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text
 # --------------------------------------------------------------------------- ODE libraries
 # (for the explicit and scipy integrators of daeclear.integrators; no SUNDIALS involved)
 
-ODE_DRIVER_SOURCES = ("ode_driver.c", "dco_model.h", "dc_model.h")
+ODE_DRIVER_SOURCES = ("ode_driver.c", "dco_model.h", "dc_model.h", "dc_linalg.h")
 __all__ += ["OdeSpec", "generate_ode_source", "build_ode_library"]
 
 

@@ -28,6 +28,7 @@
 
 #include "sundials_min.h"
 #include "dc_model.h"
+#include "dc_linalg.h"
 
 #define DC_API __attribute__((visibility("default")))
 
@@ -1267,8 +1268,8 @@ eval_failed:
   return -1;
 }
 
-/* x = (J J^T)^-1 b for the m x nq matrix J (column-major) by Cholesky of G = J J^T; -1 when
- * G is not positive definite (dependent constraints). */
+/* x = (J J^T)^-1 b for the m x nq matrix J (column-major), by Cholesky of G = J J^T (row-major,
+ * lower); nonzero when G is singular (dependent constraints). */
 static int solve_normal(const double* J, const double* b, double* G, double* x, int nq, int m) {
   for (int i = 0; i < m; ++i)
     for (int k = 0; k <= i; ++k) {
@@ -1276,28 +1277,9 @@ static int solve_normal(const double* J, const double* b, double* G, double* x, 
       for (int j = 0; j < nq; ++j) acc += J[i + (size_t)j * m] * J[k + (size_t)j * m];
       G[i * m + k] = acc;
     }
-  for (int j = 0; j < m; ++j) { /* lower Cholesky factor in place */
-    double d = G[j * m + j];
-    for (int k = 0; k < j; ++k) d -= G[j * m + k] * G[j * m + k];
-    if (!(d > 0.0)) return -1;
-    d = sqrt(d);
-    G[j * m + j] = d;
-    for (int i = j + 1; i < m; ++i) {
-      double acc = G[i * m + j];
-      for (int k = 0; k < j; ++k) acc -= G[i * m + k] * G[j * m + k];
-      G[i * m + j] = acc / d;
-    }
-  }
-  for (int i = 0; i < m; ++i) { /* L z = b */
-    double acc = b[i];
-    for (int k = 0; k < i; ++k) acc -= G[i * m + k] * x[k];
-    x[i] = acc / G[i * m + i];
-  }
-  for (int i = m - 1; i >= 0; --i) { /* L^T x = z */
-    double acc = x[i];
-    for (int k = i + 1; k < m; ++k) acc -= G[k * m + i] * x[k];
-    x[i] = acc / G[i * m + i];
-  }
+  if (cholesky(G, x, m) != 0) return -1; /* x: scratch for the original diagonal */
+  memcpy(x, b, sizeof(double) * (size_t)m);
+  chol_solve(G, m, x);
   return 0;
 }
 
