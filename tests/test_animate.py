@@ -14,26 +14,11 @@ from daeclear.cli import main
 from daeclear.errors import MissingDependencyError, OutputError
 from daeclear.mechanisms import chain, slider_crank
 from daeclear.scenefile import read_scene_file
+from scene_texts import PENDULUM
 
 SMALL = (320, 200)
 
-PENDULUM_TOML = """
-[scene]
-name = "pendulum"
-gravity = [0.0, -9.81]
-
-[[body]]
-name = "link"
-mass = 1.0
-inertia = 0.01
-position = [0.5, 0.0]
-
-[[revolute]]
-name = "A"
-body_i = "ground"
-body_j = "link"
-at = [0.0, 0.0]
-"""
+PENDULUM_TOML = PENDULUM
 
 
 @pytest.fixture(scope="module")

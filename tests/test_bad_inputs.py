@@ -19,6 +19,7 @@ from daeclear.accuracy import work_precision
 from daeclear.cli import main
 from daeclear.errors import OutputDirectoryMissing, OutputError, SceneError
 from daeclear.scenefile import read_scene_file
+from scene_texts import PENDULUM as PENDULUM_FILE
 
 SCENE = dc.mechanisms.slider_crank("ideal")
 TINY = 1e-4  # s
@@ -347,22 +348,7 @@ def test_cli_sweep_refuses_out_before_work(place, tmp_path, capsys):
 
 # --------------------------------------------------------------------------- scene files
 
-PENDULUM = """
-[scene]
-name = "pendulum"
-
-[[body]]
-name = "link"
-mass = 1.0
-inertia = 0.01
-position = [0.5, 0.0]
-
-[[revolute]]
-name = "A"
-body_i = "ground"
-body_j = "link"
-at = [0.0, 0.0]
-"""
+PENDULUM = PENDULUM_FILE
 
 SCENE_FILE: list[tuple[str, str, str, str]] = [
     # (id, [simulate] lines (or a whole [mechanism] file), field, value as shown)

@@ -5,24 +5,9 @@ import pytest
 
 import daeclear as dc
 from daeclear.cli import main
+from scene_texts import PENDULUM
 
-PENDULUM_TOML = """
-[scene]
-name = "pendulum"
-gravity = [0.0, -9.81]
-
-[[body]]
-name = "link"
-mass = 1.0
-inertia = 0.01
-position = [0.5, 0.0]
-
-[[revolute]]
-name = "A"
-body_i = "ground"
-body_j = "link"
-at = [0.0, 0.0]
-
+PENDULUM_TOML = PENDULUM + """
 [simulate]
 t_end = 0.5
 rtol = 1e-8

@@ -26,6 +26,7 @@ from daeclear.errors import AssemblyError, DaeclearError, PhysicsWarning, SceneE
 from daeclear.scene import GROUND
 from daeclear.scenefile import read_scene_file
 from daeclear.symbolic import Reference
+from scene_texts import PENDULUM_LINK
 
 CLEARANCE = 0.5e-3
 
@@ -309,18 +310,7 @@ def test_genuine_stall_is_still_caught():
 # ---------------------------------------------------------------- item 6: scene-file messages
 
 
-BODY = """[[body]]
-name = "link"
-mass = 1.0
-inertia = 0.01
-position = [0.5, 0.0]
-
-[[revolute]]
-name = "A"
-body_i = "ground"
-body_j = "link"
-at = [0.0, 0.0]
-"""
+BODY = PENDULUM_LINK.lstrip()
 
 SCENE_FILE_CASES = [
     ("body_table", "[scene]\nname = \"p\"\n" + BODY.replace("[[body]]", "[body]"),
