@@ -173,7 +173,7 @@ class DAEModel:
         }
 
     # ---- consistent states -------------------------------------------------------------
-    def _constraints(self, q: NDArray[np.float64], v: NDArray[np.float64], t: float, session: Any = None,
+    def constraints(self, q: NDArray[np.float64], v: NDArray[np.float64], t: float, session: Any = None,
                      ideal: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """(Phi, Phi_q, Phi_dot) at one state, through the compiled library when a session is open;
         ``ideal``: with the ideal joints of the clearance joints added (the chapter's start)."""
@@ -194,12 +194,12 @@ class DAEModel:
         scale = max(1.0, float(np.max(np.abs(q))))
         zero_v = np.zeros(self.n_q)
         for _ in range(max_iter):
-            Phi, Phi_q, _ = self._constraints(q, zero_v, t, session, ideal)
+            Phi, Phi_q, _ = self.constraints(q, zero_v, t, session, ideal)
             if np.max(np.abs(Phi)) < tol * scale:
                 return q
             dq, *_ = np.linalg.lstsq(Phi_q, -Phi, rcond=None)
             q = q + dq
-        Phi = self._constraints(q, zero_v, t, session, ideal)[0]
+        Phi = self.constraints(q, zero_v, t, session, ideal)[0]
         worst = np.argsort(-np.abs(Phi))[:3]
         detail = ", ".join(f"'{names[i]}' = {Phi[i]:.3g}" for i in worst)
         raise AssemblyError(
@@ -214,7 +214,7 @@ class DAEModel:
         v = np.array(v_guess, dtype=float)
         if not (self.start_constraint_names if ideal else self.constraint_names):
             return v
-        _, Phi_q, Phi_dot = self._constraints(q, v, t, session, ideal)
+        _, Phi_q, Phi_dot = self.constraints(q, v, t, session, ideal)
         dv, *_ = np.linalg.lstsq(Phi_q, -Phi_dot, rcond=None)
         return v + dv
 
@@ -560,7 +560,7 @@ def check_independent(model: DAEModel, q: NDArray[np.float64], session: Any = No
     m, n = model.n_constraints, model.n_q
     if not m:
         return
-    Phi_q = model._constraints(np.asarray(q, dtype=float), np.zeros(n), 0.0, session)[1]
+    Phi_q = model.constraints(np.asarray(q, dtype=float), np.zeros(n), 0.0, session)[1]
     if not np.all(np.isfinite(Phi_q)):
         return  # not a rank question: the positions themselves are unusable (reported when they are assembled)
     U, sigma, _ = np.linalg.svd(Phi_q)

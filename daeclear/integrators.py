@@ -776,7 +776,7 @@ class _Run:
         self.seg: _Segment | None = None
         self.t_last = 0.0
         self.success, self.status, self.message = True, 0, "end of the time span reached"
-        self.y0: NDArray | None = None  # the state at t = 0, for the physics checks
+        self.y0: NDArray | None = None  # a declared state at t = 0, for the physics checks
         self.step: float | None = None  # the fixed step (rk4, euler)
         self.missed: list[tuple[float, float, str]] = []  # steps over which a gap changed sign, no event
 
@@ -1331,7 +1331,7 @@ def integrate(
     y0, _ = model.initial_state(start=start)
     x0 = np.array(y0[:2 * n])
     run = _Run(model, ev, method_l, t_end, eval_times, store_steps, progress, max_steps)
-    run.y0, run.step = y0, step
+    run.y0, run.step = (y0 if start == "declared" else None), step  # start checks: declared states only
     for logic in model.contacts:
         run.modes.update(logic.initial_modes(0.0, y0, run.active, run.params))
     setup_time = time.perf_counter() - setup_start

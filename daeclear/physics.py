@@ -76,7 +76,8 @@ def smallest_clearance(model: Any) -> float:
 def check_run(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels: dict[str, NDArray[np.float64]],
               y0: NDArray[np.float64] | None, stats: dict[str, Any]) -> list[dict[str, Any]]:
     """Every check on a run's output (times ``t``, states ``y``, channels): penetrations, the start
-    (``y0``: the state at t = 0) and drift.
+    (``y0``: the declared state at t = 0; None after the chapter's start, consistent by
+    construction) and drift.
 
     Sets ``stats["max_constraint_drift"]``. Returns the warning records (not issued)."""
     out: list[dict[str, Any]] = []
@@ -135,7 +136,7 @@ def _initial_velocity(model: Any, y0: NDArray[np.float64]) -> list[dict[str, Any
         return []
     n = model.n_q
     q, v = np.asarray(y0[:n], dtype=float), np.asarray(y0[n:2 * n], dtype=float)
-    _, _, rates = model._constraints(q, v, 0.0, None, ideal=True)
+    _, _, rates = model.constraints(q, v, 0.0, None, ideal=True)
     names = list(model.start_constraint_names)
     fastest = max((math.hypot(v[3 * k], v[3 * k + 1]) for k in range(n // 3)), default=0.0)
     limit = max(INITIAL_VELOCITY_FRACTION * fastest, INITIAL_VELOCITY_FLOOR)
@@ -173,7 +174,7 @@ def _drift(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels:
     where = "constraints"
     if y.shape[0] > i and model.n_constraints:
         n = model.n_q
-        phi = model._constraints(y[i, :n], y[i, n:2 * n], float(t[i]), None)[0]
+        phi = model.constraints(y[i, :n], y[i, n:2 * n], float(t[i]), None)[0]
         where = model.constraint_names[int(np.argmax(np.abs(phi)))]
     return [record(
         "constraint_drift", "constraint violation |Phi|", worst, DRIFT_FRACTION * clearance, "m", where, float(t[i]),
