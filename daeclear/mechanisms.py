@@ -69,9 +69,9 @@ def _contact_law(law: Any, restitution: float | None, length: float | None) -> N
     if isinstance(law, NormalLaw):
         return law
     fields = {"restitution": DEFAULT_RESTITUTION if restitution is None else restitution, "length": length}
-    from .contact.registry import NORMAL_LAWS, _NORMAL_ALIASES, _lookup  # one source of names
+    from .contact.registry import normal_law_class  # one source of names
 
-    cls = _lookup("law", str(law), NORMAL_LAWS, _NORMAL_ALIASES)
+    cls = normal_law_class(str(law))
     accepted = set(getattr(cls, "__dataclass_fields__", {}))
     return normal_law(str(law), **{k: v for k, v in fields.items() if k in accepted and v is not None})
 

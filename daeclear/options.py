@@ -296,12 +296,12 @@ def restitution(value: Any, law: Any, *, where: str, field: str = "restitution")
     if value is None:
         return
     from .contact.base import NormalLaw
-    from .contact.registry import NORMAL_LAWS, _NORMAL_ALIASES, _lookup
+    from .contact.registry import NORMAL_LAWS, normal_law_class
 
     if isinstance(law, NormalLaw):
         fail(where, field, value, f"left out when law is a law object ({type(law).__name__}); set it on the "
              "law object instead")
-    cls = _lookup("law", str(law), NORMAL_LAWS, _NORMAL_ALIASES)
+    cls = normal_law_class(str(law))
     if "restitution" not in getattr(cls, "__dataclass_fields__", {}):
         takes = [n for n, c in NORMAL_LAWS.items() if "restitution" in getattr(c, "__dataclass_fields__", {})]
         fail(where, field, value, f"left out with law={law!r}, which has no coefficient of restitution "

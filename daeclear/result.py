@@ -483,7 +483,7 @@ class Result:
         unit_map: dict[str, str] = {}
         for name, unit in units.items():
             if name not in known:
-                close = _close_matches(name, sorted(known), n=3)
+                close = close_matches(name, sorted(known), n=3)
                 hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
                 raise ValueError(f"Result: units given for {name!r}, which is neither a channel nor a state.{hint}")
             if not isinstance(unit, str):
@@ -603,7 +603,7 @@ class Result:
         if name in self.state_names:
             return self.y[:, self.state_names.index(name)]
         candidates = sorted(set(self._channels) | set(self.state_names))
-        close = _close_matches(name, candidates)
+        close = close_matches(name, candidates)
         if close:
             hint = "Close matches: " + ", ".join(repr(c) for c in close) + "."
         else:
@@ -981,7 +981,7 @@ def _optional(module: str, what: str) -> Any:
         ) from exc
 
 
-def _close_matches(name: str, candidates: Iterable[str], n: int = 5) -> list[str]:
+def close_matches(name: str, candidates: Iterable[str], n: int = 5) -> list[str]:
     """Up to `n` candidates similar to `name`, best first, ties in alphabetical order."""
     matcher = difflib.SequenceMatcher(b=name)
     scored = []

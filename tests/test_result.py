@@ -262,7 +262,7 @@ def test_getitem_channels_and_states() -> None:
     assert result.units["motor.moment"] == "N m"
 
 
-def test_unknown_name_lists_close_matches() -> None:
+def test_unknown_name_listsclose_matches() -> None:
     result = make_result()
     with pytest.raises(KeyError) as info:
         result["slider.v"]

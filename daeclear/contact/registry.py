@@ -43,6 +43,11 @@ def _lookup(kind: str, name: Any, table: dict[str, Any], aliases: dict[str, str]
     return table[found]
 
 
+def normal_law_class(name: str) -> type:
+    """The class of the normal law named ``name`` (a registered name or alias, as for :func:`normal_law`)."""
+    return _lookup("law", name, NORMAL_LAWS, _NORMAL_ALIASES)
+
+
 def _build(cls: type, params: dict[str, Any]) -> Any:
     fields = [f.name for f in dataclasses.fields(cls)]
     unknown = sorted(set(params) - set(fields))
