@@ -335,7 +335,7 @@ class Scene:
             if element.name == name:
                 return element
         names = [e.name for e in self.elements]
-        close = difflib.getclose_matches(name, names, n=3)
+        close = difflib.get_close_matches(name, names, n=3)
         hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
         raise KeyError(f"no element '{name}' in scene '{self.name}'.{hint}")
 
@@ -355,7 +355,7 @@ class Scene:
         for joint in self.joints:
             for role, body in (("body_i", joint.body_i), ("body_j", joint.body_j)):
                 if body not in known:
-                    close = difflib.getclose_matches(str(body), sorted(known), n=1)
+                    close = difflib.get_close_matches(str(body), sorted(known), n=1)
                     hint = f" Did you mean '{close[0]}'?" if close else ""
                     out.append(
                         f"{joint.kind} '{joint.name}': {role} refers to body '{body}', "
