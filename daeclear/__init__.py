@@ -5,7 +5,7 @@ Scene --assemble--> DAEModel --simulate--> Result --> analysis | plot | io
 
 from __future__ import annotations
 
-from . import analysis, mechanisms
+from . import analysis, mechanisms, profiles
 from .assemble import DAEModel, assemble
 from .errors import (AssemblyError, DaeclearError, DaeclearWarning, Interrupted, OutputError, PhysicsWarning, SceneError,
                      SolveError)
@@ -20,5 +20,5 @@ __version__ = "0.1.0"
 __all__ = [
     "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "Driver",
     "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "Scene", "SceneError", "SolveError", "Translational",
-    "TranslationalClearance", "analysis", "assemble", "load", "load_sweep", "mechanisms", "simulate", "sweep",
+    "TranslationalClearance", "analysis", "assemble", "load", "load_sweep", "mechanisms", "profiles", "simulate", "sweep",
 ]

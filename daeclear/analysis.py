@@ -396,7 +396,8 @@ class _RestartModel(DAEModel):
     start_state: tuple[float, ...] = ()
     start_is_declared = False  # a state of a run: starting in contact is no declaration error (daeclear.physics)
 
-    def initial_state(self, session: Any = None, start: str = "declared") -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def initial_state(self, session: Any = None, start: str = "declared", allow_penetration: bool = True
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         # No Newton projection: the stored state carries the run's own (Baumgarte-controlled)
         # constraint drift, and projecting it away would move a journal by up to that drift.
         return self.consistent_state(0.0, np.array(self.start_state, dtype=float), session=session)

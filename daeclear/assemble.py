@@ -40,8 +40,10 @@ from .errors import AssemblyError, SceneError
 from .ida_session import DAEFunctions, StateLayout
 from .options import FORMULATIONS
 from .parameters import ParameterTable, structure_key
+from .physics import check_start_penetration
 from .scene import GROUND, Body, Driver, Revolute, Scene, Translational
 from .clearance import CONTACT_BUILDERS
+from .drivers import driver_constraint, driver_load, driver_parameters
 from .symbolic import AssemblyContext, BodyFrame, Channel, Reference, Term, rotation
 
 Formulation = Literal["index1", "ggl"]
@@ -334,14 +336,17 @@ class DAEModel:
             yp[:, :n] = v - np.einsum("kmn,km->kn", Phi_q, mu)
         return (y2[0], yp[0]) if single else (y2, yp)
 
-    def initial_state(self, session: Any = None, start: str = "ideal") -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def initial_state(self, session: Any = None, start: str = "ideal", allow_penetration: bool = False
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Consistent (y0, yp0) at t = 0: assembled positions and velocities, then v' and lam.
 
         ``start="ideal"`` (the chapter's, section 4.4): positions and velocities assembled on the
         mechanism whose clearance joints are ideal (journals centred in their bearings, sliders
         on their guides' mid-lines, every velocity from the kinematics of that mechanism);
         ``"declared"``: the bodies' declared state, corrected only for the scene's ideal joints.
-        With an open compiled ``session`` every evaluation runs in C."""
+        With an open compiled ``session`` every evaluation runs in C. A declared start with a contact
+        pair in deep penetration raises AssemblyError unless ``allow_penetration``
+        (:func:`daeclear.physics.check_start_penetration`)."""
         ideal = start == "ideal"
         q = self.assemble_positions(self.q_guess, session=session, ideal=ideal)
         check_independent(self, q, session)
@@ -349,7 +354,10 @@ class DAEModel:
         y = np.zeros(self.n_states)
         y[: self.n_q] = q
         y[self.n_q: 2 * self.n_q] = v
-        return self.consistent_state(0.0, y, session=session)
+        y, yp = self.consistent_state(0.0, y, session=session)
+        if not ideal and not allow_penetration:
+            check_start_penetration(self, y, yp, session)
+        return y, yp
 
     def switch_vector(self, active: Sequence[bool], params: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
         """The contact terms' on/off flags and parameters as the outputs' ``switch`` input."""
@@ -402,18 +410,6 @@ def _translational(ctx: AssemblyContext, joint: Translational) -> tuple[list[Any
     return [lateral, relative_angle], [f"{joint.name}.lateral", f"{joint.name}.angle"]
 
 
-def _driver_parameters(ref: Reference, driver: Driver, joint: Revolute) -> dict[str, Any]:
-    theta0 = driver.initial_angle
-    if theta0 is None:
-        theta0 = ref.angle(joint.body_j) - ref.angle(joint.body_i)
-    return {"angle0": theta0, "speed": driver.speed}
-
-
-def _driver(ctx: AssemblyContext, driver: Driver, joint: Revolute) -> Any:
-    bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
-    return bj.phi - bi.phi - ctx.p(driver.name, "angle0") - ctx.p(driver.name, "speed") * ctx.t
-
-
 def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
                      track_work: bool) -> tuple[ParameterTable, str]:
     """The scene's numbers as run-time parameters, and the key of its structure.
@@ -427,7 +423,7 @@ def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
         table.add("baumgarte.beta", beta)
     table.add("gravity", scene.gravity)
     structure: list[Any] = [formulation, bool(track_work), _ENGINE_VERSION]
-    revolutes = {j.name: j for j in scene.joints if isinstance(j, Revolute)}
+    joints = {j.name: j for j in scene.joints}
     for element in scene.elements:
         if isinstance(element, Body):
             table.update(element.name, {"mass": element.mass, "inertia": element.inertia})
@@ -436,7 +432,7 @@ def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
         elif isinstance(element, Translational):
             table.update(element.name, _translational_parameters(ref, element))
         elif isinstance(element, Driver):
-            table.update(element.name, _driver_parameters(ref, element, revolutes[element.joint]))
+            table.update(element.name, driver_parameters(ref, element, joints[element.joint]))
         elif type(element) in CONTACT_BUILDERS:
             values, flags = CONTACT_BUILDERS[type(element)][0](ref, element)
             table.update(element.name, values)
@@ -642,7 +638,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
     phi_list: list[Any] = []
     names: list[str] = []
     owners: list[str] = []  # the element of each constraint row
-    revolutes = {j.name: j for j in scene.joints if isinstance(j, Revolute)}
+    joints = {j.name: j for j in scene.joints}
     driver_rows: dict[str, int] = {}
     contact_builds: list[Any] = []
     for element in scene.elements:
@@ -654,7 +650,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
             eqs, labels = _translational(ctx, element)
         elif isinstance(element, Driver):
             driver_rows[element.name] = len(phi_list)
-            eqs, labels = [_driver(ctx, element, revolutes[element.joint])], [element.name]
+            eqs, labels = [driver_constraint(ctx, element, joints[element.joint])], [element.name]
         else:  # a clearance joint (scene_parameters rejected anything else)
             first_term = sum(len(b.terms) for b in contact_builds)
             first_root = sum(len(b.gaps) for b in contact_builds)
@@ -785,10 +781,11 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
             Channel(f"{b.name}.alpha", "rad/s^2", ak[2]),
         ]
     for name, row in driver_rows.items():
-        # The driver's constraint enters body j's rotation equation with +lam; the torque it
-        # applies to body j is therefore -lam (positive counter-clockwise).
-        channels.append(Channel(f"{name}.moment", "N m", -lam[row]))
-        power_d = -lam[row] * ca.mtimes(Phi_q[row, :], v)  # moment times relative angular speed
+        # The driver's constraint enters body j's equation of its coordinate with +lam; the moment
+        # (force along the axis) it applies to body j is therefore -lam (positive counter-clockwise).
+        load, unit = driver_load(joints[scene[name].joint])
+        channels.append(Channel(f"{name}.{load}", unit, -lam[row]))
+        power_d = -lam[row] * ca.mtimes(Phi_q[row, :], v)  # load times relative (angular) speed
         channels.append(Channel(f"{name}.power", "W", power_d))
         power_channels.append(power_d)
     kinetic = 0.5 * ca.dot(mass_diag, v * v)

@@ -1288,6 +1288,7 @@ def integrate(
     progress: bool = False,
     track_work: bool = False,
     start: str = "ideal",
+    allow_penetration: bool = False,
 ) -> Result:
     """Integrate with a non-IDA method; the arguments are those of :func:`daeclear.simulate`.
 
@@ -1328,7 +1329,7 @@ def integrate(
     n = model.n_q
     atol_x = tolerance_vector(model, rtol, atol)[:2 * n]
     ev = _evaluator(model, backend)
-    y0, _ = model.initial_state(start=start)
+    y0, _ = model.initial_state(start=start, allow_penetration=allow_penetration)
     x0 = np.array(y0[:2 * n])
     run = _Run(model, ev, method_l, t_end, eval_times, store_steps, progress, max_steps)
     run.y0, run.step = (y0 if start == "declared" else None), step  # start checks: declared states only

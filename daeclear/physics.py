@@ -28,7 +28,7 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from .errors import PhysicsWarning
+from .errors import AssemblyError, PhysicsWarning
 
 KINDS: tuple[str, ...] = ("penetration", "initial_penetration", "initial_velocity", "constraint_drift",
                           "contact_within_one_step", "missed_contact")
@@ -38,6 +38,10 @@ KINDS: tuple[str, ...] = ("penetration", "initial_penetration", "initial_velocit
 PENETRATION_FRACTION = 1.0
 # A run that starts with a penetration above this fraction of the clearance starts inside the wall.
 INITIAL_PENETRATION_FRACTION = 1e-2
+# A declared start deeper in a wall than this fraction of the clearance (translational joints: of the
+# smaller of the clearance and the corner radius) is refused before the run unless allowed
+# (``allow_penetration=True``): see check_start_penetration and docs/reliability.md.
+START_PENETRATION_FRACTION = 0.1
 # A clearance joint of a driven mechanism whose two sides move apart at t = 0 faster than this
 # fraction of the fastest body (and at least INITIAL_VELOCITY_FLOOR) starts with velocities
 # inconsistent with the joint: the journal flies across its play and its first impact is an
@@ -124,6 +128,36 @@ def _penetration(model: Any, joint: str, clearance: float, corner: float, t: NDA
             "result is not physical. Check the contact stiffness, the friction coefficient and the speed (a load "
             "the joint cannot carry), or a tighter rtol."))
     return out
+
+
+def start_penetration_limit(clearance: float, corner: float) -> float:
+    """The deepest penetration a declared start may have, m (see START_PENETRATION_FRACTION)."""
+    return START_PENETRATION_FRACTION * (min(clearance, corner) if corner > 0 else clearance)
+
+
+def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np.float64], session: Any = None) -> None:
+    """Refuse a start with a contact pair deeper in its wall than :func:`start_penetration_limit`.
+
+    Such a start is a declaration error (a journal declared inside the bearing wall): its first
+    contact force is the law's force at that depth, e.g. 187 kN (elastic part) for the chapter's
+    journal declared 0.2 mm deep, released as an artificial impact. Raises AssemblyError naming
+    the pair, the penetration and the clearance."""
+    if not model.clearance_joints:
+        return
+    channels = model.channels(np.zeros(1), np.asarray(y0)[None, :], np.asarray(yp0)[None, :], session=session)
+    for joint, clearance, corner in model.clearance_joints:
+        limit = start_penetration_limit(clearance, corner)
+        basis = "corner radius" if 0 < corner < clearance else "clearance"
+        for pair in joint_pairs(model, joint):
+            depth = float(channels.get(f"{pair}.penetration", np.zeros(1))[0])
+            if depth > limit:
+                raise AssemblyError(
+                    f"scene '{model.scene_name}': clearance joint '{joint}' starts in deep penetration: '{pair}' "
+                    f"is {depth:.3g} m inside the wall at t=0, {depth / clearance:.0%} of the clearance "
+                    f"{clearance:.3g} m (a declared start may penetrate at most {START_PENETRATION_FRACTION:.0%} "
+                    f"of the {basis}, {limit:.3g} m); its first contact force would be an artefact of the declared "
+                    "positions. Declare the positions with the journal (slider) inside its play, use start='ideal' "
+                    "(clearance joints centred), or pass allow_penetration=True to start there anyway.")
 
 
 def _initial_velocity(model: Any, y0: NDArray[np.float64]) -> list[dict[str, Any]]:

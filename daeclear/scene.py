@@ -23,6 +23,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any, Iterator, Union
 
 from .errors import SceneError
+from .profiles import PROFILES, ConstantSpeed, Profile
 
 GROUND = "ground"
 
@@ -247,35 +248,68 @@ class Translational(_PointJoint):
 
 @dataclass(frozen=True)
 class Driver(Element):
-    """Constant-speed rotational driver on a revolute joint.
+    """Prescribed motion of one joint coordinate (a kinematic driver constraint).
 
-    Imposes ``phi_j - phi_i = theta0 + speed * t`` on the bodies of revolute ``joint``,
-    where ``theta0`` is the relative angle of the reference configuration unless
-    ``initial_angle`` is given. The driving moment is the torque the driver applies
-    to body j (positive counter-clockwise), channel ``<name>.moment``.
+    On a revolute joint (:class:`Revolute` or :class:`RevoluteClearance`) the coordinate is
+    the relative angle ``phi_j - phi_i``; on a translational joint (:class:`Translational` or
+    :class:`TranslationalClearance`) it is the displacement of point j from point i along the
+    joint's axis (fixed to body i). The driver imposes ``x(t) = x0 + motion(t)`` with the
+    ``profile``'s motion (constant speed by default: ``x0 + speed t``; see
+    :mod:`daeclear.profiles`), where ``x0`` is the coordinate of the reference configuration
+    unless ``initial_angle`` (revolute) or ``initial_position`` (translational) is given. On a
+    clearance joint only this coordinate is prescribed: the journal (slider) stays free in its
+    play. Channels: ``<name>.moment`` (N m, revolute) or ``<name>.force`` (N, translational),
+    the load the driver applies to body j (counter-clockwise / along the axis positive), and
+    ``<name>.power`` (W).
 
     Parameters
     ----------
     name : str
         Unique name.
     joint : str
-        Name of a :class:`Revolute` joint of the scene.
-    speed : float
-        Angular speed, rad/s (counter-clockwise positive).
+        Name of a revolute or translational joint of the scene, with or without clearance.
+    speed : float or None
+        Speed of the profile, rad/s (m/s on a translational joint); None only with a
+        :class:`~daeclear.profiles.Tabulated` profile, which gives the coordinate itself.
     initial_angle : float or None
-        Relative angle ``phi_j - phi_i`` at t = 0, rad; None keeps the reference one.
+        Relative angle ``phi_j - phi_i`` at t = 0, rad (revolute joints); None keeps the reference one.
+    profile : Profile or None
+        Motion profile (:class:`~daeclear.profiles.Ramp`, ``Harmonic``, ``Tabulated``); None: constant speed.
+    initial_position : float or None
+        Displacement along the axis at t = 0, m (translational joints); None keeps the reference one.
     """
 
     name: str
     joint: str
-    speed: float
+    speed: float | None = None
     initial_angle: float | None = None
+    profile: Profile | None = None
+    initial_position: float | None = None
+
+    @property
+    def motion_profile(self) -> Profile:
+        """The profile, :class:`~daeclear.profiles.ConstantSpeed` when none is given."""
+        return ConstantSpeed() if self.profile is None else self.profile
 
     def problems(self) -> list[str]:
         out = super().problems()
-        self._check_number(out, "speed", "rad/s")
+        profile = self.motion_profile
+        if not isinstance(profile, Profile):
+            out.append(f"{self.kind} '{self.name}': profile={self.profile!r}, must be None or a daeclear.profiles "
+                       f"profile ({', '.join(c.__name__ for c in PROFILES.values())}).")
+            return out
+        if profile.uses_speed:
+            self._check_number(out, "speed", "rad/s (m/s on a translational joint)")
+        else:
+            for name in ("speed", "initial_angle", "initial_position"):
+                if getattr(self, name) is not None:
+                    out.append(f"{self.kind} '{self.name}': {name}={getattr(self, name)!r} is given by the "
+                               f"{type(profile).__name__} profile's values; leave it out.")
         if self.initial_angle is not None:
             self._check_number(out, "initial_angle", "rad")
+        if self.initial_position is not None:
+            self._check_number(out, "initial_position", "m")
+        out.extend(profile.problems(self.name))
         return out
 
 
@@ -361,12 +395,21 @@ class Scene:
                         f"{joint.kind} '{joint.name}': {role} refers to body '{body}', "
                         f"not in scene '{self.name}'.{hint}"
                     )
-        revolutes = {j.name: j for j in self.joints if isinstance(j, Revolute)}
+        joints = {j.name: j for j in self.joints}
         driven: set[str] = set()
         for driver in self.drivers:
-            if driver.joint not in revolutes:
-                out.append(f"Driver '{driver.name}': '{driver.joint}' is not a revolute joint of this scene.")
-            elif driver.joint in driven:
+            coordinate = driven_coordinate(joints.get(driver.joint))
+            if coordinate is None:
+                drivable = sorted(name for name, j in joints.items() if driven_coordinate(j))
+                out.append(f"Driver '{driver.name}': joint={driver.joint!r} is not a revolute or translational "
+                           f"joint of this scene (drivable joints: {', '.join(drivable) or 'none'}).")
+            elif driver.initial_angle is not None and coordinate == "translation":
+                out.append(f"Driver '{driver.name}': initial_angle={driver.initial_angle!r} rad on translational "
+                           f"joint '{driver.joint}'; give initial_position (m) instead.")
+            elif driver.initial_position is not None and coordinate == "rotation":
+                out.append(f"Driver '{driver.name}': initial_position={driver.initial_position!r} m on revolute "
+                           f"joint '{driver.joint}'; give initial_angle (rad) instead.")
+            if coordinate is not None and driver.joint in driven:
                 out.append(f"Driver '{driver.name}': joint '{driver.joint}' already has a driver.")
             driven.add(driver.joint)
         if not self.bodies:
@@ -732,3 +775,13 @@ def _face_law_problems(element: TranslationalClearance) -> list[str]:
     except (SceneError, TypeError) as exc:
         return [f"{element.kind} '{element.name}': face_law: {exc}"]
     return []
+
+
+def driven_coordinate(joint: Any) -> str | None:
+    """What a :class:`Driver` prescribes on ``joint``: "rotation" (revolute joints, with or without
+    clearance), "translation" (translational joints, with or without clearance) or None (not drivable)."""
+    if isinstance(joint, (Revolute, RevoluteClearance)):
+        return "rotation"
+    if isinstance(joint, (Translational, TranslationalClearance)):
+        return "translation"
+    return None

@@ -43,6 +43,15 @@ their materials and laws as tables::
     law = { name = "lankarani-nikravesh", restitution = 0.9 }
     friction = 0.05          # or "coulomb", or { name = "modified-coulomb", coefficient = 0.1 }
 
+Drivers take their motion profile as a table (see :mod:`daeclear.profiles`)::
+
+    [[driver]]
+    name = "drive"
+    joint = "A"                # a revolute or translational joint, with or without clearance
+    speed = 523.6
+    profile = { kind = "ramp", time = 0.01 }   # or "harmonic" (amplitude, frequency, phase),
+                                               # "tabulated" (times, values), "constant"
+
 Unknown tables or keys are errors that name the file, the table and the key.
 """
 
@@ -58,6 +67,7 @@ from typing import Any, Callable
 from . import mechanisms, options
 from .errors import SceneError
 from .contact import Material, friction_law, normal_law
+from .profiles import profile_from_dict
 from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
 
 MECHANISMS: dict[str, Callable[..., Scene]] = {"slider_crank": mechanisms.slider_crank, "chain": mechanisms.chain}
@@ -65,7 +75,8 @@ ELEMENT_TABLES: dict[str, type] = {
     "body": Body, "revolute": Revolute, "translational": Translational, "driver": Driver,
     "revolute_clearance": RevoluteClearance, "translational_clearance": TranslationalClearance,
 }
-SIMULATE_KEYS = ("t_end", "rtol", "atol", "formulation", "method", "backend", "max_step", "t_eval_step")
+SIMULATE_KEYS = ("t_end", "rtol", "atol", "formulation", "method", "backend", "max_step", "t_eval_step", "start",
+                 "allow_penetration")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -104,6 +115,14 @@ def _contact_fields(entry: dict[str, Any]) -> dict[str, Any]:
     except (TypeError, ValueError, SceneError) as exc:
         raise SceneError(f"key {key}: {exc}") from None
     return out
+
+
+def _profile_field(entry: dict[str, Any]) -> dict[str, Any]:
+    """A driver's profile table {kind = "ramp", time = 0.01} -> the profile object; an error names the key."""
+    try:
+        return {**entry, "profile": profile_from_dict(entry["profile"])}
+    except (TypeError, ValueError) as exc:
+        raise SceneError(f"key profile: {exc} (e.g. profile = {{ kind = \"ramp\", time = 0.01 }}).") from None
 
 
 def _single_table(path: Path, data: dict[str, Any], table: str) -> dict[str, Any]:
@@ -166,6 +185,8 @@ def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any
     try:
         if cls in (RevoluteClearance, TranslationalClearance):
             entry = _contact_fields(entry)
+        if cls is Driver and isinstance(entry.get("profile"), dict):
+            entry = _profile_field(entry)
         element = cls(**entry)
     except (TypeError, ValueError, SceneError) as exc:
         text = str(exc)
@@ -195,8 +216,10 @@ def check_simulate(simulate: dict[str, Any], *, where: str) -> dict[str, Any]:
         out["atol"] = atol.tolist() if hasattr(atol, "tolist") else atol
     if "max_step" in out:
         out["max_step"] = options.max_step(out["max_step"], where=where)
+    if "allow_penetration" in out:
+        out["allow_penetration"] = options.flag(out["allow_penetration"], where=where, field="allow_penetration")
     for key, rule in (("method", options.method), ("formulation", options.formulation),
-                      ("backend", options.backend)):
+                      ("backend", options.backend), ("start", options.start)):
         if key in out:
             out[key] = rule(out[key], where=where)
     if "t_eval_step" in out:

@@ -121,6 +121,7 @@ def simulate(
     track_work: bool = False,
     linear_solver: str = "auto",
     start: str = "ideal",
+    allow_penetration: bool = False,
 ) -> Result:
     """Integrate a scene (or an assembled model) from t = 0 to ``t_end``.
 
@@ -173,6 +174,9 @@ def simulate(
         and every position and velocity assembled on the mechanism whose clearance joints are
         ideal, from the declared state as a guess; "declared": the bodies' declared positions and
         velocities, corrected only for the scene's ideal joints.
+    allow_penetration : bool
+        Start "declared" even with a contact pair deeper in its wall than
+        :data:`daeclear.physics.START_PENETRATION_FRACTION` of the clearance (refused otherwise).
 
     Returns
     -------
@@ -184,12 +188,13 @@ def simulate(
     Raises
     ------
     AssemblyError
-        The initial positions cannot be assembled, or the constraints are redundant (the
-        message names the joints and drivers).
+        The initial positions cannot be assembled, the constraints are redundant (the
+        message names the joints and drivers), or a declared start is in deep penetration.
     """
     method = options.method(method)
     linear_solver = options.linear_solver(linear_solver)
     start = options.start(start)
+    allow_penetration = options.flag(allow_penetration, field="allow_penetration")
     t_end, rtol, max_step, max_steps, t_eval, backend, on_failure, store_steps, progress, track_work = options.run(
         t_end=t_end, rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, t_eval=t_eval, backend=backend,
         on_failure=on_failure, store_steps=store_steps, progress=progress, track_work=track_work)
@@ -200,7 +205,7 @@ def simulate(
         return integrate(scene, t_end, method=method, t_eval=t_eval, rtol=rtol, atol=atol, formulation=formulation,
                          backend=backend, max_step=max_step, max_steps=max_steps, step=step,
                          store_steps=store_steps, on_failure=on_failure, progress=progress,
-                         track_work=track_work, start=start)
+                         track_work=track_work, start=start, allow_penetration=allow_penetration)
 
     setup_start = time.perf_counter()
     model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation, track_work=track_work)
@@ -210,7 +215,7 @@ def simulate(
     atol_vec = tolerance_vector(model, rtol, atol)
     session = open_session(model.functions, backend=backend, rtol=rtol, atol=atol_vec, max_step=max_step,
                            parameters=model.parameter_values, max_steps=max_steps, linear_solver=linear_solver)
-    y0, yp0 = model.initial_state(session=session, start=start)
+    y0, yp0 = model.initial_state(session=session, start=start, allow_penetration=allow_penetration)
     if model.formulation == "ggl":
         # never ask Newton for corrections below round-off: coef * rtol >= 1e-13
         session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / rtol)))

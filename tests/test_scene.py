@@ -53,7 +53,7 @@ def test_duplicate_names_and_all_problems_at_once():
     assert "has 3 problems" in text
     assert "duplicate name" in text
     assert "mass=-2.0 kg" in text
-    assert "Driver 'motor': 'E' is not a revolute joint of this scene" in text
+    assert "Driver 'motor': joint='E' is not a revolute or translational joint of this scene" in text
 
 
 def test_joint_needs_location_and_two_bodies():
