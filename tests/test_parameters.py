@@ -10,6 +10,8 @@ parameters or is baked into the structure.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -209,3 +211,57 @@ def test_a_damaged_cached_library_is_built_again(tmp_path):
     (library,) = tmp_path.glob("dc_*.so")
     library.write_bytes(library.read_bytes()[: library.stat().st_size * 9 // 10])  # keeps its build tag
     assert run() == ["True", "True"]  # built again, not loaded
+
+
+def _driven(kind: str, second: bool) -> dc.Scene:
+    """Driven scenes (tests/test_drivers.py) in two versions that differ only in numbers."""
+    from daeclear.profiles import Harmonic, Ramp, Tabulated
+    from test_drivers import crank_bearing_clearance, disc_scene, inclined_block
+
+    if kind == "ramp":
+        return disc_scene(Ramp(time=0.2 if second else 0.05), speed=3.0 if second else 10.0)
+    if kind == "harmonic":
+        return disc_scene(Harmonic(amplitude=0.1, frequency=3.0, phase=-1.0) if second else
+                          Harmonic(amplitude=0.4, frequency=20.0, phase=0.7))
+    if kind == "tabulated":
+        values = (0.0, 1.0, 1.5, 4.0) if second else (0.3, 0.5, 0.2, 0.9)
+        return disc_scene(Tabulated(times=(0.0, 0.01, 0.05, 0.06) if second else (0.0, 0.03, 0.07, 0.1),
+                                    values=values), speed=None)
+    if kind == "translational":
+        scene = inclined_block("clearance")
+        if second:
+            k = next(i for i, e in enumerate(scene.elements) if e.name == "push")
+            scene.elements[k] = dataclasses.replace(scene.elements[k], speed=-0.8, initial_position=0.0,
+                                                    profile=Harmonic(amplitude=0.5, frequency=1.0))
+        return scene
+    return crank_bearing_clearance(0.1e-3 if second else 0.4e-3)
+
+
+@pytest.mark.parametrize("kind", ["ramp", "harmonic", "tabulated", "translational", "crank-bearing"])
+def test_driver_numbers_compile_nothing(kind):
+    """Drivers (profiles, translational and clearance joints driven): numbers share the template, and
+    the shared template equals a fresh build for the second numbers."""
+    first = dc.assemble(_driven(kind, False))
+    shared = dc.assemble(_driven(kind, True))
+    assert shared.functions is first.functions, "numbers only: the template must be reused"
+    assert not np.array_equal(shared.parameter_values, first.parameter_values)
+    clear_memos()
+    fresh = dc.assemble(_driven(kind, True))
+    assert fresh.functions is not shared.functions
+    for seed in (1, 2):
+        for a, b in zip(_functions_at(shared, seed), _functions_at(fresh, seed)):
+            np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+
+
+def test_driver_structure_changes_get_their_own_template():
+    """The profile kind and a table's number of points are structure."""
+    from daeclear.profiles import Harmonic, Ramp, Tabulated
+    from test_drivers import disc_scene
+
+    ramp = dc.assemble(disc_scene(Ramp(time=0.1))).functions
+    assert dc.assemble(disc_scene(Harmonic(amplitude=0.1, frequency=1.0))).functions is not ramp
+    assert dc.assemble(disc_scene(None)).functions is not ramp
+    four = dc.assemble(disc_scene(Tabulated(times=(0, 1, 2, 3), values=(0, 1, 2, 3)), speed=None)).functions
+    assert dc.assemble(disc_scene(Tabulated(times=(0, 1, 2, 3), values=(0, 2, 1, 3)), speed=None)).functions is four
+    assert dc.assemble(disc_scene(Tabulated(times=(0, 1, 2, 3, 4), values=(0, 1, 2, 3, 4)),
+                                  speed=None)).functions is not four
