@@ -366,3 +366,16 @@ def test_scene_file_start_options(tmp_path: Path):
     path.write_text(SCENE_FILE.format(driver="speed = 1.0") + "\n[simulate]\nallow_penetration = 1\n")
     with pytest.raises(SceneError, match=r"\[simulate\]: allow_penetration=1, must be True or False"):
         read_scene_file(path)
+
+
+def test_example_crank_bearing_clearance(tmp_path: Path, monkeypatch):
+    import importlib.util
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "crank_bearing_clearance.py"
+    spec = importlib.util.spec_from_file_location("example_crank_bearing_clearance", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    figure = tmp_path / "crank.png"
+    lines = module.main([str(figure), "--revolutions", "1", "--clearance", "0.1e-3"])
+    assert figure.stat().st_size > 10_000
+    assert lines[0].startswith("rod-slider") and "A: " not in lines[0] and "A: " in lines[1]
