@@ -379,3 +379,40 @@ def test_example_crank_bearing_clearance(tmp_path: Path, monkeypatch):
     lines = module.main([str(figure), "--revolutions", "1", "--clearance", "0.1e-3"])
     assert figure.stat().st_size > 10_000
     assert lines[0].startswith("rod-slider") and "A: " not in lines[0] and "A: " in lines[1]
+
+
+def test_translational_driver_start_from_body_fixed_points():
+    """Joint given by body-fixed points: x0 is the reference displacement of point j from point i along the axis."""
+    scene = dc.Scene("guide", gravity=(0.0, 0.0))
+    block = scene.add(dc.Body("block", mass=1.0, inertia=1e-3, position=(0.3, 0.4)))
+    scene.add(dc.Translational("G", scene.ground, block, point_i=(0.1, 0.0), point_j=(0.0, 0.0), axis=(0.6, 0.8)))
+    scene.add(dc.Driver("push", "G", speed=2.0))
+    model = dc.assemble(scene)
+    assert model.parameter("push.position0")[0] == pytest.approx((0.3 - 0.1) * 0.6 + 0.4 * 0.8, rel=1e-14)
+    result = dc.simulate(model, 0.1, rtol=1e-9, t_eval=[0.0, 0.1])
+    along = (result["block.x"] - 0.1) * 0.6 + result["block.y"] * 0.8
+    np.testing.assert_allclose(along, [0.44, 0.64], atol=1e-9)
+    np.testing.assert_allclose(result["push.force"], 0.0, atol=1e-9)  # no gravity, constant speed
+
+
+def test_profile_is_saved_with_the_result(tmp_path: Path):
+    result = dc.simulate(disc_scene(Tabulated(times=TIMES, values=VALUES), None), 0.01, rtol=1e-8)
+    result.save(tmp_path / "r.h5")
+    saved = dc.load(tmp_path / "r.h5").parameters["scene"]["elements"]["drive"]["profile"]
+    assert saved == {"kind": "tabulated", "times": list(TIMES), "values": list(VALUES)}
+
+
+def test_deep_penetration_is_refused_by_the_python_backend_too():
+    with pytest.raises(AssemblyError, match="deep penetration"):
+        dc.simulate(journal_off_centre(0.7e-3), 1e-4, start="declared", backend="python")
+
+
+def test_work_of_a_driver_through_a_clearance_bearing_closes_the_energy_balance():
+    """track_work: the driver's and the contact forces' work equals the change of mechanical energy."""
+    result = dc.simulate(crank_bearing_clearance(0.1e-3), REVOLUTION, rtol=1e-8, track_work=True)
+    assert result.events.of("A", kind="onset")
+    work = result["energy.work"]
+    balance = result["energy.mechanical"] - result["energy.mechanical"][0] - work
+    assert np.max(np.abs(balance)) < 1e-4 * np.max(np.abs(work)), (np.max(np.abs(balance)), np.max(np.abs(work)))
+    power = result["drive.power"] + result["A.power"] + result["clearance.power"]
+    np.testing.assert_allclose(result["energy.input_power"], power, rtol=1e-12, atol=1e-9)
