@@ -138,9 +138,16 @@ def crank_period(source: Result | DAEModel | Scene | Mapping[str, Any]) -> float
     """
     scene = _scene_parameters(source)
     elements = scene.get("elements", {}) if isinstance(scene, Mapping) else {}
-    speeds = sorted({abs(float(e["speed"])) for e in elements.values()
-                     if isinstance(e, Mapping) and e.get("kind") == "Driver"})
+    drivers = [e for e in elements.values() if isinstance(e, Mapping) and e.get("kind") == "Driver"]
     name = scene.get("name", "?") if isinstance(scene, Mapping) else "?"
+    for driver in drivers:  # only a constant-speed rotation repeats every 2 pi / speed
+        profile = (driver.get("profile") or {}).get("kind", "constant")
+        joint = elements.get(driver.get("joint"), {})
+        if profile != "constant" or (isinstance(joint, Mapping) and "Translational" in str(joint.get("kind"))):
+            raise DaeclearError(f"scene {name!r}: driver {driver.get('name')!r} is not a constant-speed rotation "
+                                f"(profile {profile!r} on joint {driver.get('joint')!r}), so the scene has no crank "
+                                "period: pass period= (s) explicitly.")
+    speeds = sorted({abs(float(e["speed"])) for e in drivers})
     if not speeds:
         raise DaeclearError(f"scene {name!r} has no driver, so no crank period: pass period= (s) explicitly.")
     if len(speeds) > 1 or speeds[0] == 0.0:

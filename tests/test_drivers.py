@@ -416,3 +416,34 @@ def test_work_of_a_driver_through_a_clearance_bearing_closes_the_energy_balance(
     assert np.max(np.abs(balance)) < 1e-4 * np.max(np.abs(work)), (np.max(np.abs(balance)), np.max(np.abs(work)))
     power = result["drive.power"] + result["A.power"] + result["clearance.power"]
     np.testing.assert_allclose(result["energy.input_power"], power, rtol=1e-12, atol=1e-9)
+
+
+def test_slider_declared_in_its_guide_wall_is_refused():
+    """Translational clearance joint: the limit is 10 % of the smaller of clearance (0.5 mm) and corner
+    radius (1 mm): 50 um. A free slider declared 0.2 mm below its lower surface is refused, naming a corner."""
+    def slider(depth: float) -> dc.Scene:
+        scene = dc.Scene("guide", gravity=(0.0, -9.81))
+        block = scene.add(dc.Body("slider", mass=0.14, inertia=1e-4, position=(0.0, -0.5e-3 - depth)))
+        scene.add(dc.TranslationalClearance("g", scene.ground, block, point_i=(0.0, 0.0), point_j=(0.0, 0.0),
+                                            length=0.05, width=0.05, corner_radius=1e-3, clearance=0.5e-3,
+                                            material=dc.mechanisms.STEEL))
+        return scene
+
+    with pytest.raises(AssemblyError, match=r"clearance joint 'g' starts in deep penetration: 'g\.\w+' is 0\.0002 m "
+                       r"inside the wall at t=0, 40% of the clearance 0\.0005 m .* 5e-05 m"):
+        dc.simulate(slider(0.2e-3), 1e-4, start="declared")
+    result = dc.simulate(slider(0.04e-3), 1e-4, start="declared", t_eval=[0.0, 1e-4])
+    depths = [result[name][0] for name in result.channel_names if name.startswith("g.") and name.endswith(".penetration")]
+    assert len(depths) >= 2 and max(depths) == pytest.approx(0.04e-3, rel=1e-6)  # 8 %: started
+
+
+def test_crank_period_needs_a_constant_speed_rotation():
+    from daeclear.analysis import crank_period
+    from daeclear.errors import DaeclearError
+
+    assert crank_period(disc_scene(None)) == pytest.approx(2 * math.pi / SPEED)
+    assert crank_period(crank_bearing_clearance(0.1e-3)) == pytest.approx(REVOLUTION)
+    with pytest.raises(DaeclearError, match=r"driver 'drive' is not a constant-speed rotation \(profile 'ramp'"):
+        crank_period(disc_scene(Ramp(time=0.1)))
+    with pytest.raises(DaeclearError, match=r"driver 'push' is not a constant-speed rotation .* joint 'G'"):
+        crank_period(inclined_block("ideal"))
