@@ -10,6 +10,8 @@ A mechanism file::
     [simulate]
     t_end = 0.024
     rtol = 1e-6
+    # also: atol, formulation, method, backend, max_step, t_eval_step, start ("ideal" or "declared"),
+    # allow_penetration (true: a declared start deep in a wall is not refused)
 
 A scene file (tables map key for key onto the Python classes)::
 
