@@ -44,6 +44,10 @@ def _as_vector2(value: Any) -> Vector2 | None:
     return items  # type: ignore[return-value]
 
 
+# public names of the helpers above, for the elements defined in other modules (daeclear.loads)
+is_finite_number, as_vector2 = _is_finite_number, _as_vector2
+
+
 class Element:
     """Base class of every scene element: a name, and a list of own problems."""
 
@@ -102,6 +106,9 @@ class Element:
 
 def _body_name(body: Union[str, "Body", "Ground"]) -> str:
     return body if isinstance(body, str) else getattr(body, "name", body)
+
+
+body_name = _body_name  # public name, for the elements defined in other modules
 
 
 @dataclass(frozen=True)
@@ -352,8 +359,10 @@ class Scene:
             seen.add(element.name)
         body_names = [b.name for b in self.bodies]
         known = set(body_names) | {GROUND}
-        for joint in self.joints:
-            for role, body in (("body_i", joint.body_i), ("body_j", joint.body_j)):
+        referring = [(j, (("body_i", j.body_i), ("body_j", j.body_j))) for j in self.joints]
+        referring += [(e, e.body_roles()) for e in self.elements if hasattr(e, "body_roles")]  # loads
+        for joint, roles in referring:
+            for role, body in roles:
                 if body not in known:
                     close = difflib.get_close_matches(str(body), sorted(known), n=1)
                     hint = f" Did you mean '{close[0]}'?" if close else ""

@@ -58,13 +58,18 @@ from typing import Any, Callable
 from . import mechanisms, options
 from .errors import SceneError
 from .contact import Material, friction_law, normal_law
+from .loads import Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
 from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
 
 MECHANISMS: dict[str, Callable[..., Scene]] = {"slider_crank": mechanisms.slider_crank, "chain": mechanisms.chain}
 ELEMENT_TABLES: dict[str, type] = {
     "body": Body, "revolute": Revolute, "translational": Translational, "driver": Driver,
     "revolute_clearance": RevoluteClearance, "translational_clearance": TranslationalClearance,
+    "force": Force, "torque": Torque, "spring_damper": SpringDamper,
+    "rotational_spring_damper": RotationalSpringDamper, "motor": Motor,
 }
+#: Keys of loads whose value may be a table in time, ``{ times = [...], values = [...] }``.
+LOAD_VALUE_KEYS = ("fx", "fy", "value")
 SIMULATE_KEYS = ("t_end", "rtol", "atol", "formulation", "method", "backend", "max_step", "t_eval_step")
 
 
@@ -103,6 +108,20 @@ def _contact_fields(entry: dict[str, Any]) -> dict[str, Any]:
             out["friction"] = _law(out["friction"], friction_law)
     except (TypeError, ValueError, SceneError) as exc:
         raise SceneError(f"key {key}: {exc}") from None
+    return out
+
+
+def _load_values(entry: dict[str, Any]) -> dict[str, Any]:
+    """Loads: a value written as a table {times, values} -> a daeclear.Table; an error names its key."""
+    out = dict(entry)
+    for key in LOAD_VALUE_KEYS:
+        value = out.get(key)
+        if isinstance(value, dict):
+            unknown = sorted(set(value) - {"times", "values"})
+            if unknown or len(value) != 2:
+                raise SceneError(f"key {key}: unknown key(s) {', '.join(unknown) or '(none)'}; allowed: times, "
+                                 "values (both required).")
+            out[key] = Table(value["times"], value["values"])
     return out
 
 
@@ -166,6 +185,8 @@ def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any
     try:
         if cls in (RevoluteClearance, TranslationalClearance):
             entry = _contact_fields(entry)
+        if cls in (Force, Torque):
+            entry = _load_values(entry)
         element = cls(**entry)
     except (TypeError, ValueError, SceneError) as exc:
         text = str(exc)
