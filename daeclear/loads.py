@@ -79,7 +79,8 @@ class Table:
         times, values = self.times, self.values
         for name, seq in (("times", times), ("values", values)):
             if not isinstance(seq, tuple) or not all(math.isfinite(x) for x in seq):
-                return [f"{where}Table: {name}={seq!r}, must be a sequence of finite numbers."]
+                shown = list(seq) if isinstance(seq, tuple) else seq
+                return [f"{where}Table: {name}={shown!r}, must be a sequence of finite numbers."]
         if len(times) < 2 or len(times) != len(values):
             return [f"{where}Table: {len(times)} times and {len(values)} values, must be as many (at least 2)."]
         if any(b <= a for a, b in zip(times, times[1:])):

@@ -10,6 +10,8 @@ parameters or is baked into the structure.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -209,3 +211,54 @@ def test_a_damaged_cached_library_is_built_again(tmp_path):
     (library,) = tmp_path.glob("dc_*.so")
     library.write_bytes(library.read_bytes()[: library.stat().st_size * 9 // 10])  # keeps its build tag
     assert run() == ["True", "True"]  # built again, not loaded
+
+
+def _loaded_crank(scale: float) -> dc.Scene:
+    """The revolute-clearance slider-crank with every kind of load (daeclear.loads), its numbers
+    multiplied by ``scale``: the structure does not change with ``scale``."""
+    scene = dc.mechanisms.slider_crank("revolute", rpm=3000.0 * scale)
+    ramp = dc.Table((0.0, 1e-3 * scale, 2e-3), (0.0, 5.0 * scale, 2.0))
+    wave = dc.Expression(lambda t, s, p: p.F * dc.loads.sin(p.w * t) - p.c * s.vx, F=3.0 * scale, w=900.0, c=0.1 * scale)
+    scene.add(dc.Force("push", "slider", fx=wave, fy=ramp, at=(0.17, 0.01 * scale)))
+    scene.add(dc.Force("follower", "rod", fx=1.0 * scale, frame="body"))
+    scene.add(dc.Torque("twist", "rod", dc.Expression(lambda t, s, p: -p.k * s.angle, k=0.2 * scale),
+                        reaction="crank"))
+    scene.add(dc.SpringDamper("spring", "ground", "slider", at_i=(0.3, 0.0), at_j=(0.17, 0.0),
+                              stiffness=100.0 * scale, damping=0.5 * scale, free_length=0.1 * scale))
+    scene.add(dc.RotationalSpringDamper("torsion", "crank", "rod", stiffness=0.5 * scale, damping=1e-3 * scale))
+    scene.add(dc.Motor("motor", "ground", "crank", stall_torque=2.0 * scale, no_load_speed=300.0 * scale))
+    return scene
+
+
+def test_loads_are_parameters_new_numbers_compile_nothing():
+    first = dc.assemble(_loaded_crank(1.0), track_work=True)
+    shared = dc.assemble(_loaded_crank(1.7), track_work=True)
+    assert shared.functions is first.functions, "numbers only: the template must be reused"
+    assert shared.parameter("spring.stiffness")[0] == pytest.approx(170.0)
+    assert shared.parameter("push.fy.times").tolist() == pytest.approx([0.0, 1.7e-3, 2e-3])
+    assert shared.parameter("push.fx.F")[0] == pytest.approx(5.1)
+    assert shared.parameter("motor.no_load_speed")[0] == pytest.approx(510.0)
+    clear_memos()
+    fresh = dc.assemble(_loaded_crank(1.7), track_work=True)
+    assert fresh.functions is not shared.functions
+    for seed in (1, 2):
+        for a, b in zip(_functions_at(shared, seed), _functions_at(fresh, seed)):
+            np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+    base = dc.simulate(_loaded_crank(1.0), t_end=2e-4, rtol=1e-6)
+    again = dc.simulate(_loaded_crank(1.3), t_end=2e-4, rtol=1e-6)
+    assert base.stats["compile_time"] >= 0.0 and again.stats["compile_time"] == 0.0
+
+
+def test_load_structure_changes_get_their_own_template():
+    reference = dc.assemble(_loaded_crank(1.0)).functions
+    scene = _loaded_crank(1.0)
+    i = next(k for k, e in enumerate(scene.elements) if e.name == "push")
+    scene.elements[i] = dataclasses.replace(scene.elements[i], fy=dc.Table((0.0, 1e-3), (0.0, 5.0)))  # 2 points
+    assert dc.assemble(scene).functions is not reference
+    scene = _loaded_crank(1.0)
+    scene.elements[i] = dataclasses.replace(scene.elements[i], fy=4.0)  # a number, not a table
+    assert dc.assemble(scene).functions is not reference
+    scene = _loaded_crank(1.0)
+    j = next(k for k, e in enumerate(scene.elements) if e.name == "follower")
+    scene.elements[j] = dataclasses.replace(scene.elements[j], frame="world")
+    assert dc.assemble(scene).functions is not reference
