@@ -396,3 +396,17 @@ def test_scene_file_load_errors_name_table_key_and_rule(tmp_path: Path, table, t
         read_scene_file(path)
     message = str(info.value)
     assert str(path) in message and expected in message, message
+
+
+def test_the_torque_driven_crank_example_writes_its_figure(tmp_path: Path, capsys):
+    import importlib.util
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "torque_driven_crank.py"
+    spec = importlib.util.spec_from_file_location("torque_driven_crank", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    figure = tmp_path / "speed.png"
+    assert module.main(["--quick", str(figure)]) == 0
+    assert figure.stat().st_size > 10_000
+    out = capsys.readouterr().out
+    assert "ideal joints" in out and "revolute clearance" in out and "energy residual" in out
