@@ -207,7 +207,10 @@ def _function_digest(function: Any) -> str:
     try:
         text = inspect.getsource(function)
     except (OSError, TypeError):
-        text = repr((code.co_code, code.co_consts, code.co_names)) if code is not None else repr(function)
+        text = repr(function) if code is None else ""
+    if code is not None:  # the bytecode too: two lambdas on one source line differ by it
+        consts = [c for c in code.co_consts if not inspect.iscode(c)]  # a code object's repr holds an address
+        text += repr((code.co_code, consts, code.co_names))
     captured: list[Any] = []
     if code is not None:
         cells = getattr(function, "__closure__", None) or ()

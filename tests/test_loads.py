@@ -410,3 +410,23 @@ def test_the_torque_driven_crank_example_writes_its_figure(tmp_path: Path, capsy
     assert figure.stat().st_size > 10_000
     out = capsys.readouterr().out
     assert "ideal joints" in out and "revolute clearance" in out and "energy residual" in out
+
+
+SCALE = 2.0  # a number read by an expression from outside its named numbers: structure
+
+
+def test_an_expression_function_and_the_numbers_it_reads_from_outside_are_structure():
+    def scaled(t, s, p):
+        return SCALE * p.T
+
+    both = (dc.Expression(lambda t, s, p: p.T, T=1.0), dc.Expression(lambda t, s, p: 2.0 * p.T, T=1.0))
+    keys = {dc.Torque("t", "disc", e).to_dict()["value"]["digest"] for e in both}
+    assert len(keys) == 2  # two lambdas on one line differ
+    first = dc.Expression(scaled, T=1.0).to_dict()["digest"]
+    global SCALE
+    SCALE = 3.0
+    try:
+        assert dc.Expression(scaled, T=1.0).to_dict()["digest"] != first
+    finally:
+        SCALE = 2.0
+    assert dc.Expression(scaled, T=7.0).to_dict()["digest"] == first  # named numbers are not structure
