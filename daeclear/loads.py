@@ -200,24 +200,38 @@ class Expression:
                 "digest": _function_digest(self.function), "parameters": dict(self.parameters)}
 
 
-def _function_digest(function: Any) -> str:
-    """A digest that changes when the function's code or a number it reads from outside changes
-    (such numbers are structure: give them as named numbers to make them run-time parameters)."""
+def _function_digest(function: Any, seen: frozenset[int] = frozenset()) -> str:
+    """A digest that changes when the function's code, a number it reads from outside, or a Python
+    function it calls (by a global or closure name, recursively) changes: all of that is structure
+    (give numbers as named numbers to make them run-time parameters)."""
     code = getattr(function, "__code__", None)
     try:
         text = inspect.getsource(function)
     except (OSError, TypeError):
         text = repr(function) if code is None else ""
+    captured: list[Any] = []
     if code is not None:  # the bytecode too: two lambdas on one source line differ by it
         consts = [c for c in code.co_consts if not inspect.iscode(c)]  # a code object's repr holds an address
         text += repr((code.co_code, consts, code.co_names))
-    captured: list[Any] = []
-    if code is not None:
-        cells = getattr(function, "__closure__", None) or ()
-        captured += [c.cell_contents for c in cells if _is_number(getattr(c, "cell_contents", None))]
         globs = getattr(function, "__globals__", {})
-        captured += [(n, globs[n]) for n in code.co_names if _is_number(globs.get(n))]
+        outside = [c.cell_contents for c in getattr(function, "__closure__", None) or () if _has_contents(c)]
+        outside += [(name, globs[name]) for name in code.co_names if name in globs]
+        seen = seen | {id(function)}
+        for item in outside:
+            value = item[1] if isinstance(item, tuple) else item
+            if _is_number(value):
+                captured.append(item)
+            elif inspect.isfunction(value) and id(value) not in seen:
+                captured.append(_function_digest(value, seen))
     return hashlib.sha256(f"{text}\n{captured!r}".encode()).hexdigest()[:20]
+
+
+def _has_contents(cell: Any) -> bool:
+    try:
+        cell.cell_contents
+    except ValueError:  # an empty cell (a name not yet bound)
+        return False
+    return True
 
 
 def _is_number(value: Any) -> bool:

@@ -314,7 +314,7 @@ class Scene:
         """Add an element and return it (so ``crank = scene.add(Body(...))`` reads well)."""
         if not isinstance(element, Element):
             raise SceneError(
-                f"scene '{self.name}': cannot add {element!r}; expected a Body, joint or Driver."
+                f"scene '{self.name}': cannot add {element!r}; expected a Body, joint, Driver or load (daeclear.loads)."
             )
         self.elements.append(element)
         return element

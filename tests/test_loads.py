@@ -433,3 +433,9 @@ def test_an_expression_function_and_the_numbers_it_reads_from_outside_are_struct
     finally:
         SCALE = 2.0
     assert dc.Expression(scaled, T=7.0).to_dict()["digest"] == first  # named numbers are not structure
+    calling = dc.Expression(lambda t, s, p: scaled(t, s, p) + p.T, T=1.0).to_dict()["digest"]
+    SCALE = 3.0
+    try:  # a function it calls changed: another structure
+        assert dc.Expression(lambda t, s, p: scaled(t, s, p) + p.T, T=1.0).to_dict()["digest"] != calling
+    finally:
+        SCALE = 2.0
