@@ -180,7 +180,8 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
 
     crank = body("crank", CRANK_MASS, CRANK_INERTIA)
     rod = body("rod", ROD_MASS, ROD_INERTIA)
-    state["slider"] = (state["slider"][0] - offset[0], -offset[1], *state["slider"][2:])
+    if offset != (0.0, 0.0):  # the slider's centre, from the pin where the ideal mechanism has it
+        state["slider"] = (state["slider"][0] - offset[0], -offset[1], *state["slider"][2:])
     slider = body("slider", slider_mass, slider_inertia)
     pin_b = (CRANK_LENGTH * math.cos(crank_angle), CRANK_LENGTH * math.sin(crank_angle))
     pin_c = (state["slider"][0] + offset[0], 0.0)

@@ -61,6 +61,13 @@ class JointReading:
     source: str  # the chapter's sentence
     note: str = ""  # what the text leaves open and we chose
 
+    def __post_init__(self) -> None:
+        if self.corner_stiffness not in CORNER_STIFFNESS or self.face_law not in (None, *FACE_LAWS):
+            raise ValueError(f"JointReading {self.name!r}: corner_stiffness={self.corner_stiffness!r} must be one of "
+                             f"{CORNER_STIFFNESS}, face_law={self.face_law!r} one of {(None, *FACE_LAWS)}.")
+        if (self.face_law is None) != (self.model == "corners"):
+            raise ValueError(f"JointReading {self.name!r}: a face law goes with the 'section-4.3' model only.")
+
 
 _S35 = ("For convenience, a small radius of curvature at each slider corner is considered, in order to calculate "
         "the equivalent generalized stiffness given by (3.5).")

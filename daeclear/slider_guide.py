@@ -46,6 +46,10 @@ chapter's model: not continuous, not energy-conserving at the switch). A face la
 needs an approach speed gets the mean of the approach speeds latched by its two corners
 (docs/contact_laws.md).
 
+A joint's ``reading`` (:mod:`daeclear.readings`) picks one of these models, the corner law's
+stiffness ((3.5) or the pseudo-stiffness (4.27)) and exponent, and the face law
+(``TranslationalClearance.contact_model``, ``resolved_law``, ``resolved_face_law``).
+
 Friction (only when declared): at every active contact, the modified Coulomb law (or the
 joint's law) on the sliding velocity of the slider's material point at the contact
 relative to the guide's, along ``t``.

@@ -246,3 +246,27 @@ def test_study_runs_every_reading_quick(tmp_path, monkeypatch):
         assert 0.0 < row["span.contact_fraction"] < 1.0 and row["span.impacts_per_rev"] > 0, row["case"]
         assert row["span.velocity_rms_rel"] < 0.05, row["case"]
     assert "| corners |" in (tmp_path / "metrics.md").read_text()
+
+
+def test_a_scene_file_selects_a_reading(tmp_path):
+    from daeclear.scenefile import read_scene_file
+
+    path = tmp_path / "guide.toml"
+    path.write_text('[scene]\nname = "guide"\n[[body]]\nname = "slider"\nmass = 0.14\ninertia = 1e-4\n'
+                    '[[translational_clearance]]\nname = "g"\nbody_i = "ground"\nbody_j = "slider"\n'
+                    'point_i = [0.0, 0.0]\npoint_j = [0.0, 0.0]\nlength = 0.05\nwidth = 0.05\n'
+                    'corner_radius = 1e-3\nclearance = 0.5e-3\nmaterial = { young = 207e9, poisson = 0.3 }\n'
+                    'law = { name = "lankarani-nikravesh", restitution = 0.9 }\nreading = "Unified"\n')
+    joint = read_scene_file(path).scene["g"]
+    assert joint.reading == "unified" and joint.contact_model == "section-4.3"
+    assert joint.resolved_face_law().stiffness == pytest.approx(K_PSEUDO, rel=1e-12)
+    path.write_text(path.read_text().replace('"Unified"', '"unify"'))
+    with pytest.raises(dc.SceneError, match="reading='unify' is not a reading; allowed"):
+        read_scene_file(path).scene.validate()
+
+
+def test_the_reading_table_rejects_inconsistent_entries():
+    with pytest.raises(ValueError, match="corner_stiffness='cone'"):
+        readings.JointReading("x", "corners", "cone", 1.5, None, None, "s")
+    with pytest.raises(ValueError, match="face law goes with the 'section-4.3' model"):
+        readings.JointReading("x", "corners", "sphere", 1.5, "linear", None, "s")
