@@ -50,10 +50,13 @@ IDEAL_KEYS = ("gravity", "slider_mass", "slider_inertia")  # what of a mechanism
 
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The options of ``translational_common.parse_args``, and ``--figures DIR`` (a copy of the PNGs)."""
     parser_args = list(argv) if argv is not None else sys.argv[1:]
     figures = None
     if "--figures" in parser_args:
         i = parser_args.index("--figures")
+        if i + 1 >= len(parser_args) or parser_args[i + 1].startswith("--"):
+            raise SystemExit("translational_readings.py: --figures needs a directory (e.g. docs/figures).")
         figures = Path(parser_args[i + 1])
         del parser_args[i:i + 2]
     args = tc.parse_args(__file__, __doc__.splitlines()[0], parser_args)
