@@ -81,7 +81,9 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
                  law: Any = "lankarani-nikravesh", restitution: float | None = None, friction: Any = None,
                  bearing_radius: float = BEARING_RADIUS, material: Material = STEEL,
                  length: float | None = None, contact_model: str = "corners",
-                 face_law: Any = "lankarani-plane", **options: Any) -> Scene:
+                 face_law: Any = "lankarani-plane", reading: str | None = None, slider_mass: float = SLIDER_MASS,
+                 slider_inertia: float = SLIDER_INERTIA, pin_offset: tuple[float, float] = (0.0, 0.0),
+                 **options: Any) -> Scene:
     """The chapter's slider-crank mechanism (Fig. 4.14, Table 4.1).
 
     Crank (body ``crank``) pinned to the ground at the origin by revolute ``A`` and driven
@@ -135,6 +137,16 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     face_law : str or NormalLaw
         Translational joint, "section-4.3" only: the law of a face in contact, default
         Lankarani's linear law (4.26) with the stiffness (4.27).
+    reading : str or None
+        Translational joint only: a named reading of the chapter's contact model
+        (``TranslationalClearance(reading=...)``, :mod:`daeclear.readings`); it replaces
+        ``contact_model`` and ``face_law``.
+    slider_mass, slider_inertia : float
+        The slider's mass, kg, and moment of inertia, kg m^2 (Table 4.1: 0.14 and 1e-4).
+    pin_offset : (float, float)
+        Translational joint only: the rod-slider pin in slider coordinates from the slider's
+        centre (its centre of mass), m; (0, 0): at the centre. The slider starts with the pin
+        where the ideal mechanism has it, its centre midway between the guide surfaces.
 
     Returns
     -------
@@ -149,6 +161,13 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
            isinstance(crank_angle, (int, float)) and math.isfinite(crank_angle))
     if options:
         raise SceneError(f"slider_crank(joint={joint!r}): unknown option(s) {', '.join(sorted(options))}.")
+    offset = tuple(pin_offset) if isinstance(pin_offset, (tuple, list)) else ()
+    _check("pin_offset", pin_offset, "must be two finite numbers (m)",
+           len(offset) == 2 and all(isinstance(v, (int, float)) and math.isfinite(v) for v in offset))
+    _check("pin_offset", pin_offset, "must be (0, 0) unless joint='translational'",
+           joint == "translational" or offset == (0.0, 0.0))
+    for field_name, value, default in (("reading", reading, None), ("contact_model", contact_model, "corners")):
+        _check(field_name, value, "is for joint='translational' only", joint == "translational" or value == default)
 
     omega = rpm_to_rad_s(rpm)
     state = ideal_slider_crank_state(crank_angle, omega)
@@ -161,9 +180,11 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
 
     crank = body("crank", CRANK_MASS, CRANK_INERTIA)
     rod = body("rod", ROD_MASS, ROD_INERTIA)
-    slider = body("slider", SLIDER_MASS, SLIDER_INERTIA)
+    if offset != (0.0, 0.0):  # the slider's centre, from the pin where the ideal mechanism has it
+        state["slider"] = (state["slider"][0] - offset[0], -offset[1], *state["slider"][2:])
+    slider = body("slider", slider_mass, slider_inertia)
     pin_b = (CRANK_LENGTH * math.cos(crank_angle), CRANK_LENGTH * math.sin(crank_angle))
-    pin_c = (state["slider"][0], 0.0)
+    pin_c = (state["slider"][0] + offset[0], 0.0)
     scene.add(Revolute("A", scene.ground, crank, at=(0.0, 0.0)))
     scene.add(Revolute("B", crank, rod, at=pin_b))
     if joint != "ideal":  # given for a law without one (or for a law object), it would be silently dropped
@@ -179,15 +200,16 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     if joint == "translational":
         _check("clearance", clearance, "must be a number in (0, slider length) m",
                isinstance(clearance, (int, float)) and 0 < clearance < SLIDER_LENGTH)
-        inner, outer = ROD_LENGTH - CRANK_LENGTH, ROD_LENGTH + CRANK_LENGTH  # slider centre: x range
+        # slider centre: x range; the guide's mid-line through the slider's centre
+        inner, outer = ROD_LENGTH - CRANK_LENGTH - offset[0], ROD_LENGTH + CRANK_LENGTH - offset[0]
         reach = 0.5 * SLIDER_LENGTH + GUIDE_MARGIN
         scene.add(TranslationalClearance(
-            "clearance", scene.ground, slider, point_i=(0.0, 0.0), point_j=(0.0, 0.0), axis=(1.0, 0.0),
+            "clearance", scene.ground, slider, point_i=(0.0, -offset[1]), point_j=(0.0, 0.0), axis=(1.0, 0.0),
             length=SLIDER_LENGTH, width=SLIDER_WIDTH, thickness=SLIDER_THICKNESS, corner_radius=CORNER_RADIUS,
             clearance=clearance, upper_limits=(inner - reach, outer + reach),
             lower_limits=(inner - reach, outer + reach), stroke=(inner, outer), material=material,
             law=_contact_law(law, restitution, length), face_law=_contact_law(face_law, restitution, length),
-            friction=friction_law(friction), model=contact_model))
+            friction=friction_law(friction), model=contact_model, reading=reading))
     else:
         scene.add(Translational("D", scene.ground, slider, at=pin_c, axis=(1.0, 0.0)))
     scene.add(Driver("drive", joint="A", speed=omega))

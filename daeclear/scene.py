@@ -591,6 +591,12 @@ class TranslationalClearance(_PointJoint):
         scenario of Fig. 4.9. ``"section-4.3"``: two adjacent corners on the same surface
         (a face) use ``face_law`` at the geometric centre of the penetrated area; one
         corner or two opposite corners use ``law``.
+    reading : str or None
+        A named reading of the chapter's model (:data:`daeclear.readings.JOINT_READINGS`:
+        ``corners``, ``pseudo-corners``, ``pseudo-corners-linear``, ``section-4.3``,
+        ``unified``, ``unified-hertz``): it sets the model, the corner law's stiffness
+        ((3.5) or (4.27)) and exponent, and the face law, keeping the restitution of
+        ``law``. None: ``model``, ``law`` and ``face_law`` as given.
 
     Notes
     -----
@@ -633,6 +639,7 @@ class TranslationalClearance(_PointJoint):
     face_law: Any = field(default_factory=lambda: _default_face_law())
     friction: Any = None
     model: str = "corners"
+    reading: str | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -641,8 +648,16 @@ class TranslationalClearance(_PointJoint):
             vec = _as_vector2(value) if value is not None else None
             if vec is not None:
                 object.__setattr__(self, name, vec)
-        if isinstance(self.model, str):
-            object.__setattr__(self, "model", self.model.strip().lower())
+        for name in ("model", "reading"):
+            if isinstance(getattr(self, name), str):
+                object.__setattr__(self, name, getattr(self, name).strip().lower())
+
+    @property
+    def contact_model(self) -> str:
+        """The contact model in use: the reading's, else ``model``."""
+        from .readings import joint_reading
+
+        return self.model if self.reading is None else joint_reading(self.reading).model
 
     # ---- derived geometry ----------------------------------------------------------
     @property
@@ -668,14 +683,28 @@ class TranslationalClearance(_PointJoint):
         from .contact import normal_law
 
         law = normal_law(self.law) if isinstance(self.law, str) else self.law
+        if self.reading is not None:
+            from . import readings
+
+            return readings.corner_law(readings.joint_reading(self.reading), law, owner=f"{self.kind} '{self.name}'",
+                                       corner_radius=self.corner_radius, face_half_width=self.face_half_width,
+                                       materials=self.material)
         if law.is_resolved:
             return law
         return law.resolve("sphere_plane", radii=(float(self.corner_radius),), materials=self.material)
 
     def resolved_face_law(self) -> Any:
-        """The face law with its stiffness set (kind ``"plane_face"``, half side a)."""
+        """The face law with its stiffness set (kind ``"plane_face"``, half side a); with a reading
+        its face law (None for a reading of the ``corners`` model)."""
         from .contact import normal_law
 
+        if self.reading is not None:
+            from . import readings
+
+            return readings.face_law(readings.joint_reading(self.reading),
+                                     normal_law(self.law) if isinstance(self.law, str) else self.law,
+                                     owner=f"{self.kind} '{self.name}'", face_half_width=self.face_half_width,
+                                     materials=self.material)
         law = normal_law(self.face_law) if isinstance(self.face_law, str) else self.face_law
         return law.resolve("plane_face", face_half_width=self.face_half_width, materials=self.material)
 
@@ -707,6 +736,7 @@ class TranslationalClearance(_PointJoint):
         if self.model not in SLIDER_MODELS:
             out.append(f"{self.kind} '{self.name}': model={self.model!r}, must be one of "
                        f"{', '.join(map(repr, SLIDER_MODELS))}.")
+        out.extend(_reading_problems(self))
         if out:
             return out
         L, W, R_c, c = float(self.length), float(self.width), float(self.corner_radius), self.radial_clearance
@@ -721,9 +751,30 @@ class TranslationalClearance(_PointJoint):
             out.append(f"{self.kind} '{self.name}': corner_radius={R_c!r} m, must be < min(length, width)/2 "
                        f"= {0.5 * min(L, W)!r} m.")
         out.extend(_law_problems(self))
-        if self.model == "section-4.3":
+        if self.model == "section-4.3" and self.reading is None:
             out.extend(_face_law_problems(self))
         return out
+
+
+def _reading_problems(element: TranslationalClearance) -> list[str]:
+    """A reading must be known, and ``model`` and ``face_law`` left to it."""
+    from .readings import joint_reading
+
+    if element.reading is None:
+        return []
+    where = f"{element.kind} '{element.name}'"
+    try:
+        reading = joint_reading(element.reading)
+    except SceneError as exc:
+        return [f"{where}: {exc}"]
+    out = []
+    if element.model not in ("corners", reading.model):
+        out.append(f"{where}: model={element.model!r} with reading={reading.name!r}, whose model is "
+                   f"{reading.model!r}; give one of them.")
+    if element.face_law != _default_face_law():
+        out.append(f"{where}: face_law={element.face_law!r} with reading={reading.name!r}, which sets the face "
+                   "law; leave face_law at its default.")
+    return out
 
 
 def _face_law_problems(element: TranslationalClearance) -> list[str]:

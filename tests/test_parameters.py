@@ -54,6 +54,14 @@ VARIANTS = {
     "section-4.3": (dict(joint="translational", contact_model="section-4.3"),
                     dict(joint="translational", clearance=0.6e-3, contact_model="section-4.3", restitution=0.8)),
     "ideal": (dict(joint="ideal"), dict(joint="ideal", rpm=1234.0, gravity=3.0)),
+    # readings of the translational joint (daeclear.readings): their K, n, c_e, the slider's mass and
+    # inertia and the pin's place on it are numbers
+    "reading-unified": (dict(joint="translational", reading="unified"),
+                        dict(joint="translational", reading="unified", clearance=0.3e-3, restitution=0.8,
+                             slider_mass=0.9, slider_inertia=4e-4, pin_offset=(-0.02, 0.004))),
+    "reading-pseudo-corners": (dict(joint="translational", reading="pseudo-corners", friction=0.1),
+                               dict(joint="translational", reading="pseudo-corners", friction=0.01, gravity=0.0,
+                                    pin_offset=(0.01, 0.0), slider_mass=0.5)),
 }
 
 
@@ -99,6 +107,24 @@ def test_structure_changes_get_their_own_template():
         assert dc.assemble(dc.mechanisms.slider_crank("revolute", **kwargs)).functions is not reference, kwargs
     assert dc.assemble(dc.mechanisms.slider_crank("revolute"), formulation="ggl").functions is not reference
     assert dc.assemble(dc.mechanisms.slider_crank("revolute"), track_work=True).functions is not reference
+
+
+def test_translational_readings_change_the_structure_only_with_the_equations():
+    base = dict(joint="translational", reading="pseudo-corners")
+    reference = dc.assemble(dc.mechanisms.slider_crank(**base))
+    for kwargs in (dict(slider_mass=0.98, slider_inertia=4.1e-4), dict(pin_offset=(-0.025, 0.0)), dict(gravity=0.0),
+                   dict(restitution=0.7)):
+        model = dc.assemble(dc.mechanisms.slider_crank(**base, **kwargs))
+        assert model.functions is reference.functions, kwargs
+    assert reference.parameter("clearance.law.stiffness")[0] == pytest.approx(5.98612e9, rel=1e-5)  # (4.27)
+    assert reference.parameter("clearance.law.exponent")[0] == 1.5
+    moved = dc.assemble(dc.mechanisms.slider_crank(**base, pin_offset=(-0.025, 0.003), slider_mass=0.98))
+    assert moved.parameter("C.s_j").tolist() == pytest.approx([-0.025, 0.003])  # the pin, slider coordinates
+    assert moved.parameter("slider.mass")[0] == 0.98
+    linear = dc.assemble(dc.mechanisms.slider_crank(joint="translational", reading="pseudo-corners-linear"))
+    assert linear.functions is not reference.functions  # n = 1: the law's linear branch
+    faces = dc.assemble(dc.mechanisms.slider_crank(joint="translational", reading="unified"))
+    assert faces.functions is not reference.functions  # face terms
 
 
 def test_named_parameters():
