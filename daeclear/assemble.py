@@ -449,6 +449,9 @@ def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
     structure.append(table.layout)
     described = scene.to_dict()
     described.pop("name")  # the scene's name is no part of its structure
+    for element in scene.elements:  # fields whose effect the structure flags state
+        for field_name in element.NOT_STRUCTURE:
+            described["elements"][element.name].pop(field_name, None)
     return table, structure_key(described, structure)
 
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 import difflib
 import math
 from dataclasses import dataclass, field, fields
-from typing import Any, Iterator, Union
+from typing import Any, ClassVar, Iterator, Union
 
 from .errors import SceneError
 
@@ -52,6 +52,9 @@ class Element:
     """Base class of every scene element: a name, and a list of own problems."""
 
     name: str
+    #: fields whose effect on the equations the element's structure flags already state (the
+    #: compiled engine leaves them out of the structure key: a name for numbers compiles nothing)
+    NOT_STRUCTURE: ClassVar[frozenset[str]] = frozenset()
 
     @property
     def kind(self) -> str:
@@ -640,6 +643,9 @@ class TranslationalClearance(_PointJoint):
     friction: Any = None
     model: str = "corners"
     reading: str | None = None
+    # the structure flags state the contact model in use and the laws' structure (a reading that
+    # only changes numbers compiles nothing)
+    NOT_STRUCTURE: ClassVar[frozenset[str]] = frozenset({"model", "reading"})
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -289,7 +289,7 @@ def translational_clearance_parameters(ref: Reference, joint: TranslationalClear
     stroke = joint.stroke if joint.stroke is not None else joint.upper_limits
     if stroke is not None:
         values["stroke"] = stroke
-    structure: list[Any] = [law_structure(law), law_structure(friction)]
+    structure: list[Any] = [joint.contact_model, law_structure(law), law_structure(friction)]
     for prefix, each in (("law", law), ("face_law", face_law), ("friction", friction)):
         if each is not None:
             values.update({f"{prefix}.{k}": v for k, v in law_values(each).items()})

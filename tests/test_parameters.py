@@ -125,6 +125,13 @@ def test_translational_readings_change_the_structure_only_with_the_equations():
     assert linear.functions is not reference.functions  # n = 1: the law's linear branch
     faces = dc.assemble(dc.mechanisms.slider_crank(joint="translational", reading="unified"))
     assert faces.functions is not reference.functions  # face terms
+    # a reading's name is not structure: corners ((3.5)) and pseudo-corners ((4.27)) differ in K only
+    corners = dc.assemble(dc.mechanisms.slider_crank(joint="translational"))
+    assert corners.functions is reference.functions
+    assert corners.parameter("clearance.law.stiffness")[0] != reference.parameter("clearance.law.stiffness")[0]
+    # while the model a reading selects is (section-4.3: face terms, like 'unified')
+    section = dc.assemble(dc.mechanisms.slider_crank(joint="translational", reading="section-4.3"))
+    assert section.functions is not reference.functions
 
 
 def test_named_parameters():
