@@ -10,6 +10,7 @@ run: a wrong ``sunindextype`` width would be silent memory corruption.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import logging
 import os
 import re
@@ -172,6 +173,44 @@ def test_no_hand_written_prototypes_left():
     driver = (codegen.CSRC / "ida_driver.c").read_text()
     declared = re.findall(r"^(?:SUNDIALS_EXPORT )?[A-Za-z_][\w ]*\*? ?\b((?:IDA|SUN|N_V)\w*)\(", driver, re.MULTILINE)
     assert declared == ["SUNLinSol_SuperLUMT"]
+
+
+def test_vendored_files_are_the_releases_bytes():
+    """Every vendored file but the two written for the wheel's build is byte for byte the
+    SUNDIALS release's (SHA256SUMS, recorded from it), and every header is listed or written."""
+    root = codegen.SUNDIALS_INCLUDE.parent
+    sums = dict(reversed(line.split("  ", 1)) for line in (root / "SHA256SUMS").read_text().splitlines())
+    for name, digest in sums.items():
+        assert hashlib.sha256((root / name).read_bytes()).hexdigest() == digest, name
+    headers = {p.relative_to(root).as_posix() for p in root.rglob("*.h")}
+    written = {"include/sundials/sundials_config.h", "include/sundials/sundials_export.h"}
+    assert headers == set(sums) - {"LICENSE", "NOTICE"} | written
+
+
+def test_config_lists_only_modules_the_wheel_has():
+    """sundials_config.h says which modules the wheel's SUNDIALS was built with: each has its
+    library in the wheel, and each library the driver links is among them."""
+    text = (codegen.SUNDIALS_INCLUDE / "sundials" / "sundials_config.h").read_text()
+    modules = set(re.findall(r"^#define SUNDIALS_((?:CVODE|IDA|NVECTOR|SUNMATRIX|SUNLINSOL)\w*) 1$", text, re.MULTILINE))
+    libdir, libs = codegen.sundials_libraries()
+    names = {p.name.split("-")[0].removeprefix("libsundials_") for p in libdir.glob("libsundials_*.so*")}
+    spelled = {m.lower().replace("nvector_", "nvec").replace("_", "") for m in modules}
+    assert spelled == names - {"core"}
+    assert {name.removeprefix("sundials_") for name in libs} - {"core"} <= spelled
+
+
+def test_link_refuses_a_function_the_ida_library_lacks(tmp_path):
+    """The driver gets IDA's API from IDAS' header; -z defs makes a call to an IDAS-only
+    function (sensitivities) a link error instead of a crash when the library is loaded."""
+    src = tmp_path / "uses_idas.c"
+    src.write_text("#include <idas/idas.h>\nint f(void* m) { return IDASensToggleOff(m) + IDASetMaxOrd(m, 2); }\n")
+    _, libs = codegen.sundials_libraries()
+    base = [*codegen.compiler_command(), *codegen.CFLAGS, f"-I{codegen.SUNDIALS_INCLUDE}", str(src), "-o",
+            str(tmp_path / "lib.so"), str(libs["sundials_ida"]), str(libs["sundials_core"])]
+    failed = subprocess.run(base, capture_output=True, text=True)
+    assert failed.returncode != 0 and "IDASensToggleOff" in failed.stderr
+    src.write_text("#include <idas/idas.h>\nint f(void* m) { return IDASetMaxOrd(m, 2); }\n")
+    assert subprocess.run(base, capture_output=True, text=True).returncode == 0
 
 
 def test_header_change_rebuilds(monkeypatch, tmp_path):
