@@ -567,7 +567,7 @@ static void free_superlumt(dc_session* s) {
   if (!s->lu_factored) {
     SUNMatrix I = SUNSparseMatrix(s->n, s->n, s->n, CSC_MAT, s->ctx);
     if (!I) return; /* leave the solver allocated rather than crash */
-    s->lu_initialize(s->LS); /* the real one: this is a first factorization */
+    if (s->lu_initialize) s->lu_initialize(s->LS); /* the real one: a first factorization */
     sunindextype* cp = SUNSparseMatrix_IndexPointers(I);
     sunindextype* ri = SUNSparseMatrix_IndexValues(I);
     double* d = SUNSparseMatrix_Data(I);
