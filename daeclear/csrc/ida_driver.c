@@ -26,7 +26,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sundials_min.h"
+/* The SUNDIALS 7.9.0 headers vendored in csrc/sundials/include (see its README): the wheel's
+ * libsundials_ida is IDA, declared here by IDAS' header of the same release, whose IDA* API is
+ * IDA's with sensitivity functions added (same names, signatures and constants); the link uses
+ * -z defs, so a function the IDA library lacks fails the build. sundials_config.h #errors when
+ * codegen's -DDC_SUNDIALS_MAJOR/_MINOR/_PATCH or -DDC_INDEX_SIZE disagree with the headers. */
+#include <idas/idas.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_core.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunmatrix/sunmatrix_sparse.h>
 #include "dc_model.h"
 #include "dc_linalg.h"
 
@@ -37,6 +47,22 @@
 #endif
 #ifndef DC_HAVE_SPARSE /* 1 when the wheel's sparse matrix and SuperLU_MT libraries are linked */
 #define DC_HAVE_SPARSE 0
+#endif
+#if !defined(DC_SUNDIALS_MAJOR) || !defined(DC_INDEX_SIZE) /* given by daeclear.codegen */
+#error "compile with -DDC_SUNDIALS_MAJOR/_MINOR/_PATCH and -DDC_INDEX_SIZE as daeclear.codegen does"
+#endif
+_Static_assert(8 * sizeof(sunindextype) == DC_INDEX_SIZE, "sunindextype is not DC_INDEX_SIZE bits wide");
+_Static_assert(sizeof(sunrealtype) == sizeof(double), "sunrealtype is not double");
+
+#if DC_HAVE_SPARSE
+/* SuperLU_MT's SUNDIALS header (sunlinsol/sunlinsol_superlumt.h) includes SuperLU_MT's own
+ * headers for the solver's content structure, and neither wheel that ships SUNDIALS 7.9.0
+ * (scikit-sundae: no headers; sundials4py: no SuperLU_MT) has them; this constructor is the one
+ * function of it the driver calls, declared as in that header (unchanged in SUNDIALS 7.0-7.6,
+ * and as scikit-sundae 1.2.0 declares it for the 7.9.0 libraries). Every other operation goes
+ * through the generic SUNLinearSolver API of the vendored headers. */
+SUNDIALS_EXPORT SUNLinearSolver SUNLinSol_SuperLUMT(N_Vector y, SUNMatrix A, int num_threads,
+                                                    SUNContext sunctx);
 #endif
 
 /* linear solvers of dc_open */
@@ -193,6 +219,7 @@ typedef struct {
    * jp_rowind/data position jmap[jmap_off[p] + i]. */
   int lin_sparse;          /* DC_LS_SPARSE: s->A is that SUNSparseMatrix, s->LS SuperLU_MT */
   int lu_factored;         /* a Jacobian was handed to the sparse LS (it has factorized) */
+  SUNErrCode (*lu_initialize)(SUNLinearSolver); /* SuperLU_MT's own, see keep_first_factorization */
   dc_int jp_nnz;
   sunindextype* jp_colptr; /* [n + 1] */
   sunindextype* jp_rowind; /* [jp_nnz], rows sorted within each column */
@@ -521,41 +548,17 @@ static SUNErrCode keep_factorization(SUNLinearSolver S) {
   return 0;
 }
 
-/* The ops table of a SuperLU_MT solver, found by value: the pointer field right after the
- * content (7.0-7.5) or the one after that (7.9) that points at a table starting with its
- * gettype and getid operations. Both fields exist in either layout (the second is the context
- * pointer in the older one), so nothing beyond the structure is read. */
-static dc_sun_op* find_ops(SUNLinearSolver LS) {
-  void** head = (void**)LS;
-  for (int i = 1; i <= 2; ++i) {
-    dc_sun_op* ops = (dc_sun_op*)head[i];
-    if (ops && ops[0] == (dc_sun_op)SUNLinSolGetType_SuperLUMT &&
-        ops[1] == (dc_sun_op)SUNLinSolGetID_SuperLUMT)
-      return ops;
-  }
-  return NULL;
-}
-
-/* Replace the initialize operation by keep_factorization (in this solver's own ops table: every
- * SUNLinearSolver has one, so no other solver is affected). Its slot lies between getid and
- * free, the table's last operation; it must be there exactly once. Returns 0, or -1 (left as
- * is: dc_open then refuses the sparse solver, and "auto" falls back to dense). */
-static int patch_initialize(SUNLinearSolver LS) {
-  dc_sun_op* ops = find_ops(LS);
-  int slot = -1;
-  if (!ops) return -1;
-  for (int i = 2; i < 64; ++i) {
-    if (ops[i] == (dc_sun_op)SUNLinSolFree_SuperLUMT) {
-      if (slot < 0) return -1;
-      ops[slot] = (dc_sun_op)keep_factorization;
-      return 0;
-    }
-    if (ops[i] == (dc_sun_op)SUNLinSolInitialize_SuperLUMT) {
-      if (slot >= 0) return -1;
-      slot = i;
-    }
-  }
-  return -1;
+/* Initialize the solver once (its first factorization sets the ordering and storage), then
+ * replace the initialize operation in this solver's own operations table (every
+ * SUNLinearSolver has its own, so no other solver is affected) by keep_factorization. The
+ * original operation is kept in the session for free_superlumt. Returns the initialize result. */
+static int keep_first_factorization(dc_session* s) {
+  SUNErrCode (*init)(SUNLinearSolver) = s->LS->ops->initialize;
+  if (!init) return -1;
+  s->lu_initialize = init;
+  if (init(s->LS) != 0) return -1;
+  s->LS->ops->initialize = keep_factorization;
+  return 0;
 }
 
 /* SUNLinSolFree_SuperLUMT reads uninitialized options when the solver never factorized (a
@@ -564,7 +567,7 @@ static void free_superlumt(dc_session* s) {
   if (!s->lu_factored) {
     SUNMatrix I = SUNSparseMatrix(s->n, s->n, s->n, CSC_MAT, s->ctx);
     if (!I) return; /* leave the solver allocated rather than crash */
-    SUNLinSolInitialize_SuperLUMT(s->LS); /* the real one: this is a first factorization */
+    if (s->lu_initialize) s->lu_initialize(s->LS); /* the real one: a first factorization */
     sunindextype* cp = SUNSparseMatrix_IndexPointers(I);
     sunindextype* ri = SUNSparseMatrix_IndexValues(I);
     double* d = SUNSparseMatrix_Data(I);
@@ -953,9 +956,9 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
     (void)jac_storage(s, s->A); /* a valid pattern from the start */
     s->LS = SUNLinSol_SuperLUMT(s->yy, s->A, 1, s->ctx);
     if (!s->LS) FAIL("SUNLinSol_SuperLUMT failed");
-    if (SUNLinSolInitialize_SuperLUMT(s->LS) != 0 || patch_initialize(s->LS) != 0)
-      FAIL("the SuperLU_MT solver of this SUNDIALS build cannot keep its factorization across "
-           "restarts (unexpected operations table); use linear_solver='dense'");
+    if (keep_first_factorization(s) != 0)
+      FAIL("the SuperLU_MT solver of this SUNDIALS build could not be initialized; "
+           "use linear_solver='dense'");
 #endif
   } else {
     s->A = SUNDenseMatrix(n, n, s->ctx);
