@@ -651,7 +651,7 @@ class _CLib:
         if why is not None:
             _unload(lib)
             raise StaleLibrary(f"{path}: {why}")
-        #: what the library was compiled for (sundials_min.h's -D flags)
+        #: what the library was compiled for (the -D flags checked against csrc/sundials' config)
         self.build_info: SundialsInfo = info
         #: SUNDIALSGetVersion of the SUNDIALS libraries this library loaded
         self.sundials_version = loaded
