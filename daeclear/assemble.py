@@ -38,7 +38,7 @@ from numpy.typing import ArrayLike, NDArray
 from .codegen import memo_table
 from .errors import AssemblyError, SceneError
 from .ida_session import DAEFunctions, StateLayout
-from .options import FORMULATIONS
+from .options import DEFAULT_FORMULATION, FORMULATIONS
 from .parameters import ParameterTable, structure_key
 from .scene import GROUND, Body, Driver, Revolute, Scene, Translational
 from .clearance import CONTACT_BUILDERS
@@ -497,7 +497,7 @@ _TEMPLATE_LIMIT = 64
 _ENGINE_VERSION = "engine-2"
 
 
-def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, beta: float = 5.0,
+def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: float = 5.0, beta: float = 5.0,
              track_work: bool = False) -> DAEModel:
     """Assemble a validated scene into a :class:`DAEModel`.
 
@@ -510,9 +510,10 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     ----------
     scene : Scene
         The mechanism; validated first (all problems reported at once).
-    formulation : {"index1", "ggl"}
-        ``index1``: acceleration-level constraints with Baumgarte stabilisation (the
-        chapter's); ``ggl``: stabilised index-2, drift-free in positions and velocities.
+    formulation : {"ggl", "index1"}
+        ``ggl`` (the default): stabilised index-2, drift-free in positions and velocities;
+        ``index1``: acceleration-level constraints with Baumgarte stabilisation (the chapter's,
+        Tables 4.2 and 4.3; the only one the non-IDA methods integrate).
     alpha, beta : float
         Baumgarte parameters of ``index1`` (1/s), 5 and 5 by default (Table 4.2).
     track_work : bool

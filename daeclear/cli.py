@@ -43,7 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="mechanism parameter, e.g. --set rpm=3000 or --set n_links=4 (repeatable)")
     run.add_argument("--t-end", type=float, help="end time, s (default: two crank revolutions)")
     run.add_argument("--rtol", type=float, help="relative tolerance (default 1e-6)")
-    run.add_argument("--formulation", choices=["index1", "ggl"], help="DAE formulation (default index1)")
+    run.add_argument("--formulation", choices=["index1", "ggl"], help="DAE formulation (default ggl; index1: the chapter's)")
     run.add_argument("--backend", choices=["auto", "c", "python"], default="auto")
     run.add_argument("--out", type=Path, default=Path("results"), help="output directory (default ./results)")
     run.add_argument("--name", help="base name of the output files (default: the scene name)")

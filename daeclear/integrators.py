@@ -1278,7 +1278,7 @@ def integrate(
     t_eval: ArrayLike | None = None,
     rtol: float = 1e-6,
     atol: float | ArrayLike | None = None,
-    formulation: str = "index1",
+    formulation: str | None = None,
     backend: str = "auto",
     max_step: float = 0.0,
     max_steps: int = 5_000_000,
@@ -1309,6 +1309,8 @@ def integrate(
     name = METHOD_NAMES[method_l]
     if track_work:
         raise SceneError(f"simulate: track_work=True is supported by method='ida' only, not by method={name!r}.")
+    if formulation is None:
+        formulation = options.default_formulation(method_l)
     if isinstance(scene, DAEModel):
         model = scene
     else:

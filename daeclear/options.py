@@ -20,6 +20,14 @@ from .errors import SceneError
 
 METHODS: tuple[str, ...] = ("ida", "rk45", "dop853", "radau", "bdf", "lsoda", "rk4", "euler")
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
+#: The default formulation: GGL (stabilised index 2) holds the joints closed to Newton's tolerance,
+#: so contact times converge with rtol at any clearance; index-1 Baumgarte drifts by more than a
+#: 0.01 mm clearance over 10 revolutions at rtol 1e-6 and its first contact onset stays about 1e-6
+#: (relative) off at every rtol from 1e-6 to 1e-9 (docs/engine.md, benchmarks/bench_formulation.py).
+DEFAULT_FORMULATION = "ggl"
+#: The chapter's formulation (Tables 4.2 and 4.3: index-1 with Baumgarte alpha = beta = 5): what the
+#: chapter's reproductions use, and the only one the non-IDA methods integrate.
+CHAPTER_FORMULATION = "index1"
 BACKENDS: tuple[str, ...] = ("auto", "c", "python")
 ON_FAILURE: tuple[str, ...] = ("raise", "return")
 LINEAR_SOLVERS: tuple[str, ...] = ("auto", "dense", "sparse")
@@ -180,6 +188,12 @@ def method(value: Any, *, where: str = "simulate", field: str = "method") -> str
 def formulation(value: Any, *, where: str = "simulate", field: str = "formulation") -> str:
     """DAE formulation (case-insensitive)."""
     return choice(value, FORMULATIONS, where=where, field=field)
+
+
+def default_formulation(method_name: str) -> str:
+    """The formulation used when none is given: :data:`DEFAULT_FORMULATION` for IDA, the chapter's
+    index-1 for the other methods (they integrate the index-1 ODE only)."""
+    return DEFAULT_FORMULATION if str(method_name).lower() == "ida" else CHAPTER_FORMULATION
 
 
 def backend(value: Any, *, where: str = "simulate", field: str = "backend") -> str:

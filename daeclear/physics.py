@@ -181,7 +181,8 @@ def _drift(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels:
         f"simulate: the constraints drifted by {worst:.2e} m ('{where}' at t={float(t[i]):.6g} s), "
         f"{worst / clearance:.1%} of the smallest clearance ({clearance:.2e} m) "
         f"(formulation={model.formulation!r}); contact times and forces are uncertain by that much. "
-        "Use formulation='ggl' (drift-free) or a smaller rtol.")]
+        + ("Use formulation='ggl' (drift-free, the default) or a smaller rtol." if model.formulation != "ggl"
+           else "Use a smaller rtol."))]
 
 
 def check_fixed_steps(model: Any, events: Sequence[Any], step: float,

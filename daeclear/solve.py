@@ -45,6 +45,8 @@ DRIFT_FRACTION = physics.DRIFT_FRACTION
 # keeps the pendulum's constraint residual at 1e-12 instead of 3e-11 (rtol 1e-10) and, measured,
 # halves the steps; index1 is better off with IDA's default. The python backend cannot set it.
 GGL_NEWTON_COEF = 1e-3
+# Failures in contact that plain Coulomb friction causes when the contact sticks.
+STICKING_FLAGS = ("DC_STEP_COLLAPSE", "IDA_CONV_FAIL", "IDA_ERR_FAIL")
 # Stall guard: STALL_COUNT steps shorter than STALL_STEP seconds that do not grow (and no step a
 # hundred times longer in between) end the run with a clear message instead of creeping on
 # (e.g. plain Coulomb friction chattering at zero sliding speed takes ~1e-12 s order-1 steps).
@@ -110,7 +112,7 @@ def simulate(
     rtol: float = 1e-6,
     atol: float | ArrayLike | None = None,
     method: str = "ida",
-    formulation: str = "index1",
+    formulation: str | None = None,
     backend: str = "auto",
     max_step: float = 0.0,
     max_steps: int = 5_000_000,
@@ -142,8 +144,10 @@ def simulate(
         same model as an ODE in (q, v) (index-1 formulation only) with the same contact events
         (see :mod:`daeclear.integrators`): scipy's explicit RK45/DOP853 and implicit
         Radau/BDF/LSODA, fixed-step classical Runge-Kutta "rk4" and explicit "euler".
-    formulation : {"index1", "ggl"}
-        Used when ``scene`` is a Scene.
+    formulation : {"ggl", "index1"} or None
+        Used when ``scene`` is a Scene. None: "ggl" (stabilised index 2, drift-free) for IDA,
+        "index1" (the chapter's, Baumgarte alpha = beta = 5) for the other methods, which
+        integrate that one only (:func:`daeclear.options.default_formulation`).
     backend : {"auto", "c", "python"}
         "c": generated C and an IDA loop in C (fast); "python": scikit-sundae with CasADi
         callbacks; "auto": C when a compiler works, else python with a warning.
@@ -203,6 +207,8 @@ def simulate(
                          track_work=track_work, start=start)
 
     setup_start = time.perf_counter()
+    if formulation is None:
+        formulation = options.default_formulation(method)
     model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation, track_work=track_work)
     eval_times = None
     if t_eval is not None:
@@ -211,7 +217,7 @@ def simulate(
     session = open_session(model.functions, backend=backend, rtol=rtol, atol=atol_vec, max_step=max_step,
                            parameters=model.parameter_values, max_steps=max_steps, linear_solver=linear_solver)
     y0, yp0 = model.initial_state(session=session, start=start)
-    if model.formulation == "ggl":
+    if model.formulation == "ggl" and model.n_constraints:  # without constraints GGL is index-1
         # never ask Newton for corrections below round-off: coef * rtol >= 1e-13
         session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / rtol)))
     session.set_stall(STALL_STEP, STALL_COUNT)
@@ -353,8 +359,8 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 continue  # nothing switched: IDA goes on from the root without a restart, in the same segment
             segments.append((seg_start, t, before[3]))
             seg_start = t
-            y, yp = model.consistent_state(t, y, model.term_forces(t, y, active, params, session), session,
-                                           project=True)
+            y, yp = _restart_state(model, session, t, y, yp, model.term_forces(t, y, active, params, session),
+                                   adv.roots_found)
             switch = model.switch_vector(active, params)
             session.reinit(t, y, yp, active, params, _root_directions(model, active))
             n_restarts += 1
@@ -438,14 +444,31 @@ def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:
     return directions
 
 
+def _restart_state(model: DAEModel, session: Any, t: float, y: NDArray, yp: NDArray, forces: NDArray,
+                   found: Any) -> tuple[NDArray, NDArray]:
+    """Consistent restart after a contact switch (GGL: projected onto the constraint manifold),
+    unprojected when the projection moves a root function that did not fire across zero (it
+    would never be found again: a missed contact). The compiled loop's rule (project_kept_roots)."""
+    projected = model.consistent_state(t, y, forces, session, project=True)
+    if model.formulation != "ggl" or not model.gap_names:
+        return projected
+    g0, g1 = session.roots(t, y, yp), session.roots(t, projected[0], yp)
+    quiet = np.zeros(g0.shape, bool) if found is None else np.asarray(found).ravel() == 0
+    if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
+        return model.consistent_state(t, y, forces, session, project=False)
+    return projected
+
+
 def _failure_message(model: DAEModel, adv: Any, modes: dict[str, str]) -> str:
     """Say when, where (contact modes) and why IDA failed, and what to try."""
     in_contact = [pair for pair, mode in modes.items() if mode == "contact"]
     where = f" with {', '.join(repr(p) for p in in_contact)} in contact" if in_contact else ""
     flag = f" ({adv.flag_name})" if adv.flag_name else ""
     detail = f": {adv.message}" if adv.message else ""
-    advice = "Try a smaller max_step, a tighter rtol, or formulation='ggl'."
-    if adv.flag_name == "DC_STEP_COLLAPSE" and in_contact and any(
+    advice = "Try a smaller max_step, a tighter rtol" + (", or formulation='ggl'." if model.formulation != "ggl" else ".")
+    # sticking under plain Coulomb: index-1 chatters until the stall guard stops it, GGL's Newton
+    # iteration fails to converge (or its error test fails) at the sticking point
+    if adv.flag_name in STICKING_FLAGS and in_contact and any(
             getattr(logic, "discontinuous_friction", False) for logic in model.contacts):
         advice = ("The friction law is discontinuous at zero sliding speed (plain Coulomb) and the "
                   "contact is sticking: use the modified Coulomb law (friction=<coefficient> or "

@@ -1198,6 +1198,7 @@ DC_API int dc_automaton_run(int n, const double* t, const int* dir, const double
  * goes on without a restart), 0 without configured pairs (Python decides), -1 on failure. */
 /* below, with dc_set_layout */
 static int project_state(dc_session* s, double t, double* y);
+static int project_kept_roots(dc_session* s, double t, double* y, const double* yp);
 static int make_consistent(dc_session* s, double t, double* y, double* yp, const int* on, const double* par);
 
 static int auto_handle_root(dc_session* s, double t, double t_stop) {
@@ -1241,11 +1242,15 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
   if (!switched) return 2;
   /* consistent restart: GGL on the constraint manifold with mu = 0; then multipliers and
    * derivatives from the generated solve with the new set of contact forces */
-  if (s->proj_on && project_state(s, t, y) != 0) {
-    s->ready = 0;
-    set_msg(s->msg, "projecting the state onto the constraints after a contact event at t=%.17g failed "
-            "(dependent constraints, or no convergence in %d Newton steps)", t, s->proj_iter);
-    return -1;
+  if (s->proj_on) {
+    int pr = project_kept_roots(s, t, y, yp);
+    if (pr == -3) goto eval_failed;
+    if (pr != 0) {
+      s->ready = 0;
+      set_msg(s->msg, "projecting the state onto the constraints after a contact event at t=%.17g failed "
+              "(dependent constraints, or no convergence in %d Newton steps)", t, s->proj_iter);
+      return -1;
+    }
   }
   if (s->lay_ggl) memset(y + 2 * nq + m, 0, sizeof(double) * (size_t)m);
   if (make_consistent(s, t, y, yp, s->active, s->params) != 0) goto eval_failed;
@@ -1284,6 +1289,35 @@ static int solve_normal(const double* J, const double* b, double* G, double* x, 
   memcpy(x, b, sizeof(double) * (size_t)m);
   chol_solve(G, m, x);
   return 0;
+}
+
+/* project_state for a restart, unless the projection moves a root function that did not fire
+ * across zero: a second corner a hair from its wall (a flat slider landing) would then start its
+ * segment already past the root it watches, and its contact would never be found. The restart
+ * then keeps the unprojected state (off the manifold by GGL's Newton tolerance only). 0 on
+ * success, -1/-2 from project_state, -3 when the root functions cannot be evaluated. */
+static int project_kept_roots(dc_session* s, double t, double* y, const double* yp) {
+  const int n = s->n, nr = s->n_roots;
+  double* buf = (double*)xcalloc((size_t)(n + 2 * nr), sizeof(double));
+  if (!buf) return -3;
+  double *saved = buf, *g0 = buf + n, *g1 = buf + n + nr;
+  int rc = 0;
+  memcpy(saved, y, sizeof(double) * (size_t)n);
+  if (nr > 0 && eval_roots(s, t, y, yp, g0) != 0) rc = -3;
+  if (rc == 0) rc = project_state(s, t, y);
+  if (rc == 0 && nr > 0) {
+    if (eval_roots(s, t, y, yp, g1) != 0) {
+      rc = -3;
+    } else {
+      for (int i = 0; i < nr; ++i)
+        if (!s->rootsfound[i] && g0[i] != 0.0 && (g0[i] > 0.0) != (g1[i] > 0.0)) {
+          memcpy(y, saved, sizeof(double) * (size_t)n);
+          break;
+        }
+    }
+  }
+  free(buf);
+  return rc;
 }
 
 /* Put q and v of y back on the constraint manifold: least-norm Newton on Phi(q, t) = 0, then the
