@@ -385,7 +385,7 @@ def _with_revolute_clearances(scene: Scene, joints: Any, allowed: tuple[str, ...
     for joint in chosen:
         scene = scene.with_clearance(joint, clearance=_clearance_of_joint(clearance, joint, where),
                                      bearing_radius=bearing_radius, material=material, law=contact_law,
-                                     friction=friction_law(friction))
+                                     friction=friction)
     return scene
 
 
