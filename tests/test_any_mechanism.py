@@ -383,3 +383,18 @@ def test_cli_runs_scenes_without_slider_or_driver(tmp_path, capsys):
     capsys.readouterr()
     assert main(["run", "four_bar", "--set", "clearance_joints=B,E", "--out", str(tmp_path), "--quiet"]) == 2
     assert "clearance_joints='B,E', must be distinct joint names from A, B, C, D" in capsys.readouterr().err
+
+
+def test_four_bar_example_runs(tmp_path):
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "four_bar_clearance.py"
+    spec = importlib.util.spec_from_file_location("four_bar_clearance", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert module.main(["--quick", "--out", str(tmp_path)]) == 0
+    for name in ("four_bar_clearance.png", "slider_crank_two_clearances.png"):
+        assert (tmp_path / name).stat().st_size > 20_000
+    table = (tmp_path / "metrics.md").read_text()
+    assert "four-bar, clearance at B, C, D" in table and "slider-crank, clearance at C and D" in table
