@@ -10,7 +10,7 @@ from . import options as rules
 from .contact import Material, friction_law, normal_law
 from .contact.base import NormalLaw
 from .errors import SceneError
-from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
+from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational
 
 # Table 4.1: link lengths (m), masses (kg), moments of inertia (kg m^2)
 CRANK_LENGTH, CRANK_MASS, CRANK_INERTIA = 0.05, 0.30, 1.0e-4

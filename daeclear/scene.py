@@ -341,7 +341,9 @@ class Scene:
         >>> scene = Scene("pendulum")
         >>> link = scene.add(Body("link", mass=1.0, inertia=0.01, position=(0.5, 0.0)))
         >>> _ = scene.add(Revolute("A", scene.ground, link, at=(0.0, 0.0)))
-        >>> loose = scene.with_clearance("A", clearance=0.1e-3, bearing_radius=0.01)
+        >>> from daeclear.contact import Material
+        >>> steel = Material(young=207e9, poisson=0.3)
+        >>> loose = scene.with_clearance("A", clearance=0.1e-3, bearing_radius=0.01, material=steel)
         >>> loose["A"].kind, scene["A"].kind
         ('RevoluteClearance', 'Revolute')
         """
