@@ -83,6 +83,7 @@ def _run(args: argparse.Namespace) -> int:
     from . import options
     from .mechanisms import ideal_parameters
     from .outputs import check_directory
+    from .scene import RevoluteClearance, TranslationalClearance
     from .scenefile import MECHANISMS, read_scene_file
     from .solve import simulate
 
@@ -93,6 +94,8 @@ def _run(args: argparse.Namespace) -> int:
     if args.target.endswith(".toml") or Path(args.target).is_file():
         spec = read_scene_file(args.target)  # checks its [simulate] options by the shared rules
         scene, sim = spec.scene, dict(spec.simulate)
+        if any(isinstance(j, (RevoluteClearance, TranslationalClearance)) for j in scene.joints):
+            reference_scene = scene.ideal()  # the figure compares with the ideal mechanism
         if params or args.joint:
             raise DaeclearError("--set and --joint apply to named mechanisms; edit the scene file instead.")
     elif args.target in MECHANISMS:

@@ -349,6 +349,13 @@ class Scene:
         """
         return with_clearance(self, joint, bearing=bearing, name=name, **fields_)
 
+    def ideal(self) -> "Scene":
+        """A new scene, the same mechanism with every clearance joint ideal (see :func:`ideal_joint`):
+        the reference a clearance run is compared with. This scene is left unchanged."""
+        elements = [ideal_joint(e) if isinstance(e, (RevoluteClearance, TranslationalClearance)) else e
+                    for e in self.elements]
+        return Scene(self.name, gravity=self.gravity, elements=elements, ground=self.ground)
+
     def of_type(self, cls: type) -> list[Any]:
         return [e for e in self.elements if isinstance(e, cls)]
 
@@ -835,6 +842,20 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
     if problems:
         raise SceneError(f"{label}: " + " ".join(problems))
     return element
+
+
+def ideal_joint(joint: Joint) -> Joint:
+    """The ideal joint a clearance joint stands for: same name, bodies, point and axis (the inverse of
+    :func:`clearance_joint` up to the clearance fields)."""
+    shared = {"name": joint.name, "body_i": joint.body_i, "body_j": joint.body_j,
+              "at": getattr(joint, "at", None), "point_i": getattr(joint, "point_i", None),
+              "point_j": getattr(joint, "point_j", None)}
+    if isinstance(joint, RevoluteClearance):
+        return Revolute(**shared)
+    if isinstance(joint, TranslationalClearance):
+        return Translational(**shared, axis=joint.axis)
+    raise SceneError(f"ideal joint of '{getattr(joint, 'name', joint)}': it is a "
+                     f"{getattr(joint, 'kind', type(joint).__name__)}, not a clearance joint.")
 
 
 def with_clearance(scene: Scene, joint: str, *, bearing: str | None = None, name: str | None = None,

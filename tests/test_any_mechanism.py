@@ -100,6 +100,19 @@ def test_translational_joint_gets_a_clearance():
     assert -0.52 < np.min(run["G.eta"]) < -0.5  # a few micrometres into the surface
 
 
+def test_ideal_is_the_inverse_of_with_clearance():
+    loose = M.four_bar(("B", "C", "D"))
+    ideal = loose.ideal()
+    ideal.name = "four_bar"
+    assert ideal == M.four_bar()
+    assert loose["B"].kind == "RevoluteClearance"  # left unchanged
+    guide = M.slider_crank("translational").ideal()["clearance"]
+    assert (guide.kind, guide.point_i, guide.point_j, guide.axis) == ("Translational", (0.0, 0.0), (0.0, 0.0),
+                                                                      (1.0, 0.0))
+    with pytest.raises(dc.SceneError, match="'B': it is a Revolute, not a clearance joint"):
+        dc.scene.ideal_joint(M.four_bar()["B"])
+
+
 def test_bearing_body_and_name():
     ideal = M.four_bar()
     flipped = ideal.with_clearance("C", bearing="rocker", name="pinC", clearance=0.2e-3, bearing_radius=8e-3,
@@ -364,20 +377,33 @@ t_end = 0.02
 """
 
 
-def test_cli_runs_scenes_without_slider_or_driver(tmp_path, capsys):
+def test_cli_runs_scenes_without_slider_or_driver(tmp_path, capsys, monkeypatch):
+    import daeclear.plot
     from daeclear.cli import main
     from daeclear.result import load
+
+    references = []
+    save = daeclear.plot.save_run_figure
+
+    def recording(result, path, **options):
+        references.append(options.get("reference"))
+        return save(result, path, **options)
+
+    monkeypatch.setattr(daeclear.plot, "save_run_figure", recording)
 
     path = tmp_path / "loose.toml"
     path.write_text(PENDULUM_ON_A_LOOSE_PIN)
     assert main(["run", str(path), "--out", str(tmp_path), "--quiet"]) == 0
     assert (tmp_path / "loose_pendulum.png").stat().st_size > 10_000
     assert load(tmp_path / "loose_pendulum.h5").events.of("A", kind="onset")  # the link fell onto its pin
+    reference = references[-1]  # the scene file's ideal mechanism: the pendulum on an ideal pin
+    assert reference is not None and "A.ex" not in reference and reference.t[-1] == pytest.approx(0.02)
     assert main(["run", "double_pendulum", "--set", "clearance_joints=A,B", "--t-end", "0.02", "--out",
                  str(tmp_path), "--quiet"]) == 0
     result = load(tmp_path / "double_pendulum_AB.h5")
     assert result.t[-1] == pytest.approx(0.02) and "B.ex" in result
     assert (tmp_path / "double_pendulum_AB.png").stat().st_size > 10_000
+    assert references[-1].scene_name == "double_pendulum"  # the ready mechanism with ideal joints
     assert main(["run", "four_bar", "--set", "clearance_joints=C", "--out", str(tmp_path), "--quiet"]) == 0
     assert load(tmp_path / "four_bar_C.h5").t[-1] == pytest.approx(2 * 60.0 / 5000.0)  # two crank turns
     capsys.readouterr()
