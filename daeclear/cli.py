@@ -170,7 +170,10 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
         from .plot import save_run_figure
         reference = None
         if reference_scene is not None:
-            reference = simulate(reference_scene, t_end, rtol=rtol, backend=args.backend, on_failure="return")
+            try:
+                reference = simulate(reference_scene, t_end, rtol=rtol, backend=args.backend, on_failure="return")
+            except DaeclearError as exc:  # e.g. an ideal mechanism with redundant constraints: no dashed lines
+                print(f"daeclear: no ideal-mechanism reference in the figure: {exc}", file=sys.stderr)
         # time plots chosen from what the scene holds, a journal orbit or slider path per clearance joint
         png = save_run_figure(result, args.out / f"{base}.png", reference=reference)
         print(f"wrote {png}")

@@ -439,3 +439,23 @@ def test_formulations_and_methods_agree_on_the_four_bars_first_impacts():
     for other in firsts[1:]:
         assert [pair for pair, _, _ in other] == ["B", "C", "B"]
         np.testing.assert_allclose([(t, v) for _, t, v in other], [(t, v) for _, t, v in firsts[0]], rtol=1e-4)
+
+
+def test_cli_figure_without_reference_when_the_ideal_mechanism_cannot_run(tmp_path, capsys):
+    """A bar pinned at both ends, one pin loose: it runs, but its ideal mechanism is over-constrained;
+    the run still writes its result and figure, and says why the figure has no ideal reference."""
+    from daeclear.cli import main
+
+    text = PENDULUM_ON_A_LOOSE_PIN.replace("[revolute.clearance]", """[[revolute]]
+name = "B"
+body_i = "ground"
+body_j = "link"
+at = [1.0, 0.0]
+
+[revolute.clearance]""").replace("t_end = 0.02", "t_end = 0.005")
+    path = tmp_path / "redundant.toml"
+    path.write_text(text)
+    assert main(["run", str(path), "--out", str(tmp_path), "--quiet"]) == 0
+    assert (tmp_path / "loose_pendulum.png").is_file() and (tmp_path / "loose_pendulum.h5").is_file()
+    assert "no ideal-mechanism reference in the figure: scene 'loose_pendulum': redundant constraints" \
+        in capsys.readouterr().err
