@@ -465,12 +465,10 @@ def four_bar(clearance_joints: Any = (), *, rpm: float = 5000.0, crank_angle: fl
     2.5e-4 kg m^2), the rocker a bar of the rod's section (0.175 kg, 1.46e-4 kg m^2); bearings and
     contact law as the slider-crank's revolute clearance joint (Table 4.2: 10 mm bearing radius,
     steel, Lankarani-Nikravesh with c_e = 0.9). These numbers are this package's choice, for a
-    four-bar comparable with the chapter's slider-crank; four-bars with one or several clearance
-    joints are studied in the literature with other dimensions, e.g. S. Erkaya and I. Uzmay,
-    "Determining link parameters using genetic algorithm in mechanisms with joint clearance",
-    Mech. Mach. Theory 44 (2009) 222-234, and P. Flores, C.S. Koshy, H.M. Lankarani, J. Ambrósio,
-    J.C.P. Claro, "Numerical and experimental investigation on multibody systems with revolute
-    clearance joints", Nonlinear Dyn. 65 (2011) 383-398.
+    four-bar comparable with the chapter's slider-crank, not taken from a paper; four-bars with
+    several clearance joints are studied with other dimensions e.g. by X. Liu, J. Ding and C. Wang,
+    "Design framework for motion generation of planar four-bar linkage considering clearance joints
+    and dynamics performance", Machines 10 (2022) 136, doi:10.3390/machines10020136.
 
     Parameters
     ----------
