@@ -632,6 +632,9 @@ __all__ += ["plot_slider_path", "plot_translational_response"]
 
 # --------------------------------------------------------------------------- any scene
 
+#: Joint panels per row of :func:`plot_run` (a chain of many links gets several rows).
+MAX_PANELS_PER_ROW = 4
+
 #: Kinds of clearance joints and the panel each gets in :func:`plot_run`.
 CLEARANCE_PANELS = {"RevoluteClearance": "journal orbit", "TranslationalClearance": "slider path"}
 
@@ -648,8 +651,8 @@ def default_channels(result: Result) -> tuple[str, ...]:
 
     A body named ``slider`` gives its velocity and acceleration (Figs. 4.15a-b, 4.28a-b); every
     driver its moment (Figs. 4.15c, 4.28c); a scene without a driver the angular velocity of
-    its last body and the mechanical energy; every clearance joint its contact force. Only
-    channels the result has are returned.
+    its last body and the mechanical energy; every clearance joint its contact force (the first
+    four clearance joints of a larger scene). Only channels the result has are returned.
     """
     elements = result.parameters.get("scene", {}).get("elements", {})
     kinds = {name: e.get("kind") for name, e in elements.items() if isinstance(e, dict)}
@@ -659,7 +662,7 @@ def default_channels(result: Result) -> tuple[str, ...]:
     names += [f"{d}.moment" for d in drivers]
     if not drivers and bodies:
         names += [f"{bodies[-1]}.omega", "energy.mechanical"]
-    names += [f"{joint}.normal_force" for joint in clearance_joints(result)]
+    names += [f"{joint}.normal_force" for joint in list(clearance_joints(result))[:MAX_PANELS_PER_ROW]]
     return tuple(dict.fromkeys(n for n in names if n in result))
 
 
@@ -670,7 +673,7 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
 
     Every revolute clearance joint gets its journal orbit (:func:`plot_journal_orbit`), every
     translational one its slider path (:func:`plot_slider_path`), side by side under the time
-    plots.
+    plots, four to a row.
 
     Parameters
     ----------
@@ -703,10 +706,11 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
     if not names and not panels:
         raise ValueError(f"plot_run: nothing to draw: none of channels={list(channels or [])!r} is in the result "
                          "and the scene has no clearance joint.")
-    n_cols = max(1, len(panels))
-    n_rows = len(names) + (1 if panels else 0)
-    heights = [1.0] * len(names) + ([2.0] if panels else [])
-    fig = plt.figure(figsize=(max(7.0, 3.6 * n_cols), 2.2 * len(names) + (3.8 if panels else 0.0) + 0.6))
+    n_cols = max(1, min(len(panels), MAX_PANELS_PER_ROW))
+    panel_rows = -(-len(panels) // n_cols)
+    n_rows = len(names) + panel_rows
+    heights = [1.0] * len(names) + [2.0] * panel_rows
+    fig = plt.figure(figsize=(max(7.0, 3.6 * n_cols), 2.2 * len(names) + 3.8 * panel_rows + 0.6))
     grid = fig.add_gridspec(n_rows, n_cols, height_ratios=heights)
     first = None
     for row, name in enumerate(names):
@@ -716,8 +720,8 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
         plot_channel(result, name, ax=ax, reference=ref, window=window, max_points=max_points, title=False)
         if row < len(names) - 1:
             ax.set_xlabel("")
-    for col, joint in enumerate(panels):
-        ax = fig.add_subplot(grid[n_rows - 1, col])
+    for k, joint in enumerate(panels):
+        ax = fig.add_subplot(grid[len(names) + k // n_cols, k % n_cols])
         if kinds[joint] == "RevoluteClearance":
             plot_journal_orbit(result, joint, ax=ax, window=window, max_points=max_points, markers=False,
                                title=f"{joint}: journal orbit")

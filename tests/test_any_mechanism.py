@@ -329,6 +329,13 @@ def test_default_channels_and_panels_follow_the_scene():
     fig = plot_run(runs["four_bar"], channels=["rocker.phi", "no.such"], joints=["C"])
     assert [ax.get_ylabel().split(" ")[0] for ax in fig.axes[:1]] == ["rocker.phi"] and len(fig.axes) == 2
     plt.close(fig)
+    chain = dc.simulate(M.chain(6), t_end=1e-3, rtol=1e-6)  # six clearance joints: two rows of panels
+    assert default_channels(chain) == ("link6.omega", "energy.mechanical", "pin1.normal_force", "pin2.normal_force",
+                                       "pin3.normal_force", "pin4.normal_force")
+    fig = plot_run(chain)
+    panels = fig.axes[6:]
+    assert len(panels) == 6 and len({round(ax.get_position().y0, 3) for ax in panels}) == 2
+    plt.close(fig)
     with pytest.raises(ValueError, match="joints=\\['A'\\] are not clearance joints.*B, C"):
         plot_run(runs["four_bar"], joints=["A"])
 
