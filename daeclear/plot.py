@@ -710,7 +710,8 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
     panel_rows = -(-len(panels) // n_cols)
     n_rows = len(names) + panel_rows
     heights = [1.0] * len(names) + [2.0] * panel_rows
-    fig = plt.figure(figsize=(max(7.0, 3.6 * n_cols), 2.2 * len(names) + 3.8 * panel_rows + 0.6))
+    height = 2.2 * len(names) + 3.8 * panel_rows + 0.6
+    fig = plt.figure(figsize=(max(7.0, 3.6 * n_cols), height))
     grid = fig.add_gridspec(n_rows, n_cols, height_ratios=heights)
     first = None
     for row, name in enumerate(names):
@@ -729,7 +730,7 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
             plot_slider_path(result, joint, ax=ax, window=window, max_points=max_points,
                              title=f"{joint}: slider path")
     _title(fig, result, title, True)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.4 / height))  # 0.4 in at the top for the title
     return fig
 
 
