@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import ast
 import logging
+import math
 import sys
 import warnings
 from pathlib import Path
@@ -37,11 +38,14 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="daeclear", description="Planar mechanisms with clearance joints.")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="simulate a named mechanism or a scene file (.toml)")
-    run.add_argument("target", help="mechanism name (slider_crank, chain) or path to a .toml scene file")
+    run.add_argument("target", help="mechanism name (slider_crank, chain, four_bar, double_pendulum) or path to a "
+                                    ".toml scene file")
     run.add_argument("--joint", help="slider_crank: which joint has clearance (ideal, revolute, translational)")
     run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                     help="mechanism parameter, e.g. --set rpm=3000 or --set n_links=4 (repeatable)")
-    run.add_argument("--t-end", type=float, help="end time, s (default: two crank revolutions)")
+                     help="mechanism parameter, e.g. --set rpm=3000, --set n_links=4 or --set clearance_joints=B,C "
+                          "(repeatable)")
+    run.add_argument("--t-end", type=float,
+                     help="end time, s (default: two revolutions of the driver; 0.024 s without one)")
     run.add_argument("--rtol", type=float, help="relative tolerance (default 1e-6)")
     run.add_argument("--formulation", choices=["index1", "ggl"], help="DAE formulation (default ggl; index1: the chapter's)")
     run.add_argument("--backend", choices=["auto", "c", "python"], default="auto")
@@ -77,7 +81,9 @@ def _mechanism(mechanisms: dict[str, Any], name: str, params: dict[str, Any]) ->
 
 def _run(args: argparse.Namespace) -> int:
     from . import options
+    from .mechanisms import ideal_parameters
     from .outputs import check_directory
+    from .scene import RevoluteClearance, TranslationalClearance
     from .scenefile import MECHANISMS, read_scene_file
     from .solve import simulate
 
@@ -88,14 +94,17 @@ def _run(args: argparse.Namespace) -> int:
     if args.target.endswith(".toml") or Path(args.target).is_file():
         spec = read_scene_file(args.target)  # checks its [simulate] options by the shared rules
         scene, sim = spec.scene, dict(spec.simulate)
+        if any(isinstance(j, (RevoluteClearance, TranslationalClearance)) for j in scene.joints):
+            reference_scene = scene.ideal()  # the figure compares with the ideal mechanism
         if params or args.joint:
             raise DaeclearError("--set and --joint apply to named mechanisms; edit the scene file instead.")
     elif args.target in MECHANISMS:
         if args.joint:
             params["joint"] = args.joint
         scene = _mechanism(MECHANISMS, args.target, params)
-        if params.get("joint", "ideal") != "ideal":  # the chapter plots against the ideal joint
-            reference_scene = MECHANISMS[args.target](**{**params, "joint": "ideal"})
+        ideal = ideal_parameters(args.target, params)
+        if ideal is not None:  # the chapter plots against the ideal mechanism
+            reference_scene = MECHANISMS[args.target](**ideal)
     else:
         raise DaeclearError(f"run: {args.target!r} is neither a scene file nor a mechanism "
                             f"({', '.join(MECHANISMS)}).")
@@ -105,9 +114,9 @@ def _run(args: argparse.Namespace) -> int:
         sim.pop("t_end", None)
     elif "t_end" in sim:
         t_end = sim.pop("t_end")
-    else:
-        rpm = params.get("rpm", 5000.0)
-        t_end = 2 * 60.0 / abs(float(rpm)) if rpm else 0.024  # two crank revolutions
+    else:  # two revolutions of the first driver; 24 ms (two at the chapter's 5000 rpm) without one
+        speed = abs(float(scene.drivers[0].speed)) if scene.drivers else 0.0
+        t_end = 4.0 * math.pi / speed if speed else 0.024
     rtol = options.rtol(args.rtol, where=where, field="--rtol") if args.rtol is not None else sim.pop("rtol", 1e-6)
     sim.pop("rtol", None)
     step = sim.pop("t_eval_step", None)
@@ -158,12 +167,15 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
     if not args.no_figure:
         import matplotlib
         matplotlib.use("Agg")
-        from .plot import save_response_figure
+        from .plot import save_run_figure
         reference = None
         if reference_scene is not None:
-            reference = simulate(reference_scene, t_end, rtol=rtol, backend=args.backend, on_failure="return")
-        png = save_response_figure(result, args.out / f"{base}.png", reference=reference,
-                                   channels=_figure_channels(result, scene))
+            try:
+                reference = simulate(reference_scene, t_end, rtol=rtol, backend=args.backend, on_failure="return")
+            except DaeclearError as exc:  # e.g. an ideal mechanism with redundant constraints: no dashed lines
+                print(f"daeclear: no ideal-mechanism reference in the figure: {exc}", file=sys.stderr)
+        # time plots chosen from what the scene holds, a journal orbit or slider path per clearance joint
+        png = save_run_figure(result, args.out / f"{base}.png", reference=reference)
         print(f"wrote {png}")
 
 
@@ -178,17 +190,6 @@ def _save_interrupted(result: Any, h5: Path) -> int:
         pass
     print(f"daeclear: interrupted, partial result saved to {h5} ({result.message})", file=sys.stderr)
     return EXIT_INTERRUPTED
-
-
-def _figure_channels(result: Any, scene: Any) -> tuple[str, ...]:
-    """The slider-crank's response channels if the result has any, else the last body's motion and energy
-    (a chain or a scene file without a slider would otherwise get an empty figure)."""
-    from .plot import RESPONSE_CHANNELS
-
-    if any(name in result for name in RESPONSE_CHANNELS):
-        return RESPONSE_CHANNELS
-    last = scene.bodies[-1].name
-    return tuple(c for c in (f"{last}.phi", f"{last}.omega", "drive.moment", "energy.mechanical") if c in result)
 
 
 def _floats(text: str, what: str) -> list[float]:

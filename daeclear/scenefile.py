@@ -43,6 +43,17 @@ their materials and laws as tables::
     law = { name = "lankarani-nikravesh", restitution = 0.9 }
     friction = 0.05          # or "coulomb", or { name = "modified-coulomb", coefficient = 0.1 }
 
+An ideal ``[[revolute]]`` or ``[[translational]]`` joint becomes a clearance joint with a
+``clearance`` table: its bodies, point and axis stay, the table gives the clearance joint's own
+fields (``bearing`` names a revolute joint's bearing body, ``name`` renames the joint)::
+
+    [[revolute]]
+    name = "B"
+    body_i = "crank"
+    body_j = "rod"
+    at = [0.05, 0.0]
+    clearance = { clearance = 0.5e-3, bearing_radius = 0.01, material = { young = 207e9, poisson = 0.3 } }
+
 Unknown tables or keys are errors that name the file, the table and the key.
 """
 
@@ -59,9 +70,13 @@ from . import mechanisms, options
 from .errors import SceneError
 from .contact import Material, friction_law, normal_law
 from .loads import Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
-from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
+from .scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance,
+                    clearance_joint)
 
-MECHANISMS: dict[str, Callable[..., Scene]] = {"slider_crank": mechanisms.slider_crank, "chain": mechanisms.chain}
+MECHANISMS: dict[str, Callable[..., Scene]] = {
+    "slider_crank": mechanisms.slider_crank, "chain": mechanisms.chain, "four_bar": mechanisms.four_bar,
+    "double_pendulum": mechanisms.double_pendulum,
+}
 ELEMENT_TABLES: dict[str, type] = {
     "body": Body, "revolute": Revolute, "translational": Translational, "driver": Driver,
     "revolute_clearance": RevoluteClearance, "translational_clearance": TranslationalClearance,
@@ -171,9 +186,20 @@ def _toml_type(value: Any) -> str:
 
 
 def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any]) -> Any:
+    label = f"{path}: [[{table}]] #{index + 1}"
+    if cls in (Revolute, Translational) and "clearance" in entry:  # an ideal joint given a clearance
+        entry = dict(entry)
+        table_value = entry.pop("clearance")
+        ideal = _element(path, table, index, cls, entry)
+        if not isinstance(table_value, dict):
+            raise SceneError(f"{label}: key clearance = {table_value!r} is {_a(table_value)}, must be a table of the "
+                             "clearance joint's fields, e.g. clearance = { clearance = 0.5e-3, bearing_radius = 0.01 }.")
+        try:
+            return clearance_joint(ideal, **_contact_fields(table_value))
+        except (TypeError, ValueError, SceneError) as exc:
+            raise SceneError(f"{label}: key clearance: {exc}") from None
     fields = dataclasses.fields(cls)
     allowed = [f.name for f in fields]
-    label = f"{path}: [[{table}]] #{index + 1}"
     unknown = sorted(set(entry) - set(allowed))
     if unknown:
         raise SceneError(f"{label}: unknown key(s) {', '.join(unknown)}; allowed: {', '.join(allowed)}.")

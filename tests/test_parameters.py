@@ -82,6 +82,31 @@ def test_shared_template_equals_a_fresh_build(variant):
     np.testing.assert_array_equal(shared.mass_diagonal, fresh.mass_diagonal)
 
 
+# the other ready mechanisms: (builder, scene built first, other numbers with the same structure)
+MECHANISM_VARIANTS = {
+    "four_bar": (dc.mechanisms.four_bar, dict(clearance_joints=("B", "C")),
+                 dict(clearance_joints=("B", "C"), clearance={"B": 0.2e-3, "C": 0.3e-3}, rpm=3000.0,
+                      crank_angle=0.4, bearing_radius=12e-3, restitution=0.7)),
+    "double_pendulum": (dc.mechanisms.double_pendulum, dict(clearance_joints=("A", "B")),
+                        dict(clearance_joints=("A", "B"), clearance=0.3e-3, angles=(0.3, -0.2), link_mass=0.5,
+                             gravity=3.0)),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(MECHANISM_VARIANTS))
+def test_ready_mechanisms_share_their_template(variant):
+    build, base, kwargs = MECHANISM_VARIANTS[variant]
+    first = dc.assemble(build(**base))
+    shared = dc.assemble(build(**kwargs))
+    assert shared.functions is first.functions, "numbers only: the template must be reused"
+    assert not np.array_equal(shared.parameter_values, first.parameter_values)
+    clear_memos()
+    fresh = dc.assemble(build(**kwargs))
+    assert fresh.functions is not shared.functions
+    for a, b in zip(_functions_at(shared, 1), _functions_at(fresh, 1)):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+
+
 def test_new_numbers_compile_nothing_and_keep_the_physics():
     runs = []
     for clearance in (0.5e-3, 0.25e-3):
