@@ -65,9 +65,10 @@ def test_the_spring_runs_the_same_on_the_scipy_and_python_paths():
     t_eval = np.linspace(0.0, 0.2, 201)
     scipy_run = dc.simulate(_oscillator(k, m), t_end=0.2, method="RK45", rtol=1e-10, atol=1e-12, t_eval=t_eval)
     np.testing.assert_allclose(scipy_run["mass.x"] - 0.25, 0.05 * np.cos(omega * t_eval), atol=1e-7)
-    python_run = dc.simulate(_oscillator(k, m, damping=2.0), t_end=0.2, backend="python", rtol=1e-9, t_eval=t_eval,
+    # rtol 1e-10: the energy balance of a 1 J oscillator closes to ~1e-8 (at 1e-9 GGL's python run is at 1.4e-6)
+    python_run = dc.simulate(_oscillator(k, m, damping=2.0), t_end=0.2, backend="python", rtol=1e-10, t_eval=t_eval,
                              track_work=True)
-    compiled = dc.simulate(_oscillator(k, m, damping=2.0), t_end=0.2, rtol=1e-9, t_eval=t_eval, track_work=True)
+    compiled = dc.simulate(_oscillator(k, m, damping=2.0), t_end=0.2, rtol=1e-10, t_eval=t_eval, track_work=True)
     np.testing.assert_allclose(python_run["mass.x"], compiled["mass.x"], atol=1e-7)
     assert energy_balance(python_run)["max_residual"] < 1e-6
 
