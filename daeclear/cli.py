@@ -13,6 +13,11 @@ from typing import Any, Sequence
 from .errors import DaeclearError, Interrupted, PhysicsWarning, SolveError
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by Ctrl-C
+#: ``daeclear run`` reports at most CLI_POINTS + 1 points by default (a run of any length stays
+#: affordable: memory and file) ...
+CLI_POINTS = 100_000
+#: ... spaced no finer than this (s): the chapter's two revolutions get 24 001 points, 1 us apart.
+CLI_FINEST_STEP = 1e-6
 
 
 def _parse_value(text: str) -> Any:
@@ -43,6 +48,13 @@ def build_parser() -> argparse.ArgumentParser:
                      help="mechanism parameter, e.g. --set rpm=3000 or --set n_links=4 (repeatable)")
     run.add_argument("--t-end", type=float, help="end time, s (default: two crank revolutions)")
     run.add_argument("--rtol", type=float, help="relative tolerance (default 1e-6)")
+    points = run.add_mutually_exclusive_group()
+    points.add_argument("--t-eval-step", type=float, metavar="DT",
+                        help="report the run every DT seconds (default: the scene file's t_eval_step, else "
+                             "t_end / 100000 but no finer than 1e-6 s: at most 100001 points)")
+    points.add_argument("--every-step", action="store_true",
+                        help="report every IDA step (memory and file grow with the run, ~1.7 MB per revolution "
+                             "of the chapter's slider-crank)")
     run.add_argument("--formulation", choices=["index1", "ggl"], help="DAE formulation (default index1)")
     run.add_argument("--backend", choices=["auto", "c", "python"], default="auto")
     run.add_argument("--out", type=Path, default=Path("results"), help="output directory (default ./results)")
@@ -111,8 +123,12 @@ def _run(args: argparse.Namespace) -> int:
     rtol = options.rtol(args.rtol, where=where, field="--rtol") if args.rtol is not None else sim.pop("rtol", 1e-6)
     sim.pop("rtol", None)
     step = sim.pop("t_eval_step", None)
-    if step is not None:  # the file's spacing, against the end time actually run
+    if args.t_eval_step is not None:
+        step = options.t_eval_step(args.t_eval_step, t_end, where=where, field="--t-eval-step")
+    elif step is not None:  # the file's spacing, against the end time actually run
         step = options.t_eval_step(step, t_end, where=where + f" {args.target}: [simulate]")
+    elif not args.every_step:  # a long run stays affordable: a bounded number of points
+        step = default_t_eval_step(t_end)
     base = args.name if args.name is not None else scene.name
     if not base or Path(base).name != base or base in (".", ".."):
         options.fail(where, "--name", args.name, "a plain file name without a directory (e.g. run1)")
@@ -122,20 +138,23 @@ def _run(args: argparse.Namespace) -> int:
     if args.formulation:
         sim["formulation"] = args.formulation
     run_options.update(sim)
-    if step is not None:
-        run_options["t_eval"] = options.uniform_times(step, t_end)
+    if step is not None:  # reported points on a grid; the steps are not kept (bounded memory)
+        run_options.update(t_eval_step=step, store_steps=False)
     h5 = args.out / f"{base}.h5"
     try:
         with warnings.catch_warnings():  # shown once, from the result, after the run
             warnings.simplefilter("ignore", PhysicsWarning)
-            result = simulate(scene, t_end, **run_options)
+            # streamed: the file holds what was computed whatever stops the run (Ctrl-C, a failure,
+            # running out of memory), and the run's memory does not grow with its length
+            result = simulate(scene, t_end, stream_to=h5, **run_options)
     except Interrupted as exc:
-        return _save_interrupted(exc.result, h5)
-    try:
-        result.save(h5)  # atomic; a Ctrl-C during the write is held back until the file is complete
-    except KeyboardInterrupt:
-        print(f"daeclear: interrupted, result saved to {h5} (no figure)", file=sys.stderr)
+        message = exc.result.message if exc.result is not None else "interrupted"
+        print(f"daeclear: interrupted, partial result saved to {h5} ({message})", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except MemoryError:  # reading the result back (the run itself saves what it computed)
+        print(f"daeclear: out of memory after the run; the result is in {h5}. Report fewer points "
+              "(--t-eval-step) to read it back.", file=sys.stderr)
+        return 1
     print(result)
     print(f"wrote {h5}")
     _print_physics_warnings(result)
@@ -160,24 +179,20 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
         matplotlib.use("Agg")
         from .plot import save_response_figure
         reference = None
-        if reference_scene is not None:
-            reference = simulate(reference_scene, t_end, rtol=rtol, backend=args.backend, on_failure="return")
+        if reference_scene is not None:  # on the run's own output grid: bounded, as the run
+            every_step = result.step_t is not None and result.step_t.size == result.n_times
+            grid = {} if every_step or not result.n_times else {"t_eval": result.t, "store_steps": False}
+            reference = simulate(reference_scene, t_end, rtol=rtol, backend=args.backend, on_failure="return",
+                                 **grid)
         png = save_response_figure(result, args.out / f"{base}.png", reference=reference,
                                    channels=_figure_channels(result, scene))
         print(f"wrote {png}")
 
 
-def _save_interrupted(result: Any, h5: Path) -> int:
-    """Ctrl-C during a run: save its partial result once (a second Ctrl-C waits for the file), exit 130."""
-    if result is None:
-        print("daeclear: interrupted, nothing computed yet", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    try:
-        result.save(h5)  # atomic, SIGINT deferred during the write
-    except KeyboardInterrupt:  # a Ctrl-C held back during the write: the file is complete
-        pass
-    print(f"daeclear: interrupted, partial result saved to {h5} ({result.message})", file=sys.stderr)
-    return EXIT_INTERRUPTED
+def default_t_eval_step(t_end: float) -> float:
+    """Spacing of the points ``daeclear run`` reports by default: ``t_end / CLI_POINTS``, no finer than
+    ``CLI_FINEST_STEP`` (at most CLI_POINTS + 1 points, whatever the length of the run)."""
+    return min(t_end, max(CLI_FINEST_STEP, t_end / CLI_POINTS))
 
 
 def _figure_channels(result: Any, scene: Any) -> tuple[str, ...]:
