@@ -33,6 +33,14 @@ CONFIGS = ("steps", "grid", "grid-nosteps", "stream", "cli")
 GRID = 1e-5  # s, the reported points of the grid configurations
 
 
+def _points(path: Path) -> int:
+    """Output points of a result file, read without loading it."""
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        return int(f["t"].shape[0])
+
+
 def child(config: str, revolutions: int, rpm: float) -> dict:
     """One run in this process; returns its figures (JSON-able)."""
     import tracemalloc
@@ -52,7 +60,10 @@ def child(config: str, revolutions: int, rpm: float) -> dict:
 
             code = main(["run", "slider_crank", "--joint", "revolute", "--set", f"rpm={rpm}", "--t-end", str(t_end),
                          "--out", tmp, "--no-figure", "--quiet"])
-            n_times = dc.load(Path(tmp) / "slider_crank_revolute.h5").n_times if code == 0 else -1
+            _, peak = tracemalloc.get_traced_memory()
+            tracemalloc.stop()
+            rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+            n_times = _points(Path(tmp) / "slider_crank_revolute.h5") if code == 0 else -1
         else:
             kwargs: dict = {"rtol": 1e-6}
             if config != "steps":
@@ -61,13 +72,13 @@ def child(config: str, revolutions: int, rpm: float) -> dict:
                 kwargs["store_steps"] = False
             if config == "stream":
                 kwargs["stream_to"] = Path(tmp) / "run.h5"
-                kwargs["keep"] = False
+                kwargs["keep_data"] = False
             result = dc.simulate(scene, t_end, **kwargs)
-            n_times = result.n_times if config != "stream" else dc.load(kwargs["stream_to"]).n_times
+            _, peak = tracemalloc.get_traced_memory()
+            tracemalloc.stop()
+            rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+            n_times = result.n_times if config != "stream" else _points(kwargs["stream_to"])
             del result
-        _, peak = tracemalloc.get_traced_memory()
-        tracemalloc.stop()
-    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     return {"config": config, "revolutions": revolutions, "tracemalloc_peak_mb": peak / 1e6,
             "rss_peak_mb": rss / 1e3, "rss_growth_mb": (rss - rss0) / 1e3, "n_times": n_times}
 

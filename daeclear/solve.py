@@ -491,7 +491,10 @@ def _failure_message(model: DAEModel, adv: Any, modes: dict[str, str]) -> str:
     flag = f" ({adv.flag_name})" if adv.flag_name else ""
     detail = f": {adv.message}" if adv.message else ""
     advice = "Try a smaller max_step, a tighter rtol, or formulation='ggl'."
-    if adv.flag_name == "DC_STEP_COLLAPSE" and in_contact and any(
+    if adv.flag_name == "DC_MAX_STEPS":  # not an accuracy problem: the run needs more steps
+        advice = ("The run needs more steps than max_steps allows: raise max_steps (daeclear run: --max-steps) "
+                  "in proportion to the time still to go.")
+    elif adv.flag_name == "DC_STEP_COLLAPSE" and in_contact and any(
             getattr(logic, "discontinuous_friction", False) for logic in model.contacts):
         advice = ("The friction law is discontinuous at zero sliding speed (plain Coulomb) and the "
                   "contact is sticking: use the modified Coulomb law (friction=<coefficient> or "

@@ -326,3 +326,37 @@ def test_a_streamed_file_has_the_items_of_a_saved_one(revolute, tmp_path):
     streamed = dc.simulate(revolute, REV / 2, stream_to=tmp_path / "streamed.h5")
     streamed.save(tmp_path / "saved.h5")
     assert _items(tmp_path / "streamed.h5") == _items(tmp_path / "saved.h5")
+
+
+def test_cli_step_cap_grows_with_the_run_and_is_checked(tmp_path, capsys):
+    from daeclear.cli import CLI_STEPS_PER_SECOND, default_max_steps
+
+    assert default_max_steps(2 * REV) == 5_000_000 and default_max_steps(100.0) == 100 * CLI_STEPS_PER_SECOND
+    assert main(["run", "slider_crank", "--out", str(tmp_path), "--max-steps", "0"]) == 2
+    assert "--max-steps=0, must be an integer >= 1" in capsys.readouterr().err
+
+
+def test_a_run_ended_by_the_step_cap_says_to_raise_it(revolute, tmp_path):
+    """The advice fits the cause: more steps, not a tighter tolerance; the CLI's file keeps the run so far."""
+    r = dc.simulate(revolute, REV, max_steps=2000, on_failure="return")
+    assert not r.success and "raise max_steps" in r.message and "tighter rtol" not in r.message
+    assert main(["run", "slider_crank", "--joint", "revolute", "--t-end", str(REV), "--max-steps", "2000",
+                 "--out", str(tmp_path), "--no-figure", "--quiet"]) == 1
+    saved = dc.load(tmp_path / "slider_crank_revolute.h5")
+    assert not saved.success and saved.stats["n_steps"] == 2000 and 0 < saved.t[-1] < REV
+
+
+def test_the_long_run_example_streams_and_reads_a_window(tmp_path, monkeypatch):
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "long_run_streamed.py"
+    spec = importlib.util.spec_from_file_location("long_run_streamed", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)  # type: ignore[union-attr]
+    assert module.main(["--quick", "--out", str(tmp_path)]) == 0
+    full = dc.load(tmp_path / "long_run.h5")
+    assert full.success and full.n_times == options.uniform_times(1e-5, 10 * REV).size and (tmp_path / "long_run_last_revolutions.png").stat().st_size
+    last = module.read_last(tmp_path / "long_run.h5", 2 * REV, ["slider.vx"])
+    mask = full.t >= full.t[-1] - 2 * REV
+    assert np.array_equal(last["t"], full.t[mask]) and np.array_equal(last["slider.vx"], full["slider.vx"][mask])
