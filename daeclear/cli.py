@@ -19,6 +19,8 @@ EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by 
 CLI_POINTS = 100_000
 #: ... spaced no finer than this (s): the chapter's two revolutions get 24 001 points, 1 us apart.
 CLI_FINEST_STEP = 1e-6
+#: ``daeclear run`` shows (summary, figure) at most this many of the last events of a run (the file has all).
+CLI_SHOWN_EVENTS = 20_000
 #: ``daeclear run``'s default step cap per simulated second (see default_max_steps).
 CLI_STEPS_PER_SECOND = 2_000_000
 
@@ -155,7 +157,8 @@ def _run(args: argparse.Namespace) -> int:
             warnings.simplefilter("ignore", PhysicsWarning)
             # streamed: the file holds what was computed whatever stops the run (Ctrl-C, a failure,
             # running out of memory), and the run's memory does not grow with its length
-            result = simulate(scene, t_end, stream_to=h5, **run_options)
+            outcome = simulate(scene, t_end, stream_to=h5, keep_data=False, **run_options)
+        shown_from, result = _read_back(h5)
     except Interrupted as exc:
         message = exc.result.message if exc.result is not None else "interrupted"
         print(f"daeclear: interrupted, partial result saved to {h5} ({message})", file=sys.stderr)
@@ -165,6 +168,9 @@ def _run(args: argparse.Namespace) -> int:
               "(--t-eval-step) to read it back.", file=sys.stderr)
         return 1
     print(result)
+    if shown_from is not None:
+        print(f"(the summary above and the figure show t >= {shown_from:.6g} s, the last {CLI_SHOWN_EVENTS} "
+              f"of {outcome.stats['n_events']} events; the whole run is in the file)")
     print(f"wrote {h5}")
     _print_physics_warnings(result)
     try:
@@ -196,6 +202,16 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
         png = save_response_figure(result, args.out / f"{base}.png", reference=reference,
                                    channels=_figure_channels(result, scene))
         print(f"wrote {png}")
+
+
+def _read_back(h5: Path) -> tuple[float | None, Any]:
+    """The streamed result, whole, or from the time of its last CLI_SHOWN_EVENTS events on (bounded memory:
+    the points are at most CLI_POINTS + 1, the events and segments of a long run are not)."""
+    from .result import load, load_times
+
+    events = load_times(h5, "events")
+    shown_from = float(events[-CLI_SHOWN_EVENTS]) if events.size > CLI_SHOWN_EVENTS else None
+    return shown_from, load(h5, t0=shown_from)
 
 
 def default_max_steps(t_end: float) -> int:

@@ -237,7 +237,8 @@ def simulate(
         session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / rtol)))
     session.set_stall(STALL_STEP, STALL_COUNT)
     setup_time = time.perf_counter() - setup_start
-    sim_params = {"method": method, "start": start, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
+    sim_params = {"method": method, "start": start, "rtol": rtol,
+                  "atol": None if atol is None else np.ravel(atol).tolist(),
                   "max_step": max_step, "t_end": t_end, "backend": session.backend}
     try:
         rec = Recorder(model, parameters={**model.parameters, "simulate": sim_params}, method=method,

@@ -356,7 +356,56 @@ def test_the_long_run_example_streams_and_reads_a_window(tmp_path, monkeypatch):
     spec.loader.exec_module(module)  # type: ignore[union-attr]
     assert module.main(["--quick", "--out", str(tmp_path)]) == 0
     full = dc.load(tmp_path / "long_run.h5")
-    assert full.success and full.n_times == options.uniform_times(1e-5, 10 * REV).size and (tmp_path / "long_run_last_revolutions.png").stat().st_size
+    assert full.success and full.n_times == options.uniform_times(1e-5, 10 * REV).size
+    assert (tmp_path / "long_run_last_revolutions.png").stat().st_size > 0
     last = module.read_last(tmp_path / "long_run.h5", 2 * REV, ["slider.vx"])
     mask = full.t >= full.t[-1] - 2 * REV
     assert np.array_equal(last["t"], full.t[mask]) and np.array_equal(last["slider.vx"], full["slider.vx"][mask])
+
+
+def test_a_failed_append_leaves_the_file_as_before(tmp_path):
+    """An error in the middle of an append (here a state array of the wrong width, after /t was extended)
+    takes every dataset back to its length: the file stays readable, with the rows before."""
+    from daeclear.result import ResultWriter
+
+    writer = ResultWriter(tmp_path / "w.h5", state_names=["a", "b"], units={"a": "m"}, parameters={},
+                          scene_name="s", method="ida", formulation="index1")
+    writer.append(t=[0.0, 1.0], y=np.ones((2, 2)), yp=np.zeros((2, 2)), channels={"c.x": np.arange(2.0)})
+    with pytest.raises((TypeError, ValueError)):
+        writer.append(t=[2.0], y=np.ones((1, 3)), yp=np.zeros((1, 3)), channels={"c.x": np.arange(1.0)})
+    writer.close(stats={"n_steps": 2}, success=True, status=0, message="done")
+    r = dc.load(tmp_path / "w.h5")
+    assert np.array_equal(r.t, [0.0, 1.0]) and np.array_equal(r["c.x"], [0.0, 1.0]) and r.units["a"] == "m"
+    assert r.success and r.message == "done" and r.stats == {"n_steps": 2}
+
+
+@pytest.mark.parametrize("window", [(None, None), (0.004, 0.006), (None, 0.001), (0.009, None), (0.0052, 0.0052),
+                                    (1.0, 2.0)])
+def test_load_of_a_window_equals_the_slice_of_the_whole(revolute, tmp_path, window):
+    """Every step kept (steps and points), saved and streamed: rows, events, clipped segments, steps."""
+    path = tmp_path / "run.h5"
+    whole = dc.simulate(revolute, REV, stream_to=path)
+    whole.save(tmp_path / "saved.h5")
+    for file in (path, tmp_path / "saved.h5"):
+        part, expected = dc.load(file, *window), whole.slice(*window)
+        _same(part, expected)
+        assert part.stats == expected.stats and part.parameters == expected.parameters
+    assert len(whole.events) > 20 and np.array_equal(dc.result.load_times(path, "events"), whole.events.t)
+    assert np.array_equal(dc.result.load_times(path), whole.t)
+    assert np.array_equal(dc.result.load_times(path, "steps"), whole.step_t)
+
+
+def test_cli_shows_the_last_events_of_a_long_run(tmp_path, capsys, monkeypatch):
+    """The summary and figure of a run with more events than CLI_SHOWN_EVENTS come from the window of the
+    last ones (bounded memory); the file holds the whole run."""
+    import daeclear.cli as cli
+
+    monkeypatch.setattr(cli, "CLI_SHOWN_EVENTS", 20)
+    assert main(["run", "slider_crank", "--joint", "revolute", "--t-end", str(REV), "--out", str(tmp_path),
+                 "--quiet"]) == 0
+    whole = dc.load(tmp_path / "slider_crank_revolute.h5")
+    t0 = whole.events.t[-20]
+    out = capsys.readouterr().out
+    assert f"show t >= {t0:.6g} s, the last 20 of {len(whole.events)} events" in out
+    assert f"time: {t0:.5g} to" in out or f"{whole.slice(t0, None).n_times} output times" in out
+    assert (tmp_path / "slider_crank_revolute.png").stat().st_size > 0
