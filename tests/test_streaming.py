@@ -409,3 +409,44 @@ def test_cli_shows_the_last_events_of_a_long_run(tmp_path, capsys, monkeypatch):
     assert f"show t >= {t0:.6g} s, the last 20 of {len(whole.events)} events" in out
     assert f"time: {t0:.5g} to" in out or f"{whole.slice(t0, None).n_times} output times" in out
     assert (tmp_path / "slider_crank_revolute.png").stat().st_size > 0
+
+
+def test_memory_error_without_stream_to_returns_the_partial_result(revolute, fail_after):
+    full = dc.simulate(revolute, 2 * REV, t_eval_step=1e-6, store_steps=False)
+    fail_after(6, MemoryError())
+    with pytest.raises(dc.SolveError) as info:
+        dc.simulate(revolute, 2 * REV, t_eval_step=1e-6, store_steps=False)
+    partial = info.value.result
+    assert not partial.success and partial.message.startswith("out of memory at t=")
+    _prefix(partial, full)
+
+
+@pytest.mark.parametrize("stop", [MemoryError(), KeyboardInterrupt()], ids=["MemoryError", "Ctrl-C"])
+def test_the_scipy_methods_save_the_closed_segments_when_stopped(revolute, tmp_path, monkeypatch, stop):
+    """rk4, streamed: stopped in the middle, the file holds every segment closed before (a prefix of the run)."""
+    import daeclear.integrators as integrators
+
+    kwargs = {"method": "rk4", "step": 1e-5, "t_eval_step": 1e-5, "store_steps": False}
+    full = dc.simulate(revolute, REV, **kwargs)
+    calls = [0]
+    original = integrators._Run._progress
+
+    def progress(self, t):
+        calls[0] += 1
+        if calls[0] == 40:
+            raise stop
+        return original(self, t)
+
+    monkeypatch.setattr(integrators._Run, "_progress", progress)
+    path = tmp_path / "rk4.h5"
+    if isinstance(stop, MemoryError):
+        result = dc.simulate(revolute, REV, stream_to=path, on_failure="return", progress=True, **kwargs)
+        assert result.message.startswith("out of memory at t=")
+    else:
+        with pytest.raises(Interrupted):
+            dc.simulate(revolute, REV, stream_to=path, progress=True, **kwargs)
+    partial = dc.load(path)
+    assert not partial.success and len(partial.segments) >= 1
+    k = partial.n_times
+    assert 0 < k < full.n_times and np.array_equal(partial.t, full.t[:k]) and np.array_equal(partial.y, full.y[:k])
+    assert partial.events == full.events[:len(partial.events)]
