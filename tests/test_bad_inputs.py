@@ -103,6 +103,15 @@ API_SIMULATE: list[tuple[str, dict[str, Any], str, str]] = [
     ("store_steps None", {"store_steps": None}, "store_steps", "None"),
     ("track_work 1", {"track_work": 1}, "track_work", "1"),
     ("DOP853 progress text", {"method": "DOP853", "progress": "yes"}, "progress", "'yes'"),
+    ("t_eval_step 0", {"t_eval_step": 0.0}, "t_eval_step", "0.0"),
+    ("t_eval_step > t_end", {"t_eval_step": 1.0}, "t_eval_step", "1.0"),
+    ("t_eval_step nan", {"t_eval_step": NAN}, "t_eval_step", "nan"),
+    ("t_eval_step str", {"t_eval_step": "1e-5"}, "t_eval_step", "'1e-5'"),
+    ("t_eval_step with t_eval", {"t_eval_step": 1e-5, "t_eval": [0.0, TINY]}, "t_eval_step", "1e-05"),
+    ("DOP853 t_eval_step 0", {"method": "DOP853", "t_eval_step": 0.0}, "t_eval_step", "0.0"),
+    ("keep_data False without stream_to", {"keep_data": False}, "keep_data", "False"),
+    ("keep_data text", {"keep_data": "no"}, "keep_data", "'no'"),
+    ("stream_to int", {"stream_to": 3}, "stream_to", "3"),
 ]
 
 
@@ -255,6 +264,11 @@ CLI_RUN: list[tuple[str, list[str], str, str]] = [
     ("--set gravity -1", ["--set", "gravity=-1"], "gravity", "-1"),
     ("--set unknown", ["--set", "rpmm=1"], "rpmm", "rpmm"),
     ("--joint", ["--joint", "cylindrical"], "joint", "'cylindrical'"),
+    ("--t-eval-step 0", ["--t-eval-step", "0"], "--t-eval-step", "0.0"),
+    ("--t-eval-step nan", ["--t-eval-step", "nan"], "--t-eval-step", "nan"),
+    ("--t-eval-step > t_end", ["--t-eval-step", "1"], "--t-eval-step", "1.0"),
+    ("--max-steps 0", ["--max-steps", "0"], "--max-steps", "0"),
+    ("--max-steps -5", ["--max-steps=-5"], "--max-steps", "-5"),
 ]
 
 

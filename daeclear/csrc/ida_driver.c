@@ -228,6 +228,13 @@ typedef struct {
   double* P;       /* run-time parameters, dc_model.n_parameters */
   double t_now;    /* time of the state in yy/yp (last return) */
   double t_rec;    /* time of the last recorded step (to skip duplicates) */
+  /* A step that filled the caller's last output row with output times left inside it: dc_advance
+   * returned DC_CHUNK at once and the rest of that step (its remaining output times from carry_lo
+   * on, recording, stall and root handling) resumes at the next call; IDA's interpolant is kept. */
+  int carry;
+  int carry_flag, carry_order;
+  double carry_lo, carry_t_prev, carry_h;
+  long int carry_nst, carry_nst_prev;
   int ready;       /* reinit was called */
   int tiny;        /* tiny, non-growing steps since the last normal step */
   double stall_step; /* absolute tiny-step threshold (0: relative test only), see dc_set_stall */
@@ -1050,6 +1057,7 @@ DC_API int dc_reinit(void* sp, double t0, const double* y0, const double* yp0,
   }
   s->t_now = t0;
   s->t_rec = t0;
+  s->carry = 0;
   s->tiny = 0;
   s->h_prev = 0.0;
   s->ready = 1;
@@ -1474,8 +1482,9 @@ DC_API int dc_report(void* sp, int n_points, const double* t, const double* y, c
  * on a root return the root point; duplicates skipped) is written to the step buffers, at most
  * cap rows; *n_stored rows were written.
  *
- * Returns DC_CHUNK when cap rows were written (store_steps) or cap IDA calls were made
- * (otherwise): call again. DC_TSTOP / DC_ROOT / errors < 0 otherwise; *t_out, y_out, yp_out
+ * Returns DC_CHUNK when cap rows were written (store_steps), cap IDA calls were made
+ * (otherwise), or a step filled the last of the n_eval output rows (so that a caller can hand
+ * the output times over in windows and empty the rows between calls): call again. DC_TSTOP / DC_ROOT / errors < 0 otherwise; *t_out, y_out, yp_out
  * hold the state reached, roots_out the root info (DC_ROOT), *flag_out IDA's flag (DC_ERR_IDA).
  */
 DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval, int* i_eval,
@@ -1486,6 +1495,7 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
   dc_session* s = (dc_session*)sp;
   const int n = s->n;
   int k = 0, calls = 0;
+  const int i_eval_start = *i_eval;
   long int nst = 0, nst_prev = 0;
   *n_stored = 0;
   *flag_out = 0;
@@ -1497,7 +1507,7 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
     return DC_ERR_USAGE;
   }
   /* Nothing to integrate: IDA would refuse an interval below roundoff. */
-  if (t_stop - s->t_now <= 4.0 * DBL_EPSILON * fmax(fabs(t_stop), fabs(s->t_now))) {
+  if (!s->carry && t_stop - s->t_now <= 4.0 * DBL_EPSILON * fmax(fabs(t_stop), fabs(s->t_now))) {
     copy_state(s, y_out, yp_out);
     return DC_TSTOP;
   }
@@ -1506,7 +1516,7 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
    * interpolates y(t_stop). (IDASetStopTime would refuse a stop time behind tn.) */
   double tn = s->t_now;
   IDAGetCurrentTime(s->ida, &tn);
-  if (t_stop < tn) {
+  if (!s->carry && t_stop < tn) {
     double tret = s->t_now, h = 0.0, t_prev = s->t_now;
     int order = 0;
     s->cb_msg[0] = 0;
@@ -1563,7 +1573,7 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
     *t_out = t_stop;
     return DC_TSTOP;
   }
-  int flag = IDASetStopTime(s->ida, t_stop);
+  int flag = s->carry ? 0 : IDASetStopTime(s->ida, t_stop);
   if (flag < 0) {
     *flag_out = flag;
     set_msg(s->msg, "IDASetStopTime(%.17g) failed: %s", t_stop, s->ida_msg);
@@ -1573,8 +1583,19 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
   IDAGetNumSteps(s->ida, &nst_prev);
 
   for (;;) {
-    double tret = s->t_now, h = 0.0;
-    int order = 0;
+    double tret = s->t_now, h = 0.0, t_prev = s->t_now, eval_lo;
+    int order = 0, i_before;
+    if (s->carry) { /* resume the step cut short at the last call */
+      s->carry = 0;
+      flag = s->carry_flag;
+      order = s->carry_order;
+      h = s->carry_h;
+      t_prev = s->carry_t_prev;
+      eval_lo = s->carry_lo;
+      nst = s->carry_nst;
+      nst_prev = s->carry_nst_prev;
+      goto step_taken;
+    }
     if (s->base[ST_STEPS] + (long long)nst_prev >= s->max_steps) {
       set_msg(s->msg,
               "step cap reached: %lld IDA steps in this session (max_steps=%lld) at t=%.17g",
@@ -1598,16 +1619,19 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
               s->ida_msg, s->cb_msg[0] ? "; last model error: " : "", s->cb_msg);
       return DC_ERR_IDA;
     }
-    double t_prev = s->t_now;
+    t_prev = s->t_now;
     s->t_now = tret;
     IDAGetNumSteps(s->ida, &nst);
     IDAGetLastStep(s->ida, &h);
     IDAGetLastOrder(s->ida, &order);
+    eval_lo = t_prev;
 
-    /* dense output at requested times in (t_prev, tret] */
+  step_taken:
+    /* dense output at requested times in (eval_lo, tret] */
+    i_before = *i_eval;
     while (*i_eval < n_eval && t_eval[*i_eval] <= tret) {
       double te = t_eval[*i_eval];
-      if (te > t_prev) {
+      if (te > eval_lo) {
         int f0 = IDAGetDky(s->ida, te, 0, s->dky);
         if (f0 == 0) memcpy(eval_y + (size_t)(*i_eval) * n, N_VGetArrayPointer(s->dky), sizeof(double) * (size_t)n);
         int f1 = f0 == 0 ? IDAGetDky(s->ida, te, 1, s->dky) : f0;
@@ -1621,6 +1645,20 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
         }
       }
       ++(*i_eval);
+    }
+    if (n_eval > 0 && i_before < n_eval && *i_eval == n_eval && t_eval[n_eval - 1] < tret) {
+      /* the rows are full and further output times may lie in this step: hand the rows over now */
+      s->carry = 1;
+      s->carry_flag = flag;
+      s->carry_order = order;
+      s->carry_h = h;
+      s->carry_t_prev = t_prev;
+      s->carry_lo = t_eval[n_eval - 1];
+      s->carry_nst = nst;
+      s->carry_nst_prev = nst_prev;
+      *t_out = tret;
+      copy_state(s, y_out, yp_out);
+      return DC_CHUNK;
     }
 
     /* record the return point */
@@ -1672,7 +1710,7 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
       if (handled) {
         if (handled == 1) IDAGetNumSteps(s->ida, &nst_prev); /* counters restarted with IDA */
         if ((store_steps && k >= cap) || (!store_steps && calls >= cap) ||
-            s->ev_n + s->n_auto > s->ev_cap) { /* a buffer full */
+            s->ev_n + s->n_auto > s->ev_cap || (*i_eval >= n_eval && *i_eval > i_eval_start)) { /* a buffer full */
           *t_out = tret;
           copy_state(s, y_out, yp_out);
           return DC_CHUNK;
@@ -1689,7 +1727,8 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
       copy_state(s, y_out, yp_out);
       return DC_TSTOP;
     }
-    if ((store_steps && k >= cap) || (!store_steps && calls >= cap)) {
+    if ((store_steps && k >= cap) || (!store_steps && calls >= cap) ||
+        (*i_eval >= n_eval && *i_eval > i_eval_start)) {
       *t_out = tret;
       copy_state(s, y_out, yp_out);
       return DC_CHUNK;
