@@ -268,3 +268,27 @@ def test_sweep_killed_hard_leaves_no_worker(tmp_path):
         except ProcessLookupError:
             pass
     assert len(load_sweep(path)) >= 1  # the journal of finished runs survives; the next call resumes
+
+
+def test_a_ctrl_c_python_drops_is_still_latched(monkeypatch):
+    """Python drops a KeyboardInterrupt raised inside a weakref callback ("Exception ignored"):
+    the sweep's loop checks the latch between runs, so such a Ctrl-C still stops it."""
+    import gc
+    import weakref
+
+    from daeclear.outputs import sigint_latch
+
+    dropped: list[type] = []
+    monkeypatch.setattr(sys, "unraisablehook", lambda unraisable: dropped.append(unraisable.exc_type))
+
+    class Target:
+        pass
+
+    with sigint_latch() as received:
+        target = Target()
+        weakref.finalize(target, signal.raise_signal, signal.SIGINT)
+        del target  # the callback runs now; its KeyboardInterrupt is printed and dropped
+        gc.collect()
+        assert received == [signal.SIGINT]
+    assert dropped == [KeyboardInterrupt]  # Python dropped it: only the latch remembers
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored
