@@ -52,6 +52,7 @@ from numpy.typing import ArrayLike, NDArray
 from .accuracy import energy_balance, work_precision  # re-exported: daeclear.analysis.work_precision
 from .assemble import DAEModel
 from .errors import DaeclearError, SceneError
+from .options import default_formulation
 
 if TYPE_CHECKING:
     from .result import Result
@@ -405,9 +406,12 @@ class _RestartModel(DAEModel):
 
     def initial_state(self, session: Any = None, start: str = "declared", allow_penetration: bool = True
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        # No Newton projection: the stored state carries the run's own (Baumgarte-controlled)
-        # constraint drift, and projecting it away would move a journal by up to that drift.
-        return self.consistent_state(0.0, np.array(self.start_state, dtype=float), session=session)
+        # index-1: no Newton projection (consistent_state ignores it): the stored state carries the
+        # run's own (Baumgarte-controlled) constraint drift, and projecting it away would move a
+        # journal by up to that drift. GGL: projected, as every GGL restart is; its run holds the
+        # joints to Newton's tolerance, but a stored output point is IDA's interpolant (and a
+        # perturbed one is on the manifold only to first order), and GGL cannot start off it.
+        return self.consistent_state(0.0, np.array(self.start_state, dtype=float), session=session, project=True)
 
 
 def restart_model(model: DAEModel, result: Result, index: int, *, perturbation: float = 0.0,
@@ -1030,7 +1034,7 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] = CHANNE
     for key in ("t_eval", "on_failure"):
         if key in simulate_options:
             raise SceneError(f"classify_motion: {key} is set by the analysis; it cannot be passed.")
-    formulation = simulate_options.pop("formulation", "index1")
+    formulation = simulate_options.pop("formulation", None) or default_formulation(simulate_options.get("method", "ida"))
     model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation)
     T = crank_period(model)
     offset = (float(phase) % (2.0 * math.pi)) / (2.0 * math.pi) * T

@@ -38,12 +38,13 @@ from numpy.typing import ArrayLike, NDArray
 from .codegen import memo_table
 from .errors import AssemblyError, SceneError
 from .ida_session import DAEFunctions, StateLayout
-from .options import FORMULATIONS
+from .options import DEFAULT_FORMULATION, FORMULATIONS
 from .parameters import ParameterTable, structure_key
 from .physics import check_start_penetration
 from .scene import GROUND, Body, Driver, Revolute, Scene, Translational
 from .clearance import CONTACT_BUILDERS
 from .drivers import driver_constraint, driver_load, driver_parameters
+from .loads import Load, build_loads, load_parameters
 from .symbolic import AssemblyContext, BodyFrame, Channel, Reference, Term, rotation
 
 Formulation = Literal["index1", "ggl"]
@@ -433,6 +434,8 @@ def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
             table.update(element.name, _translational_parameters(ref, element))
         elif isinstance(element, Driver):
             table.update(element.name, driver_parameters(ref, element, joints[element.joint]))
+        elif isinstance(element, Load):
+            table.update(element.name, load_parameters(ref, element))
         elif type(element) in CONTACT_BUILDERS:
             values, flags = CONTACT_BUILDERS[type(element)][0](ref, element)
             table.update(element.name, values)
@@ -442,6 +445,9 @@ def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
     structure.append(table.layout)
     described = scene.to_dict()
     described.pop("name")  # the scene's name is no part of its structure
+    for element in scene.elements:  # fields whose effect the structure flags state
+        for field_name in element.NOT_STRUCTURE:
+            described["elements"][element.name].pop(field_name, None)
     return table, structure_key(described, structure)
 
 
@@ -487,7 +493,7 @@ _TEMPLATE_LIMIT = 64
 _ENGINE_VERSION = "engine-2"
 
 
-def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, beta: float = 5.0,
+def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: float = 5.0, beta: float = 5.0,
              track_work: bool = False) -> DAEModel:
     """Assemble a validated scene into a :class:`DAEModel`.
 
@@ -500,14 +506,16 @@ def assemble(scene: Scene, formulation: str = "index1", *, alpha: float = 5.0, b
     ----------
     scene : Scene
         The mechanism; validated first (all problems reported at once).
-    formulation : {"index1", "ggl"}
-        ``index1``: acceleration-level constraints with Baumgarte stabilisation (the
-        chapter's); ``ggl``: stabilised index-2, drift-free in positions and velocities.
+    formulation : {"ggl", "index1"}
+        ``ggl`` (the default): stabilised index-2, drift-free in positions and velocities;
+        ``index1``: acceleration-level constraints with Baumgarte stabilisation (the chapter's,
+        Tables 4.2 and 4.3; the only one the non-IDA methods integrate).
     alpha, beta : float
         Baumgarte parameters of ``index1`` (1/s), 5 and 5 by default (Table 4.2).
     track_work : bool
-        Add the state ``work.input``: the work done on the mechanism by drivers and contact
-        forces, W' = driver power + contact power, integrated with the equations (kept out of
+        Add the state ``work.input``: the work done on the mechanism by drivers, contact
+        forces and loads (daeclear.loads; springs' elastic energy is potential energy),
+        W' = driver power + contact power + load power, integrated with the equations (kept out of
         the error test, so it does not change the solution). ``energy.mechanical - work`` is then
         conserved up to the integration error: channel ``energy.work``.
 
@@ -642,7 +650,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
     driver_rows: dict[str, int] = {}
     contact_builds: list[Any] = []
     for element in scene.elements:
-        if isinstance(element, Body):
+        if isinstance(element, (Body, Load)):
             continue
         if isinstance(element, Revolute):
             eqs, labels = _revolute(ctx, element)
@@ -675,7 +683,8 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
     mass_diag = ca.vertcat(*[ca.vertcat(params[f"{b.name}.mass"], params[f"{b.name}.mass"],
                                         params[f"{b.name}.inertia"]) for b in bodies])
     Q = ca.vertcat(*[ca.vertcat(params[f"{b.name}.mass"] * gx, params[f"{b.name}.mass"] * gy, 0.0) for b in bodies])
-    Q = Q + 0 * t  # keep Q symbolic in t for a uniform signature
+    loads = build_loads(ctx, scene.of_type(Load))  # applied forces, springs, motors (daeclear.loads)
+    Q = Q + loads.force + 0 * t  # keep Q symbolic in t for a uniform signature
     base_force = ca.Function("base_force", [t, q, v, P], [Q], ["t", "q", "v", "P"], ["Q"])
 
     # ---- state vector ----
@@ -718,7 +727,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
     if track_work:
         W, W_p = ca.SX.sym("W"), ca.SX.sym("W_p")
         y, yp = ca.vertcat(y, W), ca.vertcat(yp, W_p)
-        res = ca.vertcat(res, W_p - drive_power_base)
+        res = ca.vertcat(res, W_p - drive_power_base - loads.power)
         state_names.append("work.input")
         kinds.append(KIND_WORK)
     n_y = y.numel()
@@ -790,6 +799,9 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
         power_channels.append(power_d)
     kinetic = 0.5 * ca.dot(mass_diag, v * v)
     potential = -sum(params[f"{b.name}.mass"] * (gx * q[3 * k] + gy * q[3 * k + 1]) for k, b in enumerate(bodies))
+    potential = potential + loads.potential  # the springs' elastic energy
+    if loads.channels:
+        power_channels.append(loads.power)  # the loads' non-conservative power
     channels += [
         Channel("energy.kinetic", "J", kinetic),
         Channel("energy.potential", "J", potential),
@@ -804,13 +816,13 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
             Channel("constraints.position", "m", ca.mmax(ca.fabs(Phi))),
             Channel("constraints.velocity", "m/s", ca.mmax(ca.fabs(Phi_dot))),
         ]
-    channels += contact_channels
+    channels += contact_channels + list(loads.channels)
     switch = ca.vertcat(*switch_syms) if switch_syms else ca.SX(0, 1)
     outputs = ca.Function("outputs", [t, y, yp, switch, P], [ca.vertcat(*[c.expr for c in channels])],
                           ["t", "y", "yp", "switch", "P"], ["channels"])
     # accelerations, multipliers (and work rate) from (t, q, v, contact forces) as generated code:
     # consistent states at restarts and at every reported point cost ~1 us
-    work_rate = [drive_power_of + ca.dot(Fc, v)] if track_work else []
+    work_rate = [drive_power_of + ca.dot(Fc, v) + loads.power] if track_work else []
     accel = ca.Function("accel", [t, q, v, Fc, P], [ca.densify(ca.vertcat(a_sol, lam_sol, *work_rate))],
                         ["t", "q", "v", "Qc", "P"], ["a_lam"])
     kinematics_flat = ca.Function("kinematics_flat", [q, v, t, P],

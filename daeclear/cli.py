@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import ast
 import logging
+import math
 import sys
 import warnings
 from pathlib import Path
@@ -13,6 +14,15 @@ from typing import Any, Sequence
 from .errors import DaeclearError, Interrupted, PhysicsWarning, SolveError
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by Ctrl-C
+#: ``daeclear run`` reports at most CLI_POINTS + 1 points by default (a run of any length stays
+#: affordable: memory and file) ...
+CLI_POINTS = 100_000
+#: ... spaced no finer than this (s): the chapter's two revolutions get 24 001 points, 1 us apart.
+CLI_FINEST_STEP = 1e-6
+#: ``daeclear run`` shows (summary, figure) at most this many of the last events of a run (the file has all).
+CLI_SHOWN_EVENTS = 20_000
+#: ``daeclear run``'s default step cap per simulated second (see default_max_steps).
+CLI_STEPS_PER_SECOND = 2_000_000
 
 
 def _parse_value(text: str) -> Any:
@@ -37,13 +47,25 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="daeclear", description="Planar mechanisms with clearance joints.")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="simulate a named mechanism or a scene file (.toml)")
-    run.add_argument("target", help="mechanism name (slider_crank, chain) or path to a .toml scene file")
+    run.add_argument("target", help="mechanism name (slider_crank, chain, four_bar, double_pendulum) or path to a "
+                                    ".toml scene file")
     run.add_argument("--joint", help="slider_crank: which joint has clearance (ideal, revolute, translational)")
     run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                     help="mechanism parameter, e.g. --set rpm=3000 or --set n_links=4 (repeatable)")
-    run.add_argument("--t-end", type=float, help="end time, s (default: two crank revolutions)")
+                     help="mechanism parameter, e.g. --set rpm=3000, --set n_links=4 or --set clearance_joints=B,C "
+                          "(repeatable)")
+    run.add_argument("--t-end", type=float,
+                     help="end time, s (default: two revolutions of the driver; 0.024 s without one)")
     run.add_argument("--rtol", type=float, help="relative tolerance (default 1e-6)")
-    run.add_argument("--formulation", choices=["index1", "ggl"], help="DAE formulation (default index1)")
+    run.add_argument("--max-steps", type=int, metavar="N",
+                     help="cap on IDA's steps (default: 2 000 000 per simulated second, at least 5 000 000)")
+    points = run.add_mutually_exclusive_group()
+    points.add_argument("--t-eval-step", type=float, metavar="DT",
+                        help="report the run every DT seconds (default: the scene file's t_eval_step, else "
+                             "t_end / 100000 but no finer than 1e-6 s: at most 100001 points)")
+    points.add_argument("--every-step", action="store_true",
+                        help="report every IDA step (memory and file grow with the run, ~1.7 MB per revolution "
+                             "of the chapter's slider-crank)")
+    run.add_argument("--formulation", choices=["index1", "ggl"], help="DAE formulation (default ggl; index1: the chapter's)")
     run.add_argument("--backend", choices=["auto", "c", "python"], default="auto")
     run.add_argument("--out", type=Path, default=Path("results"), help="output directory (default ./results)")
     run.add_argument("--name", help="base name of the output files (default: the scene name)")
@@ -77,7 +99,9 @@ def _mechanism(mechanisms: dict[str, Any], name: str, params: dict[str, Any]) ->
 
 def _run(args: argparse.Namespace) -> int:
     from . import options
+    from .mechanisms import ideal_parameters
     from .outputs import check_directory
+    from .scene import RevoluteClearance, TranslationalClearance
     from .scenefile import MECHANISMS, read_scene_file
     from .solve import simulate
 
@@ -88,14 +112,17 @@ def _run(args: argparse.Namespace) -> int:
     if args.target.endswith(".toml") or Path(args.target).is_file():
         spec = read_scene_file(args.target)  # checks its [simulate] options by the shared rules
         scene, sim = spec.scene, dict(spec.simulate)
+        if any(isinstance(j, (RevoluteClearance, TranslationalClearance)) for j in scene.joints):
+            reference_scene = scene.ideal()  # the figure compares with the ideal mechanism
         if params or args.joint:
             raise DaeclearError("--set and --joint apply to named mechanisms; edit the scene file instead.")
     elif args.target in MECHANISMS:
         if args.joint:
             params["joint"] = args.joint
         scene = _mechanism(MECHANISMS, args.target, params)
-        if params.get("joint", "ideal") != "ideal":  # the chapter plots against the ideal joint
-            reference_scene = MECHANISMS[args.target](**{**params, "joint": "ideal"})
+        ideal = ideal_parameters(args.target, params)
+        if ideal is not None:  # the chapter plots against the ideal mechanism
+            reference_scene = MECHANISMS[args.target](**ideal)
     else:
         raise DaeclearError(f"run: {args.target!r} is neither a scene file nor a mechanism "
                             f"({', '.join(MECHANISMS)}).")
@@ -105,14 +132,18 @@ def _run(args: argparse.Namespace) -> int:
         sim.pop("t_end", None)
     elif "t_end" in sim:
         t_end = sim.pop("t_end")
-    else:
-        rpm = params.get("rpm", 5000.0)
-        t_end = 2 * 60.0 / abs(float(rpm)) if rpm else 0.024  # two crank revolutions
+    else:  # two revolutions of the first driver; 24 ms (two at the chapter's 5000 rpm) without one
+        speed = abs(float(scene.drivers[0].speed)) if scene.drivers else 0.0
+        t_end = 4.0 * math.pi / speed if speed else 0.024
     rtol = options.rtol(args.rtol, where=where, field="--rtol") if args.rtol is not None else sim.pop("rtol", 1e-6)
     sim.pop("rtol", None)
     step = sim.pop("t_eval_step", None)
-    if step is not None:  # the file's spacing, against the end time actually run
+    if args.t_eval_step is not None:
+        step = options.t_eval_step(args.t_eval_step, t_end, where=where, field="--t-eval-step")
+    elif step is not None:  # the file's spacing, against the end time actually run
         step = options.t_eval_step(step, t_end, where=where + f" {args.target}: [simulate]")
+    elif not args.every_step:  # a long run stays affordable: a bounded number of points
+        step = default_t_eval_step(t_end)
     base = args.name if args.name is not None else scene.name
     if not base or Path(base).name != base or base in (".", ".."):
         options.fail(where, "--name", args.name, "a plain file name without a directory (e.g. run1)")
@@ -122,21 +153,32 @@ def _run(args: argparse.Namespace) -> int:
     if args.formulation:
         sim["formulation"] = args.formulation
     run_options.update(sim)
-    if step is not None:
-        run_options["t_eval"] = options.uniform_times(step, t_end)
+    if step is not None:  # reported points on a grid; the steps are not kept (bounded memory)
+        run_options.update(t_eval_step=step, store_steps=False)
+    if args.max_steps is not None:
+        run_options["max_steps"] = options.max_steps(args.max_steps, where=where, field="--max-steps")
+    else:  # memory no longer limits a long run: the cap only stops a runaway one
+        run_options.setdefault("max_steps", default_max_steps(t_end))
     h5 = args.out / f"{base}.h5"
     try:
         with warnings.catch_warnings():  # shown once, from the result, after the run
             warnings.simplefilter("ignore", PhysicsWarning)
-            result = simulate(scene, t_end, **run_options)
+            # streamed: the file holds what was computed whatever stops the run (Ctrl-C, a failure,
+            # running out of memory), and the run's memory does not grow with its length
+            outcome = simulate(scene, t_end, stream_to=h5, keep_data=False, **run_options)
+        shown_from, result = _read_back(h5)
     except Interrupted as exc:
-        return _save_interrupted(exc.result, h5)
-    try:
-        result.save(h5)  # atomic; a Ctrl-C during the write is held back until the file is complete
-    except KeyboardInterrupt:
-        print(f"daeclear: interrupted, result saved to {h5} (no figure)", file=sys.stderr)
+        message = exc.result.message if exc.result is not None else "interrupted"
+        print(f"daeclear: interrupted, partial result saved to {h5} ({message})", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except MemoryError:  # reading the result back (the run itself saves what it computed)
+        print(f"daeclear: out of memory after the run; the result is in {h5}. Report fewer points "
+              "(--t-eval-step) to read it back.", file=sys.stderr)
+        return 1
     print(result)
+    if shown_from is not None:
+        print(f"(the summary above and the figure show t >= {shown_from:.6g} s, the last {CLI_SHOWN_EVENTS} "
+              f"of {outcome.stats['n_events']} events; the whole run is in the file)")
     print(f"wrote {h5}")
     _print_physics_warnings(result)
     try:
@@ -158,37 +200,41 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
     if not args.no_figure:
         import matplotlib
         matplotlib.use("Agg")
-        from .plot import save_response_figure
+        from .plot import save_run_figure
         reference = None
-        if reference_scene is not None:
-            reference = simulate(reference_scene, t_end, rtol=rtol, backend=args.backend, on_failure="return")
-        png = save_response_figure(result, args.out / f"{base}.png", reference=reference,
-                                   channels=_figure_channels(result, scene))
+        if reference_scene is not None:  # on the run's own output grid: bounded, as the run
+            every_step = result.step_t is not None and result.step_t.size == result.n_times
+            grid = {} if every_step or not result.n_times else {"t_eval": result.t, "store_steps": False}
+            try:
+                reference = simulate(reference_scene, t_end, rtol=rtol, backend=args.backend, on_failure="return",
+                                     **grid)
+            except DaeclearError as exc:  # e.g. an ideal mechanism with redundant constraints: no dashed lines
+                print(f"daeclear: no ideal-mechanism reference in the figure: {exc}", file=sys.stderr)
+        # time plots chosen from what the scene holds, a journal orbit or slider path per clearance joint
+        png = save_run_figure(result, args.out / f"{base}.png", reference=reference)
         print(f"wrote {png}")
 
 
-def _save_interrupted(result: Any, h5: Path) -> int:
-    """Ctrl-C during a run: save its partial result once (a second Ctrl-C waits for the file), exit 130."""
-    if result is None:
-        print("daeclear: interrupted, nothing computed yet", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    try:
-        result.save(h5)  # atomic, SIGINT deferred during the write
-    except KeyboardInterrupt:  # a Ctrl-C held back during the write: the file is complete
-        pass
-    print(f"daeclear: interrupted, partial result saved to {h5} ({result.message})", file=sys.stderr)
-    return EXIT_INTERRUPTED
+def _read_back(h5: Path) -> tuple[float | None, Any]:
+    """The streamed result, whole, or from the time of its last CLI_SHOWN_EVENTS events on (bounded memory:
+    the points are at most CLI_POINTS + 1, the events and segments of a long run are not)."""
+    from .result import load, load_times
+
+    events = load_times(h5, "events")
+    shown_from = float(events[-CLI_SHOWN_EVENTS]) if events.size > CLI_SHOWN_EVENTS else None
+    return shown_from, load(h5, t0=shown_from)
 
 
-def _figure_channels(result: Any, scene: Any) -> tuple[str, ...]:
-    """The slider-crank's response channels if the result has any, else the last body's motion and energy
-    (a chain or a scene file without a slider would otherwise get an empty figure)."""
-    from .plot import RESPONSE_CHANNELS
+def default_max_steps(t_end: float) -> int:
+    """IDA's step cap of ``daeclear run``: CLI_STEPS_PER_SECOND per simulated second, at least the API's 5e6
+    (the chapter's revolute slider-crank takes ~190 000 steps per simulated second at 5000 rpm)."""
+    return max(5_000_000, math.ceil(CLI_STEPS_PER_SECOND * t_end))
 
-    if any(name in result for name in RESPONSE_CHANNELS):
-        return RESPONSE_CHANNELS
-    last = scene.bodies[-1].name
-    return tuple(c for c in (f"{last}.phi", f"{last}.omega", "drive.moment", "energy.mechanical") if c in result)
+
+def default_t_eval_step(t_end: float) -> float:
+    """Spacing of the points ``daeclear run`` reports by default: ``t_end / CLI_POINTS``, no finer than
+    ``CLI_FINEST_STEP`` (at most CLI_POINTS + 1 points, whatever the length of the run)."""
+    return min(t_end, max(CLI_FINEST_STEP, t_end / CLI_POINTS))
 
 
 def _floats(text: str, what: str) -> list[float]:

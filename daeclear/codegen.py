@@ -12,16 +12,20 @@ library that holds
 * the hand-written driver ``csrc/ida_driver.c`` (IDA loop, callbacks, dense output);
 
 linked against the SUNDIALS libraries shipped inside the scikit-sundae wheel
-(``<site-packages>/scikit_sundae.libs``) by full path, with that directory as rpath. The wheel has
-no SUNDIALS headers; ``csrc/sundials_min.h`` declares the few functions used, for the SUNDIALS
-version and ``sunindextype`` width that :func:`sundials_info` detects in the wheel and hands to
-the compiler (``-DDC_SUNDIALS_MAJOR=7 ... -DDC_INDEX_SIZE=32``); the header refuses a major
-version it was not written for. The sparse matrix and SuperLU_MT libraries are linked too when
-the wheel has them (``-DDC_HAVE_SPARSE=1``: the sparse linear solver of the driver).
+(``<site-packages>/scikit_sundae.libs``) by full path, with that directory as rpath (and ``-z defs``:
+a function the libraries lack fails the link). The wheel has no SUNDIALS headers; the driver is
+compiled against the real SUNDIALS headers of the wheel's release, vendored unmodified in
+``csrc/sundials/include`` with a ``sundials_config.h`` describing the wheel's build (see
+``csrc/sundials/README.md``). :func:`sundials_info` detects the wheel's SUNDIALS version and
+``sunindextype`` width; they must equal the vendored headers' (:func:`vendored_sundials`, checked
+before compiling) and are handed to the compiler (``-DDC_SUNDIALS_MAJOR=7 ... -DDC_INDEX_SIZE=32``),
+where ``sundials_config.h`` checks them again with ``#error``. The sparse matrix and SuperLU_MT
+libraries are linked too when the wheel has them (``-DDC_HAVE_SPARSE=1``: the sparse linear
+solver of the driver).
 
-Libraries are cached: the key is the SHA-256 of the generated source, the driver sources, the
-compiler command (with those flags) and version, the SUNDIALS version and index size, and the
-SUNDIALS library paths. The cache directory is
+Libraries are cached: the key is the SHA-256 of the generated source, the driver sources and
+every vendored SUNDIALS header, the compiler command (with those flags) and version, the
+SUNDIALS version and index size, and the SUNDIALS library paths. The cache directory is
 ``$DAECLEAR_CACHE_DIR`` or ``~/.cache/daeclear``. A build compiles into a private temporary
 directory and moves the result into place with ``os.replace`` under a per-key file lock, so
 concurrent processes building the same model neither corrupt nor duplicate each other's work.
@@ -65,6 +69,9 @@ __all__ = [
     "SundialsMismatch",
     "sundials_info",
     "parse_index_size",
+    "vendored_sundials",
+    "check_vendored",
+    "SUNDIALS_INCLUDE",
     "read_build_tag",
     "cache_dir",
     "build_model_library",
@@ -72,7 +79,10 @@ __all__ = [
 ]
 
 CSRC = Path(__file__).resolve().parent / "csrc"
-DRIVER_SOURCES = ("ida_driver.c", "sundials_min.h", "dc_model.h", "dc_linalg.h")
+DRIVER_SOURCES = ("ida_driver.c", "dc_model.h", "dc_linalg.h")
+#: The vendored SUNDIALS headers (csrc/sundials/README.md), the include path of the IDA driver;
+#: every file of its parent folder is in the cache key.
+SUNDIALS_INCLUDE = CSRC / "sundials" / "include"
 SUNDIALS_LIBS = (
     "sundials_ida",
     "sundials_core",
@@ -83,7 +93,8 @@ SUNDIALS_LIBS = (
 #: Linked when the wheel has both: the driver's sparse linear solver (SuperLU_MT on a
 #: SUNSparseMatrix). SuperLU_MT's own BLAS and OpenMP libraries sit in the same folder.
 SPARSE_LIBS = ("sundials_sunmatrixsparse", "sundials_sunlinsolsuperlumt")
-#: The SUNDIALS major version whose API csrc/sundials_min.h declares (it #errors on any other).
+#: The SUNDIALS major version of the vendored headers (their sundials_config.h #errors on any
+#: other version than theirs; vendored_sundials reads the full one).
 SUNDIALS_MAJOR = 7
 #: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
 #: and checked when a library is loaded: bump it when a dc_* signature changes.
@@ -91,7 +102,7 @@ DRIVER_ABI = 3
 #: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
 ODE_DRIVER_ABI = 3
 CFLAGS = (f"-DDC_ABI_VERSION={DRIVER_ABI}", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Werror=incompatible-pointer-types",
-          "-Werror=implicit-function-declaration")
+          "-Werror=implicit-function-declaration", "-Wl,-z,defs")
 
 
 class CompilerUnavailable(DaeclearError):
@@ -383,7 +394,8 @@ class SundialsInfo:
         return major, minor, patch
 
     def compile_flags(self) -> list[str]:
-        """The -D flags that tell csrc/sundials_min.h and csrc/ida_driver.c what they build for."""
+        """The -D flags that tell the vendored sundials_config.h and csrc/ida_driver.c what they
+        build for (the header #errors when they disagree with it)."""
         major, minor, patch = self.version_tuple
         return [f"-DDC_SUNDIALS_MAJOR={major}", f"-DDC_SUNDIALS_MINOR={minor}", f"-DDC_SUNDIALS_PATCH={patch}",
                 f"-DDC_INDEX_SIZE={self.index_size}", f"-DDC_HAVE_SPARSE={int(self.has_sparse)}"]
@@ -406,6 +418,37 @@ def parse_index_size(text: str, source: str = "c_config.pxi") -> int | None:
         raise CompilerUnavailable(f"{source} declares sunindextype as {decl!r}, which is not one of "
                                   f"{', '.join(sorted(_INDEX_TYPES))}: cannot tell the SUNDIALS index size")
     return _INDEX_TYPES[decl]
+
+
+_CONFIG_MACRO = re.compile(r"^#define (SUNDIALS_VERSION_MAJOR|SUNDIALS_VERSION_MINOR|SUNDIALS_VERSION_PATCH|"
+                           r"SUNDIALS_INT32_T|SUNDIALS_INT64_T)\b\s*(\d*)", re.MULTILINE)
+
+
+def vendored_sundials() -> tuple[str, int]:
+    """(version, sunindextype bits) of the vendored SUNDIALS headers, read from their
+    ``sundials_config.h``; CompilerUnavailable when the file is missing or says neither."""
+    config = SUNDIALS_INCLUDE / "sundials" / "sundials_config.h"
+    try:
+        macros = dict(_CONFIG_MACRO.findall(config.read_text()))
+    except OSError as exc:
+        raise CompilerUnavailable(f"the vendored SUNDIALS headers are missing: {config} ({exc})") from exc
+    parts = [macros.get(f"SUNDIALS_VERSION_{x}", "") for x in ("MAJOR", "MINOR", "PATCH")]
+    widths = [bits for bits in (32, 64) if f"SUNDIALS_INT{bits}_T" in macros]
+    if not all(parts) or len(widths) != 1:
+        raise CompilerUnavailable(f"{config} defines no SUNDIALS version or no single index type")
+    return ".".join(parts), widths[0]
+
+
+def check_vendored(info: SundialsInfo) -> None:
+    """SundialsMismatch unless the wheel's SUNDIALS (version, index width) is the one the vendored
+    headers describe: compiling the driver against other headers would corrupt memory."""
+    version, bits = vendored_sundials()
+    if (info.version, info.index_size) != (version, bits):
+        raise SundialsMismatch(
+            f"the installed scikit-sundae has SUNDIALS {info.version} with a {info.index_size}-bit sunindextype, "
+            f"but daeclear's vendored SUNDIALS headers (daeclear/csrc/sundials) are version {version} with a "
+            f"{bits}-bit sunindextype: install the scikit-sundae release built on SUNDIALS {version}, or vendor "
+            f"the headers of SUNDIALS {info.version} (csrc/sundials/README.md says how)")
 
 
 def _version_from_name(path: Path) -> str | None:
@@ -562,7 +605,21 @@ def _file_lock(path: Path) -> Iterator[None]:
 
 
 def _driver_text() -> str:
-    return "".join(f"/* {name} */\n" + (CSRC / name).read_text() for name in DRIVER_SOURCES)
+    """The driver sources and every vendored SUNDIALS file, as a SHA-256 for the cache key:
+    editing any of them builds again. Files are read again only when one's size or mtime moved."""
+    files = [CSRC / name for name in DRIVER_SOURCES]
+    files += sorted(p for p in SUNDIALS_INCLUDE.parent.rglob("*") if p.is_file())
+    stats = [(p, p.stat()) for p in files]
+    return _files_digest(tuple((str(p), st.st_mtime_ns, st.st_size) for p, st in stats))
+
+
+@functools.lru_cache(maxsize=8)
+def _files_digest(stamps: tuple[tuple[str, int, int], ...]) -> str:
+    h = hashlib.sha256()
+    for name, _, _ in stamps:
+        path = Path(name)
+        h.update(name.encode() + b"\0" + path.read_bytes() + b"\0")
+    return "driver sources sha256 " + h.hexdigest()
 
 
 MemoTable = dict[Any, Any]
@@ -619,10 +676,11 @@ def _build_model_library(funcs: Any, *, model: NormalizedModel | None = None) ->
         model = normalize_model(funcs)
     libdir, libs = sundials_libraries()
     info = sundials_info()
+    check_vendored(info)
     names = SUNDIALS_LIBS + (SPARSE_LIBS if info.has_sparse else ())
     source = generate_source(model)
     link = [str(libs[name]) for name in names] + [f"-Wl,-rpath,{libdir}", "-lm"]
-    flags = [*CFLAGS, *info.compile_flags()]
+    flags = [*CFLAGS, f"-I{SUNDIALS_INCLUDE}", *info.compile_flags()]
     gomp = sorted(libdir.glob("libgomp-*.so*")) if info.has_sparse else []
     if gomp:  # SuperLU_MT's OpenMP runtime: the driver keeps its teams at one thread
         link.insert(len(names), str(gomp[0]))

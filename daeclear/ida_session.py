@@ -232,9 +232,13 @@ class Session(Protocol):
                params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None: ...
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True) -> Advance:
+                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
+                chunked: bool = False) -> Advance:
         """Integrate towards ``t_stop``; ``store_steps``: keep every step's time, size and order,
-        with ``store_states`` also its y and yp (else ``step_y``/``step_yp`` have no rows)."""
+        with ``store_states`` also its y and yp (else ``step_y``/``step_yp`` have no rows).
+        ``chunked``: return (status ``"chunk"``) whenever the step buffer is full or a step filled
+        the last of the ``t_eval`` rows, so that the caller can empty them and call again (a run in
+        bounded memory hands ``t_eval`` over in windows); the integration is not changed."""
         ...
 
     def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
@@ -459,11 +463,19 @@ class _SessionBase:
               else _root_dirs(self._model, root_directions))
         return t0, y0, yp0, act, plist, rd
 
+    @property
+    def eval_from(self) -> float:
+        """Output times after this one are still to come: the current time, or, when the last
+        (chunked) advance filled its last output row inside a step, that row's time (the rest
+        of the step's output times are given at the next call)."""
+        after = getattr(self, "_eval_after", None)
+        return self._t if after is None else after
+
     def _select_eval(self, t_eval: Any, t_stop: float) -> np.ndarray:
         if t_eval is None:
             return _EMPTY
         te = np.asarray(t_eval, dtype=float).reshape(-1)
-        lo = int(np.searchsorted(te, self._t, side="right"))
+        lo = int(np.searchsorted(te, self.eval_from, side="right"))
         hi = int(np.searchsorted(te, t_stop, side="right"))
         sel = np.ascontiguousarray(te[lo:hi])
         if sel.size > 1 and np.any(np.diff(sel) < 0):
@@ -651,7 +663,7 @@ class _CLib:
         if why is not None:
             _unload(lib)
             raise StaleLibrary(f"{path}: {why}")
-        #: what the library was compiled for (sundials_min.h's -D flags)
+        #: what the library was compiled for (the -D flags checked against csrc/sundials' config)
         self.build_info: SundialsInfo = info
         #: SUNDIALSGetVersion of the SUNDIALS libraries this library loaded
         self.sundials_version = loaded
@@ -915,12 +927,14 @@ class CSession(_SessionBase):
             self._ready = False
             raise DaeclearError(f"IDA reinit failed: {self._lib.dc_message(self._h).decode()}")
         self._t, self._y, self._yp = t0, self._y0b.copy(), self._yp0b.copy()
+        self._eval_after = None  # the C side drops a step cut short (dc_reinit)
         self._active = act
         self._params = plist
         self._ready = True
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True) -> Advance:
+                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
+                chunked: bool = False) -> Advance:
         t_stop = self._check_advance(t_stop)
         n = self._n
         te = self._select_eval(t_eval, t_stop)
@@ -947,7 +961,7 @@ class CSession(_SessionBase):
                     states = (self._sy[:k].copy(), self._syp[:k].copy()) if store_states else (_NO_ROWS[n],) * 2
                     chunks.append((self._st[:k].copy(), *states, self._sh[:k].copy(), self._sord[:k].copy()))
                 auto_events += self._take_auto_events()  # drained at every chunk: the C buffer never overflows
-                if rc != 0:
+                if rc != 0 or chunked:
                     break
                 # buffer full: back in Python between chunks, so Ctrl-C works here
                 if on_chunk is not None:  # time reached, and contact switches made in C so far
@@ -968,11 +982,16 @@ class CSession(_SessionBase):
             e = _empty_advance_arrays(n)
             st, sy, syp, sh, so = e["step_t"], e["step_y"], e["step_yp"], e["step_h"], e["step_order"]
         ne = self._i_eval.value
+        # the C loop stopped inside a step that has output times after the last row (see dc_advance)
+        self._eval_after = float(te[-1]) if rc == 0 and m and ne == m and te[-1] < self._t else None
         adv = Advance(status="tstop", t=self._t, y=self._y, yp=self._yp, step_t=st,
                       step_y=sy, step_yp=syp, step_h=sh, step_order=so, eval_t=te[:ne].copy(),
                       eval_y=ev_y[:ne], eval_yp=ev_yp[:ne], auto_events=auto_events)
         if interrupted:
             adv.status = "interrupted"
+            return adv
+        if rc == 0:  # chunked: a buffer is full, the integration goes on at the next call
+            adv.status = "chunk"
             return adv
         if rc == 1:
             return adv
@@ -1269,7 +1288,8 @@ class PythonSession(_SessionBase):
         self._apply_terms(act, plist)
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True) -> Advance:
+                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
+                chunked: bool = False) -> Advance:
         t_stop = self._check_advance(t_stop)
         n = self._n
         te = self._select_eval(t_eval, t_stop)
@@ -1349,7 +1369,8 @@ class PythonSession(_SessionBase):
                         self._t_internal = t_new
                     self._t, self._y, self._yp = t_new, y_new, yp_new
                     # t_eval points in (t_prev, t_new]: cubic Hermite on the two return points
-                    if ie < te.size and te[ie] <= t_new:
+                    filled = ie < te.size and te[ie] <= t_new
+                    if filled:
                         j = int(np.searchsorted(te, t_new, side="right"))
                         yy, yyp = _hermite(t_prev, y_prev, yp_prev, t_new, y_new, yp_new, te[ie:j])
                         ev_y[ie:j], ev_yp[ie:j] = yy, yyp
@@ -1385,6 +1406,10 @@ class PythonSession(_SessionBase):
                         break
                     if fl == 1:
                         status = "tstop"
+                        break
+                    if chunked and ((te.size and ie == te.size and filled)
+                                    or len(st) >= self._opts.buffer_steps):
+                        status = "chunk"  # the caller empties the rows and calls again
                         break
         finally:
             self._solve_time += time.perf_counter() - tic

@@ -84,6 +84,7 @@ from __future__ import annotations
 import ctypes
 import dataclasses
 import math
+import os
 import re
 import sys
 import time
@@ -102,6 +103,7 @@ from .codegen import (ODE_DRIVER_ABI, BuildResult, CompileError, CompilerUnavail
                       memo_get, memo_put, memo_table)
 from . import options, physics
 from .errors import DaeclearError, DaeclearWarning, Interrupted, SceneError, SolveError
+from .recorder import Recorder
 from .result import ContactEvent, Result
 from .scene import Scene
 
@@ -744,8 +746,10 @@ class _Run:
     """State of one integrate() call: model, evaluator, logic, records; builds the Result."""
 
     def __init__(self, model: DAEModel, ev: _Evaluator, method: str, t_end: float, eval_times: NDArray | None,
-                 store_steps: bool, progress: bool, max_steps: int) -> None:
+                 store_steps: bool, progress: bool, max_steps: int, rec: Recorder) -> None:
         self.model, self.ev, self.method, self.t_end = model, ev, method, t_end
+        self.rec = rec  # where each closed segment's output goes (kept, or streamed to a file)
+        self._handed = 0  # events handed to rec so far
         self.eval_times = eval_times
         self.pending = eval_times
         self.store_steps = store_steps
@@ -766,13 +770,6 @@ class _Run:
         self.tiny = 0
         self.stall = 0
         self.last_event_t = -math.inf
-        self.out_t: list[NDArray] = []
-        self.out_y: list[NDArray] = []
-        self.out_yp: list[NDArray] = []
-        self.out_ch: list[NDArray] = []
-        self.step_t: list[NDArray] = []
-        self.step_h: list[NDArray] = []
-        self.step_order: list[NDArray] = []
         self.seg: _Segment | None = None
         self.t_last = 0.0
         self.success, self.status, self.message = True, 0, "end of the time span reached"
@@ -861,9 +858,7 @@ class _Run:
         if not self.store_steps:
             k = 1 if seg.include_start else 0
             kt, kx, kh = kt[:k], kx[:k], kh[:k]
-        self.step_t.append(kt)
-        self.step_h.append(kh)
-        self.step_order.append(np.full(kt.size, _ORDER[self.method], dtype=np.int64))
+        self.rec.add_steps(kt, kh, np.full(kt.size, _ORDER[self.method], dtype=np.int64))
         if self.eval_times is None:
             ot, ox = kt, kx
         else:
@@ -877,12 +872,21 @@ class _Run:
             y[:, :2 * n] = ox
             y[:, 2 * n:2 * n + m] = Lam
             yp[:, :2 * n] = Xd
-            self.out_t.append(ot)
-            self.out_y.append(y)
-            self.out_yp.append(yp)
             sw = self.model.switch_vector(seg.active, seg.params)
-            self.out_ch.append(ev.channels(self.model, ot, y, yp, sw))
+            ch = ev.channels(self.model, ot, y, yp, sw)
+            self.rec.add_points(ot, y, yp, {name: np.ascontiguousarray(ch[:, i])
+                                            for i, name in enumerate(self.model.channel_names)})
+        seg.st, seg.sx, seg.et, seg.ex = [], [], [], []  # handed over: a long run keeps no segment's data
+        self.hand_over(seg)
         ev.set_terms(self.active, self.params)
+
+    def hand_over(self, seg: _Segment | None) -> None:
+        """Give the recorder a segment (its times and modes) and the events so far, and flush it."""
+        if seg is not None:
+            self.rec.segments.append((seg.t0, seg.t1, seg.modes))
+        self.rec.events.extend(self.events[self._handed:])
+        self._handed = len(self.events)
+        self.rec.flush()
 
     # ---------------------------------------------------------------- events
     def full_state(self, t: float, x: NDArray) -> tuple[NDArray, NDArray]:
@@ -947,13 +951,9 @@ class _Run:
             sys.stderr.flush()
 
     # ---------------------------------------------------------------- result
-    def result(self, setup_time: float, solve_time: float, sim_params: dict[str, Any]) -> Result:
-        n_states = self.model.n_states
-        t = np.concatenate(self.out_t) if self.out_t else np.zeros(0)
-        y = np.concatenate(self.out_y) if self.out_y else np.zeros((0, n_states))
-        yp = np.concatenate(self.out_yp) if self.out_yp else np.zeros((0, n_states))
-        ch = np.concatenate(self.out_ch) if self.out_ch else np.zeros((0, len(self.model.channel_names)))
-        channels = {name: np.ascontiguousarray(ch[:, i]) for i, name in enumerate(self.model.channel_names)}
+    def result(self, setup_time: float, solve_time: float) -> Result:
+        self.hand_over(self.seg)  # a segment left open by a failure at its start has no output points
+        self.seg = None
         stats: dict[str, Any] = {"n_steps": self.n_steps}
         stats.update(self.ev.counters())
         stats.pop("n_fixed_steps", None)
@@ -967,22 +967,13 @@ class _Run:
                      compile_time=build.compile_time if build else 0.0,
                      codegen_time=build.codegen_time if build else 0.0,
                      cache_hit=bool(build.cache_hit) if build else False)
-        segments = [(s.t0, s.t1, s.modes) for s in self.segments]
-        found = physics.check_run(self.model, t, y, channels, self.y0, stats)
+        key_t, key_y, key_channels = self.rec.key_rows()
+        found = physics.check_run(self.model, key_t, key_y, key_channels, self.y0, stats)
         if self.step is not None:
             found += physics.check_fixed_steps(self.model, self.events, self.step, self.missed)
         physics.issue(found, stacklevel=5)  # issue <- result <- integrate <- simulate <- the caller
-        return Result(
-            t=t, y=y, yp=yp, state_names=list(self.model.state_names),
-            channels=channels, units=dict(self.model.channel_units),
-            events=self.events, segments=segments,
-            step_t=np.concatenate(self.step_t) if self.step_t else np.zeros(0),
-            step_h=np.concatenate(self.step_h) if self.step_h else np.zeros(0),
-            step_order=np.concatenate(self.step_order) if self.step_order else np.zeros(0, dtype=np.int64),
-            stats=stats, success=self.success, status=self.status, message=self.message,
-            parameters={**self.model.parameters, "simulate": sim_params}, scene_name=self.model.scene_name,
-            method=METHOD_NAMES[self.method], formulation=self.model.formulation, warnings=found,
-        )
+        return self.rec.finish(stats=stats, success=self.success, status=self.status, message=self.message,
+                               warnings=found)
 
 
 def _hermite(T: NDArray, X: NDArray, Xd: NDArray, te: NDArray) -> NDArray:
@@ -1278,7 +1269,7 @@ def integrate(
     t_eval: ArrayLike | None = None,
     rtol: float = 1e-6,
     atol: float | ArrayLike | None = None,
-    formulation: str = "index1",
+    formulation: str | None = None,
     backend: str = "auto",
     max_step: float = 0.0,
     max_steps: int = 5_000_000,
@@ -1289,8 +1280,17 @@ def integrate(
     track_work: bool = False,
     start: str = "ideal",
     allow_penetration: bool = False,
+    t_eval_step: float | None = None,
+    stream_to: str | os.PathLike[str] | None = None,
+    keep_data: bool = True,
 ) -> Result:
     """Integrate with a non-IDA method; the arguments are those of :func:`daeclear.simulate`.
+
+    Output (``t_eval``/``t_eval_step``, ``store_steps``, ``stream_to``, ``keep_data``) goes to a
+    :class:`daeclear.recorder.Recorder` segment by segment (a segment runs between two contact
+    events): streamed, each segment's points are written when it ends and dropped, so memory
+    grows with the longest segment and the events (kept for the fixed-step checks), not with
+    the run; the grid of ``t_eval_step`` is built whole (8 bytes per point).
 
     ``method`` is one of RK45, DOP853, Radau, BDF, LSODA, rk4, euler (case-insensitive);
     ``step`` (s) is required by rk4 and euler and rejected by the others; ``max_step`` bounds
@@ -1307,9 +1307,12 @@ def integrate(
     t_end, rtol, max_step, max_steps, t_eval, backend, on_failure, store_steps, progress, track_work = options.run(
         t_end=t_end, rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, t_eval=t_eval, backend=backend,
         on_failure=on_failure, store_steps=store_steps, progress=progress, track_work=track_work)
+    out = options.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data)
     name = METHOD_NAMES[method_l]
     if track_work:
         raise SceneError(f"simulate: track_work=True is supported by method='ida' only, not by method={name!r}.")
+    if formulation is None:
+        formulation = options.default_formulation(method_l)
     if isinstance(scene, DAEModel):
         model = scene
     else:
@@ -1323,22 +1326,23 @@ def integrate(
     if model.formulation != "index1":
         raise SceneError(f"simulate: formulation={model.formulation!r} is integrated by IDA only; method={name!r} "
                          "integrates the chapter's index-1 formulation (formulation='index1').")
-    eval_times = None
-    if t_eval is not None:
-        eval_times = np.asarray(t_eval, dtype=float).ravel()  # checked by options.t_eval
+    eval_times = None if out.times is None else out.times.values()  # checked by options.output
     n = model.n_q
     atol_x = tolerance_vector(model, rtol, atol)[:2 * n]
     ev = _evaluator(model, backend)
     y0, _ = model.initial_state(start=start, allow_penetration=allow_penetration)
     x0 = np.array(y0[:2 * n])
-    run = _Run(model, ev, method_l, t_end, eval_times, store_steps, progress, max_steps)
+    sim_params = {"method": name, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
+                  "max_step": max_step, "t_end": t_end, "backend": ev.backend, "step": step}
+    rec = Recorder(model, parameters={**model.parameters, "simulate": sim_params}, method=name,
+                   stream_to=out.stream_to, keep_data=out.keep_data)
+    run = _Run(model, ev, method_l, t_end, eval_times, store_steps, progress, max_steps, rec)
     run.y0, run.step = (y0 if start == "declared" else None), step  # start checks: declared states only
     for logic in model.contacts:
         run.modes.update(logic.initial_modes(0.0, y0, run.active, run.params))
     setup_time = time.perf_counter() - setup_start
-    sim_params = {"method": name, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
-                  "max_step": max_step, "t_end": t_end, "backend": ev.backend, "step": step}
     tic = time.perf_counter()
+    interrupted = False
     try:
         with np.errstate(all="ignore"):
             if method_l in FIXED_STEP_METHODS:
@@ -1350,13 +1354,20 @@ def integrate(
         run.message = f"interrupted by the user at t={run.t_last:.6g} s"
         run.close_segment(hermite=method_l in FIXED_STEP_METHODS)
         interrupted = True
-    else:
-        interrupted = False
+    except MemoryError:  # keep (and, streamed, save) the segments closed before
+        run.success, run.status = False, -1
+        run.message = (f"out of memory at t={run.t_last:.6g} s. Report fewer points (t_eval_step), keep no "
+                       "steps (store_steps=False) and stream the run to a file (stream_to).")
+        if run.seg is not None:
+            run.seg.st, run.seg.sx, run.seg.pt, run.seg.px, run.seg.et, run.seg.ex = [], [], [], [], [], []
+    except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on
+        rec.abort(exc)
+        raise
     solve_time = time.perf_counter() - tic
     if run.progress:
         run._progress(t_end if run.success else run.t_last)
-    result = run.result(setup_time, solve_time, sim_params)
-    if interrupted:
+    result = run.result(setup_time, solve_time)
+    if interrupted or rec.interrupted:
         raise Interrupted(f"simulate: {result.message}; partial result in .result.", result)
     if not result.success and on_failure == "raise":
         raise SolveError(result.message + " Partial result in .result.", result)

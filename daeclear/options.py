@@ -11,6 +11,8 @@ an error, never "use the default".
 from __future__ import annotations
 
 import math
+import os
+from pathlib import Path
 from typing import Any, NamedTuple, NoReturn, Sequence
 
 import numpy as np
@@ -20,6 +22,14 @@ from .errors import SceneError
 
 METHODS: tuple[str, ...] = ("ida", "rk45", "dop853", "radau", "bdf", "lsoda", "rk4", "euler")
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
+#: The default formulation: GGL (stabilised index 2) holds the joints closed to Newton's tolerance,
+#: so contact times converge with rtol at any clearance; index-1 Baumgarte drifts by more than a
+#: 0.01 mm clearance over 10 revolutions at rtol 1e-6 and its first contact onset stays about 1e-6
+#: (relative) off at every rtol from 1e-6 to 1e-9 (docs/engine.md, benchmarks/bench_formulation.py).
+DEFAULT_FORMULATION = "ggl"
+#: The chapter's formulation (Tables 4.2 and 4.3: index-1 with Baumgarte alpha = beta = 5): what the
+#: chapter's reproductions use, and the only one the non-IDA methods integrate.
+CHAPTER_FORMULATION = "index1"
 BACKENDS: tuple[str, ...] = ("auto", "c", "python")
 ON_FAILURE: tuple[str, ...] = ("raise", "return")
 LINEAR_SOLVERS: tuple[str, ...] = ("auto", "dense", "sparse")
@@ -167,9 +177,70 @@ def t_eval_step(value: Any, end: float, *, where: str, field: str = "t_eval_step
     return number(value, where=where, field=field, unit="s", low=0.0, high=end)
 
 
+_spacing = t_eval_step  # for output(), whose argument of that name hides the function
+
+
 def uniform_times(spacing: float, end: float) -> NDArray[np.float64]:
     """Output times from 0 to ``end`` (both included), ``end / floor(end / spacing)`` apart."""
     return np.linspace(0.0, end, int(math.floor(end / spacing)) + 1)
+
+
+class OutputTimes:
+    """The reported times of a run: given values, or the uniform grid of :func:`uniform_times` made
+    window by window (a long run on a fine grid never holds the whole grid: 8 bytes per point).
+
+    ``window(i, j)`` equals ``uniform_times(spacing, end)[i:j]`` value for value."""
+
+    def __init__(self, values: NDArray[np.float64] | None = None, *, spacing: float = 0.0, end: float = 0.0) -> None:
+        self._values = values
+        self._intervals = 0 if values is not None else int(math.floor(end / spacing))
+        self._end = end
+        self.size: int = values.size if values is not None else self._intervals + 1
+
+    def window(self, start: int, stop: int) -> NDArray[np.float64]:
+        """The times of indices [start, stop) (fewer at the end)."""
+        if self._values is not None:
+            return self._values[start:stop]
+        stop = min(stop, self.size)
+        out = np.arange(start, max(start, stop), dtype=float) * (self._end / self._intervals)  # as np.linspace
+        if stop == self.size and out.size:
+            out[-1] = self._end
+        return out
+
+    def values(self) -> NDArray[np.float64]:
+        """Every time (the whole array)."""
+        return self.window(0, self.size)
+
+
+class OutputOptions(NamedTuple):
+    """What a run reports and where it goes (see :func:`output`)."""
+
+    times: OutputTimes | None  # None: every integrator step
+    stream_to: Path | None
+    keep_data: bool
+
+
+def output(*, t_eval: NDArray[np.float64] | None, t_eval_step: Any, end: float, stream_to: Any, keep_data: Any,
+           where: str = "simulate") -> OutputOptions:
+    """Check the output options of a run: ``t_eval`` (checked by :func:`t_eval`) or ``t_eval_step``
+    (one or the other), ``stream_to`` (None or an HDF5 file, checked as an output place before any
+    work) and ``keep_data`` (True or False; False only with ``stream_to``, else the data would be lost)."""
+    times = None if t_eval is None else OutputTimes(t_eval)
+    if t_eval_step is not None:
+        if t_eval is not None:
+            fail(where, "t_eval_step", t_eval_step, "left out when t_eval is given (give one or the other)")
+        times = OutputTimes(spacing=_spacing(t_eval_step, end, where=where), end=end)
+    keep = flag(keep_data, where=where, field="keep_data")
+    path = None
+    if stream_to is not None:
+        if not isinstance(stream_to, (str, os.PathLike)):
+            fail(where, "stream_to", stream_to, "None or the path of an HDF5 file (str or pathlib.Path), e.g. 'run.h5'")
+        from .outputs import check_file
+
+        path = check_file(stream_to, f"{where}: stream_to")
+    elif not keep:
+        fail(where, "keep_data", keep_data, "True when stream_to is not given (the data would be lost)")
+    return OutputOptions(times=times, stream_to=path, keep_data=keep)
 
 
 def method(value: Any, *, where: str = "simulate", field: str = "method") -> str:
@@ -180,6 +251,12 @@ def method(value: Any, *, where: str = "simulate", field: str = "method") -> str
 def formulation(value: Any, *, where: str = "simulate", field: str = "formulation") -> str:
     """DAE formulation (case-insensitive)."""
     return choice(value, FORMULATIONS, where=where, field=field)
+
+
+def default_formulation(method_name: str) -> str:
+    """The formulation used when none is given: :data:`DEFAULT_FORMULATION` for IDA, the chapter's
+    index-1 for the other methods (they integrate the index-1 ODE only)."""
+    return DEFAULT_FORMULATION if str(method_name).lower() == "ida" else CHAPTER_FORMULATION
 
 
 def backend(value: Any, *, where: str = "simulate", field: str = "backend") -> str:

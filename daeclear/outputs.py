@@ -154,6 +154,34 @@ def deferred_sigint() -> Iterator[None]:
             raise KeyboardInterrupt
 
 
+@contextlib.contextmanager
+def sigint_latch() -> Iterator[list[int]]:
+    """Remember every Ctrl-C received during the block (and raise KeyboardInterrupt as usual).
+
+    Python drops a KeyboardInterrupt raised while it runs a weakref callback or a destructor (it
+    prints "Exception ignored in ..."); a loop that checks the latch between its steps stops anyway.
+    Main thread only, like every signal handler; elsewhere the latch stays empty.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield []
+        return
+    previous = signal.getsignal(signal.SIGINT)
+    if previous in (signal.SIG_IGN, None):
+        yield []
+        return
+    received: list[int] = []
+
+    def latch(signum: int, frame: FrameType | None) -> None:
+        received.append(signum)
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGINT, latch)
+    try:
+        yield received
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
     """Write text to a temporary file beside ``path`` and rename it over ``path`` (SIGINT deferred)."""
     p = Path(path)

@@ -94,6 +94,23 @@ def check_run(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channe
     return out
 
 
+def key_rows(t: NDArray[np.float64], channels: dict[str, NDArray[np.float64]]) -> NDArray[np.intp]:
+    """The rows of a run's output that :func:`check_run` reads: the first, and the worst of every
+    ``<pair>.penetration`` channel and of ``constraints.position`` (the earliest of equal ones, as
+    check_run picks). check_run on these rows alone finds what it finds on the whole output, so a
+    run can be checked chunk by chunk in bounded memory (see :class:`daeclear.recorder.Recorder`)."""
+    if t.size == 0:
+        return np.zeros(0, dtype=np.intp)
+    rows = {0}
+    for name, values in channels.items():
+        if name.endswith(".penetration") and values.size:
+            rows.add(int(np.argmax(np.where(np.isfinite(values), values, -np.inf))))
+    drift = channels.get("constraints.position")
+    if drift is not None and drift.size and np.any(np.isfinite(drift)):
+        rows.add(int(np.nanargmax(drift)))
+    return np.array(sorted(rows), dtype=np.intp)
+
+
 def _penetration(model: Any, joint: str, clearance: float, corner: float, t: NDArray[np.float64],
                  channels: dict[str, NDArray[np.float64]], declared: bool) -> list[dict[str, Any]]:
     """Worst penetration of the joint over the run, and at t = 0 (``declared``: the start is the scene's)."""
@@ -215,7 +232,8 @@ def _drift(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels:
         f"simulate: the constraints drifted by {worst:.2e} m ('{where}' at t={float(t[i]):.6g} s), "
         f"{worst / clearance:.1%} of the smallest clearance ({clearance:.2e} m) "
         f"(formulation={model.formulation!r}); contact times and forces are uncertain by that much. "
-        "Use formulation='ggl' (drift-free) or a smaller rtol.")]
+        + ("Use formulation='ggl' (drift-free, the default) or a smaller rtol." if model.formulation != "ggl"
+           else "Use a smaller rtol."))]
 
 
 def check_fixed_steps(model: Any, events: Sequence[Any], step: float,

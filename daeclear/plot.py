@@ -546,7 +546,8 @@ def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | Non
         A run with a translational clearance joint (channels ``<joint>.xi`` and
         ``<joint>.eta``: xi from 0 to 1 along the stroke, eta the offset of the slider
         centre from the guide's mid-line over 2c, +-0.5 where a parallel slider touches
-        a surface).
+        a surface). A joint without a ``stroke`` has no ``xi``: its path is drawn against
+        ``<joint>.s``, the slider centre's position along the guide, in mm.
     joint : str
         Name of the translational clearance joint (``"clearance"`` in ``slider_crank``).
     ax : matplotlib Axes, optional
@@ -574,15 +575,20 @@ def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | Non
     created = ax is None
     ax = _axes(ax)
     xi, eta = f"{joint}.xi", f"{joint}.eta"
+    along = xi if xi in result else f"{joint}.s"  # no stroke given: the slider centre's s, in mm
+    scale = 1.0 if along == xi else 1e3
     if reference is not None:
-        ax.plot(*_curve(reference, xi, eta, window, max_points), "k:", lw=0.8, label="ideal joint")
+        x_ref, y_ref = _curve(reference, along, eta, window, max_points)
+        ax.plot(x_ref * scale, y_ref, "k:", lw=0.8, label="ideal joint")
     kw: dict[str, Any] = {"lw": 0.6, "color": "C0"}
     kw.update(line_kw)
-    ax.plot(*_curve(result, xi, eta, window, max_points), **kw)
+    x, y = _curve(result, along, eta, window, max_points)
+    ax.plot(x * scale, y, **kw)
     if limits:
         for level in (0.5, -0.5):
             ax.axhline(level, color="k", ls="--", lw=0.8)
-    ax.set_xlabel("ξ, slider position along the stroke (-)")
+    ax.set_xlabel("ξ, slider position along the stroke (-)" if along == xi
+                  else "s, slider centre along the guide (mm)")
     ax.set_ylabel("η, offset across the guide (-)")
     _title(ax, result, title, created)
     return ax
@@ -622,6 +628,127 @@ def plot_translational_response(result: Result, *, reference: Result | None = No
 
 
 __all__ += ["plot_slider_path", "plot_translational_response"]
+
+
+# --------------------------------------------------------------------------- any scene
+
+#: Joint panels per row of :func:`plot_run` (a chain of many links gets several rows).
+MAX_PANELS_PER_ROW = 4
+
+#: Kinds of clearance joints and the panel each gets in :func:`plot_run`.
+CLEARANCE_PANELS = {"RevoluteClearance": "journal orbit", "TranslationalClearance": "slider path"}
+
+
+def clearance_joints(result: Result) -> dict[str, str]:
+    """The clearance joints of the run's scene, in scene order: name -> kind (``RevoluteClearance``, ...)."""
+    elements = result.parameters.get("scene", {}).get("elements", {})
+    return {name: e["kind"] for name, e in elements.items()
+            if isinstance(e, dict) and e.get("kind") in CLEARANCE_PANELS}
+
+
+def default_channels(result: Result) -> tuple[str, ...]:
+    """Time-plot channels chosen from what the run's scene holds.
+
+    A body named ``slider`` gives its velocity and acceleration (Figs. 4.15a-b, 4.28a-b); every
+    driver its moment (Figs. 4.15c, 4.28c); a scene without a driver the angular velocity of
+    its last body and the mechanical energy; every clearance joint its contact force (the first
+    four clearance joints of a larger scene). Only channels the result has are returned.
+    """
+    elements = result.parameters.get("scene", {}).get("elements", {})
+    kinds = {name: e.get("kind") for name, e in elements.items() if isinstance(e, dict)}
+    bodies = [name for name, kind in kinds.items() if kind == "Body"]
+    drivers = [name for name, kind in kinds.items() if kind == "Driver"]
+    names = ["slider.vx", "slider.ax"] if "slider" in bodies else []
+    names += [f"{d}.moment" for d in drivers]
+    if not drivers and bodies:
+        names += [f"{bodies[-1]}.omega", "energy.mechanical"]
+    names += [f"{joint}.normal_force" for joint in list(clearance_joints(result))[:MAX_PANELS_PER_ROW]]
+    return tuple(dict.fromkeys(n for n in names if n in result))
+
+
+def plot_run(result: Result, *, reference: Result | None = None, channels: Iterable[str] | None = None,
+             joints: Iterable[str] | None = None, window: Window = None, max_points: int | None = None,
+             title: str | bool = True) -> Any:
+    """A run of any scene: time plots of its channels, then one panel per clearance joint.
+
+    Every revolute clearance joint gets its journal orbit (:func:`plot_journal_orbit`), every
+    translational one its slider path (:func:`plot_slider_path`), side by side under the time
+    plots, four to a row.
+
+    Parameters
+    ----------
+    result : Result
+        The run.
+    reference : Result, optional
+        E.g. the ideal mechanism's run: dashed in the time plots (channels it lacks, such as a
+        clearance joint's contact force, are drawn without it).
+    channels : iterable of str, optional
+        Channels plotted against time; :func:`default_channels` when None. Missing ones are skipped.
+    joints : iterable of str, optional
+        Clearance joints given a panel; every clearance joint of the scene when None.
+    window, max_points, title
+        As in :func:`plot_revolute_response`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Axes in order: the time plots, then the joint panels.
+    """
+    import matplotlib.pyplot as plt
+
+    names = [c for c in (default_channels(result) if channels is None else channels) if c in result]
+    kinds = clearance_joints(result)
+    panels = [j for j in (kinds if joints is None else joints)]
+    unknown = [j for j in panels if j not in kinds]
+    if unknown:
+        raise ValueError(f"plot_run: joints={unknown!r} are not clearance joints of the run's scene "
+                         f"(clearance joints: {', '.join(kinds) or 'none'}).")
+    if not names and not panels:
+        raise ValueError(f"plot_run: nothing to draw: none of channels={list(channels or [])!r} is in the result "
+                         "and the scene has no clearance joint.")
+    n_cols = max(1, min(len(panels), MAX_PANELS_PER_ROW))
+    panel_rows = -(-len(panels) // n_cols)
+    n_rows = len(names) + panel_rows
+    heights = [1.0] * len(names) + [2.0] * panel_rows
+    height = 2.2 * len(names) + 3.8 * panel_rows + 0.6
+    fig = plt.figure(figsize=(max(7.0, 3.6 * n_cols), height))
+    grid = fig.add_gridspec(n_rows, n_cols, height_ratios=heights)
+    first = None
+    for row, name in enumerate(names):
+        ax = fig.add_subplot(grid[row, :], sharex=first)
+        first = first or ax
+        ref = reference if reference is not None and name in reference else None
+        plot_channel(result, name, ax=ax, reference=ref, window=window, max_points=max_points, title=False)
+        if row < len(names) - 1:
+            ax.set_xlabel("")
+    for k, joint in enumerate(panels):
+        ax = fig.add_subplot(grid[len(names) + k // n_cols, k % n_cols])
+        if kinds[joint] == "RevoluteClearance":
+            plot_journal_orbit(result, joint, ax=ax, window=window, max_points=max_points, markers=False,
+                               title=f"{joint}: journal orbit")
+        else:
+            plot_slider_path(result, joint, ax=ax, window=window, max_points=max_points,
+                             title=f"{joint}: slider path")
+    _title(fig, result, title, True)
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.4 / height))  # 0.4 in at the top for the title
+    return fig
+
+
+def save_run_figure(result: Result, path: Any, **options: Any) -> Any:
+    """Write :func:`plot_run`'s figure to ``path`` (whole or not at all); returns the path."""
+    import matplotlib.pyplot as plt
+    from pathlib import Path
+
+    fig = plot_run(result, **options)
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp{path.suffix}")
+    fig.savefig(tmp, dpi=120)
+    plt.close(fig)
+    tmp.replace(path)
+    return path
+
+
+__all__ += ["clearance_joints", "default_channels", "plot_run", "save_run_figure"]
 
 
 def plot_work_precision(study: Any, *, ax: Axes | None = None) -> Axes:

@@ -2,7 +2,8 @@
 
 A `Result` is a pure data container filled by the solver (`solve.py`,
 `integrators.py`); it computes nothing about mechanics. It also owns the HDF5
-round trip: `Result.save` and `load`, and the hand-off to pandas and xarray
+round trip: `Result.save`, `ResultWriter` (the same file written while a run goes on),
+`load` (whole or a time window) and `load_times`, and the hand-off to pandas and xarray
 (`Result.to_pandas`, `Result.events_frame`, `Result.to_xarray`; optional
 dependencies, the ``data`` extra). h5py is imported here and nowhere else in
 daeclear, and only when a file is written or read; pandas and xarray only when asked for.
@@ -71,12 +72,14 @@ if TYPE_CHECKING:  # h5py, pandas and xarray are imported lazily, only where the
 
 __all__ = [
     "FORMAT_NAME",
+    "ResultWriter",
     "FORMAT_VERSION",
     "ChannelKeyError",
     "ContactEvent",
     "EventList",
     "Result",
     "load",
+    "load_times",
 ]
 
 FORMAT_NAME = "daeclear-result"
@@ -1110,21 +1113,203 @@ def _write(f: h5py.File, r: Result) -> None:
     _json_dataset(f, "warnings_json", r.warnings)
 
 
+# --------------------------------------------------------------------------- streaming
+
+
+_STREAM_ROWS = 1024  # rows per HDF5 chunk of a streamed 2-D array (1-D arrays: 4 times as many)
+#: Root message of a streamed file while its run goes on; a file left so was stopped without a word
+#: (killed): it holds the data of its last complete append.
+STREAM_RUNNING = "incomplete: the run was stopped before it finished (the data are those written until then)"
+
+
+class ResultWriter:
+    """Writes a result to an HDF5 file while its run goes on, in the layout of `Result.save`.
+
+    The file is created with every item of the layout (empty, extendable datasets; root
+    attributes ``success=False``, ``status=-1`` and the message :data:`STREAM_RUNNING`) and each
+    `append` adds rows to it, flushed to disk, with Ctrl-C held back until the rows are complete:
+    between two appends `load` reads it as the run so far. `close` writes the statistics,
+    warnings and the outcome. Streamed arrays are chunked (gzip only for integer and bool
+    channels); `load` reads them as it reads a saved file.
+
+    Parameters
+    ----------
+    path : path-like
+        The file, created or replaced (check it with :func:`daeclear.outputs.check_file` first).
+    state_names, units, parameters, scene_name, method, formulation
+        As in `Result`.
+    """
+
+    def __init__(self, path: str | os.PathLike[str], *, state_names: Sequence[str], units: Mapping[str, str],
+                 parameters: Mapping[str, Any], scene_name: str, method: str, formulation: str) -> None:
+        import h5py
+
+        self.path = Path(path)
+        self._units = dict(units)
+        self._n = len(state_names)
+        self._touched: list[tuple[h5py.Dataset, int]] = []  # (dataset, rows before) of the append under way
+        self._f = f = h5py.File(self.path, "w")
+        try:
+            f.attrs["format"] = FORMAT_NAME
+            f.attrs["version"] = FORMAT_VERSION
+            f.attrs["scene_name"] = str(scene_name)
+            f.attrs["method"] = str(method)
+            f.attrs["formulation"] = str(formulation)
+            self._outcome(False, -1, STREAM_RUNNING)
+            self._grow(f, "t", np.float64).attrs["units"] = "s"
+            self._grow(f, "y", np.float64, (self._n,))
+            self._grow(f, "yp", np.float64, (self._n,))
+            _strings(f, "state_names", list(state_names))
+            _strings(f, "state_units", [self._units.get(str(n), "") for n in state_names])
+            f.create_group("channels")
+            events = f.create_group("events")
+            self._grow(events, "t", np.float64)
+            self._grow(events, "pair", h5py.string_dtype())
+            self._grow(events, "kind", h5py.string_dtype())
+            self._grow(events, "approach_speed", np.float64)
+            self._grow(events, "y", np.float64, (self._n,))
+            segments = f.create_group("segments")
+            self._grow(segments, "t_start", np.float64)
+            self._grow(segments, "t_end", np.float64)
+            self._grow(segments, "modes", h5py.string_dtype())
+            steps = f.create_group("steps")
+            self._grow(steps, "t", np.float64)
+            self._grow(steps, "h", np.float64)
+            self._grow(steps, "order", np.int64)
+            f.create_group("stats")
+            _json_dataset(f, "stats_json", {})
+            plain = _plain(dict(parameters), "parameters")
+            _mirror(f.create_group("parameters"), plain)
+            _json_dataset(f, "parameters_json", plain)
+            _json_dataset(f, "warnings_json", [])
+            f.flush()
+        except BaseException:
+            f.close()
+            raise
+
+    @staticmethod
+    def _grow(group: h5py.Group, name: str, dtype: Any, rest: tuple[int, ...] = (),
+              compress: bool = False) -> h5py.Dataset:
+        rows = _STREAM_ROWS if rest else 4 * _STREAM_ROWS
+        extra = {"compression": "gzip", "compression_opts": 1, "shuffle": True} if compress else {}
+        return group.create_dataset(name, shape=(0, *rest), maxshape=(None, *rest), dtype=dtype,
+                                    chunks=(rows, *rest), **extra)
+
+    def _outcome(self, success: bool, status: int, message: str) -> None:
+        self._f.attrs["success"] = bool(success)
+        self._f.attrs["status"] = int(status)
+        self._f.attrs["message"] = str(message)
+
+    def _extend(self, dataset: h5py.Dataset, rows: Any) -> None:
+        k = len(rows)
+        if k:
+            n = dataset.shape[0]
+            self._touched.append((dataset, n))
+            dataset.resize(n + k, axis=0)
+            dataset[n:n + k] = rows
+
+    def append(self, *, t: ArrayLike = (), y: ArrayLike | None = None, yp: ArrayLike | None = None,
+               channels: Mapping[str, ArrayLike] | None = None, events: Sequence[ContactEvent] = (),
+               segments: Sequence[tuple[float, float, Mapping[str, str]]] = (), step_t: ArrayLike = (),
+               step_h: ArrayLike = (), step_order: ArrayLike = ()) -> None:
+        """Add output rows (``t``, ``y``, ``yp``, ``channels``: one row per time), events, segments
+        and steps; written whole (a Ctrl-C meanwhile is raised afterwards) and flushed."""
+        from .outputs import deferred_sigint
+
+        f = self._f
+        t_arr = np.asarray(t, dtype=np.float64)
+        self._touched = []
+        with deferred_sigint():
+            try:
+                self._append(f, t_arr, y, yp, channels, events, segments, step_t, step_h, step_order)
+            except BaseException:  # e.g. MemoryError: every dataset back to its length before, then go on
+                for dataset, n in reversed(self._touched):
+                    dataset.resize(n, axis=0)
+                raise
+            f.flush()
+
+    def _append(self, f: h5py.File, t_arr: NDArray[np.float64], y: Any, yp: Any, channels: Any, events: Any,
+                segments: Any, step_t: Any, step_h: Any, step_order: Any) -> None:
+        if t_arr.size:
+            self._extend(f["t"], t_arr)
+            self._extend(f["y"], np.asarray(y, dtype=np.float64))
+            self._extend(f["yp"], np.asarray(yp, dtype=np.float64))
+            group = f["channels"]
+            for name, values in (channels or {}).items():
+                arr = np.asarray(values)
+                if name not in group:
+                    self._grow(group, name, arr.dtype, arr.shape[1:],
+                               compress=arr.dtype.kind in "biu").attrs["units"] = self._units.get(name, "")
+                self._extend(group[name], arr)
+        if len(events):
+            g = f["events"]
+            self._extend(g["t"], np.array([e.t for e in events], dtype=np.float64))
+            self._extend(g["pair"], np.array([e.pair for e in events], dtype=object))
+            self._extend(g["kind"], np.array([e.kind for e in events], dtype=object))
+            self._extend(g["approach_speed"], np.array([e.approach_speed for e in events], dtype=np.float64))
+            self._extend(g["y"], np.array([e.y for e in events], dtype=np.float64).reshape(len(events), self._n))
+        if len(segments):
+            g = f["segments"]
+            self._extend(g["t_start"], np.array([float(s[0]) for s in segments], dtype=np.float64))
+            self._extend(g["t_end"], np.array([float(s[1]) for s in segments], dtype=np.float64))
+            self._extend(g["modes"], np.array(
+                [json.dumps({str(k): str(v) for k, v in s[2].items()}, ensure_ascii=False) for s in segments],
+                dtype=object))
+        st = np.asarray(step_t, dtype=np.float64)
+        if st.size:
+            g = f["steps"]
+            self._extend(g["t"], st)
+            self._extend(g["h"], np.asarray(step_h, dtype=np.float64))
+            self._extend(g["order"], np.asarray(step_order, dtype=np.int64))
+
+    def close(self, *, stats: Mapping[str, Any], success: bool, status: int, message: str,
+              warnings: Iterable[Mapping[str, Any]] = ()) -> Path:
+        """Write the statistics, the warnings and the outcome, and close the file."""
+        from .outputs import deferred_sigint
+
+        f = self._f
+        with deferred_sigint():
+            try:
+                plain = _plain(dict(stats), "stats")
+                del f["stats"], f["stats_json"], f["warnings_json"]
+                _mirror(f.create_group("stats"), plain)
+                _json_dataset(f, "stats_json", plain)
+                _json_dataset(f, "warnings_json", _plain([dict(w) for w in warnings], "warnings"))
+                self._outcome(success, status, message)
+            finally:
+                f.close()
+        return self.path
+
+    def abort(self, message: str) -> None:
+        """Close the file after an unexpected error: its data so far, ``success=False`` and ``message``."""
+        if not self._f:  # closed already
+            return
+        try:
+            self._outcome(False, -1, message)
+        finally:
+            self._f.close()
+
+
 # --------------------------------------------------------------------------- reading
 
 
-def load(path: str | os.PathLike[str]) -> Result:
-    """Read a result written by `Result.save`.
+def load(path: str | os.PathLike[str], t0: float | None = None, t1: float | None = None) -> Result:
+    """Read a result written by `Result.save` (or streamed by a run, ``simulate(stream_to=...)``).
 
     Parameters
     ----------
     path : str or path-like
         An HDF5 file with root attribute ``format="daeclear-result"``.
+    t0, t1 : float, optional
+        Read only the closed time window [t0, t1] (None: that side open): equal to
+        ``load(path).slice(t0, t1)``, but only the window's rows are read (and the times of the
+        points, events, segments and steps, 8 bytes each), so a window of a long run fits in
+        memory whatever the length of the run.
 
     Returns
     -------
     Result
-        Equal, field by field, to the result that was saved.
+        Equal, field by field, to the result that was saved (or its window).
 
     Raises
     ------
@@ -1163,7 +1348,23 @@ def load(path: str | os.PathLike[str]) -> Result:
                 f"'{path}' is a daeclear result of format version {int(version)}; this daeclear reads "
                 f"versions up to {FORMAT_VERSION}. Upgrade daeclear to read it."
             )
-        return _read(_Reader(f, path))
+        return _read(_Reader(f, path, _window(t0, t1)))
+
+
+def load_times(path: str | os.PathLike[str], of: str = "points") -> NDArray[np.float64]:
+    """The times of a result file's output points, events or steps alone (8 bytes each), e.g. to
+    choose the window of :func:`load` ``(path, t0, t1)`` in a file too long to read whole.
+
+    ``of``: ``"points"`` (``/t``), ``"events"`` (``/events/t``) or ``"steps"`` (``/steps/t``;
+    empty without steps)."""
+    import h5py
+
+    names = {"points": "t", "events": "events/t", "steps": "steps/t"}
+    if of not in names:
+        raise ValueError(f"load_times: of={of!r}, must be one of {', '.join(names)}.")
+    load(path, math.inf, math.inf)  # the file's checks (format, version, items), reading no rows
+    with h5py.File(path, "r") as f:
+        return f[names[of]][()] if names[of] in f else np.zeros(0)
 
 
 def _text(value: Any) -> str:
@@ -1173,9 +1374,18 @@ def _text(value: Any) -> str:
 class _Reader:
     """Reads items of one file; a missing item raises DaeclearError naming file and item."""
 
-    def __init__(self, f: h5py.File, path: Path) -> None:
+    def __init__(self, f: h5py.File, path: Path, window: tuple[float, float] = (-math.inf, math.inf)) -> None:
         self.f = f
         self.path = path
+        self.window = window
+
+    def rows(self, times: str) -> slice:
+        """The rows of the time-ordered dataset ``times`` inside the window (all without one)."""
+        lo, hi = self.window
+        if lo == -math.inf and hi == math.inf:
+            return slice(None)
+        t = self.array(times)
+        return slice(int(np.searchsorted(t, lo, side="left")), int(np.searchsorted(t, hi, side="right")))
 
     def _missing(self, what: str) -> DaeclearError:
         return DaeclearError(f"'{self.path}' is a damaged daeclear result: {what} is missing.")
@@ -1183,15 +1393,15 @@ class _Reader:
     def has(self, name: str) -> bool:
         return name in self.f
 
-    def array(self, name: str) -> np.ndarray:
+    def array(self, name: str, rows: slice | None = None) -> np.ndarray:
         if name not in self.f:
             raise self._missing(f"dataset '/{name}'")
-        return self.f[name][()]
+        return self.f[name][()] if rows is None else self.f[name][rows]
 
-    def strings(self, name: str) -> list[str]:
+    def strings(self, name: str, rows: slice | None = None) -> list[str]:
         if name not in self.f:
             raise self._missing(f"dataset '/{name}'")
-        return [str(s) for s in self.f[name].asstr()[()]]
+        return [str(s) for s in (self.f[name].asstr()[()] if rows is None else self.f[name].asstr()[rows])]
 
     def json(self, name: str) -> Any:
         if name not in self.f:
@@ -1212,13 +1422,15 @@ def _read(r: _Reader) -> Result:
     units = dict(zip(state_names, state_units))
     if "channels" not in r.f:
         raise r._missing("group '/channels'")
+    points = r.rows("t")
     channels: dict[str, np.ndarray] = {}
     for name in r.f["channels"]:
-        channels[name] = r.array(f"channels/{name}")
+        channels[name] = r.array(f"channels/{name}", points)
         units[name] = r.attr("units", f"/channels/{name}")
 
-    columns = (r.array("events/t"), r.strings("events/pair"), r.strings("events/kind"),
-               r.array("events/approach_speed"), r.array("events/y"))
+    rows = r.rows("events/t")
+    columns = (r.array("events/t", rows), r.strings("events/pair", rows), r.strings("events/kind", rows),
+               r.array("events/approach_speed", rows), r.array("events/y", rows))
     if len({len(c) for c in columns}) != 1:
         raise DaeclearError(
             f"'{r.path}' is a damaged daeclear result: the datasets of '/events' have different lengths "
@@ -1228,18 +1440,22 @@ def _read(r: _Reader) -> Result:
         ContactEvent(t=t, pair=pair, kind=kind, approach_speed=speed, y=y)  # type: ignore[arg-type]
         for t, pair, kind, speed, y in zip(*columns)
     ]
-    segments = [
-        (float(a), float(b), json.loads(m))
-        for a, b, m in zip(r.array("segments/t_start"), r.array("segments/t_end"), r.strings("segments/modes"))
-    ]
+    lo, hi = r.window
+    starts, ends = r.array("segments/t_start"), r.array("segments/t_end")
+    keep = np.flatnonzero((starts < hi) & (ends > lo))  # the segments overlapping the window, clipped to it
+    first = int(keep[0]) if keep.size else 0
+    modes = r.strings("segments/modes", slice(first, int(keep[-1]) + 1 if keep.size else 0))
+    segments = [(max(float(starts[i]), lo), min(float(ends[i]), hi), json.loads(modes[i - first])) for i in keep]
     steps: dict[str, Any] = {}
     if r.has("steps"):
-        steps = {"step_t": r.array("steps/t"), "step_h": r.array("steps/h"), "step_order": r.array("steps/order")}
+        rows = r.rows("steps/t")
+        steps = {"step_t": r.array("steps/t", rows), "step_h": r.array("steps/h", rows),
+                 "step_order": r.array("steps/order", rows)}
 
     return Result(
-        t=r.array("t"),
-        y=r.array("y"),
-        yp=r.array("yp"),
+        t=r.array("t", points),
+        y=r.array("y", points),
+        yp=r.array("yp", points),
         state_names=state_names,
         channels=channels,
         units=units,

@@ -20,7 +20,7 @@ from __future__ import annotations
 import difflib
 import math
 from dataclasses import dataclass, field, fields
-from typing import Any, Iterator, Union
+from typing import Any, ClassVar, Iterator, Union
 
 from .errors import SceneError
 from .profiles import PROFILES, ConstantSpeed, Profile
@@ -45,10 +45,17 @@ def _as_vector2(value: Any) -> Vector2 | None:
     return items  # type: ignore[return-value]
 
 
+# public names of the helpers above, for the elements defined in other modules (daeclear.loads)
+is_finite_number, as_vector2 = _is_finite_number, _as_vector2
+
+
 class Element:
     """Base class of every scene element: a name, and a list of own problems."""
 
     name: str
+    #: fields whose effect on the equations the element's structure flags already state (the
+    #: compiled engine leaves them out of the structure key: a name for numbers compiles nothing)
+    NOT_STRUCTURE: ClassVar[frozenset[str]] = frozenset()
 
     @property
     def kind(self) -> str:
@@ -103,6 +110,9 @@ class Element:
 
 def _body_name(body: Union[str, "Body", "Ground"]) -> str:
     return body if isinstance(body, str) else getattr(body, "name", body)
+
+
+body_name = _body_name  # public name, for the elements defined in other modules
 
 
 @dataclass(frozen=True)
@@ -341,7 +351,7 @@ class Scene:
         """Add an element and return it (so ``crank = scene.add(Body(...))`` reads well)."""
         if not isinstance(element, Element):
             raise SceneError(
-                f"scene '{self.name}': cannot add {element!r}; expected a Body, joint or Driver."
+                f"scene '{self.name}': cannot add {element!r}; expected a Body, joint, Driver or load (daeclear.loads)."
             )
         self.elements.append(element)
         return element
@@ -360,6 +370,35 @@ class Scene:
     @property
     def drivers(self) -> list[Driver]:
         return [e for e in self.elements if isinstance(e, Driver)]
+
+    def with_clearance(self, joint: str, *, bearing: str | None = None, name: str | None = None,
+                       **fields_: Any) -> "Scene":
+        """A new scene in which the ideal revolute or translational ``joint`` has a clearance.
+
+        The joint's bodies, point and axis are kept; ``fields_`` are the clearance joint's own
+        fields (``clearance``, ``bearing_radius``, ``material``, ``law``, ``friction``, ...;
+        ``length``, ``width``, ``corner_radius`` for a translational joint). ``bearing`` names
+        the body holding a revolute joint's bearing (default body_i); ``name`` renames the
+        joint. This scene is left unchanged (it stays the ideal reference). See
+        :func:`clearance_joint`.
+
+        >>> scene = Scene("pendulum")
+        >>> link = scene.add(Body("link", mass=1.0, inertia=0.01, position=(0.5, 0.0)))
+        >>> _ = scene.add(Revolute("A", scene.ground, link, at=(0.0, 0.0)))
+        >>> from daeclear.contact import Material
+        >>> steel = Material(young=207e9, poisson=0.3)
+        >>> loose = scene.with_clearance("A", clearance=0.1e-3, bearing_radius=0.01, material=steel)
+        >>> loose["A"].kind, scene["A"].kind
+        ('RevoluteClearance', 'Revolute')
+        """
+        return with_clearance(self, joint, bearing=bearing, name=name, **fields_)
+
+    def ideal(self) -> "Scene":
+        """A new scene, the same mechanism with every clearance joint ideal (see :func:`ideal_joint`):
+        the reference a clearance run is compared with. This scene is left unchanged."""
+        elements = [ideal_joint(e) if isinstance(e, (RevoluteClearance, TranslationalClearance)) else e
+                    for e in self.elements]
+        return Scene(self.name, gravity=self.gravity, elements=elements, ground=self.ground)
 
     def of_type(self, cls: type) -> list[Any]:
         return [e for e in self.elements if isinstance(e, cls)]
@@ -386,8 +425,10 @@ class Scene:
             seen.add(element.name)
         body_names = [b.name for b in self.bodies]
         known = set(body_names) | {GROUND}
-        for joint in self.joints:
-            for role, body in (("body_i", joint.body_i), ("body_j", joint.body_j)):
+        referring = [(j, (("body_i", j.body_i), ("body_j", j.body_j))) for j in self.joints]
+        referring += [(e, e.body_roles()) for e in self.elements if hasattr(e, "body_roles")]  # loads
+        for joint, roles in referring:
+            for role, body in roles:
                 if body not in known:
                     close = difflib.get_close_matches(str(body), sorted(known), n=1)
                     hint = f" Did you mean '{close[0]}'?" if close else ""
@@ -625,6 +666,12 @@ class TranslationalClearance(_PointJoint):
         scenario of Fig. 4.9. ``"section-4.3"``: two adjacent corners on the same surface
         (a face) use ``face_law`` at the geometric centre of the penetrated area; one
         corner or two opposite corners use ``law``.
+    reading : str or None
+        A named reading of the chapter's model (:data:`daeclear.readings.JOINT_READINGS`:
+        ``corners``, ``pseudo-corners``, ``pseudo-corners-linear``, ``section-4.3``,
+        ``unified``, ``unified-hertz``): it sets the model, the corner law's stiffness
+        ((3.5) or (4.27)) and exponent, and the face law, keeping the restitution of
+        ``law``. None: ``model``, ``law`` and ``face_law`` as given.
 
     Notes
     -----
@@ -667,6 +714,10 @@ class TranslationalClearance(_PointJoint):
     face_law: Any = field(default_factory=lambda: _default_face_law())
     friction: Any = None
     model: str = "corners"
+    reading: str | None = None
+    # the structure flags state the contact model in use and the laws' structure (a reading that
+    # only changes numbers compiles nothing)
+    NOT_STRUCTURE: ClassVar[frozenset[str]] = frozenset({"model", "reading"})
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -675,8 +726,16 @@ class TranslationalClearance(_PointJoint):
             vec = _as_vector2(value) if value is not None else None
             if vec is not None:
                 object.__setattr__(self, name, vec)
-        if isinstance(self.model, str):
-            object.__setattr__(self, "model", self.model.strip().lower())
+        for name in ("model", "reading"):
+            if isinstance(getattr(self, name), str):
+                object.__setattr__(self, name, getattr(self, name).strip().lower())
+
+    @property
+    def contact_model(self) -> str:
+        """The contact model in use: the reading's, else ``model``."""
+        from .readings import joint_reading
+
+        return self.model if self.reading is None else joint_reading(self.reading).model
 
     # ---- derived geometry ----------------------------------------------------------
     @property
@@ -702,14 +761,28 @@ class TranslationalClearance(_PointJoint):
         from .contact import normal_law
 
         law = normal_law(self.law) if isinstance(self.law, str) else self.law
+        if self.reading is not None:
+            from . import readings
+
+            return readings.corner_law(readings.joint_reading(self.reading), law, owner=f"{self.kind} '{self.name}'",
+                                       corner_radius=self.corner_radius, face_half_width=self.face_half_width,
+                                       materials=self.material)
         if law.is_resolved:
             return law
         return law.resolve("sphere_plane", radii=(float(self.corner_radius),), materials=self.material)
 
     def resolved_face_law(self) -> Any:
-        """The face law with its stiffness set (kind ``"plane_face"``, half side a)."""
+        """The face law with its stiffness set (kind ``"plane_face"``, half side a); with a reading
+        its face law (None for a reading of the ``corners`` model)."""
         from .contact import normal_law
 
+        if self.reading is not None:
+            from . import readings
+
+            return readings.face_law(readings.joint_reading(self.reading),
+                                     normal_law(self.law) if isinstance(self.law, str) else self.law,
+                                     owner=f"{self.kind} '{self.name}'", face_half_width=self.face_half_width,
+                                     materials=self.material)
         law = normal_law(self.face_law) if isinstance(self.face_law, str) else self.face_law
         return law.resolve("plane_face", face_half_width=self.face_half_width, materials=self.material)
 
@@ -741,6 +814,7 @@ class TranslationalClearance(_PointJoint):
         if self.model not in SLIDER_MODELS:
             out.append(f"{self.kind} '{self.name}': model={self.model!r}, must be one of "
                        f"{', '.join(map(repr, SLIDER_MODELS))}.")
+        out.extend(_reading_problems(self))
         if out:
             return out
         L, W, R_c, c = float(self.length), float(self.width), float(self.corner_radius), self.radial_clearance
@@ -755,9 +829,30 @@ class TranslationalClearance(_PointJoint):
             out.append(f"{self.kind} '{self.name}': corner_radius={R_c!r} m, must be < min(length, width)/2 "
                        f"= {0.5 * min(L, W)!r} m.")
         out.extend(_law_problems(self))
-        if self.model == "section-4.3":
+        if self.model == "section-4.3" and self.reading is None:
             out.extend(_face_law_problems(self))
         return out
+
+
+def _reading_problems(element: TranslationalClearance) -> list[str]:
+    """A reading must be known, and ``model`` and ``face_law`` left to it."""
+    from .readings import joint_reading
+
+    if element.reading is None:
+        return []
+    where = f"{element.kind} '{element.name}'"
+    try:
+        reading = joint_reading(element.reading)
+    except SceneError as exc:
+        return [f"{where}: {exc}"]
+    out = []
+    if element.model not in ("corners", reading.model):
+        out.append(f"{where}: model={element.model!r} with reading={reading.name!r}, whose model is "
+                   f"{reading.model!r}; give one of them.")
+    if element.face_law != _default_face_law():
+        out.append(f"{where}: face_law={element.face_law!r} with reading={reading.name!r}, which sets the face "
+                   "law; leave face_law at its default.")
+    return out
 
 
 def _face_law_problems(element: TranslationalClearance) -> list[str]:
@@ -775,6 +870,123 @@ def _face_law_problems(element: TranslationalClearance) -> list[str]:
     except (SceneError, TypeError) as exc:
         return [f"{element.kind} '{element.name}': face_law: {exc}"]
     return []
+
+
+# ---- clearance as a property of a joint ------------------------------------------------
+
+#: The clearance joint each ideal joint becomes, and the fields it needs besides the shared ones.
+_CLEARANCE_OF: dict[type, tuple[type, tuple[tuple[str, ...], ...]]] = {
+    Revolute: (RevoluteClearance, (("bearing_radius",), ("clearance", "journal_radius"))),
+    Translational: (TranslationalClearance, (("length",), ("width",), ("corner_radius",),
+                                             ("clearance", "guide_height"))),
+}
+
+
+def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | None = None,
+                    **fields_: Any) -> Joint:
+    """The clearance joint that replaces the ideal ``joint``: same bodies, point and axis.
+
+    Perfect and clearance joints share their kinematic data (Ambrósio and Pombo, "A unified
+    formulation for mechanical joints with and without clearances/bushings and/or stops",
+    Multibody Syst. Dyn. 42, 2018): a :class:`Revolute` becomes a :class:`RevoluteClearance`
+    whose bearing and journal centres are the joint's point (``at`` or ``point_i``/``point_j``);
+    a :class:`Translational` becomes a :class:`TranslationalClearance` whose guide is body i,
+    slider body j, with the joint's ``axis`` as the guide direction and the joint's point as
+    both the mid-line point and the slider centre. ``fields_`` are the clearance fields only
+    (clearance, geometry, material, law, friction, ...), never the shared ones.
+
+    Parameters
+    ----------
+    joint : Revolute or Translational
+        The ideal joint.
+    bearing : str or None
+        Revolute only: the body that holds the bearing (body_i or body_j of the joint); None
+        keeps body i, the other body carries the journal.
+    name : str or None
+        Name of the clearance joint (its channels are ``<name>.ex``, ...); None keeps the joint's.
+    **fields_
+        Fields of the clearance joint, e.g. ``clearance=0.5e-3, bearing_radius=10e-3,
+        material=Material(...), law="lankarani-nikravesh", friction=0.05``.
+
+    Raises
+    ------
+    SceneError
+        A joint that is not an ideal revolute or translational one (e.g. already a clearance
+        joint), an unknown or shared field, a missing one, or an invalid value.
+    """
+    label = f"clearance on joint '{getattr(joint, 'name', joint)}'"
+    if isinstance(joint, (RevoluteClearance, TranslationalClearance)):
+        raise SceneError(f"{label}: it is already a {joint.kind}; change its fields with "
+                         "dataclasses.replace, or start from the ideal joint.")
+    if type(joint) not in _CLEARANCE_OF:
+        kind = getattr(joint, "kind", type(joint).__name__)
+        raise SceneError(f"{label}: it is a {kind}; only an ideal Revolute or Translational joint can get a "
+                         "clearance.")
+    cls, required = _CLEARANCE_OF[type(joint)]
+    shared = {f.name for f in fields(type(joint))}
+    allowed = [f.name for f in fields(cls) if f.name not in shared]
+    unknown = sorted(set(fields_) - set(allowed))
+    if unknown:
+        hints = [f"{key} (shared with the ideal joint)" if key in shared else key for key in unknown]
+        raise SceneError(f"{label}: unknown field(s) {', '.join(hints)} for a {cls.__name__}; "
+                         f"allowed: {', '.join(allowed)}.")
+    missing = [" or ".join(group) for group in required if all(fields_.get(k) is None for k in group)]
+    if missing:
+        raise SceneError(f"{label}: missing {', '.join(missing)} (m), needed by a {cls.__name__}.")
+    shared_values = {f.name: getattr(joint, f.name) for f in fields(type(joint))}
+    if bearing is not None:
+        if cls is not RevoluteClearance:
+            raise SceneError(f"{label}: bearing={bearing!r} applies to a revolute joint only; a translational "
+                             "joint's guide is its body_i.")
+        if bearing not in joint.bodies:
+            raise SceneError(f"{label}: bearing={bearing!r}, must be one of the joint's bodies "
+                             f"{joint.body_i!r} or {joint.body_j!r}.")
+        if bearing == joint.body_j:  # the journal on body i: the two bodies and their points change roles
+            shared_values.update(body_i=joint.body_j, body_j=joint.body_i, point_i=joint.point_j,
+                                 point_j=joint.point_i)
+    if name is not None:
+        shared_values["name"] = name
+    element = cls(**shared_values, **fields_)
+    problems = element.problems()
+    if problems:
+        raise SceneError(f"{label}: " + " ".join(problems))
+    return element
+
+
+def ideal_joint(joint: Joint) -> Joint:
+    """The ideal joint a clearance joint stands for: same name, bodies, point and axis (the inverse of
+    :func:`clearance_joint` up to the clearance fields)."""
+    shared = {"name": joint.name, "body_i": joint.body_i, "body_j": joint.body_j,
+              "at": getattr(joint, "at", None), "point_i": getattr(joint, "point_i", None),
+              "point_j": getattr(joint, "point_j", None)}
+    if isinstance(joint, RevoluteClearance):
+        return Revolute(**shared)
+    if isinstance(joint, TranslationalClearance):
+        return Translational(**shared, axis=joint.axis)
+    raise SceneError(f"ideal joint of '{getattr(joint, 'name', joint)}': it is a "
+                     f"{getattr(joint, 'kind', type(joint).__name__)}, not a clearance joint.")
+
+
+def with_clearance(scene: Scene, joint: str, *, bearing: str | None = None, name: str | None = None,
+                   **fields_: Any) -> Scene:
+    """A new scene in which the ideal joint named ``joint`` is a clearance joint (see :func:`clearance_joint`).
+
+    The scene itself is left unchanged: one ideal mechanism serves as the reference of its
+    clearance variants (the chapter plots every clearance run against the ideal one) and a
+    sweep builds many variants from one scene. Elements are frozen, so the new scene shares
+    them; the clearance joint takes the ideal joint's place in the element order.
+    """
+    names = [e.name for e in scene.elements]
+    if joint not in names:
+        close = difflib.get_close_matches(str(joint), names, n=3)
+        hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+        joints = ", ".join(repr(j.name) for j in scene.joints)
+        raise SceneError(f"scene '{scene.name}': with_clearance: no joint named {joint!r} (joints: {joints}).{hint}")
+    index = names.index(joint)
+    element = clearance_joint(scene.elements[index], bearing=bearing, name=name, **fields_)  # type: ignore[arg-type]
+    elements = list(scene.elements)
+    elements[index] = element
+    return Scene(scene.name, gravity=scene.gravity, elements=elements, ground=scene.ground)
 
 
 def driven_coordinate(joint: Any) -> str | None:

@@ -54,6 +54,17 @@ Drivers take their motion profile as a table (see :mod:`daeclear.profiles`)::
     profile = { kind = "ramp", time = 0.01 }   # or "harmonic" (amplitude, frequency, phase),
                                                # "tabulated" (times, values), "constant"
 
+An ideal ``[[revolute]]`` or ``[[translational]]`` joint becomes a clearance joint with a
+``clearance`` table: its bodies, point and axis stay, the table gives the clearance joint's own
+fields (``bearing`` names a revolute joint's bearing body, ``name`` renames the joint)::
+
+    [[revolute]]
+    name = "B"
+    body_i = "crank"
+    body_j = "rod"
+    at = [0.05, 0.0]
+    clearance = { clearance = 0.5e-3, bearing_radius = 0.01, material = { young = 207e9, poisson = 0.3 } }
+
 Unknown tables or keys are errors that name the file, the table and the key.
 """
 
@@ -70,15 +81,24 @@ from . import mechanisms, options
 from .errors import SceneError
 from .contact import Material, friction_law, normal_law
 from .profiles import profile_from_dict
-from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
+from .loads import Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
+from .scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance,
+                    clearance_joint)
 
-MECHANISMS: dict[str, Callable[..., Scene]] = {"slider_crank": mechanisms.slider_crank, "chain": mechanisms.chain}
+MECHANISMS: dict[str, Callable[..., Scene]] = {
+    "slider_crank": mechanisms.slider_crank, "chain": mechanisms.chain, "four_bar": mechanisms.four_bar,
+    "double_pendulum": mechanisms.double_pendulum,
+}
 ELEMENT_TABLES: dict[str, type] = {
     "body": Body, "revolute": Revolute, "translational": Translational, "driver": Driver,
     "revolute_clearance": RevoluteClearance, "translational_clearance": TranslationalClearance,
+    "force": Force, "torque": Torque, "spring_damper": SpringDamper,
+    "rotational_spring_damper": RotationalSpringDamper, "motor": Motor,
 }
 SIMULATE_KEYS = ("t_end", "rtol", "atol", "formulation", "method", "backend", "max_step", "t_eval_step", "start",
                  "allow_penetration")
+#: Keys of loads whose value may be a table in time, ``{ times = [...], values = [...] }``.
+LOAD_VALUE_KEYS = ("fx", "fy", "value")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -127,6 +147,20 @@ def _profile_field(entry: dict[str, Any]) -> dict[str, Any]:
         raise SceneError(f"key profile: {exc} (e.g. profile = {{ kind = \"ramp\", time = 0.01 }}).") from None
 
 
+def _load_values(entry: dict[str, Any]) -> dict[str, Any]:
+    """Loads: a value written as a table {times, values} -> a daeclear.Table; an error names its key."""
+    out = dict(entry)
+    for key in LOAD_VALUE_KEYS:
+        value = out.get(key)
+        if isinstance(value, dict):
+            unknown = sorted(set(value) - {"times", "values"})
+            if unknown or len(value) != 2:
+                raise SceneError(f"key {key}: unknown key(s) {', '.join(unknown) or '(none)'}; allowed: times, "
+                                 "values (both required).")
+            out[key] = Table(value["times"], value["values"])
+    return out
+
+
 def _single_table(path: Path, data: dict[str, Any], table: str) -> dict[str, Any]:
     """``[table]``: one table; ``[[table]]`` or ``table = ...`` written instead is named as such."""
     value = data.get(table, {})
@@ -173,9 +207,20 @@ def _toml_type(value: Any) -> str:
 
 
 def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any]) -> Any:
+    label = f"{path}: [[{table}]] #{index + 1}"
+    if cls in (Revolute, Translational) and "clearance" in entry:  # an ideal joint given a clearance
+        entry = dict(entry)
+        table_value = entry.pop("clearance")
+        ideal = _element(path, table, index, cls, entry)
+        if not isinstance(table_value, dict):
+            raise SceneError(f"{label}: key clearance = {table_value!r} is {_a(table_value)}, must be a table of the "
+                             "clearance joint's fields, e.g. clearance = { clearance = 0.5e-3, bearing_radius = 0.01 }.")
+        try:
+            return clearance_joint(ideal, **_contact_fields(table_value))
+        except (TypeError, ValueError, SceneError) as exc:
+            raise SceneError(f"{label}: key clearance: {exc}") from None
     fields = dataclasses.fields(cls)
     allowed = [f.name for f in fields]
-    label = f"{path}: [[{table}]] #{index + 1}"
     unknown = sorted(set(entry) - set(allowed))
     if unknown:
         raise SceneError(f"{label}: unknown key(s) {', '.join(unknown)}; allowed: {', '.join(allowed)}.")
@@ -189,6 +234,8 @@ def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any
             entry = _contact_fields(entry)
         if cls is Driver and isinstance(entry.get("profile"), dict):
             entry = _profile_field(entry)
+        if cls in (Force, Torque):
+            entry = _load_values(entry)
         element = cls(**entry)
     except (TypeError, ValueError, SceneError) as exc:
         text = str(exc)

@@ -46,6 +46,10 @@ chapter's model: not continuous, not energy-conserving at the switch). A face la
 needs an approach speed gets the mean of the approach speeds latched by its two corners
 (docs/contact_laws.md).
 
+A joint's ``reading`` (:mod:`daeclear.readings`) picks one of these models, the corner law's
+stiffness ((3.5) or the pseudo-stiffness (4.27)) and exponent, and the face law
+(``TranslationalClearance.contact_model``, ``resolved_law``, ``resolved_face_law``).
+
 Friction (only when declared): at every active contact, the modified Coulomb law (or the
 joint's law) on the sliding velocity of the slider's material point at the contact
 relative to the guide's, along ``t``.
@@ -267,7 +271,7 @@ class SliderGuideLogic:
 def translational_clearance_parameters(ref: Reference, joint: TranslationalClearance) -> tuple[dict[str, Any], list[Any]]:
     """The joint's numbers (run-time parameters) and what of it is structure."""
     law = joint.resolved_law()
-    face_law = joint.resolved_face_law() if joint.model == "section-4.3" else None
+    face_law = joint.resolved_face_law() if joint.contact_model == "section-4.3" else None
     friction = joint.resolved_friction()
     s_i, s_j = ref.joint_points(joint)
     t_guide = ref.local_vector(joint.body_i, joint.axis)  # (4.14): t in guide coordinates
@@ -285,7 +289,7 @@ def translational_clearance_parameters(ref: Reference, joint: TranslationalClear
     stroke = joint.stroke if joint.stroke is not None else joint.upper_limits
     if stroke is not None:
         values["stroke"] = stroke
-    structure: list[Any] = [law_structure(law), law_structure(friction)]
+    structure: list[Any] = [joint.contact_model, law_structure(law), law_structure(friction)]
     for prefix, each in (("law", law), ("face_law", face_law), ("friction", friction)):
         if each is not None:
             values.update({f"{prefix}.{k}": v for k, v in law_values(each).items()})
@@ -304,7 +308,7 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
     """
     name, ident = joint.name, _identifier(joint.name)
     law_numeric = joint.resolved_law()
-    face_numeric = joint.resolved_face_law() if joint.model == "section-4.3" else None
+    face_numeric = joint.resolved_face_law() if joint.contact_model == "section-4.3" else None
     friction_numeric = joint.resolved_friction()
     law = symbolic_law(law_numeric, ctx.params, f"{name}.law")
     face_law = None if face_numeric is None else symbolic_law(face_numeric, ctx.params, f"{name}.face_law")

@@ -12,6 +12,7 @@ from __future__ import annotations
 import itertools
 import logging
 import math
+import os
 import sys
 import time
 from typing import Any, Sequence
@@ -23,7 +24,8 @@ from . import options, physics
 from .assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
 from .errors import Interrupted, SceneError, SolveError
 from .ida_session import open_session
-from .result import ContactEvent, Result
+from .recorder import Recorder
+from .result import Result
 from .scene import Scene
 
 log = logging.getLogger("daeclear")
@@ -45,6 +47,8 @@ DRIFT_FRACTION = physics.DRIFT_FRACTION
 # keeps the pendulum's constraint residual at 1e-12 instead of 3e-11 (rtol 1e-10) and, measured,
 # halves the steps; index1 is better off with IDA's default. The python backend cannot set it.
 GGL_NEWTON_COEF = 1e-3
+# Failures in contact that plain Coulomb friction causes when the contact sticks.
+STICKING_FLAGS = ("DC_STEP_COLLAPSE", "IDA_CONV_FAIL", "IDA_ERR_FAIL")
 # Stall guard: STALL_COUNT steps shorter than STALL_STEP seconds that do not grow (and no step a
 # hundred times longer in between) end the run with a clear message instead of creeping on
 # (e.g. plain Coulomb friction chattering at zero sliding speed takes ~1e-12 s order-1 steps).
@@ -107,10 +111,11 @@ def simulate(
     t_end: float,
     *,
     t_eval: ArrayLike | None = None,
+    t_eval_step: float | None = None,
     rtol: float = 1e-6,
     atol: float | ArrayLike | None = None,
     method: str = "ida",
-    formulation: str = "index1",
+    formulation: str | None = None,
     backend: str = "auto",
     max_step: float = 0.0,
     max_steps: int = 5_000_000,
@@ -122,6 +127,8 @@ def simulate(
     linear_solver: str = "auto",
     start: str = "ideal",
     allow_penetration: bool = False,
+    stream_to: str | os.PathLike[str] | None = None,
+    keep_data: bool = True,
 ) -> Result:
     """Integrate a scene (or an assembled model) from t = 0 to ``t_end``.
 
@@ -133,6 +140,10 @@ def simulate(
         End time, s (> 0).
     t_eval : array_like or None
         Output times in [0, t_end] (increasing). None: every internal IDA step.
+    t_eval_step : float or None
+        Output times every ``t_eval_step`` seconds from 0 to t_end (both included; the spacing is
+        ``t_end / floor(t_end / t_eval_step)``), made window by window as the run goes (a long run
+        never holds the whole grid). Give this or ``t_eval``, not both.
     rtol : float
         Relative tolerance (1e-6; the chapter's "integration tolerance").
     atol : float, array or None
@@ -143,8 +154,10 @@ def simulate(
         same model as an ODE in (q, v) (index-1 formulation only) with the same contact events
         (see :mod:`daeclear.integrators`): scipy's explicit RK45/DOP853 and implicit
         Radau/BDF/LSODA, fixed-step classical Runge-Kutta "rk4" and explicit "euler".
-    formulation : {"index1", "ggl"}
-        Used when ``scene`` is a Scene.
+    formulation : {"ggl", "index1"} or None
+        Used when ``scene`` is a Scene. None: "ggl" (stabilised index 2, drift-free) for IDA,
+        "index1" (the chapter's, Baumgarte alpha = beta = 5) for the other methods, which
+        integrate that one only (:func:`daeclear.options.default_formulation`).
     backend : {"auto", "c", "python"}
         "c": generated C and an IDA loop in C (fast); "python": scikit-sundae with CasADi
         callbacks; "auto": C when a compiler works, else python with a warning.
@@ -153,7 +166,9 @@ def simulate(
     max_steps : int
         Cap on the total number of steps; the run fails cleanly beyond it.
     store_steps : bool
-        Keep every internal step (step sizes are reported in ``result.stats``/steps).
+        Keep every internal step's time, size and order (``result.step_t``...). Without ``t_eval``
+        the steps are also the output points; False then reports the start point only. With
+        ``t_eval``/``t_eval_step``, False keeps the run's memory from growing with its length.
     on_failure : {"raise", "return"}
         On an integrator failure raise :class:`SolveError` (its ``.result`` holds the
         partial result) or return the partial result with ``success=False``.
@@ -178,6 +193,17 @@ def simulate(
         Start "declared" even with a contact pair deeper in its wall than
         :data:`daeclear.physics.START_PENETRATION_FRACTION` of the clearance (refused otherwise).
 
+    stream_to : str, path or None
+        Write the result to this HDF5 file while the run goes on (the layout of
+        :meth:`Result.save`, docs/hdf5_layout.md), chunk by chunk, and drop each chunk from memory.
+        The file is checked before any work and holds what was computed whatever stops the run:
+        a failure, an exception, Ctrl-C, running out of memory (its root ``message`` says why).
+    keep_data : bool
+        With ``stream_to``: return the result read back from the file (True, as
+        ``daeclear.load(stream_to)``), or (False) a Result of the outcome alone (success, message,
+        statistics, warnings; no time series, events or segments), so that not even the end of a
+        long run holds its data in memory.
+
     Returns
     -------
     Result
@@ -198,6 +224,7 @@ def simulate(
     t_end, rtol, max_step, max_steps, t_eval, backend, on_failure, store_steps, progress, track_work = options.run(
         t_end=t_end, rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, t_eval=t_eval, backend=backend,
         on_failure=on_failure, store_steps=store_steps, progress=progress, track_work=track_work)
+    out = options.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data)
     from .integrators import check_step, integrate  # the non-IDA methods
 
     check_step(method, step)
@@ -205,31 +232,43 @@ def simulate(
         return integrate(scene, t_end, method=method, t_eval=t_eval, rtol=rtol, atol=atol, formulation=formulation,
                          backend=backend, max_step=max_step, max_steps=max_steps, step=step,
                          store_steps=store_steps, on_failure=on_failure, progress=progress,
-                         track_work=track_work, start=start, allow_penetration=allow_penetration)
+                         track_work=track_work, start=start, t_eval_step=t_eval_step, stream_to=out.stream_to,
+                         keep_data=out.keep_data, allow_penetration=allow_penetration)
 
     setup_start = time.perf_counter()
+    if formulation is None:
+        formulation = options.default_formulation(method)
     model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation, track_work=track_work)
-    eval_times = None
-    if t_eval is not None:
-        eval_times = np.asarray(t_eval, dtype=float).ravel()  # checked by options.t_eval
     atol_vec = tolerance_vector(model, rtol, atol)
     session = open_session(model.functions, backend=backend, rtol=rtol, atol=atol_vec, max_step=max_step,
                            parameters=model.parameter_values, max_steps=max_steps, linear_solver=linear_solver)
     y0, yp0 = model.initial_state(session=session, start=start, allow_penetration=allow_penetration)
-    if model.formulation == "ggl":
+    if model.formulation == "ggl" and model.n_constraints:  # without constraints GGL is index-1
         # never ask Newton for corrections below round-off: coef * rtol >= 1e-13
         session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / rtol)))
     session.set_stall(STALL_STEP, STALL_COUNT)
     setup_time = time.perf_counter() - setup_start
-    return _run(model, session, y0, yp0, t_end, eval_times, store_steps, on_failure, progress,
-                setup_time, {"method": method, "start": start, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
-                             "max_step": max_step, "t_end": t_end, "backend": session.backend})
+    sim_params = {"method": method, "start": start, "rtol": rtol,
+                  "atol": None if atol is None else np.ravel(atol).tolist(),
+                  "max_step": max_step, "t_end": t_end, "backend": session.backend}
+    try:
+        rec = Recorder(model, parameters={**model.parameters, "simulate": sim_params}, method=method,
+                       stream_to=out.stream_to, keep_data=out.keep_data)
+    except BaseException:
+        session.close()
+        raise
+    return _run(model, session, y0, yp0, t_end, out.times, store_steps, on_failure, progress,
+                setup_time, sim_params, rec)
 
 
-def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float, eval_times: NDArray | None,
+def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float, eval_times: options.OutputTimes | None,
          store_steps: bool, on_failure: str, progress: bool, setup_time: float,
-         sim_params: dict[str, Any]) -> Result:
-    """The segment loop: advance, handle roots, restart; always returns what was computed."""
+         sim_params: dict[str, Any], rec: Recorder) -> Result:
+    """The segment loop: advance, handle roots, restart; always returns what was computed.
+
+    The output goes to ``rec`` chunk by chunk (each compiled-loop buffer, each window of output
+    times, each segment), so a run that streams to a file and keeps no steps runs in bounded memory.
+    """
     run_start = time.perf_counter()
     progress_line = _Progress(progress, t_end)
     n_terms = len(model.terms)
@@ -243,30 +282,41 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         y, yp = model.consistent_state(0.0, y0, model.term_forces(0.0, y0, active, params, session), session)
     switch = model.switch_vector(active, params)
 
-    steps_t: list[NDArray] = [np.array([0.0])]
-    steps_y: list[NDArray] = [y[None, :]]
-    steps_yp: list[NDArray] = [yp[None, :]]
-    steps_h: list[NDArray] = [np.array([0.0])]
-    steps_order: list[NDArray] = [np.array([0])]
-    steps_switch: list[NDArray] = [switch[None, :]]
-    ev_t: list[NDArray] = []
-    ev_y: list[NDArray] = []
-    ev_yp: list[NDArray] = []
-    ev_switch: list[NDArray] = []
-    if eval_times is not None and eval_times[0] == 0.0:
-        ev_t.append(np.array([0.0]))
-        ev_y.append(y[None, :])
-        ev_yp.append(yp[None, :])
-        ev_switch.append(switch[None, :])
-        pending = eval_times[1:]
-    else:
-        pending = eval_times
-    events: list[ContactEvent] = []
-    segments: list[tuple[float, float, dict[str, str]]] = []
+    # reported points not made consistent yet (IDA's raw values, with their contact switches)
+    raw: list[tuple[NDArray, NDArray, NDArray, NDArray]] = []
+    rec.add_steps(np.array([0.0]), np.array([0.0]), np.array([0]))
+    i_eval = 0  # index of the next output time
+    if eval_times is None:
+        raw.append((np.array([0.0]), y[None, :], yp[None, :], switch[None, :]))
+    elif eval_times.window(0, 1)[0] == 0.0:
+        raw.append((np.array([0.0]), y[None, :], yp[None, :], switch[None, :]))
+        i_eval = 1
+    events, segments = rec.events, rec.segments
     t = 0.0
     success, status, message = True, 0, "end of the time span reached"
     n_restarts = 0
     interrupted = False
+    c_layout = False
+
+    def flush() -> None:
+        """Make the raw points consistent and hand them, the events and the segments to the recorder.
+
+        IDA does not converge the multipliers (out of its error test) and its interpolant of them is
+        not controlled: multipliers, accelerations (and the work rate) are recomputed from every
+        point's q and v with that point's contact modes (point by point: chunks change nothing)."""
+        if raw:
+            out_t, out_y, out_yp, out_switch = (np.concatenate(c) for c in zip(*raw))
+            raw.clear()
+            if c_layout:  # one pass in C
+                out_y, out_yp, values = session.report(out_t, out_y, out_switch)
+                channels = {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(model.channel_names)}
+            else:
+                out_y, out_yp = model.consistent_state(
+                    out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)
+                channels = model.channels(out_t, out_y, out_yp, out_switch, session)
+            rec.add_points(out_t, out_y, out_yp, channels)
+        rec.flush()
+
     try:
         # the compiled loop makes states consistent itself (restarts after its own switches, the
         # reported points); the python backend leaves that to the model's Python methods
@@ -284,31 +334,26 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 states=[owners[root].pair_state(root) for root in roots])
 
         def record(adv: Any, steps: slice, evals: slice, switch: NDArray) -> None:
-            """Keep IDA's points as they are; they are made consistent in one pass at the end."""
+            """Keep IDA's points as they are; they are made consistent by flush()."""
             if store_steps and adv.step_t[steps].size:
                 k = adv.step_t[steps].size
-                steps_t.append(adv.step_t[steps])
-                steps_h.append(adv.step_h[steps])
-                steps_order.append(adv.step_order[steps])
+                rec.add_steps(adv.step_t[steps], adv.step_h[steps], adv.step_order[steps])
                 if eval_times is None:  # the steps are the output points
-                    steps_y.append(adv.step_y[steps])
-                    steps_yp.append(adv.step_yp[steps])
-                    steps_switch.append(np.repeat(switch[None, :], k, axis=0))
+                    raw.append((adv.step_t[steps], adv.step_y[steps], adv.step_yp[steps],
+                                np.repeat(switch[None, :], k, axis=0)))
             if adv.eval_t[evals].size:
                 k = adv.eval_t[evals].size
-                ev_t.append(adv.eval_t[evals])
-                ev_y.append(adv.eval_y[evals])
-                ev_yp.append(adv.eval_yp[evals])
-                ev_switch.append(np.repeat(switch[None, :], k, axis=0))
+                raw.append((adv.eval_t[evals], adv.eval_y[evals], adv.eval_yp[evals],
+                            np.repeat(switch[None, :], k, axis=0)))
 
-        # progress between the compiled loop's buffer chunks: the steps taken are not changed
-        on_chunk = ((lambda t_now, in_c=0: progress_line.update(t_now, len(events) + in_c)) if progress
-                    else None)
         seg_start = t
         while True:
-            adv = session.advance(t_end, pending, store_steps, on_chunk=on_chunk, store_states=eval_times is None)
-            if pending is not None and adv.eval_t.size:
-                pending = pending[pending > adv.eval_t[-1]]
+            window = None
+            if eval_times is not None:  # the next output times (compiled loop: at most EVAL_WINDOW of them)
+                i_eval, window = _eval_window(eval_times, i_eval, session.eval_from,
+                                              EVAL_WINDOW if c_layout else eval_times.size)
+            adv = session.advance(t_end, window, store_steps, store_states=eval_times is None, chunked=True)
+            i_eval += adv.eval_t.size
             # the C loop decided contact switches itself: split the advance at each restart and
             # record the decisions (modes, terms, latched speeds, events) in the pair logic
             s0 = e0 = 0
@@ -333,18 +378,22 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
                 adv.message = "internal: the compiled event loop left a contact root undecided"
             t, y, yp = adv.t, adv.y, adv.yp
-            if adv.status == "interrupted":  # Ctrl-C between the compiled loop's chunks: its steps are kept
-                segments.append((seg_start, t, dict(modes)))
-                seg_start = t
+            if adv.status == "interrupted":  # Ctrl-C inside the python backend's loop: its steps are kept
                 raise KeyboardInterrupt
-            progress_line.update(t, len(events))
+            if adv.status == "chunk":  # a buffer of the compiled loop is full: hand it over, go on
+                flush()
+                progress_line.update(t, rec.n_events)
+                continue
+            progress_line.update(t, rec.n_events)
             if adv.status == "error":
                 segments.append((seg_start, t, dict(modes)))
+                seg_start = math.nan
                 success, status = False, -1
                 message = _failure_message(model, adv, modes)
                 break
             if adv.status == "tstop" or t >= t_end:
                 segments.append((seg_start, t, dict(modes)))
+                seg_start = math.nan
                 break
             # a root: let every contact element decide its new modes
             before = (list(active), [p.copy() for p in params], _root_directions(model, active), dict(modes))
@@ -358,48 +407,44 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 continue  # nothing switched: IDA goes on from the root without a restart, in the same segment
             segments.append((seg_start, t, before[3]))
             seg_start = t
-            y, yp = model.consistent_state(t, y, model.term_forces(t, y, active, params, session), session,
-                                           project=True)
+            y, yp = _restart_state(model, session, t, y, yp, model.term_forces(t, y, active, params, session),
+                                   adv.roots_found)
             switch = model.switch_vector(active, params)
             session.reinit(t, y, yp, active, params, _root_directions(model, active))
             n_restarts += 1
+            flush()
     except KeyboardInterrupt:  # Ctrl-C: keep what was computed, then stop the caller too (Interrupted)
         success, status, message = False, -1, f"interrupted by the user at t={t:.6g} s"
         interrupted = True
-    finally:
-        stats = dict(session.stats())
-
-    progress_line.update(t_end if success else t, len(events))
-    step_t = np.concatenate(steps_t)
-    n_switch = switch.size
-    if eval_times is not None:
-        out_t = np.concatenate(ev_t) if ev_t else np.zeros(0)
-        out_y = np.concatenate(ev_y) if ev_y else np.zeros((0, model.n_states))
-        out_yp = np.concatenate(ev_yp) if ev_yp else np.zeros((0, model.n_states))
-        out_switch = np.concatenate(ev_switch) if ev_switch else np.zeros((0, n_switch))
-    else:
-        out_t, out_y, out_yp = step_t, np.concatenate(steps_y), np.concatenate(steps_yp)
-        out_switch = np.concatenate(steps_switch)
+    except MemoryError:  # keep (and, streamed, save) what was computed: the chunks before this one
+        raw.clear()
+        success, status = False, -1
+        message = (f"out of memory at t={t:.6g} s. Report fewer points (t_eval_step), keep no steps "
+                   "(store_steps=False) and stream the run to a file (stream_to).")
+    except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on
+        rec.abort(exc)
+        session.close()
+        raise
+    if not math.isnan(seg_start):  # stopped inside a segment: it ends where the run stopped
+        segments.append((seg_start, t, dict(modes)))
+    stats = dict(session.stats())
     post_start = time.perf_counter()
     try:
-        # IDA does not converge the multipliers (out of its error test) and its interpolant of
-        # them is not controlled: report multipliers, accelerations (and the work rate)
-        # recomputed from every point's q and v with that point's contact modes
-        if c_layout:  # one pass in C
-            out_y, out_yp, values = session.report(out_t, out_y, out_switch)
-            channels = {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(model.channel_names)}
-        else:
-            if out_t.size:
-                out_y, out_yp = model.consistent_state(
-                    out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)
-            channels = model.channels(out_t, out_y, out_yp, out_switch, session)
+        flush()
+    except BaseException as exc:
+        rec.abort(exc)
+        raise
     finally:
         session.close()
-    stats.update(n_events=len(events), n_restarts=n_restarts, setup_time=setup_time,
+
+    progress_line.update(t_end if success else t, rec.n_events)
+    stats.update(n_events=rec.n_events, n_restarts=n_restarts, setup_time=setup_time,
                  wall_time=setup_time + time.perf_counter() - run_start,
                  output_time=time.perf_counter() - post_start)
     # the start checks concern a declared state: the chapter's start is consistent by construction
-    found = physics.check_run(model, out_t, out_y, channels, y0 if sim_params["start"] == "declared" else None, stats)
+    key_t, key_y, key_channels = rec.key_rows()
+    found = physics.check_run(model, key_t, key_y, key_channels, y0 if sim_params["start"] == "declared" else None,
+                              stats)
     physics.issue(found, stacklevel=4)  # issue <- _run <- simulate <- the caller
     deep = [w for w in found if w["kind"] == "penetration" and w["t"] <= t]
     if not success and not interrupted and deep:  # the advice must fit the cause: not a tolerance problem
@@ -407,19 +452,27 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         message += (f" Before it, '{w['where']}' penetrated {w['value']:.3g} m at t={w['t']:.6g} s, more than its "
                     f"limit {w['limit']:.3g} m: the contact carries more than the joint can (friction, speed or "
                     "load); tolerances will not fix that.")
-    result = Result(
-        t=out_t, y=out_y, yp=out_yp, state_names=list(model.state_names),
-        channels=channels, units=dict(model.channel_units),
-        events=events, segments=segments, step_t=step_t, step_h=np.concatenate(steps_h),
-        step_order=np.concatenate(steps_order), stats=stats, success=success, status=status, message=message,
-        parameters={**model.parameters, "simulate": sim_params}, scene_name=model.scene_name,
-        method=sim_params["method"], formulation=model.formulation, warnings=found,
-    )
-    if interrupted:
+    result = rec.finish(stats=stats, success=success, status=status, message=message, warnings=found)
+    if interrupted or rec.interrupted:
         raise Interrupted(f"simulate: {message}; partial result in .result.", result)
     if not success and on_failure == "raise":
         raise SolveError(message + " Partial result in .result.", result)
     return result
+
+
+#: Output times handed to the compiled loop at a time: their rows are emptied between windows.
+EVAL_WINDOW = 4096
+
+
+def _eval_window(times: options.OutputTimes, i: int, t: float, size: int) -> tuple[int, NDArray]:
+    """The output times after ``t`` from index ``i`` on, at most ``size``: (index of the first, times)."""
+    while i < times.size:
+        window = times.window(i, i + size)
+        lo = int(np.searchsorted(window, t, side="right"))
+        if lo < window.size:
+            return i + lo, window[lo:]
+        i += window.size
+    return i, np.zeros(0)
 
 
 def smallest_clearance(model: DAEModel) -> float:
@@ -443,14 +496,34 @@ def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:
     return directions
 
 
+def _restart_state(model: DAEModel, session: Any, t: float, y: NDArray, yp: NDArray, forces: NDArray,
+                   found: Any) -> tuple[NDArray, NDArray]:
+    """Consistent restart after a contact switch (GGL: projected onto the constraint manifold),
+    unprojected when the projection moves a root function that did not fire across zero (it
+    would never be found again: a missed contact). The compiled loop's rule (project_kept_roots)."""
+    projected = model.consistent_state(t, y, forces, session, project=True)
+    if model.formulation != "ggl" or not model.gap_names:
+        return projected
+    g0, g1 = session.roots(t, y, yp), session.roots(t, projected[0], yp)
+    quiet = np.zeros(g0.shape, bool) if found is None else np.asarray(found).ravel() == 0
+    if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
+        return model.consistent_state(t, y, forces, session, project=False)
+    return projected
+
+
 def _failure_message(model: DAEModel, adv: Any, modes: dict[str, str]) -> str:
     """Say when, where (contact modes) and why IDA failed, and what to try."""
     in_contact = [pair for pair, mode in modes.items() if mode == "contact"]
     where = f" with {', '.join(repr(p) for p in in_contact)} in contact" if in_contact else ""
     flag = f" ({adv.flag_name})" if adv.flag_name else ""
     detail = f": {adv.message}" if adv.message else ""
-    advice = "Try a smaller max_step, a tighter rtol, or formulation='ggl'."
-    if adv.flag_name == "DC_STEP_COLLAPSE" and in_contact and any(
+    advice = "Try a smaller max_step, a tighter rtol" + (", or formulation='ggl'." if model.formulation != "ggl" else ".")
+    if adv.flag_name == "DC_MAX_STEPS":  # not an accuracy problem: the run needs more steps
+        advice = ("The run needs more steps than max_steps allows: raise max_steps (daeclear run: --max-steps) "
+                  "in proportion to the time still to go.")
+    # sticking under plain Coulomb: index-1 chatters until the stall guard stops it, GGL's Newton
+    # iteration fails to converge (or its error test fails) at the sticking point
+    elif adv.flag_name in STICKING_FLAGS and in_contact and any(
             getattr(logic, "discontinuous_friction", False) for logic in model.contacts):
         advice = ("The friction law is discontinuous at zero sliding speed (plain Coulomb) and the "
                   "contact is sticking: use the modified Coulomb law (friction=<coefficient> or "

@@ -73,7 +73,7 @@ CASES: tuple[Case, ...] = (
     Case("clearance 0.5 mm", "clearance", _sc(clearance=0.5e-3)),
     Case("clearance 0.1 mm", "clearance", _sc(clearance=0.1e-3), clearance=0.1e-3),
     Case("clearance 0.01 mm", "clearance", _sc(clearance=0.01e-3), clearance=0.01e-3),
-    Case("clearance 1 um", "clearance", _sc(clearance=1e-6), clearance=1e-6),
+    Case("clearance 1 um, index1", "clearance", _sc(clearance=1e-6), clearance=1e-6, options={"formulation": "index1"}),
     Case("clearance 1 um, GGL", "clearance", _sc(clearance=1e-6), clearance=1e-6, options={"formulation": "ggl"}),
     Case("restitution 1.0", "restitution", _sc(restitution=1.0)),
     Case("restitution 0.7", "restitution", _sc(restitution=0.7)),
@@ -86,10 +86,12 @@ CASES: tuple[Case, ...] = (
     Case("friction 0.5", "friction", _sc(friction=0.5)),
     Case("plain Coulomb 0.5 (sticking)", "friction", _sc(friction=contact.Coulomb(coefficient=0.5)),
          expect_failure=True),
-    Case("GGL formulation", "formulation", _sc(), options={"formulation": "ggl"}),
-    Case("grazing onset (1 um/s), default atol", "contact", grazing_scene, t_end=0.01, joint="bearing"),
+    Case("index1 formulation (the chapter's)", "formulation", _sc(), options={"formulation": "index1"}),
+    # the declared start: start="ideal" would centre the journal (no contact at all)
+    Case("grazing onset (1 um/s), default atol", "contact", grazing_scene, t_end=0.01, joint="bearing",
+         options={"start": "declared"}),
     Case("grazing onset (1 um/s), atol 1e-12", "contact", grazing_scene, t_end=0.01, joint="bearing",
-         options={"atol": 1e-12}),
+         options={"atol": 1e-12, "start": "declared"}),
     Case("following contact (drop and rest)", "contact", resting_scene, t_end=0.5, joint="bearing"),
 )
 

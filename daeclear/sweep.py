@@ -73,7 +73,7 @@ import numpy as np
 
 from .analysis import CHANNELS, PhasePortrait, PoincareSection
 from .errors import DaeclearError, DaeclearWarning, OutputError, SceneError
-from .outputs import check_file, deferred_sigint
+from .outputs import check_file, deferred_sigint, sigint_latch
 
 if TYPE_CHECKING:
     import h5py
@@ -1013,44 +1013,50 @@ def _execute(path: Path, todo: list[dict[str, Any]], executor: cf.Executor | Non
     parts = _parts_dir(path)
     done = failed = 0
     futures: dict[cf.Future[Any], dict[str, Any]] = {}
-    try:
-        futures = {executor.submit(_run_task, task): task for task in todo}
-        for future in cf.as_completed(futures):
-            task = futures[future]
-            try:
-                outcome = future.result()
-            except cf.BrokenExecutor as exc:
-                raise DaeclearError(f"sweep '{path}': the executor broke ({exc}): a worker died (out of memory "
-                                    f"or a crash). {done} runs were saved; run the sweep again to resume.") from exc
-            except cf.CancelledError:
-                continue
-            except Exception as exc:  # raised by the executor itself (pickling, a killed Dask worker, ...)
-                outcome = {**{k: task[k] for k in ("key", "index", "parameters")}, "status": "failed",
-                           "error": f"{type(exc).__name__}: {exc}", "traceback": tb.format_exc(),
-                           "worker": "?", "wall_time": float("nan"),
-                           "computed_at": datetime.now(timezone.utc).isoformat(timespec="seconds")}
-            if outcome["status"] == "interrupted":
-                continue  # not recorded: computed again on resume
-            _write_part(parts, outcome, mechanism, options)
-            done += 1
-            failed += outcome["status"] == "failed"
-            data = outcome.get("data") or {}
-            label = data.get("motion", {}).get("label", "FAILED") if outcome["status"] == "done" else "FAILED"
-            line.update(done, failed, f"{_short(outcome['parameters'], varying)} -> {label}")
-            if on_run is not None:
-                import h5py
+    with sigint_latch() as interrupted:  # every Ctrl-C, even one Python drops, stops the sweep
+        try:
+            futures = {executor.submit(_run_task, task): task for task in todo}
+            for future in cf.as_completed(futures):
+                if interrupted:  # a Ctrl-C that Python dropped (raised inside a weakref callback) still stops
+                    raise KeyboardInterrupt
+                task = futures[future]
+                try:
+                    outcome = future.result()
+                except cf.BrokenExecutor as exc:
+                    raise DaeclearError(f"sweep '{path}': the executor broke ({exc}): a worker died (out of "
+                                        f"memory or a crash). {done} runs were saved; run the sweep again to "
+                                        "resume.") from exc
+                except cf.CancelledError:
+                    continue
+                except Exception as exc:  # raised by the executor itself (pickling, a killed Dask worker, ...)
+                    outcome = {**{k: task[k] for k in ("key", "index", "parameters")}, "status": "failed",
+                               "error": f"{type(exc).__name__}: {exc}", "traceback": tb.format_exc(),
+                               "worker": "?", "wall_time": float("nan"),
+                               "computed_at": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+                if outcome["status"] == "interrupted":
+                    continue  # not recorded: computed again on resume
+                _write_part(parts, outcome, mechanism, options)
+                done += 1
+                failed += outcome["status"] == "failed"
+                data = outcome.get("data") or {}
+                label = data.get("motion", {}).get("label", "FAILED") if outcome["status"] == "done" else "FAILED"
+                line.update(done, failed, f"{_short(outcome['parameters'], varying)} -> {label}")
+                if on_run is not None:
+                    import h5py
 
-                with h5py.File(parts / f"{outcome['key']}.h5", "r") as f:
-                    record = _read_record(f["/"])
-                on_run(record)
-        line.update(done, failed, final=True)
-    except BaseException:
-        for future in futures:
-            future.cancel()
-        if own:
-            _terminate(executor)
-        raise
-    finally:
-        if own:
-            executor.shutdown(wait=True, cancel_futures=True)
+                    with h5py.File(parts / f"{outcome['key']}.h5", "r") as f:
+                        record = _read_record(f["/"])
+                    on_run(record)
+            if interrupted:
+                raise KeyboardInterrupt
+            line.update(done, failed, final=True)
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            if own:
+                _terminate(executor)
+            raise
+        finally:
+            if own:
+                executor.shutdown(wait=True, cancel_futures=True)
     return done

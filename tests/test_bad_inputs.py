@@ -103,6 +103,15 @@ API_SIMULATE: list[tuple[str, dict[str, Any], str, str]] = [
     ("store_steps None", {"store_steps": None}, "store_steps", "None"),
     ("track_work 1", {"track_work": 1}, "track_work", "1"),
     ("DOP853 progress text", {"method": "DOP853", "progress": "yes"}, "progress", "'yes'"),
+    ("t_eval_step 0", {"t_eval_step": 0.0}, "t_eval_step", "0.0"),
+    ("t_eval_step > t_end", {"t_eval_step": 1.0}, "t_eval_step", "1.0"),
+    ("t_eval_step nan", {"t_eval_step": NAN}, "t_eval_step", "nan"),
+    ("t_eval_step str", {"t_eval_step": "1e-5"}, "t_eval_step", "'1e-5'"),
+    ("t_eval_step with t_eval", {"t_eval_step": 1e-5, "t_eval": [0.0, TINY]}, "t_eval_step", "1e-05"),
+    ("DOP853 t_eval_step 0", {"method": "DOP853", "t_eval_step": 0.0}, "t_eval_step", "0.0"),
+    ("keep_data False without stream_to", {"keep_data": False}, "keep_data", "False"),
+    ("keep_data text", {"keep_data": "no"}, "keep_data", "'no'"),
+    ("stream_to int", {"stream_to": 3}, "stream_to", "3"),
 ]
 
 
@@ -255,6 +264,11 @@ CLI_RUN: list[tuple[str, list[str], str, str]] = [
     ("--set gravity -1", ["--set", "gravity=-1"], "gravity", "-1"),
     ("--set unknown", ["--set", "rpmm=1"], "rpmm", "rpmm"),
     ("--joint", ["--joint", "cylindrical"], "joint", "'cylindrical'"),
+    ("--t-eval-step 0", ["--t-eval-step", "0"], "--t-eval-step", "0.0"),
+    ("--t-eval-step nan", ["--t-eval-step", "nan"], "--t-eval-step", "nan"),
+    ("--t-eval-step > t_end", ["--t-eval-step", "1"], "--t-eval-step", "1.0"),
+    ("--max-steps 0", ["--max-steps", "0"], "--max-steps", "0"),
+    ("--max-steps -5", ["--max-steps=-5"], "--max-steps", "-5"),
 ]
 
 
@@ -439,3 +453,54 @@ def test_there_are_at_least_100_cases():
     n = (len(API_SIMULATE) + len(API_MECHANISMS) + len(API_STUDY) + len(API_SWEEP) + 4 + 4 + 4 + 1 + len(CLI_RUN) + 5
          + len(CLI_STUDY) + 2 + len(CLI_SWEEP) + 4 + 2 * len(SCENE_FILE) + len(MECHANISM_FILE) + 2)
     assert n >= 100, n
+
+
+# --------------------------------------------------------------------------- loads (daeclear.loads)
+
+API_LOADS: list[tuple[str, Callable[[], Any], str, str]] = [
+    # (id, the load added to the ideal slider-crank, field, value as shown)
+    ("force fx nan", lambda: dc.Force("f", "slider", fx=NAN), "fx", "nan"),
+    ("force fy text", lambda: dc.Force("f", "slider", fy="10"), "fy", "'10'"),
+    ("force on the ground", lambda: dc.Force("f", "ground", fx=1.0), "body", "'ground'"),
+    ("force frame", lambda: dc.Force("f", "slider", fx=1.0, frame="local"), "frame", "'local'"),
+    ("force at", lambda: dc.Force("f", "slider", fx=1.0, at=(1.0,)), "at", "(1.0,)"),
+    ("force unknown body", lambda: dc.Force("f", "slidr", fx=1.0), "body", "'slidr'"),
+    ("table decreasing", lambda: dc.Torque("t", "crank", dc.Table((1.0, 0.5), (0.0, 1.0))), "times", "[1.0, 0.5]"),
+    ("table lengths", lambda: dc.Torque("t", "crank", dc.Table((0.0, 0.5, 1.0), (0.0, 1.0))), "value", "3 times"),
+    ("table inf", lambda: dc.Torque("t", "crank", dc.Table((0.0, INF), (0.0, 1.0))), "times", "inf"),
+    ("expression number", lambda: dc.Torque("t", "crank", dc.Expression(lambda t, s, p: p.a, a=NAN)), "a", "nan"),
+    ("expression math", lambda: dc.Torque("t", "crank", dc.Expression(lambda t, s, p: math.exp(-t))), "value",
+     "does not run on CasADi"),
+    ("expression if", lambda: dc.Torque("t", "crank", dc.Expression(lambda t, s, p: 1.0 if s.speed > 0 else 0.0)),
+     "value", "does not run on CasADi"),
+    ("expression raises", lambda: dc.Torque("t", "crank", dc.Expression(lambda t, s, p: p.missing)), "value",
+     "missing"),
+    ("torque reaction itself", lambda: dc.Torque("t", "crank", 1.0, reaction="crank"), "reaction", "'crank'"),
+    ("spring stiffness < 0", lambda: dc.SpringDamper("s", "ground", "slider", at_i=(0.0, 0.0), at_j=(0.17, 0.0),
+                                                     stiffness=-5.0), "stiffness", "-5.0"),
+    ("spring damping nan", lambda: dc.SpringDamper("s", "ground", "slider", at_i=(0.0, 0.0), at_j=(0.17, 0.0),
+                                                   damping=NAN), "damping", "nan"),
+    ("spring points coincide", lambda: dc.SpringDamper("s", "ground", "slider", at_i=(0.17, 0.0),
+                                                       at_j=(0.17, 0.0), stiffness=1.0), "at_i", "(0.17, 0.0)"),
+    ("spring free length < 0", lambda: dc.SpringDamper("s", "ground", "slider", at_i=(0.0, 0.0), at_j=(0.17, 0.0),
+                                                       free_length=-0.1), "free_length", "-0.1"),
+    ("torsion same body", lambda: dc.RotationalSpringDamper("r", "rod", "rod", stiffness=1.0), "body_j", "'rod'"),
+    ("torsion free angle inf", lambda: dc.RotationalSpringDamper("r", "crank", "rod", free_angle=INF), "free_angle",
+     "inf"),
+    ("motor stall 0", lambda: dc.Motor("m", "ground", "crank", stall_torque=0.0, no_load_speed=300.0),
+     "stall_torque", "0.0"),
+    ("motor signs", lambda: dc.Motor("m", "ground", "crank", stall_torque=2.0, no_load_speed=-300.0),
+     "no_load_speed", "-300.0"),
+    ("motor unknown body", lambda: dc.Motor("m", "gound", "crank", stall_torque=2.0, no_load_speed=300.0),
+     "body_i", "'gound'"),
+]
+
+
+@pytest.mark.parametrize("case, build, field, shown", API_LOADS, ids=[c[0] for c in API_LOADS])
+def test_loads_refuse(case, build, field, shown):
+    scene = dc.mechanisms.slider_crank("ideal")
+    scene.add(build())
+    with pytest.raises(SceneError) as info:
+        dc.assemble(scene)
+    text = str(info.value)
+    assert field in text and shown in text, text

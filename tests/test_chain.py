@@ -23,11 +23,14 @@ from daeclear.scenefile import MECHANISMS, read_scene_file
 
 @pytest.mark.parametrize("n", [1, 2, 3, 5])
 def test_sizes_free_and_driven(n: int) -> None:
-    """States are q 3N + v 3N + lambda m: no constraint when free, pin + driver (m = 3) when driven."""
-    free = dc.assemble(chain(n)).summary()
+    """States are q 3N + v 3N + lambda m (index-1), + mu m (GGL, the default): no constraint when
+    free, pin + driver (m = 3) when driven."""
+    free = dc.assemble(chain(n), "index1").summary()
     assert free == {**free, "bodies": n, "states": 6 * n, "constraints": 0, "terms": n, "gaps": n}
-    driven = dc.assemble(chain(n, rpm=600.0)).summary()
+    driven = dc.assemble(chain(n, rpm=600.0), "index1").summary()
     assert driven == {**driven, "bodies": n, "states": 6 * n + 3, "constraints": 3, "terms": n - 1, "gaps": n - 1}
+    assert dc.assemble(chain(n)).summary()["states"] == 6 * n
+    assert dc.assemble(chain(n, rpm=600.0)).summary()["states"] == 6 * n + 6
 
 
 def test_scene_layout() -> None:

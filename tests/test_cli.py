@@ -37,7 +37,7 @@ def test_run_scene_file(tmp_path):
 @pytest.mark.parametrize(
     "args, text",
     [
-        (["run", "four_bar"], "neither a scene file nor a mechanism"),
+        (["run", "five_bar"], "neither a scene file nor a mechanism"),  # four_bar is one now
         (["run", "slider_crank", "--set", "rpmm=1"], "unknown option(s) rpmm"),
         (["run", "slider_crank", "--set", "rpm"], "expected KEY=VALUE"),
     ],

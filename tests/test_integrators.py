@@ -27,12 +27,12 @@ def slider_x(t):
 
 @pytest.fixture(scope="module")
 def ideal():
-    return dc.assemble(dc.mechanisms.slider_crank("ideal", gravity=0.0))
+    return dc.assemble(dc.mechanisms.slider_crank("ideal", gravity=0.0), "index1")  # the non-IDA methods integrate index-1
 
 
 @pytest.fixture(scope="module")
 def clearance():
-    return dc.assemble(dc.mechanisms.slider_crank("revolute", gravity=0.0))
+    return dc.assemble(dc.mechanisms.slider_crank("revolute", gravity=0.0), "index1")
 
 
 # ----------------------------------------------------------------------------- ideal mechanism
@@ -196,7 +196,7 @@ def test_bad_method_step_and_formulation(ideal):
 
 def test_failing_run_returns_partial_result():
     # a model of its own: a run that ends in a blow-up may leave its contact logic in a storm state
-    clearance = dc.assemble(dc.mechanisms.slider_crank("revolute", gravity=0.0))
+    clearance = dc.assemble(dc.mechanisms.slider_crank("revolute", gravity=0.0), "index1")
     result = dc.simulate(clearance, 0.024, method="euler", step=1e-4, on_failure="return")
     assert not result.success and result.status == -1
     assert result.message.startswith("euler failed at t=")
@@ -226,7 +226,7 @@ def test_without_a_compiler_falls_back_to_python(monkeypatch, tmp_path):
     monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
     monkeypatch.setenv("DAECLEAR_CACHE_DIR", str(tmp_path))  # nothing cached there
     clear_memos()  # nor loaded in this process (models of one structure share their library)
-    model = dc.assemble(dc.mechanisms.slider_crank("ideal", gravity=0.0))
+    model = dc.assemble(dc.mechanisms.slider_crank("ideal", gravity=0.0), "index1")
     with pytest.warns(dc.DaeclearWarning, match="compiled right-hand side is unavailable"):
         result = dc.simulate(model, 1e-3, method="rk4", step=1e-5)
     assert result.success and result.stats["backend"] == "python"

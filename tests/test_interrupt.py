@@ -76,16 +76,22 @@ def test_ctrl_c_with_on_failure_raise_is_not_a_solve_error(ctrl_c_after):
 
 
 def test_cli_run_ctrl_c_saves_the_partial_result_once(ctrl_c_after, tmp_path, capsys, monkeypatch):
-    saves = []
+    """The run streams to its file (daeclear.result.ResultWriter): the file is completed once, when the run
+    stops, and not written again by Result.save."""
+    from daeclear.result import ResultWriter
+
+    saves, closes = [], []
     original = dc.Result.save
     monkeypatch.setattr(dc.Result, "save", lambda self, path: saves.append(path) or original(self, path))
+    close = ResultWriter.close
+    monkeypatch.setattr(ResultWriter, "close", lambda self, **kw: closes.append(self.path) or close(self, **kw))
     ctrl_c_after(4)
     code = main(["run", "slider_crank", "--joint", "revolute", "--t-end", str(T_END), "--out", str(tmp_path)])
     assert code == 130
     err = capsys.readouterr().err
     h5 = tmp_path / "slider_crank_revolute.h5"
     assert f"interrupted, partial result saved to {h5}" in err and "Traceback" not in err
-    assert saves == [h5]  # once
+    assert closes == [h5] and saves == []  # once
     partial = dc.load(h5)
     assert not partial.success and "interrupted" in partial.message and 0 < partial.t[-1] < T_END
     assert sorted(p.name for p in tmp_path.iterdir()) == [h5.name]  # no figure, no temporary file
@@ -113,19 +119,25 @@ def test_second_ctrl_c_during_the_save_does_not_lose_it(tmp_path, monkeypatch):
 
 
 def test_cli_second_ctrl_c_during_the_partial_save(ctrl_c_after, tmp_path, capsys, monkeypatch):
+    """A real SIGINT while the streamed file is completed (its statistics written): held back until it is."""
     import daeclear.result as result_module
 
-    original = result_module._write
+    original, close = result_module._mirror, result_module.ResultWriter.close
+    closing, sent = [], []
 
-    def write_then_ctrl_c(f, r):
-        os.kill(os.getpid(), signal.SIGINT)
-        original(f, r)
+    def mirror_then_ctrl_c(group, tree):
+        if closing and not sent:
+            sent.append(os.kill(os.getpid(), signal.SIGINT))
+            time.sleep(0.01)
+        original(group, tree)
 
-    monkeypatch.setattr(result_module, "_write", write_then_ctrl_c)
+    monkeypatch.setattr(result_module, "_mirror", mirror_then_ctrl_c)
+    monkeypatch.setattr(result_module.ResultWriter, "close", lambda self, **kw: closing.append(1) or close(self, **kw))
     ctrl_c_after(4)
     assert main(["run", "slider_crank", "--joint", "revolute", "--t-end", str(T_END), "--out", str(tmp_path)]) == 130
-    assert "partial result saved" in capsys.readouterr().err
-    assert not dc.load(tmp_path / "slider_crank_revolute.h5").success
+    assert sent and "partial result saved" in capsys.readouterr().err
+    partial = dc.load(tmp_path / "slider_crank_revolute.h5")
+    assert not partial.success and "interrupted" in partial.message and partial.stats["n_steps"] > 0
 
 
 STUDY = ["study", "slider_crank", "--joint", "ideal", "--t-end", "0.002", "--methods", "ida,rk4", "--rtols", "1e-5",
@@ -256,3 +268,27 @@ def test_sweep_killed_hard_leaves_no_worker(tmp_path):
         except ProcessLookupError:
             pass
     assert len(load_sweep(path)) >= 1  # the journal of finished runs survives; the next call resumes
+
+
+def test_a_ctrl_c_python_drops_is_still_latched(monkeypatch):
+    """Python drops a KeyboardInterrupt raised inside a weakref callback ("Exception ignored"):
+    the sweep's loop checks the latch between runs, so such a Ctrl-C still stops it."""
+    import gc
+    import weakref
+
+    from daeclear.outputs import sigint_latch
+
+    dropped: list[type] = []
+    monkeypatch.setattr(sys, "unraisablehook", lambda unraisable: dropped.append(unraisable.exc_type))
+
+    class Target:
+        pass
+
+    with sigint_latch() as received:
+        target = Target()
+        weakref.finalize(target, signal.raise_signal, signal.SIGINT)
+        del target  # the callback runs now; its KeyboardInterrupt is printed and dropped
+        gc.collect()
+        assert received == [signal.SIGINT]
+    assert dropped == [KeyboardInterrupt]  # Python dropped it: only the latch remembers
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored

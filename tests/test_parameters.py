@@ -54,6 +54,14 @@ VARIANTS = {
     "section-4.3": (dict(joint="translational", contact_model="section-4.3"),
                     dict(joint="translational", clearance=0.6e-3, contact_model="section-4.3", restitution=0.8)),
     "ideal": (dict(joint="ideal"), dict(joint="ideal", rpm=1234.0, gravity=3.0)),
+    # readings of the translational joint (daeclear.readings): their K, n, c_e, the slider's mass and
+    # inertia and the pin's place on it are numbers
+    "reading-unified": (dict(joint="translational", reading="unified"),
+                        dict(joint="translational", reading="unified", clearance=0.3e-3, restitution=0.8,
+                             slider_mass=0.9, slider_inertia=4e-4, pin_offset=(-0.02, 0.004))),
+    "reading-pseudo-corners": (dict(joint="translational", reading="pseudo-corners", friction=0.1),
+                               dict(joint="translational", reading="pseudo-corners", friction=0.01, gravity=0.0,
+                                    pin_offset=(0.01, 0.0), slider_mass=0.5)),
 }
 
 
@@ -72,6 +80,31 @@ def test_shared_template_equals_a_fresh_build(variant):
             np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
     np.testing.assert_array_equal(shared.q_guess, fresh.q_guess)
     np.testing.assert_array_equal(shared.mass_diagonal, fresh.mass_diagonal)
+
+
+# the other ready mechanisms: (builder, scene built first, other numbers with the same structure)
+MECHANISM_VARIANTS = {
+    "four_bar": (dc.mechanisms.four_bar, dict(clearance_joints=("B", "C")),
+                 dict(clearance_joints=("B", "C"), clearance={"B": 0.2e-3, "C": 0.3e-3}, rpm=3000.0,
+                      crank_angle=0.4, bearing_radius=12e-3, restitution=0.7)),
+    "double_pendulum": (dc.mechanisms.double_pendulum, dict(clearance_joints=("A", "B")),
+                        dict(clearance_joints=("A", "B"), clearance=0.3e-3, angles=(0.3, -0.2), link_mass=0.5,
+                             gravity=3.0)),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(MECHANISM_VARIANTS))
+def test_ready_mechanisms_share_their_template(variant):
+    build, base, kwargs = MECHANISM_VARIANTS[variant]
+    first = dc.assemble(build(**base))
+    shared = dc.assemble(build(**kwargs))
+    assert shared.functions is first.functions, "numbers only: the template must be reused"
+    assert not np.array_equal(shared.parameter_values, first.parameter_values)
+    clear_memos()
+    fresh = dc.assemble(build(**kwargs))
+    assert fresh.functions is not shared.functions
+    for a, b in zip(_functions_at(shared, 1), _functions_at(fresh, 1)):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
 
 
 def test_new_numbers_compile_nothing_and_keep_the_physics():
@@ -97,12 +130,38 @@ def test_structure_changes_get_their_own_template():
     different = [dict(friction=0.1), dict(restitution=1.0), dict(law="hertz")]
     for kwargs in different:
         assert dc.assemble(dc.mechanisms.slider_crank("revolute", **kwargs)).functions is not reference, kwargs
-    assert dc.assemble(dc.mechanisms.slider_crank("revolute"), formulation="ggl").functions is not reference
+    assert (dc.assemble(dc.mechanisms.slider_crank("revolute"), formulation="ggl").functions
+            is not dc.assemble(dc.mechanisms.slider_crank("revolute"), formulation="index1").functions)
     assert dc.assemble(dc.mechanisms.slider_crank("revolute"), track_work=True).functions is not reference
 
 
+def test_translational_readings_change_the_structure_only_with_the_equations():
+    base = dict(joint="translational", reading="pseudo-corners")
+    reference = dc.assemble(dc.mechanisms.slider_crank(**base))
+    for kwargs in (dict(slider_mass=0.98, slider_inertia=4.1e-4), dict(pin_offset=(-0.025, 0.0)), dict(gravity=0.0),
+                   dict(restitution=0.7)):
+        model = dc.assemble(dc.mechanisms.slider_crank(**base, **kwargs))
+        assert model.functions is reference.functions, kwargs
+    assert reference.parameter("clearance.law.stiffness")[0] == pytest.approx(5.98612e9, rel=1e-5)  # (4.27)
+    assert reference.parameter("clearance.law.exponent")[0] == 1.5
+    moved = dc.assemble(dc.mechanisms.slider_crank(**base, pin_offset=(-0.025, 0.003), slider_mass=0.98))
+    assert moved.parameter("C.s_j").tolist() == pytest.approx([-0.025, 0.003])  # the pin, slider coordinates
+    assert moved.parameter("slider.mass")[0] == 0.98
+    linear = dc.assemble(dc.mechanisms.slider_crank(joint="translational", reading="pseudo-corners-linear"))
+    assert linear.functions is not reference.functions  # n = 1: the law's linear branch
+    faces = dc.assemble(dc.mechanisms.slider_crank(joint="translational", reading="unified"))
+    assert faces.functions is not reference.functions  # face terms
+    # a reading's name is not structure: corners ((3.5)) and pseudo-corners ((4.27)) differ in K only
+    corners = dc.assemble(dc.mechanisms.slider_crank(joint="translational"))
+    assert corners.functions is reference.functions
+    assert corners.parameter("clearance.law.stiffness")[0] != reference.parameter("clearance.law.stiffness")[0]
+    # while the model a reading selects is (section-4.3: face terms, like 'unified')
+    section = dc.assemble(dc.mechanisms.slider_crank(joint="translational", reading="section-4.3"))
+    assert section.functions is not reference.functions
+
+
 def test_named_parameters():
-    model = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.3e-3, rpm=6000.0), alpha=7.0)
+    model = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.3e-3, rpm=6000.0), "index1", alpha=7.0)
     assert model.parameter("clearance.clearance")[0] == pytest.approx(0.3e-3)
     assert model.parameter("drive.speed")[0] == pytest.approx(6000.0 * np.pi / 30.0)
     assert model.parameter("baumgarte.alpha")[0] == 7.0
@@ -154,14 +213,14 @@ def test_drift_against_the_smallest_clearance_is_reported():
     drift-free GGL formulation stays far below it."""
     scene = dc.mechanisms.slider_crank("revolute", clearance=1e-5)
     with pytest.warns(dc.DaeclearWarning, match="constraints drifted"):
-        drifting = dc.simulate(scene, t_end=0.002, rtol=1e-6)
+        drifting = dc.simulate(scene, t_end=0.002, rtol=1e-6, formulation="index1")
     assert drifting.stats["max_constraint_drift"] > 1e-8
     import warnings
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", dc.DaeclearWarning)
         exact = dc.simulate(scene, t_end=0.002, rtol=1e-6, formulation="ggl")
-        chapter = dc.simulate(dc.mechanisms.slider_crank("revolute"), t_end=0.002, rtol=1e-6)
+        chapter = dc.simulate(dc.mechanisms.slider_crank("revolute"), t_end=0.002, rtol=1e-6, formulation="index1")
     assert exact.stats["max_constraint_drift"] < 1e-2 * drifting.stats["max_constraint_drift"]
     assert chapter.stats["max_constraint_drift"] < 1e-3 * 0.5e-3
 
@@ -211,6 +270,57 @@ def test_a_damaged_cached_library_is_built_again(tmp_path):
     (library,) = tmp_path.glob("dc_*.so")
     library.write_bytes(library.read_bytes()[: library.stat().st_size * 9 // 10])  # keeps its build tag
     assert run() == ["True", "True"]  # built again, not loaded
+
+
+def _loaded_crank(scale: float) -> dc.Scene:
+    """The revolute-clearance slider-crank with every kind of load (daeclear.loads), its numbers
+    multiplied by ``scale``: the structure does not change with ``scale``."""
+    scene = dc.mechanisms.slider_crank("revolute", rpm=3000.0 * scale)
+    ramp = dc.Table((0.0, 1e-3 * scale, 2e-3), (0.0, 5.0 * scale, 2.0))
+    wave = dc.Expression(lambda t, s, p: p.F * dc.loads.sin(p.w * t) - p.c * s.vx, F=3.0 * scale, w=900.0, c=0.1 * scale)
+    scene.add(dc.Force("push", "slider", fx=wave, fy=ramp, at=(0.17, 0.01 * scale)))
+    scene.add(dc.Force("follower", "rod", fx=1.0 * scale, frame="body"))
+    scene.add(dc.Torque("twist", "rod", dc.Expression(lambda t, s, p: -p.k * s.angle, k=0.2 * scale),
+                        reaction="crank"))
+    scene.add(dc.SpringDamper("spring", "ground", "slider", at_i=(0.3, 0.0), at_j=(0.17, 0.0),
+                              stiffness=100.0 * scale, damping=0.5 * scale, free_length=0.1 * scale))
+    scene.add(dc.RotationalSpringDamper("torsion", "crank", "rod", stiffness=0.5 * scale, damping=1e-3 * scale))
+    scene.add(dc.Motor("motor", "ground", "crank", stall_torque=2.0 * scale, no_load_speed=300.0 * scale))
+    return scene
+
+
+def test_loads_are_parameters_new_numbers_compile_nothing():
+    first = dc.assemble(_loaded_crank(1.0), track_work=True)
+    shared = dc.assemble(_loaded_crank(1.7), track_work=True)
+    assert shared.functions is first.functions, "numbers only: the template must be reused"
+    assert shared.parameter("spring.stiffness")[0] == pytest.approx(170.0)
+    assert shared.parameter("push.fy.times").tolist() == pytest.approx([0.0, 1.7e-3, 2e-3])
+    assert shared.parameter("push.fx.F")[0] == pytest.approx(5.1)
+    assert shared.parameter("motor.no_load_speed")[0] == pytest.approx(510.0)
+    clear_memos()
+    fresh = dc.assemble(_loaded_crank(1.7), track_work=True)
+    assert fresh.functions is not shared.functions
+    for seed in (1, 2):
+        for a, b in zip(_functions_at(shared, seed), _functions_at(fresh, seed)):
+            np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+    base = dc.simulate(_loaded_crank(1.0), t_end=2e-4, rtol=1e-6)
+    again = dc.simulate(_loaded_crank(1.3), t_end=2e-4, rtol=1e-6)
+    assert base.stats["compile_time"] >= 0.0 and again.stats["compile_time"] == 0.0
+
+
+def test_load_structure_changes_get_their_own_template():
+    reference = dc.assemble(_loaded_crank(1.0)).functions
+    scene = _loaded_crank(1.0)
+    i = next(k for k, e in enumerate(scene.elements) if e.name == "push")
+    scene.elements[i] = dataclasses.replace(scene.elements[i], fy=dc.Table((0.0, 1e-3), (0.0, 5.0)))  # 2 points
+    assert dc.assemble(scene).functions is not reference
+    scene = _loaded_crank(1.0)
+    scene.elements[i] = dataclasses.replace(scene.elements[i], fy=4.0)  # a number, not a table
+    assert dc.assemble(scene).functions is not reference
+    scene = _loaded_crank(1.0)
+    j = next(k for k, e in enumerate(scene.elements) if e.name == "follower")
+    scene.elements[j] = dataclasses.replace(scene.elements[j], frame="world")
+    assert dc.assemble(scene).functions is not reference
 
 
 def _driven(kind: str, second: bool) -> dc.Scene:

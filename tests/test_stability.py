@@ -23,7 +23,7 @@ def test_case_finishes_bounded_or_fails_clearly(name):
 
 def test_drift_larger_than_a_tiny_clearance_is_flagged():
     """index1's Baumgarte drift at rtol 1e-6 (~1 um) swamps a 1 um clearance: reported, not hidden."""
-    case = next(c for c in CASES if c.name == "clearance 1 um")
+    case = next(c for c in CASES if c.name == "clearance 1 um, index1")
     row = run_case(case, rtol=1e-6, n_eval=2001)
     assert row["finished"] and not row["passed"]
     assert row["drift"] > row["drift_bound"] == pytest.approx(0.5e-6)

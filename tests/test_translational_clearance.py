@@ -192,10 +192,13 @@ def test_moving_tilted_guide_conserves_momentum(friction):
         assert total[-1] < 0.99 * total[0] and np.all(np.diff(total) < 1e-9 * total[0])
 
 
-def test_energy_conserved_in_the_free_slider_crank():
+@pytest.mark.parametrize("formulation, rtol", [("index1", 1e-8), ("ggl", 1e-9)])
+def test_energy_conserved_in_the_free_slider_crank(formulation, rtol):
+    """Measured: index1 loses 7.7e-7 of the energy at rtol 1e-8; GGL 4.2e-6 at 1e-8 (in the free
+    phases, not at its projected restarts) and 1.1e-6 at 1e-9: GGL needs one decade more here."""
     scene = dc.mechanisms.slider_crank("translational", gravity=0.0, restitution=1.0)
     scene.elements = [e for e in scene.elements if not isinstance(e, Driver)]
-    result = dc.simulate(scene, 0.05, start="declared", rtol=1e-8)
+    result = dc.simulate(scene, 0.05, start="declared", rtol=rtol, formulation=formulation)
     assert len(result.events.of(kind="onset")) > 50
     total = result["energy.mechanical"] + result["clearance.elastic_energy"]
     assert np.ptp(total) / total[0] < 2e-6

@@ -77,6 +77,7 @@ Example
 
 from __future__ import annotations
 
+from . import _backend as backend  # the math of laws written once for numbers and CasADi (public name)
 from .base import KINDS, NormalLaw
 from .cylindrical import DubowskyFreudenstein, ESDU78035, Goldsmith
 from .friction import Coulomb, FrictionLaw, ModifiedCoulomb, NoFriction
@@ -89,7 +90,7 @@ from .normal import Flores, Hertz, HuntCrossley, KelvinVoigt, LankaraniNikravesh
 from .registry import FRICTION_LAWS, NORMAL_LAWS, friction_law, normal_law
 
 __all__ = [
-    "Coulomb", "DubowskyFreudenstein", "ESDU78035", "FRICTION_LAWS", "Flores", "FrictionLaw", "Goldsmith",
+    "Coulomb", "DubowskyFreudenstein", "backend", "ESDU78035", "FRICTION_LAWS", "Flores", "FrictionLaw", "Goldsmith",
     "Hertz", "HuntCrossley", "ImpactResult", "KINDS", "KelvinVoigt", "LankaraniNikravesh", "LankaraniPlane",
     "Material", "ModifiedCoulomb", "NORMAL_LAWS", "NoFriction", "NormalLaw", "external_contact_stiffness",
     "friction_law", "internal_contact_stiffness", "normal_law", "plane_face_stiffness", "simulate_impact",

@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 
 __all__ = [
-    "as_numeric", "exp", "fabs", "fmax", "fmin", "if_else", "is_symbolic", "log", "log1p",
-    "sign", "sqrt",
+    "as_numeric", "atan2", "cos", "exp", "fabs", "fmax", "fmin", "if_else", "is_symbolic", "log", "log1p",
+    "sign", "sin", "sqrt", "tanh",
 ]
 
 
@@ -75,6 +75,26 @@ def exp(x: Any) -> Any:
 def sqrt(x: Any) -> Any:
     """Square root."""
     return _ca().sqrt(x) if is_symbolic(x) else np.sqrt(x)
+
+
+def sin(x: Any) -> Any:
+    """Sine."""
+    return _ca().sin(x) if is_symbolic(x) else np.sin(x)
+
+
+def cos(x: Any) -> Any:
+    """Cosine."""
+    return _ca().cos(x) if is_symbolic(x) else np.cos(x)
+
+
+def tanh(x: Any) -> Any:
+    """Hyperbolic tangent (a smooth sign: ``tanh(x / eps)``)."""
+    return _ca().tanh(x) if is_symbolic(x) else np.tanh(x)
+
+
+def atan2(y: Any, x: Any) -> Any:
+    """Angle of the vector (x, y), in (-pi, pi]."""
+    return _ca().atan2(y, x) if is_symbolic(y, x) else np.arctan2(y, x)
 
 
 def sign(x: Any) -> Any:

@@ -26,7 +26,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sundials_min.h"
+/* The SUNDIALS 7.9.0 headers vendored in csrc/sundials/include (see its README): the wheel's
+ * libsundials_ida is IDA, declared here by IDAS' header of the same release, whose IDA* API is
+ * IDA's with sensitivity functions added (same names, signatures and constants); the link uses
+ * -z defs, so a function the IDA library lacks fails the build. sundials_config.h #errors when
+ * codegen's -DDC_SUNDIALS_MAJOR/_MINOR/_PATCH or -DDC_INDEX_SIZE disagree with the headers. */
+#include <idas/idas.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_core.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunmatrix/sunmatrix_sparse.h>
 #include "dc_model.h"
 #include "dc_linalg.h"
 
@@ -37,6 +47,22 @@
 #endif
 #ifndef DC_HAVE_SPARSE /* 1 when the wheel's sparse matrix and SuperLU_MT libraries are linked */
 #define DC_HAVE_SPARSE 0
+#endif
+#if !defined(DC_SUNDIALS_MAJOR) || !defined(DC_INDEX_SIZE) /* given by daeclear.codegen */
+#error "compile with -DDC_SUNDIALS_MAJOR/_MINOR/_PATCH and -DDC_INDEX_SIZE as daeclear.codegen does"
+#endif
+_Static_assert(8 * sizeof(sunindextype) == DC_INDEX_SIZE, "sunindextype is not DC_INDEX_SIZE bits wide");
+_Static_assert(sizeof(sunrealtype) == sizeof(double), "sunrealtype is not double");
+
+#if DC_HAVE_SPARSE
+/* SuperLU_MT's SUNDIALS header (sunlinsol/sunlinsol_superlumt.h) includes SuperLU_MT's own
+ * headers for the solver's content structure, and neither wheel that ships SUNDIALS 7.9.0
+ * (scikit-sundae: no headers; sundials4py: no SuperLU_MT) has them; this constructor is the one
+ * function of it the driver calls, declared as in that header (unchanged in SUNDIALS 7.0-7.6,
+ * and as scikit-sundae 1.2.0 declares it for the 7.9.0 libraries). Every other operation goes
+ * through the generic SUNLinearSolver API of the vendored headers. */
+SUNDIALS_EXPORT SUNLinearSolver SUNLinSol_SuperLUMT(N_Vector y, SUNMatrix A, int num_threads,
+                                                    SUNContext sunctx);
 #endif
 
 /* linear solvers of dc_open */
@@ -193,6 +219,7 @@ typedef struct {
    * jp_rowind/data position jmap[jmap_off[p] + i]. */
   int lin_sparse;          /* DC_LS_SPARSE: s->A is that SUNSparseMatrix, s->LS SuperLU_MT */
   int lu_factored;         /* a Jacobian was handed to the sparse LS (it has factorized) */
+  SUNErrCode (*lu_initialize)(SUNLinearSolver); /* SuperLU_MT's own, see keep_first_factorization */
   dc_int jp_nnz;
   sunindextype* jp_colptr; /* [n + 1] */
   sunindextype* jp_rowind; /* [jp_nnz], rows sorted within each column */
@@ -201,6 +228,13 @@ typedef struct {
   double* P;       /* run-time parameters, dc_model.n_parameters */
   double t_now;    /* time of the state in yy/yp (last return) */
   double t_rec;    /* time of the last recorded step (to skip duplicates) */
+  /* A step that filled the caller's last output row with output times left inside it: dc_advance
+   * returned DC_CHUNK at once and the rest of that step (its remaining output times from carry_lo
+   * on, recording, stall and root handling) resumes at the next call; IDA's interpolant is kept. */
+  int carry;
+  int carry_flag, carry_order;
+  double carry_lo, carry_t_prev, carry_h;
+  long int carry_nst, carry_nst_prev;
   int ready;       /* reinit was called */
   int tiny;        /* tiny, non-growing steps since the last normal step */
   double stall_step; /* absolute tiny-step threshold (0: relative test only), see dc_set_stall */
@@ -521,41 +555,17 @@ static SUNErrCode keep_factorization(SUNLinearSolver S) {
   return 0;
 }
 
-/* The ops table of a SuperLU_MT solver, found by value: the pointer field right after the
- * content (7.0-7.5) or the one after that (7.9) that points at a table starting with its
- * gettype and getid operations. Both fields exist in either layout (the second is the context
- * pointer in the older one), so nothing beyond the structure is read. */
-static dc_sun_op* find_ops(SUNLinearSolver LS) {
-  void** head = (void**)LS;
-  for (int i = 1; i <= 2; ++i) {
-    dc_sun_op* ops = (dc_sun_op*)head[i];
-    if (ops && ops[0] == (dc_sun_op)SUNLinSolGetType_SuperLUMT &&
-        ops[1] == (dc_sun_op)SUNLinSolGetID_SuperLUMT)
-      return ops;
-  }
-  return NULL;
-}
-
-/* Replace the initialize operation by keep_factorization (in this solver's own ops table: every
- * SUNLinearSolver has one, so no other solver is affected). Its slot lies between getid and
- * free, the table's last operation; it must be there exactly once. Returns 0, or -1 (left as
- * is: dc_open then refuses the sparse solver, and "auto" falls back to dense). */
-static int patch_initialize(SUNLinearSolver LS) {
-  dc_sun_op* ops = find_ops(LS);
-  int slot = -1;
-  if (!ops) return -1;
-  for (int i = 2; i < 64; ++i) {
-    if (ops[i] == (dc_sun_op)SUNLinSolFree_SuperLUMT) {
-      if (slot < 0) return -1;
-      ops[slot] = (dc_sun_op)keep_factorization;
-      return 0;
-    }
-    if (ops[i] == (dc_sun_op)SUNLinSolInitialize_SuperLUMT) {
-      if (slot >= 0) return -1;
-      slot = i;
-    }
-  }
-  return -1;
+/* Initialize the solver once (its first factorization sets the ordering and storage), then
+ * replace the initialize operation in this solver's own operations table (every
+ * SUNLinearSolver has its own, so no other solver is affected) by keep_factorization. The
+ * original operation is kept in the session for free_superlumt. Returns the initialize result. */
+static int keep_first_factorization(dc_session* s) {
+  SUNErrCode (*init)(SUNLinearSolver) = s->LS->ops->initialize;
+  if (!init) return -1;
+  s->lu_initialize = init;
+  if (init(s->LS) != 0) return -1;
+  s->LS->ops->initialize = keep_factorization;
+  return 0;
 }
 
 /* SUNLinSolFree_SuperLUMT reads uninitialized options when the solver never factorized (a
@@ -564,7 +574,7 @@ static void free_superlumt(dc_session* s) {
   if (!s->lu_factored) {
     SUNMatrix I = SUNSparseMatrix(s->n, s->n, s->n, CSC_MAT, s->ctx);
     if (!I) return; /* leave the solver allocated rather than crash */
-    SUNLinSolInitialize_SuperLUMT(s->LS); /* the real one: this is a first factorization */
+    if (s->lu_initialize) s->lu_initialize(s->LS); /* the real one: a first factorization */
     sunindextype* cp = SUNSparseMatrix_IndexPointers(I);
     sunindextype* ri = SUNSparseMatrix_IndexValues(I);
     double* d = SUNSparseMatrix_Data(I);
@@ -953,9 +963,9 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
     (void)jac_storage(s, s->A); /* a valid pattern from the start */
     s->LS = SUNLinSol_SuperLUMT(s->yy, s->A, 1, s->ctx);
     if (!s->LS) FAIL("SUNLinSol_SuperLUMT failed");
-    if (SUNLinSolInitialize_SuperLUMT(s->LS) != 0 || patch_initialize(s->LS) != 0)
-      FAIL("the SuperLU_MT solver of this SUNDIALS build cannot keep its factorization across "
-           "restarts (unexpected operations table); use linear_solver='dense'");
+    if (keep_first_factorization(s) != 0)
+      FAIL("the SuperLU_MT solver of this SUNDIALS build could not be initialized; "
+           "use linear_solver='dense'");
 #endif
   } else {
     s->A = SUNDenseMatrix(n, n, s->ctx);
@@ -1047,6 +1057,7 @@ DC_API int dc_reinit(void* sp, double t0, const double* y0, const double* yp0,
   }
   s->t_now = t0;
   s->t_rec = t0;
+  s->carry = 0;
   s->tiny = 0;
   s->h_prev = 0.0;
   s->ready = 1;
@@ -1195,6 +1206,7 @@ DC_API int dc_automaton_run(int n, const double* t, const int* dir, const double
  * goes on without a restart), 0 without configured pairs (Python decides), -1 on failure. */
 /* below, with dc_set_layout */
 static int project_state(dc_session* s, double t, double* y);
+static int project_kept_roots(dc_session* s, double t, double* y, const double* yp);
 static int make_consistent(dc_session* s, double t, double* y, double* yp, const int* on, const double* par);
 
 static int auto_handle_root(dc_session* s, double t, double t_stop) {
@@ -1238,11 +1250,15 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
   if (!switched) return 2;
   /* consistent restart: GGL on the constraint manifold with mu = 0; then multipliers and
    * derivatives from the generated solve with the new set of contact forces */
-  if (s->proj_on && project_state(s, t, y) != 0) {
-    s->ready = 0;
-    set_msg(s->msg, "projecting the state onto the constraints after a contact event at t=%.17g failed "
-            "(dependent constraints, or no convergence in %d Newton steps)", t, s->proj_iter);
-    return -1;
+  if (s->proj_on) {
+    int pr = project_kept_roots(s, t, y, yp);
+    if (pr == -3) goto eval_failed;
+    if (pr != 0) {
+      s->ready = 0;
+      set_msg(s->msg, "projecting the state onto the constraints after a contact event at t=%.17g failed "
+              "(dependent constraints, or no convergence in %d Newton steps)", t, s->proj_iter);
+      return -1;
+    }
   }
   if (s->lay_ggl) memset(y + 2 * nq + m, 0, sizeof(double) * (size_t)m);
   if (make_consistent(s, t, y, yp, s->active, s->params) != 0) goto eval_failed;
@@ -1281,6 +1297,35 @@ static int solve_normal(const double* J, const double* b, double* G, double* x, 
   memcpy(x, b, sizeof(double) * (size_t)m);
   chol_solve(G, m, x);
   return 0;
+}
+
+/* project_state for a restart, unless the projection moves a root function that did not fire
+ * across zero: a second corner a hair from its wall (a flat slider landing) would then start its
+ * segment already past the root it watches, and its contact would never be found. The restart
+ * then keeps the unprojected state (off the manifold by GGL's Newton tolerance only). 0 on
+ * success, -1/-2 from project_state, -3 when the root functions cannot be evaluated. */
+static int project_kept_roots(dc_session* s, double t, double* y, const double* yp) {
+  const int n = s->n, nr = s->n_roots;
+  double* buf = (double*)xcalloc((size_t)(n + 2 * nr), sizeof(double));
+  if (!buf) return -3;
+  double *saved = buf, *g0 = buf + n, *g1 = buf + n + nr;
+  int rc = 0;
+  memcpy(saved, y, sizeof(double) * (size_t)n);
+  if (nr > 0 && eval_roots(s, t, y, yp, g0) != 0) rc = -3;
+  if (rc == 0) rc = project_state(s, t, y);
+  if (rc == 0 && nr > 0) {
+    if (eval_roots(s, t, y, yp, g1) != 0) {
+      rc = -3;
+    } else {
+      for (int i = 0; i < nr; ++i)
+        if (!s->rootsfound[i] && g0[i] != 0.0 && (g0[i] > 0.0) != (g1[i] > 0.0)) {
+          memcpy(y, saved, sizeof(double) * (size_t)n);
+          break;
+        }
+    }
+  }
+  free(buf);
+  return rc;
 }
 
 /* Put q and v of y back on the constraint manifold: least-norm Newton on Phi(q, t) = 0, then the
@@ -1437,8 +1482,9 @@ DC_API int dc_report(void* sp, int n_points, const double* t, const double* y, c
  * on a root return the root point; duplicates skipped) is written to the step buffers, at most
  * cap rows; *n_stored rows were written.
  *
- * Returns DC_CHUNK when cap rows were written (store_steps) or cap IDA calls were made
- * (otherwise): call again. DC_TSTOP / DC_ROOT / errors < 0 otherwise; *t_out, y_out, yp_out
+ * Returns DC_CHUNK when cap rows were written (store_steps), cap IDA calls were made
+ * (otherwise), or a step filled the last of the n_eval output rows (so that a caller can hand
+ * the output times over in windows and empty the rows between calls): call again. DC_TSTOP / DC_ROOT / errors < 0 otherwise; *t_out, y_out, yp_out
  * hold the state reached, roots_out the root info (DC_ROOT), *flag_out IDA's flag (DC_ERR_IDA).
  */
 DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval, int* i_eval,
@@ -1449,6 +1495,7 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
   dc_session* s = (dc_session*)sp;
   const int n = s->n;
   int k = 0, calls = 0;
+  const int i_eval_start = *i_eval;
   long int nst = 0, nst_prev = 0;
   *n_stored = 0;
   *flag_out = 0;
@@ -1460,7 +1507,7 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
     return DC_ERR_USAGE;
   }
   /* Nothing to integrate: IDA would refuse an interval below roundoff. */
-  if (t_stop - s->t_now <= 4.0 * DBL_EPSILON * fmax(fabs(t_stop), fabs(s->t_now))) {
+  if (!s->carry && t_stop - s->t_now <= 4.0 * DBL_EPSILON * fmax(fabs(t_stop), fabs(s->t_now))) {
     copy_state(s, y_out, yp_out);
     return DC_TSTOP;
   }
@@ -1469,7 +1516,7 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
    * interpolates y(t_stop). (IDASetStopTime would refuse a stop time behind tn.) */
   double tn = s->t_now;
   IDAGetCurrentTime(s->ida, &tn);
-  if (t_stop < tn) {
+  if (!s->carry && t_stop < tn) {
     double tret = s->t_now, h = 0.0, t_prev = s->t_now;
     int order = 0;
     s->cb_msg[0] = 0;
@@ -1526,7 +1573,7 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
     *t_out = t_stop;
     return DC_TSTOP;
   }
-  int flag = IDASetStopTime(s->ida, t_stop);
+  int flag = s->carry ? 0 : IDASetStopTime(s->ida, t_stop);
   if (flag < 0) {
     *flag_out = flag;
     set_msg(s->msg, "IDASetStopTime(%.17g) failed: %s", t_stop, s->ida_msg);
@@ -1536,8 +1583,19 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
   IDAGetNumSteps(s->ida, &nst_prev);
 
   for (;;) {
-    double tret = s->t_now, h = 0.0;
-    int order = 0;
+    double tret = s->t_now, h = 0.0, t_prev = s->t_now, eval_lo;
+    int order = 0, i_before;
+    if (s->carry) { /* resume the step cut short at the last call */
+      s->carry = 0;
+      flag = s->carry_flag;
+      order = s->carry_order;
+      h = s->carry_h;
+      t_prev = s->carry_t_prev;
+      eval_lo = s->carry_lo;
+      nst = s->carry_nst;
+      nst_prev = s->carry_nst_prev;
+      goto step_taken;
+    }
     if (s->base[ST_STEPS] + (long long)nst_prev >= s->max_steps) {
       set_msg(s->msg,
               "step cap reached: %lld IDA steps in this session (max_steps=%lld) at t=%.17g",
@@ -1561,16 +1619,19 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
               s->ida_msg, s->cb_msg[0] ? "; last model error: " : "", s->cb_msg);
       return DC_ERR_IDA;
     }
-    double t_prev = s->t_now;
+    t_prev = s->t_now;
     s->t_now = tret;
     IDAGetNumSteps(s->ida, &nst);
     IDAGetLastStep(s->ida, &h);
     IDAGetLastOrder(s->ida, &order);
+    eval_lo = t_prev;
 
-    /* dense output at requested times in (t_prev, tret] */
+  step_taken:
+    /* dense output at requested times in (eval_lo, tret] */
+    i_before = *i_eval;
     while (*i_eval < n_eval && t_eval[*i_eval] <= tret) {
       double te = t_eval[*i_eval];
-      if (te > t_prev) {
+      if (te > eval_lo) {
         int f0 = IDAGetDky(s->ida, te, 0, s->dky);
         if (f0 == 0) memcpy(eval_y + (size_t)(*i_eval) * n, N_VGetArrayPointer(s->dky), sizeof(double) * (size_t)n);
         int f1 = f0 == 0 ? IDAGetDky(s->ida, te, 1, s->dky) : f0;
@@ -1584,6 +1645,20 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
         }
       }
       ++(*i_eval);
+    }
+    if (n_eval > 0 && i_before < n_eval && *i_eval == n_eval && t_eval[n_eval - 1] < tret) {
+      /* the rows are full and further output times may lie in this step: hand the rows over now */
+      s->carry = 1;
+      s->carry_flag = flag;
+      s->carry_order = order;
+      s->carry_h = h;
+      s->carry_t_prev = t_prev;
+      s->carry_lo = t_eval[n_eval - 1];
+      s->carry_nst = nst;
+      s->carry_nst_prev = nst_prev;
+      *t_out = tret;
+      copy_state(s, y_out, yp_out);
+      return DC_CHUNK;
     }
 
     /* record the return point */
@@ -1635,7 +1710,7 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
       if (handled) {
         if (handled == 1) IDAGetNumSteps(s->ida, &nst_prev); /* counters restarted with IDA */
         if ((store_steps && k >= cap) || (!store_steps && calls >= cap) ||
-            s->ev_n + s->n_auto > s->ev_cap) { /* a buffer full */
+            s->ev_n + s->n_auto > s->ev_cap || (*i_eval >= n_eval && *i_eval > i_eval_start)) { /* a buffer full */
           *t_out = tret;
           copy_state(s, y_out, yp_out);
           return DC_CHUNK;
@@ -1652,7 +1727,8 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
       copy_state(s, y_out, yp_out);
       return DC_TSTOP;
     }
-    if ((store_steps && k >= cap) || (!store_steps && calls >= cap)) {
+    if ((store_steps && k >= cap) || (!store_steps && calls >= cap) ||
+        (*i_eval >= n_eval && *i_eval > i_eval_start)) {
       *t_out = tret;
       copy_state(s, y_out, yp_out);
       return DC_CHUNK;
