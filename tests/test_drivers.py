@@ -179,7 +179,7 @@ def test_slider_driven_along_a_guide_with_play():
     assert result.events, "gravity has a component across the guide: the slider must reach a surface"
     np.testing.assert_allclose(result["push.force"], 2.0 * acc + 2.0 * 9.81 * math.sin(INCLINE), rtol=1e-5)
     along = (result["block.x"] - 0.1) * math.cos(INCLINE) + (result["block.y"] - 0.2) * math.sin(INCLINE)
-    np.testing.assert_allclose(along, x, atol=1e-7)  # Baumgarte drift at rtol 1e-8: 2e-8 m
+    np.testing.assert_allclose(along, x, atol=1e-7)  # rtol 1e-8 (index1: Baumgarte drift 2e-8 m)
     across = -(result["block.x"] - 0.1) * math.sin(INCLINE) + (result["block.y"] - 0.2) * math.cos(INCLINE)
     assert np.min(across) < -0.4e-3 and np.max(np.abs(across)) < 0.6e-3  # down to the lower surface, not through
 
@@ -205,7 +205,7 @@ def test_crank_driven_through_a_clearance_bearing_tends_to_the_ideal_mechanism()
     """Over the first revolution at 5000 rpm, the slider velocity and the crank moment of the
     mechanism with both clearances approach the ideal mechanism's as the clearance shrinks 4x and
     4x again (relative RMS differences measured: slider velocity 7.6 %, 2.6 %, 0.83 %; crank
-    moment 169 %, 88 %, 42 %: impact spikes), and the impacts at the pivot get softer. The crank
+    moment 172 %, 88 %, 42 %: impact spikes; GGL, the default), and the impacts at the pivot get softer. The crank
     keeps its prescribed speed although its journal moves in the play."""
     t = np.linspace(0.0, REVOLUTION, 601)
     ideal = dc.simulate(dc.mechanisms.slider_crank("ideal"), REVOLUTION, rtol=1e-8, t_eval=t)
@@ -220,7 +220,7 @@ def test_crank_driven_through_a_clearance_bearing_tends_to_the_ideal_mechanism()
         moment.append(rms(result["drive.moment"] - ideal["drive.moment"]) / rms(ideal["drive.moment"]))
     assert velocity[0] > 2.0 * velocity[1] > 4.0 * velocity[2] and velocity[2] < 0.015, velocity
     assert moment[0] > 1.5 * moment[1] > 2.25 * moment[2] and moment[2] < 0.6, moment
-    assert depth[0] > 1.5 * depth[1] > 2.25 * depth[2], depth  # softer impacts at the pivot: 103, 51, 26 um
+    assert depth[0] > 1.5 * depth[1] > 2.25 * depth[2], depth  # softer impacts at the pivot: 103, 50, 24 um
 
 
 # ---------------------------------------------------------------- the start in deep penetration
