@@ -41,15 +41,10 @@ BEARING_RADIUS = 10e-3  # m, the chapter's bearing (Table 4.2), used at the cran
 
 
 def crank_bearing_clearance(clearance: float) -> dc.Scene:
-    """slider_crank("revolute") with the crank pivot ``A`` replaced by a clearance joint with the
-    same bodies and point; the driver ``drive`` on ``A`` then drives the crank through it."""
+    """slider_crank("revolute") with the crank pivot ``A`` made a clearance joint with the same bodies
+    and point (bearing on the ground); the driver ``drive`` on ``A`` then drives the crank through it."""
     scene = dc.mechanisms.slider_crank("revolute", clearance=clearance, rpm=RPM)
-    k = next(i for i, e in enumerate(scene.elements) if e.name == "A")
-    pivot = scene.elements[k]
-    scene.elements[k] = dc.RevoluteClearance("A", pivot.body_i, pivot.body_j, at=pivot.at,
-                                            bearing_radius=BEARING_RADIUS, clearance=clearance,
-                                            material=dc.mechanisms.STEEL)
-    return scene
+    return scene.with_clearance("A", bearing_radius=BEARING_RADIUS, clearance=clearance, material=dc.mechanisms.STEEL)
 
 
 def run(clearance: float, revolutions: int, points: int = 400) -> dict[str, dc.Result]:

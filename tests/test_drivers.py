@@ -447,3 +447,20 @@ def test_crank_period_needs_a_constant_speed_rotation():
         crank_period(disc_scene(Ramp(time=0.1)))
     with pytest.raises(DaeclearError, match=r"driver 'push' is not a constant-speed rotation .* joint 'G'"):
         crank_period(inclined_block("ideal"))
+
+
+def test_four_bar_driven_through_a_clearance_bearing():
+    """mechanisms.four_bar(("A",)): the driven joint itself has clearance; the crank keeps its speed."""
+    t = np.linspace(0.0, REVOLUTION, 121)
+    result = dc.simulate(dc.mechanisms.four_bar(("A",)), REVOLUTION, rtol=1e-7, t_eval=t)
+    assert isinstance(dc.mechanisms.four_bar(("A",))["A"], dc.RevoluteClearance)
+    assert result.success and result.events.of("A", kind="onset")
+    np.testing.assert_allclose(result["crank.omega"], 5000 * math.pi / 30, rtol=1e-6)
+    assert np.max(np.abs(result["A.ex"])) > 0.25e-3  # the journal crosses its play
+
+
+def test_with_clearance_builds_the_same_crank_bearing():
+    """Scene.with_clearance (the public way) gives the element built by hand in crank_bearing_clearance."""
+    made = dc.mechanisms.slider_crank("revolute", clearance=0.1e-3).with_clearance(
+        "A", clearance=0.1e-3, bearing_radius=10e-3, material=dc.mechanisms.STEEL)
+    assert made["A"] == crank_bearing_clearance(0.1e-3)["A"]
