@@ -400,6 +400,21 @@ class Scene:
                     for e in self.elements]
         return Scene(self.name, gravity=self.gravity, elements=elements, ground=self.ground)
 
+    def without(self, *names: str) -> "Scene":
+        """A new scene without the named elements (e.g. the Driver of a crank that a Motor will
+        drive instead). Every name must exist; this scene is left unchanged.
+
+        >>> scene = Scene("pendulum")
+        >>> link = scene.add(Body("link", mass=1.0, inertia=0.01, position=(0.5, 0.0)))
+        >>> _ = scene.add(Revolute("A", scene.ground, link, at=(0.0, 0.0)))
+        >>> [e.name for e in scene.without("A")], [e.name for e in scene]
+        (['link'], ['link', 'A'])
+        """
+        for name in names:
+            self[name]  # KeyError naming the scene and the closest names
+        elements = [e for e in self.elements if e.name not in names]
+        return Scene(self.name, gravity=self.gravity, elements=elements, ground=self.ground)
+
     def of_type(self, cls: type) -> list[Any]:
         return [e for e in self.elements if isinstance(e, cls)]
 

@@ -233,8 +233,8 @@ NO_LOAD_SPEED = 3000.0 * math.pi / 30.0  # rad/s
 
 def torque_driven_crank(joint: str = "ideal", stall_torque: float = 20.0) -> dc.Scene:
     """The chapter's slider-crank started at rest, its driver replaced by a motor on the crank."""
-    scene = dc.mechanisms.slider_crank(joint, rpm=0.0)
-    scene.elements = [e for e in scene.elements if not isinstance(e, dc.Driver)]
+    scene = dc.mechanisms.slider_crank(joint, rpm=0.0).without("drive")
+    assert not scene.drivers
     scene.add(dc.Motor("motor", scene.ground, "crank", stall_torque=stall_torque, no_load_speed=NO_LOAD_SPEED))
     return scene
 

@@ -104,3 +104,13 @@ def test_bad_formulation_and_mechanism_options():
         dc.mechanisms.slider_crank(gravity=-1)
     with pytest.raises(SceneError, match="unknown option"):
         dc.mechanisms.slider_crank(clearence=1e-3)
+
+
+def test_without_returns_a_new_scene_without_the_named_elements():
+    scene = dc.mechanisms.slider_crank("revolute")
+    free = scene.without("drive", "D")
+    assert [e.name for e in free] == [e.name for e in scene if e.name not in ("drive", "D")]
+    assert scene["drive"] is not None and scene["D"] is not None  # unchanged
+    assert free.name == scene.name and free.gravity == scene.gravity
+    with pytest.raises(KeyError, match="no element 'driev'.*'drive'"):
+        scene.without("driev")
