@@ -352,9 +352,9 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
             # the C loop decided contact switches itself: split the advance at each restart and
             # record the decisions (modes, terms, latched speeds, events) in the pair logic
             s0 = e0 = 0
+            ends = _split_rows(adv)  # one search for all restarts of the advance
             for t_ev, decided in itertools.groupby(adv.auto_events, key=lambda ev: ev.t):
-                s1 = int(np.searchsorted(adv.step_t, t_ev, side="right"))
-                e1 = int(np.searchsorted(adv.eval_t, t_ev, side="right"))
+                s1, e1 = ends[t_ev]
                 record(adv, slice(s0, s1), slice(e0, e1), switch)
                 segments.append((seg_start, t_ev, dict(modes)))
                 for ev in decided:
@@ -428,9 +428,8 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         flush()
     except BaseException as exc:
         rec.abort(exc)
-        raise
-    finally:
         session.close()
+        raise
 
     progress_line.update(t_end if success else t, rec.n_events)
     stats.update(n_events=rec.n_events, n_restarts=n_restarts, setup_time=setup_time,
@@ -438,8 +437,11 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                  output_time=time.perf_counter() - post_start)
     # the start checks concern a declared state: the chapter's start is consistent by construction
     key_t, key_y, key_channels = rec.key_rows()
-    found = physics.check_run(model, key_t, key_y, key_channels, y0 if sim_params["start"] == "declared" else None,
-                              stats)
+    try:  # the session stays open for the checks: they evaluate the constraints in its library, not in CasADi
+        found = physics.check_run(model, key_t, key_y, key_channels,
+                                  y0 if sim_params["start"] == "declared" else None, stats, session)
+    finally:
+        session.close()
     physics.issue(found, stacklevel=4)  # issue <- _run <- simulate <- the caller
     deep = [w for w in found if w["kind"] == "penetration" and w["t"] <= t]
     if not success and not interrupted and deep:  # the advice must fit the cause: not a tolerance problem
@@ -457,6 +459,16 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
 
 #: Output times handed to the compiled loop at a time: their rows are emptied between windows.
 EVAL_WINDOW = 4096
+
+
+def _split_rows(adv: Any) -> dict[float, tuple[int, int]]:
+    """Event time -> (steps, output points) of the advance up to and including that time."""
+    if not adv.auto_events:
+        return {}
+    times = np.array([ev.t for ev in adv.auto_events])
+    steps = np.searchsorted(adv.step_t, times, side="right").tolist()
+    evals = np.searchsorted(adv.eval_t, times, side="right").tolist()
+    return {t: (s, e) for t, s, e in zip(times.tolist(), steps, evals)}
 
 
 def _eval_window(times: options.OutputTimes, i: int, t: float, size: int) -> tuple[int, NDArray]:
