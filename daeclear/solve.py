@@ -330,16 +330,15 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
 
         def record(adv: Any, steps: slice, evals: slice, switch: NDArray) -> None:
             """Keep IDA's points as they are; they are made consistent by flush()."""
-            if store_steps and adv.step_t[steps].size:
-                k = adv.step_t[steps].size
-                rec.add_steps(adv.step_t[steps], adv.step_h[steps], adv.step_order[steps])
+            step_t, eval_t = adv.step_t[steps], adv.eval_t[evals]  # each slice once: this runs at every switch
+            if store_steps and step_t.size:
+                rec.add_steps(step_t, adv.step_h[steps], adv.step_order[steps])
                 if eval_times is None:  # the steps are the output points
-                    raw.append((adv.step_t[steps], adv.step_y[steps], adv.step_yp[steps],
-                                np.repeat(switch[None, :], k, axis=0)))
-            if adv.eval_t[evals].size:
-                k = adv.eval_t[evals].size
-                raw.append((adv.eval_t[evals], adv.eval_y[evals], adv.eval_yp[evals],
-                            np.repeat(switch[None, :], k, axis=0)))
+                    raw.append((step_t, adv.step_y[steps], adv.step_yp[steps],
+                                np.repeat(switch[None, :], step_t.size, axis=0)))
+            if eval_t.size:
+                raw.append((eval_t, adv.eval_y[evals], adv.eval_yp[evals],
+                            np.repeat(switch[None, :], eval_t.size, axis=0)))
 
         seg_start = t
         while True:
