@@ -423,20 +423,18 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         segments.append((seg_start, t, dict(modes)))
     stats = dict(session.stats())
     post_start = time.perf_counter()
-    try:
-        flush()
-    except BaseException as exc:
-        rec.abort(exc)
-        session.close()
-        raise
-
-    progress_line.update(t_end if success else t, rec.n_events)
-    stats.update(n_events=rec.n_events, n_restarts=n_restarts, setup_time=setup_time,
-                 wall_time=setup_time + time.perf_counter() - run_start,
-                 output_time=time.perf_counter() - post_start)
-    # the start checks concern a declared state: the chapter's start is consistent by construction
-    key_t, key_y, key_channels = rec.key_rows()
-    try:  # the session stays open for the checks: they evaluate the constraints in its library, not in CasADi
+    try:  # the session stays open through the checks: they evaluate constraints in its library, not in CasADi
+        try:
+            flush()
+        except BaseException as exc:
+            rec.abort(exc)
+            raise
+        progress_line.update(t_end if success else t, rec.n_events)
+        stats.update(n_events=rec.n_events, n_restarts=n_restarts, setup_time=setup_time,
+                     wall_time=setup_time + time.perf_counter() - run_start,
+                     output_time=time.perf_counter() - post_start)
+        # the start checks concern a declared state: the chapter's start is consistent by construction
+        key_t, key_y, key_channels = rec.key_rows()
         found = physics.check_run(model, key_t, key_y, key_channels,
                                   y0 if sim_params["start"] == "declared" else None, stats, session)
     finally:
