@@ -10,19 +10,25 @@ on two crank revolutions (400 output points), side by side, best of --repeats:
 Columns: whole-call wall time, the IDA loop in C (``stats["solve_time"]``), and their difference,
 the set-up (assembly, initial state, session) and the rest (event recording, report pass, Result).
 Target: about 1 ms above the IDA loop for a scene seen before or differing only in numbers.
+``--parts`` then times the pieces of that overhead one by one in a quiet loop (best of --repeats,
+each call repeated 50 times): inside a sweep, right after an IDA loop, the same calls take longer
+(cold caches), so the pieces add up to less than the column "above it".
 
-    python benchmarks/bench_overhead.py [--repeats 20]
+    python benchmarks/bench_overhead.py [--repeats 20] [--parts]
 """
 
 from __future__ import annotations
 
 import argparse
 import time
+import timeit
 import warnings
 
 import numpy as np
 
 import daeclear as dc
+from daeclear import automaton, physics, solve
+from daeclear.ida_session import open_session
 
 REV = 60.0 / 5000.0
 
@@ -42,9 +48,51 @@ def measure(label: str, make, t_end: float, repeats: int) -> None:
           f"(set-up {setup * 1e3:5.2f} ms, rest {(wall - solve - setup) * 1e3:5.2f} ms)")
 
 
+def parts(repeats: int) -> None:
+    """The pieces of a call's overhead, each timed alone (best of ``repeats`` rounds of 50 calls)."""
+    def best(call) -> float:
+        return min(timeit.repeat(call, number=50, repeat=repeats)) / 50
+
+    scenes = iter([dc.mechanisms.slider_crank("revolute", gravity=0.0, clearance=0.5e-3 * (1 + 1e-4 * i))
+                   for i in range(50 * repeats + 1)])
+    model = dc.assemble(next(scenes))
+    atol = solve.tolerance_vector(model, 1e-7, None)
+
+    def session():
+        return open_session(model.functions, backend="c", rtol=1e-7, atol=atol, parameters=model.parameter_values)
+
+    open_one = session()
+    y0, _ = model.initial_state(session=open_one)
+    pair = model.contacts[0]
+    onset = automaton.Decision(kind=automaton.ONSET, contact=True, held=False, latched=0.3, watch=-1)
+    active, params = [False] * len(model.terms), [np.zeros(term.n_params) for term in model.terms]
+    result = dc.simulate(model, t_end=0.002, rtol=1e-7, t_eval=np.linspace(0.0, 0.002, 400))
+    # three output rows, their constraint drift set to 1 m: the checks take the drift warning's path,
+    # which evaluates the constraints at the worst row to name the equation
+    key = (result.t[:3], result.y[:3], {name: values[:3] for name, values in result.channels.items()}
+           | {"constraints.position": np.ones(3)})
+    rows = {
+        "assemble a new scene": lambda: dc.assemble(next(scenes)),
+        "open and close a session": lambda: session().close(),
+        "initial state": lambda: model.initial_state(session=open_one),
+        "physics checks, drift warned": lambda: physics.check_run(model, *key, None, {}, open_one),
+        "record one contact switch": lambda: pair.record(pair.root_index, 0.001, y0, 0.3, onset, active, params),
+        "switch vector": lambda: model.switch_vector(active, params),
+        "Result of 400 points": lambda: dc.Result(
+            t=result.t, y=result.y, yp=result.yp, state_names=result.state_names, channels=result.channels,
+            units=result.units, events=result.events, segments=result.segments, stats=result.stats,
+            parameters=result.parameters),
+    }
+    print("Pieces of the overhead, each alone (quiet loop)")
+    for label, call in rows.items():
+        print(f"  {label:<28} {best(call) * 1e6:8.1f} us")
+    open_one.close()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=20)
+    parser.add_argument("--parts", action="store_true", help="also time the pieces of the overhead one by one")
     args = parser.parse_args()
     warnings.simplefilter("ignore", dc.DaeclearWarning)
     scene = dc.mechanisms.slider_crank("revolute", gravity=0.0)
@@ -56,6 +104,8 @@ def main() -> None:
                                                                       clearance=0.5e-3 * (1 + 1e-3 * i)),
                 t_end, args.repeats)
         measure("model", lambda i: model, t_end, args.repeats)
+    if args.parts:
+        parts(args.repeats)
 
 
 if __name__ == "__main__":

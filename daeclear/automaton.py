@@ -141,7 +141,9 @@ def step(state: PairState, t: float, direction: int, rate: float, *, storm: Stor
 def recorded(state: PairState, decision: Decision) -> PairState:
     """The state after a decision taken elsewhere (the compiled loop): its mode and latched speed.
     The storm history stays with the side that decides."""
-    return replace(state, contact=decision.contact, held=decision.held, latched=decision.latched)
+    # the constructor, not dataclasses.replace: this runs at every event of a compiled run
+    return PairState(contact=decision.contact, held=decision.held, free_since=state.free_since,
+                     latched=decision.latched, recent=state.recent)
 
 
 def _push(recent: tuple[float, ...], t: float, storm: Storm) -> tuple[float, ...]:

@@ -78,10 +78,11 @@ def smallest_clearance(model: Any) -> float:
 
 
 def check_run(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels: dict[str, NDArray[np.float64]],
-              y0: NDArray[np.float64] | None, stats: dict[str, Any]) -> list[dict[str, Any]]:
+              y0: NDArray[np.float64] | None, stats: dict[str, Any], session: Any = None) -> list[dict[str, Any]]:
     """Every check on a run's output (times ``t``, states ``y``, channels): penetrations, the start
     (``y0``: the declared state at t = 0; None after the chapter's start, consistent by
-    construction) and drift.
+    construction) and drift. An open ``session`` evaluates the constraints (the run's compiled
+    library instead of a CasADi call).
 
     Sets ``stats["max_constraint_drift"]``. Returns the warning records (not issued)."""
     out: list[dict[str, Any]] = []
@@ -89,8 +90,8 @@ def check_run(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channe
     for name, clearance, corner in model.clearance_joints:
         out += _penetration(model, name, clearance, corner, t, channels, declared)
     if y0 is not None and declared and model.driver_names:
-        out += _initial_velocity(model, y0)
-    out += _drift(model, t, y, channels, stats)
+        out += _initial_velocity(model, y0, session)
+    out += _drift(model, t, y, channels, stats, session)
     return out
 
 
@@ -177,7 +178,7 @@ def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np
                     "(clearance joints centred), or pass allow_penetration=True to start there anyway.")
 
 
-def _initial_velocity(model: Any, y0: NDArray[np.float64]) -> list[dict[str, Any]]:
+def _initial_velocity(model: Any, y0: NDArray[np.float64], session: Any = None) -> list[dict[str, Any]]:
     """Speed at which each clearance joint's two sides move apart at t = 0 (0 for an ideal start).
 
     Checked for driven mechanisms only: their velocities follow from the driver, so a joint whose
@@ -187,7 +188,7 @@ def _initial_velocity(model: Any, y0: NDArray[np.float64]) -> list[dict[str, Any
         return []
     n = model.n_q
     q, v = np.asarray(y0[:n], dtype=float), np.asarray(y0[n:2 * n], dtype=float)
-    _, _, rates = model.constraints(q, v, 0.0, None, ideal=True)
+    _, _, rates = model.constraints(q, v, 0.0, session, ideal=True)
     names = list(model.start_constraint_names)
     fastest = max((math.hypot(v[3 * k], v[3 * k + 1]) for k in range(n // 3)), default=0.0)
     limit = max(INITIAL_VELOCITY_FRACTION * fastest, INITIAL_VELOCITY_FLOOR)
@@ -211,7 +212,7 @@ def _initial_velocity(model: Any, y0: NDArray[np.float64]) -> list[dict[str, Any
 
 
 def _drift(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels: dict[str, NDArray[np.float64]],
-           stats: dict[str, Any]) -> list[dict[str, Any]]:
+           stats: dict[str, Any], session: Any = None) -> list[dict[str, Any]]:
     """Largest constraint violation of the run, against DRIFT_FRACTION of the smallest clearance."""
     drift = channels.get("constraints.position")
     if drift is None or drift.size == 0:
@@ -225,7 +226,7 @@ def _drift(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels:
     where = "constraints"
     if y.shape[0] > i and model.n_constraints:
         n = model.n_q
-        phi = model.constraints(y[i, :n], y[i, n:2 * n], float(t[i]), None)[0]
+        phi = model.constraints(y[i, :n], y[i, n:2 * n], float(t[i]), session)[0]
         where = model.constraint_names[int(np.argmax(np.abs(phi)))]
     return [record(
         "constraint_drift", "constraint violation |Phi|", worst, DRIFT_FRACTION * clearance, "m", where, float(t[i]),

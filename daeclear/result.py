@@ -301,6 +301,10 @@ class EventList(Sequence[ContactEvent]):
 # --------------------------------------------------------------------------- plain values
 
 
+# exact types _plain returns unchanged (subclasses such as numpy.float64 take the checks below)
+_PLAIN_LEAVES = frozenset({type(None), bool, str, int, float})
+
+
 def _plain(value: Any, where: str) -> Any:
     """``value`` as plain JSON-able Python.
 
@@ -310,27 +314,30 @@ def _plain(value: Any, where: str) -> Any:
     DaeclearWarning naming ``where``: a finished run is never lost to an odd parameter.
     Non-string dict keys raise TypeError.
     """
+    if type(value) in _PLAIN_LEAVES:  # the common case first: plain numbers and strings stay as they are
+        return value
     if value is None or isinstance(value, (bool, str)):
         return value
     if isinstance(value, int):
         return int(value)
     if isinstance(value, float):
         return float(value)
+    if type(value) is dict or isinstance(value, Mapping):
+        out: dict[str, Any] = {}
+        for key, item in value.items():
+            if not isinstance(key, str):
+                raise TypeError(f"{where}: key {key!r} is a {type(key).__name__}, keys must be strings.")
+            out[key] = item if type(item) in _PLAIN_LEAVES else _plain(item, f"{where}[{key!r}]")
+        return out
+    if isinstance(value, (list, tuple)):
+        return [item if type(item) in _PLAIN_LEAVES else _plain(item, f"{where}[{i}]") for i, item in enumerate(value)]
+    # after the containers: dicts and lists, the bulk of a scene, skip these (slower ABC) checks
     if isinstance(value, np.generic):
         return _plain(value.item(), where)
     if isinstance(value, np.ndarray):
         return _plain(value.tolist(), where)
     if isinstance(value, os.PathLike):
         return os.fspath(value)
-    if isinstance(value, Mapping):
-        out: dict[str, Any] = {}
-        for key, item in value.items():
-            if not isinstance(key, str):
-                raise TypeError(f"{where}: key {key!r} is a {type(key).__name__}, keys must be strings.")
-            out[key] = _plain(item, f"{where}[{key!r}]")
-        return out
-    if isinstance(value, (list, tuple)):
-        return [_plain(item, f"{where}[{i}]") for i, item in enumerate(value)]
     if is_dataclass(value) and not isinstance(value, type):
         out = {f.name: _plain(getattr(value, f.name), f"{where}[{f.name!r}]") for f in fields(value)}
         kind = getattr(type(value), "name", None)  # a contact law's registered name, e.g. "hunt-crossley"

@@ -335,16 +335,15 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
 
         def record(adv: Any, steps: slice, evals: slice, switch: NDArray) -> None:
             """Keep IDA's points as they are; they are made consistent by flush()."""
-            if store_steps and adv.step_t[steps].size:
-                k = adv.step_t[steps].size
-                rec.add_steps(adv.step_t[steps], adv.step_h[steps], adv.step_order[steps])
+            step_t, eval_t = adv.step_t[steps], adv.eval_t[evals]  # each slice once: this runs at every switch
+            if store_steps and step_t.size:
+                rec.add_steps(step_t, adv.step_h[steps], adv.step_order[steps])
                 if eval_times is None:  # the steps are the output points
-                    raw.append((adv.step_t[steps], adv.step_y[steps], adv.step_yp[steps],
-                                np.repeat(switch[None, :], k, axis=0)))
-            if adv.eval_t[evals].size:
-                k = adv.eval_t[evals].size
-                raw.append((adv.eval_t[evals], adv.eval_y[evals], adv.eval_yp[evals],
-                            np.repeat(switch[None, :], k, axis=0)))
+                    raw.append((step_t, adv.step_y[steps], adv.step_yp[steps],
+                                np.repeat(switch[None, :], step_t.size, axis=0)))
+            if eval_t.size:
+                raw.append((eval_t, adv.eval_y[evals], adv.eval_yp[evals],
+                            np.repeat(switch[None, :], eval_t.size, axis=0)))
 
         seg_start = t
         while True:
@@ -357,9 +356,9 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
             # the C loop decided contact switches itself: split the advance at each restart and
             # record the decisions (modes, terms, latched speeds, events) in the pair logic
             s0 = e0 = 0
+            ends = _split_rows(adv)  # one search for all restarts of the advance
             for t_ev, decided in itertools.groupby(adv.auto_events, key=lambda ev: ev.t):
-                s1 = int(np.searchsorted(adv.step_t, t_ev, side="right"))
-                e1 = int(np.searchsorted(adv.eval_t, t_ev, side="right"))
+                s1, e1 = ends[t_ev]
                 record(adv, slice(s0, s1), slice(e0, e1), switch)
                 segments.append((seg_start, t_ev, dict(modes)))
                 for ev in decided:
@@ -429,22 +428,22 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         segments.append((seg_start, t, dict(modes)))
     stats = dict(session.stats())
     post_start = time.perf_counter()
-    try:
-        flush()
-    except BaseException as exc:
-        rec.abort(exc)
-        raise
+    try:  # the session stays open through the checks: they evaluate constraints in its library, not in CasADi
+        try:
+            flush()
+        except BaseException as exc:
+            rec.abort(exc)
+            raise
+        progress_line.update(t_end if success else t, rec.n_events)
+        stats.update(n_events=rec.n_events, n_restarts=n_restarts, setup_time=setup_time,
+                     wall_time=setup_time + time.perf_counter() - run_start,
+                     output_time=time.perf_counter() - post_start)
+        # the start checks concern a declared state: the chapter's start is consistent by construction
+        key_t, key_y, key_channels = rec.key_rows()
+        found = physics.check_run(model, key_t, key_y, key_channels,
+                                  y0 if sim_params["start"] == "declared" else None, stats, session)
     finally:
         session.close()
-
-    progress_line.update(t_end if success else t, rec.n_events)
-    stats.update(n_events=rec.n_events, n_restarts=n_restarts, setup_time=setup_time,
-                 wall_time=setup_time + time.perf_counter() - run_start,
-                 output_time=time.perf_counter() - post_start)
-    # the start checks concern a declared state: the chapter's start is consistent by construction
-    key_t, key_y, key_channels = rec.key_rows()
-    found = physics.check_run(model, key_t, key_y, key_channels, y0 if sim_params["start"] == "declared" else None,
-                              stats)
     physics.issue(found, stacklevel=4)  # issue <- _run <- simulate <- the caller
     deep = [w for w in found if w["kind"] == "penetration" and w["t"] <= t]
     if not success and not interrupted and deep:  # the advice must fit the cause: not a tolerance problem
@@ -462,6 +461,16 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
 
 #: Output times handed to the compiled loop at a time: their rows are emptied between windows.
 EVAL_WINDOW = 4096
+
+
+def _split_rows(adv: Any) -> dict[float, tuple[int, int]]:
+    """Event time -> (steps, output points) of the advance up to and including that time."""
+    if not adv.auto_events:
+        return {}
+    times = np.array([ev.t for ev in adv.auto_events])
+    steps = np.searchsorted(adv.step_t, times, side="right").tolist()
+    evals = np.searchsorted(adv.eval_t, times, side="right").tolist()
+    return {t: (s, e) for t, s, e in zip(times.tolist(), steps, evals)}
 
 
 def _eval_window(times: options.OutputTimes, i: int, t: float, size: int) -> tuple[int, NDArray]:
