@@ -75,6 +75,7 @@ __all__ = [
     "phase_portrait",
     "poincare_section",
     "restart_model",
+    "section_channels",
     "read_twins",
     "sampling_times",
     "twin_divergence",
@@ -83,6 +84,16 @@ __all__ = [
 
 CHANNELS: tuple[str, str] = ("slider.vx", "slider.ax")
 """Default channel pair: the chapter's "Poincaré maps" plot slider acceleration against velocity."""
+
+
+def section_channels(scene: Scene | DAEModel) -> tuple[str, str]:
+    """The default section channels of a scene: the chapter's pair (:data:`CHANNELS`) when a body is
+    named ``slider``, else the angular velocity and acceleration of the last body (the output link:
+    a four-bar's rocker, a double pendulum's second link)."""
+    bodies = list(scene.body_names) if isinstance(scene, DAEModel) else [b.name for b in scene.bodies]
+    if "slider" in bodies or not bodies:
+        return CHANNELS
+    return (f"{bodies[-1]}.omega", f"{bodies[-1]}.alpha")
 
 MotionLabel = Literal["periodic", "quasi-periodic", "chaotic", "non-periodic", "uncertain", "undetermined"]
 MOTION_LABELS: tuple[str, ...] = ("periodic", "quasi-periodic", "chaotic", "non-periodic", "uncertain", "undetermined")
@@ -970,7 +981,7 @@ def _check_int(name: str, value: Any, low: int) -> int:
     return int(value)
 
 
-def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] = CHANNELS, revolutions: int = 30,
+def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None = None, revolutions: int = 30,
                     transient: int = 10, per_revolution: int = 32, phase: float = 0.0, twin: bool | str = True,
                     twin_revolutions: int = 20, perturbation: float = DEFAULT_PERTURBATION, seed: int = 0,
                     tol: float = DEFAULT_TOL, max_period: int = DEFAULT_MAX_PERIOD,
@@ -982,8 +993,9 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] = CHANNE
     ----------
     scene : Scene or DAEModel
         A driven mechanism (its driver sets the period T).
-    channels : sequence of str
-        Section channels (default slider velocity and acceleration, as the chapter).
+    channels : sequence of str, optional
+        Section channels; default :func:`section_channels` (slider velocity and acceleration, as
+        the chapter, or the last body's angular velocity and acceleration without a slider).
     revolutions : int
         Revolutions analysed after the transient (30): revolutions + 1 section points.
     transient : int
@@ -1036,6 +1048,7 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] = CHANNE
             raise SceneError(f"classify_motion: {key} is set by the analysis; it cannot be passed.")
     formulation = simulate_options.pop("formulation", None) or default_formulation(simulate_options.get("method", "ida"))
     model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation)
+    channels = section_channels(model) if channels is None else channels
     T = crank_period(model)
     offset = (float(phase) % (2.0 * math.pi)) / (2.0 * math.pi) * T
     if offset > T * (1.0 - _TIME_MATCH):

@@ -334,7 +334,8 @@ def _add_sweep_parser(sub: Any) -> None:
     sweep.add_argument("--revolutions", type=int, default=30, help="revolutions analysed (default 30)")
     sweep.add_argument("--transient", type=int, default=10, help="revolutions discarded first (default 10)")
     sweep.add_argument("--per-revolution", type=int, default=32, help="output samples per revolution (default 32)")
-    sweep.add_argument("--channels", default="slider.vx,slider.ax", help="Poincaré-section channels")
+    sweep.add_argument("--channels", help="Poincaré-section channels (default: slider.vx,slider.ax with a body "
+                                          "named slider, else the last body's omega,alpha)")
     sweep.add_argument("--twin", choices=["always", "auto", "never"], default="always",
                        help="twin runs for the chaos test: always (default), only when the section does not "
                             "recur (auto), or never")
@@ -402,7 +403,10 @@ def _sweep(args: argparse.Namespace) -> int:
     options.per_revolution(args.per_revolution, where=where, field="--per-revolution")
     options.rtol(args.rtol, where=where, field="--rtol")
     options.workers(args.workers, where=where, field="--workers")
-    options.names([c.strip() for c in args.channels.split(",") if c.strip()], where=where, field="--channels")
+    channels = None
+    if args.channels is not None:
+        channels = [c.strip() for c in args.channels.split(",") if c.strip()]
+        options.names(channels, where=where, field="--channels")
     if not args.out.parent.exists():
         check_directory(args.out.parent, "daeclear sweep OUT (its directory)")
     check_file(args.out, "daeclear sweep OUT", what="a sweep file (.h5)", example="sweep.h5")  # before any work
@@ -423,7 +427,7 @@ def _sweep(args: argparse.Namespace) -> int:
     twin = {"auto": "auto", "always": True, "never": False}[args.twin]
     try:
         result = sweep(args.out, grid or None, runs=points, mechanism=args.target, fixed=fixed,
-                       channels=[c.strip() for c in args.channels.split(",") if c.strip()], keep=args.keep,
+                       channels=channels, keep=args.keep,
                        revolutions=args.revolutions, transient=args.transient, per_revolution=args.per_revolution,
                        twin=twin, rtol=args.rtol, executor=executor, max_workers=args.workers,
                        resume=not args.restart, retry_failed=args.retry_failed, progress=not args.quiet)

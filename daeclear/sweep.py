@@ -71,7 +71,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .analysis import CHANNELS, PhasePortrait, PoincareSection
+from .analysis import CHANNELS, PhasePortrait, PoincareSection, section_channels
 from .errors import DaeclearError, DaeclearWarning, OutputError, SceneError
 from .outputs import check_file, deferred_sigint, sigint_latch
 
@@ -837,7 +837,7 @@ def _terminate(executor: cf.Executor) -> None:
 
 def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None = None, *,
           runs: Iterable[Mapping[str, Any]] | None = None, mechanism: str | Callable[..., Any] = "slider_crank",
-          fixed: Mapping[str, Any] | None = None, channels: Sequence[str] = CHANNELS,
+          fixed: Mapping[str, Any] | None = None, channels: Sequence[str] | None = None,
           store_channels: Sequence[str] | None = None, keep: str = "channels", revolutions: int = 30,
           transient: int = 10, per_revolution: int = 32, twin: bool | str = True, rtol: float = 1e-6,
           analysis: Mapping[str, Any] | None = None, executor: cf.Executor | None = None,
@@ -860,8 +860,10 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     fixed : mapping, optional
         Parameters common to every run (e.g. ``{"joint": "revolute"}``); part of each run's
         parameters and key.
-    channels : sequence of str
-        Poincaré-section channels (slider velocity and acceleration by default).
+    channels : sequence of str, optional
+        Poincaré-section channels; default those of the first point's scene
+        (:func:`daeclear.analysis.section_channels`: slider velocity and acceleration, or the last
+        body's angular velocity and acceleration in a mechanism without a slider).
     store_channels : sequence of str, optional
         Channels stored over the analysed span with ``keep="channels"``; default ``channels``.
     keep : {"section", "channels", "full"}
@@ -921,7 +923,8 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     check.per_revolution(per_revolution)
     check.rtol(rtol, where="sweep")
     check.workers(max_workers)
-    check.names(list(channels) if not isinstance(channels, str) else channels, where="sweep", field="channels")
+    if channels is not None:
+        check.names(list(channels) if not isinstance(channels, str) else channels, where="sweep", field="channels")
     if not isinstance(twin, bool) and twin != "auto":
         check.fail("sweep", "twin", twin, "True, False or 'auto'")
     extra = dict(analysis or {})
@@ -932,19 +935,21 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     overlap = sorted(set(extra) & {"channels", "revolutions", "transient", "per_revolution", "twin", "rtol"})
     if overlap:
         raise SceneError(f"sweep: give {', '.join(overlap)} as sweep() keywords, not in analysis=.")
-    options = {"channels": [str(c) for c in channels], "revolutions": revolutions, "transient": transient,
-               "per_revolution": per_revolution, "twin": twin, "rtol": rtol, **extra}
-    stored = [str(c) for c in (store_channels if store_channels is not None else channels)]
-    file_options = {**{k: _plain_value(k, v) for k, v in options.items()}, "keep": keep, "store_channels": stored}
-    mech_name = _mechanism_name(mechanism)
     if not isinstance(mechanism, str) and not callable(mechanism):
         raise SceneError(f"sweep: mechanism={mechanism!r}, must be a mechanism name or a callable.")
-
     base = {str(k): _plain_value(str(k), v) for k, v in (fixed or {}).items()}
     points = grid_points(grid) if grid else []
     points += [dict(p) for p in (runs or [])]
     if not points:
         raise SceneError("sweep: no parameter points; give grid= and/or runs=.")
+    if channels is None:  # from what the mechanism holds (every point has its bodies)
+        first = {**base, **{str(k): _plain_value(str(k), v) for k, v in points[0].items()}}
+        channels = section_channels(_build_scene(mechanism, first))
+    options = {"channels": [str(c) for c in channels], "revolutions": revolutions, "transient": transient,
+               "per_revolution": per_revolution, "twin": twin, "rtol": rtol, **extra}
+    stored = [str(c) for c in (store_channels if store_channels is not None else channels)]
+    file_options = {**{k: _plain_value(k, v) for k, v in options.items()}, "keep": keep, "store_channels": stored}
+    mech_name = _mechanism_name(mechanism)
     tasks: list[dict[str, Any]] = []
     order: dict[str, int] = {}
     for point in points:

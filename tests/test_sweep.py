@@ -281,3 +281,17 @@ def test_a_sweep_builds_one_library_per_structure(tmp_path, monkeypatch):
                 fixed=FIXED, max_workers=2, **FAST)
     assert len(out) == 6 and all(r.ok for r in out.runs)
     assert len(list(cache.glob("dc_*.so"))) == 1
+
+
+def test_section_channels_follow_the_scene_without_a_slider(tmp_path):
+    from daeclear.analysis import section_channels
+
+    assert section_channels(dc.mechanisms.slider_crank("revolute")) == ("slider.vx", "slider.ax")
+    assert section_channels(dc.mechanisms.four_bar()) == ("rocker.omega", "rocker.alpha")
+    assert section_channels(dc.assemble(dc.mechanisms.double_pendulum())) == ("link2.omega", "link2.alpha")
+    out = dc.sweep(tmp_path / "four_bar.h5", {"clearance": [0.3e-3]}, mechanism="four_bar",
+                   fixed={"clearance_joints": ["C"]}, revolutions=2, transient=0, per_revolution=8, twin=False,
+                   max_workers=1, progress=False)
+    assert out.options["channels"] == ["rocker.omega", "rocker.alpha"]
+    run = out.runs[0]
+    assert run.ok and set(out.channels(run)) >= {"rocker.omega", "rocker.alpha"}
