@@ -286,6 +286,25 @@ class Load(Element):
             out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number >= 0.")
 
 
+class BetweenBodies(Load):
+    """A load between two bodies ``body_i`` and ``body_j`` (names, or the Body objects)."""
+
+    body_i: str
+    body_j: str
+
+    def __post_init__(self) -> None:
+        for name in ("body_i", "body_j"):
+            object.__setattr__(self, name, body_name(getattr(self, name)))
+
+    def body_roles(self) -> tuple[tuple[str, str], ...]:
+        return (("body_i", self.body_i), ("body_j", self.body_j))
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        self._check_distinct(out, "body_i", "body_j")
+        return out
+
+
 #: Frames of a :class:`Force`'s components.
 FORCE_FRAMES: tuple[str, ...] = ("world", "body")
 
@@ -368,7 +387,7 @@ class Torque(Load):
 
 
 @dataclass(frozen=True)
-class SpringDamper(Load):
+class SpringDamper(BetweenBodies):
     """A linear spring-damper between point ``at_i`` of ``body_i`` and ``at_j`` of ``body_j``
     (world points of the reference configuration; the points move with their bodies).
 
@@ -389,18 +408,13 @@ class SpringDamper(Load):
     free_length: float | None = None
 
     def __post_init__(self) -> None:
-        for name in ("body_i", "body_j"):
-            object.__setattr__(self, name, body_name(getattr(self, name)))
+        super().__post_init__()
         for name in ("at_i", "at_j"):
             if as_vector2(getattr(self, name)) is not None:
                 object.__setattr__(self, name, as_vector2(getattr(self, name)))
 
-    def body_roles(self) -> tuple[tuple[str, str], ...]:
-        return (("body_i", self.body_i), ("body_j", self.body_j))
-
     def problems(self) -> list[str]:
         out = super().problems()
-        self._check_distinct(out, "body_i", "body_j")
         self._check_vector(out, "at_i", "m")
         self._check_vector(out, "at_j", "m")
         self._check_nonnegative(out, "stiffness", "N/m")
@@ -415,7 +429,7 @@ class SpringDamper(Load):
 
 
 @dataclass(frozen=True)
-class RotationalSpringDamper(Load):
+class RotationalSpringDamper(BetweenBodies):
     """A torsional spring-damper between ``body_i`` and ``body_j``: the torque on body j is
     ``-stiffness * (theta - free_angle) - damping * dtheta/dt`` with ``theta = phi_j - phi_i``
     (the opposite on body i). ``free_angle`` None: the reference relative angle. Channels
@@ -430,16 +444,8 @@ class RotationalSpringDamper(Load):
     damping: float = 0.0
     free_angle: float | None = None
 
-    def __post_init__(self) -> None:
-        for name in ("body_i", "body_j"):
-            object.__setattr__(self, name, body_name(getattr(self, name)))
-
-    def body_roles(self) -> tuple[tuple[str, str], ...]:
-        return (("body_i", self.body_i), ("body_j", self.body_j))
-
     def problems(self) -> list[str]:
         out = super().problems()
-        self._check_distinct(out, "body_i", "body_j")
         self._check_nonnegative(out, "stiffness", "N m/rad")
         self._check_nonnegative(out, "damping", "N m s/rad")
         if self.free_angle is not None:
@@ -448,7 +454,7 @@ class RotationalSpringDamper(Load):
 
 
 @dataclass(frozen=True)
-class Motor(Load):
+class Motor(BetweenBodies):
     """A motor between a stator ``body_i`` (e.g. the ground) and a rotor ``body_j`` (e.g. a crank),
     with the linear torque-speed characteristic of a DC motor::
 
@@ -465,16 +471,8 @@ class Motor(Load):
     stall_torque: float = 0.0
     no_load_speed: float = 0.0
 
-    def __post_init__(self) -> None:
-        for name in ("body_i", "body_j"):
-            object.__setattr__(self, name, body_name(getattr(self, name)))
-
-    def body_roles(self) -> tuple[tuple[str, str], ...]:
-        return (("body_i", self.body_i), ("body_j", self.body_j))
-
     def problems(self) -> list[str]:
         out = super().problems()
-        self._check_distinct(out, "body_i", "body_j")
         for field_name, unit in (("stall_torque", "N m"), ("no_load_speed", "rad/s")):
             value = getattr(self, field_name)
             if not is_finite_number(value) or value == 0:

@@ -18,6 +18,7 @@ import pytest
 import daeclear as dc
 import daeclear.contact as dcc
 from daeclear import mechanisms as M
+from scene_texts import PENDULUM_LINK
 
 STEEL = dcc.Material(young=207e9, poisson=0.3)
 
@@ -148,19 +149,7 @@ def test_scene_file_clearance_table(tmp_path):
     text = """
 [scene]
 name = "loose"
-
-[[body]]
-name = "link"
-mass = 1.0
-inertia = 0.01
-position = [0.5, 0.0]
-
-[[revolute]]
-name = "A"
-body_i = "ground"
-body_j = "link"
-at = [0.0, 0.0]
-clearance = { clearance = 0.1e-3, bearing_radius = 0.01, material = { young = 207e9, poisson = 0.3 }, law = { name = "lankarani-nikravesh", restitution = 0.9 } }
+""" + PENDULUM_LINK + """clearance = { clearance = 0.1e-3, bearing_radius = 0.01, material = { young = 207e9, poisson = 0.3 }, law = { name = "lankarani-nikravesh", restitution = 0.9 } }
 """
     path = tmp_path / "loose.toml"
     path.write_text(text)
@@ -361,19 +350,7 @@ def test_slider_path_without_a_stroke_is_drawn_along_the_guide():
 PENDULUM_ON_A_LOOSE_PIN = """
 [scene]
 name = "loose_pendulum"
-
-[[body]]
-name = "link"
-mass = 1.0
-inertia = 0.01
-position = [0.5, 0.0]
-
-[[revolute]]
-name = "A"
-body_i = "ground"
-body_j = "link"
-at = [0.0, 0.0]
-
+""" + PENDULUM_LINK + """
 [revolute.clearance]
 clearance = 0.1e-3
 bearing_radius = 0.01

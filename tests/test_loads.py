@@ -20,6 +20,7 @@ import daeclear as dc
 from daeclear.accuracy import energy_balance
 from daeclear.loads import exp, fmax
 from daeclear.scenefile import read_scene_file
+from scene_texts import PENDULUM_LINK
 
 
 def _oscillator(k: float = 800.0, m: float = 2.0, guided: bool = True, **spring) -> dc.Scene:
@@ -298,19 +299,7 @@ LOADS_TOML = """
 [scene]
 name = "loaded"
 gravity = [0.0, -9.81]
-
-[[body]]
-name = "link"
-mass = 1.0
-inertia = 0.01
-position = [0.5, 0.0]
-
-[[revolute]]
-name = "A"
-body_i = "ground"
-body_j = "link"
-at = [0.0, 0.0]
-
+""" + PENDULUM_LINK + """
 [[force]]
 name = "push"
 body = "link"
