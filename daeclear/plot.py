@@ -202,7 +202,6 @@ def save_response_figure(result: Result, path: Any, *, reference: Result | None 
     restitution, friction) unless ``title`` is False or a text. Returns the path written.
     """
     import matplotlib.pyplot as plt
-    from pathlib import Path
 
     names = [c for c in channels if c in result]
     fig, axes = plt.subplots(len(names), 1, figsize=(7.0, 2.2 * len(names) + 0.6), sharex=True, squeeze=False)
@@ -212,9 +211,18 @@ def save_response_figure(result: Result, path: Any, *, reference: Result | None 
             ax.set_xlabel("")
     _title(fig, result, title, True)
     fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def save_figure(fig: Any, path: Any, dpi: int = 120) -> Any:
+    """Write ``fig`` to ``path`` whole or not at all (a temporary file renamed into place), close
+    it, and return the path."""
+    import matplotlib.pyplot as plt
+    from pathlib import Path
+
     path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp{path.suffix}")
-    fig.savefig(tmp, dpi=120)
+    fig.savefig(tmp, dpi=dpi)
     plt.close(fig)
     tmp.replace(path)
     return path
@@ -736,19 +744,10 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
 
 def save_run_figure(result: Result, path: Any, **options: Any) -> Any:
     """Write :func:`plot_run`'s figure to ``path`` (whole or not at all); returns the path."""
-    import matplotlib.pyplot as plt
-    from pathlib import Path
-
-    fig = plot_run(result, **options)
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp{path.suffix}")
-    fig.savefig(tmp, dpi=120)
-    plt.close(fig)
-    tmp.replace(path)
-    return path
+    return save_figure(plot_run(result, **options), path)
 
 
-__all__ += ["clearance_joints", "default_channels", "plot_run", "save_run_figure"]
+__all__ += ["clearance_joints", "default_channels", "plot_run", "save_figure", "save_run_figure"]
 
 
 def plot_work_precision(study: Any, *, ax: Axes | None = None) -> Axes:
