@@ -8,7 +8,7 @@ Lankarani-Nikravesh c_e = 0.9, gravity, 5000 rpm) it prints:
 1. the chapter's run, five crank revolutions (three of transient, two shown) at rtol 1e-6 and
    1e-8: IDA's wall time of the whole ``simulate`` call (best of --repeats, model compiled and
    cached), accepted steps, residual and Jacobian evaluations and contact events;
-2. a work-precision study over one revolution (``daeclear.accuracy.work_precision``: reference
+2. a work-precision study over one revolution (``daeclear.studies.accuracy.work_precision``: reference
    DOP853 at rtol 1e-12, error window where it agrees with IDA at rtol 1e-12), and IDA's speed
    ratio against the fastest explicit method (RK45, DOP853, rk4, euler) and the fastest scipy
    implicit method (Radau, BDF, LSODA) whose error is at most IDA's (equal or better accuracy).
@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 import daeclear as dc
-from daeclear.accuracy import work_precision
+from daeclear.studies.accuracy import work_precision
 
 REV = 60.0 / 5000.0
 EXPLICIT = {"RK45": {"method": "RK45"}, "DOP853": {"method": "DOP853"}, "rk4": {"method": "rk4"},

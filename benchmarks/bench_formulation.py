@@ -38,7 +38,7 @@ from typing import Any, Callable
 import numpy as np
 
 import daeclear as dc
-from daeclear.assemble import DAEModel
+from daeclear.assembly.assemble import DAEModel
 
 REV = 60.0 / 5000.0
 WINDOW = 0.002

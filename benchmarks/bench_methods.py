@@ -12,7 +12,7 @@ and later errors say nothing about the integrator (the reference itself is check
 DOP853 at rtol 1e-12). Then the speed ratio: for each IDA run, the fastest other method whose
 error is at most IDA's (IDA at equal or worse accuracy), and how much slower it is.
 
-Last, the gap check of daeclear.integrators with and without its cubic Hermite test for crossings
+Last, the gap check of daeclear.solvers.explicit with and without its cubic Hermite test for crossings
 inside a step (docs/performance.md): event counts over the first 5 ms and the two revolutions.
 """
 
@@ -31,8 +31,8 @@ except ImportError:  # running from a checkout without installing
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import daeclear as dc  # noqa: E402
-import daeclear.integrators as integrators  # noqa: E402
-from daeclear.automaton import PairState  # noqa: E402
+import daeclear.solvers.explicit as integrators  # noqa: E402
+from daeclear.assembly.automaton import PairState  # noqa: E402
 
 T_END = 0.024
 WINDOW = 0.005

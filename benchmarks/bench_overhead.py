@@ -27,8 +27,9 @@ import warnings
 import numpy as np
 
 import daeclear as dc
-from daeclear import automaton, physics, solve
-from daeclear.ida_session import open_session
+from daeclear.assembly import automaton
+from daeclear.solvers import physics, ida as solve
+from daeclear.engine.ida_session import open_session
 
 REV = 60.0 / 5000.0
 

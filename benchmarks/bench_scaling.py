@@ -24,7 +24,7 @@ build is cold and no measurement sees another's libraries or memory:
 
 Growth exponents are least-squares slopes of log(value) against log(N) over the sizes that
 finished, and the slope between the two largest of them (constant costs flatten the small sizes). Only public API is used (``daeclear.simulate``, ``daeclear.assemble``,
-``daeclear.mechanisms.chain``, ``daeclear.codegen.cache_dir``), so the benchmark keeps working
+``daeclear.mechanisms.chain``, ``daeclear.engine.codegen.cache_dir``), so the benchmark keeps working
 when the compiled engine changes.
 
     python benchmarks/bench_scaling.py [--sizes 1,2,4,8,16,32] [--t-end 0.05] [--repeats 3] [--timeout 300]
@@ -129,7 +129,7 @@ class DescendantPeak:
 def child(n: int, t_end: float, repeats: int) -> None:
     """Measure one chain size in this (fresh) process and report as TAG lines on stdout."""
     import daeclear as dc
-    from daeclear.codegen import cache_dir
+    from daeclear.engine.codegen import cache_dir
 
     _report(cache=str(cache_dir()))
     scene = dc.mechanisms.chain(n)

@@ -30,7 +30,7 @@ try:
 except ImportError:  # running from a checkout without installing
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from daeclear.ida_session import DAEFunctions, open_session  # noqa: E402
+from daeclear.engine.ida_session import DAEFunctions, open_session  # noqa: E402
 
 G = 9.81
 

@@ -42,7 +42,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="bench_sweep-") as tmp:
         os.environ["DAECLEAR_CACHE_DIR"] = str(Path(tmp) / "cache")  # before daeclear builds anything
         import daeclear as dc
-        from daeclear.codegen import cache_dir
+        from daeclear.engine.codegen import cache_dir
 
         clearances = np.geomspace(1e-5, 5e-4, args.points)
         t_end = args.revolutions * REV

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 import daeclear as dc
-from daeclear.accuracy import work_precision
+from daeclear.studies.accuracy import work_precision
 
 REV = 60.0 / 5000.0
 RIVALS = {name: {"method": name} for name in ("RK45", "DOP853", "Radau", "BDF", "LSODA")}

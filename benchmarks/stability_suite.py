@@ -1,4 +1,4 @@
-"""Run the stability suite (daeclear.stability.CASES) and print its table; --write updates docs/stability.md.
+"""Run the stability suite (daeclear.studies.stability.CASES) and print its table; --write updates docs/stability.md.
 
     python benchmarks/stability_suite.py [--rtol 1e-6] [--write]
 """
@@ -8,7 +8,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from daeclear.stability import CASES, run_suite, to_markdown
+from daeclear.studies.stability import CASES, run_suite, to_markdown
 
 
 NOTES = """

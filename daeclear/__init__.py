@@ -5,16 +5,26 @@ Scene --assemble--> DAEModel --simulate--> Result --> analysis | plot | io
 
 from __future__ import annotations
 
-from . import analysis, loads, mechanisms, profiles
-from .assemble import DAEModel, assemble
+# Old module paths, thin aliases for one release (daeclear.old_paths): those `import daeclear` loaded
+# before the move are imported first, so that `daeclear.<old>.<name>` keeps working after
+# `import daeclear` and the names bound below win over the aliases (the function `sweep` over the
+# module `daeclear.sweep`).
+from . import old_paths  # noqa: F401  (installs the finder of the old paths)
+from . import (  # noqa: F401
+    accuracy, analysis, automaton, codegen, ida_session, loads, mechanisms, outputs, physics, profiles,
+    recorder, result, scene, sweep)
+
+from .studies import analysis
+from .model import loads, mechanisms, profiles
+from .assembly.assemble import DAEModel, assemble
 from .errors import (AssemblyError, DaeclearError, DaeclearWarning, Interrupted, OutputError, PhysicsWarning, SceneError,
                      SolveError)
-from .result import ContactEvent, Result, load
+from .results.result import ContactEvent, Result, load
 from .contact import Material
-from .loads import Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
-from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
-from .solve import simulate
-from .sweep import load_sweep, sweep  # the function `sweep` shadows the module: import names from daeclear.sweep
+from .model.loads import Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
+from .model.scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
+from .solvers.ida import simulate
+from .studies.sweep import load_sweep, sweep  # the function `sweep` shadows the module: import names from daeclear.studies.sweep
 
 __version__ = "0.1.0"
 

@@ -99,11 +99,11 @@ def _mechanism(mechanisms: dict[str, Any], name: str, params: dict[str, Any]) ->
 
 def _run(args: argparse.Namespace) -> int:
     from . import options
-    from .mechanisms import ideal_parameters
-    from .outputs import check_directory
-    from .scene import RevoluteClearance, TranslationalClearance
-    from .scenefile import MECHANISMS, read_scene_file
-    from .solve import simulate
+    from .model.mechanisms import ideal_parameters
+    from .results.outputs import check_directory
+    from .model.scene import RevoluteClearance, TranslationalClearance
+    from .model.scenefile import MECHANISMS, read_scene_file
+    from .solvers.ida import simulate
 
     where = "daeclear run"
     params = _parse_sets(args.set)
@@ -195,7 +195,7 @@ def _run(args: argparse.Namespace) -> int:
 def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_scene: Any, t_end: float, rtol: float,
                 base: str) -> None:
     """The response figure of ``daeclear run`` (against the ideal joint when there is one)."""
-    from .solve import simulate
+    from .solvers.ida import simulate
 
     if not args.no_figure:
         import matplotlib
@@ -218,7 +218,7 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
 def _read_back(h5: Path) -> tuple[float | None, Any]:
     """The streamed result, whole, or from the time of its last CLI_SHOWN_EVENTS events on (bounded memory:
     the points are at most CLI_POINTS + 1, the events and segments of a long run are not)."""
-    from .result import load, load_times
+    from .results.result import load, load_times
 
     events = load_times(h5, "events")
     shown_from = float(events[-CLI_SHOWN_EVENTS]) if events.size > CLI_SHOWN_EVENTS else None
@@ -246,9 +246,9 @@ def _floats(text: str, what: str) -> list[float]:
 
 def _study(args: argparse.Namespace) -> int:
     from . import options
-    from .accuracy import WorkPrecision, work_precision
-    from .outputs import check_directory
-    from .scenefile import MECHANISMS
+    from .studies.accuracy import WorkPrecision, work_precision
+    from .results.outputs import check_directory
+    from .model.scenefile import MECHANISMS
 
     where = "daeclear study"
     if args.target not in MECHANISMS:
@@ -305,7 +305,7 @@ def _study(args: argparse.Namespace) -> int:
 
 def _write_study_tables(study: Any, out: Path) -> str:
     """The study's CSV and markdown tables, each written whole (atomic, Ctrl-C deferred); the markdown text."""
-    from .outputs import atomic_write_text, deferred_sigint
+    from .results.outputs import atomic_write_text, deferred_sigint
 
     text = study.to_markdown()
     with deferred_sigint():  # both tables, or a second Ctrl-C waits until both are written
@@ -379,8 +379,8 @@ def _sweep(args: argparse.Namespace) -> int:
     import json
 
     from . import options
-    from .outputs import check_directory, check_file
-    from .sweep import sweep
+    from .results.outputs import check_directory, check_file
+    from .studies.sweep import sweep
 
     fixed = _parse_sets(args.set)
     if args.joint:
@@ -507,8 +507,8 @@ def _add_animate_parser(sub: Any) -> None:
 
 
 def _animate(args: argparse.Namespace) -> int:
-    from .animate import CLI_FIELDS, render
-    from .result import load
+    from .plot.animate import CLI_FIELDS, render
+    from .results.result import load
 
     if not args.result.is_file():
         raise DaeclearError(f"animate: no result file '{args.result}'; give a .h5 file written by daeclear run or "

@@ -235,7 +235,7 @@ def output(*, t_eval: NDArray[np.float64] | None, t_eval_step: Any, end: float, 
     if stream_to is not None:
         if not isinstance(stream_to, (str, os.PathLike)):
             fail(where, "stream_to", stream_to, "None or the path of an HDF5 file (str or pathlib.Path), e.g. 'run.h5'")
-        from .outputs import check_file
+        from .results.outputs import check_file
 
         path = check_file(stream_to, f"{where}: stream_to")
     elif not keep:

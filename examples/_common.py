@@ -43,9 +43,9 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 import daeclear as dc
-from daeclear import style
-from daeclear.mechanisms import slider_crank
-from daeclear.plot import _contact_intervals as contact_intervals
+from daeclear.plot import style
+from daeclear.model.mechanisms import slider_crank
+from daeclear.plot.figures import _contact_intervals as contact_intervals
 
 RPM = 5000.0
 PERIOD = 60.0 / RPM  # s per crank revolution (0.012 s at 5000 rpm)
@@ -416,7 +416,7 @@ def save_figure(fig: Any, path: Path, *, dpi: int = 110) -> Path:
 
 
 def shared_caption(results: Sequence[dc.Result]) -> str:
-    """The parameters every run of ``results`` shares, from :func:`daeclear.style.caption`.
+    """The parameters every run of ``results`` shares, from :func:`daeclear.plot.style.caption`.
 
     For the title of a figure that compares cases: the parameter that varies is in the panel
     titles or the legend, the others once in the figure title. A part that differs only in its
@@ -442,7 +442,7 @@ def shared_caption(results: Sequence[dc.Result]) -> str:
 
 
 def title_of(what: str, results: Sequence[dc.Result] | dc.Result) -> str:
-    """Figure title: what it shows, then on a second line the run's parameters (:func:`daeclear.style.caption`)
+    """Figure title: what it shows, then on a second line the run's parameters (:func:`daeclear.plot.style.caption`)
     or, for several runs, the ones they share (:func:`shared_caption`)."""
     if isinstance(results, dc.Result):
         return f"{what}\n{style.caption(results)}"

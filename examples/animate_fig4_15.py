@@ -30,7 +30,7 @@ import numpy as np
 matplotlib.use("Agg")
 
 import daeclear as dc  # noqa: E402
-from daeclear.mechanisms import slider_crank  # noqa: E402
+from daeclear.model.mechanisms import slider_crank  # noqa: E402
 
 CLEARANCE = 0.5e-3  # m (Fig. 4.15)
 RESTITUTION = 0.9  # Table 4.2

@@ -63,7 +63,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parse_args(argv)
     import matplotlib.pyplot as plt
 
-    from daeclear import style
+    from daeclear.plot import style
     from daeclear.plot import plot_bifurcation
 
     clearances = [float(c) for c in np.geomspace(C_MIN, C_MAX, 2 if args.quick else args.points)]

@@ -38,7 +38,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import daeclear as dc  # noqa: E402
-from daeclear import mechanisms  # noqa: E402
+from daeclear.model import mechanisms  # noqa: E402
 from daeclear.plot import plot_channel, plot_journal_orbit, plot_run  # noqa: E402
 
 RPM = 5000.0

@@ -8,7 +8,7 @@ per family into ``--out`` (default
 in the PNG's ``Title`` text. With the default output directory it also writes
 ``docs/gallery.md``, the page that shows them.
 
-Every figure is titled with the parameters of its runs (``daeclear.style.caption``): clearance,
+Every figure is titled with the parameters of its runs (``daeclear.plot.style.caption``): clearance,
 crank speed, contact law and restitution, friction; a figure comparing cases states the shared
 parameters in its title and the varied one in its panel titles or legend.
 

@@ -32,7 +32,7 @@ matplotlib.use("Agg")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import _common as cm  # noqa: E402
-from daeclear.mechanisms import slider_crank  # noqa: E402
+from daeclear.model.mechanisms import slider_crank  # noqa: E402
 
 CLEARANCES = (0.5e-3, 0.2e-3, 0.1e-3, 0.01e-3)  # m (Figs. 4.16-4.18 a-d)
 RESTITUTION = 0.9

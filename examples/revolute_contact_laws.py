@@ -48,8 +48,8 @@ from daeclear.contact import (  # noqa: E402
     Hertz,
     LankaraniNikravesh,
 )
-from daeclear import style  # noqa: E402
-from daeclear.mechanisms import BEARING_RADIUS, STEEL, slider_crank  # noqa: E402
+from daeclear.plot import style  # noqa: E402
+from daeclear.model.mechanisms import BEARING_RADIUS, STEEL, slider_crank  # noqa: E402
 
 CLEARANCE = 0.5e-3  # m
 RESTITUTION = 0.9  # Lankarani-Nikravesh only

@@ -34,8 +34,8 @@ matplotlib.use("Agg")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import _common as cm  # noqa: E402
-from daeclear import style  # noqa: E402
-from daeclear.mechanisms import slider_crank  # noqa: E402
+from daeclear.plot import style  # noqa: E402
+from daeclear.model.mechanisms import slider_crank  # noqa: E402
 from daeclear.plot import plot_revolute_response, plot_step_sizes  # noqa: E402
 
 CLEARANCE = 0.5e-3  # m (Fig. 4.15)

@@ -38,9 +38,9 @@ import numpy as np  # noqa: E402
 
 import _common as cm  # noqa: E402
 import daeclear as dc  # noqa: E402
-from daeclear import style  # noqa: E402
+from daeclear.plot import style  # noqa: E402
 from daeclear.contact import ImpactResult  # noqa: E402
-from daeclear.mechanisms import slider_crank  # noqa: E402
+from daeclear.model.mechanisms import slider_crank  # noqa: E402
 from daeclear.plot import plot_force_penetration, plot_force_time  # noqa: E402
 
 RESTITUTIONS = (1.00, 0.99, 0.95, 0.90)  # c_e (Fig. 4.26)

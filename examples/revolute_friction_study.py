@@ -35,7 +35,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import _common as cm  # noqa: E402
 from daeclear.contact import ModifiedCoulomb  # noqa: E402
-from daeclear.mechanisms import slider_crank  # noqa: E402
+from daeclear.model.mechanisms import slider_crank  # noqa: E402
 
 FRICTION = (0.01, 0.03, 0.05, 0.1)  # c_f (Figs. 4.19-4.21 a-d)
 CLEARANCE = 0.5e-3  # m

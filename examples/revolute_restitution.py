@@ -30,7 +30,7 @@ matplotlib.use("Agg")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import _common as cm  # noqa: E402
-from daeclear.mechanisms import slider_crank  # noqa: E402
+from daeclear.model.mechanisms import slider_crank  # noqa: E402
 
 RESTITUTIONS = (1.00, 0.99, 0.95, 0.90)  # c_e (Fig. 4.25 a-d)
 CLEARANCE = 0.5e-3  # m

@@ -31,8 +31,8 @@ matplotlib.use("Agg")
 
 import _common as cm  # noqa: E402
 import daeclear as dc  # noqa: E402
-from daeclear.mechanisms import slider_crank  # noqa: E402
-from daeclear.sweep import SweepResult  # noqa: E402
+from daeclear.model.mechanisms import slider_crank  # noqa: E402
+from daeclear.studies.sweep import SweepResult  # noqa: E402
 
 CLEARANCES = [0.5e-3, 0.2e-3, 0.1e-3, 0.01e-3]  # m (Figs. 4.16-4.18 and 4.29-4.31)
 FRICTIONS = [0.01, 0.03, 0.05, 0.1]  # modified Coulomb coefficients (Figs. 4.19-4.21 and 4.32-4.34)
@@ -162,7 +162,7 @@ def markdown(table: list[dict[str, Any]]) -> str:
 def figures(name: str, result: SweepResult, out: Path) -> list[Path]:
     import matplotlib.pyplot as plt
 
-    from daeclear import style
+    from daeclear.plot import style
     from daeclear.plot import plot_poincare_section
 
     study = STUDIES[name]

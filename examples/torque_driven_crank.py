@@ -40,7 +40,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import daeclear as dc  # noqa: E402
-from daeclear.accuracy import energy_balance  # noqa: E402
+from daeclear.studies.accuracy import energy_balance  # noqa: E402
 
 STALL_TORQUE = 100.0  # N m
 NO_LOAD_SPEED = 5000.0 * math.pi / 30.0  # rad/s (5000 rpm, the chapter's crank speed)

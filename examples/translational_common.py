@@ -39,7 +39,7 @@ from _common import (  # noqa: F401  (re-exported: the translational scripts use
     distinct_points, figure_title, markdown_table, poincare_points, print_written, save_figure, save_result,
     study_title, title_of,
 )
-from daeclear.mechanisms import slider_crank
+from daeclear.model.mechanisms import slider_crank
 
 DEFAULT_REVOLUTIONS = 10  # revolutions analysed after the transient (section 4.4's examples: 20)
 WINDOW_LABEL = "time histories"  # what shows the last two revolutions (Span.describe, --help)

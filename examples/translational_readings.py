@@ -3,11 +3,11 @@
 The chapter says of its Fig. 4.28 (c = 0.5 mm) that the slider velocity is "smooth and close to
 the ideal joint simulation", that slider and guide "are in permanent contact for long periods",
 with "some sudden changes" from impacts and "visible high peaks in the crank moment". This
-study runs every reading of the model the text supports (:mod:`daeclear.readings`: the joint
+study runs every reading of the model the text supports (:mod:`daeclear.model.readings`: the joint
 readings with Table 4.1's mechanism, and daeclear's default joint reading with every mechanism
-reading), measures those statements (:mod:`daeclear.response_metrics`) over the analysed span
+reading), measures those statements (:mod:`daeclear.studies.response_metrics`) over the analysed span
 and over the first two revolutions from the start, and says which readings meet all of
-:data:`daeclear.response_metrics.FIG_4_28`.
+:data:`daeclear.studies.response_metrics.FIG_4_28`.
 
 Each reading is compared with the ideal joint of the same mechanism (same gravity, slider mass
 and inertia), on the same output times.
@@ -34,9 +34,9 @@ import numpy as np  # noqa: E402
 
 import translational_common as tc  # noqa: E402
 import daeclear as dc  # noqa: E402
-from daeclear import readings  # noqa: E402
-from daeclear.mechanisms import slider_crank  # noqa: E402
-from daeclear.response_metrics import FIG_4_28, measure, verdict  # noqa: E402
+from daeclear.model import readings  # noqa: E402
+from daeclear.model.mechanisms import slider_crank  # noqa: E402
+from daeclear.studies.response_metrics import FIG_4_28, measure, verdict  # noqa: E402
 
 JOINT = tc.JOINT
 #: (joint reading, mechanism reading): every joint reading with Table 4.1's mechanism, then the

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.accuracy import channel_error, converged_window, event_time_error, work_precision
+from daeclear.studies.accuracy import channel_error, converged_window, event_time_error, work_precision
 from daeclear.errors import SceneError
 
 REV = 60.0 / 5000.0

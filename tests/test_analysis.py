@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.analysis import (
+from daeclear.studies.analysis import (
     Divergence,
     PoincareSection,
     classify_motion,
@@ -28,7 +28,7 @@ from daeclear.analysis import (
     twin_evidence,
 )
 from daeclear.errors import DaeclearError, SceneError
-from daeclear.mechanisms import slider_crank
+from daeclear.model.mechanisms import slider_crank
 
 T = 0.012  # s, one crank revolution at the chapter's 5000 rpm
 SPEED = 2 * math.pi / T

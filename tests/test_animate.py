@@ -9,11 +9,11 @@ import pytest
 from PIL import Image
 
 import daeclear as dc
-from daeclear.animate import MAX_FRAMES, frame_count, frame_times
+from daeclear.plot.animate import MAX_FRAMES, frame_count, frame_times
 from daeclear.cli import main
 from daeclear.errors import MissingDependencyError, OutputError
-from daeclear.mechanisms import chain, slider_crank
-from daeclear.scenefile import read_scene_file
+from daeclear.model.mechanisms import chain, slider_crank
+from daeclear.model.scenefile import read_scene_file
 from scene_texts import PENDULUM
 
 SMALL = (320, 200)
@@ -216,7 +216,7 @@ def test_fig4_15_example_script(tmp_path):
 
 def test_contact_state_of_a_frame():
     """In contact at the frame's time, an impact since the previous frame (over by now), or free."""
-    from daeclear.animate import CONTACT, FREE, IMPACT, _contact_state, _Sampler
+    from daeclear.plot.animate import CONTACT, FREE, IMPACT, _contact_state, _Sampler
 
     t = np.arange(5.0)
     result = dc.Result(t=t, y=np.zeros((5, 0)), yp=np.zeros((5, 0)), state_names=[], units={},

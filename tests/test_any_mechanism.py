@@ -17,7 +17,7 @@ import pytest
 
 import daeclear as dc
 import daeclear.contact as dcc
-from daeclear import mechanisms as M
+from daeclear.model import mechanisms as M
 from scene_texts import PENDULUM_LINK
 
 STEEL = dcc.Material(young=207e9, poisson=0.3)
@@ -111,7 +111,7 @@ def test_ideal_is_the_inverse_of_with_clearance():
     assert (guide.kind, guide.point_i, guide.point_j, guide.axis) == ("Translational", (0.0, 0.0), (0.0, 0.0),
                                                                       (1.0, 0.0))
     with pytest.raises(dc.SceneError, match="'B': it is a Revolute, not a clearance joint"):
-        dc.scene.ideal_joint(M.four_bar()["B"])
+        dc.model.scene.ideal_joint(M.four_bar()["B"])
 
 
 def test_bearing_body_and_name():
@@ -144,7 +144,7 @@ def test_with_clearance_bad_input(call, message):
 
 
 def test_scene_file_clearance_table(tmp_path):
-    from daeclear.scenefile import read_scene_file
+    from daeclear.model.scenefile import read_scene_file
 
     text = """
 [scene]
@@ -364,7 +364,7 @@ t_end = 0.02
 def test_cli_runs_scenes_without_slider_or_driver(tmp_path, capsys, monkeypatch):
     import daeclear.plot
     from daeclear.cli import main
-    from daeclear.result import load
+    from daeclear.results.result import load
 
     references = []
     save = daeclear.plot.save_run_figure

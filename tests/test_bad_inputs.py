@@ -15,10 +15,10 @@ from typing import Any, Callable
 import pytest
 
 import daeclear as dc
-from daeclear.accuracy import work_precision
+from daeclear.studies.accuracy import work_precision
 from daeclear.cli import main
 from daeclear.errors import OutputDirectoryMissing, OutputError, SceneError
-from daeclear.scenefile import read_scene_file
+from daeclear.model.scenefile import read_scene_file
 from scene_texts import PENDULUM as PENDULUM_FILE
 
 SCENE = dc.mechanisms.slider_crank("ideal")
@@ -30,16 +30,16 @@ def no_work(monkeypatch):
     """A bad input must be refused before any run: the runs of the CLI, studies and sweeps are guarded."""
     import sys
 
-    import daeclear.accuracy
-    import daeclear.solve
+    import daeclear.studies.accuracy
+    import daeclear.solvers.ida
 
-    sweep_module = sys.modules["daeclear.sweep"]  # daeclear.sweep is the function
+    sweep_module = sys.modules["daeclear.studies.sweep"]  # daeclear.sweep is the function
 
     def guard(*args: Any, **kwargs: Any) -> Any:
         raise AssertionError("a bad input reached the computation")
 
-    monkeypatch.setattr(daeclear.solve, "simulate", guard)
-    monkeypatch.setattr(daeclear.accuracy, "simulate", guard)
+    monkeypatch.setattr(daeclear.solvers.ida, "simulate", guard)
+    monkeypatch.setattr(daeclear.studies.accuracy, "simulate", guard)
     monkeypatch.setattr(sweep_module, "_execute", guard)
 
 
@@ -217,7 +217,7 @@ def test_sweep_refuses_place(place, tmp_path):
 @pytest.mark.parametrize("writer", ["to_csv", "to_markdown"])
 @pytest.mark.parametrize("place", ["a folder", "under a file"])
 def test_study_tables_refuse_place(writer, place, tmp_path):
-    from daeclear.accuracy import WorkPrecision
+    from daeclear.studies.accuracy import WorkPrecision
 
     study = WorkPrecision(rows=[], channels=["slider.vx"], window=(0.0, 1.0), window_reason="given",
                           reference=None, reference_options={}, assembly_time=0.0)  # type: ignore[arg-type]

@@ -17,8 +17,8 @@ import pytest
 
 import daeclear as dc
 from daeclear.errors import SceneError
-from daeclear.mechanisms import CHAIN_LINK_INERTIA, CHAIN_LINK_LENGTH, CHAIN_LINK_MASS, chain
-from daeclear.scenefile import MECHANISMS, read_scene_file
+from daeclear.model.mechanisms import CHAIN_LINK_INERTIA, CHAIN_LINK_LENGTH, CHAIN_LINK_MASS, chain
+from daeclear.model.scenefile import MECHANISMS, read_scene_file
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 5])

@@ -20,10 +20,10 @@ from scipy.interpolate import CubicSpline
 
 import daeclear as dc
 from daeclear.errors import AssemblyError, SceneError
-from daeclear.profiles import ConstantSpeed, Harmonic, Ramp, Tabulated
-from daeclear.scene import GROUND
-from daeclear.scenefile import read_scene_file
-from daeclear.symbolic import Reference
+from daeclear.model.profiles import ConstantSpeed, Harmonic, Ramp, Tabulated
+from daeclear.model.scene import GROUND
+from daeclear.model.scenefile import read_scene_file
+from daeclear.assembly.symbolic import Reference
 
 INERTIA = 0.02  # kg m^2, the driven disc
 SPEED = 10.0  # rad/s
@@ -438,7 +438,7 @@ def test_slider_declared_in_its_guide_wall_is_refused():
 
 
 def test_crank_period_needs_a_constant_speed_rotation():
-    from daeclear.analysis import crank_period
+    from daeclear.studies.analysis import crank_period
     from daeclear.errors import DaeclearError
 
     assert crank_period(disc_scene(None)) == pytest.approx(2 * math.pi / SPEED)

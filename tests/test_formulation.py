@@ -16,7 +16,7 @@ import pytest
 
 import daeclear as dc
 from daeclear import options
-from daeclear.physics import DRIFT_FRACTION
+from daeclear.solvers.physics import DRIFT_FRACTION
 
 CLEARANCE = 0.01e-3
 REV = 60.0 / 5000.0
@@ -51,7 +51,7 @@ def test_drift_stays_a_small_fraction_of_a_small_clearance(scene):
 
 @pytest.fixture(scope="module")
 def translational_twin() -> tuple[dc.DAEModel, dc.Result, int]:
-    from daeclear.analysis import crank_period, sampling_times
+    from daeclear.studies.analysis import crank_period, sampling_times
 
     model = dc.assemble(dc.mechanisms.slider_crank("translational", clearance=CLEARANCE))
     period = crank_period(model)
@@ -67,7 +67,7 @@ def test_a_projected_restart_does_not_skip_a_contact(translational_twin, backend
     gap from just above zero to just below: its contact was never found and the slider went 49 mm
     (python backend) or 0.17 m (compiled) through the guide. The restart now keeps the unprojected
     state when the projection flips a root function that did not fire."""
-    from daeclear.analysis import DEFAULT_PERTURBATION, restart_model
+    from daeclear.studies.analysis import DEFAULT_PERTURBATION, restart_model
 
     model, base, index = translational_twin
     twin = dc.simulate(restart_model(model, base, index, perturbation=DEFAULT_PERTURBATION), 0.025, backend=backend)

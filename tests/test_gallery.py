@@ -78,7 +78,7 @@ def test_shared_caption_keeps_what_every_case_has(gallery: ModuleType) -> None:
     import _common as cm
 
     import daeclear as dc
-    from daeclear.mechanisms import slider_crank
+    from daeclear.model.mechanisms import slider_crank
 
     def Run(restitution: float, clearance: float) -> dc.Result:  # noqa: N802  (a 10 us run records the scene)
         return dc.simulate(slider_crank("revolute", clearance=clearance, restitution=restitution), 1e-5)

@@ -1,4 +1,4 @@
-"""The integrator backend (daeclear.ida_session, daeclear.codegen): compiled C and pure Python.
+"""The integrator backend (daeclear.engine.ida_session, daeclear.engine.codegen): compiled C and pure Python.
 
 Every model here is built by hand with CasADi. Compiled libraries go to a per-run temporary
 cache directory (DAECLEAR_CACHE_DIR), so each distinct model compiles once per run.
@@ -14,9 +14,9 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from daeclear import codegen
+from daeclear.engine import codegen
 from daeclear.errors import DaeclearError, DaeclearWarning
-from daeclear.ida_session import (
+from daeclear.engine.ida_session import (
     FLAG_MAX_STEPS,
     FLAG_STEP_COLLAPSE,
     TINY_STEP_COUNT,
@@ -586,7 +586,7 @@ def test_extras_evaluate_over_points_like_casadi():
     import casadi as ca
     import numpy as np
 
-    from daeclear.ida_session import DAEFunctions, open_session
+    from daeclear.engine.ida_session import DAEFunctions, open_session
 
     t, y, yp, c = ca.SX.sym("t"), ca.SX.sym("y", 2), ca.SX.sym("yp", 2), ca.SX.sym("cj")
     res = ca.vertcat(yp[0] - y[1], yp[1] + y[0])

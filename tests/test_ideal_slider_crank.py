@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.mechanisms import (CRANK_INERTIA, CRANK_LENGTH as R, CRANK_MASS, ROD_INERTIA, ROD_LENGTH as L,
+from daeclear.model.mechanisms import (CRANK_INERTIA, CRANK_LENGTH as R, CRANK_MASS, ROD_INERTIA, ROD_LENGTH as L,
                                  ROD_MASS, SLIDER_MASS, rpm_to_rad_s)
 
 OMEGA = rpm_to_rad_s(5000.0)

@@ -1,4 +1,4 @@
-"""The other integrators (daeclear.integrators): scipy RK45/DOP853/Radau/BDF/LSODA, fixed-step rk4/euler.
+"""The other integrators (daeclear.solvers.explicit): scipy RK45/DOP853/Radau/BDF/LSODA, fixed-step rk4/euler.
 
 Measured (gcc 12, 2-core machine), ideal slider-crank without gravity, one crank revolution (12 ms),
 largest slider.x error against the closed form at rtol 1e-8: RK45 9e-10, DOP853 2e-9, Radau 2e-10,
@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.codegen import clear_memos
-from daeclear.integrators import _candidate, _cubic_extrema
-from daeclear.mechanisms import CRANK_LENGTH as R, ROD_LENGTH as L, rpm_to_rad_s
+from daeclear.engine.codegen import clear_memos
+from daeclear.solvers.explicit import _candidate, _cubic_extrema
+from daeclear.model.mechanisms import CRANK_LENGTH as R, ROD_LENGTH as L, rpm_to_rad_s
 
 OMEGA = rpm_to_rad_s(5000.0)
 REV = 2 * np.pi / OMEGA  # one crank revolution, 12 ms

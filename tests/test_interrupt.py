@@ -19,10 +19,10 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.accuracy import WorkPrecision, work_precision
+from daeclear.studies.accuracy import WorkPrecision, work_precision
 from daeclear.cli import main
 from daeclear.errors import Interrupted
-from daeclear.sweep import load_sweep
+from daeclear.studies.sweep import load_sweep
 
 T_END = 0.006
 
@@ -30,7 +30,7 @@ T_END = 0.006
 @pytest.fixture
 def ctrl_c_after(monkeypatch):
     """``ctrl_c_after(n)``: the n-th progress update of a run raises KeyboardInterrupt (a Ctrl-C there)."""
-    import daeclear.solve as solve
+    import daeclear.solvers.ida as solve
 
     monkeypatch.setattr(solve, "open_session", functools.partial(solve.open_session, buffer_steps=64))
     original = solve._Progress.update
@@ -76,9 +76,9 @@ def test_ctrl_c_with_on_failure_raise_is_not_a_solve_error(ctrl_c_after):
 
 
 def test_cli_run_ctrl_c_saves_the_partial_result_once(ctrl_c_after, tmp_path, capsys, monkeypatch):
-    """The run streams to its file (daeclear.result.ResultWriter): the file is completed once, when the run
+    """The run streams to its file (daeclear.results.result.ResultWriter): the file is completed once, when the run
     stops, and not written again by Result.save."""
-    from daeclear.result import ResultWriter
+    from daeclear.results.result import ResultWriter
 
     saves, closes = [], []
     original = dc.Result.save
@@ -99,7 +99,7 @@ def test_cli_run_ctrl_c_saves_the_partial_result_once(ctrl_c_after, tmp_path, ca
 
 def test_second_ctrl_c_during_the_save_does_not_lose_it(tmp_path, monkeypatch):
     """SIGINT arriving in the middle of the HDF5 write is held back until the file is complete and in place."""
-    import daeclear.result as result_module
+    import daeclear.results.result as result_module
 
     result = dc.simulate(dc.mechanisms.slider_crank("ideal"), 1e-3)
     original = result_module._write
@@ -120,7 +120,7 @@ def test_second_ctrl_c_during_the_save_does_not_lose_it(tmp_path, monkeypatch):
 
 def test_cli_second_ctrl_c_during_the_partial_save(ctrl_c_after, tmp_path, capsys, monkeypatch):
     """A real SIGINT while the streamed file is completed (its statistics written): held back until it is."""
-    import daeclear.result as result_module
+    import daeclear.results.result as result_module
 
     original, close = result_module._mirror, result_module.ResultWriter.close
     closing, sent = [], []
@@ -146,7 +146,7 @@ STUDY = ["study", "slider_crank", "--joint", "ideal", "--t-end", "0.002", "--met
 
 @pytest.fixture
 def ctrl_c_in_second_study_run(monkeypatch):
-    import daeclear.accuracy as accuracy
+    import daeclear.studies.accuracy as accuracy
 
     original = accuracy._timed
     calls = [0]
@@ -276,7 +276,7 @@ def test_a_ctrl_c_python_drops_is_still_latched(monkeypatch):
     import gc
     import weakref
 
-    from daeclear.outputs import sigint_latch
+    from daeclear.results.outputs import sigint_latch
 
     dropped: list[type] = []
     monkeypatch.setattr(sys, "unraisablehook", lambda unraisable: dropped.append(unraisable.exc_type))

@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear import ida_session
+from daeclear.engine import ida_session
 from daeclear.errors import DaeclearError, SceneError
-from daeclear.ida_session import DAEFunctions, open_session
-from daeclear.mechanisms import chain, slider_crank
+from daeclear.engine.ida_session import DAEFunctions, open_session
+from daeclear.model.mechanisms import chain, slider_crank
 
 G = 9.81
 

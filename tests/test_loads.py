@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.accuracy import energy_balance
-from daeclear.loads import exp, fmax
-from daeclear.scenefile import read_scene_file
+from daeclear.studies.accuracy import energy_balance
+from daeclear.model.loads import exp, fmax
+from daeclear.model.scenefile import read_scene_file
 from scene_texts import PENDULUM_LINK
 
 

@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.codegen import clear_memos
+from daeclear.engine.codegen import clear_memos
 from daeclear.contact import FRICTION_LAWS, NORMAL_LAWS, Material, friction_law, normal_law
-from daeclear.parameters import is_parametric, law_values, symbolic_law
+from daeclear.assembly.parameters import is_parametric, law_values, symbolic_law
 
 STEEL = Material(young=207e9, poisson=0.3)
 
@@ -54,7 +54,7 @@ VARIANTS = {
     "section-4.3": (dict(joint="translational", contact_model="section-4.3"),
                     dict(joint="translational", clearance=0.6e-3, contact_model="section-4.3", restitution=0.8)),
     "ideal": (dict(joint="ideal"), dict(joint="ideal", rpm=1234.0, gravity=3.0)),
-    # readings of the translational joint (daeclear.readings): their K, n, c_e, the slider's mass and
+    # readings of the translational joint (daeclear.model.readings): their K, n, c_e, the slider's mass and
     # inertia and the pin's place on it are numbers
     "reading-unified": (dict(joint="translational", reading="unified"),
                         dict(joint="translational", reading="unified", clearance=0.3e-3, restitution=0.8,
@@ -325,7 +325,7 @@ def test_load_structure_changes_get_their_own_template():
 
 def _driven(kind: str, second: bool) -> dc.Scene:
     """Driven scenes (tests/test_drivers.py) in two versions that differ only in numbers."""
-    from daeclear.profiles import Harmonic, Ramp, Tabulated
+    from daeclear.model.profiles import Harmonic, Ramp, Tabulated
     from test_drivers import crank_bearing_clearance, disc_scene, inclined_block
 
     if kind == "ramp":
@@ -365,7 +365,7 @@ def test_driver_numbers_compile_nothing(kind):
 
 def test_driver_structure_changes_get_their_own_template():
     """The profile kind and a table's number of points are structure."""
-    from daeclear.profiles import Harmonic, Ramp, Tabulated
+    from daeclear.model.profiles import Harmonic, Ramp, Tabulated
     from test_drivers import disc_scene
 
     ramp = dc.assemble(disc_scene(Ramp(time=0.1))).functions

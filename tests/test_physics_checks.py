@@ -18,14 +18,14 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-import daeclear.integrators as integrators
-import daeclear.solve as solve
-from daeclear import physics
+import daeclear.solvers.explicit as integrators
+import daeclear.solvers.ida as solve
+from daeclear.solvers import physics
 from daeclear.cli import main
 from daeclear.errors import AssemblyError, DaeclearError, PhysicsWarning, SceneError
-from daeclear.scene import GROUND
-from daeclear.scenefile import read_scene_file
-from daeclear.symbolic import Reference
+from daeclear.model.scene import GROUND
+from daeclear.model.scenefile import read_scene_file
+from daeclear.assembly.symbolic import Reference
 from scene_texts import PENDULUM_LINK
 
 CLEARANCE = 0.5e-3
@@ -161,7 +161,7 @@ def test_velocities_inconsistent_with_the_joint():
 
 def test_a_restart_from_a_computed_state_may_start_in_contact():
     """analysis.restart_model starts from a run's own state (twin runs): its start is not a declaration."""
-    from daeclear.analysis import restart_model
+    from daeclear.studies.analysis import restart_model
 
     model = dc.assemble(journal_inside_the_wall())
     declared = quiet_simulate(model, 0.002, start="declared", t_eval=np.linspace(0.0, 0.002, 21),
@@ -360,7 +360,7 @@ def test_scene_file_messages_name_file_table_and_key(tmp_path: Path, capsys, nam
 
 
 def test_truncated_sweep_file_says_how_to_recover(tmp_path: Path):
-    from daeclear.sweep import load_sweep, sweep
+    from daeclear.studies.sweep import load_sweep, sweep
 
     fast = dict(revolutions=8, transient=2, per_revolution=16, twin=False, progress=False)
     path = tmp_path / "s.h5"

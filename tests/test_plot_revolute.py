@@ -15,7 +15,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import daeclear as dc  # noqa: E402
-from daeclear.plot import (  # noqa: E402
+from daeclear.plot.figures import (  # noqa: E402
     _contact_intervals,
     plot_cases,
     plot_channel,
@@ -24,7 +24,7 @@ from daeclear.plot import (  # noqa: E402
     plot_revolute_response,
     plot_step_sizes,
 )
-from daeclear.result import ContactEvent, Result  # noqa: E402
+from daeclear.results.result import ContactEvent, Result  # noqa: E402
 
 C = 0.5e-3  # m, radial clearance of the synthetic joint
 

@@ -1,5 +1,5 @@
-"""Readings of the translational clearance joint (daeclear.readings) and the Fig. 4.28 metrics
-(daeclear.response_metrics).
+"""Readings of the translational clearance joint (daeclear.model.readings) and the Fig. 4.28 metrics
+(daeclear.studies.response_metrics).
 
 Checked: every reading is selectable by name and resolves to the stiffness and exponent the
 chapter's equations give by hand ((3.5) with R_c = 1 mm, (4.27) with a = 25 mm from Table 4.3);
@@ -20,11 +20,11 @@ import pytest
 
 import daeclear as dc
 import daeclear.contact as dcc
-from daeclear import readings
-from daeclear.response_metrics import (FIG_4_28, contact_periods, measure, onset_times, relative_rms,
+from daeclear.model import readings
+from daeclear.studies.response_metrics import (FIG_4_28, contact_periods, measure, onset_times, relative_rms,
                                        revolution_peaks, verdict)
-from daeclear.result import ContactEvent, EventList
-from daeclear.scene import TranslationalClearance
+from daeclear.results.result import ContactEvent, EventList
+from daeclear.model.scene import TranslationalClearance
 
 # Table 4.3: steel E = 207 GPa, nu = 0.3; slider 50 x 50 x 50 mm; corner radius 1 mm
 SIGMA = (1.0 - 0.3 ** 2) / 207e9  # (3.4), 1/Pa (without pi, docs/contact_laws.md)
@@ -249,7 +249,7 @@ def test_study_runs_every_reading_quick(tmp_path, monkeypatch):
 
 
 def test_a_scene_file_selects_a_reading(tmp_path):
-    from daeclear.scenefile import read_scene_file
+    from daeclear.model.scenefile import read_scene_file
 
     path = tmp_path / "guide.toml"
     path.write_text('[scene]\nname = "guide"\n[[body]]\nname = "slider"\nmass = 0.14\ninertia = 1e-4\n'

@@ -1,4 +1,4 @@
-"""Tests of daeclear.result: Result access, EventList, slicing and the HDF5 round trip."""
+"""Tests of daeclear.results.result: Result access, EventList, slicing and the HDF5 round trip."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from daeclear.errors import DaeclearError, DaeclearWarning, MissingDependencyError
-from daeclear.result import FORMAT_NAME, FORMAT_VERSION, ContactEvent, EventList, Result, load
+from daeclear.results.result import FORMAT_NAME, FORMAT_VERSION, ContactEvent, EventList, Result, load
 
 STATE_NAMES = ["crank.x", "crank.vx", "slider.x", "slider.vx", "lambda.A.x"]
 

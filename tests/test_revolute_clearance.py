@@ -13,9 +13,9 @@ import pytest
 from scipy.integrate import simpson
 
 import daeclear as dc
-from daeclear.assemble import EXTRA_TERM0
+from daeclear.assembly.assemble import EXTRA_TERM0
 from daeclear.errors import SceneError
-from daeclear.scene import Driver, RevoluteClearance
+from daeclear.model.scene import Driver, RevoluteClearance
 
 PERIOD = 60.0 / 5000.0  # one crank revolution at 5000 rpm
 
@@ -194,7 +194,7 @@ def test_bouncing_settles_into_resting_contact_at_the_static_penetration():
 def test_storm_guard_holds_then_releases(monkeypatch):
     """Synthetic roots: 25 switches in a microsecond hold the term on; quick re-contacts change
     nothing; a re-contact after a real flight is a new onset with a freshly latched speed."""
-    from daeclear import clearance
+    from daeclear.assembly import revolute_joint as clearance
 
     model = dc.assemble(bearing_drop(0.9))
     logic = model.contacts[0]
@@ -220,7 +220,7 @@ def test_storm_guard_holds_then_releases(monkeypatch):
 def test_energy_balance_with_driver_and_dissipation():
     """dE/dt = driver power + contact power: the balance closes on a dense output grid, and the
     multipliers reported at IDA's own steps are converged (no spurious moment spikes)."""
-    from daeclear.accuracy import energy_balance
+    from daeclear.studies.accuracy import energy_balance
 
     scene = dc.mechanisms.slider_crank("revolute")
     dense = dc.simulate(scene, 0.012, t_eval=np.linspace(0.0, 0.012, 24001), rtol=1e-8)
@@ -272,8 +272,8 @@ def test_compiled_events_with_tiny_step_buffers(monkeypatch):
     change nothing: same steps, same events (a regression test for a buffer overrun)."""
     import functools
 
-    import daeclear.solve as solve_module
-    from daeclear.ida_session import open_session
+    import daeclear.solvers.ida as solve_module
+    from daeclear.engine.ida_session import open_session
 
     for scene in (dc.mechanisms.slider_crank("revolute", gravity=0.0), dc.mechanisms.slider_crank("translational")):
         model = dc.assemble(scene)

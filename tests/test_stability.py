@@ -2,7 +2,7 @@
 
 import pytest
 
-from daeclear.stability import CASES, ENERGY_BOUND, run_case
+from daeclear.studies.stability import CASES, ENERGY_BOUND, run_case
 
 FAST = ["clearance 0.5 mm", "clearance 1 um, GGL", "20000 rpm", "stiffness 1e13", "plain Coulomb 0.5 (sticking)",
         "grazing onset (1 um/s), atol 1e-12", "following contact (drop and rest)"]

@@ -78,7 +78,7 @@ def test_output_windows_inside_steps_lose_no_point():
     so windows of EVAL_WINDOW times end inside steps. Every point is IDA's interpolant at its own
     time: the driven crank angle is exactly linear in t, and the constraints hold (a lost, shifted or
     unfilled row would show)."""
-    from daeclear.solve import EVAL_WINDOW
+    from daeclear.solvers.ida import EVAL_WINDOW
 
     t_end = 0.004
     r = dc.simulate(dc.mechanisms.slider_crank("ideal"), t_end, t_eval_step=1e-7, store_steps=False)
@@ -136,7 +136,7 @@ def test_memory_of_a_decimated_or_streamed_run_does_not_grow_with_its_length(rev
 @pytest.fixture
 def fail_after(monkeypatch):
     """``fail_after(n, exc)``: the n-th progress update of a run raises ``exc`` (small step buffers)."""
-    import daeclear.solve as solve
+    import daeclear.solvers.ida as solve
 
     monkeypatch.setattr(solve, "open_session", functools.partial(solve.open_session, buffer_steps=64))
     original = solve._Progress.update
@@ -225,7 +225,7 @@ def test_the_scipy_methods_stream_the_same_data(revolute, tmp_path):
 ])
 @pytest.mark.parametrize("method", ["ida", "rk4"])
 def test_output_options_are_checked_before_any_work(kwargs, field, shown, method, monkeypatch, tmp_path):
-    import daeclear.solve as solve
+    import daeclear.solvers.ida as solve
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(solve, "assemble", lambda *a, **k: pytest.fail("assembled despite a bad option"))
@@ -292,7 +292,7 @@ def test_cli_memory_error_saves_the_computed_prefix(tmp_path, capsys, fail_after
     (["--t-eval-step", "1"], "--t-eval-step=1.0 s, must be a finite number > 0 and <= 0.024"),
 ])
 def test_cli_t_eval_step_is_checked_before_any_work(argv, shown, tmp_path, capsys, monkeypatch):
-    import daeclear.solve as solve
+    import daeclear.solvers.ida as solve
 
     monkeypatch.setattr(solve, "simulate", lambda *a, **k: pytest.fail("ran despite a bad option"))
     assert main(["run", "slider_crank", "--out", str(tmp_path), *argv]) == 2
@@ -366,7 +366,7 @@ def test_the_long_run_example_streams_and_reads_a_window(tmp_path, monkeypatch):
 def test_a_failed_append_leaves_the_file_as_before(tmp_path):
     """An error in the middle of an append (here a state array of the wrong width, after /t was extended)
     takes every dataset back to its length: the file stays readable, with the rows before."""
-    from daeclear.result import ResultWriter
+    from daeclear.results.result import ResultWriter
 
     writer = ResultWriter(tmp_path / "w.h5", state_names=["a", "b"], units={"a": "m"}, parameters={},
                           scene_name="s", method="ida", formulation="index1")
@@ -390,9 +390,9 @@ def test_load_of_a_window_equals_the_slice_of_the_whole(revolute, tmp_path, wind
         part, expected = dc.load(file, *window), whole.slice(*window)
         _same(part, expected)
         assert part.stats == expected.stats and part.parameters == expected.parameters
-    assert len(whole.events) > 20 and np.array_equal(dc.result.load_times(path, "events"), whole.events.t)
-    assert np.array_equal(dc.result.load_times(path), whole.t)
-    assert np.array_equal(dc.result.load_times(path, "steps"), whole.step_t)
+    assert len(whole.events) > 20 and np.array_equal(dc.results.result.load_times(path, "events"), whole.events.t)
+    assert np.array_equal(dc.results.result.load_times(path), whole.t)
+    assert np.array_equal(dc.results.result.load_times(path, "steps"), whole.step_t)
 
 
 def test_cli_shows_the_last_events_of_a_long_run(tmp_path, capsys, monkeypatch):
@@ -424,7 +424,7 @@ def test_memory_error_without_stream_to_returns_the_partial_result(revolute, fai
 @pytest.mark.parametrize("stop", [MemoryError(), KeyboardInterrupt()], ids=["MemoryError", "Ctrl-C"])
 def test_the_scipy_methods_save_the_closed_segments_when_stopped(revolute, tmp_path, monkeypatch, stop):
     """rk4, streamed: stopped in the middle, the file holds every segment closed before (a prefix of the run)."""
-    import daeclear.integrators as integrators
+    import daeclear.solvers.explicit as integrators
 
     kwargs = {"method": "rk4", "step": 1e-5, "t_eval_step": 1e-5, "store_steps": False}
     full = dc.simulate(revolute, REV, **kwargs)

@@ -18,8 +18,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from daeclear import style  # noqa: E402
-from daeclear.mechanisms import slider_crank  # noqa: E402
+from daeclear.plot import style  # noqa: E402
+from daeclear.model.mechanisms import slider_crank  # noqa: E402
 from daeclear.plot import (  # noqa: E402
     plot_bifurcation,
     plot_channel,
@@ -32,7 +32,7 @@ from daeclear.plot import (  # noqa: E402
     plot_translational_response,
     save_response_figure,
 )
-from daeclear.result import ContactEvent, Result  # noqa: E402
+from daeclear.results.result import ContactEvent, Result  # noqa: E402
 
 C = 0.5e-3  # m
 

@@ -22,9 +22,9 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from daeclear import codegen
+from daeclear.engine import codegen
 from daeclear.errors import DaeclearError, DaeclearWarning
-from daeclear.ida_session import DAEFunctions, _CLib, open_session
+from daeclear.engine.ida_session import DAEFunctions, _CLib, open_session
 
 
 @pytest.fixture(autouse=True)

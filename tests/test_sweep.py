@@ -22,7 +22,7 @@ import pytest
 import daeclear as dc
 from daeclear.cli import main
 from daeclear.errors import DaeclearError, SceneError
-from daeclear.sweep import grid_points, load_sweep, run_key, sweep
+from daeclear.studies.sweep import grid_points, load_sweep, run_key, sweep
 
 FAST = dict(revolutions=8, transient=2, per_revolution=16, twin=False, progress=False)
 FIXED = {"joint": "revolute"}
@@ -272,7 +272,7 @@ def test_a_sweep_builds_one_library_per_structure(tmp_path, monkeypatch):
     """Numbers are run-time data: a clearance x friction-coefficient sweep on two worker processes,
     from an empty compile cache, compiles one library (the friction law is the same structure for
     every coefficient), and every worker loads it."""
-    from daeclear.codegen import clear_memos
+    from daeclear.engine.codegen import clear_memos
 
     cache = tmp_path / "cache"
     monkeypatch.setenv("DAECLEAR_CACHE_DIR", str(cache))
@@ -284,7 +284,7 @@ def test_a_sweep_builds_one_library_per_structure(tmp_path, monkeypatch):
 
 
 def test_section_channels_follow_the_scene_without_a_slider(tmp_path):
-    from daeclear.analysis import section_channels
+    from daeclear.studies.analysis import section_channels
 
     assert section_channels(dc.mechanisms.slider_crank("revolute")) == ("slider.vx", "slider.ax")
     assert section_channels(dc.mechanisms.four_bar()) == ("rocker.omega", "rocker.alpha")

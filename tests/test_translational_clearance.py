@@ -28,7 +28,7 @@ import pytest
 import daeclear as dc
 import daeclear.contact as dcc
 from daeclear.errors import SceneError
-from daeclear.scene import Driver, TranslationalClearance
+from daeclear.model.scene import Driver, TranslationalClearance
 
 STEEL = dcc.Material(young=207e9, poisson=0.3)
 M, L, W, R_C, C = 0.14, 0.05, 0.05, 1e-3, 0.5e-3  # slider mass (kg), Table 4.3 geometry (m)

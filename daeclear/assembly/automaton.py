@@ -1,0 +1,151 @@
+"""The contact-mode automaton of one pair: the one definition of the event rule.
+
+A contact pair (one gap function, positive in penetration) is *free* or in *contact*, and may be
+*held* by the storm guard. At every root of its gap the automaton takes the crossing's time,
+direction (+1 upward, -1 downward, 0 none) and the penetration rate there, and decides:
+
+* free, upward crossing: *onset*; the approach speed ``max(rate, min_approach_speed)`` is
+  latched (the floor keeps the damping bounded for grazing contacts) and the term goes on;
+* contact, downward crossing: *separation*; the term goes off, unless this separation completes
+  a storm (``storm.events`` switches within ``storm.window`` seconds, this one included): then the
+  pair is *held*, its term stays on (the force is zero with a zero derivative while the gap is
+  open, so nothing physical changes) and both crossings are watched;
+* held: a downward crossing restarts the flight clock (``free_since``); an upward one changes
+  nothing unless the flight lasted longer than ``storm.window``, in which case the hold ends and
+  the crossing is a genuine onset with a freshly latched speed;
+* anything else decides nothing (no event, no restart).
+
+:func:`step` is pure. The compiled IDA loop runs a line-by-line C mirror of it (``pair_step`` in
+``csrc/ida_driver.c``) for the pairs it switches itself and reports each decision; the Python
+logic objects (:mod:`daeclear.assembly.revolute_joint`, :mod:`daeclear.assembly.translational_joint`) run :func:`step` for the
+other backends and only record the compiled loop's decisions. ``tests/test_automaton.py`` drives
+both with the same random root sequences and requires identical decisions.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass, field, replace
+from typing import Final
+
+#: Storm guard defaults: this many switches of one pair within STORM_WINDOW seconds hold its term on.
+STORM_EVENTS: Final[int] = 20
+STORM_WINDOW: Final[float] = 1e-6
+
+#: Decision kinds (the values the C loop reports) and the event kinds they make.
+NONE: Final[int] = 0
+ONSET: Final[int] = 1
+SEPARATION: Final[int] = -1
+EVENT_KINDS: Final[dict[int, str]] = {ONSET: "onset", SEPARATION: "separation"}
+
+
+@dataclass(frozen=True)
+class Storm:
+    """Storm-guard constants: ``events`` switches within ``window`` seconds hold the term on."""
+
+    events: int = STORM_EVENTS
+    window: float = STORM_WINDOW
+
+    def __post_init__(self) -> None:
+        if isinstance(self.events, bool) or not isinstance(self.events, numbers.Integral) or self.events < 1:
+            raise ValueError(f"Storm: events={self.events!r}, must be an integer >= 1.")
+        if not (isinstance(self.window, numbers.Real) and math.isfinite(self.window) and self.window >= 0):
+            raise ValueError(f"Storm: window={self.window!r} s, must be a finite number >= 0.")
+        object.__setattr__(self, "events", int(self.events))  # plain numbers for C and for equality
+        object.__setattr__(self, "window", float(self.window))
+
+
+@dataclass(frozen=True)
+class PairState:
+    """What the automaton remembers of one pair.
+
+    ``recent`` holds the times of the last ``storm.events`` switches (oldest first), ``free_since``
+    the start of the current flight of a held pair, ``latched`` the approach speed latched at the
+    last onset (floored).
+    """
+
+    contact: bool = False
+    held: bool = False
+    free_since: float = 0.0
+    latched: float = 0.0
+    recent: tuple[float, ...] = field(default=())
+
+    @property
+    def term_on(self) -> bool:
+        """The pair's force term is on in contact and while held."""
+        return self.contact or self.held
+
+    @property
+    def watch(self) -> int:
+        """Root direction to watch next: onsets (+1) while free, separations (-1) in contact, both (0) held."""
+        return 0 if self.held else -1 if self.contact else 1
+
+
+@dataclass(frozen=True)
+class Decision:
+    """The outcome of one root: event ``kind`` (ONSET, SEPARATION or NONE) and the pair's new mode.
+
+    A decision of kind NONE changes nothing the integrator sees (no event, no restart).
+    """
+
+    kind: int
+    contact: bool
+    held: bool
+    latched: float
+    watch: int
+
+    @property
+    def term_on(self) -> bool:
+        return self.contact or self.held
+
+
+def floor_speed(rate: float, min_approach_speed: float) -> float:
+    """The approach speed latched at an onset: the rate, floored (a NaN rate gives the floor, as C's fmax)."""
+    return rate if rate > min_approach_speed else min_approach_speed
+
+
+def start(in_contact: bool, rate: float, min_approach_speed: float) -> PairState:
+    """A pair's state at the start of a run: its mode from the initial gap, its rate latched, no history."""
+    return PairState(contact=bool(in_contact), latched=floor_speed(rate, min_approach_speed))
+
+
+def decision_of(state: PairState, kind: int) -> Decision:
+    """The decision that leaves the pair in ``state``."""
+    return Decision(kind, state.contact, state.held, state.latched, state.watch)
+
+
+def step(state: PairState, t: float, direction: int, rate: float, *, storm: Storm,
+         min_approach_speed: float) -> tuple[PairState, Decision]:
+    """Decide a root of the pair's gap at time ``t`` (non-decreasing per pair) crossed in
+    ``direction`` with penetration rate ``rate``; return the new state and the decision."""
+    if direction != 0 and state.held:
+        if direction < 0:
+            state, direction = replace(state, free_since=t), 0  # the held pair's flight starts again
+        elif t - state.free_since <= storm.window:
+            direction = 0  # a re-contact inside the storm: the held term stays as it is
+        else:
+            state = replace(state, held=False)  # a genuine onset after a real flight
+    if direction > 0 and not state.contact:
+        state = replace(state, contact=True, latched=floor_speed(rate, min_approach_speed),
+                        recent=_push(state.recent, t, storm))
+        return state, decision_of(state, ONSET)
+    if direction < 0 and state.contact:
+        hold = 1 + sum(1 for s in state.recent if t - s < storm.window) >= storm.events
+        state = replace(state, contact=False, held=hold, free_since=t if hold else state.free_since,
+                        recent=_push(state.recent, t, storm))
+        return state, decision_of(state, SEPARATION)
+    return state, decision_of(state, NONE)
+
+
+def recorded(state: PairState, decision: Decision) -> PairState:
+    """The state after a decision taken elsewhere (the compiled loop): its mode and latched speed.
+    The storm history stays with the side that decides."""
+    # the constructor, not dataclasses.replace: this runs at every event of a compiled run
+    return PairState(contact=decision.contact, held=decision.held, free_since=state.free_since,
+                     latched=decision.latched, recent=state.recent)
+
+
+def _push(recent: tuple[float, ...], t: float, storm: Storm) -> tuple[float, ...]:
+    """The last ``storm.events`` switch times after a switch at ``t`` (C keeps the same ring)."""
+    return (recent + (t,))[-storm.events:]

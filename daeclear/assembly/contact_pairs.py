@@ -1,0 +1,152 @@
+"""Clearance joints as contact elements: symbolic forces, gap functions, channels, event logic.
+
+A clearance joint adds no constraint. It brings
+
+* *terms*: generalized contact forces that the solver switches on only while the pair is
+  in contact (inactive terms are never evaluated);
+* *gaps*: root functions watched by IDA, positive in penetration;
+* *channels*: output quantities (eccentricity, penetration, forces);
+* *logic*: what happens at a root (mode switch, approach speed latched at onset).
+
+Event rule (documented in docs/user_guide.md, "Contact events")
+---------------------------------------------------------------
+A pair is *free* or in *contact*. While free, only upward crossings of its gap are
+watched (onset); while in contact only downward ones (separation). At an onset the
+approach speed (the penetration rate at the located root) is latched, floored at the
+law's ``min_approach_speed`` so the damping term stays bounded for grazing contacts,
+and the term is switched on; at a separation it is switched off. Every switch restarts
+IDA from a consistent state. The contact force is exactly zero with a zero derivative
+at zero penetration for every continuous law, so a switch never jumps the force; and
+because IDA returns a root just past the crossing, a restart never reports the same
+crossing twice. Following (continuous) contact keeps the pair in contact mode with no
+events at all; a Zeno-like cascade of ever shorter bounces is cut by the storm guard.
+The rule, storm guard included, is defined once in :mod:`daeclear.assembly.automaton`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from .automaton import EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
+from ..results.result import ContactEvent
+from .symbolic import AssemblyContext, Channel, Term
+
+
+@dataclass
+class PairLogic:
+    """Mode switching of one contact pair: one gap (root) and one term.
+
+    ``rate`` evaluates ``(gap, penetration_rate)`` from ``(q, v)``; ``needs_approach`` says
+    whether the term's parameter is the approach speed latched at onset. The rule, storm guard
+    included, is :func:`daeclear.assembly.automaton.step` with this pair's ``storm`` constants; the term
+    is on while the pair is in contact or held.
+    """
+
+    pair: str
+    root_index: int
+    term_index: int
+    rate: Callable[..., tuple[NDArray, NDArray]]  # (q, v) -> (gap, penetration rate)
+    n_q: int
+    needs_approach: bool
+    min_approach_speed: float
+    discontinuous_friction: bool = False
+    storm: Storm = field(default_factory=Storm)
+    state: PairState = field(default_factory=PairState)
+
+    @property
+    def held(self) -> bool:
+        """The storm guard holds the term on (see :mod:`daeclear.assembly.automaton`)."""
+        return self.state.held
+
+    @property
+    def roots(self) -> range:
+        """Indices of the gaps (roots) of this element."""
+        return range(self.root_index, self.root_index + 1)
+
+    def pair_state(self, root: int) -> PairState:
+        """The automaton state of the pair of gap ``root``."""
+        return self.state
+
+    def _gap_rate(self, y: NDArray) -> tuple[float, float]:
+        q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
+        gap, rate = self.rate(q, v)
+        return float(gap[0]), float(rate[0])
+
+    def _params(self) -> NDArray:
+        return np.array([self.state.latched]) if self.needs_approach else np.zeros(0)
+
+    def initial_modes(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> dict[str, str]:
+        gap, rate = self._gap_rate(y)
+        self.state = start(gap > 0.0, rate, self.min_approach_speed)  # a new run starts without history
+        active[self.term_index] = self.state.term_on
+        params[self.term_index] = self._params()
+        return {self.pair: "contact" if self.state.contact else "free"}
+
+    def root_directions(self, active: Sequence[bool]) -> list[tuple[int, int]]:
+        """While free watch onsets (+1), in contact separations (-1), held both (0)."""
+        return [(self.root_index, self.state.watch)]
+
+    def on_roots(self, t: float, y: NDArray, yp: NDArray, roots_found: NDArray | None,
+                 active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+        """Decide a root of the pair's gap by the automaton; return the events it records."""
+        if roots_found is None or roots_found[self.root_index] == 0:
+            return []
+        rate = self._gap_rate(y)[1]
+        self.state, decision = step(self.state, t, int(roots_found[self.root_index]), rate, storm=self.storm,
+                                    min_approach_speed=self.min_approach_speed)
+        return self.record(self.root_index, t, y, rate, decision, active, params)
+
+    def record(self, root: int, t: float, y: NDArray, rate: float, decision: Decision,
+               active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+        """Apply a decision taken at a root of gap ``root`` (here or by the compiled loop): the
+        pair's mode, its term and latched speed; return the event it makes, if any."""
+        if decision.kind == NONE:
+            return []
+        self.state = recorded(self.state, decision)
+        active[self.term_index] = decision.term_on
+        if decision.kind == ONSET:
+            params[self.term_index] = self._params()
+        return [ContactEvent(t=t, pair=self.pair, kind=EVENT_KINDS[decision.kind], approach_speed=rate, y=y.copy())]
+
+    def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]]:
+        """(root, term, (q, v, P) -> [gap; rate], needs approach speed, floor): the pairs whose
+        switches the compiled IDA loop decides itself, by the C mirror of the automaton."""
+        fn = self.rate.function
+        q, v, P = (ca.SX.sym(label, fn.numel_in(i)) for i, label in enumerate(("q", "v", "P")))
+        gap, rate = fn(q, v, P)
+        f = ca.Function(f"{self.pair.replace('.', '_')}_gap_rate", [q, v, P], [ca.vertcat(gap, rate)])
+        return [(self.root_index, self.term_index, f, bool(self.needs_approach), float(self.min_approach_speed))]
+
+
+@dataclass(frozen=True)
+class ContactBuild:
+    """What a clearance joint contributes to the assembled model.
+
+    ``logic(P)`` makes the joint's event logic for one parameter vector (the structure is
+    built once; each bound model gets its own logic with its own numbers and run state).
+    """
+
+    terms: list[Term]
+    gaps: list[Any]
+    gap_names: list[str]
+    channels: Callable[[Sequence[tuple[Any, Any]]], list[Channel]]
+    logic: Callable[[NDArray[np.float64]], list[Any]]
+    # the constraints of the ideal joint the clearance joint replaces (the chapter's start:
+    # clearance joints centred, the mechanism assembled as if they were ideal), with their names
+    ideal: list[Any]
+    ideal_names: list[str]
+
+
+def approach_floor(ctx: AssemblyContext, law: Any, prefix: str) -> Callable[[NDArray[np.float64]], float]:
+    """The law's ``min_approach_speed`` read from a parameter vector (or the baked number)."""
+    name = f"{prefix}.min_approach_speed"
+    if name in ctx.params:
+        index = ctx.offsets[name]
+        return lambda P: float(P[index])
+    floor = float(getattr(law, "min_approach_speed", 0.0))
+    return lambda P: floor

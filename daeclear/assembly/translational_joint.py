@@ -1,0 +1,487 @@
+"""Translational clearance joint (section 4.3): a slider free inside a guide, contact at its corners.
+
+Geometry (eqs. 4.14-4.20), body i the guide, body j the slider (the chapter swaps the
+letters). The guide has a mid-line through the point ``O`` (``point_i``) along the unit
+vector ``t`` (4.14) fixed to the guide; ``n = perp(t)`` points to the *upper* surface,
+at ``+H/2``, the lower one is at ``-H/2``. For a slider corner ``r_k`` (4.15)
+
+    s_k = t . (r_k - O)            coordinate along the guide
+    A_j = O + s_k t +- (H/2) n     closest guide point (4.16), on the surface
+    d_k = +-n . (r_k - O) - H/2    signed penetration, > 0 in contact
+
+``d_k = -n_k . delta`` with ``delta = A_j - r_k`` (4.17) and ``n_k`` the surface's normal
+pointing out of the guide (the chapter's ``n`` of (4.18)), so ``d_k > 0`` is the chapter's
+condition (4.19) and ``d_k = |delta|`` (4.20) in contact. The penetration is measured at the sharp corner of
+the ``L x W`` rectangle as in the chapter; the corner radius R_c only sets the stiffness
+of the corner contact (a sphere of radius R_c on a plane, eq. 3.5). The penetration rate
+is ``(d d_k / dq) v`` (4.21). The force on the slider acts at the corner, the opposite
+one on the guide at ``A_j``, both transported to the centres of mass (4.22)-(4.25).
+
+Pairs and gaps: corners A, B (upper) against the upper surface and C, D (lower) against
+the lower one: 4 pairs, 4 gap functions watched by IDA. A slider that cannot turn over
+in its guide (checked by the scene) can touch nothing else. The gap of a pair is
+``min(d_k, s_k - s_P, s_Q - s_k)`` when the surface has contact limits ``(s_P, s_Q)``:
+negative (no contact) while the corner's projection is outside the segment, so a corner
+that leaves the segment separates there.
+
+Models
+------
+``corners``: one term per pair, the joint's corner law (sphere on a plane, eq. 3.9 with
+(3.5) by default) with the approach speed latched at the pair's onset, in every scenario
+of Fig. 4.9.
+
+``section-4.3``: in addition one term per face (A-B on the upper surface, C-D on the
+lower). While both corners of a face are in contact the face term is on and their two
+corner terms are off: force ``face_law(d_mean, d_mean_dot)`` with the average penetration
+``d_mean = (d_1 + d_2)/2`` (Lankarani's linear law (4.26) with the stiffness (4.27) by
+default). Our reading of "the geometric centre of the penetrated area" (Fig. 4.13a): the
+penetrated region of the slider beyond the surface line is the trapezoid with parallel
+sides ``d_1`` and ``d_2`` a slider length apart; the force acts normal to the surface
+through its centroid, at ``s = s_1 + (s_2 - s_1)(d_1 + 2 d_2)/(3 (d_1 + d_2))`` on the
+surface line. This is exactly the resultant of a linear (Winkler) pressure proportional
+to the local penetration, so the face force derives from the potential
+``K (d_1^2 + d_1 d_2 + d_2^2) / 6``. One corner, or two opposite corners, use the corner
+law. When a face forms or breaks, the force switches between the two laws (the
+chapter's model: not continuous, not energy-conserving at the switch). A face law that
+needs an approach speed gets the mean of the approach speeds latched by its two corners
+(docs/contact_laws.md).
+
+A joint's ``reading`` (:mod:`daeclear.model.readings`) picks one of these models, the corner law's
+stiffness ((3.5) or the pseudo-stiffness (4.27)) and exponent, and the face law
+(``TranslationalClearance.contact_model``, ``resolved_law``, ``resolved_face_law``).
+
+Friction (only when declared): at every active contact, the modified Coulomb law (or the
+joint's law) on the sliding velocity of the slider's material point at the contact
+relative to the guide's, along ``t``.
+
+Events follow the rule of :mod:`daeclear.assembly.automaton` (onset watched while free, separation
+while in contact, approach speed latched at the located onset and floored, the same
+storm guard per corner). A face's switches are reported as events of the pair
+``<name>.upper_face`` / ``<name>.lower_face``, after the corner events that caused them.
+
+Channels (``<name>`` the joint's name, ``<pair>`` ``<name>.A_upper`` ... ``<name>.D_lower``)
+---------------------------------------------------------------------------------------
+``<name>.s``, ``<name>.y`` (m): slider centre along the guide and its offset from the
+mid-line; ``<name>.tilt`` (rad): angle from the guide to the slider; ``<name>.eta`` =
+y / (2c) (+-0.5 where a parallel slider touches a surface); ``<name>.xi`` = 0..1 along the
+joint's ``stroke`` (dimensionless path of Fig. 4.28d); per pair ``<pair>.penetration``,
+``.penetration_rate``, ``.normal_force``, ``.in_contact`` (1 also while its face carries
+it), with friction ``.friction_force`` and ``.sliding_velocity``; per face (``section-4.3``)
+``<name>.upper_face.penetration`` (the average), ``.normal_force``, ``.in_contact`` and the
+friction channels; ``<name>.penetration`` (largest corner penetration),
+``<name>.normal_force`` (sum over pairs and faces), ``<name>.in_contact`` (any), and
+``<name>.elastic_energy`` (J): the energy stored in the elastic part of the active laws
+(K d^(n+1)/(n+1) per corner, the Winkler potential per face), so that mechanical plus
+elastic energy is conserved by elastic laws.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from .automaton import EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
+from .contact_pairs import ContactBuild, approach_floor
+from .parameters import law_structure, law_values, symbolic_law
+from ..results.result import ContactEvent
+from ..model.scene import TranslationalClearance
+from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular, rotation
+
+#: Corners: name, sign along the slider length, sign across it, surface it can touch.
+CORNERS: tuple[tuple[str, int, int, str], ...] = (
+    ("A", +1, +1, "upper"), ("B", -1, +1, "upper"), ("C", -1, -1, "lower"), ("D", +1, -1, "lower"))
+#: Faces: name and the indices (in CORNERS) of its two corners, rear first.
+FACES: tuple[tuple[str, int, int], ...] = (("upper_face", 1, 0), ("lower_face", 2, 3))
+# Keeps the centroid of the penetrated trapezoid finite when both penetrations vanish
+# (only reached while Newton iterates; the term is off otherwise), m.
+_CENTROID_EPS = 1e-18
+
+
+def _identifier(name: str) -> str:
+    """A CasADi-safe function name fragment (letters, digits, single underscores)."""
+    ident = re.sub(r"_+", "_", re.sub(r"[^0-9A-Za-z]", "_", name)).strip("_")
+    return ident if ident and ident[0].isalpha() else f"j_{ident}"
+
+
+def _elastic_energy(numeric: Any, law: Any, d: Any) -> Any | None:
+    """Energy stored by the elastic part ``K d^n`` of a law, ``K d^(n+1)/(n+1)``; None if unknown.
+    ``numeric`` decides (structure), ``law`` (possibly with symbolic numbers) gives the formula."""
+    if getattr(numeric, "stiffness", None) is None:
+        return None
+    n_value = float(getattr(numeric, "effective_exponent", 1.0 if numeric.geometry == "face" else math.nan))
+    if not math.isfinite(n_value):
+        return None
+    n = getattr(law, "effective_exponent", n_value)
+    return law.stiffness * ca.fmax(d, 0.0) ** (n + 1.0) / (n + 1.0)
+
+
+def _unit(v: Sequence[float]) -> NDArray[np.float64]:
+    v = np.asarray(v, dtype=float)
+    return v / math.hypot(*v)
+
+
+@dataclass
+class SliderGuideLogic:
+    """Mode switching of one translational clearance joint: four corner pairs and, in the
+    ``section-4.3`` model, two faces.
+
+    Each corner is a pair of :mod:`daeclear.assembly.automaton` (free, contact or held, by the root of its
+    gap); the terms follow from the modes: a face term is on while both its corners are in
+    contact, a corner term while its corner's term is on (in contact or held) and its face is
+    not. ``rate`` maps ``(q, v)`` to the four gaps and the four penetration rates.
+    """
+
+    name: str
+    pairs: list[str]
+    first_root: int
+    corner_terms: list[int]
+    face_names: list[str]
+    face_terms: list[int]
+    face_corners: list[tuple[int, int]]
+    rate: Callable[..., tuple[NDArray, NDArray]]  # (q, v) -> (gaps, penetration rates)
+    n_q: int
+    needs_approach: bool
+    min_approach_speed: float
+    face_needs_approach: bool
+    face_min_approach_speed: float
+    storm: Storm = field(default_factory=Storm)
+    states: list[PairState] = field(default_factory=list)
+    face_on: list[bool] = field(default_factory=list)
+
+    @property
+    def roots(self) -> range:
+        """Indices of the gaps (roots) of this element: one per corner."""
+        return range(self.first_root, self.first_root + len(self.pairs))
+
+    def pair_state(self, root: int) -> PairState:
+        """The automaton state of the corner of gap ``root``."""
+        return self.states[root - self.first_root]
+
+    def _evaluate(self, y: NDArray) -> tuple[NDArray, NDArray]:
+        q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
+        gaps, rates = self.rate(q, v)
+        return np.asarray(gaps, dtype=float).ravel(), np.asarray(rates, dtype=float).ravel()
+
+    def _apply(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+        """Set the terms from the modes; return the events of faces that formed or broke."""
+        events: list[ContactEvent] = []
+        in_face = [False] * len(self.pairs)
+        for f, (a, b) in enumerate(self.face_corners):
+            on = self.states[a].contact and self.states[b].contact
+            k = self.face_terms[f]
+            if on and not self.face_on[f]:
+                speed = 0.5 * (self.states[a].latched + self.states[b].latched)
+                params[k] = (np.array([max(speed, self.face_min_approach_speed)]) if self.face_needs_approach
+                             else np.zeros(0))
+                events.append(ContactEvent(t=t, pair=self.face_names[f], kind="onset", approach_speed=speed,
+                                           y=y.copy()))
+            elif not on and self.face_on[f]:
+                events.append(ContactEvent(t=t, pair=self.face_names[f], kind="separation",
+                                           approach_speed=float("nan"), y=y.copy()))
+            self.face_on[f] = on
+            active[k] = on
+            in_face[a] = in_face[b] = on
+        for i, k in enumerate(self.corner_terms):
+            active[k] = self.states[i].term_on and not in_face[i]
+        return events
+
+    def _corner_params(self, i: int) -> NDArray:
+        return np.array([self.states[i].latched]) if self.needs_approach else np.zeros(0)
+
+    def initial_modes(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> dict[str, str]:
+        gaps, rates = self._evaluate(y)
+        # a new run starts without history
+        self.states = [start(gaps[i] > 0.0, float(rates[i]), self.min_approach_speed) for i in range(len(self.pairs))]
+        self.face_on = [False] * len(self.face_names)
+        for i, k in enumerate(self.corner_terms):
+            params[k] = self._corner_params(i)
+        self._apply(t, y, active, params)
+        modes = {p: ("contact" if st.contact else "free") for p, st in zip(self.pairs, self.states)}
+        modes.update({f: ("contact" if on else "free") for f, on in zip(self.face_names, self.face_on)})
+        return modes
+
+    def root_directions(self, active: Sequence[bool]) -> list[tuple[int, int]]:
+        """While a corner is free watch its onsets (+1), in contact separations (-1), held both (0)."""
+        return [(self.first_root + i, st.watch) for i, st in enumerate(self.states)]
+
+    def on_roots(self, t: float, y: NDArray, yp: NDArray, roots_found: NDArray | None,
+                 active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+        """Decide the roots of the corners' gaps by the automaton; return the events of corners and faces."""
+        if roots_found is None:
+            return []
+        found = roots_found[self.first_root:self.first_root + len(self.pairs)]
+        if not np.any(found):
+            return []
+        gaps, rates = self._evaluate(y)
+        events: list[ContactEvent] = []
+        for i, direction in enumerate(int(d) for d in found):
+            if direction == 0:
+                continue
+            rate = float(rates[i])
+            self.states[i], decision = step(self.states[i], t, direction, rate, storm=self.storm,
+                                            min_approach_speed=self.min_approach_speed)
+            events += self._record_corner(i, t, y, rate, decision, params)
+        events += self._apply(t, y, active, params)
+        return events
+
+    def record(self, root: int, t: float, y: NDArray, rate: float, decision: Decision,
+               active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+        """Apply a decision taken at a root of gap ``root`` (here or by the compiled loop) to its
+        corner and the terms; return the events of the corner and of faces that formed or broke."""
+        events = self._record_corner(root - self.first_root, t, y, rate, decision, params)
+        if events:
+            events += self._apply(t, y, active, params)
+        return events
+
+    def _record_corner(self, i: int, t: float, y: NDArray, rate: float, decision: Decision,
+                       params: list[NDArray]) -> list[ContactEvent]:
+        """Set corner i's mode and latched speed from a decision; return its event, if any."""
+        if decision.kind == NONE:
+            return []
+        self.states[i] = recorded(self.states[i], decision)
+        if decision.kind == ONSET:
+            params[self.corner_terms[i]] = self._corner_params(i)
+        return [ContactEvent(t=t, pair=self.pairs[i], kind=EVENT_KINDS[decision.kind], approach_speed=rate,
+                             y=y.copy())]
+
+    def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
+        """Without faces (model ``corners``) every corner term follows its own pair, so the compiled
+        IDA loop may decide its switches itself; with faces the terms depend on two corners."""
+        if self.face_names:
+            return None
+        fn = getattr(self.rate, "function", None)
+        if fn is None:
+            return None
+        q, v, P = (ca.SX.sym(label, fn.numel_in(i)) for i, label in enumerate(("q", "v", "P")))
+        gaps, rates = fn(q, v, P)
+        out = []
+        for i, pair in enumerate(self.pairs):
+            f = ca.Function(f"{pair.replace('.', '_')}_gap_rate", [q, v, P], [ca.vertcat(gaps[i], rates[i])])
+            out.append((self.first_root + i, self.corner_terms[i], f, bool(self.needs_approach),
+                        float(self.min_approach_speed)))
+        return out
+
+
+def translational_clearance_parameters(ref: Reference, joint: TranslationalClearance) -> tuple[dict[str, Any], list[Any]]:
+    """The joint's numbers (run-time parameters) and what of it is structure."""
+    law = joint.resolved_law()
+    face_law = joint.resolved_face_law() if joint.contact_model == "section-4.3" else None
+    friction = joint.resolved_friction()
+    s_i, s_j = ref.joint_points(joint)
+    t_guide = ref.local_vector(joint.body_i, joint.axis)  # (4.14): t in guide coordinates
+    # slider length direction, slider coordinates
+    e_slider = ref.local_vector(joint.body_j, joint.axis) if joint.slider_axis is None else _unit(joint.slider_axis)
+    values: dict[str, Any] = {
+        "s_i": s_i, "s_j": s_j, "length": float(joint.length), "width": float(joint.width),
+        "height": joint.height, "clearance": joint.radial_clearance, "t_guide": t_guide, "e_slider": e_slider,
+        # angle from the guide's direction to the slider's length direction, both bodies at angle 0
+        "tilt0": math.atan2(e_slider[1], e_slider[0]) - math.atan2(t_guide[1], t_guide[0]),
+    }
+    for surface, limits in (("upper", joint.upper_limits), ("lower", joint.lower_limits)):
+        if limits is not None:
+            values[f"{surface}_limits"] = limits
+    stroke = joint.stroke if joint.stroke is not None else joint.upper_limits
+    if stroke is not None:
+        values["stroke"] = stroke
+    structure: list[Any] = [joint.contact_model, law_structure(law), law_structure(friction)]
+    for prefix, each in (("law", law), ("face_law", face_law), ("friction", friction)):
+        if each is not None:
+            values.update({f"{prefix}.{k}": v for k, v in law_values(each).items()})
+    if face_law is not None:
+        structure.append(law_structure(face_law))
+    return values, structure
+
+
+def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClearance, first_term: int,
+                                  first_root: int) -> ContactBuild:
+    """Slider-guide contact (section 4.3): eqs. (4.14)-(4.27) with the joint's laws and model.
+
+    Terms, in order: the corner pairs A_upper, B_upper, C_lower, D_lower, then (model
+    ``section-4.3``) the faces upper_face, lower_face. Gaps: the four corner pairs. Every
+    number comes from the run-time parameters ``<joint>.*``.
+    """
+    name, ident = joint.name, _identifier(joint.name)
+    law_numeric = joint.resolved_law()
+    face_numeric = joint.resolved_face_law() if joint.contact_model == "section-4.3" else None
+    friction_numeric = joint.resolved_friction()
+    law = symbolic_law(law_numeric, ctx.params, f"{name}.law")
+    face_law = None if face_numeric is None else symbolic_law(face_numeric, ctx.params, f"{name}.face_law")
+    friction = symbolic_law(friction_numeric, ctx.params, f"{name}.friction")
+    L, W = ctx.p(name, "length"), ctx.p(name, "width")
+    H, c = ctx.p(name, "height"), ctx.p(name, "clearance")
+    guide, slider = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
+    s_i, s_j = ctx.p(name, "s_i"), ctx.p(name, "s_j")
+    t_guide, e_slider = ctx.p(name, "t_guide"), ctx.p(name, "e_slider")
+    w_slider = perpendicular(e_slider)
+
+    O = guide.point(s_i)  # a point of the mid-line
+    t_vec = ca.mtimes(rotation(guide.phi), t_guide)
+    n_vec = perpendicular(t_vec)  # towards the upper surface
+    centre = slider.point(s_j)
+    rel_centre = centre - O
+    limits = {surface: ctx.p(name, f"{surface}_limits") if f"{name}.{surface}_limits" in ctx.params else None
+              for surface in ("upper", "lower")}
+    side = {"upper": 1.0, "lower": -1.0}
+
+    def surface_point(s: Any, surface: str) -> Any:
+        return O + s * t_vec + side[surface] * 0.5 * H * n_vec  # (4.16) on the surface line
+
+    def sliding_velocity(point: Any) -> Any:
+        return ca.dot(slider.world_point_velocity(point) - guide.world_point_velocity(point), t_vec)
+
+    def contact_force(F_N: Any, point_slider: Any, point_guide: Any, surface: str) -> tuple[Any, Any, Any]:
+        """Generalized force of a normal force F_N (and friction) on the slider at ``point_slider``."""
+        n_in = -side[surface] * n_vec  # surface normal pointing into the guide
+        v_T = sliding_velocity(point_guide)
+        F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
+        f_slider = F_N * n_in + F_T * t_vec  # (4.22)
+        Q = ctx.generalized_force([(joint.body_j, f_slider, point_slider),  # (4.23)
+                                   (joint.body_i, -f_slider, point_guide)])  # (4.24)-(4.25)
+        return Q, F_T, v_T
+
+    corner_s, corner_d, corner_gap, corner_rate = [], [], [], []
+    terms: list[Term] = []
+    pair_names: list[str] = []
+    forces: list[tuple[Any, Any, Any, Any]] = []  # per term: (F_N, F_T, v_T, p)
+    energies: list[Any | None] = []  # per term: elastic energy stored while the term is on
+    n_params = 1 if law_numeric.needs_approach_speed else 0
+    for label, sign_l, sign_w, surface in CORNERS:
+        local = s_j + sign_l * 0.5 * L * e_slider + sign_w * 0.5 * W * w_slider
+        r_k = slider.point(local)  # (4.15)
+        u = r_k - O
+        s_k = ca.dot(t_vec, u)
+        d_k = side[surface] * ca.dot(n_vec, u) - 0.5 * H  # (4.17)-(4.20): -n^T delta
+        d_dot = ca.jtimes(d_k, ctx.q, ctx.v)  # (4.21) along the normal
+        gap = d_k
+        if limits[surface] is not None:
+            lo, hi = limits[surface][0], limits[surface][1]
+            gap = ca.fmin(d_k, ca.fmin(s_k - lo, hi - s_k))
+        corner_s.append(s_k)
+        corner_d.append(d_k)
+        corner_gap.append(gap)
+        corner_rate.append(d_dot)
+        pair = f"{label}_{surface}"
+        pair_names.append(f"{name}.{pair}")
+        p = ca.SX.sym("p", n_params)
+        F_N = law.force(d_k, d_dot, p[0] if n_params else None)
+        Q, F_T, v_T = contact_force(F_N, r_k, surface_point(s_k, surface), surface)
+        terms.append(Term(f"{name}.{pair}", ca.Function(f"{ident}_{pair}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P],
+                                                         [Q], ["t", "q", "v", "p", "P"], ["Q"]), n_params))
+        forces.append((F_N, F_T, v_T, p))
+        energies.append(_elastic_energy(law_numeric, law, d_k))
+
+    face_names: list[str] = []
+    face_corners: list[tuple[int, int]] = []
+    face_params = 0
+    if face_law is not None and face_numeric is not None:
+        face_params = 1 if face_numeric.needs_approach_speed else 0
+        for face, a, b in FACES:
+            surface = CORNERS[a][3]
+            d_1, d_2, s_1, s_2 = corner_d[a], corner_d[b], corner_s[a], corner_s[b]
+            d_mean = 0.5 * (d_1 + d_2)  # average penetration
+            d_mean_dot = 0.5 * (corner_rate[a] + corner_rate[b])
+            w_1, w_2 = ca.fmax(d_1, 0.0), ca.fmax(d_2, 0.0)
+            # centroid of the penetrated trapezoid (sides d_1, d_2), measured along the guide
+            s_gc = 0.5 * (s_1 + s_2) + (s_2 - s_1) * (w_2 - w_1) / (6.0 * (w_1 + w_2) + _CENTROID_EPS)
+            point = surface_point(s_gc, surface)
+            p = ca.SX.sym("p", face_params)
+            F_N = face_law.force(d_mean, d_mean_dot, p[0] if face_params else None)
+            Q, F_T, v_T = contact_force(F_N, point, point, surface)
+            terms.append(Term(f"{name}.{face}", ca.Function(f"{ident}_{face}_force",
+                                                             [ctx.t, ctx.q, ctx.v, p, ctx.P], [Q],
+                                                             ["t", "q", "v", "p", "P"], ["Q"]), face_params))
+            forces.append((F_N, F_T, v_T, p))
+            # Winkler potential of the linear law at the trapezoid's centroid (see module docstring)
+            linear = getattr(face_numeric, "effective_exponent", 1.0) == 1.0 and face_numeric.stiffness is not None
+            energies.append(face_law.stiffness * (w_1 * w_1 + w_1 * w_2 + w_2 * w_2) / 6.0 if linear else None)
+            face_names.append(f"{name}.{face}")
+            face_corners.append((a, b))
+
+    rate = ca.Function(f"{ident}_rates", [ctx.q, ctx.v, ctx.P], [ca.vertcat(*corner_gap), ca.vertcat(*corner_rate)])
+    n_corners = len(CORNERS)
+    floor = approach_floor(ctx, law_numeric, f"{name}.law")
+    face_floor = approach_floor(ctx, face_numeric, f"{name}.face_law") if face_numeric is not None else None
+
+    def logic(P: NDArray[np.float64]) -> list[Any]:
+        return [SliderGuideLogic(
+            name=name, pairs=pair_names, first_root=first_root,
+            corner_terms=[first_term + i for i in range(n_corners)],
+            face_names=face_names, face_terms=[first_term + n_corners + f for f in range(len(face_names))],
+            face_corners=face_corners, rate=BufferedFunction(rate, bound=(P,)), n_q=ctx.n_q,
+            needs_approach=law_numeric.needs_approach_speed, min_approach_speed=floor(P),
+            face_needs_approach=bool(face_numeric is not None and face_numeric.needs_approach_speed),
+            face_min_approach_speed=face_floor(P) if face_floor is not None else 0.0,
+        )]
+
+    y_centre = ca.dot(n_vec, rel_centre)
+    s_centre = ca.dot(t_vec, rel_centre)
+    # angle from the guide's direction to the slider's length direction
+    tilt = slider.phi - guide.phi + ctx.p(name, "tilt0")
+    stroke = ctx.p(name, "stroke") if f"{name}.stroke" in ctx.params else None
+
+    def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
+        def switched(k: int, expr: Any) -> Any:
+            on, p_sym = switches[k]
+            p = forces[k][3]
+            return on * (ca.substitute(expr, p, p_sym) if p.numel() else expr)
+
+        out = [
+            Channel(f"{name}.s", "m", s_centre),
+            Channel(f"{name}.y", "m", y_centre),
+            Channel(f"{name}.tilt", "rad", tilt),
+            Channel(f"{name}.eta", "", y_centre / (2.0 * c)),
+        ]
+        if stroke is not None:
+            out.append(Channel(f"{name}.xi", "", (s_centre - stroke[0]) / (stroke[1] - stroke[0])))
+        total = 0.0
+        any_contact = 0.0
+        in_face = [0.0] * n_corners
+        for f, (a, b) in enumerate(face_corners):
+            on_f = switches[n_corners + f][0]
+            in_face[a] = in_face[a] + on_f
+            in_face[b] = in_face[b] + on_f
+        for i, pair in enumerate(pair_names):
+            F_N = switched(i, forces[i][0])
+            total = total + F_N
+            in_contact = switches[i][0] + in_face[i]
+            any_contact = ca.fmax(any_contact, in_contact)
+            out += [
+                Channel(f"{pair}.penetration", "m", corner_d[i]),
+                Channel(f"{pair}.penetration_rate", "m/s", corner_rate[i]),
+                Channel(f"{pair}.normal_force", "N", F_N),
+                Channel(f"{pair}.in_contact", "", in_contact),
+            ]
+            if not friction.frictionless:
+                out += [Channel(f"{pair}.friction_force", "N", switched(i, forces[i][1])),
+                        Channel(f"{pair}.sliding_velocity", "m/s", forces[i][2])]
+        for f, face in enumerate(face_names):
+            k = n_corners + f
+            a, b = face_corners[f]
+            F_N = switched(k, forces[k][0])
+            total = total + F_N
+            out += [
+                Channel(f"{face}.penetration", "m", 0.5 * (corner_d[a] + corner_d[b])),
+                Channel(f"{face}.normal_force", "N", F_N),
+                Channel(f"{face}.in_contact", "", switches[k][0]),
+            ]
+            if not friction.frictionless:
+                out += [Channel(f"{face}.friction_force", "N", switched(k, forces[k][1])),
+                        Channel(f"{face}.sliding_velocity", "m/s", forces[k][2])]
+        if all(e is not None for e in energies):
+            stored = sum(switches[k][0] * e for k, e in enumerate(energies))
+            out.append(Channel(f"{name}.elastic_energy", "J", stored))
+        out += [
+            Channel(f"{name}.penetration", "m", ca.mmax(ca.vertcat(*corner_d))),
+            Channel(f"{name}.normal_force", "N", total),
+            Channel(f"{name}.in_contact", "", any_contact),
+        ]
+        return out
+
+    return ContactBuild(terms=terms, gaps=corner_gap, gap_names=pair_names, channels=channels, logic=logic,
+                        ideal=[y_centre, tilt], ideal_names=[f"{name}.lateral", f"{name}.angle"])

@@ -1,0 +1,623 @@
+"""Applied loads: point forces, torques, spring-dampers and motors acting on the bodies of a scene.
+
+A load adds no state and no constraint: it adds to the applied generalized force ``Q(t, q, v)``
+of the equations of motion, like gravity. So the residual, the Schur-complement solve of the
+accelerations, ``base_force`` (the scipy methods) and the compiled loops all see it.
+
+Elements (frozen dataclasses, SI units, world points ``at`` given in the reference
+configuration as for joints):
+
+* :class:`Force`: a point force on a body (world or body-fixed components);
+* :class:`Torque`: a torque on a body, optionally between two bodies (``reaction``);
+* :class:`SpringDamper`: a linear spring-damper between two body points (free length);
+* :class:`RotationalSpringDamper`: a torsional spring-damper between two bodies (free angle);
+* :class:`Motor`: a torque between two bodies with the linear torque-speed characteristic
+  ``T = stall_torque * (1 - omega_rel / no_load_speed)`` of a DC motor.
+
+The value of a :class:`Force` component or a :class:`Torque` is a number, a :class:`Table` in
+time (linear interpolation, held constant outside its times) or an :class:`Expression`: a
+function of time, the body's state and named numbers, written once with the functions of
+this module (``sin``, ``exp``, ``fmax``, ...) so that it runs on numbers and on CasADi symbols.
+
+Every number (forces, table points, an expression's named numbers, stiffnesses, free lengths,
+body-fixed points) is a run-time parameter: changing it compiles nothing. The structure is which
+elements there are, the kind of each value, a table's number of points and an expression's
+function (its source code).
+
+Energy bookkeeping: the elastic energy of the springs is part of ``energy.potential`` (so an
+undamped spring conserves ``energy.mechanical``); every other power (applied forces and torques,
+motors, the dampers) is part of ``energy.input_power`` and of the work ``work.input``
+(``track_work=True``). Each element's channel ``<name>.power`` is that non-conservative power, so
+``energy.input_power`` is the sum of the ``.power`` channels of drivers, contacts and loads.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import math
+import types
+from dataclasses import dataclass
+from typing import Any, Callable, Iterable, Sequence
+
+from ..contact import backend
+from .scene import GROUND, Element, Vector2, as_vector2, body_name, is_finite_number
+
+# the math of expressions, written once for numbers and CasADi symbols
+atan2, cos, exp, fabs, fmax, fmin = backend.atan2, backend.cos, backend.exp, backend.fabs, backend.fmax, backend.fmin
+if_else, log, sign, sin, sqrt, tanh = backend.if_else, backend.log, backend.sign, backend.sin, backend.sqrt, backend.tanh
+
+__all__ = [
+    "Expression", "Force", "Load", "LoadState", "Motor", "RotationalSpringDamper", "SpringDamper", "Table",
+    "Torque", "atan2", "cos", "exp", "fabs", "fmax", "fmin", "if_else", "log", "sign", "sin", "sqrt", "tanh",
+]
+
+# ---------------------------------------------------------------------------- values
+
+
+@dataclass(frozen=True)
+class Table:
+    """A value tabulated in time: linear interpolation between ``(times[k], values[k])``, held at
+    the first and last value outside ``[times[0], times[-1]]``.
+
+    The interpolant is continuous (its slope jumps at the table's times, which IDA's step
+    control handles); the times and values are run-time parameters, their number is structure.
+    """
+
+    times: tuple[float, ...]
+    values: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        for name in ("times", "values"):
+            try:
+                object.__setattr__(self, name, tuple(float(x) for x in getattr(self, name)))
+            except (TypeError, ValueError):
+                pass  # reported by problems()
+
+    def problems(self, where: str) -> list[str]:
+        """Problems of the table, each headed by ``where`` (e.g. ``"Torque 't': value="``)."""
+        times, values = self.times, self.values
+        for name, seq in (("times", times), ("values", values)):
+            if not isinstance(seq, tuple) or not all(math.isfinite(x) for x in seq):
+                shown = list(seq) if isinstance(seq, tuple) else seq
+                return [f"{where}Table: {name}={shown!r}, must be a sequence of finite numbers."]
+        if len(times) < 2 or len(times) != len(values):
+            return [f"{where}Table: {len(times)} times and {len(values)} values, must be as many (at least 2)."]
+        if any(b <= a for a, b in zip(times, times[1:])):
+            return [f"{where}Table: times={list(times)!r} s, must be strictly increasing."]
+        return []
+
+    def __call__(self, t: Any) -> Any:
+        """The interpolated value at ``t`` (numbers or CasADi symbols): one formula for both,
+        ``v0 + sum_k (s_k - s_{k-1}) max(t - t_k, 0)`` with ``s_k`` the slope after ``t_k``."""
+        return _interpolate(self.times, self.values, t)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": "Table", "times": list(self.times), "values": list(self.values)}
+
+
+def _interpolate(times: Sequence[Any], values: Sequence[Any], t: Any) -> Any:
+    """Piecewise-linear interpolation, constant outside the table, branch-free (see :class:`Table`)."""
+    n = len(times)
+    slopes = [(values[k + 1] - values[k]) / (times[k + 1] - times[k]) for k in range(n - 1)] + [0.0]
+    out = values[0] + 0.0 * t
+    previous: Any = 0.0
+    for k in range(n):
+        out = out + (slopes[k] - previous) * fmax(t - times[k], 0.0)
+        previous = slopes[k]
+    return out
+
+
+@dataclass(frozen=True)
+class LoadState:
+    """What an :class:`Expression` sees of the loaded body: its centre of mass ``(x, y)``, angle
+    ``phi``, velocities ``(vx, vy)``, ``omega``; and ``angle``, ``speed``: the rotation relative to
+    the reaction body of a :class:`Torque` (``phi`` and ``omega`` when there is none)."""
+
+    x: Any
+    y: Any
+    phi: Any
+    vx: Any
+    vy: Any
+    omega: Any
+    angle: Any
+    speed: Any
+
+
+@dataclass(frozen=True, init=False)
+class Expression:
+    """A load value written as a function ``function(t, s, p)`` of time, the :class:`LoadState`
+    ``s`` and the named numbers ``p`` (attributes: ``p.T0``), e.g.::
+
+        Expression(lambda t, s, p: p.T0 * exp(-t / p.tau), T0=10.0, tau=0.2)
+
+    The function is structure: it is traced once with CasADi symbols, so it must use the math
+    functions of :mod:`daeclear.loads` (``sin``, ``exp``, ``fmax``, ``if_else``, ...), not
+    ``math`` or Python ``if`` on the state. Its numbers are run-time parameters: give every
+    number that may change as a named number, not inside the function.
+    """
+
+    function: Callable[..., Any]
+    parameters: tuple[tuple[str, float], ...]
+
+    def __init__(self, function: Callable[..., Any], /, **parameters: Any) -> None:
+        object.__setattr__(self, "function", function)
+        object.__setattr__(self, "parameters", tuple(parameters.items()))
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(name for name, _ in self.parameters)
+
+    def __call__(self, t: Any, state: LoadState, numbers: dict[str, Any] | None = None) -> Any:
+        """The value at ``t`` and ``state``, with ``numbers`` (name -> value or symbol) or the declared ones."""
+        values = dict(self.parameters) if numbers is None else numbers
+        return self.function(t, state, types.SimpleNamespace(**values))
+
+    def problems(self, where: str) -> list[str]:
+        if not callable(self.function):
+            return [f"{where}Expression: function={self.function!r}, must be a function (t, s, p) -> value."]
+        out = [f"{where}Expression: {name}={value!r}, must be a finite number (named numbers are run-time "
+               "parameters)." for name, value in self.parameters if not is_finite_number(value)]
+        if out:
+            return out
+        return self._trace_problems(where)
+
+    def _trace_problems(self, where: str) -> list[str]:
+        """Run the function on numbers and on CasADi symbols at one sample point: both must give
+        the same number (``math.sin`` of a symbol, for one, gives NaN)."""
+        import casadi as ca
+        import numpy as np
+
+        label = f"{where}Expression {getattr(self.function, '__qualname__', self.function)!r}"
+        sample = (0.0123, 0.1, -0.2, 0.3, 0.4, -0.5, 0.6, 0.25, 0.35)
+        try:
+            with np.errstate(all="ignore"):
+                value = self(np.float64(sample[0]), LoadState(*map(np.float64, sample[1:])))
+                number = float(np.asarray(value, dtype=float).reshape(()))
+        except Exception as exc:  # a user function: any failure is reported, not raised
+            return [f"{label} does not return one number ({type(exc).__name__}: {exc})."]
+        sym = ca.SX.sym("x", len(sample) + len(self.parameters))
+        try:
+            value = ca.SX(self(sym[0], LoadState(*[sym[k] for k in range(1, len(sample))]),
+                               {name: sym[len(sample) + k] for k, name in enumerate(self.names)}))
+            if value.numel() != 1:
+                raise ValueError(f"it has {value.numel()} elements")
+            traced = float(ca.Function("trace", [sym], [value])([*sample, *(v for _, v in self.parameters)]))
+        except Exception as exc:
+            traced = math.nan
+            detail = f" ({type(exc).__name__}: {exc})"
+        else:
+            detail = ""
+        same = math.isclose(traced, number, rel_tol=1e-9, abs_tol=1e-12) or (math.isnan(traced) and math.isnan(number))
+        if not same:
+            return [f"{label} does not run on CasADi symbols as on numbers{detail}; write it with the functions of "
+                    "daeclear.loads (sin, cos, exp, fmax, if_else, ...), not math or Python 'if' on the state."]
+        return []
+
+    def to_dict(self) -> dict[str, Any]:
+        """The function's identity (name and a digest of its source and captured numbers) and the numbers."""
+        return {"kind": "Expression", "function": getattr(self.function, "__qualname__", repr(self.function)),
+                "digest": _function_digest(self.function), "parameters": dict(self.parameters)}
+
+
+def _function_digest(function: Any, seen: frozenset[int] = frozenset()) -> str:
+    """A digest that changes when the function's code, a number it reads from outside, or a Python
+    function it calls (by a global or closure name, recursively) changes: all of that is structure
+    (give numbers as named numbers to make them run-time parameters)."""
+    code = getattr(function, "__code__", None)
+    try:
+        text = inspect.getsource(function)
+    except (OSError, TypeError):
+        text = repr(function) if code is None else ""
+    captured: list[Any] = []
+    if code is not None:  # the bytecode too: two lambdas on one source line differ by it
+        consts = [c for c in code.co_consts if not inspect.iscode(c)]  # a code object's repr holds an address
+        text += repr((code.co_code, consts, code.co_names))
+        globs = getattr(function, "__globals__", {})
+        outside = [c.cell_contents for c in getattr(function, "__closure__", None) or () if _has_contents(c)]
+        outside += [(name, globs[name]) for name in code.co_names if name in globs]
+        seen = seen | {id(function)}
+        for item in outside:
+            value = item[1] if isinstance(item, tuple) else item
+            if _is_number(value):
+                captured.append(item)
+            elif inspect.isfunction(value) and id(value) not in seen:
+                captured.append(_function_digest(value, seen))
+    return hashlib.sha256(f"{text}\n{captured!r}".encode()).hexdigest()[:20]
+
+
+def _has_contents(cell: Any) -> bool:
+    try:
+        cell.cell_contents
+    except ValueError:  # an empty cell (a name not yet bound)
+        return False
+    return True
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+Value = float | Table | Expression
+
+
+def _value_problems(element: Element, field_name: str, unit: str) -> list[str]:
+    value = getattr(element, field_name)
+    where = f"{element.kind} '{element.name}': {field_name}="
+    if isinstance(value, (Table, Expression)):
+        return value.problems(where)
+    if not is_finite_number(value):
+        return [f"{where}{value!r} {unit}, must be a finite number, a daeclear.Table or a daeclear.Expression."]
+    return []
+
+
+def _value_parameters(value: Any) -> dict[str, Any]:
+    """A value's numbers, keyed under the value's field: '' (a number), 'times'/'values', or names."""
+    if isinstance(value, Table):
+        return {"times": value.times, "values": value.values}
+    if isinstance(value, Expression):
+        return dict(value.parameters)
+    return {"": float(value)}
+
+
+# ---------------------------------------------------------------------------- elements
+
+
+class Load(Element):
+    """Base class of the load elements: bodies they act on, for the scene's reference checks."""
+
+    def body_roles(self) -> tuple[tuple[str, str], ...]:
+        """(field, body name) of every body the load refers to."""
+        raise NotImplementedError
+
+    def _check_distinct(self, out: list[str], first: str, second: str) -> None:
+        a, b = getattr(self, first), getattr(self, second)
+        if a == b:
+            out.append(f"{self.kind} '{self.name}': {first} and {second} are both '{a}'; give two different bodies.")
+
+    def _check_moving(self, out: list[str], field_name: str) -> None:
+        if getattr(self, field_name) == GROUND:
+            out.append(f"{self.kind} '{self.name}': {field_name}='{GROUND}', must be a moving body "
+                       "(a load on the fixed ground does nothing).")
+
+    def _check_nonnegative(self, out: list[str], field_name: str, unit: str) -> None:
+        value = getattr(self, field_name)
+        if not is_finite_number(value) or value < 0:
+            out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number >= 0.")
+
+
+class BetweenBodies(Load):
+    """A load between two bodies ``body_i`` and ``body_j`` (names, or the Body objects)."""
+
+    body_i: str
+    body_j: str
+
+    def __post_init__(self) -> None:
+        for name in ("body_i", "body_j"):
+            object.__setattr__(self, name, body_name(getattr(self, name)))
+
+    def body_roles(self) -> tuple[tuple[str, str], ...]:
+        return (("body_i", self.body_i), ("body_j", self.body_j))
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        self._check_distinct(out, "body_i", "body_j")
+        return out
+
+
+#: Frames of a :class:`Force`'s components.
+FORCE_FRAMES: tuple[str, ...] = ("world", "body")
+
+
+@dataclass(frozen=True)
+class Force(Load):
+    """A point force on ``body`` at the world point ``at`` of the reference configuration (the
+    centre of mass when None); the point moves with the body.
+
+    Parameters
+    ----------
+    name : str
+        Unique name; channels ``<name>.fx``, ``<name>.fy`` (world components, N) and
+        ``<name>.power`` (W).
+    body : str or Body
+        The loaded body (not the ground).
+    fx, fy : float, Table or Expression
+        Components, N: in the world frame (``frame="world"``) or in the body frame, turning
+        with the body (``frame="body"``, a follower force).
+    at : (float, float) or None
+        World point of application in the reference configuration, m.
+    frame : {"world", "body"}
+    """
+
+    name: str
+    body: str
+    fx: Value = 0.0
+    fy: Value = 0.0
+    at: Vector2 | None = None
+    frame: str = "world"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "body", body_name(self.body))
+        if self.at is not None and as_vector2(self.at) is not None:
+            object.__setattr__(self, "at", as_vector2(self.at))
+
+    def body_roles(self) -> tuple[tuple[str, str], ...]:
+        return (("body", self.body),)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        self._check_moving(out, "body")
+        self._check_vector(out, "at", "m", optional=True)
+        if self.frame not in FORCE_FRAMES:
+            out.append(f"{self.kind} '{self.name}': frame={self.frame!r}, must be one of "
+                       f"{', '.join(map(repr, FORCE_FRAMES))}.")
+        out += _value_problems(self, "fx", "N") + _value_problems(self, "fy", "N")
+        return out
+
+
+@dataclass(frozen=True)
+class Torque(Load):
+    """A torque on ``body`` (counter-clockwise positive); with a ``reaction`` body the opposite
+    torque acts on it (a torque between two bodies, e.g. a motor on a frame).
+
+    Channels ``<name>.torque`` (N m) and ``<name>.power`` (W: torque times the speed of ``body``
+    relative to ``reaction``). ``value``: a number, a :class:`Table` or an :class:`Expression`
+    (whose state's ``angle`` and ``speed`` are relative to ``reaction``).
+    """
+
+    name: str
+    body: str
+    value: Value = 0.0
+    reaction: str | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "body", body_name(self.body))
+        if self.reaction is not None:
+            object.__setattr__(self, "reaction", body_name(self.reaction))
+
+    def body_roles(self) -> tuple[tuple[str, str], ...]:
+        return (("body", self.body),) + ((("reaction", self.reaction),) if self.reaction is not None else ())
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        self._check_moving(out, "body")
+        if self.reaction is not None:
+            self._check_distinct(out, "body", "reaction")
+        return out + _value_problems(self, "value", "N m")
+
+
+@dataclass(frozen=True)
+class SpringDamper(BetweenBodies):
+    """A linear spring-damper between point ``at_i`` of ``body_i`` and ``at_j`` of ``body_j``
+    (world points of the reference configuration; the points move with their bodies).
+
+    Tension ``F = stiffness * (L - free_length) + damping * dL/dt`` along the line of the points
+    (positive pulls them together). ``free_length`` None: the reference distance. Channels
+    ``<name>.length``, ``<name>.elongation`` (L - free_length, m), ``<name>.force`` (tension, N),
+    ``<name>.elastic_energy`` (J, part of ``energy.potential``), ``<name>.power`` (the damper's
+    power, W, <= 0). The points must not coincide during a run (the line is undefined there).
+    """
+
+    name: str
+    body_i: str
+    body_j: str
+    at_i: Vector2 = (0.0, 0.0)
+    at_j: Vector2 = (0.0, 0.0)
+    stiffness: float = 0.0
+    damping: float = 0.0
+    free_length: float | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        for name in ("at_i", "at_j"):
+            if as_vector2(getattr(self, name)) is not None:
+                object.__setattr__(self, name, as_vector2(getattr(self, name)))
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        self._check_vector(out, "at_i", "m")
+        self._check_vector(out, "at_j", "m")
+        self._check_nonnegative(out, "stiffness", "N/m")
+        self._check_nonnegative(out, "damping", "N s/m")
+        if self.free_length is not None:
+            self._check_nonnegative(out, "free_length", "m")
+        a, b = as_vector2(self.at_i), as_vector2(self.at_j)
+        if a is not None and b is not None and math.dist(a, b) < 1e-12:
+            out.append(f"{self.kind} '{self.name}': at_i={self.at_i!r} and at_j={self.at_j!r} m coincide; the "
+                       "spring's line is undefined: give two distinct points.")
+        return out
+
+
+@dataclass(frozen=True)
+class RotationalSpringDamper(BetweenBodies):
+    """A torsional spring-damper between ``body_i`` and ``body_j``: the torque on body j is
+    ``-stiffness * (theta - free_angle) - damping * dtheta/dt`` with ``theta = phi_j - phi_i``
+    (the opposite on body i). ``free_angle`` None: the reference relative angle. Channels
+    ``<name>.deflection`` (rad), ``<name>.torque`` (on body j, N m), ``<name>.elastic_energy``
+    (J, part of ``energy.potential``), ``<name>.power`` (the damper's power, W, <= 0).
+    """
+
+    name: str
+    body_i: str
+    body_j: str
+    stiffness: float = 0.0
+    damping: float = 0.0
+    free_angle: float | None = None
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        self._check_nonnegative(out, "stiffness", "N m/rad")
+        self._check_nonnegative(out, "damping", "N m s/rad")
+        if self.free_angle is not None:
+            self._check_number(out, "free_angle", "rad")
+        return out
+
+
+@dataclass(frozen=True)
+class Motor(BetweenBodies):
+    """A motor between a stator ``body_i`` (e.g. the ground) and a rotor ``body_j`` (e.g. a crank),
+    with the linear torque-speed characteristic of a DC motor::
+
+        T = stall_torque * (1 - omega_rel / no_load_speed),   omega_rel = omega_j - omega_i
+
+    T acts on body j, -T on body i. Give ``stall_torque`` and ``no_load_speed`` the same sign
+    (negative: a clockwise motor). Above the no-load speed the torque brakes. Channels
+    ``<name>.torque`` (N m), ``<name>.speed`` (rad/s), ``<name>.power`` (W).
+    """
+
+    name: str
+    body_i: str
+    body_j: str
+    stall_torque: float = 0.0
+    no_load_speed: float = 0.0
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        for field_name, unit in (("stall_torque", "N m"), ("no_load_speed", "rad/s")):
+            value = getattr(self, field_name)
+            if not is_finite_number(value) or value == 0:
+                out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite "
+                           "number other than 0.")
+        if not out and (self.stall_torque > 0) != (self.no_load_speed > 0):
+            out.append(f"{self.kind} '{self.name}': stall_torque={self.stall_torque!r} N m and no_load_speed="
+                       f"{self.no_load_speed!r} rad/s, must have the same sign (the motor's direction).")
+        return out
+
+
+LOAD_TYPES: tuple[type, ...] = (Force, Torque, SpringDamper, RotationalSpringDamper, Motor)
+
+
+# ---------------------------------------------------------------------------- assembly
+
+def load_parameters(ref: Any, load: Load) -> dict[str, Any]:
+    """The load's numbers as run-time parameters (``ref``: the scene's reference configuration)."""
+    out: dict[str, Any] = {}
+    if isinstance(load, Force):
+        out["point"] = (0.0, 0.0) if load.at is None else ref.local_point(load.body, load.at)
+        for field_name in ("fx", "fy"):
+            out.update(_keyed(field_name, _value_parameters(getattr(load, field_name))))
+    elif isinstance(load, Torque):
+        out.update(_keyed("value", _value_parameters(load.value)))
+    elif isinstance(load, SpringDamper):
+        free = math.dist(load.at_i, load.at_j) if load.free_length is None else load.free_length
+        out.update(s_i=ref.local_point(load.body_i, load.at_i), s_j=ref.local_point(load.body_j, load.at_j),
+                   stiffness=load.stiffness, damping=load.damping, free_length=free)
+    elif isinstance(load, RotationalSpringDamper):
+        free = ref.angle(load.body_j) - ref.angle(load.body_i) if load.free_angle is None else load.free_angle
+        out.update(stiffness=load.stiffness, damping=load.damping, free_angle=free)
+    else:
+        out.update(stall_torque=load.stall_torque, no_load_speed=load.no_load_speed)
+    return out
+
+
+def _keyed(field_name: str, values: dict[str, Any]) -> dict[str, Any]:
+    return {(f"{field_name}.{k}" if k else field_name): v for k, v in values.items()}
+
+
+@dataclass(frozen=True)
+class LoadBuild:
+    """The symbolic contribution of a scene's loads: generalized force, elastic energy,
+    non-conservative power (W) and output channels."""
+
+    force: Any
+    potential: Any
+    power: Any
+    channels: tuple[Any, ...]
+
+
+def build_loads(ctx: Any, loads: Iterable[Load]) -> LoadBuild:
+    """Symbolic generalized forces (length n_q), energies and channels of ``loads`` (CasADi SX)."""
+    import casadi as ca
+
+    from ..assembly.symbolic import Channel, rotation
+
+    Q = ca.SX.zeros(ctx.n_q)
+    potential, power = ca.SX(0.0), ca.SX(0.0)
+    channels: list[Any] = []
+    for load in loads:
+        name = load.name
+        if isinstance(load, Force):
+            frame = ctx.frames[load.body]
+            s = ctx.p(name, "point")
+            state = _state(frame, None)
+            f = ca.vertcat(_value(ctx, name, "fx", load.fx, state), _value(ctx, name, "fy", load.fy, state))
+            if load.frame == "body":
+                f = ca.mtimes(rotation(frame.phi), f)
+            Q += ctx.generalized_force([(load.body, f, frame.point(s))])
+            p = ca.dot(f, frame.point_velocity(s))
+            channels += [Channel(f"{name}.fx", "N", f[0]), Channel(f"{name}.fy", "N", f[1])]
+        elif isinstance(load, SpringDamper):
+            bi, bj = ctx.frames[load.body_i], ctx.frames[load.body_j]
+            si, sj = ctx.p(name, "s_i"), ctx.p(name, "s_j")
+            d = bj.point(sj) - bi.point(si)
+            length = ca.sqrt(ca.dot(d, d))
+            u = d / length
+            rate = ca.dot(u, bj.point_velocity(sj) - bi.point_velocity(si))
+            k, c = ctx.p(name, "stiffness"), ctx.p(name, "damping")
+            stretch = length - ctx.p(name, "free_length")
+            tension = k * stretch + c * rate
+            Q += ctx.generalized_force([(load.body_i, tension * u, bi.point(si)),
+                                        (load.body_j, -tension * u, bj.point(sj))])
+            elastic = 0.5 * k * stretch**2
+            potential += elastic
+            p = -c * rate**2
+            channels += [Channel(f"{name}.length", "m", length), Channel(f"{name}.elongation", "m", stretch),
+                         Channel(f"{name}.force", "N", tension), Channel(f"{name}.elastic_energy", "J", elastic)]
+        else:  # torques between a body and another body (or the ground)
+            if isinstance(load, Torque):
+                body, other = load.body, load.reaction or GROUND
+            else:
+                body, other = load.body_j, load.body_i
+            fj, fi = ctx.frames[body], ctx.frames[other]
+            speed = fj.omega - fi.omega
+            if isinstance(load, Torque):
+                torque = _value(ctx, name, "value", load.value, _state(fj, fi))
+                p = torque * speed
+            elif isinstance(load, Motor):
+                torque = ctx.p(name, "stall_torque") * (1.0 - speed / ctx.p(name, "no_load_speed"))
+                p = torque * speed
+                channels.append(Channel(f"{name}.speed", "rad/s", speed))
+            else:
+                k, c = ctx.p(name, "stiffness"), ctx.p(name, "damping")
+                deflection = fj.phi - fi.phi - ctx.p(name, "free_angle")
+                torque = -k * deflection - c * speed
+                elastic = 0.5 * k * deflection**2
+                potential += elastic
+                p = -c * speed**2
+                channels += [Channel(f"{name}.deflection", "rad", deflection),
+                             Channel(f"{name}.elastic_energy", "J", elastic)]
+            Q += _generalized_torque(ctx, [(body, torque), (other, -torque)])
+            channels.append(Channel(f"{name}.torque", "N m", torque))
+        power += p
+        channels.append(Channel(f"{name}.power", "W", p))
+    return LoadBuild(force=Q, potential=potential, power=power, channels=tuple(channels))
+
+
+def _state(frame: Any, reaction: Any) -> LoadState:
+    angle = frame.phi if reaction is None else frame.phi - reaction.phi
+    speed = frame.omega if reaction is None else frame.omega - reaction.omega
+    return LoadState(frame.r[0], frame.r[1], frame.phi, frame.v[0], frame.v[1], frame.omega, angle, speed)
+
+
+def _value(ctx: Any, owner: str, field_name: str, value: Any, state: LoadState) -> Any:
+    """A load value as an expression of (t, q, v) and the parameters ``<owner>.<field>[.<key>]``."""
+    if isinstance(value, Table):
+        times, values = ctx.params[f"{owner}.{field_name}.times"], ctx.params[f"{owner}.{field_name}.values"]
+        n = len(value.times)
+        return _interpolate([times[k] for k in range(n)], [values[k] for k in range(n)], ctx.t)
+    if isinstance(value, Expression):
+        numbers = {key: ctx.p(owner, f"{field_name}.{key}") for key in value.names}
+        return value(ctx.t, state, numbers)
+    return ctx.p(owner, field_name)
+
+
+def _generalized_torque(ctx: Any, torques: Sequence[tuple[str, Any]]) -> Any:
+    """Generalized force (length n_q) of torques ``(body, torque)``; the ground's is dropped."""
+    import casadi as ca
+
+    Q = ca.SX.zeros(ctx.n_q)
+    for body, torque in torques:
+        frame = ctx.frames[body]
+        if frame.index is not None:
+            Q[3 * frame.index + 2] += torque
+    return Q

@@ -1,0 +1,363 @@
+"""The one style of daeclear's figures: captions that carry the run's parameters, time
+windows and decimation for long runs, parameter axes with units and log scales.
+
+Every figure function of :mod:`daeclear.plot` draws through these helpers, so a figure says
+which clearance, speed, contact law, restitution and friction produced it, a 200-revolution
+run can be shown over a window or thinned to a number of points that still shows its peaks,
+and a sweep over a geometric grid gets a log axis with the parameter's unit.
+matplotlib is imported only when an Axes is made.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from ..results.result import Result
+
+__all__ = [
+    "PARAMETER_AXES",
+    "TITLE_SIZE",
+    "caption",
+    "decimate",
+    "format_parameter",
+    "is_geometric",
+    "new_axes",
+    "parameter_axis",
+    "parameter_display",
+    "parameter_label",
+    "quantity_label",
+    "run_parameters",
+    "select_times",
+    "set_title",
+    "stride",
+    "sweep_caption",
+    "window_index",
+]
+
+TITLE_SIZE = "medium"
+"""Font size of every figure and panel title."""
+
+PARAMETER_AXES: dict[str, tuple[float, str]] = {
+    "clearance": (1e3, "mm"),
+    "bearing_radius": (1e3, "mm"),
+    "journal_radius": (1e3, "mm"),
+    "length": (1e3, "mm"),
+    "width": (1e3, "mm"),
+    "corner_radius": (1e3, "mm"),
+    "rpm": (1.0, "rpm"),
+    "gravity": (1.0, "m/s²"),
+    "crank_angle": (1.0, "rad"),
+    "restitution": (1.0, "-"),
+    "friction": (1.0, "-"),
+    "rtol": (1.0, "-"),
+}
+"""How a swept parameter is shown: name -> (factor from its SI value, unit of the axis).
+
+The parameters of :func:`daeclear.mechanisms.slider_crank` and :func:`~daeclear.mechanisms.chain`,
+given in SI units (``clearance`` in m, shown in mm; ``rpm`` in rev/min).
+"""
+
+_LAW_NAMES = {"lankarani-nikravesh": "Lankarani-Nikravesh", "hunt-crossley": "Hunt-Crossley", "flores": "Flores",
+              "hertz": "Hertz", "esdu-78035": "ESDU-78035", "goldsmith": "Goldsmith",
+              "dubowsky-freudenstein": "Dubowsky-Freudenstein", "lankarani-plane": "Lankarani plane",
+              "kelvin-voigt": "Kelvin-Voigt"}
+_FRICTION_NAMES = {"coulomb": "Coulomb", "modified-coulomb": "modified Coulomb"}
+
+
+# --------------------------------------------------------------------------- axes and titles
+
+
+def new_axes(ax: Axes | None = None) -> Axes:
+    """``ax``, or the Axes of a new figure when None."""
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+
+    return plt.figure().add_subplot()
+
+
+def set_title(target: Any, text: str) -> None:
+    """Title of an Axes, or the suptitle of a Figure, in the common size (nothing for empty text)."""
+    if not text:
+        return
+    if hasattr(target, "suptitle"):
+        target.suptitle(text, fontsize=TITLE_SIZE)
+    else:
+        target.set_title(text, fontsize=TITLE_SIZE)
+
+
+def quantity_label(name: str, unit: str) -> str:
+    """Axis label ``"name (unit)"``, or the name alone when there is no unit."""
+    return f"{name} ({unit})" if unit else name
+
+
+# --------------------------------------------------------------------------- captions
+
+
+def _number(value: Any) -> float | None:
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+
+
+def _law_text(law: Any) -> str:
+    if isinstance(law, str):
+        return _LAW_NAMES.get(law, law)
+    if not isinstance(law, Mapping):
+        return ""
+    name = law.get("name")
+    text = _LAW_NAMES.get(name, str(name)) if isinstance(name, str) else "contact law"
+    restitution = _number(law.get("restitution"))
+    return f"{text} $c_e$ = {restitution:g}" if restitution is not None else text
+
+
+def _friction_text(friction: Any) -> str:
+    if friction is None or friction == {} or friction is False:
+        return "frictionless"
+    coefficient = _number(friction)
+    if coefficient is not None:
+        return "frictionless" if coefficient == 0 else f"friction $c_f$ = {coefficient:g}"
+    if isinstance(friction, str):
+        return "frictionless" if friction == "none" else _FRICTION_NAMES.get(friction, friction)
+    if isinstance(friction, Mapping):
+        name = friction.get("name")
+        if name == "none":
+            return "frictionless"
+        coefficient = _number(friction.get("coefficient"))
+        text = _FRICTION_NAMES.get(name, str(name)) if isinstance(name, str) else "friction"
+        if coefficient is not None:
+            return "frictionless" if coefficient == 0 else f"{text} $c_f$ = {coefficient:g}"
+        return text
+    return ""
+
+
+def run_parameters(result: Result) -> dict[str, Any]:
+    """The parameters a figure of ``result`` should state, read from ``result.parameters["scene"]``.
+
+    Returns
+    -------
+    dict
+        ``"rpm"``: crank speed of the first driver (rev/min); ``"joints"``: one dict per
+        clearance joint, ``{"name", "kind", "clearance" (m), "law" (text), "restitution",
+        "friction" (text)}``; entries that the scene does not have are left out.
+    """
+    scene = result.parameters.get("scene") if isinstance(result.parameters, Mapping) else None
+    elements = scene.get("elements", {}) if isinstance(scene, Mapping) else {}
+    out: dict[str, Any] = {}
+    joints: list[dict[str, Any]] = []
+    for name, element in (elements.items() if isinstance(elements, Mapping) else ()):
+        if not isinstance(element, Mapping):
+            continue
+        speed = _number(element.get("speed"))
+        if element.get("kind") == "Driver" and speed is not None and "rpm" not in out:
+            out["rpm"] = speed * 60.0 / (2.0 * math.pi)
+        clearance = _number(element.get("clearance"))
+        if clearance is None:
+            continue
+        joint: dict[str, Any] = {"name": str(name), "kind": str(element.get("kind", "")), "clearance": clearance}
+        law = element.get("law")
+        if law is not None:
+            joint["law"] = _law_text(law)
+            if isinstance(law, Mapping) and _number(law.get("restitution")) is not None:
+                joint["restitution"] = float(law["restitution"])
+        if "friction" in element:
+            joint["friction"] = _friction_text(element.get("friction"))
+        joints.append(joint)
+    if joints:
+        out["joints"] = joints
+    return out
+
+
+def _joint_text(joint: Mapping[str, Any]) -> str:
+    parts = [f"c = {joint['clearance'] * 1e3:g} mm"]
+    parts += [joint[k] for k in ("law", "friction") if joint.get(k)]
+    return ", ".join(parts)
+
+
+def caption(result: Result, *, name: bool = True) -> str:
+    """One line naming the run: scene, clearance, crank speed, law and restitution, friction.
+
+    E.g. ``"slider_crank_revolute: c = 0.5 mm, 5000 rpm, Lankarani-Nikravesh $c_e$ = 0.9,
+    frictionless"``; a failed run is marked ``(FAILED: partial result)``. Several clearance
+    joints with different settings are listed by joint name.
+    """
+    info = run_parameters(result)
+    joints = info.get("joints", [])
+    texts = list(dict.fromkeys(_joint_text(j) for j in joints))
+    parts: list[str] = []
+    if len(texts) == 1:
+        first, _, rest = texts[0].partition(", ")
+        parts.append(first)
+        if "rpm" in info:
+            parts.append(f"{info['rpm']:.4g} rpm")
+        if rest:
+            parts.append(rest)
+    else:
+        if "rpm" in info:
+            parts.append(f"{info['rpm']:.4g} rpm")
+        parts += [f"{j['name']}: {_joint_text(j)}" for j in joints]
+    text = ", ".join(parts)
+    if name and result.scene_name:
+        text = f"{result.scene_name}: {text}" if text else result.scene_name
+    if not result.success:
+        text += "  (FAILED: partial result)"
+    return text
+
+
+def format_parameter(name: str, value: Any) -> str:
+    """``"name = value unit"`` in the display unit of :data:`PARAMETER_AXES`."""
+    number = _number(value)
+    if number is None:
+        if name == "friction":
+            return _friction_text(value)
+        return f"{name} = {value}"
+    scale, unit = PARAMETER_AXES.get(name, (1.0, ""))
+    if unit == name:  # "5000 rpm", not "rpm = 5000 rpm"
+        return f"{number * scale:g} {unit}"
+    unit = "" if unit == "-" else unit
+    return f"{name} = {number * scale:g}" + (f" {unit}" if unit else "")
+
+
+def sweep_caption(sweep: Any, exclude: Iterable[str] = ()) -> str:
+    """The mechanism and the parameters every run of a sweep shares (the ones not on an axis)."""
+    runs = list(getattr(sweep, "runs", ()))
+    skip = set(exclude)
+    fixed: dict[str, Any] = {}
+    if runs:
+        for key, value in runs[0].parameters.items():
+            if key not in skip and all(r.parameters.get(key, object()) == value for r in runs):
+                fixed[key] = value
+    mechanism = str(getattr(sweep, "mechanism", "") or "")
+    text = ", ".join(format_parameter(k, v) for k, v in fixed.items())
+    return f"{mechanism}: {text}" if mechanism and text else mechanism or text
+
+
+# --------------------------------------------------------------------------- time windows and decimation
+
+
+def _check_max_points(max_points: int | None) -> None:
+    if max_points is not None and (isinstance(max_points, bool) or int(max_points) != max_points
+                                   or max_points < 2):
+        raise ValueError(f"max_points={max_points!r}, must be an integer >= 2 (or None: every point).")
+
+
+def decimate(y: ArrayLike, max_points: int | None, index: NDArray[np.intp] | None = None) -> NDArray[np.intp]:
+    """Indices of at most ``max_points`` samples of ``y`` that keep its envelope (min-max decimation).
+
+    The samples (all of ``y``, or ``y[index]``) are cut into ``max_points // 2`` runs of
+    consecutive points, and the lowest and highest point of each run are kept, in time
+    order: peaks (impacts) survive, which plain striding would miss. ``max_points=None``
+    keeps every point.
+    """
+    _check_max_points(max_points)
+    values = np.asarray(y)
+    idx = np.arange(values.shape[0]) if index is None else np.asarray(index, dtype=np.intp)
+    if max_points is None or idx.size <= max_points:
+        return idx
+    v = values[idx].astype(np.float64)
+    v = v.reshape(v.shape[0], -1)[:, 0] if v.ndim > 1 else v
+    n_bins = max_points // 2
+    edges = np.linspace(0, idx.size, n_bins + 1).astype(np.intp)
+    keep: list[int] = []
+    for a, b in zip(edges[:-1], edges[1:]):
+        if b <= a:
+            continue
+        chunk = v[a:b]
+        finite = np.isfinite(chunk)
+        if not finite.any():
+            keep.append(a)
+            continue
+        lo = a + int(np.nanargmin(np.where(finite, chunk, np.nan)))
+        hi = a + int(np.nanargmax(np.where(finite, chunk, np.nan)))
+        keep.extend(sorted({lo, hi}))
+    return idx[np.asarray(keep, dtype=np.intp)]
+
+
+def stride(index: NDArray[np.intp], max_points: int | None) -> NDArray[np.intp]:
+    """At most ``max_points`` of ``index``, evenly spaced, first and last kept (for x-y curves)."""
+    _check_max_points(max_points)
+    if max_points is None or index.size <= max_points:
+        return index
+    picks = np.unique(np.linspace(0, index.size - 1, max_points).round().astype(np.intp))
+    return index[picks]
+
+
+def window_index(t: ArrayLike, window: tuple[float | None, float | None] | None) -> NDArray[np.intp]:
+    """Indices of the times inside the closed ``window = (t0, t1)`` (None: every time, or an open side)."""
+    times = np.asarray(t, dtype=np.float64)
+    if window is None:
+        return np.arange(times.shape[0])
+    try:
+        t0, t1 = window
+    except (TypeError, ValueError):
+        raise ValueError(f"window={window!r}, must be a pair (t0, t1) in s (either may be None).") from None
+    lo = -math.inf if t0 is None else float(t0)
+    hi = math.inf if t1 is None else float(t1)
+    if lo > hi:
+        raise ValueError(f"window=({t0}, {t1}): t0 must not exceed t1.")
+    return np.flatnonzero((times >= lo) & (times <= hi))
+
+
+def select_times(t: ArrayLike, y: ArrayLike | None = None, *, window: tuple[float | None, float | None] | None = None,
+                 max_points: int | None = None) -> NDArray[np.intp]:
+    """Indices to plot of a time series: inside ``window``, then min-max decimated on ``y`` to ``max_points``
+    (evenly strided when no ``y`` is given, e.g. for an x-y curve)."""
+    index = window_index(t, window)
+    if y is None:
+        return stride(index, max_points)
+    return decimate(y, max_points, index)
+
+
+# --------------------------------------------------------------------------- parameter axes
+
+
+def is_geometric(values: Iterable[Any], rtol: float = 1e-6) -> bool:
+    """True for three or more distinct positive numbers in constant ratio (a ``geomspace`` grid)."""
+    try:
+        x = np.unique(np.asarray([float(v) for v in values if _number(v) is not None], dtype=np.float64))
+    except (TypeError, ValueError):
+        return False
+    if x.size < 3 or not np.all(np.isfinite(x)) or np.any(x <= 0):
+        return False
+    ratios = x[1:] / x[:-1]
+    return bool(np.allclose(ratios, ratios[0], rtol=rtol, atol=0.0)) and ratios[0] > 1 + 1e-9
+
+
+def parameter_display(name: str, scale: float | None = None, unit: str | None = None) -> tuple[float, str]:
+    """Factor and unit of a parameter axis: the given ones, else :data:`PARAMETER_AXES`, else (1, "")."""
+    if scale is None and unit is None:
+        return PARAMETER_AXES.get(name, (1.0, ""))
+    if scale is None:
+        default_scale, default_unit = PARAMETER_AXES.get(name, (1.0, ""))
+        return (default_scale if unit == default_unit else 1.0), unit or ""
+    if unit is None:
+        default_scale, default_unit = PARAMETER_AXES.get(name, (1.0, ""))
+        return float(scale), (default_unit if scale == default_scale else "")
+    return float(scale), unit
+
+
+def parameter_label(name: str, unit: str) -> str:
+    """Axis label of a parameter, ``"clearance (mm)"``."""
+    return quantity_label(name, unit)
+
+
+def parameter_axis(ax: Axes, which: str, name: str, values: Iterable[Any], unit: str,
+                   log: bool | None = None) -> bool:
+    """Label the x or y axis with the parameter and its unit; log scale when ``log`` or, if None, when
+    ``values`` form a geometric grid. Returns whether the axis is logarithmic."""
+    use_log = is_geometric(values) if log is None else bool(log)
+    if which == "x":
+        ax.set_xlabel(parameter_label(name, unit))
+        if use_log:
+            ax.set_xscale("log")
+    else:
+        ax.set_ylabel(parameter_label(name, unit))
+        if use_log:
+            ax.set_yscale("log")
+    return use_log

@@ -1,0 +1,197 @@
+"""Output places checked before any work, and writes that neither an error nor Ctrl-C can half-do.
+
+:func:`check_file` and :func:`check_directory` are the one rule for every place daeclear writes
+(``Result.save``, ``daeclear.sweep``, ``daeclear run|study|sweep``): called before a run starts,
+so a bad ``--out`` costs nothing instead of a whole computation. The message names the option,
+the path and what is allowed. Writability is tested by creating (and removing) a probe file, the
+only test that also holds for root and read-only file systems.
+
+:func:`deferred_sigint` holds Ctrl-C back while a result is written: a second Ctrl-C during the
+save of a partial result is delivered after the file is complete (and renamed into place).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import tempfile
+import threading
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from types import FrameType
+
+from ..errors import OutputDirectoryMissing, OutputError
+
+
+def _probe(directory: Path, option: str, path: Path) -> None:
+    """Create and remove a file in ``directory``: the only writability test that also holds for root."""
+    try:
+        fd, name = tempfile.mkstemp(prefix=".daeclear-probe-", dir=directory)
+    except OSError as exc:
+        raise OutputError(f"{option} '{path}': cannot write in directory '{directory}' "
+                          f"({exc.strerror or exc}); give a writable place.") from None
+    os.close(fd)
+    os.unlink(name)
+
+
+def check_file(path: str | os.PathLike[str], option: str, *, what: str = "an HDF5 file (.h5)",
+               example: str = "result.h5") -> Path:
+    """Check that ``path`` can become (or replace) a file: not a directory, in an existing writable directory.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The output file.
+    option : str
+        How the user named it (``--out``, ``Result.save(path)``, ``sweep(path)``), for the message.
+    what : str
+        What is allowed there, for the message.
+    example : str
+        A file name suggested when ``path`` is a directory.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    OutputError
+        ``path`` is a directory or another non-file, or its directory cannot be written.
+    OutputDirectoryMissing
+        Its directory does not exist (also a FileNotFoundError).
+    """
+    p = Path(path)
+    if str(path) == "":
+        raise OutputError(f"{option} '': an empty path; must be {what}.")
+    if p.is_dir():
+        raise OutputError(f"{option} '{p}': is a directory; must be {what}, e.g. '{p / example}'.")
+    if p.exists() and not p.is_file():
+        raise OutputError(f"{option} '{p}': exists and is not a regular file; must be {what}.")
+    parent = p.parent
+    if not parent.exists():
+        raise OutputDirectoryMissing(f"{option} '{p}': directory '{parent}' does not exist; must be {what} in an "
+                                     "existing directory.")
+    if not parent.is_dir():
+        raise OutputError(f"{option} '{p}': '{parent}' is not a directory; must be {what} in a directory.")
+    _probe(parent, option, p)
+    return p
+
+
+def check_directory(path: str | os.PathLike[str], option: str, *, files: Sequence[str] = (),
+                    create: bool = True) -> Path:
+    """Check (and create) an output directory and the files that will be written in it.
+
+    ``path`` must be a directory or not exist yet (then its nearest existing parent must be a
+    writable directory, and it is created when ``create``); each of ``files`` inside it must not
+    be a directory.
+
+    Raises
+    ------
+    OutputError
+        ``path`` is a file, cannot be created or written, or one of ``files`` is a directory.
+    """
+    p = Path(path)
+    allowed = "a directory (created if missing)"
+    if str(path) == "":
+        raise OutputError(f"{option} '': an empty path; must be {allowed}.")
+    if p.exists() and not p.is_dir():
+        raise OutputError(f"{option} '{p}': is a file; must be {allowed}.")
+    if not p.exists():
+        ancestor = p.parent
+        while not ancestor.exists() and ancestor != ancestor.parent:
+            ancestor = ancestor.parent
+        if not ancestor.is_dir():
+            raise OutputError(f"{option} '{p}': '{ancestor}' is a file; must be {allowed}.")
+        if not create:
+            _probe(ancestor, option, p)
+            return p
+        try:
+            p.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise OutputError(f"{option} '{p}': cannot create the directory ({exc.strerror or exc}); must be "
+                              f"{allowed} in a writable place.") from None
+    _probe(p, option, p)
+    for name in files:
+        target = p / name
+        if target.is_dir():
+            raise OutputError(f"{option} '{p}': '{target}' is a directory where the file {name} is written; "
+                              "remove it or choose another --out/--name.")
+    return p
+
+
+# --------------------------------------------------------------------------- Ctrl-C during a write
+
+
+@contextlib.contextmanager
+def deferred_sigint() -> Iterator[None]:
+    """Hold SIGINT back for the duration of the block; a Ctrl-C received meanwhile is raised after it.
+
+    Only the main thread can install signal handlers; elsewhere (and when SIGINT is ignored or
+    not Python's default handler's business) the block runs unshielded.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.getsignal(signal.SIGINT)
+    if previous in (signal.SIG_IGN, None):
+        yield
+        return
+    received: list[int] = []
+
+    def hold(signum: int, frame: FrameType | None) -> None:
+        received.append(signum)
+
+    signal.signal(signal.SIGINT, hold)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if received:
+        if callable(previous):
+            previous(signal.SIGINT, None)  # the default handler raises KeyboardInterrupt
+        else:
+            raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def sigint_latch() -> Iterator[list[int]]:
+    """Remember every Ctrl-C received during the block (and raise KeyboardInterrupt as usual).
+
+    Python drops a KeyboardInterrupt raised while it runs a weakref callback or a destructor (it
+    prints "Exception ignored in ..."); a loop that checks the latch between its steps stops anyway.
+    Main thread only, like every signal handler; elsewhere the latch stays empty.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield []
+        return
+    previous = signal.getsignal(signal.SIGINT)
+    if previous in (signal.SIG_IGN, None):
+        yield []
+        return
+    received: list[int] = []
+
+    def latch(signum: int, frame: FrameType | None) -> None:
+        received.append(signum)
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGINT, latch)
+    try:
+        yield received
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
+    """Write text to a temporary file beside ``path`` and rename it over ``path`` (SIGINT deferred)."""
+    p = Path(path)
+    tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
+    with deferred_sigint():
+        try:
+            tmp.write_text(text)
+            os.replace(tmp, p)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+    return p
+

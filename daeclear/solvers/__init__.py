@@ -1,0 +1,19 @@
+"""DAEModel -> Result: the IDA loop (:func:`simulate`, ida), the explicit and scipy methods (explicit)
+and the run checks (physics).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["simulate"]
+
+
+def __getattr__(name: str) -> Any:
+    """``simulate`` on first use: importing the package must not load the IDA loop, which imports
+    the assembly, which uses this package's run checks (physics)."""
+    if name == "simulate":
+        from .ida import simulate
+
+        return simulate
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

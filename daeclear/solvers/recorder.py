@@ -1,0 +1,134 @@
+"""Where a run's output goes while it runs: kept in memory, or streamed to an HDF5 file.
+
+The solvers (:mod:`daeclear.solvers.ida`, :mod:`daeclear.solvers.explicit`) hand a :class:`Recorder` their
+reported points chunk by chunk, already made consistent (multipliers, accelerations, channels),
+and their steps, events and segments. In memory the chunks are kept and joined into the
+`Result` at the end. Streamed (``stream_to``), each chunk is appended to the file and dropped,
+so the run's memory does not grow with its length, and the file holds what was computed
+whatever stops the run (see :class:`daeclear.results.result.ResultWriter`). Either way the recorder keeps
+the few rows the physics checks read (:func:`daeclear.solvers.physics.key_rows`), so a streamed run is
+checked exactly as a run kept in memory.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import physics
+from ..results.result import ContactEvent, Result, ResultWriter, load
+
+
+class Recorder:
+    """The output of one run (see the module docstring).
+
+    ``events`` and ``segments`` are the lists the solver appends to; :meth:`flush` writes the new
+    ones (streamed: and empties the lists; :attr:`n_events` counts every event of the run).
+    """
+
+    def __init__(self, model: Any, *, parameters: Mapping[str, Any], method: str,
+                 stream_to: Path | None = None, keep_data: bool = True) -> None:
+        self.model = model
+        self.keep_data = keep_data
+        self.events: list[ContactEvent] = []
+        self.segments: list[tuple[float, float, dict[str, str]]] = []
+        self._written_events = 0
+        self.interrupted = False  # a Ctrl-C arrived while finish() completed the file
+        self._header = dict(state_names=list(model.state_names), units=dict(model.channel_units),
+                            parameters=parameters, scene_name=model.scene_name, method=method,
+                            formulation=model.formulation)
+        self.writer = ResultWriter(stream_to, **self._header) if stream_to is not None else None
+        self._points: list[tuple[NDArray, NDArray, NDArray, dict[str, NDArray]]] = []
+        self._steps: list[tuple[NDArray, NDArray, NDArray]] = []
+        n = model.n_states
+        self._key: tuple[NDArray, NDArray, dict[str, NDArray]] = (np.zeros(0), np.zeros((0, n)), {})
+
+    @property
+    def n_events(self) -> int:
+        """Events of the run so far (written and pending)."""
+        return self._written_events + len(self.events)
+
+    def add_points(self, t: NDArray, y: NDArray, yp: NDArray, channels: dict[str, NDArray]) -> None:
+        """Reported points, consistent: one row per time of ``t``."""
+        if not t.size:
+            return
+        self._keep_key_rows(t, y, channels)
+        if self.writer is not None:
+            self.writer.append(t=t, y=y, yp=yp, channels=channels)
+        else:
+            self._points.append((t, y, yp, channels))
+
+    def add_steps(self, t: NDArray, h: NDArray, order: NDArray) -> None:
+        """The integrator's steps: time, size and order of each."""
+        if not t.size:
+            return
+        if self.writer is not None:
+            self.writer.append(step_t=t, step_h=h, step_order=order)
+        else:
+            self._steps.append((t, h, order))
+
+    def flush(self) -> None:
+        """Write the events and segments added since the last flush (streamed only)."""
+        if self.writer is not None and (self.events or self.segments):
+            self.writer.append(events=self.events, segments=self.segments)
+            self._written_events += len(self.events)
+            self.events.clear()
+            self.segments.clear()
+
+    def _keep_key_rows(self, t: NDArray, y: NDArray, channels: dict[str, NDArray]) -> None:
+        names = [c for c in channels if c.endswith(".penetration") or c == "constraints.position"]
+        kt, ky, kc = self._key
+        t2 = np.concatenate([kt, t])
+        y2 = np.concatenate([ky, y])
+        c2 = {c: np.concatenate([kc[c], channels[c]]) if c in kc else channels[c] for c in names}
+        rows = physics.key_rows(t2, c2)
+        self._key = (t2[rows], y2[rows], {c: v[rows] for c, v in c2.items()})
+
+    def key_rows(self) -> tuple[NDArray, NDArray, dict[str, NDArray]]:
+        """(t, y, channels) of the rows the physics checks read (:func:`daeclear.solvers.physics.key_rows`)."""
+        return self._key
+
+    def finish(self, *, stats: Mapping[str, Any], success: bool, status: int, message: str,
+               warnings: list[dict[str, Any]]) -> Result:
+        """The run's Result: in memory, the chunks joined; streamed, the file completed and read back
+        (``keep_data``) or a Result of the outcome alone (no time series, events or segments)."""
+        outcome = dict(stats=stats, success=success, status=status, message=message, warnings=warnings)
+        if self.writer is not None:
+            self.flush()
+            try:
+                path = self.writer.close(**outcome)
+            except KeyboardInterrupt:  # held back while the file was completed: it is complete
+                self.interrupted = True
+                path = self.writer.path
+            if self.keep_data:
+                return load(path)
+            n = self.model.n_states
+            header = {**self._header, "units": {s: u for s, u in self._header["units"].items()
+                                                if s in self._header["state_names"]}}
+            return Result(t=np.zeros(0), y=np.zeros((0, n)), yp=np.zeros((0, n)), channels={}, **header, **outcome)
+        n = self.model.n_states
+        names = list(self.model.channel_names)
+        if self._points:
+            t = np.concatenate([p[0] for p in self._points])
+            y = np.concatenate([p[1] for p in self._points])
+            yp = np.concatenate([p[2] for p in self._points])
+            channels = {c: np.concatenate([p[3][c] for p in self._points]) for c in self._points[0][3]}
+        else:
+            t, y, yp = np.zeros(0), np.zeros((0, n)), np.zeros((0, n))
+            channels = {c: np.zeros(0) for c in names}
+        self._points.clear()
+        steps = [np.concatenate(c) for c in zip(*self._steps)] if self._steps else [
+            np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)]
+        return Result(t=t, y=y, yp=yp, channels=channels, events=self.events, segments=self.segments,
+                      step_t=steps[0], step_h=steps[1], step_order=steps[2], **self._header, **outcome)
+
+    def abort(self, error: BaseException) -> None:
+        """After an unexpected error: a streamed file is closed with what it holds and the error as its message."""
+        if self.writer is not None:
+            try:
+                self.flush()
+            finally:
+                self.writer.abort(f"stopped by {type(error).__name__}: {error}")
