@@ -230,3 +230,15 @@ def test_public_api_unchanged():
         assert hasattr(daeclear, name), name
     assert (daeclear.DAEModel, daeclear.assemble, daeclear.Scene, daeclear.Result, daeclear.simulate,
             daeclear.sweep) == (DAEModel, assemble, Scene, Result, simulate, sweep)
+
+
+def test_every_sub_package_is_a_regular_package():
+    """A folder of modules without __init__.py would import as a namespace package and be left out
+    of the wheel (a .gitignore pattern once dropped daeclear/results/__init__.py)."""
+    root = Path(__file__).resolve().parents[1]
+    tracked = set(subprocess.run(["git", "ls-files", "daeclear"], cwd=root, capture_output=True, text=True,
+                                 check=True).stdout.split())
+    folders = {str(Path(f).parent) for f in tracked if f.endswith(".py")}
+    assert folders, "no tracked modules found"
+    missing = sorted(d for d in folders if f"{d}/__init__.py" not in tracked)
+    assert not missing, f"folders of modules without a tracked __init__.py: {missing}"

@@ -198,8 +198,8 @@ class EventList(Sequence[ContactEvent]):
 
     Examples
     --------
-    >>> onsets = result.events.of("C", kind="onset")
-    >>> onsets.t, onsets.approach_speed          # doctest: +SKIP
+    >>> onsets = result.events.of("C", kind="onset")   # doctest: +SKIP
+    >>> onsets.t, onsets.approach_speed                # doctest: +SKIP
     """
 
     __slots__ = ("_events",)
