@@ -80,7 +80,7 @@ def test_translational_slider_crank(translational, tmp_path, capsys):
                                  channel="slider.vx", magnify=20, progress=True)
     assert path.stat().st_size > 5_000
     assert _frames(path) == (8, 50)  # round(0.004 s x 100 x 20)
-    assert "frame 8/8" in capsys.readouterr().err
+    assert "animating translational.gif: 8/8 frames  100.0 %" in capsys.readouterr().err  # daeclear/progress.py
 
 
 def test_chain_and_scene_file(tmp_path):
@@ -169,7 +169,7 @@ def test_cli_animates_a_saved_result(translational, tmp_path, capsys):
     # default output: the result's name with .gif
     assert main(["animate", str(h5), "--fps", "5", "--slow-motion", "100", "--size", "320", "200"]) == 0
     assert _frames(tmp_path / "run.gif")[0] == 2
-    assert "frame 2/2" in capsys.readouterr().err
+    assert "animating run.gif: 2/2 frames  100.0 %" in capsys.readouterr().err  # daeclear/progress.py
 
 
 @pytest.mark.parametrize(

@@ -33,18 +33,20 @@ def ctrl_c_after(monkeypatch):
     import daeclear.solvers.ida as solve
 
     monkeypatch.setattr(solve, "open_session", functools.partial(solve.open_session, buffer_steps=64))
-    original = solve._Progress.update
+    from daeclear.progress import Progress
+
+    original = Progress.update
 
     def arm(n: int) -> list[int]:
         calls = [0]
 
-        def update(self, t, n_events):
+        def update(self, t, note=""):
             calls[0] += 1
             if calls[0] == n:
                 raise KeyboardInterrupt
-            return original(self, t, n_events)
+            return original(self, t, note)
 
-        monkeypatch.setattr(solve._Progress, "update", update)
+        monkeypatch.setattr(Progress, "update", update)
         return calls
 
     return arm

@@ -139,18 +139,20 @@ def fail_after(monkeypatch):
     import daeclear.solvers.ida as solve
 
     monkeypatch.setattr(solve, "open_session", functools.partial(solve.open_session, buffer_steps=64))
-    original = solve._Progress.update
+    from daeclear.progress import Progress
+
+    original = Progress.update
 
     def arm(n: int, exc: BaseException) -> None:
         calls = [0]
 
-        def update(self, t, n_events):
+        def update(self, t, note=""):
             calls[0] += 1
             if calls[0] == n:
                 raise exc
-            return original(self, t, n_events)
+            return original(self, t, note)
 
-        monkeypatch.setattr(solve._Progress, "update", update)
+        monkeypatch.setattr(Progress, "update", update)
 
     return arm
 

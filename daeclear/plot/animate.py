@@ -39,7 +39,6 @@ from __future__ import annotations
 import math
 import os
 import shutil
-import sys
 import uuid
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -52,6 +51,7 @@ from numpy.typing import NDArray
 from .. import options
 from . import style
 from ..errors import MissingDependencyError, SceneError
+from ..progress import Progress
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -395,47 +395,6 @@ def _guide_geometry(joint: _Joint, geo: _Geometry) -> dict[str, Any] | None:
     limits = [_vec(spec.get(k)) for k in ("upper_limits", "lower_limits")]
     return {"L": L, "W": W, "c": c, "t_guide": t_guide, "e_slider": e_slider,
             "limits": [lim for lim in limits if lim is not None]}
-
-
-# --------------------------------------------------------------------------- progress
-
-
-class _Progress:
-    """Frames rendered so far: tqdm when installed, else one line on stderr (only when asked)."""
-
-    def __init__(self, enabled: bool, total: int, label: str) -> None:
-        self.enabled, self.total, self.label, self.last = enabled, total, label, -1
-        self.bar: Any = None
-        if enabled:
-            try:
-                from tqdm import tqdm
-            except ImportError:
-                tqdm = None
-            if tqdm is not None:
-                self.bar = tqdm(total=total, desc=label, unit="frame", file=sys.stderr, leave=True)
-
-    def update(self, done: int) -> None:
-        if not self.enabled:
-            return
-        if self.bar is not None:
-            self.bar.update(done - self.bar.n)
-            return
-        percent = 100 * done // self.total
-        if percent != self.last or done == self.total:
-            self.last = percent
-            sys.stderr.write(f"\r  {self.label}: frame {done}/{self.total}  {percent:3d} %")
-            sys.stderr.flush()
-
-    def close(self, message: str = "") -> None:
-        if not self.enabled:
-            return
-        if self.bar is not None:
-            self.bar.close()
-        else:
-            sys.stderr.write("\n")
-        if message:
-            sys.stderr.write(message + "\n")
-        sys.stderr.flush()
 
 
 # --------------------------------------------------------------------------- the figure
@@ -859,7 +818,7 @@ def animate(result: Result, path: str | os.PathLike[str], *, fps: float = 25.0, 
         quarter of the slider width (a 1-2-5 number; 10 for Table 4.3). The panel of a
         revolute clearance joint plots the eccentricity in micrometres and needs none.
     progress : bool
-        Show the frames rendered on stderr (tqdm when installed, else one line).
+        Show the frames rendered on stderr (a tqdm bar on a terminal, else a few plain lines).
 
     Returns
     -------
@@ -975,7 +934,7 @@ def _write(fig: Figure, writer: Any, target: Path, n_frames: int, updates: Seque
     from ..results.outputs import deferred_sigint
 
     tmp = target.with_name(f".{target.stem}.{uuid.uuid4().hex[:12]}.tmp{target.suffix}")
-    bar = _Progress(show, n_frames, f"animating {target.name}")
+    bar = Progress(n_frames, unit="frames", desc=f"animating {target.name}", enabled=show)
     try:
         writer.setup(fig, str(tmp), dpi=_DPI)
         try:

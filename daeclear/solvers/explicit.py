@@ -86,7 +86,6 @@ import dataclasses
 import math
 import os
 import re
-import sys
 import time
 import warnings
 import weakref
@@ -105,6 +104,7 @@ from .. import options
 from . import physics
 from ..errors import DaeclearError, DaeclearWarning, Interrupted, SceneError, SolveError
 from .recorder import Recorder
+from ..progress import Progress
 from ..results.result import ContactEvent, Result
 from ..model.scene import Scene
 
@@ -756,7 +756,7 @@ class _Run:
         self.store_steps = store_steps
         self.max_steps = max_steps
         self.progress = progress
-        self._last_frac = -1.0
+        self.bar = Progress(t_end, unit="s", desc="simulate", enabled=progress)
         self.n = model.n_q
         self.m = model.n_constraints
         nt = len(model.terms)
@@ -943,13 +943,7 @@ class _Run:
         return True
 
     def _progress(self, t: float) -> None:
-        frac = min(1.0, t / self.t_end)
-        if frac - self._last_frac >= 0.01 or (frac >= 1.0 > self._last_frac):
-            self._last_frac = frac
-            sys.stderr.write(f"\r  t = {t:.6g} s  {100 * frac:5.1f} %  events {len(self.events)}")
-            if frac >= 1.0:
-                sys.stderr.write("\n")
-            sys.stderr.flush()
+        self.bar.update(t, f"events {len(self.events)}")
 
     # ---------------------------------------------------------------- result
     def result(self, setup_time: float, solve_time: float) -> Result:
@@ -1362,11 +1356,13 @@ def integrate(
         if run.seg is not None:
             run.seg.st, run.seg.sx, run.seg.pt, run.seg.px, run.seg.et, run.seg.ex = [], [], [], [], [], []
     except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on
+        run.bar.close()
         rec.abort(exc)
         raise
     solve_time = time.perf_counter() - tic
     if run.progress:
         run._progress(t_end if run.success else run.t_last)
+    run.bar.close()
     result = run.result(setup_time, solve_time)
     if interrupted or rec.interrupted:
         raise Interrupted(f"simulate: {result.message}; partial result in .result.", result)

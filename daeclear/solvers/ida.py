@@ -13,7 +13,6 @@ import itertools
 import logging
 import math
 import os
-import sys
 import time
 from typing import Any, Sequence
 
@@ -26,6 +25,7 @@ from ..assembly.assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
 from ..errors import Interrupted, SceneError, SolveError
 from ..engine.ida_session import open_session
 from .recorder import Recorder
+from ..progress import Progress
 from ..results.result import Result
 from ..model.scene import Scene
 
@@ -87,24 +87,6 @@ def tolerance_vector(model: DAEModel, rtol: float, atol: float | ArrayLike | Non
     vec[kinds == KIND_MULTIPLIER] = max(MULTIPLIER_ATOL_FACTOR * rtol, MULTIPLIER_ATOL_FLOOR)
     vec[kinds == KIND_WORK] = 1e30  # a pure quadrature: out of the error test, the solution is unchanged
     return vec
-
-
-class _Progress:
-    """A one-line progress display on stderr for long runs (only when asked for)."""
-
-    def __init__(self, enabled: bool, t_end: float) -> None:
-        self.enabled, self.t_end, self.last = enabled, t_end, -1.0
-
-    def update(self, t: float, n_events: int) -> None:
-        if not self.enabled:
-            return
-        frac = min(1.0, t / self.t_end) if self.t_end > 0 else 1.0
-        if frac - self.last >= 0.01 or frac >= 1.0:
-            self.last = frac
-            sys.stderr.write(f"\r  t = {t:.6g} s  {100 * frac:5.1f} %  events {n_events}")
-            if frac >= 1.0:
-                sys.stderr.write("\n")
-            sys.stderr.flush()
 
 
 def simulate(
@@ -271,7 +253,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     times, each segment), so a run that streams to a file and keeps no steps runs in bounded memory.
     """
     run_start = time.perf_counter()
-    progress_line = _Progress(progress, t_end)
+    progress_line = Progress(t_end, unit="s", desc="simulate", enabled=progress)
     n_terms = len(model.terms)
     active = [False] * n_terms
     params = [np.zeros(term.n_params) for term in model.terms]
@@ -382,9 +364,9 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
                 raise KeyboardInterrupt
             if adv.status == "chunk":  # a buffer of the compiled loop is full: hand it over, go on
                 flush()
-                progress_line.update(t, rec.n_events)
+                progress_line.update(t, f"events {rec.n_events}")
                 continue
-            progress_line.update(t, rec.n_events)
+            progress_line.update(t, f"events {rec.n_events}")
             if adv.status == "error":
                 segments.append((seg_start, t, dict(modes)))
                 seg_start = math.nan
@@ -422,6 +404,7 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         message = (f"out of memory at t={t:.6g} s. Report fewer points (t_eval_step), keep no steps "
                    "(store_steps=False) and stream the run to a file (stream_to).")
     except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on
+        progress_line.close()
         rec.abort(exc)
         session.close()
         raise
@@ -435,7 +418,8 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         except BaseException as exc:
             rec.abort(exc)
             raise
-        progress_line.update(t_end if success else t, rec.n_events)
+        progress_line.update(t_end if success else t, f"events {rec.n_events}")
+        progress_line.close()
         stats.update(n_events=rec.n_events, n_restarts=n_restarts, setup_time=setup_time,
                      wall_time=setup_time + time.perf_counter() - run_start,
                      output_time=time.perf_counter() - post_start)

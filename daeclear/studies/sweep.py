@@ -73,6 +73,7 @@ import numpy as np
 
 from .analysis import CHANNELS, PhasePortrait, PoincareSection, section_channels
 from ..errors import DaeclearError, DaeclearWarning, OutputError, SceneError
+from ..progress import Progress
 from ..results.outputs import check_file, deferred_sigint, sigint_latch
 
 if TYPE_CHECKING:
@@ -776,41 +777,6 @@ def _acquire_lock(path: Path, meta: Mapping[str, Any]) -> Path:
     raise DaeclearError(f"sweep '{path}': cannot take the lock file '{lock}'.")
 
 
-def _clock(seconds: float) -> str:
-    seconds = int(round(seconds))
-    return f"{seconds // 3600}:{seconds // 60 % 60:02d}:{seconds % 60:02d}"
-
-
-class _ProgressLine:
-    """One progress line on stderr: rewritten in place on a terminal, one line per update otherwise."""
-
-    def __init__(self, enabled: bool, total: int, skipped: int, stream: Any = None) -> None:
-        self.enabled, self.total, self.skipped = enabled, total, skipped
-        self.stream = stream or sys.stderr
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.start = time.perf_counter()
-        self.last_write = 0.0
-
-    def update(self, done: int, failed: int, last: str = "", final: bool = False) -> None:
-        if not self.enabled:
-            return
-        now = time.perf_counter()
-        if not (final or self.tty or now - self.last_write >= 2.0 or done == 0):
-            return
-        self.last_write = now
-        todo = self.total - self.skipped
-        elapsed = now - self.start
-        eta = f", ~{_clock(elapsed / done * (todo - done))} left" if 0 < done < todo else ""
-        text = (f"sweep: {done}/{todo} runs" + (f" ({failed} failed)" if failed else "")
-                + (f", {self.skipped} already done" if self.skipped else "")
-                + f" | {_clock(elapsed)} elapsed{eta}" + (f" | {last}" if last else ""))
-        if self.tty:
-            self.stream.write("\r" + text[:150].ljust(150) + ("\n" if final else ""))
-        else:
-            self.stream.write(text + "\n")
-        self.stream.flush()
-
-
 # --------------------------------------------------------------------------- the sweep
 
 
@@ -1005,10 +971,15 @@ def _execute(path: Path, todo: list[dict[str, Any]], executor: cf.Executor | Non
              progress: bool, total: int, skipped: int, varying: Sequence[str],
              on_run: Callable[[RunRecord], None] | None, mechanism: str, options: Mapping[str, Any]) -> int:
     """Submit the runs, save each as it finishes; returns the number saved."""
-    line = _ProgressLine(progress, total, skipped)
-    line.update(0, 0)
+    line = Progress(total - skipped, unit="runs", desc="sweep", enabled=progress)
+
+    def note(failed: int, last: str = "") -> str:
+        return " | ".join(part for part in (f"{failed} failed" if failed else "",
+                                            f"{skipped} already done" if skipped else "", last) if part)
+
+    line.update(0, note(0))
     if not todo:
-        line.update(0, 0, "nothing to do", final=True)
+        line.close(note(0, "nothing to do"))
         return 0
     own = executor is None
     if own:  # the platform's start method: fork on Linux (scripts need no __main__ guard), spawn elsewhere
@@ -1045,7 +1016,7 @@ def _execute(path: Path, todo: list[dict[str, Any]], executor: cf.Executor | Non
                 failed += outcome["status"] == "failed"
                 data = outcome.get("data") or {}
                 label = data.get("motion", {}).get("label", "FAILED") if outcome["status"] == "done" else "FAILED"
-                line.update(done, failed, f"{_short(outcome['parameters'], varying)} -> {label}")
+                line.update(done, note(failed, f"{_short(outcome['parameters'], varying)} -> {label}"))
                 if on_run is not None:
                     import h5py
 
@@ -1054,8 +1025,9 @@ def _execute(path: Path, todo: list[dict[str, Any]], executor: cf.Executor | Non
                     on_run(record)
             if interrupted:
                 raise KeyboardInterrupt
-            line.update(done, failed, final=True)
+            line.close()
         except BaseException:
+            line.close()
             for future in futures:
                 future.cancel()
             if own:
