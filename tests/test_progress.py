@@ -149,3 +149,23 @@ def test_cli_run_quiet_prints_no_progress(tmp_path, capsys):
     assert "simulate:" in capsys.readouterr().err
     assert main(args + ["--out", str(tmp_path / "quiet"), "--quiet"]) == 0
     assert "simulate:" not in capsys.readouterr().err
+
+
+def test_a_sweep_shows_done_failed_already_done_and_the_last_label(tmp_path, capsys):
+    from daeclear.studies.sweep import sweep
+
+    path = tmp_path / "clearance.h5"
+    fast = dict(revolutions=8, transient=2, per_revolution=16, twin=False, max_workers=1, fixed={"joint": "revolute"})
+    out = sweep(path, {"clearance": [0.01e-3, 0.5e-3]}, progress=True, **fast)
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0].startswith("  sweep: 0/2 runs    0.0 %")
+    assert lines[-1].startswith("  sweep: 2/2 runs  100.0 %")
+    assert re.search(r"\| clearance=(1e-05|0\.0005) -> ([\w-]+)$", lines[-1]).group(2) in {r.motion for r in out.runs}
+    # again, with one more point: the finished runs are skipped and said so
+    sweep(path, {"clearance": [0.01e-3, 0.5e-3, 0.02e-3]}, progress=True, **fast)
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[-1].startswith("  sweep: 1/1 runs  100.0 %") and "| 2 already done | clearance=2e-05 -> " in lines[-1]
+    sweep(path, {"clearance": [0.01e-3, 0.5e-3, 0.02e-3]}, progress=True, **fast)
+    assert capsys.readouterr().err.splitlines()[-1].endswith("| 3 already done | nothing to do")
+    sweep(path, {"clearance": [0.01e-3, 0.5e-3, 0.02e-3]}, progress=False, **fast)
+    assert capsys.readouterr().err == ""
