@@ -169,3 +169,17 @@ def test_a_sweep_shows_done_failed_already_done_and_the_last_label(tmp_path, cap
     assert capsys.readouterr().err.splitlines()[-1].endswith("| 3 already done | nothing to do")
     sweep(path, {"clearance": [0.01e-3, 0.5e-3, 0.02e-3]}, progress=False, **fast)
     assert capsys.readouterr().err == ""
+
+
+def test_a_work_precision_study_names_each_run_as_it_starts(capsys):
+    from daeclear.studies.accuracy import work_precision
+
+    study = work_precision(dc.mechanisms.slider_crank("ideal"), 0.002, methods={"ida": {"method": "ida"},
+                           "rk4": {"method": "rk4"}}, rtols=[1e-5], steps=[1e-5], repeats=0, progress=True)
+    assert [r["label"] for r in study.rows] == ["ida", "rk4"]
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert lines == [lines[0], lines[1], lines[2]] and "work-precision" not in captured.out
+    assert lines[0].startswith("  work-precision: 0/2 runs    0.0 %") and lines[0].endswith("| ida rtol=1e-05 ...")
+    assert lines[1].startswith("  work-precision: 1/2 runs   50.0 %") and lines[1].endswith("| rk4 step=1e-05 ...")
+    assert lines[2].startswith("  work-precision: 2/2 runs  100.0 %")

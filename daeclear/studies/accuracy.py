@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 from ..assembly.assemble import DAEModel, assemble
 from .. import options
 from ..errors import Interrupted, SceneError
+from ..progress import Progress
 from ..results.outputs import atomic_write_text, check_file
 from ..results.result import Result
 from ..model.scene import Scene
@@ -291,6 +292,22 @@ def _measure(rows: list[dict[str, Any]], scene_for_ref: Scene | DAEModel, ref: R
              t_eval: NDArray, channels: Sequence[str], window: tuple[float, float], repeats: int,
              progress: bool) -> None:
     """The timed runs of every method and tolerance, appended to ``rows`` as each finishes."""
+    total = sum(len(steps if str(m.get("method", "ida")).lower() in FIXED_STEP_METHODS else rtols)
+                for m in methods.values())
+    bar = Progress(total, unit="runs", desc="work-precision", enabled=progress)
+    try:
+        _measure_all(rows, scene_for_ref, ref, methods, rtols, steps, t_end, t_eval, channels, window, repeats, bar)
+        bar.update(total, "")
+    finally:
+        bar.close()
+
+
+def _measure_all(rows: list[dict[str, Any]], scene_for_ref: Scene | DAEModel, ref: Result,
+                 methods: Mapping[str, Mapping[str, Any]], rtols: Sequence[float], steps: Sequence[float],
+                 t_end: float, t_eval: NDArray, channels: Sequence[str], window: tuple[float, float], repeats: int,
+                 bar: Progress) -> None:
+    """The loop of :func:`_measure`, reporting each run to ``bar`` as it starts."""
+    done = 0
     for label, method_options in methods.items():
         method = str(method_options.get("method", "ida")).lower()
         fixed = method in FIXED_STEP_METHODS
@@ -298,8 +315,8 @@ def _measure(rows: list[dict[str, Any]], scene_for_ref: Scene | DAEModel, ref: R
         for value in values:
             opts = {k: v for k, v in method_options.items() if k not in ("rtol", "step")}
             opts["step" if fixed else "rtol"] = value
-            if progress:
-                print(f"  {label} {'step' if fixed else 'rtol'}={value:g} ...", flush=True)
+            bar.update(done, f"{label} {'step' if fixed else 'rtol'}={value:g} ...")
+            done += 1
             try:
                 result, wall = _timed(scene_for_ref, t_end, t_eval, opts, repeats)
             except Exception as exc:  # a run that cannot even start stays in the table

@@ -20,6 +20,7 @@ import numpy as np
 from .. import contact
 from .accuracy import energy_balance
 from ..errors import DaeclearError
+from ..progress import Progress
 from ..model.mechanisms import STEEL, slider_crank
 from ..model.scene import Body, RevoluteClearance, Scene
 from ..solvers.ida import simulate
@@ -129,10 +130,14 @@ def run_case(case: Case, rtol: float = 1e-6, n_eval: int = 20001) -> dict[str, A
 def run_suite(cases: tuple[Case, ...] = CASES, rtol: float = 1e-6, progress: bool = False) -> list[dict[str, Any]]:
     """Run every case (see :data:`CASES`)."""
     rows = []
-    for case in cases:
-        if progress:
-            print(f"  {case.name} ...", flush=True)
-        rows.append(run_case(case, rtol))
+    bar = Progress(len(cases), unit="cases", desc="stability", enabled=progress)
+    try:
+        for case in cases:
+            bar.update(len(rows), f"{case.name} ...")
+            rows.append(run_case(case, rtol))
+        bar.update(len(rows), "")
+    finally:
+        bar.close()
     return rows
 
 
