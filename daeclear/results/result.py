@@ -48,7 +48,6 @@ arrays stay contiguous and uncompressed (gzip would save ~20% at ~8x the time).
 
 from __future__ import annotations
 
-import difflib
 import json
 import math
 import os
@@ -64,6 +63,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import DaeclearError, DaeclearWarning, MissingDependencyError
+from ..options import close_matches
 
 if TYPE_CHECKING:  # h5py, pandas and xarray are imported lazily, only where they are used
     import h5py
@@ -968,7 +968,7 @@ class Result:
         with deferred_sigint():  # a Ctrl-C during the write arrives once the file is complete
             try:
                 with h5py.File(tmp, "x") as f:
-                    _write(f, self)
+                    write_result_group(f, self)
                 with open(tmp, "rb+") as fh:  # data on disk before the rename makes it visible
                     os.fsync(fh.fileno())
                 os.replace(tmp, path)
@@ -989,18 +989,6 @@ def _optional(module: str, what: str) -> Any:
             f"{what} needs {module}, which is not installed. Install daeclear's data extra: "
             f'pip install "daeclear[data]" (or pip install {module}).'
         ) from exc
-
-
-def close_matches(name: str, candidates: Iterable[str], n: int = 5) -> list[str]:
-    """Up to `n` candidates similar to `name`, best first, ties in alphabetical order."""
-    matcher = difflib.SequenceMatcher(b=name)
-    scored = []
-    for c in candidates:
-        matcher.set_seq1(c)
-        ratio = matcher.ratio()
-        if ratio >= 0.6:
-            scored.append((-ratio, c))
-    return [c for _, c in sorted(scored)[:n]]
 
 
 def _window(t0: float | None, t1: float | None) -> tuple[float, float]:
@@ -1074,7 +1062,10 @@ def _mirror(group: h5py.Group, tree: Mapping[str, Any]) -> None:
             continue  # an int beyond 64 bits: JSON only
 
 
-def _write(f: h5py.File, r: Result) -> None:
+def write_result_group(f: h5py.File | h5py.Group, r: Result) -> None:
+    """Write ``r`` in the layout of a result file (:meth:`Result.save`) into an open HDF5 file or
+    group; a sweep keeps its full reference runs inside its own file this way
+    (:func:`read_result_group` reads them back)."""
     f.attrs["format"] = FORMAT_NAME
     f.attrs["version"] = FORMAT_VERSION
     f.attrs["scene_name"] = r.scene_name
@@ -1479,3 +1470,29 @@ def _read(r: _Reader) -> Result:
         warnings=r.json("warnings_json") if r.has("warnings_json") else [],  # older files: no warnings
         **steps,
     )
+
+
+class _GroupAsFile:
+    """Lets the reader read a Result stored inside a group (absolute names become relative)."""
+
+    def __init__(self, group: h5py.Group) -> None:
+        self._group = group
+
+    def _name(self, name: str) -> str:
+        return name.lstrip("/") or "."
+
+    def __getitem__(self, name: str) -> Any:
+        return self._group[self._name(name)]
+
+    def __contains__(self, name: str) -> bool:
+        return self._name(name) in self._group
+
+    @property
+    def attrs(self) -> Any:
+        return self._group.attrs
+
+
+def read_result_group(group: h5py.Group, path: Path) -> Result:
+    """The Result that :func:`write_result_group` wrote into ``group``, an open group of the file at
+    ``path`` (named in the messages about a damaged result)."""
+    return _read(_Reader(_GroupAsFile(group), path))  # type: ignore[arg-type]
