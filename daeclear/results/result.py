@@ -968,7 +968,7 @@ class Result:
         with deferred_sigint():  # a Ctrl-C during the write arrives once the file is complete
             try:
                 with h5py.File(tmp, "x") as f:
-                    write_result_group(f, self)
+                    _write(f, self)
                 with open(tmp, "rb+") as fh:  # data on disk before the rename makes it visible
                     os.fsync(fh.fileno())
                 os.replace(tmp, path)
@@ -1062,10 +1062,8 @@ def _mirror(group: h5py.Group, tree: Mapping[str, Any]) -> None:
             continue  # an int beyond 64 bits: JSON only
 
 
-def write_result_group(f: h5py.File | h5py.Group, r: Result) -> None:
-    """Write ``r`` in the layout of a result file (:meth:`Result.save`) into an open HDF5 file or
-    group; a sweep keeps its full reference runs inside its own file this way
-    (:func:`read_result_group` reads them back)."""
+def _write(f: h5py.File | h5py.Group, r: Result) -> None:
+    """Write ``r`` in the layout of a result file into an open HDF5 file or group."""
     f.attrs["format"] = FORMAT_NAME
     f.attrs["version"] = FORMAT_VERSION
     f.attrs["scene_name"] = r.scene_name
@@ -1470,6 +1468,13 @@ def _read(r: _Reader) -> Result:
         warnings=r.json("warnings_json") if r.has("warnings_json") else [],  # older files: no warnings
         **steps,
     )
+
+
+def write_result_group(group: h5py.Group, r: Result) -> None:
+    """Write ``r`` in the layout of a result file (:meth:`Result.save`) into ``group``, an open group
+    of another HDF5 file: a sweep keeps its full reference runs inside its own file this way
+    (:func:`read_result_group` reads them back)."""
+    _write(group, r)
 
 
 class _GroupAsFile:
