@@ -10,10 +10,11 @@ an error, never "use the default".
 
 from __future__ import annotations
 
+import difflib
 import math
 import os
 from pathlib import Path
-from typing import Any, NamedTuple, NoReturn, Sequence
+from typing import Any, Iterable, NamedTuple, NoReturn, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -50,6 +51,19 @@ def fail(where: str, field: str, value: Any, rule: str, unit: str = "", *, shown
     shown = shown if shown is not None else repr(value)
     shown = f"{shown} {unit}" if unit else shown
     raise SceneError(f"{where}: {field}={shown}, must be {rule}.")
+
+
+def close_matches(name: str, candidates: Iterable[str], n: int = 5) -> list[str]:
+    """Up to `n` candidates similar to `name`, best first, ties in alphabetical order: the "close
+    matches" hint of a message about an unknown name (a channel, a state, a unit's channel)."""
+    matcher = difflib.SequenceMatcher(b=name)
+    scored = []
+    for c in candidates:
+        matcher.set_seq1(c)
+        ratio = matcher.ratio()
+        if ratio >= 0.6:
+            scored.append((-ratio, c))
+    return [c for _, c in sorted(scored)[:n]]
 
 
 def _real(value: Any) -> bool:

@@ -6,8 +6,8 @@ untangle), except those under ``if TYPE_CHECKING:``, which never run. ``from pac
 is an edge to the module ``package.name`` when there is one, else to the package. Old module paths
 (``daeclear.old_paths``) are edges to the module they stand for.
 
-What the sub-packages still have (phase 2 of issue 13 removes it) is listed below: a circle or a
-private import that is not listed fails now; the strict xfail tests fail once the lists can shrink.
+The lists of what is still to be untangled are empty since phase 2 of issue 13: any import circle
+or private import across modules fails.
 """
 
 from __future__ import annotations
@@ -25,25 +25,10 @@ from daeclear.old_paths import OLD_PATHS
 
 PACKAGE = Path(daeclear.__file__).resolve().parent
 
-#: Import edges inside circles (importer, imported), still there after the move.
-KNOWN_CIRCLE_EDGES = {
-    # the IDA loop hands the other methods over lazily; they take its tolerance rule (tolerance_vector) back
-    ("daeclear.solvers.ida", "daeclear.solvers.explicit"),
-    ("daeclear.solvers.explicit", "daeclear.solvers.ida"),
-    # a joint's reading (lazy in scene) takes the slider's dimensions and the slider-crank from mechanisms
-    ("daeclear.model.scene", "daeclear.model.readings"),
-    ("daeclear.model.readings", "daeclear.model.mechanisms"),
-    ("daeclear.model.mechanisms", "daeclear.model.scene"),
-    # Result.animate (lazy) and the animation's use of results.result.close_matches (lazy)
-    ("daeclear.results.result", "daeclear.plot.animate"),
-    ("daeclear.plot.animate", "daeclear.results.result"),
-}
-#: Private names imported from another module (importer, module, name).
-KNOWN_PRIVATE_IMPORTS = {
-    ("daeclear.studies.sweep", "daeclear.results.result", "_write"),
-    ("daeclear.studies.sweep", "daeclear.results.result", "_read"),
-    ("daeclear.studies.sweep", "daeclear.results.result", "_Reader"),
-}
+#: Import edges inside circles (importer, imported) still to be untangled: none since phase 2.
+KNOWN_CIRCLE_EDGES: set[tuple[str, str]] = set()
+#: Private names imported from another module (importer, module, name) still to be untangled: none.
+KNOWN_PRIVATE_IMPORTS: set[tuple[str, str, str]] = set()
 
 
 def module_name(path: Path) -> str:
@@ -150,9 +135,9 @@ def private_imports() -> set[tuple[str, str, str]]:
 
 
 def test_the_import_reader_sees_lazy_imports_and_skips_type_checking():
-    """The reader itself: scene imports readings inside a method; style's Result import is typing only."""
+    """The reader itself: scene imports joint_readings inside a method; style's Result import is typing only."""
     edges = {(a, b) for a, b, _ in imports()}
-    assert ("daeclear.model.scene", "daeclear.model.readings") in edges
+    assert ("daeclear.model.scene", "daeclear.model.joint_readings") in edges
     assert ("daeclear.plot.style", "daeclear.results.result") not in edges
     assert ("daeclear", "daeclear.studies.sweep") in edges
 
@@ -161,9 +146,6 @@ def test_no_circles_beyond_the_known_ones():
     assert circle_edges() <= KNOWN_CIRCLE_EDGES
 
 
-@pytest.mark.xfail(strict=True, reason="phase 2 of issue 13: the circles of KNOWN_CIRCLE_EDGES (solvers.ida <-> "
-                                       "solvers.explicit, model.scene -> readings -> mechanisms -> scene, "
-                                       "results.result <-> plot.animate)")
 def test_no_import_circles():
     assert circle_edges() == set()
 
@@ -172,8 +154,6 @@ def test_no_private_imports_beyond_the_known_ones():
     assert private_imports() <= KNOWN_PRIVATE_IMPORTS
 
 
-@pytest.mark.xfail(strict=True, reason="phase 2 of issue 13: sweep reads and writes a Result through "
-                                       "results.result's _write, _read and _Reader")
 def test_no_private_imports_across_modules():
     assert private_imports() == set()
 

@@ -748,7 +748,7 @@ class TranslationalClearance(_PointJoint):
     @property
     def contact_model(self) -> str:
         """The contact model in use: the reading's, else ``model``."""
-        from .readings import joint_reading
+        from .joint_readings import joint_reading
 
         return self.model if self.reading is None else joint_reading(self.reading).model
 
@@ -777,7 +777,7 @@ class TranslationalClearance(_PointJoint):
 
         law = normal_law(self.law) if isinstance(self.law, str) else self.law
         if self.reading is not None:
-            from . import readings
+            from . import joint_readings as readings
 
             return readings.corner_law(readings.joint_reading(self.reading), law, owner=f"{self.kind} '{self.name}'",
                                        corner_radius=self.corner_radius, face_half_width=self.face_half_width,
@@ -792,7 +792,7 @@ class TranslationalClearance(_PointJoint):
         from ..contact import normal_law
 
         if self.reading is not None:
-            from . import readings
+            from . import joint_readings as readings
 
             return readings.face_law(readings.joint_reading(self.reading),
                                      normal_law(self.law) if isinstance(self.law, str) else self.law,
@@ -851,7 +851,7 @@ class TranslationalClearance(_PointJoint):
 
 def _reading_problems(element: TranslationalClearance) -> list[str]:
     """A reading must be known, and ``model`` and ``face_law`` left to it."""
-    from .readings import joint_reading
+    from .joint_readings import joint_reading
 
     if element.reading is None:
         return []

@@ -342,11 +342,9 @@ def _default_channel(result: Result, geo: _Geometry, clearance: Sequence[_Joint]
 
 
 def _check_channel(result: Result, channel: Any, f: _Fields) -> str:
-    from ..results.result import close_matches
-
     if not isinstance(channel, str) or channel not in result:
         names = sorted(set(result.channel_names) | set(result.state_names))
-        close = close_matches(str(channel), names, n=3) if isinstance(channel, str) else []
+        close = options.close_matches(str(channel), names, n=3) if isinstance(channel, str) else []
         hint = f" (close: {', '.join(close)})" if close else ""
         options.fail(f.where, f.channel, channel, f"a channel of the result{hint}, e.g. {names[0]!r}"
                      if names else "a channel of the result")

@@ -48,7 +48,6 @@ arrays stay contiguous and uncompressed (gzip would save ~20% at ~8x the time).
 
 from __future__ import annotations
 
-import difflib
 import json
 import math
 import os
@@ -64,6 +63,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import DaeclearError, DaeclearWarning, MissingDependencyError
+from ..options import close_matches
 
 if TYPE_CHECKING:  # h5py, pandas and xarray are imported lazily, only where they are used
     import h5py
@@ -991,18 +991,6 @@ def _optional(module: str, what: str) -> Any:
         ) from exc
 
 
-def close_matches(name: str, candidates: Iterable[str], n: int = 5) -> list[str]:
-    """Up to `n` candidates similar to `name`, best first, ties in alphabetical order."""
-    matcher = difflib.SequenceMatcher(b=name)
-    scored = []
-    for c in candidates:
-        matcher.set_seq1(c)
-        ratio = matcher.ratio()
-        if ratio >= 0.6:
-            scored.append((-ratio, c))
-    return [c for _, c in sorted(scored)[:n]]
-
-
 def _window(t0: float | None, t1: float | None) -> tuple[float, float]:
     lo = -math.inf if t0 is None else float(t0)
     hi = math.inf if t1 is None else float(t1)
@@ -1074,7 +1062,8 @@ def _mirror(group: h5py.Group, tree: Mapping[str, Any]) -> None:
             continue  # an int beyond 64 bits: JSON only
 
 
-def _write(f: h5py.File, r: Result) -> None:
+def _write(f: h5py.File | h5py.Group, r: Result) -> None:
+    """Write ``r`` in the layout of a result file into an open HDF5 file or group."""
     f.attrs["format"] = FORMAT_NAME
     f.attrs["version"] = FORMAT_VERSION
     f.attrs["scene_name"] = r.scene_name
@@ -1479,3 +1468,36 @@ def _read(r: _Reader) -> Result:
         warnings=r.json("warnings_json") if r.has("warnings_json") else [],  # older files: no warnings
         **steps,
     )
+
+
+def write_result_group(group: h5py.Group, r: Result) -> None:
+    """Write ``r`` in the layout of a result file (:meth:`Result.save`) into ``group``, an open group
+    of another HDF5 file: a sweep keeps its full reference runs inside its own file this way
+    (:func:`read_result_group` reads them back)."""
+    _write(group, r)
+
+
+class _GroupAsFile:
+    """Lets the reader read a Result stored inside a group (absolute names become relative)."""
+
+    def __init__(self, group: h5py.Group) -> None:
+        self._group = group
+
+    def _name(self, name: str) -> str:
+        return name.lstrip("/") or "."
+
+    def __getitem__(self, name: str) -> Any:
+        return self._group[self._name(name)]
+
+    def __contains__(self, name: str) -> bool:
+        return self._name(name) in self._group
+
+    @property
+    def attrs(self) -> Any:
+        return self._group.attrs
+
+
+def read_result_group(group: h5py.Group, path: Path) -> Result:
+    """The Result that :func:`write_result_group` wrote into ``group``, an open group of the file at
+    ``path`` (named in the messages about a damaged result)."""
+    return _read(_Reader(_GroupAsFile(group), path))  # type: ignore[arg-type]

@@ -105,6 +105,7 @@ from . import physics
 from ..errors import DaeclearError, DaeclearWarning, Interrupted, SceneError, SolveError
 from .recorder import Recorder
 from ..progress import Progress
+from .tolerances import tolerance_vector
 from ..results.result import ContactEvent, Result
 from ..model.scene import Scene
 
@@ -1248,14 +1249,6 @@ def _run_fixed(run: _Run, x0: NDArray, step: float) -> None:
         t, x, _ = restart  # the next segment starts at the event
 
 
-def _positive(name: str, value: Any, unit: str, allow_zero: bool = False) -> float:
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-    ok = ok and (value >= 0 if allow_zero else value > 0)
-    if not ok:
-        raise SceneError(f"simulate: {name}={value!r} {unit}, must be a finite number {'>= 0' if allow_zero else '> 0'}.")
-    return float(value)
-
-
 def integrate(
     scene: Scene | DAEModel,
     t_end: float,
@@ -1292,8 +1285,6 @@ def integrate(
     the scipy methods' steps (0: unbounded); ``backend`` "c" (generated C), "python"
     (FunctionBuffer) or "auto". See the module docstring for events, outputs and failures.
     """
-    from .ida import tolerance_vector  # solve imports this module lazily
-
     method_l = str(method).lower()
     if method_l not in METHOD_NAMES:
         valid = ", ".join(["ida", *METHOD_NAMES.values()])

@@ -21,11 +21,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import options
 from . import physics
-from ..assembly.assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel, assemble
-from ..errors import Interrupted, SceneError, SolveError
+from ..assembly.assemble import DAEModel, assemble
+from ..errors import Interrupted, SolveError
 from ..engine.ida_session import open_session
 from .recorder import Recorder
 from ..progress import Progress
+from .tolerances import tolerance_vector
 from ..results.result import Result
 from ..model.scene import Scene
 
@@ -33,15 +34,6 @@ log = logging.getLogger("daeclear")
 
 METHODS: tuple[str, ...] = options.METHODS
 ON_FAILURE: tuple[str, ...] = options.ON_FAILURE
-# Multipliers are kept out of IDA's error test by a huge absolute tolerance (scikit-sundae has
-# no IDASetSuppressAlg): atol = MULTIPLIER_ATOL_FACTOR * rtol, see docs/performance.md.
-MULTIPLIER_ATOL_FACTOR = 1e12
-# ... and never below this floor (N or N m): at rtol 1e-11, 1e12 * rtol = 10 N would put impact
-# multipliers of 1e3..1e5 N back into the error test, which breaks the index-2 GGL runs.
-MULTIPLIER_ATOL_FLOOR = 1e4
-# Default absolute tolerance of positions and velocities, relative to rtol: contact runs resolve
-# micrometre penetrations, so positions need an absolute floor well below the clearance.
-DEFAULT_ATOL_FACTOR = 1e-3
 # Constraint drift (largest |Phi| of a run) above this fraction of the smallest clearance is warned of.
 DRIFT_FRACTION = physics.DRIFT_FRACTION
 # GGL holds Phi = 0 only as tightly as IDA's Newton test (safety factor 0.33 by default). 1e-3
@@ -58,35 +50,6 @@ STICKING_FLAGS = ("DC_STEP_COLLAPSE", "IDA_CONV_FAIL", "IDA_ERR_FAIL")
 # ordinary contact steps a stall. 2.4e-12 s is what it was for the chapter's 0.024 s runs.
 STALL_STEP = 2.4e-12
 STALL_COUNT = 2000
-
-
-def _positive(name: str, value: Any, unit: str, allow_zero: bool = False) -> float:
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-    ok = ok and (value >= 0 if allow_zero else value > 0)
-    if not ok:
-        rule = ">= 0" if allow_zero else "> 0"
-        raise SceneError(f"simulate: {name}={value!r} {unit}, must be a finite number {rule}.")
-    return float(value)
-
-
-def tolerance_vector(model: DAEModel, rtol: float, atol: float | ArrayLike | None) -> NDArray[np.float64]:
-    """Absolute tolerances per state: q and v from ``atol``; multipliers out of the error test."""
-    kinds = np.array(model.state_kinds)
-    if atol is None:
-        vec = np.full(model.n_states, DEFAULT_ATOL_FACTOR * rtol)
-    elif np.ndim(atol) == 0:
-        vec = np.full(model.n_states, _positive("atol", float(atol), ""))  # type: ignore[arg-type]
-    else:
-        vec = np.asarray(atol, dtype=float).copy()
-        if vec.shape != (model.n_states,) or not np.all(np.isfinite(vec)) or np.any(vec <= 0):
-            raise SceneError(
-                f"simulate: atol has shape {vec.shape}; give a positive number or {model.n_states} "
-                f"positive values (one per state: {', '.join(model.state_names[:4])}, ...)."
-            )
-        return vec
-    vec[kinds == KIND_MULTIPLIER] = max(MULTIPLIER_ATOL_FACTOR * rtol, MULTIPLIER_ATOL_FLOOR)
-    vec[kinds == KIND_WORK] = 1e30  # a pure quadrature: out of the error test, the solution is unchanged
-    return vec
 
 
 def simulate(

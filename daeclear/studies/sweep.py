@@ -351,9 +351,9 @@ def _write_run(group: h5py.Group, outcome: Mapping[str, Any], mechanism: str, op
             ds = channels.create_dataset(name, data=values)
             ds.attrs["units"] = "s" if name == "t" else data["units"].get(name, "")
     if "result" in data:
-        from ..results.result import _write  # the Result's own layout, inside this group
+        from ..results.result import write_result_group  # the Result's own layout, inside this group
 
-        _write(group.create_group("result"), data["result"])
+        write_result_group(group.create_group("result"), data["result"])
 
 
 def _write_part(parts: Path, outcome: Mapping[str, Any], mechanism: str, options: Mapping[str, Any]) -> Path:
@@ -470,26 +470,6 @@ def _same(a: Any, b: Any) -> bool:
     if isinstance(a, float) and isinstance(b, (int, float)) and not isinstance(b, bool):
         return math.isclose(a, float(b), rel_tol=1e-12)
     return bool(a == b)
-
-
-class _GroupAsFile:
-    """Lets daeclear.results.result's reader read a Result stored inside a group (absolute names become relative)."""
-
-    def __init__(self, group: h5py.Group) -> None:
-        self._group = group
-
-    def _name(self, name: str) -> str:
-        return name.lstrip("/") or "."
-
-    def __getitem__(self, name: str) -> Any:
-        return self._group[self._name(name)]
-
-    def __contains__(self, name: str) -> bool:
-        return self._name(name) in self._group
-
-    @property
-    def attrs(self) -> Any:
-        return self._group.attrs
 
 
 def _check_format(f: h5py.File, path: Path) -> None:
@@ -638,7 +618,7 @@ class SweepResult:
 
     def result(self, run: RunRecord | str | int) -> Result:
         """The full reference run (sweeps with ``keep="full"``)."""
-        from ..results.result import _read, _Reader
+        from ..results.result import read_result_group
 
         record = self._record(run)
         f, where = self._open(record)
@@ -647,7 +627,7 @@ class SweepResult:
             if "result" not in g:
                 raise DaeclearError(f"run {record.key}: no full result stored (sweep keep="
                                     f"{self.options.get('keep')!r}; use keep='full').")
-            return _read(_Reader(_GroupAsFile(g["result"]), self.path))  # type: ignore[arg-type]
+            return read_result_group(g["result"], self.path)
 
     def bifurcation_data(self, parameter: str, channel: str | int = 0) -> tuple[np.ndarray, np.ndarray, list[str]]:
         """Section values of one channel against a swept parameter, for a bifurcation diagram.
