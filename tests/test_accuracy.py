@@ -72,3 +72,24 @@ def test_window_ends_where_independent_references_part():
 def test_bad_channel_is_rejected():
     with pytest.raises(SceneError, match="no channel 'slider.v'"):
         work_precision(dc.mechanisms.slider_crank(), 0.001, channels=["slider.v"])
+
+
+def test_a_failed_check_run_is_an_error_not_the_whole_window():
+    """The converged window needs the check run: when it fails, the study says so instead of
+    measuring errors over a window where nothing says the reference is right."""
+    with pytest.raises(dc.DaeclearError, match=r"check run .*max_steps=5.* failed.*window="):
+        work_precision(dc.mechanisms.slider_crank("revolute", gravity=0.0), 0.4e-3, channels=["slider.vx"],
+                       methods={"IDA": {"method": "ida"}}, rtols=(1e-6,), n_eval=41, repeats=0,
+                       check={"method": "ida", "rtol": 1e-12, "max_steps": 5})
+
+
+def test_the_default_check_is_the_index1_formulation():
+    """The documented default check: IDA on the index-1 formulation at rtol 1e-12 (independent of
+    the GGL default of the runs it judges); with it the Fig. 4.15 scene's window over two crank
+    revolutions ends where the motion becomes sensitive to the impact sequence, before the end."""
+    study = work_precision(dc.mechanisms.slider_crank("revolute", gravity=0.0), 2 * REV, channels=["slider.vx"],
+                           methods={"IDA": {"method": "ida"}}, rtols=(1e-7,), n_eval=201, repeats=0)
+    assert 0.002 < study.window[1] < 2 * REV
+    assert study.notes and "diverge" in study.notes[0]
+    (row,) = study.rows
+    assert row["status"] == 0 and row["error"] < 1e-2

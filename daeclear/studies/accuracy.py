@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from ..assembly.assemble import DAEModel, assemble
 from .. import options
-from ..errors import Interrupted, SceneError
+from ..errors import DaeclearError, Interrupted, SceneError
 from ..progress import Progress
 from ..results.outputs import atomic_write_text, check_file
 from ..results.result import Result
@@ -257,13 +257,18 @@ def work_precision(
                              f"{', '.join(model.channel_names[:8])}, ...")
     t_eval = np.linspace(0.0, t_end, n_eval)
     ref_options = dict(reference or {"method": "DOP853", "rtol": 1e-12})
-    check_options = dict(check or {"method": "ida", "rtol": 1e-12})
+    check_options = dict(check or {"method": "ida", "rtol": 1e-12, "formulation": "index1"})
     scene_for_ref = scene if isinstance(scene, Scene) else model
     ref = simulate(scene_for_ref, t_end, t_eval=t_eval, on_failure="raise", **ref_options)
     notes = []
     if window is None:
         other = simulate(scene_for_ref, t_end, t_eval=t_eval, on_failure="return", **check_options)
-        t_conv = converged_window(ref, other, channels, converged_tol) if other.success else t_end
+        if not other.success:  # without the check nothing says where the reference is converged
+            raise DaeclearError(
+                f"work_precision: the check run ({', '.join(f'{k}={v}' for k, v in check_options.items())}) that "
+                f"finds where the reference is converged failed: {other.message} Give check= with other "
+                "options, or the error window with window=(t0, t1).")
+        t_conv = converged_window(ref, other, channels, converged_tol)
         window = (0.0, t_conv)
         reason = (f"the reference agrees with an independent run ({', '.join(f'{k}={v}' for k, v in check_options.items())}) "
                   f"to {converged_tol:g} of each channel's range up to there")
