@@ -127,15 +127,17 @@ def t0(value: Any, end: float, *, where: str = "simulate", field: str = "t0") ->
     return float(value)
 
 
-def state(value: Any, size: int, *, where: str = "simulate", field: str = "y0") -> NDArray[np.float64]:
-    """A full state vector: ``size`` finite numbers (a row of ``result.y`` of the same model)."""
-    rule = f"{size} finite numbers (a row of result.y of the same model: model.n_states = {size})"
+def state(value: Any, size: int | None, *, where: str = "simulate", field: str = "y0") -> NDArray[np.float64]:
+    """A full state vector: ``size`` finite numbers (a row of ``result.y`` of the same model; None:
+    any length, checked again once the model, and so its size, is known)."""
+    rule = (f"{size} finite numbers (a row of result.y of the same model: model.n_states = {size})" if size is not None
+            else "finite numbers (a row of result.y of the same model)")
     try:
         values = np.array(value, dtype=float)
     except (TypeError, ValueError):
         fail(where, field, value, rule)
     shown = f"array of shape {values.shape}" if values.ndim != 1 or values.size > 6 else repr(values.tolist())
-    if values.ndim != 1 or values.size != size:
+    if values.ndim != 1 or values.size == 0 or (size is not None and values.size != size):
         fail(where, field, value, rule + f", not shape {values.shape}", shown=shown)
     bad = ~np.isfinite(values)
     if bad.any():

@@ -15,8 +15,9 @@ or a sweep sets those per call, and they never change the computed trajectory.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -69,7 +70,7 @@ class SolverOptions:
         for name, value in values.items():
             object.__setattr__(self, name, value)
 
-    def replace(self, **changes: Any) -> "SolverOptions":
+    def replace(self, **changes: Any) -> SolverOptions:
         """A copy with ``changes`` (checked as on construction); unknown names are an error."""
         _check_names(changes, "replace")
         return dataclasses.replace(self, **changes)
@@ -82,7 +83,7 @@ class SolverOptions:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> "SolverOptions":
+    def from_dict(cls, data: Mapping[str, Any]) -> SolverOptions:
         """Options from :meth:`to_dict`'s form (missing settings take their defaults)."""
         if not isinstance(data, Mapping):
             fail(WHERE, "from_dict", data, "a mapping of setting names to values")
@@ -92,7 +93,7 @@ class SolverOptions:
             values["atol"] = tuple(values["atol"])
         return cls(**values)
 
-    def merged(self, *, where: str = "simulate", **keywords: Any) -> "SolverOptions":
+    def merged(self, *, where: str = "simulate", **keywords: Any) -> SolverOptions:
         """These options with every keyword that is not :data:`UNSET` put in its place; a bad
         keyword is reported as given to ``where`` (``simulate: rtol=2.0, must be ...``).
 

@@ -152,6 +152,19 @@ def test_bad_start_time_and_state_are_refused_before_any_work(ideal_model) -> No
         dc.simulate(slider_crank(), T, method="rk45", t0=T / 8, y0=np.zeros(3))
 
 
+def test_a_bad_state_for_a_scene_is_refused_before_assembly(monkeypatch) -> None:
+    from daeclear.solvers import ida
+
+    def no_assembly(*args, **kwargs):
+        raise AssertionError("assembled before the state was checked")
+
+    monkeypatch.setattr(ida, "assemble", no_assembly)
+    with pytest.raises(SceneError, match=r"simulate: y0=\[0.0, inf\], must be finite numbers .*\(inf at index 1\)"):
+        dc.simulate(slider_crank(), T, t0=T / 8, y0=[0.0, np.inf])
+    with pytest.raises(SceneError, match=r"simulate: y0=\[\], must be finite numbers .*not shape \(0,\)"):
+        dc.simulate(slider_crank(), T, y0=[])
+
+
 @pytest.mark.parametrize("backend", ["c", "python"])
 def test_ida_restart_from_the_last_state_continues_the_run(ideal_model, backend: str) -> None:
     """Ideal joints (GGL): 0 -> T against 0 -> T/2 then T/2 -> T, compared on one output grid."""
@@ -304,10 +317,10 @@ def test_runs_leave_the_model_unchanged_and_are_independent(clearance_model) -> 
     for backend in ("python", "c"):  # two runs at the same time in threads, from one assembled model
         results: dict[int, dc.Result] = {}
 
-        def run(k: int) -> None:
+        def run(k: int, backend: str, results: dict[int, dc.Result]) -> None:
             results[k] = dc.simulate(clearance_model, T / 4, rtol=1e-7, t_eval_step=T / 200, backend=backend)
 
-        threads = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+        threads = [threading.Thread(target=run, args=(k, backend, results)) for k in range(2)]
         for thread in threads:
             thread.start()
         for thread in threads:
@@ -373,3 +386,19 @@ def test_the_restart_example_runs(capsys) -> None:
     assert "in free flight, from rtol 1e-06 to rtol 1e-09" in out
     restart_alone = float(out.split("the restart alone")[1].split("(")[2].split(" of the stroke")[0])
     assert restart_alone < 1e-4  # a restart continues the run (measured 2e-6 on the full example)
+
+
+def test_the_work_state_carries_over_a_restart() -> None:
+    """track_work: the integrated work is part of the state, so a restart continues it (the energy
+    balance E - E0 - W stays closed over both parts)."""
+    model = dc.assemble(slider_crank(), track_work=True)
+    k = model.state_names.index("work.input")
+    grid = np.linspace(0.0, T, 49)
+    full = dc.simulate(model, T, rtol=1e-9, t_eval=grid)
+    head = dc.simulate(model, T / 2, rtol=1e-9, t_eval=grid[grid <= T / 2])
+    rest = dc.simulate(model, T, rtol=1e-9, t0=T / 2, y0=head.y[-1], t_eval=grid[grid >= T / 2])
+    assert rest.y[0, k] == head.y[-1, k] and abs(head.y[-1, k]) > 0
+    scale = np.ptp(full.y[:, k])
+    assert np.abs(rest.y[:, k] - full.y[grid >= T / 2, k]).max() < 1e-6 * scale
+    balance = np.concatenate([head["energy.mechanical"] - head.y[:, k], rest["energy.mechanical"] - rest.y[:, k]])
+    assert np.ptp(balance) < 1e-6 * np.ptp(full["energy.mechanical"])

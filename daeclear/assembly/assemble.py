@@ -115,7 +115,7 @@ class DAEModel:
         for name in ("q_guess", "v_guess", "mass_diagonal", "parameter_values"):
             object.__setattr__(self, name, _read_only(getattr(self, name)))
 
-    def for_run(self, *, from_state: bool = False) -> "DAEModel":
+    def for_run(self, *, from_state: bool = False) -> DAEModel:
         """A copy of this model for one run: the same functions and numbers, its own contact logic.
 
         The contact logic objects hold a run's state (each pair's mode, latched approach speed and

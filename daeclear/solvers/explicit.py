@@ -1295,7 +1295,7 @@ def integrate(
     t_end, rtol, max_step, max_steps, t_eval, backend, on_failure, store_steps, progress, track_work = options.run(
         t_end=t_end, t0=t0, rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, t_eval=t_eval,
         backend=backend, on_failure=on_failure, store_steps=store_steps, progress=progress, track_work=track_work)
-    t0 = options.t0(t0, t_end)
+    t0 = float(t0)  # checked by options.run
     out = options.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data,
                          start=t0)
     name = METHOD_NAMES[method_l]

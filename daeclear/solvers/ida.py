@@ -202,11 +202,11 @@ def simulate(
         t_end=t_end, t0=t0, rtol=rtol, atol=atol, max_step=settings.max_step, max_steps=settings.max_steps,
         t_eval=t_eval, backend=settings.backend, on_failure=on_failure, store_steps=store_steps, progress=progress,
         track_work=settings.track_work)
-    t0 = opts.t0(t0, t_end)
+    t0 = float(t0)  # checked by opts.run
     out = opts.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data,
                       start=t0)
-    if y0 is not None and isinstance(scene, DAEModel):  # checked before any work (a Scene: after assembly)
-        y0 = opts.state(y0, scene.n_states)
+    if y0 is not None:  # checked before any work (a Scene's length: once it is assembled)
+        y0 = opts.state(y0, scene.n_states if isinstance(scene, DAEModel) else None)
     from .explicit import integrate  # the non-IDA methods
 
     if method != "ida":
