@@ -23,6 +23,7 @@ from .results.result import ContactEvent, Result, load
 from .contact import Material
 from .model.loads import Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
 from .model.scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
+from .solver_options import SolverOptions
 from .solvers.ida import simulate
 from .studies.sweep import load_sweep, sweep  # the function `sweep` shadows the module: import names from daeclear.studies.sweep
 
@@ -30,7 +31,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "Driver",
-    "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "Scene", "SceneError", "SolveError", "Translational",
+    "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "Scene", "SceneError", "SolveError", "SolverOptions", "Translational",
     "TranslationalClearance", "analysis", "assemble", "load", "load_sweep", "mechanisms", "profiles", "simulate", "sweep",
     # applied loads (daeclear.loads)
     "Expression", "Force", "Motor", "RotationalSpringDamper", "SpringDamper", "Table", "Torque", "loads",

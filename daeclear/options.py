@@ -119,6 +119,33 @@ def t_end(value: Any, *, where: str = "simulate", field: str = "t_end") -> float
     return number(value, where=where, field=field, unit="s", low=0.0)
 
 
+def t0(value: Any, end: float, *, where: str = "simulate", field: str = "t0") -> float:
+    """Start time of a run: a finite number >= 0 and < t_end, s."""
+    ok = _real(value) and math.isfinite(float(value)) and 0.0 <= float(value) < end
+    if not ok:
+        fail(where, field, value, f"a finite number >= 0 and < t_end={end:g} s", "s")
+    return float(value)
+
+
+def state(value: Any, size: int | None, *, where: str = "simulate", field: str = "y0") -> NDArray[np.float64]:
+    """A full state vector: ``size`` finite numbers (a row of ``result.y`` of the same model; None:
+    any length, checked again once the model, and so its size, is known)."""
+    rule = (f"{size} finite numbers (a row of result.y of the same model: model.n_states = {size})" if size is not None
+            else "finite numbers (a row of result.y of the same model)")
+    try:
+        values = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        fail(where, field, value, rule)
+    shown = f"array of shape {values.shape}" if values.ndim != 1 or values.size > 6 else repr(values.tolist())
+    if values.ndim != 1 or values.size == 0 or (size is not None and values.size != size):
+        fail(where, field, value, rule + f", not shape {values.shape}", shown=shown)
+    bad = ~np.isfinite(values)
+    if bad.any():
+        index = int(np.argmax(bad))
+        fail(where, field, value, rule + f" ({float(values[index])!r} at index {index})", shown=shown)
+    return values
+
+
 def rtol(value: Any, *, where: str = "simulate", field: str = "rtol") -> float:
     """Relative tolerance: a finite number in [1e-14, 1e-2]."""
     lo, hi = RTOL_RANGE
@@ -159,11 +186,11 @@ def step(value: Any, *, where: str = "simulate", field: str = "step") -> float:
 
 
 def t_eval(value: ArrayLike | None, end: float, *, where: str = "simulate",
-           field: str = "t_eval") -> NDArray[np.float64] | None:
-    """Output times: None, or finite, strictly increasing values in [0, t_end] (NaN is an error, not a cut)."""
+           field: str = "t_eval", start: float = 0.0) -> NDArray[np.float64] | None:
+    """Output times: None, or finite, strictly increasing values in [t0, t_end] (NaN is an error, not a cut)."""
     if value is None:
         return None
-    rule = f"finite, strictly increasing values in [0, t_end={end:g}]"
+    rule = f"finite, strictly increasing values in [{'0' if start == 0 else f't0={start:g}'}, t_end={end:g}]"
     try:
         times = np.asarray(value, dtype=float).ravel()
     except (TypeError, ValueError):
@@ -174,7 +201,7 @@ def t_eval(value: ArrayLike | None, end: float, *, where: str = "simulate",
     if bad.any():
         index = int(np.argmax(bad))
         fail(where, field, value, rule + f" ({float(times[index])!r} at index {index})", shown=_show(times))
-    if np.any(np.diff(times) <= 0) or times[0] < 0 or times[-1] > end:
+    if np.any(np.diff(times) <= 0) or times[0] < start or times[-1] > end:
         fail(where, field, value, rule, shown=_show(times))
     return times
 
@@ -194,9 +221,9 @@ def t_eval_step(value: Any, end: float, *, where: str, field: str = "t_eval_step
 _spacing = t_eval_step  # for output(), whose argument of that name hides the function
 
 
-def uniform_times(spacing: float, end: float) -> NDArray[np.float64]:
-    """Output times from 0 to ``end`` (both included), ``end / floor(end / spacing)`` apart."""
-    return np.linspace(0.0, end, int(math.floor(end / spacing)) + 1)
+def uniform_times(spacing: float, end: float, start: float = 0.0) -> NDArray[np.float64]:
+    """Output times from ``start`` to ``end`` (both included), ``(end - start) / floor((end - start) / spacing)`` apart."""
+    return np.linspace(start, end, int(math.floor((end - start) / spacing)) + 1)
 
 
 class OutputTimes:
@@ -205,10 +232,11 @@ class OutputTimes:
 
     ``window(i, j)`` equals ``uniform_times(spacing, end)[i:j]`` value for value."""
 
-    def __init__(self, values: NDArray[np.float64] | None = None, *, spacing: float = 0.0, end: float = 0.0) -> None:
+    def __init__(self, values: NDArray[np.float64] | None = None, *, spacing: float = 0.0, end: float = 0.0,
+                 start: float = 0.0) -> None:
         self._values = values
-        self._intervals = 0 if values is not None else int(math.floor(end / spacing))
-        self._end = end
+        self._intervals = 0 if values is not None else int(math.floor((end - start) / spacing))
+        self._start, self._end = start, end
         self.size: int = values.size if values is not None else self._intervals + 1
 
     def window(self, start: int, stop: int) -> NDArray[np.float64]:
@@ -216,7 +244,8 @@ class OutputTimes:
         if self._values is not None:
             return self._values[start:stop]
         stop = min(stop, self.size)
-        out = np.arange(start, max(start, stop), dtype=float) * (self._end / self._intervals)  # as np.linspace
+        span = self._end - self._start
+        out = np.arange(start, max(start, stop), dtype=float) * (span / self._intervals) + self._start  # as np.linspace
         if stop == self.size and out.size:
             out[-1] = self._end
         return out
@@ -235,7 +264,7 @@ class OutputOptions(NamedTuple):
 
 
 def output(*, t_eval: NDArray[np.float64] | None, t_eval_step: Any, end: float, stream_to: Any, keep_data: Any,
-           where: str = "simulate") -> OutputOptions:
+           where: str = "simulate", start: float = 0.0) -> OutputOptions:
     """Check the output options of a run: ``t_eval`` (checked by :func:`t_eval`) or ``t_eval_step``
     (one or the other), ``stream_to`` (None or an HDF5 file, checked as an output place before any
     work) and ``keep_data`` (True or False; False only with ``stream_to``, else the data would be lost)."""
@@ -243,7 +272,7 @@ def output(*, t_eval: NDArray[np.float64] | None, t_eval_step: Any, end: float, 
     if t_eval_step is not None:
         if t_eval is not None:
             fail(where, "t_eval_step", t_eval_step, "left out when t_eval is given (give one or the other)")
-        times = OutputTimes(spacing=_spacing(t_eval_step, end, where=where), end=end)
+        times = OutputTimes(spacing=_spacing(t_eval_step, end - start, where=where), end=end, start=start)
     keep = flag(keep_data, where=where, field="keep_data")
     path = None
     if stream_to is not None:
@@ -312,10 +341,11 @@ def run(**values: Any) -> RunOptions:
     """Check the options shared by :func:`daeclear.simulate` and every integrator (the fields of
     :class:`RunOptions`, plus ``atol``, checked here and converted per model by the solver)."""
     end = t_end(values["t_end"])
+    begin = t0(values.get("t0", 0.0), end)
     atol(values["atol"])
     return RunOptions(
         t_end=end, rtol=rtol(values["rtol"]), max_step=max_step(values["max_step"]),
-        max_steps=max_steps(values["max_steps"]), t_eval=t_eval(values["t_eval"], end),
+        max_steps=max_steps(values["max_steps"]), t_eval=t_eval(values["t_eval"], end, start=begin),
         backend=backend(values["backend"]), on_failure=on_failure(values["on_failure"]),
         store_steps=flag(values["store_steps"], field="store_steps"),
         progress=flag(values["progress"], field="progress"),

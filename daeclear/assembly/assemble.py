@@ -26,6 +26,7 @@ where ``Phi' = Phi_q v + Phi_t`` and ``gamma = -(d Phi'/dq) v - d Phi'/dt``.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from dataclasses import dataclass, field
@@ -45,7 +46,7 @@ from ..model.scene import GROUND, Body, Driver, Revolute, Scene, Translational
 from .revolute_joint import CONTACT_BUILDERS
 from .drivers import driver_constraint, driver_load, driver_parameters
 from ..model.loads import Load, build_loads, load_parameters
-from .symbolic import AssemblyContext, BodyFrame, Channel, Reference, Term, rotation
+from .symbolic import AssemblyContext, BodyFrame, BufferedFunction, Channel, Reference, Term, rotation
 
 Formulation = Literal["index1", "ggl"]
 
@@ -108,6 +109,25 @@ class DAEModel:
     driver_names: tuple[str, ...] = ()
     # False for a model that starts from a computed state (a restart), whose start is not checked
     start_is_declared: ClassVar[bool] = True
+
+    def __post_init__(self) -> None:
+        # frozen means frozen: the arrays are read-only (a copy when the caller's array is writable)
+        for name in ("q_guess", "v_guess", "mass_diagonal", "parameter_values"):
+            object.__setattr__(self, name, _read_only(getattr(self, name)))
+
+    def for_run(self, *, from_state: bool = False) -> DAEModel:
+        """A copy of this model for one run: the same functions and numbers, its own contact logic.
+
+        The contact logic objects hold a run's state (each pair's mode, latched approach speed and
+        storm history); a run works on its own copies, so that a model is never changed by a run
+        and runs of one model (one after the other, or at the same time in threads) are
+        independent. ``from_state``: the run starts from a given state of a run (``simulate(...,
+        y0=...)``), whose contacts at the start are no declaration error (:mod:`daeclear.solvers.physics`).
+        """
+        run_model = dataclasses.replace(self, contacts=tuple(_run_copy(logic) for logic in self.contacts))
+        if from_state:  # an instance value over the class's: this copy only (the class default stays)
+            object.__setattr__(run_model, "start_is_declared", False)
+        return run_model
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -861,6 +881,27 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
         constraint_elements=tuple(owners), driver_names=tuple(driver_rows),
     )  # numbers are bound per scene (_Template.bind)
     return _Template(model=model, layout=table.layout, logic=logic_makers, auto_pairs=tuple(auto_pairs))
+
+
+def _run_copy(logic: Any) -> Any:
+    """A contact logic object for one run: a shallow copy whose lists (pair states, faces) and
+    buffered functions (their input and output arrays) are its own."""
+    fresh = copy.copy(logic)
+    for name, value in vars(logic).items():
+        if isinstance(value, list):
+            setattr(fresh, name, list(value))
+        elif isinstance(value, BufferedFunction):
+            setattr(fresh, name, copy.copy(value))  # a new buffer (BufferedFunction.__setstate__)
+    return fresh
+
+
+def _read_only(values: ArrayLike) -> NDArray[np.float64]:
+    """``values`` as a read-only float array (copied unless it already is one)."""
+    array = np.asarray(values, dtype=float)
+    if array.flags.writeable:
+        array = array.copy()
+        array.setflags(write=False)
+    return array
 
 
 def _mapped(function: ca.Function, n: int) -> ca.Function:

@@ -1065,7 +1065,7 @@ def _locate(ev: _Evaluator, X_of: Callable[[float], NDArray | None], ta0: float,
     return best[0], np.array(best[1], dtype=float), roots
 
 
-def _run_scipy(run: _Run, x0: NDArray, rtol: float, atol: NDArray, max_step: float) -> None:
+def _run_scipy(run: _Run, x0: NDArray, rtol: float, atol: NDArray, max_step: float, t0: float = 0.0) -> None:
     import scipy.integrate as si
 
     cls = {"rk45": si.RK45, "dop853": si.DOP853, "radau": si.Radau, "bdf": si.BDF, "lsoda": si.LSODA}[run.method]
@@ -1074,7 +1074,7 @@ def _run_scipy(run: _Run, x0: NDArray, rtol: float, atol: NDArray, max_step: flo
     if run.method in IMPLICIT_METHODS:
         opts["jac"] = ev.jac
     hint = "Try a smaller max_step, a looser rtol or another method."
-    t, x = 0.0, x0
+    t, x = t0, x0
     while True:
         run.open_segment(t, x)
         dirs = run.directions()
@@ -1192,11 +1192,11 @@ def _end_segment(run: _Run, restart: Any, hermite: bool, t_end: float) -> bool:
     return t < t_end
 
 
-def _run_fixed(run: _Run, x0: NDArray, step: float) -> None:
+def _run_fixed(run: _Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
     ev, t_end = run.ev, run.t_end
     scheme = FIXED_STEP_METHODS[run.method]
     hint = "Try a smaller step."
-    t, x = 0.0, x0
+    t, x = t0, x0
     while True:
         run.open_segment(t, x)
         dirs = run.directions()
@@ -1271,6 +1271,8 @@ def integrate(
     t_eval_step: float | None = None,
     stream_to: str | os.PathLike[str] | None = None,
     keep_data: bool = True,
+    t0: float = 0.0,
+    y0: ArrayLike | None = None,
 ) -> Result:
     """Integrate with a non-IDA method; the arguments are those of :func:`daeclear.simulate`.
 
@@ -1291,9 +1293,11 @@ def integrate(
         raise SceneError(f"simulate: method={method!r}, must be one of {valid} (case-insensitive).")
     step = check_step(method_l, step)
     t_end, rtol, max_step, max_steps, t_eval, backend, on_failure, store_steps, progress, track_work = options.run(
-        t_end=t_end, rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, t_eval=t_eval, backend=backend,
-        on_failure=on_failure, store_steps=store_steps, progress=progress, track_work=track_work)
-    out = options.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data)
+        t_end=t_end, t0=t0, rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, t_eval=t_eval,
+        backend=backend, on_failure=on_failure, store_steps=store_steps, progress=progress, track_work=track_work)
+    t0 = float(t0)  # checked by options.run
+    out = options.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data,
+                         start=t0)
     name = METHOD_NAMES[method_l]
     if track_work:
         raise SceneError(f"simulate: track_work=True is supported by method='ida' only, not by method={name!r}.")
@@ -1312,29 +1316,41 @@ def integrate(
     if model.formulation != "index1":
         raise SceneError(f"simulate: formulation={model.formulation!r} is integrated by IDA only; method={name!r} "
                          "integrates the chapter's index-1 formulation (formulation='index1').")
+    from_state = y0 is not None
+    if from_state:
+        y0 = options.state(y0, model.n_states)
+    model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
     eval_times = None if out.times is None else out.times.values()  # checked by options.output
     n = model.n_q
     atol_x = tolerance_vector(model, rtol, atol)[:2 * n]
     ev = _evaluator(model, backend)
-    y0, _ = model.initial_state(start=start, allow_penetration=allow_penetration)
+    if from_state:  # q and v as given (index-1: no projection), multipliers recomputed at t0
+        y0, _ = model.consistent_state(t0, y0)
+    else:
+        y0, _ = model.initial_state(start=start, allow_penetration=allow_penetration)
     x0 = np.array(y0[:2 * n])
     sim_params = {"method": name, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
                   "max_step": max_step, "t_end": t_end, "backend": ev.backend, "step": step}
+    if from_state:
+        sim_params["start"] = "state"
+    if t0 != 0.0:
+        sim_params["t0"] = t0
     rec = Recorder(model, parameters={**model.parameters, "simulate": sim_params}, method=name,
                    stream_to=out.stream_to, keep_data=out.keep_data)
     run = _Run(model, ev, method_l, t_end, eval_times, store_steps, progress, max_steps, rec)
-    run.y0, run.step = (y0 if start == "declared" else None), step  # start checks: declared states only
+    run.y0, run.step = (y0 if start == "declared" and not from_state else None), step  # declared starts only
+    run.t_last = t0
     for logic in model.contacts:
-        run.modes.update(logic.initial_modes(0.0, y0, run.active, run.params))
+        run.modes.update(logic.initial_modes(t0, y0, run.active, run.params))
     setup_time = time.perf_counter() - setup_start
     tic = time.perf_counter()
     interrupted = False
     try:
         with np.errstate(all="ignore"):
             if method_l in FIXED_STEP_METHODS:
-                _run_fixed(run, x0, step)  # type: ignore[arg-type]
+                _run_fixed(run, x0, step, t0)  # type: ignore[arg-type]
             else:
-                _run_scipy(run, x0, rtol, atol_x, max_step)
+                _run_scipy(run, x0, rtol, atol_x, max_step, t0)
     except KeyboardInterrupt:  # Ctrl-C: keep what was computed, then stop the caller too (Interrupted)
         run.success, run.status = False, -1
         run.message = f"interrupted by the user at t={run.t_last:.6g} s"

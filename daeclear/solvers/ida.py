@@ -19,7 +19,7 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import options
+from .. import options as opts
 from . import physics
 from ..assembly.assemble import DAEModel, assemble
 from ..errors import Interrupted, SolveError
@@ -29,11 +29,14 @@ from ..progress import Progress
 from .tolerances import tolerance_vector
 from ..results.result import Result
 from ..model.scene import Scene
+from ..solver_options import UNSET, SolverOptions
+
+DEFAULTS = SolverOptions()
 
 log = logging.getLogger("daeclear")
 
-METHODS: tuple[str, ...] = options.METHODS
-ON_FAILURE: tuple[str, ...] = options.ON_FAILURE
+METHODS: tuple[str, ...] = opts.METHODS
+ON_FAILURE: tuple[str, ...] = opts.ON_FAILURE
 # Constraint drift (largest |Phi| of a run) above this fraction of the smallest clearance is warned of.
 DRIFT_FRACTION = physics.DRIFT_FRACTION
 # GGL holds Phi = 0 only as tightly as IDA's Newton test (safety factor 0.33 by default). 1e-3
@@ -56,40 +59,63 @@ def simulate(
     scene: Scene | DAEModel,
     t_end: float,
     *,
+    options: SolverOptions | None = None,
+    t0: float = 0.0,
+    y0: ArrayLike | None = None,
     t_eval: ArrayLike | None = None,
     t_eval_step: float | None = None,
-    rtol: float = 1e-6,
-    atol: float | ArrayLike | None = None,
-    method: str = "ida",
-    formulation: str | None = None,
-    backend: str = "auto",
-    max_step: float = 0.0,
-    max_steps: int = 5_000_000,
+    rtol: float = UNSET,
+    atol: float | ArrayLike | None = UNSET,
+    method: str = UNSET,
+    formulation: str | None = UNSET,
+    backend: str = UNSET,
+    max_step: float = UNSET,
+    max_steps: int = UNSET,
     store_steps: bool = True,
     on_failure: str = "raise",
     progress: bool = False,
-    step: float | None = None,
-    track_work: bool = False,
-    linear_solver: str = "auto",
-    start: str = "ideal",
-    allow_penetration: bool = False,
+    step: float | None = UNSET,
+    track_work: bool = UNSET,
+    linear_solver: str = UNSET,
+    start: str = UNSET,
+    allow_penetration: bool = UNSET,
     stream_to: str | os.PathLike[str] | None = None,
     keep_data: bool = True,
 ) -> Result:
-    """Integrate a scene (or an assembled model) from t = 0 to ``t_end``.
+    """Integrate a scene (or an assembled model) from ``t0`` (0 by default) to ``t_end``.
+
+    The solver settings (``method`` ... ``allow_penetration``, the fields of
+    :class:`daeclear.SolverOptions`) come from ``options`` when given, and a keyword given
+    explicitly overrides the same setting of ``options``: ``simulate(m, T, options=o, rtol=1e-8)``
+    is ``simulate(m, T, options=o.replace(rtol=1e-8))``. The defaults below are SolverOptions'.
 
     Parameters
     ----------
     scene : Scene or DAEModel
-        The mechanism; a Scene is assembled with ``formulation`` first.
+        The mechanism; a Scene is assembled with ``formulation`` first. A model is never changed
+        by a run (its contact logic is copied per run): runs of one model, one after the other or
+        at the same time in threads, are independent.
     t_end : float
-        End time, s (> 0).
+        End time, s (> t0).
+    options : SolverOptions or None
+        The solver settings as one checked value (None: the defaults).
+    t0 : float
+        Start time, s (finite, >= 0, < t_end). Drivers and time-dependent loads are evaluated at
+        the true time: a run from t0 continues a run that reached t0.
+    y0 : array_like or None
+        The full state at ``t0`` (a row of ``result.y`` of a run of the same model, ``model.n_states``
+        values): positions and velocities are kept as given (GGL: projected onto the constraint
+        manifold, as at every restart), multipliers and accelerations recomputed, the contact
+        modes set from the gaps at ``t0`` (a pair starting in contact latches its penetration
+        rate there). None: the start of ``start``. Restarting from the last state of a run
+        continues it to the integration tolerance; a run's history (contact storm guard, BDF
+        history) starts afresh.
     t_eval : array_like or None
-        Output times in [0, t_end] (increasing). None: every internal IDA step.
+        Output times in [t0, t_end] (increasing). None: every internal IDA step.
     t_eval_step : float or None
-        Output times every ``t_eval_step`` seconds from 0 to t_end (both included; the spacing is
-        ``t_end / floor(t_end / t_eval_step)``), made window by window as the run goes (a long run
-        never holds the whole grid). Give this or ``t_eval``, not both.
+        Output times every ``t_eval_step`` seconds from t0 to t_end (both included; the spacing is
+        ``(t_end - t0) / floor((t_end - t0) / t_eval_step)``), made window by window as the run goes
+        (a long run never holds the whole grid). Give this or ``t_eval``, not both.
     rtol : float
         Relative tolerance (1e-6; the chapter's "integration tolerance").
     atol : float, array or None
@@ -131,7 +157,7 @@ def simulate(
         "auto" (sparse for large models, see :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES`).
         The python backend and the other methods ignore it. Reported in ``result.stats``.
     start : {"ideal", "declared"}
-        How the run starts. "ideal" (the chapter's, section 4.4): every clearance joint centred
+        How the run starts without ``y0`` (ignored with ``y0``, as is ``allow_penetration``). "ideal" (the chapter's, section 4.4): every clearance joint centred
         and every position and velocity assembled on the mechanism whose clearance joints are
         ideal, from the declared state as a guess; "declared": the bodies' declared positions and
         velocities, corrected only for the scene's ideal joints.
@@ -163,51 +189,74 @@ def simulate(
         The initial positions cannot be assembled, the constraints are redundant (the
         message names the joints and drivers), or a declared start is in deep penetration.
     """
-    method = options.method(method)
-    linear_solver = options.linear_solver(linear_solver)
-    start = options.start(start)
-    allow_penetration = options.flag(allow_penetration, field="allow_penetration")
-    t_end, rtol, max_step, max_steps, t_eval, backend, on_failure, store_steps, progress, track_work = options.run(
-        t_end=t_end, rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, t_eval=t_eval, backend=backend,
-        on_failure=on_failure, store_steps=store_steps, progress=progress, track_work=track_work)
-    out = options.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data)
-    from .explicit import check_step, integrate  # the non-IDA methods
+    if options is not None and not isinstance(options, SolverOptions):
+        opts.fail("simulate", "options", options, "None or a daeclear.SolverOptions")
+    settings = (DEFAULTS if options is None else options).merged(
+        method=method, rtol=rtol, atol=atol, formulation=formulation, backend=backend, max_step=max_step,
+        max_steps=max_steps, step=step, linear_solver=linear_solver, start=start,
+        allow_penetration=allow_penetration, track_work=track_work)
+    method, rtol, atol, formulation = settings.method, settings.rtol, settings.atol_value(), settings.formulation
+    step, linear_solver, start = settings.step, settings.linear_solver, settings.start
+    allow_penetration = settings.allow_penetration
+    t_end, rtol, max_step, max_steps, t_eval, backend, on_failure, store_steps, progress, track_work = opts.run(
+        t_end=t_end, t0=t0, rtol=rtol, atol=atol, max_step=settings.max_step, max_steps=settings.max_steps,
+        t_eval=t_eval, backend=settings.backend, on_failure=on_failure, store_steps=store_steps, progress=progress,
+        track_work=settings.track_work)
+    t0 = float(t0)  # checked by opts.run
+    out = opts.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data,
+                      start=t0)
+    if y0 is not None:  # checked before any work (a Scene's length: once it is assembled)
+        y0 = opts.state(y0, scene.n_states if isinstance(scene, DAEModel) else None)
+    from .explicit import integrate  # the non-IDA methods
 
-    check_step(method, step)
     if method != "ida":
         return integrate(scene, t_end, method=method, t_eval=t_eval, rtol=rtol, atol=atol, formulation=formulation,
                          backend=backend, max_step=max_step, max_steps=max_steps, step=step,
                          store_steps=store_steps, on_failure=on_failure, progress=progress,
                          track_work=track_work, start=start, t_eval_step=t_eval_step, stream_to=out.stream_to,
-                         keep_data=out.keep_data, allow_penetration=allow_penetration)
+                         keep_data=out.keep_data, allow_penetration=allow_penetration, t0=t0, y0=y0)
 
     setup_start = time.perf_counter()
     if formulation is None:
-        formulation = options.default_formulation(method)
+        formulation = opts.default_formulation(method)
     model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation, track_work=track_work)
+    if y0 is not None:
+        y0 = opts.state(y0, model.n_states)
+    from_state = y0 is not None
+    model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
     atol_vec = tolerance_vector(model, rtol, atol)
     session = open_session(model.functions, backend=backend, rtol=rtol, atol=atol_vec, max_step=max_step,
                            parameters=model.parameter_values, max_steps=max_steps, linear_solver=linear_solver)
-    y0, yp0 = model.initial_state(session=session, start=start, allow_penetration=allow_penetration)
+    try:
+        if y0 is None:
+            y0, yp0 = model.initial_state(session=session, start=start, allow_penetration=allow_penetration)
+        else:  # a given state: q and v kept (GGL: projected), multipliers and derivatives recomputed at t0
+            y0, yp0 = model.consistent_state(t0, y0, session=session, project=True)
+    except BaseException:
+        session.close()
+        raise
     if model.formulation == "ggl" and model.n_constraints:  # without constraints GGL is index-1
         # never ask Newton for corrections below round-off: coef * rtol >= 1e-13
         session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / rtol)))
     session.set_stall(STALL_STEP, STALL_COUNT)
     setup_time = time.perf_counter() - setup_start
-    sim_params = {"method": method, "start": start, "rtol": rtol,
-                  "atol": None if atol is None else np.ravel(atol).tolist(),
+    sim_params = {"method": method, "start": "state" if from_state else start,
+                  "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
                   "max_step": max_step, "t_end": t_end, "backend": session.backend}
+    if t0 != 0.0:
+        sim_params["t0"] = t0
     try:
         rec = Recorder(model, parameters={**model.parameters, "simulate": sim_params}, method=method,
                        stream_to=out.stream_to, keep_data=out.keep_data)
     except BaseException:
         session.close()
         raise
-    return _run(model, session, y0, yp0, t_end, out.times, store_steps, on_failure, progress,
+    return _run(model, session, t0, y0, yp0, t_end, out.times, store_steps, on_failure, progress,
                 setup_time, sim_params, rec)
 
 
-def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float, eval_times: options.OutputTimes | None,
+def _run(model: DAEModel, session: Any, t0: float, y0: NDArray, yp0: NDArray, t_end: float,
+         eval_times: opts.OutputTimes | None,
          store_steps: bool, on_failure: str, progress: bool, setup_time: float,
          sim_params: dict[str, Any], rec: Recorder) -> Result:
     """The segment loop: advance, handle roots, restart; always returns what was computed.
@@ -222,23 +271,23 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
     params = [np.zeros(term.n_params) for term in model.terms]
     modes: dict[str, str] = {}
     for logic in model.contacts:
-        modes.update(logic.initial_modes(0.0, y0, active, params))
+        modes.update(logic.initial_modes(t0, y0, active, params))
     y, yp = y0, yp0
     if any(active):
-        y, yp = model.consistent_state(0.0, y0, model.term_forces(0.0, y0, active, params, session), session)
+        y, yp = model.consistent_state(t0, y0, model.term_forces(t0, y0, active, params, session), session)
     switch = model.switch_vector(active, params)
 
     # reported points not made consistent yet (IDA's raw values, with their contact switches)
     raw: list[tuple[NDArray, NDArray, NDArray, NDArray]] = []
-    rec.add_steps(np.array([0.0]), np.array([0.0]), np.array([0]))
+    rec.add_steps(np.array([t0]), np.array([0.0]), np.array([0]))
     i_eval = 0  # index of the next output time
     if eval_times is None:
-        raw.append((np.array([0.0]), y[None, :], yp[None, :], switch[None, :]))
-    elif eval_times.window(0, 1)[0] == 0.0:
-        raw.append((np.array([0.0]), y[None, :], yp[None, :], switch[None, :]))
+        raw.append((np.array([t0]), y[None, :], yp[None, :], switch[None, :]))
+    elif eval_times.window(0, 1)[0] == t0:
+        raw.append((np.array([t0]), y[None, :], yp[None, :], switch[None, :]))
         i_eval = 1
     events, segments = rec.events, rec.segments
-    t = 0.0
+    t = t0
     success, status, message = True, 0, "end of the time span reached"
     n_restarts = 0
     interrupted = False
@@ -386,6 +435,9 @@ def _run(model: DAEModel, session: Any, y0: NDArray, yp0: NDArray, t_end: float,
         stats.update(n_events=rec.n_events, n_restarts=n_restarts, setup_time=setup_time,
                      wall_time=setup_time + time.perf_counter() - run_start,
                      output_time=time.perf_counter() - post_start)
+        if model.gap_names:  # the run's end state of the storm guard (kept in this run's logic, not in the model)
+            stats["held_pairs"] = [model.gap_names[root] for logic in model.contacts for root in logic.roots
+                                   if logic.pair_state(root).held]
         # the start checks concern a declared state: the chapter's start is consistent by construction
         key_t, key_y, key_channels = rec.key_rows()
         found = physics.check_run(model, key_t, key_y, key_channels,
@@ -421,7 +473,7 @@ def _split_rows(adv: Any) -> dict[float, tuple[int, int]]:
     return {t: (s, e) for t, s, e in zip(times.tolist(), steps, evals)}
 
 
-def _eval_window(times: options.OutputTimes, i: int, t: float, size: int) -> tuple[int, NDArray]:
+def _eval_window(times: opts.OutputTimes, i: int, t: float, size: int) -> tuple[int, NDArray]:
     """The output times after ``t`` from index ``i`` on, at most ``size``: (index of the first, times)."""
     while i < times.size:
         window = times.window(i, i + size)

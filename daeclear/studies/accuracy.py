@@ -28,6 +28,7 @@ from ..progress import Progress
 from ..results.outputs import atomic_write_text, check_file
 from ..results.result import Result
 from ..model.scene import Scene
+from ..solver_options import SolverOptions
 from ..solvers.ida import simulate
 
 FIXED_STEP_METHODS = ("rk4", "euler")
@@ -166,6 +167,40 @@ def converged_window(reference: Result, check: Result, channels: Sequence[str], 
     return float(t[max(first - 1, 0)])
 
 
+Settings = Mapping[str, Any] | SolverOptions  # the options of one run: simulate keywords or a SolverOptions
+
+
+def _keywords(settings: Settings) -> dict[str, Any]:
+    """``settings`` as keywords of :func:`simulate` (a SolverOptions goes in as ``options``)."""
+    return {"options": settings} if isinstance(settings, SolverOptions) else dict(settings)
+
+
+def _method_of(settings: Settings) -> str:
+    """The method of ``settings``, lower case ("ida" when not given)."""
+    if isinstance(settings, SolverOptions):
+        return settings.method
+    return str(settings.get("method", "ida")).lower()
+
+
+def _describe(settings: Settings) -> str:
+    """``settings`` as ``name=value`` items (a SolverOptions: the settings that differ from the defaults)."""
+    if isinstance(settings, SolverOptions):
+        default = SolverOptions().to_dict()
+        items = {k: v for k, v in settings.to_dict().items() if v != default[k]}
+    else:
+        items = dict(settings)
+    return ", ".join(f"{k}={v}" for k, v in items.items())
+
+
+def _with(settings: Settings, name: str, value: float) -> dict[str, Any]:
+    """Keywords of ``settings`` with the tolerance or step ``name`` set to ``value``."""
+    if isinstance(settings, SolverOptions):
+        return {"options": settings.replace(**{name: value})}
+    opts = {k: v for k, v in settings.items() if k not in ("rtol", "step")}
+    opts[name] = value
+    return opts
+
+
 def _timed(model: Scene | DAEModel, t_end: float, t_eval: NDArray, options: dict[str, Any], repeats: int
            ) -> tuple[Result, float]:
     """Best-of-repeats wall time of the whole ``simulate`` call, a Scene (assembled in the call,
@@ -190,11 +225,11 @@ def work_precision(
     t_end: float,
     *,
     channels: Sequence[str] = ("slider.vx",),
-    methods: Mapping[str, Mapping[str, Any]] | None = None,
+    methods: Mapping[str, Settings] | None = None,
     rtols: Sequence[float] = (1e-4, 1e-6, 1e-8),
     steps: Sequence[float] = (1e-5, 5e-6),
-    reference: Mapping[str, Any] | None = None,
-    check: Mapping[str, Any] | None = None,
+    reference: Settings | None = None,
+    check: Settings | None = None,
     window: tuple[float, float] | None = None,
     converged_tol: float = 1e-6,
     n_eval: int = 2001,
@@ -212,15 +247,16 @@ def work_precision(
         End of the runs, s.
     channels : sequence of str
         Channels whose error is measured (relative to the reference's range).
-    methods : mapping label -> simulate options
-        E.g. ``{"IDA": {"method": "ida"}, "DOP853": {"method": "DOP853"}, "RK4": {"method": "rk4"}}``;
-        adaptive methods run at every ``rtols``, fixed-step ones (rk4, euler) at every ``steps``.
-        Default: IDA, DOP853, LSODA and RK4.
-    reference : mapping
+    methods : mapping label -> simulate options or SolverOptions
+        E.g. ``{"IDA": {"method": "ida"}, "DOP853": {"method": "DOP853"}, "RK4": {"method": "rk4"}}``
+        or ``{"IDA sparse": SolverOptions(linear_solver="sparse")}``; adaptive methods run at every
+        ``rtols``, fixed-step ones (rk4, euler) at every ``steps`` (each replacing the rtol or step
+        of the entry). Default: IDA, DOP853, LSODA and RK4.
+    reference : mapping, SolverOptions or None
         Options of the reference run (default DOP853 at rtol 1e-12: an explicit high-order method,
         independent of the implicit runs it judges).
-    check : mapping
-        Options of the second reference used to find the converged window (default IDA, index-1,
+    check : mapping, SolverOptions or None
+        Options of the second reference used to find the converged window (default IDA,
         rtol 1e-12).
     window : (t0, t1) or None
         Error window; None: from 0 to where ``reference`` and ``check`` stop agreeing to
@@ -247,7 +283,10 @@ def work_precision(
     repeats = options.repeats(repeats)
     n_eval = options.n_eval(n_eval)
     for label, opts in methods.items():
-        options.method(opts.get("method", "ida"), where="work_precision", field=f"methods[{label!r}]['method']")
+        if not isinstance(opts, (Mapping, SolverOptions)):
+            options.fail("work_precision", f"methods[{label!r}]", opts, "a mapping of simulate options or a SolverOptions")
+        if not isinstance(opts, SolverOptions):  # a SolverOptions was checked when it was made
+            options.method(opts.get("method", "ida"), where="work_precision", field=f"methods[{label!r}]['method']")
     start = time.perf_counter()
     model = scene if isinstance(scene, DAEModel) else assemble(scene)
     assembly_time = time.perf_counter() - start
@@ -256,21 +295,22 @@ def work_precision(
             raise SceneError(f"work_precision: no channel {name!r} in the model; channels are "
                              f"{', '.join(model.channel_names[:8])}, ...")
     t_eval = np.linspace(0.0, t_end, n_eval)
-    ref_options = dict(reference or {"method": "DOP853", "rtol": 1e-12})
-    check_options = dict(check or {"method": "ida", "rtol": 1e-12, "formulation": "index1"})
+    ref_settings = reference if reference is not None else {"method": "DOP853", "rtol": 1e-12}
+    check_settings = check if check is not None else {"method": "ida", "rtol": 1e-12, "formulation": "index1"}
+    ref_options = ref_settings.to_dict() if isinstance(ref_settings, SolverOptions) else dict(ref_settings)
     scene_for_ref = scene if isinstance(scene, Scene) else model
-    ref = simulate(scene_for_ref, t_end, t_eval=t_eval, on_failure="raise", **ref_options)
+    ref = simulate(scene_for_ref, t_end, t_eval=t_eval, on_failure="raise", **_keywords(ref_settings))
     notes = []
     if window is None:
-        other = simulate(scene_for_ref, t_end, t_eval=t_eval, on_failure="return", **check_options)
+        other = simulate(scene_for_ref, t_end, t_eval=t_eval, on_failure="return", **_keywords(check_settings))
         if not other.success:  # without the check nothing says where the reference is converged
             raise DaeclearError(
-                f"work_precision: the check run ({', '.join(f'{k}={v}' for k, v in check_options.items())}) that "
-                f"finds where the reference is converged failed: {other.message} Give check= with other "
-                "options, or the error window with window=(t0, t1).")
+                f"work_precision: the check run ({_describe(check_settings)}) that finds where the reference is "
+                f"converged failed: {other.message} Give check= with other options, or the error window with "
+                "window=(t0, t1).")
         t_conv = converged_window(ref, other, channels, converged_tol)
         window = (0.0, t_conv)
-        reason = (f"the reference agrees with an independent run ({', '.join(f'{k}={v}' for k, v in check_options.items())}) "
+        reason = (f"the reference agrees with an independent run ({_describe(check_settings)}) "
                   f"to {converged_tol:g} of each channel's range up to there")
         if t_conv < t_end:
             notes.append(f"After t = {t_conv:.6g} s the two references diverge (sensitive dependence on the "
@@ -293,12 +333,11 @@ def work_precision(
 
 
 def _measure(rows: list[dict[str, Any]], scene_for_ref: Scene | DAEModel, ref: Result,
-             methods: Mapping[str, Mapping[str, Any]], rtols: Sequence[float], steps: Sequence[float], t_end: float,
+             methods: Mapping[str, Settings], rtols: Sequence[float], steps: Sequence[float], t_end: float,
              t_eval: NDArray, channels: Sequence[str], window: tuple[float, float], repeats: int,
              progress: bool) -> None:
     """The timed runs of every method and tolerance, appended to ``rows`` as each finishes."""
-    total = sum(len(steps if str(m.get("method", "ida")).lower() in FIXED_STEP_METHODS else rtols)
-                for m in methods.values())
+    total = sum(len(steps if _method_of(m) in FIXED_STEP_METHODS else rtols) for m in methods.values())
     bar = Progress(total, unit="runs", desc="work-precision", enabled=progress)
     try:
         _measure_all(rows, scene_for_ref, ref, methods, rtols, steps, t_end, t_eval, channels, window, repeats, bar)
@@ -308,18 +347,17 @@ def _measure(rows: list[dict[str, Any]], scene_for_ref: Scene | DAEModel, ref: R
 
 
 def _measure_all(rows: list[dict[str, Any]], scene_for_ref: Scene | DAEModel, ref: Result,
-                 methods: Mapping[str, Mapping[str, Any]], rtols: Sequence[float], steps: Sequence[float],
+                 methods: Mapping[str, Settings], rtols: Sequence[float], steps: Sequence[float],
                  t_end: float, t_eval: NDArray, channels: Sequence[str], window: tuple[float, float], repeats: int,
                  bar: Progress) -> None:
     """The loop of :func:`_measure`, reporting each run to ``bar`` as it starts."""
     done = 0
     for label, method_options in methods.items():
-        method = str(method_options.get("method", "ida")).lower()
+        method = _method_of(method_options)
         fixed = method in FIXED_STEP_METHODS
         values = steps if fixed else rtols
         for value in values:
-            opts = {k: v for k, v in method_options.items() if k not in ("rtol", "step")}
-            opts["step" if fixed else "rtol"] = value
+            opts = _with(method_options, "step" if fixed else "rtol", value)
             bar.update(done, f"{label} {'step' if fixed else 'rtol'}={value:g} ...")
             done += 1
             try:

@@ -23,6 +23,7 @@ from ..errors import DaeclearError
 from ..progress import Progress
 from ..model.mechanisms import STEEL, slider_crank
 from ..model.scene import Body, RevoluteClearance, Scene
+from ..solver_options import SolverOptions
 from ..solvers.ida import simulate
 
 REV = 60.0 / 5000.0
@@ -97,16 +98,20 @@ CASES: tuple[Case, ...] = (
 )
 
 
-def run_case(case: Case, rtol: float = 1e-6, n_eval: int = 20001) -> dict[str, Any]:
+def run_case(case: Case, rtol: float | None = None, n_eval: int = 20001, *,
+             options: SolverOptions | None = None) -> dict[str, Any]:
     """Run one case; return a row of the stability table (never raises for a solver failure).
 
+    ``options``: the solver settings of every case (default SolverOptions()); ``rtol`` (given)
+    and the case's own options override them, ``track_work`` is always on.
     Energy: E - E0 - W with the work state (``track_work=True``); drift: max |Phi| of the ideal joints.
     """
     start = time.perf_counter()
     t_eval = np.linspace(0.0, case.t_end, n_eval)
+    tolerance = {} if rtol is None else {"rtol": rtol}
     try:
-        result = simulate(case.scene(), case.t_end, t_eval=t_eval, rtol=rtol, on_failure="return",
-                          track_work=True, **case.options)
+        result = simulate(case.scene(), case.t_end, t_eval=t_eval, options=options, on_failure="return",
+                          track_work=True, **{**tolerance, **case.options})
     except DaeclearError as exc:
         return {"case": case.name, "group": case.group, "finished": False, "passed": case.expect_failure,
                 "message": f"{type(exc).__name__}: {exc}", "wall_time": time.perf_counter() - start}
@@ -127,14 +132,16 @@ def run_case(case: Case, rtol: float = 1e-6, n_eval: int = 20001) -> dict[str, A
     return row
 
 
-def run_suite(cases: tuple[Case, ...] = CASES, rtol: float = 1e-6, progress: bool = False) -> list[dict[str, Any]]:
-    """Run every case (see :data:`CASES`)."""
+def run_suite(cases: tuple[Case, ...] = CASES, rtol: float | None = None, progress: bool = False, *,
+              options: SolverOptions | None = None) -> list[dict[str, Any]]:
+    """Run every case (see :data:`CASES`) with the solver settings ``options`` (default
+    SolverOptions(), rtol 1e-6); ``rtol``, when given, overrides theirs."""
     rows = []
     bar = Progress(len(cases), unit="cases", desc="stability", enabled=progress)
     try:
         for case in cases:
             bar.update(len(rows), f"{case.name} ...")
-            rows.append(run_case(case, rtol))
+            rows.append(run_case(case, rtol, options=options))
         bar.update(len(rows), "")
     finally:
         bar.close()
