@@ -9,7 +9,8 @@ import math
 import sys
 import warnings
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 from .errors import DaeclearError, Interrupted, PhysicsWarning, SolveError
 
@@ -65,7 +66,8 @@ def build_parser() -> argparse.ArgumentParser:
     points.add_argument("--every-step", action="store_true",
                         help="report every IDA step (memory and file grow with the run, ~1.7 MB per revolution "
                              "of the chapter's slider-crank)")
-    run.add_argument("--formulation", choices=["index1", "ggl"], help="DAE formulation (default ggl; index1: the chapter's)")
+    run.add_argument("--formulation", choices=["index1", "ggl"],
+                     help="DAE formulation (default ggl; index1: the chapter's)")
     run.add_argument("--backend", choices=["auto", "c", "python"], default="auto")
     run.add_argument("--out", type=Path, default=Path("results"), help="output directory (default ./results)")
     run.add_argument("--name", help="base name of the output files (default: the scene name)")

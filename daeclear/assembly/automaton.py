@@ -17,8 +17,8 @@ direction (+1 upward, -1 downward, 0 none) and the penetration rate there, and d
 
 :func:`step` is pure. The compiled IDA loop runs a line-by-line C mirror of it (``pair_step`` in
 ``csrc/ida_driver.c``) for the pairs it switches itself and reports each decision; the Python
-logic objects (:mod:`daeclear.assembly.revolute_joint`, :mod:`daeclear.assembly.translational_joint`) run :func:`step` for the
-other backends and only record the compiled loop's decisions. ``tests/test_automaton.py`` drives
+logic objects (:mod:`daeclear.assembly.revolute_joint`, :mod:`daeclear.assembly.translational_joint`) run
+:func:`step` for the other backends and only record the compiled loop's decisions. ``tests/test_automaton.py`` drives
 both with the same random root sequences and requires identical decisions.
 """
 

@@ -26,7 +26,8 @@ The rule, storm guard included, is defined once in :mod:`daeclear.assembly.autom
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence
+from typing import Any
+from collections.abc import Callable, Sequence
 
 import casadi as ca
 import numpy as np

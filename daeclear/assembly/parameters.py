@@ -26,7 +26,8 @@ import dataclasses
 import hashlib
 import json
 import math
-from typing import Any, Iterable
+from typing import Any
+from collections.abc import Iterable
 
 import casadi as ca
 import numpy as np
@@ -141,7 +142,8 @@ _TWIN_CLASSES: dict[type, type] = {}
 def _twin_class(cls: type) -> type:
     """A subclass whose structural flags are fixed numbers, not expressions of its fields."""
     if cls not in _TWIN_CLASSES:
-        fixed = {flag: property(lambda self, flag=flag: self._fixed_flags[flag]) for flag in _FLAGS if hasattr(cls, flag)}
+        fixed = {flag: property(lambda self, flag=flag: self._fixed_flags[flag])
+                 for flag in _FLAGS if hasattr(cls, flag)}
         _TWIN_CLASSES[cls] = type(cls.__name__, (cls,), fixed)
     return _TWIN_CLASSES[cls]
 

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 import casadi as ca
 import numpy as np
@@ -102,8 +103,10 @@ class Reference:
     def joint_points(self, joint: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Body-fixed joint points of bodies i and j: ``point_i``/``point_j`` when given, else
         the world point ``at`` of the reference configuration."""
-        s_i = np.asarray(joint.point_i, dtype=float) if joint.point_i is not None else self.local_point(joint.body_i, joint.at)
-        s_j = np.asarray(joint.point_j, dtype=float) if joint.point_j is not None else self.local_point(joint.body_j, joint.at)
+        s_i = (np.asarray(joint.point_i, dtype=float) if joint.point_i is not None
+               else self.local_point(joint.body_i, joint.at))
+        s_j = (np.asarray(joint.point_j, dtype=float) if joint.point_j is not None
+               else self.local_point(joint.body_j, joint.at))
         return s_i, s_j
 
 

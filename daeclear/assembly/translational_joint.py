@@ -80,7 +80,8 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence
+from typing import Any
+from collections.abc import Callable, Sequence
 
 import casadi as ca
 import numpy as np
@@ -268,7 +269,8 @@ class SliderGuideLogic:
         return out
 
 
-def translational_clearance_parameters(ref: Reference, joint: TranslationalClearance) -> tuple[dict[str, Any], list[Any]]:
+def translational_clearance_parameters(ref: Reference,
+                                       joint: TranslationalClearance) -> tuple[dict[str, Any], list[Any]]:
     """The joint's numbers (run-time parameters) and what of it is structure."""
     law = joint.resolved_law()
     face_law = joint.resolved_face_law() if joint.contact_model == "section-4.3" else None

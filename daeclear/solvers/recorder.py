@@ -13,7 +13,8 @@ checked exactly as a run kept in memory.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
+from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import NDArray
