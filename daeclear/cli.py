@@ -134,8 +134,8 @@ def _run(args: argparse.Namespace) -> int:
         sim.pop("t_end", None)
     elif "t_end" in sim:
         t_end = sim.pop("t_end")
-    else:  # two revolutions of the first driver; 24 ms (two at the chapter's 5000 rpm) without one
-        speed = abs(float(scene.drivers[0].speed)) if scene.drivers else 0.0
+    else:  # two revolutions of the first driver; 24 ms (two at the chapter's 5000 rpm) without one or its speed
+        speed = abs(float(scene.drivers[0].speed or 0.0)) if scene.drivers else 0.0
         t_end = 4.0 * math.pi / speed if speed else 0.024
     rtol = options.rtol(args.rtol, where=where, field="--rtol") if args.rtol is not None else sim.pop("rtol", 1e-6)
     sim.pop("rtol", None)
@@ -426,7 +426,8 @@ def _sweep(args: argparse.Namespace) -> int:
         else:
             client = Client(args.dask)
         executor = client.get_executor()
-    twin = {"auto": "auto", "always": True, "never": False}[args.twin]
+    twins: dict[str, bool | str] = {"auto": "auto", "always": True, "never": False}
+    twin = twins[args.twin]
     try:
         result = sweep(args.out, grid or None, runs=points, mechanism=args.target, fixed=fixed,
                        channels=channels, keep=args.keep,

@@ -35,7 +35,7 @@ from numpy.typing import NDArray
 
 from .automaton import EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
 from ..results.result import ContactEvent
-from .symbolic import AssemblyContext, Channel, Term
+from .symbolic import AssemblyContext, BufferedFunction, Channel, Term
 
 
 @dataclass
@@ -51,7 +51,7 @@ class PairLogic:
     pair: str
     root_index: int
     term_index: int
-    rate: Callable[..., tuple[NDArray, NDArray]]  # (q, v) -> (gap, penetration rate)
+    rate: BufferedFunction  # (q, v) -> (gap, penetration rate)
     n_q: int
     needs_approach: bool
     min_approach_speed: float

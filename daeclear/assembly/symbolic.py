@@ -170,10 +170,12 @@ class BufferedFunction:
         self._inputs = [np.zeros(function.numel_in(i)) for i in range(function.n_in())]
         self._outputs = [np.zeros(function.numel_out(i)) for i in range(function.n_out())]
         self._buffer, self._eval = function.buffer()
+        # (CasADi's stub asks a size the binding takes from the memoryview; numpy types arrays as buffers
+        # only from Python 3.12 on)
         for i, a in enumerate(self._inputs):
-            self._buffer.set_arg(i, memoryview(a))
+            self._buffer.set_arg(i, memoryview(a))  # type: ignore[call-arg, arg-type]
         for i, r in enumerate(self._outputs):
-            self._buffer.set_res(i, memoryview(r))
+            self._buffer.set_res(i, memoryview(r))  # type: ignore[call-arg, arg-type]
         for a, x in zip(self._inputs[len(self._inputs) - len(self.bound):], self.bound):
             a[:] = np.ravel(x)
 

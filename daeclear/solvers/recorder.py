@@ -96,7 +96,8 @@ class Recorder:
                warnings: list[dict[str, Any]]) -> Result:
         """The run's Result: in memory, the chunks joined; streamed, the file completed and read back
         (``keep_data``) or a Result of the outcome alone (no time series, events or segments)."""
-        outcome = dict(stats=stats, success=success, status=status, message=message, warnings=warnings)
+        outcome: dict[str, Any] = dict(stats=stats, success=success, status=status, message=message,
+                                       warnings=warnings)
         if self.writer is not None:
             self.flush()
             try:
