@@ -33,7 +33,8 @@ import argparse
 import copy
 import time
 import warnings
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 import numpy as np
 
@@ -126,7 +127,8 @@ def main() -> None:
     candidates = {k: v for k, v in CANDIDATES.items() if not args.quick or k in ("index1", "ggl")}
     print(f"slider-crank, 5000 rpm, gravity on; window {WINDOW * 1e3:g} ms for onset/moment/accel, "
           f"{args.revolutions} revolutions for drift/steps/wall (best of {args.repeats})")
-    print("| scene | formulation | rtol | onset rel. err | moment err | accel err | drift (m) | drift / c | steps | cpu (s) | wall (s) |")
+    print("| scene | formulation | rtol | onset rel. err | moment err | accel err | drift (m) | drift / c | steps "
+          "| cpu (s) | wall (s) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for label, (scene, clearance) in scenes().items():
         if args.quick and label not in ("revolute c=0.5 mm", "revolute c=0.01 mm"):

@@ -45,7 +45,8 @@ def measure(label: str, make, t_end: float, repeats: int) -> None:
         wall = time.perf_counter() - start
         rows.append((wall, result.stats["solve_time"], result.stats["setup_time"]))
     wall, solve, setup = min(rows)
-    print(f"  {label:<12} wall {wall * 1e3:7.2f} ms  IDA loop {solve * 1e3:7.2f} ms  above it {(wall - solve) * 1e3:6.2f} ms "
+    print(f"  {label:<12} wall {wall * 1e3:7.2f} ms  IDA loop {solve * 1e3:7.2f} ms  "
+          f"above it {(wall - solve) * 1e3:6.2f} ms "
           f"(set-up {setup * 1e3:5.2f} ms, rest {(wall - solve - setup) * 1e3:5.2f} ms)")
 
 

@@ -23,7 +23,8 @@ build is cold and no measurement sees another's libraries or memory:
   child's descendants, sampled from /proc during the build; Linux only).
 
 Growth exponents are least-squares slopes of log(value) against log(N) over the sizes that
-finished, and the slope between the two largest of them (constant costs flatten the small sizes). Only public API is used (``daeclear.simulate``, ``daeclear.assemble``,
+finished, and the slope between the two largest of them (constant costs flatten the small sizes).
+Only public API is used (``daeclear.simulate``, ``daeclear.assemble``,
 ``daeclear.mechanisms.chain``, ``daeclear.engine.codegen.cache_dir``), so the benchmark keeps working
 when the compiled engine changes.
 
@@ -87,7 +88,7 @@ class DescendantPeak:
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
 
-    def __enter__(self) -> "DescendantPeak":
+    def __enter__(self) -> DescendantPeak:
         if self.available:
             self._thread.start()
         return self
@@ -297,7 +298,8 @@ def _sizes(text: str) -> list[int]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sizes", type=_sizes, default=[1, 2, 4, 8, 16, 32], help="chain sizes N (default 1,2,4,8,16,32)")
+    parser.add_argument("--sizes", type=_sizes, default=[1, 2, 4, 8, 16, 32],
+                        help="chain sizes N (default 1,2,4,8,16,32)")
     parser.add_argument("--t-end", type=float, default=0.05, help="simulated time of the solve measurement, s (0.05)")
     parser.add_argument("--repeats", type=int, default=3, help="warm solve repeats, best kept (3)")
     parser.add_argument("--timeout", type=float, default=300.0, help="wall-time limit per size, s (300)")

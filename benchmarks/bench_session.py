@@ -45,7 +45,8 @@ def ball_model(K=1e7):
     rt = ca.vertcat(0, -K * ca.fmax(-y[0], 0) ** 1.5)
     return DAEFunctions(
         2, ca.Function("res", [t, y, yp], [r]), ca.Function("Jac", [t, y, yp, cj], [_J(r, y, yp, cj)]),
-        (ca.Function("contact", [t, y, yp, p], [rt]),), (ca.Function("contact_J", [t, y, yp, p, cj], [_J(rt, y, yp, cj)]),),
+        (ca.Function("contact", [t, y, yp, p], [rt]),),
+        (ca.Function("contact_J", [t, y, yp, p, cj], [_J(rt, y, yp, cj)]),),
         ca.Function("gap", [t, y, yp], [y[0]]), "bench_ball",
     )
 
@@ -84,7 +85,8 @@ def chain_model(links=5, L=0.2, m=1.0, wall=0.2, K=1e9, ce=0.9, alpha=5.0, beta=
     yp0 = np.zeros(n)
     unknowns = ca.vertcat(vd, lam)
     r_dyn = r[nq:]  # equations of motion and constraints: linear in (v', lambda)
-    res_fn = ca.Function("r0", [unknowns], [ca.substitute(r_dyn, ca.vertcat(q, v, qd), ca.vertcat(y0[:nq], y0[nq:2 * nq], y0[nq:2 * nq]))])
+    known = ca.vertcat(y0[:nq], y0[nq:2 * nq], y0[nq:2 * nq])
+    res_fn = ca.Function("r0", [unknowns], [ca.substitute(r_dyn, ca.vertcat(q, v, qd), known)])
     A = np.array(ca.densify(ca.Function("A", [unknowns], [ca.jacobian(res_fn(unknowns), unknowns)])(0)))
     b = -np.array(res_fn(np.zeros(nq + links))).ravel()
     sol = np.linalg.solve(A, b)
@@ -131,7 +133,7 @@ def bench(name, funcs, y0, yp0, atol, rtol, t_end, repeat, approach_index=None):
     print(f"\n{name}: n={funcs.n}, t_end={t_end}, rtol={rtol:g}")
     print(f"  {'backend':8s} {'wall [s]':>10s} {'solve [s]':>10s} {'events':>7s} {'steps':>8s} {'res evals':>10s} "
           f"{'jac evals':>10s} {'root evals':>10s}")
-    for backend, (wall, events, st, last) in rows.items():
+    for backend, (wall, events, st, _last) in rows.items():
         print(f"  {backend:8s} {wall:10.4f} {st['solve_time']:10.4f} {events:7d} {st['n_steps']:8d} "
               f"{st['n_res_evals']:10d} {st['n_jac_evals']:10d} {st['n_root_evals']:10d}")
     ratio = rows["python"][0] / rows["c"][0]
@@ -156,7 +158,8 @@ def main(argv=None):
             s = open_session(funcs, backend="c", rtol=1e-8, atol=atol)
             total = time.perf_counter() - tic
             st = s.stats()
-            print(f"25-state model, fresh cache: open_session {total:.2f} s (code generation {st['codegen_time']:.3f} s, "
+            print(f"25-state model, fresh cache: open_session {total:.2f} s "
+                  f"(code generation {st['codegen_time']:.3f} s, "
                   f"compiler {st['compile_time']:.2f} s); SUNDIALS {s.sundials_version}")
             s.close()
             tic = time.perf_counter()

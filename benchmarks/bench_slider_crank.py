@@ -34,7 +34,8 @@ def run(label: str, scene: dc.Scene, t_end: float, rtol: float, repeats: int, ba
             best, best_wall = result, wall
     s = best.stats
     events_window = sum(1 for e in best.events if e.t >= t_window)
-    print(f"{label:<38} rtol {rtol:<6.0e} wall {best_wall * 1e3:8.2f} ms  IDA loop {s['solve_time'] * 1e3:8.2f} ms  steps {s['n_steps']:6d}  "
+    print(f"{label:<38} rtol {rtol:<6.0e} wall {best_wall * 1e3:8.2f} ms  "
+          f"IDA loop {s['solve_time'] * 1e3:8.2f} ms  steps {s['n_steps']:6d}  "
           f"res {s['n_res_evals']:6d}  jac {s['n_jac_evals']:5d}  events {s['n_events']:4d} "
           f"({events_window} in the last two revolutions)  assembly {assembly * 1e3:.0f} ms  "
           f"compile {first.stats.get('compile_time', 0.0):.2f} s  backend {best.parameters['simulate']['backend']}")

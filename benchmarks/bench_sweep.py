@@ -76,7 +76,8 @@ def main() -> None:
               "session), build excluded")
         print(f"  first point          {walls[0]:8.3f} s (symbolic template, C generation, compilation)")
         warm = sum(walls[1:]) / sum(solves[1:])
-        print(f"  points 2-{args.points}: wall / solve {warm:6.2f}     (target <= {TARGET}: {'ok' if warm <= TARGET else 'MISSED'})")
+        verdict = "ok" if warm <= TARGET else "MISSED"
+        print(f"  points 2-{args.points}: wall / solve {warm:6.2f}     (target <= {TARGET}: {verdict})")
         if args.no_sweep:
             return
         start = time.perf_counter()

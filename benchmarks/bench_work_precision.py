@@ -36,12 +36,14 @@ def study(t_end: float, channels: list[str], repeats: int) -> list[str]:
     wp = work_precision(scene, t_end, channels=channels, rtols=np.logspace(-5, -9, 5),
                         methods={"IDA": {"method": "ida"}, **RIVALS}, repeats=repeats, n_eval=400)
     ida = [r for r in wp.rows if r["label"] == "IDA"]
-    lines = ["| IDA rtol | IDA error | IDA wall | fastest rival at equal or better error | its error | its wall | ratio |",
+    lines = ["| IDA rtol | IDA error | IDA wall | fastest rival at equal or better error | its error | its wall "
+             "| ratio |",
              "|---|---|---|---|---|---|---|"]
     for row in ida:
         rivals = [r for r in wp.rows if r["label"] != "IDA" and r["status"] == 0 and r["error"] <= row["error"]]
         if not rivals or row["status"] != 0:
-            lines.append(f"| {row['tolerance']:.0e} | {row['error']:.2e} | {row['wall_time'] * 1e3:.1f} ms | none | | | |")
+            lines.append(f"| {row['tolerance']:.0e} | {row['error']:.2e} | {row['wall_time'] * 1e3:.1f} ms "
+                         "| none | | | |")
             continue
         best = min(rivals, key=lambda r: r["wall_time"])
         lines.append(f"| {row['tolerance']:.0e} | {row['error']:.2e} | {row['wall_time'] * 1e3:.1f} ms | "
@@ -60,7 +62,8 @@ def main() -> None:
     args = parser.parse_args()
     out = []
     for label, (t_end, channels) in WINDOWS.items():
-        out += [f"### Fig. 4.15 scene, {label}, whole simulate(scene) calls", ""] + study(t_end, channels, args.repeats) + [""]
+        out += [f"### Fig. 4.15 scene, {label}, whole simulate(scene) calls", ""]
+        out += study(t_end, channels, args.repeats) + [""]
         print("\n".join(out[-12:]), flush=True)
     if args.write:
         path = Path(__file__).resolve().parent.parent / "docs" / "work_precision.md"
@@ -69,7 +72,8 @@ def main() -> None:
         if MARK_BEGIN in text:
             text = text[:text.index(MARK_BEGIN)] + block + text[text.index(MARK_END) + len(MARK_END):]
         else:
-            text = text.rstrip() + "\n\n## IDA against scipy, Scene in (`python benchmarks/bench_work_precision.py`)\n\n" + block + "\n"
+            title = "## IDA against scipy, Scene in (`python benchmarks/bench_work_precision.py`)"
+            text = text.rstrip() + "\n\n" + title + "\n\n" + block + "\n"
         path.write_text(text)
         print(f"wrote {path}")
 

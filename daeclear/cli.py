@@ -9,7 +9,8 @@ import math
 import sys
 import warnings
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 from .errors import DaeclearError, Interrupted, PhysicsWarning, SolveError
 
@@ -65,7 +66,8 @@ def build_parser() -> argparse.ArgumentParser:
     points.add_argument("--every-step", action="store_true",
                         help="report every IDA step (memory and file grow with the run, ~1.7 MB per revolution "
                              "of the chapter's slider-crank)")
-    run.add_argument("--formulation", choices=["index1", "ggl"], help="DAE formulation (default ggl; index1: the chapter's)")
+    run.add_argument("--formulation", choices=["index1", "ggl"],
+                     help="DAE formulation (default ggl; index1: the chapter's)")
     run.add_argument("--backend", choices=["auto", "c", "python"], default="auto")
     run.add_argument("--out", type=Path, default=Path("results"), help="output directory (default ./results)")
     run.add_argument("--name", help="base name of the output files (default: the scene name)")
@@ -132,8 +134,8 @@ def _run(args: argparse.Namespace) -> int:
         sim.pop("t_end", None)
     elif "t_end" in sim:
         t_end = sim.pop("t_end")
-    else:  # two revolutions of the first driver; 24 ms (two at the chapter's 5000 rpm) without one
-        speed = abs(float(scene.drivers[0].speed)) if scene.drivers else 0.0
+    else:  # two revolutions of the first driver; 24 ms (two at the chapter's 5000 rpm) without one or its speed
+        speed = abs(float(scene.drivers[0].speed or 0.0)) if scene.drivers else 0.0
         t_end = 4.0 * math.pi / speed if speed else 0.024
     rtol = options.rtol(args.rtol, where=where, field="--rtol") if args.rtol is not None else sim.pop("rtol", 1e-6)
     sim.pop("rtol", None)
@@ -424,7 +426,8 @@ def _sweep(args: argparse.Namespace) -> int:
         else:
             client = Client(args.dask)
         executor = client.get_executor()
-    twin = {"auto": "auto", "always": True, "never": False}[args.twin]
+    twins: dict[str, bool | str] = {"auto": "auto", "always": True, "never": False}
+    twin = twins[args.twin]
     try:
         result = sweep(args.out, grid or None, runs=points, mechanism=args.target, fixed=fixed,
                        channels=channels, keep=args.keep,

@@ -56,7 +56,7 @@ class OldPathFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
                  if not name.startswith("_") and not isinstance(value, types.ModuleType)]
         module.__doc__ = f"Moved to {new.__name__}; this old path stays as a thin alias for one release."
         module.__dict__.update({name: getattr(new, name) for name in names})
-        module.__all__ = names
+        module.__dict__["__all__"] = names
 
 
 if not any(isinstance(finder, OldPathFinder) for finder in sys.meta_path):

@@ -132,7 +132,7 @@ def _bar(total: float, unit: str, desc: str, stream: Any) -> Any:
     """A tqdm bar on ``stream``, without tqdm's monitor thread (sweeps fork worker processes)."""
     from tqdm import tqdm
 
-    class Bar(tqdm):  # type: ignore[misc,type-arg]
+    class Bar(tqdm):
         monitor_interval = 0
 
     spec = "{n:.6g}/{total:.6g}" + (f" {unit}" if unit else "")

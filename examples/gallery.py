@@ -26,7 +26,8 @@ import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 import matplotlib
 
@@ -147,7 +148,8 @@ def markdown(sizes: dict[str, int], seconds: float) -> str:
         "title and the varied one in its panel titles or legend.",
         "",
         f"Made by `python examples/gallery.py` ({len(sizes)} images, {total / 1e3:.0f} kB, {seconds:.0f} s on the",
-        "project's 2-core machine with a warm compile cache): each example script's cases with its default settings (4 revolutions of",
+        "project's 2-core machine with a warm compile cache): each example script's cases with its default "
+        "settings (4 revolutions of",
         "transient discarded, 20 analysed for section 4.4 and 10 for section 4.5, the last two plotted),",
         f"{DPI} dpi. The command under each image makes the family's full figure set, HDF5 results and",
         "metrics into `results/<script>/`; [examples.md](examples.md) describes the scripts. The response at",

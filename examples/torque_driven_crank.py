@@ -30,7 +30,7 @@ import dataclasses
 import math
 import sys
 from pathlib import Path
-from typing import Sequence
+from collections.abc import Sequence
 
 import matplotlib
 

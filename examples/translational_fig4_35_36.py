@@ -16,7 +16,8 @@ import argparse
 import sys
 from functools import partial
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any
+from collections.abc import Callable, Sequence
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 

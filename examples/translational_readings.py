@@ -26,7 +26,8 @@ import sys
 import time
 import warnings
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 

@@ -230,7 +230,8 @@ def test_twin_perturbation_stays_on_the_constraint_manifold():
     model = dc.assemble(slider_crank("revolute", clearance=0.5e-3))
     run = dc.simulate(model, T, t_eval=sampling_times(T, 1, per_revolution=8))
     base = restart_model(model, run, 8)
-    phi0 = np.array(model.kinematics(np.array(base.start_state[: model.n_q]), np.zeros(model.n_q), 0.0, model.parameter_values)[0])
+    q0 = np.array(base.start_state[: model.n_q])
+    phi0 = np.array(model.kinematics(q0, np.zeros(model.n_q), 0.0, model.parameter_values)[0])
     for size in (1e-6, 1e-5):
         twin = restart_model(model, run, 8, perturbation=size, seed=3)
         q = np.array(twin.start_state[: model.n_q])

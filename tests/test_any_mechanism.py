@@ -149,8 +149,9 @@ def test_scene_file_clearance_table(tmp_path):
     text = """
 [scene]
 name = "loose"
-""" + PENDULUM_LINK + """clearance = { clearance = 0.1e-3, bearing_radius = 0.01, material = { young = 207e9, poisson = 0.3 }, law = { name = "lankarani-nikravesh", restitution = 0.9 } }
-"""
+""" + PENDULUM_LINK + ("clearance = { clearance = 0.1e-3, bearing_radius = 0.01, "
+                       "material = { young = 207e9, poisson = 0.3 }, "
+                       'law = { name = "lankarani-nikravesh", restitution = 0.9 } }\n')
     path = tmp_path / "loose.toml"
     path.write_text(text)
     scene = read_scene_file(path).scene

@@ -56,7 +56,7 @@ def test_compiled_automaton_takes_the_python_decisions(c_session):
                                       contact=start.contact, held=start.held, latched=start.latched)
         assert got == expected, (storm, vmin, start, times, directions, rates)
         before = start
-        for d, r, dec in zip(directions, rates, expected):
+        for _d, r, dec in zip(directions, rates, expected):
             seen["onset"] += dec.kind == ONSET
             seen["separation"] += dec.kind == SEPARATION
             seen["none"] += dec.kind == NONE

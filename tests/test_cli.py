@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from scipy.interpolate import CubicSpline
 
 import daeclear as dc
 from daeclear.cli import main
@@ -32,6 +33,19 @@ def test_run_scene_file(tmp_path):
     result = dc.load(tmp_path / "pendulum.h5")
     assert result.t[-1] == pytest.approx(0.5)
     assert result.parameters["simulate"]["rtol"] == 1e-8
+
+
+def test_run_scene_file_with_a_tabulated_driver_and_no_t_end(tmp_path):
+    # a tabulated driver has no speed to count two revolutions by: the run lasts the 24 ms default
+    path = tmp_path / "pendulum.toml"
+    path.write_text(PENDULUM + '\n[[driver]]\nname = "d"\njoint = "A"\n'
+                    'profile = { kind = "tabulated", times = [0.0, 0.01, 0.02], values = [0.0, 0.1, 0.3] }\n')
+    assert main(["run", str(path), "--out", str(tmp_path), "--no-figure", "--quiet"]) == 0
+    result = dc.load(tmp_path / "pendulum.h5")
+    assert result.t[-1] == pytest.approx(0.024)
+    # after the table the angle goes on along the natural spline's end slope
+    spline = CubicSpline([0.0, 0.01, 0.02], [0.0, 0.1, 0.3], bc_type="natural")
+    assert result["link.phi"][-1] == pytest.approx(0.3 + float(spline(0.02, 1)) * 0.004, rel=1e-6)
 
 
 @pytest.mark.parametrize(

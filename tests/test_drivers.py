@@ -59,7 +59,8 @@ def tabulated_closed(t):
     end, slope = TIMES[-1], float(spline(TIMES[-1], 1))
     inside = t <= end
     return (np.where(inside, spline(np.minimum(t, end)), VALUES[-1] + slope * (t - end)),
-            np.where(inside, spline(np.minimum(t, end), 1), slope), np.where(inside, spline(np.minimum(t, end), 2), 0.0))
+            np.where(inside, spline(np.minimum(t, end), 1), slope),
+            np.where(inside, spline(np.minimum(t, end), 2), 0.0))
 
 
 PROFILES = {
@@ -433,7 +434,8 @@ def test_slider_declared_in_its_guide_wall_is_refused():
                        r"inside the wall at t=0, 40% of the clearance 0\.0005 m .* 5e-05 m"):
         dc.simulate(slider(0.2e-3), 1e-4, start="declared")
     result = dc.simulate(slider(0.04e-3), 1e-4, start="declared", t_eval=[0.0, 1e-4])
-    depths = [result[name][0] for name in result.channel_names if name.startswith("g.") and name.endswith(".penetration")]
+    depths = [result[name][0] for name in result.channel_names
+              if name.startswith("g.") and name.endswith(".penetration")]
     assert len(depths) >= 2 and max(depths) == pytest.approx(0.04e-3, rel=1e-6)  # 8 %: started
 
 

@@ -150,7 +150,7 @@ def test_linear_ode_backends_agree_and_chunking_is_transparent():
             s.reinit(0.0, [1.0], [-2.0], [], [])
             outs[backend, buf] = s.advance(2.0), s.stats()
     ref, ref_stats = outs["c", 4096]
-    for key, (a, st) in outs.items():
+    for a, st in outs.values():
         np.testing.assert_array_equal(a.step_t, ref.step_t)  # same IDA, same steps
         np.testing.assert_allclose(a.step_y, ref.step_y, rtol=1e-13, atol=0)
         assert st["n_steps"] == ref_stats["n_steps"] and st["n_res_evals"] == ref_stats["n_res_evals"]
@@ -187,7 +187,7 @@ def test_ball_energy_and_penetration(bounces, backend):
     assert len(roots) == 12  # 6 impacts in 5 s (period 2 sqrt(2H/g) plus contact time)
     # directions alternate (onset -1, separation +1): no root is reported twice at a restart
     assert [r[1] for r in roots] == [-1, +1] * 6
-    for t, direction, y, active in roots:
+    for t, direction, y, _active in roots:
         energy = 0.5 * y[1] ** 2 + G * y[0]
         assert abs(energy - G * H) < 1e-5 * G * H, (t, energy)
         assert abs(y[0]) < 1e-12  # IDA's root is within roundoff of the crossing...
@@ -531,7 +531,8 @@ def test_term_without_parameters_and_several_terms():
     funcs = DAEFunctions(
         1, ca.Function("res", [t, y, yp], [r]), ca.Function("Jac", [t, y, yp, cj], [_J(r, y, yp, cj)]),
         (ca.Function("t0", [t, y, yp, p0], [r0]), ca.Function("t1", [t, y, yp, p1], [r1])),
-        (ca.Function("t0J", [t, y, yp, p0, cj], [_J(r0, y, yp, cj)]), ca.Function("t1J", [t, y, yp, p1, cj], [_J(r1, y, yp, cj)])),
+        (ca.Function("t0J", [t, y, yp, p0, cj], [_J(r0, y, yp, cj)]),
+         ca.Function("t1J", [t, y, yp, p1, cj], [_J(r1, y, yp, cj)])),
         None, "two_terms",
     )
     for backend in BACKENDS:
@@ -593,7 +594,8 @@ def test_extras_evaluate_over_points_like_casadi():
     a, b = ca.SX.sym("a", 2), ca.SX.sym("b")
     extra = ca.Function("extra", [a, b], [ca.vertcat(ca.sin(a[0]) * b, a[1] ** 2, a[0] + a[1])])
     funcs = DAEFunctions(n=2, residual=ca.Function("r", [t, y, yp], [res]),
-                         jacobian=ca.Function("j", [t, y, yp, c], [ca.densify(ca.jacobian(res, y) + c * ca.jacobian(res, yp))]),
+                         jacobian=ca.Function("j", [t, y, yp, c],
+                                              [ca.densify(ca.jacobian(res, y) + c * ca.jacobian(res, yp))]),
                          term_residuals=(), term_jacobians=(), roots=None, name="extras_test", extras=(extra,))
     A = np.random.default_rng(1).normal(size=(50, 2))
     expected = np.array(extra.map(50)(A.T, 3.0)).T

@@ -27,7 +27,8 @@ def slider_x(t):
 
 @pytest.fixture(scope="module")
 def ideal():
-    return dc.assemble(dc.mechanisms.slider_crank("ideal", gravity=0.0), "index1")  # the non-IDA methods integrate index-1
+    # the non-IDA methods integrate index-1
+    return dc.assemble(dc.mechanisms.slider_crank("ideal", gravity=0.0), "index1")
 
 
 @pytest.fixture(scope="module")

@@ -277,7 +277,8 @@ def _loaded_crank(scale: float) -> dc.Scene:
     multiplied by ``scale``: the structure does not change with ``scale``."""
     scene = dc.mechanisms.slider_crank("revolute", rpm=3000.0 * scale)
     ramp = dc.Table((0.0, 1e-3 * scale, 2e-3), (0.0, 5.0 * scale, 2.0))
-    wave = dc.Expression(lambda t, s, p: p.F * dc.loads.sin(p.w * t) - p.c * s.vx, F=3.0 * scale, w=900.0, c=0.1 * scale)
+    wave = dc.Expression(lambda t, s, p: p.F * dc.loads.sin(p.w * t) - p.c * s.vx,
+                         F=3.0 * scale, w=900.0, c=0.1 * scale)
     scene.add(dc.Force("push", "slider", fx=wave, fy=ramp, at=(0.17, 0.01 * scale)))
     scene.add(dc.Force("follower", "rod", fx=1.0 * scale, frame="body"))
     scene.add(dc.Torque("twist", "rod", dc.Expression(lambda t, s, p: -p.k * s.angle, k=0.2 * scale),

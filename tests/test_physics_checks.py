@@ -279,7 +279,8 @@ def test_stall_threshold_does_not_scale_with_t_end(monkeypatch):
     monkeypatch.setattr(solve, "open_session", spy)
     scene = dc.mechanisms.slider_crank("ideal")
     dc.simulate(scene, 0.01, store_steps=False, t_eval=[0.0, 0.01])
-    dc.simulate(scene, 1.0, store_steps=False, t_eval=[0.0, 1.0], max_steps=200, on_failure="return")  # the setting only
+    # the setting only
+    dc.simulate(scene, 1.0, store_steps=False, t_eval=[0.0, 1.0], max_steps=200, on_failure="return")
     assert seen[0] == seen[1] == (solve.STALL_STEP, solve.STALL_COUNT)
 
 
@@ -318,7 +319,8 @@ BODY = PENDULUM_LINK.lstrip()
 SCENE_FILE_CASES = [
     ("body_table", "[scene]\nname = \"p\"\n" + BODY.replace("[[body]]", "[body]"),
      ["[body] is a single table", "write [[body]]"]),
-    ("simulate_array", BODY + "[[simulate]]\nt_end = 1.0\n", ["[[simulate]] is an array of tables", "write [simulate]"]),
+    ("simulate_array", BODY + "[[simulate]]\nt_end = 1.0\n",
+     ["[[simulate]] is an array of tables", "write [simulate]"]),
     ("mechanism_array", "[[mechanism]]\nname = \"slider_crank\"\n", ["[[mechanism]]", "write [mechanism]"]),
     ("scene_value", "scene = \"p\"\n" + BODY, ["scene = 'p' is a string", "write [scene]"]),
     ("mass_string", BODY.replace("mass = 1.0", "mass = \"heavy\""), ["[[body]] #1", "key mass", "mass='heavy'"]),
@@ -337,7 +339,8 @@ SCENE_FILE_CASES = [
     ("law_key", BODY + "[[revolute_clearance]]\nname = \"c\"\nbody_i = \"ground\"\nbody_j = \"link\"\n"
      "at = [1.0, 0.0]\nbearing_radius = 0.01\nclearance = 1e-4\nmaterial = { young = 2e11, poisson = 0.3 }\n"
      "law = { name = \"hertz\", stiff = 3 }\n", ["[[revolute_clearance]] #1", "key law", "stiff"]),
-    ("mechanism_rpm", "[mechanism]\nname = \"slider_crank\"\nrpm = \"fast\"\n", ["[mechanism]", "key rpm", "rpm='fast'"]),
+    ("mechanism_rpm", "[mechanism]\nname = \"slider_crank\"\nrpm = \"fast\"\n",
+     ["[mechanism]", "key rpm", "rpm='fast'"]),
 ]
 
 

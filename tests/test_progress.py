@@ -1,4 +1,5 @@
-"""The progress display (daeclear/progress.py): plain rate-limited lines off a terminal, tqdm on one, nothing when off."""
+"""The progress display (daeclear/progress.py): plain rate-limited lines off a terminal, tqdm on one, nothing
+when off."""
 
 from __future__ import annotations
 

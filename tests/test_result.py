@@ -426,7 +426,7 @@ def test_to_pandas_keeps_values_units_and_dtypes() -> None:
     assert df.attrs["units"]["C.point[0]"] == "m" and df.attrs["units"]["t"] == "s"
     assert df.attrs["scene_name"] == "slider_crank" and df.attrs["method"] == "ida"
     # a copy: editing the frame leaves the result alone
-    df.iloc[0, 0] = not df.iloc[0, 0] if df.dtypes.iloc[0] == bool else df.iloc[0, 0] + 1
+    df.iloc[0, 0] = not df.iloc[0, 0] if df.dtypes.iloc[0].kind == "b" else df.iloc[0, 0] + 1
     assert result[df.columns[0]][0] != df.iloc[0, 0]
 
 

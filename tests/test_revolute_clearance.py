@@ -203,7 +203,7 @@ def test_storm_guard_holds_then_releases(monkeypatch):
     active, params = [False], [np.zeros(1)]
     up, down = np.array([1], dtype=np.int32), np.array([-1], dtype=np.int32)
     t = 0.0
-    for i in range(clearance.STORM_EVENTS):
+    for _ in range(clearance.STORM_EVENTS):
         t += 1e-8
         logic.on_roots(t, y, y, up if not active[0] else down, active, params)
     assert logic.held and active[0]  # the separation that completed the storm kept the term on

@@ -39,7 +39,8 @@ def test_bad_body_fields(field, value, match):
 def test_unknown_body_name_suggests_close_match():
     scene = pendulum_scene()
     scene.add(dc.Revolute("B", "lnk", scene.ground, at=(1.0, 0.0)))
-    with pytest.raises(SceneError, match=r"Revolute 'B': body_i refers to body 'lnk', not in scene 'pendulum'. Did you mean 'link'\?"):
+    with pytest.raises(SceneError, match=r"Revolute 'B': body_i refers to body 'lnk', not in scene 'pendulum'. "
+                                         r"Did you mean 'link'\?"):
         scene.validate()
 
 

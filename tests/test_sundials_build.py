@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from daeclear.engine import codegen
-from daeclear.errors import DaeclearError, DaeclearWarning
+from daeclear.errors import DaeclearWarning
 from daeclear.engine.ida_session import DAEFunctions, _CLib, open_session
 
 
@@ -191,7 +191,8 @@ def test_config_lists_only_modules_the_wheel_has():
     """sundials_config.h says which modules the wheel's SUNDIALS was built with: each has its
     library in the wheel, and each library the driver links is among them."""
     text = (codegen.SUNDIALS_INCLUDE / "sundials" / "sundials_config.h").read_text()
-    modules = set(re.findall(r"^#define SUNDIALS_((?:CVODE|IDA|NVECTOR|SUNMATRIX|SUNLINSOL)\w*) 1$", text, re.MULTILINE))
+    define = r"^#define SUNDIALS_((?:CVODE|IDA|NVECTOR|SUNMATRIX|SUNLINSOL)\w*) 1$"
+    modules = set(re.findall(define, text, re.MULTILINE))
     libdir, libs = codegen.sundials_libraries()
     names = {p.name.split("-")[0].removeprefix("libsundials_") for p in libdir.glob("libsundials_*.so*")}
     spelled = {m.lower().replace("nvector_", "nvec").replace("_", "") for m in modules}

@@ -205,7 +205,8 @@ def test_energy_conserved_in_the_free_slider_crank(formulation, rtol):
 
 
 def test_resting_slider_settles_at_the_static_penetration():
-    result = dc.simulate(guide_scene("corners", restitution=0.9, gravity=9.81, y0=-C + 2e-6), 0.05, start="declared", rtol=1e-8)
+    scene = guide_scene("corners", restitution=0.9, gravity=9.81, y0=-C + 2e-6)
+    result = dc.simulate(scene, 0.05, start="declared", rtol=1e-8)
     static = (M * 9.81 / (2 * K_CORNER)) ** (2 / 3)  # two corners carry m g
     assert result["g.C_lower.penetration"][-1] == pytest.approx(static, rel=1e-4)
     assert result["g.D_lower.in_contact"][-1] == 1 and result["g.A_upper.in_contact"][-1] == 0

@@ -265,8 +265,8 @@ def rewrite_imports(text: str, old_package: str | None, new_package: str | None,
                 target = f"{PKG}.plot"
             groups.setdefault(target, []).append(alias.name + (f" as {alias.asname}" if alias.asname else ""))
 
-        def render(module: str) -> str:
-            return relative(new_package, module) if node.level else module  # type: ignore[arg-type]
+        def render(module: str, relative_import: bool = bool(node.level)) -> str:
+            return relative(new_package, module) if relative_import else module  # type: ignore[arg-type]
 
         start = char_offset(lines, offsets, node.lineno, node.col_offset)
         end = char_offset(lines, offsets, node.end_lineno, node.end_col_offset)  # type: ignore[arg-type]
@@ -324,7 +324,7 @@ def rewrite_text(text: str, moves: dict[str, str], public_attrs: set[str]) -> st
     for local in sorted(set(re.findall(r"^\s*(?:>>> )?import " + PKG + r" as (\w+)", text, re.M))):
         attrs = sorted((m for m in moves if m != "plot" and m not in public_attrs), key=len, reverse=True)
         text = re.sub(r"(?<![\w.])" + local + r"\.(" + "|".join(attrs) + r")(?=\.\w)",
-                      lambda m: f"{local}.{moves[m.group(1)]}", text)
+                      lambda m, local=local: f"{local}.{moves[m.group(1)]}", text)
     path_pattern = re.compile(r"(?<![\w/])" + PKG + r"/(" + "|".join(sorted(moves, key=len, reverse=True)) + r")\.py\b")
     text = path_pattern.sub(lambda m: f"{PKG}/{moves[m.group(1)].replace('.', '/')}.py", text)
     # a module named by its bare file name in backquotes (`solve.py`): its path under the package now

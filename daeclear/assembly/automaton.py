@@ -17,8 +17,8 @@ direction (+1 upward, -1 downward, 0 none) and the penetration rate there, and d
 
 :func:`step` is pure. The compiled IDA loop runs a line-by-line C mirror of it (``pair_step`` in
 ``csrc/ida_driver.c``) for the pairs it switches itself and reports each decision; the Python
-logic objects (:mod:`daeclear.assembly.revolute_joint`, :mod:`daeclear.assembly.translational_joint`) run :func:`step` for the
-other backends and only record the compiled loop's decisions. ``tests/test_automaton.py`` drives
+logic objects (:mod:`daeclear.assembly.revolute_joint`, :mod:`daeclear.assembly.translational_joint`) run
+:func:`step` for the other backends and only record the compiled loop's decisions. ``tests/test_automaton.py`` drives
 both with the same random root sequences and requires identical decisions.
 """
 
@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass, field, replace
-from typing import Final
+from typing import Final, Literal
 
 #: Storm guard defaults: this many switches of one pair within STORM_WINDOW seconds hold its term on.
 STORM_EVENTS: Final[int] = 20
@@ -37,7 +37,8 @@ STORM_WINDOW: Final[float] = 1e-6
 NONE: Final[int] = 0
 ONSET: Final[int] = 1
 SEPARATION: Final[int] = -1
-EVENT_KINDS: Final[dict[int, str]] = {ONSET: "onset", SEPARATION: "separation"}
+# (the kinds are daeclear.results.result.EventKind, spelled here: this module imports nothing of the package)
+EVENT_KINDS: Final[dict[int, Literal["onset", "separation"]]] = {ONSET: "onset", SEPARATION: "separation"}
 
 
 @dataclass(frozen=True)

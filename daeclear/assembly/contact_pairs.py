@@ -26,7 +26,8 @@ The rule, storm guard included, is defined once in :mod:`daeclear.assembly.autom
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence
+from typing import Any
+from collections.abc import Callable, Sequence
 
 import casadi as ca
 import numpy as np
@@ -34,7 +35,7 @@ from numpy.typing import NDArray
 
 from .automaton import EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
 from ..results.result import ContactEvent
-from .symbolic import AssemblyContext, Channel, Term
+from .symbolic import AssemblyContext, BufferedFunction, Channel, Term
 
 
 @dataclass
@@ -50,7 +51,7 @@ class PairLogic:
     pair: str
     root_index: int
     term_index: int
-    rate: Callable[..., tuple[NDArray, NDArray]]  # (q, v) -> (gap, penetration rate)
+    rate: BufferedFunction  # (q, v) -> (gap, penetration rate)
     n_q: int
     needs_approach: bool
     min_approach_speed: float

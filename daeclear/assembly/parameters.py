@@ -26,7 +26,8 @@ import dataclasses
 import hashlib
 import json
 import math
-from typing import Any, Iterable
+from typing import Any
+from collections.abc import Iterable
 
 import casadi as ca
 import numpy as np
@@ -138,10 +139,15 @@ _FLAGS = ("needs_approach_speed", "dissipative", "is_resolved", "frictionless")
 _TWIN_CLASSES: dict[type, type] = {}
 
 
+def _fixed_flag(flag: str) -> property:
+    """A read-only attribute ``flag`` answered from the twin's ``_fixed_flags``."""
+    return property(lambda self: self._fixed_flags[flag])
+
+
 def _twin_class(cls: type) -> type:
     """A subclass whose structural flags are fixed numbers, not expressions of its fields."""
     if cls not in _TWIN_CLASSES:
-        fixed = {flag: property(lambda self, flag=flag: self._fixed_flags[flag]) for flag in _FLAGS if hasattr(cls, flag)}
+        fixed = {flag: _fixed_flag(flag) for flag in _FLAGS if hasattr(cls, flag)}
         _TWIN_CLASSES[cls] = type(cls.__name__, (cls,), fixed)
     return _TWIN_CLASSES[cls]
 
@@ -174,7 +180,7 @@ def _check_parametric(law: Any) -> bool:
 def _twin(law: Any, symbols: dict[str, Any]) -> Any:
     """A copy of ``law`` with some numeric fields replaced by symbols (no validation: the
     numeric law was validated already; its structural flags are kept as numbers)."""
-    twin = object.__new__(_twin_class(type(law)))
+    twin: Any = object.__new__(_twin_class(type(law)))
     object.__setattr__(twin, "_fixed_flags", {flag: getattr(law, flag) for flag in _FLAGS if hasattr(law, flag)})
     for f in dataclasses.fields(law):
         object.__setattr__(twin, f.name, symbols.get(f.name, getattr(law, f.name)))
@@ -198,7 +204,7 @@ def symbolic_law(law: Any, symbols: dict[str, Any], prefix: str) -> Any:
 def law_structure(law: Any) -> list[Any]:
     """What of a law decides the equations' shape: its class, the flags the assembly branches
     on, which fields are set, and all its numbers when it is baked."""
-    flags = [type(law).__name__]
+    flags: list[Any] = [type(law).__name__]
     for attr in ("needs_approach_speed", "dissipative", "frictionless", "smooth", "geometry"):
         if hasattr(law, attr):
             flags.append((attr, getattr(law, attr)))

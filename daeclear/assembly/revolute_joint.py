@@ -6,7 +6,8 @@ The contact-pair machinery it shares with the translational joint is :mod:`daecl
 
 from __future__ import annotations
 
-from typing import Any, Callable, Sequence
+from typing import Any
+from collections.abc import Callable, Sequence
 
 import casadi as ca
 import numpy as np

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 import casadi as ca
 import numpy as np
@@ -102,8 +103,10 @@ class Reference:
     def joint_points(self, joint: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Body-fixed joint points of bodies i and j: ``point_i``/``point_j`` when given, else
         the world point ``at`` of the reference configuration."""
-        s_i = np.asarray(joint.point_i, dtype=float) if joint.point_i is not None else self.local_point(joint.body_i, joint.at)
-        s_j = np.asarray(joint.point_j, dtype=float) if joint.point_j is not None else self.local_point(joint.body_j, joint.at)
+        s_i = (np.asarray(joint.point_i, dtype=float) if joint.point_i is not None
+               else self.local_point(joint.body_i, joint.at))
+        s_j = (np.asarray(joint.point_j, dtype=float) if joint.point_j is not None
+               else self.local_point(joint.body_j, joint.at))
         return s_i, s_j
 
 
@@ -167,10 +170,12 @@ class BufferedFunction:
         self._inputs = [np.zeros(function.numel_in(i)) for i in range(function.n_in())]
         self._outputs = [np.zeros(function.numel_out(i)) for i in range(function.n_out())]
         self._buffer, self._eval = function.buffer()
+        # (CasADi's stub asks a size the binding takes from the memoryview; numpy types arrays as buffers
+        # only from Python 3.12 on)
         for i, a in enumerate(self._inputs):
-            self._buffer.set_arg(i, memoryview(a))
+            self._buffer.set_arg(i, memoryview(a))  # type: ignore[call-arg, arg-type]
         for i, r in enumerate(self._outputs):
-            self._buffer.set_res(i, memoryview(r))
+            self._buffer.set_res(i, memoryview(r))  # type: ignore[call-arg, arg-type]
         for a, x in zip(self._inputs[len(self._inputs) - len(self.bound):], self.bound):
             a[:] = np.ravel(x)
 

@@ -80,7 +80,8 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 import casadi as ca
 import numpy as np
@@ -122,8 +123,8 @@ def _elastic_energy(numeric: Any, law: Any, d: Any) -> Any | None:
 
 
 def _unit(v: Sequence[float]) -> NDArray[np.float64]:
-    v = np.asarray(v, dtype=float)
-    return v / math.hypot(*v)
+    a = np.asarray(v, dtype=float)
+    return a / math.hypot(*a)
 
 
 @dataclass
@@ -144,7 +145,7 @@ class SliderGuideLogic:
     face_names: list[str]
     face_terms: list[int]
     face_corners: list[tuple[int, int]]
-    rate: Callable[..., tuple[NDArray, NDArray]]  # (q, v) -> (gaps, penetration rates)
+    rate: BufferedFunction  # (q, v) -> (gaps, penetration rates)
     n_q: int
     needs_approach: bool
     min_approach_speed: float
@@ -268,7 +269,8 @@ class SliderGuideLogic:
         return out
 
 
-def translational_clearance_parameters(ref: Reference, joint: TranslationalClearance) -> tuple[dict[str, Any], list[Any]]:
+def translational_clearance_parameters(ref: Reference,
+                                       joint: TranslationalClearance) -> tuple[dict[str, Any], list[Any]]:
     """The joint's numbers (run-time parameters) and what of it is structure."""
     law = joint.resolved_law()
     face_law = joint.resolved_face_law() if joint.contact_model == "section-4.3" else None
@@ -359,8 +361,9 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         d_k = side[surface] * ca.dot(n_vec, u) - 0.5 * H  # (4.17)-(4.20): -n^T delta
         d_dot = ca.jtimes(d_k, ctx.q, ctx.v)  # (4.21) along the normal
         gap = d_k
-        if limits[surface] is not None:
-            lo, hi = limits[surface][0], limits[surface][1]
+        limit = limits[surface]
+        if limit is not None:
+            lo, hi = limit[0], limit[1]
             gap = ca.fmin(d_k, ca.fmin(s_k - lo, hi - s_k))
         corner_s.append(s_k)
         corner_d.append(d_k)

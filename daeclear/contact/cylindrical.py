@@ -165,7 +165,8 @@ class _CylindricalLaw(NormalLaw):
         """``sigma_i + sigma_j`` in the law's ``sigma_convention`` (1/Pa)."""
         if self.materials is None:
             raise SceneError(f"{type(self).__name__}: materials=None; call resolve(...) first.")
-        total = self.materials[0].sigma + self.materials[1].sigma
+        material_i, material_j = material_pair(self.materials, type(self).__name__)
+        total = material_i.sigma + material_j.sigma
         return total / math.pi if self.sigma_convention == "pi" else total
 
     @abc.abstractmethod
@@ -177,6 +178,7 @@ class _CylindricalLaw(NormalLaw):
         if not self.is_resolved:
             raise SceneError(f"{type(self).__name__}: bearing_radius, journal_radius or materials is None; "
                              "call resolve(kind='internal_cylinder', radii=..., materials=...) first.")
+        assert self.bearing_radius is not None and self.journal_radius is not None  # is_resolved
         sigma_s = self.sigma_sum
         s = sigma_s / self.length
         x = self._force_scale(sigma_s, self.length, self.bearing_radius, self.journal_radius)

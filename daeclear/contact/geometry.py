@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Union
 
 from ..errors import SceneError
 from ._checks import check_number
@@ -63,7 +62,7 @@ class Material:
         return (1.0 - self.poisson**2) / self.young
 
 
-MaterialPair = Union[Material, tuple[Material, Material]]
+MaterialPair = Material | tuple[Material, Material]
 
 
 def material_pair(materials: MaterialPair | None, owner: str = "contact") -> tuple[Material, Material]:

@@ -75,7 +75,8 @@ import math
 import re
 import tomllib
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 from . import mechanisms
 from .. import options
@@ -215,7 +216,8 @@ def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any
         ideal = _element(path, table, index, cls, entry)
         if not isinstance(table_value, dict):
             raise SceneError(f"{label}: key clearance = {table_value!r} is {_a(table_value)}, must be a table of the "
-                             "clearance joint's fields, e.g. clearance = { clearance = 0.5e-3, bearing_radius = 0.01 }.")
+                             "clearance joint's fields, e.g. "
+                             "clearance = { clearance = 0.5e-3, bearing_radius = 0.01 }.")
         try:
             return clearance_joint(ideal, **_contact_fields(table_value))
         except (TypeError, ValueError, SceneError) as exc:
@@ -263,7 +265,7 @@ def check_simulate(simulate: dict[str, Any], *, where: str) -> dict[str, Any]:
         out["rtol"] = options.rtol(out["rtol"], where=where)
     if "atol" in out:
         atol = options.atol(out["atol"], where=where)
-        out["atol"] = atol.tolist() if hasattr(atol, "tolist") else atol
+        out["atol"] = atol if atol is None or isinstance(atol, float) else atol.tolist()
     if "max_step" in out:
         out["max_step"] = options.max_step(out["max_step"], where=where)
     if "allow_penetration" in out:

@@ -13,7 +13,8 @@ checked exactly as a run kept in memory.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
+from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import NDArray
@@ -95,7 +96,8 @@ class Recorder:
                warnings: list[dict[str, Any]]) -> Result:
         """The run's Result: in memory, the chunks joined; streamed, the file completed and read back
         (``keep_data``) or a Result of the outcome alone (no time series, events or segments)."""
-        outcome = dict(stats=stats, success=success, status=status, message=message, warnings=warnings)
+        outcome: dict[str, Any] = dict(stats=stats, success=success, status=status, message=message,
+                                       warnings=warnings)
         if self.writer is not None:
             self.flush()
             try:

@@ -20,7 +20,8 @@ crank moment". Measured here on sampled channels (numpy only):
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence
+from typing import Any
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -98,13 +99,13 @@ def relative_rms(x: ArrayLike, reference: ArrayLike) -> float:
 def revolution_peaks(t: ArrayLike, x: ArrayLike, period: float, t0: float | None = None) -> NDArray[np.float64]:
     """The largest ``|x|`` in each whole revolution ``[t0 + k period, t0 + (k+1) period)`` (t0: the first t);
     one value, over all of ``t``, when it spans less than one revolution."""
-    t, x = np.asarray(t, dtype=float), np.abs(np.asarray(x, dtype=float))
-    start = float(t[0]) if t0 is None else float(t0)
-    n = int(np.floor((t[-1] - start) / period + 1e-9))
+    times, size = np.asarray(t, dtype=float), np.abs(np.asarray(x, dtype=float))
+    start = float(times[0]) if t0 is None else float(t0)
+    n = int(np.floor((times[-1] - start) / period + 1e-9))
     if n == 0:
-        return np.array([np.max(x)])
-    k = np.floor((t - start) / period + 1e-9).astype(int)
-    return np.array([np.max(x[k == i]) for i in range(n) if np.any(k == i)])
+        return np.array([np.max(size)])
+    k = np.floor((times - start) / period + 1e-9).astype(int)
+    return np.array([np.max(size[k == i]) for i in range(n) if np.any(k == i)])
 
 
 def onset_times(events: Any, joint: str, t0: float = -np.inf, t1: float = np.inf, *, same: float = 1e-9) -> NDArray:
