@@ -10,29 +10,32 @@ from __future__ import annotations
 # `import daeclear` and the names bound below win over the aliases (the function `sweep` over the
 # module `daeclear.sweep`).
 from . import old_paths  # noqa: F401  (installs the finder of the old paths)
-from . import (  # noqa: F401
+# the names below are served by the old-path finder (mypy cannot see them)
+from . import (  # type: ignore[attr-defined]  # noqa: F401
     accuracy, analysis, automaton, codegen, ida_session, loads, mechanisms, outputs, physics, profiles,
     recorder, result, scene, sweep)
 
-from .studies import analysis
-from .model import loads, mechanisms, profiles
+from .studies import analysis  # noqa: F811  (the module of the new path wins over its alias)
+from .model import loads, mechanisms, profiles  # noqa: F811
 from .assembly.assemble import DAEModel, assemble
-from .errors import (AssemblyError, DaeclearError, DaeclearWarning, Interrupted, OutputError, PhysicsWarning, SceneError,
-                     SolveError)
+from .errors import (AssemblyError, DaeclearError, DaeclearWarning, Interrupted, OutputError, PhysicsWarning,
+                     SceneError, SolveError)
 from .results.result import ContactEvent, Result, load
 from .contact import Material
 from .model.loads import Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
 from .model.scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
 from .solver_options import SolverOptions
 from .solvers.ida import simulate
-from .studies.sweep import load_sweep, sweep  # the function `sweep` shadows the module: import names from daeclear.studies.sweep
+# the function `sweep` shadows the module: import names from daeclear.studies.sweep
+from .studies.sweep import load_sweep, sweep  # noqa: F811
 
 __version__ = "0.1.0"
 
 __all__ = [
     "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "Driver",
-    "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "Scene", "SceneError", "SolveError", "SolverOptions", "Translational",
-    "TranslationalClearance", "analysis", "assemble", "load", "load_sweep", "mechanisms", "profiles", "simulate", "sweep",
+    "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "Scene",
+    "SceneError", "SolveError", "SolverOptions", "Translational", "TranslationalClearance", "analysis", "assemble",
+    "load", "load_sweep", "mechanisms", "profiles", "simulate", "sweep",
     # applied loads (daeclear.loads)
     "Expression", "Force", "Motor", "RotationalSpringDamper", "SpringDamper", "Table", "Torque", "loads",
 ]

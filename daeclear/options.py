@@ -14,7 +14,8 @@ import difflib
 import math
 import os
 from pathlib import Path
-from typing import Any, Iterable, NamedTuple, NoReturn, Sequence
+from typing import Any, NamedTuple, NoReturn
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -222,7 +223,8 @@ _spacing = t_eval_step  # for output(), whose argument of that name hides the fu
 
 
 def uniform_times(spacing: float, end: float, start: float = 0.0) -> NDArray[np.float64]:
-    """Output times from ``start`` to ``end`` (both included), ``(end - start) / floor((end - start) / spacing)`` apart."""
+    """Output times from ``start`` to ``end`` (both included), ``(end - start) / floor((end - start) / spacing)``
+    apart."""
     return np.linspace(start, end, int(math.floor((end - start) / spacing)) + 1)
 
 

@@ -118,7 +118,8 @@ def checked(values: Mapping[str, Any], *, where: str) -> dict[str, Any]:
         "method": method,
         "rtol": options.rtol(values["rtol"], where=where),
         "atol": atol if atol is None or isinstance(atol, float) else tuple(float(x) for x in atol),
-        "formulation": None if values["formulation"] is None else options.formulation(values["formulation"], where=where),
+        "formulation": (None if values["formulation"] is None
+                        else options.formulation(values["formulation"], where=where)),
         "backend": options.backend(values["backend"], where=where),
         "max_step": options.max_step(values["max_step"], where=where),
         "max_steps": options.max_steps(values["max_steps"], where=where),

@@ -14,7 +14,8 @@ import logging
 import math
 import os
 import time
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -157,7 +158,8 @@ def simulate(
         "auto" (sparse for large models, see :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES`).
         The python backend and the other methods ignore it. Reported in ``result.stats``.
     start : {"ideal", "declared"}
-        How the run starts without ``y0`` (ignored with ``y0``, as is ``allow_penetration``). "ideal" (the chapter's, section 4.4): every clearance joint centred
+        How the run starts without ``y0`` (ignored with ``y0``, as is ``allow_penetration``).
+        "ideal" (the chapter's, section 4.4): every clearance joint centred
         and every position and velocity assembled on the mechanism whose clearance joints are
         ideal, from the declared state as a guess; "declared": the bodies' declared positions and
         velocities, corrected only for the scene's ideal joints.
@@ -396,11 +398,13 @@ def _run(model: DAEModel, session: Any, t0: float, y0: NDArray, yp0: NDArray, t_
                 events.extend(new_events)
                 for event in new_events:
                     modes[event.pair] = "contact" if event.kind == "onset" else "free"
+            directions = _root_directions(model, active)
             if (before[0] == active and all(np.array_equal(a, b) for a, b in zip(before[1], params))
-                    and np.array_equal(before[2], _root_directions(model, active))):
+                    and (directions is None or np.array_equal(before[2], directions))):
                 continue  # nothing switched: IDA goes on from the root without a restart, in the same segment
             segments.append((seg_start, t, before[3]))
             seg_start = t
+            assert adv.roots_found is not None  # a root return always says which roots
             y, yp = _restart_state(model, session, t, y, yp, model.term_forces(t, y, active, params, session),
                                    adv.roots_found)
             switch = model.switch_vector(active, params)
@@ -526,7 +530,8 @@ def _failure_message(model: DAEModel, adv: Any, modes: dict[str, str]) -> str:
     where = f" with {', '.join(repr(p) for p in in_contact)} in contact" if in_contact else ""
     flag = f" ({adv.flag_name})" if adv.flag_name else ""
     detail = f": {adv.message}" if adv.message else ""
-    advice = "Try a smaller max_step, a tighter rtol" + (", or formulation='ggl'." if model.formulation != "ggl" else ".")
+    advice = "Try a smaller max_step, a tighter rtol" + (", or formulation='ggl'." if model.formulation != "ggl"
+                                                         else ".")
     if adv.flag_name == "DC_MAX_STEPS":  # not an accuracy problem: the run needs more steps
         advice = ("The run needs more steps than max_steps allows: raise max_steps (daeclear run: --max-steps) "
                   "in proportion to the time still to go.")

@@ -16,7 +16,8 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -106,8 +107,7 @@ class WorkPrecision:
         for row in self.rows:
             if row["label"] != label or row["status"] != 0:
                 continue
-            rivals = [self.best(o, row["error"]) for o in others]
-            rivals = [r for r in rivals if r is not None]
+            rivals = [r for r in (self.best(o, row["error"]) for o in others) if r is not None]
             if rivals:
                 rival = min(rivals, key=lambda r: r["wall_time"])
                 out.append({"tolerance": row["tolerance"], "error": row["error"], "wall_time": row["wall_time"],
@@ -284,7 +284,8 @@ def work_precision(
     n_eval = options.n_eval(n_eval)
     for label, opts in methods.items():
         if not isinstance(opts, (Mapping, SolverOptions)):
-            options.fail("work_precision", f"methods[{label!r}]", opts, "a mapping of simulate options or a SolverOptions")
+            options.fail("work_precision", f"methods[{label!r}]", opts,
+                         "a mapping of simulate options or a SolverOptions")
         if not isinstance(opts, SolverOptions):  # a SolverOptions was checked when it was made
             options.method(opts.get("method", "ida"), where="work_precision", field=f"methods[{label!r}]['method']")
     start = time.perf_counter()

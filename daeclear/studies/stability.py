@@ -13,7 +13,8 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 import numpy as np
 
@@ -136,7 +137,7 @@ def run_suite(cases: tuple[Case, ...] = CASES, rtol: float | None = None, progre
               options: SolverOptions | None = None) -> list[dict[str, Any]]:
     """Run every case (see :data:`CASES`) with the solver settings ``options`` (default
     SolverOptions(), rtol 1e-6); ``rtol``, when given, overrides theirs."""
-    rows = []
+    rows: list[dict[str, Any]] = []
     bar = Progress(len(cases), unit="cases", desc="stability", enabled=progress)
     try:
         for case in cases:
@@ -155,7 +156,8 @@ def to_markdown(rows: list[dict[str, Any]], rtol: float) -> str:
         f"contact forces integrated with the equations (track_work=True); bounds: energy {ENERGY_BOUND:g}, "
         f"constraint drift {DRIFT_BOUND:g} m and at most half the clearance.",
         "",
-        "| case | passed | finished | wall (s) | steps | events | max penetration (m) | energy residual | drift (m) | message |",
+        "| case | passed | finished | wall (s) | steps | events | max penetration (m) | energy residual | drift (m) "
+        "| message |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
