@@ -281,7 +281,8 @@ class PythonSession(SessionBase):
                     filled = ie < te.size and te[ie] <= t_new
                     if filled:
                         j = int(np.searchsorted(te, t_new, side="right"))
-                        yy, yyp = cubic_hermite(t_prev, y_prev, yp_prev, t_new, y_new, yp_new, te[ie:j], derivative=True)
+                        yy, yyp = cubic_hermite(t_prev, y_prev, yp_prev, t_new, y_new, yp_new, te[ie:j],
+                                                derivative=True)
                         ev_y[ie:j], ev_yp[ie:j] = yy, yyp
                         ie = j
                     if store_steps and t_new > t_rec:
