@@ -9,7 +9,7 @@ each is reported with the IDA loop's own time (``stats["solve_time"]``), the ste
 evaluations and the nonzeros of the union Jacobian pattern the sparse solver factors.
 
 ``ratio`` is dense wall / sparse wall: above 1 the sparse solver is faster. The threshold
-``daeclear.engine.ida_session.SPARSE_MIN_STATES`` of ``linear_solver="auto"`` is set from this table.
+``daeclear.engine.c_session.SPARSE_MIN_STATES`` of ``linear_solver="auto"`` is set from this table.
 Only public API is used (``daeclear.simulate``, ``daeclear.mechanisms.chain``).
 
     python benchmarks/bench_linear_solver.py [--sizes 1,2,4,8,16,32] [--t-end 0.01] [--repeats 5] [--rtol 1e-6]

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.engine import ida_session
+from daeclear.engine import c_session, ida_session
 from daeclear.errors import DaeclearError, SceneError
 from daeclear.engine.ida_session import DAEFunctions, open_session
 from daeclear.model.mechanisms import chain, slider_crank
@@ -61,7 +61,7 @@ def test_option_is_validated_with_a_clear_message():
 def test_auto_uses_the_measured_threshold(monkeypatch):
     s = open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8)
     assert s.linear_solver == "dense" and ida_session.SPARSE_MIN_STATES > 2
-    monkeypatch.setattr(ida_session, "SPARSE_MIN_STATES", 2)
+    monkeypatch.setattr(c_session, "SPARSE_MIN_STATES", 2)
     assert open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8).linear_solver == "sparse"
     assert open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="dense").linear_solver == "dense"
 
@@ -73,8 +73,8 @@ def test_python_backend_stays_dense():
 
 def test_sparse_unavailable_is_a_clear_error():
     with pytest.raises(DaeclearError, match="linear_solver='sparse' is not available"):
-        ida_session._resolve_linear_solver("sparse", 100, has_sparse=False)
-    assert ida_session._resolve_linear_solver("auto", 10_000, has_sparse=False) == "dense"
+        c_session._resolve_linear_solver("sparse", 100, has_sparse=False)
+    assert c_session._resolve_linear_solver("auto", 10_000, has_sparse=False) == "dense"
 
 
 # --------------------------------------------------------------------------- union pattern

@@ -2,7 +2,7 @@
 wheel, equal to those of the vendored SUNDIALS headers, handed to the compiler, kept in the cache
 key, and checked before a library is used.
 
-Libraries built for a faked SUNDIALS (``codegen.sundials_info`` monkeypatched, with a copy of the
+Libraries built for a faked SUNDIALS (``sundials.sundials_info`` monkeypatched, with a copy of the
 vendored headers made to describe that SUNDIALS: :func:`fake`) must be refused or rebuilt, never
 run: a wrong ``sunindextype`` width would be silent memory corruption.
 """
@@ -22,9 +22,10 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from daeclear.engine import codegen
+from daeclear.engine import codegen, sundials
 from daeclear.errors import DaeclearWarning
-from daeclear.engine.ida_session import DAEFunctions, _CLib, open_session
+from daeclear.engine.ida_session import DAEFunctions, open_session
+from daeclear.engine.library import ModelLibrary
 
 
 @pytest.fixture(autouse=True)
@@ -56,8 +57,8 @@ def test_detection_matches_the_wheel():
     core = libs["sundials_core"]
     assert core.name.endswith(".so." + info.version)  # file name and SUNDIALSGetVersionNumber agree
     assert info.version_tuple[0] == codegen.SUNDIALS_MAJOR
-    pxi = codegen._sksundae_dir() / "c_config.pxi"
-    assert info.index_size == codegen.parse_index_size(pxi.read_text()) == codegen._probe_index_size(libs)
+    pxi = sundials._sksundae_dir() / "c_config.pxi"
+    assert info.index_size == codegen.parse_index_size(pxi.read_text()) == sundials._probe_index_size(libs)
     assert info.has_sparse == all(name in libs for name in codegen.SPARSE_LIBS)
     major, minor, patch = info.version_tuple
     assert info.compile_flags() == [f"-DDC_SUNDIALS_MAJOR={major}", f"-DDC_SUNDIALS_MINOR={minor}",
@@ -85,18 +86,18 @@ def test_undeterminable_or_contradictory_build_fails_clearly(monkeypatch, tmp_pa
     codegen.sundials_libraries()  # cached with the real wheel before _sksundae_dir is faked
     detect = codegen.sundials_info.__wrapped__  # the detection itself, not its per-process cache
     # c_config.pxi and the libraries disagree
-    monkeypatch.setattr(codegen, "_probe_index_size", lambda libs: 64)
+    monkeypatch.setattr(sundials, "_probe_index_size", lambda libs: 64)
     with pytest.raises(codegen.SundialsMismatch, match="declares a 32-bit sunindextype but .* use 64-bit"):
         detect()
     # no c_config.pxi: the probe decides alone ...
-    monkeypatch.setattr(codegen, "_sksundae_dir", lambda: tmp_path)
+    monkeypatch.setattr(sundials, "_sksundae_dir", lambda: tmp_path)
     assert detect().index_size == 64
     # ... and nothing is guessed when it cannot
-    monkeypatch.setattr(codegen, "_probe_index_size", lambda libs: None)
+    monkeypatch.setattr(sundials, "_probe_index_size", lambda libs: None)
     with pytest.raises(codegen.CompilerUnavailable, match="cannot determine the SUNDIALS index size"):
         detect()
     # the file name and the library disagree on the version
-    monkeypatch.setattr(codegen, "_version_from_library", lambda core: "7.8.3")
+    monkeypatch.setattr(sundials, "_version_from_library", lambda core: "7.8.3")
     with pytest.raises(codegen.SundialsMismatch, match="named for SUNDIALS 7.9.0 but reports version 7.8.3"):
         detect()
 
@@ -125,10 +126,10 @@ def fake(monkeypatch, *, headers: bool = True, **changes) -> codegen.SundialsInf
     """Pretend the wheel has another SUNDIALS build; with ``headers``, daeclear also vendors the
     matching headers (a copy made by headers_for in the test's temporary directory)."""
     info = dataclasses.replace(codegen.sundials_info(), **changes)
-    monkeypatch.setattr(codegen, "sundials_info", lambda: info)
+    monkeypatch.setattr(sundials, "sundials_info", lambda: info)
     if headers:
         root = Path(os.environ["DAECLEAR_CACHE_DIR"]).parent / "headers"
-        monkeypatch.setattr(codegen, "SUNDIALS_INCLUDE", headers_for(root, info.version, info.index_size))
+        monkeypatch.setattr(sundials, "SUNDIALS_INCLUDE", headers_for(root, info.version, info.index_size))
     return info
 
 
@@ -218,7 +219,7 @@ def test_header_change_rebuilds(monkeypatch, tmp_path):
     """Any byte of a vendored header is in the cache key."""
     before = codegen.build_model_library(decay_model(1.75, "headers"))
     copy = headers_for(tmp_path, codegen.sundials_info().version, codegen.sundials_info().index_size)
-    monkeypatch.setattr(codegen, "SUNDIALS_INCLUDE", copy)
+    monkeypatch.setattr(sundials, "SUNDIALS_INCLUDE", copy)
     same_bytes = codegen.build_model_library(decay_model(1.75, "headers"))
     assert not same_bytes.cache_hit and same_bytes.key != before.key  # other path, other command
     types = copy / "sundials" / "sundials_types.h"
@@ -247,7 +248,7 @@ def test_another_major_version_is_refused_by_the_header(monkeypatch):
     with pytest.raises(codegen.SundialsMismatch,
                        match=r"SUNDIALS 8\.0\.0 with a 32-bit .* vendored SUNDIALS headers .* are version 7\.9\.0"):
         open_session(decay_model(1.5, "major8"), backend="c", rtol=1e-8, atol=1e-10)
-    monkeypatch.setattr(codegen, "check_vendored", lambda info: None)
+    monkeypatch.setattr(sundials, "check_vendored", lambda info: None)
     with pytest.raises(codegen.CompileError, match=r"#error .*are not version 7\.9\.0, the version of the vendored"):
         open_session(decay_model(1.5, "major8"), backend="c", rtol=1e-8, atol=1e-10)
 
@@ -256,7 +257,7 @@ def test_mismatched_index_size_stops_the_build(monkeypatch):
     fake(monkeypatch, index_size=64, headers=False)
     with pytest.raises(codegen.SundialsMismatch, match="64-bit sunindextype, but .* 32-bit sunindextype"):
         codegen.build_model_library(decay_model(1.5, "wide"))
-    monkeypatch.setattr(codegen, "check_vendored", lambda info: None)
+    monkeypatch.setattr(sundials, "check_vendored", lambda info: None)
     with pytest.raises(codegen.CompileError, match="#error .*do not use the 32-bit sunindextype"):
         codegen.build_model_library(decay_model(1.5, "wide"))
 
@@ -271,7 +272,7 @@ def test_stale_library_is_rebuilt_not_loaded(monkeypatch, caplog):
         fake(m, version="7.8.1", index_size=64)
         stale = codegen.build_model_library(decay_model(2.5, "stale"))
     real = codegen.build_model_library(decay_model(2.5, "stale"))
-    assert real.path != stale.path and str(real.path) not in _CLib._cache
+    assert real.path != stale.path and str(real.path) not in ModelLibrary._cache
     shutil.copyfile(stale.path, real.path)  # the stale library under the current key,
     shutil.copyfile(stale.path.with_suffix(".sha256"), real.path.with_suffix(".sha256"))  # intact
     funcs = decay_model(2.5, "stale")

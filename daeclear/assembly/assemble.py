@@ -36,9 +36,9 @@ import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..engine.codegen import memo_table
+from ..engine.build import memo_table
 from ..errors import AssemblyError, SceneError
-from ..engine.ida_session import DAEFunctions, StateLayout
+from ..engine.session_base import DAEFunctions, StateLayout
 from ..options import DEFAULT_FORMULATION, FORMULATIONS
 from .parameters import ParameterTable, structure_key
 from ..solvers.physics import check_start_penetration

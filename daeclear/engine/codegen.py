@@ -1,6 +1,6 @@
-"""C code generation and compilation of a DAE model for the compiled IDA backend.
+"""C code generation of a DAE model (and of an ODE model) from its CasADi functions.
 
-``build_model_library(funcs)`` turns a :class:`daeclear.engine.ida_session.DAEFunctions` into a shared
+``build_model_library(funcs)`` turns a :class:`daeclear.engine.session_base.DAEFunctions` into a shared
 library that holds
 
 * the model's CasADi functions generated as C by ``casadi.CodeGenerator`` (symbols ``dc_res``,
@@ -13,48 +13,63 @@ library that holds
 
 linked against the SUNDIALS libraries shipped inside the scikit-sundae wheel
 (``<site-packages>/scikit_sundae.libs``) by full path, with that directory as rpath (and ``-z defs``:
-a function the libraries lack fails the link). The wheel has no SUNDIALS headers; the driver is
-compiled against the real SUNDIALS headers of the wheel's release, vendored unmodified in
-``csrc/sundials/include`` with a ``sundials_config.h`` describing the wheel's build (see
-``csrc/sundials/README.md``). :func:`sundials_info` detects the wheel's SUNDIALS version and
-``sunindextype`` width; they must equal the vendored headers' (:func:`vendored_sundials`, checked
-before compiling) and are handed to the compiler (``-DDC_SUNDIALS_MAJOR=7 ... -DDC_INDEX_SIZE=32``),
-where ``sundials_config.h`` checks them again with ``#error``. The sparse matrix and SuperLU_MT
-libraries are linked too when the wheel has them (``-DDC_HAVE_SPARSE=1``: the sparse linear
-solver of the driver).
+a function the libraries lack fails the link). The driver is compiled against the vendored SUNDIALS
+headers (:mod:`daeclear.engine.sundials`): the wheel's SUNDIALS version and ``sunindextype`` width
+must equal the vendored headers' (checked before compiling) and are handed to the compiler
+(``-DDC_SUNDIALS_MAJOR=7 ... -DDC_INDEX_SIZE=32``), where ``sundials_config.h`` checks them again
+with ``#error``. The sparse matrix and SuperLU_MT libraries are linked too when the wheel has them
+(``-DDC_HAVE_SPARSE=1``: the sparse linear solver of the driver). ``build_ode_library`` does the
+same for an :class:`OdeSpec` with ``csrc/ode_driver.c`` and no SUNDIALS.
 
-Libraries are cached: the key is the SHA-256 of the generated source, the driver sources and
-every vendored SUNDIALS header, the compiler command (with those flags) and version, the
-SUNDIALS version and index size, and the SUNDIALS library paths. The cache directory is
-``$DAECLEAR_CACHE_DIR`` or ``~/.cache/daeclear``. A build compiles into a private temporary
-directory and moves the result into place with ``os.replace`` under a per-key file lock, so
-concurrent processes building the same model neither corrupt nor duplicate each other's work.
+Compiling and caching is :mod:`daeclear.engine.build` (the key also holds every vendored SUNDIALS
+header, the SUNDIALS version and index size, and the SUNDIALS library paths), loading is
+:mod:`daeclear.engine.library`. The names of both that were defined here before are still
+importable from this module.
 """
 
 from __future__ import annotations
 
-import contextlib
-import ctypes
-import functools
 import dataclasses
+import functools
 import hashlib
-import importlib.util
-import os
-import re
-import shlex
-import shutil
-import subprocess
-import sysconfig
-import tempfile
 import time
-import weakref
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import casadi
 
-from ..errors import AssemblyError, DaeclearError
+from . import sundials
+from ..errors import AssemblyError
+from .build import (
+    CSRC,
+    BuildResult,
+    CompileError,
+    CompilerUnavailable,
+    MemoTable,
+    cache_dir,
+    clear_memos,
+    compile_cached,
+    compiler_command,
+    memo_get,
+    memo_put,
+    memo_table,
+)
+from .library import DRIVER_ABI, ODE_DRIVER_ABI
+from .sundials import (
+    SPARSE_LIBS,
+    SUNDIALS_INCLUDE,
+    SUNDIALS_LIBS,
+    SUNDIALS_MAJOR,
+    SundialsInfo,
+    SundialsMismatch,
+    check_vendored,
+    parse_index_size,
+    read_build_tag,
+    sundials_info,
+    sundials_libraries,
+    vendored_sundials,
+)
 
 __all__ = [
     "CompilerUnavailable",
@@ -76,46 +91,23 @@ __all__ = [
     "cache_dir",
     "build_model_library",
     "clear_memos",
+    # also re-exported from their new homes (build, sundials, library)
+    "CSRC",
+    "SUNDIALS_LIBS",
+    "SPARSE_LIBS",
+    "SUNDIALS_MAJOR",
+    "DRIVER_ABI",
+    "ODE_DRIVER_ABI",
+    "MemoTable",
+    "memo_table",
+    "memo_get",
+    "memo_put",
+    "compile_cached",
 ]
 
-CSRC = Path(__file__).resolve().parent / "csrc"
 DRIVER_SOURCES = ("ida_driver.c", "dc_model.h", "dc_linalg.h")
-#: The vendored SUNDIALS headers (csrc/sundials/README.md), the include path of the IDA driver;
-#: every file of its parent folder is in the cache key.
-SUNDIALS_INCLUDE = CSRC / "sundials" / "include"
-SUNDIALS_LIBS = (
-    "sundials_ida",
-    "sundials_core",
-    "sundials_nvecserial",
-    "sundials_sunmatrixdense",
-    "sundials_sunlinsoldense",
-)
-#: Linked when the wheel has both: the driver's sparse linear solver (SuperLU_MT on a
-#: SUNSparseMatrix). SuperLU_MT's own BLAS and OpenMP libraries sit in the same folder.
-SPARSE_LIBS = ("sundials_sunmatrixsparse", "sundials_sunlinsolsuperlumt")
-#: The SUNDIALS major version of the vendored headers (their sundials_config.h #errors on any
-#: other version than theirs; vendored_sundials reads the full one).
-SUNDIALS_MAJOR = 7
-#: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
-#: and checked when a library is loaded: bump it when a dc_* signature changes.
-DRIVER_ABI = 3
-#: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
-ODE_DRIVER_ABI = 3
 CFLAGS = (f"-DDC_ABI_VERSION={DRIVER_ABI}", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Werror=incompatible-pointer-types",
           "-Werror=implicit-function-declaration", "-Wl,-z,defs")
-
-
-class CompilerUnavailable(DaeclearError):
-    """No working C compiler (or no SUNDIALS libraries) for the compiled backend."""
-
-
-class CompileError(DaeclearError):
-    """The C compiler failed on the generated model; the message holds its output."""
-
-
-class SundialsMismatch(CompilerUnavailable):
-    """The wheel's SUNDIALS libraries contradict themselves or a compiled library: its version or
-    index size cannot be trusted, so the compiled backend is not used."""
 
 
 # --------------------------------------------------------------------------- normalisation
@@ -314,301 +306,14 @@ def generate_source(model: NormalizedModel) -> str:
     return src + "\n".join(lines)
 
 
-# --------------------------------------------------------------------------- toolchain
-
-
-def compiler_command() -> list[str]:
-    """The C compiler command: $CC, else sysconfig's CC, else cc/gcc. Raises CompilerUnavailable."""
-    env_cc = os.environ.get("CC")
-    candidates: list[tuple[str, str]] = []
-    if env_cc is not None and env_cc.strip():
-        candidates.append((env_cc, "$CC"))
-    else:
-        cfg = sysconfig.get_config_var("CC")
-        if cfg:
-            candidates.append((cfg, "sysconfig CC"))
-        candidates += [("cc", "default"), ("gcc", "default")]
-    tried = []
-    for cmd, origin in candidates:
-        parts = shlex.split(cmd)
-        if not parts:
-            continue
-        exe = shutil.which(parts[0])
-        if exe is not None:
-            return [exe, *parts[1:]]
-        tried.append(f"{parts[0]!r} ({origin})")
-        if origin == "$CC":
-            break  # an explicit $CC is not second-guessed
-    raise CompilerUnavailable(f"no C compiler found: tried {', '.join(tried)}")
-
-
-@functools.lru_cache(maxsize=16)
-def _compiler_version(exe: str) -> str:
-    try:
-        out = subprocess.run([exe, "--version"], capture_output=True, text=True, timeout=30)
-        return (out.stdout or out.stderr).strip().splitlines()[0] if (out.stdout or out.stderr) else ""
-    except (OSError, subprocess.SubprocessError) as exc:
-        raise CompilerUnavailable(f"C compiler {exe!r} does not run: {exc}") from exc
-
-
-def _sksundae_dir() -> Path:
-    spec = importlib.util.find_spec("sksundae")
-    if spec is None or spec.origin is None:
-        raise CompilerUnavailable("scikit-sundae (sksundae) is not installed")
-    return Path(spec.origin).resolve().parent
-
-
-@functools.lru_cache(maxsize=1)
-def sundials_libraries() -> tuple[Path, dict[str, Path]]:
-    """(directory, {name: path}) of the SUNDIALS shared libraries inside the scikit-sundae wheel:
-    every one of ``SUNDIALS_LIBS``, and those of ``SPARSE_LIBS`` that are present."""
-    libdir = _sksundae_dir().parent / "scikit_sundae.libs"
-    if not libdir.is_dir():
-        raise CompilerUnavailable(f"SUNDIALS libraries not found: {libdir} does not exist")
-    found: dict[str, Path] = {}
-    for name in SUNDIALS_LIBS + SPARSE_LIBS:
-        hits = sorted(libdir.glob(f"lib{name}-*.so*"))
-        if hits:
-            found[name] = hits[0]
-        elif name in SUNDIALS_LIBS:
-            raise CompilerUnavailable(f"SUNDIALS library lib{name} not found in {libdir}")
-    return libdir, found
-
-
-@dataclass(frozen=True)
-class SundialsInfo:
-    """What the compiled driver depends on in the wheel's SUNDIALS build.
-
-    ``version`` is major.minor.patch; ``index_size`` the width of ``sunindextype`` in bits (32 or
-    64), which sizes every vector, matrix and sparse index the driver hands to SUNDIALS;
-    ``has_sparse`` whether the sparse matrix and SuperLU_MT libraries are there.
-    """
-
-    version: str
-    index_size: int
-    has_sparse: bool
-
-    @property
-    def version_tuple(self) -> tuple[int, int, int]:
-        major, minor, patch = (int(x) for x in self.version.split("."))
-        return major, minor, patch
-
-    def compile_flags(self) -> list[str]:
-        """The -D flags that tell the vendored sundials_config.h and csrc/ida_driver.c what they
-        build for (the header #errors when they disagree with it)."""
-        major, minor, patch = self.version_tuple
-        return [f"-DDC_SUNDIALS_MAJOR={major}", f"-DDC_SUNDIALS_MINOR={minor}", f"-DDC_SUNDIALS_PATCH={patch}",
-                f"-DDC_INDEX_SIZE={self.index_size}", f"-DDC_HAVE_SPARSE={int(self.has_sparse)}"]
-
-
-#: C spellings of sunindextype in c_config.pxi (Linux, LP64) and their width in bits
-_INDEX_TYPES = {"int": 32, "int32_t": 32, "long": 64, "long int": 64, "long long": 64, "long long int": 64,
-                "int64_t": 64}
-
-
-def parse_index_size(text: str, source: str = "c_config.pxi") -> int | None:
-    """Width in bits of ``sunindextype`` declared in scikit-sundae's ``c_config.pxi`` (``ctypedef
-    int sunindextype``); None when the file declares none; CompilerUnavailable for a type that is
-    not a known 32- or 64-bit integer (guessing would corrupt memory)."""
-    m = re.search(r"^\s*ctypedef\s+([A-Za-z_][\w ]*?)\s+sunindextype\s*(?:#.*)?$", text, re.MULTILINE)
-    if m is None:
-        return None
-    decl = " ".join(m.group(1).split())
-    if decl not in _INDEX_TYPES:
-        raise CompilerUnavailable(f"{source} declares sunindextype as {decl!r}, which is not one of "
-                                  f"{', '.join(sorted(_INDEX_TYPES))}: cannot tell the SUNDIALS index size")
-    return _INDEX_TYPES[decl]
-
-
-_CONFIG_MACRO = re.compile(r"^#define (SUNDIALS_VERSION_MAJOR|SUNDIALS_VERSION_MINOR|SUNDIALS_VERSION_PATCH|"
-                           r"SUNDIALS_INT32_T|SUNDIALS_INT64_T)\b\s*(\d*)", re.MULTILINE)
-
-
-def vendored_sundials() -> tuple[str, int]:
-    """(version, sunindextype bits) of the vendored SUNDIALS headers, read from their
-    ``sundials_config.h``; CompilerUnavailable when the file is missing or says neither."""
-    config = SUNDIALS_INCLUDE / "sundials" / "sundials_config.h"
-    try:
-        macros = dict(_CONFIG_MACRO.findall(config.read_text()))
-    except OSError as exc:
-        raise CompilerUnavailable(f"the vendored SUNDIALS headers are missing: {config} ({exc})") from exc
-    parts = [macros.get(f"SUNDIALS_VERSION_{x}", "") for x in ("MAJOR", "MINOR", "PATCH")]
-    widths = [bits for bits in (32, 64) if f"SUNDIALS_INT{bits}_T" in macros]
-    if not all(parts) or len(widths) != 1:
-        raise CompilerUnavailable(f"{config} defines no SUNDIALS version or no single index type")
-    return ".".join(parts), widths[0]
-
-
-def check_vendored(info: SundialsInfo) -> None:
-    """SundialsMismatch unless the wheel's SUNDIALS (version, index width) is the one the vendored
-    headers describe: compiling the driver against other headers would corrupt memory."""
-    version, bits = vendored_sundials()
-    if (info.version, info.index_size) != (version, bits):
-        raise SundialsMismatch(
-            f"the installed scikit-sundae has SUNDIALS {info.version} with a {info.index_size}-bit sunindextype, "
-            f"but daeclear's vendored SUNDIALS headers (daeclear/engine/csrc/sundials) are version {version} with a "
-            f"{bits}-bit sunindextype: install the scikit-sundae release built on SUNDIALS {version}, or vendor "
-            f"the headers of SUNDIALS {info.version} (csrc/sundials/README.md says how)")
-
-
-def _version_from_name(path: Path) -> str | None:
-    """``libsundials_core-<hash>.so.7.9.0`` -> "7.9.0" (the core library's version is SUNDIALS')."""
-    m = re.search(r"\.so\.(\d+)\.(\d+)\.(\d+)$", path.name)
-    return ".".join(m.groups()) if m else None
-
-
-def _version_from_library(core: Path) -> str | None:
-    """SUNDIALSGetVersionNumber of the core library, or None when it cannot be called."""
-    try:
-        lib = ctypes.CDLL(str(core))
-        fn = lib.SUNDIALSGetVersionNumber
-    except (OSError, AttributeError):
-        return None
-    parts = [ctypes.c_int(-1) for _ in range(3)]
-    label = ctypes.create_string_buffer(64)
-    fn.restype = ctypes.c_int
-    fn.argtypes = [ctypes.POINTER(ctypes.c_int)] * 3 + [ctypes.c_char_p, ctypes.c_int]
-    if fn(*(ctypes.byref(x) for x in parts), label, 64) != 0 or min(x.value for x in parts) < 0:
-        return None
-    return ".".join(str(x.value) for x in parts)
-
-
-def _probe_index_size(libs: dict[str, Path]) -> int | None:
-    """Width of sunindextype the libraries were really built with, or None if it cannot be probed.
-
-    Public API only: a dense 2 x 2 matrix converted to CSC has column pointers [0, 2, 4]; read as
-    32-bit integers they are [0, 2, 4] in an int32 build and [0, 0, 2] in an int64 one. The
-    sizes are passed as 64-bit values, which either build reads correctly (x86-64 registers).
-    """
-    try:
-        core = ctypes.CDLL(str(libs["sundials_core"]))
-        dense = ctypes.CDLL(str(libs["sundials_sunmatrixdense"]))
-        sparse = ctypes.CDLL(str(libs["sundials_sunmatrixsparse"]))
-    except (OSError, KeyError):
-        return None
-    V = ctypes.c_void_p
-    core.SUNContext_Create.argtypes = [ctypes.c_int, ctypes.POINTER(V)]
-    core.SUNContext_Free.argtypes = [ctypes.POINTER(V)]
-    core.SUNMatDestroy.argtypes = [V]
-    core.SUNMatDestroy.restype = None
-    dense.SUNDenseMatrix.argtypes = [ctypes.c_int64, ctypes.c_int64, V]
-    dense.SUNDenseMatrix.restype = V
-    dense.SUNDenseMatrix_Data.argtypes = [V]
-    dense.SUNDenseMatrix_Data.restype = ctypes.POINTER(ctypes.c_double)
-    sparse.SUNSparseFromDenseMatrix.argtypes = [V, ctypes.c_double, ctypes.c_int]
-    sparse.SUNSparseFromDenseMatrix.restype = V
-    sparse.SUNSparseMatrix_IndexPointers.argtypes = [V]
-    sparse.SUNSparseMatrix_IndexPointers.restype = ctypes.POINTER(ctypes.c_int32)
-    ctx = V()
-    if core.SUNContext_Create(0, ctypes.byref(ctx)) != 0 or not ctx.value:
-        return None
-    A = B = None
-    try:
-        A = dense.SUNDenseMatrix(2, 2, ctx)
-        if not A:
-            return None
-        data = dense.SUNDenseMatrix_Data(A)
-        for i in range(4):
-            data[i] = 1.0
-        B = sparse.SUNSparseFromDenseMatrix(A, 0.0, 0)  # CSC_MAT
-        if not B:
-            return None
-        ptr = sparse.SUNSparseMatrix_IndexPointers(B)
-        words = [ptr[i] for i in range(3)]
-        return {(0, 2, 4): 32, (0, 0, 2): 64}.get(tuple(words))
-    finally:
-        for M in (B, A):
-            if M:
-                core.SUNMatDestroy(M)
-        core.SUNContext_Free(ctypes.byref(ctx))
-
-
-_BUILD_TAG = re.compile(rb"daeclear-build:abi=(\d+);sundials=(\d+)\.(\d+)\.(\d+);index=(\d+);sparse=(\d);")
-
-
-def read_build_tag(path: Path) -> tuple[int, SundialsInfo] | None:
-    """(driver ABI, SUNDIALS build) a compiled model library was made for, read from the file's
-    bytes (the driver's ``dc_build_tag``) without loading it; None when it has no tag."""
-    data = path.read_bytes()
-    start = data.find(b"daeclear-build:")
-    m = _BUILD_TAG.match(data, start) if start >= 0 else None
-    if m is None:
-        return None
-    abi, major, minor, patch, index, sparse = (int(x) for x in m.groups())
-    return abi, SundialsInfo(f"{major}.{minor}.{patch}", index, bool(sparse))
-
-
-@functools.lru_cache(maxsize=1)
-def sundials_info() -> SundialsInfo:
-    """Detect the SUNDIALS version and index size of the wheel's libraries (once per process).
-
-    Version: from the core library's file name (``.so.7.9.0``) and from
-    ``SUNDIALSGetVersionNumber`` of that library; both must agree when both are known.
-    Index size: ``sunindextype`` in ``sksundae/c_config.pxi``, cross-checked on the libraries
-    themselves (:func:`_probe_index_size`); when the file is missing or silent the probe alone
-    decides. Whatever cannot be determined, or contradicts itself, raises CompilerUnavailable
-    (SundialsMismatch): the compiled backend is then not used, never built on a guess.
-    """
-    _, libs = sundials_libraries()
-    core = libs["sundials_core"]
-    named, reported = _version_from_name(core), _version_from_library(core)
-    if named and reported and named != reported:
-        raise SundialsMismatch(f"{core.name} is named for SUNDIALS {named} but reports version {reported}")
-    version = reported or named
-    if version is None:
-        raise CompilerUnavailable(f"cannot determine the SUNDIALS version of {core}: no version in its name "
-                                  "and SUNDIALSGetVersionNumber could not be called")
-    pxi = _sksundae_dir() / "c_config.pxi"
-    declared = parse_index_size(pxi.read_text(), str(pxi)) if pxi.is_file() else None
-    probed = _probe_index_size(libs)
-    if declared is not None and probed is not None and declared != probed:
-        raise SundialsMismatch(f"{pxi} declares a {declared}-bit sunindextype but the SUNDIALS libraries in "
-                               f"{core.parent} use {probed}-bit indices")
-    index_size = declared if declared is not None else probed
-    if index_size is None:
-        raise CompilerUnavailable(f"cannot determine the SUNDIALS index size (sunindextype): {pxi} "
-                                  f"{'declares none' if pxi.is_file() else 'does not exist'} and probing the "
-                                  "libraries failed")
-    return SundialsInfo(version, index_size, all(name in libs for name in SPARSE_LIBS))
-
-
-def cache_dir() -> Path:
-    d = os.environ.get("DAECLEAR_CACHE_DIR")
-    return Path(d).expanduser() if d else Path.home() / ".cache" / "daeclear"
-
-
 # --------------------------------------------------------------------------- build
-
-
-@dataclass(frozen=True)
-class BuildResult:
-    path: Path
-    key: str
-    cache_hit: bool
-    compile_time: float   # s spent in the compiler (0 on a cache hit)
-    codegen_time: float   # s spent generating C and hashing
-
-
-@contextlib.contextmanager
-def _file_lock(path: Path) -> Iterator[None]:
-    try:
-        import fcntl
-    except ImportError:  # pragma: no cover - non-POSIX
-        yield
-        return
-    with open(path, "a+") as fh:
-        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
 
 
 def _driver_text() -> str:
     """The driver sources and every vendored SUNDIALS file, as a SHA-256 for the cache key:
     editing any of them builds again. Files are read again only when one's size or mtime moved."""
     files = [CSRC / name for name in DRIVER_SOURCES]
-    files += sorted(p for p in SUNDIALS_INCLUDE.parent.rglob("*") if p.is_file())
+    files += sorted(p for p in sundials.SUNDIALS_INCLUDE.parent.rglob("*") if p.is_file())
     stats = [(p, p.stat()) for p in files]
     return _files_digest(tuple((str(p), st.st_mtime_ns, st.st_size) for p, st in stats))
 
@@ -620,39 +325,6 @@ def _files_digest(stamps: tuple[tuple[str, int, int], ...]) -> str:
         path = Path(name)
         h.update(name.encode() + b"\0" + path.read_bytes() + b"\0")
     return "driver sources sha256 " + h.hexdigest()
-
-
-MemoTable = dict[Any, Any]
-_MEMO_TABLES: list[MemoTable] = []
-
-
-def memo_table() -> MemoTable:
-    """A new in-process memo (by object identity with memo_get/memo_put, or by any key);
-    :func:`clear_memos` empties them all."""
-    table: MemoTable = {}
-    _MEMO_TABLES.append(table)
-    return table
-
-
-def clear_memos() -> None:
-    """Forget every assembled template, normalised model, generated spec and loaded library of
-    this process (the disk cache stays): the next run generates and loads again, e.g. after changing ``$CC``."""
-    for table in _MEMO_TABLES:
-        table.clear()
-
-
-def memo_get(table: MemoTable, obj: Any) -> Any:
-    """The value memoised for this very object (identity, kept only while the object lives)."""
-    entry = table.get(id(obj))
-    return entry[1] if entry is not None and entry[0]() is obj else None
-
-
-def memo_put(table: MemoTable, obj: Any, value: Any) -> None:
-    try:
-        ref = weakref.ref(obj, lambda _r, key=id(obj): table.pop(key, None))
-    except TypeError:
-        return
-    table[id(obj)] = (ref, value)
 
 
 # Libraries already built in this process, by DAEFunctions identity (shared by every model of
@@ -674,13 +346,14 @@ def _build_model_library(funcs: Any, *, model: NormalizedModel | None = None) ->
     t0 = time.perf_counter()
     if model is None:
         model = normalize_model(funcs)
-    libdir, libs = sundials_libraries()
-    info = sundials_info()
-    check_vendored(info)
+    # through the module: tests fake the wheel's SUNDIALS there
+    libdir, libs = sundials.sundials_libraries()
+    info = sundials.sundials_info()
+    sundials.check_vendored(info)
     names = SUNDIALS_LIBS + (SPARSE_LIBS if info.has_sparse else ())
     source = generate_source(model)
     link = [str(libs[name]) for name in names] + [f"-Wl,-rpath,{libdir}", "-lm"]
-    flags = [*CFLAGS, f"-I{SUNDIALS_INCLUDE}", *info.compile_flags()]
+    flags = [*CFLAGS, f"-I{sundials.SUNDIALS_INCLUDE}", *info.compile_flags()]
     gomp = sorted(libdir.glob("libgomp-*.so*")) if info.has_sparse else []
     if gomp:  # SuperLU_MT's OpenMP runtime: the driver keeps its teams at one thread
         link.insert(len(names), str(gomp[0]))
@@ -690,81 +363,6 @@ def _build_model_library(funcs: Any, *, model: NormalizedModel | None = None) ->
            "\n".join(str(libs[name]) for name in names)]
     return compile_cached("dc", f"the model {model.name!r}", source, "ida_driver.c", _driver_text(), flags, link,
                           key, t0)
-
-
-def _sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
-def _intact(library: Path, digest: Path) -> bool:
-    """The cached library exists and is byte for byte the one that was built (a truncated or
-    damaged file would crash the interpreter when loaded)."""
-    try:
-        return library.is_file() and digest.read_text().strip() == _sha256(library)
-    except OSError:
-        return False
-
-
-def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text: str, flags: list[str],
-                   link: list[str], extra_key: list[str], t0: float) -> BuildResult:
-    """Compile ``source`` with the driver ``csrc/<driver>`` into a cached shared library.
-
-    The cache key hashes the generated source, the driver sources, the compiler command and
-    version and ``extra_key``; the library is built in a temporary directory under a file lock
-    and moved into place atomically, so concurrent processes never see a half-written file. Its
-    SHA-256 is kept beside it (``<stem>.sha256``) and checked before a cached library is used: a
-    truncated or damaged file is built again, never loaded.
-    ``t0`` is when code generation started (reported as ``codegen_time``).
-    """
-    cc = compiler_command()
-    version = _compiler_version(cc[0])
-    flags = [*flags, f"-I{CSRC}"]
-    h = hashlib.sha256()
-    for part in (prefix, source, driver_text, shlex.join(cc + flags + link), version, *extra_key):
-        h.update(part.encode())
-        h.update(b"\0")
-    key = h.hexdigest()
-    codegen_time = time.perf_counter() - t0
-
-    root = cache_dir()
-    try:
-        root.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise CompilerUnavailable(f"cache directory {root} cannot be created: {exc}") from exc
-    stem = f"{prefix}_{key[:40]}"
-    target = root / f"{stem}.so"
-    digest = root / f"{stem}.sha256"
-    if _intact(target, digest):
-        return BuildResult(target, key, True, 0.0, codegen_time)
-    with _file_lock(root / f"{stem}.lock"):
-        if _intact(target, digest):  # built by another process meanwhile
-            return BuildResult(target, key, True, 0.0, codegen_time)
-        target.unlink(missing_ok=True)  # absent, truncated or altered: never loaded, built again
-        t1 = time.perf_counter()
-        with tempfile.TemporaryDirectory(prefix=f"{stem}-", dir=root) as tmp:
-            tmpd = Path(tmp)
-            model_c = tmpd / "model.c"
-            model_c.write_text(source)
-            out = tmpd / "lib.so"
-            cmd = [*cc, *flags, str(model_c), str(CSRC / driver), "-o", str(out), *link]
-            try:
-                proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
-            except (OSError, subprocess.SubprocessError) as exc:
-                raise CompilerUnavailable(f"running the C compiler {cc[0]!r} failed: {exc}") from exc
-            if proc.returncode != 0 or not out.is_file():
-                msg = (proc.stderr or proc.stdout or "").strip()
-                if len(msg) > 4000:
-                    msg = msg[:2000] + "\n...\n" + msg[-2000:]
-                raise CompileError(f"compiling {what} failed (exit {proc.returncode}):\n$ {shlex.join(cmd)}\n{msg}")
-            # keep the generated source next to the library, for debugging
-            src_tmp = tmpd / "src.c"
-            src_tmp.write_text(source)
-            os.replace(src_tmp, root / f"{stem}.c")
-            digest_tmp = tmpd / "lib.sha256"
-            digest_tmp.write_text(_sha256(out))
-            os.replace(digest_tmp, digest)  # the digest first: a library is never there without it
-            os.replace(out, target)
-        return BuildResult(target, key, False, time.perf_counter() - t1, codegen_time)
 
 
 # --------------------------------------------------------------------------- ODE libraries

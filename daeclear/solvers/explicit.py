@@ -90,7 +90,6 @@ import time
 import warnings
 import weakref
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, Callable, Sequence
 
 import casadi as ca
@@ -98,7 +97,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..assembly.assemble import DAEModel, assemble
-from ..engine.codegen import (ODE_DRIVER_ABI, BuildResult, CompileError, CompilerUnavailable, OdeSpec, build_ode_library,
+from ..engine.hermite import cubic_hermite
+from ..engine.library import OdeLibrary
+from ..engine.codegen import (BuildResult, CompileError, CompilerUnavailable, OdeSpec, build_ode_library,
                       memo_get, memo_put, memo_table)
 from .. import options
 from . import physics
@@ -278,46 +279,8 @@ def _cubic_extrema(G0: float, Gd0: float, G1: float, Gd1: float, h: float) -> li
 # =========================================================================== evaluators
 
 
-class _CLib:
-    """ctypes view of one compiled ODE library."""
-
-    _cache: dict[str, "_CLib"] = {}
-
-    def __init__(self, path: Path) -> None:
-        lib = ctypes.CDLL(str(path))
-        P, I, D, LL = ctypes.c_void_p, ctypes.c_int, ctypes.c_double, ctypes.c_longlong
-        sig = {
-            "dco_abi_version": (I, []),
-            "dco_info": (I, [P, P, P, P, P]),
-            "dco_message": (ctypes.c_char_p, [P]),
-            "dco_open": (P, [P, P, ctypes.c_char_p, I]),
-            "dco_free": (None, [P]),
-            "dco_set_terms": (None, [P, P, P]),
-            "dco_rhs": (I, [P, D, P, P]),
-            "dco_jac": (I, [P, D, P, P]),
-            "dco_gaps": (I, [P, D, P, P, P]),
-            "dco_step": (I, [P, I, D, P, D, P]),
-            "dco_batch": (I, [P, I, P, P, P, P]),
-            "dco_fixed": (I, [P, I, D, P, D, D, LL, P, I, P, P, P, P, P, P, P, P]),
-            "dco_counters": (None, [P, P]),
-            "dco_set_hermite": (None, [P, I]),
-            "dco_outputs": (I, [P, I, P, P, P, P, P]),
-            "dco_output_sizes": (None, [P, P, P]),
-        }
-        for name, (res, args) in sig.items():
-            fn = getattr(lib, name)
-            fn.restype, fn.argtypes = res, args
-        if lib.dco_abi_version() != ODE_DRIVER_ABI:
-            raise DaeclearError(f"{path}: ODE driver ABI version {lib.dco_abi_version()} != {ODE_DRIVER_ABI}")
-        self.lib = lib
-        self.path = path
-
-    @classmethod
-    def load(cls, path: Path) -> "_CLib":
-        key = str(path)
-        if key not in cls._cache:
-            cls._cache[key] = cls(path)
-        return cls._cache[key]
+#: ctypes view of one compiled ODE library (opened, declared and checked in daeclear.engine.library)
+_CLib = OdeLibrary
 
 
 class _Evaluator:
@@ -977,12 +940,7 @@ def _hermite(T: NDArray, X: NDArray, Xd: NDArray, te: NDArray) -> NDArray:
     if T.size == 1:
         return np.repeat(X[:1], te.size, axis=0)
     k = np.clip(np.searchsorted(T, te, side="left"), 1, T.size - 1)
-    t0, t1 = T[k - 1], T[k]
-    h = (t1 - t0)[:, None]
-    u = ((te - t0) / (t1 - t0))[:, None]
-    u2, u3 = u * u, u * u * u
-    return ((2 * u3 - 3 * u2 + 1) * X[k - 1] + (u3 - 2 * u2 + u) * h * Xd[k - 1]
-            + (-2 * u3 + 3 * u2) * X[k] + (u3 - u2) * h * Xd[k])
+    return cubic_hermite(T[k - 1], X[k - 1], Xd[k - 1], T[k], X[k], Xd[k], te)
 
 
 def _locate(ev: _Evaluator, X_of: Callable[[float], NDArray | None], ta0: float, g_a: tuple[NDArray, NDArray],

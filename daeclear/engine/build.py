@@ -1,0 +1,243 @@
+"""Compiling generated C into a cached shared library: the C compiler, the cache directory, the
+cache key, the per-key file lock, and the in-process memos.
+
+:func:`compile_cached` is used for both kinds of library (the IDA model libraries and the ODE
+evaluator libraries, :mod:`daeclear.engine.codegen`); it knows nothing of CasADi or SUNDIALS, which is why
+it is separate from code generation (:mod:`daeclear.engine.codegen`) and from the SUNDIALS checks
+(:mod:`daeclear.engine.sundials`).
+
+Libraries are cached: the key is the SHA-256 of the generated source, the driver sources, the
+compiler command (with its flags) and version, and whatever else the caller names (SUNDIALS version
+and index size, library paths). The cache directory is ``$DAECLEAR_CACHE_DIR`` or
+``~/.cache/daeclear``. A build compiles into a private temporary directory and moves the result
+into place with ``os.replace`` under a per-key file lock, so concurrent processes building the same
+model neither corrupt nor duplicate each other's work.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import hashlib
+import os
+import shlex
+import shutil
+import subprocess
+import sysconfig
+import tempfile
+import time
+import weakref
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterator
+
+from ..errors import DaeclearError
+
+__all__ = [
+    "CSRC",
+    "CompilerUnavailable",
+    "CompileError",
+    "BuildResult",
+    "compiler_command",
+    "cache_dir",
+    "compile_cached",
+    "MemoTable",
+    "memo_table",
+    "memo_get",
+    "memo_put",
+    "clear_memos",
+]
+
+#: The hand-written C drivers and the vendored SUNDIALS headers (on the include path of every build).
+CSRC = Path(__file__).resolve().parent / "csrc"
+
+
+class CompilerUnavailable(DaeclearError):
+    """No working C compiler (or no SUNDIALS libraries) for the compiled backend."""
+
+
+class CompileError(DaeclearError):
+    """The C compiler failed on the generated model; the message holds its output."""
+
+
+# --------------------------------------------------------------------------- toolchain
+
+
+def compiler_command() -> list[str]:
+    """The C compiler command: $CC, else sysconfig's CC, else cc/gcc. Raises CompilerUnavailable."""
+    env_cc = os.environ.get("CC")
+    candidates: list[tuple[str, str]] = []
+    if env_cc is not None and env_cc.strip():
+        candidates.append((env_cc, "$CC"))
+    else:
+        cfg = sysconfig.get_config_var("CC")
+        if cfg:
+            candidates.append((cfg, "sysconfig CC"))
+        candidates += [("cc", "default"), ("gcc", "default")]
+    tried = []
+    for cmd, origin in candidates:
+        parts = shlex.split(cmd)
+        if not parts:
+            continue
+        exe = shutil.which(parts[0])
+        if exe is not None:
+            return [exe, *parts[1:]]
+        tried.append(f"{parts[0]!r} ({origin})")
+        if origin == "$CC":
+            break  # an explicit $CC is not second-guessed
+    raise CompilerUnavailable(f"no C compiler found: tried {', '.join(tried)}")
+
+
+@functools.lru_cache(maxsize=16)
+def _compiler_version(exe: str) -> str:
+    try:
+        out = subprocess.run([exe, "--version"], capture_output=True, text=True, timeout=30)
+        return (out.stdout or out.stderr).strip().splitlines()[0] if (out.stdout or out.stderr) else ""
+    except (OSError, subprocess.SubprocessError) as exc:
+        raise CompilerUnavailable(f"C compiler {exe!r} does not run: {exc}") from exc
+
+def cache_dir() -> Path:
+    d = os.environ.get("DAECLEAR_CACHE_DIR")
+    return Path(d).expanduser() if d else Path.home() / ".cache" / "daeclear"
+
+
+# --------------------------------------------------------------------------- build
+
+
+@dataclass(frozen=True)
+class BuildResult:
+    path: Path
+    key: str
+    cache_hit: bool
+    compile_time: float   # s spent in the compiler (0 on a cache hit)
+    codegen_time: float   # s spent generating C and hashing
+
+
+@contextlib.contextmanager
+def _file_lock(path: Path) -> Iterator[None]:
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - non-POSIX
+        yield
+        return
+    with open(path, "a+") as fh:
+        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
+
+
+# --------------------------------------------------------------------------- in-process memos
+
+
+MemoTable = dict[Any, Any]
+_MEMO_TABLES: list[MemoTable] = []
+
+
+def memo_table() -> MemoTable:
+    """A new in-process memo (by object identity with memo_get/memo_put, or by any key);
+    :func:`clear_memos` empties them all."""
+    table: MemoTable = {}
+    _MEMO_TABLES.append(table)
+    return table
+
+
+def clear_memos() -> None:
+    """Forget every assembled template, normalised model, generated spec and loaded library of
+    this process (the disk cache stays): the next run generates and loads again, e.g. after changing ``$CC``."""
+    for table in _MEMO_TABLES:
+        table.clear()
+
+
+def memo_get(table: MemoTable, obj: Any) -> Any:
+    """The value memoised for this very object (identity, kept only while the object lives)."""
+    entry = table.get(id(obj))
+    return entry[1] if entry is not None and entry[0]() is obj else None
+
+
+def memo_put(table: MemoTable, obj: Any, value: Any) -> None:
+    try:
+        ref = weakref.ref(obj, lambda _r, key=id(obj): table.pop(key, None))
+    except TypeError:
+        return
+    table[id(obj)] = (ref, value)
+
+
+# --------------------------------------------------------------------------- cached build
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _intact(library: Path, digest: Path) -> bool:
+    """The cached library exists and is byte for byte the one that was built (a truncated or
+    damaged file would crash the interpreter when loaded)."""
+    try:
+        return library.is_file() and digest.read_text().strip() == _sha256(library)
+    except OSError:
+        return False
+
+
+def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text: str, flags: list[str],
+                   link: list[str], extra_key: list[str], t0: float) -> BuildResult:
+    """Compile ``source`` with the driver ``csrc/<driver>`` into a cached shared library.
+
+    The cache key hashes the generated source, the driver sources, the compiler command and
+    version and ``extra_key``; the library is built in a temporary directory under a file lock
+    and moved into place atomically, so concurrent processes never see a half-written file. Its
+    SHA-256 is kept beside it (``<stem>.sha256``) and checked before a cached library is used: a
+    truncated or damaged file is built again, never loaded.
+    ``t0`` is when code generation started (reported as ``codegen_time``).
+    """
+    cc = compiler_command()
+    version = _compiler_version(cc[0])
+    flags = [*flags, f"-I{CSRC}"]
+    h = hashlib.sha256()
+    for part in (prefix, source, driver_text, shlex.join(cc + flags + link), version, *extra_key):
+        h.update(part.encode())
+        h.update(b"\0")
+    key = h.hexdigest()
+    codegen_time = time.perf_counter() - t0
+
+    root = cache_dir()
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise CompilerUnavailable(f"cache directory {root} cannot be created: {exc}") from exc
+    stem = f"{prefix}_{key[:40]}"
+    target = root / f"{stem}.so"
+    digest = root / f"{stem}.sha256"
+    if _intact(target, digest):
+        return BuildResult(target, key, True, 0.0, codegen_time)
+    with _file_lock(root / f"{stem}.lock"):
+        if _intact(target, digest):  # built by another process meanwhile
+            return BuildResult(target, key, True, 0.0, codegen_time)
+        target.unlink(missing_ok=True)  # absent, truncated or altered: never loaded, built again
+        t1 = time.perf_counter()
+        with tempfile.TemporaryDirectory(prefix=f"{stem}-", dir=root) as tmp:
+            tmpd = Path(tmp)
+            model_c = tmpd / "model.c"
+            model_c.write_text(source)
+            out = tmpd / "lib.so"
+            cmd = [*cc, *flags, str(model_c), str(CSRC / driver), "-o", str(out), *link]
+            try:
+                proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+            except (OSError, subprocess.SubprocessError) as exc:
+                raise CompilerUnavailable(f"running the C compiler {cc[0]!r} failed: {exc}") from exc
+            if proc.returncode != 0 or not out.is_file():
+                msg = (proc.stderr or proc.stdout or "").strip()
+                if len(msg) > 4000:
+                    msg = msg[:2000] + "\n...\n" + msg[-2000:]
+                raise CompileError(f"compiling {what} failed (exit {proc.returncode}):\n$ {shlex.join(cmd)}\n{msg}")
+            # keep the generated source next to the library, for debugging
+            src_tmp = tmpd / "src.c"
+            src_tmp.write_text(source)
+            os.replace(src_tmp, root / f"{stem}.c")
+            digest_tmp = tmpd / "lib.sha256"
+            digest_tmp.write_text(_sha256(out))
+            os.replace(digest_tmp, digest)  # the digest first: a library is never there without it
+            os.replace(out, target)
+        return BuildResult(target, key, False, time.perf_counter() - t1, codegen_time)
+

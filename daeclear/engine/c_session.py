@@ -1,0 +1,498 @@
+"""The compiled IDA session: SUNDIALS IDA, the model's callbacks and the step loop in C.
+
+The model is generated as C with CasADi, compiled with the hand-written IDA driver
+(``csrc/ida_driver.c``) into a shared library linked against the SUNDIALS libraries of the
+scikit-sundae wheel (:mod:`daeclear.engine.codegen`), loaded by :mod:`daeclear.engine.library` and
+driven here through ctypes a few calls per segment. No Python runs per step or per model
+evaluation. Separate from the python backend (:mod:`daeclear.engine.python_session`), which has the
+same interface (:class:`daeclear.engine.session_base.Session`) but nothing else in common.
+
+Linear solver (``linear_solver``): IDA's Newton iteration solves with the iteration matrix
+dF/dy + cj dF/dy' either by dense LU (SUNDIALS' dense matrix) or by sparse LU (SuperLU_MT, one
+thread, on a SUNSparseMatrix whose pattern is the union of the base and all term Jacobians'
+patterns). ``"auto"`` picks sparse from ``SPARSE_MIN_STATES`` states on (measured,
+``benchmarks/bench_linear_solver.py``).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import logging
+import time
+import weakref
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..assembly.automaton import Decision, PairState, Storm
+from ..errors import DaeclearError
+from .build import BuildResult
+from .codegen import NormalizedModel
+from .library import ModelLibrary
+from .session_base import (
+    FLAG_MAX_STEPS,
+    FLAG_STEP_COLLAPSE,
+    NO_ROWS,
+    OWN_FLAG_NAMES,
+    STORE_STATES,
+    STORE_TIMES,
+    Advance,
+    AutoEvent,
+    SessionBase,
+    SessionOptions,
+    StateLayout,
+    empty_advance_arrays,
+)
+from .sundials import SPARSE_LIBS
+
+__all__ = ["CSession", "SPARSE_MIN_STATES"]
+
+#: linear_solver="auto" uses the sparse solver for models with at least this many states. Measured
+#: with benchmarks/bench_linear_solver.py (chains of N links, 6 N states; docs/performance.md):
+#: dense is faster up to 120 states (SuperLU_MT's fixed cost per factorization), sparse from 144
+#: states on (whole simulate calls 1.1x faster at 144 states, 1.3x at 192, 1.8x at 384).
+SPARSE_MIN_STATES = 144
+_LS_CODES = {"dense": 0, "sparse": 1}  # dc_open's linear_solver argument
+log = logging.getLogger("daeclear")
+
+_STAT_KEYS = (
+    "n_steps",
+    "n_res_evals",
+    "n_jac_evals",
+    "n_lin_setups",
+    "n_nonlin_iters",
+    "n_nonlin_conv_fails",
+    "n_err_test_fails",
+    "n_root_evals",
+    "n_reinits",
+)
+
+
+def _resolve_linear_solver(requested: str, n: int, has_sparse: bool) -> str:
+    """The linear solver a compiled session uses: "auto" is sparse from SPARSE_MIN_STATES states on
+    (when the library has the sparse solver)."""
+    if requested == "auto":
+        return "sparse" if has_sparse and n >= SPARSE_MIN_STATES else "dense"
+    if requested == "sparse" and not has_sparse:
+        raise DaeclearError("linear_solver='sparse' is not available: the scikit-sundae wheel lacks "
+                            f"lib{SPARSE_LIBS[0]} or lib{SPARSE_LIBS[1]}; use 'dense' or 'auto'")
+    return requested
+
+
+def _free_c_session(lib: Any, handle: int) -> None:
+    lib.dc_free(handle)
+
+
+def _ptr(a: np.ndarray | None) -> int | None:
+    return None if a is None or a.size == 0 else a.ctypes.data
+
+
+class CSession(SessionBase):
+    """Compiled backend: IDA, callbacks and the step loop in C (see module docstring)."""
+
+    backend = "c"
+
+    def __init__(self, model: NormalizedModel, opts: SessionOptions, clib: ModelLibrary, build: BuildResult) -> None:
+        super().__init__(model, opts)
+        n, nt, nr, npar = clib.model_info(self._nt)
+        if (n, nt, nr, tuple(npar)) != (model.n, self._nt, model.n_roots, model.n_params) \
+                or clib.lib.dc_n_parameters() != model.n_parameters:
+            raise DaeclearError(
+                f"compiled library {clib.path} does not match the model: (n, terms, roots, params) = "
+                f"{(n, nt, nr, npar)} != {(model.n, self._nt, model.n_roots, list(model.n_params))}"
+            )
+        self._clib = clib
+        self._lib = clib.lib
+        self._build = build
+        self._linear_solver = _resolve_linear_solver(opts.linear_solver, n, clib.build_info.has_sparse)
+        err = ctypes.create_string_buffer(1024)
+
+        def dc_open() -> Any:
+            return self._lib.dc_open(opts.rtol, opts.atol.ctypes.data, opts.max_step, opts.max_order,
+                                     opts.max_steps, _ptr(opts.root_directions), _ptr(opts.parameters),
+                                     _LS_CODES[self._linear_solver], err, 1024)
+
+        h = dc_open()
+        if not h and self._linear_solver == "sparse" and opts.linear_solver == "auto":
+            log.info("daeclear: sparse linear solver unavailable, using dense LU: %s", err.value.decode())
+            self._linear_solver = "dense"
+            h = dc_open()
+        if not h:
+            raise DaeclearError(f"opening the compiled IDA session failed: {err.value.decode()}")
+        self._h = h
+        self._finalizer = weakref.finalize(self, _free_c_session, self._lib, h)
+        self._jac_nnz = int(self._lib.dc_jac_nnz(h))
+        cap = opts.buffer_steps
+        self._cap = cap
+        # persistent buffers (addresses cached: ctypes calls stay cheap)
+        self._st = np.empty(cap)
+        self._sy = np.empty((cap, n))
+        self._syp = np.empty((cap, n))
+        self._sh = np.empty(cap)
+        self._sord = np.empty(cap, dtype=np.int32)
+        self._yout = np.empty(n)
+        self._ypout = np.empty(n)
+        self._roots = np.zeros(max(nr, 1), dtype=np.int32)
+        self._i_eval = ctypes.c_int()
+        self._n_stored = ctypes.c_int()
+        self._t_out = ctypes.c_double()
+        self._flag = ctypes.c_int()
+        self._addr = dict(
+            st=self._st.ctypes.data, sy=self._sy.ctypes.data, syp=self._syp.ctypes.data,
+            sh=self._sh.ctypes.data, sord=self._sord.ctypes.data, yout=self._yout.ctypes.data,
+            ypout=self._ypout.ctypes.data, roots=self._roots.ctypes.data,
+            i_eval=ctypes.addressof(self._i_eval), n_stored=ctypes.addressof(self._n_stored),
+            t_out=ctypes.addressof(self._t_out), flag=ctypes.addressof(self._flag),
+        )
+        self._statbuf = np.zeros(len(_STAT_KEYS), dtype=np.int64)
+        self._extra_meta: dict[int, tuple[Any, ...]] = {}
+        # reinit inputs: copied into fixed arrays whose addresses are known
+        self._y0b = np.zeros(n)
+        self._yp0b = np.zeros(n)
+        self._actb = np.zeros(max(self._nt, 1), dtype=np.int32)
+        self._rdb = np.zeros(max(nr, 1), dtype=np.int32)
+        self._pcat = np.zeros(max(sum(model.n_params), 1))
+        self._poff = np.concatenate([[0], np.cumsum(model.n_params)]).astype(int).tolist()
+        for name in ("y0b", "yp0b", "actb", "rdb", "pcat"):
+            self._addr[name] = getattr(self, "_" + name).ctypes.data
+
+    def set_hints(self, *, nonlin_conv_coef: float | None = None, init_step: float | None = None) -> bool:
+        """Solver hints: Newton convergence factor (IDA default 0.33) and the first step of the
+        next restart (0: IDA's estimate). Returns True (the compiled backend applies them)."""
+        if nonlin_conv_coef is not None and self._lib.dc_set_nonlin_conv_coef(self._h, nonlin_conv_coef) < 0:
+            raise DaeclearError(f"nonlin_conv_coef={nonlin_conv_coef!r} rejected by IDA; must be > 0.")
+        if init_step is not None and self._lib.dc_set_init_step(self._h, init_step) < 0:
+            raise DaeclearError(f"init_step={init_step!r} rejected by IDA.")
+        return True
+
+    def set_auto_events(self, pairs: Sequence[tuple[int, int, int, bool, float]], *, storms: Sequence[Storm],
+                        states: Sequence[PairState], capacity: int = 256) -> bool:
+        """Let the C loop decide every contact switch itself (after :meth:`set_layout`, see ida_driver.c).
+
+        ``pairs``: (root index, term index, gap-rate extra, needs approach speed, min speed), one
+        per root function; ``storms``: each pair's storm-guard constants; ``states``: each pair's
+        :class:`daeclear.assembly.automaton.PairState` to start from (its history is not carried over).
+        Each advance then returns the switches it made in ``Advance.auto_events``.
+        """
+        np_ = len(pairs)
+        if len(storms) != np_ or len(states) != np_:
+            raise ValueError(f"set_auto_events: {np_} pairs, {len(storms)} storms, {len(states)} states")
+        capacity = max(int(capacity), np_)
+
+        def arr(values: Any, dt: Any) -> np.ndarray:
+            return np.ascontiguousarray(list(values) or [0], dtype=dt)
+
+        self._auto_arrays = [
+            arr((p[0] for p in pairs), np.int32), arr((p[1] for p in pairs), np.int32),
+            arr((p[2] for p in pairs), np.int32), arr((p[3] for p in pairs), np.int32),
+            arr((p[4] for p in pairs), np.float64), arr((st.events for st in storms), np.int32),
+            arr((st.window for st in storms), np.float64), arr((st.contact for st in states), np.int32),
+            arr((st.held for st in states), np.int32), arr((st.latched for st in states), np.float64)]
+        ptr = [a.ctypes.data for a in self._auto_arrays]
+        rc = self._lib.dc_set_auto(self._h, np_, *ptr, capacity)
+        if rc != 0:
+            raise DaeclearError("configuring the events decided in C failed")
+        self._auto_cap = capacity
+        self._auto_buf = (np.empty(capacity), np.empty(capacity, dtype=np.int32),
+                          np.empty((capacity, 4), dtype=np.int32), np.empty(capacity), np.empty(capacity),
+                          np.empty((capacity, self._n)))
+        return True
+
+    def set_layout(self, layout: StateLayout) -> bool:
+        """The model's state layout and extras, so that C makes states consistent itself: restarts
+        after the switches it decides (GGL: projected on the constraint manifold) and :meth:`report`."""
+        L = layout
+        rc = self._lib.dc_set_layout(self._h, L.n_q, L.n_constraints, int(L.ggl), int(L.track_work), L.accel_extra,
+                                     L.force_extra0, L.kinematics_extra, L.outputs_extra, int(L.project), L.tol,
+                                     L.max_iter)
+        if rc != 0:
+            raise DaeclearError("configuring the state layout of the compiled model failed")
+        self._n_channels = int(self._model.extras[L.outputs_extra].numel_out(0))
+        return True
+
+    def report(self, t: np.ndarray, y: np.ndarray, switch: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The reported points made consistent in one C pass: (y with recomputed multipliers, yp,
+        output channels), one row per time (see ``dc_report``); after :meth:`set_layout`."""
+        t = np.ascontiguousarray(t, dtype=float)
+        y = np.ascontiguousarray(y, dtype=float)
+        switch = np.ascontiguousarray(switch, dtype=float)
+        N = t.size
+        y_out, yp_out = np.empty((N, self._n)), np.empty((N, self._n))
+        channels = np.empty((N, self._n_channels))
+        if N and self._lib.dc_report(self._h, N, t.ctypes.data, y.ctypes.data, switch.ctypes.data,
+                                     y_out.ctypes.data, yp_out.ctypes.data, channels.ctypes.data) != 0:
+            raise DaeclearError("making the reported points consistent in the compiled model failed")
+        return y_out, yp_out, channels
+
+    def _take_auto_events(self) -> list[AutoEvent]:
+        buf = getattr(self, "_auto_buf", None)
+        if buf is None:
+            return []
+        t, pair, info, rate, latched, y = buf
+        k = self._lib.dc_take_events(self._h, self._auto_cap, t.ctypes.data, pair.ctypes.data, info.ctypes.data,
+                                     rate.ctypes.data, latched.ctypes.data, y.ctypes.data)
+        return [AutoEvent(float(t[i]), int(pair[i]), float(rate[i]),
+                          Decision(int(info[i, 0]), bool(info[i, 1]), bool(info[i, 2]), float(latched[i]),
+                                   int(info[i, 3])), y[i].copy()) for i in range(k)]
+
+    def automaton_run(self, times: Sequence[float], directions: Sequence[int], rates: Sequence[float], *,
+                      storm: Storm, min_approach_speed: float, contact: bool = False, held: bool = False,
+                      latched: float = 0.0) -> list[Decision]:
+        """Run the compiled loop's pair automaton over a root sequence from the given state with no
+        history (a test hook: the decisions must be those of :func:`daeclear.assembly.automaton.step`)."""
+        t = np.ascontiguousarray(times, dtype=np.float64)
+        d = np.ascontiguousarray(directions, dtype=np.int32)
+        r = np.ascontiguousarray(rates, dtype=np.float64)
+        n = t.size
+        if d.size != n or r.size != n:
+            raise ValueError("automaton_run: times, directions and rates differ in length")
+        out_i = np.zeros((4, max(n, 1)), dtype=np.int32)
+        out_l = np.zeros(max(n, 1))
+        rc = self._lib.dc_automaton_run(n, t.ctypes.data, d.ctypes.data, r.ctypes.data, storm.events,
+                                        float(storm.window), float(min_approach_speed), int(contact), int(held),
+                                        float(latched), *(out_i[j].ctypes.data for j in range(4)),
+                                        out_l.ctypes.data)
+        if rc != 0:
+            raise DaeclearError("dc_automaton_run rejected its arguments")
+        return [Decision(int(out_i[0, i]), bool(out_i[1, i]), bool(out_i[2, i]), float(out_l[i]), int(out_i[3, i]))
+                for i in range(n)]
+
+    def active_terms(self) -> tuple[list[bool], list[np.ndarray]]:
+        """The active flags and parameters the C loop integrates with now."""
+        act = np.zeros(max(self._nt, 1), dtype=np.int32)
+        par = np.zeros(max(sum(self._model.n_params), 1))
+        self._lib.dc_get_active(self._h, act.ctypes.data, par.ctypes.data)
+        off = self._poff
+        return [bool(a) for a in act[:self._nt]], [par[off[k]:off[k + 1]].copy() for k in range(self._nt)]
+
+    def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
+        inputs = [*inputs, self._opts.parameters]
+        meta = self._extra_meta.get(k)
+        if meta is None:  # input sizes, output size and reusable ctypes arrays, once per function
+            f = self._model.extras[k]
+            sizes = [f.numel_in(j) for j in range(f.n_in())]
+            meta = (sizes, f.numel_out(0), (ctypes.c_void_p * max(len(sizes), 1))(),
+                    (ctypes.c_int * max(len(sizes), 1))())
+            self._extra_meta[k] = meta
+        sizes, n_out, ptrs, strides = meta
+        keep = []
+        for j, x in enumerate(inputs):
+            a = x if (type(x) is np.ndarray and x.dtype == np.float64 and x.flags.c_contiguous) \
+                else np.ascontiguousarray(x, dtype=float)
+            size = sizes[j]
+            if a.size == size:
+                strides[j] = 0
+            elif a.size == n_points * size:
+                strides[j] = size
+            else:
+                raise ValueError(f"eval_extra({k}): input {j} has shape {a.shape}, expected ({n_points}, {size}) or ({size},)")
+            ptrs[j] = a.__array_interface__["data"][0]
+            keep.append(a)
+        out = np.empty((n_points, n_out))
+        rc = self._lib.dc_eval_extra(k, n_points, len(sizes), ptrs, strides, out.__array_interface__["data"][0], n_out)
+        if rc != 0:
+            raise DaeclearError(f"evaluating {self._model.extras[k].name()} in the compiled model failed (status {rc}).")
+        return out
+
+    # ---------------------------------------------------------------- core
+    def _load_terms(self, act: np.ndarray, plist: list[np.ndarray]) -> None:
+        nt = self._nt
+        if nt:
+            self._actb[:nt] = act
+            off = self._poff
+            for k in range(nt):
+                if off[k + 1] > off[k]:
+                    self._pcat[off[k]:off[k + 1]] = plist[k]
+
+    def reinit(self, t0: float, y0: np.ndarray, yp0: np.ndarray, active: Sequence[bool],
+               params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None:
+        t0, y0, yp0, act, plist, rd = self._check_reinit(t0, y0, yp0, active, params, root_directions)
+        A = self._addr
+        self._y0b[:] = y0
+        self._yp0b[:] = yp0
+        self._load_terms(act, plist)
+        if self.n_roots:
+            self._rdb[:] = rd
+        rc = self._lib.dc_reinit(self._h, t0, A["y0b"], A["yp0b"], A["actb"], A["pcat"], A["rdb"])
+        if rc != 0:
+            self._ready = False
+            raise DaeclearError(f"IDA reinit failed: {self._lib.dc_message(self._h).decode()}")
+        self._t, self._y, self._yp = t0, self._y0b.copy(), self._yp0b.copy()
+        self._eval_after = None  # the C side drops a step cut short (dc_reinit)
+        self._active = act
+        self._params = plist
+        self._ready = True
+
+    def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
+                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
+                chunked: bool = False) -> Advance:
+        t_stop = self._check_advance(t_stop)
+        n = self._n
+        te = self._select_eval(t_eval, t_stop)
+        m = te.size
+        ev_y = np.empty((m, n))
+        ev_yp = np.empty((m, n))
+        te_p, evy_p, evyp_p = (te.ctypes.data, ev_y.ctypes.data, ev_yp.ctypes.data) if m else (None, None, None)
+        A = self._addr
+        self._i_eval.value = 0
+        chunks: list[tuple[np.ndarray, ...]] = []
+        auto_events: list[AutoEvent] = []
+        store = (STORE_TIMES | (STORE_STATES if store_states else 0)) if store_steps else 0
+        lib, h = self._lib, self._h
+        tic = time.perf_counter()
+        interrupted = False
+        try:
+            while True:
+                rc = lib.dc_advance(h, t_stop, te_p, m, A["i_eval"], evy_p, evyp_p,
+                                    store, self._cap, A["st"], A["sy"], A["syp"], A["sh"], A["sord"],
+                                    A["n_stored"], A["t_out"], A["yout"], A["ypout"], A["roots"],
+                                    A["flag"])
+                k = self._n_stored.value
+                if k:
+                    states = (self._sy[:k].copy(), self._syp[:k].copy()) if store_states else (NO_ROWS[n],) * 2
+                    chunks.append((self._st[:k].copy(), *states, self._sh[:k].copy(), self._sord[:k].copy()))
+                auto_events += self._take_auto_events()  # drained at every chunk: the C buffer never overflows
+                if rc != 0 or chunked:
+                    break
+                # buffer full: back in Python between chunks, so Ctrl-C works here
+                if on_chunk is not None:  # time reached, and contact switches made in C so far
+                    on_chunk(self._t_out.value, len(auto_events))
+        except KeyboardInterrupt:  # between chunks: return the steps taken so far, marked "interrupted"
+            interrupted, rc = True, 1
+        finally:
+            self._solve_time += time.perf_counter() - tic
+            # also after an interrupt between chunks: the C side stopped at a valid state
+            self._t = self._t_out.value
+            self._y = self._yout.copy()  # shared with the Advance: the session only reads it
+            self._yp = self._ypout.copy()
+        if len(chunks) == 1:
+            st, sy, syp, sh, so = chunks[0]
+        elif chunks:
+            st, sy, syp, sh, so = (np.concatenate(c) for c in zip(*chunks))
+        else:
+            e = empty_advance_arrays(n)
+            st, sy, syp, sh, so = e["step_t"], e["step_y"], e["step_yp"], e["step_h"], e["step_order"]
+        ne = self._i_eval.value
+        # the C loop stopped inside a step that has output times after the last row (see dc_advance)
+        self._eval_after = float(te[-1]) if rc == 0 and m and ne == m and te[-1] < self._t else None
+        adv = Advance(status="tstop", t=self._t, y=self._y, yp=self._yp, step_t=st,
+                      step_y=sy, step_yp=syp, step_h=sh, step_order=so, eval_t=te[:ne].copy(),
+                      eval_y=ev_y[:ne], eval_yp=ev_yp[:ne], auto_events=auto_events)
+        if interrupted:
+            adv.status = "interrupted"
+            return adv
+        if rc == 0:  # chunked: a buffer is full, the integration goes on at the next call
+            adv.status = "chunk"
+            return adv
+        if rc == 1:
+            return adv
+        if rc == 2:
+            adv.status = "root"
+            adv.roots_found = self._roots[: self.n_roots].copy()
+            return adv
+        adv.status = "error"
+        msg = self._lib.dc_message(h).decode()
+        if rc == -2:
+            adv.flag, adv.flag_name = FLAG_MAX_STEPS, OWN_FLAG_NAMES[FLAG_MAX_STEPS]
+        elif rc == -3:
+            adv.flag, adv.flag_name = FLAG_STEP_COLLAPSE, OWN_FLAG_NAMES[FLAG_STEP_COLLAPSE]
+        else:
+            adv.flag = self._flag.value
+            adv.flag_name = self._clib.flag_name(adv.flag) if adv.flag else "DC_USAGE"
+        adv.message = msg
+        return adv
+
+    # ---------------------------------------------------------------- model evaluation
+    def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._check_open()
+        y, yp = self._vec(y, "y"), self._vec(yp, "yp")
+        out = np.empty(self._n)
+        self._sync_terms()
+        if self._lib.dc_eval_residual(self._h, float(t), y.ctypes.data, yp.ctypes.data, out.ctypes.data):
+            raise DaeclearError(f"the generated residual failed at t={t}")
+        return out
+
+    def sparse_jacobian(self, t: float, y: np.ndarray, yp: np.ndarray,
+                        cj: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The iteration matrix as the sparse solver sees it: CSC (data, row indices, column
+        pointers) on the union of the base and all term Jacobians' patterns (explicit zeros for
+        inactive terms), whatever the session's linear solver."""
+        self._check_open()
+        y, yp = self._vec(y, "y"), self._vec(yp, "yp")
+        colptr = np.empty(self._n + 1, dtype=np.int64)
+        rowind = np.empty(max(self._jac_nnz, 1), dtype=np.int64)
+        data = np.empty(max(self._jac_nnz, 1))
+        self._lib.dc_jac_pattern(self._h, colptr.ctypes.data, rowind.ctypes.data)
+        self._sync_terms()
+        if self._lib.dc_eval_jacobian_sparse(self._h, float(t), y.ctypes.data, yp.ctypes.data, float(cj),
+                                             data.ctypes.data):
+            raise DaeclearError(f"the generated Jacobian failed at t={t}")
+        return data[:self._jac_nnz], rowind[:self._jac_nnz], colptr
+
+    def jacobian(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray:
+        self._check_open()
+        y, yp = self._vec(y, "y"), self._vec(yp, "yp")
+        out = np.empty((self._n, self._n), order="F")
+        self._sync_terms()
+        if self._lib.dc_eval_jacobian(self._h, float(t), y.ctypes.data, yp.ctypes.data, float(cj),
+                                      out.ctypes.data):
+            raise DaeclearError(f"the generated Jacobian failed at t={t}")
+        return np.ascontiguousarray(out)
+
+    def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._check_open()
+        y, yp = self._vec(y, "y"), self._vec(yp, "yp")
+        out = np.empty(self.n_roots)
+        if self.n_roots and self._lib.dc_eval_roots(self._h, float(t), y.ctypes.data, yp.ctypes.data,
+                                                    out.ctypes.data):
+            raise DaeclearError(f"the generated root function failed at t={t}")
+        return out
+
+    def set_terms(self, active: Sequence[bool], params: Sequence[np.ndarray]) -> None:
+        """Set active terms and parameters without restarting IDA (for residual/jacobian checks).
+
+        The next advance() without reinit() integrates with them; prefer reinit() in event logic.
+        """
+        _, _, _, act, plist, _ = self._check_reinit(self._t, self._y, self._yp, active, params, None)
+        self._active, self._params = act, plist
+        self._sync_terms()
+
+    def _sync_terms(self) -> None:
+        self._load_terms(self._active, self._params)
+        self._lib.dc_set_terms(self._h, self._addr["actb"], self._addr["pcat"])
+
+    # ---------------------------------------------------------------- stats and lifetime
+    def stats(self) -> dict[str, int | float | str]:
+        self._check_open()
+        self._lib.dc_stats(self._h, self._statbuf.ctypes.data)
+        out: dict[str, int | float | str] = {k: int(v) for k, v in zip(_STAT_KEYS, self._statbuf)}
+        out["solve_time"] = self._solve_time
+        out["compile_time"] = self._build.compile_time
+        out["codegen_time"] = self._build.codegen_time
+        out["cache_hit"] = bool(self._build.cache_hit)
+        out["linear_solver"] = "sparse" if self._lib.dc_linear_solver(self._h) else "dense"
+        out["jac_nnz"] = self._jac_nnz
+        return out
+
+    @property
+    def linear_solver(self) -> str:
+        """"dense" or "sparse": the LU IDA's Newton iteration uses in this session."""
+        return self._linear_solver
+
+    @property
+    def library_path(self) -> Path:
+        return self._build.path
+
+    @property
+    def cache_hit(self) -> bool:
+        return self._build.cache_hit
+
+    @property
+    def sundials_version(self) -> str:
+        return self._clib.sundials_version
+
+    def close(self) -> None:
+        if not self._closed:
+            self._closed = True
+            self._finalizer()

@@ -1,0 +1,47 @@
+"""Cubic Hermite interpolation: the one interpolant between two states with known time derivatives.
+
+Used for output times between steps wherever the integrator gives no dense output of its own: the
+python IDA session (:mod:`daeclear.engine.python_session`) and the fixed-step schemes of
+:mod:`daeclear.solvers.explicit`. A module of its own because both use it and neither owns it.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, overload
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = ["cubic_hermite"]
+
+
+@overload
+def cubic_hermite(t0: ArrayLike, y0: NDArray, yp0: NDArray, t1: ArrayLike, y1: NDArray, yp1: NDArray,
+                  t: NDArray, *, derivative: Literal[False] = ...) -> NDArray: ...
+
+
+@overload
+def cubic_hermite(t0: ArrayLike, y0: NDArray, yp0: NDArray, t1: ArrayLike, y1: NDArray, yp1: NDArray,
+                  t: NDArray, *, derivative: Literal[True]) -> tuple[NDArray, NDArray]: ...
+
+
+def cubic_hermite(t0: ArrayLike, y0: NDArray, yp0: NDArray, t1: ArrayLike, y1: NDArray, yp1: NDArray,
+                  t: NDArray, *, derivative: bool = False) -> NDArray | tuple[NDArray, NDArray]:
+    """The cubic that has the values ``y0``, ``y1`` and the derivatives ``yp0``, ``yp1`` at ``t0``,
+    ``t1``, evaluated at the times ``t`` (1-D, m points): an (m, n) array of values, with
+    ``derivative=True`` also its time derivative (a cubic is reproduced exactly).
+
+    One interval for all points (``t0``, ``t1`` scalars, ``y0`` ... of shape (n,)) or one per point
+    (``t0``, ``t1`` of shape (m,), ``y0`` ... of shape (m, n)). The points need not lie inside
+    their interval (then it extrapolates).
+    """
+    dt = np.asarray(t1, dtype=float) - t0
+    u = ((t - t0) / dt)[..., None]
+    h = dt[..., None]
+    u2, u3 = u * u, u * u * u
+    y = (2 * u3 - 3 * u2 + 1) * y0 + (u3 - 2 * u2 + u) * h * yp0 + (-2 * u3 + 3 * u2) * y1 + (u3 - u2) * h * yp1
+    if not derivative:
+        return y
+    yp = ((6 * u2 - 6 * u) / h * y0 + (3 * u2 - 4 * u + 1) * yp0 + (-6 * u2 + 6 * u) / h * y1
+          + (3 * u2 - 2 * u) * yp1)
+    return y, yp

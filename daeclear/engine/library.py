@@ -1,0 +1,259 @@
+"""Loading compiled libraries: the one place that opens a built shared library with ctypes.
+
+It declares the library's functions from a prototype table, checks that the library was built for
+this daeclear's driver interface (ABI version) and, for the IDA model libraries, for the SUNDIALS
+it runs with, and unloads one that must not run (:class:`StaleLibrary`). Every library is opened
+once per process and path (:meth:`LoadedLibrary.load`).
+
+Two kinds of library are loaded, both built by :mod:`daeclear.engine.codegen`:
+
+* :class:`ModelLibrary`: an IDA model (``csrc/ida_driver.c``, symbols ``dc_*``), driven by
+  :class:`daeclear.engine.c_session.CSession`;
+* :class:`OdeLibrary`: the ODE evaluator of the scipy and fixed-step integrators
+  (``csrc/ode_driver.c``, symbols ``dco_*``), driven by :mod:`daeclear.solvers.explicit`.
+
+Separate from generating and compiling the C (codegen, build): loading decides whether a file
+may run in this process at all. A model library is used only if it was built for the SUNDIALS
+version and index size that the wheel has now (its build tag, read from the file before loading,
+against :func:`daeclear.engine.sundials.sundials_info`) and that the loaded SUNDIALS reports
+(``dc_build_info`` and ``SUNDIALSGetVersion``).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import re
+from pathlib import Path
+from typing import Any, ClassVar, Mapping, Sequence
+
+from . import sundials
+from ..errors import DaeclearError
+from .sundials import SundialsInfo
+
+__all__ = [
+    "DRIVER_ABI",
+    "ODE_DRIVER_ABI",
+    "Prototypes",
+    "StaleLibrary",
+    "open_library",
+    "unload",
+    "LoadedLibrary",
+    "ModelLibrary",
+    "OdeLibrary",
+]
+
+#: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
+#: and checked when a library is loaded: bump it when a dc_* signature changes.
+DRIVER_ABI = 3
+#: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
+ODE_DRIVER_ABI = 3
+
+#: A prototype table: C function name -> (restype, argtypes), as ctypes declares them.
+Prototypes = Mapping[str, tuple[Any, Sequence[Any]]]
+
+P, I, D = ctypes.c_void_p, ctypes.c_int, ctypes.c_double
+S, LL, LONG = ctypes.c_char_p, ctypes.c_longlong, ctypes.c_long
+
+#: The dc_* functions of csrc/ida_driver.c.
+MODEL_PROTOTYPES: Prototypes = {
+    "dc_abi_version": (I, []),
+    "dc_build_info": (I, [P, I]),
+    "dc_sundials_version": (I, [S, I]),
+    "dc_model_info": (I, [P, P, P, P]),
+    "dc_model_name": (S, []),
+    "dc_message": (S, [P]),
+    "dc_open": (P, [D, P, D, I, LL, P, P, I, S, I]),
+    "dc_jac_nnz": (LL, [P]),
+    "dc_linear_solver": (I, [P]),
+    "dc_jac_pattern": (None, [P, P, P]),
+    "dc_eval_jacobian_sparse": (I, [P, D, P, P, D, P]),
+    "dc_n_parameters": (I, []),
+    "dc_set_nonlin_conv_coef": (I, [P, D]),
+    "dc_n_extra": (I, []),
+    "dc_eval_extra": (I, [I, I, I, P, P, P, I]),
+    "dc_set_auto": (I, [P, I, P, P, P, P, P, P, P, P, P, P, I]),
+    "dc_take_events": (I, [P, I, P, P, P, P, P, P]),
+    "dc_automaton_run": (I, [I, P, P, P, I, D, D, I, I, D, P, P, P, P, P]),
+    "dc_pending_events": (I, [P]),
+    "dc_get_active": (None, [P, P, P]),
+    "dc_set_layout": (I, [P, I, I, I, I, I, I, I, I, I, D, I]),
+    "dc_report": (I, [P, I, P, P, P, P, P, P]),
+    "dc_set_stall": (I, [P, D, I]),
+    "dc_set_init_step": (I, [P, D]),
+    "dc_free": (None, [P]),
+    "dc_reinit": (I, [P, D, P, P, P, P, P]),
+    "dc_advance": (I, [P, D, P, I, P, P, P, I, I, P, P, P, P, P, P, P, P, P, P, P]),
+    "dc_stats": (None, [P, P]),
+    "dc_eval_residual": (I, [P, D, P, P, P]),
+    "dc_eval_jacobian": (I, [P, D, P, P, D, P]),
+    "dc_eval_roots": (I, [P, D, P, P, P]),
+    "dc_set_terms": (None, [P, P, P]),
+    "dc_flag_name": (None, [LONG, S, I]),
+}
+
+#: The dco_* functions of csrc/ode_driver.c.
+ODE_PROTOTYPES: Prototypes = {
+    "dco_abi_version": (I, []),
+    "dco_info": (I, [P, P, P, P, P]),
+    "dco_message": (S, [P]),
+    "dco_open": (P, [P, P, S, I]),
+    "dco_free": (None, [P]),
+    "dco_set_terms": (None, [P, P, P]),
+    "dco_rhs": (I, [P, D, P, P]),
+    "dco_jac": (I, [P, D, P, P]),
+    "dco_gaps": (I, [P, D, P, P, P]),
+    "dco_step": (I, [P, I, D, P, D, P]),
+    "dco_batch": (I, [P, I, P, P, P, P]),
+    "dco_fixed": (I, [P, I, D, P, D, D, LL, P, I, P, P, P, P, P, P, P, P]),
+    "dco_counters": (None, [P, P]),
+    "dco_set_hermite": (None, [P, I]),
+    "dco_outputs": (I, [P, I, P, P, P, P, P]),
+    "dco_output_sizes": (None, [P, P, P]),
+}
+
+
+class StaleLibrary(DaeclearError):
+    """A cached compiled library was built for another driver ABI, SUNDIALS version or index size
+    than the wheel's now (or than the SUNDIALS it loads): it must not run."""
+
+
+def open_library(path: Path, prototypes: Prototypes) -> ctypes.CDLL:
+    """dlopen ``path`` and declare every function of ``prototypes`` (restype, argtypes) on it."""
+    lib = ctypes.CDLL(str(path))
+    for name, (restype, argtypes) in prototypes.items():
+        fn = getattr(lib, name)
+        fn.restype, fn.argtypes = restype, list(argtypes)
+    return lib
+
+
+def unload(lib: ctypes.CDLL) -> None:
+    """dlclose a library that must not be used, so that one rebuilt at the same path is really
+    loaded (dlopen of a path that is still open returns the old library)."""
+    import _ctypes
+
+    _ctypes.dlclose(lib._handle)
+
+
+def _version_prefix(text: str) -> str:
+    m = re.match(r"\d+\.\d+\.\d+", text)
+    return m.group(0) if m else text
+
+
+def _staleness(built: SundialsInfo, current: SundialsInfo) -> str | None:
+    """Why a library built for the SUNDIALS ``built`` must not run with the wheel's SUNDIALS
+    ``current``; None if it may."""
+    if (built.version, built.index_size) != (current.version, current.index_size):
+        return (f"built for SUNDIALS {built.version} with {built.index_size}-bit indices, but the wheel has "
+                f"SUNDIALS {current.version} with {current.index_size}-bit indices")
+    if built.has_sparse != current.has_sparse:
+        return (f"built {'with' if built.has_sparse else 'without'} the sparse solver libraries, which the wheel "
+                f"{'has' if current.has_sparse else 'lacks'} now")
+    return None
+
+
+def _check_loaded(lib: ctypes.CDLL, tagged: SundialsInfo) -> tuple[SundialsInfo, str, str | None]:
+    """(build info, SUNDIALSGetVersion, problem or None) of a loaded library: dc_build_info must
+    say what the file's tag said, and the SUNDIALS it resolved must be the version it was built
+    for (another libsundials found first, e.g. through LD_LIBRARY_PATH, would be a silent ABI
+    mismatch)."""
+    buf = ctypes.create_string_buffer(64)
+    lib.dc_sundials_version(buf, 64)
+    loaded = buf.value.decode()
+    raw = (ctypes.c_int * 6)()
+    lib.dc_build_info(raw, 6)
+    info = SundialsInfo(f"{raw[0]}.{raw[1]}.{raw[2]}", raw[3], bool(raw[5]))
+    if info != tagged or raw[4] != info.index_size:
+        return info, loaded, (f"its dc_build_info ({info}, sunindextype {raw[4]} bits) contradicts its build tag "
+                              f"({tagged})")
+    if _version_prefix(loaded) != info.version:
+        return info, loaded, f"built for SUNDIALS {info.version}, but the SUNDIALS it loads reports version {loaded!r}"
+    return info, loaded, None
+
+
+class LoadedLibrary:
+    """ctypes view of one compiled library (``lib``, its functions declared from ``PROTOTYPES``),
+    opened once per process and path by :meth:`load` and shared by everything that uses it."""
+
+    PROTOTYPES: ClassVar[Prototypes] = {}
+    _cache: ClassVar[dict[str, Any]] = {}
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        cls._cache = {}  # one cache per kind of library
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.lib = open_library(path, self.PROTOTYPES)
+
+    @classmethod
+    def load(cls, path: Path) -> Any:
+        """The library at ``path``, opened (and checked) on the first call of this process."""
+        key = str(path)
+        if key not in cls._cache:
+            cls._cache[key] = cls(path)
+        return cls._cache[key]
+
+
+class ModelLibrary(LoadedLibrary):
+    """ctypes view of one compiled IDA model library (shared by all its sessions).
+
+    Before loading, the build tag in the file must name this daeclear's driver ABI and the
+    wheel's SUNDIALS version, index size and sparse libraries (:func:`_staleness`); once loaded,
+    ``dc_build_info`` must agree and the SUNDIALS it resolved must report that version
+    (:func:`_check_loaded`), else it is unloaded before any call into SUNDIALS. A mismatch
+    raises StaleLibrary.
+    """
+
+    PROTOTYPES = MODEL_PROTOTYPES
+
+    def __init__(self, path: Path) -> None:
+        tag = sundials.read_build_tag(path)
+        if tag is None:
+            raise StaleLibrary(f"{path}: no daeclear build tag (built by another daeclear version)")
+        abi, tagged = tag
+        if abi != DRIVER_ABI:
+            raise StaleLibrary(f"{path}: driver ABI version {abi} != {DRIVER_ABI}")
+        why = _staleness(tagged, sundials.sundials_info())
+        if why is not None:
+            raise StaleLibrary(f"{path}: {why}")
+        super().__init__(path)
+        lib = self.lib
+        if lib.dc_abi_version() != DRIVER_ABI:
+            abi = lib.dc_abi_version()
+            unload(lib)
+            raise StaleLibrary(f"{path}: driver ABI version {abi} != {DRIVER_ABI} (build tag said {DRIVER_ABI})")
+        info, loaded, why = _check_loaded(lib, tagged)
+        if why is not None:
+            unload(lib)
+            raise StaleLibrary(f"{path}: {why}")
+        #: what the library was compiled for (the -D flags checked against csrc/sundials' config)
+        self.build_info: SundialsInfo = info
+        #: SUNDIALSGetVersion of the SUNDIALS libraries this library loaded
+        self.sundials_version = loaded
+
+    def model_info(self, n_terms: int) -> tuple[int, int, int, list[int]]:
+        """(n, terms, roots, parameters per term) of the compiled model."""
+        n, nt, nr = ctypes.c_int(), ctypes.c_int(), ctypes.c_int()
+        np_ = (ctypes.c_int * max(n_terms, 1))()
+        self.lib.dc_model_info(ctypes.addressof(n), ctypes.addressof(nt), ctypes.addressof(nr),
+                               ctypes.addressof(np_))
+        return n.value, nt.value, nr.value, list(np_)[: nt.value]
+
+    def flag_name(self, flag: int) -> str:
+        """SUNDIALS' name of an IDA return flag."""
+        buf = ctypes.create_string_buffer(64)
+        self.lib.dc_flag_name(flag, buf, 64)
+        return buf.value.decode()
+
+
+class OdeLibrary(LoadedLibrary):
+    """ctypes view of one compiled ODE library (csrc/ode_driver.c); a library built for another
+    ODE driver ABI raises DaeclearError."""
+
+    PROTOTYPES = ODE_PROTOTYPES
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(path)
+        lib = self.lib
+        if lib.dco_abi_version() != ODE_DRIVER_ABI:
+            raise DaeclearError(f"{path}: ODE driver ABI version {lib.dco_abi_version()} != {ODE_DRIVER_ABI}")

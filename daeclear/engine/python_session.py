@@ -1,0 +1,389 @@
+"""The python IDA session: scikit-sundae's ``IDA`` with callbacks that evaluate the model's CasADi
+functions through ``casadi.FunctionBuffer``.
+
+The fallback when no C compiler works (and ``backend="python"``). Same interface as the compiled
+session (:class:`daeclear.engine.session_base.Session`); the differences are listed in
+:mod:`daeclear.engine.ida_session`. Separate from :mod:`daeclear.engine.c_session` because the two
+share the interface only: one drives C through ctypes, this one drives scikit-sundae from Python.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import time
+from typing import Any, Sequence
+
+import casadi
+import numpy as np
+
+from ..errors import DaeclearError
+from .codegen import NormalizedModel
+from .hermite import cubic_hermite
+from .session_base import (
+    FLAG_MAX_STEPS,
+    FLAG_STEP_COLLAPSE,
+    OWN_FLAG_NAMES,
+    TINY_STEP_GROWTH,
+    TINY_STEP_REL,
+    Advance,
+    SessionBase,
+    SessionOptions,
+)
+
+__all__ = ["PythonSession"]
+
+
+class _ModelError(Exception):
+    """Raised inside a scikit-sundae callback; ends the advance with a clear message."""
+
+
+class _Buffered:
+    """A CasADi function evaluated through FunctionBuffer on fixed numpy arrays."""
+
+    def __init__(self, f: casadi.Function, args: list[np.ndarray]) -> None:
+        self.buf, self.call = f.buffer()
+        self.args = args  # kept alive: the buffer points into them
+        for i, a in enumerate(args):
+            self.buf.set_arg(i, memoryview(a))
+        self.out = np.zeros(f.nnz_out(0))
+        self.buf.set_res(0, memoryview(self.out))
+
+
+class PythonSession(SessionBase):
+    """scikit-sundae IDA with FunctionBuffer callbacks (see module docstring)."""
+
+    backend = "python"
+
+    def __init__(self, model: NormalizedModel, opts: SessionOptions, fallback_reason: str | None = None) -> None:
+        super().__init__(model, opts)
+        import sksundae  # noqa: F401  (fail early if missing)
+
+        n = model.n
+        self.fallback_reason = fallback_reason
+        # shared input arrays: every function reads t, y, yp, cj from the same memory
+        self._a_t = np.zeros(1)
+        self._a_y = np.zeros(n)
+        self._a_yp = np.zeros(n)
+        self._a_cj = np.zeros(1)
+        self._a_p = [np.zeros(p) for p in model.n_params]
+        P = opts.parameters
+        base = [self._a_t, self._a_y, self._a_yp]
+        self._res = _Buffered(model.res, base + [P])
+        self._jac = _Buffered(model.dense(model.jac), base + [self._a_cj, P])
+        self._tres = [_Buffered(f, base + [p, P]) for f, p in zip(model.term_res, self._a_p)]
+        self._tjac = [_Buffered(model.dense(f), base + [p, self._a_cj, P]) for f, p in zip(model.term_jac, self._a_p)]
+        self._roots_fn = _Buffered(model.roots, base + [P]) if model.roots is not None else None
+        self._active_idx: list[int] = []
+        self._solver: Any = None
+        self._solver_dirs: np.ndarray | None = None
+        self._count = dict(res=0, jac=0, roots=0, steps=0, reinits=0)
+        self._pending_tn = False
+        self._t_internal = 0.0
+        self._tiny = 0
+        self._h_prev = 0.0
+
+    # ---------------------------------------------------------------- evaluation
+    def _eval_res(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._a_t[0] = t
+        self._a_y[:] = y
+        self._a_yp[:] = yp
+        self._res.call()
+        r = self._res.out
+        if self._active_idx:
+            r = r.copy()
+            for k in self._active_idx:
+                self._tres[k].call()
+                r += self._tres[k].out
+        return r
+
+    def _eval_jac(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray:
+        self._a_t[0] = t
+        self._a_y[:] = y
+        self._a_yp[:] = yp
+        self._a_cj[0] = cj
+        self._jac.call()
+        J = self._jac.out
+        if self._active_idx:
+            J = J.copy()
+            for k in self._active_idx:
+                self._tjac[k].call()
+                J += self._tjac[k].out
+        return J.reshape(self._n, self._n, order="F")
+
+    def _eval_roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._a_t[0] = t
+        self._a_y[:] = y
+        self._a_yp[:] = yp
+        self._roots_fn.call()
+        return self._roots_fn.out
+
+    def _make_solver(self, rd: np.ndarray) -> Any:
+        from sksundae.ida import IDA
+
+        count = self._count
+        eval_res, eval_jac, eval_roots = self._eval_res, self._eval_jac, self._eval_roots
+        isfinite = math.isfinite
+
+        def resfn(t, y, yp, res):
+            count["res"] += 1
+            r = eval_res(t, y, yp)
+            if not isfinite(float(r.sum())):
+                i = int(np.flatnonzero(~np.isfinite(r))[0])
+                raise _ModelError(f"residual component {i} is {r[i]} at t={t!r} (y[{i}]={y[i]})")
+            res[:] = r
+
+        def jacfn(t, y, yp, res, cj, JJ):
+            count["jac"] += 1
+            J = eval_jac(t, y, yp, cj)
+            if not isfinite(float(J.sum())):
+                raise _ModelError(f"the Jacobian has non-finite entries at t={t!r}")
+            JJ[:, :] = J
+
+        options: dict[str, Any] = dict(
+            rtol=self._opts.rtol, atol=self._opts.atol.copy(), max_step=self._opts.max_step,
+            max_order=self._opts.max_order, max_num_steps=500, jacfn=jacfn, linsolver="dense",
+        )
+        if self.n_roots:
+            def events(t, y, yp, out):
+                count["roots"] += 1
+                g = eval_roots(t, y, yp)
+                if not isfinite(float(g.sum())):
+                    raise _ModelError(f"a root function is non-finite at t={t!r}: {g.tolist()}")
+                out[:] = g
+
+            events.terminal = [True] * self.n_roots
+            events.direction = [int(d) for d in rd]
+            options.update(eventsfn=events, num_events=self.n_roots)
+            self._events = events
+        return IDA(resfn, **options)
+
+    # ---------------------------------------------------------------- core
+    def reinit(self, t0: float, y0: np.ndarray, yp0: np.ndarray, active: Sequence[bool],
+               params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None:
+        t0, y0, yp0, act, plist, rd = self._check_reinit(t0, y0, yp0, active, params, root_directions)
+        self._apply_terms(act, plist)
+        if self._solver is None or (self.n_roots and not np.array_equal(rd, self._solver_dirs)):
+            # scikit-sundae sets root directions only when it builds its IDA memory
+            self._solver = self._make_solver(rd)
+            self._solver_dirs = rd.copy()
+        try:
+            self._solver.init_step(t0, y0, yp0)
+        except _ModelError as exc:
+            self._ready = False
+            raise DaeclearError(f"IDA reinit failed: {exc}") from exc
+        except RuntimeError as exc:
+            self._ready = False
+            raise DaeclearError(f"IDA reinit failed: {exc}") from exc
+        self._count["reinits"] += 1
+        self._t, self._y, self._yp = t0, y0.copy(), yp0.copy()
+        self._t_internal = t0
+        self._pending_tn = False
+        self._tiny = 0
+        self._h_prev = 0.0
+        self._ready = True
+
+    def _apply_terms(self, act: np.ndarray, plist: list[np.ndarray]) -> None:
+        self._active = act
+        self._params = plist
+        for k, p in enumerate(plist):
+            self._a_p[k][:] = p
+        self._active_idx = [k for k in range(self._nt) if act[k]]
+
+    def set_terms(self, active: Sequence[bool], params: Sequence[np.ndarray]) -> None:
+        """Set active terms and parameters without restarting IDA (see CSession.set_terms)."""
+        _, _, _, act, plist, _ = self._check_reinit(self._t, self._y, self._yp, active, params, None)
+        self._apply_terms(act, plist)
+
+    def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
+                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
+                chunked: bool = False) -> Advance:
+        t_stop = self._check_advance(t_stop)
+        n = self._n
+        te = self._select_eval(t_eval, t_stop)
+        ev_y = np.empty((te.size, n))
+        ev_yp = np.empty((te.size, n))
+        ie = 0
+        st: list[float] = []
+        sy: list[np.ndarray] = []
+        syp: list[np.ndarray] = []
+        sh: list[float] = []
+        t_rec = self._t
+        status, flag, flag_name, message, roots = "tstop", 0, "", "", None
+        solver = self._solver
+        max_steps = self._opts.max_steps
+        tic = time.perf_counter()
+        try:
+            if t_stop - self._t <= 4.0 * np.finfo(float).eps * max(abs(t_stop), abs(self._t)):
+                status = "tstop"
+            else:
+                while True:
+                    if self._count["steps"] >= max_steps:
+                        status, flag = "error", FLAG_MAX_STEPS
+                        flag_name = OWN_FLAG_NAMES[flag]
+                        message = (f"step cap reached: {self._count['steps']} IDA steps in this session "
+                                   f"(max_steps={max_steps}) at t={self._t!r}")
+                        break
+                    interpolated = False
+                    try:
+                        if self._pending_tn:
+                            # after a root return IDA's internal time tn is beyond self._t; a
+                            # t_stop inside (self._t, tn) makes IDASetStopTime fail (scikit-sundae
+                            # prints that error): then IDA_NORMAL mode interpolates, as in C
+                            try:
+                                with contextlib.redirect_stdout(io.StringIO()):
+                                    r = solver.step(t_stop, method="onestep", tstop=t_stop)
+                            except RuntimeError as exc:
+                                if "IDASetStopTime" not in str(exc):
+                                    raise
+                                r = solver.step(t_stop, method="normal", tstop=None)
+                                interpolated = True
+                        else:
+                            r = solver.step(t_stop, method="onestep", tstop=t_stop)
+                    except _ModelError as exc:
+                        status, flag, flag_name = "error", -8, "IDA_RES_FAIL"
+                        message = f"IDA_RES_FAIL at t={self._t!r}: {exc}"
+                        break
+                    fl = int(r.status)
+                    if fl < 0:
+                        status, flag = "error", fl
+                        flag_name = _IDA_FLAG_NAMES.get(fl, f"IDA flag {fl}")
+                        message = f"{flag_name} at t={float(r.t)!r}: {r.message}"
+                        self._t, self._y, self._yp = float(r.t), np.array(r.y, float), np.array(r.yp, float)
+                        break
+                    t_prev, y_prev, yp_prev = self._t, self._y, self._yp
+                    t_new = float(r.t)
+                    y_new = np.array(r.y, dtype=float).reshape(-1)
+                    yp_new = np.array(r.yp, dtype=float).reshape(-1)
+                    # was a new internal step taken in this call?
+                    new_step = False
+                    h = float("nan")
+                    if interpolated:  # no step taken; IDA still holds tn for the next call
+                        if fl == 0:
+                            fl = 1  # y(t_stop) returned: this advance is done
+                    elif fl == 2:  # root
+                        if not self._pending_tn:
+                            new_step = True
+                            self._count["steps"] += 1
+                        self._pending_tn = True
+                    elif self._pending_tn:  # y(tn) returned after a root: no new step
+                        self._pending_tn = False
+                        h = t_new - self._t_internal
+                        self._t_internal = t_new
+                    elif t_new > t_prev:
+                        new_step = True
+                        self._count["steps"] += 1
+                        h = t_new - self._t_internal
+                        self._t_internal = t_new
+                    self._t, self._y, self._yp = t_new, y_new, yp_new
+                    # t_eval points in (t_prev, t_new]: cubic Hermite on the two return points
+                    filled = ie < te.size and te[ie] <= t_new
+                    if filled:
+                        j = int(np.searchsorted(te, t_new, side="right"))
+                        yy, yyp = cubic_hermite(t_prev, y_prev, yp_prev, t_new, y_new, yp_new, te[ie:j],
+                                                derivative=True)
+                        ev_y[ie:j], ev_yp[ie:j] = yy, yyp
+                        ie = j
+                    if store_steps and t_new > t_rec:
+                        st.append(t_new)
+                        sy.append(y_new)
+                        syp.append(yp_new)
+                        sh.append(h)
+                        t_rec = t_new
+                    if new_step and fl != 1 and not math.isnan(h):
+                        thr = max(TINY_STEP_REL * max(1.0, abs(t_new)), self._stall_step)
+                        if abs(h) >= (100.0 * thr if self._stall_step > 0 else thr):
+                            self._tiny = 0
+                        elif abs(h) < thr and not abs(h) > TINY_STEP_GROWTH * abs(self._h_prev):
+                            self._tiny += 1
+                        self._h_prev = h
+                        if self._tiny >= self._stall_count:
+                            status, flag = "error", FLAG_STEP_COLLAPSE
+                            flag_name = OWN_FLAG_NAMES[flag]
+                            message = (f"step size collapsed: {self._tiny} steps with |h| < "
+                                       f"max({TINY_STEP_REL}*max(1,|t|), {self._stall_step} s) that did "
+                                       f"not grow (last h={h:.3g}) "
+                                       f"at t={t_new!r}")
+                            break
+                    if fl == 2:
+                        status = "root"
+                        roots = np.asarray(r.i_events[-1], dtype=np.int32).copy()
+                        ev = getattr(self, "_events", None)
+                        if ev is not None:  # keep scikit-sundae's event log from growing
+                            for name in ("_i", "_t", "_y", "_yp"):
+                                getattr(ev, name).clear()
+                        break
+                    if fl == 1:
+                        status = "tstop"
+                        break
+                    if chunked and ((te.size and ie == te.size and filled)
+                                    or len(st) >= self._opts.buffer_steps):
+                        status = "chunk"  # the caller empties the rows and calls again
+                        break
+        finally:
+            self._solve_time += time.perf_counter() - tic
+        k = len(st)
+        adv = Advance(
+            status=status, t=self._t, y=self._y.copy(), yp=self._yp.copy(),
+            step_t=np.array(st, dtype=float), step_y=np.array(sy, dtype=float).reshape(k, n),
+            step_yp=np.array(syp, dtype=float).reshape(k, n), step_h=np.array(sh, dtype=float),
+            step_order=np.full(k, -1, dtype=np.int32), eval_t=te[:ie].copy(), eval_y=ev_y[:ie],
+            eval_yp=ev_yp[:ie], roots_found=roots, flag=flag, flag_name=flag_name, message=message,
+        )
+        return adv
+
+    def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._check_open()
+        return self._eval_res(float(t), self._vec(y, "y"), self._vec(yp, "yp")).copy()
+
+    def jacobian(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray:
+        self._check_open()
+        return np.ascontiguousarray(self._eval_jac(float(t), self._vec(y, "y"), self._vec(yp, "yp"), float(cj)))
+
+    def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._check_open()
+        if self._roots_fn is None:
+            return np.empty(0)
+        return self._eval_roots(float(t), self._vec(y, "y"), self._vec(yp, "yp")).copy()
+
+    def stats(self) -> dict[str, int | float | str]:
+        c = self._count
+        return {
+            "n_steps": c["steps"],
+            "n_res_evals": c["res"],
+            "n_jac_evals": c["jac"],
+            "n_lin_setups": -1,
+            "n_nonlin_iters": -1,
+            "n_nonlin_conv_fails": -1,
+            "n_err_test_fails": -1,
+            "n_root_evals": c["roots"],
+            "n_reinits": c["reinits"],
+            "solve_time": self._solve_time,
+            "compile_time": 0.0,
+            "codegen_time": 0.0,
+            "cache_hit": False,
+            "linear_solver": "dense",
+            "jac_nnz": self._n * self._n,
+        }
+
+    @property
+    def linear_solver(self) -> str:
+        """Always "dense": scikit-sundae is driven with its dense linear solver here."""
+        return "dense"
+
+    def close(self) -> None:
+        self._closed = True
+        self._solver = None
+
+
+_IDA_FLAG_NAMES = {
+    -1: "IDA_TOO_MUCH_WORK", -2: "IDA_TOO_MUCH_ACC", -3: "IDA_ERR_FAIL", -4: "IDA_CONV_FAIL",
+    -5: "IDA_LINIT_FAIL", -6: "IDA_LSETUP_FAIL", -7: "IDA_LSOLVE_FAIL", -8: "IDA_RES_FAIL",
+    -9: "IDA_REP_RES_ERR", -10: "IDA_RTFUNC_FAIL", -11: "IDA_CONSTR_FAIL",
+    -12: "IDA_FIRST_RES_FAIL", -13: "IDA_LINESEARCH_FAIL", -14: "IDA_NO_RECOVERY",
+    -15: "IDA_NLS_INIT_FAIL", -16: "IDA_NLS_SETUP_FAIL", -17: "IDA_NLS_FAIL",
+    -20: "IDA_MEM_NULL", -21: "IDA_MEM_FAIL", -22: "IDA_ILL_INPUT", -23: "IDA_NO_MALLOC",
+    -24: "IDA_BAD_EWT", -25: "IDA_BAD_K", -26: "IDA_BAD_T", -27: "IDA_BAD_DKY",
+    -28: "IDA_VECTOROP_ERR", -29: "IDA_CONTEXT_ERR", -99: "IDA_UNRECOGNIZED_ERROR",
+}

@@ -1,0 +1,445 @@
+"""What both IDA session backends share: the DAE they integrate (:class:`DAEFunctions`), what an
+advance returns (:class:`Advance`), the :class:`Session` protocol, the validation of the session
+options, and :class:`SessionBase`, the common base class of the compiled and the python session.
+
+Separate from the backends (:mod:`daeclear.engine.c_session`, :mod:`daeclear.engine.python_session`)
+and from :func:`daeclear.engine.ida_session.open_session`, which chooses between them: both backends
+and the callers above them depend on these types, and nothing here depends on a backend.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple, Protocol, Sequence, runtime_checkable
+
+import casadi
+import numpy as np
+
+from ..assembly.automaton import Decision
+from ..errors import DaeclearError
+from ..options import LINEAR_SOLVERS
+from .codegen import NormalizedModel
+
+__all__ = [
+    "DAEFunctions",
+    "AutoEvent",
+    "StateLayout",
+    "Advance",
+    "Session",
+    "SessionOptions",
+    "check_options",
+    "SessionBase",
+    "FLAG_MAX_STEPS",
+    "FLAG_STEP_COLLAPSE",
+    "OWN_FLAG_NAMES",
+    "TINY_STEP_REL",
+    "TINY_STEP_COUNT",
+    "TINY_STEP_GROWTH",
+    "STORE_TIMES",
+    "STORE_STATES",
+    "NO_ROWS",
+    "empty_advance_arrays",
+]
+
+#: flag of an Advance that stopped because the session's step cap (max_steps) was reached
+FLAG_MAX_STEPS = -1001
+#: flag of an Advance that stopped because the step size collapsed (see TINY_STEP_REL)
+FLAG_STEP_COLLAPSE = -1002
+#: a step is tiny when |h| < TINY_STEP_REL * max(1, |t|); TINY_STEP_COUNT tiny steps that did not
+#: grow by more than TINY_STEP_GROWTH over the previous one, with no normal step in between, stop
+#: the advance (step-size collapse). Growing tiny steps (IDA's start-up doubling) do not count.
+TINY_STEP_REL = 1e-14
+TINY_STEP_COUNT = 20
+TINY_STEP_GROWTH = 1.5
+
+#: names of the flags that daeclear sets itself (not IDA)
+OWN_FLAG_NAMES = {FLAG_MAX_STEPS: "DC_MAX_STEPS", FLAG_STEP_COLLAPSE: "DC_STEP_COLLAPSE"}
+
+
+@dataclass(frozen=True)
+class DAEFunctions:
+    """A DAE F(t, y, y') = 0 with switchable terms, as CasADi functions.
+
+    residual: (t[1], y[n], yp[n], P) -> r[n], always active.
+    jacobian: (t, y, yp, cj[1], P) -> J[n x n] = dr/dy + cj dr/dyp (dense or sparse output).
+    term_residuals[k]: (t, y, yp, p_k[n_params_k], P) -> r_k[n], added to r while term k is active.
+    term_jacobians[k]: (t, y, yp, p_k, cj, P) -> J_k[n x n], added to J while term k is active.
+    roots: (t, y, yp, P) -> g[n_roots], or None when the model has no events.
+    extras[k]: any functions with vector inputs, P last, and one output, compiled into the same
+    library and evaluated over many points at once by :meth:`Session.eval_extra` (post-processing:
+    output channels, consistent restarts); never called by IDA.
+
+    ``P`` holds the ``n_parameters`` run-time parameters (the values are given to
+    :func:`open_session`); with ``n_parameters == 0`` the functions may leave it out.
+    """
+
+    n: int
+    residual: casadi.Function
+    jacobian: casadi.Function
+    term_residuals: tuple[casadi.Function, ...]
+    term_jacobians: tuple[casadi.Function, ...]
+    roots: casadi.Function | None
+    name: str = "model"
+    extras: tuple[casadi.Function, ...] = ()
+    n_parameters: int = 0
+
+
+class AutoEvent(NamedTuple):
+    """A contact switch the compiled loop decided itself: pair index (in the order given to
+    :meth:`CSession.set_auto_events`), the penetration rate there, the decision and the state."""
+
+    t: float
+    pair: int
+    rate: float
+    decision: Decision
+    y: np.ndarray
+
+
+@dataclass(frozen=True)
+class StateLayout:
+    """Where things are in y = [q, v, lambda, mu (GGL), work (track_work)] and which extras the
+    compiled loop uses to make a state consistent (see ``dc_set_layout`` in ida_driver.c)."""
+
+    n_q: int
+    n_constraints: int
+    ggl: bool
+    track_work: bool
+    accel_extra: int
+    force_extra0: int
+    kinematics_extra: int
+    outputs_extra: int
+    project: bool  # restarts after switches decided in C are projected on the constraint manifold
+    tol: float
+    max_iter: int
+
+
+@dataclass
+class Advance:
+    """What one :meth:`Session.advance` call did.
+
+    ``step_*`` hold every point where IDA returned in one-step mode during the call: the end of
+    each internal step, and on a root return the root point itself (which lies inside IDA's last
+    internal step). Times strictly increase; the start point of the call is not included.
+    ``step_h`` is the size of the internal step the point belongs to, ``step_order`` the BDF
+    order used for it (-1 when unknown: python backend).
+    ``eval_*`` hold the requested ``t_eval`` points reached in this call, in (t_start, t].
+    """
+
+    status: str  # "tstop" | "root" | "error" | "interrupted" (Ctrl-C between chunks: the steps so far)
+    t: float
+    y: np.ndarray
+    yp: np.ndarray
+    step_t: np.ndarray
+    step_y: np.ndarray
+    step_yp: np.ndarray
+    step_h: np.ndarray
+    step_order: np.ndarray
+    eval_t: np.ndarray
+    eval_y: np.ndarray
+    eval_yp: np.ndarray
+    roots_found: np.ndarray | None = None
+    flag: int = 0
+    flag_name: str = ""
+    message: str = ""
+    # contact switches the compiled loop decided itself (see CSession.set_auto_events), in time order
+    auto_events: list[AutoEvent] = field(default_factory=list)
+
+    @property
+    def success(self) -> bool:
+        return self.status != "error"
+
+
+@runtime_checkable
+class Session(Protocol):
+    backend: str
+
+    def reinit(self, t0: float, y0: np.ndarray, yp0: np.ndarray, active: Sequence[bool],
+               params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None: ...
+
+    def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
+                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
+                chunked: bool = False) -> Advance:
+        """Integrate towards ``t_stop``; ``store_steps``: keep every step's time, size and order,
+        with ``store_states`` also its y and yp (else ``step_y``/``step_yp`` have no rows).
+        ``chunked``: return (status ``"chunk"``) whenever the step buffer is full or a step filled
+        the last of the ``t_eval`` rows, so that the caller can empty them and call again (a run in
+        bounded memory hands ``t_eval`` over in windows); the integration is not changed."""
+        ...
+
+    def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
+
+    def jacobian(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray: ...
+
+    def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
+
+    def stats(self) -> dict[str, int | float | str]: ...
+
+    def close(self) -> None: ...
+
+
+# =========================================================================== options
+
+
+@dataclass
+class SessionOptions:
+    """The validated options of one session (see :func:`check_options`)."""
+
+    rtol: float
+    atol: np.ndarray
+    max_step: float
+    max_order: int
+    max_steps: int
+    root_directions: np.ndarray  # int32 (n_roots,)
+    buffer_steps: int
+    parameters: np.ndarray  # run-time parameters P (n_parameters,)
+    linear_solver: str = "auto"  # one of LINEAR_SOLVERS, as requested
+
+
+def _root_dirs(model: NormalizedModel, rd: Any, what: str = "root_directions") -> np.ndarray:
+    if rd is None:
+        return np.zeros(model.n_roots, dtype=np.int32)
+    arr = np.asarray(rd)
+    if arr.shape != (model.n_roots,):
+        raise ValueError(f"{what} must have shape ({model.n_roots},), got {arr.shape}")
+    if arr.size and (arr.min() < -1 or arr.max() > 1 or not np.array_equal(arr, np.round(arr))):
+        raise ValueError(f"{what} values must be -1, 0 or +1, got {arr.tolist()}")
+    return np.ascontiguousarray(arr, dtype=np.int32)
+
+
+def check_options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, max_order: Any,
+                  max_steps: Any, root_directions: Any, buffer_steps: Any, parameters: Any,
+                  linear_solver: Any = "auto") -> SessionOptions:
+    """The options of :func:`daeclear.engine.ida_session.open_session`, checked (ValueError naming the
+    option and the allowed values) and converted."""
+    if not isinstance(linear_solver, str) or linear_solver.lower() not in LINEAR_SOLVERS:
+        raise ValueError(f"linear_solver={linear_solver!r} is not a linear solver: valid values are "
+                         f"{', '.join(map(repr, LINEAR_SOLVERS))}")
+    rtol = float(rtol)
+    if not (math.isfinite(rtol) and rtol > 0):
+        raise ValueError(f"rtol must be a positive number, got {rtol}")
+    a = np.asarray(atol, dtype=float)
+    if a.ndim == 0:
+        a = np.full(model.n, float(a))
+    if a.shape != (model.n,):
+        raise ValueError(f"atol must be a scalar or have shape ({model.n},), got {a.shape}")
+    if not np.all(np.isfinite(a) & (a > 0)):
+        raise ValueError(f"atol must be positive and finite, got {a.tolist()}")
+    max_step = float(max_step)
+    if not (max_step >= 0 and math.isfinite(max_step)):
+        raise ValueError(f"max_step must be >= 0 (0: unbounded), got {max_step}")
+    if int(max_order) != max_order or not 1 <= int(max_order) <= 5:
+        raise ValueError(f"max_order must be an integer in [1, 5], got {max_order}")
+    if int(max_steps) != max_steps or int(max_steps) < 1:
+        raise ValueError(f"max_steps must be a positive integer, got {max_steps}")
+    if int(buffer_steps) != buffer_steps or int(buffer_steps) < 1:
+        raise ValueError(f"buffer_steps must be a positive integer, got {buffer_steps}")
+    P = np.zeros(0) if parameters is None else np.ascontiguousarray(parameters, dtype=float).ravel()
+    if P.size != model.n_parameters:
+        raise ValueError(f"parameters must have {model.n_parameters} values (the model's run-time parameters), "
+                         f"got {P.size}")
+    return SessionOptions(rtol, np.ascontiguousarray(a), max_step, int(max_order), int(max_steps),
+                          _root_dirs(model, root_directions), int(buffer_steps), P, linear_solver.lower())
+
+
+# =========================================================================== common base
+
+
+# dc_advance's store_steps flags (csrc/ida_driver.c DC_STORE_TIMES, DC_STORE_STATES)
+STORE_TIMES, STORE_STATES = 1, 2
+
+
+class _NoRows(dict):
+    """Empty (0, n) arrays by n: the step states of an advance that was not asked to keep them."""
+
+    def __missing__(self, n: int) -> np.ndarray:
+        self[n] = value = np.empty((0, n))
+        value.flags.writeable = False
+        return value
+
+
+#: NO_ROWS[n]: a read-only empty (0, n) array
+NO_ROWS = _NoRows()
+
+_EMPTY = np.empty(0)
+_EMPTY.flags.writeable = False
+
+
+def empty_advance_arrays(n: int) -> dict[str, np.ndarray]:
+    """The step arrays of an Advance that took no step (n states)."""
+    return dict(
+        step_t=np.empty(0), step_y=np.empty((0, n)), step_yp=np.empty((0, n)),
+        step_h=np.empty(0), step_order=np.empty(0, dtype=np.int32),
+    )
+
+
+class SessionBase:
+    """State, validation and the backend-independent methods of both sessions."""
+
+    backend = "?"
+
+    def __init__(self, model: NormalizedModel, opts: SessionOptions) -> None:
+        self._model = model
+        self._opts = opts
+        self._n = model.n
+        self._nt = len(model.term_res)
+        self._ready = False
+        self._closed = False
+        self._t = 0.0
+        self._y = np.zeros(model.n)
+        self._yp = np.zeros(model.n)
+        self._active = np.zeros(self._nt, dtype=np.int32)
+        self._params = [np.zeros(p) for p in model.n_params]
+        self._stall_step, self._stall_count = 0.0, TINY_STEP_COUNT
+        self._solve_time = 0.0
+        self._extra_stats: dict[str, int | float | str] = {}
+
+    # ---------------------------------------------------------------- properties
+    @property
+    def n(self) -> int:
+        return self._n
+
+    @property
+    def n_terms(self) -> int:
+        return self._nt
+
+    @property
+    def n_roots(self) -> int:
+        return self._model.n_roots
+
+    @property
+    def n_params(self) -> tuple[int, ...]:
+        return self._model.n_params
+
+    @property
+    def t(self) -> float:
+        """Time of the current state (last reinit or last advance)."""
+        return self._t
+
+    # ---------------------------------------------------------------- validation
+    def _vec(self, v: Any, what: str) -> np.ndarray:
+        a = np.ascontiguousarray(v, dtype=float)
+        if a.shape != (self._n,):
+            raise ValueError(f"{what} must have shape ({self._n},), got {a.shape}")
+        return a
+
+    def set_hints(self, *, nonlin_conv_coef: float | None = None, init_step: float | None = None) -> bool:
+        """Solver hints (see CSession.set_hints); scikit-sundae exposes neither, so the python
+        backend ignores them and returns False."""
+        return False
+
+    def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
+        """Evaluate ``DAEFunctions.extras[k]`` at ``n_points`` points: each input is an array of
+        shape (n_points, size) or (size,) (the same for every point); returns (n_points, n_out).
+        The compiled backend loops in C; the python backend maps the CasADi function. The
+        run-time parameters are appended as the last input."""
+        f = self._model.extras[k]
+        inputs = [*inputs, self._opts.parameters]
+        cols = [np.zeros((0, n_points)) if f.numel_in(j) == 0 else
+                np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, f.numel_in(j)), (n_points, f.numel_in(j))).T
+                for j, x in enumerate(inputs)]
+        fm = f if n_points == 1 else f.map(n_points)
+        return np.array(fm(*cols)).reshape(-1, n_points).T.copy()
+
+    def set_auto_events(self, pairs: Sequence[Any], **kwargs: Any) -> bool:
+        """Only the compiled backend switches contact pairs in C; returns False here."""
+        return False
+
+    def set_layout(self, layout: "StateLayout") -> bool:
+        """Only the compiled backend makes states consistent in C; returns False here."""
+        return False
+
+    def set_stall(self, stall_step: float, count: int) -> None:
+        """Stall detection: ``count`` tiny steps (below ``stall_step`` s and not growing, with no
+        step 100x larger in between) end an advance with DC_STEP_COLLAPSE. Both backends."""
+        if not (stall_step >= 0.0) or count < 1:
+            raise ValueError(f"set_stall: stall_step={stall_step!r} must be >= 0 and count={count!r} >= 1")
+        self._stall_step, self._stall_count = float(stall_step), int(count)
+        if self.backend == "c":
+            self._lib.dc_set_stall(self._h, self._stall_step, self._stall_count)
+
+    def _check_reinit(self, t0: Any, y0: Any, yp0: Any, active: Any, params: Any,
+                      root_directions: Any) -> tuple[float, np.ndarray, np.ndarray, np.ndarray,
+                                                     list[np.ndarray], np.ndarray]:
+        """Validate reinit arguments (kept lean: it runs at every event)."""
+        if self._closed:
+            raise DaeclearError("the session is closed")
+        t0 = float(t0)
+        n, nt = self._n, self._nt
+        y0 = np.asarray(y0, dtype=float)
+        yp0 = np.asarray(yp0, dtype=float)
+        if y0.shape != (n,):
+            raise ValueError(f"y0 must have shape ({n},), got {y0.shape}")
+        if yp0.shape != (n,):
+            raise ValueError(f"yp0 must have shape ({n},), got {yp0.shape}")
+        if not (math.isfinite(t0) and math.isfinite(y0.sum()) and math.isfinite(yp0.sum())):
+            raise ValueError(f"t0, y0 and yp0 must be finite (t0={t0}, y0={y0.tolist()}, yp0={yp0.tolist()})")
+        if active is None:
+            active = ()
+        if len(active) != nt:
+            raise ValueError(f"active must have {nt} entries (one per term), got {len(active)}")
+        act = np.array([1 if a else 0 for a in active], dtype=np.int32)
+        if params is None:
+            params = (None,) * nt
+        if len(params) != nt:
+            raise ValueError(f"params must have {nt} entries (one per term), got {len(params)}")
+        plist = []
+        n_params = self._model.n_params
+        for k in range(nt):
+            p, npk = params[k], n_params[k]
+            pa = np.zeros(npk) if p is None else np.asarray(p, dtype=float).reshape(-1)
+            if pa.size != npk:
+                raise ValueError(f"params[{k}] must have {npk} entries, got {pa.size}")
+            if act[k] and npk and not math.isfinite(pa.sum()):
+                raise ValueError(f"params[{k}] of active term {k} must be finite, got {pa.tolist()}")
+            plist.append(pa)
+        rd = (self._opts.root_directions if root_directions is None
+              else _root_dirs(self._model, root_directions))
+        return t0, y0, yp0, act, plist, rd
+
+    @property
+    def eval_from(self) -> float:
+        """Output times after this one are still to come: the current time, or, when the last
+        (chunked) advance filled its last output row inside a step, that row's time (the rest
+        of the step's output times are given at the next call)."""
+        after = getattr(self, "_eval_after", None)
+        return self._t if after is None else after
+
+    def _select_eval(self, t_eval: Any, t_stop: float) -> np.ndarray:
+        if t_eval is None:
+            return _EMPTY
+        te = np.asarray(t_eval, dtype=float).reshape(-1)
+        lo = int(np.searchsorted(te, self.eval_from, side="right"))
+        hi = int(np.searchsorted(te, t_stop, side="right"))
+        sel = np.ascontiguousarray(te[lo:hi])
+        if sel.size > 1 and np.any(np.diff(sel) < 0):
+            raise ValueError("t_eval must be sorted in increasing order")
+        return sel
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise DaeclearError("the session is closed")
+
+    def _check_advance(self, t_stop: Any) -> float:
+        self._check_open()
+        if not self._ready:
+            raise DaeclearError("advance() called before reinit()")
+        t_stop = float(t_stop)
+        if math.isnan(t_stop) or t_stop < self._t:
+            raise ValueError(f"t_stop={t_stop!r} is behind the current time {self._t!r}")
+        if math.isinf(t_stop):
+            raise ValueError("t_stop must be finite")
+        return t_stop
+
+    # ---------------------------------------------------------------- context manager
+    def __enter__(self) -> "SessionBase":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return (f"<{type(self).__name__} backend={self.backend!r} model={self._model.name!r} "
+                f"n={self._n} terms={self._nt} roots={self._model.n_roots} t={self._t!r}>")
+
+
