@@ -41,7 +41,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, Iterable, Sequence
 
 from ..contact import backend
-from .scene import GROUND, Element, Vector2, as_vector2, body_name, is_finite_number
+from .elements import GROUND, Element, Vector2, as_vector2, body_name, is_finite_number
 
 # the math of expressions, written once for numbers and CasADi symbols
 atan2, cos, exp, fabs, fmax, fmin = backend.atan2, backend.cos, backend.exp, backend.fabs, backend.fmax, backend.fmin
