@@ -44,7 +44,7 @@ def _as_vector2(value: Any) -> Vector2 | None:
     return items  # type: ignore[return-value]
 
 
-# public names of the helpers above, for the elements defined in other modules (daeclear.loads)
+# public names of the helpers above, for the elements defined in other modules (clearance joints, loads)
 is_finite_number, as_vector2 = _is_finite_number, _as_vector2
 
 
