@@ -1,0 +1,518 @@
+"""Clearance joints: a revolute joint with radial play and a translational joint with a loose slider.
+
+:class:`RevoluteClearance` and :class:`TranslationalClearance` add no constraint but contact-impact
+forces (section 4.2 and 4.3 of the chapter); :func:`clearance_joint` and :func:`ideal_joint` turn an
+ideal joint into its clearance joint and back. Separate from :mod:`daeclear.model.elements` (bodies,
+ideal joints, drivers) because these elements carry the contact laws, materials and readings.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+from typing import Any, ClassVar
+
+from ..errors import SceneError
+from .elements import Joint, PointJoint, Revolute, Translational, Vector2, as_vector2
+
+def _default_law() -> Any:
+    from ..contact import LankaraniNikravesh
+
+    return LankaraniNikravesh(restitution=0.9)
+
+
+def _law_problems(element: RevoluteClearance) -> list[str]:
+    """Resolve the joint's contact and friction laws once, reporting what is wrong."""
+    from ..contact import friction_law, normal_law
+    from ..contact.base import NormalLaw
+
+    out: list[str] = []
+    law = element.law
+    try:
+        if isinstance(law, str):
+            law = normal_law(law)
+        if not isinstance(law, NormalLaw):
+            out.append(f"{element.kind} '{element.name}': law={law!r}, must be a daeclear.contact law or a law name.")
+        else:
+            element.resolved_law()
+    except (SceneError, TypeError) as exc:
+        out.append(f"{element.kind} '{element.name}': {exc}")
+    try:
+        friction_law(element.friction)
+    except (SceneError, TypeError) as exc:
+        out.append(f"{element.kind} '{element.name}': friction: {exc}")
+    return out
+
+
+@dataclass(frozen=True)
+class RevoluteClearance(PointJoint):
+    """Revolute joint with radial clearance: a journal (body j) inside a bearing (body i).
+
+    The joint adds no constraint; the journal moves freely inside the bearing and a
+    contact-impact force acts when the eccentricity exceeds the clearance (section 4.2,
+    eqs. 4.1-4.13). ``at`` is the common centre of bearing and journal in the reference
+    configuration (or give ``point_i``/``point_j`` in body coordinates).
+
+    Parameters
+    ----------
+    name : str
+        Unique name; channels ``<name>.ex``, ``<name>.penetration``, ... and events use it.
+    body_i, body_j : str or Body
+        Bearing body and journal body.
+    bearing_radius : float
+        Bearing radius R_i, m.
+    clearance : float or None
+        Radial clearance c = R_i - R_j, m (give this or ``journal_radius``).
+    journal_radius : float or None
+        Journal radius R_j, m.
+    material : Material or (Material, Material) or None
+        Materials of bearing and journal (one for both); needed when the law's stiffness
+        is computed (``stiffness=None``).
+    law : NormalLaw or str
+        Normal contact law (default Lankarani-Nikravesh with c_e = 0.9, eq. 3.9).
+    friction : None, float, str or FrictionLaw
+        None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
+    """
+
+    bearing_radius: float = 0.0
+    clearance: float | None = None
+    journal_radius: float | None = None
+    material: Any = None
+    law: Any = field(default_factory=lambda: _default_law())
+    friction: Any = None
+
+    @property
+    def radial_clearance(self) -> float:
+        if self.clearance is not None:
+            return float(self.clearance)
+        return float(self.bearing_radius) - float(self.journal_radius or 0.0)
+
+    @property
+    def journal(self) -> float:
+        return float(self.bearing_radius) - self.radial_clearance
+
+    def resolved_law(self) -> Any:
+        """The normal law with its stiffness (or cylinder geometry) set from radii and materials."""
+        from ..contact import normal_law
+
+        law = normal_law(self.law) if isinstance(self.law, str) else self.law
+        if law.is_resolved:
+            return law
+        return law.resolve("internal_cylinder", radii=(float(self.bearing_radius), self.journal),
+                           materials=self.material)
+
+    def resolved_friction(self) -> Any:
+        from ..contact import friction_law
+
+        return friction_law(self.friction)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        self._check_positive(out, "bearing_radius", "m")
+        self._check_one_positive(out, "clearance", "journal_radius", "m")
+        if not out:
+            c, R = self.radial_clearance, float(self.bearing_radius)
+            if not 0.0 < c < R:
+                out.append(f"{self.kind} '{self.name}': journal radius {self.journal!r} m must be in "
+                           f"(0, bearing_radius={R!r} m): clearance {c!r} m, must be in (0, {R!r}).")
+            else:
+                out.extend(_law_problems(self))
+        return out
+
+
+def _default_face_law() -> Any:
+    from ..contact import LankaraniPlane
+
+    return LankaraniPlane()
+
+
+#: Contact models of :class:`TranslationalClearance` (see its docstring).
+SLIDER_MODELS: tuple[str, ...] = ("corners", "section-4.3")
+
+
+@dataclass(frozen=True)
+class TranslationalClearance(PointJoint):
+    """Translational joint with clearance: a rectangular slider (body j) free inside a guide (body i).
+
+    The joint adds no constraint; each slider corner that reaches a guide surface is
+    pushed back by a contact-impact force (section 4.3, eqs. 4.14-4.27). The guide is two
+    parallel surfaces a distance ``H`` apart, symmetric about the guide's *mid-line*; the
+    slider is an ``L x W`` rectangle (``thickness`` out of plane) with rounded corners.
+
+    Geometry and names. ``at`` is, in the reference configuration (bodies at their
+    declared positions and angles), both a point of the guide's mid-line and the slider's
+    centre, the slider parallel to the guide; or give ``point_i`` (a mid-line point, guide
+    coordinates) and ``point_j`` (the slider centre, slider coordinates). ``axis`` is the
+    guide direction (world, reference configuration), fixed to the guide, and the slider's
+    length direction in the reference configuration. Coordinates along the guide, ``s``,
+    are measured from the mid-line point along ``axis``; "upper" is the surface on the
+    left of ``axis`` (+90 degrees). Corners, counter-clockwise from the front upper one
+    (front = +axis): ``A`` (+L/2, +W/2), ``B`` (-L/2, +W/2), ``C`` (-L/2, -W/2),
+    ``D`` (+L/2, -W/2). Contact pairs are named ``<name>.A_upper``, ``<name>.B_upper``,
+    ``<name>.C_lower``, ``<name>.D_lower``; faces ``<name>.upper_face`` (A, B) and
+    ``<name>.lower_face`` (C, D). The chapter calls the slider body i and the guide
+    body j; here, as for :class:`Translational` and :class:`RevoluteClearance`, the
+    outer part is body i.
+
+    Parameters
+    ----------
+    name : str
+        Unique name; channels and events use it.
+    body_i, body_j : str or Body
+        Guide body and slider body.
+    axis : (float, float)
+        Guide direction, world frame, reference configuration (need not be unit).
+    slider_axis : (float, float) or None
+        The slider's length direction in slider body coordinates; None: ``axis`` in the
+        reference configuration (the slider starts parallel to the guide). Give it to
+        start tilted: e.g. ``(1, 0)`` with the slider body at ``angle=tilt``.
+    length, width : float
+        Slider length L (along the guide) and width W (across), m.
+    corner_radius : float
+        Corner radius R_c, m, in (0, min(L, W)/2): the stiffness of a corner contact
+        (sphere on a plane, eq. 3.5). The penetration is measured at the sharp corner
+        of the L x W rectangle, as in eqs. (4.16)-(4.20).
+    clearance : float or None
+        c = (H - W)/2, m (give this or ``guide_height``).
+    guide_height : float or None
+        Distance H between the guide surfaces, m.
+    thickness : float or None
+        Slider thickness (out of plane), m; None means ``length``. A face in contact
+        is ``length x thickness``; eq. (4.27) takes the half side of the square of the
+        same area, ``a = sqrt(length * thickness) / 2`` (25 mm for Table 4.3).
+    upper_limits, lower_limits : (float, float) or None
+        Segment limits (P, Q) of the upper and (R, S) of the lower surface, as ``s``
+        coordinates, m: a corner can touch a surface only while its projection lies
+        between them. None: unbounded.
+    stroke : (float, float) or None
+        ``s`` coordinates of the slider centre mapped to xi = 0 and xi = 1 in the
+        dimensionless path (channel ``<name>.xi``); None: ``upper_limits`` if given,
+        else no ``xi`` channel.
+    material : Material or (Material, Material) or None
+        Materials of guide and slider; needed when a stiffness is computed.
+    law : NormalLaw or str
+        Corner law (sphere of radius R_c on a plane), default Lankarani-Nikravesh with
+        c_e = 0.9 (eq. 3.9), stiffness from (3.5) when not given.
+    face_law : NormalLaw or str
+        Law of a face in contact in the ``section-4.3`` model, on the average
+        penetration of its two corners; default Lankarani's linear law (4.26) with the
+        stiffness (4.27). A Hertz-type law given here is resolved with n = 1 (the
+        "unified" damped model). Unused by the ``corners`` model.
+    friction : None, float, str or FrictionLaw
+        None: frictionless; a float: modified Coulomb (3.16) with that coefficient, at
+        every active contact.
+    model : {"corners", "section-4.3"}
+        ``"corners"``: every touching corner is a sphere on a plane, whatever the
+        scenario of Fig. 4.9. ``"section-4.3"``: two adjacent corners on the same surface
+        (a face) use ``face_law`` at the geometric centre of the penetrated area; one
+        corner or two opposite corners use ``law``.
+    reading : str or None
+        A named reading of the chapter's model (:data:`daeclear.model.readings.JOINT_READINGS`:
+        ``corners``, ``pseudo-corners``, ``pseudo-corners-linear``, ``section-4.3``,
+        ``unified``, ``unified-hertz``): it sets the model, the corner law's stiffness
+        ((3.5) or (4.27)) and exponent, and the face law, keeping the restitution of
+        ``law``. None: ``model``, ``law`` and ``face_law`` as given.
+
+    Notes
+    -----
+    The slider must not be able to turn over in the guide (``sqrt(L^2 + W^2) > H``):
+    then the upper corners can only ever touch the upper surface and the lower corners
+    the lower one, and these four pairs are all the contacts there are.
+
+    The ``section-4.3`` model switches between two laws of very different stiffness: when
+    a face forms under a corner that is already deep (a tilted slider), the stored elastic
+    energy jumps up (channel ``<name>.elastic_energy``; docs/validation.md, section 4.5). It
+    is the chapter's model for a slider that lands flat (frictionless, pin at the slider's
+    centre, Fig. 4.35b); for tilting sliders (friction) use ``corners``.
+
+    Example
+    -------
+    >>> import daeclear as dc
+    >>> scene = dc.Scene("guide", gravity=(0.0, -9.81))
+    >>> slider = scene.add(dc.Body("slider", mass=0.14, inertia=1e-4))
+    >>> joint = scene.add(dc.TranslationalClearance(
+    ...     "g", scene.ground, slider, at=(0.0, 0.0), length=0.05, width=0.05, corner_radius=1e-3,
+    ...     clearance=0.5e-3, material=dc.Material(young=207e9, poisson=0.3)))
+    >>> scene.validate()
+    >>> round(joint.resolved_law().stiffness / 1e9, 2)  # sphere of R_c on a plane, eq. (3.5)
+    4.8
+    """
+
+    axis: Vector2 = (1.0, 0.0)
+    slider_axis: Vector2 | None = None
+    length: float = 0.0
+    width: float = 0.0
+    corner_radius: float = 0.0
+    clearance: float | None = None
+    guide_height: float | None = None
+    thickness: float | None = None
+    upper_limits: Vector2 | None = None
+    lower_limits: Vector2 | None = None
+    stroke: Vector2 | None = None
+    material: Any = None
+    law: Any = field(default_factory=lambda: _default_law())
+    face_law: Any = field(default_factory=lambda: _default_face_law())
+    friction: Any = None
+    model: str = "corners"
+    reading: str | None = None
+    # the structure flags state the contact model in use and the laws' structure (a reading that
+    # only changes numbers compiles nothing)
+    NOT_STRUCTURE: ClassVar[frozenset[str]] = frozenset({"model", "reading"})
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        for name in ("axis", "slider_axis", "upper_limits", "lower_limits", "stroke"):
+            value = getattr(self, name)
+            vec = as_vector2(value) if value is not None else None
+            if vec is not None:
+                object.__setattr__(self, name, vec)
+        for name in ("model", "reading"):
+            if isinstance(getattr(self, name), str):
+                object.__setattr__(self, name, getattr(self, name).strip().lower())
+
+    @property
+    def contact_model(self) -> str:
+        """The contact model in use: the reading's, else ``model``."""
+        from .joint_readings import joint_reading
+
+        return self.model if self.reading is None else joint_reading(self.reading).model
+
+    # ---- derived geometry ----------------------------------------------------------
+    @property
+    def radial_clearance(self) -> float:
+        """c = (H - W) / 2, m."""
+        if self.clearance is not None:
+            return float(self.clearance)
+        return 0.5 * (float(self.guide_height or 0.0) - float(self.width))
+
+    @property
+    def height(self) -> float:
+        """Distance between the guide surfaces H = W + 2c, m."""
+        return float(self.width) + 2.0 * self.radial_clearance
+
+    @property
+    def face_half_width(self) -> float:
+        """Half side a of the square with the area of a slider face, m (eq. 4.27)."""
+        thickness = float(self.length if self.thickness is None else self.thickness)
+        return 0.5 * math.sqrt(float(self.length) * thickness)
+
+    def resolved_law(self) -> Any:
+        """The corner law with its stiffness set (kind ``"sphere_plane"``, radius R_c)."""
+        from ..contact import normal_law
+
+        law = normal_law(self.law) if isinstance(self.law, str) else self.law
+        if self.reading is not None:
+            from . import joint_readings as readings
+
+            return readings.corner_law(readings.joint_reading(self.reading), law, owner=f"{self.kind} '{self.name}'",
+                                       corner_radius=self.corner_radius, face_half_width=self.face_half_width,
+                                       materials=self.material)
+        if law.is_resolved:
+            return law
+        return law.resolve("sphere_plane", radii=(float(self.corner_radius),), materials=self.material)
+
+    def resolved_face_law(self) -> Any:
+        """The face law with its stiffness set (kind ``"plane_face"``, half side a); with a reading
+        its face law (None for a reading of the ``corners`` model)."""
+        from ..contact import normal_law
+
+        if self.reading is not None:
+            from . import joint_readings as readings
+
+            return readings.face_law(readings.joint_reading(self.reading),
+                                     normal_law(self.law) if isinstance(self.law, str) else self.law,
+                                     owner=f"{self.kind} '{self.name}'", face_half_width=self.face_half_width,
+                                     materials=self.material)
+        law = normal_law(self.face_law) if isinstance(self.face_law, str) else self.face_law
+        return law.resolve("plane_face", face_half_width=self.face_half_width, materials=self.material)
+
+    def resolved_friction(self) -> Any:
+        from ..contact import friction_law
+
+        return friction_law(self.friction)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        for name in ("axis", "slider_axis"):
+            value = getattr(self, name)
+            vec = as_vector2(value) if value is not None or name == "axis" else (1.0, 0.0)
+            if vec is None or math.hypot(*vec) < 1e-12:
+                out.append(f"{self.kind} '{self.name}': {name}={value!r}, must be a non-zero 2-vector.")
+        for name in ("length", "width", "corner_radius"):
+            self._check_positive(out, name, "m")
+        if self.thickness is not None:
+            self._check_positive(out, "thickness", "m")
+        self._check_one_positive(out, "clearance", "guide_height", "m")
+        for name in ("upper_limits", "lower_limits", "stroke"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            pair = as_vector2(value)
+            if pair is None or not pair[0] < pair[1]:
+                out.append(f"{self.kind} '{self.name}': {name}={value!r} m, must be two finite numbers "
+                           "(start, end) with start < end.")
+        if self.model not in SLIDER_MODELS:
+            out.append(f"{self.kind} '{self.name}': model={self.model!r}, must be one of "
+                       f"{', '.join(map(repr, SLIDER_MODELS))}.")
+        out.extend(_reading_problems(self))
+        if out:
+            return out
+        L, W, R_c, c = float(self.length), float(self.width), float(self.corner_radius), self.radial_clearance
+        if c <= 0:
+            out.append(f"{self.kind} '{self.name}': guide_height={self.guide_height!r} m must exceed the slider "
+                       f"width {W!r} m: clearance (H - W)/2 = {c!r} m, must be > 0.")
+        elif math.hypot(L, W) <= self.height:
+            out.append(f"{self.kind} '{self.name}': the slider ({L!r} x {W!r} m, diagonal {math.hypot(L, W):.6g} m) "
+                       f"can turn over in a guide {self.height:.6g} m high; the diagonal must exceed the guide "
+                       "height (reduce the clearance or lengthen the slider).")
+        if R_c >= 0.5 * min(L, W):
+            out.append(f"{self.kind} '{self.name}': corner_radius={R_c!r} m, must be < min(length, width)/2 "
+                       f"= {0.5 * min(L, W)!r} m.")
+        out.extend(_law_problems(self))
+        if self.model == "section-4.3" and self.reading is None:
+            out.extend(_face_law_problems(self))
+        return out
+
+
+def _reading_problems(element: TranslationalClearance) -> list[str]:
+    """A reading must be known, and ``model`` and ``face_law`` left to it."""
+    from .joint_readings import joint_reading
+
+    if element.reading is None:
+        return []
+    where = f"{element.kind} '{element.name}'"
+    try:
+        reading = joint_reading(element.reading)
+    except SceneError as exc:
+        return [f"{where}: {exc}"]
+    out = []
+    if element.model not in ("corners", reading.model):
+        out.append(f"{where}: model={element.model!r} with reading={reading.name!r}, whose model is "
+                   f"{reading.model!r}; give one of them.")
+    if element.face_law != _default_face_law():
+        out.append(f"{where}: face_law={element.face_law!r} with reading={reading.name!r}, which sets the face "
+                   "law; leave face_law at its default.")
+    return out
+
+
+def _face_law_problems(element: TranslationalClearance) -> list[str]:
+    from ..contact import normal_law
+    from ..contact.base import NormalLaw
+
+    law = element.face_law
+    try:
+        if isinstance(law, str):
+            law = normal_law(law)
+        if not isinstance(law, NormalLaw):
+            return [f"{element.kind} '{element.name}': face_law={law!r}, must be a daeclear.contact law or a "
+                    "law name."]
+        element.resolved_face_law()
+    except (SceneError, TypeError) as exc:
+        return [f"{element.kind} '{element.name}': face_law: {exc}"]
+    return []
+
+
+# ---- clearance as a property of a joint ------------------------------------------------
+
+#: The clearance joint each ideal joint becomes, and the fields it needs besides the shared ones.
+_CLEARANCE_OF: dict[type, tuple[type, tuple[tuple[str, ...], ...]]] = {
+    Revolute: (RevoluteClearance, (("bearing_radius",), ("clearance", "journal_radius"))),
+    Translational: (TranslationalClearance, (("length",), ("width",), ("corner_radius",),
+                                             ("clearance", "guide_height"))),
+}
+
+
+def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | None = None,
+                    **fields_: Any) -> Joint:
+    """The clearance joint that replaces the ideal ``joint``: same bodies, point and axis.
+
+    Perfect and clearance joints share their kinematic data (Ambrósio and Pombo, "A unified
+    formulation for mechanical joints with and without clearances/bushings and/or stops",
+    Multibody Syst. Dyn. 42, 2018): a :class:`Revolute` becomes a :class:`RevoluteClearance`
+    whose bearing and journal centres are the joint's point (``at`` or ``point_i``/``point_j``);
+    a :class:`Translational` becomes a :class:`TranslationalClearance` whose guide is body i,
+    slider body j, with the joint's ``axis`` as the guide direction and the joint's point as
+    both the mid-line point and the slider centre. ``fields_`` are the clearance fields only
+    (clearance, geometry, material, law, friction, ...), never the shared ones.
+
+    Parameters
+    ----------
+    joint : Revolute or Translational
+        The ideal joint.
+    bearing : str or None
+        Revolute only: the body that holds the bearing (body_i or body_j of the joint); None
+        keeps body i, the other body carries the journal.
+    name : str or None
+        Name of the clearance joint (its channels are ``<name>.ex``, ...); None keeps the joint's.
+    **fields_
+        Fields of the clearance joint, e.g. ``clearance=0.5e-3, bearing_radius=10e-3,
+        material=Material(...), law="lankarani-nikravesh", friction=0.05``.
+
+    Raises
+    ------
+    SceneError
+        A joint that is not an ideal revolute or translational one (e.g. already a clearance
+        joint), an unknown or shared field, a missing one, or an invalid value.
+    """
+    label = f"clearance on joint '{getattr(joint, 'name', joint)}'"
+    if isinstance(joint, (RevoluteClearance, TranslationalClearance)):
+        raise SceneError(f"{label}: it is already a {joint.kind}; change its fields with "
+                         "dataclasses.replace, or start from the ideal joint.")
+    if type(joint) not in _CLEARANCE_OF:
+        kind = getattr(joint, "kind", type(joint).__name__)
+        raise SceneError(f"{label}: it is a {kind}; only an ideal Revolute or Translational joint can get a "
+                         "clearance.")
+    cls, required = _CLEARANCE_OF[type(joint)]
+    shared = {f.name for f in fields(type(joint))}
+    allowed = [f.name for f in fields(cls) if f.name not in shared]
+    unknown = sorted(set(fields_) - set(allowed))
+    if unknown:
+        hints = [f"{key} (shared with the ideal joint)" if key in shared else key for key in unknown]
+        raise SceneError(f"{label}: unknown field(s) {', '.join(hints)} for a {cls.__name__}; "
+                         f"allowed: {', '.join(allowed)}.")
+    missing = [" or ".join(group) for group in required if all(fields_.get(k) is None for k in group)]
+    if missing:
+        raise SceneError(f"{label}: missing {', '.join(missing)} (m), needed by a {cls.__name__}.")
+    shared_values = {f.name: getattr(joint, f.name) for f in fields(type(joint))}
+    if bearing is not None:
+        if cls is not RevoluteClearance:
+            raise SceneError(f"{label}: bearing={bearing!r} applies to a revolute joint only; a translational "
+                             "joint's guide is its body_i.")
+        if bearing not in joint.bodies:
+            raise SceneError(f"{label}: bearing={bearing!r}, must be one of the joint's bodies "
+                             f"{joint.body_i!r} or {joint.body_j!r}.")
+        if bearing == joint.body_j:  # the journal on body i: the two bodies and their points change roles
+            shared_values.update(body_i=joint.body_j, body_j=joint.body_i, point_i=joint.point_j,
+                                 point_j=joint.point_i)
+    if name is not None:
+        shared_values["name"] = name
+    element = cls(**shared_values, **fields_)
+    problems = element.problems()
+    if problems:
+        raise SceneError(f"{label}: " + " ".join(problems))
+    return element
+
+
+def ideal_joint(joint: Joint) -> Joint:
+    """The ideal joint a clearance joint stands for: same name, bodies, point and axis (the inverse of
+    :func:`clearance_joint` up to the clearance fields)."""
+    shared = {"name": joint.name, "body_i": joint.body_i, "body_j": joint.body_j,
+              "at": getattr(joint, "at", None), "point_i": getattr(joint, "point_i", None),
+              "point_j": getattr(joint, "point_j", None)}
+    if isinstance(joint, RevoluteClearance):
+        return Revolute(**shared)
+    if isinstance(joint, TranslationalClearance):
+        return Translational(**shared, axis=joint.axis)
+    raise SceneError(f"ideal joint of '{getattr(joint, 'name', joint)}': it is a "
+                     f"{getattr(joint, 'kind', type(joint).__name__)}, not a clearance joint.")
+
+
+
+def driven_coordinate(joint: Any) -> str | None:
+    """What a :class:`Driver` prescribes on ``joint``: "rotation" (revolute joints, with or without
+    clearance), "translation" (translational joints, with or without clearance) or None (not drivable)."""
+    if isinstance(joint, (Revolute, RevoluteClearance)):
+        return "rotation"
+    if isinstance(joint, (Translational, TranslationalClearance)):
+        return "translation"
+    return None

@@ -1,0 +1,324 @@
+"""The elements of a scene: the :class:`Element` base and its checks, bodies, ideal joints and drivers.
+
+Plain data (frozen dataclasses, SI units, planar 2-vectors) that knows nothing of CasADi or
+of the solver; each element lists its own problems. Separate from :mod:`daeclear.model.scene`
+(the container that checks elements against each other) so that every element module
+(:mod:`daeclear.model.clearance_joints`, :mod:`daeclear.model.loads`) builds on this one.
+
+Conventions
+-----------
+* Every body has generalized coordinates ``(x, y, phi)`` of its centre of mass.
+* Joints join two bodies at a world point ``at`` given in the *reference
+  configuration*, i.e. with the bodies at their declared ``position`` and
+  ``angle``. The body-fixed attachment points are taken from that configuration.
+  Alternatively give them directly in body coordinates with ``point_i`` and
+  ``point_j``; then the declared positions are only guesses that assembly corrects.
+* The ground is the body named ``"ground"``: fixed at the origin, angle zero.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Any, ClassVar
+
+from .profiles import PROFILES, ConstantSpeed, Profile
+
+GROUND = "ground"
+
+Vector2 = tuple[float, float]
+
+
+def _is_finite_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _as_vector2(value: Any) -> Vector2 | None:
+    """Return ``value`` as a tuple of two finite floats, or None if it is not one."""
+    try:
+        items = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        return None
+    if len(items) != 2 or not all(math.isfinite(v) for v in items):
+        return None
+    return items  # type: ignore[return-value]
+
+
+# public names of the helpers above, for the elements defined in other modules (clearance joints, loads)
+is_finite_number, as_vector2 = _is_finite_number, _as_vector2
+
+
+class Element:
+    """Base class of every scene element: a name, and a list of own problems."""
+
+    name: str
+    #: fields whose effect on the equations the element's structure flags already state (the
+    #: compiled engine leaves them out of the structure key: a name for numbers compiles nothing)
+    NOT_STRUCTURE: ClassVar[frozenset[str]] = frozenset()
+
+    @property
+    def kind(self) -> str:
+        return type(self).__name__
+
+    def problems(self) -> list[str]:
+        """Problems of this element alone (empty when valid)."""
+        if not isinstance(self.name, str) or not self.name.strip():
+            return [f"{self.kind}: name={self.name!r}, must be a non-empty string."]
+        if "." in self.name or "/" in self.name:
+            return [f"{self.kind} '{self.name}': name must not contain '.' or '/' (used in channel names)."]
+        return []
+
+    def _check_positive(self, out: list[str], field_name: str, unit: str) -> None:
+        value = getattr(self, field_name)
+        if not _is_finite_number(value) or value <= 0:
+            out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number > 0.")
+
+    def _check_vector(self, out: list[str], field_name: str, unit: str, optional: bool = False) -> None:
+        value = getattr(self, field_name)
+        if optional and value is None:
+            return
+        if _as_vector2(value) is None:
+            out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be two finite numbers (x, y).")
+
+    def _check_one_positive(self, out: list[str], first: str, second: str, unit: str) -> None:
+        """Exactly one of two alternative fields is given, and it is > 0."""
+        a, b = getattr(self, first), getattr(self, second)
+        if (a is None) == (b is None):
+            out.append(f"{self.kind} '{self.name}': give exactly one of {first}= or {second}= "
+                       f"(got {first}={a!r}, {second}={b!r}).")
+        else:
+            self._check_positive(out, first if a is not None else second, unit)
+
+    def _check_number(self, out: list[str], field_name: str, unit: str) -> None:
+        value = getattr(self, field_name)
+        if not _is_finite_number(value):
+            out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number.")
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data description (element kind and fields) for files and HDF5 attributes."""
+        out: dict[str, Any] = {"kind": self.kind}
+        for f in fields(self):  # type: ignore[arg-type]
+            value = getattr(self, f.name)
+            if hasattr(value, "to_dict"):
+                value = value.to_dict()
+            elif isinstance(value, tuple):
+                value = list(value)
+            out[f.name] = value
+        return out
+
+
+def _body_name(body: str | Body | Ground) -> str:
+    return body if isinstance(body, str) else getattr(body, "name", body)
+
+
+body_name = _body_name  # public name, for the elements defined in other modules
+
+
+@dataclass(frozen=True)
+class Body(Element):
+    """A rigid body moving in the plane.
+
+    Parameters
+    ----------
+    name : str
+        Unique name in the scene (used by joints, channels and errors).
+    mass : float
+        Mass, kg (> 0).
+    inertia : float
+        Moment of inertia about the centre of mass, kg m^2 (> 0).
+    position : (float, float)
+        Initial position of the centre of mass, m (a guess when constrained).
+    angle : float
+        Initial angle of the body frame, rad.
+    velocity : (float, float)
+        Initial velocity of the centre of mass, m/s (a guess when constrained).
+    angular_velocity : float
+        Initial angular velocity, rad/s (a guess when constrained).
+    """
+
+    name: str
+    mass: float
+    inertia: float
+    position: Vector2 = (0.0, 0.0)
+    angle: float = 0.0
+    velocity: Vector2 = (0.0, 0.0)
+    angular_velocity: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("position", "velocity"):
+            vec = _as_vector2(getattr(self, name))
+            if vec is not None:
+                object.__setattr__(self, name, vec)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        if self.name == GROUND:
+            out.append(f"Body '{GROUND}': the name is reserved for the fixed ground; use scene.ground.")
+        self._check_positive(out, "mass", "kg")
+        self._check_positive(out, "inertia", "kg m^2")
+        self._check_vector(out, "position", "m")
+        self._check_number(out, "angle", "rad")
+        self._check_vector(out, "velocity", "m/s")
+        self._check_number(out, "angular_velocity", "rad/s")
+        return out
+
+
+@dataclass(frozen=True)
+class Ground:
+    """The fixed ground: the body named ``"ground"`` at the origin with angle zero."""
+
+    name: str = GROUND
+
+
+@dataclass(frozen=True)
+class Joint(Element):
+    """Base class of joints between two bodies ``body_i`` and ``body_j``."""
+
+    name: str
+    body_i: str
+    body_j: str
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "body_i", _body_name(self.body_i))
+        object.__setattr__(self, "body_j", _body_name(self.body_j))
+
+    @property
+    def bodies(self) -> tuple[str, str]:
+        return (self.body_i, self.body_j)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        if self.body_i == self.body_j:
+            out.append(f"{self.kind} '{self.name}': joins body '{self.body_i}' to itself; give two different bodies.")
+        return out
+
+
+@dataclass(frozen=True)
+class PointJoint(Joint):
+    """A joint located by a world point ``at`` or by body-fixed points ``point_i``/``point_j``
+    (the base of the ideal and of the clearance revolute and translational joints)."""
+
+    at: Vector2 | None = None
+    point_i: Vector2 | None = None
+    point_j: Vector2 | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        for name in ("at", "point_i", "point_j"):
+            vec = _as_vector2(getattr(self, name)) if getattr(self, name) is not None else None
+            if vec is not None:
+                object.__setattr__(self, name, vec)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        self._check_vector(out, "at", "m", optional=True)
+        self._check_vector(out, "point_i", "m", optional=True)
+        self._check_vector(out, "point_j", "m", optional=True)
+        local = (self.point_i is not None, self.point_j is not None)
+        if self.at is None and not all(local):
+            out.append(
+                f"{self.kind} '{self.name}': give the world point at=(x, y), "
+                "or both body-fixed points point_i and point_j."
+            )
+        return out
+
+
+@dataclass(frozen=True)
+class Revolute(PointJoint):
+    """Ideal revolute (pin) joint: point P of body i coincides with point P of body j.
+
+    Adds two constraint equations, ``r_i + A_i s_i - r_j - A_j s_j = 0``.
+    """
+
+
+@dataclass(frozen=True)
+class Translational(PointJoint):
+    """Ideal translational (prismatic) joint: body j slides on body i along ``axis``.
+
+    ``axis`` is a world direction in the reference configuration (fixed to body i);
+    the two constraints keep the joint point of body j on the line through the joint
+    point of body i along ``axis``, and keep the relative angle constant.
+    """
+
+    axis: Vector2 = (1.0, 0.0)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        vec = _as_vector2(self.axis)
+        if vec is not None:
+            object.__setattr__(self, "axis", vec)
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        vec = _as_vector2(self.axis)
+        if vec is None or math.hypot(*vec) < 1e-12:
+            out.append(f"{self.kind} '{self.name}': axis={self.axis!r}, must be a non-zero 2-vector.")
+        return out
+
+
+@dataclass(frozen=True)
+class Driver(Element):
+    """Prescribed motion of one joint coordinate (a kinematic driver constraint).
+
+    On a revolute joint (:class:`Revolute` or :class:`RevoluteClearance`) the coordinate is
+    the relative angle ``phi_j - phi_i``; on a translational joint (:class:`Translational` or
+    :class:`TranslationalClearance`) it is the displacement of point j from point i along the
+    joint's axis (fixed to body i). The driver imposes ``x(t) = x0 + motion(t)`` with the
+    ``profile``'s motion (constant speed by default: ``x0 + speed t``; see
+    :mod:`daeclear.profiles`), where ``x0`` is the coordinate of the reference configuration
+    unless ``initial_angle`` (revolute) or ``initial_position`` (translational) is given. On a
+    clearance joint only this coordinate is prescribed: the journal (slider) stays free in its
+    play. Channels: ``<name>.moment`` (N m, revolute) or ``<name>.force`` (N, translational),
+    the load the driver applies to body j (counter-clockwise / along the axis positive), and
+    ``<name>.power`` (W).
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    joint : str
+        Name of a revolute or translational joint of the scene, with or without clearance.
+    speed : float or None
+        Speed of the profile, rad/s (m/s on a translational joint); None only with a
+        :class:`~daeclear.profiles.Tabulated` profile, which gives the coordinate itself.
+    initial_angle : float or None
+        Relative angle ``phi_j - phi_i`` at t = 0, rad (revolute joints); None keeps the reference one.
+    profile : Profile or None
+        Motion profile (:class:`~daeclear.profiles.Ramp`, ``Harmonic``, ``Tabulated``); None: constant speed.
+    initial_position : float or None
+        Displacement along the axis at t = 0, m (translational joints); None keeps the reference one.
+    """
+
+    name: str
+    joint: str
+    speed: float | None = None
+    initial_angle: float | None = None
+    profile: Profile | None = None
+    initial_position: float | None = None
+
+    @property
+    def motion_profile(self) -> Profile:
+        """The profile, :class:`~daeclear.profiles.ConstantSpeed` when none is given."""
+        return ConstantSpeed() if self.profile is None else self.profile
+
+    def problems(self) -> list[str]:
+        out = super().problems()
+        profile = self.motion_profile
+        if not isinstance(profile, Profile):
+            out.append(f"{self.kind} '{self.name}': profile={self.profile!r}, must be None or a daeclear.profiles "
+                       f"profile ({', '.join(c.__name__ for c in PROFILES.values())}).")
+            return out
+        if profile.uses_speed:
+            self._check_number(out, "speed", "rad/s (m/s on a translational joint)")
+        else:
+            for name in ("speed", "initial_angle", "initial_position"):
+                if getattr(self, name) is not None:
+                    out.append(f"{self.kind} '{self.name}': {name}={getattr(self, name)!r} is given by the "
+                               f"{type(profile).__name__} profile's values; leave it out.")
+        if self.initial_angle is not None:
+            self._check_number(out, "initial_angle", "rad")
+        if self.initial_position is not None:
+            self._check_number(out, "initial_position", "m")
+        out.extend(profile.problems(self.name))
+        return out
+
