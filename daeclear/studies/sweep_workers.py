@@ -1,0 +1,107 @@
+"""What a sweep's workers run, and the lifecycle of the local process pool.
+
+:func:`run_task` builds the scene of one parameter point, classifies its motion and returns plain
+data (it runs in a worker process, on any ``concurrent.futures.Executor``: a local pool or a Dask
+cluster); :func:`ignore_sigint` is the local pool's initializer and :func:`terminate_pool` stops
+its workers on an interrupt. Separate from the sweep's bookkeeping (:mod:`daeclear.studies.sweep`)
+and its file (:mod:`daeclear.studies.sweep_file`): workers only compute, they never write files.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import os
+import signal
+import socket
+import sys
+import time
+import traceback as tb
+from collections.abc import Callable, Mapping
+from datetime import datetime, timezone
+from typing import Any
+
+import numpy as np
+
+from ..errors import SceneError
+
+__all__ = ["build_scene", "ignore_sigint", "run_task", "terminate_pool"]
+
+
+def build_scene(mechanism: str | Callable[..., Any], parameters: Mapping[str, Any]) -> Any:
+    """The scene of one parameter point: ``mechanism(**parameters)`` (a callable or a ready mechanism's name)."""
+    if callable(mechanism):
+        return mechanism(**parameters)
+    from ..model.scenefile import MECHANISMS
+
+    if mechanism not in MECHANISMS:
+        raise SceneError(f"sweep: mechanism={mechanism!r}, must be one of {', '.join(MECHANISMS)} or a callable "
+                         "returning a Scene.")
+    return MECHANISMS[mechanism](**parameters)
+
+
+def ignore_sigint(parent: int | None = None) -> None:
+    """Process-pool initializer: Ctrl-C goes to the sweep's own process, which stops the workers; and
+    on Linux a worker dies with the sweep's process (killed hard, no cleanup) instead of lingering."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):  # pragma: no cover - no prctl: workers end with their queue
+            return
+        if parent is not None and os.getppid() != parent:  # the parent died before prctl took effect
+            os._exit(1)
+
+
+def run_task(task: Mapping[str, Any]) -> dict[str, Any]:
+    """Build the scene of one point, classify its motion and return plain data (runs in a worker)."""
+    from .analysis import classify_motion
+
+    start = time.perf_counter()
+    out: dict[str, Any] = {"key": task["key"], "index": task["index"], "parameters": dict(task["parameters"]),
+                           "worker": f"{socket.gethostname()}:{os.getpid()}"}
+    try:
+        scene = build_scene(task["mechanism"], task["parameters"])
+        analysis = classify_motion(scene, **task["analysis"])
+        section = analysis.section
+        data: dict[str, Any] = {
+            "section": {"t": np.asarray(section.t), "points": np.asarray(section.points),
+                        "channels": list(section.channels), "units": list(section.units),
+                        "size": np.asarray(section.size), "center": np.asarray(section.center),
+                        "period": section.period},
+            "motion": {"label": analysis.motion.label, "period": analysis.motion.period,
+                       "reason": analysis.motion.reason, "evidence": dict(analysis.motion.evidence)},
+        }
+        if task["keep"] in ("channels", "full"):
+            t0 = float(task["analysis"].get("transient", 10)) * section.period
+            result = analysis.result
+            mask = result.window_mask(t0 - 1e-9 * section.period, None)
+            data["channels"] = {"t": np.asarray(result.t)[mask],
+                                **{name: np.asarray(result[name])[mask] for name in task["store_channels"]}}
+            data["units"] = {name: result.units.get(name, "") for name in task["store_channels"]}
+        if task["keep"] == "full":
+            data["result"] = analysis.result
+        out.update(status="done", data=data)
+    except KeyboardInterrupt:
+        out.update(status="interrupted")
+    except Exception as exc:  # a failed run is recorded with its error, never lost
+        message = str(exc)
+        if "interrupted by the user" in message:
+            out.update(status="interrupted")
+        else:
+            out.update(status="failed", error=f"{type(exc).__name__}: {message}", traceback=tb.format_exc())
+    out["wall_time"] = time.perf_counter() - start
+    out["computed_at"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    return out
+
+
+def terminate_pool(executor: cf.Executor) -> None:
+    """Stop our own process pool's workers now (their running tasks are abandoned, not recorded)."""
+    processes = getattr(executor, "_processes", None) or {}
+    for process in list(processes.values()):
+        try:
+            process.terminate()
+        except Exception:  # already gone
+            pass

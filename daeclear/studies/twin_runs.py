@@ -1,0 +1,347 @@
+"""Twin trajectories: restart a run on its attractor, perturb one twin, measure how they separate.
+
+The sensitivity half of the motion analysis: :func:`restart_model` restarts a run from a state on
+the attractor (one twin perturbed along the constraint manifold), :func:`twin_divergence` measures
+the twins' separation and section points, and :func:`twin_evidence` turns any such pair of
+trajectories into the numbers the classification reads (:class:`Divergence`: Lyapunov fit,
+amplification, decorrelation, section gap). Separate from the section test
+(:mod:`daeclear.studies.poincare`) and from the rules that combine both
+(:mod:`daeclear.studies.motion_class`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .motion_thresholds import DEFAULT_MAX_PERIOD, MIN_AMPLIFICATION, SATURATION_FRACTION, TIME_MATCH
+from .poincare import PoincareSection, crank_period, match_times, recurrence_defects
+from ..assembly.assemble import DAEModel
+from ..errors import DaeclearError
+
+if TYPE_CHECKING:
+    from ..results.result import Result
+
+__all__ = ["Divergence", "all_free", "restart_model", "twin_divergence", "twin_evidence"]
+
+
+# --------------------------------------------------------------------------- twin trajectories
+
+
+def _state_selection(result: Result) -> list[int]:
+    """Columns of y that are positions or velocities (states with a unit; multipliers have none)."""
+    return [i for i, name in enumerate(result.state_names) if result.units.get(name, "")]
+
+
+@dataclass(frozen=True)
+class _RestartModel(DAEModel):
+    """A DAEModel whose run starts from a given state (positions and velocities kept as given)."""
+
+    start_state: tuple[float, ...] = ()
+    start_is_declared = False  # a state of a run: starting in contact is no declaration error (daeclear.solvers.physics)
+
+    def initial_state(self, session: Any = None, start: str = "declared", allow_penetration: bool = True
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        # index-1: no Newton projection (consistent_state ignores it): the stored state carries the
+        # run's own (Baumgarte-controlled) constraint drift, and projecting it away would move a
+        # journal by up to that drift. GGL: projected, as every GGL restart is; its run holds the
+        # joints to Newton's tolerance, but a stored output point is IDA's interpolant (and a
+        # perturbed one is on the manifold only to first order), and GGL cannot start off it.
+        return self.consistent_state(0.0, np.array(self.start_state, dtype=float), session=session, project=True)
+
+
+def restart_model(model: DAEModel, result: Result, index: int, *, perturbation: float = 0.0,
+                  seed: int = 0) -> DAEModel:
+    """A model whose run starts at t = 0 from the state of ``result`` at output ``index``.
+
+    The scene is T-periodic in time (drivers at one speed, constant gravity), so a state
+    at t = j T is a valid initial state at t = 0 once every body angle is unwound by the
+    whole turns it made since t = 0. Positions and velocities are kept as they are (no
+    re-assembly), multipliers and accelerations recomputed. Contact modes are set from
+    the gaps at the restart (restart in free flight to avoid re-latching an approach speed).
+
+    Parameters
+    ----------
+    model : DAEModel
+        The model of ``result``.
+    result : Result
+        A run of ``model`` whose output ``index`` is at a whole number of periods.
+    index : int
+        Output index of the restart state.
+    perturbation : float
+        Size (Euclidean norm over the positions q, m and rad mixed) of a random
+        perturbation of the positions, projected on the constraint manifold's tangent
+        space so the joints stay closed to first order; 0 for none.
+    seed : int
+        Seed of the perturbation's random direction.
+
+    Returns
+    -------
+    DAEModel
+        A subclass instance usable wherever a model is (``simulate(model, ...)``).
+    """
+    T = crank_period(model)
+    t_restart = float(result.t[index])
+    turns = t_restart / T
+    if abs(turns - round(turns)) > 1e-6:
+        raise DaeclearError(f"restart_model: t = {t_restart:.9g} s is not a whole number of periods "
+                            f"(T = {T:.6g} s); a restart needs the driver at its initial angle.")
+    y = np.array(result.y[index], dtype=float)
+    n_q = model.n_q
+    for i, name in enumerate(result.state_names[:n_q]):
+        if result.units.get(name) == "rad":  # unwind whole turns: rotation matrices and drivers are 2 pi periodic
+            y[i] -= 2.0 * math.pi * round((y[i] - float(result.y[0, i])) / (2.0 * math.pi))
+    if perturbation:
+        rng = np.random.default_rng(seed)
+        u = rng.standard_normal(n_q)
+        q, v = y[:n_q], y[n_q:2 * n_q]
+        if model.n_constraints:  # along the constraint manifold: project on the null space of Phi_q
+            Phi_q = np.array(model.kinematics(q, v, 0.0, model.parameter_values)[1], dtype=float).reshape(model.n_constraints, n_q)
+            _, sv, vt = np.linalg.svd(Phi_q)
+            rank = int(np.sum(sv > 1e-10 * sv[0])) if sv.size and sv[0] > 0 else 0
+            null = vt[rank:].T
+            u = null @ (null.T @ u)
+        norm = float(np.linalg.norm(u))
+        if norm <= 1e-12:
+            raise DaeclearError(f"restart_model: scene {model.scene_name!r} has no free position to perturb "
+                                "(its joints and drivers fix every coordinate).")
+        y[:n_q] += perturbation * u / norm
+    kw = {f.name: getattr(model, f.name) for f in dataclasses.fields(model) if f.name != "start_state"}
+    return _RestartModel(**kw, start_state=tuple(float(x) for x in y))
+
+
+def all_free(result: Result, t: float) -> bool:
+    """True when every contact pair is free (not in contact) strictly inside a segment containing t."""
+    for a, b, modes in result.segments:
+        if a < t < b:
+            return all(mode == "free" for mode in modes.values())
+    return False
+
+
+@dataclass(frozen=True)
+class Divergence:
+    """Separation of twin trajectories restarted on the attractor, one of them perturbed.
+
+    Attributes
+    ----------
+    t : ndarray (m,)
+        Times since the restart, s.
+    distance : ndarray (m,)
+        RMS over positions and velocities of |twin a - twin b| / (attractor range of the state).
+    restart_time : float
+        Time of the restart state in the original run, s.
+    restart_in_contact : bool
+        True when no section time of the analysed span was in free flight, so the restart is
+        in contact (the approach speed latched at the last impact is replaced by the current
+        penetration rate for that contact: the twins are then a slightly different system).
+    perturbation : float
+        Size of the position perturbation, m (Euclidean norm over q).
+    d0 : float
+        Normalised separation at the restart (the perturbation).
+    d_start : float
+        Separation at the first sample after the restart: the integration noise of two runs
+        whose steps differ (about rtol) when it exceeds d0; the growth is measured from it.
+    d_saturation : float
+        Median separation over the second half of the twin run.
+    amplification : float
+        d_saturation / d_start.
+    lyapunov : float
+        Largest Lyapunov exponent estimate, 1/s: slope of ln(distance) against time over the
+        growth window; nan when the separation grew less than MIN_AMPLIFICATION times.
+    r_squared : float
+        Coefficient of determination of that straight-line fit (nan without a fit).
+    fit_window : (float, float)
+        Times since restart (s) of the fitted samples.
+    decorrelation : float
+        RMS distance between the twins' section points over the second half of the twin run,
+        in units of the attractor's size, divided by sqrt(2) x the section's RMS spread: about 1
+        when the twins are as far apart as two unrelated points of the attractor, << 1 when
+        they stay together.
+    period : float
+        T, s.
+    section_gap : float
+        The numerator of the decorrelation alone: RMS distance between the twins' late section
+        points in units of the attractor size, the recurrence test's own yardstick (a periodic
+        section's spread is integration noise, so its decorrelation is a ratio to noise; the gap
+        is compared with ``tol`` instead). nan when not measured.
+    twin_recurrence : float
+        Recurrence defect of the unperturbed twin's late section points (smallest over k, attractor
+        units): a faithful restart of a periodic run recurs as the reference does. nan when not measured.
+    """
+
+    t: NDArray[np.float64]
+    distance: NDArray[np.float64]
+    restart_time: float
+    restart_in_contact: bool
+    perturbation: float
+    d0: float
+    d_start: float
+    d_saturation: float
+    amplification: float
+    lyapunov: float
+    r_squared: float
+    fit_window: tuple[float, float]
+    decorrelation: float
+    period: float
+    section_gap: float = float("nan")
+    twin_recurrence: float = float("nan")
+
+    @property
+    def lyapunov_per_revolution(self) -> float:
+        """Lyapunov exponent times T: growth in nepers per crank revolution."""
+        return self.lyapunov * self.period
+
+    def evidence(self) -> dict[str, Any]:
+        """The scalar fields as a plain dict (for reports and HDF5 attributes)."""
+        return {
+            "decorrelation": self.decorrelation,
+            "lyapunov": self.lyapunov,
+            "lyapunov_per_revolution": self.lyapunov_per_revolution,
+            "fit_r2": self.r_squared,
+            "fit_window_start": self.fit_window[0],
+            "fit_window_end": self.fit_window[1],
+            "twin_d0": self.d0,
+            "twin_d_start": self.d_start,
+            "twin_d_saturation": self.d_saturation,
+            "twin_amplification": self.amplification,
+            "twin_perturbation": self.perturbation,
+            "twin_section_gap": self.section_gap,
+            "twin_recurrence": self.twin_recurrence,
+            "restart_time": self.restart_time,
+            "restart_in_contact": self.restart_in_contact,
+        }
+
+
+def twin_evidence(t: ArrayLike, distance: ArrayLike, points_a: ArrayLike, points_b: ArrayLike,
+                  section: PoincareSection, *, restart_time: float = 0.0, restart_in_contact: bool = False,
+                  perturbation: float = float("nan"), max_period: int = DEFAULT_MAX_PERIOD) -> Divergence:
+    """Twin evidence from arrays: Lyapunov fit, amplification, decorrelation and section gap.
+
+    The array-level half of :func:`twin_divergence`, public so that any pair of trajectories
+    (a small ODE, a map, measured data) is judged by exactly the numbers a mechanism's twins are.
+
+    Parameters
+    ----------
+    t : array_like (m,)
+        Times since the restart, s (t[0] = 0: the restart).
+    distance : array_like (m,)
+        Normalised separation of the twins at those times (e.g. RMS over the states of
+        |a - b| / attractor range); distance[0] is the perturbation.
+    points_a, points_b : array_like (n, d)
+        The twins' section points (one row per revolution from the restart), in the units of
+        ``section.points``.
+    section : PoincareSection
+        Section of the reference run: attractor size, centre and spread.
+    restart_time, restart_in_contact, perturbation : float, bool, float
+        Recorded as evidence.
+    max_period : int
+        Longest period of the unperturbed twin's recurrence check.
+
+    Returns
+    -------
+    Divergence
+    """
+    t = np.asarray(t, dtype=float)
+    distance = np.asarray(distance, dtype=float)
+    d0 = float(distance[0]) if distance.size else float("nan")
+    d_start = float(distance[1]) if distance.size > 1 else float("nan")
+    late = t >= 0.5 * t[-1] if t.size else np.zeros(0, dtype=bool)
+    d_sat = float(np.median(distance[late])) if np.any(late) else float("nan")
+    floor = max(d_start, d0) if math.isfinite(d0) else d_start
+    amplification = d_sat / floor if floor > 0 else float("nan")
+    lyapunov, r2, window = float("nan"), float("nan"), (float("nan"), float("nan"))
+    if math.isfinite(amplification) and amplification >= MIN_AMPLIFICATION:
+        above = np.nonzero(distance[1:] >= SATURATION_FRACTION * d_sat)[0]
+        end = int(above[0]) + 1 if above.size else distance.size - 1
+        end = min(max(end, 4), distance.size - 1)
+        tt, ld = t[1:end + 1], np.log(np.maximum(distance[1:end + 1], np.finfo(float).tiny))
+        A = np.column_stack([tt, np.ones_like(tt)])
+        coef, *_ = np.linalg.lstsq(A, ld, rcond=None)
+        resid = ld - A @ coef
+        total = float(np.sum((ld - ld.mean()) ** 2))
+        lyapunov = float(coef[0])
+        r2 = 1.0 - float(np.sum(resid**2)) / total if total > 0 else float("nan")
+        window = (float(tt[0]), float(tt[-1]))
+
+    # decorrelation and gap of the twins' late section points, in the reference section's units
+    pa = np.asarray(points_a, dtype=float).reshape(-1, len(section.channels))
+    pb = np.asarray(points_b, dtype=float).reshape(-1, len(section.channels))
+    decorrelation = gap = recurrence = float("nan")
+    if pa.shape == pb.shape and pa.shape[0] >= 2 and len(section) >= 2 and np.all(np.isfinite(section.size)):
+        size = np.where(section.size > 0, section.size, np.inf)
+        half = pa.shape[0] // 2
+        na, nb = (pa[half:] - section.center) / size, (pb[half:] - section.center) / size
+        gap = float(np.sqrt(np.mean(np.sum((na - nb) ** 2, axis=1))))
+        p = section.normalized()
+        spread = float(np.sqrt(np.mean(np.sum((p - p.mean(axis=0)) ** 2, axis=1))))
+        decorrelation = gap / (math.sqrt(2.0) * spread) if spread > 0 else float("nan")
+        defects = recurrence_defects(na, max_period) if na.shape[0] >= 2 else {}
+        recurrence = min(defects.values()) if defects else float("nan")
+    return Divergence(t=t, distance=distance, restart_time=float(restart_time),
+                      restart_in_contact=bool(restart_in_contact), perturbation=float(perturbation), d0=d0,
+                      d_start=d_start, d_saturation=d_sat, amplification=float(amplification), lyapunov=lyapunov,
+                      r_squared=r2, fit_window=window, decorrelation=decorrelation, period=section.period,
+                      section_gap=gap, twin_recurrence=recurrence)
+
+
+def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *, reference: Result,
+                    restart_time: float = 0.0, restart_in_contact: bool = False, perturbation: float = float("nan"),
+                    offset: float = 0.0) -> Divergence:
+    """Separation, Lyapunov estimate and decorrelation of two twin runs.
+
+    Measures the separation of the states and the twins' section points, then hands them to
+    :func:`twin_evidence` (the same numbers for any pair of trajectories).
+
+    Parameters
+    ----------
+    twin_a, twin_b : Result
+        Unperturbed and perturbed runs from the same restart state, on the same output times,
+        which contain the section times ``offset + k T``.
+    section : PoincareSection
+        Section of the reference run: gives the channels, the attractor size and the spread.
+    reference : Result
+        The reference run: the attractor range of each state over the section's window.
+    restart_time, restart_in_contact, perturbation : float, bool, float
+        Recorded as evidence.
+    offset : float
+        Section time within the revolution, s.
+
+    Returns
+    -------
+    Divergence
+    """
+    if twin_a.t.shape != twin_b.t.shape or not np.allclose(twin_a.t, twin_b.t, rtol=0, atol=1e-12):
+        raise DaeclearError("twin_divergence: the twin runs have different output times.")
+    T = section.period
+    cols = _state_selection(reference)
+    window = reference.window_mask(section.t[0] if len(section) else None, None)
+    y_ref = np.asarray(reference.y)[window][:, cols]
+    ranges = np.ptp(y_ref, axis=0) if y_ref.shape[0] else np.zeros(len(cols))
+    units = [reference.units[reference.state_names[i]] for i in cols]
+    keep = np.zeros(len(cols), dtype=bool)
+    for unit in set(units):
+        same = np.array([u == unit for u in units])
+        top = float(np.max(ranges[same])) if np.any(same) else 0.0
+        keep |= same & (ranges > 1e-9 * top) & (ranges > 0)
+    idx = [c for c, k in zip(cols, keep) if k]
+    scale = ranges[keep]
+    diff = (np.asarray(twin_a.y)[:, idx] - np.asarray(twin_b.y)[:, idx]) / scale
+    distance = np.sqrt(np.mean(diff**2, axis=1)) if idx else np.zeros(twin_a.n_times)
+    t = np.asarray(twin_a.t) - float(twin_a.t[0])
+
+    n_sec = int(math.floor((float(twin_a.t[-1]) - offset) / T + TIME_MATCH)) + 1 if twin_a.n_times else 0
+    times = (float(twin_a.t[0]) if twin_a.n_times else 0.0) + offset + T * np.arange(max(n_sec, 0))
+    d = len(section.channels)
+    pa = pb = np.zeros((0, d))
+    if times.size >= 2:
+        ia, ib = match_times(twin_a, times, T), match_times(twin_b, times, T)
+        pa = np.column_stack([np.asarray(twin_a[c], dtype=float)[ia] for c in section.channels])
+        pb = np.column_stack([np.asarray(twin_b[c], dtype=float)[ib] for c in section.channels])
+    return twin_evidence(t, distance, pa, pb, section, restart_time=restart_time,
+                         restart_in_contact=restart_in_contact, perturbation=perturbation)
+
