@@ -120,6 +120,26 @@ def test_second_ctrl_c_during_the_save_does_not_lose_it(tmp_path, monkeypatch):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["partial.h5"]
 
 
+@pytest.mark.parametrize("failure", [OSError("disk full"), KeyboardInterrupt()])
+def test_atomic_file_replaces_whole_or_leaves_the_old_file(tmp_path, failure):
+    """outputs.atomic_file, the one temporary-file-and-rename write: a failure (an error or a Ctrl-C)
+    in the middle of the write leaves the old file byte for byte and no temporary file; a completed
+    write replaces it whole."""
+    from daeclear.results.outputs import atomic_file, atomic_write_text
+
+    target = tmp_path / "table.csv"
+    target.write_text("old\n")
+    with pytest.raises(type(failure)), atomic_file(target) as tmp:
+        assert tmp.parent == tmp_path and tmp != target
+        tmp.write_text("half of the new")
+        raise failure
+    assert target.read_text() == "old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["table.csv"]
+    atomic_write_text(target, "new\n")
+    assert target.read_text() == "new\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["table.csv"]
+
+
 def test_cli_second_ctrl_c_during_the_partial_save(ctrl_c_after, tmp_path, capsys, monkeypatch):
     """A real SIGINT while the streamed file is completed (its statistics written): held back until it is."""
     import daeclear.results.hdf5_stream as stream_module

@@ -46,7 +46,6 @@ from __future__ import annotations
 
 import json
 import os
-import uuid
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -184,20 +183,12 @@ def save_result(r: Result, path: str | os.PathLike[str]) -> Path:
     """Write ``r`` to an HDF5 file, atomically: what :meth:`Result.save` does (see its docstring)."""
     import h5py
 
-    from .outputs import check_file, deferred_sigint
+    from .outputs import atomic_file, check_file, deferred_sigint
 
     path = check_file(path, "Result.save(path)")  # the one output-place rule (daeclear.results.outputs)
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:12]}.tmp")
-    with deferred_sigint():  # a Ctrl-C during the write arrives once the file is complete
-        try:
-            with h5py.File(tmp, "x") as f:
-                _write(f, r)
-            with open(tmp, "rb+") as fh:  # data on disk before the rename makes it visible
-                os.fsync(fh.fileno())
-            os.replace(tmp, path)
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
+    # a Ctrl-C during the write arrives once the file is complete (and renamed into place)
+    with deferred_sigint(), atomic_file(path) as tmp, h5py.File(tmp, "x") as f:
+        _write(f, r)
     return path
 
 
