@@ -40,7 +40,6 @@ __all__ = ["EVENT_KINDS", "FORMAT_NAME", "FORMAT_VERSION", "STREAM_RUNNING", "Ch
            "write_result_group"]
 
 
-
 class ChannelKeyError(DaeclearError, KeyError):
     """A channel or state name that the result does not hold.
 
