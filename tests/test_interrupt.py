@@ -101,17 +101,17 @@ def test_cli_run_ctrl_c_saves_the_partial_result_once(ctrl_c_after, tmp_path, ca
 
 def test_second_ctrl_c_during_the_save_does_not_lose_it(tmp_path, monkeypatch):
     """SIGINT arriving in the middle of the HDF5 write is held back until the file is complete and in place."""
-    import daeclear.results.result as result_module
+    import daeclear.results.hdf5_write as write_module
 
     result = dc.simulate(dc.mechanisms.slider_crank("ideal"), 1e-3)
-    original = result_module._write
+    original = write_module._write
 
     def write_then_ctrl_c(f, r):
         os.kill(os.getpid(), signal.SIGINT)  # a real Ctrl-C, mid-write
         time.sleep(0.01)
         original(f, r)
 
-    monkeypatch.setattr(result_module, "_write", write_then_ctrl_c)
+    monkeypatch.setattr(write_module, "_write", write_then_ctrl_c)
     path = tmp_path / "partial.h5"
     with pytest.raises(KeyboardInterrupt):
         result.save(path)
@@ -120,11 +120,31 @@ def test_second_ctrl_c_during_the_save_does_not_lose_it(tmp_path, monkeypatch):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["partial.h5"]
 
 
+@pytest.mark.parametrize("failure", [OSError("disk full"), KeyboardInterrupt()])
+def test_atomic_file_replaces_whole_or_leaves_the_old_file(tmp_path, failure):
+    """outputs.atomic_file, the one temporary-file-and-rename write: a failure (an error or a Ctrl-C)
+    in the middle of the write leaves the old file byte for byte and no temporary file; a completed
+    write replaces it whole."""
+    from daeclear.results.outputs import atomic_file, atomic_write_text
+
+    target = tmp_path / "table.csv"
+    target.write_text("old\n")
+    with pytest.raises(type(failure)), atomic_file(target) as tmp:
+        assert tmp.parent == tmp_path and tmp != target
+        tmp.write_text("half of the new")
+        raise failure
+    assert target.read_text() == "old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["table.csv"]
+    atomic_write_text(target, "new\n")
+    assert target.read_text() == "new\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["table.csv"]
+
+
 def test_cli_second_ctrl_c_during_the_partial_save(ctrl_c_after, tmp_path, capsys, monkeypatch):
     """A real SIGINT while the streamed file is completed (its statistics written): held back until it is."""
-    import daeclear.results.result as result_module
+    import daeclear.results.hdf5_stream as stream_module
 
-    original, close = result_module._mirror, result_module.ResultWriter.close
+    original, close = stream_module.mirror, stream_module.ResultWriter.close
     closing, sent = [], []
 
     def mirror_then_ctrl_c(group, tree):
@@ -133,8 +153,8 @@ def test_cli_second_ctrl_c_during_the_partial_save(ctrl_c_after, tmp_path, capsy
             time.sleep(0.01)
         original(group, tree)
 
-    monkeypatch.setattr(result_module, "_mirror", mirror_then_ctrl_c)
-    monkeypatch.setattr(result_module.ResultWriter, "close", lambda self, **kw: closing.append(1) or close(self, **kw))
+    monkeypatch.setattr(stream_module, "mirror", mirror_then_ctrl_c)
+    monkeypatch.setattr(stream_module.ResultWriter, "close", lambda self, **kw: closing.append(1) or close(self, **kw))
     ctrl_c_after(4)
     assert main(["run", "slider_crank", "--joint", "revolute", "--t-end", str(T_END), "--out", str(tmp_path)]) == 130
     assert sent and "partial result saved" in capsys.readouterr().err

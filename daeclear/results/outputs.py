@@ -8,6 +8,7 @@ only test that also holds for root and read-only file systems.
 
 :func:`deferred_sigint` holds Ctrl-C back while a result is written: a second Ctrl-C during the
 save of a partial result is delivered after the file is complete (and renamed into place).
+:func:`atomic_file` is the one temporary-file-and-rename write (``Result.save``, the tables).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import os
 import signal
 import tempfile
 import threading
+import uuid
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from types import FrameType
@@ -182,16 +184,32 @@ def sigint_latch() -> Iterator[list[int]]:
         signal.signal(signal.SIGINT, previous)
 
 
+@contextlib.contextmanager
+def atomic_file(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """A temporary path beside ``path`` to write; renamed over ``path`` once the block completes.
+
+    The one implementation of atomic output files: the file written at the yielded path is
+    fsync'ed (data on disk before the rename makes it visible) and renamed over ``path``
+    (`os.replace`, atomic on POSIX), so an existing file at ``path`` is either left untouched or
+    replaced whole. On any exception (KeyboardInterrupt too) the temporary file is removed and the
+    exception raised. Hold Ctrl-C back around it with :func:`deferred_sigint` where a Ctrl-C
+    should wait for the file.
+    """
+    p = Path(path)
+    tmp = p.with_name(f".{p.name}.{uuid.uuid4().hex[:12]}.tmp")
+    try:
+        yield tmp
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, p)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
 def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
     """Write text to a temporary file beside ``path`` and rename it over ``path`` (SIGINT deferred)."""
     p = Path(path)
-    tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
-    with deferred_sigint():
-        try:
-            tmp.write_text(text)
-            os.replace(tmp, p)
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
+    with deferred_sigint(), atomic_file(p) as tmp:
+        tmp.write_text(text)
     return p
-

@@ -1,0 +1,202 @@
+"""Reading result files: the constructor keywords of a `Result` from an HDF5 file, group or window.
+
+The checks of a file (format, version, every item of the layout, with messages naming the file and
+what is missing) and the windowed reading that `load` (daeclear.results.result) builds a `Result`
+from. It returns keywords rather than a `Result` so that daeclear.results.result can offer `load`
+without an import circle. h5py is imported only when a file is read.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import DaeclearError
+from .events import ContactEvent
+from .hdf5_write import FORMAT_NAME, FORMAT_VERSION
+from .values import time_window
+
+if TYPE_CHECKING:  # h5py is imported lazily, only where a file is read
+    import h5py
+
+__all__ = ["read_dataset", "read_file", "read_group"]
+
+
+def read_file(path: str | os.PathLike[str], t0: float | None = None, t1: float | None = None) -> dict[str, Any]:
+    """The `Result` keywords of the result file at ``path``, of the window [t0, t1]; see :func:`daeclear.load`."""
+    import h5py
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no result file '{path}'.")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise DaeclearError(f"'{path}' is not a daeclear result: it cannot be opened as HDF5 ({exc}).") from exc
+    with f:
+        fmt = f.attrs.get("format")
+        if fmt is None:
+            raise DaeclearError(
+                f"'{path}' is not a daeclear result: the root attribute 'format' is missing "
+                f"(expected {FORMAT_NAME!r}, as written by Result.save)."
+            )
+        if _text(fmt) != FORMAT_NAME:
+            raise DaeclearError(
+                f"'{path}' is not a daeclear result: root attribute format={_text(fmt)!r}, expected {FORMAT_NAME!r}."
+            )
+        version = f.attrs.get("version")
+        if version is None:
+            raise DaeclearError(f"'{path}' is a damaged daeclear result: the root attribute 'version' is missing.")
+        if int(version) > FORMAT_VERSION:
+            raise DaeclearError(
+                f"'{path}' is a daeclear result of format version {int(version)}; this daeclear reads "
+                f"versions up to {FORMAT_VERSION}. Upgrade daeclear to read it."
+            )
+        return _read(_Reader(f, path, time_window(t0, t1)))
+
+
+def read_dataset(path: str | os.PathLike[str], name: str) -> np.ndarray:
+    """The dataset ``name`` of the file at ``path``, or an empty array if the file has none."""
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        return f[name][()] if name in f else np.zeros(0)
+
+
+def _text(value: Any) -> str:
+    return value.decode("utf-8") if isinstance(value, bytes) else str(value)
+
+
+class _Reader:
+    """Reads items of one file; a missing item raises DaeclearError naming file and item."""
+
+    def __init__(self, f: h5py.File, path: Path, window: tuple[float, float] = (-math.inf, math.inf)) -> None:
+        self.f = f
+        self.path = path
+        self.window = window
+
+    def rows(self, times: str) -> slice:
+        """The rows of the time-ordered dataset ``times`` inside the window (all without one)."""
+        lo, hi = self.window
+        if lo == -math.inf and hi == math.inf:
+            return slice(None)
+        t = self.array(times)
+        return slice(int(np.searchsorted(t, lo, side="left")), int(np.searchsorted(t, hi, side="right")))
+
+    def _missing(self, what: str) -> DaeclearError:
+        return DaeclearError(f"'{self.path}' is a damaged daeclear result: {what} is missing.")
+
+    def has(self, name: str) -> bool:
+        return name in self.f
+
+    def array(self, name: str, rows: slice | None = None) -> np.ndarray:
+        if name not in self.f:
+            raise self._missing(f"dataset '/{name}'")
+        return self.f[name][()] if rows is None else self.f[name][rows]
+
+    def strings(self, name: str, rows: slice | None = None) -> list[str]:
+        if name not in self.f:
+            raise self._missing(f"dataset '/{name}'")
+        return [str(s) for s in (self.f[name].asstr()[()] if rows is None else self.f[name].asstr()[rows])]
+
+    def json(self, name: str) -> Any:
+        if name not in self.f:
+            raise self._missing(f"dataset '/{name}'")
+        return json.loads(self.f[name].asstr()[()])
+
+    def attr(self, name: str, obj: str = "/") -> Any:
+        attrs = self.f[obj].attrs
+        if name not in attrs:
+            raise self._missing(f"attribute '{name}' of '{obj}'")
+        value = attrs[name]
+        return value.item() if isinstance(value, np.generic) else _text(value) if isinstance(value, bytes) else value
+
+
+def _read(r: _Reader) -> dict[str, Any]:
+    """The `Result` keywords read by ``r``."""
+    state_names = r.strings("state_names")
+    state_units = r.strings("state_units")
+    units = dict(zip(state_names, state_units))
+    if "channels" not in r.f:
+        raise r._missing("group '/channels'")
+    points = r.rows("t")
+    channels: dict[str, np.ndarray] = {}
+    for name in r.f["channels"]:
+        channels[name] = r.array(f"channels/{name}", points)
+        units[name] = r.attr("units", f"/channels/{name}")
+
+    rows = r.rows("events/t")
+    columns = (r.array("events/t", rows), r.strings("events/pair", rows), r.strings("events/kind", rows),
+               r.array("events/approach_speed", rows), r.array("events/y", rows))
+    if len({len(c) for c in columns}) != 1:
+        raise DaeclearError(
+            f"'{r.path}' is a damaged daeclear result: the datasets of '/events' have different lengths "
+            f"{[len(c) for c in columns]}."
+        )
+    events = [
+        ContactEvent(t=t, pair=pair, kind=kind, approach_speed=speed, y=y)  # type: ignore[arg-type]
+        for t, pair, kind, speed, y in zip(*columns)
+    ]
+    lo, hi = r.window
+    starts, ends = r.array("segments/t_start"), r.array("segments/t_end")
+    keep = np.flatnonzero((starts < hi) & (ends > lo))  # the segments overlapping the window, clipped to it
+    first = int(keep[0]) if keep.size else 0
+    modes = r.strings("segments/modes", slice(first, int(keep[-1]) + 1 if keep.size else 0))
+    segments = [(max(float(starts[i]), lo), min(float(ends[i]), hi), json.loads(modes[i - first])) for i in keep]
+    steps: dict[str, Any] = {}
+    if r.has("steps"):
+        rows = r.rows("steps/t")
+        steps = {"step_t": r.array("steps/t", rows), "step_h": r.array("steps/h", rows),
+                 "step_order": r.array("steps/order", rows)}
+
+    return dict(
+        t=r.array("t", points),
+        y=r.array("y", points),
+        yp=r.array("yp", points),
+        state_names=state_names,
+        channels=channels,
+        units=units,
+        events=events,
+        segments=segments,
+        stats=r.json("stats_json"),
+        success=bool(r.attr("success")),
+        status=int(r.attr("status")),
+        message=str(r.attr("message")),
+        parameters=r.json("parameters_json"),
+        scene_name=str(r.attr("scene_name")),
+        method=str(r.attr("method")),
+        formulation=str(r.attr("formulation")),
+        warnings=r.json("warnings_json") if r.has("warnings_json") else [],  # older files: no warnings
+        **steps,
+    )
+
+
+class _GroupAsFile:
+    """Lets the reader read a Result stored inside a group (absolute names become relative)."""
+
+    def __init__(self, group: h5py.Group) -> None:
+        self._group = group
+
+    def _name(self, name: str) -> str:
+        return name.lstrip("/") or "."
+
+    def __getitem__(self, name: str) -> Any:
+        return self._group[self._name(name)]
+
+    def __contains__(self, name: str) -> bool:
+        return self._name(name) in self._group
+
+    @property
+    def attrs(self) -> Any:
+        return self._group.attrs
+
+
+def read_group(group: h5py.Group, path: Path) -> dict[str, Any]:
+    """The `Result` keywords of what :func:`write_result_group` wrote into ``group``, an open group of
+    the file at ``path`` (named in the messages about a damaged result)."""
+    return _read(_Reader(_GroupAsFile(group), path))  # type: ignore[arg-type]

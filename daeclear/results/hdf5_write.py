@@ -1,0 +1,199 @@
+"""Writing a `Result` to HDF5: the file layout, `save_result` (atomic) and `write_result_group`.
+
+The one place that knows how a finished result is laid out in a file; the streaming writer
+(daeclear.results.hdf5_stream) and the reader (daeclear.results.hdf5_read) follow the same layout
+with the helpers and constants here. h5py is imported only when a file is written.
+
+docs/hdf5_layout.md documents the file item by item for readers without daeclear
+(a test keeps it in step with `_write`).
+
+HDF5 layout (root attributes ``format="daeclear-result"``, ``version=1``)::
+
+    /                     attrs: format, version, scene_name, method, formulation,
+                                 success, status, message
+    /t                    (n_times,)            attr units="s"
+    /y, /yp               (n_times, n_states)   time first
+    /state_names          (n_states,)           strings, e.g. "crank.x", "lambda.A.x"
+    /state_units          (n_states,)           strings ("" when unknown)
+    /channels/<name>      (n_times, ...)        attr units; one dataset per channel
+    /events/t             (n_events,)
+    /events/pair          (n_events,)           strings
+    /events/kind          (n_events,)           "onset" | "separation"
+    /events/approach_speed (n_events,)          m/s, nan where meaningless
+    /events/y             (n_events, n_states)  full state at each event
+    /segments/t_start, /segments/t_end  (n_segments,)
+    /segments/modes       (n_segments,)         JSON object per segment: {pair: mode}
+    /steps/t, /steps/h, /steps/order            IDA's internal steps (only if recorded)
+    /stats                group, one attribute per statistic
+    /stats_json           scalar string: the statistics as JSON (what `load` reads)
+    /parameters           groups and attributes mirroring the nested parameters
+    /parameters_json      scalar string: the parameters as JSON (what `load` reads)
+    /warnings_json        scalar string: the physics warnings as a JSON list (absent in older files)
+
+Channel names keep their dots (``/channels/slider.vx``): a "." is an ordinary
+character in an HDF5 name. The ``/stats`` and ``/parameters`` groups are a
+readable mirror for other tools (HDFView, h5dump, MATLAB): every number, string,
+bool and homogeneous list becomes an attribute (a dataset when longer than
+1024 items), every nested dict a group. Values that HDF5 cannot hold this way
+(None, mixed lists, lists of dicts) live only in the JSON copies, which are the
+lossless source `load` reads. Arrays of more than 16384 values that compress
+cheaply (integers, bools, mostly-zero floats such as contact forces) are stored
+chunked with shuffle + gzip level 1, which any HDF5 tool reads; other float
+arrays stay contiguous and uncompressed (gzip would save ~20% at ~8x the time).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:  # h5py is imported lazily, only where a file is written
+    import h5py
+
+    from .result import Result
+
+__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "json_dataset", "mirror", "save_result", "string_dataset",
+           "write_result_group"]
+
+FORMAT_NAME = "daeclear-result"
+"""Value of the root ``format`` attribute of every file written by `Result.save`."""
+
+FORMAT_VERSION = 1
+"""Version of the HDF5 layout written by this daeclear; `load` reads versions <= this."""
+
+_COMPRESS_MIN_SIZE = 16384  # values; smaller arrays are stored contiguous, uncompressed
+_MIRROR_ATTR_MAX_LEN = 1024  # longer lists become datasets (HDF5 attributes are limited to 64 KiB)
+
+
+def _compress(data: np.ndarray) -> bool:
+    """Whether gzip is cheap and worth it: large integer or bool arrays, large mostly-zero arrays.
+
+    General float64 data (states, velocities) shrinks by only ~20% at ~8x the write time,
+    so it is stored uncompressed; contact forces and penetrations, zero in free flight, shrink a lot.
+    """
+    if data.size < _COMPRESS_MIN_SIZE:
+        return False
+    return data.dtype.kind in "biu" or np.count_nonzero(data) <= data.size // 2
+
+
+def _dataset(group: h5py.Group, name: str, data: np.ndarray) -> h5py.Dataset:
+    if _compress(data):
+        return group.create_dataset(name, data=data, chunks=True, compression="gzip",
+                                    compression_opts=1, shuffle=True)
+    return group.create_dataset(name, data=data)
+
+
+def string_dataset(group: h5py.Group, name: str, values: Sequence[str]) -> h5py.Dataset:
+    """Write ``values`` as a dataset of UTF-8 strings (names, units, event pairs and kinds)."""
+    import h5py
+
+    return group.create_dataset(name, data=np.array(list(values), dtype=object), dtype=h5py.string_dtype())
+
+
+def json_dataset(group: h5py.Group, name: str, value: Any) -> None:
+    """Write ``value`` as a scalar JSON string dataset: the lossless copy of stats, parameters, warnings."""
+    import h5py
+
+    group.create_dataset(name, data=json.dumps(value, ensure_ascii=False), dtype=h5py.string_dtype())
+
+
+def mirror(group: h5py.Group, tree: Mapping[str, Any]) -> None:
+    """Write a nested dict as groups and attributes that any HDF5 tool can read."""
+    import h5py
+
+    for key, value in tree.items():
+        if not key or "/" in key or key == ".":
+            continue  # not an HDF5 name; the JSON copy keeps it
+        if isinstance(value, dict):
+            mirror(group.create_group(key), value)
+            continue
+        if isinstance(value, (bool, int, float, str)):
+            data: Any = value
+        elif isinstance(value, list) and value and (
+            all(isinstance(v, bool) for v in value)
+            or all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+        ):
+            data = np.asarray(value)
+        elif isinstance(value, list) and value and all(isinstance(v, str) for v in value):
+            data = np.array(value, dtype=h5py.string_dtype())
+        else:
+            continue  # None, empty, mixed or nested lists: JSON only
+        try:
+            if isinstance(data, np.ndarray) and data.size > _MIRROR_ATTR_MAX_LEN:
+                group.create_dataset(key, data=data)
+            else:
+                group.attrs[key] = data
+        except OverflowError:
+            continue  # an int beyond 64 bits: JSON only
+
+
+def _write(f: h5py.File | h5py.Group, r: Result) -> None:
+    """Write ``r`` in the layout of a result file into an open HDF5 file or group."""
+    f.attrs["format"] = FORMAT_NAME
+    f.attrs["version"] = FORMAT_VERSION
+    f.attrs["scene_name"] = r.scene_name
+    f.attrs["method"] = r.method
+    f.attrs["formulation"] = r.formulation
+    f.attrs["success"] = r.success
+    f.attrs["status"] = r.status
+    f.attrs["message"] = r.message
+
+    _dataset(f, "t", np.asarray(r.t)).attrs["units"] = "s"
+    _dataset(f, "y", np.asarray(r.y))
+    _dataset(f, "yp", np.asarray(r.yp))
+    string_dataset(f, "state_names", r.state_names)
+    string_dataset(f, "state_units", [r.units[n] for n in r.state_names])
+
+    channels = f.create_group("channels")
+    for name in r.channel_names:
+        _dataset(channels, name, np.asarray(r.channels[name])).attrs["units"] = r.units[name]
+
+    events = f.create_group("events")
+    _dataset(events, "t", r.events.t)
+    string_dataset(events, "pair", r.events.pair)
+    string_dataset(events, "kind", r.events.kind)
+    _dataset(events, "approach_speed", r.events.approach_speed)
+    y_events = np.array([e.y for e in r.events], dtype=np.float64).reshape(len(r.events), r.n_states)
+    _dataset(events, "y", y_events)
+
+    segments = f.create_group("segments")
+    _dataset(segments, "t_start", np.array([s[0] for s in r.segments], dtype=np.float64))
+    _dataset(segments, "t_end", np.array([s[1] for s in r.segments], dtype=np.float64))
+    string_dataset(segments, "modes", [json.dumps(s[2], ensure_ascii=False) for s in r.segments])
+
+    if r.step_t is not None:
+        steps = f.create_group("steps")
+        _dataset(steps, "t", np.asarray(r.step_t))
+        _dataset(steps, "h", np.asarray(r.step_h))
+        _dataset(steps, "order", np.asarray(r.step_order))
+
+    mirror(f.create_group("stats"), r.stats)
+    json_dataset(f, "stats_json", r.stats)
+    mirror(f.create_group("parameters"), r.parameters)
+    json_dataset(f, "parameters_json", r.parameters)
+    json_dataset(f, "warnings_json", r.warnings)
+
+
+def save_result(r: Result, path: str | os.PathLike[str]) -> Path:
+    """Write ``r`` to an HDF5 file, atomically: what :meth:`Result.save` does (see its docstring)."""
+    import h5py
+
+    from .outputs import atomic_file, check_file, deferred_sigint
+
+    path = check_file(path, "Result.save(path)")  # the one output-place rule (daeclear.results.outputs)
+    # a Ctrl-C during the write arrives once the file is complete (and renamed into place)
+    with deferred_sigint(), atomic_file(path) as tmp, h5py.File(tmp, "x") as f:
+        _write(f, r)
+    return path
+
+
+def write_result_group(group: h5py.Group, r: Result) -> None:
+    """Write ``r`` in the layout of a result file (:meth:`Result.save`) into ``group``, an open group
+    of another HDF5 file: a sweep keeps its full reference runs inside its own file this way
+    (:func:`read_result_group` reads them back)."""
+    _write(group, r)

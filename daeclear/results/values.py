@@ -1,0 +1,92 @@
+"""How a result holds what it is given: plain JSON values, read-only arrays, checked time windows.
+
+Shared by the `Result` container, its events and the HDF5 writers and reader (parameters and
+statistics are stored as plain values in memory and in files alike), so it lives apart from each.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+from collections.abc import Mapping
+from dataclasses import fields, is_dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import DaeclearWarning
+
+__all__ = ["readonly", "time_window", "to_plain"]
+
+
+def readonly(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a`` (the caller's array keeps its own flags)."""
+    view = a.view()
+    view.flags.writeable = False
+    return view
+
+
+def time_window(t0: float | None, t1: float | None) -> tuple[float, float]:
+    """The closed window [t0, t1] as floats (None: that side open, +-inf); ValueError if ``t0 > t1``."""
+    lo = -math.inf if t0 is None else float(t0)
+    hi = math.inf if t1 is None else float(t1)
+    if lo > hi:
+        raise ValueError(f"time window t0={t0} > t1={t1}; t0 must not exceed t1.")
+    return lo, hi
+
+
+# exact types to_plain returns unchanged (subclasses such as numpy.float64 take the checks below)
+_PLAIN_LEAVES = frozenset({type(None), bool, str, int, float})
+
+
+def to_plain(value: Any, where: str) -> Any:
+    """``value`` as plain JSON-able Python.
+
+    numpy scalars and arrays, tuples and paths are converted; a dataclass instance (e.g. a
+    Material) becomes the dict of its fields, headed by ``"name"`` when its class has a name
+    (a contact or friction law: figures and readers of the file need to know which law). Anything else is stored as its ``repr`` with a
+    DaeclearWarning naming ``where``: a finished run is never lost to an odd parameter.
+    Non-string dict keys raise TypeError.
+    """
+    if type(value) in _PLAIN_LEAVES:  # the common case first: plain numbers and strings stay as they are
+        return value
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, int):
+        return int(value)
+    if isinstance(value, float):
+        return float(value)
+    if type(value) is dict or isinstance(value, Mapping):
+        out: dict[str, Any] = {}
+        for key, item in value.items():
+            if not isinstance(key, str):
+                raise TypeError(f"{where}: key {key!r} is a {type(key).__name__}, keys must be strings.")
+            out[key] = item if type(item) in _PLAIN_LEAVES else to_plain(item, f"{where}[{key!r}]")
+        return out
+    if isinstance(value, (list, tuple)):
+        return [item if type(item) in _PLAIN_LEAVES else to_plain(item, f"{where}[{i}]")
+                for i, item in enumerate(value)]
+    # after the containers: dicts and lists, the bulk of a scene, skip these (slower ABC) checks
+    if isinstance(value, np.generic):
+        return to_plain(value.item(), where)
+    if isinstance(value, np.ndarray):
+        return to_plain(value.tolist(), where)
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    if is_dataclass(value) and not isinstance(value, type):
+        out = {f.name: to_plain(getattr(value, f.name), f"{where}[{f.name!r}]") for f in fields(value)}
+        kind = getattr(type(value), "name", None)  # a contact law's registered name, e.g. "hunt-crossley"
+        if isinstance(kind, str) and "name" not in out:
+            out = {"name": kind, **out}
+        return out
+    text = repr(value)
+    warnings.warn(
+        f"{where}: a {type(value).__name__} is not a number, string, bool, None, list or dict; "
+        f"stored as its repr {text[:60]!r}.",
+        DaeclearWarning,
+        stacklevel=4,
+    )
+    return text
+
+
