@@ -6,6 +6,12 @@
 * implicit (scipy): ``"Radau"``, ``"BDF"``, ``"LSODA"`` (with the generated Jacobian);
 * fixed step: ``"rk4"`` (classical Runge-Kutta) and ``"euler"`` (explicit Euler), with ``step=``.
 
+This module holds the entry point and the two integration loops (scipy, fixed step); the parts
+they use live beside it: :mod:`~daeclear.solvers.ode_model` (the model as an ODE, symbolic),
+:mod:`~daeclear.solvers.ode_evaluators` (its compiled or Python evaluation),
+:mod:`~daeclear.solvers.ode_crossings` (gap crossings within a step) and
+:mod:`~daeclear.solvers.ode_run` (the run's segments, events, failure and Result).
+
 The model
 ---------
 The index-1 DAE is an ODE in ``x = (q, v)``: ``q' = v``, ``v' = a(t, q, v)`` with ``a`` and the
