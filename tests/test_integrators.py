@@ -12,7 +12,7 @@ import pytest
 
 import daeclear as dc
 from daeclear.engine.codegen import clear_memos
-from daeclear.solvers.explicit import _candidate, _cubic_extrema
+from daeclear.solvers.ode_crossings import candidate as _candidate, cubic_extrema as _cubic_extrema
 from daeclear.model.mechanisms import CRANK_LENGTH as R, ROD_LENGTH as L, rpm_to_rad_s
 
 OMEGA = rpm_to_rad_s(5000.0)

@@ -426,12 +426,12 @@ def test_memory_error_without_stream_to_returns_the_partial_result(revolute, fai
 @pytest.mark.parametrize("stop", [MemoryError(), KeyboardInterrupt()], ids=["MemoryError", "Ctrl-C"])
 def test_the_scipy_methods_save_the_closed_segments_when_stopped(revolute, tmp_path, monkeypatch, stop):
     """rk4, streamed: stopped in the middle, the file holds every segment closed before (a prefix of the run)."""
-    import daeclear.solvers.explicit as integrators
+    import daeclear.solvers.ode_run as integrators
 
     kwargs = {"method": "rk4", "step": 1e-5, "t_eval_step": 1e-5, "store_steps": False}
     full = dc.simulate(revolute, REV, **kwargs)
     calls = [0]
-    original = integrators._Run._progress
+    original = integrators.Run._progress
 
     def progress(self, t):
         calls[0] += 1
@@ -439,7 +439,7 @@ def test_the_scipy_methods_save_the_closed_segments_when_stopped(revolute, tmp_p
             raise stop
         return original(self, t)
 
-    monkeypatch.setattr(integrators._Run, "_progress", progress)
+    monkeypatch.setattr(integrators.Run, "_progress", progress)
     path = tmp_path / "rk4.h5"
     if isinstance(stop, MemoryError):
         result = dc.simulate(revolute, REV, stream_to=path, on_failure="return", progress=True, **kwargs)
