@@ -112,7 +112,8 @@ def test_simulate_takes_the_options_object_and_an_explicit_keyword_overrides_it(
     np.testing.assert_array_equal(overridden.y, reference.y)
     # a keyword given as the default value still overrides (it was given)
     assert dc.simulate(ideal_model, T / 4, options=loose, rtol=1e-6).parameters["simulate"]["rtol"] == 1e-6
-    with pytest.raises(SceneError, match=r"simulate: options=\{'rtol': 1e-06\}, must be None or a daeclear.SolverOptions"):
+    with pytest.raises(SceneError,
+                       match=r"simulate: options=\{'rtol': 1e-06\}, must be None or a daeclear.SolverOptions"):
         dc.simulate(ideal_model, T, options={"rtol": 1e-6})  # type: ignore[arg-type]
     with pytest.raises(SceneError, match=r"simulate: rtol=2.0, must be a finite number in \[1e-14, 0.01\]"):
         dc.simulate(ideal_model, T, options=loose, rtol=2.0)  # a bad keyword: the rule, named as given
@@ -144,7 +145,8 @@ def test_bad_start_time_and_state_are_refused_before_any_work(ideal_model) -> No
     bad[4] = np.nan
     with pytest.raises(SceneError, match=r"simulate: y0=.*\(nan at index 4\)"):
         dc.simulate(ideal_model, T, t0=T / 8, y0=bad)
-    with pytest.raises(SceneError, match=r"simulate: y0=array of shape \(2, 36\), must be 36 finite numbers .*not shape \(2, 36\)"):
+    with pytest.raises(SceneError,
+                       match=r"simulate: y0=array of shape \(2, 36\), must be 36 finite numbers .*not shape \(2, 36\)"):
         dc.simulate(ideal_model, T, y0=np.vstack([y, y]))
     with pytest.raises(SceneError, match=r"simulate: t_eval=.*values in \[t0=0.003, t_end=0.024\]"):
         dc.simulate(ideal_model, T, t0=T / 8, y0=y, t_eval=[0.0, T])

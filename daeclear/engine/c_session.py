@@ -21,7 +21,8 @@ import logging
 import time
 import weakref
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -286,13 +287,15 @@ class CSession(SessionBase):
             elif a.size == n_points * size:
                 strides[j] = size
             else:
-                raise ValueError(f"eval_extra({k}): input {j} has shape {a.shape}, expected ({n_points}, {size}) or ({size},)")
+                raise ValueError(f"eval_extra({k}): input {j} has shape {a.shape}, "
+                                 f"expected ({n_points}, {size}) or ({size},)")
             ptrs[j] = a.__array_interface__["data"][0]
             keep.append(a)
         out = np.empty((n_points, n_out))
         rc = self._lib.dc_eval_extra(k, n_points, len(sizes), ptrs, strides, out.__array_interface__["data"][0], n_out)
         if rc != 0:
-            raise DaeclearError(f"evaluating {self._model.extras[k].name()} in the compiled model failed (status {rc}).")
+            raise DaeclearError(f"evaluating {self._model.extras[k].name()} in the compiled model failed "
+                                f"(status {rc}).")
         return out
 
     # ---------------------------------------------------------------- core

@@ -106,8 +106,8 @@ __all__ = [
 ]
 
 DRIVER_SOURCES = ("ida_driver.c", "dc_model.h", "dc_linalg.h")
-CFLAGS = (f"-DDC_ABI_VERSION={DRIVER_ABI}", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Werror=incompatible-pointer-types",
-          "-Werror=implicit-function-declaration", "-Wl,-z,defs")
+CFLAGS = (f"-DDC_ABI_VERSION={DRIVER_ABI}", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
+          "-Werror=incompatible-pointer-types", "-Werror=implicit-function-declaration", "-Wl,-z,defs")
 
 
 # --------------------------------------------------------------------------- normalisation
@@ -443,7 +443,8 @@ def _check_ode_spec(spec: OdeSpec) -> None:
         f = spec.outputs
         if not isinstance(f, casadi.Function) or f.n_in() != 5 or f.n_out() != 1 or f.numel_in(0) != 1 \
                 or f.numel_in(1) != f.numel_in(2) or f.numel_in(4) != n_P:
-            raise AssemblyError("OdeSpec.outputs must be a casadi.Function (t[1], y[n_y], yp[n_y], switch, P) -> channels")
+            raise AssemblyError("OdeSpec.outputs must be a casadi.Function (t[1], y[n_y], yp[n_y], switch, P) "
+                                "-> channels")
 
 
 def generate_ode_source(spec: OdeSpec) -> str:

@@ -24,7 +24,8 @@ from __future__ import annotations
 import ctypes
 import re
 from pathlib import Path
-from typing import Any, ClassVar, Mapping, Sequence
+from typing import Any, ClassVar
+from collections.abc import Mapping, Sequence
 
 from . import sundials
 from ..errors import DaeclearError

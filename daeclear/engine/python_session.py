@@ -13,7 +13,8 @@ import contextlib
 import io
 import math
 import time
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 import casadi
 import numpy as np

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple, Protocol, Sequence, runtime_checkable
+from typing import Any, NamedTuple, Protocol, runtime_checkable
+from collections.abc import Sequence
 
 import casadi
 import numpy as np
@@ -345,7 +346,7 @@ class SessionBase:
         """Only the compiled backend switches contact pairs in C; returns False here."""
         return False
 
-    def set_layout(self, layout: "StateLayout") -> bool:
+    def set_layout(self, layout: StateLayout) -> bool:
         """Only the compiled backend makes states consistent in C; returns False here."""
         return False
 
@@ -432,7 +433,7 @@ class SessionBase:
         return t_stop
 
     # ---------------------------------------------------------------- context manager
-    def __enter__(self) -> "SessionBase":
+    def __enter__(self) -> SessionBase:
         return self
 
     def __exit__(self, *exc: Any) -> None:

@@ -536,7 +536,8 @@ class Result:
                 window: tuple[float | None, float | None] | None = None, slow_motion: float | None = None,
                 size: tuple[int, int] = (720, 450), channel: str | None = None, magnify: float | None = None,
                 progress: bool = False) -> Path:
-        """Write an animated GIF (or MP4 with ffmpeg) of the mechanism moving; see :func:`daeclear.plot.animate.animate`.
+        """Write an animated GIF (or MP4 with ffmpeg) of the mechanism moving; see
+        :func:`daeclear.plot.animate.animate`.
 
         Frames: ``max(2, round(duration * slow_motion * fps))`` evenly spaced over the window.
 

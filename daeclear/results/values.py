@@ -45,8 +45,9 @@ def to_plain(value: Any, where: str) -> Any:
 
     numpy scalars and arrays, tuples and paths are converted; a dataclass instance (e.g. a
     Material) becomes the dict of its fields, headed by ``"name"`` when its class has a name
-    (a contact or friction law: figures and readers of the file need to know which law). Anything else is stored as its ``repr`` with a
-    DaeclearWarning naming ``where``: a finished run is never lost to an odd parameter.
+    (a contact or friction law: figures and readers of the file need to know which law). Anything
+    else is stored as its ``repr`` with a DaeclearWarning naming ``where``: a finished run is never
+    lost to an odd parameter.
     Non-string dict keys raise TypeError.
     """
     if type(value) in _PLAIN_LEAVES:  # the common case first: plain numbers and strings stay as they are
