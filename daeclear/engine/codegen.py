@@ -56,6 +56,7 @@ from .build import (
     memo_table,
 )
 from .library import DRIVER_ABI, ODE_DRIVER_ABI
+from .stall_guard import c_defines
 from .sundials import (
     SPARSE_LIBS,
     SUNDIALS_INCLUDE,
@@ -353,7 +354,7 @@ def _build_model_library(funcs: Any, *, model: NormalizedModel | None = None) ->
     names = SUNDIALS_LIBS + (SPARSE_LIBS if info.has_sparse else ())
     source = generate_source(model)
     link = [str(libs[name]) for name in names] + [f"-Wl,-rpath,{libdir}", "-lm"]
-    flags = [*CFLAGS, f"-I{sundials.SUNDIALS_INCLUDE}", *info.compile_flags()]
+    flags = [*CFLAGS, *c_defines(), f"-I{sundials.SUNDIALS_INCLUDE}", *info.compile_flags()]
     gomp = sorted(libdir.glob("libgomp-*.so*")) if info.has_sparse else []
     if gomp:  # SuperLU_MT's OpenMP runtime: the driver keeps its teams at one thread
         link.insert(len(names), str(gomp[0]))

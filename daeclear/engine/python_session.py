@@ -26,8 +26,6 @@ from .session_base import (
     FLAG_MAX_STEPS,
     FLAG_STEP_COLLAPSE,
     OWN_FLAG_NAMES,
-    TINY_STEP_GROWTH,
-    TINY_STEP_REL,
     Advance,
     SessionBase,
     SessionOptions,
@@ -82,8 +80,6 @@ class PythonSession(SessionBase):
         self._count = dict(res=0, jac=0, roots=0, steps=0, reinits=0)
         self._pending_tn = False
         self._t_internal = 0.0
-        self._tiny = 0
-        self._h_prev = 0.0
 
     # ---------------------------------------------------------------- evaluation
     def _eval_res(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
@@ -181,8 +177,7 @@ class PythonSession(SessionBase):
         self._t, self._y, self._yp = t0, y0.copy(), yp0.copy()
         self._t_internal = t0
         self._pending_tn = False
-        self._tiny = 0
-        self._h_prev = 0.0
+        self._stall.reset()
         self._ready = True
 
     def _apply_terms(self, act: np.ndarray, plist: list[np.ndarray]) -> None:
@@ -293,19 +288,10 @@ class PythonSession(SessionBase):
                         sh.append(h)
                         t_rec = t_new
                     if new_step and fl != 1 and not math.isnan(h):
-                        thr = max(TINY_STEP_REL * max(1.0, abs(t_new)), self._stall_step)
-                        if abs(h) >= (100.0 * thr if self._stall_step > 0 else thr):
-                            self._tiny = 0
-                        elif abs(h) < thr and not abs(h) > TINY_STEP_GROWTH * abs(self._h_prev):
-                            self._tiny += 1
-                        self._h_prev = h
-                        if self._tiny >= self._stall_count:
+                        if self._stall.step(t_new, h):
                             status, flag = "error", FLAG_STEP_COLLAPSE
                             flag_name = OWN_FLAG_NAMES[flag]
-                            message = (f"step size collapsed: {self._tiny} steps with |h| < "
-                                       f"max({TINY_STEP_REL}*max(1,|t|), {self._stall_step} s) that did "
-                                       f"not grow (last h={h:.3g}) "
-                                       f"at t={t_new!r}")
+                            message = self._stall.describe(t_new, h)
                             break
                     if fl == 2:
                         status = "root"

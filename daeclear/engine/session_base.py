@@ -21,6 +21,7 @@ from ..assembly.automaton import Decision
 from ..errors import DaeclearError
 from ..options import LINEAR_SOLVERS
 from .codegen import NormalizedModel
+from .stall_guard import TINY_STEP_COUNT, TINY_STEP_GROWTH, TINY_STEP_REL, StallGuard
 
 __all__ = [
     "DAEFunctions",
@@ -45,14 +46,8 @@ __all__ = [
 
 #: flag of an Advance that stopped because the session's step cap (max_steps) was reached
 FLAG_MAX_STEPS = -1001
-#: flag of an Advance that stopped because the step size collapsed (see TINY_STEP_REL)
+#: flag of an Advance that stopped because the step size collapsed (daeclear.engine.stall_guard)
 FLAG_STEP_COLLAPSE = -1002
-#: a step is tiny when |h| < TINY_STEP_REL * max(1, |t|); TINY_STEP_COUNT tiny steps that did not
-#: grow by more than TINY_STEP_GROWTH over the previous one, with no normal step in between, stop
-#: the advance (step-size collapse). Growing tiny steps (IDA's start-up doubling) do not count.
-TINY_STEP_REL = 1e-14
-TINY_STEP_COUNT = 20
-TINY_STEP_GROWTH = 1.5
 
 #: names of the flags that daeclear sets itself (not IDA)
 OWN_FLAG_NAMES = {FLAG_MAX_STEPS: "DC_MAX_STEPS", FLAG_STEP_COLLAPSE: "DC_STEP_COLLAPSE"}
@@ -291,7 +286,7 @@ class SessionBase:
         self._yp = np.zeros(model.n)
         self._active = np.zeros(self._nt, dtype=np.int32)
         self._params = [np.zeros(p) for p in model.n_params]
-        self._stall_step, self._stall_count = 0.0, TINY_STEP_COUNT
+        self._stall = StallGuard()  # the step-size collapse rule (daeclear.engine.stall_guard)
         self._solve_time = 0.0
         self._extra_stats: dict[str, int | float | str] = {}
 
@@ -355,9 +350,9 @@ class SessionBase:
         step 100x larger in between) end an advance with DC_STEP_COLLAPSE. Both backends."""
         if not (stall_step >= 0.0) or count < 1:
             raise ValueError(f"set_stall: stall_step={stall_step!r} must be >= 0 and count={count!r} >= 1")
-        self._stall_step, self._stall_count = float(stall_step), int(count)
+        self._stall.stall_step, self._stall.count = float(stall_step), int(count)
         if self.backend == "c":
-            self._lib.dc_set_stall(self._h, self._stall_step, self._stall_count)
+            self._lib.dc_set_stall(self._h, self._stall.stall_step, self._stall.count)
 
     def _check_reinit(self, t0: Any, y0: Any, yp0: Any, active: Any, params: Any,
                       root_directions: Any) -> tuple[float, np.ndarray, np.ndarray, np.ndarray,

@@ -80,8 +80,8 @@ points not counted), ``n_jac_evals``, ``n_root_evals`` (gap evaluations), ``n_lu
 
 Failures (``success=False`` with a message that says when, which pairs were in contact and why):
 the scheme's own failure (scipy's step-size underflow, a singular Newton matrix), a non-finite
-state or right-hand side, a step-size collapse (``TINY_STEP_COUNT`` steps below
-``TINY_STEP_REL * max(1, |t|)``), ``max_steps`` accepted steps, or an event loop that does not
+state or right-hand side, a step-size collapse (the rule of every integrator,
+:mod:`daeclear.engine.stall_guard`), ``max_steps`` accepted steps, or an event loop that does not
 advance (``STALL_EVENTS`` events at the same time).
 """
 
@@ -206,13 +206,8 @@ def _run_scipy(run: Run, x0: NDArray, rtol: float, atol: NDArray, max_step: floa
                 bad = int(np.flatnonzero(~np.isfinite(x1))[0])
                 run.fail(t_prev, f"the state became non-finite ({run.model.state_names[bad]} = {x1[bad]})", hint)
                 break
-            run.n_steps += 1
-            if t1 - t_prev < TINY_STEP_REL * max(1.0, abs(t1)):
-                run.n_steps -= 1
-                if not run.count_step(t_prev, t1):
-                    break
-            else:
-                run.tiny = 0
+            if not run.count_step(t_prev, t1):
+                break
             sol = None
             if watch:
                 gg = ev.gaps(t1, x1)

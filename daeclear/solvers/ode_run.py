@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 
 from ..assembly.assemble import DAEModel
 from ..engine.hermite import cubic_hermite
+from ..engine.stall_guard import TINY_STEP_COUNT, TINY_STEP_REL, StallGuard
 from ..progress import Progress
 from ..results.result import ContactEvent, Result
 from . import physics
@@ -42,9 +43,6 @@ IMPLICIT_METHODS: tuple[str, ...] = ("radau", "bdf", "lsoda")
 FIXED_STEP_METHODS: dict[str, int] = {"rk4": 4, "euler": 1}
 _ORDER = {"rk45": 5, "dop853": 8, "radau": 5, "bdf": -1, "lsoda": -1, "rk4": 4, "euler": 1}
 
-# step-size collapse: TINY_STEP_COUNT consecutive accepted steps below TINY_STEP_REL * max(1, |t|)
-TINY_STEP_REL = 1e-14
-TINY_STEP_COUNT = 20
 
 
 @dataclass
@@ -91,7 +89,7 @@ class Run:
         self.n_steps = 0
         self.n_restarts = 0
         self.n_lu = 0
-        self.tiny = 0
+        self.stall_guard = StallGuard()  # step-size collapse (daeclear.engine.stall_guard)
         self.stall = 0
         self.last_event_t = -math.inf
         self.seg: Segment | None = None
@@ -254,15 +252,10 @@ class Run:
     def count_step(self, t_old: float, t_new: float) -> bool:
         """Count an accepted step; False (after fail()) on a step-size collapse."""
         self.n_steps += 1
-        if t_new - t_old < TINY_STEP_REL * max(1.0, abs(t_new)):
-            self.tiny += 1
-            if self.tiny >= TINY_STEP_COUNT:
-                self.fail(t_new, f"the step size collapsed ({TINY_STEP_COUNT} steps below "
-                          f"{TINY_STEP_REL:g} * max(1, |t|), last h={t_new - t_old:.3g} s)",
-                          "Try a looser rtol, a smaller max_step or another method.")
-                return False
-        else:
-            self.tiny = 0
+        if self.stall_guard.step(t_new, t_new - t_old):
+            self.fail(t_new, "the " + self.stall_guard.describe(t_new, t_new - t_old),
+                      "Try a looser rtol, a smaller max_step or another method.")
+            return False
         return True
 
     def _progress(self, t: float) -> None:

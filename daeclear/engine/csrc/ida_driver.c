@@ -102,9 +102,10 @@ enum {
  * grow (|h| <= DC_TINY_GROWTH * previous |h|), with no normal step in between, are a collapse of
  * the step size: the loop stops instead of creeping on forever. Tiny steps that keep growing
  * are IDA's start-up doubling after a tiny initial step (0.5 / ||y'||_wrms) and do not count. */
-#define DC_TINY_REL 1e-14
-#define DC_TINY_MAX 20
-#define DC_TINY_GROWTH 1.5
+/* The numbers are daeclear.engine.stall_guard's, given as -D defines by the build (one home). */
+#if !defined(DC_TINY_REL) || !defined(DC_TINY_MAX) || !defined(DC_TINY_GROWTH) || !defined(DC_NORMAL_STEP_FACTOR)
+#error "build with daeclear.engine.stall_guard.c_defines(): -DDC_TINY_REL=... -DDC_TINY_MAX=... -DDC_TINY_GROWTH=... -DDC_NORMAL_STEP_FACTOR=..."
+#endif
 
 #define MSG_LEN 1024
 
@@ -1681,7 +1682,7 @@ DC_API int dc_advance(void* sp, double t_stop, const double* t_eval, int n_eval,
      * the threshold is still caught. */
     if (nst > nst_prev && flag != IDA_TSTOP_RETURN) {
       double thr = fmax(DC_TINY_REL * fmax(1.0, fabs(tret)), s->stall_step);
-      if (fabs(h) >= (s->stall_step > 0.0 ? 100.0 * thr : thr))
+      if (fabs(h) >= (s->stall_step > 0.0 ? DC_NORMAL_STEP_FACTOR * thr : thr))
         s->tiny = 0;
       else if (fabs(h) < thr && !(fabs(h) > DC_TINY_GROWTH * fabs(s->h_prev)))
         ++s->tiny;
