@@ -368,3 +368,65 @@ def test_a_file_written_before_solver_options_is_read_and_resumed(tmp_path):
         assert json.loads(f.attrs["options_json"])["solver"] == dc.SolverOptions(rtol=1e-7, max_step=2e-4).to_dict()
     with pytest.raises(DaeclearError, match=r"solver\.rtol: file 1e-07, now 1e-06"):
         sweep(path, {"clearance": CLEARANCES}, fixed=FIXED, analysis={"max_step": 2e-4}, **FAST)
+
+
+# --------------------------------------------------------------------------- the journal's atomic writes
+
+
+def _failed_outcome(key, index=0):
+    return {"key": key, "index": index, "parameters": {"clearance": -1.0 - index}, "status": "failed",
+            "error": "SceneError: bad", "traceback": "Traceback ...", "worker": "here:1", "wall_time": 0.1,
+            "computed_at": "2026-01-01T00:00:00+00:00"}
+
+
+def test_journal_writes_go_through_the_one_atomic_write(tmp_path, monkeypatch):
+    """write_part and consolidate write through results.outputs.atomic_file; a Ctrl-C (or any error)
+    while they write leaves the old file byte for byte, the journal in place and no temporary file."""
+    import contextlib
+
+    from daeclear.studies import sweep_journal
+    from daeclear.results import outputs
+
+    used = []
+
+    @contextlib.contextmanager
+    def recording(path):
+        used.append(Path(path).name)
+        with outputs.atomic_file(path) as tmp:
+            yield tmp
+
+    monkeypatch.setattr(sweep_journal, "atomic_file", recording)
+    path = tmp_path / "journal.h5"
+    parts = path.with_name(path.name + ".parts")
+    first = sweep_journal.write_part(parts, _failed_outcome("run-a"), "slider_crank", {"revolutions": 8})
+    sweep_journal.consolidate(path, mechanism="slider_crank", options={"revolutions": 8}, order={"run-a": 0})
+    assert used == ["run-a.h5", "journal.h5"] and not first.exists() and not parts.exists()
+    assert [r.key for r in load_sweep(path).runs] == ["run-a"]
+    before = path.read_bytes()
+
+    def interrupted(group, outcome, mechanism, options):  # Ctrl-C half-way through a write
+        group.attrs["half"] = 1
+        raise KeyboardInterrupt
+
+    real_write_run = sweep_journal.write_run
+    monkeypatch.setattr(sweep_journal, "write_run", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        sweep_journal.write_part(parts, _failed_outcome("run-b", 1), "slider_crank", {"revolutions": 8})
+    assert _parts_left(path) == []  # neither the part nor its temporary file
+    monkeypatch.setattr(sweep_journal, "write_run", real_write_run)
+    sweep_journal.write_part(parts, _failed_outcome("run-b", 1), "slider_crank", {"revolutions": 8})
+
+    def header_interrupted(f, mechanism, options):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sweep_journal, "write_header", header_interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        sweep_journal.consolidate(path, mechanism="slider_crank", options={"revolutions": 8},
+                                  order={"run-a": 0, "run-b": 1})
+    assert path.read_bytes() == before and _parts_left(path) == ["run-b.h5"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["journal.h5", "journal.h5.parts"]  # no temporary file
+    assert [r.key for r in load_sweep(path).runs] == ["run-a", "run-b"]  # the journal's run is still read
+    monkeypatch.undo()
+    sweep_journal.consolidate(path, mechanism="slider_crank", options={"revolutions": 8},
+                              order={"run-a": 0, "run-b": 1})
+    assert [r.key for r in load_sweep(path).runs] == ["run-a", "run-b"] and not parts.exists()

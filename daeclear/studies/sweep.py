@@ -8,7 +8,8 @@ that writes files.
 Robustness (a run's data is never half-written, an interrupted sweep loses no finished run):
 
 - each finished run is first written to its own journal file ``<path>.parts/<key>.h5``
-  under a temporary name, fsync'ed and renamed (atomic on POSIX);
+  under a temporary name, fsync'ed and renamed (atomic on POSIX; the package's one atomic
+  write, :func:`daeclear.results.outputs.atomic_file`);
 - at the end (and on an interrupt or an error) the journal is merged into ``<path>``: a
   new file is written beside it and renamed over it, then the merged journal files are
   deleted; a crash at any point leaves either the old or the new file, plus the journal;
