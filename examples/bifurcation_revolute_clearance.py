@@ -67,14 +67,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     from daeclear.plot import plot_bifurcation
 
     clearances = [float(c) for c in np.geomspace(C_MIN, C_MAX, 2 if args.quick else args.points)]
-    options = {"revolutions": args.revolutions, "transient": args.transient, "per_revolution": 32,
-               "rtol": args.rtol, "twin": True}
+    analysis = {"revolutions": args.revolutions, "transient": args.transient, "per_revolution": 32, "twin": True}
     if args.quick:
-        options.update(revolutions=8, transient=2, per_revolution=16, twin=False)
+        analysis.update(revolutions=8, transient=2, per_revolution=16, twin=False)
     executor, closers = sweep_studies.executor_for(args)
     try:
         result = dc.sweep(args.out / "bifurcation.h5", {"clearance": clearances}, fixed={"joint": "revolute"},
-                          executor=executor, max_workers=args.workers, resume=not args.restart, **options)
+                          options=dc.SolverOptions(rtol=args.rtol), executor=executor, max_workers=args.workers,
+                          resume=not args.restart, **analysis)
     finally:
         for obj in closers:
             obj.close()

@@ -101,14 +101,15 @@ def executor_for(args: argparse.Namespace) -> tuple[Any, list[Any]]:
 def run_sweep(name: str, args: argparse.Namespace, values: Sequence[Any]) -> SweepResult:
     """The study's sweep (resumed if its file exists), on the chosen executor."""
     study = STUDIES[name]
-    options: dict[str, Any] = {"revolutions": args.revolutions, "transient": args.transient,
-                               "per_revolution": args.per_revolution, "rtol": args.rtol, "twin": True}
+    analysis: dict[str, Any] = {"revolutions": args.revolutions, "transient": args.transient,
+                                "per_revolution": args.per_revolution, "twin": True}
     if args.quick:
-        options.update(revolutions=8, transient=2, per_revolution=16, twin=False)
+        analysis.update(revolutions=8, transient=2, per_revolution=16, twin=False)
     executor, closers = executor_for(args)
     try:
         return dc.sweep(args.out / f"{name}.h5", {study["parameter"]: list(values)}, fixed=study["fixed"],
-                        executor=executor, max_workers=args.workers, resume=not args.restart, **options)
+                        options=dc.SolverOptions(rtol=args.rtol), executor=executor, max_workers=args.workers,
+                        resume=not args.restart, **analysis)
     finally:
         for obj in closers:
             obj.close()
@@ -217,7 +218,7 @@ def main(name: str, argv: Sequence[str] | None = None) -> int:
     text = markdown(table)
     header = (f"# {study['title']}\n\n{result.options.get('revolutions')} revolutions analysed after "
               f"{result.options.get('transient')} of transient, {result.options.get('per_revolution')} samples per "
-              f"revolution, rtol {result.options.get('rtol')}, twins: {result.options.get('twin')}. "
+              f"revolution, rtol {result.solver_options.rtol:g}, twins: {result.options.get('twin')}. "
               f"{result.n_computed} runs computed now, {result.n_skipped} found in the sweep file.\n")
     (args.out / "metrics.md").write_text(header + "\n" + text + "\n")
     (args.out / "metrics.json").write_text(json.dumps({"about": study["title"], "options": result.options,

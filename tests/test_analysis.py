@@ -22,7 +22,7 @@ from daeclear.studies.analysis import (
     crank_period,
     phase_portrait,
     poincare_section,
-    restart_model,
+    restart_state,
     sampling_times,
     twin_divergence,
     twin_evidence,
@@ -144,6 +144,27 @@ def test_twin_divergence_fits_the_exponential_growth():
     assert div.lyapunov_per_revolution == pytest.approx(lam * T, rel=0.02)
 
 
+def test_twin_divergence_reads_twins_at_their_true_times():
+    """Twins restarted at t_r = 3T run from 3T (simulate(t0=...)): the same data shifted in time gives the
+    same evidence, the section at offset + k T is read at the twins' own times, and restart_time is t_r."""
+    t = sampling_times(T, 12, per_revolution=32)
+    phase = 2 * np.pi * t / T
+    d = 1e-6 * np.exp(0.3 * phase)
+    a0 = _result(t, {"s.v": np.sin(phase), "s.w": np.cos(phase)}, states={"s.x": np.sin(phase)})
+    b0 = _result(t, {"s.v": np.sin(phase) + d, "s.w": np.cos(phase) - d}, states={"s.x": np.sin(phase) + d})
+    sec = poincare_section(a0, ("s.v", "s.w"), t0=0.25 * T)
+    at_zero = twin_divergence(a0, b0, sec, reference=a0, offset=0.25 * T)
+    shifted = [_result(t + 3 * T, {n: r[n] for n in ("s.v", "s.w")}, states={"s.x": r["s.x"]}) for r in (a0, b0)]
+    at_3T = twin_divergence(shifted[0], shifted[1], sec, reference=a0, offset=0.25 * T)
+    assert at_3T.restart_time == pytest.approx(3 * T) and at_zero.restart_time == 0.0
+    assert np.allclose(at_3T.t, at_zero.t, rtol=0, atol=1e-15) and np.array_equal(at_3T.distance, at_zero.distance)
+    for name in ("lyapunov", "amplification", "decorrelation", "section_gap", "twin_recurrence"):
+        assert getattr(at_3T, name) == pytest.approx(getattr(at_zero, name), rel=1e-12), name
+    assert math.isfinite(at_3T.section_gap) and at_3T.section_gap > 0  # the section was read
+    with pytest.raises(DaeclearError, match="no output"):  # an offset off the twins' grid is not silently shifted
+        twin_divergence(shifted[0], shifted[1], sec, reference=a0, offset=0.3 * T)
+
+
 # --------------------------------------------------------------------------- the chapter's slider-crank
 
 
@@ -210,34 +231,79 @@ def test_classification_is_stable_to_the_sampling_choices(clearance, expected):
 
 
 def test_restart_reproduces_the_continuous_run():
-    """A restart from the state at t = 2T (angles unwound by whole turns) continues the same motion."""
+    """A restart from the state at t = 2T, or at any output time, continues the same motion at the true time."""
     model = dc.assemble(slider_crank("ideal"))
     t = sampling_times(T, 4, per_revolution=16)
     run = dc.simulate(model, 4 * T, t_eval=t, rtol=1e-8)
-    index = int(np.argmin(np.abs(t - 2 * T)))
-    again = dc.simulate(restart_model(model, run, index), 2 * T, t_eval=t[t <= 2 * T + 1e-12], rtol=1e-8)
-    for name in ("slider.x", "slider.vx", "rod.phi", "drive.moment"):
-        ref = run[name][index:]
-        assert np.allclose(again[name], ref, rtol=0, atol=1e-5 * np.ptp(ref)), name
-    assert again["crank.phi"][0] == pytest.approx(run["crank.phi"][0])  # unwound by 2 turns
-    with pytest.raises(DaeclearError, match="whole number of periods"):
-        restart_model(model, run, index + 1)
+    for index in (int(np.argmin(np.abs(t - 2 * T))), 21):  # a whole period, and 5/16 of a turn past one
+        start = restart_state(model, run, index)
+        assert start.t0 == run.t[index] and np.array_equal(start.y0, run.y[index])
+        again = dc.simulate(model, 4 * T, t0=start.t0, y0=start.y0, t_eval=t[index:], rtol=1e-8)
+        assert np.array_equal(again.t, run.t[index:])
+        for name in ("slider.x", "slider.vx", "rod.phi", "drive.moment", "crank.phi"):
+            ref = run[name][index:]
+            assert np.allclose(again[name], ref, rtol=0, atol=1e-5 * np.ptp(ref)), (index, name)
+        assert again["crank.phi"][0] == pytest.approx(run["crank.phi"][index])  # not unwound: the true angle
     with pytest.raises(DaeclearError, match="no free position"):  # the ideal mechanism has no degree of freedom
-        restart_model(model, run, index, perturbation=1e-6)
+        restart_state(model, run, 8, perturbation=1e-6)
 
 
 def test_twin_perturbation_stays_on_the_constraint_manifold():
     model = dc.assemble(slider_crank("revolute", clearance=0.5e-3))
     run = dc.simulate(model, T, t_eval=sampling_times(T, 1, per_revolution=8))
-    base = restart_model(model, run, 8)
-    q0 = np.array(base.start_state[: model.n_q])
-    phi0 = np.array(model.kinematics(q0, np.zeros(model.n_q), 0.0, model.parameter_values)[0])
+    base = restart_state(model, run, 8)
+    q0 = base.y0[: model.n_q]
+    phi0 = np.array(model.kinematics(q0, np.zeros(model.n_q), base.t0, model.parameter_values)[0])
     for size in (1e-6, 1e-5):
-        twin = restart_model(model, run, 8, perturbation=size, seed=3)
-        q = np.array(twin.start_state[: model.n_q])
-        assert np.linalg.norm(q - np.array(base.start_state[: model.n_q])) == pytest.approx(size)
-        Phi = np.array(model.kinematics(q, np.zeros(model.n_q), 0.0, model.parameter_values)[0])
+        twin = restart_state(model, run, 8, perturbation=size, seed=3)
+        assert twin.t0 == base.t0 == run.t[8]
+        q = twin.y0[: model.n_q]
+        assert np.linalg.norm(q - q0) == pytest.approx(size)
+        assert np.array_equal(twin.y0[model.n_q:], base.y0[model.n_q:])  # velocities and multipliers untouched
+        Phi = np.array(model.kinematics(q, np.zeros(model.n_q), twin.t0, model.parameter_values)[0])
         assert np.max(np.abs(Phi - phi0)) < 1e-3 * size  # second order in the perturbation only
+
+
+def test_twins_continue_the_reference_run_at_the_true_time():
+    """classify_motion's twins restart from the reference run's state at t_r and run from t_r
+    (simulate(t0=t_r, y0=...)): unperturbed, they are a straight run over the same times. On the ideal
+    slider-crank (no clearance: nothing sensitive to amplify the restart) the twin equals the
+    reference to the integration tolerance, and both twins are the same computation."""
+    model = dc.assemble(slider_crank("ideal"))
+    analysis = classify_motion(model, transient=2, revolutions=4, twin_revolutions=3, per_revolution=16,
+                               perturbation=0.0, rtol=1e-8)
+    ref, (twin, other) = analysis.result, analysis.twins
+    assert twin.t[0] == pytest.approx(2 * T) and twin.t[-1] == pytest.approx(5 * T)
+    assert analysis.divergence.restart_time == twin.t[0]
+    start = int(np.argmin(np.abs(ref.t - twin.t[0])))
+    assert np.allclose(twin.t, ref.t[start:start + twin.n_times], rtol=0, atol=1e-12)
+    for name in ("slider.x", "slider.vx", "crank.phi", "rod.phi", "drive.moment"):
+        expected = ref[name][start:start + twin.n_times]
+        assert np.allclose(twin[name], expected, rtol=0, atol=1e-5 * np.ptp(expected)), name
+        assert np.array_equal(twin[name], other[name]), name
+    assert np.all(analysis.divergence.distance == 0.0)
+
+
+def test_classify_motion_takes_solver_options():
+    """options=SolverOptions(...) is the keyword form (the same runs, bit for bit); a keyword overrides it."""
+    scene = dc.assemble(slider_crank("revolute", clearance=0.5e-3))
+    short = dict(transient=1, revolutions=3, per_revolution=16, twin_revolutions=2)
+    keywords = classify_motion(scene, rtol=1e-7, max_step=1e-4, **short)
+    options = dc.SolverOptions(rtol=1e-7, max_step=1e-4)
+    with_options = classify_motion(scene, options=options, **short)
+    for a, b in ((keywords.result, with_options.result), (keywords.twins[1], with_options.twins[1])):
+        assert np.array_equal(a.t, b.t) and np.array_equal(a.y, b.y)
+    assert with_options.options["solver"] == options.to_dict() == keywords.options["solver"]
+    assert with_options.options["rtol"] == 1e-7
+    overridden = classify_motion(scene, options=options, rtol=1e-6, twin=False, **short)
+    assert overridden.result.parameters["simulate"]["rtol"] == 1e-6
+    assert overridden.options["solver"] == options.replace(rtol=1e-6).to_dict()
+    with pytest.raises(SceneError, match="options"):
+        classify_motion(scene, options={"rtol": 1e-7}, **short)
+    with pytest.raises(SceneError, match="rtol"):
+        classify_motion(scene, options=options, rtol=2.0, **short)
+    with pytest.raises(SceneError, match="y0"):
+        classify_motion(scene, y0=np.zeros(scene.n_states), **short)
 
 
 def test_classify_motion_rejects_bad_options():

@@ -160,14 +160,15 @@ def test_velocities_inconsistent_with_the_joint():
 
 
 def test_a_restart_from_a_computed_state_may_start_in_contact():
-    """analysis.restart_model starts from a run's own state (twin runs): its start is not a declaration."""
-    from daeclear.studies.analysis import restart_model
+    """A restart from a run's own state (twin runs, analysis.restart_state) is not a declaration."""
+    from daeclear.studies.analysis import restart_state
 
     model = dc.assemble(journal_inside_the_wall())
     declared = quiet_simulate(model, 0.002, start="declared", t_eval=np.linspace(0.0, 0.002, 21),
                               allow_penetration=True)
     assert "initial_penetration" in kinds(declared)
-    again = quiet_simulate(restart_model(model, declared, 0), 0.002)
+    start = restart_state(model, declared, 0)
+    again = quiet_simulate(model, 0.002, t0=start.t0, y0=start.y0)
     assert again["clearance.penetration"][0] == pytest.approx(0.2e-3, rel=1e-6)
     assert not {"initial_penetration", "initial_velocity"} & set(kinds(again))
 

@@ -295,3 +295,138 @@ def test_section_channels_follow_the_scene_without_a_slider(tmp_path):
     assert out.options["channels"] == ["rocker.omega", "rocker.alpha"]
     run = out.runs[0]
     assert run.ok and set(out.channels(run)) >= {"rocker.omega", "rocker.alpha"}
+
+
+# --------------------------------------------------------------------------- solver settings as one object
+
+
+def test_sweep_with_options_is_the_keyword_form(tmp_path):
+    """options=SolverOptions(...) gives the keyword form's file, bit for bit; the file stores the options
+    (to_dict) and gives them back (from_dict); a resume in the other form is the same sweep."""
+    options = dc.SolverOptions(rtol=1e-7, max_step=2e-4)
+    by_keywords = sweep(tmp_path / "keywords.h5", {"clearance": CLEARANCES}, fixed=FIXED, max_workers=2, rtol=1e-7,
+                        analysis={"max_step": 2e-4}, **FAST)
+    by_options = sweep(tmp_path / "options.h5", {"clearance": CLEARANCES}, fixed=FIXED, max_workers=2,
+                       options=options, **FAST)
+    assert len(by_options) == 2 and all(r.ok for r in by_options.runs)
+    assert by_options.solver_options == by_keywords.solver_options == options
+    with h5py.File(tmp_path / "keywords.h5", "r") as a, h5py.File(tmp_path / "options.h5", "r") as b:
+        assert json.loads(b.attrs["options_json"])["solver"] == options.to_dict()
+        assert a.attrs["options_json"] == b.attrs["options_json"]
+        assert sorted(a["runs"]) == sorted(b["runs"])
+        for key in a["runs"]:
+            _same(_datasets(a["runs"][key]), _datasets(b["runs"][key]))
+    direct = dc.analysis.classify_motion(dc.mechanisms.slider_crank("revolute", clearance=0.5e-3), options=options,
+                                         revolutions=8, transient=2, per_revolution=16, twin=False)
+    assert np.array_equal(by_options.section(1).points, direct.section.points)  # the workers ran these settings
+    default = dc.analysis.classify_motion(dc.mechanisms.slider_crank("revolute", clearance=0.5e-3),
+                                          revolutions=8, transient=2, per_revolution=16, twin=False)
+    assert not np.array_equal(default.section.points, direct.section.points)  # ... which change the numbers
+    again = sweep(tmp_path / "keywords.h5", {"clearance": CLEARANCES}, fixed=FIXED, options=options, **FAST)
+    assert again.n_computed == 0 and again.n_skipped == 2
+    overridden = sweep(tmp_path / "options.h5", {"clearance": CLEARANCES}, fixed=FIXED,
+                       options=options.replace(rtol=1e-3), rtol=1e-7, **FAST)  # the keyword wins, as in simulate
+    assert overridden.n_computed == 0 and overridden.n_skipped == 2
+
+
+def test_resume_with_other_solver_options_is_refused(tmp_path):
+    path = tmp_path / "solver.h5"
+    options = dc.SolverOptions(rtol=1e-7)
+    sweep(path, {"clearance": [0.5e-3]}, fixed=FIXED, max_workers=1, options=options, **FAST)
+    before = path.read_bytes()
+    with pytest.raises(DaeclearError, match=r"solver\.max_step: file 0\.0, now 0\.0002") as info:
+        sweep(path, {"clearance": [0.5e-3]}, fixed=FIXED, options=options.replace(max_step=2e-4), **FAST)
+    assert "rtol" not in str(info.value)  # only what differs is named
+    with pytest.raises(DaeclearError, match=r"solver\.method: file 'ida', now 'lsoda'; solver\.rtol: file 1e-07, now "
+                                            r"1e-06"):
+        sweep(path, {"clearance": [0.5e-3]}, fixed=FIXED, options=dc.SolverOptions(method="LSODA"), **FAST)
+    with pytest.raises(DaeclearError, match=r"revolutions: file 8, now 9; solver\.rtol: file 1e-07, now 1e-08"):
+        sweep(path, {"clearance": [0.5e-3]}, fixed=FIXED, options=options, **{**FAST, "revolutions": 9}, rtol=1e-8)
+    assert path.read_bytes() == before  # the refused calls changed nothing
+    with pytest.raises(SceneError, match="options"):
+        sweep(tmp_path / "bad.h5", {"clearance": [0.5e-3]}, fixed=FIXED, options={"rtol": 1e-7}, **FAST)
+    with pytest.raises(SceneError, match=r"sweep: rtol=2\.0"):
+        sweep(tmp_path / "bad.h5", {"clearance": [0.5e-3]}, fixed=FIXED, rtol=2.0, **FAST)
+    assert not (tmp_path / "bad.h5").exists()
+
+
+def test_a_file_written_before_solver_options_is_read_and_resumed(tmp_path):
+    """Files of the keyword era kept rtol (atol, max_step, ...) among the analysis options: they read as
+    the SolverOptions they mean, and the same sweep resumes them without computing anything again."""
+    path = tmp_path / "old.h5"
+    sweep(path, {"clearance": CLEARANCES}, fixed=FIXED, max_workers=2, rtol=1e-7, analysis={"max_step": 2e-4}, **FAST)
+    with h5py.File(path, "r+") as f:
+        options = json.loads(f.attrs["options_json"])
+        solver = options.pop("solver")
+        f.attrs["options_json"] = json.dumps({**options, "rtol": solver["rtol"], "max_step": solver["max_step"]},
+                                             sort_keys=True)
+    old = load_sweep(path)
+    assert old.solver_options == dc.SolverOptions(rtol=1e-7, max_step=2e-4) and "rtol" not in old.options
+    resumed = sweep(path, {"clearance": CLEARANCES}, fixed=FIXED, rtol=1e-7, analysis={"max_step": 2e-4}, **FAST)
+    assert resumed.n_computed == 0 and resumed.n_skipped == 2
+    with h5py.File(path, "r") as f:  # merged in the current form
+        assert json.loads(f.attrs["options_json"])["solver"] == dc.SolverOptions(rtol=1e-7, max_step=2e-4).to_dict()
+    with pytest.raises(DaeclearError, match=r"solver\.rtol: file 1e-07, now 1e-06"):
+        sweep(path, {"clearance": CLEARANCES}, fixed=FIXED, analysis={"max_step": 2e-4}, **FAST)
+
+
+# --------------------------------------------------------------------------- the journal's atomic writes
+
+
+def _failed_outcome(key, index=0):
+    return {"key": key, "index": index, "parameters": {"clearance": -1.0 - index}, "status": "failed",
+            "error": "SceneError: bad", "traceback": "Traceback ...", "worker": "here:1", "wall_time": 0.1,
+            "computed_at": "2026-01-01T00:00:00+00:00"}
+
+
+def test_journal_writes_go_through_the_one_atomic_write(tmp_path, monkeypatch):
+    """write_part and consolidate write through results.outputs.atomic_file; a Ctrl-C (or any error)
+    while they write leaves the old file byte for byte, the journal in place and no temporary file."""
+    import contextlib
+
+    from daeclear.studies import sweep_journal
+    from daeclear.results import outputs
+
+    used = []
+
+    @contextlib.contextmanager
+    def recording(path):
+        used.append(Path(path).name)
+        with outputs.atomic_file(path) as tmp:
+            yield tmp
+
+    monkeypatch.setattr(sweep_journal, "atomic_file", recording)
+    path = tmp_path / "journal.h5"
+    parts = path.with_name(path.name + ".parts")
+    first = sweep_journal.write_part(parts, _failed_outcome("run-a"), "slider_crank", {"revolutions": 8})
+    sweep_journal.consolidate(path, mechanism="slider_crank", options={"revolutions": 8}, order={"run-a": 0})
+    assert used == ["run-a.h5", "journal.h5"] and not first.exists() and not parts.exists()
+    assert [r.key for r in load_sweep(path).runs] == ["run-a"]
+    before = path.read_bytes()
+
+    def interrupted(group, outcome, mechanism, options):  # Ctrl-C half-way through a write
+        group.attrs["half"] = 1
+        raise KeyboardInterrupt
+
+    real_write_run = sweep_journal.write_run
+    monkeypatch.setattr(sweep_journal, "write_run", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        sweep_journal.write_part(parts, _failed_outcome("run-b", 1), "slider_crank", {"revolutions": 8})
+    assert _parts_left(path) == []  # neither the part nor its temporary file
+    monkeypatch.setattr(sweep_journal, "write_run", real_write_run)
+    sweep_journal.write_part(parts, _failed_outcome("run-b", 1), "slider_crank", {"revolutions": 8})
+
+    def header_interrupted(f, mechanism, options):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sweep_journal, "write_header", header_interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        sweep_journal.consolidate(path, mechanism="slider_crank", options={"revolutions": 8},
+                                  order={"run-a": 0, "run-b": 1})
+    assert path.read_bytes() == before and _parts_left(path) == ["run-b.h5"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["journal.h5", "journal.h5.parts"]  # no temporary file
+    assert [r.key for r in load_sweep(path).runs] == ["run-a", "run-b"]  # the journal's run is still read
+    monkeypatch.undo()
+    sweep_journal.consolidate(path, mechanism="slider_crank", options={"revolutions": 8},
+                              order={"run-a": 0, "run-b": 1})
+    assert [r.key for r in load_sweep(path).runs] == ["run-a", "run-b"] and not parts.exists()

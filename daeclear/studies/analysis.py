@@ -45,6 +45,7 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -61,10 +62,11 @@ from .motion_thresholds import (  # noqa: F401
     MIN_POINTS, SATURATION_FRACTION, SENSITIVE_AMPLIFICATION, SIZE_QUANTILES, TIME_MATCH)
 from .poincare import (CHANNELS, PhasePortrait, PoincareSection, crank_period, match_times, phase_portrait,
                        poincare_section, sampling_times, section_channels)
-from .twin_runs import Divergence, all_free, restart_model, twin_divergence, twin_evidence
+from .twin_runs import Divergence, RestartState, all_free, restart_state, twin_divergence, twin_evidence
 from ..assembly.assemble import DAEModel
 from ..errors import DaeclearError, SceneError  # noqa: F401  (DaeclearError: re-exported as before)
 from ..options import default_formulation
+from ..solver_options import UNSET, SolverOptions
 
 if TYPE_CHECKING:
     from ..results.result import Result
@@ -78,6 +80,7 @@ __all__ = [
     "MotionClass",
     "PhasePortrait",
     "PoincareSection",
+    "RestartState",
     "TwinReading",
     "classify_motion",
     "classify_section",
@@ -86,7 +89,7 @@ __all__ = [
     "work_precision",
     "phase_portrait",
     "poincare_section",
-    "restart_model",
+    "restart_state",
     "section_channels",
     "read_twins",
     "sampling_times",
@@ -113,9 +116,10 @@ class MotionAnalysis:
     divergence : Divergence or None
         Twin evidence (None with ``twin=False``).
     twins : (Result, Result) or None
-        The unperturbed and perturbed restarted runs.
+        The unperturbed and perturbed restarted runs (from the restart time on, at their true times).
     options : dict
-        The options of the analysis (revolutions, transient, ...).
+        The options of the analysis (revolutions, transient, ...), with ``rtol`` and, under
+        ``"solver"``, every solver setting of the runs (:meth:`daeclear.SolverOptions.to_dict`).
     """
 
     result: Result
@@ -141,8 +145,8 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
                     transient: int = 10, per_revolution: int = 32, phase: float = 0.0, twin: bool | str = True,
                     twin_revolutions: int = 20, perturbation: float = DEFAULT_PERTURBATION, seed: int = 0,
                     tol: float = DEFAULT_TOL, max_period: int = DEFAULT_MAX_PERIOD,
-                    decorrelation: float = DEFAULT_DECORRELATION, rtol: float = 1e-6,
-                    **simulate_options: Any) -> MotionAnalysis:
+                    decorrelation: float = DEFAULT_DECORRELATION, rtol: float = UNSET,
+                    options: SolverOptions | None = None, **simulate_options: Any) -> MotionAnalysis:
     """Simulate a scene, take its Poincaré section after a transient and classify the motion.
 
     Parameters
@@ -176,10 +180,14 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
     tol, max_period, decorrelation : float, int, float
         Classification thresholds (:func:`classify_section`).
     rtol : float
-        IDA relative tolerance (1e-6).
+        Relative tolerance (default that of ``options``, 1e-6 without it).
+    options : SolverOptions, optional
+        The solver settings of every run (:class:`daeclear.SolverOptions`); a solver keyword given
+        explicitly (``rtol``, ``atol``, ``method``, ...) overrides the same setting, as in
+        :func:`daeclear.simulate`. ``formulation`` is used when ``scene`` is a Scene.
     **simulate_options
-        Passed to :func:`daeclear.simulate` (``atol``, ``max_step``, ``backend``,
-        ``formulation`` when ``scene`` is a Scene, ...).
+        Passed to :func:`daeclear.simulate`: solver settings (``atol``, ``max_step``, ``backend``,
+        ``formulation``, ...) and what a run reports (``store_steps``, ``progress``).
 
     Returns
     -------
@@ -199,11 +207,16 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
     twin_revolutions = _check_int("twin_revolutions", twin_revolutions, 2)
     if twin not in ("auto", True, False):
         raise SceneError(f"classify_motion: twin={twin!r}, must be 'auto', True or False.")
-    for key in ("t_eval", "on_failure"):
+    for key in ("t_eval", "t_eval_step", "on_failure", "t0", "y0"):
         if key in simulate_options:
             raise SceneError(f"classify_motion: {key} is set by the analysis; it cannot be passed.")
-    formulation = simulate_options.pop("formulation", None) or default_formulation(simulate_options.get("method", "ida"))
-    model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation)
+    if options is not None and not isinstance(options, SolverOptions):
+        raise SceneError(f"classify_motion: options={options!r}, must be None or a daeclear.SolverOptions.")
+    solver_keys = {f.name for f in dataclasses.fields(SolverOptions)}
+    given = {k: simulate_options.pop(k) for k in list(simulate_options) if k in solver_keys}
+    settings = (options or SolverOptions()).merged(where="classify_motion", rtol=rtol, **given)
+    formulation = settings.formulation or default_formulation(settings.method)
+    model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation, track_work=settings.track_work)
     channels = section_channels(model) if channels is None else channels
     T = crank_period(model)
     offset = (float(phase) % (2.0 * math.pi)) / (2.0 * math.pi) * T
@@ -212,14 +225,16 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
     simulate_options.setdefault("store_steps", False)
     n_total = transient + revolutions
     result = simulate(model, n_total * T, t_eval=sampling_times(T, n_total, per_revolution=per_revolution,
-                                                                offset=offset), rtol=rtol, **simulate_options)
+                                                                offset=offset), options=settings,
+                      **simulate_options)
     t0 = transient * T + offset
     section = poincare_section(result, channels, t0=t0, period=T)
     options = {"channels": list(section.channels), "revolutions": revolutions, "transient": transient,
                "per_revolution": per_revolution, "phase": float(phase),
                "twin": twin if isinstance(twin, str) else bool(twin), "twin_revolutions": twin_revolutions,
                "perturbation": float(perturbation), "seed": int(seed), "tol": float(tol),
-               "max_period": int(max_period), "decorrelation": float(decorrelation), "rtol": float(rtol)}
+               "max_period": int(max_period), "decorrelation": float(decorrelation), "rtol": settings.rtol,
+               "solver": settings.to_dict()}
     divergence, twins = None, None
     motion = classify_section(section, None, tol=tol, max_period=max_period, decorrelation=decorrelation)
     if twin is True or (twin == "auto" and motion.label == "non-periodic"):
@@ -227,13 +242,17 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
         idx = match_times(result, whole, T)
         free = [i for i, t in zip(idx, whole) if all_free(result, float(t))]
         index = int(free[0]) if free else int(idx[0])
-        grid = sampling_times(T, twin_revolutions, per_revolution=per_revolution, offset=offset)
-        runs = [simulate(restart_model(model, result, index, perturbation=p, seed=seed), twin_revolutions * T,
-                         t_eval=grid, rtol=rtol, **simulate_options) for p in (0.0, perturbation)]
+        t_r = float(result.t[index])  # the twins continue the run from t_r, at the true time
+        grid = t_r + sampling_times(T, twin_revolutions, per_revolution=per_revolution, offset=offset)
+        t_end = max(t_r + twin_revolutions * T, float(grid[-1]))
+        runs = []
+        for p in (0.0, perturbation):
+            start = restart_state(model, result, index, perturbation=p, seed=seed)
+            runs.append(simulate(model, t_end, t0=start.t0, y0=start.y0, t_eval=grid, options=settings,
+                                 **simulate_options))
         twins = (runs[0], runs[1])
-        divergence = twin_divergence(runs[0], runs[1], section, reference=result,
-                                     restart_time=float(result.t[index]), restart_in_contact=not free,
-                                     perturbation=perturbation, offset=offset)
+        divergence = twin_divergence(runs[0], runs[1], section, reference=result, restart_time=t_r,
+                                     restart_in_contact=not free, perturbation=perturbation, offset=offset)
         motion = classify_section(section, divergence, tol=tol, max_period=max_period, decorrelation=decorrelation)
     return MotionAnalysis(result=result, section=section, motion=motion, divergence=divergence, twins=twins,
                           options=options)

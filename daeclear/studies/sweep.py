@@ -8,7 +8,8 @@ that writes files.
 Robustness (a run's data is never half-written, an interrupted sweep loses no finished run):
 
 - each finished run is first written to its own journal file ``<path>.parts/<key>.h5``
-  under a temporary name, fsync'ed and renamed (atomic on POSIX);
+  under a temporary name, fsync'ed and renamed (atomic on POSIX; the package's one atomic
+  write, :func:`daeclear.results.outputs.atomic_file`);
 - at the end (and on an interrupt or an error) the journal is merged into ``<path>``: a
   new file is written beside it and renamed over it, then the merged journal files are
   deleted; a crash at any point leaves either the old or the new file, plus the journal;
@@ -41,6 +42,7 @@ On a Dask cluster::
 from __future__ import annotations
 
 import concurrent.futures as cf
+import dataclasses
 import hashlib
 import itertools
 import json
@@ -48,20 +50,21 @@ import math
 import os
 import traceback as tb
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from datetime import datetime, timezone
+from datetime import datetime, UTC
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from .poincare import CHANNELS, PhasePortrait, PoincareSection, section_channels  # noqa: F401  (re-exported)
-from .sweep_file import (FORMAT_NAME, FORMAT_VERSION, RunRecord, SweepResult, load_sweep,  # noqa: F401
-                         part_files, parts_dir, read_record)
+from .sweep_file import (FORMAT_NAME, FORMAT_VERSION, SOLVER_KEY, RunRecord, SweepResult,  # noqa: F401
+                         load_sweep, part_files, parts_dir, read_record, solver_options)
 from .sweep_journal import acquire_lock, consolidate, lock_path, write_part
 from .sweep_workers import build_scene, ignore_sigint, run_task, terminate_pool
 from ..errors import DaeclearError, DaeclearWarning, OutputError, SceneError  # noqa: F401
 from ..progress import Progress
 from ..results.outputs import check_file, deferred_sigint, sigint_latch
+from ..solver_options import UNSET, SolverOptions
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "KEEP", "RunRecord", "SweepResult", "grid_points", "load_sweep",
            "run_key", "sweep"]
@@ -70,6 +73,8 @@ KEEP: tuple[str, ...] = ("section", "channels", "full")
 ANALYSIS_OPTIONS = ("channels", "revolutions", "transient", "per_revolution", "phase", "twin", "twin_revolutions",
                     "perturbation", "seed", "tol", "max_period", "decorrelation", "rtol", "atol", "max_step",
                     "formulation", "backend")
+#: The solver settings analysis= may still give (the keyword form); they go into the sweep's SolverOptions.
+SOLVER_ANALYSIS_OPTIONS = ("atol", "max_step", "formulation", "backend")
 
 
 # --------------------------------------------------------------------------- parameters and keys
@@ -142,12 +147,28 @@ def _short(parameters: Mapping[str, Any], names: Sequence[str]) -> str:
                     for n in names if n in parameters)
 
 
+def _differences(previous: SweepResult, mechanism: str, file_options: Mapping[str, Any],
+                 solver: SolverOptions) -> list[str]:
+    """What differs between a sweep file's settings and this call's (``"<name>: file <a>, now <b>"``);
+    the solver settings are compared as SolverOptions rebuilt from the file (``solver.rtol: ...``)."""
+    diffs = [f"mechanism: file {previous.mechanism!r}, now {mechanism!r}"] if previous.mechanism != mechanism else []
+    old = {k: v for k, v in previous.options.items() if k != SOLVER_KEY}
+    new = {k: v for k, v in file_options.items() if k != SOLVER_KEY}
+    diffs += [f"{k}: file {old.get(k)!r}, now {new.get(k)!r}" for k in sorted(set(old) | set(new))
+              if old.get(k) != new.get(k)]
+    before = previous.solver_options
+    diffs += [f"{SOLVER_KEY}.{f.name}: file {getattr(before, f.name)!r}, now {getattr(solver, f.name)!r}"
+              for f in dataclasses.fields(SolverOptions) if getattr(before, f.name) != getattr(solver, f.name)]
+    return diffs
+
+
 def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None = None, *,
           runs: Iterable[Mapping[str, Any]] | None = None, mechanism: str | Callable[..., Any] = "slider_crank",
           fixed: Mapping[str, Any] | None = None, channels: Sequence[str] | None = None,
           store_channels: Sequence[str] | None = None, keep: str = "channels", revolutions: int = 30,
-          transient: int = 10, per_revolution: int = 32, twin: bool | str = True, rtol: float = 1e-6,
-          analysis: Mapping[str, Any] | None = None, executor: cf.Executor | None = None,
+          transient: int = 10, per_revolution: int = 32, twin: bool | str = True, rtol: float = UNSET,
+          options: SolverOptions | None = None, analysis: Mapping[str, Any] | None = None,
+          executor: cf.Executor | None = None,
           max_workers: int | None = None, resume: bool = True, retry_failed: bool = False, progress: bool = True,
           on_run: Callable[[RunRecord], None] | None = None) -> SweepResult:
     """Run and classify one scene per parameter point, in parallel, into one HDF5 file.
@@ -176,12 +197,20 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     keep : {"section", "channels", "full"}
         What each run stores beyond its classification and section: nothing, the stored
         channels (default), or also the full reference Result.
-    revolutions, transient, per_revolution, twin, rtol
+    revolutions, transient, per_revolution, twin
         Passed to :func:`daeclear.analysis.classify_motion`.
+    rtol : float
+        Relative tolerance of every run (default that of ``options``, 1e-6 without it).
+    options : SolverOptions, optional
+        The solver settings of every run (:class:`daeclear.SolverOptions`: method, tolerances,
+        formulation, backend, ...). ``rtol=`` and the solver settings of ``analysis=`` override
+        the same setting, as keywords do in :func:`daeclear.simulate`. Stored in the file
+        (``options_json["solver"]``, :meth:`SolverOptions.to_dict`); ``SweepResult.solver_options``
+        gives it back, and a resume with other settings is refused.
     analysis : mapping, optional
         Further options of :func:`~daeclear.analysis.classify_motion` (``phase``, ``tol``,
-        ``max_period``, ``decorrelation``, ``perturbation``, ``seed``, ``twin_revolutions``,
-        ``atol``, ``max_step``, ``formulation``, ``backend``).
+        ``max_period``, ``decorrelation``, ``perturbation``, ``seed``, ``twin_revolutions``) and,
+        as keywords, the solver settings ``atol``, ``max_step``, ``formulation``, ``backend``.
     executor : concurrent.futures.Executor, optional
         Where runs go. Default: a local process pool (spawned processes, ``max_workers``
         of them, the platform's start method: on macOS and Windows a script must call
@@ -209,8 +238,8 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     SceneError
         Bad arguments (unknown option, non-plain parameter value, no points).
     DaeclearError
-        The file belongs to another sweep (different mechanism or options: the message says
-        which), is locked by a running sweep, or the process pool broke (finished runs are
+        The file belongs to another sweep (different mechanism, analysis or solver options:
+        the message names each difference), is locked by a running sweep, or the process pool broke (finished runs are
         saved; run again to resume).
     KeyboardInterrupt
         Re-raised after the finished runs are saved.
@@ -228,8 +257,9 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     check.revolutions(revolutions)
     check.transient(transient)
     check.per_revolution(per_revolution)
-    check.rtol(rtol, where="sweep")
     check.workers(max_workers)
+    if options is not None and not isinstance(options, SolverOptions):
+        check.fail("sweep", "options", options, "None or a daeclear.SolverOptions")
     if channels is not None:
         check.names(list(channels) if not isinstance(channels, str) else channels, where="sweep", field="channels")
     if not isinstance(twin, bool) and twin != "auto":
@@ -242,6 +272,8 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     overlap = sorted(set(extra) & {"channels", "revolutions", "transient", "per_revolution", "twin", "rtol"})
     if overlap:
         raise SceneError(f"sweep: give {', '.join(overlap)} as sweep() keywords, not in analysis=.")
+    solver = (options or SolverOptions()).merged(  # one object: the keywords override options, as in simulate
+        where="sweep", rtol=rtol, **{k: extra.pop(k) for k in SOLVER_ANALYSIS_OPTIONS if k in extra})
     if not isinstance(mechanism, str) and not callable(mechanism):
         raise SceneError(f"sweep: mechanism={mechanism!r}, must be a mechanism name or a callable.")
     base = {str(k): _plain_value(str(k), v) for k, v in (fixed or {}).items()}
@@ -252,10 +284,11 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     if channels is None:  # from what the mechanism holds (every point has its bodies)
         first = {**base, **{str(k): _plain_value(str(k), v) for k, v in points[0].items()}}
         channels = section_channels(build_scene(mechanism, first))
-    options = {"channels": [str(c) for c in channels], "revolutions": revolutions, "transient": transient,
-               "per_revolution": per_revolution, "twin": twin, "rtol": rtol, **extra}
+    analysis_options = {"channels": [str(c) for c in channels], "revolutions": revolutions, "transient": transient,
+                        "per_revolution": per_revolution, "twin": twin, **extra}
     stored = [str(c) for c in (store_channels if store_channels is not None else channels)]
-    file_options = {**{k: _plain_value(k, v) for k, v in options.items()}, "keep": keep, "store_channels": stored}
+    file_options = {**{k: _plain_value(k, v) for k, v in analysis_options.items()}, "keep": keep,
+                    "store_channels": stored, SOLVER_KEY: solver.to_dict()}
     mech_name = _mechanism_name(mechanism)
     tasks: list[dict[str, Any]] = []
     order: dict[str, int] = {}
@@ -266,8 +299,8 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
             continue  # the same point twice: one run
         order[key] = len(tasks)
         tasks.append({"key": key, "index": len(tasks), "parameters": params, "mechanism": mechanism,
-                      "analysis": {k: (tuple(v) if k == "channels" else v) for k, v in options.items()},
-                      "keep": keep, "store_channels": stored})
+                      "analysis": {k: (tuple(v) if k == "channels" else v) for k, v in analysis_options.items()},
+                      SOLVER_KEY: solver.to_dict(), "keep": keep, "store_channels": stored})
     varying = [n for n in dict.fromkeys(k for t in tasks for k in t["parameters"])
                if len({json.dumps(t["parameters"].get(n)) for t in tasks}) > 1]
 
@@ -282,12 +315,8 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
         existing: dict[str, RunRecord] = {}
         if path.is_file() or part_files(path):
             previous = load_sweep(path)
-            if previous.options and (previous.mechanism, previous.options) != (mech_name, file_options):
-                diffs = [f"{k}: file {previous.options.get(k)!r}, now {file_options.get(k)!r}"
-                         for k in sorted(set(previous.options) | set(file_options))
-                         if previous.options.get(k) != file_options.get(k)]
-                if previous.mechanism != mech_name:
-                    diffs.insert(0, f"mechanism: file {previous.mechanism!r}, now {mech_name!r}")
+            diffs = _differences(previous, mech_name, file_options, solver) if previous.options else []
+            if diffs:
                 raise DaeclearError(f"sweep '{path}' was made with other settings ({'; '.join(diffs)}). Use another "
                                     "file, or resume=False to start it over.")
             existing = {r.key: r for r in previous.runs}
@@ -349,7 +378,7 @@ def _execute(path: Path, todo: list[dict[str, Any]], executor: cf.Executor | Non
                     outcome = {**{k: task[k] for k in ("key", "index", "parameters")}, "status": "failed",
                                "error": f"{type(exc).__name__}: {exc}", "traceback": tb.format_exc(),
                                "worker": "?", "wall_time": float("nan"),
-                               "computed_at": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+                               "computed_at": datetime.now(UTC).isoformat(timespec="seconds")}
                 if outcome["status"] == "interrupted":
                     continue  # not recorded: computed again on resume
                 write_part(parts, outcome, mechanism, options)

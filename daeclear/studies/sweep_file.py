@@ -1,7 +1,8 @@
 """The sweep file: its HDF5 layout, written one run at a time and read back (``load_sweep``).
 
 HDF5 layout of ``<path>`` (root attributes ``format="daeclear-sweep"``, ``version=1``,
-``mechanism``, ``options_json``)::
+``mechanism``, ``options_json``: the analysis options, ``keep``, ``store_channels`` and, under
+``"solver"``, the runs' :class:`daeclear.SolverOptions` as :meth:`~daeclear.SolverOptions.to_dict`)::
 
     /runs/<key>                 attrs: the run's parameters, one attribute each (None as
                                 "None"), and parameters_json (the lossless copy)
@@ -41,12 +42,37 @@ if TYPE_CHECKING:
     import h5py
 
     from ..results.result import Result
+    from ..solver_options import SolverOptions
 
-__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "RunRecord", "SweepResult", "json_default", "load_sweep", "part_files",
-           "parts_dir", "read_record", "write_header", "write_run"]
+__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "SOLVER_KEY", "RunRecord", "SweepResult", "json_default", "load_sweep",
+           "part_files", "parts_dir", "read_record", "solver_options", "write_header", "write_run"]
 
 FORMAT_NAME = "daeclear-sweep"
 FORMAT_VERSION = 1
+#: The entry of a sweep's options that holds its SolverOptions (``SolverOptions.to_dict()``).
+SOLVER_KEY = "solver"
+#: Solver settings that files written before SolverOptions kept among the analysis options.
+_LEGACY_SOLVER_KEYS = ("rtol", "atol", "max_step", "formulation", "backend")
+
+
+def solver_options(options: Mapping[str, Any]) -> SolverOptions:
+    """The SolverOptions of a sweep's options (``options[SOLVER_KEY]``, rebuilt by ``from_dict``)."""
+    from ..solver_options import SolverOptions
+
+    return SolverOptions.from_dict(options.get(SOLVER_KEY, {}))
+
+
+def _current_form(options: dict[str, Any]) -> dict[str, Any]:
+    """A sweep's options as written now: a file made before SolverOptions kept ``rtol`` (and any of
+    ``atol``, ``max_step``, ``formulation``, ``backend``) among the analysis options; they become
+    its ``SOLVER_KEY`` entry, so that such a file is read, and resumed, like a new one."""
+    if not options or SOLVER_KEY in options:
+        return options
+    legacy = {k: options[k] for k in _LEGACY_SOLVER_KEYS if k in options}
+    rest = {k: v for k, v in options.items() if k not in _LEGACY_SOLVER_KEYS}
+    from ..solver_options import SolverOptions
+
+    return {**rest, SOLVER_KEY: SolverOptions.from_dict(legacy).to_dict()}
 
 
 # --------------------------------------------------------------------------- records
@@ -260,8 +286,9 @@ class SweepResult:
     mechanism : str
         The mechanism (name, or ``module:function`` of a callable).
     options : dict
-        The analysis options of the sweep (:func:`daeclear.analysis.classify_motion`), ``keep``
-        and the stored channels.
+        The analysis options of the sweep (:func:`daeclear.analysis.classify_motion`), ``keep``,
+        the stored channels and, under ``"solver"``, the solver settings as a dict
+        (:attr:`solver_options` rebuilds the SolverOptions).
     n_computed, n_skipped : int
         Runs computed and runs found finished by the call that returned this (0 from `load_sweep`).
     """
@@ -277,6 +304,11 @@ class SweepResult:
 
     def __len__(self) -> int:
         return len(self.runs)
+
+    @property
+    def solver_options(self) -> SolverOptions:
+        """The solver settings of the sweep's runs (:class:`daeclear.SolverOptions`, from the file)."""
+        return solver_options(self.options)
 
     def __iter__(self) -> Any:
         return iter(self.runs)
@@ -478,4 +510,4 @@ def load_sweep(path: str | os.PathLike[str]) -> SweepResult:
             warnings.warn(f"sweep: journal file {part} cannot be read ({exc}); skipped.", DaeclearWarning,
                           stacklevel=2)
     runs = sorted(records.values(), key=lambda r: (r.index, r.key))
-    return SweepResult(path, runs, mechanism, options)
+    return SweepResult(path, runs, mechanism, _current_form(options))

@@ -2,7 +2,8 @@
 
 Each finished run goes to its own journal file ``<path>.parts/<key>.h5`` (temporary name, fsync,
 rename: atomic on POSIX, :func:`write_part`); :func:`consolidate` merges the journal into a new
-file renamed over ``<path>``, so a crash at any point leaves the old or the new file plus the
+file renamed over ``<path>``; both write through :func:`daeclear.results.outputs.atomic_file`,
+the package's one atomic write, so a crash at any point leaves the old or the new file plus the
 journal; ``<path>.lock`` (:func:`acquire_lock`) keeps two sweeps from writing one file at once.
 Separate from the layout of a run (:mod:`daeclear.studies.sweep_file`): this module only decides
 how and when bytes reach the disk safely.
@@ -13,7 +14,6 @@ from __future__ import annotations
 import json
 import os
 import socket
-import uuid
 import warnings
 from collections.abc import Mapping
 from pathlib import Path
@@ -21,26 +21,20 @@ from typing import Any
 
 from .sweep_file import json_default, part_files, parts_dir, write_header, write_run
 from ..errors import DaeclearError, DaeclearWarning
+from ..results.outputs import atomic_file
 
 __all__ = ["acquire_lock", "consolidate", "lock_path", "write_part"]
 
 
 def write_part(parts: Path, outcome: Mapping[str, Any], mechanism: str, options: Mapping[str, Any]) -> Path:
-    """Write one run to ``parts/<key>.h5`` atomically (temporary name, fsync, rename)."""
+    """Write one run to ``parts/<key>.h5`` atomically (:func:`~daeclear.results.outputs.atomic_file`:
+    a temporary name beside it, fsync, rename; removed on any exception, Ctrl-C included)."""
     import h5py
 
     parts.mkdir(parents=True, exist_ok=True)
     final = parts / f"{outcome['key']}.h5"
-    tmp = parts / f".{outcome['key']}.{uuid.uuid4().hex[:12]}.tmp"
-    try:
-        with h5py.File(tmp, "x") as f:
-            write_run(f, outcome, mechanism, options)
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, final)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    with atomic_file(final) as tmp, h5py.File(tmp, "x") as f:  # closed before atomic_file's fsync and rename
+        write_run(f, outcome, mechanism, options)
     return final
 
 
@@ -49,9 +43,8 @@ def consolidate(path: Path, *, mechanism: str, options: Mapping[str, Any], order
     import h5py
 
     parts = part_files(path)
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:12]}.tmp")
     merged: list[Path] = []
-    try:
+    with atomic_file(path) as tmp:
         with h5py.File(tmp, "x") as dst:
             write_header(dst, mechanism, options)
             runs = dst.create_group("runs")
@@ -77,16 +70,10 @@ def consolidate(path: Path, *, mechanism: str, options: Mapping[str, Any], order
                 else:  # a run of an earlier grid: after the current ones, in its old order
                     info.attrs["index"] = extra
                     extra += 1
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
     for part in merged:
         part.unlink(missing_ok=True)
     if parts_dir(path).is_dir():  # half-written parts of a killed sweep (the lock is ours: no writer runs)
-        for stale in parts_dir(path).glob(".run-*.tmp"):
+        for stale in parts_dir(path).glob(".run-*.tmp"):  # atomic_file's temporary names: .<key>.h5.<hex>.tmp
             stale.unlink(missing_ok=True)
     try:
         parts_dir(path).rmdir()

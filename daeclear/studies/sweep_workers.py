@@ -17,11 +17,12 @@ import sys
 import time
 import traceback as tb
 from collections.abc import Callable, Mapping
-from datetime import datetime, timezone
+from datetime import datetime, UTC
 from typing import Any
 
 import numpy as np
 
+from .sweep_file import SOLVER_KEY
 from ..errors import SceneError
 
 __all__ = ["build_scene", "ignore_sigint", "run_task", "terminate_pool"]
@@ -58,13 +59,15 @@ def ignore_sigint(parent: int | None = None) -> None:
 def run_task(task: Mapping[str, Any]) -> dict[str, Any]:
     """Build the scene of one point, classify its motion and return plain data (runs in a worker)."""
     from .analysis import classify_motion
+    from ..solver_options import SolverOptions
 
     start = time.perf_counter()
     out: dict[str, Any] = {"key": task["key"], "index": task["index"], "parameters": dict(task["parameters"]),
                            "worker": f"{socket.gethostname()}:{os.getpid()}"}
     try:
         scene = build_scene(task["mechanism"], task["parameters"])
-        analysis = classify_motion(scene, **task["analysis"])
+        options = SolverOptions.from_dict(task[SOLVER_KEY])  # plain data across the executor
+        analysis = classify_motion(scene, options=options, **task["analysis"])
         section = analysis.section
         data: dict[str, Any] = {
             "section": {"t": np.asarray(section.t), "points": np.asarray(section.points),
@@ -93,7 +96,7 @@ def run_task(task: Mapping[str, Any]) -> dict[str, Any]:
         else:
             out.update(status="failed", error=f"{type(exc).__name__}: {message}", traceback=tb.format_exc())
     out["wall_time"] = time.perf_counter() - start
-    out["computed_at"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    out["computed_at"] = datetime.now(UTC).isoformat(timespec="seconds")
     return out
 
 

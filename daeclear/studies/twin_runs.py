@@ -1,7 +1,8 @@
 """Twin trajectories: restart a run on its attractor, perturb one twin, measure how they separate.
 
-The sensitivity half of the motion analysis: :func:`restart_model` restarts a run from a state on
-the attractor (one twin perturbed along the constraint manifold), :func:`twin_divergence` measures
+The sensitivity half of the motion analysis: :func:`restart_state` takes a run's state on the
+attractor to restart from (one twin perturbed along the constraint manifold; ``simulate(...,
+t0=, y0=)`` continues the run at its true time), :func:`twin_divergence` measures
 the twins' separation and section points, and :func:`twin_evidence` turns any such pair of
 trajectories into the numbers the classification reads (:class:`Divergence`: Lyapunov fit,
 amplification, decorrelation, section gap). Separate from the section test
@@ -11,23 +12,22 @@ amplification, decorrelation, section gap). Separate from the section test
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .motion_thresholds import DEFAULT_MAX_PERIOD, MIN_AMPLIFICATION, SATURATION_FRACTION, TIME_MATCH
-from .poincare import PoincareSection, crank_period, match_times, recurrence_defects
+from .poincare import PoincareSection, match_times, recurrence_defects
 from ..assembly.assemble import DAEModel
 from ..errors import DaeclearError
 
 if TYPE_CHECKING:
     from ..results.result import Result
 
-__all__ = ["Divergence", "all_free", "restart_model", "twin_divergence", "twin_evidence"]
+__all__ = ["Divergence", "RestartState", "all_free", "restart_state", "twin_divergence", "twin_evidence"]
 
 
 # --------------------------------------------------------------------------- twin trajectories
@@ -38,81 +38,62 @@ def _state_selection(result: Result) -> list[int]:
     return [i for i, name in enumerate(result.state_names) if result.units.get(name, "")]
 
 
-@dataclass(frozen=True)
-class _RestartModel(DAEModel):
-    """A DAEModel whose run starts from a given state (positions and velocities kept as given)."""
+class RestartState(NamedTuple):
+    """Where a restarted run starts: ``simulate(model, t0 + span, t0=state.t0, y0=state.y0)``."""
 
-    start_state: tuple[float, ...] = ()
-    start_is_declared = False  # a state of a run: starting in contact is no declaration error (daeclear.solvers.physics)
-
-    def initial_state(self, session: Any = None, start: str = "declared", allow_penetration: bool = True
-                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        # index-1: no Newton projection (consistent_state ignores it): the stored state carries the
-        # run's own (Baumgarte-controlled) constraint drift, and projecting it away would move a
-        # journal by up to that drift. GGL: projected, as every GGL restart is; its run holds the
-        # joints to Newton's tolerance, but a stored output point is IDA's interpolant (and a
-        # perturbed one is on the manifold only to first order), and GGL cannot start off it.
-        return self.consistent_state(0.0, np.array(self.start_state, dtype=float), session=session, project=True)
+    t0: float
+    y0: NDArray[np.float64]
 
 
-def restart_model(model: DAEModel, result: Result, index: int, *, perturbation: float = 0.0,
-                  seed: int = 0) -> DAEModel:
-    """A model whose run starts at t = 0 from the state of ``result`` at output ``index``.
+def restart_state(model: DAEModel, result: Result, index: int, *, perturbation: float = 0.0,
+                  seed: int = 0) -> RestartState:
+    """The time and state of ``result`` at output ``index``, optionally perturbed, to restart from.
 
-    The scene is T-periodic in time (drivers at one speed, constant gravity), so a state
-    at t = j T is a valid initial state at t = 0 once every body angle is unwound by the
-    whole turns it made since t = 0. Positions and velocities are kept as they are (no
-    re-assembly), multipliers and accelerations recomputed. Contact modes are set from
-    the gaps at the restart (restart in free flight to avoid re-latching an approach speed).
+    ``simulate(model, t0 + span, t0=t0, y0=y0)`` continues the run from there (drivers at the true
+    time; positions and velocities kept, GGL projected; multipliers recomputed; contact modes from
+    the gaps at ``t0``): see *Restarts from a state* in docs/user_guide.md. Any output time will
+    do; the twin runs of :func:`daeclear.analysis.classify_motion` restart in free flight.
 
     Parameters
     ----------
     model : DAEModel
         The model of ``result``.
     result : Result
-        A run of ``model`` whose output ``index`` is at a whole number of periods.
+        A run of ``model``.
     index : int
         Output index of the restart state.
     perturbation : float
         Size (Euclidean norm over the positions q, m and rad mixed) of a random
-        perturbation of the positions, projected on the constraint manifold's tangent
-        space so the joints stay closed to first order; 0 for none.
+        perturbation of the positions, projected on the null space of the constraint Jacobian
+        at ``t0`` so the joints stay closed to first order; 0 for none.
     seed : int
         Seed of the perturbation's random direction.
 
     Returns
     -------
-    DAEModel
-        A subclass instance usable wherever a model is (``simulate(model, ...)``).
+    RestartState
+        ``(t0, y0)``: the output time and a copy of the (perturbed) state.
     """
-    T = crank_period(model)
     t_restart = float(result.t[index])
-    turns = t_restart / T
-    if abs(turns - round(turns)) > 1e-6:
-        raise DaeclearError(f"restart_model: t = {t_restart:.9g} s is not a whole number of periods "
-                            f"(T = {T:.6g} s); a restart needs the driver at its initial angle.")
     y = np.array(result.y[index], dtype=float)
     n_q = model.n_q
-    for i, name in enumerate(result.state_names[:n_q]):
-        if result.units.get(name) == "rad":  # unwind whole turns: rotation matrices and drivers are 2 pi periodic
-            y[i] -= 2.0 * math.pi * round((y[i] - float(result.y[0, i])) / (2.0 * math.pi))
     if perturbation:
         rng = np.random.default_rng(seed)
         u = rng.standard_normal(n_q)
         q, v = y[:n_q], y[n_q:2 * n_q]
         if model.n_constraints:  # along the constraint manifold: project on the null space of Phi_q
-            Phi_q = np.array(model.kinematics(q, v, 0.0, model.parameter_values)[1], dtype=float).reshape(model.n_constraints, n_q)
+            Phi_q = np.array(model.kinematics(q, v, t_restart, model.parameter_values)[1],
+                             dtype=float).reshape(model.n_constraints, n_q)
             _, sv, vt = np.linalg.svd(Phi_q)
             rank = int(np.sum(sv > 1e-10 * sv[0])) if sv.size and sv[0] > 0 else 0
             null = vt[rank:].T
             u = null @ (null.T @ u)
         norm = float(np.linalg.norm(u))
         if norm <= 1e-12:
-            raise DaeclearError(f"restart_model: scene {model.scene_name!r} has no free position to perturb "
+            raise DaeclearError(f"restart_state: scene {model.scene_name!r} has no free position to perturb "
                                 "(its joints and drivers fix every coordinate).")
         y[:n_q] += perturbation * u / norm
-    kw = {f.name: getattr(model, f.name) for f in dataclasses.fields(model) if f.name != "start_state"}
-    return _RestartModel(**kw, start_state=tuple(float(x) for x in y))
+    return RestartState(t_restart, y)
 
 
 def all_free(result: Result, t: float) -> bool:
@@ -290,8 +271,8 @@ def twin_evidence(t: ArrayLike, distance: ArrayLike, points_a: ArrayLike, points
 
 
 def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *, reference: Result,
-                    restart_time: float = 0.0, restart_in_contact: bool = False, perturbation: float = float("nan"),
-                    offset: float = 0.0) -> Divergence:
+                    restart_time: float | None = None, restart_in_contact: bool = False,
+                    perturbation: float = float("nan"), offset: float = 0.0) -> Divergence:
     """Separation, Lyapunov estimate and decorrelation of two twin runs.
 
     Measures the separation of the states and the twins' section points, then hands them to
@@ -300,16 +281,21 @@ def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *,
     Parameters
     ----------
     twin_a, twin_b : Result
-        Unperturbed and perturbed runs from the same restart state, on the same output times,
-        which contain the section times ``offset + k T``.
+        Unperturbed and perturbed runs from the same restart state (at their true times: a
+        restart at t_r runs from t_r, :func:`restart_state`), on the same output times, which
+        contain the section times ``offset + k T`` from the restart on.
     section : PoincareSection
         Section of the reference run: gives the channels, the attractor size and the spread.
     reference : Result
         The reference run: the attractor range of each state over the section's window.
-    restart_time, restart_in_contact, perturbation : float, bool, float
+    restart_time : float, optional
+        Recorded as evidence; default the twins' first output time (the restart).
+    restart_in_contact, perturbation : bool, float
         Recorded as evidence.
     offset : float
-        Section time within the revolution, s.
+        Section time within the revolution, s: the section times are the times ``offset + k T``
+        (k an integer) in the twins' span, the reference's own section times when the twins
+        continue the reference run.
 
     Returns
     -------
@@ -332,16 +318,19 @@ def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *,
     scale = ranges[keep]
     diff = (np.asarray(twin_a.y)[:, idx] - np.asarray(twin_b.y)[:, idx]) / scale
     distance = np.sqrt(np.mean(diff**2, axis=1)) if idx else np.zeros(twin_a.n_times)
-    t = np.asarray(twin_a.t) - float(twin_a.t[0])
-
-    n_sec = int(math.floor((float(twin_a.t[-1]) - offset) / T + TIME_MATCH)) + 1 if twin_a.n_times else 0
-    times = (float(twin_a.t[0]) if twin_a.n_times else 0.0) + offset + T * np.arange(max(n_sec, 0))
+    start = float(twin_a.t[0]) if twin_a.n_times else 0.0
+    t = np.asarray(twin_a.t) - start  # times since the restart
+    times = np.zeros(0)
+    if twin_a.n_times:  # the section times offset + k T inside [start, end]
+        first = offset + T * math.ceil((start - offset) / T - TIME_MATCH)
+        n_sec = int(math.floor((float(twin_a.t[-1]) - first) / T + TIME_MATCH)) + 1
+        times = first + T * np.arange(max(n_sec, 0))
     d = len(section.channels)
     pa = pb = np.zeros((0, d))
     if times.size >= 2:
         ia, ib = match_times(twin_a, times, T), match_times(twin_b, times, T)
         pa = np.column_stack([np.asarray(twin_a[c], dtype=float)[ia] for c in section.channels])
         pb = np.column_stack([np.asarray(twin_b[c], dtype=float)[ib] for c in section.channels])
-    return twin_evidence(t, distance, pa, pb, section, restart_time=restart_time,
+    return twin_evidence(t, distance, pa, pb, section, restart_time=start if restart_time is None else restart_time,
                          restart_in_contact=restart_in_contact, perturbation=perturbation)
 
