@@ -45,7 +45,8 @@ from ..errors import AssemblyError, SceneError
 from ..engine.session_base import DAEFunctions
 from ..options import DEFAULT_FORMULATION, FORMULATIONS
 from .parameters import ParameterTable, structure_key
-from ..model.scene import GROUND, Body, Driver, Revolute, Scene, Translational
+from ..model.scene import (GROUND, Body, Driver, Revolute, RevoluteClearance, Scene, Translational,
+                           TranslationalClearance)
 from .revolute_joint import CONTACT_BUILDERS
 from .drivers import driver_constraint, driver_load, driver_parameters
 from ..model.loads import Load, build_loads, load_parameters
@@ -155,7 +156,9 @@ class _Template:
                         "track_work": track_work},
             contacts=contacts, auto_pairs=auto_pairs, parameter_layout=self.layout, parameter_values=P,
             clearance_joints=tuple((e.name, float(e.radial_clearance), float(getattr(e, "corner_radius", 0.0)))
-                                   for e in scene.elements if type(e) in CONTACT_BUILDERS),
+                                   for e in scene.elements
+                                   if isinstance(e, (RevoluteClearance, TranslationalClearance))
+                                   and type(e) in CONTACT_BUILDERS),
         )
 
 
@@ -416,7 +419,9 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
     for name, row in driver_rows.items():
         # The driver's constraint enters body j's equation of its coordinate with +lam; the moment
         # (force along the axis) it applies to body j is therefore -lam (positive counter-clockwise).
-        load, unit = driver_load(joints[scene[name].joint])
+        driver = scene[name]
+        assert isinstance(driver, Driver)  # driver_rows holds the names of the scene's drivers only
+        load, unit = driver_load(joints[driver.joint])
         channels.append(Channel(f"{name}.{load}", unit, -lam[row]))
         power_d = -lam[row] * ca.mtimes(Phi_q[row, :], v)  # load times relative (angular) speed
         channels.append(Channel(f"{name}.power", "W", power_d))
@@ -464,8 +469,9 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
     sample = [logic for make in logic_makers for logic in make(table.vector)]
     auto_pairs = []
     simple = [getattr(logic, "simple_pairs", lambda: None)() for logic in sample]
-    if sample and all(pairs is not None for pairs in simple):
-        for index, pairs in enumerate(simple):
+    given = [pairs for pairs in simple if pairs is not None]
+    if sample and len(given) == len(simple):
+        for index, pairs in enumerate(given):
             for root, term_index, gap_rate, needs, _floor in pairs:
                 extras.append(gap_rate)
                 auto_pairs.append((root, term_index, len(extras) - 1, needs, index))

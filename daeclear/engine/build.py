@@ -158,8 +158,11 @@ def memo_get(table: MemoTable, obj: Any) -> Any:
 
 
 def memo_put(table: MemoTable, obj: Any, value: Any) -> None:
+    def forget(_ref: Any, key: int = id(obj)) -> None:  # the key only: the callback must not keep obj alive
+        table.pop(key, None)
+
     try:
-        ref = weakref.ref(obj, lambda _r, key=id(obj): table.pop(key, None))
+        ref = weakref.ref(obj, forget)
     except TypeError:
         return
     table[id(obj)] = (ref, value)

@@ -322,7 +322,7 @@ class CSession(SessionBase):
             self._ready = False
             raise DaeclearError(f"IDA reinit failed: {self._lib.dc_message(self._h).decode()}")
         self._t, self._y, self._yp = t0, self._y0b.copy(), self._yp0b.copy()
-        self._eval_after = None  # the C side drops a step cut short (dc_reinit)
+        self._eval_after: float | None = None  # the C side drops a step cut short (dc_reinit)
         self._active = act
         self._params = plist
         self._ready = True

@@ -172,7 +172,8 @@ def _with_parameters(f: Any, n_base: int, n_parameters: int) -> Any:
     if not isinstance(f, casadi.Function) or f.n_in() != n_base:
         return f
     sym = casadi.SX if f.is_a("SXFunction") else casadi.MX
-    ins = [sym.sym(f"i{k}", f.sparsity_in(k)) for k in range(n_base)] + [sym.sym("P", n_parameters)]
+    # list[Any]: all SX or all MX at run time; casadi's stubs take no list of SX | MX
+    ins: list[Any] = [sym.sym(f"i{k}", f.sparsity_in(k)) for k in range(n_base)] + [sym.sym("P", n_parameters)]
     return casadi.Function(f.name(), ins, f.call(ins[:n_base]))
 
 
@@ -181,8 +182,9 @@ def _wrap(f: casadi.Function, name: str, in_sizes: list[int], out_shape: tuple[i
     """Same function with column-vector inputs and an output of out_shape (dense unless
     ``keep_sparsity``)."""
     sym = casadi.SX if f.is_a("SXFunction") else casadi.MX
-    ins = [sym.sym(f"i{k}", s) for k, s in enumerate(in_sizes)]
-    args = [casadi.reshape(x, f.size_in(k)) for k, x in enumerate(ins)]
+    # list[Any]: all SX or all MX at run time; casadi's stubs take no list of SX | MX
+    ins: list[Any] = [sym.sym(f"i{k}", s) for k, s in enumerate(in_sizes)]
+    args: list[Any] = [casadi.reshape(x, f.size_in(k)) for k, x in enumerate(ins)]
     out = casadi.reshape(f.call(args)[0], out_shape[0], out_shape[1])
     return casadi.Function(name, ins, [out if keep_sparsity else casadi.densify(out)])
 
@@ -466,9 +468,10 @@ def generate_ode_source(spec: OdeSpec) -> str:
         funs["dcog_outputs"] = spec.outputs
     for name, f in funs.items():
         # re-wrap under the C symbol name the table refers to
-        ins = [casadi.SX.sym(f"i{i}", f.numel_in(i)) if f.is_a("SXFunction") else
-               casadi.MX.sym(f"i{i}", f.numel_in(i)) for i in range(f.n_in())]
-        args = [casadi.reshape(x, f.size_in(i)) for i, x in enumerate(ins)]
+        # list[Any]: all SX or all MX at run time; casadi's stubs take no list of SX | MX
+        ins: list[Any] = [casadi.SX.sym(f"i{i}", f.numel_in(i)) if f.is_a("SXFunction") else
+                          casadi.MX.sym(f"i{i}", f.numel_in(i)) for i in range(f.n_in())]
+        args: list[Any] = [casadi.reshape(x, f.size_in(i)) for i, x in enumerate(ins)]
         outs = [casadi.densify(o) for o in f.call(args)]
         cg.add(casadi.Function(name, ins, outs))
     src = cg.dump()

@@ -45,9 +45,10 @@ class _Buffered:
         self.buf, self.call = f.buffer()
         self.args = args  # kept alive: the buffer points into them
         for i, a in enumerate(args):
-            self.buf.set_arg(i, memoryview(a))
+            # casadi's stubs want a size and a Buffer; the runtime takes a memoryview of a numpy array
+            self.buf.set_arg(i, memoryview(a))  # type: ignore[call-arg, arg-type]
         self.out = np.zeros(f.nnz_out(0))
-        self.buf.set_res(0, memoryview(self.out))
+        self.buf.set_res(0, memoryview(self.out))  # type: ignore[call-arg, arg-type]
 
 
 class PythonSession(SessionBase):
@@ -113,8 +114,11 @@ class PythonSession(SessionBase):
         self._a_t[0] = t
         self._a_y[:] = y
         self._a_yp[:] = yp
-        self._roots_fn.call()
-        return self._roots_fn.out
+        roots = self._roots_fn
+        if roots is None:  # the events callback exists only when the model has root functions
+            raise _ModelError("the model has no root functions")
+        roots.call()
+        return roots.out
 
     def _make_solver(self, rd: np.ndarray) -> Any:
         from sksundae.ida import IDA
@@ -150,8 +154,9 @@ class PythonSession(SessionBase):
                     raise _ModelError(f"a root function is non-finite at t={t!r}: {g.tolist()}")
                 out[:] = g
 
-            events.terminal = [True] * self.n_roots
-            events.direction = [int(d) for d in rd]
+            # sksundae reads these two attributes of the events function
+            events.terminal = [True] * self.n_roots  # type: ignore[attr-defined]
+            events.direction = [int(d) for d in rd]  # type: ignore[attr-defined]
             options.update(eventsfn=events, num_events=self.n_roots)
             self._events = events
         return IDA(resfn, **options)
@@ -161,7 +166,8 @@ class PythonSession(SessionBase):
                params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None:
         t0, y0, yp0, act, plist, rd = self._check_reinit(t0, y0, yp0, active, params, root_directions)
         self._apply_terms(act, plist)
-        if self._solver is None or (self.n_roots and not np.array_equal(rd, self._solver_dirs)):
+        dirs = self._solver_dirs
+        if self._solver is None or (self.n_roots and (dirs is None or not np.array_equal(rd, dirs))):
             # scikit-sundae sets root directions only when it builds its IDA memory
             self._solver = self._make_solver(rd)
             self._solver_dirs = rd.copy()

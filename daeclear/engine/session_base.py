@@ -17,7 +17,7 @@ from collections.abc import Sequence
 import casadi
 import numpy as np
 
-from ..assembly.automaton import Decision
+from ..assembly.automaton import Decision, PairState, Storm
 from ..errors import DaeclearError
 from ..options import LINEAR_SOLVERS
 from .codegen import NormalizedModel
@@ -171,6 +171,10 @@ class Session(Protocol):
 
     def stats(self) -> dict[str, int | float | str]: ...
 
+    def set_hints(self, *, nonlin_conv_coef: float | None = None, init_step: float | None = None) -> bool: ...
+
+    def set_stall(self, stall_step: float, count: int) -> None: ...
+
     def close(self) -> None: ...
 
 
@@ -289,6 +293,10 @@ class SessionBase:
         self._stall = StallGuard()  # the step-size collapse rule (daeclear.engine.stall_guard)
         self._solve_time = 0.0
         self._extra_stats: dict[str, int | float | str] = {}
+        # the compiled library and its session handle: set by CSession only, used here by set_stall
+        # when backend == "c" (declared, not assigned: the python session has neither)
+        self._lib: Any
+        self._h: Any
 
     # ---------------------------------------------------------------- properties
     @property
@@ -337,7 +345,8 @@ class SessionBase:
         fm = f if n_points == 1 else f.map(n_points)
         return np.array(fm(*cols)).reshape(-1, n_points).T.copy()
 
-    def set_auto_events(self, pairs: Sequence[Any], **kwargs: Any) -> bool:
+    def set_auto_events(self, pairs: Sequence[tuple[int, int, int, bool, float]], *, storms: Sequence[Storm],
+                        states: Sequence[PairState], capacity: int = 256) -> bool:
         """Only the compiled backend switches contact pairs in C; returns False here."""
         return False
 
@@ -428,6 +437,10 @@ class SessionBase:
         return t_stop
 
     # ---------------------------------------------------------------- context manager
+    def close(self) -> None:
+        """Free the solver; the session cannot be used afterwards (each backend frees its own)."""
+        raise NotImplementedError
+
     def __enter__(self) -> SessionBase:
         return self
 

@@ -21,7 +21,7 @@ def _default_law() -> Any:
     return LankaraniNikravesh(restitution=0.9)
 
 
-def _law_problems(element: RevoluteClearance) -> list[str]:
+def _law_problems(element: RevoluteClearance | TranslationalClearance) -> list[str]:
     """Resolve the joint's contact and friction laws once, reporting what is wrong."""
     from ..contact import friction_law, normal_law
     from ..contact.base import NormalLaw
@@ -458,7 +458,7 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
     if isinstance(joint, (RevoluteClearance, TranslationalClearance)):
         raise SceneError(f"{label}: it is already a {joint.kind}; change its fields with "
                          "dataclasses.replace, or start from the ideal joint.")
-    if type(joint) not in _CLEARANCE_OF:
+    if not isinstance(joint, PointJoint) or type(joint) not in _CLEARANCE_OF:  # (both keys are PointJoints)
         kind = getattr(joint, "kind", type(joint).__name__)
         raise SceneError(f"{label}: it is a {kind}; only an ideal Revolute or Translational joint can get a "
                          "clearance.")
@@ -496,7 +496,7 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
 def ideal_joint(joint: Joint) -> Joint:
     """The ideal joint a clearance joint stands for: same name, bodies, point and axis (the inverse of
     :func:`clearance_joint` up to the clearance fields)."""
-    shared = {"name": joint.name, "body_i": joint.body_i, "body_j": joint.body_j,
+    shared: dict[str, Any] = {"name": joint.name, "body_i": joint.body_i, "body_j": joint.body_j,
               "at": getattr(joint, "at", None), "point_i": getattr(joint, "point_i", None),
               "point_j": getattr(joint, "point_j", None)}
     if isinstance(joint, RevoluteClearance):

@@ -41,7 +41,7 @@ def _as_vector2(value: Any) -> Vector2 | None:
         return None
     if len(items) != 2 or not all(math.isfinite(v) for v in items):
         return None
-    return items  # type: ignore[return-value]
+    return items
 
 
 # public names of the helpers above, for the elements defined in other modules (clearance joints, loads)
@@ -108,7 +108,9 @@ class Element:
 
 
 def _body_name(body: str | Body | Ground) -> str:
-    return body if isinstance(body, str) else getattr(body, "name", body)
+    """The name of a body given by name or as the element (anything else is kept, for problems())."""
+    given: Any = body
+    return given if isinstance(given, str) else getattr(given, "name", given)
 
 
 body_name = _body_name  # public name, for the elements defined in other modules

@@ -315,8 +315,10 @@ def load_parameters(ref: Any, load: Load) -> dict[str, Any]:
     elif isinstance(load, RotationalSpringDamper):
         free = ref.angle(load.body_j) - ref.angle(load.body_i) if load.free_angle is None else load.free_angle
         out.update(stiffness=load.stiffness, damping=load.damping, free_angle=free)
-    else:
+    elif isinstance(load, Motor):
         out.update(stall_torque=load.stall_torque, no_load_speed=load.no_load_speed)
+    else:
+        raise TypeError(f"load_parameters: {load.kind} '{load.name}' is not a known load kind")
     return out
 
 
@@ -376,8 +378,10 @@ def build_loads(ctx: Any, loads: Iterable[Load]) -> LoadBuild:
         else:  # torques between a body and another body (or the ground)
             if isinstance(load, Torque):
                 body, other = load.body, load.reaction or GROUND
-            else:
+            elif isinstance(load, BetweenBodies):
                 body, other = load.body_j, load.body_i
+            else:
+                raise TypeError(f"build_loads: {load.kind} '{load.name}' is not a known load kind")
             fj, fi = ctx.frames[body], ctx.frames[other]
             speed = fj.omega - fi.omega
             if isinstance(load, Torque):

@@ -4,7 +4,7 @@ crank-rocker four-bar and a double pendulum with clearance at any subset of thei
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, TypeGuard
 
 from .. import options as rules
 from ..contact import Material, friction_law, normal_law
@@ -186,11 +186,11 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     slider = body("slider", slider_mass, slider_inertia)
     pin_b = (CRANK_LENGTH * math.cos(crank_angle), CRANK_LENGTH * math.sin(crank_angle))
     pin_c = (state["slider"][0] + offset[0], 0.0)
-    scene.add(Revolute("A", scene.ground, crank, at=(0.0, 0.0)))
-    scene.add(Revolute("B", crank, rod, at=pin_b))
-    scene.add(Revolute("C", rod, slider, at=pin_c))
+    scene.add(Revolute("A", scene.ground.name, crank.name, at=(0.0, 0.0)))
+    scene.add(Revolute("B", crank.name, rod.name, at=pin_b))
+    scene.add(Revolute("C", rod.name, slider.name, at=pin_c))
     # the guide's mid-line runs along X through the slider's centre (the X axis unless the pin is offset)
-    scene.add(Translational("D", scene.ground, slider, point_i=(0.0, -offset[1]), point_j=(0.0, 0.0),
+    scene.add(Translational("D", scene.ground.name, slider.name, point_i=(0.0, -offset[1]), point_j=(0.0, 0.0),
                             axis=(1.0, 0.0)))
     scene.add(Driver("drive", joint="A", speed=omega))
     if joint == "ideal":
@@ -223,7 +223,8 @@ CHAIN_LINK_MASS = 0.196
 CHAIN_LINK_INERTIA = CHAIN_LINK_MASS * CHAIN_LINK_LENGTH ** 2 / 12.0
 
 
-def _finite(value: Any) -> bool:
+def _finite(value: Any) -> TypeGuard[float]:
+    """A finite int or float (not a bool)."""
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
@@ -542,10 +543,10 @@ def four_bar(clearance_joints: Any = (), *, rpm: float = 5000.0, crank_angle: fl
     pin_b = (a * math.cos(crank_angle), a * math.sin(crank_angle))
     beta = state["coupler"][2]
     pin_c = (pin_b[0] + b * math.cos(beta), pin_b[1] + b * math.sin(beta))
-    scene.add(Revolute("A", scene.ground, "crank", at=(0.0, 0.0)))
+    scene.add(Revolute("A", scene.ground.name, "crank", at=(0.0, 0.0)))
     scene.add(Revolute("B", "crank", "coupler", at=pin_b))
     scene.add(Revolute("C", "coupler", "rocker", at=pin_c))
-    scene.add(Revolute("D", scene.ground, "rocker", at=(FOUR_BAR_GROUND, 0.0)))
+    scene.add(Revolute("D", scene.ground.name, "rocker", at=(FOUR_BAR_GROUND, 0.0)))
     scene.add(Driver("drive", joint="A", speed=omega))
     return _with_revolute_clearances(scene, clearance_joints, FOUR_BAR_JOINTS, where, clearance=clearance, law=law,
                                      restitution=restitution, friction=friction, bearing_radius=bearing_radius,

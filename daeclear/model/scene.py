@@ -142,7 +142,8 @@ class Scene:
             seen.add(element.name)
         body_names = [b.name for b in self.bodies]
         known = set(body_names) | {GROUND}
-        referring = [(j, (("body_i", j.body_i), ("body_j", j.body_j))) for j in self.joints]
+        referring: list[tuple[Element, Any]] = [(j, (("body_i", j.body_i), ("body_j", j.body_j)))
+                                                for j in self.joints]
         referring += [(e, e.body_roles()) for e in self.elements if hasattr(e, "body_roles")]  # loads
         for joint, roles in referring:
             for role, body in roles:

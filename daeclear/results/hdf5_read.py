@@ -199,4 +199,4 @@ class _GroupAsFile:
 def read_group(group: h5py.Group, path: Path) -> dict[str, Any]:
     """The `Result` keywords of what :func:`write_result_group` wrote into ``group``, an open group of
     the file at ``path`` (named in the messages about a damaged result)."""
-    return _read(_Reader(_GroupAsFile(group), path))  # type: ignore[arg-type]
+    return _read(_Reader(_GroupAsFile(group), path))

@@ -78,7 +78,7 @@ def _compress(data: np.ndarray) -> bool:
     """
     if data.size < _COMPRESS_MIN_SIZE:
         return False
-    return data.dtype.kind in "biu" or np.count_nonzero(data) <= data.size // 2
+    return bool(data.dtype.kind in "biu" or np.count_nonzero(data) <= data.size // 2)
 
 
 def _dataset(group: h5py.Group, name: str, data: np.ndarray) -> h5py.Dataset:

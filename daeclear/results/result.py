@@ -323,7 +323,7 @@ class Result:
         return isinstance(name, str) and (name in self._channels or name in self.state_names)
 
     # A Result is not iterable: iterate over result.channel_names or result.state_names.
-    __iter__ = None  # type: ignore[assignment]
+    __iter__ = None
 
     def __repr__(self) -> str:
         def seconds(x: float) -> str:

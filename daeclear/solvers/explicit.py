@@ -164,7 +164,7 @@ def _run_scipy(run: Run, x0: NDArray, rtol: float, atol: NDArray, max_step: floa
         run.open_segment(t, x)
         dirs = run.directions()
         watch = dirs is not None  # every gap, in its direction (0: both, as IDA)
-        g0 = gd0 = None
+        g0 = gd0 = np.empty(0)  # read only when watch
         if watch:
             gg = ev.gaps(t, x)
             if gg is None:
@@ -185,7 +185,7 @@ def _run_scipy(run: Run, x0: NDArray, rtol: float, atol: NDArray, max_step: floa
         watched = [(i, d) for i in range(n_gaps) for d in (1, -1) if dirs[i] * d >= 0]  # type: ignore[index]
         next_eval = run.pending[0] if run.pending is not None and run.pending.size else math.inf
         t_prev = t
-        restart = None
+        restart: tuple[float, NDArray, Any] | None = None
         while True:
             if run.n_steps >= run.max_steps:
                 run.fail(t_prev, f"max_steps={run.max_steps} steps reached", "Raise max_steps or loosen rtol.")
@@ -223,8 +223,11 @@ def _run_scipy(run: Run, x0: NDArray, rtol: float, atol: NDArray, max_step: floa
                         cands.append((i, d, s))
                 if cands:
                     sol = solver.dense_output()
-                    found = locate(ev, lambda tt, sol=sol: np.array(sol(tt), dtype=float), t_prev, (g0, gd0),
-                                   t1, x1, (g1, gd1), cands, n_gaps)
+
+                    def dense(tt: float, sol: Any = sol) -> NDArray:
+                        return np.array(sol(tt), dtype=float)
+
+                    found = locate(ev, dense, t_prev, (g0, gd0), t1, x1, (g1, gd1), cands, n_gaps)
                     if isinstance(found, str):
                         run.fail(t_prev, found, hint)
                         break
@@ -256,6 +259,7 @@ def _run_scipy(run: Run, x0: NDArray, rtol: float, atol: NDArray, max_step: floa
         run.n_lu += getattr(solver, "nlu", 0) - lu0
         if not _end_segment(run, restart, False, t_end):
             return
+        assert restart is not None  # _end_segment goes on only after an event
         t, x, _ = restart  # the next segment starts at the event
 
 
@@ -280,7 +284,7 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
     while True:
         run.open_segment(t, x)
         dirs = run.directions()
-        restart = None
+        restart: tuple[float, NDArray, Any] | None = None
         while True:
             left = run.max_steps - run.n_steps
             if left <= 0:
@@ -311,8 +315,11 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
                 run.fail(t, ev.last_message, hint)
                 break
             ta, xa = t, x
-            found = locate(ev, lambda tt, ta=ta, xa=xa: ev.step(scheme, ta, xa, tt - ta), ta, gg_a, tb, xb, gg_b,
-                           cands, ev.ng)  # type: ignore[arg-type]
+
+            def restep(tt: float, ta: float = ta, xa: NDArray = xa) -> NDArray | None:
+                return ev.step(scheme, ta, xa, tt - ta)
+
+            found = locate(ev, restep, ta, gg_a, tb, xb, gg_b, cands, ev.ng)
             if isinstance(found, str):
                 run.fail(t, found, hint)
                 break
@@ -326,6 +333,7 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
             break
         if not _end_segment(run, restart, True, t_end):
             return
+        assert restart is not None  # _end_segment goes on only after an event
         t, x, _ = restart  # the next segment starts at the event
 
 
@@ -396,16 +404,15 @@ def integrate(
     if model.formulation != "index1":
         raise SceneError(f"simulate: formulation={model.formulation!r} is integrated by IDA only; method={name!r} "
                          "integrates the chapter's index-1 formulation (formulation='index1').")
-    from_state = y0 is not None
-    if from_state:
-        y0 = options.state(y0, model.n_states)
+    given = None if y0 is None else options.state(y0, model.n_states)
+    from_state = given is not None
     model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
     eval_times = None if out.times is None else out.times.values()  # checked by options.output
     n = model.n_q
     atol_x = tolerance_vector(model, rtol, atol)[:2 * n]
     ev = evaluator(model, backend)
-    if from_state:  # q and v as given (index-1: no projection), multipliers recomputed at t0
-        y0, _ = model.consistent_state(t0, y0)
+    if given is not None:  # q and v as given (index-1: no projection), multipliers recomputed at t0
+        y0, _ = model.consistent_state(t0, given)
     else:
         y0, _ = model.initial_state(start=start, allow_penetration=allow_penetration)
     x0 = np.array(y0[:2 * n])

@@ -400,7 +400,7 @@ def _run(model: DAEModel, session: Any, t0: float, y0: NDArray, yp0: NDArray, t_
                     modes[event.pair] = "contact" if event.kind == "onset" else "free"
             directions = _root_directions(model, active)
             if (before[0] == active and all(np.array_equal(a, b) for a, b in zip(before[1], params))
-                    and (directions is None or np.array_equal(before[2], directions))):
+                    and (directions is None or (before[2] is not None and np.array_equal(before[2], directions)))):
                 continue  # nothing switched: IDA goes on from the root without a restart, in the same segment
             segments.append((seg_start, t, before[3]))
             seg_start = t
@@ -509,7 +509,7 @@ def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:
     return directions
 
 
-def _restart_state(model: DAEModel, session: Any, t: float, y: NDArray, yp: NDArray, forces: NDArray,
+def _restart_state(model: DAEModel, session: Any, t: float, y: NDArray, yp: NDArray, forces: NDArray | None,
                    found: Any) -> tuple[NDArray, NDArray]:
     """Consistent restart after a contact switch (GGL: projected onto the constraint manifold),
     unprojected when the projection moves a root function that did not fire across zero (it

@@ -93,9 +93,10 @@ def locate(ev: Evaluator, X_of: Callable[[float], NDArray | None], ta0: float, g
         if tb >= tb_end or s >= tb_end - ta0:
             tb, xb, Gb = tb_end, x_end, G1
         else:
-            xb = X_of(tb)
-            if xb is None:
+            x_tb = X_of(tb)
+            if x_tb is None:
                 return ev.last_message or f"the state could not be computed at t={tb:.17g}"
+            xb = x_tb
             gg = ev.gaps(tb, xb)
             if gg is None:
                 return ev.last_message

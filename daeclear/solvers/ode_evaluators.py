@@ -65,6 +65,50 @@ class Evaluator:
         self.ng = spec.n_gaps
         self.poff = np.concatenate([[0], np.cumsum(spec.n_params)]).astype(int)
         self.last_message = ""
+        #: what compiled the model (None for the python evaluation)
+        self.build: BuildResult | None = None
+
+    # the interface both evaluations implement (declared here so that callers type-check against it)
+    def message(self) -> str:
+        """The last error message of the evaluation."""
+        raise NotImplementedError
+
+    def set_terms(self, active: Sequence[bool], params: Sequence[NDArray]) -> None:
+        """Switch the optional force terms on/off and set their parameters."""
+        raise NotImplementedError
+
+    def rhs(self, t: float, x: NDArray) -> NDArray:
+        """Right-hand side dx/dt of the first-order ODE at (t, x)."""
+        raise NotImplementedError
+
+    def jac(self, t: float, x: NDArray) -> NDArray:
+        """Jacobian d(rhs)/dx at (t, x)."""
+        raise NotImplementedError
+
+    def gaps(self, t: float, x: NDArray) -> tuple[NDArray, NDArray] | None:
+        """Gaps and their rates at (t, x), None when the evaluation failed."""
+        raise NotImplementedError
+
+    def step(self, scheme: int, t: float, x: NDArray, h: float) -> NDArray | None:
+        """One step of length h of a fixed-step scheme, None when the evaluation failed."""
+        raise NotImplementedError
+
+    def batch(self, t: NDArray, X: NDArray) -> tuple[NDArray, NDArray]:
+        """State derivatives and multipliers at N points (t[i], X[i])."""
+        raise NotImplementedError
+
+    def fixed(self, scheme: int, t0: float, x0: NDArray, step: float, t_stop: float, max_steps: int,
+              rootdir: NDArray | None, hermite: bool) -> dict[str, Any]:
+        """The fixed-step loop up to t_stop, a full step buffer, a gap-crossing candidate or an error."""
+        raise NotImplementedError
+
+    def channels(self, model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> NDArray:
+        """Output channels (N, n_channels) at N points with one switch vector."""
+        raise NotImplementedError
+
+    def counters(self) -> dict[str, int]:
+        """Call counters of the evaluation."""
+        raise NotImplementedError
 
     def _pcat(self, params: Sequence[NDArray]) -> NDArray:
         out = np.zeros(max(int(self.poff[-1]), 1))
@@ -218,9 +262,10 @@ class _Buffered:
         self.shapes = [f.size_out(i) for i in range(f.n_out())]
         self.buf, self.call = f.buffer()
         for i, a in enumerate(self.args):
-            self.buf.set_arg(i, memoryview(a))
+            # casadi's stubs want a size and a Buffer; the runtime takes a memoryview of a numpy array
+            self.buf.set_arg(i, memoryview(a))  # type: ignore[call-arg, arg-type]
         for i, o in enumerate(self.outs):
-            self.buf.set_res(i, memoryview(o))
+            self.buf.set_res(i, memoryview(o))  # type: ignore[call-arg, arg-type]
 
     def __call__(self, *inputs: Any) -> list[NDArray]:
         for a, value in zip(self.args, inputs):
@@ -237,7 +282,6 @@ class _PyEvaluator(Evaluator):
 
     def __init__(self, spec: OdeSpec) -> None:
         super().__init__(spec)
-        self.build = None
         P = spec.parameters
         self._sys = _Buffered(spec.sys, P)
         self._sys_jac = _Buffered(spec.sys_jac, P)
