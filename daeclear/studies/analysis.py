@@ -229,7 +229,7 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
                       **simulate_options)
     t0 = transient * T + offset
     section = poincare_section(result, channels, t0=t0, period=T)
-    options = {"channels": list(section.channels), "revolutions": revolutions, "transient": transient,
+    recorded = {"channels": list(section.channels), "revolutions": revolutions, "transient": transient,
                "per_revolution": per_revolution, "phase": float(phase),
                "twin": twin if isinstance(twin, str) else bool(twin), "twin_revolutions": twin_revolutions,
                "perturbation": float(perturbation), "seed": int(seed), "tol": float(tol),
@@ -255,5 +255,5 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
                                      restart_in_contact=not free, perturbation=perturbation, offset=offset)
         motion = classify_section(section, divergence, tol=tol, max_period=max_period, decorrelation=decorrelation)
     return MotionAnalysis(result=result, section=section, motion=motion, divergence=divergence, twins=twins,
-                          options=options)
+                          options=recorded)
 

@@ -220,17 +220,17 @@ def classify_section(section: PoincareSection, divergence: Divergence | None = N
                                f"decorrelated >= {decorrelation:g}, restarted in free flight): chaotic motion "
                                f"that is small in {', '.join(section.channels)}.")
         if twins.sensitive or twins.exponent or twins.apart:
-            why = []
+            reasons: list[str] = []
             if twins.exponent:
-                why.append(f"a positive exponent resolved over >= {MIN_AMPLIFICATION:g}-fold growth "
+                reasons.append(f"a positive exponent resolved over >= {MIN_AMPLIFICATION:g}-fold growth "
                            f"(R^2 >= {MIN_FIT_R2:g})")
             if twins.apart:
-                why.append(f"section gap > tol {tol:g}")
+                reasons.append(f"section gap > tol {tol:g}")
             if twins.sensitive and twins.decorrelated:
-                why.append("growth that would mark chaos small in the section, but the twins were restarted "
+                reasons.append("growth that would mark chaos small in the section, but the twins were restarted "
                            "in contact (not faithful copies)")
             return MotionClass("uncertain", 0, evidence,
-                               f"section test says period {k} ({recurs}); twin test disagrees ({'; '.join(why)}): "
+                               f"section test says period {k} ({recurs}); twin test disagrees ({'; '.join(reasons)}): "
                                f"{twins.numbers}; unperturbed twin's own recurrence defect "
                                f"{_num(divergence.twin_recurrence)}.")
         return MotionClass("periodic", k, evidence,

@@ -239,7 +239,7 @@ class PoincareSection:
                 if len(self) else f"PoincareSection(empty, channels {', '.join(self.channels)})")
 
 
-def match_times(result: Result, times: NDArray[np.float64], period: float) -> NDArray[np.intp]:
+def match_times(result: Result, times: NDArray[np.floating[Any]], period: float) -> NDArray[np.intp]:
     """Indices of the output times equal (to 1e-9 T) to ``times``; raises naming the first missing one."""
     t = np.asarray(result.t)
     tol = TIME_MATCH * period

@@ -39,7 +39,7 @@ def grazing_scene(approach_speed: float = 1e-6) -> Scene:
     c = 0.5e-3
     journal = scene.add(Body("journal", mass=0.1, inertia=1e-5, position=(c - 1e-9, 0.0),
                              velocity=(approach_speed, 0.0)))
-    scene.add(RevoluteClearance("bearing", scene.ground, journal, point_i=(0.0, 0.0), point_j=(0.0, 0.0),
+    scene.add(RevoluteClearance("bearing", scene.ground.name, journal.name, point_i=(0.0, 0.0), point_j=(0.0, 0.0),
                                 bearing_radius=10e-3, clearance=c, material=STEEL,
                                 law=contact.LankaraniNikravesh(restitution=0.9)))
     return scene
@@ -49,7 +49,7 @@ def resting_scene() -> Scene:
     """A journal dropped under gravity into a fixed bearing: impacts, then following contact."""
     scene = Scene("resting", gravity=(0.0, -9.81))
     journal = scene.add(Body("journal", mass=0.1, inertia=1e-5))
-    scene.add(RevoluteClearance("bearing", scene.ground, journal, at=(0.0, 0.0), bearing_radius=10e-3,
+    scene.add(RevoluteClearance("bearing", scene.ground.name, journal.name, at=(0.0, 0.0), bearing_radius=10e-3,
                                 clearance=0.5e-3, material=STEEL, law=contact.LankaraniNikravesh(restitution=0.9)))
     return scene
 

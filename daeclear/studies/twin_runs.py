@@ -320,7 +320,7 @@ def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *,
     distance = np.sqrt(np.mean(diff**2, axis=1)) if idx else np.zeros(twin_a.n_times)
     start = float(twin_a.t[0]) if twin_a.n_times else 0.0
     t = np.asarray(twin_a.t) - start  # times since the restart
-    times = np.zeros(0)
+    times: NDArray[np.floating[Any]] = np.zeros(0)
     if twin_a.n_times:  # the section times offset + k T inside [start, end]
         first = offset + T * math.ceil((start - offset) / T - TIME_MATCH)
         n_sec = int(math.floor((float(twin_a.t[-1]) - first) / T + TIME_MATCH)) + 1
