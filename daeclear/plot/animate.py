@@ -32,6 +32,10 @@ last frame", with the deepest penetration), so an impact shorter than the frame 
 lights up.
 
 matplotlib (and pillow, which it requires) is imported only when an animation is made.
+
+This module checks the options, lays out the figure and writes the file with its progress; the
+frame is drawn by :mod:`daeclear.plot.mechanism_frame` (the mechanism) and
+:mod:`daeclear.plot.animation_panels` (the magnified joints and the time cursor).
 """
 
 from __future__ import annotations

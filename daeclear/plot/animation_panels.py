@@ -186,8 +186,9 @@ class _Cursor:
 
 
 def layout_frame(fig: Figure, result: Result, geo: Geometry, sampler: Sampler, shown: Sequence[Joint],
-            contact: dict[str, NDArray[np.float64]], depth: dict[str, NDArray[np.float64]], magnify: float | None,
-            channel: str, t0: float, t1: float, scale: float, unit: str, where: str) -> list[Callable[[int], None]]:
+                 contact: dict[str, NDArray[np.float64]], depth: dict[str, NDArray[np.float64]],
+                 magnify: float | None, channel: str, t0: float, t1: float, scale: float, unit: str,
+                 where: str) -> list[Callable[[int], None]]:
     """Make the panels (mechanism, one per clearance joint, time cursor); their frame updates."""
     grid = fig.add_gridspec(2, 2 if shown else 1, width_ratios=[1.7, 1] if shown else None, height_ratios=[3, 1],
                             left=0.08, right=0.98, bottom=0.1, top=0.9, hspace=0.35, wspace=0.25)

@@ -221,6 +221,7 @@ def _float(spec: Mapping[str, Any], key: str) -> float | None:
 
 
 def revolute_clearance(spec: Mapping[str, Any]) -> float | None:
+    """Radial clearance of a revolute clearance joint's description (given, or bearing minus journal radius)."""
     c = _float(spec, "clearance")
     if c is not None:
         return c
@@ -251,6 +252,7 @@ def guide_geometry(joint: Joint, geo: Geometry) -> dict[str, Any] | None:
 
 
 def pen_line(ax: Axes, color: str, **kw: Any) -> Any:
+    """An empty line on ``ax`` that a frame update fills with data."""
     (line,) = ax.plot([], [], color=color, **kw)
     return line
 
@@ -406,6 +408,7 @@ class MechanismPanel:
 
 
 def status_text(ax: Axes) -> Any:
+    """The text at the top left of a panel that says what its joint does in the frame."""
     return ax.text(0.03, 0.96, "", transform=ax.transAxes, va="top", ha="left", fontsize="small", zorder=10)
 
 

@@ -229,6 +229,3 @@ def save_figure(fig: Any, path: Any, dpi: int = 120) -> Any:
     plt.close(fig)
     tmp.replace(path)
     return path
-
-
-# --------------------------------------------------------------------------- revolute clearance joint (section 4.4)
