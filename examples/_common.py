@@ -46,7 +46,7 @@ import numpy as np
 import daeclear as dc
 from daeclear.plot import style
 from daeclear.model.mechanisms import slider_crank
-from daeclear.plot.figures import _contact_intervals as contact_intervals
+from daeclear.plot.joint_figures import _contact_intervals as contact_intervals
 
 RPM = 5000.0
 PERIOD = 60.0 / RPM  # s per crank revolution (0.012 s at 5000 rpm)

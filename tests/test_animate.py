@@ -216,7 +216,8 @@ def test_fig4_15_example_script(tmp_path):
 
 def test_contact_state_of_a_frame():
     """In contact at the frame's time, an impact since the previous frame (over by now), or free."""
-    from daeclear.plot.animate import CONTACT, FREE, IMPACT, _contact_state, _Sampler
+    from daeclear.plot.mechanism_frame import CONTACT, FREE, IMPACT
+    from daeclear.plot.mechanism_frame import Sampler as _Sampler, contact_state as _contact_state
 
     t = np.arange(5.0)
     result = dc.Result(t=t, y=np.zeros((5, 0)), yp=np.zeros((5, 0)), state_names=[], units={},

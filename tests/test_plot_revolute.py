@@ -16,7 +16,6 @@ import pytest  # noqa: E402
 
 import daeclear as dc  # noqa: E402
 from daeclear.plot.figures import (  # noqa: E402
-    _contact_intervals,
     plot_cases,
     plot_channel,
     plot_journal_orbit,
@@ -24,6 +23,7 @@ from daeclear.plot.figures import (  # noqa: E402
     plot_revolute_response,
     plot_step_sizes,
 )
+from daeclear.plot.joint_figures import _contact_intervals  # noqa: E402
 from daeclear.results.result import ContactEvent, Result  # noqa: E402
 
 C = 0.5e-3  # m, radial clearance of the synthetic joint

@@ -1,5 +1,9 @@
 """Figures of runs and studies (figures), their shared style (style) and animations (animate).
 
+figures gathers the figure functions, drawn in run_panels (one run over time), joint_figures (the
+chapter's revolute and translational joint figures) and study_figures (studies); animate writes an
+animation whose frames are drawn by mechanism_frame and animation_panels.
+
 The figure functions are importable from here: ``from daeclear.plot import plot_channel``.
 """
 

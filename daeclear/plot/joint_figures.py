@@ -1,0 +1,427 @@
+"""Figures of one clearance joint: the chapter's figure families of section 4.4 (revolute) and 4.5 (translational).
+
+Journal orbit, phase portrait, step sizes, a grid of cases, the revolute response (Figs. 4.15-4.27),
+the slider path and the translational response (Figs. 4.28-4.31). Separate from the panels of a
+run (:mod:`daeclear.plot.run_panels`), which they are built from, and from the study figures.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+from . import style
+from .run_panels import Window, response_panels, set_run_title, xy_curve
+
+if TYPE_CHECKING:  # matplotlib is imported only when a figure is drawn
+    from matplotlib.axes import Axes
+
+    from ..results.result import Result
+
+__all__ = ["plot_cases", "plot_journal_orbit", "plot_phase_portrait", "plot_revolute_response", "plot_slider_path",
+           "plot_step_sizes", "plot_translational_response"]
+
+# --------------------------------------------------------------------------- revolute clearance joint (section 4.4)
+
+_LENGTH_SCALE = {"m": 1.0, "mm": 1e3, "um": 1e6}
+_LENGTH_LABEL = {"m": "m", "mm": "mm", "um": "µm"}
+
+
+def _contact_intervals(result: Result, pair: str | None = None) -> list[tuple[float, float]]:
+    """Time intervals [t_onset, t_separation] in which ``pair`` (every pair when None) is in contact.
+
+    Built from ``result.events``. A result that starts in contact (its first event of the
+    pair is a separation, or, without events, its first segment has the pair in contact)
+    gets an interval from ``result.t[0]``; one that ends in contact, an interval up to
+    ``result.t[-1]``.
+    """
+    if result.n_times == 0:
+        return []
+    t_first, t_last = float(result.t[0]), float(result.t[-1])
+    events = result.events.of(pair)
+    if len(events):
+        in_contact = events[0].kind == "separation"
+    else:
+        modes = result.segments[0][2] if result.segments else {}
+        in_contact = any(mode == "contact" for name, mode in modes.items()
+                         if pair is None or name == pair or name.startswith(pair + "."))
+    intervals: list[tuple[float, float]] = []
+    start = t_first if in_contact else None
+    for event in events:
+        if event.kind == "onset" and start is None:
+            start = event.t
+        elif event.kind == "separation" and start is not None:
+            intervals.append((start, event.t))
+            start = None
+    if start is not None:
+        intervals.append((start, max(start, t_last)))
+    return intervals
+
+
+def _clearance_of(result: Result, joint: str) -> float | None:
+    """Radial clearance (m) of clearance joint ``joint`` from the result's scene parameters."""
+    element = result.parameters.get("scene", {}).get("elements", {}).get(joint, {})
+    value = element.get("clearance") if isinstance(element, dict) else None
+    return float(value) if isinstance(value, (int, float)) else None
+
+
+def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | None = None, markers: bool = True,
+                       clearance: float | None = None, unit: str = "um", window: Window = None,
+                       max_points: int | None = None, title: str | bool | None = None, **line_kw: Any) -> Axes:
+    """Journal centre relative to the bearing centre, with the clearance circle (Figs. 4.15d, 4.17, 4.20, 4.24).
+
+    Parameters
+    ----------
+    result : Result
+        A run with the channels ``<joint>.ex`` and ``<joint>.ey`` (eccentricity vector
+        e = r_journal - r_bearing, eq. 4.1).
+    joint : str
+        Name of the revolute clearance joint (``"clearance"`` in ``slider_crank``).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    markers : bool
+        Put a marker on every output point. For one marker per IDA step, as in the
+        chapter, pass a result simulated without ``t_eval`` (its output times are
+        the steps): the markers crowd where the steps are small (contact) and thin out
+        in free flight. Points outside the circle show the penetration.
+    clearance : float, optional
+        Radial clearance c (m) of the dashed circle; read from the result's scene
+        parameters when None (no circle if it cannot be found).
+    unit : {"um", "mm", "m"}
+        Length unit of both axes.
+    window : (t0, t1), optional
+        Time window in s; only the orbit inside it is drawn.
+    max_points : int, optional
+        Draw at most this many points, evenly spaced in the output times.
+    title : str or bool, optional
+        As in :func:`plot_channel` (the run's caption on a new figure).
+    **line_kw
+        Passed to ``ax.plot`` for the orbit.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax.lines[0]`` is the orbit (x: e_x, y: e_y in ``unit``), ``ax.lines[1]`` the
+        clearance circle |e| = c (dashed), when drawn. Equal aspect ratio.
+    """
+    if unit not in _LENGTH_SCALE:
+        raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTH_SCALE)}.")
+    import numpy as np
+
+    created = ax is None
+    ax = style.new_axes(ax)
+    scale = _LENGTH_SCALE[unit]
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0"}
+    if markers:
+        kw.update(marker=".", ms=2.5)
+    kw.update(line_kw)
+    ex, ey = xy_curve(result, f"{joint}.ex", f"{joint}.ey", window, max_points)
+    ax.plot(ex * scale, ey * scale, **kw)
+    c = clearance if clearance is not None else _clearance_of(result, joint)
+    if c is not None:
+        angle = np.linspace(0.0, 2.0 * np.pi, 361)
+        ax.plot(c * scale * np.cos(angle), c * scale * np.sin(angle), "k--", lw=0.8)
+    ax.set_aspect("equal", adjustable="datalim")
+    label = _LENGTH_LABEL[unit]
+    ax.set_xlabel(f"journal x rel. to bearing ({label})")
+    ax.set_ylabel(f"journal y rel. to bearing ({label})")
+    set_run_title(ax, result, title, created)
+    return ax
+
+
+def plot_phase_portrait(result: Result, x: str = "slider.vx", y: str = "slider.ax", *, ax: Axes | None = None,
+                        reference: Result | None = None, window: Window = None, max_points: int | None = None,
+                        title: str | bool | None = None, **line_kw: Any) -> Axes:
+    """One channel against another over the whole result (Figs. 4.18, 4.21: slider acceleration against velocity).
+
+    The chapter calls these plots Poincaré maps: a closed curve traced again and again
+    is a periodic response, a band filled by curves that never repeat a chaotic one.
+
+    Parameters
+    ----------
+    result : Result
+        The run; a dense ``t_eval`` gives a smooth curve.
+    x, y : str
+        Channel names (default slider velocity on x, slider acceleration on y).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    reference : Result, optional
+        Drawn first, black dashed (e.g. the ideal joint, whose portrait is one closed curve).
+    window : (t0, t1), optional
+        Time window in s (e.g. the steady state after the transient).
+    max_points : int, optional
+        Draw at most this many points per curve, evenly spaced in the output times.
+    title : str or bool, optional
+        As in :func:`plot_channel` (the run's caption on a new figure).
+    **line_kw
+        Passed to ``ax.plot`` for the result's curve.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax.lines[0]`` is the reference curve when given, then the result's curve.
+    """
+    created = ax is None
+    ax = style.new_axes(ax)
+    if reference is not None:
+        ax.plot(*xy_curve(reference, x, y, window, max_points), "k--", lw=0.8, label="ideal joint")
+    kw: dict[str, Any] = {"lw": 0.5, "color": "C0"}
+    kw.update(line_kw)
+    ax.plot(*xy_curve(result, x, y, window, max_points), **kw)
+    for axis_label, name in ((ax.set_xlabel, x), (ax.set_ylabel, y)):
+        axis_label(style.quantity_label(name, result.units.get(name, "")))
+    set_run_title(ax, result, title, created)
+    return ax
+
+
+def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None = None, shade: bool = True,
+                    window: Window = None, max_points: int | None = None, title: str | bool | None = None,
+                    **line_kw: Any) -> Axes:
+    """IDA's step size against time, log scale, contact intervals shaded (section 4.4, Figs. 4.15d, 4.24).
+
+    Parameters
+    ----------
+    result : Result
+        A run with recorded steps (``result.step_t``, ``result.step_h``; ``simulate``
+        records them by default, whatever ``t_eval``).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    pair : str, optional
+        Contact pair whose contact intervals are shaded (every pair when None).
+    shade : bool
+        Shade the contact intervals (from ``result.events``) in grey.
+    window : (t0, t1), optional
+        Time window in s: steps reaching a time inside it are drawn, contact intervals are
+        clipped to it.
+    max_points : int, optional
+        Draw at most this many steps (min-max decimation of the step size).
+    title : str or bool, optional
+        As in :func:`plot_channel` (the run's caption on a new figure).
+    **line_kw
+        Passed to ``ax.plot`` for the step sizes.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax.lines[0]``: step size h (s) against the time reached by the step (s); the
+        zero-size placeholder of the initial point is left out. One patch per contact
+        interval.
+
+    Raises
+    ------
+    ValueError
+        If the result has no recorded steps.
+    """
+    import numpy as np
+
+    if result.step_t is None or result.step_h is None:
+        raise ValueError(f"plot_step_sizes: result of scene {result.scene_name!r} has no recorded steps "
+                         f"(simulate(..., store_steps=True) records them).")
+    created = ax is None
+    ax = style.new_axes(ax)
+    h = np.asarray(result.step_h)
+    t = np.asarray(result.step_t)
+    inside = style.window_index(t, window)
+    index = style.decimate(h, max_points, inside[h[inside] > 0])
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0", "marker": ".", "ms": 1.5}
+    kw.update(line_kw)
+    ax.plot(t[index], h[index], **kw)
+    ax.set_yscale("log")
+    if shade:
+        lo, hi = (None, None) if window is None else window
+        lo = -np.inf if lo is None else float(lo)
+        hi = np.inf if hi is None else float(hi)
+        spans = [(max(a, lo), min(b, hi)) for a, b in _contact_intervals(result, pair) if b >= lo and a <= hi]
+        for k, (t0, t1) in enumerate(spans):
+            ax.axvspan(t0, t1, color="0.85", lw=0, zorder=0, label="contact" if k == 0 else None)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("IDA step size (s)")
+    set_run_title(ax, result, title, created)
+    return ax
+
+
+def plot_cases(results: Mapping[str, Result], draw: Any, *, ncols: int = 2, sharex: bool = False,
+               sharey: bool = False, panel_size: tuple[float, float] = (3.8, 2.9), suptitle: str | None = None,
+               **kwargs: Any) -> Any:
+    """One panel per labelled result, each drawn by a figure function (Figs. 4.16-4.25).
+
+    Parameters
+    ----------
+    results : mapping of str to Result
+        Panel title -> result, in panel order; titles get the chapter's "(a)", "(b)", ...
+    draw : callable
+        A figure function called as ``draw(result, ax=ax, **kwargs)``, e.g.
+        ``plot_journal_orbit``, ``plot_phase_portrait``, ``plot_step_sizes`` or
+        ``functools.partial(plot_channel, channel="drive.moment")``.
+    ncols : int
+        Panels per row.
+    sharex, sharey : bool
+        Share axes between panels (as ``plt.subplots``).
+    panel_size : (float, float)
+        Width and height of one panel, inches.
+    suptitle : str, optional
+        Figure title.
+    **kwargs
+        Passed to every ``draw`` call (e.g. ``reference=ideal``, ``window=(t0, t1)``,
+        ``max_points=4000``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Its first ``len(results)`` axes hold the panels; unused grid cells are hidden.
+    """
+    import matplotlib.pyplot as plt
+
+    n = len(results)
+    if n == 0:
+        raise ValueError("plot_cases: no results to draw.")
+    ncols = max(1, min(int(ncols), n))
+    nrows = -(-n // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(panel_size[0] * ncols, panel_size[1] * nrows + 0.4),
+                             sharex=sharex, sharey=sharey, squeeze=False)
+    flat = list(axes.ravel())
+    for k, (label, result) in enumerate(results.items()):
+        draw(result, ax=flat[k], **kwargs)
+        style.set_title(flat[k], f"({chr(ord('a') + k)}) {label}")
+    for extra in flat[n:]:
+        extra.set_visible(False)
+    if suptitle:
+        style.set_title(fig, suptitle)
+    fig.tight_layout()
+    return fig
+
+
+def plot_revolute_response(result: Result, *, reference: Result | None = None, orbit: Result | None = None,
+                           joint: str = "clearance", window: Window = None, max_points: int | None = None,
+                           title: str | bool = True) -> Any:
+    """Fig. 4.15 in four panels: slider velocity, slider acceleration, crank moment, journal orbit.
+
+    Parameters
+    ----------
+    result : Result
+        The clearance-joint run (a dense ``t_eval`` for panels a-c).
+    reference : Result, optional
+        The ideal-joint run over the same times, dashed in panels a-c.
+    orbit : Result, optional
+        Run whose output times are IDA's steps (``t_eval=None``), for panel d's
+        one-marker-per-step orbit; ``result`` when None.
+    joint : str
+        Name of the revolute clearance joint.
+    window : (t0, t1), optional
+        Time window in s of every panel.
+    max_points : int, optional
+        At most this many points per line (min-max decimation in panels a-c, even spacing
+        in the orbit).
+    title : str or bool
+        Figure title: True for the run's caption (clearance, speed, law, restitution,
+        friction), a str for that text, False for none.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Axes in order (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) orbit.
+    """
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(10.0, 7.0))
+    (a, b), (c, d) = axes
+    response_panels(result, reference, (a, b, c), window, max_points)
+    plot_journal_orbit(orbit if orbit is not None else result, joint, ax=d, window=window, max_points=max_points,
+                       title="(d) journal trajectory relative to the bearing")
+    set_run_title(fig, result, title, True)
+    fig.tight_layout()
+    return fig
+
+
+
+
+def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | None = None, limits: bool = True,
+                     reference: Result | None = None, window: Window = None, max_points: int | None = None,
+                     title: str | bool | None = None, **line_kw: Any) -> Axes:
+    """Dimensionless path of the slider centre inside the guide (Figs. 4.28d, 4.30, 4.33).
+
+    Parameters
+    ----------
+    result : Result
+        A run with a translational clearance joint (channels ``<joint>.xi`` and
+        ``<joint>.eta``: xi from 0 to 1 along the stroke, eta the offset of the slider
+        centre from the guide's mid-line over 2c, +-0.5 where a parallel slider touches
+        a surface). A joint without a ``stroke`` has no ``xi``: its path is drawn against
+        ``<joint>.s``, the slider centre's position along the guide, in mm.
+    joint : str
+        Name of the translational clearance joint (``"clearance"`` in ``slider_crank``).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    limits : bool
+        Draw the geometric contact limits, eta = +-0.5 (dashed): beyond them the slider
+        and the guide are in contact (the chapter's horizontal lines).
+    reference : Result, optional
+        Drawn first, black dotted (e.g. the ideal joint: eta = 0 along the stroke).
+    window : (t0, t1), optional
+        Time window in s; only the path inside it is drawn.
+    max_points : int, optional
+        Draw at most this many points per path, evenly spaced in the output times.
+    title : str or bool, optional
+        As in :func:`plot_channel` (the run's caption on a new figure).
+    **line_kw
+        Passed to ``ax.plot`` for the path.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax.lines[0]`` is the reference path when given, then the slider path, then the
+        two limit lines.
+    """
+    created = ax is None
+    ax = style.new_axes(ax)
+    xi, eta = f"{joint}.xi", f"{joint}.eta"
+    along = xi if xi in result else f"{joint}.s"  # no stroke given: the slider centre's s, in mm
+    scale = 1.0 if along == xi else 1e3
+    if reference is not None:
+        x_ref, y_ref = xy_curve(reference, along, eta, window, max_points)
+        ax.plot(x_ref * scale, y_ref, "k:", lw=0.8, label="ideal joint")
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0"}
+    kw.update(line_kw)
+    x, y = xy_curve(result, along, eta, window, max_points)
+    ax.plot(x * scale, y, **kw)
+    if limits:
+        for level in (0.5, -0.5):
+            ax.axhline(level, color="k", ls="--", lw=0.8)
+    ax.set_xlabel("ξ, slider position along the stroke (-)" if along == xi
+                  else "s, slider centre along the guide (mm)")
+    ax.set_ylabel("η, offset across the guide (-)")
+    set_run_title(ax, result, title, created)
+    return ax
+
+
+def plot_translational_response(result: Result, *, reference: Result | None = None,
+                                joint: str = "clearance", window: Window = None, max_points: int | None = None,
+                                title: str | bool = True) -> Any:
+    """Fig. 4.28 in four panels: slider velocity, slider acceleration, crank moment, slider path.
+
+    Parameters
+    ----------
+    result : Result
+        The clearance-joint run (a dense ``t_eval``).
+    reference : Result, optional
+        The ideal-joint run over the same times, dashed in panels a-c.
+    joint : str
+        Name of the translational clearance joint.
+    window, max_points, title
+        As in :func:`plot_revolute_response`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Axes in order (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) path.
+    """
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(10.0, 7.0))
+    (a, b), (c, d) = axes
+    response_panels(result, reference, (a, b, c), window, max_points)
+    plot_slider_path(result, joint, ax=d, window=window, max_points=max_points,
+                     title="(d) dimensionless slider path inside the guide")
+    set_run_title(fig, result, title, True)
+    fig.tight_layout()
+    return fig
