@@ -14,7 +14,7 @@ import difflib
 import math
 import os
 from pathlib import Path
-from typing import Any, NamedTuple, NoReturn
+from typing import Any, NamedTuple, NoReturn, TypeGuard
 from collections.abc import Iterable, Sequence
 
 import numpy as np
@@ -67,7 +67,7 @@ def close_matches(name: str, candidates: Iterable[str], n: int = 5) -> list[str]
     return [c for _, c in sorted(scored)[:n]]
 
 
-def _real(value: Any) -> bool:
+def is_real(value: Any) -> TypeGuard[float]:
     """A real number (numpy scalars included), not a bool."""
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
 
@@ -75,7 +75,7 @@ def _real(value: Any) -> bool:
 def number(value: Any, *, where: str, field: str, unit: str = "", low: float | None = None,
            low_open: bool = True, high: float | None = None) -> float:
     """A finite real number in (low, high] (or [low, high] when ``low_open`` is False)."""
-    ok = _real(value) and math.isfinite(float(value))
+    ok = is_real(value) and math.isfinite(float(value))
     if ok and low is not None:
         ok = float(value) > low if low_open else float(value) >= low
     if ok and high is not None:
@@ -122,7 +122,7 @@ def t_end(value: Any, *, where: str = "simulate", field: str = "t_end") -> float
 
 def t0(value: Any, end: float, *, where: str = "simulate", field: str = "t0") -> float:
     """Start time of a run: a finite number >= 0 and < t_end, s."""
-    ok = _real(value) and math.isfinite(float(value)) and 0.0 <= float(value) < end
+    ok = is_real(value) and math.isfinite(float(value)) and 0.0 <= float(value) < end
     if not ok:
         fail(where, field, value, f"a finite number >= 0 and < t_end={end:g} s", "s")
     return float(value)
@@ -150,7 +150,7 @@ def state(value: Any, size: int | None, *, where: str = "simulate", field: str =
 def rtol(value: Any, *, where: str = "simulate", field: str = "rtol") -> float:
     """Relative tolerance: a finite number in [1e-14, 1e-2]."""
     lo, hi = RTOL_RANGE
-    ok = _real(value) and math.isfinite(float(value)) and lo <= float(value) <= hi
+    ok = is_real(value) and math.isfinite(float(value)) and lo <= float(value) <= hi
     if not ok:
         fail(where, field, value, f"a finite number in [{lo:g}, {hi:g}]")
     return float(value)
@@ -160,7 +160,7 @@ def atol(value: Any, *, where: str = "simulate", field: str = "atol") -> float |
     """Absolute tolerance: None (default), a finite number > 0, or finite values > 0 (one per state)."""
     if value is None:
         return None
-    if _real(value):
+    if is_real(value):
         return number(value, where=where, field=field, low=0.0)
     try:
         values = np.asarray(value, dtype=float)

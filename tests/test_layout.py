@@ -223,3 +223,21 @@ def test_every_sub_package_is_a_regular_package():
     assert folders, "no tracked modules found"
     missing = sorted(d for d in folders if f"{d}/__init__.py" not in tracked)
     assert not missing, f"folders of modules without a tracked __init__.py: {missing}"
+
+
+#: Issue 13: every module "under about 600 lines with one job a newcomer can name from its path".
+MODULE_LINE_LIMIT = 650
+
+
+def test_every_module_is_short_and_says_its_job():
+    """Each module of the package stays under the line limit and opens with a docstring that says
+    its one job (the first line of the docstring is what docs/layout.md's table is made of)."""
+    too_long, undocumented = [], []
+    for name, path in package_files().items():
+        text = path.read_text()
+        if len(text.splitlines()) > MODULE_LINE_LIMIT:
+            too_long.append(f"{name}: {len(text.splitlines())} lines")
+        if not (ast.get_docstring(ast.parse(text)) or "").strip():
+            undocumented.append(name)
+    assert not too_long, f"modules over {MODULE_LINE_LIMIT} lines: {too_long}"
+    assert not undocumented, f"modules without a docstring: {undocumented}"

@@ -124,13 +124,13 @@ def _window(result: Result, window: Window, f: _Fields) -> tuple[float, float]:
     if window is None:
         return start, end
     try:
-        t0, t1 = window  # type: ignore[misc]
+        t0, t1 = window
     except (TypeError, ValueError):
         options.fail(f.where, f.window, window, rule)
     lo = start if t0 is None else t0
     hi = end if t1 is None else t1
     for value in (lo, hi):
-        if not options._real(value) or not math.isfinite(float(value)):
+        if not options.is_real(value) or not math.isfinite(float(value)):
             options.fail(f.where, f.window, window, rule)
     # a window given from printed times (e.g. 0.004 for 0.0040000000000001) is inside the run
     slack = 1e-9 * max(abs(start), abs(end), end - start)
@@ -207,9 +207,10 @@ def _writer(path: Path, fps: float, f: _Fields) -> Any:
 
             def grab_frame(self, **savefig_kwargs: Any) -> None:
                 super().grab_frame(**savefig_kwargs)
-                self._frames[-1] = self._frames[-1].convert("RGB").convert("P", palette=Image.Palette.ADAPTIVE)
+                frames = self._frames  # type: ignore[attr-defined]  # PillowWriter's list, not in the stubs
+                frames[-1] = frames[-1].convert("RGB").convert("P", palette=Image.Palette.ADAPTIVE)
 
-        return _Compact(fps=fps)
+        return _Compact(fps=fps)  # type: ignore[arg-type]  # stubs say int; a float fps works as given
     program = str(matplotlib.rcParams["animation.ffmpeg_path"])
     if shutil.which(program) is None:
         raise MissingDependencyError(
@@ -217,7 +218,8 @@ def _writer(path: Path, fps: float, f: _Fields) -> Any:
             f"(matplotlib rcParams['animation.ffmpeg_path'] = {program!r}); install ffmpeg, or write a .gif "
             "(pillow, no external program needed).")
     # libx264 with yuv420p needs even width and height
-    return animation.FFMpegWriter(fps=fps, codec="h264", extra_args=["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2"])
+    return animation.FFMpegWriter(fps=fps, codec="h264",  # type: ignore[arg-type]  # as above
+                                  extra_args=["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2"])
 
 
 def _check_path(path: Any, f: _Fields) -> Path:

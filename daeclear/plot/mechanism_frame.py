@@ -118,7 +118,7 @@ def scene_geometry(result: Result, where: str) -> Geometry:
             position = _vec(spec.get("position"))
             angle = spec.get("angle", 0.0)
             bodies[str(name)] = (position if position is not None else np.zeros(2),
-                                 float(angle) if options._real(angle) else 0.0)
+                                 float(angle) if options.is_real(angle) else 0.0)
     if not bodies:
         raise SceneError(f"{where}: the scene description has no body to draw.")
     geo = Geometry(name=str(scene.get("name", "")), ground=ground, bodies=bodies)  # type: ignore[union-attr]
@@ -217,7 +217,7 @@ def nice_number(value: float) -> float:
 
 def _float(spec: Mapping[str, Any], key: str) -> float | None:
     value = spec.get(key)
-    return float(value) if options._real(value) and math.isfinite(float(value)) else None
+    return float(value) if options.is_real(value) and math.isfinite(float(value)) else None
 
 
 def revolute_clearance(spec: Mapping[str, Any]) -> float | None:
@@ -321,18 +321,18 @@ class MechanismPanel:
                     continue
                 centre = _world(pj, joint.s_j)
                 along = (centre - _world(pi, joint.s_i)) @ _direction(pi[:1], g["t_guide"])[0]
-                reach = g["limits"] or [(float(along.min()) - g["L"], float(along.max()) + g["L"])]
+                limits = g["limits"] or [(float(along.min()) - g["L"], float(along.max()) + g["L"])]
                 half = 0.5 * g["W"] + g["c"]
                 for side in (1.0, -1.0):
                     surface = pen_line(ax, _GROUND, lw=1.2, zorder=1)
-                    self.updates.append(self._guide_update(surface, pi, joint.s_i, g["t_guide"], reach, side * half))
+                    self.updates.append(self._guide_update(surface, pi, joint.s_i, g["t_guide"], limits, side * half))
                 block = ax.fill([], [], fc="0.85", ec=FREE_COLOR, lw=1.5, zorder=2)[0]
                 a = _direction(pj, g["e_slider"])
                 self.updates.append(self._block_update(block, centre, a, g["L"], g["W"], contact.get(joint.name)))
                 extent.append(centre)
                 normal = np.array([-g["t_guide"][1], g["t_guide"][0]])
                 extent += [_world(pi, joint.s_i + r * g["t_guide"] + side * half * normal)
-                           for lim in reach for r in lim for side in (1.0, -1.0)]
+                           for lim in limits for r in lim for side in (1.0, -1.0)]
         if ideal_pins:
             pins = pen_line(ax, "0.1", ls="none", marker="o", ms=5, mfc="white", mew=1.2, zorder=5)
             stacked = np.stack(ideal_pins, axis=1)  # (n, n_pins, 2)
@@ -346,7 +346,9 @@ class MechanismPanel:
             ax.plot(pts[:, 0], pts[:, 1] - 0.025 * span, ls="none", marker="^", ms=9, color=_GROUND, zorder=0)
         # equal scales: widen the shorter side of the data to the panel's shape
         box = ax.get_position()
-        width, height = ax.figure.get_size_inches()
+        figure = ax.get_figure(root=True)
+        assert figure is not None  # the axes were made on a figure (layout_frame)
+        width, height = figure.get_size_inches()
         shape = (box.width * width) / max(box.height * height, 1e-9)
         dx, dy = hi - lo
         centre = 0.5 * (lo + hi)
