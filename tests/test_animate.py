@@ -230,3 +230,27 @@ def test_contact_state_of_a_frame():
     state, depth = _contact_state(_Sampler(result, times, 0.0, 4.0), "j")
     assert list(state) == [FREE, FREE, IMPACT]
     assert depth[2] == pytest.approx(2e-6)
+
+
+def test_a_failed_animation_leaves_the_old_file_and_no_temporary(revolute, tmp_path, monkeypatch):
+    """The animation writes through results.outputs.atomic_file (a temporary name that keeps the
+    suffix the writer reads): an error while rendering leaves an existing file untouched and no
+    temporary file behind; a finished one replaces it."""
+    import matplotlib.animation
+
+    target = tmp_path / "run.gif"
+    target.write_bytes(b"old")
+    seen = []
+
+    def broken_grab(self, **kwargs):
+        seen.append(self.outfile)
+        raise OSError("disk full")
+
+    monkeypatch.setattr(matplotlib.animation.PillowWriter, "grab_frame", broken_grab)
+    with pytest.raises(OSError, match="disk full"):
+        revolute.animate(target, fps=10, window=(0.001, 0.002), slow_motion=100, size=SMALL)
+    assert seen and str(seen[0]).endswith(".gif") and seen[0] != str(target)
+    assert target.read_bytes() == b"old" and list(tmp_path.iterdir()) == [target]
+    monkeypatch.undo()
+    revolute.animate(target, fps=10, window=(0.001, 0.002), slow_motion=100, size=SMALL)
+    assert target.read_bytes()[:3] == b"GIF" and list(tmp_path.iterdir()) == [target]

@@ -43,7 +43,6 @@ from __future__ import annotations
 import math
 import os
 import shutil
-import uuid
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -360,28 +359,27 @@ def render(result: Result, path: Any, *, fps: Any, window: Window, slow_motion: 
 
 def _write(fig: Figure, writer: Any, target: Path, n_frames: int, updates: Sequence[Callable[[int], None]],
            clock: Any, times: NDArray[np.float64], unit: str, decimals: int, show: bool) -> None:
-    """Render every frame into a temporary file beside ``target``, renamed over it once complete."""
-    from ..results.outputs import deferred_sigint
+    """Render every frame into a temporary file beside ``target``, renamed over it once complete
+    (:func:`daeclear.results.outputs.atomic_file`; Ctrl-C waits while the file is finished)."""
+    from ..results.outputs import atomic_file, deferred_sigint
 
-    tmp = target.with_name(f".{target.stem}.{uuid.uuid4().hex[:12]}.tmp{target.suffix}")
     bar = Progress(n_frames, unit="frames", desc=f"animating {target.name}", enabled=show)
     try:
-        writer.setup(fig, str(tmp), dpi=_DPI)
-        try:
-            for k in range(n_frames):
-                for update in updates:
-                    update(k)
-                clock.set_text(f"t = {times[k]:.{decimals}f} {unit}")
-                writer.grab_frame()
-                bar.update(k + 1)
-        finally:
-            bar.close()
-        with deferred_sigint():
-            writer.finish()
-            os.replace(tmp, target)
+        with atomic_file(target, keep_suffix=True) as tmp:
+            writer.setup(fig, str(tmp), dpi=_DPI)
+            try:
+                for k in range(n_frames):
+                    for update in updates:
+                        update(k)
+                    clock.set_text(f"t = {times[k]:.{decimals}f} {unit}")
+                    writer.grab_frame()
+                    bar.update(k + 1)
+            finally:
+                bar.close()
+            with deferred_sigint():
+                writer.finish()
     except BaseException:
         proc = getattr(writer, "_proc", None)  # ffmpeg, when it was started
         if proc is not None and proc.poll() is None:
             proc.kill()
-        tmp.unlink(missing_ok=True)
         raise

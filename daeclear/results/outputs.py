@@ -185,7 +185,7 @@ def sigint_latch() -> Iterator[list[int]]:
 
 
 @contextlib.contextmanager
-def atomic_file(path: str | os.PathLike[str]) -> Iterator[Path]:
+def atomic_file(path: str | os.PathLike[str], *, keep_suffix: bool = False) -> Iterator[Path]:
     """A temporary path beside ``path`` to write; renamed over ``path`` once the block completes.
 
     The one implementation of atomic output files: the file written at the yielded path is
@@ -193,10 +193,12 @@ def atomic_file(path: str | os.PathLike[str]) -> Iterator[Path]:
     (`os.replace`, atomic on POSIX), so an existing file at ``path`` is either left untouched or
     replaced whole. On any exception (KeyboardInterrupt too) the temporary file is removed and the
     exception raised. Hold Ctrl-C back around it with :func:`deferred_sigint` where a Ctrl-C
-    should wait for the file.
+    should wait for the file. ``keep_suffix``: the temporary name ends in ``path``'s suffix, for
+    writers that choose the format by it (the animations' GIF and MP4 writers).
     """
     p = Path(path)
-    tmp = p.with_name(f".{p.name}.{uuid.uuid4().hex[:12]}.tmp")
+    tail = f".tmp{p.suffix}" if keep_suffix else ".tmp"
+    tmp = p.with_name(f".{p.stem if keep_suffix else p.name}.{uuid.uuid4().hex[:12]}{tail}")
     try:
         yield tmp
         with open(tmp, "rb+") as fh:
