@@ -218,14 +218,17 @@ def save_response_figure(result: Result, path: Any, *, reference: Result | None 
 
 
 def save_figure(fig: Any, path: Any, dpi: int = 120) -> Any:
-    """Write ``fig`` to ``path`` whole or not at all (a temporary file renamed into place), close
-    it, and return the path."""
+    """Write ``fig`` to ``path`` whole or not at all (:func:`daeclear.results.outputs.atomic_file`),
+    close it, and return the path."""
     import matplotlib.pyplot as plt
     from pathlib import Path
 
+    from ..results.outputs import atomic_file
+
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp{path.suffix}")
-    fig.savefig(tmp, dpi=dpi)
-    plt.close(fig)
-    tmp.replace(path)
+    try:
+        with atomic_file(path, keep_suffix=True) as tmp:  # savefig reads the format from the suffix
+            fig.savefig(tmp, dpi=dpi)
+    finally:
+        plt.close(fig)
     return path
