@@ -78,7 +78,7 @@ def test_output_windows_inside_steps_lose_no_point():
     so windows of EVAL_WINDOW times end inside steps. Every point is IDA's interpolant at its own
     time: the driven crank angle is exactly linear in t, and the constraints hold (a lost, shifted or
     unfilled row would show)."""
-    from daeclear.solvers.ida import EVAL_WINDOW
+    from daeclear.solvers.ida_loop import EVAL_WINDOW
 
     t_end = 0.004
     r = dc.simulate(dc.mechanisms.slider_crank("ideal"), t_end, t_eval_step=1e-7, store_steps=False)

@@ -1,0 +1,361 @@
+"""The IDA segment loop of one run: advance, record contact switches, restart, finish.
+
+:func:`daeclear.solvers.ida.simulate` checks the options, opens the session and the recorder and
+hands them to a :class:`SegmentLoop`, which integrates segment by segment. Between two roots of
+the gap functions the set of active contact terms is fixed. The compiled loop may decide the
+switches of simple pairs itself (:meth:`SegmentLoop.record_advance` records its decisions in the
+pair logic); any other root returns to Python, where each contact element's event logic decides
+the new modes and IDA restarts from a consistent state (:meth:`SegmentLoop.decide_roots`). The
+points go to the recorder chunk by chunk (:meth:`SegmentLoop.flush`), so a run that streams to a
+file and keeps no steps runs in bounded memory, and whatever stops the run (a failure, Ctrl-C,
+running out of memory) the result holds what was computed (:meth:`SegmentLoop.finish`).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from typing import Any
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import options as opts
+from . import physics
+from ..assembly.assemble import DAEModel
+from ..errors import Interrupted, SolveError
+from .recorder import Recorder
+from ..progress import Progress
+from ..results.result import Result
+
+#: Output times handed to the compiled loop at a time: their rows are emptied between windows.
+EVAL_WINDOW = 4096
+# Failures in contact that plain Coulomb friction causes when the contact sticks.
+STICKING_FLAGS = ("DC_STEP_COLLAPSE", "IDA_CONV_FAIL", "IDA_ERR_FAIL")
+
+
+class SegmentLoop:
+    """One run's loop state: active terms and their parameters, contact modes, the switch vector,
+    the current segment's start and the reported points not yet made consistent."""
+
+    def __init__(self, model: DAEModel, session: Any, rec: Recorder, t0: float, y0: NDArray, yp0: NDArray,
+                 t_end: float, eval_times: opts.OutputTimes | None, store_steps: bool, progress: bool) -> None:
+        """Set the contact modes from the state at ``t0`` and record the start point."""
+        self.run_start = time.perf_counter()
+        self.progress_line = Progress(t_end, unit="s", desc="simulate", enabled=progress)
+        self.model, self.session, self.rec = model, session, rec
+        self.t_end, self.eval_times, self.store_steps = t_end, eval_times, store_steps
+        self.active = [False] * len(model.terms)
+        self.params = [np.zeros(term.n_params) for term in model.terms]
+        self.modes: dict[str, str] = {}
+        for logic in model.contacts:
+            self.modes.update(logic.initial_modes(t0, y0, self.active, self.params))
+        y, yp = y0, yp0
+        if any(self.active):
+            y, yp = model.consistent_state(t0, y0, model.term_forces(t0, y0, self.active, self.params, session),
+                                           session)
+        self.switch = model.switch_vector(self.active, self.params)
+        # reported points not made consistent yet (IDA's raw values, with their contact switches)
+        self.raw: list[tuple[NDArray, NDArray, NDArray, NDArray]] = []
+        rec.add_steps(np.array([t0]), np.array([0.0]), np.array([0]))
+        self.i_eval = 0  # index of the next output time
+        if eval_times is None:
+            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
+        elif eval_times.window(0, 1)[0] == t0:
+            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
+            self.i_eval = 1
+        self.events, self.segments = rec.events, rec.segments
+        self.t, self.y, self.yp, self.y0 = t0, y, yp, y0
+        self.seg_start = t0  # nan once the last segment is closed
+        self.success, self.status, self.message = True, 0, "end of the time span reached"
+        self.n_restarts = 0
+        self.interrupted = False
+        self.c_layout = False  # the compiled loop makes the points consistent itself
+        self.c_decides = False  # the compiled loop decides every contact switch itself
+        self.owners: dict[int, Any] = {}  # root -> the contact logic it belongs to
+
+    def run(self, on_failure: str, setup_time: float, sim_params: dict[str, Any]) -> Result:
+        """Integrate to the end, a failure or Ctrl-C; always return (or attach) what was computed."""
+        try:
+            self.prepare()
+            self.advance_to_end()
+        except KeyboardInterrupt:  # Ctrl-C: keep what was computed, then stop the caller too (Interrupted)
+            self.success, self.status = False, -1
+            self.message = f"interrupted by the user at t={self.t:.6g} s"
+            self.interrupted = True
+        except MemoryError:  # keep (and, streamed, save) what was computed: the chunks before this one
+            self.raw.clear()
+            self.success, self.status = False, -1
+            self.message = (f"out of memory at t={self.t:.6g} s. Report fewer points (t_eval_step), keep no steps "
+                            "(store_steps=False) and stream the run to a file (stream_to).")
+        except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on
+            self.progress_line.close()
+            self.rec.abort(exc)
+            self.session.close()
+            raise
+        if not math.isnan(self.seg_start):  # stopped inside a segment: it ends where the run stopped
+            self.segments.append((self.seg_start, self.t, dict(self.modes)))
+        return self.finish(on_failure, setup_time, sim_params)
+
+    def prepare(self) -> None:
+        """Start IDA; let the compiled loop make states consistent and decide simple pairs' switches."""
+        model, session = self.model, self.session
+        # the compiled loop makes states consistent itself (restarts after its own switches, the
+        # reported points); the python backend leaves that to the model's Python methods
+        self.c_layout = session.set_layout(model.layout(project=model.formulation == "ggl"))
+        session.reinit(self.t, self.y, self.yp, self.active, self.params, _root_directions(model, self.active))
+        # the compiled loop may decide every contact switch itself (simple pairs): the rule and the
+        # starting state of each pair come from its logic object; Python then only records
+        if model.auto_pairs:
+            self.owners = {root: logic for logic in model.contacts for root in logic.roots}
+            roots = [pair[0] for pair in model.auto_pairs]
+            self.c_decides = self.c_layout and session.set_auto_events(
+                model.auto_pairs, storms=[self.owners[root].storm for root in roots],
+                states=[self.owners[root].pair_state(root) for root in roots])
+
+    def advance_to_end(self) -> None:
+        """Advance chunk by chunk and segment by segment until the end, a failure or an exception."""
+        while True:
+            adv = self.advance()
+            self.record_advance(adv)
+            self.check_decisions(adv)
+            self.t, self.y, self.yp = adv.t, adv.y, adv.yp
+            if adv.status == "interrupted":  # Ctrl-C inside the python backend's loop: its steps are kept
+                raise KeyboardInterrupt
+            if adv.status == "chunk":  # a buffer of the compiled loop is full: hand it over, go on
+                self.flush()
+                self.progress_line.update(self.t, f"events {self.rec.n_events}")
+                continue
+            self.progress_line.update(self.t, f"events {self.rec.n_events}")
+            if adv.status == "error":
+                self.close_segment()
+                self.success, self.status = False, -1
+                self.message = _failure_message(self.model, adv, self.modes)
+                return
+            if adv.status == "tstop" or self.t >= self.t_end:
+                self.close_segment()
+                return
+            self.decide_roots(adv)
+
+    def advance(self) -> Any:
+        """One call of the session's loop, with the next window of output times (if any)."""
+        window = None
+        if self.eval_times is not None:  # the next output times (compiled loop: at most EVAL_WINDOW of them)
+            self.i_eval, window = _eval_window(self.eval_times, self.i_eval, self.session.eval_from,
+                                               EVAL_WINDOW if self.c_layout else self.eval_times.size)
+        adv = self.session.advance(self.t_end, window, self.store_steps, store_states=self.eval_times is None,
+                                   chunked=True)
+        self.i_eval += adv.eval_t.size
+        return adv
+
+    def close_segment(self) -> None:
+        """The current segment ends where the run stopped (and no other follows)."""
+        self.segments.append((self.seg_start, self.t, dict(self.modes)))
+        self.seg_start = math.nan
+
+    def record_advance(self, adv: Any) -> None:
+        """Record the compiled loop's own contact switches: split the advance at each restart and
+        record the decisions (modes, terms, latched speeds, events) in the pair logic."""
+        s0 = e0 = 0
+        ends = _split_rows(adv)  # one search for all restarts of the advance
+        for t_ev, decided in itertools.groupby(adv.auto_events, key=lambda ev: ev.t):
+            s1, e1 = ends[t_ev]
+            self.keep_points(adv, slice(s0, s1), slice(e0, e1), self.switch)
+            self.segments.append((self.seg_start, t_ev, dict(self.modes)))
+            for ev in decided:
+                root = self.model.auto_pairs[ev.pair][0]
+                for event in self.owners[root].record(root, t_ev, ev.y, ev.rate, ev.decision, self.active,
+                                                      self.params):
+                    self.events.append(event)
+                    self.modes[event.pair] = "contact" if event.kind == "onset" else "free"
+            self.switch = self.model.switch_vector(self.active, self.params)
+            self.seg_start, s0, e0 = t_ev, s1, e1
+            self.n_restarts += 1
+        self.keep_points(adv, slice(s0, None), slice(e0, None), self.switch)
+
+    def keep_points(self, adv: Any, steps: slice, evals: slice, switch: NDArray) -> None:
+        """Keep IDA's points as they are; they are made consistent by flush()."""
+        step_t, eval_t = adv.step_t[steps], adv.eval_t[evals]  # each slice once: this runs at every switch
+        if self.store_steps and step_t.size:
+            self.rec.add_steps(step_t, adv.step_h[steps], adv.step_order[steps])
+            if self.eval_times is None:  # the steps are the output points
+                self.raw.append((step_t, adv.step_y[steps], adv.step_yp[steps],
+                                 np.repeat(switch[None, :], step_t.size, axis=0)))
+        if eval_t.size:
+            self.raw.append((eval_t, adv.eval_y[evals], adv.eval_yp[evals],
+                             np.repeat(switch[None, :], eval_t.size, axis=0)))
+
+    def check_decisions(self, adv: Any) -> None:
+        """Turn the advance into an internal error when the compiled loop and Python disagree."""
+        if adv.auto_events and not _same_terms(self.session.active_terms(), self.active, self.params):
+            adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
+            adv.message = "internal: the compiled event loop and the recorded contact modes disagree"
+        elif self.c_decides and adv.status == "root":
+            adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
+            adv.message = "internal: the compiled event loop left a contact root undecided"
+
+    def decide_roots(self, adv: Any) -> None:
+        """At a root returned to Python let every contact element decide its new modes; restart IDA
+        from a consistent state when anything switched (else it goes on in the same segment)."""
+        model, active, params, t = self.model, self.active, self.params, self.t
+        before = (list(active), [p.copy() for p in params], _root_directions(model, active), dict(self.modes))
+        for logic in model.contacts:
+            new_events = logic.on_roots(t, self.y, self.yp, adv.roots_found, active, params)
+            self.events.extend(new_events)
+            for event in new_events:
+                self.modes[event.pair] = "contact" if event.kind == "onset" else "free"
+        directions = _root_directions(model, active)
+        if (before[0] == active and all(np.array_equal(a, b) for a, b in zip(before[1], params))
+                and (directions is None or (before[2] is not None and np.array_equal(before[2], directions)))):
+            return  # nothing switched: IDA goes on from the root without a restart, in the same segment
+        self.segments.append((self.seg_start, t, before[3]))
+        self.seg_start = t
+        assert adv.roots_found is not None  # a root return always says which roots
+        self.y, self.yp = _restart_state(model, self.session, t, self.y, self.yp,
+                                         model.term_forces(t, self.y, active, params, self.session),
+                                         adv.roots_found)
+        self.switch = model.switch_vector(active, params)
+        self.session.reinit(t, self.y, self.yp, active, params, _root_directions(model, active))
+        self.n_restarts += 1
+        self.flush()
+
+    def flush(self) -> None:
+        """Make the raw points consistent and hand them, the events and the segments to the recorder.
+
+        IDA does not converge the multipliers (out of its error test) and its interpolant of them is
+        not controlled: multipliers, accelerations (and the work rate) are recomputed from every
+        point's q and v with that point's contact modes (point by point: chunks change nothing)."""
+        model, session, raw = self.model, self.session, self.raw
+        if raw:
+            out_t, out_y, out_yp, out_switch = (np.concatenate(c) for c in zip(*raw))
+            raw.clear()
+            if self.c_layout:  # one pass in C
+                out_y, out_yp, values = session.report(out_t, out_y, out_switch)
+                channels = {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(model.channel_names)}
+            else:
+                out_y, out_yp = model.consistent_state(
+                    out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)
+                channels = model.channels(out_t, out_y, out_yp, out_switch, session)
+            self.rec.add_points(out_t, out_y, out_yp, channels)
+        self.rec.flush()
+
+    def finish(self, on_failure: str, setup_time: float, sim_params: dict[str, Any]) -> Result:
+        """Flush, check the physics, build the Result; raise (with it) on Ctrl-C or a failure when asked."""
+        stats = dict(self.session.stats())
+        found = self.checked_output(stats, setup_time, sim_params)
+        physics.issue(found, stacklevel=5)  # issue <- finish <- run <- simulate <- the caller
+        t, message = self.t, self.message
+        deep = [w for w in found if w["kind"] == "penetration" and w["t"] <= t]
+        if not self.success and not self.interrupted and deep:  # the advice must fit the cause: not a tolerance problem
+            w = deep[0]
+            message += (f" Before it, '{w['where']}' penetrated {w['value']:.3g} m at t={w['t']:.6g} s, more than "
+                        f"its limit {w['limit']:.3g} m: the contact carries more than the joint can (friction, speed "
+                        "or load); tolerances will not fix that.")
+        result = self.rec.finish(stats=stats, success=self.success, status=self.status, message=message,
+                                 warnings=found)
+        if self.interrupted or self.rec.interrupted:
+            raise Interrupted(f"simulate: {message}; partial result in .result.", result)
+        if not self.success and on_failure == "raise":
+            raise SolveError(message + " Partial result in .result.", result)
+        return result
+
+    def checked_output(self, stats: dict[str, Any], setup_time: float, sim_params: dict[str, Any]) -> list[dict]:
+        """Hand over the last points, complete ``stats`` and run the physics checks (their findings);
+        the session stays open through the checks: they evaluate constraints in its library, not in CasADi."""
+        model, session, rec = self.model, self.session, self.rec
+        post_start = time.perf_counter()
+        try:
+            try:
+                self.flush()
+            except BaseException as exc:
+                rec.abort(exc)
+                raise
+            self.progress_line.update(self.t_end if self.success else self.t, f"events {rec.n_events}")
+            self.progress_line.close()
+            stats.update(n_events=rec.n_events, n_restarts=self.n_restarts, setup_time=setup_time,
+                         wall_time=setup_time + time.perf_counter() - self.run_start,
+                         output_time=time.perf_counter() - post_start)
+            if model.gap_names:  # the run's end state of the storm guard (kept in this run's logic, not in the model)
+                stats["held_pairs"] = [model.gap_names[root] for logic in model.contacts for root in logic.roots
+                                       if logic.pair_state(root).held]
+            # the start checks concern a declared state: the chapter's start is consistent by construction
+            key_t, key_y, key_channels = rec.key_rows()
+            return physics.check_run(model, key_t, key_y, key_channels,
+                                     self.y0 if sim_params["start"] == "declared" else None, stats, session)
+        finally:
+            session.close()
+
+
+def _split_rows(adv: Any) -> dict[float, tuple[int, int]]:
+    """Event time -> (steps, output points) of the advance up to and including that time."""
+    if not adv.auto_events:
+        return {}
+    times = np.array([ev.t for ev in adv.auto_events])
+    steps = np.searchsorted(adv.step_t, times, side="right").tolist()
+    evals = np.searchsorted(adv.eval_t, times, side="right").tolist()
+    return {t: (s, e) for t, s, e in zip(times.tolist(), steps, evals)}
+
+
+def _eval_window(times: opts.OutputTimes, i: int, t: float, size: int) -> tuple[int, NDArray]:
+    """The output times after ``t`` from index ``i`` on, at most ``size``: (index of the first, times)."""
+    while i < times.size:
+        window = times.window(i, i + size)
+        lo = int(np.searchsorted(window, t, side="right"))
+        if lo < window.size:
+            return i + lo, window[lo:]
+        i += window.size
+    return i, np.zeros(0)
+
+
+def _same_terms(c_terms: tuple[list[bool], list[NDArray]], active: Sequence[bool], params: Sequence[NDArray]) -> bool:
+    """The compiled loop's active terms and parameters are those recorded from its decisions."""
+    return c_terms[0] == list(active) and all(np.array_equal(a, b) for a, b in zip(c_terms[1], params))
+
+
+def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:
+    """Root directions for the next segment: each contact pair watches only its next switch."""
+    if not model.gap_names:
+        return None
+    directions = np.zeros(len(model.gap_names), dtype=np.int32)
+    for logic in model.contacts:
+        for index, direction in logic.root_directions(active):
+            directions[index] = direction
+    return directions
+
+
+def _restart_state(model: DAEModel, session: Any, t: float, y: NDArray, yp: NDArray, forces: NDArray | None,
+                   found: Any) -> tuple[NDArray, NDArray]:
+    """Consistent restart after a contact switch (GGL: projected onto the constraint manifold),
+    unprojected when the projection moves a root function that did not fire across zero (it
+    would never be found again: a missed contact). The compiled loop's rule (project_kept_roots)."""
+    projected = model.consistent_state(t, y, forces, session, project=True)
+    if model.formulation != "ggl" or not model.gap_names:
+        return projected
+    g0, g1 = session.roots(t, y, yp), session.roots(t, projected[0], yp)
+    quiet = np.zeros(g0.shape, bool) if found is None else np.asarray(found).ravel() == 0
+    if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
+        return model.consistent_state(t, y, forces, session, project=False)
+    return projected
+
+
+def _failure_message(model: DAEModel, adv: Any, modes: dict[str, str]) -> str:
+    """Say when, where (contact modes) and why IDA failed, and what to try."""
+    in_contact = [pair for pair, mode in modes.items() if mode == "contact"]
+    where = f" with {', '.join(repr(p) for p in in_contact)} in contact" if in_contact else ""
+    flag = f" ({adv.flag_name})" if adv.flag_name else ""
+    detail = f": {adv.message}" if adv.message else ""
+    advice = "Try a smaller max_step, a tighter rtol" + (", or formulation='ggl'." if model.formulation != "ggl"
+                                                         else ".")
+    if adv.flag_name == "DC_MAX_STEPS":  # not an accuracy problem: the run needs more steps
+        advice = ("The run needs more steps than max_steps allows: raise max_steps (daeclear run: --max-steps) "
+                  "in proportion to the time still to go.")
+    # sticking under plain Coulomb: index-1 chatters until the stall guard stops it, GGL's Newton
+    # iteration fails to converge (or its error test fails) at the sticking point
+    elif adv.flag_name in STICKING_FLAGS and in_contact and any(
+            getattr(logic, "discontinuous_friction", False) for logic in model.contacts):
+        advice = ("The friction law is discontinuous at zero sliding speed (plain Coulomb) and the "
+                  "contact is sticking: use the modified Coulomb law (friction=<coefficient> or "
+                  "daeclear.contact.ModifiedCoulomb), which is continuous.")
+    return f"IDA failed at t={adv.t:.6g} s{flag}{where}{detail}. {advice}"
