@@ -13,9 +13,10 @@ from __future__ import annotations
 import logging
 import os
 import time
+from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from .. import options as opts
 from . import physics
@@ -220,6 +221,29 @@ def simulate(
         y0 = opts.state(y0, model.n_states)
     from_state = y0 is not None
     model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
+    session, y0, yp0 = _start_session(model, t0, y0, rtol=rtol, atol=atol, backend=backend, max_step=max_step,
+                                      max_steps=max_steps, linear_solver=linear_solver, start=start,
+                                      allow_penetration=allow_penetration)
+    setup_time = time.perf_counter() - setup_start
+    sim_params = {"method": method, "start": "state" if from_state else start,
+                  "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
+                  "max_step": max_step, "t_end": t_end, "backend": session.backend}
+    if t0 != 0.0:
+        sim_params["t0"] = t0
+    try:
+        rec = Recorder(model, parameters={**model.parameters, "simulate": sim_params}, method=method,
+                       stream_to=out.stream_to, keep_data=out.keep_data)
+    except BaseException:
+        session.close()
+        raise
+    return SegmentLoop(model, session, rec, t0, y0, yp0, t_end, out.times, store_steps, progress).run(
+        on_failure, setup_time, sim_params)
+
+
+def _start_session(model: DAEModel, t0: float, y0: NDArray | None, *, rtol: float, atol: Any, backend: str,
+                   max_step: float, max_steps: int, linear_solver: str, start: str,
+                   allow_penetration: bool) -> tuple[Any, NDArray, NDArray]:
+    """Open one run's IDA session and find its consistent start (the session is closed if that fails)."""
     atol_vec = tolerance_vector(model, rtol, atol)
     session = open_session(model.functions, backend=backend, rtol=rtol, atol=atol_vec, max_step=max_step,
                            parameters=model.parameter_values, max_steps=max_steps, linear_solver=linear_solver)
@@ -235,20 +259,7 @@ def simulate(
         # never ask Newton for corrections below round-off: coef * rtol >= 1e-13
         session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / rtol)))
     session.set_stall(STALL_STEP, STALL_COUNT)
-    setup_time = time.perf_counter() - setup_start
-    sim_params = {"method": method, "start": "state" if from_state else start,
-                  "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
-                  "max_step": max_step, "t_end": t_end, "backend": session.backend}
-    if t0 != 0.0:
-        sim_params["t0"] = t0
-    try:
-        rec = Recorder(model, parameters={**model.parameters, "simulate": sim_params}, method=method,
-                       stream_to=out.stream_to, keep_data=out.keep_data)
-    except BaseException:
-        session.close()
-        raise
-    return SegmentLoop(model, session, rec, t0, y0, yp0, t_end, out.times, store_steps, progress).run(
-        on_failure, setup_time, sim_params)
+    return session, y0, yp0
 
 
 def smallest_clearance(model: DAEModel) -> float:
