@@ -112,7 +112,7 @@ class PairLogic:
         active[self.term_index] = decision.term_on
         if decision.kind == ONSET:
             params[self.term_index] = self._params()
-        return [ContactEvent(t=t, pair=self.pair, kind=EVENT_KINDS[decision.kind], approach_speed=rate, y=y.copy())]
+        return [ContactEvent.from_solver(t, self.pair, EVENT_KINDS[decision.kind], rate, np.array(y, dtype=float))]
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]]:
         """(root, term, (q, v, P) -> [gap; rate], needs approach speed, floor): the pairs whose

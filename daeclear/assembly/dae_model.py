@@ -358,10 +358,11 @@ class DAEModel:
 
     def switch_vector(self, active: Sequence[bool], params: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
         """The contact terms' on/off flags and parameters as the outputs' ``switch`` input."""
-        parts: list[NDArray[np.float64]] = []
+        values: list[float] = []  # plain floats, one array at the end: this runs at every contact switch
         for on, p in zip(active, params):
-            parts += [np.array([1.0 if on else 0.0]), np.asarray(p, dtype=float).ravel()]
-        return np.concatenate(parts) if parts else np.zeros(0)
+            values.append(1.0 if on else 0.0)
+            values.extend(np.asarray(p, dtype=float).ravel().tolist())
+        return np.array(values, dtype=float)
 
     def channels(self, t: NDArray[np.float64], y: NDArray[np.float64], yp: NDArray[np.float64],
                  switch: NDArray[np.float64] | None = None, session: Any = None) -> dict[str, NDArray[np.float64]]:
@@ -399,12 +400,12 @@ def check_independent(model: DAEModel, q: NDArray[np.float64], session: Any = No
     Phi_q = model.constraints(np.asarray(q, dtype=float), np.zeros(n), 0.0, session)[1]
     if not np.all(np.isfinite(Phi_q)):
         return  # not a rank question: the positions themselves are unusable (reported when they are assembled)
-    U, sigma, _ = np.linalg.svd(Phi_q)
+    sigma = np.linalg.svd(Phi_q, compute_uv=False)  # the singular vectors only when there is a null space
     scale = float(sigma[0]) if sigma.size else 0.0
     rank = int(np.sum(sigma > RANK_TOL * scale))
     if rank >= m:
         return
-    null = U[:, rank:]
+    null = np.linalg.svd(Phi_q)[0][:, rank:]
     rows = [i for i in range(m) if np.linalg.norm(null[i]) > NULL_WEIGHT]
     owners = model.constraint_elements or tuple(name.rsplit(".", 1)[0] for name in model.constraint_names)
     involved = list(dict.fromkeys(owners[i] for i in rows))

@@ -248,8 +248,7 @@ class SliderGuideLogic:
         self.states[i] = recorded(self.states[i], decision)
         if decision.kind == ONSET:
             params[self.corner_terms[i]] = self._corner_params(i)
-        return [ContactEvent(t=t, pair=self.pairs[i], kind=EVENT_KINDS[decision.kind], approach_speed=rate,
-                             y=y.copy())]
+        return [ContactEvent.from_solver(t, self.pairs[i], EVENT_KINDS[decision.kind], rate, np.array(y, dtype=float))]
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
         """Without faces (model ``corners``) every corner term follows its own pair, so the compiled

@@ -233,9 +233,13 @@ class CSession(SessionBase):
         t, pair, info, rate, latched, y = buf
         k = self._lib.dc_take_events(self._h, self._auto_cap, t.ctypes.data, pair.ctypes.data, info.ctypes.data,
                                      rate.ctypes.data, latched.ctypes.data, y.ctypes.data)
-        return [AutoEvent(float(t[i]), int(pair[i]), float(rate[i]),
-                          Decision(int(info[i, 0]), bool(info[i, 1]), bool(info[i, 2]), float(latched[i]),
-                                   int(info[i, 3])), y[i].copy()) for i in range(k)]
+        if not k:
+            return []
+        states = y[:k].copy()  # one copy; each event's state is a row of it
+        return [AutoEvent(ti, pi, ri, Decision(kind, bool(contact), bool(held), li, watch), states[i])
+                for i, (ti, pi, ri, (kind, contact, held, watch), li)
+                in enumerate(zip(t[:k].tolist(), pair[:k].tolist(), rate[:k].tolist(), info[:k].tolist(),
+                                 latched[:k].tolist()))]
 
     def automaton_run(self, times: Sequence[float], directions: Sequence[int], rates: Sequence[float], *,
                       storm: Storm, min_approach_speed: float, contact: bool = False, held: bool = False,

@@ -76,6 +76,16 @@ class ContactEvent:
         object.__setattr__(self, "approach_speed", float(self.approach_speed))
         object.__setattr__(self, "y", readonly(y))
 
+    @classmethod
+    def from_solver(cls, t: float, pair: str, kind: str, approach_speed: float,
+                    y: NDArray[np.float64]) -> ContactEvent:
+        """An event the contact logic records at every switch, without the checks of the constructor:
+        ``kind`` is one of EVENT_KINDS and ``y`` a 1-D float64 state the event may own (made read-only)."""
+        event = object.__new__(cls)
+        y.flags.writeable = False
+        event.__dict__.update(t=float(t), pair=pair, kind=kind, approach_speed=float(approach_speed), y=y)
+        return event
+
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, ContactEvent):
             return NotImplemented

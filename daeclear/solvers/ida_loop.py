@@ -58,13 +58,14 @@ class SegmentLoop:
                                            session)
         self.switch = model.switch_vector(self.active, self.params)
         # reported points not made consistent yet (IDA's raw values, with their contact switches)
+        # each piece's rows share one switch vector: repeated once per flush, not once per piece
         self.raw: list[tuple[NDArray, NDArray, NDArray, NDArray]] = []
         rec.add_steps(np.array([t0]), np.array([0.0]), np.array([0]))
         self.i_eval = 0  # index of the next output time
         if eval_times is None:
-            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
+            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch))
         elif eval_times.window(0, 1)[0] == t0:
-            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
+            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch))
             self.i_eval = 1
         self.events, self.segments = rec.events, rec.segments
         self.t, self.y, self.yp, self.y0 = t0, y, yp, y0
@@ -181,11 +182,9 @@ class SegmentLoop:
         if self.store_steps and step_t.size:
             self.rec.add_steps(step_t, adv.step_h[steps], adv.step_order[steps])
             if self.eval_times is None:  # the steps are the output points
-                self.raw.append((step_t, adv.step_y[steps], adv.step_yp[steps],
-                                 np.repeat(switch[None, :], step_t.size, axis=0)))
+                self.raw.append((step_t, adv.step_y[steps], adv.step_yp[steps], switch))
         if eval_t.size:
-            self.raw.append((eval_t, adv.eval_y[evals], adv.eval_yp[evals],
-                             np.repeat(switch[None, :], eval_t.size, axis=0)))
+            self.raw.append((eval_t, adv.eval_y[evals], adv.eval_yp[evals], switch))
 
     def check_decisions(self, adv: Any) -> None:
         """Turn the advance into an internal error when the compiled loop and Python disagree."""
@@ -229,8 +228,10 @@ class SegmentLoop:
         point's q and v with that point's contact modes (point by point: chunks change nothing)."""
         model, session, raw = self.model, self.session, self.raw
         if raw:
-            out_t, out_y, out_yp, out_switch = (np.concatenate(c) for c in zip(*raw))
+            times, ys, yps, switches = zip(*raw)
             raw.clear()
+            out_t, out_y, out_yp = np.concatenate(times), np.concatenate(ys), np.concatenate(yps)
+            out_switch = np.repeat(np.array(switches), [t.size for t in times], axis=0)
             if self.c_layout:  # one pass in C
                 out_y, out_yp, values = session.report(out_t, out_y, out_switch)
                 channels = {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(model.channel_names)}
