@@ -351,6 +351,20 @@ def test_event_list_filters_and_fields() -> None:
         ContactEvent(0.0, "C", "impact", 0.0, y)  # type: ignore[arg-type]
 
 
+def test_event_from_solver_equals_the_checked_constructor() -> None:
+    """The contact logic's fast path builds the same event as the constructor: equal fields, a
+    float time and speed, and a state that cannot be changed through the event."""
+    y = np.array([1.0, 2.0, 3.0])
+    fast = ContactEvent.from_solver(np.float64(0.25), "C", "onset", np.float64(0.5), y.copy())
+    checked = ContactEvent(t=0.25, pair="C", kind="onset", approach_speed=0.5, y=y)
+    assert fast == checked and repr(fast) == repr(checked)
+    assert type(fast.t) is float and type(fast.approach_speed) is float
+    with pytest.raises(ValueError, match="read-only"):
+        fast.y[0] = 9.0
+    with pytest.raises(AttributeError):
+        fast.t = 1.0  # type: ignore[misc]
+
+
 def test_result_events_of_pair() -> None:
     result = make_result()
     np.testing.assert_array_equal(result.events.of("C", kind="onset").t, [0.0125])
