@@ -246,6 +246,26 @@ def test_a_scene_changed_in_place_is_assembled_anew():
         dc.assemble(scene)  # validated again
 
 
+def test_a_scene_seen_before_reuses_its_model_and_start():
+    """assemble(scene) of an unchanged scene returns the model bound before; a model remembers its
+    consistent start, which equals one computed anew, and a model with new numbers starts afresh."""
+    scene = dc.mechanisms.slider_crank("revolute", clearance=0.4e-3, gravity=0.0)
+    model = dc.assemble(scene)
+    assert dc.assemble(scene) is model and dc.assemble(scene, "index1") is not model
+    first = dc.simulate(model, 1e-4, rtol=1e-7)
+    assert len(model.start_memo) == 1  # the run copy filled its model's memo
+    y0, yp0 = model.initial_state()  # python evaluation: its own entry
+    y0[:] = np.nan  # the caller's copy: the memo stays as it was
+    again = model.initial_state()
+    fresh = dataclasses.replace(model, start_memo={}).initial_state()
+    np.testing.assert_array_equal(again[0], fresh[0])
+    np.testing.assert_array_equal(again[1], fresh[1])
+    second = dc.simulate(model, 1e-4, rtol=1e-7)
+    np.testing.assert_array_equal(first.y, second.y)
+    other = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.3e-3, gravity=0.0))
+    assert other.start_memo == {} and other.start_memo is not model.start_memo
+
+
 def test_a_damaged_cached_library_is_built_again(tmp_path):
     """A cached library truncated after its build (a full disk, a killed copy) is detected by its
     digest and rebuilt by the next process, never loaded (loading it could crash the interpreter).

@@ -154,7 +154,7 @@ class _Template:
             mass_diagonal=np.concatenate([[b.mass, b.mass, b.inertia] for b in bodies]),
             parameters={"scene": scene.to_dict(), "formulation": formulation, "alpha": alpha, "beta": beta,
                         "track_work": track_work},
-            contacts=contacts, auto_pairs=auto_pairs, parameter_layout=self.layout, parameter_values=P,
+            contacts=contacts, auto_pairs=auto_pairs, parameter_layout=self.layout, parameter_values=P, start_memo={},
             clearance_joints=tuple((e.name, float(e.radial_clearance), float(getattr(e, "corner_radius", 0.0)))
                                    for e in scene.elements
                                    if isinstance(e, (RevoluteClearance, TranslationalClearance))
@@ -213,39 +213,33 @@ def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: flo
     for label, value in (("alpha", alpha), ("beta", beta)):
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
             raise SceneError(f"{label}={value!r} 1/s, must be a finite number >= 0.")
-    table, key = _validated_parameters(scene, formulation, alpha, beta, bool(track_work))
+    elements = tuple(scene.elements)
+    identity = (scene.name, tuple(scene.gravity), scene.ground, formulation, alpha, beta, bool(track_work))
+    seen = _SEEN.get(id(scene))
+    if seen is not None and seen[1] == identity and len(seen[0]) == len(elements) \
+            and all(a is b for a, b in zip(seen[0], elements)):
+        return seen[2]  # the scene unchanged: its model (immutable) as it was bound
+    scene.validate()
+    table, key = scene_parameters(scene, formulation, alpha, beta, bool(track_work))
     template = _TEMPLATES.get(key)
     if template is None:
         template = _build_template(scene, formulation, bool(track_work), table, f"mechanism_{key[:16]}")
         if len(_TEMPLATES) >= _TEMPLATE_LIMIT:
             _TEMPLATES.pop(next(iter(_TEMPLATES)))
         _TEMPLATES[key] = template
-    return template.bind(scene, table, alpha, beta)
-
-
-# Scenes assembled before in this process: (elements, name, gravity, ground, options) -> their
-# parameters and structure key. The entry holds the very element objects (frozen dataclasses),
-# so an unchanged scene is recognised by identity and a changed one (an element added, replaced,
-# gravity or name reassigned) is not; validation and parameters are then skipped.
-_SEEN: dict[int, tuple[Any, ...]] = memo_table()
-_SEEN_LIMIT = 32
-
-
-def _validated_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
-                          track_work: bool) -> tuple[ParameterTable, str]:
-    """``scene.validate()`` then :func:`scene_parameters`, skipped for a scene seen unchanged."""
-    elements = tuple(scene.elements)
-    identity = (scene.name, tuple(scene.gravity), scene.ground, formulation, alpha, beta, track_work)
-    seen = _SEEN.get(id(scene))
-    if seen is not None and seen[1] == identity and len(seen[0]) == len(elements) \
-            and all(a is b for a, b in zip(seen[0], elements)):
-        return seen[2], seen[3]
-    scene.validate()
-    table, key = scene_parameters(scene, formulation, alpha, beta, track_work)
+    model = template.bind(scene, table, alpha, beta)
     if len(_SEEN) >= _SEEN_LIMIT:
         _SEEN.pop(next(iter(_SEEN)))
-    _SEEN[id(scene)] = (elements, identity, table, key)
-    return table, key
+    _SEEN[id(scene)] = (elements, identity, model)
+    return model
+
+
+# Scenes assembled before in this process: id -> (elements, (name, gravity, ground, options),
+# the bound model). The entry holds the very element objects (frozen dataclasses), so an
+# unchanged scene is recognised by identity and a changed one (an element added, replaced,
+# gravity or name reassigned) is not; validation, parameters and binding are then skipped.
+_SEEN: dict[int, tuple[Any, ...]] = memo_table()
+_SEEN_LIMIT = 32
 
 
 def _build_template(scene: Scene, formulation: str, track_work: bool, table: ParameterTable,

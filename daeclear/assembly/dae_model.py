@@ -83,6 +83,11 @@ class DAEModel:
     # (name, clearance m, corner radius m or 0) of each clearance joint: the limits of the physics checks
     clearance_joints: tuple[tuple[str, float, float], ...] = ()
     driver_names: tuple[str, ...] = ()
+    # consistent starts found for these numbers, by (start, allow_penetration, evaluator): a pure
+    # function of the model, kept so that a model run again (a study's repeated runs, a scene seen
+    # before) skips assembling its start; shared by the run copies, new for every bound model
+    start_memo: dict[tuple[str, bool, str], tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
+        default_factory=dict, compare=False, repr=False)
     # False for a model that starts from a computed state (a restart), whose start is not checked
     start_is_declared: ClassVar[bool] = True
 
@@ -344,6 +349,10 @@ class DAEModel:
         With an open compiled ``session`` every evaluation runs in C. A declared start with a contact
         pair in deep penetration raises AssemblyError unless ``allow_penetration``
         (:func:`daeclear.solvers.physics.check_start_penetration`)."""
+        key = (start, bool(allow_penetration), "casadi" if session is None else type(session).__name__)
+        known = self.start_memo.get(key)
+        if known is not None:
+            return known[0].copy(), known[1].copy()
         ideal = start == "ideal"
         q = self.assemble_positions(self.q_guess, session=session, ideal=ideal)
         check_independent(self, q, session)
@@ -354,6 +363,7 @@ class DAEModel:
         y, yp = self.consistent_state(0.0, y, session=session)
         if not ideal and not allow_penetration:
             check_start_penetration(self, y, yp, session)
+        self.start_memo[key] = (_read_only(y), _read_only(yp))
         return y, yp
 
     def switch_vector(self, active: Sequence[bool], params: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
