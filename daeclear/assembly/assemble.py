@@ -87,8 +87,9 @@ def _translational(ctx: AssemblyContext, joint: Translational) -> tuple[list[Any
 
 
 def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
-                     track_work: bool) -> tuple[ParameterTable, str]:
-    """The scene's numbers as run-time parameters, and the key of its structure.
+                     track_work: bool) -> tuple[ParameterTable, str, dict[str, Any]]:
+    """The scene's numbers as run-time parameters, the key of its structure and the scene's
+    plain-data description (``Scene.to_dict``, computed once for the key and the model).
 
     Pure Python (no CasADi): this is all that a scene of a known structure costs to assemble.
     """
@@ -119,11 +120,10 @@ def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
             raise AssemblyError(f"{element.kind} '{element.name}': element type not supported by assemble().")
     structure.append(table.layout)
     described = scene.to_dict()
-    described.pop("name")  # the scene's name is no part of its structure
-    for element in scene.elements:  # fields whose effect the structure flags state
-        for field_name in element.NOT_STRUCTURE:
-            described["elements"][element.name].pop(field_name, None)
-    return table, structure_key(described, structure)
+    # the scene's name is no part of its structure, nor are the fields whose effect the flags state
+    elements = {e.name: {k: v for k, v in described["elements"][e.name].items() if k not in e.NOT_STRUCTURE}
+                for e in scene.elements}
+    return table, structure_key({"gravity": described["gravity"], "elements": elements}, structure), described
 
 
 @dataclass(frozen=True)
@@ -137,7 +137,8 @@ class _Template:
     # (root, term, gap-rate extra, needs approach speed, index of the contact logic) of simple pairs
     auto_pairs: tuple[tuple[int, int, int, bool, int], ...]
 
-    def bind(self, scene: Scene, table: ParameterTable, alpha: float, beta: float) -> DAEModel:
+    def bind(self, scene: Scene, table: ParameterTable, described: dict[str, Any], alpha: float,
+             beta: float) -> DAEModel:
         if table.layout != self.layout:  # a structure key collision would land here
             raise AssemblyError(f"scene '{scene.name}': its parameters do not match the cached structure.")
         P = table.vector
@@ -152,7 +153,7 @@ class _Template:
             q_guess=np.concatenate([[*b.position, b.angle] for b in bodies]),
             v_guess=np.concatenate([[*b.velocity, b.angular_velocity] for b in bodies]),
             mass_diagonal=np.concatenate([[b.mass, b.mass, b.inertia] for b in bodies]),
-            parameters={"scene": scene.to_dict(), "formulation": formulation, "alpha": alpha, "beta": beta,
+            parameters={"scene": described, "formulation": formulation, "alpha": alpha, "beta": beta,
                         "track_work": track_work},
             contacts=contacts, auto_pairs=auto_pairs, parameter_layout=self.layout, parameter_values=P, start_memo={},
             clearance_joints=tuple((e.name, float(e.radial_clearance), float(getattr(e, "corner_radius", 0.0)))
@@ -220,14 +221,14 @@ def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: flo
             and all(a is b for a, b in zip(seen[0], elements)):
         return seen[2]  # the scene unchanged: its model (immutable) as it was bound
     scene.validate()
-    table, key = scene_parameters(scene, formulation, alpha, beta, bool(track_work))
+    table, key, described = scene_parameters(scene, formulation, alpha, beta, bool(track_work))
     template = _TEMPLATES.get(key)
     if template is None:
         template = _build_template(scene, formulation, bool(track_work), table, f"mechanism_{key[:16]}")
         if len(_TEMPLATES) >= _TEMPLATE_LIMIT:
             _TEMPLATES.pop(next(iter(_TEMPLATES)))
         _TEMPLATES[key] = template
-    model = template.bind(scene, table, alpha, beta)
+    model = template.bind(scene, table, described, alpha, beta)
     if len(_SEEN) >= _SEEN_LIMIT:
         _SEEN.pop(next(iter(_SEEN)))
     _SEEN[id(scene)] = (elements, identity, model)
