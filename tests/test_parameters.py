@@ -264,6 +264,13 @@ def test_a_scene_seen_before_reuses_its_model_and_start():
     np.testing.assert_array_equal(first.y, second.y)
     other = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.3e-3, gravity=0.0))
     assert other.start_memo == {} and other.start_memo is not model.start_memo
+    # a copy with other numbers shares the filled memo but never reads a start of the old numbers
+    slower = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.4e-3, gravity=0.0, rpm=4000.0))
+    copied = dataclasses.replace(model, parameter_values=slower.parameter_values)
+    assert copied.start_memo is model.start_memo and model.start_memo
+    y_copied = copied.initial_state()[0]
+    np.testing.assert_allclose(y_copied, slower.initial_state()[0], rtol=1e-9, atol=1e-12)
+    assert not np.allclose(y_copied, again[0])  # the crank turns slower: other velocities
 
 
 def test_a_damaged_cached_library_is_built_again(tmp_path):

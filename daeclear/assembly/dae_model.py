@@ -83,10 +83,11 @@ class DAEModel:
     # (name, clearance m, corner radius m or 0) of each clearance joint: the limits of the physics checks
     clearance_joints: tuple[tuple[str, float, float], ...] = ()
     driver_names: tuple[str, ...] = ()
-    # consistent starts found for these numbers, by (start, allow_penetration, evaluator): a pure
-    # function of the model, kept so that a model run again (a study's repeated runs, a scene seen
-    # before) skips assembling its start; shared by the run copies, new for every bound model
-    start_memo: dict[tuple[str, bool, str], tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
+    # consistent starts found for this model, by (start, allow_penetration, evaluator, the numbers
+    # and guesses they came from): kept so that a model run again (a study's repeated runs, a scene
+    # seen before) skips assembling its start; shared by the run copies, new for every bound model
+    # (the numbers in the key keep a model copied with other numbers from reading a stale start)
+    start_memo: dict[tuple[Any, ...], tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
         default_factory=dict, compare=False, repr=False)
     # False for a model that starts from a computed state (a restart), whose start is not checked
     start_is_declared: ClassVar[bool] = True
@@ -349,7 +350,8 @@ class DAEModel:
         With an open compiled ``session`` every evaluation runs in C. A declared start with a contact
         pair in deep penetration raises AssemblyError unless ``allow_penetration``
         (:func:`daeclear.solvers.physics.check_start_penetration`)."""
-        key = (start, bool(allow_penetration), "casadi" if session is None else type(session).__name__)
+        key = (start, bool(allow_penetration), "casadi" if session is None else type(session).__name__,
+               self.parameter_values.tobytes(), self.q_guess.tobytes(), self.v_guess.tobytes())
         known = self.start_memo.get(key)
         if known is not None:
             return known[0].copy(), known[1].copy()
