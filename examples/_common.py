@@ -183,8 +183,7 @@ def run_case(label: str, scene: dc.Scene, span: Span, args: argparse.Namespace, 
     model = dc.assemble(scene, "index1")  # the chapter's formulation (Tables 4.2, 4.3: Baumgarte 5, 5)
     dense = dc.simulate(model, span.t_end, t_eval=span.t_eval, rtol=args.rtol)
     per_step = dc.simulate(model, span.t_end, rtol=args.rtol)
-    if (check_events and len(dense.events) != len(per_step.events)
-            or not np.array_equal(dense.events.t, per_step.events.t)):
+    if check_events and not np.array_equal(dense.events.t, per_step.events.t):  # also when the counts differ
         warnings.warn(f"{label}: the dense and per-step runs found different events "
                       f"({len(dense.events)} and {len(per_step.events)}); the orbit figure may not match.",
                       stacklevel=2)
