@@ -8,13 +8,13 @@ the solver switches on and off between integration segments.
 
 Formulations
 ------------
-``index1`` (the chapter's, default)::
+``index1`` (the chapter's; Tables 4.2 and 4.3)::
 
     q' - v                                   = 0
     M v' + Phi_q^T lam - Q(q, v, t)          = 0
     Phi_q v' - gamma + 2 alpha Phi' + beta^2 Phi = 0     (Baumgarte)
 
-``ggl`` (stabilised index 2, Gear-Gupta-Leimkuhler; drift-free)::
+``ggl`` (the default: stabilised index 2, Gear-Gupta-Leimkuhler; drift-free)::
 
     q' - v + Phi_q^T mu                      = 0
     M v' + Phi_q^T lam - Q(q, v, t)          = 0
@@ -246,246 +246,284 @@ _SEEN_LIMIT = 32
 def _build_template(scene: Scene, formulation: str, track_work: bool, table: ParameterTable,
                     library_name: str) -> _Template:
     """The symbolic DAE of the scene's structure, every number a symbol of the parameter vector P."""
-    bodies = scene.bodies
-    nb = len(bodies)
-    n = 3 * nb
-    t = ca.SX.sym("t")
-    q = ca.SX.sym("q", n)
-    v = ca.SX.sym("v", n)
-    a = ca.SX.sym("a", n)
-    P = ca.SX.sym("P", table.vector.size)
-    params = table.symbols(P)
+    build = _TemplateBuilder(scene, formulation, track_work, table)
+    build.constraints()
+    build.forces()
+    build.equations()
+    build.contact_terms()
+    build.output_channels()
+    return build.template(library_name)
 
-    frames: dict[str, BodyFrame] = {
-        GROUND: BodyFrame(GROUND, None, ca.DM.zeros(2), ca.DM(0.0), ca.DM.zeros(2), ca.DM(0.0))
-    }
-    for k, body in enumerate(bodies):
-        frames[body.name] = BodyFrame(body.name, k, q[3 * k:3 * k + 2], q[3 * k + 2], v[3 * k:3 * k + 2], v[3 * k + 2])
-    ctx = AssemblyContext(t, q, v, a, P, frames, params, table.offsets())
 
-    # ---- constraints ----
-    phi_list: list[Any] = []
-    names: list[str] = []
-    owners: list[str] = []  # the element of each constraint row
-    joints = {j.name: j for j in scene.joints}
-    driver_rows: dict[str, int] = {}
-    contact_builds: list[Any] = []
-    for element in scene.elements:
-        if isinstance(element, (Body, Load)):
-            continue
-        if isinstance(element, Revolute):
-            eqs, labels = _revolute(ctx, element)
-        elif isinstance(element, Translational):
-            eqs, labels = _translational(ctx, element)
-        elif isinstance(element, Driver):
-            driver_rows[element.name] = len(phi_list)
-            eqs, labels = [driver_constraint(ctx, element, joints[element.joint])], [element.name]
-        else:  # a clearance joint (scene_parameters rejected anything else)
-            first_term = sum(len(b.terms) for b in contact_builds)
-            first_root = sum(len(b.gaps) for b in contact_builds)
-            contact_builds.append(CONTACT_BUILDERS[type(element)][1](ctx, element, first_term, first_root))
-            continue
-        phi_list.extend(eqs)
-        names.extend(labels)
-        owners.extend([element.name] * len(eqs))
+class _TemplateBuilder:
+    """The steps of :func:`_build_template`, one method each, in this order: constraints, masses
+    and forces, the state vector and residual, the contact terms, the output channels, and the
+    generated functions with the compiled loop's simple pairs. The symbols each step makes are
+    attributes the later steps read."""
 
-    m = len(phi_list)
-    Phi = ca.vertcat(*phi_list) if m else ca.SX(0, 1)
-    Phi_q = ca.jacobian(Phi, q)
-    Phi_t = ca.jacobian(Phi, t)
-    Phi_dot = ca.mtimes(Phi_q, v) + Phi_t
-    gamma = -(ca.mtimes(ca.jacobian(Phi_dot, q), v) + ca.jacobian(Phi_dot, t))
-    kinematics = ca.Function("kinematics", [q, v, t, P], [Phi, ca.densify(Phi_q), Phi_dot, gamma],
-                             ["q", "v", "t", "P"], ["Phi", "Phi_q", "Phi_dot", "gamma"])
+    def __init__(self, scene: Scene, formulation: str, track_work: bool, table: ParameterTable) -> None:
+        self.scene, self.formulation, self.track_work, self.table = scene, formulation, track_work, table
+        self.bodies = scene.bodies
+        self.n = n = 3 * len(self.bodies)
+        t, q, v, a = ca.SX.sym("t"), ca.SX.sym("q", n), ca.SX.sym("v", n), ca.SX.sym("a", n)
+        P = ca.SX.sym("P", table.vector.size)
+        self.t, self.q, self.v, self.a, self.P = t, q, v, a, P
+        self.params = table.symbols(P)
+        frames: dict[str, BodyFrame] = {
+            GROUND: BodyFrame(GROUND, None, ca.DM.zeros(2), ca.DM(0.0), ca.DM.zeros(2), ca.DM(0.0))
+        }
+        for k, body in enumerate(self.bodies):
+            frames[body.name] = BodyFrame(body.name, k, q[3 * k:3 * k + 2], q[3 * k + 2], v[3 * k:3 * k + 2],
+                                          v[3 * k + 2])
+        self.ctx = AssemblyContext(t, q, v, a, P, frames, self.params, table.offsets())
+        self.joints = {j.name: j for j in scene.joints}
 
-    # ---- masses and applied forces ----
-    g_vec = params["gravity"]
-    gx, gy = g_vec[0], g_vec[1]
-    mass_diag = ca.vertcat(*[ca.vertcat(params[f"{b.name}.mass"], params[f"{b.name}.mass"],
-                                        params[f"{b.name}.inertia"]) for b in bodies])
-    Q = ca.vertcat(*[ca.vertcat(params[f"{b.name}.mass"] * gx, params[f"{b.name}.mass"] * gy, 0.0) for b in bodies])
-    loads = build_loads(ctx, scene.of_type(Load))  # applied forces, springs, motors (daeclear.loads)
-    Q = Q + loads.force + 0 * t  # keep Q symbolic in t for a uniform signature
-    base_force = ca.Function("base_force", [t, q, v, P], [Q], ["t", "q", "v", "P"], ["Q"])
+    def constraints(self) -> None:
+        """Ideal joints and drivers as rows of Phi(q, t) = 0; clearance joints as contact builds."""
+        ctx, t, q, v, P = self.ctx, self.t, self.q, self.v, self.P
+        phi_list: list[Any] = []
+        names: list[str] = []
+        owners: list[str] = []  # the element of each constraint row
+        driver_rows: dict[str, int] = {}
+        contact_builds: list[Any] = []
+        for element in self.scene.elements:
+            if isinstance(element, (Body, Load)):
+                continue
+            if isinstance(element, Revolute):
+                eqs, labels = _revolute(ctx, element)
+            elif isinstance(element, Translational):
+                eqs, labels = _translational(ctx, element)
+            elif isinstance(element, Driver):
+                driver_rows[element.name] = len(phi_list)
+                eqs, labels = [driver_constraint(ctx, element, self.joints[element.joint])], [element.name]
+            else:  # a clearance joint (scene_parameters rejected anything else)
+                first_term = sum(len(b.terms) for b in contact_builds)
+                first_root = sum(len(b.gaps) for b in contact_builds)
+                contact_builds.append(CONTACT_BUILDERS[type(element)][1](ctx, element, first_term, first_root))
+                continue
+            phi_list.extend(eqs)
+            names.extend(labels)
+            owners.extend([element.name] * len(eqs))
+        self.phi_list, self.names, self.owners = phi_list, names, owners
+        self.driver_rows, self.contact_builds = driver_rows, contact_builds
+        self.m = m = len(phi_list)
+        self.Phi = Phi = ca.vertcat(*phi_list) if m else ca.SX(0, 1)
+        self.Phi_q = Phi_q = ca.jacobian(Phi, q)
+        Phi_t = ca.jacobian(Phi, t)
+        self.Phi_dot = Phi_dot = ca.mtimes(Phi_q, v) + Phi_t
+        self.gamma = gamma = -(ca.mtimes(ca.jacobian(Phi_dot, q), v) + ca.jacobian(Phi_dot, t))
+        self.kinematics = ca.Function("kinematics", [q, v, t, P], [Phi, ca.densify(Phi_q), Phi_dot, gamma],
+                                      ["q", "v", "t", "P"], ["Phi", "Phi_q", "Phi_dot", "gamma"])
 
-    # ---- state vector ----
-    lam = ca.SX.sym("lam", m)
-    lam_p = ca.SX.sym("lam_p", m)
-    q_p = ca.SX.sym("q_p", n)
-    body_state = [f"{b.name}.{c}" for b in bodies for c in ("x", "y", "phi")]
-    body_rate = [f"{b.name}.{c}" for b in bodies for c in ("vx", "vy", "omega")]
-    state_names = body_state + body_rate + [f"lambda.{c}" for c in names]
-    kinds = [KIND_POSITION] * n + [KIND_VELOCITY] * n + [KIND_MULTIPLIER] * m
-    eom = mass_diag * a + ca.mtimes(Phi_q.T, lam) - Q
-    if formulation == "index1":
-        alpha, beta = params["baumgarte.alpha"], params["baumgarte.beta"]
-        y = ca.vertcat(q, v, lam)
-        yp = ca.vertcat(q_p, a, lam_p)
-        res = ca.vertcat(q_p - v, eom, ca.mtimes(Phi_q, a) - gamma + 2 * alpha * Phi_dot + beta**2 * Phi)
-    else:
-        mu = ca.SX.sym("mu", m)
-        mu_p = ca.SX.sym("mu_p", m)
-        y = ca.vertcat(q, v, lam, mu)
-        yp = ca.vertcat(q_p, a, lam_p, mu_p)
-        res = ca.vertcat(q_p - v + ca.mtimes(Phi_q.T, mu), eom, Phi_dot, Phi)
-        state_names += [f"mu.{c}" for c in names]
-        kinds += [KIND_MULTIPLIER] * m
-    drive_power = sum((-lam[row] * ca.mtimes(Phi_q[row, :], v) for row in driver_rows.values()), ca.SX(0.0))
-    # Multipliers from (t, q, v) and extra generalized forces Fc, by the Schur complement of the
-    # KKT system [M Phi_q^T; Phi_q 0][a; lam] = [Q + Fc; c] (M is diagonal). Used for consistent
-    # states and for the work rate, which must not depend on IDA's unconverged multipliers.
-    Minv = 1.0 / mass_diag
-    rhs_c = gamma - 2 * alpha * Phi_dot - beta**2 * Phi if formulation == "index1" else gamma
-    Fc = ca.SX.sym("Fc", n)
-    if m:
-        PMinv = Phi_q * ca.repmat(Minv.T, m, 1)  # Phi_q M^-1
-        lam_sol = ca.solve(ca.mtimes(PMinv, Phi_q.T), ca.mtimes(PMinv, Q + Fc) - rhs_c)
-    else:
-        lam_sol = ca.SX(0, 1)
-    a_sol = Minv * (Q + Fc - ca.mtimes(Phi_q.T, lam_sol))
-    drive_power_of = ca.substitute(drive_power, lam, lam_sol) if m else ca.SX(0.0)  # linear in Fc
-    drive_power_base = ca.substitute(drive_power_of, Fc, ca.SX.zeros(n))
-    if track_work:
-        W, W_p = ca.SX.sym("W"), ca.SX.sym("W_p")
-        y, yp = ca.vertcat(y, W), ca.vertcat(yp, W_p)
-        res = ca.vertcat(res, W_p - drive_power_base - loads.power)
-        state_names.append("work.input")
-        kinds.append(KIND_WORK)
-    n_y = y.numel()
-    cj = ca.SX.sym("cj")
-    residual = ca.Function("residual", [t, y, yp, P], [res], ["t", "y", "yp", "P"], ["r"])
-    jac = ca.jacobian(res, y) + cj * ca.jacobian(res, yp)
-    jacobian = ca.Function("jacobian", [t, y, yp, cj, P], [jac], ["t", "y", "yp", "cj", "P"], ["J"])
+    def forces(self) -> None:
+        """The diagonal mass matrix and the applied forces Q: gravity and the loads."""
+        params, bodies, t, q, v, P = self.params, self.bodies, self.t, self.q, self.v, self.P
+        g_vec = params["gravity"]
+        self.gx, self.gy = gx, gy = g_vec[0], g_vec[1]
+        self.mass_diag = ca.vertcat(*[ca.vertcat(params[f"{b.name}.mass"], params[f"{b.name}.mass"],
+                                                 params[f"{b.name}.inertia"]) for b in bodies])
+        Q = ca.vertcat(*[ca.vertcat(params[f"{b.name}.mass"] * gx, params[f"{b.name}.mass"] * gy, 0.0)
+                         for b in bodies])
+        self.loads = build_loads(self.ctx, self.scene.of_type(Load))  # applied forces, springs, motors
+        self.Q = Q = Q + self.loads.force + 0 * t  # keep Q symbolic in t for a uniform signature
+        self.base_force = ca.Function("base_force", [t, q, v, P], [Q], ["t", "q", "v", "P"], ["Q"])
 
-    # ---- contact terms: generalized forces added to the equations of motion rows ----
-    terms: list[Term] = []
-    term_res: list[ca.Function] = []
-    term_jac: list[ca.Function] = []
-    gaps: list[Any] = []
-    gap_names: list[str] = []
-    contact_channels: list[Channel] = []
-    switch_syms: list[Any] = []  # per term: on/off flag and parameters, inputs of the outputs
-    power_channels: list[Any] = []
-    for build in contact_builds:
-        switches = []
-        for term in build.terms:
-            ident = _c_identifier(term.name)
-            on_k, p_k = ca.SX.sym(f"{ident}_on"), ca.SX.sym(f"{ident}_p", term.n_params)
-            switches.append((on_k, p_k))
-            switch_syms += [on_k, p_k]
-        contact_channels.extend(build.channels(switches))
-        for term, (on_k, p_k) in zip(build.terms, switches):
-            # power of the contact force on the mechanism (energy balance: dE/dt = sum of powers)
-            power = ca.if_else(on_k > 0, ca.dot(term.force(t, q, v, p_k, P), v), 0.0)  # 0 (not NaN) when off
-            contact_channels.append(Channel(f"{term.name}.power", "W", power))
-            power_channels.append(power)
-        for term in build.terms:
-            p = ca.SX.sym("p", term.n_params)
-            Qk = term.force(t, q, v, p, P)
-            # the term's share of the work rate: its own power and the driver power it causes
-            work_row = ([-(ca.dot(Qk, v) + ca.substitute(drive_power_of, Fc, Qk) - drive_power_base)]
-                        if track_work else [])
-            r_k = ca.vertcat(ca.SX.zeros(n), -Qk, ca.SX.zeros(n_y - 2 * n - len(work_row)), *work_row)
-            ident = _c_identifier(term.name)  # term names may hold dots (channel names); C may not
-            term_res.append(ca.Function(f"{ident}_res", [t, y, yp, p, P], [r_k], ["t", "y", "yp", "p", "P"], ["r"]))
-            j_k = ca.jacobian(r_k, y) + cj * ca.jacobian(r_k, yp)
-            term_jac.append(ca.Function(f"{ident}_jac", [t, y, yp, p, cj, P], [j_k],
-                                        ["t", "y", "yp", "p", "cj", "P"], ["J"]))
-            terms.append(term)
-        gaps.extend(build.gaps)
-        gap_names.extend(build.gap_names)
-    roots = None
-    if gaps:
-        roots = ca.Function("roots", [t, y, yp, P], [ca.vertcat(*gaps)], ["t", "y", "yp", "P"], ["g"])
+    def equations(self) -> None:
+        """The state vector, the residual of the formulation and its Jacobian; the multipliers and
+        accelerations from (t, q, v, Fc) for consistent states and the work rate."""
+        t, q, v, a, P, n, m = self.t, self.q, self.v, self.a, self.P, self.n, self.m
+        Phi, Phi_q, Phi_dot, gamma, Q, names = self.Phi, self.Phi_q, self.Phi_dot, self.gamma, self.Q, self.names
+        lam, lam_p, q_p = ca.SX.sym("lam", m), ca.SX.sym("lam_p", m), ca.SX.sym("q_p", n)
+        state_names = ([f"{b.name}.{c}" for b in self.bodies for c in ("x", "y", "phi")]
+                       + [f"{b.name}.{c}" for b in self.bodies for c in ("vx", "vy", "omega")]
+                       + [f"lambda.{c}" for c in names])
+        kinds = [KIND_POSITION] * n + [KIND_VELOCITY] * n + [KIND_MULTIPLIER] * m
+        eom = self.mass_diag * a + ca.mtimes(Phi_q.T, lam) - Q
+        if self.formulation == "index1":
+            alpha, beta = self.params["baumgarte.alpha"], self.params["baumgarte.beta"]
+            y = ca.vertcat(q, v, lam)
+            yp = ca.vertcat(q_p, a, lam_p)
+            res = ca.vertcat(q_p - v, eom, ca.mtimes(Phi_q, a) - gamma + 2 * alpha * Phi_dot + beta**2 * Phi)
+        else:
+            mu, mu_p = ca.SX.sym("mu", m), ca.SX.sym("mu_p", m)
+            y = ca.vertcat(q, v, lam, mu)
+            yp = ca.vertcat(q_p, a, lam_p, mu_p)
+            res = ca.vertcat(q_p - v + ca.mtimes(Phi_q.T, mu), eom, Phi_dot, Phi)
+            state_names += [f"mu.{c}" for c in names]
+            kinds += [KIND_MULTIPLIER] * m
+        drive_power = sum((-lam[row] * ca.mtimes(Phi_q[row, :], v) for row in self.driver_rows.values()), ca.SX(0.0))
+        # Multipliers from (t, q, v) and extra generalized forces Fc, by the Schur complement of the
+        # KKT system [M Phi_q^T; Phi_q 0][a; lam] = [Q + Fc; c] (M is diagonal). Used for consistent
+        # states and for the work rate, which must not depend on IDA's unconverged multipliers.
+        Minv = 1.0 / self.mass_diag
+        rhs_c = gamma - 2 * alpha * Phi_dot - beta**2 * Phi if self.formulation == "index1" else gamma
+        self.Fc = Fc = ca.SX.sym("Fc", n)
+        if m:
+            PMinv = Phi_q * ca.repmat(Minv.T, m, 1)  # Phi_q M^-1
+            lam_sol = ca.solve(ca.mtimes(PMinv, Phi_q.T), ca.mtimes(PMinv, Q + Fc) - rhs_c)
+        else:
+            lam_sol = ca.SX(0, 1)
+        self.a_sol, self.lam_sol = Minv * (Q + Fc - ca.mtimes(Phi_q.T, lam_sol)), lam_sol
+        self.drive_power_of = ca.substitute(drive_power, lam, lam_sol) if m else ca.SX(0.0)  # linear in Fc
+        self.drive_power_base = ca.substitute(self.drive_power_of, Fc, ca.SX.zeros(n))
+        if self.track_work:
+            W, W_p = ca.SX.sym("W"), ca.SX.sym("W_p")
+            y, yp = ca.vertcat(y, W), ca.vertcat(yp, W_p)
+            res = ca.vertcat(res, W_p - self.drive_power_base - self.loads.power)
+            state_names.append("work.input")
+            kinds.append(KIND_WORK)
+        self.lam, self.y, self.yp, self.state_names, self.kinds = lam, y, yp, state_names, kinds
+        self.n_y = y.numel()
+        self.cj = cj = ca.SX.sym("cj")
+        self.residual = ca.Function("residual", [t, y, yp, P], [res], ["t", "y", "yp", "P"], ["r"])
+        jac = ca.jacobian(res, y) + cj * ca.jacobian(res, yp)
+        self.jacobian = ca.Function("jacobian", [t, y, yp, cj, P], [jac], ["t", "y", "yp", "cj", "P"], ["J"])
 
-    # ---- output channels ----
-    channels: list[Channel] = []
-    for k, b in enumerate(bodies):
-        sl = slice(3 * k, 3 * k + 3)
-        qk, vk, ak = q[sl], v[sl], a[sl]
+    def contact_terms(self) -> None:
+        """Each contact term's generalized force added to the equations of motion rows (its residual
+        and Jacobian), its switch inputs, channels and power, and the gap functions (IDA's roots)."""
+        t, q, v, P, n, n_y, y, yp, cj = self.t, self.q, self.v, self.P, self.n, self.n_y, self.y, self.yp, self.cj
+        self.terms: list[Term] = []
+        self.term_res: list[ca.Function] = []
+        self.term_jac: list[ca.Function] = []
+        gaps: list[Any] = []
+        self.gap_names: list[str] = []
+        self.contact_channels: list[Channel] = []
+        self.switch_syms: list[Any] = []  # per term: on/off flag and parameters, inputs of the outputs
+        self.power_channels: list[Any] = []
+        for build in self.contact_builds:
+            switches = []
+            for term in build.terms:
+                ident = _c_identifier(term.name)
+                on_k, p_k = ca.SX.sym(f"{ident}_on"), ca.SX.sym(f"{ident}_p", term.n_params)
+                switches.append((on_k, p_k))
+                self.switch_syms += [on_k, p_k]
+            self.contact_channels.extend(build.channels(switches))
+            for term, (on_k, p_k) in zip(build.terms, switches):
+                # power of the contact force on the mechanism (energy balance: dE/dt = sum of powers)
+                power = ca.if_else(on_k > 0, ca.dot(term.force(t, q, v, p_k, P), v), 0.0)  # 0 (not NaN) when off
+                self.contact_channels.append(Channel(f"{term.name}.power", "W", power))
+                self.power_channels.append(power)
+            for term in build.terms:
+                p = ca.SX.sym("p", term.n_params)
+                Qk = term.force(t, q, v, p, P)
+                # the term's share of the work rate: its own power and the driver power it causes
+                work_row = ([-(ca.dot(Qk, v) + ca.substitute(self.drive_power_of, self.Fc, Qk)
+                               - self.drive_power_base)] if self.track_work else [])
+                r_k = ca.vertcat(ca.SX.zeros(n), -Qk, ca.SX.zeros(n_y - 2 * n - len(work_row)), *work_row)
+                ident = _c_identifier(term.name)  # term names may hold dots (channel names); C may not
+                self.term_res.append(ca.Function(f"{ident}_res", [t, y, yp, p, P], [r_k],
+                                                 ["t", "y", "yp", "p", "P"], ["r"]))
+                j_k = ca.jacobian(r_k, y) + cj * ca.jacobian(r_k, yp)
+                self.term_jac.append(ca.Function(f"{ident}_jac", [t, y, yp, p, cj, P], [j_k],
+                                                 ["t", "y", "yp", "p", "cj", "P"], ["J"]))
+                self.terms.append(term)
+            gaps.extend(build.gaps)
+            self.gap_names.extend(build.gap_names)
+        self.roots = None
+        if gaps:
+            self.roots = ca.Function("roots", [t, y, yp, P], [ca.vertcat(*gaps)], ["t", "y", "yp", "P"], ["g"])
+
+    def output_channels(self) -> None:
+        """The channels of every reported point: bodies, drivers, energy, constraints, contacts, loads."""
+        q, v, a, params, bodies, gx, gy = self.q, self.v, self.a, self.params, self.bodies, self.gx, self.gy
+        channels: list[Channel] = []
+        for k, b in enumerate(bodies):
+            sl = slice(3 * k, 3 * k + 3)
+            qk, vk, ak = q[sl], v[sl], a[sl]
+            channels += [
+                Channel(f"{b.name}.x", "m", qk[0]), Channel(f"{b.name}.y", "m", qk[1]),
+                Channel(f"{b.name}.phi", "rad", qk[2]),
+                Channel(f"{b.name}.vx", "m/s", vk[0]), Channel(f"{b.name}.vy", "m/s", vk[1]),
+                Channel(f"{b.name}.omega", "rad/s", vk[2]),
+                Channel(f"{b.name}.ax", "m/s^2", ak[0]), Channel(f"{b.name}.ay", "m/s^2", ak[1]),
+                Channel(f"{b.name}.alpha", "rad/s^2", ak[2]),
+            ]
+        for name, row in self.driver_rows.items():
+            # The driver's constraint enters body j's equation of its coordinate with +lam; the moment
+            # (force along the axis) it applies to body j is therefore -lam (positive counter-clockwise).
+            driver = self.scene[name]
+            assert isinstance(driver, Driver)  # driver_rows holds the names of the scene's drivers only
+            load, unit = driver_load(self.joints[driver.joint])
+            channels.append(Channel(f"{name}.{load}", unit, -self.lam[row]))
+            power_d = -self.lam[row] * ca.mtimes(self.Phi_q[row, :], v)  # load times relative (angular) speed
+            channels.append(Channel(f"{name}.power", "W", power_d))
+            self.power_channels.append(power_d)
+        kinetic = 0.5 * ca.dot(self.mass_diag, v * v)
+        potential = -sum(params[f"{b.name}.mass"] * (gx * q[3 * k] + gy * q[3 * k + 1]) for k, b in enumerate(bodies))
+        potential = potential + self.loads.potential  # the springs' elastic energy
+        if self.loads.channels:
+            self.power_channels.append(self.loads.power)  # the loads' non-conservative power
         channels += [
-            Channel(f"{b.name}.x", "m", qk[0]), Channel(f"{b.name}.y", "m", qk[1]),
-            Channel(f"{b.name}.phi", "rad", qk[2]),
-            Channel(f"{b.name}.vx", "m/s", vk[0]), Channel(f"{b.name}.vy", "m/s", vk[1]),
-            Channel(f"{b.name}.omega", "rad/s", vk[2]),
-            Channel(f"{b.name}.ax", "m/s^2", ak[0]), Channel(f"{b.name}.ay", "m/s^2", ak[1]),
-            Channel(f"{b.name}.alpha", "rad/s^2", ak[2]),
+            Channel("energy.kinetic", "J", kinetic),
+            Channel("energy.potential", "J", potential),
+            Channel("energy.mechanical", "J", kinetic + potential),
         ]
-    for name, row in driver_rows.items():
-        # The driver's constraint enters body j's equation of its coordinate with +lam; the moment
-        # (force along the axis) it applies to body j is therefore -lam (positive counter-clockwise).
-        driver = scene[name]
-        assert isinstance(driver, Driver)  # driver_rows holds the names of the scene's drivers only
-        load, unit = driver_load(joints[driver.joint])
-        channels.append(Channel(f"{name}.{load}", unit, -lam[row]))
-        power_d = -lam[row] * ca.mtimes(Phi_q[row, :], v)  # load times relative (angular) speed
-        channels.append(Channel(f"{name}.power", "W", power_d))
-        power_channels.append(power_d)
-    kinetic = 0.5 * ca.dot(mass_diag, v * v)
-    potential = -sum(params[f"{b.name}.mass"] * (gx * q[3 * k] + gy * q[3 * k + 1]) for k, b in enumerate(bodies))
-    potential = potential + loads.potential  # the springs' elastic energy
-    if loads.channels:
-        power_channels.append(loads.power)  # the loads' non-conservative power
-    channels += [
-        Channel("energy.kinetic", "J", kinetic),
-        Channel("energy.potential", "J", potential),
-        Channel("energy.mechanical", "J", kinetic + potential),
-    ]
-    if power_channels:  # drivers and contact forces: the rate of change of the mechanical energy
-        channels.append(Channel("energy.input_power", "W", sum(power_channels)))
-    if track_work:
-        channels.append(Channel("energy.work", "J", y[n_y - 1]))
-    if m:
-        channels += [
-            Channel("constraints.position", "m", ca.mmax(ca.fabs(Phi))),
-            Channel("constraints.velocity", "m/s", ca.mmax(ca.fabs(Phi_dot))),
-        ]
-    channels += contact_channels + list(loads.channels)
-    switch = ca.vertcat(*switch_syms) if switch_syms else ca.SX(0, 1)
-    outputs = ca.Function("outputs", [t, y, yp, switch, P], [ca.vertcat(*[c.expr for c in channels])],
-                          ["t", "y", "yp", "switch", "P"], ["channels"])
-    # accelerations, multipliers (and work rate) from (t, q, v, contact forces) as generated code:
-    # consistent states at restarts and at every reported point cost ~1 us
-    work_rate = [drive_power_of + ca.dot(Fc, v) + loads.power] if track_work else []
-    accel = ca.Function("accel", [t, q, v, Fc, P], [ca.densify(ca.vertcat(a_sol, lam_sol, *work_rate))],
-                        ["t", "q", "v", "Qc", "P"], ["a_lam"])
-    kinematics_flat = ca.Function("kinematics_flat", [q, v, t, P],
-                                  [ca.densify(ca.vertcat(Phi, ca.vec(Phi_q), Phi_dot))], ["q", "v", "t", "P"], ["K"])
-    start_list = phi_list + [c for build in contact_builds for c in build.ideal]
-    start_names = tuple(names) + tuple(label for build in contact_builds for label in build.ideal_names)
-    Phi_s = ca.vertcat(*start_list) if start_list else ca.SX(0, 1)
-    Phi_s_q = ca.jacobian(Phi_s, q)
-    Phi_s_dot = ca.mtimes(Phi_s_q, v) + ca.jacobian(Phi_s, t)
-    start_flat = ca.Function("start_kinematics_flat", [q, v, t, P],
-                             [ca.densify(ca.vertcat(Phi_s, ca.vec(Phi_s_q), Phi_s_dot))], ["q", "v", "t", "P"], ["K"])
-    extras = [outputs, accel, kinematics_flat, start_flat] + [term.force for term in terms]
-    # simple contact pairs whose switches the compiled loop may handle itself (see ida_driver.c)
-    logic_makers = tuple(build.logic for build in contact_builds)
-    sample = [logic for make in logic_makers for logic in make(table.vector)]
-    auto_pairs = []
-    simple = [getattr(logic, "simple_pairs", lambda: None)() for logic in sample]
-    given = [pairs for pairs in simple if pairs is not None]
-    if sample and len(given) == len(simple):
-        for index, pairs in enumerate(given):
-            for root, term_index, gap_rate, needs, _floor in pairs:
-                extras.append(gap_rate)
-                auto_pairs.append((root, term_index, len(extras) - 1, needs, index))
-    functions = DAEFunctions(
-        n=n_y, residual=residual, jacobian=jacobian, term_residuals=tuple(term_res),
-        term_jacobians=tuple(term_jac), roots=roots, name=library_name, extras=tuple(extras),
-        n_parameters=int(P.numel()),
-    )
-    model = DAEModel(
-        scene_name=scene.name, formulation=formulation, alpha=0.0, beta=0.0,
-        body_names=tuple(b.name for b in bodies), constraint_names=tuple(names),
-        state_names=tuple(state_names), state_kinds=tuple(kinds), functions=functions,
-        terms=tuple(terms), gap_names=tuple(gap_names),
-        channel_names=tuple(c.name for c in channels), channel_units={c.name: c.unit for c in channels},
-        outputs=outputs, q_guess=np.zeros(n), v_guess=np.zeros(n), mass_diagonal=np.ones(n),
-        kinematics=kinematics, base_force=base_force, track_work=track_work, start_constraint_names=start_names,
-        constraint_elements=tuple(owners), driver_names=tuple(driver_rows),
-    )  # numbers are bound per scene (_Template.bind)
-    return _Template(model=model, layout=table.layout, logic=logic_makers, auto_pairs=tuple(auto_pairs))
+        if self.power_channels:  # drivers and contact forces: the rate of change of the mechanical energy
+            channels.append(Channel("energy.input_power", "W", sum(self.power_channels)))
+        if self.track_work:
+            channels.append(Channel("energy.work", "J", self.y[self.n_y - 1]))
+        if self.m:
+            channels += [
+                Channel("constraints.position", "m", ca.mmax(ca.fabs(self.Phi))),
+                Channel("constraints.velocity", "m/s", ca.mmax(ca.fabs(self.Phi_dot))),
+            ]
+        self.channels = channels + self.contact_channels + list(self.loads.channels)
+
+    def template(self, library_name: str) -> _Template:
+        """The generated functions (outputs, accelerations, kinematics, the compiled loop's simple
+        pairs) and the model of the structure, its numbers bound per scene (:meth:`_Template.bind`)."""
+        t, q, v, P, n, y, yp, channels = self.t, self.q, self.v, self.P, self.n, self.y, self.yp, self.channels
+        switch = ca.vertcat(*self.switch_syms) if self.switch_syms else ca.SX(0, 1)
+        outputs = ca.Function("outputs", [t, y, yp, switch, P], [ca.vertcat(*[c.expr for c in channels])],
+                              ["t", "y", "yp", "switch", "P"], ["channels"])
+        # accelerations, multipliers (and work rate) from (t, q, v, contact forces) as generated code:
+        # consistent states at restarts and at every reported point cost ~1 us
+        work_rate = [self.drive_power_of + ca.dot(self.Fc, v) + self.loads.power] if self.track_work else []
+        accel = ca.Function("accel", [t, q, v, self.Fc, P],
+                            [ca.densify(ca.vertcat(self.a_sol, self.lam_sol, *work_rate))],
+                            ["t", "q", "v", "Qc", "P"], ["a_lam"])
+        kinematics_flat = ca.Function("kinematics_flat", [q, v, t, P],
+                                      [ca.densify(ca.vertcat(self.Phi, ca.vec(self.Phi_q), self.Phi_dot))],
+                                      ["q", "v", "t", "P"], ["K"])
+        builds = self.contact_builds
+        start_list = self.phi_list + [c for build in builds for c in build.ideal]
+        start_names = tuple(self.names) + tuple(label for build in builds for label in build.ideal_names)
+        Phi_s = ca.vertcat(*start_list) if start_list else ca.SX(0, 1)
+        Phi_s_q = ca.jacobian(Phi_s, q)
+        Phi_s_dot = ca.mtimes(Phi_s_q, v) + ca.jacobian(Phi_s, t)
+        start_flat = ca.Function("start_kinematics_flat", [q, v, t, P],
+                                 [ca.densify(ca.vertcat(Phi_s, ca.vec(Phi_s_q), Phi_s_dot))],
+                                 ["q", "v", "t", "P"], ["K"])
+        extras = [outputs, accel, kinematics_flat, start_flat] + [term.force for term in self.terms]
+        # simple contact pairs whose switches the compiled loop may handle itself (see ida_driver.c)
+        logic_makers = tuple(build.logic for build in builds)
+        sample = [logic for make in logic_makers for logic in make(self.table.vector)]
+        auto_pairs = []
+        simple = [getattr(logic, "simple_pairs", lambda: None)() for logic in sample]
+        given = [pairs for pairs in simple if pairs is not None]
+        if sample and len(given) == len(simple):
+            for index, pairs in enumerate(given):
+                for root, term_index, gap_rate, needs, _floor in pairs:
+                    extras.append(gap_rate)
+                    auto_pairs.append((root, term_index, len(extras) - 1, needs, index))
+        functions = DAEFunctions(
+            n=self.n_y, residual=self.residual, jacobian=self.jacobian, term_residuals=tuple(self.term_res),
+            term_jacobians=tuple(self.term_jac), roots=self.roots, name=library_name, extras=tuple(extras),
+            n_parameters=int(P.numel()),
+        )
+        model = DAEModel(
+            scene_name=self.scene.name, formulation=self.formulation, alpha=0.0, beta=0.0,
+            body_names=tuple(b.name for b in self.bodies), constraint_names=tuple(self.names),
+            state_names=tuple(self.state_names), state_kinds=tuple(self.kinds), functions=functions,
+            terms=tuple(self.terms), gap_names=tuple(self.gap_names),
+            channel_names=tuple(c.name for c in channels), channel_units={c.name: c.unit for c in channels},
+            outputs=outputs, q_guess=np.zeros(n), v_guess=np.zeros(n), mass_diagonal=np.ones(n),
+            kinematics=self.kinematics, base_force=self.base_force, track_work=self.track_work,
+            start_constraint_names=start_names, constraint_elements=tuple(self.owners),
+            driver_names=tuple(self.driver_rows),
+        )  # numbers are bound per scene (_Template.bind)
+        return _Template(model=model, layout=self.table.layout, logic=logic_makers, auto_pairs=tuple(auto_pairs))
 
 
 def _c_identifier(name: str) -> str:
