@@ -202,129 +202,99 @@ class PythonSession(SessionBase):
                 store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
                 chunked: bool = False) -> Advance:
         t_stop = self._check_advance(t_stop)
-        n = self._n
-        te = self._select_eval(t_eval, t_stop)
-        ev_y = np.empty((te.size, n))
-        ev_yp = np.empty((te.size, n))
-        ie = 0
-        st: list[float] = []
-        sy: list[np.ndarray] = []
-        syp: list[np.ndarray] = []
-        sh: list[float] = []
-        t_rec = self._t
-        status, flag, flag_name, message, roots = "tstop", 0, "", "", None
-        solver = self._solver
-        max_steps = self._opts.max_steps
+        rows = _Rows(self._select_eval(t_eval, t_stop), self._n, self._t)
+        outcome = _Outcome()
         tic = time.perf_counter()
         try:
-            if t_stop - self._t <= 4.0 * np.finfo(float).eps * max(abs(t_stop), abs(self._t)):
-                status = "tstop"
-            else:
-                while True:
-                    if self._count["steps"] >= max_steps:
-                        status, flag = "error", FLAG_MAX_STEPS
-                        flag_name = OWN_FLAG_NAMES[flag]
-                        message = (f"step cap reached: {self._count['steps']} IDA steps in this session "
-                                   f"(max_steps={max_steps}) at t={self._t!r}")
-                        break
-                    interpolated = False
-                    try:
-                        if self._pending_tn:
-                            # after a root return IDA's internal time tn is beyond self._t; a
-                            # t_stop inside (self._t, tn) makes IDASetStopTime fail (scikit-sundae
-                            # prints that error): then IDA_NORMAL mode interpolates, as in C
-                            try:
-                                with contextlib.redirect_stdout(io.StringIO()):
-                                    r = solver.step(t_stop, method="onestep", tstop=t_stop)
-                            except RuntimeError as exc:
-                                if "IDASetStopTime" not in str(exc):
-                                    raise
-                                r = solver.step(t_stop, method="normal", tstop=None)
-                                interpolated = True
-                        else:
-                            r = solver.step(t_stop, method="onestep", tstop=t_stop)
-                    except _ModelError as exc:
-                        status, flag, flag_name = "error", -8, "IDA_RES_FAIL"
-                        message = f"IDA_RES_FAIL at t={self._t!r}: {exc}"
-                        break
-                    fl = int(r.status)
-                    if fl < 0:
-                        status, flag = "error", fl
-                        flag_name = _IDA_FLAG_NAMES.get(fl, f"IDA flag {fl}")
-                        message = f"{flag_name} at t={float(r.t)!r}: {r.message}"
-                        self._t, self._y, self._yp = float(r.t), np.array(r.y, float), np.array(r.yp, float)
-                        break
-                    t_prev, y_prev, yp_prev = self._t, self._y, self._yp
-                    t_new = float(r.t)
-                    y_new = np.array(r.y, dtype=float).reshape(-1)
-                    yp_new = np.array(r.yp, dtype=float).reshape(-1)
-                    # was a new internal step taken in this call?
-                    new_step = False
-                    h = float("nan")
-                    if interpolated:  # no step taken; IDA still holds tn for the next call
-                        if fl == 0:
-                            fl = 1  # y(t_stop) returned: this advance is done
-                    elif fl == 2:  # root
-                        if not self._pending_tn:
-                            new_step = True
-                            self._count["steps"] += 1
-                        self._pending_tn = True
-                    elif self._pending_tn:  # y(tn) returned after a root: no new step
-                        self._pending_tn = False
-                        h = t_new - self._t_internal
-                        self._t_internal = t_new
-                    elif t_new > t_prev:
-                        new_step = True
-                        self._count["steps"] += 1
-                        h = t_new - self._t_internal
-                        self._t_internal = t_new
-                    self._t, self._y, self._yp = t_new, y_new, yp_new
-                    # t_eval points in (t_prev, t_new]: cubic Hermite on the two return points
-                    filled = ie < te.size and te[ie] <= t_new
-                    if filled:
-                        j = int(np.searchsorted(te, t_new, side="right"))
-                        yy, yyp = cubic_hermite(t_prev, y_prev, yp_prev, t_new, y_new, yp_new, te[ie:j],
-                                                derivative=True)
-                        ev_y[ie:j], ev_yp[ie:j] = yy, yyp
-                        ie = j
-                    if store_steps and t_new > t_rec:
-                        st.append(t_new)
-                        sy.append(y_new)
-                        syp.append(yp_new)
-                        sh.append(h)
-                        t_rec = t_new
-                    if new_step and fl != 1 and not math.isnan(h):
-                        if self._stall.step(t_new, h):
-                            status, flag = "error", FLAG_STEP_COLLAPSE
-                            flag_name = OWN_FLAG_NAMES[flag]
-                            message = self._stall.describe(t_new, h)
-                            break
-                    if fl == 2:
-                        status = "root"
-                        roots = np.asarray(r.i_events[-1], dtype=np.int32).copy()
-                        ev = getattr(self, "_events", None)
-                        if ev is not None:  # keep scikit-sundae's event log from growing
-                            for name in ("_i", "_t", "_y", "_yp"):
-                                getattr(ev, name).clear()
-                        break
-                    if fl == 1:
-                        status = "tstop"
-                        break
-                    if chunked and ((te.size and ie == te.size and filled)
-                                    or len(st) >= self._opts.buffer_steps):
-                        status = "chunk"  # the caller empties the rows and calls again
-                        break
+            if t_stop - self._t > 4.0 * np.finfo(float).eps * max(abs(t_stop), abs(self._t)):
+                self._step_until(t_stop, rows, outcome, store_steps, chunked)
         finally:
             self._solve_time += time.perf_counter() - tic
-        k = len(st)
-        adv = Advance(
-            status=status, t=self._t, y=self._y.copy(), yp=self._yp.copy(),
-            step_t=np.array(st, dtype=float), step_y=np.array(sy, dtype=float).reshape(k, n),
-            step_yp=np.array(syp, dtype=float).reshape(k, n), step_h=np.array(sh, dtype=float),
-            step_order=np.full(k, -1, dtype=np.int32), eval_t=te[:ie].copy(), eval_y=ev_y[:ie],
-            eval_yp=ev_yp[:ie], roots_found=roots, flag=flag, flag_name=flag_name, message=message,
-        )
-        return adv
+        return rows.advance(outcome, self._t, self._y, self._yp)
+
+    def _step_until(self, t_stop: float, rows: _Rows, outcome: _Outcome, store_steps: bool, chunked: bool) -> None:
+        """IDA in one-step mode until t_stop, a root, a failure, the step cap or (chunked) a full buffer."""
+        while True:
+            if self._count["steps"] >= self._opts.max_steps:
+                outcome.fail(FLAG_MAX_STEPS, OWN_FLAG_NAMES[FLAG_MAX_STEPS],
+                             f"step cap reached: {self._count['steps']} IDA steps in this session "
+                             f"(max_steps={self._opts.max_steps}) at t={self._t!r}")
+                return
+            try:
+                r, interpolated = self._ida_step(t_stop)
+            except _ModelError as exc:
+                outcome.fail(-8, "IDA_RES_FAIL", f"IDA_RES_FAIL at t={self._t!r}: {exc}")
+                return
+            fl = int(r.status)
+            if fl < 0:
+                flag_name = _IDA_FLAG_NAMES.get(fl, f"IDA flag {fl}")
+                outcome.fail(fl, flag_name, f"{flag_name} at t={float(r.t)!r}: {r.message}")
+                self._t, self._y, self._yp = float(r.t), np.array(r.y, float), np.array(r.yp, float)
+                return
+            t_prev, y_prev, yp_prev = self._t, self._y, self._yp
+            fl, new_step, h = self._take_return(r, fl, interpolated)
+            filled = rows.interpolate(t_prev, y_prev, yp_prev, self._t, self._y, self._yp)
+            if store_steps:
+                rows.keep_step(self._t, self._y, self._yp, h)
+            if new_step and fl != 1 and not math.isnan(h) and self._stall.step(self._t, h):
+                outcome.fail(FLAG_STEP_COLLAPSE, OWN_FLAG_NAMES[FLAG_STEP_COLLAPSE], self._stall.describe(self._t, h))
+                return
+            if fl == 2:
+                outcome.status, outcome.roots = "root", np.asarray(r.i_events[-1], dtype=np.int32).copy()
+                ev = getattr(self, "_events", None)
+                if ev is not None:  # keep scikit-sundae's event log from growing
+                    for name in ("_i", "_t", "_y", "_yp"):
+                        getattr(ev, name).clear()
+                return
+            if fl == 1:
+                return  # t_stop reached: status "tstop"
+            if chunked and ((rows.te.size and rows.ie == rows.te.size and filled)
+                            or len(rows.st) >= self._opts.buffer_steps):
+                outcome.status = "chunk"  # the caller empties the rows and calls again
+                return
+
+    def _ida_step(self, t_stop: float) -> tuple[Any, bool]:
+        """One call of IDA towards t_stop: (its return, whether it only interpolated)."""
+        solver = self._solver
+        if not self._pending_tn:
+            return solver.step(t_stop, method="onestep", tstop=t_stop), False
+        # after a root return IDA's internal time tn is beyond self._t; a t_stop inside
+        # (self._t, tn) makes IDASetStopTime fail (scikit-sundae prints that error): then
+        # IDA_NORMAL mode interpolates, as in C
+        try:
+            with contextlib.redirect_stdout(io.StringIO()):
+                return solver.step(t_stop, method="onestep", tstop=t_stop), False
+        except RuntimeError as exc:
+            if "IDASetStopTime" not in str(exc):
+                raise
+            return solver.step(t_stop, method="normal", tstop=None), True
+
+    def _take_return(self, r: Any, fl: int, interpolated: bool) -> tuple[int, bool, float]:
+        """Move the session to IDA's returned point: (flag, whether a new internal step was taken,
+        that step's size or nan)."""
+        t_new = float(r.t)
+        new_step, h = False, float("nan")
+        if interpolated:  # no step taken; IDA still holds tn for the next call
+            if fl == 0:
+                fl = 1  # y(t_stop) returned: this advance is done
+        elif fl == 2:  # root
+            if not self._pending_tn:
+                new_step = True
+                self._count["steps"] += 1
+            self._pending_tn = True
+        elif self._pending_tn:  # y(tn) returned after a root: no new step
+            self._pending_tn = False
+            h = t_new - self._t_internal
+            self._t_internal = t_new
+        elif t_new > self._t:
+            new_step = True
+            self._count["steps"] += 1
+            h = t_new - self._t_internal
+            self._t_internal = t_new
+        self._t = t_new
+        self._y = np.array(r.y, dtype=float).reshape(-1)
+        self._yp = np.array(r.yp, dtype=float).reshape(-1)
+        return fl, new_step, h
 
     def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
         self._check_open()
@@ -380,3 +350,61 @@ _IDA_FLAG_NAMES = {
     -24: "IDA_BAD_EWT", -25: "IDA_BAD_K", -26: "IDA_BAD_T", -27: "IDA_BAD_DKY",
     -28: "IDA_VECTOROP_ERR", -29: "IDA_CONTEXT_ERR", -99: "IDA_UNRECOGNIZED_ERROR",
 }
+
+
+class _Outcome:
+    """How an advance of the python session ended (``Advance.status`` and its flag)."""
+
+    def __init__(self) -> None:
+        self.status, self.flag, self.flag_name, self.message = "tstop", 0, "", ""
+        self.roots: np.ndarray | None = None
+
+    def fail(self, flag: int, flag_name: str, message: str) -> None:
+        self.status, self.flag, self.flag_name, self.message = "error", flag, flag_name, message
+
+
+class _Rows:
+    """The points one advance of the python session reports: the output times it reaches (cubic
+    Hermite between two IDA returns) and the returns themselves (its steps)."""
+
+    def __init__(self, te: np.ndarray, n: int, t_start: float) -> None:
+        self.te, self.n = te, n
+        self.ev_y, self.ev_yp = np.empty((te.size, n)), np.empty((te.size, n))
+        self.ie = 0  # output times filled so far
+        self.st: list[float] = []
+        self.sy: list[np.ndarray] = []
+        self.syp: list[np.ndarray] = []
+        self.sh: list[float] = []
+        self.t_rec = t_start  # the last time kept as a step
+
+    def interpolate(self, t_prev: float, y_prev: np.ndarray, yp_prev: np.ndarray, t_new: float,
+                    y_new: np.ndarray, yp_new: np.ndarray) -> bool:
+        """Fill the output times in (t_prev, t_new]; whether there was any."""
+        te, ie = self.te, self.ie
+        if not (ie < te.size and te[ie] <= t_new):
+            return False
+        j = int(np.searchsorted(te, t_new, side="right"))
+        self.ev_y[ie:j], self.ev_yp[ie:j] = cubic_hermite(t_prev, y_prev, yp_prev, t_new, y_new, yp_new, te[ie:j],
+                                                          derivative=True)
+        self.ie = j
+        return True
+
+    def keep_step(self, t: float, y: np.ndarray, yp: np.ndarray, h: float) -> None:
+        """Keep an IDA return beyond the last kept one as a step."""
+        if t > self.t_rec:
+            self.st.append(t)
+            self.sy.append(y)
+            self.syp.append(yp)
+            self.sh.append(h)
+            self.t_rec = t
+
+    def advance(self, outcome: _Outcome, t: float, y: np.ndarray, yp: np.ndarray) -> Advance:
+        k, n, ie = len(self.st), self.n, self.ie
+        return Advance(
+            status=outcome.status, t=t, y=y.copy(), yp=yp.copy(),
+            step_t=np.array(self.st, dtype=float), step_y=np.array(self.sy, dtype=float).reshape(k, n),
+            step_yp=np.array(self.syp, dtype=float).reshape(k, n), step_h=np.array(self.sh, dtype=float),
+            step_order=np.full(k, -1, dtype=np.int32), eval_t=self.te[:ie].copy(), eval_y=self.ev_y[:ie],
+            eval_yp=self.ev_yp[:ie], roots_found=outcome.roots, flag=outcome.flag, flag_name=outcome.flag_name,
+            message=outcome.message,
+        )
