@@ -150,117 +150,155 @@ def check_step(method: str, step: Any) -> float | None:
 # =========================================================================== the run
 
 
+_SCIPY_HINT = "Try a smaller max_step, a looser rtol or another method."
+
+
 def _run_scipy(run: Run, x0: NDArray, rtol: float, atol: NDArray, max_step: float, t0: float = 0.0) -> None:
+    """Integrate segment by segment with a scipy solver, restarting it at every contact event."""
     import scipy.integrate as si
 
     cls = {"rk45": si.RK45, "dop853": si.DOP853, "radau": si.Radau, "bdf": si.BDF, "lsoda": si.LSODA}[run.method]
-    ev, t_end = run.ev, run.t_end
     opts: dict[str, Any] = dict(rtol=rtol, atol=atol, max_step=max_step if max_step > 0 else np.inf)
     if run.method in IMPLICIT_METHODS:
-        opts["jac"] = ev.jac
-    hint = "Try a smaller max_step, a looser rtol or another method."
+        opts["jac"] = run.ev.jac
     t, x = t0, x0
     while True:
         run.open_segment(t, x)
-        dirs = run.directions()
-        watch = dirs is not None  # every gap, in its direction (0: both, as IDA)
-        g0 = gd0 = np.empty(0)  # read only when watch
-        if watch:
-            gg = ev.gaps(t, x)
-            if gg is None:
-                run.fail(t, ev.last_message, "")
-                return
-            g0, gd0 = gg
+        watch = _Watch.start(run, t, x)
+        if watch is None:
+            return
         try:
-            solver = cls(ev.rhs, t, x, t_end, **opts)
+            solver = cls(run.ev.rhs, t, x, run.t_end, **opts)
         except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-            run.fail(t, f"the solver could not start: {exc}", hint)
+            run.fail(t, f"the solver could not start: {exc}", _SCIPY_HINT)
             return
         lu0 = getattr(solver, "nlu", 0)
+        t_last, restart = _scipy_segment(run, solver, watch, t)
         seg = run.seg
         assert seg is not None
-        add_t, add_x = seg.pt.append, seg.px.append
-        solver_step = solver.step
-        n_gaps = 0 if dirs is None else len(dirs)
-        watched = [(i, d) for i in range(n_gaps) for d in (1, -1) if dirs[i] * d >= 0]  # type: ignore[index]
-        next_eval = run.pending[0] if run.pending is not None and run.pending.size else math.inf
-        t_prev = t
-        restart: tuple[float, NDArray, Any] | None = None
-        while True:
-            if run.n_steps >= run.max_steps:
-                run.fail(t_prev, f"max_steps={run.max_steps} steps reached", "Raise max_steps or loosen rtol.")
-                break
-            try:
-                msg = solver_step()
-            except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-                msg = f"{type(exc).__name__}: {exc}"
-                solver.status = "failed"
-            if solver.status == "failed":
-                why = str(msg or "the solver failed")
-                if ev.last_message:
-                    why += f" (last model error: {ev.last_message})"
-                run.fail(t_prev, why, hint)
-                break
-            t1, x1 = float(solver.t), solver.y.copy()
-            if not math.isfinite(x1.sum()):
-                bad = int(np.flatnonzero(~np.isfinite(x1))[0])
-                run.fail(t_prev, f"the state became non-finite ({run.model.state_names[bad]} = {x1[bad]})", hint)
-                break
-            if not run.count_step(t_prev, t1):
-                break
-            sol = None
-            if watch:
-                gg = ev.gaps(t1, x1)
-                if gg is None:
-                    run.fail(t1, ev.last_message, hint)
-                    break
-                g1, gd1 = gg
-                h = t1 - t_prev
-                cands = []
-                for i, d in watched:
-                    s = candidate(d * g0[i], d * gd0[i], d * g1[i], d * gd1[i], h, HERMITE_GAP_CHECK)
-                    if s > 0.0:
-                        cands.append((i, d, s))
-                if cands:
-                    sol = solver.dense_output()
-
-                    def dense(tt: float, sol: Any = sol) -> NDArray:
-                        return np.array(sol(tt), dtype=float)
-
-                    found = locate(ev, dense, t_prev, (g0, gd0), t1, x1, (g1, gd1), cands, n_gaps)
-                    if isinstance(found, str):
-                        run.fail(t_prev, found, hint)
-                        break
-                    if found is not None:
-                        t_ev, x_ev, roots = found
-                        te = run.pending_upto(t_ev)
-                        if te.size:
-                            run.add_evals(te, np.atleast_2d(np.array(sol(te), dtype=float).T))
-                        add_t(t_ev)
-                        add_x(x_ev)
-                        restart = (t_ev, x_ev, roots)
-                        break
-                g0, gd0 = g1, gd1
-            if next_eval <= t1:
-                te = run.pending_upto(t1)
-                if sol is None:
-                    sol = solver.dense_output()
-                run.add_evals(te, np.atleast_2d(np.array(sol(te), dtype=float).T))
-                next_eval = run.pending[0] if run.pending is not None and run.pending.size else math.inf
-            add_t(t1)
-            add_x(x1)
-            if run.progress:
-                run._progress(t1)
-            t_prev = t1
-            if solver.status == "finished":
-                break
-        seg.t1 = t_prev if restart is None else restart[0]
+        seg.t1 = t_last if restart is None else restart[0]
         run.t_last = seg.t1
         run.n_lu += getattr(solver, "nlu", 0) - lu0
-        if not _end_segment(run, restart, False, t_end):
+        if not _end_segment(run, restart, False, run.t_end):
             return
         assert restart is not None  # _end_segment goes on only after an event
         t, x, _ = restart  # the next segment starts at the event
+
+
+class _Watch:
+    """The gap functions a segment watches (each in the direction of its next switch, 0: both, as
+    IDA) and their values and rates at the last accepted step."""
+
+    def __init__(self, dirs: Any, g: NDArray, gd: NDArray) -> None:
+        self.enabled = dirs is not None
+        self.n_gaps = 0 if dirs is None else len(dirs)
+        self.watched = [(i, d) for i in range(self.n_gaps) for d in (1, -1) if dirs[i] * d >= 0]
+        self.g, self.gd = g, gd
+
+    @classmethod
+    def start(cls, run: Run, t: float, x: NDArray) -> _Watch | None:
+        """The watch at the segment's start; None (the run failed) when the gaps cannot be evaluated."""
+        dirs = run.directions()
+        if dirs is None:
+            return cls(None, np.empty(0), np.empty(0))  # g and gd are read only when enabled
+        gg = run.ev.gaps(t, x)
+        if gg is None:
+            run.fail(t, run.ev.last_message, "")
+            return None
+        return cls(dirs, *gg)
+
+
+def _scipy_segment(run: Run, solver: Any, watch: _Watch, t: float) -> tuple[float, tuple[float, NDArray, Any] | None]:
+    """Step one segment to its end, an event or a failure: (time of the last step, the event to
+    restart from or None)."""
+    seg = run.seg
+    assert seg is not None
+    add_t, add_x = seg.pt.append, seg.px.append
+    solver_step = solver.step
+    next_eval = run.pending[0] if run.pending is not None and run.pending.size else math.inf
+    t_prev = t
+    while True:
+        if run.n_steps >= run.max_steps:
+            run.fail(t_prev, f"max_steps={run.max_steps} steps reached", "Raise max_steps or loosen rtol.")
+            return t_prev, None
+        try:
+            msg = solver_step()
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+            msg = f"{type(exc).__name__}: {exc}"
+            solver.status = "failed"
+        if solver.status == "failed":
+            why = str(msg or "the solver failed")
+            if run.ev.last_message:
+                why += f" (last model error: {run.ev.last_message})"
+            run.fail(t_prev, why, _SCIPY_HINT)
+            return t_prev, None
+        t1, x1 = float(solver.t), solver.y.copy()
+        if not math.isfinite(x1.sum()):
+            bad = int(np.flatnonzero(~np.isfinite(x1))[0])
+            run.fail(t_prev, f"the state became non-finite ({run.model.state_names[bad]} = {x1[bad]})", _SCIPY_HINT)
+            return t_prev, None
+        if not run.count_step(t_prev, t1):
+            return t_prev, None
+        sol = None
+        if watch.enabled:
+            outcome, sol = _event_in_step(run, solver, watch, t_prev, t1, x1)
+            if isinstance(outcome, tuple):  # an event: its point ends the segment
+                add_t(outcome[0])
+                add_x(outcome[1])
+                return t_prev, outcome
+            if outcome == "failed":
+                return t_prev, None
+        if next_eval <= t1:
+            te = run.pending_upto(t1)
+            if sol is None:
+                sol = solver.dense_output()
+            run.add_evals(te, np.atleast_2d(np.array(sol(te), dtype=float).T))
+            next_eval = run.pending[0] if run.pending is not None and run.pending.size else math.inf
+        add_t(t1)
+        add_x(x1)
+        if run.progress:
+            run._progress(t1)
+        t_prev = t1
+        if solver.status == "finished":
+            return t_prev, None
+
+
+def _event_in_step(run: Run, solver: Any, watch: _Watch, t_prev: float, t1: float,
+                   x1: NDArray) -> tuple[Any, Any]:
+    """Look for a watched gap crossing inside the step (t_prev, t1]: (the event (t, x, roots), with the
+    output times before it reported; "failed" after run.fail; or "none"), and the step's dense
+    output when it was made. The watch moves on to t1 when there is no event."""
+    ev = run.ev
+    gg = ev.gaps(t1, x1)
+    if gg is None:
+        run.fail(t1, ev.last_message, _SCIPY_HINT)
+        return "failed", None
+    g0, gd0, (g1, gd1) = watch.g, watch.gd, gg
+    h = t1 - t_prev
+    cands = []
+    for i, d in watch.watched:
+        s = candidate(d * g0[i], d * gd0[i], d * g1[i], d * gd1[i], h, HERMITE_GAP_CHECK)
+        if s > 0.0:
+            cands.append((i, d, s))
+    sol = None
+    if cands:
+        sol = solver.dense_output()
+
+        def dense(tt: float, sol: Any = sol) -> NDArray:
+            return np.array(sol(tt), dtype=float)
+
+        found = locate(ev, dense, t_prev, (g0, gd0), t1, x1, (g1, gd1), cands, watch.n_gaps)
+        if isinstance(found, str):
+            run.fail(t_prev, found, _SCIPY_HINT)
+            return "failed", sol
+        if found is not None:
+            t_ev, x_ev, roots = found
+            te = run.pending_upto(t_ev)
+            if te.size:
+                run.add_evals(te, np.atleast_2d(np.array(sol(te), dtype=float).T))
+            return (t_ev, x_ev, roots), sol
+    watch.g, watch.gd = g1, gd1
+    return "none", sol
 
 
 def _end_segment(run: Run, restart: Any, hermite: bool, t_end: float) -> bool:
