@@ -34,7 +34,7 @@ DEFAULT_FORMULATION = "ggl"
 CHAPTER_FORMULATION = "index1"
 BACKENDS: tuple[str, ...] = ("auto", "c", "python")
 ON_FAILURE: tuple[str, ...] = ("raise", "return")
-LINEAR_SOLVERS: tuple[str, ...] = ("auto", "dense", "sparse")
+LINEAR_SOLVERS: tuple[str, ...] = ("auto", "reduced", "dense", "sparse")
 #: How a run starts: "ideal" (the chapter's: clearance joints centred, positions and velocities
 #: assembled on the mechanism whose clearance joints are ideal) or "declared" (the bodies' own
 #: positions and velocities, corrected only for the ideal joints the scene has).

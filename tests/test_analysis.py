@@ -186,16 +186,23 @@ def test_chapter_large_clearance_is_chaotic():
     analysis = classify_motion(slider_crank("revolute", clearance=0.5e-3), **SHORT)
     motion = analysis.motion
     assert motion.label == "chaotic", motion
-    assert motion.evidence["periodicity_defect"] > 0.2  # measured 0.3-0.6
+    # measured 0.3-0.6, 0.15 since the IDA loop refreshes its Jacobian more often (a chaotic
+    # run's number); periodic runs give 0.002-0.004 (test_chapter_friction_...)
+    assert motion.evidence["periodicity_defect"] > 0.1
     assert motion.evidence["decorrelation"] > 0.3
     assert motion.evidence["lyapunov"] > 0
     assert analysis.twins is not None and analysis.divergence.amplification > 100
 
 
 def test_chapter_friction_makes_the_response_closer_to_periodic():
-    """Fig. 4.21: with c = 0.5 mm, friction 0.1 gives a periodic map, 0.01 a spread one."""
-    low = classify_motion(slider_crank("revolute", clearance=0.5e-3, friction=0.01), twin=False, **SHORT).motion
-    high = classify_motion(slider_crank("revolute", clearance=0.5e-3, friction=0.1), twin=False, **SHORT).motion
+    """Fig. 4.21: with c = 0.5 mm, friction 0.1 gives a periodic map, 0.01 a spread one.
+
+    Friction 0.1 settles onto its period-1 orbit within 5 to 15 revolutions, depending on the
+    solver's step history (measured: after 5 its defect is 0.003 or 0.03 with IDA's Jacobian
+    refreshed at a 25 % or 5 % change of cj); after 20 it is 0.002-0.004 either way."""
+    settled = {**SHORT, "transient": 20}
+    low = classify_motion(slider_crank("revolute", clearance=0.5e-3, friction=0.01), twin=False, **settled).motion
+    high = classify_motion(slider_crank("revolute", clearance=0.5e-3, friction=0.1), twin=False, **settled).motion
     assert (high.label, high.period) == ("periodic", 1)
     assert low.label == "non-periodic"
     assert high.evidence["periodicity_defect"] < low.evidence["periodicity_defect"] / 10

@@ -50,9 +50,9 @@ def dense_of(data, rows, colptr, n):
 
 def test_option_is_validated_with_a_clear_message():
     with pytest.raises(ValueError, match=r"linear_solver='banded' is not a linear solver: valid values are "
-                                         r"'auto', 'dense', 'sparse'"):
+                                         r"'auto', 'reduced', 'dense', 'sparse'"):
         open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="banded")
-    with pytest.raises(SceneError, match=r"linear_solver='lu', must be one of auto, dense, sparse"):
+    with pytest.raises(SceneError, match=r"linear_solver='lu', must be one of auto, reduced, dense, sparse"):
         dc.simulate(chain(1), 1e-3, linear_solver="lu")
     s = open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="SPARSE")
     assert s.linear_solver == "sparse" and s.stats()["linear_solver"] == "sparse"
@@ -60,7 +60,7 @@ def test_option_is_validated_with_a_clear_message():
 
 def test_auto_uses_the_measured_threshold(monkeypatch):
     s = open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8)
-    assert s.linear_solver == "dense" and ida_session.SPARSE_MIN_STATES > 2
+    assert s.linear_solver == "reduced" == s.stats()["linear_solver"] and ida_session.SPARSE_MIN_STATES > 2
     monkeypatch.setattr(c_session, "SPARSE_MIN_STATES", 2)
     assert open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8).linear_solver == "sparse"
     assert open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="dense").linear_solver == "dense"
@@ -74,7 +74,7 @@ def test_python_backend_stays_dense():
 def test_sparse_unavailable_is_a_clear_error():
     with pytest.raises(DaeclearError, match="linear_solver='sparse' is not available"):
         c_session._resolve_linear_solver("sparse", 100, has_sparse=False)
-    assert c_session._resolve_linear_solver("auto", 10_000, has_sparse=False) == "dense"
+    assert c_session._resolve_linear_solver("auto", 10_000, has_sparse=False) == "reduced"
 
 
 # --------------------------------------------------------------------------- union pattern
@@ -104,9 +104,11 @@ def test_union_pattern_holds_every_term_and_fills_like_the_dense_matrix():
 # --------------------------------------------------------------------------- same results
 
 
-def both(scene, t_end: float, rtol: float = 1e-8) -> tuple[dc.Result, dc.Result]:
-    out = [dc.simulate(scene, t_end, rtol=rtol, backend="c", linear_solver=ls) for ls in ("dense", "sparse")]
-    assert [r.stats["linear_solver"] for r in out] == ["dense", "sparse"]
+def both(scene, t_end: float, rtol: float = 1e-8, solvers: tuple[str, str] = ("dense", "sparse"),
+         formulation: str = "ggl") -> tuple[dc.Result, dc.Result]:
+    out = [dc.simulate(scene, t_end, rtol=rtol, backend="c", linear_solver=ls, formulation=formulation)
+           for ls in solvers]
+    assert [r.stats["linear_solver"] for r in out] == list(solvers)
     return out[0], out[1]
 
 
@@ -123,6 +125,55 @@ def test_sparse_and_dense_agree_on_the_slider_crank():
     a, b = both(slider_crank("revolute"), 0.005)
     assert len(a.events) >= 20
     assert_same_run(a, b, t_tol=1e-9, y_rtol=1e-6)
+
+
+@pytest.mark.parametrize("formulation", ["ggl", "index1"])
+def test_reduced_agrees_with_the_whole_dense_lu_on_the_slider_crank(formulation):
+    """The reduced solver changes only IDA's iteration matrix (GGL: the q-derivative of
+    Phi_q^T mu dropped), never the equations: same events and states to the tolerance."""
+    a, b = both(slider_crank("revolute"), 0.005, solvers=("reduced", "dense"), formulation=formulation)
+    assert len(a.events) >= 20
+    assert_same_run(a, b, t_tol=1e-9, y_rtol=1e-6)
+
+
+def test_reduced_agrees_with_sparse_on_a_chain_of_three():
+    a, b = both(chain(3), 0.02, solvers=("reduced", "sparse"))
+    assert {e.pair for e in a.events} == {"pin1", "pin2", "pin3"}
+    assert_same_run(a, b, t_tol=1e-8, y_rtol=1e-6)
+
+
+@pytest.mark.parametrize("formulation", ["ggl", "index1"])
+def test_reduced_solve_equals_a_plain_lu(formulation):
+    """J x = b by eliminating the n_q position rows equals numpy's LU of the whole J wherever the
+    q-row block is diagonal: always for index1; for GGL where mu = 0 (every consistent state) and
+    here also off it, because each body's angle enters Phi_q only through its own rotation, so
+    d(Phi_q^T mu)/dq is diagonal. Eliminating no rows is a plain LU again."""
+    model = dc.assemble(slider_crank("revolute"), formulation)
+    y, yp = model.initial_state()
+    s = open_session(model.functions, backend="c", rtol=1e-8, atol=1e-10, parameters=model.parameter_values,
+                     linear_solver="reduced")
+    s.set_terms([False] * len(model.terms), [np.zeros(term.n_params) for term in model.terms])
+    layout = model.layout(project=False)
+    nq, mu = layout.n_q, slice(2 * layout.n_q + layout.n_constraints, None)
+    rng = np.random.default_rng(7)
+    b = rng.normal(size=model.n_states)
+    for cj in (1e3, 1e7):
+        J = s.jacobian(0.0, y, yp, cj)
+        exact = np.linalg.solve(J, b)
+        np.testing.assert_allclose(s.solve_reduced(0.0, y, yp, cj, b, nq), exact, rtol=1e-9,
+                                   atol=1e-12 * np.abs(exact).max())
+        np.testing.assert_allclose(s.solve_reduced(0.0, y, yp, cj, b, 0), exact, rtol=1e-9,
+                                   atol=1e-12 * np.abs(exact).max())
+    if formulation == "ggl":
+        assert not np.any(y[mu])
+        y_mu = y.copy()
+        y_mu[mu] = 1e-3  # mu off the manifold: the q-row block is cj I + d(Phi_q^T mu)/dq
+        J = s.jacobian(0.0, y_mu, yp, 1e3)
+        block = J[:nq, :nq]
+        assert np.any(np.diag(block) != 1e3) and not np.any(block - np.diag(np.diag(block)))
+        exact = np.linalg.solve(J, b)
+        np.testing.assert_allclose(s.solve_reduced(0.0, y_mu, yp, 1e3, b, nq), exact, rtol=1e-9,
+                                   atol=1e-12 * np.abs(exact).max())
 
 
 def test_sparse_and_dense_agree_on_a_chain_of_three():

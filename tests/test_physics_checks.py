@@ -190,7 +190,8 @@ def test_warnings_are_saved_and_loaded(tmp_path: Path):
     assert result.warnings
     again = dc.load(result.save(tmp_path / "run.h5"))
     assert again.warnings == result.warnings
-    assert "warnings: 2 (penetration, constraint_drift)" in repr(again)
+    kinds = list(dict.fromkeys(w["kind"] for w in result.warnings))
+    assert "penetration" in kinds and f"warnings: {len(result.warnings)} ({', '.join(kinds)})" in repr(again)
     # a file written before warnings existed: no warnings
     with h5py.File(tmp_path / "run.h5", "r+") as f:
         del f["warnings_json"]

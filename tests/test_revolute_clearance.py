@@ -231,13 +231,13 @@ def test_energy_balance_with_driver_and_dissipation():
     assert np.max(np.abs(steps["drive.moment"])) < 1.5 * np.max(np.abs(dense["drive.moment"]))
 
 
-def test_compiled_event_loop_matches_python_event_handling():
+def test_compiled_event_loop_matches_python_event_handling(plain_ida):
     """The compiled loop switches simple pairs itself; the python backend hands every root to the
-    pair logic. Same steps, same events, same channels (index-1: the python backend cannot set
-    GGL's Newton coefficient, see test_compiled_ggl_restarts_match_python)."""
+    pair logic. Same steps, same events, same channels (index-1 and IDA's own settings: the python
+    backend cannot set GGL's Newton coefficient, see test_compiled_ggl_restarts_match_python)."""
     model = dc.assemble(dc.mechanisms.slider_crank("revolute", gravity=0.0), "index1")
     assert model.auto_pairs == ((0, 0, EXTRA_TERM0 + len(model.terms), True, 1e-4),)  # gap-rate extra after the forces
-    fast = dc.simulate(model, 0.006, rtol=1e-8, backend="c")
+    fast = dc.simulate(model, 0.006, rtol=1e-8, backend="c", linear_solver=plain_ida)
     slow = dc.simulate(model, 0.006, rtol=1e-8, backend="python")
     assert fast.stats["n_steps"] == slow.stats["n_steps"]
     assert fast.events.kind == slow.events.kind and len(fast.events) > 20

@@ -54,7 +54,8 @@ __all__ = ["CSession", "SPARSE_MIN_STATES"]
 #: dense is faster up to 120 states (SuperLU_MT's fixed cost per factorization), sparse from 144
 #: states on (whole simulate calls 1.1x faster at 144 states, 1.3x at 192, 1.8x at 384).
 SPARSE_MIN_STATES = 144
-_LS_CODES = {"dense": 0, "sparse": 1}  # dc_open's linear_solver argument
+_LS_CODES = {"dense": 0, "sparse": 1, "reduced": 2}  # dc_open's linear_solver argument (DC_LS_*)
+_LS_NAMES = {code: name for name, code in _LS_CODES.items()}
 log = logging.getLogger("daeclear")
 
 _STAT_KEYS = (
@@ -72,9 +73,9 @@ _STAT_KEYS = (
 
 def _resolve_linear_solver(requested: str, n: int, has_sparse: bool) -> str:
     """The linear solver a compiled session uses: "auto" is sparse from SPARSE_MIN_STATES states on
-    (when the library has the sparse solver)."""
+    (when the library has the sparse solver), the reduced dense LU below."""
     if requested == "auto":
-        return "sparse" if has_sparse and n >= SPARSE_MIN_STATES else "dense"
+        return "sparse" if has_sparse and n >= SPARSE_MIN_STATES else "reduced"
     if requested == "sparse" and not has_sparse:
         raise DaeclearError("linear_solver='sparse' is not available: the scikit-sundae wheel lacks "
                             f"lib{SPARSE_LIBS[0]} or lib{SPARSE_LIBS[1]}; use 'dense' or 'auto'")
@@ -116,8 +117,9 @@ class CSession(SessionBase):
 
         h = dc_open()
         if not h and self._linear_solver == "sparse" and opts.linear_solver == "auto":
-            log.info("daeclear: sparse linear solver unavailable, using dense LU: %s", err.value.decode())
-            self._linear_solver = "dense"
+            log.info("daeclear: sparse linear solver unavailable, using the reduced dense LU: %s",
+                     err.value.decode())
+            self._linear_solver = "reduced"
             h = dc_open()
         if not h:
             raise DaeclearError(f"opening the compiled IDA session failed: {err.value.decode()}")
@@ -158,13 +160,18 @@ class CSession(SessionBase):
         for name in ("y0b", "yp0b", "actb", "rdb", "pcat"):
             self._addr[name] = getattr(self, "_" + name).ctypes.data
 
-    def set_hints(self, *, nonlin_conv_coef: float | None = None, init_step: float | None = None) -> bool:
-        """Solver hints: Newton convergence factor (IDA default 0.33) and the first step of the
-        next restart (0: IDA's estimate). Returns True (the compiled backend applies them)."""
+    def set_hints(self, *, nonlin_conv_coef: float | None = None, jacobian_refresh: float | None = None,
+                  first_step: bool | None = None) -> bool:
+        """Solver hints: Newton convergence factor (IDA default 0.33), the relative change of cj
+        from which IDA evaluates a new Jacobian (IDA default 0.25) and whether the run's first
+        step is the second-order estimate of ida_driver.c's first_step (else IDA's own). Returns
+        True (the compiled backend applies them)."""
         if nonlin_conv_coef is not None and self._lib.dc_set_nonlin_conv_coef(self._h, nonlin_conv_coef) < 0:
             raise DaeclearError(f"nonlin_conv_coef={nonlin_conv_coef!r} rejected by IDA; must be > 0.")
-        if init_step is not None and self._lib.dc_set_init_step(self._h, init_step) < 0:
-            raise DaeclearError(f"init_step={init_step!r} rejected by IDA.")
+        if jacobian_refresh is not None and self._lib.dc_set_jacobian_refresh(self._h, jacobian_refresh) < 0:
+            raise DaeclearError(f"jacobian_refresh={jacobian_refresh!r} rejected by IDA; must be >= 0.")
+        if first_step is not None:
+            self._lib.dc_set_first_step(self._h, int(first_step))
         return True
 
     def set_auto_events(self, pairs: Sequence[tuple[int, int, int, bool, float]], *, storms: Sequence[Storm],
@@ -447,6 +454,19 @@ class CSession(SessionBase):
             raise DaeclearError(f"the generated Jacobian failed at t={t}")
         return np.ascontiguousarray(out)
 
+    def solve_reduced(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float, b: np.ndarray,
+                      n_kinematic: int) -> np.ndarray:
+        """x with J x = b, J the iteration matrix at (t, y, yp, cj), by the "reduced" linear
+        solver with the first ``n_kinematic`` rows eliminated (its check against a plain LU)."""
+        self._check_open()
+        y, yp, x = self._vec(y, "y"), self._vec(yp, "yp"), self._vec(b, "b").copy()
+        self._sync_terms()
+        rc = self._lib.dc_solve_reduced(self._h, int(n_kinematic), float(t), y.ctypes.data, yp.ctypes.data,
+                                        float(cj), x.ctypes.data)
+        if rc:
+            raise DaeclearError(f"the reduced linear solve failed at t={t} ({'singular' if rc > 0 else 'error'})")
+        return x
+
     def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
         self._check_open()
         y, yp = self._vec(y, "y"), self._vec(yp, "yp")
@@ -478,13 +498,13 @@ class CSession(SessionBase):
         out["compile_time"] = self._build.compile_time
         out["codegen_time"] = self._build.codegen_time
         out["cache_hit"] = bool(self._build.cache_hit)
-        out["linear_solver"] = "sparse" if self._lib.dc_linear_solver(self._h) else "dense"
+        out["linear_solver"] = _LS_NAMES[self._lib.dc_linear_solver(self._h)]
         out["jac_nnz"] = self._jac_nnz
         return out
 
     @property
     def linear_solver(self) -> str:
-        """"dense" or "sparse": the LU IDA's Newton iteration uses in this session."""
+        """"reduced", "dense" or "sparse": the LU IDA's Newton iteration uses in this session."""
         return self._linear_solver
 
     @property

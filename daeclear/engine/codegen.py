@@ -106,7 +106,7 @@ __all__ = [
     "compile_cached",
 ]
 
-DRIVER_SOURCES = ("ida_driver.c", "dc_model.h", "dc_linalg.h")
+DRIVER_SOURCES = ("ida_driver.c", "dc_model.h", "dc_linalg.h", "dc_reduced_ls.h")
 CFLAGS = (f"-DDC_ABI_VERSION={DRIVER_ABI}", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
           "-Werror=incompatible-pointer-types", "-Werror=implicit-function-declaration", "-Wl,-z,defs")
 

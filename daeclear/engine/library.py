@@ -45,7 +45,7 @@ __all__ = [
 
 #: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
 #: and checked when a library is loaded: bump it when a dc_* signature changes.
-DRIVER_ABI = 3
+DRIVER_ABI = 4
 #: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
 ODE_DRIVER_ABI = 3
 
@@ -70,6 +70,7 @@ MODEL_PROTOTYPES: Prototypes = {
     "dc_eval_jacobian_sparse": (I, [P, D, P, P, D, P]),
     "dc_n_parameters": (I, []),
     "dc_set_nonlin_conv_coef": (I, [P, D]),
+    "dc_set_jacobian_refresh": (I, [P, D]),
     "dc_n_extra": (I, []),
     "dc_eval_extra": (I, [I, I, I, P, P, P, I]),
     "dc_set_auto": (I, [P, I, P, P, P, P, P, P, P, P, P, P, I]),
@@ -80,7 +81,8 @@ MODEL_PROTOTYPES: Prototypes = {
     "dc_set_layout": (I, [P, I, I, I, I, I, I, I, I, I, D, I]),
     "dc_report": (I, [P, I, P, P, P, P, P, P]),
     "dc_set_stall": (I, [P, D, I]),
-    "dc_set_init_step": (I, [P, D]),
+    "dc_set_first_step": (I, [P, I]),
+    "dc_solve_reduced": (I, [P, I, D, P, P, D, P]),
     "dc_free": (None, [P]),
     "dc_reinit": (I, [P, D, P, P, P, P, P]),
     "dc_advance": (I, [P, D, P, I, P, P, P, I, I, P, P, P, P, P, P, P, P, P, P, P]),

@@ -171,7 +171,8 @@ class Session(Protocol):
 
     def stats(self) -> dict[str, int | float | str]: ...
 
-    def set_hints(self, *, nonlin_conv_coef: float | None = None, init_step: float | None = None) -> bool: ...
+    def set_hints(self, *, nonlin_conv_coef: float | None = None, jacobian_refresh: float | None = None,
+                  first_step: bool | None = None) -> bool: ...
 
     def set_stall(self, stall_step: float, count: int) -> None: ...
 
@@ -327,8 +328,9 @@ class SessionBase:
             raise ValueError(f"{what} must have shape ({self._n},), got {a.shape}")
         return a
 
-    def set_hints(self, *, nonlin_conv_coef: float | None = None, init_step: float | None = None) -> bool:
-        """Solver hints (see CSession.set_hints); scikit-sundae exposes neither, so the python
+    def set_hints(self, *, nonlin_conv_coef: float | None = None, jacobian_refresh: float | None = None,
+                  first_step: bool | None = None) -> bool:
+        """Solver hints (see CSession.set_hints); scikit-sundae exposes none of them, so the python
         backend ignores them and returns False."""
         return False
 

@@ -41,6 +41,16 @@ DRIFT_FRACTION = physics.DRIFT_FRACTION
 # keeps the pendulum's constraint residual at 1e-12 instead of 3e-11 (rtol 1e-10) and, measured,
 # halves the steps; index1 is better off with IDA's default. The python backend cannot set it.
 GGL_NEWTON_COEF = 1e-3
+# IDA evaluates a new Jacobian when cj (alpha / h) has changed by this fraction (IDA's default 0.25).
+# Contact runs change h often: with 0.25 a stale iteration matrix costs the GGL runs 2.2 Newton
+# iterations per step and a convergence failure every 25 steps; with 0.05, measured on the Fig. 4.15
+# scene, 1.3 iterations and none, 20-25 % less CPU for both formulations (docs/engine.md).
+JACOBIAN_REFRESH = 0.05
+IDA_JACOBIAN_REFRESH = 0.25  # IDA's own, what the python backend (scikit-sundae) runs with
+# The first step of a run: True takes the second-order estimate of the compiled driver (first_step
+# in ida_driver.c) over IDA's first-order one, which is 1e-16 s on the chapter's scenes and lets
+# GGL's Newton iteration fail there at rtol 1e-9 with the fresher Jacobians above.
+FIRST_STEP_ESTIMATE = True
 # Stall guard: STALL_COUNT steps shorter than STALL_STEP seconds that do not grow (and no step a
 # hundred times longer in between) end the run with a clear message instead of creeping on
 # (e.g. plain Coulomb friction chattering at zero sliding speed takes ~1e-12 s order-1 steps).
@@ -148,9 +158,12 @@ def simulate(
     step : float or None
         Step size, s, of the fixed-step methods "rk4" and "euler" (required there, e.g. the
         chapter's 1e-5); rejected by the other methods.
-    linear_solver : {"auto", "dense", "sparse"}
-        LU of IDA's Newton iteration in the compiled backend: dense, sparse (SuperLU_MT), or
-        "auto" (sparse for large models, see :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES`).
+    linear_solver : {"auto", "reduced", "dense", "sparse"}
+        LU of IDA's Newton iteration in the compiled backend: "reduced" (dense LU of the system
+        left after eliminating the position rows, 23 unknowns instead of 32 on the slider-crank),
+        "dense" (dense LU of the whole system, what the python backend does), "sparse"
+        (SuperLU_MT), or "auto" (sparse for large models, see
+        :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES`, reduced below).
         The python backend and the other methods ignore it. Reported in ``result.stats``.
     start : {"ideal", "declared"}
         How the run starts without ``y0`` (ignored with ``y0``, as is ``allow_penetration``).
@@ -255,6 +268,7 @@ def _start_session(model: DAEModel, t0: float, y0: NDArray | None, *, rtol: floa
     except BaseException:
         session.close()
         raise
+    session.set_hints(jacobian_refresh=JACOBIAN_REFRESH, first_step=FIRST_STEP_ESTIMATE)
     if model.formulation == "ggl" and model.n_constraints:  # without constraints GGL is index-1
         # never ask Newton for corrections below round-off: coef * rtol >= 1e-13
         session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / rtol)))

@@ -39,6 +39,7 @@
 #include <sunmatrix/sunmatrix_sparse.h>
 #include "dc_model.h"
 #include "dc_linalg.h"
+#include "dc_reduced_ls.h"
 
 #define DC_API __attribute__((visibility("default")))
 
@@ -66,8 +67,9 @@ SUNDIALS_EXPORT SUNLinearSolver SUNLinSol_SuperLUMT(N_Vector y, SUNMatrix A, int
 #endif
 
 /* linear solvers of dc_open */
-#define DC_LS_DENSE 0
-#define DC_LS_SPARSE 1
+#define DC_LS_DENSE 0   /* SUNDIALS' dense LU of the whole iteration matrix */
+#define DC_LS_SPARSE 1  /* SuperLU_MT */
+#define DC_LS_REDUCED 2 /* dense LU of the reduced system, dc_reduced_ls.h */
 
 #if DC_HAVE_SPARSE && defined(DC_SUPERLUMT_OMP)
 /* SuperLU_MT factors inside an OpenMP parallel loop over its num_threads (1 here) without a
@@ -219,6 +221,7 @@ typedef struct {
    * their CSC patterns, built once by build_jac_pattern. Nonzero i of part p lands at
    * jp_rowind/data position jmap[jmap_off[p] + i]. */
   int lin_sparse;          /* DC_LS_SPARSE: s->A is that SUNSparseMatrix, s->LS SuperLU_MT */
+  int lin_kind;            /* DC_LS_DENSE, DC_LS_SPARSE or DC_LS_REDUCED */
   int lu_factored;         /* a Jacobian was handed to the sparse LS (it has factorized) */
   SUNErrCode (*lu_initialize)(SUNLinearSolver); /* SuperLU_MT's own, see keep_first_factorization */
   dc_int jp_nnz;
@@ -242,6 +245,8 @@ typedef struct {
   int stall_count;   /* tiny steps that end the advance (default DC_TINY_MAX) */
   double h_prev;   /* size of the previous step (collapse detection) */
   long long max_steps;
+  double rtol, max_step; /* IDA's relative tolerance and step limit (0: none), for first_step */
+  int first_step_on;     /* the first start takes first_step(), not IDA's estimate (dc_set_first_step) */
   long long base[ST_N]; /* counters accumulated over earlier reinit segments */
   char msg[MSG_LEN];    /* our own message for the last non-success return */
   char cb_msg[MSG_LEN]; /* set by a callback that refused its input (NaN, CasADi error) */
@@ -297,6 +302,29 @@ static void err_handler(int line, const char* func, const char* file, const char
   if (!s) return;
   snprintf(s->ida_msg, MSG_LEN, "%s (code %d): %s", func ? func : "?", (int)code,
            msg ? msg : "");
+}
+
+/* The first step of a run started at (y, yp): the step whose BDF1 local error in the positions,
+ * h^2 / 2 * q'', has half the weighted tolerance IDA's error test allows, h = 1 / sqrt(|q''|_wrms),
+ * q'' = v' the consistent accelerations; never below IDA's own estimate 0.5 / |yp|_wrms, never
+ * above max_step. IDA's estimate is first order: a coordinate at zero moving fast, weighted by
+ * its tiny absolute tolerance, makes it 1e-16 s on the chapter's scenes, and GGL's index-2
+ * Newton iteration fails at such steps at rtol 1e-9 (the ideal four-bar, with the Jacobian
+ * refreshed at a 5 % change of cj). Returns 0 (IDA's estimate) before dc_set_layout or without
+ * accelerations. */
+static double first_step(const dc_session* s, const double* y, const double* yp) {
+  const double* atol = N_VGetArrayPointer(s->atol);
+  double sum_a = 0.0, sum_yp = 0.0, h;
+  if (!s->lay_ready) return 0.0;
+  for (int i = 0; i < s->n; ++i) {
+    const double w = 1.0 / (s->rtol * fabs(y[i]) + atol[i]);
+    sum_yp += (w * yp[i]) * (w * yp[i]);
+    if (i < s->lay_nq) sum_a += (w * yp[s->lay_nq + i]) * (w * yp[s->lay_nq + i]);
+  }
+  if (!(sum_a > 0.0) || !isfinite(sum_a) || !isfinite(sum_yp)) return 0.0;
+  h = 1.0 / sqrt(sqrt(sum_a / s->n));
+  if (sum_yp > 0.0) h = fmax(h, 0.5 / sqrt(sum_yp / s->n));
+  return s->max_step > 0.0 ? fmin(h, s->max_step) : h;
 }
 
 static int first_nonfinite(const double* v, int m) {
@@ -860,6 +888,8 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
   s->n_terms = M->n_terms;
   s->n_roots = M->n_roots;
   s->max_steps = max_steps;
+  s->rtol = rtol;
+  s->max_step = max_step;
   s->mem_res = s->mem_jac = s->mem_roots = -1;
 
   /* CasADi work memory */
@@ -935,12 +965,13 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
     if (rc == -2) FAIL("a generated Jacobian is not %d x %d", n, n);
     if (rc == -3) FAIL("the Jacobian has too many nonzeros for the wheel's 32-bit sunindextype");
   }
-  if (linear_solver != DC_LS_DENSE && linear_solver != DC_LS_SPARSE)
-    FAIL("unknown linear solver %d (0: dense, 1: sparse)", linear_solver);
+  if (linear_solver != DC_LS_DENSE && linear_solver != DC_LS_SPARSE && linear_solver != DC_LS_REDUCED)
+    FAIL("unknown linear solver %d (0: dense, 1: sparse, 2: reduced)", linear_solver);
   if (linear_solver == DC_LS_SPARSE && !DC_HAVE_SPARSE)
     FAIL("this library was built without the sparse solver (the wheel lacks "
          "libsundials_sunmatrixsparse or libsundials_sunlinsolsuperlumt)");
   s->lin_sparse = linear_solver == DC_LS_SPARSE;
+  s->lin_kind = linear_solver;
 
   /* SUNDIALS objects */
   if (SUNContext_Create(SUN_COMM_NULL, &s->ctx) != 0 || !s->ctx)
@@ -971,8 +1002,8 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
   } else {
     s->A = SUNDenseMatrix(n, n, s->ctx);
     if (!s->A) FAIL("SUNDenseMatrix failed");
-    s->LS = SUNLinSol_Dense(s->yy, s->A, s->ctx);
-    if (!s->LS) FAIL("SUNLinSol_Dense failed");
+    s->LS = linear_solver == DC_LS_REDUCED ? rls_create(n, s->ctx) : SUNLinSol_Dense(s->yy, s->A, s->ctx);
+    if (!s->LS) FAIL("the dense linear solver could not be created (out of memory)");
   }
   s->ida = IDACreate(s->ctx);
   if (!s->ida) FAIL("IDACreate failed");
@@ -1001,10 +1032,15 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
 }
 
 /* Solver hints applied from the next step or restart on: the safety factor of IDA's
- * Newton convergence test (default 0.33; smaller solves the algebraic equations tighter)
- * and the first step size after the next (re)start (0: IDA's own estimate). */
+ * Newton convergence test (default 0.33; smaller solves the algebraic equations tighter). */
 DC_API int dc_set_nonlin_conv_coef(void* sp, double coef) {
   return IDASetNonlinConvCoef(((dc_session*)sp)->ida, coef);
+}
+
+/* The relative change of cj (IDA's coefficient of yp in the iteration matrix) from which IDA
+ * evaluates a new Jacobian (IDA's default 0.25). */
+DC_API int dc_set_jacobian_refresh(void* sp, double dcj) {
+  return IDASetDeltaCjLSetup(((dc_session*)sp)->ida, dcj);
 }
 
 /* Stall detection: steps below stall_step seconds (0: only the relative collapse test) that do
@@ -1017,8 +1053,11 @@ DC_API int dc_set_stall(void* sp, double stall_step, int count) {
   return 0;
 }
 
-DC_API int dc_set_init_step(void* sp, double h) {
-  return IDASetInitStep(((dc_session*)sp)->ida, h);
+/* 1: the run's first start takes first_step() (restarts after contact switches keep IDA's own
+ * estimate: a longer first step after a switch lets the error grow at a given rtol); 0: IDA's. */
+DC_API int dc_set_first_step(void* sp, int on) {
+  ((dc_session*)sp)->first_step_on = on != 0;
+  return 0;
 }
 
 /* (Re)start IDA at (t0, y0, yp0) with fresh BDF history; set active terms, their parameters
@@ -1035,7 +1074,8 @@ DC_API int dc_reinit(void* sp, double t0, const double* y0, const double* yp0,
   }
   memcpy(N_VGetArrayPointer(s->yy), y0, sizeof(double) * (size_t)s->n);
   memcpy(N_VGetArrayPointer(s->yp), yp0, sizeof(double) * (size_t)s->n);
-  flag = IDAReInit(s->ida, t0, s->yy, s->yp);
+  flag = IDASetInitStep(s->ida, s->ready || !s->first_step_on ? 0.0 : first_step(s, y0, yp0));
+  if (flag >= 0) flag = IDAReInit(s->ida, t0, s->yy, s->yp);
   if (flag < 0) {
     s->ready = 0;
     set_msg(s->msg, "IDAReInit failed with flag %d: %s", flag, s->ida_msg);
@@ -1267,7 +1307,8 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
   long long cur[ST_N];
   ida_counters(s, cur);
   for (int i = 0; i < ST_N; ++i) s->base[i] += cur[i];
-  if (IDAReInit(s->ida, t, s->yy, s->yp) < 0 || IDASetRootDirection(s->ida, s->rootdir) < 0 ||
+  if (IDASetInitStep(s->ida, 0.0) < 0 || IDAReInit(s->ida, t, s->yy, s->yp) < 0 ||
+      IDASetRootDirection(s->ida, s->rootdir) < 0 ||
       IDASetStopTime(s->ida, t_stop) < 0) {
     s->ready = 0;
     set_msg(s->msg, "restarting IDA after a contact event at t=%.17g failed: %s", t, s->ida_msg);
@@ -1442,6 +1483,7 @@ DC_API int dc_set_layout(void* sp, int nq, int m, int ggl, int track_work, int a
     const dc_int* sp_out = dc_extra_tab[outputs_extra].sparsity_out(0);
     s->lay_n_channels = (int)(sp_out[0] * sp_out[1]);
   }
+  if (s->lin_kind == DC_LS_REDUCED && rls_set_kinematic_rows(s->LS, nq) != 0) return -1;
   s->lay_ready = 1;
   return 0;
 }
@@ -1764,11 +1806,32 @@ DC_API int dc_eval_jacobian_sparse(void* sp, double t, const double* y, const do
   return eval_jac((dc_session*)sp, t, y, yp, cj, data, 1);
 }
 
+/* Solve J x = b with the reduced dense solver (nk position rows eliminated), J the iteration
+ * matrix at (t, y, yp, cj) of the active terms; b is overwritten by x. The solver IDA uses, on
+ * its own copy: a check against a plain LU. 0 ok, 1 singular, -1 evaluation failed or no memory. */
+DC_API int dc_solve_reduced(void* sp, int nk, double t, const double* y, const double* yp, double cj,
+                            double* b) {
+  dc_session* s = (dc_session*)sp;
+  SUNMatrix J = SUNDenseMatrix(s->n, s->n, s->ctx);
+  SUNLinearSolver LS = J ? rls_create(s->n, s->ctx) : NULL;
+  N_Vector x = N_VMake_Serial(s->n, b, s->ctx);
+  int rc = -1;
+  if (J && LS && x && rls_set_kinematic_rows(LS, nk) == 0 &&
+      eval_jac(s, t, y, yp, cj, SUNDenseMatrix_Data(J), 0) == 0) {
+    rc = SUNLinSolSetup(LS, J) != SUN_SUCCESS;
+    if (rc == 0) rc = SUNLinSolSolve(LS, J, x, x, 0.0) != SUN_SUCCESS ? -1 : 0;
+  }
+  if (x) N_VDestroy(x);
+  if (LS) SUNLinSolFree(LS);
+  if (J) SUNMatDestroy(J);
+  return rc;
+}
+
 /* Nonzeros of the union pattern. */
 DC_API long long dc_jac_nnz(void* sp) { return (long long)((dc_session*)sp)->jp_nnz; }
 
-/* The session's linear solver: DC_LS_DENSE or DC_LS_SPARSE. */
-DC_API int dc_linear_solver(void* sp) { return ((dc_session*)sp)->lin_sparse; }
+/* The session's linear solver: DC_LS_DENSE, DC_LS_SPARSE or DC_LS_REDUCED. */
+DC_API int dc_linear_solver(void* sp) { return ((dc_session*)sp)->lin_kind; }
 
 /* The union pattern as 64-bit CSC arrays: colptr[n + 1], rowind[dc_jac_nnz]. */
 DC_API void dc_jac_pattern(void* sp, long long* colptr, long long* rowind) {
