@@ -229,3 +229,27 @@ def test_sessions_closed_before_any_step_free_cleanly():
         s.close()
     s = open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="sparse")
     del s
+
+
+# --------------------------------------------------------------------------- first step
+
+
+def test_first_step_is_the_second_order_estimate(plain_ida):
+    """The run's first step is h = 1/sqrt(|q''|_wrms) from the consistent accelerations (never
+    below IDA's 0.5/|y'|_wrms), computed here again in numpy; IDA's own estimate is 1e-16 s on
+    the four-bar, and GGL's Newton iteration failed from it at rtol 1e-9 (ida_driver.c)."""
+    from daeclear.model import mechanisms as M
+    from daeclear.solvers import ida
+    from daeclear.solvers.tolerances import tolerance_vector
+
+    model, rtol = dc.assemble(M.four_bar()), 1e-9
+    y, yp = model.initial_state()
+    w = 1.0 / (rtol * np.abs(y) + tolerance_vector(model, rtol, None))
+    nq, n = model.layout(project=False).n_q, model.n_states
+    h_ida = 0.5 / np.sqrt(np.sum((w * yp) ** 2) / n)
+    expected = max(1.0 / np.sqrt(np.sqrt(np.sum((w[:nq] * yp[nq:2 * nq]) ** 2) / n)), h_ida)
+    plain = dc.simulate(model, 1e-4, rtol=rtol, backend="c", linear_solver=plain_ida)
+    assert plain.stats["first_step"] == pytest.approx(h_ida, rel=1e-6) and h_ida < 1e-15
+    ida.FIRST_STEP_ESTIMATE = True  # undone by plain_ida's monkeypatch
+    run = dc.simulate(model, 1e-4, rtol=rtol, backend="c", linear_solver=plain_ida)
+    assert not run.events and run.stats["first_step"] == pytest.approx(expected, rel=1e-9) and expected > 1e-9

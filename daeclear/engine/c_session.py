@@ -500,6 +500,7 @@ class CSession(SessionBase):
         out["cache_hit"] = bool(self._build.cache_hit)
         out["linear_solver"] = _LS_NAMES[self._lib.dc_linear_solver(self._h)]
         out["jac_nnz"] = self._jac_nnz
+        out["first_step"] = float(self._lib.dc_first_step(self._h))  # tried after the latest (re)start
         return out
 
     @property

@@ -82,6 +82,7 @@ MODEL_PROTOTYPES: Prototypes = {
     "dc_report": (I, [P, I, P, P, P, P, P, P]),
     "dc_set_stall": (I, [P, D, I]),
     "dc_set_first_step": (I, [P, I]),
+    "dc_first_step": (D, [P]),
     "dc_solve_reduced": (I, [P, I, D, P, P, D, P]),
     "dc_free": (None, [P]),
     "dc_reinit": (I, [P, D, P, P, P, P, P]),

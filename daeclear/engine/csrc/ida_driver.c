@@ -70,6 +70,7 @@ SUNDIALS_EXPORT SUNLinearSolver SUNLinSol_SuperLUMT(N_Vector y, SUNMatrix A, int
 #define DC_LS_DENSE 0   /* SUNDIALS' dense LU of the whole iteration matrix */
 #define DC_LS_SPARSE 1  /* SuperLU_MT */
 #define DC_LS_REDUCED 2 /* dense LU of the reduced system, dc_reduced_ls.h */
+#define LIN_SPARSE(s) ((s)->lin_kind == DC_LS_SPARSE) /* IDA's matrix is sparse (CSC), else dense */
 
 #if DC_HAVE_SPARSE && defined(DC_SUPERLUMT_OMP)
 /* SuperLU_MT factors inside an OpenMP parallel loop over its num_threads (1 here) without a
@@ -220,8 +221,8 @@ typedef struct {
   /* Jacobian pattern shared by all parts (0: base Jacobian, 1 + k: term k's): the union of
    * their CSC patterns, built once by build_jac_pattern. Nonzero i of part p lands at
    * jp_rowind/data position jmap[jmap_off[p] + i]. */
-  int lin_sparse;          /* DC_LS_SPARSE: s->A is that SUNSparseMatrix, s->LS SuperLU_MT */
-  int lin_kind;            /* DC_LS_DENSE, DC_LS_SPARSE or DC_LS_REDUCED */
+  int lin_kind;            /* DC_LS_DENSE, DC_LS_REDUCED (s->A dense) or DC_LS_SPARSE (s->A a
+                            * SUNSparseMatrix, s->LS SuperLU_MT): see LIN_SPARSE */
   int lu_factored;         /* a Jacobian was handed to the sparse LS (it has factorized) */
   SUNErrCode (*lu_initialize)(SUNLinearSolver); /* SuperLU_MT's own, see keep_first_factorization */
   dc_int jp_nnz;
@@ -485,7 +486,7 @@ static void entry_position(const dc_session* s, dc_int i, int sparse, int* row, 
  * too. */
 static double* jac_storage(dc_session* s, SUNMatrix J) {
 #if DC_HAVE_SPARSE
-  if (s->lin_sparse) {
+  if (LIN_SPARSE(s)) {
     memcpy(SUNSparseMatrix_IndexPointers(J), s->jp_colptr, sizeof(sunindextype) * ((size_t)s->n + 1));
     memcpy(SUNSparseMatrix_IndexValues(J), s->jp_rowind, sizeof(sunindextype) * (size_t)s->jp_nnz);
     return SUNSparseMatrix_Data(J);
@@ -502,7 +503,7 @@ static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vec
   (void)t1;
   (void)t2;
   (void)t3;
-  int rc = eval_jac(s, t, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), cj, Jd, s->lin_sparse);
+  int rc = eval_jac(s, t, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), cj, Jd, LIN_SPARSE(s));
   if (rc) {
     if (rc == -1)
       set_msg(s->cb_msg, "the generated base Jacobian returned an error at t=%.17g", t);
@@ -511,15 +512,15 @@ static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vec
               -rc - 2, t);
     return -1;
   }
-  int i = first_nonfinite(Jd, (int)jac_len(s, s->lin_sparse));
+  int i = first_nonfinite(Jd, (int)jac_len(s, LIN_SPARSE(s)));
   if (i >= 0) {
     int row, col;
-    entry_position(s, i, s->lin_sparse, &row, &col);
+    entry_position(s, i, LIN_SPARSE(s), &row, &col);
     set_msg(s->cb_msg, "Jacobian entry (%d, %d) is %g at t=%.17g", row, col, Jd[i], t);
     return 1;
   }
 #if DC_HAVE_SPARSE
-  if (s->lin_sparse) {
+  if (LIN_SPARSE(s)) {
     ONE_OMP_THREAD(); /* IDA factors the matrix next, on this thread */
     s->lu_factored = 1; /* see free_superlumt */
   }
@@ -624,7 +625,7 @@ static void free_superlumt(dc_session* s) {
 static void free_linear_solver(dc_session* s) {
   if (!s->LS) return;
 #if DC_HAVE_SPARSE
-  if (s->lin_sparse) {
+  if (LIN_SPARSE(s)) {
     free_superlumt(s);
     return;
   }
@@ -970,7 +971,6 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
   if (linear_solver == DC_LS_SPARSE && !DC_HAVE_SPARSE)
     FAIL("this library was built without the sparse solver (the wheel lacks "
          "libsundials_sunmatrixsparse or libsundials_sunlinsolsuperlumt)");
-  s->lin_sparse = linear_solver == DC_LS_SPARSE;
   s->lin_kind = linear_solver;
 
   /* SUNDIALS objects */
@@ -986,7 +986,7 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
   memset(N_VGetArrayPointer(s->yy), 0, sizeof(double) * (size_t)n);
   memset(N_VGetArrayPointer(s->yp), 0, sizeof(double) * (size_t)n);
   memcpy(N_VGetArrayPointer(s->atol), atol, sizeof(double) * (size_t)n);
-  if (s->lin_sparse) {
+  if (LIN_SPARSE(s)) {
 #if DC_HAVE_SPARSE
     /* one thread: the factorizations are small and the machine is shared; more threads cost
      * more in OpenMP start-up than they save */
@@ -1829,6 +1829,12 @@ DC_API int dc_solve_reduced(void* sp, int nk, double t, const double* y, const d
 
 /* Nonzeros of the union pattern. */
 DC_API long long dc_jac_nnz(void* sp) { return (long long)((dc_session*)sp)->jp_nnz; }
+
+/* The step IDA tried first after the latest (re)start (first_step() or IDA's estimate). */
+DC_API double dc_first_step(void* sp) {
+  double h = 0.0;
+  return IDAGetActualInitStep(((dc_session*)sp)->ida, &h) < 0 ? 0.0 : h;
+}
 
 /* The session's linear solver: DC_LS_DENSE, DC_LS_SPARSE or DC_LS_REDUCED. */
 DC_API int dc_linear_solver(void* sp) { return ((dc_session*)sp)->lin_kind; }
