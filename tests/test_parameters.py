@@ -252,6 +252,7 @@ def test_a_scene_seen_before_reuses_its_model_and_start():
     scene = dc.mechanisms.slider_crank("revolute", clearance=0.4e-3, gravity=0.0)
     model = dc.assemble(scene)
     assert dc.assemble(scene) is model and dc.assemble(scene, "index1") is not model
+    model.start_memo.clear()  # shared by every model of this structure (other tests filled it)
     first = dc.simulate(model, 1e-4, rtol=1e-7)
     assert len(model.start_memo) == 1  # the run copy filled its model's memo
     y0, yp0 = model.initial_state()  # python evaluation: its own entry
@@ -262,8 +263,16 @@ def test_a_scene_seen_before_reuses_its_model_and_start():
     np.testing.assert_array_equal(again[1], fresh[1])
     second = dc.simulate(model, 1e-4, rtol=1e-7)
     np.testing.assert_array_equal(first.y, second.y)
+    # one structure, one memo: another clearance reads the same start (the start does not depend
+    # on it), which equals one computed anew for that clearance
     other = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.3e-3, gravity=0.0))
-    assert other.start_memo == {} and other.start_memo is not model.start_memo
+    assert other.start_memo is model.start_memo
+    entries = len(model.start_memo)
+    shared = other.initial_state()
+    assert len(model.start_memo) == entries  # read, not computed
+    fresh_other = dataclasses.replace(other, start_memo={}).initial_state()
+    np.testing.assert_array_equal(shared[0], fresh_other[0])
+    np.testing.assert_array_equal(shared[1], fresh_other[1])
     # a copy with other numbers shares the filled memo but never reads a start of the old numbers
     slower = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.4e-3, gravity=0.0, rpm=4000.0))
     copied = dataclasses.replace(model, parameter_values=slower.parameter_values)
@@ -271,6 +280,34 @@ def test_a_scene_seen_before_reuses_its_model_and_start():
     y_copied = copied.initial_state()[0]
     np.testing.assert_allclose(y_copied, slower.initial_state()[0], rtol=1e-9, atol=1e-12)
     assert not np.allclose(y_copied, again[0])  # the crank turns slower: other velocities
+
+
+def test_the_start_depends_on_the_numbers_its_functions_read():
+    """The memo key of the chapter's start holds exactly the parameters that the kinematics and
+    accelerations read (CasADi's sparsity): not the clearance joint's clearance, radii and law;
+    a new mass or driver speed computes a new start, a declared start keys on every number."""
+    from daeclear.assembly.dae_model import start_parameters
+
+    model = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.4e-3, friction=0.1))
+    names = [name for name, size in model.parameter_layout for _ in range(size)]
+    read = {names[i] for i in model.start_parameters}
+    unread = set(names) - read
+    assert {"clearance.clearance", "clearance.bearing_radius", "clearance.journal_radius",
+            "clearance.law.stiffness", "clearance.law.restitution"} <= unread
+    assert all(name.startswith("clearance.") for name in unread)  # only the clearance joint's numbers
+    assert {"crank.mass", "rod.inertia", "slider.mass", "gravity", "drive.speed"} <= read
+    np.testing.assert_array_equal(model.start_parameters, start_parameters(model.functions))
+    model.start_memo.clear()
+    model.initial_state()
+    heavier = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.4e-3, friction=0.1, slider_mass=1.5))
+    assert heavier.start_memo is model.start_memo
+    y_heavy, yp_heavy = heavier.initial_state()
+    assert len(model.start_memo) == 2  # a new mass: a new start
+    assert not np.allclose(y_heavy, model.initial_state()[0])  # other multipliers (the motion is driven)
+    wider = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.5e-3, friction=0.1))
+    wider.initial_state(start="declared")
+    model.initial_state(start="declared")
+    assert len(model.start_memo) == 4  # declared: the clearance is part of the key
 
 
 def test_a_damaged_cached_library_is_built_again(tmp_path):

@@ -54,7 +54,8 @@ from .symbolic import AssemblyContext, BodyFrame, Channel, Reference, Term, rota
 # the model and its constants, re-exported: ``from daeclear.assembly.assemble import DAEModel`` keeps working
 from .dae_model import (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_START_KINEMATICS,  # noqa: F401
                         EXTRA_TERM0, KIND_MULTIPLIER, KIND_POSITION, KIND_VELOCITY, KIND_WORK, NEWTON_STEPS,
-                        NULL_WEIGHT, POSITION_TOL, RANK_TOL, DAEModel, Formulation, check_independent)
+                        NULL_WEIGHT, POSITION_TOL, RANK_TOL, DAEModel, Formulation, check_independent,
+                        start_parameters)
 
 
 # ---- element parameters (numbers) and builders (structure) --------------------------------
@@ -155,7 +156,7 @@ class _Template:
             mass_diagonal=np.concatenate([[b.mass, b.mass, b.inertia] for b in bodies]),
             parameters={"scene": described, "formulation": formulation, "alpha": alpha, "beta": beta,
                         "track_work": track_work},
-            contacts=contacts, auto_pairs=auto_pairs, parameter_layout=self.layout, parameter_values=P, start_memo={},
+            contacts=contacts, auto_pairs=auto_pairs, parameter_layout=self.layout, parameter_values=P,
             clearance_joints=tuple((e.name, float(e.radial_clearance), float(getattr(e, "corner_radius", 0.0)))
                                    for e in scene.elements
                                    if isinstance(e, (RevoluteClearance, TranslationalClearance))
@@ -521,7 +522,7 @@ class _TemplateBuilder:
             outputs=outputs, q_guess=np.zeros(n), v_guess=np.zeros(n), mass_diagonal=np.ones(n),
             kinematics=self.kinematics, base_force=self.base_force, track_work=self.track_work,
             start_constraint_names=start_names, constraint_elements=tuple(self.owners),
-            driver_names=tuple(self.driver_rows),
+            driver_names=tuple(self.driver_rows), start_parameters=start_parameters(functions),
         )  # numbers are bound per scene (_Template.bind)
         return _Template(model=model, layout=self.table.layout, logic=logic_makers, auto_pairs=tuple(auto_pairs))
 

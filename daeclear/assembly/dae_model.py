@@ -85,10 +85,14 @@ class DAEModel:
     driver_names: tuple[str, ...] = ()
     # consistent starts found for this model, by (start, allow_penetration, evaluator, the numbers
     # and guesses they came from): kept so that a model run again (a study's repeated runs, a scene
-    # seen before) skips assembling its start; shared by the run copies, new for every bound model
-    # (the numbers in the key keep a model copied with other numbers from reading a stale start)
+    # seen before) skips assembling its start; shared by the run copies and by every model bound to
+    # one structure (the numbers in the key keep a model with other numbers from reading a stale start)
     start_memo: dict[tuple[Any, ...], tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
         default_factory=dict, compare=False, repr=False)
+    # indices of the parameters the chapter's ("ideal") start depends on (None: all of them), the
+    # numbers of its memo key: scenes that differ only in clearances or contact and friction laws
+    # share one start (see start_parameters())
+    start_parameters: NDArray[np.intp] | None = field(default=None, compare=False, repr=False)
     # False for a model that starts from a computed state (a restart), whose start is not checked
     start_is_declared: ClassVar[bool] = True
 
@@ -350,12 +354,15 @@ class DAEModel:
         With an open compiled ``session`` every evaluation runs in C. A declared start with a contact
         pair in deep penetration raises AssemblyError unless ``allow_penetration``
         (:func:`daeclear.solvers.physics.check_start_penetration`)."""
+        ideal = start == "ideal"
+        # a declared start is checked against the gaps (penetration): every number is in its key
+        numbers = self.parameter_values if not ideal or self.start_parameters is None else \
+            self.parameter_values[self.start_parameters]
         key = (start, bool(allow_penetration), "casadi" if session is None else type(session).__name__,
-               self.parameter_values.tobytes(), self.q_guess.tobytes(), self.v_guess.tobytes())
+               numbers.tobytes(), self.q_guess.tobytes(), self.v_guess.tobytes())
         known = self.start_memo.get(key)
         if known is not None:
             return known[0].copy(), known[1].copy()
-        ideal = start == "ideal"
         q = self.assemble_positions(self.q_guess, session=session, ideal=ideal)
         check_independent(self, q, session)
         v = self.assemble_velocities(q, self.v_guess, session=session, ideal=ideal)
@@ -365,6 +372,8 @@ class DAEModel:
         y, yp = self.consistent_state(0.0, y, session=session)
         if not ideal and not allow_penetration:
             check_start_penetration(self, y, yp, session)
+        if len(self.start_memo) >= START_MEMO_LIMIT:  # a long sweep of masses or lengths: the oldest goes
+            self.start_memo.pop(next(iter(self.start_memo)), None)
         self.start_memo[key] = (_read_only(y), _read_only(yp))
         return y, yp
 
@@ -389,6 +398,25 @@ class DAEModel:
         S = np.zeros((t.size, n_s)) if switch is None else np.asarray(switch, dtype=float).reshape(t.size, n_s)
         values = self.evaluate(EXTRA_OUTPUTS, [t.reshape(-1, 1), np.asarray(y), np.asarray(yp), S], t.size, session)
         return {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(self.channel_names)}
+
+
+# Starts kept per structure (see DAEModel.start_memo); a start is ~0.3 ms to compute again.
+START_MEMO_LIMIT = 256
+
+
+def start_parameters(functions: DAEFunctions) -> NDArray[np.intp]:
+    """Indices of the run-time parameters that the chapter's start reads: the parameter inputs on
+    which the kinematics (with and without the clearance joints' ideal joints) and the
+    accelerations depend, found from CasADi's sparsity. Clearances, radii and contact and friction
+    law numbers are not among them: the start of the mechanism with ideal joints and every contact
+    open is the same for all of them."""
+    used = np.zeros(functions.n_parameters, dtype=bool)
+    for k in (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_START_KINEMATICS):
+        f = functions.extras[k]
+        used |= np.asarray(f.which_depends(f.name_in(f.n_in() - 1), f.name_out(), 1, False), dtype=bool)
+    index = np.flatnonzero(used)
+    index.setflags(write=False)
+    return index
 
 
 # Constraint rows are dependent when the constraint Jacobian's singular value falls below RANK_TOL

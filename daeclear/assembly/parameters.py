@@ -44,13 +44,18 @@ class ParameterTable:
     """
 
     def __init__(self) -> None:
-        self._values: dict[str, NDArray[np.float64]] = {}
+        # plain floats (one array at the end): a scene's table is made at every assembly
+        self._values: dict[str, list[float]] = {}
 
     def add(self, name: str, value: Any) -> None:
         """Add one entry; ``value`` is a number or a sequence of numbers."""
         if name in self._values:
             raise KeyError(f"parameter {name!r} added twice")
-        self._values[name] = np.atleast_1d(np.asarray(value, dtype=float)).ravel()
+        kind = type(value)
+        if kind is float or kind is int:
+            self._values[name] = [float(value)]
+        else:
+            self._values[name] = np.asarray(value, dtype=float).ravel().tolist()
 
     def update(self, prefix: str, values: dict[str, Any]) -> None:
         """Add every ``values`` entry under ``prefix.<key>``."""
@@ -59,14 +64,14 @@ class ParameterTable:
 
     @property
     def layout(self) -> tuple[tuple[str, int], ...]:
-        return tuple((name, v.size) for name, v in self._values.items())
+        return tuple((name, len(v)) for name, v in self._values.items())
 
     @property
     def vector(self) -> NDArray[np.float64]:
-        return np.concatenate(list(self._values.values())) if self._values else np.zeros(0)
+        return np.array([x for v in self._values.values() for x in v], dtype=float)
 
     def value(self, name: str) -> NDArray[np.float64]:
-        return self._values[name]
+        return np.array(self._values[name], dtype=float)
 
     def symbols(self, P: Any) -> dict[str, Any]:
         """Name -> the slice of the symbol vector ``P`` that holds it (scalars as 1x1)."""
@@ -89,7 +94,16 @@ class ParameterTable:
 
 def _mask(value: Any) -> Any:
     """A plain-data copy of ``value`` with every number replaced by ``'#'``."""
-    if value is None or isinstance(value, (bool, str)):
+    kind = type(value)  # the exact plain types first: this runs on every field of a scene
+    if kind is str or kind is bool or value is None:
+        return value
+    if kind is float or kind is int:
+        return "#"
+    if kind is dict:
+        return {str(k): _mask(v) for k, v in value.items()}
+    if kind is list or kind is tuple:
+        return [_mask(v) for v in value]
+    if isinstance(value, (bool, str)):
         return value
     if isinstance(value, (int, float, np.floating, np.integer)):
         return "#"

@@ -234,7 +234,8 @@ class SegmentLoop:
             out_switch = np.repeat(np.array(switches), [t.size for t in times], axis=0)
             if self.c_layout:  # one pass in C
                 out_y, out_yp, values = session.report(out_t, out_y, out_switch)
-                channels = {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(model.channel_names)}
+                # one transposed copy: each channel is a contiguous row of it
+                channels = dict(zip(model.channel_names, values.T.copy()))
             else:
                 out_y, out_yp = model.consistent_state(
                     out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)

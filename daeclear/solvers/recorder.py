@@ -113,7 +113,9 @@ class Recorder:
             return Result(t=np.zeros(0), y=np.zeros((0, n)), yp=np.zeros((0, n)), channels={}, **header, **outcome)
         n = self.model.n_states
         names = list(self.model.channel_names)
-        if self._points:
+        if len(self._points) == 1:  # one chunk (a short run): nothing to join
+            t, y, yp, channels = self._points[0]
+        elif self._points:
             t = np.concatenate([p[0] for p in self._points])
             y = np.concatenate([p[1] for p in self._points])
             yp = np.concatenate([p[2] for p in self._points])
