@@ -625,3 +625,27 @@ def test_hdf5_layout_document_snippet_reads_a_file_with_plain_h5py(tmp_path: Pat
         assert speed == e.approach_speed or (math.isnan(speed) and math.isnan(e.approach_speed))
     assert ns["parameters"] == result.parameters and ns["stats"] == result.stats
     assert [e[0] for e in ns["onsets"]] == list(result.events.of(kind="onset").t)  # type: ignore[attr-defined]
+
+
+def test_a_run_result_is_what_the_checked_constructor_makes() -> None:
+    """Result.of_run (the solvers' path, without the constructor's checks) gives the same fields,
+    types and read-only arrays as Result(...) given the same data, and the data pass its checks."""
+    import daeclear as dc
+
+    run = dc.simulate(dc.mechanisms.slider_crank("revolute", clearance=0.2e-3), 2e-3, rtol=1e-6)
+    assert len(run.events) >= 2
+    checked = Result(**run.to_dict())
+    assert checked.state_names == run.state_names and checked.units == run.units
+    assert list(checked.units) == list(run.units)  # the same order: states, then sorted channels
+    assert checked.channel_names == run.channel_names
+    for name in run.channel_names:
+        assert run[name].dtype == checked[name].dtype and not run[name].flags.writeable
+        np.testing.assert_array_equal(run[name], checked[name])
+    for mine, theirs in ((run.t, checked.t), (run.y, checked.y), (run.step_t, checked.step_t),
+                         (run.step_order, checked.step_order)):
+        assert mine.dtype == theirs.dtype and not mine.flags.writeable
+        np.testing.assert_array_equal(mine, theirs)
+    assert run.step_order.dtype == np.int64
+    assert list(checked.events) == list(run.events) and checked.segments == run.segments
+    assert all(type(a) is float and type(b) is float for a, b, _ in run.segments)
+    assert checked.stats == run.stats and checked.parameters == run.parameters

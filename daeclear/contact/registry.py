@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import numbers
 import re
 from typing import Any
@@ -32,11 +33,16 @@ def _key(name: str) -> str:
     return re.sub(r"[-_\s]+", "", name.strip().lower())
 
 
+@functools.lru_cache(maxsize=8)
+def _keys(names: tuple[str, ...], aliases: tuple[tuple[str, str], ...]) -> dict[str, str]:
+    """Lookup key -> registered name, for the registry's names and aliases as they are now."""
+    return {_key(n): n for n in names} | {_key(a): n for a, n in aliases}
+
+
 def _lookup(kind: str, name: Any, table: dict[str, Any], aliases: dict[str, str]) -> Any:
     if not isinstance(name, str):
         raise SceneError(f"{kind}: name={name!r} is not a string; valid names: {', '.join(table)}.")
-    keys = {_key(n): n for n in table} | {_key(a): n for a, n in aliases.items()}
-    found = keys.get(_key(name))
+    found = _keys(tuple(table), tuple(aliases.items())).get(_key(name))
     if found is None:
         raise SceneError(f"{kind}: unknown name {name!r}; valid names: {', '.join(table)} "
                          f"(aliases: {', '.join(aliases)}).")

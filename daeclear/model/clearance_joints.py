@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
 from ..errors import SceneError
-from .elements import Joint, PointJoint, Revolute, Translational, Vector2, as_vector2
+from .elements import Joint, PointJoint, Revolute, Translational, Vector2, as_vector2, computed_once
 
 def _default_law() -> Any:
     from ..contact import LankaraniNikravesh
@@ -91,6 +91,7 @@ class RevoluteClearance(PointJoint):
     def journal(self) -> float:
         return float(self.bearing_radius) - self.radial_clearance
 
+    @computed_once
     def resolved_law(self) -> Any:
         """The normal law with its stiffness (or cylinder geometry) set from radii and materials."""
         from ..contact import normal_law
@@ -101,6 +102,7 @@ class RevoluteClearance(PointJoint):
         return law.resolve("internal_cylinder", radii=(float(self.bearing_radius), self.journal),
                            materials=self.material)
 
+    @computed_once
     def resolved_friction(self) -> Any:
         from ..contact import friction_law
 
@@ -296,6 +298,7 @@ class TranslationalClearance(PointJoint):
         thickness = float(self.length if self.thickness is None else self.thickness)
         return 0.5 * math.sqrt(float(self.length) * thickness)
 
+    @computed_once
     def resolved_law(self) -> Any:
         """The corner law with its stiffness set (kind ``"sphere_plane"``, radius R_c)."""
         from ..contact import normal_law
@@ -311,6 +314,7 @@ class TranslationalClearance(PointJoint):
             return law
         return law.resolve("sphere_plane", radii=(float(self.corner_radius),), materials=self.material)
 
+    @computed_once
     def resolved_face_law(self) -> Any:
         """The face law with its stiffness set (kind ``"plane_face"``, half side a); with a reading
         its face law (None for a reading of the ``corners`` model)."""
@@ -326,6 +330,7 @@ class TranslationalClearance(PointJoint):
         law = normal_law(self.face_law) if isinstance(self.face_law, str) else self.face_law
         return law.resolve("plane_face", face_half_width=self.face_half_width, materials=self.material)
 
+    @computed_once
     def resolved_friction(self) -> Any:
         from ..contact import friction_law
 

@@ -18,7 +18,9 @@ Conventions
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
@@ -27,6 +29,24 @@ from .profiles import PROFILES, ConstantSpeed, Profile
 GROUND = "ground"
 
 Vector2 = tuple[float, float]
+
+
+def computed_once(method: Callable[[Any], Any]) -> Callable[[Any], Any]:
+    """A method of a frozen element whose result follows from its fields alone (a resolved contact
+    law): computed at the first call and kept on the instance (not a field: equality, ``to_dict``
+    and ``dataclasses.replace`` ignore it). A call that raises keeps nothing."""
+    slot = f"_computed_{method.__name__}"
+
+    @functools.wraps(method)
+    def once(self: Any) -> Any:
+        try:
+            return self.__dict__[slot]
+        except KeyError:
+            value = method(self)
+            object.__setattr__(self, slot, value)
+            return value
+
+    return once
 
 
 def _is_finite_number(value: Any) -> bool:

@@ -51,8 +51,6 @@ class ChannelKeyError(DaeclearError, KeyError):
         return str(self.args[0]) if self.args else ""
 
 
-
-
 # --------------------------------------------------------------------------- Result
 
 
@@ -172,10 +170,8 @@ class Result:
         yp_arr = np.asarray(yp, dtype=np.float64)
         for label, arr in (("y", y_arr), ("yp", yp_arr)):
             if arr.shape != shape:
-                raise ValueError(
-                    f"Result: {label} has shape {arr.shape}, expected (n_times, n_states) = {shape} "
-                    f"from t and state_names."
-                )
+                raise ValueError(f"Result: {label} has shape {arr.shape}, expected (n_times, n_states) = {shape} "
+                                 "from t and state_names.")
 
         chans: dict[str, np.ndarray] = {}
         for name, values in channels.items():
@@ -183,13 +179,11 @@ class Result:
                 raise ValueError(f"Result: channel name {name!r} is invalid; use '<object>.<quantity>' without '/'.")
             arr = np.asarray(values)
             if arr.ndim == 0 or arr.shape[0] != n_times:
-                raise ValueError(
-                    f"Result: channel {name!r} has shape {arr.shape}, its first dimension must be n_times={n_times}."
-                )
-            chans[name] = readonly(arr)
+                raise ValueError(f"Result: channel {name!r} has shape {arr.shape}, its first dimension must be "
+                                 f"n_times={n_times}.")
+            chans[name] = arr
 
         known = set(chans) | set(names)
-        unit_map: dict[str, str] = {}
         for name, unit in units.items():
             if name not in known:
                 close = close_matches(name, sorted(known), n=3)
@@ -197,15 +191,11 @@ class Result:
                 raise ValueError(f"Result: units given for {name!r}, which is neither a channel nor a state.{hint}")
             if not isinstance(unit, str):
                 raise ValueError(f"Result: unit of {name!r} is {unit!r}, must be a string such as 'm/s'.")
-        for name in [*names, *sorted(chans)]:
-            unit_map[name] = units.get(name, "")
 
         event_list = EventList(events)
         for e in event_list:
             if e.y.shape != (len(names),):
-                raise ValueError(
-                    f"Result: event {e!r} has a state of shape {e.y.shape}, expected ({len(names)},)."
-                )
+                raise ValueError(f"Result: event {e!r} has a state of shape {e.y.shape}, expected ({len(names)},).")
 
         segs: list[tuple[float, float, dict[str, str]]] = []
         for i, (t_start, t_end, modes) in enumerate(segments):
@@ -222,35 +212,54 @@ class Result:
             sh = np.asarray(step_h, dtype=np.float64)
             so = np.asarray(step_order, dtype=np.int64)
             if st.ndim != 1 or sh.shape != st.shape or so.shape != st.shape:
-                raise ValueError(
-                    f"Result: step_t, step_h, step_order have shapes {st.shape}, {sh.shape}, {so.shape}; "
-                    f"they must be equal and one-dimensional."
-                )
-            steps = (readonly(st), readonly(sh), readonly(so))
+                raise ValueError(f"Result: step_t, step_h, step_order have shapes {st.shape}, {sh.shape}, "
+                                 f"{so.shape}; they must be equal and one-dimensional.")
+            steps = (st, sh, so)
 
         if status not in (-1, 0, 1):
             raise ValueError(f"Result: status={status!r}, must be 0 (end reached), 1 (terminal event) or -1 (failed).")
         if bool(success) != (status >= 0):
             raise ValueError(f"Result: success={success} contradicts status={status} (only status -1 is a failure).")
+        self._assign(t_arr, y_arr, yp_arr, names, chans, units, event_list, segs, steps, dict(
+            stats=stats, success=success, status=status, message=message, parameters=parameters,
+            scene_name=scene_name, method=method, formulation=formulation, warnings=warnings))
 
-        self.t: NDArray[np.float64] = readonly(t_arr)
-        self.y: NDArray[np.float64] = readonly(y_arr)
-        self.yp: NDArray[np.float64] = readonly(yp_arr)
+    @classmethod
+    def of_run(cls, *, t: NDArray, y: NDArray, yp: NDArray, state_names: Sequence[str], channels: Mapping[str, NDArray],
+               units: Mapping[str, str], events: Iterable[ContactEvent],
+               segments: list[tuple[float, float, dict[str, str]]], step_t: NDArray, step_h: NDArray,
+               step_order: NDArray, **outcome: Any) -> Result:
+        """A solver's Result, from the data its recorder joined: float64 arrays of matching shapes,
+        channels and units of the model, events in time order, segments as (float, float, modes);
+        ``outcome``: every other keyword of the constructor (stats ... warnings). The constructor's
+        checks of those (about a tenth of a millisecond a run) are skipped."""
+        result = cls.__new__(cls)
+        result._assign(t, y, yp, list(state_names), dict(channels), units, EventList(events), segments,
+                       (step_t, step_h, step_order), outcome)
+        return result
+
+    def _assign(self, t: NDArray, y: NDArray, yp: NDArray, names: list[str], channels: dict[str, NDArray],
+                units: Mapping[str, str], events: EventList, segments: list[tuple[float, float, dict[str, str]]],
+                steps: tuple[NDArray, NDArray, NDArray] | None, outcome: Mapping[str, Any]) -> None:
+        """Set the fields from checked data: arrays as read-only views, values as plain data."""
+        self.t: NDArray[np.float64] = readonly(t)
+        self.y: NDArray[np.float64] = readonly(y)
+        self.yp: NDArray[np.float64] = readonly(yp)
         self.state_names: list[str] = names
-        self._channels = chans
-        self.units: dict[str, str] = unit_map
-        self._events = event_list
-        self.segments: list[tuple[float, float, dict[str, str]]] = segs
-        self._steps = steps
-        self.stats: dict[str, Any] = to_plain(dict(stats or {}), "stats")
-        self.success: bool = bool(success)
-        self.status: int = int(status)
-        self.message: str = str(message)
-        self.parameters: dict[str, Any] = to_plain(dict(parameters or {}), "parameters")
-        self.scene_name: str = str(scene_name)
-        self.method: str = str(method)
-        self.formulation: str = str(formulation)
-        self.warnings: list[dict[str, Any]] = to_plain([dict(w) for w in warnings], "warnings")
+        self._channels = {name: readonly(values) for name, values in channels.items()}
+        self.units: dict[str, str] = {name: units.get(name, "") for name in [*names, *sorted(channels)]}
+        self._events = events
+        self.segments: list[tuple[float, float, dict[str, str]]] = segments
+        self._steps = None if steps is None else (readonly(steps[0]), readonly(steps[1]), readonly(steps[2]))
+        self.stats: dict[str, Any] = to_plain(dict(outcome["stats"] or {}), "stats")
+        self.success: bool = bool(outcome["success"])
+        self.status: int = int(outcome["status"])
+        self.message: str = str(outcome["message"])
+        self.parameters: dict[str, Any] = to_plain(dict(outcome["parameters"] or {}), "parameters")
+        self.scene_name: str = str(outcome["scene_name"])
+        self.method: str = str(outcome["method"])
+        self.formulation: str = str(outcome["formulation"])
+        self.warnings: list[dict[str, Any]] = to_plain([dict(w) for w in outcome["warnings"]], "warnings")
 
     # ------------------------------------------------------------------ access
 

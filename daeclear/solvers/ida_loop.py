@@ -159,6 +159,8 @@ class SegmentLoop:
     def record_advance(self, adv: Any) -> None:
         """Record the compiled loop's own contact switches: split the advance at each restart and
         record the decisions (modes, terms, latched speeds, events) in the pair logic."""
+        if self.store_steps and adv.step_t.size:  # the steps of every segment at once
+            self.rec.add_steps(adv.step_t, adv.step_h, adv.step_order)
         s0 = e0 = 0
         ends = _split_rows(adv)  # one search for all restarts of the advance
         for t_ev, decided in itertools.groupby(adv.auto_events, key=lambda ev: ev.t):
@@ -177,14 +179,16 @@ class SegmentLoop:
         self.keep_points(adv, slice(s0, None), slice(e0, None), self.switch)
 
     def keep_points(self, adv: Any, steps: slice, evals: slice, switch: NDArray) -> None:
-        """Keep IDA's points as they are; they are made consistent by flush()."""
-        step_t, eval_t = adv.step_t[steps], adv.eval_t[evals]  # each slice once: this runs at every switch
-        if self.store_steps and step_t.size:
-            self.rec.add_steps(step_t, adv.step_h[steps], adv.step_order[steps])
-            if self.eval_times is None:  # the steps are the output points
+        """Keep IDA's points of one segment as they are, with its switch vector; they are made
+        consistent by flush()."""
+        if self.eval_times is None:  # the steps are the output points
+            step_t = adv.step_t[steps]
+            if self.store_steps and step_t.size:
                 self.raw.append((step_t, adv.step_y[steps], adv.step_yp[steps], switch))
-        if eval_t.size:
-            self.raw.append((eval_t, adv.eval_y[evals], adv.eval_yp[evals], switch))
+        else:
+            eval_t = adv.eval_t[evals]
+            if eval_t.size:
+                self.raw.append((eval_t, adv.eval_y[evals], adv.eval_yp[evals], switch))
 
     def check_decisions(self, adv: Any) -> None:
         """Turn the advance into an internal error when the compiled loop and Python disagree."""

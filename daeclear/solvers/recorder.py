@@ -126,8 +126,9 @@ class Recorder:
         self._points.clear()
         steps = [np.concatenate(c) for c in zip(*self._steps)] if self._steps else [
             np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)]
-        return Result(t=t, y=y, yp=yp, channels=channels, events=self.events, segments=self.segments,
-                      step_t=steps[0], step_h=steps[1], step_order=steps[2], **self._header, **outcome)
+        return Result.of_run(t=t, y=y, yp=yp, channels=channels, events=self.events, segments=self.segments,
+                             step_t=steps[0], step_h=steps[1], step_order=steps[2].astype(np.int64, copy=False),
+                             **self._header, **outcome)
 
     def abort(self, error: BaseException) -> None:
         """After an unexpected error: a streamed file is closed with what it holds and the error as its message."""
