@@ -10,7 +10,6 @@ scene: every solver uses the model, only assembly needs CasADi's symbolic constr
 from __future__ import annotations
 
 import copy
-import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal
 from collections.abc import Sequence
@@ -110,7 +109,8 @@ class DAEModel:
         independent. ``from_state``: the run starts from a given state of a run (``simulate(...,
         y0=...)``), whose contacts at the start are no declaration error (:mod:`daeclear.solvers.physics`).
         """
-        run_model = dataclasses.replace(self, contacts=tuple(_run_copy(logic) for logic in self.contacts))
+        run_model = copy.copy(self)  # every field shared (read-only arrays, the start memo) but the logic
+        object.__setattr__(run_model, "contacts", tuple(_run_copy(logic) for logic in self.contacts))
         if from_state:  # an instance value over the class's: this copy only (the class default stays)
             object.__setattr__(run_model, "start_is_declared", False)
         return run_model
