@@ -8,10 +8,11 @@ evaluation. Separate from the python backend (:mod:`daeclear.engine.python_sessi
 same interface (:class:`daeclear.engine.session_base.Session`) but nothing else in common.
 
 Linear solver (``linear_solver``): IDA's Newton iteration solves with the iteration matrix
-dF/dy + cj dF/dy' either by dense LU (SUNDIALS' dense matrix) or by sparse LU (SuperLU_MT, one
-thread, on a SUNSparseMatrix whose pattern is the union of the base and all term Jacobians'
-patterns). ``"auto"`` picks sparse from ``SPARSE_MIN_STATES`` states on (measured,
-``benchmarks/bench_linear_solver.py``).
+dF/dy + cj dF/dy' by dense LU of the system left after eliminating the position rows
+(``"reduced"``, csrc/dc_reduced_ls.h), by dense LU of the whole matrix (``"dense"``, SUNDIALS'
+own) or by sparse LU (``"sparse"``: SuperLU_MT, one thread, on a SUNSparseMatrix whose pattern is
+the union of the base and all term Jacobians' patterns). ``"auto"`` picks sparse from
+``SPARSE_MIN_STATES`` states on, reduced below (measured, ``benchmarks/bench_linear_solver.py``).
 """
 
 from __future__ import annotations
@@ -49,11 +50,12 @@ from .sundials import SPARSE_LIBS
 
 __all__ = ["CSession", "SPARSE_MIN_STATES"]
 
-#: linear_solver="auto" uses the sparse solver for models with at least this many states. Measured
-#: with benchmarks/bench_linear_solver.py (chains of N links, 6 N states; docs/performance.md):
-#: dense is faster up to 120 states (SuperLU_MT's fixed cost per factorization), sparse from 144
-#: states on (whole simulate calls 1.1x faster at 144 states, 1.3x at 192, 1.8x at 384).
-SPARSE_MIN_STATES = 144
+#: linear_solver="auto" uses the sparse solver for models with at least this many states, the
+#: reduced dense LU below. Measured with benchmarks/bench_linear_solver.py (chains of N links, 6 N
+#: states; docs/performance.md): the reduced LU is faster up to 192 states (SuperLU_MT's fixed cost
+#: per factorization), the two tie at 216, sparse is faster from 240 on (whole simulate calls 1.15x
+#: at 240 states, 1.5x at 384).
+SPARSE_MIN_STATES = 216
 _LS_CODES = {"dense": 0, "sparse": 1, "reduced": 2}  # dc_open's linear_solver argument (DC_LS_*)
 _LS_NAMES = {code: name for name, code in _LS_CODES.items()}
 log = logging.getLogger("daeclear")
