@@ -41,6 +41,15 @@ def test_first_onset_converges_at_a_small_clearance(scene):
     assert abs(onset - reference) / reference < 1e-7  # measured 1.6e-8 (index1: 1.7e-6)
 
 
+def test_index1_first_onset_at_a_tiny_clearance_is_accurate(scene):
+    """index1 starts with IDA's own first step: with the longer second-order first step that GGL
+    takes, its first onset at c = 0.01 mm and rtol 1e-6 came 7.3e-3 (relative) late."""
+    reference = dc.simulate(scene, 5e-5, method="DOP853", rtol=1e-12).events.of(kind="onset")[0].t
+    for rtol in (1e-6, 1e-8):
+        onset = dc.simulate(scene, 5e-5, rtol=rtol, formulation="index1").events.of(kind="onset")[0].t
+        assert abs(onset - reference) / reference < 1e-5  # measured 7.7e-7 and 1.0e-6
+
+
 def test_drift_stays_a_small_fraction_of_a_small_clearance(scene):
     with warnings.catch_warnings():
         warnings.simplefilter("error", dc.DaeclearWarning)  # no drift warning either

@@ -115,3 +115,23 @@ def test_without_returns_a_new_scene_without_the_named_elements():
     assert free.name == scene.name and free.gravity == scene.gravity
     with pytest.raises(KeyError, match="no element 'driev'.*'drive'"):
         scene.without("driev")
+
+
+def test_a_clearance_joint_resolves_its_laws_once():
+    """resolved_law() of a frozen clearance joint is computed at the first call and kept; a joint
+    with other numbers (dataclasses.replace) resolves its own; equality, to_dict and pickling see
+    the fields only."""
+    import dataclasses
+    import pickle
+
+    scene = dc.mechanisms.slider_crank("revolute", clearance=0.5e-3)
+    joint = next(e for e in scene.elements if e.name == "clearance")
+    law = joint.resolved_law()
+    assert joint.resolved_law() is law and joint.resolved_friction() is joint.resolved_friction()
+    tighter = dataclasses.replace(joint, clearance=0.1e-3)
+    assert tighter.resolved_law() is not law
+    assert tighter.resolved_law().stiffness != law.stiffness  # the journal radius enters the stiffness
+    assert tighter.resolved_law() == dataclasses.replace(joint, clearance=0.1e-3).resolved_law()
+    fresh = dataclasses.replace(joint)
+    assert fresh == joint and fresh.to_dict() == joint.to_dict() and "_computed_resolved_law" not in vars(fresh)
+    assert pickle.loads(pickle.dumps(joint)).resolved_law() == law
