@@ -409,9 +409,9 @@ class _TemplateBuilder:
                 p = ca.SX.sym("p", term.n_params)
                 Qk = term.force(t, q, v, p, P)
                 # the term's share of the work rate: its own power and the driver power it causes
-                work_row = ([-(ca.dot(Qk, v) + ca.substitute(self.drive_power_of, self.Fc, Qk)
+                work_row = ([-(ca.dot(Qk, v) + ca.substitute(self.drive_power_of, self.Fc, ca.densify(Qk))
                                - self.drive_power_base)] if self.track_work else [])
-                r_k = ca.vertcat(ca.SX.zeros(n), -Qk, ca.SX.zeros(n_y - 2 * n - len(work_row)), *work_row)
+                r_k = ca.vertcat(ca.SX(n, 1), -Qk, ca.SX(n_y - 2 * n - len(work_row), 1), *work_row)  # structural zeros
                 ident = _c_identifier(term.name)  # term names may hold dots (channel names); C may not
                 self.term_res.append(ca.Function(f"{ident}_res", [t, y, yp, p, P], [r_k],
                                                  ["t", "y", "yp", "p", "P"], ["r"]))
@@ -484,8 +484,9 @@ class _TemplateBuilder:
         accel = ca.Function("accel", [t, q, v, self.Fc, P],
                             [ca.densify(ca.vertcat(self.a_sol, self.lam_sol, *work_rate))],
                             ["t", "q", "v", "Qc", "P"], ["a_lam"])
+        # sparse: the driver scatters extras into dense vectors (Phi_q has a few nonzeros a row)
         kinematics_flat = ca.Function("kinematics_flat", [q, v, t, P],
-                                      [ca.densify(ca.vertcat(self.Phi, ca.vec(self.Phi_q), self.Phi_dot))],
+                                      [ca.vertcat(self.Phi, ca.vec(self.Phi_q), self.Phi_dot)],
                                       ["q", "v", "t", "P"], ["K"])
         builds = self.contact_builds
         start_list = self.phi_list + [c for build in builds for c in build.ideal]
@@ -494,7 +495,7 @@ class _TemplateBuilder:
         Phi_s_q = ca.jacobian(Phi_s, q)
         Phi_s_dot = ca.mtimes(Phi_s_q, v) + ca.jacobian(Phi_s, t)
         start_flat = ca.Function("start_kinematics_flat", [q, v, t, P],
-                                 [ca.densify(ca.vertcat(Phi_s, ca.vec(Phi_s_q), Phi_s_dot))],
+                                 [ca.vertcat(Phi_s, ca.vec(Phi_s_q), Phi_s_dot)],
                                  ["q", "v", "t", "P"], ["K"])
         extras = [outputs, accel, kinematics_flat, start_flat] + [term.force for term in self.terms]
         # simple contact pairs whose switches the compiled loop may handle itself (see ida_driver.c)

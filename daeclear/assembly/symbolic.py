@@ -144,7 +144,7 @@ class AssemblyContext:
         its moment m = (x_P - x) f_y - (y_P - y) f_x (eqs. 4.10-4.13, 4.22-4.25). Loads on the
         ground are dropped.
         """
-        Q = ca.SX.zeros(self.n_q)
+        Q = ca.SX(self.n_q, 1)  # structural zeros: only the loaded bodies' entries are nonzeros
         for body, force, point in loads:
             frame = self.frames[body]
             if frame.index is None:

@@ -120,9 +120,12 @@ class NormalizedModel:
 
     Signatures (sizes): ``res (1, n, n, n_P) -> n``; ``jac (1, n, n, 1, n_P) -> n x n``;
     ``term_res[k] (1, n, n, p_k, n_P) -> n``; ``term_jac[k] (1, n, n, p_k, 1, n_P) -> n x n``;
-    ``roots (1, n, n, n_P) -> n_roots`` or None; ``extras[k] (..., n_P) -> vector``. Residuals,
-    roots and extras have dense outputs; the Jacobians keep CasADi's sparsity (compressed
-    column storage), so generated code grows with their nonzeros, not with n^2.
+    ``roots (1, n, n, n_P) -> n_roots`` or None; ``extras[k] (..., n_P) -> vector``. The
+    residual and the roots have dense outputs; the Jacobians, the terms' residuals and the extras
+    keep CasADi's sparsity (compressed column storage: the driver adds a term's nonzeros to the
+    residual and scatters an extra's into a dense vector, ``extra_dense``; the Python backend
+    takes :meth:`dense` copies), so generated code grows with their nonzeros, not with n^2 (a
+    term touches two bodies of a chain of N).
     """
 
     n: int
@@ -210,7 +213,7 @@ def normalize_model(funcs: Any) -> NormalizedModel:
         fr, fj = _with_parameters(fr, 4, n_P), _with_parameters(fj, 5, n_P)
         p = _check(fr, f"term_residuals[{k}]", [1, n, n, None, n_P], n)[3]
         _check(fj, f"term_jacobians[{k}]", [1, n, n, p, 1, n_P], n * n)
-        tres.append(_wrap(fr, f"dc_term{k}_res", [1, n, n, p, n_P], (n, 1)))
+        tres.append(_wrap(fr, f"dc_term{k}_res", [1, n, n, p, n_P], (n, 1), keep_sparsity=True))
         tjac.append(_wrap(fj, f"dc_term{k}_jac", [1, n, n, p, 1, n_P], (n, n), keep_sparsity=True))
         n_params.append(p)
     roots = None
@@ -228,7 +231,7 @@ def normalize_model(funcs: Any) -> NormalizedModel:
         sizes = _check(f, f"extras[{k}]", [None] * f.n_in(), None)
         if sizes[-1] != n_P:
             raise AssemblyError(f"extras[{k}] ({f.name()}) must take the {n_P} run-time parameters as its last input")
-        extras.append(_wrap(f, f"dc_extra{k}", sizes, (f.numel_out(0), 1)))
+        extras.append(_wrap(f, f"dc_extra{k}", sizes, (f.numel_out(0), 1), keep_sparsity=True))
     return NormalizedModel(
         extras=tuple(extras),
         n=n,

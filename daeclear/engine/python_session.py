@@ -72,7 +72,7 @@ class PythonSession(SessionBase):
         base = [self._a_t, self._a_y, self._a_yp]
         self._res = _Buffered(model.res, base + [P])
         self._jac = _Buffered(model.dense(model.jac), base + [self._a_cj, P])
-        self._tres = [_Buffered(f, base + [p, P]) for f, p in zip(model.term_res, self._a_p)]
+        self._tres = [_Buffered(model.dense(f), base + [p, P]) for f, p in zip(model.term_res, self._a_p)]
         self._tjac = [_Buffered(model.dense(f), base + [p, self._a_cj, P]) for f, p in zip(model.term_jac, self._a_p)]
         self._roots_fn = _Buffered(model.roots, base + [P]) if model.roots is not None else None
         self._active_idx: list[int] = []

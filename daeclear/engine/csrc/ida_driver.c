@@ -284,6 +284,7 @@ typedef struct {
   double** xres;
   dc_int* xiw;
   double* xw;
+  double* xnz;        /* the nonzeros of a sparse extra's output, before extra_dense scatters them */
   int* lay_on;        /* [n_terms] */
 } dc_session;
 
@@ -336,6 +337,40 @@ static int first_nonfinite(const double* v, int m) {
 
 /* ---------------------------------------------------------------- model evaluation ---- */
 
+/* CasADi's compressed column storage: nrow, ncol, colind[ncol+1], row[nnz]; a dense pattern
+ * is written as just nrow, ncol, 1 (a sparse one always has colind[0] == 0). */
+static int sp_dense(const dc_int* sp) { return sp[2] == 1; }
+
+static dc_int nnz_of(const dc_fun_t* f) {
+  const dc_int* sp = f->sparsity_out(0);
+  return sp_dense(sp) ? sp[0] * sp[1] : sp[2 + sp[1]];
+}
+
+/* Nonzeros of column c are [col_begin, col_end) of the value array; row_at gives their rows.
+ * A dense pattern stores every entry, column-major. */
+static dc_int col_begin(const dc_int* sp, dc_int c) { return sp_dense(sp) ? c * sp[0] : sp[2 + c]; }
+static dc_int col_end(const dc_int* sp, dc_int c) { return sp_dense(sp) ? (c + 1) * sp[0] : sp[3 + c]; }
+static dc_int row_at(const dc_int* sp, dc_int k) { return sp_dense(sp) ? k % sp[0] : sp[3 + sp[1] + k]; }
+
+/* Evaluate an extra (one column output) into the dense vector out. The generated extras keep
+ * CasADi's sparsity (a term's generalized force touches two bodies, a kinematic Jacobian a few
+ * coordinates per row: dense outputs made the generated code grow like N^2 on chains): a sparse
+ * output is written to nz (nnz values) and scattered, zeros elsewhere. */
+static int extra_dense(const dc_fun_t* f, const double** arg, double** res, dc_int* iw, double* w, int mem,
+                       double* out, double* nz) {
+  const dc_int* sp = f->sparsity_out(0);
+  if (sp_dense(sp)) {
+    res[0] = out;
+    return f->eval(arg, res, iw, w, mem);
+  }
+  res[0] = nz;
+  const int status = f->eval(arg, res, iw, w, mem);
+  if (status != 0) return status;
+  memset(out, 0, sizeof(double) * (size_t)(sp[0] * sp[1]));
+  for (dc_int k = col_begin(sp, 0); k < col_end(sp, 0); ++k) out[row_at(sp, k)] = nz[k];
+  return 0;
+}
+
 static int eval_res(dc_session* s, double t, const double* y, const double* yp, double* r) {
   const dc_model_t* M = &dc_model;
   s->arg[0] = &t;
@@ -353,25 +388,11 @@ static int eval_res(dc_session* s, double t, const double* y, const double* yp, 
     s->arg[4] = s->P;
     s->res[0] = s->tmp_r;
     if (M->term_res[k].eval(s->arg, s->res, s->iw, s->w, s->mem_term_res[k])) return -(k + 2);
-    for (int i = 0; i < s->n; ++i) r[i] += s->tmp_r[i];
+    const dc_int* sp = M->term_res[k].sparsity_out(0); /* the term's nonzeros: two bodies' rows */
+    for (dc_int i = col_begin(sp, 0); i < col_end(sp, 0); ++i) r[row_at(sp, i)] += s->tmp_r[i];
   }
   return 0;
 }
-
-/* CasADi's compressed column storage: nrow, ncol, colind[ncol+1], row[nnz]; a dense pattern
- * is written as just nrow, ncol, 1 (a sparse one always has colind[0] == 0). */
-static int sp_dense(const dc_int* sp) { return sp[2] == 1; }
-
-static dc_int nnz_of(const dc_fun_t* f) {
-  const dc_int* sp = f->sparsity_out(0);
-  return sp_dense(sp) ? sp[0] * sp[1] : sp[2 + sp[1]];
-}
-
-/* Nonzeros of column c are [col_begin, col_end) of the value array; row_at gives their rows.
- * A dense pattern stores every entry, column-major. */
-static dc_int col_begin(const dc_int* sp, dc_int c) { return sp_dense(sp) ? c * sp[0] : sp[2 + c]; }
-static dc_int col_end(const dc_int* sp, dc_int c) { return sp_dense(sp) ? (c + 1) * sp[0] : sp[3 + c]; }
-static dc_int row_at(const dc_int* sp, dc_int k) { return sp_dense(sp) ? k % sp[0] : sp[3 + sp[1] + k]; }
 
 /* The generated Jacobian of part p: 0 the base Jacobian, 1 + k term k's. */
 static const dc_fun_t* jac_part(int p) { return p == 0 ? &dc_model.jac : &dc_model.term_jac[p - 1]; }
@@ -692,14 +713,14 @@ DC_API int dc_eval_extra(int k, int n_points, int n_in, const double* const* inp
   double** res = (double**)calloc((size_t)sz_res + 1, sizeof(double*));
   dc_int* iw = (dc_int*)calloc((size_t)sz_iw + 1, sizeof(dc_int));
   double* w = (double*)calloc((size_t)sz_w + 1, sizeof(double));
-  int status = (arg && res && iw && w && n_in <= sz_arg) ? 0 : -1;
+  double* nz = (double*)calloc((size_t)nnz_of(f) + 1, sizeof(double));
+  int status = (arg && res && iw && w && nz && n_in <= sz_arg) ? 0 : -1;
   if (status == 0) {
     f->incref();
     int mem = f->checkout();
     for (int i = 0; i < n_points && status == 0; ++i) {
       for (int j = 0; j < n_in; ++j) arg[j] = inputs[j] ? inputs[j] + (size_t)i * (size_t)in_strides[j] : 0;
-      res[0] = out + (size_t)i * (size_t)out_stride;
-      status = f->eval(arg, res, iw, w, mem);
+      status = extra_dense(f, arg, res, iw, w, mem, out + (size_t)i * (size_t)out_stride, nz);
     }
     f->release(mem);
     f->decref();
@@ -708,6 +729,7 @@ DC_API int dc_eval_extra(int k, int n_points, int n_in, const double* const* inp
   free(res);
   free(iw);
   free(w);
+  free(nz);
   return status;
 }
 
@@ -716,8 +738,7 @@ DC_API int dc_eval_extra(int k, int n_points, int n_in, const double* const* inp
  * generated SX functions keep no state between calls (their checkout is a constant). */
 static int eval_extra1(dc_session* s, int k, int n_in, const double* const* in, double* out) {
   for (int j = 0; j < n_in; ++j) s->xarg[j] = in[j];
-  s->xres[0] = out;
-  return dc_extra_tab[k].eval(s->xarg, s->xres, s->xiw, s->xw, 0);
+  return extra_dense(&dc_extra_tab[k], s->xarg, s->xres, s->xiw, s->xw, 0, out, s->xnz);
 }
 
 DC_API void dc_flag_name(long flag, char* buf, int len) { flag_name(flag, buf, len); }
@@ -793,6 +814,7 @@ DC_API void dc_free(void* sp) {
   free(s->xres);
   free(s->xiw);
   free(s->xw);
+  free(s->xnz);
   free(s);
 }
 
@@ -1469,17 +1491,22 @@ DC_API int dc_set_layout(void* sp, int nq, int m, int ggl, int track_work, int a
   s->proj_tol = tol;
   s->proj_iter = max_iter;
   {
-    dc_int sa = 5, sr = 1, si = 0, sw = 0;
-    for (int k = 0; k < dc_n_extras; ++k) work_max(&dc_extra_tab[k], &sa, &sr, &si, &sw);
+    dc_int sa = 5, sr = 1, si = 0, sw = 0, snz = 1;
+    for (int k = 0; k < dc_n_extras; ++k) {
+      work_max(&dc_extra_tab[k], &sa, &sr, &si, &sw);
+      if (nnz_of(&dc_extra_tab[k]) > snz) snz = nnz_of(&dc_extra_tab[k]);
+    }
     free(s->xarg);
     free(s->xres);
     free(s->xiw);
     free(s->xw);
+    free(s->xnz);
     s->xarg = (const double**)xcalloc((size_t)sa, sizeof(double*));
     s->xres = (double**)xcalloc((size_t)sr, sizeof(double*));
     s->xiw = (dc_int*)xcalloc((size_t)si, sizeof(dc_int));
     s->xw = (double*)xcalloc((size_t)sw, sizeof(double));
-    if (!s->xarg || !s->xres || !s->xiw || !s->xw) return -1;
+    s->xnz = (double*)xcalloc((size_t)snz, sizeof(double));
+    if (!s->xarg || !s->xres || !s->xiw || !s->xw || !s->xnz) return -1;
     const dc_int* sp_out = dc_extra_tab[outputs_extra].sparsity_out(0);
     s->lay_n_channels = (int)(sp_out[0] * sp_out[1]);
   }
