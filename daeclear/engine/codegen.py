@@ -4,9 +4,10 @@
 library that holds
 
 * the model's CasADi functions generated as C by ``casadi.CodeGenerator`` (symbols ``dc_res``,
-  ``dc_jac``, ``dc_roots``, ``dc_term<k>_res``, ``dc_term<k>_jac``), every one normalised to dense
-  column-vector inputs and a dense output (``casadi.densify``; the Jacobians column-major, as
-  SUNDIALS' dense matrix stores them);
+  ``dc_jac``, ``dc_roots``, ``dc_term<k>_res``, ``dc_term<k>_jac``, ``dc_extra<k>``), every one
+  normalised to dense column-vector inputs; the residual and the roots have dense outputs, the
+  Jacobians, the terms' residuals and the extras keep their sparsity (the driver scatters their
+  nonzeros, see :class:`NormalizedModel`);
 * a small generated table (``dc_model``: sizes, parameter counts, function pointers; layout in
   ``csrc/dc_model.h``);
 * the hand-written driver ``csrc/ida_driver.c`` (IDA loop, callbacks, dense output);
