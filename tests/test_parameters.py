@@ -310,6 +310,25 @@ def test_the_start_depends_on_the_numbers_its_functions_read():
     assert len(model.start_memo) == 4  # declared: the clearance is part of the key
 
 
+def test_the_start_memo_keeps_the_latest_starts(monkeypatch):
+    """A structure's start memo is bounded (a long sweep of masses): beyond START_MEMO_LIMIT the
+    oldest start goes, and a start computed again equals the one it replaces."""
+    from daeclear.assembly import dae_model
+
+    monkeypatch.setattr(dae_model, "START_MEMO_LIMIT", 2)
+    models = [dc.assemble(dc.mechanisms.slider_crank("revolute", slider_mass=mass)) for mass in (1.0, 1.5, 2.0)]
+    memo = models[0].start_memo
+    memo.clear()
+    first = models[0].initial_state()
+    models[1].initial_state()
+    models[2].initial_state()
+    assert len(memo) == 2
+    again = models[0].initial_state()  # evicted, computed anew
+    assert len(memo) == 2
+    np.testing.assert_array_equal(first[0], again[0])
+    np.testing.assert_array_equal(first[1], again[1])
+
+
 def test_a_damaged_cached_library_is_built_again(tmp_path):
     """A cached library truncated after its build (a full disk, a killed copy) is detected by its
     digest and rebuilt by the next process, never loaded (loading it could crash the interpreter).

@@ -373,7 +373,10 @@ class DAEModel:
         if not ideal and not allow_penetration:
             check_start_penetration(self, y, yp, session)
         if len(self.start_memo) >= START_MEMO_LIMIT:  # a long sweep of masses or lengths: the oldest goes
-            self.start_memo.pop(next(iter(self.start_memo)), None)
+            try:
+                self.start_memo.pop(next(iter(self.start_memo)), None)
+            except (RuntimeError, StopIteration):  # another thread's run changed the memo meanwhile
+                pass
         self.start_memo[key] = (_read_only(y), _read_only(yp))
         return y, yp
 
