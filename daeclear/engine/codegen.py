@@ -143,8 +143,14 @@ class NormalizedModel:
 
     def dense(self, f: casadi.Function) -> casadi.Function:
         """``f`` with a dense output (for the Python backend, which adds whole matrices)."""
-        ins = [casadi.MX.sym(f"i{k}", f.sparsity_in(k)) for k in range(f.n_in())]
-        return casadi.Function(f.name() + "_dense", ins, [casadi.densify(f.call(ins)[0])])
+        return densified(f)
+
+
+def densified(f: casadi.Function) -> casadi.Function:
+    """``f`` with dense outputs: for the Python evaluators, which read whole vectors and matrices
+    through FunctionBuffer (the generated C keeps the sparsity and its drivers scatter)."""
+    ins = [casadi.MX.sym(f"i{k}", f.sparsity_in(k)) for k in range(f.n_in())]
+    return casadi.Function(f.name() + "_dense", ins, [casadi.densify(o) for o in f.call(ins)])
 
 
 def _check(f: Any, what: str, sizes: list[int | None], out_numel: int | None) -> list[int]:
@@ -383,8 +389,8 @@ __all__ += ["OdeSpec", "generate_ode_source", "build_ode_library"]
 class OdeSpec:
     """An index-1 mechanism as an ODE in x = (q, v), as CasADi functions for ``csrc/ode_driver.c``.
 
-    Sizes: n coordinates, m constraints. Every function has dense column-vector inputs; matrix
-    outputs are dense (stored column-major in C):
+    Sizes: n coordinates, m constraints. Every function has dense column-vector inputs; its
+    outputs keep their sparsity (the driver scatters them into dense arrays, matrices column-major):
 
     * ``sys``: (t[1], q[n], v[n]) -> (Q[n], Phi_q[m x n], c[m]), c the Baumgarte right-hand side;
     * ``sys_jac``: (t, q, v, a[n], lam[m]) -> d[Phi_q^T lam - Q; Phi_q a - c]/d(q, v), (n+m) x 2n;
@@ -428,9 +434,6 @@ def _check_ode_spec(spec: OdeSpec) -> None:
         if got_in != ins or got_out != outs:
             raise AssemblyError(f"OdeSpec.{what} ({f.name()}): input sizes {got_in} and output sizes "
                                 f"{got_out}, expected {ins} and {outs}")
-        for i in range(f.n_out()):
-            if not f.sparsity_out(i).is_dense():
-                raise AssemblyError(f"OdeSpec.{what} ({f.name()}): output {i} must be dense")
 
     if len(spec.mass) != n or not all(mk > 0 for mk in spec.mass):
         raise AssemblyError(f"OdeSpec.mass must hold {n} positive values, got {list(spec.mass)}")
@@ -476,8 +479,7 @@ def generate_ode_source(spec: OdeSpec) -> str:
         ins: list[Any] = [casadi.SX.sym(f"i{i}", f.numel_in(i)) if f.is_a("SXFunction") else
                           casadi.MX.sym(f"i{i}", f.numel_in(i)) for i in range(f.n_in())]
         args: list[Any] = [casadi.reshape(x, f.size_in(i)) for i, x in enumerate(ins)]
-        outs = [casadi.densify(o) for o in f.call(args)]
-        cg.add(casadi.Function(name, ins, outs))
+        cg.add(casadi.Function(name, ins, f.call(args)))  # sparsity kept: ode_driver.c's call() scatters
     src = cg.dump()
     lines = [
         "",

@@ -29,6 +29,7 @@ from ..engine.codegen import (
     CompilerUnavailable,
     OdeSpec,
     build_ode_library,
+    densified,
     memo_get,
     memo_put,
     memo_table,
@@ -283,11 +284,11 @@ class _PyEvaluator(Evaluator):
     def __init__(self, spec: OdeSpec) -> None:
         super().__init__(spec)
         P = spec.parameters
-        self._sys = _Buffered(spec.sys, P)
-        self._sys_jac = _Buffered(spec.sys_jac, P)
-        self._gaps = _Buffered(spec.gaps, P) if spec.gaps is not None else None
-        self._tf = [_Buffered(f, P) for f in spec.term_force]
-        self._tj = [_Buffered(f, P) for f in spec.term_jac]
+        self._sys = _Buffered(densified(spec.sys), P)  # whole arrays (the C driver scatters instead)
+        self._sys_jac = _Buffered(densified(spec.sys_jac), P)
+        self._gaps = _Buffered(densified(spec.gaps), P) if spec.gaps is not None else None
+        self._tf = [_Buffered(densified(f), P) for f in spec.term_force]
+        self._tj = [_Buffered(densified(f), P) for f in spec.term_jac]
         self.minv = 1.0 / np.asarray(spec.mass)
         self.active = [False] * self.nt
         self.params: list[NDArray] = [np.zeros(p) for p in spec.n_params]

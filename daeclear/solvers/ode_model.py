@@ -57,17 +57,18 @@ def _symbolic_spec(model: DAEModel) -> OdeSpec:
     alpha, beta = P[int(offsets["baumgarte.alpha"])], P[int(offsets["baumgarte.beta"])]
     c = gamma - 2.0 * alpha * Phi_dot - beta ** 2 * Phi
     Q = model.base_force(t, q, v, P)
-    sys_f = ca.Function("sys", [t, q, v, P], [ca.densify(Q), ca.densify(Phi_q), ca.densify(c)])
+    # sparse outputs: the generated C keeps their nonzeros only (ode_driver.c scatters them)
+    sys_f = ca.Function("sys", [t, q, v, P], [Q, Phi_q, c])
     a = ca.SX.sym("a", n)
     lam = ca.SX.sym("lam", m)
     r = ca.vertcat(ca.mtimes(Phi_q.T, lam) - Q, ca.mtimes(Phi_q, a) - c)
-    sys_jac = ca.Function("sys_jac", [t, q, v, a, lam, P], [ca.densify(ca.jacobian(r, x))])
+    sys_jac = ca.Function("sys_jac", [t, q, v, a, lam, P], [ca.jacobian(r, x)])
     forces, jacs, n_params = [], [], []
     for k, term in enumerate(model.terms):
         p = ca.SX.sym("p", term.n_params)
         F = term.force(t, q, v, p, P)
-        forces.append(ca.Function(f"term{k}", [t, q, v, p, P], [ca.densify(F)]))
-        jacs.append(ca.Function(f"term{k}_jac", [t, q, v, p, P], [ca.densify(ca.jacobian(F, x))]))
+        forces.append(ca.Function(f"term{k}", [t, q, v, p, P], [F]))
+        jacs.append(ca.Function(f"term{k}_jac", [t, q, v, p, P], [ca.jacobian(F, x)]))
         n_params.append(term.n_params)
     gaps = None
     if model.functions.roots is not None and model.gap_names:
@@ -80,7 +81,7 @@ def _symbolic_spec(model: DAEModel) -> OdeSpec:
                 raise SceneError(f"simulate: the gap functions of model '{model.scene_name}' depend on {label}; "
                                  "only method='ida' integrates such a model.")
         g_dot = ca.mtimes(ca.jacobian(g, q), v) + ca.jacobian(g, t)
-        gaps = ca.Function("gaps", [t, q, v, P], [ca.densify(g), ca.densify(g_dot)])
+        gaps = ca.Function("gaps", [t, q, v, P], [g, g_dot])
     return OdeSpec(n=n, m=m, mass=tuple(float(mk) for mk in model.mass_diagonal), sys=sys_f, sys_jac=sys_jac,
                    gaps=gaps, term_force=tuple(forces), term_jac=tuple(jacs), n_params=tuple(n_params),
                    name=model.functions.name, outputs=model.outputs, n_parameters=int(P.numel()))

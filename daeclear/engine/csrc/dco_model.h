@@ -3,8 +3,9 @@
  * CasADi-generated functions of an index-1 mechanism written as an ODE in x = (q, v),
  * and that the ODE driver (ode_driver.c) reads.
  *
- * Every function takes dense column vectors, the run-time parameters P last, and writes dense
- * outputs (matrices column-major). The mass diagonal and P are given to dco_open.
+ * Every function takes dense column vectors, the run-time parameters P last; its outputs keep
+ * CasADi's sparsity (sparsity_out), and the driver's call() scatters them into dense arrays
+ * (matrices column-major). The mass diagonal and P are given to dco_open.
  */
 #ifndef DAECLEAR_DCO_MODEL_H
 #define DAECLEAR_DCO_MODEL_H

@@ -70,6 +70,7 @@ typedef struct {
   int* poff;
   double *minv, *Q, *Pq, *c, *f, *Fk, *S, *Sd, *r, *lam, *D, *Jk, *b, *zl;
   double *k1, *k2, *k3, *k4, *xt, *xcur, *g0, *gd0, *g1, *gd1;
+  double* nz; /* the nonzeros of a call's sparse outputs, before call() scatters them */
   long long cnt[C_N];
   char msg[MSG_LEN];
 } dco_session;
@@ -89,12 +90,37 @@ static int first_nonfinite(const double* v, int k) {
   return -1;
 }
 
+/* CasADi's compressed column storage: nrow, ncol, colind[ncol+1], row[nnz]; a dense pattern is
+ * written as just nrow, ncol, 1. */
+static int sp_dense(const dc_int* sp) { return sp[2] == 1; }
+
+/* Evaluate f into the dense (column-major) outputs out[0..nout). The generated functions keep
+ * CasADi's sparsity (a term's force touches two bodies of a chain, its Jacobian their columns:
+ * dense outputs made the code grow like N^3 on chains); a sparse output is written to s->nz and
+ * scattered, zeros elsewhere. */
 static int call(dco_session* s, const dc_fun_t* f, int mem, int nin, const double** in, int nout,
                 double** out) {
+  dc_int off = 0;
   for (int i = 0; i < nin; ++i) s->arg[i] = in[i];
   s->arg[nin] = s->P;
-  for (int i = 0; i < nout; ++i) s->res[i] = out[i];
-  return f->eval(s->arg, s->res, s->iw, s->w, mem);
+  for (int i = 0; i < nout; ++i) {
+    const dc_int* sp = f->sparsity_out(i);
+    s->res[i] = sp_dense(sp) ? out[i] : s->nz + off;
+    if (!sp_dense(sp)) off += sp[2 + sp[1]];
+  }
+  const int status = f->eval(s->arg, s->res, s->iw, s->w, mem);
+  if (status != 0) return status;
+  off = 0;
+  for (int i = 0; i < nout; ++i) {
+    const dc_int* sp = f->sparsity_out(i);
+    if (sp_dense(sp)) continue;
+    const dc_int nrow = sp[0], ncol = sp[1], *colind = sp + 2, *row = sp + 3 + ncol;
+    memset(out[i], 0, sizeof(double) * (size_t)(nrow * ncol));
+    for (dc_int c = 0; c < ncol; ++c)
+      for (dc_int k = colind[c]; k < colind[c + 1]; ++k) out[i][c * nrow + row[k]] = s->nz[off + k];
+    off += colind[ncol];
+  }
+  return 0;
 }
 
 /* ------------------------------------------------------------------ linear algebra ---- */
@@ -351,7 +377,7 @@ DCO_API void dco_free(void* sp) {
   }
   double* bufs[] = {s->minv, s->Q, s->Pq, s->c, s->f, s->Fk, s->S, s->Sd, s->r, s->lam, s->D,
                     s->Jk, s->b, s->zl, s->k1, s->k2, s->k3, s->k4, s->xt, s->xcur, s->g0,
-                    s->gd0, s->g1, s->gd1, s->params, s->w};
+                    s->gd0, s->g1, s->gd1, s->params, s->w, s->nz};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i) free(bufs[i]);
   free(s->arg);
   free(s->res);
@@ -430,9 +456,13 @@ DCO_API void* dco_open(const double* mass, const double* P, char* err, int errle
   ALLOC(gd0, ng);
   ALLOC(g1, ng);
   ALLOC(gd1, ng);
+  { /* the outputs of one call at most: every function's outputs are no larger than these */
+    dc_int most = (dc_int)(n + m) * nx + n + m * n + m + 2 * ng + M->n_channels;
+    ALLOC(nz, most);
+  }
 #undef ALLOC
   if (!s->arg || !s->res || !s->iw || !s->w || !s->mem_tf || !s->mem_tj || !s->active ||
-      !s->poff || !s->params || !s->P || !s->minv || !s->D || !s->Jk || !s->gd1) {
+      !s->poff || !s->params || !s->P || !s->minv || !s->D || !s->Jk || !s->gd1 || !s->nz) {
     if (err && errlen > 0) snprintf(err, errlen, "out of memory");
     dco_free(s);
     return NULL;
