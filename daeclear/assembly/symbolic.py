@@ -162,17 +162,11 @@ class BufferedFunction:
     instead of ~50-100 us for a plain call): for small functions on the per-event path.
 
     ``bound`` fills the function's last inputs once (the model parameters); calls pass the rest.
-    The buffer is made at the first call: every run copies its contact logic, and in a run whose
-    switches the compiled loop decides the Python functions are never called.
     """
 
     def __init__(self, function: ca.Function, bound: Sequence[Any] = ()) -> None:
         self.function = function
         self.bound = tuple(np.asarray(b, dtype=float) for b in bound)
-        self._eval: Any = None  # the buffer's evaluation, made at the first call
-
-    def _make_buffer(self) -> None:
-        function = self.function
         self._inputs = [np.zeros(function.numel_in(i)) for i in range(function.n_in())]
         self._outputs = [np.zeros(function.numel_out(i)) for i in range(function.n_out())]
         self._buffer, self._eval = function.buffer()
@@ -186,8 +180,6 @@ class BufferedFunction:
             a[:] = np.ravel(x)
 
     def __call__(self, *args: Any) -> tuple[NDArray[np.float64], ...]:
-        if self._eval is None:
-            self._make_buffer()
         for a, x in zip(self._inputs, args):
             a[:] = np.ravel(x)
         self._eval()

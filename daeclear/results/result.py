@@ -234,11 +234,11 @@ class Result:
         ``outcome``: every other keyword of the constructor (stats ... warnings). The constructor's
         checks of those (about a tenth of a millisecond a run) are skipped."""
         result = cls.__new__(cls)
-        result._assign(t, y, yp, list(state_names), dict(channels), units, EventList(events), segments,
+        result._assign(t, y, yp, list(state_names), channels, units, EventList(events), segments,
                        (step_t, step_h, step_order), outcome)
         return result
 
-    def _assign(self, t: NDArray, y: NDArray, yp: NDArray, names: list[str], channels: dict[str, NDArray],
+    def _assign(self, t: NDArray, y: NDArray, yp: NDArray, names: list[str], channels: Mapping[str, NDArray],
                 units: Mapping[str, str], events: EventList, segments: list[tuple[float, float, dict[str, str]]],
                 steps: tuple[NDArray, NDArray, NDArray] | None, outcome: Mapping[str, Any]) -> None:
         """Set the fields from checked data: arrays as read-only views, values as plain data."""
