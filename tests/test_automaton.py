@@ -214,6 +214,14 @@ def test_compiled_and_python_backends_decide_the_same_storms(kind, storm, plain_
     assert fast.stats["n_steps"] == slow.stats["n_steps"]
     assert fast.stats["n_restarts"] == slow.stats["n_restarts"]
     assert [m for *_, m in fast.segments] == [m for *_, m in slow.segments]
+    # every reported point carries its segment's contact terms and latched speeds (the compiled
+    # loop's switch vectors, recorded per restart): the contact forces agree point for point
+    np.testing.assert_allclose(fast.t, slow.t, rtol=0, atol=1e-15)
+    forces = [name for name in fast.channels if name.endswith(("normal_force", "in_contact"))]
+    assert forces and max(np.max(fast.channels[name]) for name in forces) > 100.0
+    for name in [*forces, "drive.moment"]:
+        scale = np.max(np.abs(slow.channels[name]))
+        np.testing.assert_allclose(fast.channels[name], slow.channels[name], rtol=0, atol=1e-6 * scale, err_msg=name)
 
 
 def test_a_small_event_buffer_is_drained_between_chunks(monkeypatch):

@@ -108,11 +108,21 @@ class PairLogic:
         pair's mode, its term and latched speed; return the event it makes, if any."""
         if decision.kind == NONE:
             return []
+        self.apply(root, t, y, decision, active, params)
+        return [ContactEvent.from_solver(t, self.pair, EVENT_KINDS[decision.kind], rate, np.array(y, dtype=float))]
+
+    def apply(self, root: int, t: float, y: NDArray, decision: Decision, active: list[bool],
+              params: list[NDArray]) -> None:
+        """Take a decision's mode, term and latched speed without recording its event (the compiled
+        loop's events of one advance are recorded by the IDA loop; see ``record``)."""
         self.state = recorded(self.state, decision)
         active[self.term_index] = decision.term_on
         if decision.kind == ONSET:
             params[self.term_index] = self._params()
-        return [ContactEvent.from_solver(t, self.pair, EVENT_KINDS[decision.kind], rate, np.array(y, dtype=float))]
+
+    def pair_name(self, root: int) -> str:
+        """The name of the pair of gap ``root`` (its events' ``pair``)."""
+        return self.pair
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]]:
         """(root, term, (q, v, P) -> [gap; rate], needs approach speed, floor): the pairs whose

@@ -240,14 +240,29 @@ class SliderGuideLogic:
             events += self._apply(t, y, active, params)
         return events
 
+    def apply(self, root: int, t: float, y: NDArray, decision: Decision, active: list[bool],
+              params: list[NDArray]) -> None:
+        """Take a decision of a corner without recording its event (the compiled loop's events of
+        one advance are recorded by the IDA loop; it decides corners of joints without faces only)."""
+        if decision.kind != NONE:
+            self._take_decision(root - self.first_root, decision, params)
+            self._apply(t, y, active, params)
+
+    def pair_name(self, root: int) -> str:
+        """The name of the corner of gap ``root`` (its events' ``pair``)."""
+        return self.pairs[root - self.first_root]
+
+    def _take_decision(self, i: int, decision: Decision, params: list[NDArray]) -> None:
+        self.states[i] = recorded(self.states[i], decision)
+        if decision.kind == ONSET:
+            params[self.corner_terms[i]] = self._corner_params(i)
+
     def _record_corner(self, i: int, t: float, y: NDArray, rate: float, decision: Decision,
                        params: list[NDArray]) -> list[ContactEvent]:
         """Set corner i's mode and latched speed from a decision; return its event, if any."""
         if decision.kind == NONE:
             return []
-        self.states[i] = recorded(self.states[i], decision)
-        if decision.kind == ONSET:
-            params[self.corner_terms[i]] = self._corner_params(i)
+        self._take_decision(i, decision, params)
         return [ContactEvent.from_solver(t, self.pairs[i], EVENT_KINDS[decision.kind], rate, np.array(y, dtype=float))]
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:

@@ -40,7 +40,7 @@ from .session_base import (
     STORE_STATES,
     STORE_TIMES,
     Advance,
-    AutoEvent,
+    AutoEvents,
     SessionBase,
     SessionOptions,
     StateLayout,
@@ -235,20 +235,17 @@ class CSession(SessionBase):
             raise DaeclearError("making the reported points consistent in the compiled model failed")
         return y_out, yp_out, channels
 
-    def _take_auto_events(self) -> list[AutoEvent]:
+    def _take_auto_events(self) -> AutoEvents | None:
         buf = getattr(self, "_auto_buf", None)
         if buf is None:
-            return []
+            return None
         t, pair, info, rate, latched, y = buf
         k = self._lib.dc_take_events(self._h, self._auto_cap, t.ctypes.data, pair.ctypes.data, info.ctypes.data,
                                      rate.ctypes.data, latched.ctypes.data, y.ctypes.data)
         if not k:
-            return []
-        states = y[:k].copy()  # one copy; each event's state is a row of it
-        return [AutoEvent(ti, pi, ri, Decision(kind, bool(contact), bool(held), li, watch), states[i])
-                for i, (ti, pi, ri, (kind, contact, held, watch), li)
-                in enumerate(zip(t[:k].tolist(), pair[:k].tolist(), rate[:k].tolist(), info[:k].tolist(),
-                                 latched[:k].tolist()))]
+            return None
+        return AutoEvents(t[:k].copy(), pair[:k].copy(), info[:k].copy(), rate[:k].copy(), latched[:k].copy(),
+                          y[:k].copy())
 
     def automaton_run(self, times: Sequence[float], directions: Sequence[int], rates: Sequence[float], *,
                       storm: Storm, min_approach_speed: float, contact: bool = False, held: bool = False,
@@ -353,7 +350,7 @@ class CSession(SessionBase):
         A = self._addr
         self._i_eval.value = 0
         chunks: list[tuple[np.ndarray, ...]] = []
-        auto_events: list[AutoEvent] = []
+        auto_events: list[AutoEvents] = []
         store = (STORE_TIMES | (STORE_STATES if store_states else 0)) if store_steps else 0
         lib, h = self._lib, self._h
         tic = time.perf_counter()
@@ -368,12 +365,14 @@ class CSession(SessionBase):
                 if k:
                     states = (self._sy[:k].copy(), self._syp[:k].copy()) if store_states else (NO_ROWS[n],) * 2
                     chunks.append((self._st[:k].copy(), *states, self._sh[:k].copy(), self._sord[:k].copy()))
-                auto_events += self._take_auto_events()  # drained at every chunk: the C buffer never overflows
+                taken = self._take_auto_events()  # drained at every chunk: the C buffer never overflows
+                if taken is not None:
+                    auto_events.append(taken)
                 if rc != 0 or chunked:
                     break
                 # buffer full: back in Python between chunks, so Ctrl-C works here
                 if on_chunk is not None:  # time reached, and contact switches made in C so far
-                    on_chunk(self._t_out.value, len(auto_events))
+                    on_chunk(self._t_out.value, sum(len(a) for a in auto_events))
         except KeyboardInterrupt:  # between chunks: return the steps taken so far, marked "interrupted"
             interrupted, rc = True, 1
         finally:
@@ -394,7 +393,7 @@ class CSession(SessionBase):
         self._eval_after = float(te[-1]) if rc == 0 and m and ne == m and te[-1] < self._t else None
         adv = Advance(status="tstop", t=self._t, y=self._y, yp=self._yp, step_t=st,
                       step_y=sy, step_yp=syp, step_h=sh, step_order=so, eval_t=te[:ne].copy(),
-                      eval_y=ev_y[:ne], eval_yp=ev_yp[:ne], auto_events=auto_events)
+                      eval_y=ev_y[:ne], eval_yp=ev_yp[:ne], auto_events=AutoEvents.join(auto_events))
         if interrupted:
             adv.status = "interrupted"
             return adv

@@ -76,7 +76,7 @@ from .session_base import (
     TINY_STEP_GROWTH,
     TINY_STEP_REL,
     Advance,
-    AutoEvent,
+    AutoEvents,
     DAEFunctions,
     Session,
     StateLayout,
@@ -96,7 +96,7 @@ __all__ = [
     "FLAG_MAX_STEPS",
     "FLAG_STEP_COLLAPSE",
     # defined in session_base, c_session and python_session now, still importable from here
-    "AutoEvent",
+    "AutoEvents",
     "StateLayout",
     "CSession",
     "PythonSession",

@@ -10,8 +10,9 @@ and the callers above them depend on these types, and nothing here depends on a 
 from __future__ import annotations
 
 import math
+import dataclasses
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple, Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 from collections.abc import Sequence
 
 import casadi
@@ -25,7 +26,7 @@ from .stall_guard import TINY_STEP_COUNT, TINY_STEP_GROWTH, TINY_STEP_REL, Stall
 
 __all__ = [
     "DAEFunctions",
-    "AutoEvent",
+    "AutoEvents",
     "StateLayout",
     "Advance",
     "Session",
@@ -81,15 +82,36 @@ class DAEFunctions:
     n_parameters: int = 0
 
 
-class AutoEvent(NamedTuple):
-    """A contact switch the compiled loop decided itself: pair index (in the order given to
-    :meth:`CSession.set_auto_events`), the penetration rate there, the decision and the state."""
+@dataclass(frozen=True)
+class AutoEvents:
+    """The contact switches the compiled loop decided itself in one advance, in time order, one
+    row each (columns, not objects: a run records dozens per revolution). ``pair``: index in the
+    order given to :meth:`CSession.set_auto_events`; ``info``: the decision's kind, contact, held
+    and watch; ``rate``: the penetration rate there; ``latched``: the pair's latched approach speed
+    after the decision; ``y``: the state at the switch."""
 
-    t: float
-    pair: int
-    rate: float
-    decision: Decision
+    t: np.ndarray
+    pair: np.ndarray
+    info: np.ndarray
+    rate: np.ndarray
+    latched: np.ndarray
     y: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    def decision(self, i: int) -> Decision:
+        """The decision of row ``i``."""
+        kind, contact, held, watch = self.info[i].tolist()
+        return Decision(kind, bool(contact), bool(held), float(self.latched[i]), watch)
+
+    @staticmethod
+    def join(parts: Sequence[AutoEvents]) -> AutoEvents | None:
+        """The rows of ``parts`` in order (None without any)."""
+        if len(parts) < 2:
+            return parts[0] if parts else None
+        names = [f.name for f in dataclasses.fields(AutoEvents)]
+        return AutoEvents(*(np.concatenate([getattr(p, name) for p in parts]) for name in names))
 
 
 @dataclass(frozen=True)
@@ -139,7 +161,7 @@ class Advance:
     flag_name: str = ""
     message: str = ""
     # contact switches the compiled loop decided itself (see CSession.set_auto_events), in time order
-    auto_events: list[AutoEvent] = field(default_factory=list)
+    auto_events: AutoEvents | None = None
 
     @property
     def success(self) -> bool:

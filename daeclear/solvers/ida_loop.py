@@ -13,7 +13,6 @@ running out of memory) the result holds what was computed (:meth:`SegmentLoop.fi
 
 from __future__ import annotations
 
-import itertools
 import math
 import time
 from typing import Any
@@ -28,7 +27,9 @@ from ..assembly.assemble import DAEModel
 from ..errors import Interrupted, SolveError
 from .recorder import Recorder
 from ..progress import Progress
-from ..results.result import Result
+from ..assembly.automaton import EVENT_KINDS, ONSET
+from ..engine.session_base import AutoEvents
+from ..results.result import ContactEvent, Result
 
 #: Output times handed to the compiled loop at a time: their rows are emptied between windows.
 EVAL_WINDOW = 4096
@@ -57,15 +58,14 @@ class SegmentLoop:
             y, yp = model.consistent_state(t0, y0, model.term_forces(t0, y0, self.active, self.params, session),
                                            session)
         self.switch = model.switch_vector(self.active, self.params)
-        # reported points not made consistent yet (IDA's raw values, with their contact switches)
-        # each piece's rows share one switch vector: repeated once per flush, not once per piece
+        # reported points not made consistent yet (IDA's raw values, with each row's switch vector)
         self.raw: list[tuple[NDArray, NDArray, NDArray, NDArray]] = []
         rec.add_steps(np.array([t0]), np.array([0.0]), np.array([0]))
         self.i_eval = 0  # index of the next output time
         if eval_times is None:
-            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch))
+            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
         elif eval_times.window(0, 1)[0] == t0:
-            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch))
+            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
             self.i_eval = 1
         self.events, self.segments = rec.events, rec.segments
         self.t, self.y, self.yp, self.y0 = t0, y, yp, y0
@@ -75,7 +75,9 @@ class SegmentLoop:
         self.interrupted = False
         self.c_layout = False  # the compiled loop makes the points consistent itself
         self.c_decides = False  # the compiled loop decides every contact switch itself
-        self.owners: dict[int, Any] = {}  # root -> the contact logic it belongs to
+        # per pair the compiled loop decides: (its logic, root, name, switch vector column of its term, the
+        # term's parameter is the latched approach speed)
+        self.auto_info: list[tuple[Any, int, str, int, bool]] = []
 
     def run(self, on_failure: str, setup_time: float, sim_params: dict[str, Any]) -> Result:
         """Integrate to the end, a failure or Ctrl-C; always return (or attach) what was computed."""
@@ -110,11 +112,13 @@ class SegmentLoop:
         # the compiled loop may decide every contact switch itself (simple pairs): the rule and the
         # starting state of each pair come from its logic object; Python then only records
         if model.auto_pairs:
-            self.owners = {root: logic for logic in model.contacts for root in logic.roots}
-            roots = [pair[0] for pair in model.auto_pairs]
+            owners = {root: logic for logic in model.contacts for root in logic.roots}
+            columns = np.cumsum([0] + [1 + term.n_params for term in model.terms]).tolist()
+            self.auto_info = [(owners[root], root, owners[root].pair_name(root), columns[term], bool(needs))
+                              for root, term, _, needs, _ in model.auto_pairs]
             self.c_decides = self.c_layout and session.set_auto_events(
-                model.auto_pairs, storms=[self.owners[root].storm for root in roots],
-                states=[self.owners[root].pair_state(root) for root in roots])
+                model.auto_pairs, storms=[logic.storm for logic, *_ in self.auto_info],
+                states=[logic.pair_state(root) for logic, root, *_ in self.auto_info])
 
     def advance_to_end(self) -> None:
         """Advance chunk by chunk and segment by segment until the end, a failure or an exception."""
@@ -157,42 +161,66 @@ class SegmentLoop:
         self.seg_start = math.nan
 
     def record_advance(self, adv: Any) -> None:
-        """Record the compiled loop's own contact switches: split the advance at each restart and
-        record the decisions (modes, terms, latched speeds, events) in the pair logic."""
+        """Record the compiled loop's own contact switches (:meth:`record_switches`) and keep the
+        advance's points, each with the switch vector of the segment it belongs to."""
         if self.store_steps and adv.step_t.size:  # the steps of every segment at once
             self.rec.add_steps(adv.step_t, adv.step_h, adv.step_order)
-        s0 = e0 = 0
-        ends = _split_rows(adv)  # one search for all restarts of the advance
-        for t_ev, decided in itertools.groupby(adv.auto_events, key=lambda ev: ev.t):
-            s1, e1 = ends[t_ev]
-            self.keep_points(adv, slice(s0, s1), slice(e0, e1), self.switch)
-            self.segments.append((self.seg_start, t_ev, dict(self.modes)))
-            for ev in decided:
-                root = self.model.auto_pairs[ev.pair][0]
-                for event in self.owners[root].record(root, t_ev, ev.y, ev.rate, ev.decision, self.active,
-                                                      self.params):
-                    self.events.append(event)
-                    self.modes[event.pair] = "contact" if event.kind == "onset" else "free"
-            self.switch = self.model.switch_vector(self.active, self.params)
-            self.seg_start, s0, e0 = t_ev, s1, e1
-            self.n_restarts += 1
-        self.keep_points(adv, slice(s0, None), slice(e0, None), self.switch)
+        rows = (adv.step_t, adv.step_y, adv.step_yp) if self.eval_times is None else (
+            adv.eval_t, adv.eval_y, adv.eval_yp)
+        if self.eval_times is None and not self.store_steps or not rows[0].size:
+            if adv.auto_events is not None:
+                self.record_switches(adv.auto_events)
+            return
+        if adv.auto_events is None:
+            switch = np.broadcast_to(self.switch, (rows[0].size, self.switch.size))
+        else:  # a row at a restart's time belongs to the segment that ends there
+            times, switches = self.record_switches(adv.auto_events)
+            ends = np.searchsorted(rows[0], times, side="right")
+            switch = np.repeat(switches, np.diff(ends, prepend=0, append=rows[0].size), axis=0)
+        self.raw.append((*rows, switch))
 
-    def keep_points(self, adv: Any, steps: slice, evals: slice, switch: NDArray) -> None:
-        """Keep IDA's points of one segment as they are, with its switch vector; they are made
-        consistent by flush()."""
-        if self.eval_times is None:  # the steps are the output points
-            step_t = adv.step_t[steps]
-            if self.store_steps and step_t.size:
-                self.raw.append((step_t, adv.step_y[steps], adv.step_yp[steps], switch))
-        else:
-            eval_t = adv.eval_t[evals]
-            if eval_t.size:
-                self.raw.append((eval_t, adv.eval_y[evals], adv.eval_yp[evals], switch))
+    def record_switches(self, auto: AutoEvents) -> tuple[list[float], NDArray]:
+        """Record the switches the compiled loop decided in one advance: events, modes and segments
+        in time order, and each pair's final state in its logic. Return the restart times and the
+        switch vectors before the first restart and after each."""
+        events, segments, modes = self.events, self.segments, self.modes
+        switch = self.switch.copy()
+        switches, times = [self.switch], []
+        last: dict[int, int] = {}  # pair -> its last row
+        onset: dict[int, int] = {}  # pair -> its last onset's row (the latched speed of its term)
+        kinds = auto.info[:, 0].tolist()
+        term_on = (auto.info[:, 1] | auto.info[:, 2]).tolist()
+        for i, (t, p, rate, latched) in enumerate(zip(auto.t.tolist(), auto.pair.tolist(), auto.rate.tolist(),
+                                                      auto.latched.tolist())):
+            if not times or t != times[-1]:  # a restart: the segment before it ends
+                if times:
+                    switches.append(switch.copy())
+                segments.append((self.seg_start, t, dict(modes)))
+                self.seg_start = t
+                times.append(t)
+            _, _, name, column, needs = self.auto_info[p]
+            events.append(ContactEvent.from_solver(t, name, EVENT_KINDS[kinds[i]], rate, auto.y[i]))
+            modes[name] = "contact" if kinds[i] == ONSET else "free"
+            switch[column] = 1.0 if term_on[i] else 0.0  # as the compiled loop sets its term
+            if needs:
+                switch[column + 1] = latched
+            last[p] = i
+            if kinds[i] == ONSET:
+                onset[p] = i
+        switches.append(switch)
+        for p, i in last.items():  # a pair's state is its last decision's, its latched speed its last onset's
+            logic, root = self.auto_info[p][:2]
+            for j in sorted({onset.get(p, i), i}):
+                logic.apply(root, float(auto.t[j]), auto.y[j], auto.decision(j), self.active, self.params)
+        self.switch = switch
+        self.n_restarts += len(times)
+        return times, np.array(switches)
 
     def check_decisions(self, adv: Any) -> None:
         """Turn the advance into an internal error when the compiled loop and Python disagree."""
-        if adv.auto_events and not _same_terms(self.session.active_terms(), self.active, self.params):
+        if adv.auto_events is not None and not (
+                _same_terms(self.session.active_terms(), self.active, self.params)
+                and np.array_equal(self.switch, self.model.switch_vector(self.active, self.params))):
             adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
             adv.message = "internal: the compiled event loop and the recorded contact modes disagree"
         elif self.c_decides and adv.status == "root":
@@ -232,10 +260,11 @@ class SegmentLoop:
         point's q and v with that point's contact modes (point by point: chunks change nothing)."""
         model, session, raw = self.model, self.session, self.raw
         if raw:
-            times, ys, yps, switches = zip(*raw)
+            if len(raw) == 1:
+                out_t, out_y, out_yp, out_switch = raw[0]
+            else:
+                out_t, out_y, out_yp, out_switch = (np.concatenate(column) for column in zip(*raw))
             raw.clear()
-            out_t, out_y, out_yp = np.concatenate(times), np.concatenate(ys), np.concatenate(yps)
-            out_switch = np.repeat(np.array(switches), [t.size for t in times], axis=0)
             if self.c_layout:  # one pass in C
                 out_y, out_yp, values = session.report(out_t, out_y, out_switch)
                 # one transposed copy: each channel is a contiguous row of it
@@ -292,16 +321,6 @@ class SegmentLoop:
                                      self.y0 if sim_params["start"] == "declared" else None, stats, session)
         finally:
             session.close()
-
-
-def _split_rows(adv: Any) -> dict[float, tuple[int, int]]:
-    """Event time -> (steps, output points) of the advance up to and including that time."""
-    if not adv.auto_events:
-        return {}
-    times = np.array([ev.t for ev in adv.auto_events])
-    steps = np.searchsorted(adv.step_t, times, side="right").tolist()
-    evals = np.searchsorted(adv.eval_t, times, side="right").tolist()
-    return {t: (s, e) for t, s, e in zip(times.tolist(), steps, evals)}
 
 
 def _eval_window(times: opts.OutputTimes, i: int, t: float, size: int) -> tuple[int, NDArray]:
