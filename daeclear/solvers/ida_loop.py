@@ -185,7 +185,8 @@ class SegmentLoop:
         switch vectors before the first restart and after each."""
         events, segments, modes = self.events, self.segments, self.modes
         switch = self.switch.copy()
-        switches, times = [self.switch], []
+        switches: list[NDArray] = [self.switch]
+        times: list[float] = []
         last: dict[int, int] = {}  # pair -> its last row
         onset: dict[int, int] = {}  # pair -> its last onset's row (the latched speed of its term)
         kinds = auto.info[:, 0].tolist()
