@@ -334,6 +334,38 @@ def test_runs_leave_the_model_unchanged_and_are_independent(clearance_model) -> 
     assert _same(_snapshot(clearance_model), before)
 
 
+def test_a_buffered_function_gives_each_thread_its_own_buffer() -> None:
+    """The contact logic's gap function is shared by the runs of a model (a run copies none of
+    it): threads calling it at the same time each get their own inputs' results, and a pickled
+    copy (a process pool's) evaluates the same."""
+    import pickle
+
+    import casadi as ca
+
+    from daeclear.assembly.symbolic import BufferedFunction
+
+    x, p = ca.SX.sym("x", 2), ca.SX.sym("p")
+    function = BufferedFunction(ca.Function("f", [x, p], [x * p, ca.sum1(x)]), bound=(np.array([3.0]),))
+    failures: list[str] = []
+
+    def hammer(k: int) -> None:
+        for i in range(2000):
+            value = np.array([k, i], dtype=float)
+            scaled, total = function(value)
+            if not (np.array_equal(scaled, 3.0 * value) and total[0] == k + i):
+                failures.append(f"thread {k}, call {i}: {scaled}, {total}")
+                return
+
+    threads = [threading.Thread(target=hammer, args=(k,)) for k in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert not failures
+    copied = pickle.loads(pickle.dumps(function))
+    np.testing.assert_array_equal(copied(np.array([1.0, 2.0]))[0], [3.0, 6.0])
+
+
 def test_ode_methods_leave_the_model_unchanged() -> None:
     model = dc.assemble(slider_crank("revolute"), "index1")
     before = _snapshot(model)

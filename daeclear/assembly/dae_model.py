@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..engine.session_base import DAEFunctions, StateLayout
 from ..errors import AssemblyError
 from ..solvers.physics import check_start_penetration
-from .symbolic import BufferedFunction, Term
+from .symbolic import Term
 
 Formulation = Literal["index1", "ggl"]
 
@@ -480,14 +480,12 @@ def _mapped(function: ca.Function, n: int) -> ca.Function:
 
 
 def _run_copy(logic: Any) -> Any:
-    """A contact logic object for one run: a shallow copy whose lists (pair states, faces) and
-    buffered functions (their input and output arrays) are its own."""
+    """A contact logic object for one run: a shallow copy whose lists (pair states, faces) are its
+    own (its buffered functions are shared: each thread evaluates them in its own buffers)."""
     fresh = copy.copy(logic)
     for name, value in vars(logic).items():
         if isinstance(value, list):
             setattr(fresh, name, list(value))
-        elif isinstance(value, BufferedFunction):
-            setattr(fresh, name, copy.copy(value))  # a new buffer (BufferedFunction.__setstate__)
     return fresh
 
 

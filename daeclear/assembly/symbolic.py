@@ -7,6 +7,7 @@ element builders. Nothing here knows a particular joint.
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 from typing import Any
 from collections.abc import Sequence
@@ -162,30 +163,44 @@ class BufferedFunction:
     instead of ~50-100 us for a plain call): for small functions on the per-event path.
 
     ``bound`` fills the function's last inputs once (the model parameters); calls pass the rest.
+    Each thread gets its own buffer and arrays, made at its first call: runs of one model in
+    threads share the object, and a run copies none of it.
     """
 
     def __init__(self, function: ca.Function, bound: Sequence[Any] = ()) -> None:
         self.function = function
         self.bound = tuple(np.asarray(b, dtype=float) for b in bound)
-        self._inputs = [np.zeros(function.numel_in(i)) for i in range(function.n_in())]
-        self._outputs = [np.zeros(function.numel_out(i)) for i in range(function.n_out())]
-        self._buffer, self._eval = function.buffer()
+        self._local = threading.local()
+
+    def _arrays(self) -> tuple[list[NDArray[np.float64]], list[NDArray[np.float64]], Any]:
+        """This thread's (inputs, outputs, evaluate), made at its first call."""
+        made = getattr(self._local, "arrays", None)
+        if made is not None:
+            return made
+        function = self.function
+        inputs = [np.zeros(function.numel_in(i)) for i in range(function.n_in())]
+        outputs = [np.zeros(function.numel_out(i)) for i in range(function.n_out())]
+        buffer, evaluate = function.buffer()
         # (CasADi's stub asks a size the binding takes from the memoryview; numpy types arrays as buffers
         # only from Python 3.12 on)
-        for i, a in enumerate(self._inputs):
-            self._buffer.set_arg(i, memoryview(a))  # type: ignore[call-arg, arg-type]
-        for i, r in enumerate(self._outputs):
-            self._buffer.set_res(i, memoryview(r))  # type: ignore[call-arg, arg-type]
-        for a, x in zip(self._inputs[len(self._inputs) - len(self.bound):], self.bound):
+        for i, a in enumerate(inputs):
+            buffer.set_arg(i, memoryview(a))  # type: ignore[call-arg, arg-type]
+        for i, r in enumerate(outputs):
+            buffer.set_res(i, memoryview(r))  # type: ignore[call-arg, arg-type]
+        for a, x in zip(inputs[len(inputs) - len(self.bound):], self.bound):
             a[:] = np.ravel(x)
+        self._local.buffer = buffer  # kept alive with its arrays
+        self._local.arrays = (inputs, outputs, evaluate)
+        return self._local.arrays
 
     def __call__(self, *args: Any) -> tuple[NDArray[np.float64], ...]:
-        for a, x in zip(self._inputs, args):
+        inputs, outputs, evaluate = self._arrays()
+        for a, x in zip(inputs, args):
             a[:] = np.ravel(x)
-        self._eval()
-        return tuple(r.copy() for r in self._outputs)
+        evaluate()
+        return tuple(r.copy() for r in outputs)
 
-    def __getstate__(self) -> dict[str, Any]:  # picklable for process pools: rebuild the buffer
+    def __getstate__(self) -> dict[str, Any]:  # picklable for process pools: no buffers
         return {"function": self.function, "bound": self.bound}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
