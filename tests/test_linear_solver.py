@@ -147,7 +147,7 @@ def test_reduced_solve_equals_a_plain_lu(formulation):
     """J x = b by eliminating the n_q position rows equals numpy's LU of the whole J wherever the
     q-row block is diagonal: always for index1; for GGL where mu = 0 (every consistent state) and
     here also off it, because each body's angle enters Phi_q only through its own rotation, so
-    d(Phi_q^T mu)/dq is diagonal. Eliminating no rows is a plain LU again."""
+    d(Phi_q^T mu)/dq is diagonal. Eliminating fewer rows (none: a plain LU) gives the same."""
     model = dc.assemble(slider_crank("revolute"), formulation)
     y, yp = model.initial_state()
     s = open_session(model.functions, backend="c", rtol=1e-8, atol=1e-10, parameters=model.parameter_values,
@@ -160,10 +160,11 @@ def test_reduced_solve_equals_a_plain_lu(formulation):
     for cj in (1e3, 1e7):
         J = s.jacobian(0.0, y, yp, cj)
         exact = np.linalg.solve(J, b)
-        np.testing.assert_allclose(s.solve_reduced(0.0, y, yp, cj, b, nq), exact, rtol=1e-9,
-                                   atol=1e-12 * np.abs(exact).max())
-        np.testing.assert_allclose(s.solve_reduced(0.0, y, yp, cj, b, 0), exact, rtol=1e-9,
-                                   atol=1e-12 * np.abs(exact).max())
+        # every count of eliminated rows: the LU solve takes four columns at a time, so the factored
+        # sizes n - nk cover every remainder of 4 (and nk = 0 is a plain LU)
+        for nk in range(nq + 1):
+            np.testing.assert_allclose(s.solve_reduced(0.0, y, yp, cj, b, nk), exact, rtol=1e-9,
+                                       atol=1e-12 * np.abs(exact).max(), err_msg=f"nk={nk}")
     if formulation == "ggl":
         assert not np.any(y[mu])
         y_mu = y.copy()
@@ -174,6 +175,26 @@ def test_reduced_solve_equals_a_plain_lu(formulation):
         exact = np.linalg.solve(J, b)
         np.testing.assert_allclose(s.solve_reduced(0.0, y_mu, yp, 1e3, b, nq), exact, rtol=1e-9,
                                    atol=1e-12 * np.abs(exact).max())
+
+
+def test_reduced_solve_of_general_matrices():
+    """The reduced solver on random matrices whose first nk rows have a diagonal block: exact
+    (to round-off) for every nk, so for every size of the factored part and every remainder of
+    the four-column blocks of its substitutions (a mechanism's Jacobian leaves many of the
+    factors' entries zero; these matrices leave none)."""
+    model = dc.assemble(slider_crank("revolute"), "ggl")
+    y, yp = model.initial_state()
+    n = model.n_states
+    s = open_session(model.functions, backend="c", rtol=1e-8, atol=1e-10, parameters=model.parameter_values,
+                     linear_solver="reduced")
+    rng = np.random.default_rng(11)
+    for nk in range(n):
+        A = rng.normal(size=(n, n)) + n * np.eye(n)
+        A[:nk, :nk] = np.diag(rng.uniform(1.0, 2.0, nk))
+        b = rng.normal(size=n)
+        exact = np.linalg.solve(A, b)
+        np.testing.assert_allclose(s.solve_reduced(0.0, y, yp, 1.0, b, nk, matrix=A), exact, rtol=1e-10,
+                                   atol=1e-12 * np.abs(exact).max(), err_msg=f"nk={nk}")
 
 
 def test_sparse_and_dense_agree_on_a_chain_of_three():

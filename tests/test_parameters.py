@@ -209,17 +209,19 @@ def test_friction_laws_are_parametric(name):
 
 def test_drift_against_the_smallest_clearance_is_reported():
     """index-1 with Baumgarte drifts (multipliers are out of the error test): at c = 0.01 mm and
-    rtol 1e-6 the drift over 4 ms is about 3e-8 m (1e-8 after 2 ms), above 1e-3 of the clearance:
-    a warning names it; the drift-free GGL formulation stays far below it."""
+    rtol 1e-6 the drift over a revolution (12 ms) is about 2e-7 m (1e-8 after 2 ms, where it
+    sits on the warning's threshold), far above 1e-3 of the clearance: a warning names it; the
+    drift-free GGL formulation stays far below it, and so does the chapter's 0.5 mm clearance
+    over 4 ms."""
     scene = dc.mechanisms.slider_crank("revolute", clearance=1e-5)
     with pytest.warns(dc.DaeclearWarning, match="constraints drifted"):
-        drifting = dc.simulate(scene, t_end=0.004, rtol=1e-6, formulation="index1")
-    assert drifting.stats["max_constraint_drift"] > 1e-8
+        drifting = dc.simulate(scene, t_end=0.012, rtol=1e-6, formulation="index1")
+    assert drifting.stats["max_constraint_drift"] > 5e-8
     import warnings
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", dc.DaeclearWarning)
-        exact = dc.simulate(scene, t_end=0.004, rtol=1e-6, formulation="ggl")
+        exact = dc.simulate(scene, t_end=0.012, rtol=1e-6, formulation="ggl")
         chapter = dc.simulate(dc.mechanisms.slider_crank("revolute"), t_end=0.004, rtol=1e-6, formulation="index1")
     assert exact.stats["max_constraint_drift"] < 1e-2 * drifting.stats["max_constraint_drift"]
     assert chapter.stats["max_constraint_drift"] < 1e-3 * 0.5e-3

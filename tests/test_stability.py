@@ -22,8 +22,9 @@ def test_case_finishes_bounded_or_fails_clearly(name):
 
 
 def test_drift_larger_than_a_tiny_clearance_is_flagged():
-    """index1's Baumgarte drift at rtol 1e-6 (~1 um) swamps a 1 um clearance: reported, not hidden."""
+    """index1's Baumgarte drift swamps a 1 um clearance: reported, not hidden. (At rtol 1e-6 it sits
+    at the bound, 0.4-1.2 um as round-off moves the impacts; at 3e-6 it is 2 um, four times it.)"""
     case = next(c for c in CASES if c.name == "clearance 1 um, index1")
-    row = run_case(case, rtol=1e-6, n_eval=2001)
+    row = run_case(case, rtol=3e-6, n_eval=2001)
     assert row["finished"] and not row["passed"]
     assert row["drift"] > row["drift_bound"] == pytest.approx(0.5e-6)

@@ -456,14 +456,18 @@ class CSession(SessionBase):
         return np.ascontiguousarray(out)
 
     def solve_reduced(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float, b: np.ndarray,
-                      n_kinematic: int) -> np.ndarray:
-        """x with J x = b, J the iteration matrix at (t, y, yp, cj), by the "reduced" linear
-        solver with the first ``n_kinematic`` rows eliminated (its check against a plain LU)."""
+                      n_kinematic: int, matrix: np.ndarray | None = None) -> np.ndarray:
+        """x with J x = b, J the iteration matrix at (t, y, yp, cj) or the given n x n ``matrix``,
+        by the "reduced" linear solver with the first ``n_kinematic`` rows eliminated (its check
+        against a plain LU)."""
         self._check_open()
         y, yp, x = self._vec(y, "y"), self._vec(yp, "yp"), self._vec(b, "b").copy()
+        A = None if matrix is None else np.asfortranarray(matrix, dtype=float)
+        if A is not None and A.shape != (self._n, self._n):
+            raise ValueError(f"solve_reduced: matrix has shape {A.shape}, must be ({self._n}, {self._n})")
         self._sync_terms()
         rc = self._lib.dc_solve_reduced(self._h, int(n_kinematic), float(t), y.ctypes.data, yp.ctypes.data,
-                                        float(cj), x.ctypes.data)
+                                        float(cj), None if A is None else A.ctypes.data, x.ctypes.data)
         if rc:
             raise DaeclearError(f"the reduced linear solve failed at t={t} ({'singular' if rc > 0 else 'error'})")
         return x

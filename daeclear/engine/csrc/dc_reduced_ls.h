@@ -91,10 +91,14 @@ static int rls_setup(SUNLinearSolver S, SUNMatrix A) {
 }
 
 /* x <- (LU)^-1 P x with the factors of SUNDlsMat_denseGETRF: its GETRS, with the divisions by
- * U's diagonal (a chain of dependent divisions, a quarter of the solve at n = 23) replaced by
- * products with their reciprocals. */
+ * U's diagonal (a chain of dependent divisions) replaced by products with their reciprocals, and
+ * both substitutions four columns at a time: a column-by-column substitution waits at every
+ * column for the previous one's update of x (a store and a load on the critical path); a block
+ * of four waits once, then updates the rows below (above) with four products each. 160 instead
+ * of 265 ns at n = 23 (the slider-crank's GGL system). */
 static void rls_lu_solve(const dc_reduced_ls* c, sunindextype n, double* x) {
   double* const* a = c->cols;
+  const double* r = c->rdiag;
   for (sunindextype k = 0; k < n; ++k) {
     const sunindextype pk = c->piv[k];
     if (pk != k) {
@@ -103,14 +107,38 @@ static void rls_lu_solve(const dc_reduced_ls* c, sunindextype n, double* x) {
       x[pk] = tmp;
     }
   }
-  for (sunindextype k = 0; k + 1 < n; ++k) { /* L y = P x, L unit lower */
+  sunindextype k = 0;
+  for (; k + 4 <= n; k += 4) { /* L y = P x, L unit lower: columns k .. k + 3 */
+    const double *c0 = a[k], *c1 = a[k + 1], *c2 = a[k + 2], *c3 = a[k + 3];
+    const double x0 = x[k];
+    const double x1 = x[k + 1] - c0[k + 1] * x0;
+    const double x2 = x[k + 2] - c0[k + 2] * x0 - c1[k + 2] * x1;
+    const double x3 = x[k + 3] - c0[k + 3] * x0 - c1[k + 3] * x1 - c2[k + 3] * x2;
+    x[k + 1] = x1;
+    x[k + 2] = x2;
+    x[k + 3] = x3;
+    for (sunindextype i = k + 4; i < n; ++i) x[i] -= c0[i] * x0 + c1[i] * x1 + c2[i] * x2 + c3[i] * x3;
+  }
+  for (; k + 1 < n; ++k) {
     const double* col = a[k];
     const double xk = x[k];
     for (sunindextype i = k + 1; i < n; ++i) x[i] -= col[i] * xk;
   }
-  for (sunindextype k = n - 1; k >= 0; --k) { /* U x = y */
+  for (k = n - 1; k >= 3; k -= 4) { /* U x = y: columns k .. k - 3 */
+    const double *c0 = a[k], *c1 = a[k - 1], *c2 = a[k - 2], *c3 = a[k - 3];
+    const double x0 = x[k] * r[k];
+    const double x1 = (x[k - 1] - c0[k - 1] * x0) * r[k - 1];
+    const double x2 = (x[k - 2] - c0[k - 2] * x0 - c1[k - 2] * x1) * r[k - 2];
+    const double x3 = (x[k - 3] - c0[k - 3] * x0 - c1[k - 3] * x1 - c2[k - 3] * x2) * r[k - 3];
+    x[k] = x0;
+    x[k - 1] = x1;
+    x[k - 2] = x2;
+    x[k - 3] = x3;
+    for (sunindextype i = 0; i < k - 3; ++i) x[i] -= c0[i] * x0 + c1[i] * x1 + c2[i] * x2 + c3[i] * x3;
+  }
+  for (; k >= 0; --k) {
     const double* col = a[k];
-    const double xk = (x[k] *= c->rdiag[k]);
+    const double xk = (x[k] *= r[k]);
     for (sunindextype i = 0; i < k; ++i) x[i] -= col[i] * xk;
   }
 }

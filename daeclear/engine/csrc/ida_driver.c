@@ -1834,17 +1834,19 @@ DC_API int dc_eval_jacobian_sparse(void* sp, double t, const double* y, const do
 }
 
 /* Solve J x = b with the reduced dense solver (nk position rows eliminated), J the iteration
- * matrix at (t, y, yp, cj) of the active terms; b is overwritten by x. The solver IDA uses, on
- * its own copy: a check against a plain LU. 0 ok, 1 singular, -1 evaluation failed or no memory. */
+ * matrix at (t, y, yp, cj) of the active terms, or the given column-major n x n matrix A (not
+ * NULL); b is overwritten by x. The solver IDA uses, on its own copy: a check against a plain
+ * LU. 0 ok, 1 singular, -1 evaluation failed or no memory. */
 DC_API int dc_solve_reduced(void* sp, int nk, double t, const double* y, const double* yp, double cj,
-                            double* b) {
+                            const double* A, double* b) {
   dc_session* s = (dc_session*)sp;
   SUNMatrix J = SUNDenseMatrix(s->n, s->n, s->ctx);
   SUNLinearSolver LS = J ? rls_create(s->n, s->ctx) : NULL;
   N_Vector x = N_VMake_Serial(s->n, b, s->ctx);
   int rc = -1;
+  if (J && A) memcpy(SUNDenseMatrix_Data(J), A, sizeof(double) * (size_t)s->n * (size_t)s->n);
   if (J && LS && x && rls_set_kinematic_rows(LS, nk) == 0 &&
-      eval_jac(s, t, y, yp, cj, SUNDenseMatrix_Data(J), 0) == 0) {
+      (A || eval_jac(s, t, y, yp, cj, SUNDenseMatrix_Data(J), 0) == 0)) {
     rc = SUNLinSolSetup(LS, J) != SUN_SUCCESS;
     if (rc == 0) rc = SUNLinSolSolve(LS, J, x, x, 0.0) != SUN_SUCCESS ? -1 : 0;
   }
