@@ -14,6 +14,7 @@ or a sweep sets those per call, and they never change the computed trajectory.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -99,8 +100,14 @@ class SolverOptions:
 
         The rule of :func:`daeclear.simulate`: a keyword given explicitly overrides the options object."""
         given = {k: v for k, v in keywords.items() if v is not UNSET}
-        checked({**self.to_dict(), **given}, where=where)
-        return self.replace(**given)
+        if not given:
+            return self
+        _check_names(given, "merged")
+        values = checked({**self.to_dict(), **given}, where=where)
+        merged = copy.copy(self)  # checked once (here, naming where), not again by the constructor
+        for name, value in values.items():
+            object.__setattr__(merged, name, value)
+        return merged
 
     def atol_value(self) -> float | np.ndarray | None:
         """``atol`` as the solvers take it (one value, an array per state, or None)."""

@@ -21,7 +21,10 @@ __all__ = ["readonly", "time_window", "to_plain"]
 
 
 def readonly(a: np.ndarray) -> np.ndarray:
-    """A read-only view of ``a`` (the caller's array keeps its own flags)."""
+    """A read-only view of ``a`` (the caller's array keeps its own flags); ``a`` itself when it is
+    read-only already."""
+    if not a.flags.writeable:
+        return a
     view = a.view()
     view.flags.writeable = False
     return view

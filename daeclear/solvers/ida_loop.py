@@ -175,8 +175,8 @@ class SegmentLoop:
             switch = np.broadcast_to(self.switch, (rows[0].size, self.switch.size))
         else:  # a row at a restart's time belongs to the segment that ends there
             times, switches = self.record_switches(adv.auto_events)
-            ends = np.searchsorted(rows[0], times, side="right")
-            switch = np.repeat(switches, np.diff(ends, prepend=0, append=rows[0].size), axis=0)
+            ends = [0, *np.searchsorted(rows[0], times, side="right").tolist(), rows[0].size]
+            switch = np.repeat(switches, [b - a for a, b in zip(ends, ends[1:])], axis=0)
         self.raw.append((*rows, switch))
 
     def record_switches(self, auto: AutoEvents) -> tuple[list[float], NDArray]:
@@ -268,8 +268,10 @@ class SegmentLoop:
             raw.clear()
             if self.c_layout:  # one pass in C
                 out_y, out_yp, values = session.report(out_t, out_y, out_switch)
-                # one transposed copy: each channel is a contiguous row of it
-                channels = dict(zip(model.channel_names, values.T.copy()))
+                # one transposed copy, read-only: each channel is a contiguous (read-only) row of it
+                block = values.T.copy()
+                block.flags.writeable = False
+                channels = dict(zip(model.channel_names, block))
             else:
                 out_y, out_yp = model.consistent_state(
                     out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)

@@ -82,9 +82,11 @@ class Recorder:
     def _keep_key_rows(self, t: NDArray, y: NDArray, channels: dict[str, NDArray]) -> None:
         names = [c for c in channels if c.endswith(".penetration") or c == "constraints.position"]
         kt, ky, kc = self._key
-        t2 = np.concatenate([kt, t])
-        y2 = np.concatenate([ky, y])
-        c2 = {c: np.concatenate([kc[c], channels[c]]) if c in kc else channels[c] for c in names}
+        if kt.size:  # the rows kept so far compete with the new ones
+            t2, y2 = np.concatenate([kt, t]), np.concatenate([ky, y])
+            c2 = {c: np.concatenate([kc[c], channels[c]]) if c in kc else channels[c] for c in names}
+        else:
+            t2, y2, c2 = t, y, {c: channels[c] for c in names}
         rows = physics.key_rows(t2, c2)
         self._key = (t2[rows], y2[rows], {c: v[rows] for c, v in c2.items()})
 
