@@ -132,8 +132,9 @@ class CSession(SessionBase):
         self._cap = cap
         # persistent buffers (addresses cached: ctypes calls stay cheap)
         self._st = np.empty(cap)
-        self._sy = np.empty((cap, n))
-        self._syp = np.empty((cap, n))
+        # the steps' states (1 MB each at n = 32): made at the first advance that stores them
+        self._sy: np.ndarray | None = None
+        self._syp: np.ndarray | None = None
         self._sh = np.empty(cap)
         self._sord = np.empty(cap, dtype=np.int32)
         self._yout = np.empty(n)
@@ -144,7 +145,7 @@ class CSession(SessionBase):
         self._t_out = ctypes.c_double()
         self._flag = ctypes.c_int()
         self._addr = dict(
-            st=self._st.ctypes.data, sy=self._sy.ctypes.data, syp=self._syp.ctypes.data,
+            st=self._st.ctypes.data, sy=None, syp=None,
             sh=self._sh.ctypes.data, sord=self._sord.ctypes.data, yout=self._yout.ctypes.data,
             ypout=self._ypout.ctypes.data, roots=self._roots.ctypes.data,
             i_eval=ctypes.addressof(self._i_eval), n_stored=ctypes.addressof(self._n_stored),
@@ -352,6 +353,9 @@ class CSession(SessionBase):
         chunks: list[tuple[np.ndarray, ...]] = []
         auto_events: list[AutoEvents] = []
         store = (STORE_TIMES | (STORE_STATES if store_states else 0)) if store_steps else 0
+        if store & STORE_STATES and self._sy is None:
+            self._sy, self._syp = np.empty((self._cap, n)), np.empty((self._cap, n))
+            A["sy"], A["syp"] = self._sy.ctypes.data, self._syp.ctypes.data
         lib, h = self._lib, self._h
         tic = time.perf_counter()
         interrupted = False
@@ -363,7 +367,9 @@ class CSession(SessionBase):
                                     A["flag"])
                 k = self._n_stored.value
                 if k:
-                    states = (self._sy[:k].copy(), self._syp[:k].copy()) if store_states else (NO_ROWS[n],) * 2
+                    sy, syp = self._sy, self._syp
+                    states = (sy[:k].copy(), syp[:k].copy()) if sy is not None and syp is not None and store_states \
+                        else (NO_ROWS[n],) * 2
                     chunks.append((self._st[:k].copy(), *states, self._sh[:k].copy(), self._sord[:k].copy()))
                 taken = self._take_auto_events()  # drained at every chunk: the C buffer never overflows
                 if taken is not None:

@@ -54,6 +54,7 @@ here before is still importable from here.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import warnings
 from pathlib import Path
@@ -108,6 +109,8 @@ __all__ = [
 ]
 
 _NORMALIZED = memo_table()  # normalize_model results by DAEFunctions identity
+# libraries loaded in this process by DAEFunctions identity: (library, its BuildResult as a cache hit)
+_LOADED = memo_table()
 log = logging.getLogger("daeclear")
 
 _warned: set[str] = set()
@@ -191,7 +194,13 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
     if b == "python":
         return PythonSession(model, opts)
     try:
-        clib, build = _load_library(funcs, model)
+        loaded = memo_get(_LOADED, funcs)
+        if loaded is None:
+            clib, build = _load_library(funcs, model)
+            memo_put(_LOADED, funcs, (clib, dataclasses.replace(build, cache_hit=True, compile_time=0.0,
+                                                                codegen_time=0.0)))
+        else:  # loaded before in this process: no file checks (the loaded library stays valid)
+            clib, build = loaded
         return CSession(model, opts, clib, build)
     except (CompilerUnavailable, CompileError, OSError) as exc:
         if b == "c":
