@@ -286,3 +286,32 @@ def test_compiled_events_with_tiny_step_buffers(monkeypatch):
         assert chunked.events.kind == normal.events.kind and len(normal.events) > 5
         np.testing.assert_array_equal(chunked.events.t, normal.events.t)
         np.testing.assert_array_equal(chunked.t, normal.t)
+
+
+def test_runs_with_output_times_come_back_in_long_pieces(monkeypatch):
+    """With output times the C loop stores the steps' times alone, in buffers 16 times longer than
+    the state buffers: the 4200 steps of two revolutions come back in one advance (each piece is
+    made consistent and checked apart); tiny buffers (48 rows) give the same run in many pieces."""
+    import functools
+
+    import daeclear.solvers.ida as solve_module
+    from daeclear.engine.c_session import CSession
+    from daeclear.engine.ida_session import open_session
+
+    model = dc.assemble(dc.mechanisms.slider_crank("revolute"))
+    calls = []
+    advance = CSession.advance
+    monkeypatch.setattr(CSession, "advance", lambda self, *a, **k: calls.append(1) or advance(self, *a, **k))
+    t_eval = np.linspace(0.0, 0.024, 129)
+    whole = dc.simulate(model, 0.024, t_eval=t_eval)
+    assert whole.stats["n_steps"] > 4096 and len(whole.events) > 20 and len(calls) == 1
+    calls.clear()
+    monkeypatch.setattr(solve_module, "open_session", functools.partial(open_session, buffer_steps=3))
+    pieces = dc.simulate(model, 0.024, t_eval=t_eval)
+    assert len(calls) > 80
+    assert pieces.stats["n_steps"] == whole.stats["n_steps"]
+    np.testing.assert_array_equal(pieces.step_t, whole.step_t)
+    np.testing.assert_array_equal(pieces.events.t, whole.events.t)
+    np.testing.assert_array_equal(pieces.y, whole.y)
+    for name in ("clearance.normal_force", "drive.moment"):
+        np.testing.assert_array_equal(pieces.channels[name], whole.channels[name])

@@ -92,6 +92,9 @@ def _ptr(a: np.ndarray | None) -> int | None:
     return None if a is None or a.size == 0 else a.ctypes.data
 
 
+#: rows of the times-only step buffers (time, size, order) per row of the state buffers
+TIMES_ROWS_PER_STATE_ROW = 16
+
 class CSession(SessionBase):
     """Compiled backend: IDA, callbacks and the step loop in C (see module docstring)."""
 
@@ -128,8 +131,12 @@ class CSession(SessionBase):
         self._h = h
         self._finalizer = weakref.finalize(self, _free_c_session, self._lib, h)
         self._jac_nnz = int(self._lib.dc_jac_nnz(h))
-        cap = opts.buffer_steps
-        self._cap = cap
+        # rows of the step buffers: buffer_steps with the steps' states, TIMES_ROWS_PER_STATE_ROW
+        # times as many for times alone (20 bytes a row: a run of tens of thousands of steps with
+        # output times comes back in one piece, not in a piece per 4096 steps, each made consistent
+        # and checked apart)
+        self._cap = opts.buffer_steps
+        cap = self._cap_times = opts.buffer_steps * TIMES_ROWS_PER_STATE_ROW
         # persistent buffers (addresses cached: ctypes calls stay cheap)
         self._st = np.empty(cap)
         # the steps' states (1 MB each at n = 32): made at the first advance that stores them
@@ -356,13 +363,16 @@ class CSession(SessionBase):
         if store & STORE_STATES and self._sy is None:
             self._sy, self._syp = np.empty((self._cap, n)), np.empty((self._cap, n))
             A["sy"], A["syp"] = self._sy.ctypes.data, self._syp.ctypes.data
+        # times only: the long buffers; without any steps cap counts IDA calls (a streamed run hands
+        # its events over every buffer_steps calls, so its memory does not grow with its length)
+        cap = self._cap_times if store == STORE_TIMES else self._cap
         lib, h = self._lib, self._h
         tic = time.perf_counter()
         interrupted = False
         try:
             while True:
                 rc = lib.dc_advance(h, t_stop, te_p, m, A["i_eval"], evy_p, evyp_p,
-                                    store, self._cap, A["st"], A["sy"], A["syp"], A["sh"], A["sord"],
+                                    store, cap, A["st"], A["sy"], A["syp"], A["sh"], A["sord"],
                                     A["n_stored"], A["t_out"], A["yout"], A["ypout"], A["roots"],
                                     A["flag"])
                 k = self._n_stored.value
