@@ -336,8 +336,9 @@ def test_runs_leave_the_model_unchanged_and_are_independent(clearance_model) -> 
 
 def test_a_buffered_function_gives_each_thread_its_own_buffer() -> None:
     """The contact logic's gap function is shared by the runs of a model (a run copies none of
-    it): threads calling it at the same time each get their own inputs' results, and a pickled
-    copy (a process pool's) evaluates the same."""
+    it): threads calling it at the same time each get their own inputs' results, a pickled copy
+    (a process pool's) evaluates the same, and two models of one structure (one CasADi function,
+    other numbers) sharing a thread's buffer each evaluate with their own numbers."""
     import pickle
 
     import casadi as ca
@@ -364,6 +365,11 @@ def test_a_buffered_function_gives_each_thread_its_own_buffer() -> None:
     assert not failures
     copied = pickle.loads(pickle.dumps(function))
     np.testing.assert_array_equal(copied(np.array([1.0, 2.0]))[0], [3.0, 6.0])
+    # two models of one structure share the thread's buffer, each with its own bound numbers
+    other = BufferedFunction(function.function, bound=(np.array([-2.0]),))
+    for _ in range(3):
+        np.testing.assert_array_equal(function(np.array([1.0, 2.0]))[0], [3.0, 6.0])
+        np.testing.assert_array_equal(other(np.array([1.0, 2.0]))[0], [-2.0, -4.0])
 
 
 def test_ode_methods_leave_the_model_unchanged() -> None:

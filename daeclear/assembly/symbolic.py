@@ -158,47 +158,62 @@ class AssemblyContext:
         return Q
 
 
+class _FunctionBuffer:
+    """One thread's CasADi FunctionBuffer of one Function, on fixed numpy arrays."""
+
+    def __init__(self, function: ca.Function) -> None:
+        self.function = function  # kept: the table below is keyed by its id
+        self.inputs = [np.zeros(function.numel_in(i)) for i in range(function.n_in())]
+        self.outputs = [np.zeros(function.numel_out(i)) for i in range(function.n_out())]
+        self.buffer, self.evaluate = function.buffer()
+        # (CasADi's stub asks a size the binding takes from the memoryview; numpy types arrays as buffers
+        # only from Python 3.12 on)
+        for i, a in enumerate(self.inputs):
+            self.buffer.set_arg(i, memoryview(a))  # type: ignore[call-arg, arg-type]
+        for i, r in enumerate(self.outputs):
+            self.buffer.set_res(i, memoryview(r))  # type: ignore[call-arg, arg-type]
+        self.bound_by: Any = None  # the BufferedFunction whose bound inputs the arrays hold
+
+
+# per thread: id(Function) -> its _FunctionBuffer, shared by every BufferedFunction of that Function
+_BUFFERS = threading.local()
+_BUFFER_LIMIT = 256
+
+
 class BufferedFunction:
     """A CasADi Function called through a FunctionBuffer on fixed numpy arrays (~1 us a call
     instead of ~50-100 us for a plain call): for small functions on the per-event path.
 
-    ``bound`` fills the function's last inputs once (the model parameters); calls pass the rest.
-    Each thread gets its own buffer and arrays, made at its first call: runs of one model in
-    threads share the object, and a run copies none of it.
+    ``bound`` fills the function's last inputs (the model parameters); calls pass the rest. Each
+    thread has one buffer per Function, shared by the BufferedFunctions of that Function (the
+    models of one structure, with their own parameters): runs of one model in threads share the
+    object, a run copies none of it, and a new model of a known structure makes no buffer.
     """
 
     def __init__(self, function: ca.Function, bound: Sequence[Any] = ()) -> None:
         self.function = function
-        self.bound = tuple(np.asarray(b, dtype=float) for b in bound)
-        self._local = threading.local()
+        self.bound = tuple(np.asarray(b, dtype=float).ravel() for b in bound)
 
-    def _arrays(self) -> tuple[list[NDArray[np.float64]], list[NDArray[np.float64]], Any]:
-        """This thread's (inputs, outputs, evaluate), made at its first call."""
-        made = getattr(self._local, "arrays", None)
-        if made is not None:
-            return made
-        function = self.function
-        inputs = [np.zeros(function.numel_in(i)) for i in range(function.n_in())]
-        outputs = [np.zeros(function.numel_out(i)) for i in range(function.n_out())]
-        buffer, evaluate = function.buffer()
-        # (CasADi's stub asks a size the binding takes from the memoryview; numpy types arrays as buffers
-        # only from Python 3.12 on)
-        for i, a in enumerate(inputs):
-            buffer.set_arg(i, memoryview(a))  # type: ignore[call-arg, arg-type]
-        for i, r in enumerate(outputs):
-            buffer.set_res(i, memoryview(r))  # type: ignore[call-arg, arg-type]
-        for a, x in zip(inputs[len(inputs) - len(self.bound):], self.bound):
-            a[:] = np.ravel(x)
-        self._local.buffer = buffer  # kept alive with its arrays
-        self._local.arrays = (inputs, outputs, evaluate)
-        return self._local.arrays
+    def _arrays(self) -> _FunctionBuffer:
+        """This thread's buffer of the function, holding this object's bound inputs."""
+        table = getattr(_BUFFERS, "table", None)
+        if table is None or len(table) >= _BUFFER_LIMIT:  # a process of many structures: start afresh
+            table = _BUFFERS.table = {}
+        entry = table.get(id(self.function))
+        if entry is None:
+            entry = table[id(self.function)] = _FunctionBuffer(self.function)
+        if entry.bound_by is not self:
+            for a, x in zip(entry.inputs[len(entry.inputs) - len(self.bound):], self.bound):
+                a[:] = x
+            entry.bound_by = self
+        return entry
 
     def __call__(self, *args: Any) -> tuple[NDArray[np.float64], ...]:
-        inputs, outputs, evaluate = self._arrays()
-        for a, x in zip(inputs, args):
+        entry = self._arrays()
+        for a, x in zip(entry.inputs, args):
             a[:] = np.ravel(x)
-        evaluate()
-        return tuple(r.copy() for r in outputs)
+        entry.evaluate()
+        return tuple(r.copy() for r in entry.outputs)
 
     def __getstate__(self) -> dict[str, Any]:  # picklable for process pools: no buffers
         return {"function": self.function, "bound": self.bound}
