@@ -58,7 +58,7 @@ def study(t_end: float, channels: list[str], repeats: int) -> list[str]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--repeats", type=int, default=10)
     parser.add_argument("--write", action="store_true", help="write the tables into docs/work_precision.md")
     args = parser.parse_args()
     out = []

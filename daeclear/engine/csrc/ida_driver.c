@@ -1005,6 +1005,9 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
   s->atol = N_VNew_Serial(n, s->ctx);
   s->dky = N_VNew_Serial(n, s->ctx);
   if (!s->yy || !s->yp || !s->atol || !s->dky) FAIL("N_VNew_Serial failed");
+  /* IDA clones its vectors from yy: with fused operations its predictor, corrector and error
+   * norms make one pass (N_VLinearCombination, ...) instead of one call per term */
+  if (N_VEnableFusedOps_Serial(s->yy, SUNTRUE) != SUN_SUCCESS) FAIL("N_VEnableFusedOps_Serial failed");
   memset(N_VGetArrayPointer(s->yy), 0, sizeof(double) * (size_t)n);
   memset(N_VGetArrayPointer(s->yp), 0, sizeof(double) * (size_t)n);
   memcpy(N_VGetArrayPointer(s->atol), atol, sizeof(double) * (size_t)n);
