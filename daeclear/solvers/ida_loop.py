@@ -183,39 +183,41 @@ class SegmentLoop:
         """Record the switches the compiled loop decided in one advance: events, modes and segments
         in time order, and each pair's final state in its logic. Return the restart times and the
         switch vectors before the first restart and after each."""
-        events, segments, modes = self.events, self.segments, self.modes
-        switch = self.switch.copy()
-        switches: list[NDArray] = [self.switch]
+        events, segments, modes, info = self.events, self.segments, self.modes, self.auto_info
+        switch = self.switch.tolist()  # plain floats while recording: one array at the end
+        switches: list[list[float]] = [switch]
         times: list[float] = []
         last: dict[int, int] = {}  # pair -> its last row
         onset: dict[int, int] = {}  # pair -> its last onset's row (the latched speed of its term)
         kinds = auto.info[:, 0].tolist()
         term_on = (auto.info[:, 1] | auto.info[:, 2]).tolist()
+        ys = auto.y
         for i, (t, p, rate, latched) in enumerate(zip(auto.t.tolist(), auto.pair.tolist(), auto.rate.tolist(),
                                                       auto.latched.tolist())):
             if not times or t != times[-1]:  # a restart: the segment before it ends
-                if times:
-                    switches.append(switch.copy())
                 segments.append((self.seg_start, t, dict(modes)))
                 self.seg_start = t
                 times.append(t)
-            _, _, name, column, needs = self.auto_info[p]
-            events.append(ContactEvent.from_solver(t, name, EVENT_KINDS[kinds[i]], rate, auto.y[i]))
-            modes[name] = "contact" if kinds[i] == ONSET else "free"
+                switch = switch.copy()
+                switches.append(switch)
+            _, _, name, column, needs = info[p]
+            kind = kinds[i]
+            events.append(ContactEvent.from_solver(t, name, EVENT_KINDS[kind], rate, ys[i]))
+            modes[name] = "contact" if kind == ONSET else "free"
             switch[column] = 1.0 if term_on[i] else 0.0  # as the compiled loop sets its term
             if needs:
                 switch[column + 1] = latched
             last[p] = i
-            if kinds[i] == ONSET:
+            if kind == ONSET:
                 onset[p] = i
-        switches.append(switch)
         for p, i in last.items():  # a pair's state is its last decision's, its latched speed its last onset's
-            logic, root = self.auto_info[p][:2]
+            logic, root = info[p][:2]
             for j in sorted({onset.get(p, i), i}):
-                logic.apply(root, float(auto.t[j]), auto.y[j], auto.decision(j), self.active, self.params)
-        self.switch = switch
+                logic.apply(root, float(auto.t[j]), ys[j], auto.decision(j), self.active, self.params)
+        rows = np.array(switches)
+        self.switch = rows[-1].copy()
         self.n_restarts += len(times)
-        return times, np.array(switches)
+        return times, rows
 
     def check_decisions(self, adv: Any) -> None:
         """Turn the advance into an internal error when the compiled loop and Python disagree."""
