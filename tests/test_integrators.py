@@ -122,9 +122,11 @@ def test_first_impact_agrees_across_methods(clearance):
 
 def test_same_event_sequence_as_ida_before_chaos(clearance):
     """Over the first 5 ms (15 events) every adaptive scheme at tight tolerance and rk4 at a fine step
-    find the same onsets and separations as IDA, at the same times."""
+    find the same onsets and separations as IDA, at the same times. (IDA at rtol 1e-11: at 1e-10 its
+    last approach speed is 4.7e-5 off DOP853's at 1e-12, rk4's 5.4e-5 the other way, and the two
+    sat on the 1e-4 tolerance.)"""
     t_end = 5e-3
-    ref = dc.simulate(clearance, t_end, rtol=1e-10)
+    ref = dc.simulate(clearance, t_end, rtol=1e-11)
     assert len(ref.events) >= 10
     for method, kw in [("DOP853", dict(rtol=1e-10)), ("LSODA", dict(rtol=1e-9)), ("rk4", dict(step=2e-7))]:
         result = dc.simulate(clearance, t_end, method=method, **kw)
