@@ -1,6 +1,6 @@
 """IDA against every scipy method at equal accuracy, each run a whole ``simulate(scene, ...)`` call.
 
-    python benchmarks/bench_work_precision.py [--repeats 3] [--write]
+    python benchmarks/bench_work_precision.py [--repeats 10] [--write]
 
 The Fig. 4.15 scene (revolute clearance 0.5 mm, Lankarani-Nikravesh c_e = 0.9, 5000 rpm, no
 gravity, from t = 0) on two windows: the first 2 ms (first impacts) and two crank revolutions.
