@@ -48,7 +48,7 @@ from .session_base import (
 )
 from .sundials import SPARSE_LIBS
 
-__all__ = ["CSession", "SPARSE_MIN_STATES", "DENSE_BELOW_RTOL"]
+__all__ = ["CSession", "SPARSE_MIN_STATES"]
 
 #: linear_solver="auto" uses the sparse solver for models with at least this many states, the
 #: reduced dense LU below. Measured with benchmarks/bench_linear_solver.py (chains of N links, 6 N
@@ -56,12 +56,6 @@ __all__ = ["CSession", "SPARSE_MIN_STATES", "DENSE_BELOW_RTOL"]
 #: per factorization), the two tie at 216, sparse is faster from 240 on (whole simulate calls 1.15x
 #: at 240 states, 1.5x at 384).
 SPARSE_MIN_STATES = 216
-#: ... and SUNDIALS' dense LU of the whole system (not the reduced one) below this rtol: on the
-#: slider-crank with a revolute clearance (GGL, no gravity, two revolutions) runs with the reduced
-#: LU failed in contact (IDA_CONV_FAIL, the step collapsing) at rtol 1e-11 with every variant of its
-#: solve tried (column by column or in blocks, reciprocals or divisions, no rows eliminated) and at
-#: 1e-10 with some, where the dense LU finished them all; at 2e-10 and above every variant finished.
-DENSE_BELOW_RTOL = 5e-10
 _LS_CODES = {"dense": 0, "sparse": 1, "reduced": 2}  # dc_open's linear_solver argument (DC_LS_*)
 _LS_NAMES = {code: name for name, code in _LS_CODES.items()}
 log = logging.getLogger("daeclear")
@@ -79,14 +73,11 @@ _STAT_KEYS = (
 )
 
 
-def _resolve_linear_solver(requested: str, n: int, has_sparse: bool, rtol: float) -> str:
+def _resolve_linear_solver(requested: str, n: int, has_sparse: bool) -> str:
     """The linear solver a compiled session uses: "auto" is sparse from SPARSE_MIN_STATES states on
-    (when the library has the sparse solver), below that the reduced dense LU, or the dense LU of
-    the whole system at rtol below DENSE_BELOW_RTOL."""
+    (when the library has the sparse solver), the reduced dense LU below."""
     if requested == "auto":
-        if has_sparse and n >= SPARSE_MIN_STATES:
-            return "sparse"
-        return "dense" if rtol < DENSE_BELOW_RTOL else "reduced"
+        return "sparse" if has_sparse and n >= SPARSE_MIN_STATES else "reduced"
     if requested == "sparse" and not has_sparse:
         raise DaeclearError("linear_solver='sparse' is not available: the scikit-sundae wheel lacks "
                             f"lib{SPARSE_LIBS[0]} or lib{SPARSE_LIBS[1]}; use 'dense' or 'auto'")
@@ -121,7 +112,7 @@ class CSession(SessionBase):
         self._clib = clib
         self._lib = clib.lib
         self._build = build
-        self._linear_solver = _resolve_linear_solver(opts.linear_solver, n, clib.build_info.has_sparse, opts.rtol)
+        self._linear_solver = _resolve_linear_solver(opts.linear_solver, n, clib.build_info.has_sparse)
         err = ctypes.create_string_buffer(1024)
 
         def dc_open() -> Any:

@@ -30,8 +30,7 @@ position rows q' - v (+ Phi_q^T mu) eliminated, csrc/dc_reduced_ls.h), by dense 
 matrix (``"dense"``, SUNDIALS' own) or by sparse LU (``"sparse"``: SuperLU_MT, one thread, on a
 SUNSparseMatrix whose pattern is the union of the base and all term Jacobians' patterns).
 ``"auto"`` picks sparse from ``SPARSE_MIN_STATES`` states on (measured,
-``benchmarks/bench_linear_solver.py``), reduced below, and dense at rtol below ``DENSE_BELOW_RTOL``
-(where runs with the reduced LU failed in contact). The python backend is always dense.
+``benchmarks/bench_linear_solver.py``), reduced below. The python backend is always dense.
 
 A compiled library is used only if it was built for the SUNDIALS version and index size that
 the wheel has now (its build tag, read from the file before loading, against
@@ -178,8 +177,7 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
     default directions (-1, 0, +1 per root function; reinit may override them per segment).
     buffer_steps: rows of the step buffers the C loop fills before returning to Python.
     parameters: the run-time parameters P of the model (``funcs.n_parameters`` values).
-    linear_solver: "auto" (sparse from SPARSE_MIN_STATES states on, reduced below; dense at rtol below
-    DENSE_BELOW_RTOL), "reduced", "dense"
+    linear_solver: "auto" (sparse from SPARSE_MIN_STATES states on, reduced below), "reduced", "dense"
     or "sparse" (SuperLU_MT on the union of the Jacobians' patterns); case-insensitive. Compiled backend
     only: the python backend always uses scikit-sundae's dense solver.
     Call reinit() before the first advance().

@@ -165,8 +165,7 @@ def simulate(
         left after eliminating the position rows, 23 unknowns instead of 32 on the slider-crank),
         "dense" (dense LU of the whole system, what the python backend does), "sparse"
         (SuperLU_MT), or "auto" (sparse for large models, see
-        :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES`, reduced below, dense at rtol below
-        :data:`daeclear.engine.c_session.DENSE_BELOW_RTOL`).
+        :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES`, reduced below).
         The python backend and the other methods ignore it. Reported in ``result.stats``.
     start : {"ideal", "declared"}
         How the run starts without ``y0`` (ignored with ``y0``, as is ``allow_penetration``).
