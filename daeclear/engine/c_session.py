@@ -95,6 +95,7 @@ def _ptr(a: np.ndarray | None) -> int | None:
 #: rows of the times-only step buffers (time, size, order) per row of the state buffers
 TIMES_ROWS_PER_STATE_ROW = 16
 
+
 class CSession(SessionBase):
     """Compiled backend: IDA, callbacks and the step loop in C (see module docstring)."""
 

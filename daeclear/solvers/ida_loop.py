@@ -24,11 +24,11 @@ from numpy.typing import NDArray
 from .. import options as opts
 from . import physics
 from ..assembly.assemble import DAEModel
+from ..assembly.automaton import EVENT_KINDS, ONSET
+from ..engine.session_base import AutoEvents
 from ..errors import Interrupted, SolveError
 from .recorder import Recorder
 from ..progress import Progress
-from ..assembly.automaton import EVENT_KINDS, ONSET
-from ..engine.session_base import AutoEvents
 from ..results.result import ContactEvent, Result
 
 #: Output times handed to the compiled loop at a time: their rows are emptied between windows.
