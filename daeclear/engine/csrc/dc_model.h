@@ -44,6 +44,37 @@ typedef struct {
 
 extern const dc_model_t dc_model;
 
+/* CasADi's compressed column storage, the patterns of sparsity_out: nrow, ncol, colind[ncol+1],
+ * row[nnz]; a dense pattern is written as just nrow, ncol, 1 (a sparse one has colind[0] == 0).
+ * The generated functions keep their sparsity; both drivers scatter the nonzeros with these. */
+static inline int dc_sp_dense(const dc_int* sp) { return sp[2] == 1; }
+static inline dc_int dc_sp_nnz(const dc_int* sp) { return dc_sp_dense(sp) ? sp[0] * sp[1] : sp[2 + sp[1]]; }
+/* Nonzeros of column c are [dc_sp_begin, dc_sp_end) of the value array; dc_sp_row gives their
+ * rows. A dense pattern stores every entry, column-major. */
+static inline dc_int dc_sp_begin(const dc_int* sp, dc_int c) { return dc_sp_dense(sp) ? c * sp[0] : sp[2 + c]; }
+static inline dc_int dc_sp_end(const dc_int* sp, dc_int c) { return dc_sp_dense(sp) ? (c + 1) * sp[0] : sp[3 + c]; }
+static inline dc_int dc_sp_row(const dc_int* sp, dc_int k) { return dc_sp_dense(sp) ? k % sp[0] : sp[3 + sp[1] + k]; }
+
+/* Write (add == 0) or add (add != 0) the nonzeros nz of pattern sp into the column-major array
+ * out with leading dimension ld (>= nrow); entries outside the pattern are left as they are. */
+static inline void dc_sp_scatter(const dc_int* sp, const double* nz, double* out, dc_int ld, int add) {
+  const dc_int nrow = sp[0], ncol = sp[1];
+  if (dc_sp_dense(sp)) {
+    for (dc_int c = 0; c < ncol; ++c)
+      for (dc_int i = 0; i < nrow; ++i) {
+        if (add) out[c * ld + i] += nz[c * nrow + i];
+        else out[c * ld + i] = nz[c * nrow + i];
+      }
+    return;
+  }
+  const dc_int *colind = sp + 2, *row = sp + 3 + ncol;
+  for (dc_int c = 0; c < ncol; ++c)
+    for (dc_int k = colind[c]; k < colind[c + 1]; ++k) {
+      if (add) out[c * ld + row[k]] += nz[k];
+      else out[c * ld + row[k]] = nz[k];
+    }
+}
+
 /* post-processing functions (DAEFunctions.extras), evaluated point by point by dc_eval_extra */
 extern const int dc_n_extras;
 extern const dc_fun_t dc_extra_tab[];

@@ -337,20 +337,7 @@ static int first_nonfinite(const double* v, int m) {
 
 /* ---------------------------------------------------------------- model evaluation ---- */
 
-/* CasADi's compressed column storage: nrow, ncol, colind[ncol+1], row[nnz]; a dense pattern
- * is written as just nrow, ncol, 1 (a sparse one always has colind[0] == 0). */
-static int sp_dense(const dc_int* sp) { return sp[2] == 1; }
-
-static dc_int nnz_of(const dc_fun_t* f) {
-  const dc_int* sp = f->sparsity_out(0);
-  return sp_dense(sp) ? sp[0] * sp[1] : sp[2 + sp[1]];
-}
-
-/* Nonzeros of column c are [col_begin, col_end) of the value array; row_at gives their rows.
- * A dense pattern stores every entry, column-major. */
-static dc_int col_begin(const dc_int* sp, dc_int c) { return sp_dense(sp) ? c * sp[0] : sp[2 + c]; }
-static dc_int col_end(const dc_int* sp, dc_int c) { return sp_dense(sp) ? (c + 1) * sp[0] : sp[3 + c]; }
-static dc_int row_at(const dc_int* sp, dc_int k) { return sp_dense(sp) ? k % sp[0] : sp[3 + sp[1] + k]; }
+static dc_int nnz_of(const dc_fun_t* f) { return dc_sp_nnz(f->sparsity_out(0)); }
 
 /* Evaluate an extra (one column output) into the dense vector out. The generated extras keep
  * CasADi's sparsity (a term's generalized force touches two bodies, a kinematic Jacobian a few
@@ -359,7 +346,7 @@ static dc_int row_at(const dc_int* sp, dc_int k) { return sp_dense(sp) ? k % sp[
 static int extra_dense(const dc_fun_t* f, const double** arg, double** res, dc_int* iw, double* w, int mem,
                        double* out, double* nz) {
   const dc_int* sp = f->sparsity_out(0);
-  if (sp_dense(sp)) {
+  if (dc_sp_dense(sp)) {
     res[0] = out;
     return f->eval(arg, res, iw, w, mem);
   }
@@ -367,7 +354,7 @@ static int extra_dense(const dc_fun_t* f, const double** arg, double** res, dc_i
   const int status = f->eval(arg, res, iw, w, mem);
   if (status != 0) return status;
   memset(out, 0, sizeof(double) * (size_t)(sp[0] * sp[1]));
-  for (dc_int k = col_begin(sp, 0); k < col_end(sp, 0); ++k) out[row_at(sp, k)] = nz[k];
+  dc_sp_scatter(sp, nz, out, sp[0], 0);
   return 0;
 }
 
@@ -388,8 +375,8 @@ static int eval_res(dc_session* s, double t, const double* y, const double* yp, 
     s->arg[4] = s->P;
     s->res[0] = s->tmp_r;
     if (M->term_res[k].eval(s->arg, s->res, s->iw, s->w, s->mem_term_res[k])) return -(k + 2);
-    const dc_int* sp = M->term_res[k].sparsity_out(0); /* the term's nonzeros: two bodies' rows */
-    for (dc_int i = col_begin(sp, 0); i < col_end(sp, 0); ++i) r[row_at(sp, i)] += s->tmp_r[i];
+    /* the term's nonzeros: two bodies' rows */
+    dc_sp_scatter(M->term_res[k].sparsity_out(0), s->tmp_r, r, s->n, 1);
   }
   return 0;
 }
@@ -397,24 +384,11 @@ static int eval_res(dc_session* s, double t, const double* y, const double* yp, 
 /* The generated Jacobian of part p: 0 the base Jacobian, 1 + k term k's. */
 static const dc_fun_t* jac_part(int p) { return p == 0 ? &dc_model.jac : &dc_model.term_jac[p - 1]; }
 
-/* Add the nonzeros nz of an n x n matrix with pattern sp to the dense column-major J. */
-static void scatter_add(const dc_int* sp, const double* nz, double* J, int n) {
-  const dc_int ncol = sp[1];
-  if (sp_dense(sp)) {
-    for (dc_int i = 0; i < sp[0] * ncol; ++i) J[i] += nz[i];
-    return;
-  }
-  const dc_int* colind = sp + 2;
-  const dc_int* row = sp + 3 + ncol;
-  for (dc_int c = 0; c < ncol; ++c)
-    for (dc_int k = colind[c]; k < colind[c + 1]; ++k) J[(size_t)c * (size_t)n + (size_t)row[k]] += nz[k];
-}
-
 /* Add the nonzeros nz of Jacobian part p to out: the dense column-major n x n matrix, or (sparse)
  * the data array of the union pattern, through the precomputed positions (no search per entry). */
 static void add_part(const dc_session* s, int p, const double* nz, double* out, int sparse) {
   if (!sparse) {
-    scatter_add(jac_part(p)->sparsity_out(0), nz, out, s->n);
+    dc_sp_scatter(jac_part(p)->sparsity_out(0), nz, out, s->n, 1);
     return;
   }
   const dc_int* map = s->jmap + s->jmap_off[p];
@@ -864,8 +838,8 @@ static int build_jac_pattern(dc_session* s) {
     const dc_int start = nnz;
     for (int p = 0; p < parts; ++p) { /* collect the column's distinct rows */
       const dc_int* sp = jac_part(p)->sparsity_out(0);
-      for (dc_int k = col_begin(sp, c); k < col_end(sp, c); ++k) {
-        dc_int r = row_at(sp, k);
+      for (dc_int k = dc_sp_begin(sp, c); k < dc_sp_end(sp, c); ++k) {
+        dc_int r = dc_sp_row(sp, k);
         if (pos[r] < 0) {
           pos[r] = 0;
           s->jp_rowind[nnz++] = (sunindextype)r;
@@ -876,8 +850,8 @@ static int build_jac_pattern(dc_session* s) {
     for (dc_int k = start; k < nnz; ++k) pos[s->jp_rowind[k]] = k;
     for (int p = 0; p < parts; ++p) { /* where each part's nonzeros of this column go */
       const dc_int* sp = jac_part(p)->sparsity_out(0);
-      for (dc_int k = col_begin(sp, c); k < col_end(sp, c); ++k)
-        s->jmap[s->jmap_off[p] + k] = pos[row_at(sp, k)];
+      for (dc_int k = dc_sp_begin(sp, c); k < dc_sp_end(sp, c); ++k)
+        s->jmap[s->jmap_off[p] + k] = pos[dc_sp_row(sp, k)];
     }
     for (dc_int k = start; k < nnz; ++k) pos[s->jp_rowind[k]] = -1;
     s->jp_colptr[c + 1] = (sunindextype)nnz;

@@ -90,10 +90,6 @@ static int first_nonfinite(const double* v, int k) {
   return -1;
 }
 
-/* CasADi's compressed column storage: nrow, ncol, colind[ncol+1], row[nnz]; a dense pattern is
- * written as just nrow, ncol, 1. */
-static int sp_dense(const dc_int* sp) { return sp[2] == 1; }
-
 /* Evaluate f into the dense (column-major) outputs out[0..nout). The generated functions keep
  * CasADi's sparsity (a term's force touches two bodies of a chain, its Jacobian their columns:
  * dense outputs made the code grow like N^3 on chains); a sparse output is written to s->nz and
@@ -105,20 +101,18 @@ static int call(dco_session* s, const dc_fun_t* f, int mem, int nin, const doubl
   s->arg[nin] = s->P;
   for (int i = 0; i < nout; ++i) {
     const dc_int* sp = f->sparsity_out(i);
-    s->res[i] = sp_dense(sp) ? out[i] : s->nz + off;
-    if (!sp_dense(sp)) off += sp[2 + sp[1]];
+    s->res[i] = dc_sp_dense(sp) ? out[i] : s->nz + off;
+    if (!dc_sp_dense(sp)) off += dc_sp_nnz(sp);
   }
   const int status = f->eval(s->arg, s->res, s->iw, s->w, mem);
   if (status != 0) return status;
   off = 0;
   for (int i = 0; i < nout; ++i) {
     const dc_int* sp = f->sparsity_out(i);
-    if (sp_dense(sp)) continue;
-    const dc_int nrow = sp[0], ncol = sp[1], *colind = sp + 2, *row = sp + 3 + ncol;
-    memset(out[i], 0, sizeof(double) * (size_t)(nrow * ncol));
-    for (dc_int c = 0; c < ncol; ++c)
-      for (dc_int k = colind[c]; k < colind[c + 1]; ++k) out[i][c * nrow + row[k]] = s->nz[off + k];
-    off += colind[ncol];
+    if (dc_sp_dense(sp)) continue;
+    memset(out[i], 0, sizeof(double) * (size_t)(sp[0] * sp[1]));
+    dc_sp_scatter(sp, s->nz + off, out[i], sp[0], 0);
+    off += dc_sp_nnz(sp);
   }
   return 0;
 }
