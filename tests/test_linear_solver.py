@@ -187,7 +187,8 @@ def test_reduced_solve_of_general_matrices():
     """The reduced solver on random matrices whose first nk rows have a diagonal block: exact
     (to round-off) for every nk, so for every size of the factored part and every remainder of
     the four-column blocks of its substitutions (a mechanism's Jacobian leaves many of the
-    factors' entries zero; these matrices leave none)."""
+    factors' entries zero; the dense matrices leave none), and on sparse ones (the solver keeps
+    the nonzeros of J_rq in lists)."""
     model = dc.assemble(slider_crank("revolute"), "ggl")
     y, yp = model.initial_state()
     n = model.n_states
@@ -195,12 +196,16 @@ def test_reduced_solve_of_general_matrices():
                      linear_solver="reduced")
     rng = np.random.default_rng(11)
     for nk in range(n):
-        A = rng.normal(size=(n, n)) + n * np.eye(n)
-        A[:nk, :nk] = np.diag(rng.uniform(1.0, 2.0, nk))
-        b = rng.normal(size=n)
-        exact = np.linalg.solve(A, b)
-        np.testing.assert_allclose(s.solve_reduced(0.0, y, yp, 1.0, b, nk, matrix=A), exact, rtol=1e-10,
-                                   atol=1e-12 * np.abs(exact).max(), err_msg=f"nk={nk}")
+        for sparse in (False, True):  # True: most of J_rq, J_qr and J_rr zero, as a mechanism's are
+            A = rng.normal(size=(n, n))
+            if sparse:
+                A *= rng.uniform(size=(n, n)) < 0.2
+            A += n * np.eye(n)
+            A[:nk, :nk] = np.diag(rng.uniform(1.0, 2.0, nk))
+            b = rng.normal(size=n)
+            exact = np.linalg.solve(A, b)
+            np.testing.assert_allclose(s.solve_reduced(0.0, y, yp, 1.0, b, nk, matrix=A), exact, rtol=1e-10,
+                                       atol=1e-12 * np.abs(exact).max(), err_msg=f"nk={nk} sparse={sparse}")
 
 
 def test_sparse_and_dense_agree_on_a_chain_of_three():
