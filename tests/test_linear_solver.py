@@ -214,6 +214,34 @@ def test_sparse_and_dense_agree_on_a_chain_of_three():
     assert_same_run(a, b, t_tol=1e-8, y_rtol=1e-6)
 
 
+def jacobian_not_finite_model(part: str) -> DAEFunctions:
+    """y' = -y (two states) whose base Jacobian (part "base": entry (1, 1) inf from t = 0.5) or
+    whose one term's Jacobian (part "term": entry (0, 1) NaN from t = 0.2) is not finite."""
+    t, y, yp, cj, p = ca.SX.sym("t"), ca.SX.sym("y", 2), ca.SX.sym("yp", 2), ca.SX.sym("cj"), ca.SX.sym("p", 1)
+    bad = ca.if_else(t > 0.5, ca.inf, 1) if part == "base" else 1
+    rc = ca.vertcat(p[0] * y[1], 0)
+    term_bad = ca.if_else(t > 0.2, np.nan, 1) if part == "term" else 1
+    return DAEFunctions(2, ca.Function("res", [t, y, yp], [yp + y]),
+                        ca.Function("Jac", [t, y, yp, cj], [ca.diag(ca.vertcat(cj + 1, cj + bad))]),
+                        (ca.Function("rc", [t, y, yp, p], [rc]),),
+                        (ca.Function("Jc", [t, y, yp, p, cj], [ca.jacobian(rc, y) * term_bad]),), None,
+                        f"jac_not_finite_{part}")
+
+
+def test_a_jacobian_entry_that_is_not_finite_is_named_by_every_solver():
+    """The loop checks the assembled Jacobian at the positions of the base and active terms'
+    patterns (the rest is zero): an inf of the base Jacobian and a NaN of an active term's are
+    each found and named by row and column, and the run stops with that message."""
+    for part, entry, value, after in (("base", "(1, 1)", "inf", 0.5), ("term", "(0, 1)", "nan", 0.2)):
+        funcs = jacobian_not_finite_model(part)
+        for ls in ("reduced", "dense", "sparse"):
+            s = open_session(funcs, backend="c", rtol=1e-6, atol=1e-8, linear_solver=ls)
+            s.reinit(0.0, [1.0, 1.0], [-1.0, -1.0], [True], [np.full(1, 0.1)])
+            a = s.advance(1.0)
+            assert a.status == "error" and after < a.t < 1.0, (part, ls, a.status, a.t)
+            assert f"Jacobian entry {entry} is {value}" in a.message, (part, ls, a.message)
+
+
 def test_ball_bounces_alike():
     """A term whose Jacobian entry lies outside the base pattern: the sparse matrix has its slot."""
     out = {}

@@ -8,6 +8,8 @@
 #ifndef DAECLEAR_DC_MODEL_H
 #define DAECLEAR_DC_MODEL_H
 
+#include <math.h>
+
 typedef long long int dc_int;
 
 typedef int (*dc_eval_fn)(const double** arg, double** res, dc_int* iw, double* w, int mem);
@@ -73,6 +75,24 @@ static inline void dc_sp_scatter(const dc_int* sp, const double* nz, double* out
       if (add) out[c * ld + row[k]] += nz[k];
       else out[c * ld + row[k]] = nz[k];
     }
+}
+
+/* The index of the first entry of v[0..m) that is not finite, or -1 (the drivers' check of every
+ * evaluated output: a NaN or inf is reported by name, never integrated). */
+static inline int dc_first_nonfinite(const double* v, int m) {
+  for (int i = 0; i < m; ++i)
+    if (!isfinite(v[i])) return i;
+  return -1;
+}
+
+/* The column-major index (c * ld + row) of an entry of out at a position of pattern sp that is
+ * not finite, or -1: an array assembled from generated nonzeros is zero elsewhere, so checking
+ * the patterns is checking it (a 32 x 32 Jacobian has about 100 of them). */
+static inline dc_int dc_sp_first_nonfinite(const dc_int* sp, const double* out, dc_int ld) {
+  for (dc_int c = 0; c < sp[1]; ++c)
+    for (dc_int k = dc_sp_begin(sp, c); k < dc_sp_end(sp, c); ++k)
+      if (!isfinite(out[c * ld + dc_sp_row(sp, k)])) return c * ld + dc_sp_row(sp, k);
+  return -1;
 }
 
 /* post-processing functions (DAEFunctions.extras), evaluated point by point by dc_eval_extra */

@@ -329,12 +329,6 @@ static double first_step(const dc_session* s, const double* y, const double* yp)
   return s->max_step > 0.0 ? fmin(h, s->max_step) : h;
 }
 
-static int first_nonfinite(const double* v, int m) {
-  for (int i = 0; i < m; ++i)
-    if (!isfinite(v[i])) return i;
-  return -1;
-}
-
 /* ---------------------------------------------------------------- model evaluation ---- */
 
 static dc_int nnz_of(const dc_fun_t* f) { return dc_sp_nnz(f->sparsity_out(0)); }
@@ -401,11 +395,12 @@ static dc_int jac_len(const dc_session* s, int sparse) {
   return sparse ? s->jp_nnz : (dc_int)s->n * (dc_int)s->n;
 }
 
-/* J = base Jacobian + active terms' Jacobians, into out (layout: see add_part). */
+/* J = base Jacobian + active terms' Jacobians, into out (layout: see add_part); zeroed: J is
+ * zero already (IDA zeroes a direct solver's matrix before it calls jac_cb). */
 static int eval_jac(dc_session* s, double t, const double* y, const double* yp, double cj,
-                    double* J, int sparse) {
+                    double* J, int sparse, int zeroed) {
   const dc_model_t* M = &dc_model;
-  memset(J, 0, sizeof(double) * (size_t)jac_len(s, sparse));
+  if (!zeroed) memset(J, 0, sizeof(double) * (size_t)jac_len(s, sparse));
   s->arg[0] = &t;
   s->arg[1] = y;
   s->arg[2] = yp;
@@ -453,7 +448,7 @@ static int res_cb(sunrealtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* da
               -rc - 2, t);
     return -1; /* unrecoverable */
   }
-  int i = first_nonfinite(r, s->n);
+  int i = dc_first_nonfinite(r, s->n);
   if (i >= 0) {
     set_msg(s->cb_msg,
             "residual component %d is %g at t=%.17g (y[%d]=%g); IDA retried with smaller steps",
@@ -490,6 +485,18 @@ static double* jac_storage(dc_session* s, SUNMatrix J) {
   return SUNDenseMatrix_Data(J);
 }
 
+/* An entry of the assembled Jacobian that is not finite (its index in the storage), or -1: in
+ * the dense matrix only the positions of the base and active terms' patterns can be. */
+static dc_int jac_first_nonfinite(const dc_session* s, const double* Jd) {
+  if (LIN_SPARSE(s)) return dc_first_nonfinite(Jd, (int)s->jp_nnz);
+  for (int p = 0; p <= s->n_terms; ++p) {
+    if (p > 0 && !s->active[p - 1]) continue;
+    const dc_int i = dc_sp_first_nonfinite(jac_part(p)->sparsity_out(0), Jd, s->n);
+    if (i >= 0) return i;
+  }
+  return -1;
+}
+
 static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vector rr,
                   SUNMatrix J, void* data, N_Vector t1, N_Vector t2, N_Vector t3) {
   dc_session* s = (dc_session*)data;
@@ -498,7 +505,7 @@ static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vec
   (void)t1;
   (void)t2;
   (void)t3;
-  int rc = eval_jac(s, t, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), cj, Jd, LIN_SPARSE(s));
+  int rc = eval_jac(s, t, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), cj, Jd, LIN_SPARSE(s), 1);
   if (rc) {
     if (rc == -1)
       set_msg(s->cb_msg, "the generated base Jacobian returned an error at t=%.17g", t);
@@ -507,7 +514,7 @@ static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vec
               -rc - 2, t);
     return -1;
   }
-  int i = first_nonfinite(Jd, (int)jac_len(s, LIN_SPARSE(s)));
+  const dc_int i = jac_first_nonfinite(s, Jd);
   if (i >= 0) {
     int row, col;
     entry_position(s, i, LIN_SPARSE(s), &row, &col);
@@ -529,7 +536,7 @@ static int root_cb(sunrealtype t, N_Vector yy, N_Vector yp, sunrealtype* g, void
     set_msg(s->cb_msg, "the generated root function returned an error at t=%.17g", t);
     return -1;
   }
-  int i = first_nonfinite(g, s->n_roots);
+  int i = dc_first_nonfinite(g, s->n_roots);
   if (i >= 0) {
     set_msg(s->cb_msg, "root function %d is %g at t=%.17g", i, g[i], t);
     return -1;
@@ -1800,14 +1807,14 @@ DC_API int dc_eval_residual(void* sp, double t, const double* y, const double* y
 
 DC_API int dc_eval_jacobian(void* sp, double t, const double* y, const double* yp, double cj,
                             double* J) {
-  return eval_jac((dc_session*)sp, t, y, yp, cj, J, 0);
+  return eval_jac((dc_session*)sp, t, y, yp, cj, J, 0, 0);
 }
 
 /* The same Jacobian as the nonzeros of the session's union pattern (dc_jac_pattern): what the
  * sparse solver's callback fills. */
 DC_API int dc_eval_jacobian_sparse(void* sp, double t, const double* y, const double* yp,
                                    double cj, double* data) {
-  return eval_jac((dc_session*)sp, t, y, yp, cj, data, 1);
+  return eval_jac((dc_session*)sp, t, y, yp, cj, data, 1, 0);
 }
 
 /* Solve J x = b with the reduced dense solver (nk position rows eliminated), J the iteration
@@ -1823,7 +1830,7 @@ DC_API int dc_solve_reduced(void* sp, int nk, double t, const double* y, const d
   int rc = -1;
   if (J && A) memcpy(SUNDenseMatrix_Data(J), A, sizeof(double) * (size_t)s->n * (size_t)s->n);
   if (J && LS && x && rls_set_kinematic_rows(LS, nk) == 0 &&
-      (A || eval_jac(s, t, y, yp, cj, SUNDenseMatrix_Data(J), 0) == 0)) {
+      (A || eval_jac(s, t, y, yp, cj, SUNDenseMatrix_Data(J), 0, 0) == 0)) {
     rc = SUNLinSolSetup(LS, J) != SUN_SUCCESS;
     if (rc == 0) rc = SUNLinSolSolve(LS, J, x, x, 0.0) != SUN_SUCCESS ? -1 : 0;
   }

@@ -84,12 +84,6 @@ static void set_msg(dco_session* s, const char* fmt, ...) {
 
 static void* xcalloc(size_t n, size_t sz) { return calloc(n ? n : 1, sz); }
 
-static int first_nonfinite(const double* v, int k) {
-  for (int i = 0; i < k; ++i)
-    if (!isfinite(v[i])) return i;
-  return -1;
-}
-
 /* Evaluate f into the dense (column-major) outputs out[0..nout). The generated functions keep
  * CasADi's sparsity (a term's force touches two bodies of a chain, its Jacobian their columns:
  * dense outputs made the code grow like N^3 on chains); a sparse output is written to s->nz and
@@ -175,7 +169,7 @@ static int accel(dco_session* s, double t, const double* x, double* xdot) {
       xdot[k] = v[k];
       xdot[n + k] = s->minv[k] * fk;
     }
-    int i = first_nonfinite(xdot, s->nx);
+    int i = dc_first_nonfinite(xdot, s->nx);
     if (i >= 0) {
       set_msg(s, "the right-hand side component %d is %g at t=%.17g (the state has diverged or "
               "is outside the model's domain)", i, xdot[i], t);
@@ -193,8 +187,8 @@ static int eval_gaps(dco_session* s, double t, const double* x, double* g, doubl
     set_msg(s, "the generated gap function returned an error at t=%.17g", t);
     return DCO_EVAL_ERR;
   }
-  int i = first_nonfinite(g, s->ng);
-  if (i < 0) i = first_nonfinite(gd, s->ng);
+  int i = dc_first_nonfinite(g, s->ng);
+  if (i < 0) i = dc_first_nonfinite(gd, s->ng);
   if (i >= 0) {
     set_msg(s, "gap function %d (or its rate) is not finite at t=%.17g", i, t);
     return DCO_NONFINITE;
@@ -244,7 +238,7 @@ static int eval_jac(dco_session* s, double t, const double* x, double* J) {
       J[(n + k) * nx + j] = s->minv[k] * v;
     }
   }
-  int i = first_nonfinite(J, nx * nx);
+  int i = dc_first_nonfinite(J, nx * nx);
   if (i >= 0) {
     set_msg(s, "Jacobian entry (%d, %d) is %g at t=%.17g", i / nx, i % nx, J[i], t);
     return DCO_NONFINITE;
@@ -275,7 +269,7 @@ static int scheme_step(dco_session* s, int scheme, double t, const double* x, do
     for (int i = 0; i < nx; ++i)
       xn[i] = x[i] + h6 * (s->k1[i] + 2.0 * s->k2[i] + 2.0 * s->k3[i] + s->k4[i]);
   }
-  int i = first_nonfinite(xn, nx);
+  int i = dc_first_nonfinite(xn, nx);
   if (i >= 0) {
     set_msg(s, "state component %d became %g in the step from t=%.17g (h=%g)", i, xn[i], t, h);
     return DCO_NONFINITE;
