@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import json
 import math
 from typing import Any
 from collections.abc import Iterable
@@ -118,9 +117,10 @@ def _mask(value: Any) -> Any:
 
 def structure_key(scene_dict: dict[str, Any], extra: Iterable[Any]) -> str:
     """SHA-256 of the scene description with numbers masked, plus ``extra`` (formulation,
-    options and the laws' structural flags, see :func:`law_structure`)."""
-    text = json.dumps([_mask(scene_dict), list(extra)], sort_keys=True, default=repr)
-    return hashlib.sha256(text.encode()).hexdigest()
+    options and the laws' structural flags, see :func:`law_structure`). The text hashed is the
+    repr of plain data in the order ``Scene.to_dict`` gives (a third of the time of a JSON text
+    with sorted keys: this runs for every scene simulated)."""
+    return hashlib.sha256(repr([_mask(scene_dict), list(extra)]).encode()).hexdigest()
 
 
 # ---- laws ------------------------------------------------------------------------------

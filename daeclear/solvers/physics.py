@@ -96,6 +96,12 @@ def check_run(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channe
     return out
 
 
+def _worst_drift_row(drift: NDArray[np.float64]) -> int:
+    """The row of the largest constraint drift, NaN never (np.nanargmax without its overhead): the
+    first of equal ones. ``drift`` has a finite value."""
+    return int(np.argmax(np.where(np.isnan(drift), -np.inf, drift)))
+
+
 def key_rows(t: NDArray[np.float64], channels: dict[str, NDArray[np.float64]]) -> NDArray[np.intp]:
     """The rows of a run's output that :func:`check_run` reads: the first, and the worst of every
     ``<pair>.penetration`` channel and of ``constraints.position`` (the earliest of equal ones, as
@@ -108,8 +114,8 @@ def key_rows(t: NDArray[np.float64], channels: dict[str, NDArray[np.float64]]) -
         if name.endswith(".penetration") and values.size:
             rows.add(int(np.argmax(np.where(np.isfinite(values), values, -np.inf))))
     drift = channels.get("constraints.position")
-    if drift is not None and drift.size and np.any(np.isfinite(drift)):
-        rows.add(int(np.nanargmax(drift)))
+    if drift is not None and drift.size and np.isfinite(drift).any():
+        rows.add(_worst_drift_row(drift))
     return np.array(sorted(rows), dtype=np.intp)
 
 
@@ -218,7 +224,7 @@ def _drift(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels:
     drift = channels.get("constraints.position")
     if drift is None or drift.size == 0:
         return []
-    i = int(np.nanargmax(drift)) if np.any(np.isfinite(drift)) else 0
+    i = _worst_drift_row(drift) if np.isfinite(drift).any() else 0
     worst = float(drift[i])
     stats["max_constraint_drift"] = worst
     clearance = smallest_clearance(model)
