@@ -102,16 +102,34 @@ class SolverOptions:
         given = {k: v for k, v in keywords.items() if v is not UNSET}
         if not given:
             return self
+        # the same plain keywords again (a loop of runs): the options checked the first time
+        key = (self, where, *((k, type(v), v) for k, v in given.items())) \
+            if all(type(v) in _MEMO_TYPES for v in given.values()) else None
+        known = _MERGED.get(key) if key is not None else None
+        if known is not None:
+            return known
         _check_names(given, "merged")
         values = checked({**self.to_dict(), **given}, where=where)
         merged = copy.copy(self)  # checked once (here, naming where), not again by the constructor
         for name, value in values.items():
             object.__setattr__(merged, name, value)
+        if key is not None:
+            if len(_MERGED) >= _MERGED_LIMIT:
+                _MERGED.pop(next(iter(_MERGED)))
+            _MERGED[key] = merged
         return merged
 
     def atol_value(self) -> float | np.ndarray | None:
         """``atol`` as the solvers take it (one value, an array per state, or None)."""
         return np.array(self.atol) if isinstance(self.atol, tuple) else self.atol
+
+
+# merged() of plain keywords, by (options, where, (name, type, value)...): a keyword's exact type is
+# in the key (True and 1, 1 and 1.0 are told apart; 0.0 and -0.0, equal keys, are both max_step's
+# "unbounded"); an invalid value raises before it is stored
+_MEMO_TYPES = frozenset({str, bool, int, float})
+_MERGED: dict[tuple[Any, ...], SolverOptions] = {}
+_MERGED_LIMIT = 64
 
 
 def checked(values: Mapping[str, Any], *, where: str) -> dict[str, Any]:

@@ -121,6 +121,23 @@ def test_simulate_takes_the_options_object_and_an_explicit_keyword_overrides_it(
         dc.simulate(ideal_model, T, options=loose, method="rk4")
 
 
+def test_merged_options_of_the_same_plain_keywords_are_checked_once() -> None:
+    """A loop of runs with the same keywords gets the options checked the first time; a keyword
+    of another type or value is checked anew (True and 1 are not the same flag)."""
+    base = dc.SolverOptions(rtol=1e-4)
+    first = base.merged(rtol=1e-7, track_work=True)
+    assert first.rtol == 1e-7 and first.track_work is True and base.rtol == 1e-4
+    assert base.merged(rtol=1e-7, track_work=True) is first
+    assert base.merged(rtol=1e-8, track_work=True).rtol == 1e-8
+    assert dc.SolverOptions(rtol=1e-5).merged(rtol=1e-7, track_work=True) is not first
+    with pytest.raises(SceneError, match=r"simulate: track_work=1, must be True or False"):
+        base.merged(rtol=1e-7, track_work=1)
+    with pytest.raises(SceneError, match=r"where: rtol=2.0, must be a finite number"):
+        base.merged(where="where", rtol=2.0)
+    with pytest.raises(SceneError, match=r"where: rtol=2.0, must be a finite number"):  # never stored
+        base.merged(where="where", rtol=2.0)
+
+
 def test_options_pick_the_method_of_a_run(ideal_model) -> None:
     scene = slider_crank()
     rk4 = dc.simulate(scene, T / 8, options=dc.SolverOptions(method="rk4", step=1e-5, formulation="index1"))
