@@ -333,6 +333,10 @@ def test_runs_leave_the_model_unchanged_and_are_independent(clearance_model) -> 
     second = dc.simulate(clearance_model, T / 2, rtol=1e-7, t_eval_step=T / 200)
     np.testing.assert_array_equal(first.y, second.y)
     assert [(e.t, e.kind) for e in first.events] == [(e.t, e.kind) for e in second.events]
+    for e in first.events:  # the compiled loop's events: plain floats, a read-only state of their own run
+        assert type(e.t) is float and type(e.approach_speed) is float and not e.y.flags.writeable
+        with pytest.raises(ValueError, match="read-only"):
+            e.y[0] = 1.0
     for backend in ("python", "c"):  # two runs at the same time in threads, from one assembled model
         results: dict[int, dc.Result] = {}
 

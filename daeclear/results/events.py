@@ -81,9 +81,17 @@ class ContactEvent:
                     y: NDArray[np.float64]) -> ContactEvent:
         """An event the contact logic records at every switch, without the checks of the constructor:
         ``kind`` is one of EVENT_KINDS and ``y`` a 1-D float64 state the event may own (made read-only)."""
-        event = object.__new__(cls)
         y.flags.writeable = False
-        event.__dict__.update(t=float(t), pair=pair, kind=kind, approach_speed=float(approach_speed), y=y)
+        return cls.of_readonly_row(float(t), pair, kind, float(approach_speed), y)
+
+    @classmethod
+    def of_readonly_row(cls, t: float, pair: str, kind: str, approach_speed: float,
+                        y: NDArray[np.float64]) -> ContactEvent:
+        """:meth:`from_solver` for floats and a read-only row (of a block made read-only once: the
+        compiled loop's tens of events a run, half the time of setting each row's flags)."""
+        event = object.__new__(cls)
+        object.__setattr__(event, "__dict__", {"t": t, "pair": pair, "kind": kind, "approach_speed": approach_speed,
+                                               "y": y})
         return event
 
     def __eq__(self, other: object) -> bool:

@@ -192,8 +192,10 @@ class SegmentLoop:
         kinds = auto.info[:, 0].tolist()
         term_on = (auto.info[:, 1] | auto.info[:, 2]).tolist()
         ys = auto.y
-        for i, (t, p, rate, latched) in enumerate(zip(auto.t.tolist(), auto.pair.tolist(), auto.rate.tolist(),
-                                                      auto.latched.tolist())):
+        ys.flags.writeable = False  # the events own its rows (read-only views)
+        new_event = ContactEvent.of_readonly_row
+        for i, (t, p, rate, latched, y) in enumerate(zip(auto.t.tolist(), auto.pair.tolist(), auto.rate.tolist(),
+                                                         auto.latched.tolist(), ys)):
             if not times or t != times[-1]:  # a restart: the segment before it ends
                 segments.append((self.seg_start, t, dict(modes)))
                 self.seg_start = t
@@ -202,7 +204,7 @@ class SegmentLoop:
                 switches.append(switch)
             _, _, name, column, needs = info[p]
             kind = kinds[i]
-            events.append(ContactEvent.from_solver(t, name, EVENT_KINDS[kind], rate, ys[i]))
+            events.append(new_event(t, name, EVENT_KINDS[kind], rate, y))
             modes[name] = "contact" if kind == ONSET else "free"
             switch[column] = 1.0 if term_on[i] else 0.0  # as the compiled loop sets its term
             if needs:
