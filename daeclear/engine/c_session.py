@@ -52,10 +52,10 @@ __all__ = ["CSession", "SPARSE_MIN_STATES"]
 
 #: linear_solver="auto" uses the sparse solver for models with at least this many states, the
 #: reduced dense LU below. Measured with benchmarks/bench_linear_solver.py (chains of N links, 6 N
-#: states; docs/performance.md): the reduced LU is faster up to 192 states (SuperLU_MT's fixed cost
-#: per factorization), the two tie at 216, sparse is faster from 240 on (whole simulate calls 1.15x
-#: at 240 states, 1.5x at 384).
-SPARSE_MIN_STATES = 216
+#: states; docs/performance.md): the reduced LU is faster up to 336 states (SuperLU_MT's fixed cost
+#: per factorization), sparse is faster from 360 on (whole simulate calls 1.04x at 360 states,
+#: 1.07x at 384).
+SPARSE_MIN_STATES = 360
 _LS_CODES = {"dense": 0, "sparse": 1, "reduced": 2}  # dc_open's linear_solver argument (DC_LS_*)
 _LS_NAMES = {code: name for name, code in _LS_CODES.items()}
 log = logging.getLogger("daeclear")
