@@ -14,7 +14,7 @@ the pass least disturbed by the machine's other load), then the same sweep throu
 process (its file, classification and Poincaré section included).
 
     python benchmarks/bench_sweep.py [--points 50] [--revolutions 2] [--rtol 1e-6] [--per-revolution 64]
-                                     [--passes 5] [--no-sweep]
+                                     [--passes 10] [--no-sweep]
 
 Output: ``--per-revolution`` points per crank revolution (``t_eval``, as sweeps sample their
 Poincare sections and stored channels); 0 reports every IDA step, whose channels cost about
@@ -44,7 +44,7 @@ def main() -> None:
     parser.add_argument("--rtol", type=float, default=1e-6)
     parser.add_argument("--per-revolution", type=int, default=64, help="output points per revolution (0: every step)")
     parser.add_argument("--no-sweep", action="store_true", help="skip the daeclear.sweep part")
-    parser.add_argument("--passes", type=int, default=5, help="passes over the clearances (the first builds)")
+    parser.add_argument("--passes", type=int, default=10, help="passes over the clearances (the first builds)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="bench_sweep-") as tmp:
         os.environ["DAECLEAR_CACHE_DIR"] = str(Path(tmp) / "cache")  # before daeclear builds anything
