@@ -115,7 +115,7 @@ class SolverOptions:
             object.__setattr__(merged, name, value)
         if key is not None:
             if len(_MERGED) >= _MERGED_LIMIT:
-                _MERGED.pop(next(iter(_MERGED)))
+                _MERGED.clear()  # one atomic step (threads): the next runs fill it again
             _MERGED[key] = merged
         return merged
 
