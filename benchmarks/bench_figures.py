@@ -13,7 +13,8 @@ Lankarani-Nikravesh c_e = 0.9, gravity, 5000 rpm) it prints:
    ratio against the fastest explicit method (RK45, DOP853, rk4, euler) and the fastest scipy
    implicit method (Radau, BDF, LSODA) whose error is at most IDA's (equal or better accuracy).
 
-With --write the tables and work-precision figures go to docs/performance.md and docs/figures/.
+With --write the tables go to their block of docs/work_precision.md (the rest of the page stays)
+and the work-precision figures to docs/figures/.
 """
 
 from __future__ import annotations
@@ -27,6 +28,12 @@ import daeclear as dc
 from daeclear.studies.accuracy import work_precision
 
 REV = 60.0 / 5000.0
+MARK_BEGIN = "<!-- bench_figures: begin -->"
+MARK_END = "<!-- bench_figures: end -->"
+HEADER = ("# Work-precision: IDA against explicit and scipy integrators\n\n"
+          "Produced by `python benchmarks/bench_figures.py --write` on the project's 2-core machine. "
+          "Wall times are best of the repeats of the whole `simulate` call with the model compiled "
+          "and cached.\n\n")
 EXPLICIT = {"RK45": {"method": "RK45"}, "DOP853": {"method": "DOP853"}, "rk4": {"method": "rk4"},
             "euler": {"method": "euler"}}
 IMPLICIT = {"LSODA": {"method": "LSODA"}, "BDF": {"method": "BDF"}, "Radau": {"method": "Radau"}}
@@ -55,7 +62,7 @@ def chapter_run(scene: dc.Scene, rtol: float, repeats: int) -> dict[str, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--write", action="store_true", help="write docs/performance.md tables and figures")
+    parser.add_argument("--write", action="store_true", help="write the tables into docs/work_precision.md and the figures into docs/figures")
     args = parser.parse_args()
     out: list[str] = []
 
@@ -109,10 +116,13 @@ def main() -> None:
             say()
     if args.write:
         path = Path(__file__).resolve().parents[1] / "docs" / "work_precision.md"
-        path.write_text("# Work-precision: IDA against explicit and scipy integrators\n\n"
-                        "Produced by `python benchmarks/bench_figures.py --write` on the project's 2-core machine. "
-                        "Wall times are best of the repeats of the whole `simulate` call with the model compiled "
-                        "and cached.\n\n" + "\n".join(out) + "\n")
+        block = "\n".join([MARK_BEGIN, "", *out, MARK_END])
+        text = path.read_text() if path.exists() else ""
+        if MARK_BEGIN in text:  # only this script's block: the rest of the page (other studies) stays
+            text = text[:text.index(MARK_BEGIN)] + block + text[text.index(MARK_END) + len(MARK_END):]
+        else:
+            text = HEADER + block + "\n" + text
+        path.write_text(text)
         print(f"wrote {path}")
 
 
