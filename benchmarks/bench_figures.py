@@ -62,7 +62,8 @@ def chapter_run(scene: dc.Scene, rtol: float, repeats: int) -> dict[str, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--write", action="store_true", help="write the tables into docs/work_precision.md and the figures into docs/figures")
+    parser.add_argument("--write", action="store_true",
+                        help="write the tables into docs/work_precision.md, the figures into docs/figures")
     args = parser.parse_args()
     out: list[str] = []
 
