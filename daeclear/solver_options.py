@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from . import options
+from .engine.build import memo_put_bounded, memo_table
 from .options import fail
 
 WHERE = "SolverOptions"
@@ -114,9 +115,7 @@ class SolverOptions:
         for name, value in values.items():
             object.__setattr__(merged, name, value)
         if key is not None:
-            if len(_MERGED) >= _MERGED_LIMIT:
-                _MERGED.clear()  # one atomic step (threads): the next runs fill it again
-            _MERGED[key] = merged
+            memo_put_bounded(_MERGED, key, merged, _MERGED_LIMIT)
         return merged
 
     def atol_value(self) -> float | np.ndarray | None:
@@ -128,7 +127,7 @@ class SolverOptions:
 # in the key (True and 1, 1 and 1.0 are told apart; 0.0 and -0.0, equal keys, are both max_step's
 # "unbounded"); an invalid value raises before it is stored
 _MEMO_TYPES = frozenset({str, bool, int, float})
-_MERGED: dict[tuple[Any, ...], SolverOptions] = {}
+_MERGED: dict[tuple[Any, ...], SolverOptions] = memo_table()
 _MERGED_LIMIT = 64
 
 

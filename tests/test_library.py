@@ -58,3 +58,19 @@ def test_other_interface_versions_are_refused(paths, monkeypatch):
 def test_an_ode_library_is_no_model_library(paths):
     with pytest.raises(StaleLibrary, match="no daeclear build tag"):
         ModelLibrary(paths[1])
+
+
+def test_a_bounded_memo_drops_its_oldest_entries() -> None:
+    """The in-process memos of templates, seen scenes, starts and options stay bounded: the oldest
+    entries go first, the newest is always kept, and a memo over its limit shrinks back to it."""
+    from daeclear.engine.build import memo_put_bounded
+
+    table: dict = {}
+    for k in range(10):
+        memo_put_bounded(table, k, str(k), 4)
+    assert list(table) == [6, 7, 8, 9] and table[9] == "9"
+    memo_put_bounded(table, 6, "again", 4)  # an old key put again: the oldest other entries make room
+    assert len(table) == 4 and table[6] == "again"
+    big = {k: k for k in range(10)}
+    memo_put_bounded(big, "new", 0, 3)
+    assert list(big) == [8, 9, "new"]

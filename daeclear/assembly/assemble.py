@@ -40,7 +40,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ..engine.build import memo_table
+from ..engine.build import memo_put_bounded, memo_table
 from ..errors import AssemblyError, SceneError
 from ..engine.session_base import DAEFunctions
 from ..options import DEFAULT_FORMULATION, FORMULATIONS
@@ -226,13 +226,9 @@ def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: flo
     template = _TEMPLATES.get(key)
     if template is None:
         template = _build_template(scene, formulation, bool(track_work), table, f"mechanism_{key[:16]}")
-        if len(_TEMPLATES) >= _TEMPLATE_LIMIT:
-            _TEMPLATES.pop(next(iter(_TEMPLATES)))
-        _TEMPLATES[key] = template
+        memo_put_bounded(_TEMPLATES, key, template, _TEMPLATE_LIMIT)
     model = template.bind(scene, table, described, alpha, beta)
-    if len(_SEEN) >= _SEEN_LIMIT:
-        _SEEN.pop(next(iter(_SEEN)))
-    _SEEN[id(scene)] = (elements, identity, model)
+    memo_put_bounded(_SEEN, id(scene), (elements, identity, model), _SEEN_LIMIT)
     return model
 
 

@@ -18,6 +18,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..engine.build import memo_put_bounded
 from ..engine.session_base import DAEFunctions, StateLayout
 from ..errors import AssemblyError
 from ..solvers.physics import check_start_penetration
@@ -372,12 +373,8 @@ class DAEModel:
         y, yp = self.consistent_state(0.0, y, session=session)
         if not ideal and not allow_penetration:
             check_start_penetration(self, y, yp, session)
-        if len(self.start_memo) >= START_MEMO_LIMIT:  # a long sweep of masses or lengths: the oldest goes
-            try:
-                self.start_memo.pop(next(iter(self.start_memo)), None)
-            except (RuntimeError, StopIteration):  # another thread's run changed the memo meanwhile
-                pass
-        self.start_memo[key] = (_read_only(y), _read_only(yp))
+        # a long sweep of masses or lengths: the oldest starts go
+        memo_put_bounded(self.start_memo, key, (_read_only(y), _read_only(yp)), START_MEMO_LIMIT)
         return y, yp
 
     def switch_vector(self, active: Sequence[bool], params: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:

@@ -151,6 +151,18 @@ def clear_memos() -> None:
         table.clear()
 
 
+def memo_put_bounded(table: MemoTable, key: Any, value: Any, limit: int) -> None:
+    """``table[key] = value``, the oldest entries dropped first while the table holds ``limit``
+    (a long sweep of new numbers keeps its memos bounded). Safe when another thread changes the
+    table meanwhile: an eviction that loses that race is skipped."""
+    while len(table) >= limit:
+        try:
+            table.pop(next(iter(table)), None)
+        except (RuntimeError, StopIteration):  # the table changed under the iterator
+            break
+    table[key] = value
+
+
 def memo_get(table: MemoTable, obj: Any) -> Any:
     """The value memoised for this very object (identity, kept only while the object lives)."""
     entry = table.get(id(obj))

@@ -167,7 +167,7 @@ class SegmentLoop:
             self.rec.add_steps(adv.step_t, adv.step_h, adv.step_order)
         rows = (adv.step_t, adv.step_y, adv.step_yp) if self.eval_times is None else (
             adv.eval_t, adv.eval_y, adv.eval_yp)
-        if self.eval_times is None and not self.store_steps or not rows[0].size:
+        if (self.eval_times is None and not self.store_steps) or not rows[0].size:  # no points to keep
             if adv.auto_events is not None:
                 self.record_switches(adv.auto_events)
             return
