@@ -606,3 +606,54 @@ def test_extras_evaluate_over_points_like_casadi():
         got = session.eval_extra(0, [A, np.array([3.0])], 50)
         np.testing.assert_allclose(got, expected, rtol=1e-14, atol=1e-14)
         session.close()
+
+
+# --------------------------------------------------------------------------- pooled C sessions
+
+
+def _bounce(s, t_end=2.0):
+    """Bounce the ball of ball_model to t_end or a failure: (status, t, root times, step times, y,
+    the counters of stats)."""
+    s.reinit(0.0, [1.0, 0.0], [0.0, -G], [False], [np.ones(1)])
+    roots, steps = [], []
+    while True:
+        a = s.advance(t_end)
+        steps.append(a.step_t)
+        if a.status != "root":
+            break
+        roots.append(a.t)
+        s.reinit(a.t, a.y, a.yp, [a.y[1] < 0], [np.ones(1)])
+    counters = {k: v for k, v in s.stats().items() if k.startswith("n_") or k == "first_step"}
+    return a.status, a.t, roots, np.concatenate(steps), a.y, counters
+
+
+def test_a_pooled_c_session_runs_step_for_step_as_a_new_one():
+    """A closed session's C session is re-armed (dc_reset) for the next session of the same
+    library: whatever the run before it set (tolerances, step limits, root directions, Newton
+    hints, stall rule, a first-step choice) and however it ended, the next one runs exactly as a
+    freshly opened one."""
+    from daeclear.engine import c_session
+
+    model = ball_model()
+    settings = dict(backend="c", rtol=1e-8, atol=np.array([1e-12, 1e-10]))
+    c_session._POOL.clear()
+    fresh = open_session(model, **settings)
+    status, t, roots, steps, y, counters = _bounce(fresh)
+    assert status == "tstop" and t == 2.0 and len(roots) == 4
+    fresh.close()
+    c_session._POOL.clear()  # the next session opens its own
+    dirty = open_session(model, backend="c", rtol=1e-4, atol=1e-6, max_step=1e-3, max_steps=700,
+                         root_directions=np.array([1]))
+    dirty.set_hints(nonlin_conv_coef=0.01, jacobian_refresh=0.9, first_step=True)
+    dirty.set_stall(1e-2, 3)
+    assert _bounce(dirty)[0] == "error"  # the step cap, inside the flight
+    dirty.close()
+    pooled = open_session(model, **settings)
+    assert pooled._hd is dirty._hd  # the same C session, reset
+    again = _bounce(pooled)
+    assert again[:3] == (status, t, roots)
+    np.testing.assert_array_equal(again[3], steps)
+    np.testing.assert_array_equal(again[4], y)
+    assert again[5] == counters
+    pooled.close()
+    assert open_session(model, **settings)._hd is pooled._hd  # and again

@@ -29,7 +29,7 @@ import numpy as np
 
 from ..assembly.automaton import Decision, PairState, Storm
 from ..errors import DaeclearError
-from .build import BuildResult
+from .build import BuildResult, memo_put_bounded, memo_table
 from .codegen import NormalizedModel
 from .library import ModelLibrary
 from .session_base import (
@@ -96,6 +96,87 @@ def _ptr(a: np.ndarray | None) -> int | None:
 TIMES_ROWS_PER_STATE_ROW = 16
 
 
+class _Handle:
+    """One C session (dc_open) and the buffers the loop fills: what depends on the library, its
+    linear solver, max_order and buffer_steps alone. A closed CSession's handle goes to a small
+    pool; the next session of the same library and settings takes it, re-armed by dc_reset (a
+    reset session runs step for step as a new one), instead of opening and freeing another:
+    dc_open and dc_free cost more than the Python around a short run. Freed when collected."""
+
+    def __init__(self, lib: Any, h: int, n: int, nr: int, nt: int, n_params: int, buffer_steps: int) -> None:
+        self.lib, self.h = lib, h
+        weakref.finalize(self, _free_c_session, lib, h)
+        self.jac_nnz = int(lib.dc_jac_nnz(h))
+        # rows of the step buffers: buffer_steps with the steps' states, TIMES_ROWS_PER_STATE_ROW
+        # times as many for times alone (20 bytes a row: a run of tens of thousands of steps with
+        # output times comes back in one piece, not in a piece per 4096 steps, each made consistent
+        # and checked apart)
+        self.cap = buffer_steps
+        cap = self.cap_times = buffer_steps * TIMES_ROWS_PER_STATE_ROW
+        # persistent buffers (addresses cached: ctypes calls stay cheap)
+        self.st = np.empty(cap)
+        # the steps' states (1 MB each at n = 32): made at the first advance that stores them
+        self.sy: np.ndarray | None = None
+        self.syp: np.ndarray | None = None
+        self.sh = np.empty(cap)
+        self.sord = np.empty(cap, dtype=np.int32)
+        self.yout = np.empty(n)
+        self.ypout = np.empty(n)
+        self.roots = np.zeros(max(nr, 1), dtype=np.int32)
+        self.i_eval = ctypes.c_int()
+        self.n_stored = ctypes.c_int()
+        self.t_out = ctypes.c_double()
+        self.flag = ctypes.c_int()
+        self.statbuf = np.zeros(len(_STAT_KEYS), dtype=np.int64)
+        # reinit inputs: copied into fixed arrays whose addresses are known
+        self.y0b = np.zeros(n)
+        self.yp0b = np.zeros(n)
+        self.actb = np.zeros(max(nt, 1), dtype=np.int32)
+        self.rdb = np.zeros(max(nr, 1), dtype=np.int32)
+        self.pcat = np.zeros(max(n_params, 1))
+        self.addr = dict(
+            st=self.st.ctypes.data, sy=None, syp=None,
+            sh=self.sh.ctypes.data, sord=self.sord.ctypes.data, yout=self.yout.ctypes.data,
+            ypout=self.ypout.ctypes.data, roots=self.roots.ctypes.data,
+            i_eval=ctypes.addressof(self.i_eval), n_stored=ctypes.addressof(self.n_stored),
+            t_out=ctypes.addressof(self.t_out), flag=ctypes.addressof(self.flag),
+            y0b=self.y0b.ctypes.data, yp0b=self.yp0b.ctypes.data, actb=self.actb.ctypes.data,
+            rdb=self.rdb.ctypes.data, pcat=self.pcat.ctypes.data,
+        )
+
+
+#: closed sessions' handles by (library, linear solver, max_order, buffer_steps): at most
+#: POOL_PER_KEY each (threads running the same model at once), for the POOL_KEYS newest keys
+POOL_PER_KEY = 2
+POOL_KEYS = 8
+_POOL: dict[tuple[int, str, int, int], list[_Handle]] = memo_table()
+
+
+def _take_pooled(key: tuple[int, str, int, int], opts: SessionOptions) -> _Handle | None:
+    """A pooled handle re-armed with ``opts`` (dc_reset), or None (none pooled, or its reset failed)."""
+    handles = _POOL.get(key)
+    try:
+        hd = handles.pop() if handles else None
+    except IndexError:  # another thread took the last one
+        return None
+    if hd is not None and hd.lib.dc_reset(hd.h, opts.rtol, opts.atol.ctypes.data, opts.max_step, opts.max_steps,
+                                          _ptr(opts.root_directions), _ptr(opts.parameters)) != 0:
+        log.info("daeclear: a pooled IDA session could not be reset (%s); opening a new one",
+                 hd.lib.dc_message(hd.h).decode())
+        return None  # freed when collected
+    return hd
+
+
+def _put_pooled(key: tuple[int, str, int, int], hd: _Handle) -> None:
+    """Keep a closed session's handle for the next session (or drop it: freed when collected)."""
+    handles = _POOL.get(key)
+    if handles is None:
+        handles = []
+        memo_put_bounded(_POOL, key, handles, POOL_KEYS)
+    if len(handles) < POOL_PER_KEY:
+        handles.append(hd)
+
+
 class CSession(SessionBase):
     """Compiled backend: IDA, callbacks and the step loop in C (see module docstring)."""
 
@@ -114,6 +195,24 @@ class CSession(SessionBase):
         self._lib = clib.lib
         self._build = build
         self._linear_solver = _resolve_linear_solver(opts.linear_solver, n, clib.build_info.has_sparse)
+        self._pool_key = (id(self._lib), self._linear_solver, opts.max_order, opts.buffer_steps)
+        hd = _take_pooled(self._pool_key, opts)
+        if hd is None:
+            hd = self._open(opts, n, nr)
+            self._pool_key = (id(self._lib), self._linear_solver, opts.max_order, opts.buffer_steps)
+        self._hd = hd
+        self._h, self._jac_nnz, self._cap, self._cap_times = hd.h, hd.jac_nnz, hd.cap, hd.cap_times
+        self._st, self._sy, self._syp, self._sh, self._sord = hd.st, hd.sy, hd.syp, hd.sh, hd.sord
+        self._yout, self._ypout, self._roots, self._statbuf = hd.yout, hd.ypout, hd.roots, hd.statbuf
+        self._i_eval, self._n_stored, self._t_out, self._flag = hd.i_eval, hd.n_stored, hd.t_out, hd.flag
+        self._y0b, self._yp0b, self._actb, self._rdb, self._pcat = hd.y0b, hd.yp0b, hd.actb, hd.rdb, hd.pcat
+        self._addr = hd.addr
+        self._extra_meta: dict[int, tuple[Any, ...]] = {}
+        self._poff = np.concatenate([[0], np.cumsum(model.n_params)]).astype(int).tolist()
+
+    def _open(self, opts: SessionOptions, n: int, nr: int) -> _Handle:
+        """A new C session (dc_open) with its buffers; the sparse solver falls back to the reduced
+        LU when "auto" chose it and it cannot be set up."""
         err = ctypes.create_string_buffer(1024)
 
         def dc_open() -> Any:
@@ -129,47 +228,7 @@ class CSession(SessionBase):
             h = dc_open()
         if not h:
             raise DaeclearError(f"opening the compiled IDA session failed: {err.value.decode()}")
-        self._h = h
-        self._finalizer = weakref.finalize(self, _free_c_session, self._lib, h)
-        self._jac_nnz = int(self._lib.dc_jac_nnz(h))
-        # rows of the step buffers: buffer_steps with the steps' states, TIMES_ROWS_PER_STATE_ROW
-        # times as many for times alone (20 bytes a row: a run of tens of thousands of steps with
-        # output times comes back in one piece, not in a piece per 4096 steps, each made consistent
-        # and checked apart)
-        self._cap = opts.buffer_steps
-        cap = self._cap_times = opts.buffer_steps * TIMES_ROWS_PER_STATE_ROW
-        # persistent buffers (addresses cached: ctypes calls stay cheap)
-        self._st = np.empty(cap)
-        # the steps' states (1 MB each at n = 32): made at the first advance that stores them
-        self._sy: np.ndarray | None = None
-        self._syp: np.ndarray | None = None
-        self._sh = np.empty(cap)
-        self._sord = np.empty(cap, dtype=np.int32)
-        self._yout = np.empty(n)
-        self._ypout = np.empty(n)
-        self._roots = np.zeros(max(nr, 1), dtype=np.int32)
-        self._i_eval = ctypes.c_int()
-        self._n_stored = ctypes.c_int()
-        self._t_out = ctypes.c_double()
-        self._flag = ctypes.c_int()
-        self._addr = dict(
-            st=self._st.ctypes.data, sy=None, syp=None,
-            sh=self._sh.ctypes.data, sord=self._sord.ctypes.data, yout=self._yout.ctypes.data,
-            ypout=self._ypout.ctypes.data, roots=self._roots.ctypes.data,
-            i_eval=ctypes.addressof(self._i_eval), n_stored=ctypes.addressof(self._n_stored),
-            t_out=ctypes.addressof(self._t_out), flag=ctypes.addressof(self._flag),
-        )
-        self._statbuf = np.zeros(len(_STAT_KEYS), dtype=np.int64)
-        self._extra_meta: dict[int, tuple[Any, ...]] = {}
-        # reinit inputs: copied into fixed arrays whose addresses are known
-        self._y0b = np.zeros(n)
-        self._yp0b = np.zeros(n)
-        self._actb = np.zeros(max(self._nt, 1), dtype=np.int32)
-        self._rdb = np.zeros(max(nr, 1), dtype=np.int32)
-        self._pcat = np.zeros(max(sum(model.n_params), 1))
-        self._poff = np.concatenate([[0], np.cumsum(model.n_params)]).astype(int).tolist()
-        for name in ("y0b", "yp0b", "actb", "rdb", "pcat"):
-            self._addr[name] = getattr(self, "_" + name).ctypes.data
+        return _Handle(self._lib, h, n, nr, self._nt, sum(self._model.n_params), opts.buffer_steps)
 
     def set_hints(self, *, nonlin_conv_coef: float | None = None, jacobian_refresh: float | None = None,
                   first_step: bool | None = None) -> bool:
@@ -361,8 +420,8 @@ class CSession(SessionBase):
         chunks: list[tuple[np.ndarray, ...]] = []
         auto_events: list[AutoEvents] = []
         store = (STORE_TIMES | (STORE_STATES if store_states else 0)) if store_steps else 0
-        if store & STORE_STATES and self._sy is None:
-            self._sy, self._syp = np.empty((self._cap, n)), np.empty((self._cap, n))
+        if store & STORE_STATES and self._sy is None:  # kept by the handle for the sessions after this one
+            self._sy, self._syp = self._hd.sy, self._hd.syp = np.empty((self._cap, n)), np.empty((self._cap, n))
             A["sy"], A["syp"] = self._sy.ctypes.data, self._syp.ctypes.data
         # times only: the long buffers; without any steps cap counts IDA calls (a streamed run hands
         # its events over every buffer_steps calls, so its memory does not grow with its length)
@@ -543,6 +602,8 @@ class CSession(SessionBase):
         return self._clib.sundials_version
 
     def close(self) -> None:
+        """Close the session: its C session goes to the pool of this library's sessions (the next
+        session takes it with dc_reset instead of dc_open) or, the pool full, is freed."""
         if not self._closed:
             self._closed = True
-            self._finalizer()
+            _put_pooled(self._pool_key, self._hd)

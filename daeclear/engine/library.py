@@ -45,7 +45,7 @@ __all__ = [
 
 #: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
 #: and checked when a library is loaded: bump it when a dc_* signature changes.
-DRIVER_ABI = 5
+DRIVER_ABI = 6
 #: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
 ODE_DRIVER_ABI = 3
 
@@ -85,6 +85,7 @@ MODEL_PROTOTYPES: Prototypes = {
     "dc_first_step": (D, [P]),
     "dc_solve_reduced": (I, [P, I, D, P, P, D, P, P]),
     "dc_free": (None, [P]),
+    "dc_reset": (I, [P, D, P, D, LL, P, P]),
     "dc_reinit": (I, [P, D, P, P, P, P, P]),
     "dc_advance": (I, [P, D, P, I, P, P, P, I, I, P, P, P, P, P, P, P, P, P, P, P]),
     "dc_stats": (None, [P, P]),

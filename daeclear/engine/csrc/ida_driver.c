@@ -868,6 +868,11 @@ static int build_jac_pattern(dc_session* s) {
   return 0;
 }
 
+/* IDA's own step cap: in one-step mode it never binds; the session's cap (max_steps) is ours. */
+static long ida_max_steps(long long max_steps) {
+  return 0 < max_steps && max_steps < 2000000000LL ? (long)max_steps : 2000000000L;
+}
+
 /* Open a session: IDA memory, linear solver (DC_LS_DENSE: dense LU; DC_LS_SPARSE: SuperLU_MT on
  * the union pattern, one thread), tolerances, options and root functions.
  * IDAInit is called here with a zero state; dc_reinit then (re)starts with IDAReInit.
@@ -1025,8 +1030,7 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
   CHECK(IDASetJacFn(s->ida, jac_cb));
   CHECK(IDASetMaxOrd(s->ida, max_order));
   CHECK(IDASetMaxStep(s->ida, max_step));
-  /* one-step mode: IDA's own per-call step limit never binds; the session cap is ours */
-  CHECK(IDASetMaxNumSteps(s->ida, 0 < max_steps && max_steps < 2000000000LL ? (long)max_steps : 2000000000L));
+  CHECK(IDASetMaxNumSteps(s->ida, ida_max_steps(max_steps)));
   if (M->n_roots > 0) {
     CHECK(IDARootInit(s->ida, M->n_roots, root_cb));
     CHECK(IDASetRootDirection(s->ida, s->rootdir_default));
@@ -1035,6 +1039,67 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
 #undef CHECK
 #undef FAIL
   return s;
+}
+
+/* IDA's default Newton convergence coefficient (EPCON of ida.c), restored by dc_reset. */
+#define DC_IDA_EPCON 0.33
+
+/* Re-arm the session of a finished run for another run of the same library, as dc_open would
+ * open it with these settings: tolerances, step limits, default root directions and run-time
+ * parameters are set, every field a run changes goes back to its value after dc_open, and the
+ * IDA options a run may set (dc_set_nonlin_conv_coef, dc_set_jacobian_refresh) back to IDA's
+ * defaults. Kept: what depends on the library, the linear solver and max_order alone (IDA
+ * memory, vectors, matrix, linear solver, Jacobian pattern, CasADi work memory), so a reset
+ * session runs step for step as a new one. dc_reinit starts it. Returns 0, or an IDA flag < 0
+ * with a message (dc_message); the session is then unusable (free it). */
+DC_API int dc_reset(void* sp, double rtol, const double* atol, double max_step, long long max_steps,
+                    const int* rootdir, const double* P) {
+  dc_session* s = (dc_session*)sp;
+  const dc_model_t* M = &dc_model;
+  int np = 0, flag;
+  for (int k = 0; k < s->n_terms; ++k) np += M->n_params[k];
+  s->msg[0] = s->cb_msg[0] = s->ida_msg[0] = 0;
+  if (M->n_parameters > 0) {
+    if (!P) {
+      set_msg(s->msg, "the model has %d run-time parameters and none were given", M->n_parameters);
+      return -1;
+    }
+    memcpy(s->P, P, sizeof(double) * (size_t)M->n_parameters);
+  }
+  s->rtol = rtol;
+  s->max_step = max_step;
+  s->max_steps = max_steps;
+  for (int i = 0; i < s->n_roots; ++i) {
+    s->rootdir_default[i] = rootdir ? rootdir[i] : 0;
+    s->rootdir[i] = s->rootsfound[i] = 0;
+  }
+  for (int k = 0; k < s->n_terms; ++k) s->active[k] = 0;
+  if (np > 0) memset(s->params, 0, sizeof(double) * (size_t)np);
+  memset(s->base, 0, sizeof s->base);
+  s->t_now = s->t_rec = 0.0;
+  s->carry = s->carry_flag = s->carry_order = 0;
+  s->carry_lo = s->carry_t_prev = s->carry_h = 0.0;
+  s->carry_nst = s->carry_nst_prev = 0;
+  s->ready = 0;
+  s->tiny = 0;
+  s->h_prev = 0.0;
+  s->stall_step = 0.0;
+  s->stall_count = DC_TINY_MAX;
+  s->first_step_on = 0;
+  s->n_auto = 0; /* dc_set_auto and dc_set_layout (re)allocate what they configure */
+  s->ev_n = 0;
+  s->lay_ready = 0;
+  s->proj_on = 0;
+  memcpy(N_VGetArrayPointer(s->atol), atol, sizeof(double) * (size_t)s->n);
+  flag = IDASVtolerances(s->ida, rtol, s->atol);
+  if (flag >= 0) flag = IDASetMaxStep(s->ida, max_step);
+  if (flag >= 0) flag = IDASetMaxNumSteps(s->ida, ida_max_steps(max_steps));
+  if (flag >= 0) flag = IDAClearStopTime(s->ida); /* dc_advance sets it */
+  if (flag >= 0) flag = IDASetNonlinConvCoef(s->ida, DC_IDA_EPCON);
+  if (flag >= 0) flag = IDASetDeltaCjLSetup(s->ida, -1.0); /* out of [0, 1): IDA's default */
+  if (flag >= 0 && s->n_roots > 0) flag = IDASetRootDirection(s->ida, s->rootdir_default);
+  if (flag < 0) set_msg(s->msg, "resetting the session failed with flag %d: %s", flag, s->ida_msg);
+  return flag < 0 ? flag : 0;
 }
 
 /* Solver hints applied from the next step or restart on: the safety factor of IDA's
