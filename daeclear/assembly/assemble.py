@@ -90,7 +90,7 @@ def _translational(ctx: AssemblyContext, joint: Translational) -> tuple[list[Any
 def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
                      track_work: bool) -> tuple[ParameterTable, str, dict[str, Any]]:
     """The scene's numbers as run-time parameters, the key of its structure and the scene's
-    plain-data description (``Scene.to_dict``, computed once for the key and the model).
+    plain-data description (``Scene.to_dict``, for the model's parameters).
 
     Pure Python (no CasADi): this is all that a scene of a known structure costs to assemble.
     """
@@ -120,11 +120,7 @@ def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
         else:
             raise AssemblyError(f"{element.kind} '{element.name}': element type not supported by assemble().")
     structure.append(table.layout)
-    described = scene.to_dict()
-    # the scene's name is no part of its structure, nor are the fields whose effect the flags state
-    elements = {e.name: {k: v for k, v in described["elements"][e.name].items() if k not in e.NOT_STRUCTURE}
-                for e in scene.elements}
-    return table, structure_key({"gravity": described["gravity"], "elements": elements}, structure), described
+    return table, structure_key(scene.elements, structure), scene.to_dict()
 
 
 @dataclass(frozen=True)

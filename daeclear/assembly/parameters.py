@@ -32,7 +32,10 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["ParameterTable", "structure_key", "law_values", "symbolic_law", "law_structure", "is_parametric"]
+from ..model.elements import kept
+
+__all__ = ["ParameterTable", "structure_key", "element_structure", "law_values", "symbolic_law", "law_structure",
+           "is_parametric"]
 
 
 class ParameterTable:
@@ -115,12 +118,24 @@ def _mask(value: Any) -> Any:
     return repr(value)
 
 
-def structure_key(scene_dict: dict[str, Any], extra: Iterable[Any]) -> str:
-    """SHA-256 of the scene description with numbers masked, plus ``extra`` (formulation,
-    options and the laws' structural flags, see :func:`law_structure`). The text hashed is the
-    repr of plain data in the order ``Scene.to_dict`` gives (a third of the time of a JSON text
-    with sorted keys: this runs for every scene simulated)."""
-    return hashlib.sha256(repr([_mask(scene_dict), list(extra)]).encode()).hexdigest()
+def element_structure(element: Any) -> str:
+    """An element's description (``to_dict``) without the fields of its ``NOT_STRUCTURE`` and with
+    every number masked, as text; kept on a frozen element (it follows from the fields alone), so
+    the elements the scenes of a sweep share are described once."""
+    return kept(element, "_structure_text", _element_structure)
+
+
+def _element_structure(element: Any) -> str:
+    described = element.to_dict()
+    return repr(_mask({k: v for k, v in described.items() if k not in element.NOT_STRUCTURE}))
+
+
+def structure_key(elements: Iterable[Any], extra: Iterable[Any]) -> str:
+    """SHA-256 of a scene's structure: each element's name and :func:`element_structure` in the
+    scene's order, plus ``extra`` (formulation, options and the laws' structural flags, see
+    :func:`law_structure`). The scene's name and its numbers (gravity included) are no part of it."""
+    text = repr([[(e.name, element_structure(e)) for e in elements], list(extra)])
+    return hashlib.sha256(text.encode()).hexdigest()
 
 
 # ---- laws ------------------------------------------------------------------------------
@@ -217,7 +232,11 @@ def symbolic_law(law: Any, symbols: dict[str, Any], prefix: str) -> Any:
 
 def law_structure(law: Any) -> list[Any]:
     """What of a law decides the equations' shape: its class, the flags the assembly branches
-    on, which fields are set, and all its numbers when it is baked."""
+    on, which fields are set, and all its numbers when it is baked (kept on the frozen law)."""
+    return kept(law, "_law_structure", _law_structure)
+
+
+def _law_structure(law: Any) -> list[Any]:
     flags: list[Any] = [type(law).__name__]
     for attr in ("needs_approach_speed", "dissipative", "frictionless", "smooth", "geometry"):
         if hasattr(law, attr):

@@ -31,22 +31,38 @@ GROUND = "ground"
 Vector2 = tuple[float, float]
 
 
+def kept(element: Any, slot: str, compute: Callable[[Any], Any]) -> Any:
+    """``compute(element)``, kept on the element under ``slot`` when its class is a frozen dataclass
+    (the value then follows from its fields alone: not a field, so equality, ``to_dict`` and
+    ``dataclasses.replace`` ignore it; scenes that share the element share it); computed anew on
+    any other element. A call that raises keeps nothing."""
+    params = getattr(type(element), "__dataclass_params__", None)
+    if params is None or not params.frozen:
+        return compute(element)
+    try:
+        return element.__dict__[slot]
+    except KeyError:
+        value = compute(element)
+        object.__setattr__(element, slot, value)
+        return value
+
+
 def computed_once(method: Callable[[Any], Any]) -> Callable[[Any], Any]:
     """A method of a frozen element whose result follows from its fields alone (a resolved contact
-    law): computed at the first call and kept on the instance (not a field: equality, ``to_dict``
-    and ``dataclasses.replace`` ignore it). A call that raises keeps nothing."""
+    law): computed at the first call and kept on the instance (see :func:`kept`)."""
     slot = f"_computed_{method.__name__}"
 
     @functools.wraps(method)
     def once(self: Any) -> Any:
-        try:
-            return self.__dict__[slot]
-        except KeyError:
-            value = method(self)
-            object.__setattr__(self, slot, value)
-            return value
+        return kept(self, slot, method)
 
     return once
+
+
+def own_problems(element: Element) -> tuple[str, ...]:
+    """``element.problems()``, kept on a frozen element: a scene validated again, or another scene
+    sharing the element (a sweep's), does not check it again."""
+    return kept(element, "_own_problems", lambda e: tuple(e.problems()))
 
 
 def _is_finite_number(value: Any) -> bool:

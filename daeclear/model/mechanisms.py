@@ -10,7 +10,8 @@ from .. import options as rules
 from ..contact import Material, friction_law, normal_law
 from ..contact.base import NormalLaw
 from ..errors import SceneError
-from .scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational
+from ..engine.build import MemoTable, memo_by_values, memo_table
+from .scene import GROUND, Body, Driver, Element, Revolute, RevoluteClearance, Scene, Translational
 
 # Table 4.1: link lengths (m), masses (kg), moments of inertia (kg m^2)
 CRANK_LENGTH, CRANK_MASS, CRANK_INERTIA = 0.05, 0.30, 1.0e-4
@@ -69,12 +70,48 @@ def _contact_law(law: Any, restitution: float | None, length: float | None) -> N
     """A law object from a law or a name; ``restitution``/``length`` fill the fields the law has."""
     if isinstance(law, NormalLaw):
         return law
+    return memo_by_values(_LAWS, (str(law), restitution, length), _make_contact_law)
+
+
+def _make_contact_law(name: str, restitution: float | None, length: float | None) -> NormalLaw:
     fields = {"restitution": DEFAULT_RESTITUTION if restitution is None else restitution, "length": length}
     from ..contact.registry import normal_law_class  # one source of names
 
-    cls = normal_law_class(str(law))
-    accepted = set(getattr(cls, "__dataclass_fields__", {}))
-    return normal_law(str(law), **{k: v for k, v in fields.items() if k in accepted and v is not None})
+    accepted = set(getattr(normal_law_class(name), "__dataclass_fields__", {}))
+    return normal_law(name, **{k: v for k, v in fields.items() if k in accepted and v is not None})
+
+
+# Laws and the ideal mechanism's elements, kept by the values they are made of. They are frozen, so
+# scenes share them: a sweep's scenes differ in the clearance joint alone, and what is kept per
+# element or law (its structure text, its problems) is computed once.
+_LAWS: MemoTable = memo_table()
+_IDEAL_ELEMENTS: MemoTable = memo_table()
+
+
+def _make_ideal_elements(omega: float, crank_angle: float, slider_mass: float, slider_inertia: float,
+                         offset: tuple[float, ...]) -> tuple[Element, ...]:
+    """Bodies crank, rod, slider; revolutes A, B, C; translational D; driver drive (see slider_crank)."""
+    state = ideal_slider_crank_state(crank_angle, omega)
+
+    def body(body_name: str, mass: float, inertia: float) -> Body:
+        x, y, phi, vx, vy, w = state[body_name]
+        return Body(body_name, mass=mass, inertia=inertia, position=(x, y), angle=phi, velocity=(vx, vy),
+                    angular_velocity=w)
+
+    crank = body("crank", CRANK_MASS, CRANK_INERTIA)
+    rod = body("rod", ROD_MASS, ROD_INERTIA)
+    if offset != (0.0, 0.0):  # the slider's centre, from the pin where the ideal mechanism has it
+        state["slider"] = (state["slider"][0] - offset[0], -offset[1], *state["slider"][2:])
+    slider = body("slider", slider_mass, slider_inertia)
+    pin_b = (CRANK_LENGTH * math.cos(crank_angle), CRANK_LENGTH * math.sin(crank_angle))
+    pin_c = (state["slider"][0] + offset[0], 0.0)
+    return (crank, rod, slider,
+            Revolute("A", GROUND, crank.name, at=(0.0, 0.0)),
+            Revolute("B", crank.name, rod.name, at=pin_b),
+            Revolute("C", rod.name, slider.name, at=pin_c),
+            # the guide's mid-line runs along X through the slider's centre (the X axis unless the pin is offset)
+            Translational("D", GROUND, slider.name, point_i=(0.0, -offset[1]), point_j=(0.0, 0.0), axis=(1.0, 0.0)),
+            Driver("drive", joint="A", speed=omega))
 
 
 def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 5000.0,
@@ -171,28 +208,9 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
         _check(field_name, value, "is for joint='translational' only", joint == "translational" or value == default)
 
     omega = rpm_to_rad_s(rpm)
-    state = ideal_slider_crank_state(crank_angle, omega)
-    scene = Scene(name or ("slider_crank" if joint == "ideal" else f"slider_crank_{joint}"), gravity=(0.0, -gravity))
-
-    def body(body_name: str, mass: float, inertia: float) -> Body:
-        x, y, phi, vx, vy, w = state[body_name]
-        return scene.add(Body(body_name, mass=mass, inertia=inertia, position=(x, y), angle=phi,
-                              velocity=(vx, vy), angular_velocity=w))
-
-    crank = body("crank", CRANK_MASS, CRANK_INERTIA)
-    rod = body("rod", ROD_MASS, ROD_INERTIA)
-    if offset != (0.0, 0.0):  # the slider's centre, from the pin where the ideal mechanism has it
-        state["slider"] = (state["slider"][0] - offset[0], -offset[1], *state["slider"][2:])
-    slider = body("slider", slider_mass, slider_inertia)
-    pin_b = (CRANK_LENGTH * math.cos(crank_angle), CRANK_LENGTH * math.sin(crank_angle))
-    pin_c = (state["slider"][0] + offset[0], 0.0)
-    scene.add(Revolute("A", scene.ground.name, crank.name, at=(0.0, 0.0)))
-    scene.add(Revolute("B", crank.name, rod.name, at=pin_b))
-    scene.add(Revolute("C", rod.name, slider.name, at=pin_c))
-    # the guide's mid-line runs along X through the slider's centre (the X axis unless the pin is offset)
-    scene.add(Translational("D", scene.ground.name, slider.name, point_i=(0.0, -offset[1]), point_j=(0.0, 0.0),
-                            axis=(1.0, 0.0)))
-    scene.add(Driver("drive", joint="A", speed=omega))
+    numbers = (omega, crank_angle, slider_mass, slider_inertia, offset)
+    scene = Scene(name or ("slider_crank" if joint == "ideal" else f"slider_crank_{joint}"), gravity=(0.0, -gravity),
+                  elements=list(memo_by_values(_IDEAL_ELEMENTS, numbers, _make_ideal_elements)))
     if joint == "ideal":
         return scene
     rules.restitution(restitution, law, where="slider_crank")  # given for a law without one, it would be dropped

@@ -21,7 +21,7 @@ from ..errors import SceneError
 from .clearance_joints import (SLIDER_MODELS, RevoluteClearance, TranslationalClearance,  # noqa: F401
                                clearance_joint, driven_coordinate, ideal_joint)
 from .elements import (GROUND, Body, Driver, Element, Ground, Joint, PointJoint, Revolute,  # noqa: F401
-                       Translational, Vector2, as_vector2, body_name, is_finite_number)
+                       Translational, Vector2, as_vector2, body_name, is_finite_number, own_problems)
 from .profiles import PROFILES, ConstantSpeed, Profile  # noqa: F401  (re-exported, as before the split)
 
 
@@ -136,7 +136,7 @@ class Scene:
             out.append(f"scene '{self.name}': gravity={self.gravity!r} m/s^2, must be two finite numbers.")
         seen: set[str] = set()
         for element in self.elements:
-            out.extend(element.problems())
+            out.extend(own_problems(element))
             if element.name in seen:
                 out.append(f"{element.kind} '{element.name}': duplicate name; every name in a scene must be unique.")
             seen.add(element.name)
