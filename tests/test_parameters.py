@@ -461,3 +461,51 @@ def test_driver_structure_changes_get_their_own_template():
     assert dc.assemble(disc_scene(Tabulated(times=(0, 1, 2, 3), values=(0, 2, 1, 3)), speed=None)).functions is four
     assert dc.assemble(disc_scene(Tabulated(times=(0, 1, 2, 3, 4), values=(0, 1, 2, 3, 4)),
                                   speed=None)).functions is not four
+
+
+def test_a_sweeps_scenes_share_the_elements_that_did_not_change():
+    """slider_crank keeps its ideal elements and contact laws by the exact values they are made of
+    (frozen, so scenes share them and what is kept on them): the scenes of new clearances share
+    every element but the clearance joint; other numbers, or the same number as an int, make new
+    elements; equal elements, shared or not, have one structure."""
+    from daeclear.assembly.parameters import structure_key
+
+    a, b = (dc.mechanisms.slider_crank("revolute", clearance=c) for c in (1e-4, 2e-4))
+    for x, y in zip(a.elements, b.elements):
+        assert (x is y) == (x.name != "clearance"), x.name
+    assert a["clearance"].law is b["clearance"].law
+    other = dc.mechanisms.slider_crank("revolute", clearance=1e-4, rpm=3000.0)
+    assert other["crank"] is not a["crank"]
+    assert other["crank"].angular_velocity == pytest.approx(3000.0 * 2.0 * np.pi / 60.0)
+    assert type(dc.mechanisms.slider_crank(slider_mass=1)["slider"].mass) is int
+    assert type(dc.mechanisms.slider_crank(slider_mass=1.0)["slider"].mass) is float
+    assert structure_key(a.elements, ["ggl"]) == structure_key(b.elements, ["ggl"])
+    unshared = [dataclasses.replace(e) for e in a.elements]  # new objects: nothing kept on them yet
+    assert structure_key(unshared, ["ggl"]) == structure_key(a.elements, ["ggl"])
+    assert structure_key(other.elements, ["ggl"]) == structure_key(a.elements, ["ggl"])  # numbers only
+    assert structure_key(a.elements, ["index1"]) != structure_key(a.elements, ["ggl"])
+
+
+def test_values_are_kept_on_frozen_elements_only():
+    """elements.kept computes once on a frozen element, every time on a mutable one (its fields can change)."""
+    from daeclear.model.elements import kept
+
+    @dataclasses.dataclass
+    class Mutable:
+        x: float
+
+    calls: list[float] = []
+
+    def compute(element) -> float:
+        calls.append(element.x)
+        return element.x
+
+    loose = Mutable(1.0)
+    assert kept(loose, "_x", compute) == 1.0
+    loose.x = 2.0
+    assert kept(loose, "_x", compute) == 2.0 and calls == [1.0, 2.0]
+    body = dc.Body("b", mass=1.0, inertia=0.1)
+    calls.clear()
+    assert [kept(body, "_mass", lambda e: compute(Mutable(e.mass))) for _ in range(3)] == [1.0] * 3
+    assert calls == [1.0]
+    assert dataclasses.replace(body) == body and "_mass" not in dataclasses.replace(body).__dict__
