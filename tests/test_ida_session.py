@@ -650,6 +650,14 @@ def test_a_pooled_c_session_runs_step_for_step_as_a_new_one():
     dirty.close()
     pooled = open_session(model, **settings)
     assert pooled._hd is dirty._hd  # the same C session, reset
+    # the closed session's handle now serves another session: every entry point refuses
+    for call in (lambda: dirty.set_hints(jacobian_refresh=0.5), lambda: dirty.set_stall(1e-9, 5),
+                 lambda: dirty.active_terms(), lambda: dirty.advance(3.0), lambda: dirty.stats(),
+                 lambda: dirty.reinit(0.0, [1.0, 0.0], [0.0, -G], [False], [np.ones(1)]),
+                 lambda: dirty.report(np.zeros(1), np.zeros((1, 2)), np.zeros((1, 2))),
+                 lambda: dirty.residual(0.0, np.zeros(2), np.zeros(2))):
+        with pytest.raises(DaeclearError, match="closed"):
+            call()
     again = _bounce(pooled)
     assert again[:3] == (status, t, roots)
     np.testing.assert_array_equal(again[3], steps)

@@ -236,6 +236,7 @@ class CSession(SessionBase):
         from which IDA evaluates a new Jacobian (IDA default 0.25) and whether the run's first
         step is the second-order estimate of ida_driver.c's first_step (else IDA's own). Returns
         True (the compiled backend applies them)."""
+        self._check_open()
         if nonlin_conv_coef is not None and self._lib.dc_set_nonlin_conv_coef(self._h, nonlin_conv_coef) < 0:
             raise DaeclearError(f"nonlin_conv_coef={nonlin_conv_coef!r} rejected by IDA; must be > 0.")
         if jacobian_refresh is not None and self._lib.dc_set_jacobian_refresh(self._h, jacobian_refresh) < 0:
@@ -253,6 +254,7 @@ class CSession(SessionBase):
         :class:`daeclear.assembly.automaton.PairState` to start from (its history is not carried over).
         Each advance then returns the switches it made in ``Advance.auto_events``.
         """
+        self._check_open()
         np_ = len(pairs)
         if len(storms) != np_ or len(states) != np_:
             raise ValueError(f"set_auto_events: {np_} pairs, {len(storms)} storms, {len(states)} states")
@@ -280,6 +282,7 @@ class CSession(SessionBase):
     def set_layout(self, layout: StateLayout) -> bool:
         """The model's state layout and extras, so that C makes states consistent itself: restarts
         after the switches it decides (GGL: projected on the constraint manifold) and :meth:`report`."""
+        self._check_open()
         L = layout
         rc = self._lib.dc_set_layout(self._h, L.n_q, L.n_constraints, int(L.ggl), int(L.track_work), L.accel_extra,
                                      L.force_extra0, L.kinematics_extra, L.outputs_extra, int(L.project), L.tol,
@@ -292,6 +295,7 @@ class CSession(SessionBase):
     def report(self, t: np.ndarray, y: np.ndarray, switch: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The reported points made consistent in one C pass: (y with recomputed multipliers, yp,
         output channels), one row per time (see ``dc_report``); after :meth:`set_layout`."""
+        self._check_open()
         t = np.ascontiguousarray(t, dtype=float)
         y = np.ascontiguousarray(y, dtype=float)
         switch = np.ascontiguousarray(switch, dtype=float)
@@ -339,6 +343,7 @@ class CSession(SessionBase):
 
     def active_terms(self) -> tuple[list[bool], list[np.ndarray]]:
         """The active flags and parameters the C loop integrates with now."""
+        self._check_open()
         act = np.zeros(max(self._nt, 1), dtype=np.int32)
         par = np.zeros(max(sum(self._model.n_params), 1))
         self._lib.dc_get_active(self._h, act.ctypes.data, par.ctypes.data)

@@ -383,6 +383,7 @@ class SessionBase:
         step 100x larger in between) end an advance with DC_STEP_COLLAPSE. Both backends."""
         if not (stall_step >= 0.0) or count < 1:
             raise ValueError(f"set_stall: stall_step={stall_step!r} must be >= 0 and count={count!r} >= 1")
+        self._check_open()
         self._stall.stall_step, self._stall.count = float(stall_step), int(count)
         if self.backend == "c":
             self._lib.dc_set_stall(self._h, self._stall.stall_step, self._stall.count)
