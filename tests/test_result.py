@@ -315,6 +315,12 @@ def test_odd_parameter_values_are_kept_not_fatal(tmp_path: Path) -> None:
     assert load(result.save(tmp_path / "run.h5")).parameters == result.parameters
     with pytest.raises(TypeError, match=r"parameters\['scene'\]: key 1 is a int"):
         make_result(parameters={"scene": {1: "x"}})
+    # deeper: list indices and a dataclass's fields are named on the way down
+    with pytest.warns(DaeclearWarning, match=r"parameters\['a'\]\[1\]\['m'\]\['young'\]: a Law "):
+        nested = make_result(parameters={"a": [0.5, {"m": Material(Law(), 0.3)}]})
+    assert nested.parameters == {"a": [0.5, {"m": {"young": "Law(restitution=0.9)", "poisson": 0.3}}]}
+    with pytest.raises(TypeError, match=r"parameters\['a'\]\[0\]: key 2.0 is a float"):
+        make_result(parameters={"a": [{2.0: "x"}]})
 
 
 def test_numpy_values_in_parameters_become_plain() -> None:

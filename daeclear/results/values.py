@@ -53,7 +53,22 @@ def to_plain(value: Any, where: str) -> Any:
     lost to an odd parameter.
     Non-string dict keys raise TypeError.
     """
-    if type(value) in _PLAIN_LEAVES:  # the common case first: plain numbers and strings stay as they are
+    return _plain(value, (where,))
+
+
+# field names by dataclass type: the same few (Material, the contact laws) come back in every run
+_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
+
+
+def _location(path: tuple[Any, ...]) -> str:
+    """``where[key][index]...``: where a value sits in what to_plain was given (made only for a
+    message: a path of keys costs less than a text per container)."""
+    return str(path[0]) + "".join(f"[{key!r}]" for key in path[1:])
+
+
+def _plain(value: Any, path: tuple[Any, ...]) -> Any:
+    kind = type(value)
+    if kind in _PLAIN_LEAVES:  # the common case first: plain numbers and strings stay as they are
         return value
     if value is None or isinstance(value, (bool, str)):
         return value
@@ -61,35 +76,37 @@ def to_plain(value: Any, where: str) -> Any:
         return int(value)
     if isinstance(value, float):
         return float(value)
-    if type(value) is dict or isinstance(value, Mapping):
+    if kind is dict or isinstance(value, Mapping):
         out: dict[str, Any] = {}
         for key, item in value.items():
             if not isinstance(key, str):
-                raise TypeError(f"{where}: key {key!r} is a {type(key).__name__}, keys must be strings.")
-            out[key] = item if type(item) in _PLAIN_LEAVES else to_plain(item, f"{where}[{key!r}]")
+                raise TypeError(f"{_location(path)}: key {key!r} is a {type(key).__name__}, keys must be strings.")
+            out[key] = item if type(item) in _PLAIN_LEAVES else _plain(item, (*path, key))
         return out
     if isinstance(value, (list, tuple)):
-        return [item if type(item) in _PLAIN_LEAVES else to_plain(item, f"{where}[{i}]")
-                for i, item in enumerate(value)]
+        return [item if type(item) in _PLAIN_LEAVES else _plain(item, (*path, i)) for i, item in enumerate(value)]
     # after the containers: dicts and lists, the bulk of a scene, skip these (slower ABC) checks
     if isinstance(value, np.generic):
-        return to_plain(value.item(), where)
+        return _plain(value.item(), path)
     if isinstance(value, np.ndarray):
-        return to_plain(value.tolist(), where)
+        return _plain(value.tolist(), path)
     if isinstance(value, os.PathLike):
         return os.fspath(value)
     if is_dataclass(value) and not isinstance(value, type):
-        out = {f.name: to_plain(getattr(value, f.name), f"{where}[{f.name!r}]") for f in fields(value)}
-        kind = getattr(type(value), "name", None)  # a contact law's registered name, e.g. "hunt-crossley"
-        if isinstance(kind, str) and "name" not in out:
-            out = {"name": kind, **out}
+        names = _FIELD_NAMES.get(kind)
+        if names is None:
+            names = _FIELD_NAMES[kind] = tuple(f.name for f in fields(value))
+        out = {name: _plain(getattr(value, name), (*path, name)) for name in names}
+        label = getattr(kind, "name", None)  # a contact law's registered name, e.g. "hunt-crossley"
+        if isinstance(label, str) and "name" not in out:
+            out = {"name": label, **out}
         return out
     text = repr(value)
     warnings.warn(
-        f"{where}: a {type(value).__name__} is not a number, string, bool, None, list or dict; "
+        f"{_location(path)}: a {kind.__name__} is not a number, string, bool, None, list or dict; "
         f"stored as its repr {text[:60]!r}.",
         DaeclearWarning,
-        stacklevel=4,
+        stacklevel=5,
     )
     return text
 
