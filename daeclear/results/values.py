@@ -66,25 +66,37 @@ def _location(path: tuple[Any, ...]) -> str:
     return str(path[0]) + "".join(f"[{key!r}]" for key in path[1:])
 
 
+def _plain_dict(value: Mapping[Any, Any], path: tuple[Any, ...]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, item in value.items():
+        if type(key) is not str and not isinstance(key, str):
+            raise TypeError(f"{_location(path)}: key {key!r} is a {type(key).__name__}, keys must be strings.")
+        out[key] = item if type(item) in _PLAIN_LEAVES else _plain(item, (*path, key))
+    return out
+
+
+def _plain_list(value: list[Any] | tuple[Any, ...], path: tuple[Any, ...]) -> list[Any]:
+    return [item if type(item) in _PLAIN_LEAVES else _plain(item, (*path, i)) for i, item in enumerate(value)]
+
+
 def _plain(value: Any, path: tuple[Any, ...]) -> Any:
     kind = type(value)
-    if kind in _PLAIN_LEAVES:  # the common case first: plain numbers and strings stay as they are
+    if kind in _PLAIN_LEAVES:  # the common cases first: plain numbers and strings stay as they are,
         return value
-    if value is None or isinstance(value, (bool, str)):
+    if kind is dict:  # and plain dicts and lists, the bulk of a scene, are copied
+        return _plain_dict(value, path)
+    if kind is list:
+        return _plain_list(value, path)
+    if isinstance(value, (bool, str)):
         return value
     if isinstance(value, int):
         return int(value)
     if isinstance(value, float):
         return float(value)
-    if kind is dict or isinstance(value, Mapping):
-        out: dict[str, Any] = {}
-        for key, item in value.items():
-            if not isinstance(key, str):
-                raise TypeError(f"{_location(path)}: key {key!r} is a {type(key).__name__}, keys must be strings.")
-            out[key] = item if type(item) in _PLAIN_LEAVES else _plain(item, (*path, key))
-        return out
+    if isinstance(value, Mapping):
+        return _plain_dict(value, path)
     if isinstance(value, (list, tuple)):
-        return [item if type(item) in _PLAIN_LEAVES else _plain(item, (*path, i)) for i, item in enumerate(value)]
+        return _plain_list(value, path)
     # after the containers: dicts and lists, the bulk of a scene, skip these (slower ABC) checks
     if isinstance(value, np.generic):
         return _plain(value.item(), path)
