@@ -466,26 +466,31 @@ def test_the_work_state_carries_over_a_restart() -> None:
     assert np.ptp(balance) < 1e-6 * np.ptp(full["energy.mechanical"])
 
 
-def test_a_run_on_a_pooled_c_session_equals_a_run_on_a_new_one() -> None:
+@pytest.mark.parametrize("linear_solver", ["reduced", "dense", "sparse"])
+def test_a_run_on_a_pooled_c_session_equals_a_run_on_a_new_one(linear_solver: str) -> None:
     """simulate closes its compiled session into a pool, and the next run of the same structure
-    takes it (dc_reset): after a run with other numbers and settings that failed, a run equals the
-    same run on a newly opened session, step for step."""
+    and linear solver takes it (dc_reset): after a run with other numbers and settings that
+    failed, a run equals the same run on a newly opened session, step for step (the sparse LU
+    keeps its symbolic factorization, which depends on the pattern alone)."""
     from daeclear.engine import c_session
 
     def handles() -> list:
         return [h for pooled in c_session._POOL.values() for h in pooled]
 
     scene, t_end = slider_crank("revolute", clearance=1e-4), 0.004
-    settings = dict(t_end=t_end, t_eval=np.linspace(0.0, t_end, 41), rtol=1e-7, backend="c")
+    settings = dict(t_end=t_end, t_eval=np.linspace(0.0, t_end, 41), rtol=1e-7, backend="c",
+                    linear_solver=linear_solver)
     c_session._POOL.clear()
     fresh = dc.simulate(scene, **settings)
     c_session._POOL.clear()  # the next run opens its own session
     failed = dc.simulate(slider_crank("revolute", clearance=3e-4, restitution=0.5), t_end=t_end, rtol=1e-5,
-                         max_step=1e-6, max_steps=300, backend="c", on_failure="return")
+                         max_step=1e-6, max_steps=300, backend="c", on_failure="return",
+                         linear_solver=linear_solver)
     assert not failed.success and "max_steps" in failed.message
     (handle,) = handles()
     again = dc.simulate(scene, **settings)
     assert handles() == [handle]  # taken and given back
+    assert again.stats["linear_solver"] == fresh.stats["linear_solver"] == linear_solver
     assert len(fresh.events) >= 4
     assert [(e.t, e.kind) for e in again.events] == [(e.t, e.kind) for e in fresh.events]
     np.testing.assert_array_equal(again.step_t, fresh.step_t)
