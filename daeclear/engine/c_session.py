@@ -4,8 +4,10 @@ The model is generated as C with CasADi, compiled with the hand-written IDA driv
 (``csrc/ida_driver.c``) into a shared library linked against the SUNDIALS libraries of the
 scikit-sundae wheel (:mod:`daeclear.engine.codegen`), loaded by :mod:`daeclear.engine.library` and
 driven here through ctypes a few calls per segment. No Python runs per step or per model
-evaluation. Separate from the python backend (:mod:`daeclear.engine.python_session`), which has the
-same interface (:class:`daeclear.engine.session_base.Session`) but nothing else in common.
+evaluation. A closed session's C session goes to a small pool, and the next session of the same
+library takes it reset (``dc_reset``) instead of opening another (see :class:`_Handle`).
+Separate from the python backend (:mod:`daeclear.engine.python_session`), which has the same
+interface (:class:`daeclear.engine.session_base.Session`) but nothing else in common.
 
 Linear solver (``linear_solver``): IDA's Newton iteration solves with the iteration matrix
 dF/dy + cj dF/dy' by dense LU of the system left after eliminating the position rows
@@ -195,11 +197,9 @@ class CSession(SessionBase):
         self._lib = clib.lib
         self._build = build
         self._linear_solver = _resolve_linear_solver(opts.linear_solver, n, clib.build_info.has_sparse)
-        self._pool_key = (id(self._lib), self._linear_solver, opts.max_order, opts.buffer_steps)
-        hd = _take_pooled(self._pool_key, opts)
+        hd = _take_pooled(self._pool_key(), opts)
         if hd is None:
-            hd = self._open(opts, n, nr)
-            self._pool_key = (id(self._lib), self._linear_solver, opts.max_order, opts.buffer_steps)
+            hd = self._open(opts, n, nr)  # "auto" may fall back from the sparse LU to the reduced one
         self._hd = hd
         self._h, self._jac_nnz, self._cap, self._cap_times = hd.h, hd.jac_nnz, hd.cap, hd.cap_times
         self._st, self._sy, self._syp, self._sh, self._sord = hd.st, hd.sy, hd.syp, hd.sh, hd.sord
@@ -209,6 +209,10 @@ class CSession(SessionBase):
         self._addr = hd.addr
         self._extra_meta: dict[int, tuple[Any, ...]] = {}
         self._poff = np.concatenate([[0], np.cumsum(model.n_params)]).astype(int).tolist()
+
+    def _pool_key(self) -> tuple[int, str, int, int]:
+        """What a pooled handle must share with this session: library, linear solver, max_order, buffer_steps."""
+        return id(self._lib), self._linear_solver, self._opts.max_order, self._opts.buffer_steps
 
     def _open(self, opts: SessionOptions, n: int, nr: int) -> _Handle:
         """A new C session (dc_open) with its buffers; the sparse solver falls back to the reduced
@@ -611,4 +615,4 @@ class CSession(SessionBase):
         session takes it with dc_reset instead of dc_open) or, the pool full, is freed."""
         if not self._closed:
             self._closed = True
-            _put_pooled(self._pool_key, self._hd)
+            _put_pooled(self._pool_key(), self._hd)
