@@ -648,6 +648,7 @@ def test_a_pooled_c_session_runs_step_for_step_as_a_new_one():
     dirty.set_stall(1e-2, 3)
     assert _bounce(dirty)[0] == "error"  # the step cap, inside the flight
     dirty.close()
+    assert dirty._hd.sy is None and dirty._hd.addr["sy"] is None  # pooled without the steps' state buffers
     pooled = open_session(model, **settings)
     assert pooled._hd is dirty._hd  # the same C session, reset
     # the closed session's handle now serves another session: every entry point refuses

@@ -150,7 +150,7 @@ class _Handle:
 #: closed sessions' handles by (library, linear solver, max_order, buffer_steps): at most
 #: POOL_PER_KEY each (threads running the same model at once), for the POOL_KEYS newest keys
 POOL_PER_KEY = 2
-POOL_KEYS = 8
+POOL_KEYS = 4
 _POOL: dict[tuple[int, str, int, int], list[_Handle]] = memo_table()
 
 
@@ -170,7 +170,10 @@ def _take_pooled(key: tuple[int, str, int, int], opts: SessionOptions) -> _Handl
 
 
 def _put_pooled(key: tuple[int, str, int, int], hd: _Handle) -> None:
-    """Keep a closed session's handle for the next session (or drop it: freed when collected)."""
+    """Keep a closed session's handle for the next session (or drop it: freed when collected),
+    without the steps' state buffers (2 x buffer_steps x n values: the next run that stores
+    states makes its own), so that the pool holds little more than IDA's memory."""
+    hd.sy = hd.syp = hd.addr["sy"] = hd.addr["syp"] = None
     handles = _POOL.get(key)
     if handles is None:
         handles = []
