@@ -11,8 +11,8 @@ Columns: whole-call wall time, the IDA loop in C (``stats["solve_time"]``), and 
 the set-up (assembly, initial state, session) and the rest (event recording, report pass, Result).
 Target: about 1 ms above the IDA loop for a scene seen before or differing only in numbers.
 ``--parts`` then times the pieces of that overhead one by one in a quiet loop (best of --repeats,
-each call repeated 50 times): inside a sweep, right after an IDA loop, the same calls take longer
-(cold caches), so the pieces add up to less than the column "above it".
+each call repeated 50 times): inside a run the same calls take longer (the run's other pieces
+evict their code and data from the caches), so the pieces add up to less than the column "above it".
 
     python benchmarks/bench_overhead.py [--repeats 20] [--parts]
 """
