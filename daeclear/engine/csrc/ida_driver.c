@@ -873,6 +873,33 @@ static long ida_max_steps(long long max_steps) {
   return 0 < max_steps && max_steps < 2000000000LL ? (long)max_steps : 2000000000L;
 }
 
+/* Every field a run changes, at its value before the run's first dc_reinit: what dc_open leaves
+ * and dc_reset restores (one list for both). The arrays are allocated. */
+static void clear_run_state(dc_session* s) {
+  int np = 0;
+  for (int k = 0; k < s->n_terms; ++k) {
+    s->active[k] = 0;
+    np += dc_model.n_params[k];
+  }
+  if (np > 0) memset(s->params, 0, sizeof(double) * (size_t)np);
+  for (int i = 0; i < s->n_roots; ++i) s->rootdir[i] = s->rootsfound[i] = 0;
+  memset(s->base, 0, sizeof s->base);
+  s->t_now = s->t_rec = 0.0;
+  s->carry = s->carry_flag = s->carry_order = 0;
+  s->carry_lo = s->carry_t_prev = s->carry_h = 0.0;
+  s->carry_nst = s->carry_nst_prev = 0;
+  s->ready = 0;
+  s->tiny = 0;
+  s->h_prev = 0.0;
+  s->stall_step = 0.0;
+  s->stall_count = DC_TINY_MAX;
+  s->first_step_on = 0;
+  s->n_auto = 0; /* dc_set_auto and dc_set_layout (re)allocate what they configure */
+  s->ev_n = 0;
+  s->lay_ready = 0;
+  s->proj_on = 0;
+}
+
 /* Open a session: IDA memory, linear solver (DC_LS_DENSE: dense LU; DC_LS_SPARSE: SuperLU_MT on
  * the union pattern, one thread), tolerances, options and root functions.
  * IDAInit is called here with a zero state; dc_reinit then (re)starts with IDAReInit.
@@ -947,7 +974,6 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
       np += M->n_params[k];
     }
     s->params = (double*)xcalloc((size_t)np, sizeof(double));
-    s->stall_count = DC_TINY_MAX;
   s->rootdir_default = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
     s->rootdir = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
     s->rootsfound = (int*)xcalloc((size_t)M->n_roots, sizeof(int));
@@ -960,6 +986,7 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
     if (!s->params || !s->rootdir_default || !s->rootdir || !s->rootsfound || !s->tmp_r ||
         !s->tmp_J || !s->P)
       FAIL("out of memory");
+    clear_run_state(s);
     if (M->n_parameters > 0) {
       if (!P) FAIL("the model has %d run-time parameters and none were given", M->n_parameters);
       memcpy(s->P, P, sizeof(double) * (size_t)M->n_parameters);
@@ -1056,8 +1083,7 @@ DC_API int dc_reset(void* sp, double rtol, const double* atol, double max_step, 
                     const int* rootdir, const double* P) {
   dc_session* s = (dc_session*)sp;
   const dc_model_t* M = &dc_model;
-  int np = 0, flag;
-  for (int k = 0; k < s->n_terms; ++k) np += M->n_params[k];
+  int flag;
   s->msg[0] = s->cb_msg[0] = s->ida_msg[0] = 0;
   if (M->n_parameters > 0) {
     if (!P) {
@@ -1069,27 +1095,8 @@ DC_API int dc_reset(void* sp, double rtol, const double* atol, double max_step, 
   s->rtol = rtol;
   s->max_step = max_step;
   s->max_steps = max_steps;
-  for (int i = 0; i < s->n_roots; ++i) {
-    s->rootdir_default[i] = rootdir ? rootdir[i] : 0;
-    s->rootdir[i] = s->rootsfound[i] = 0;
-  }
-  for (int k = 0; k < s->n_terms; ++k) s->active[k] = 0;
-  if (np > 0) memset(s->params, 0, sizeof(double) * (size_t)np);
-  memset(s->base, 0, sizeof s->base);
-  s->t_now = s->t_rec = 0.0;
-  s->carry = s->carry_flag = s->carry_order = 0;
-  s->carry_lo = s->carry_t_prev = s->carry_h = 0.0;
-  s->carry_nst = s->carry_nst_prev = 0;
-  s->ready = 0;
-  s->tiny = 0;
-  s->h_prev = 0.0;
-  s->stall_step = 0.0;
-  s->stall_count = DC_TINY_MAX;
-  s->first_step_on = 0;
-  s->n_auto = 0; /* dc_set_auto and dc_set_layout (re)allocate what they configure */
-  s->ev_n = 0;
-  s->lay_ready = 0;
-  s->proj_on = 0;
+  for (int i = 0; i < s->n_roots; ++i) s->rootdir_default[i] = rootdir ? rootdir[i] : 0;
+  clear_run_state(s);
   memcpy(N_VGetArrayPointer(s->atol), atol, sizeof(double) * (size_t)s->n);
   flag = IDASVtolerances(s->ida, rtol, s->atol);
   if (flag >= 0) flag = IDASetMaxStep(s->ida, max_step);
