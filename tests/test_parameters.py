@@ -509,3 +509,83 @@ def test_values_are_kept_on_frozen_elements_only():
     assert [kept(body, "_mass", lambda e: compute(Mutable(e.mass))) for _ in range(3)] == [1.0] * 3
     assert calls == [1.0]
     assert dataclasses.replace(body) == body and "_mass" not in dataclasses.replace(body).__dict__
+
+
+def test_values_kept_with_other_objects_follow_those_objects():
+    """elements.kept_with reuses a value while the element is given the very same (frozen) objects,
+    and computes it anew for other objects, equal or not, or for a mutable element or input."""
+    from daeclear.model.elements import kept_with
+
+    @dataclasses.dataclass
+    class Mutable:
+        x: float
+
+    joint = dc.Revolute("A", "b", "ground", at=(0.0, 0.0))
+    b1, b2 = dc.Body("b", mass=1.0, inertia=0.1), dc.Body("b", mass=1.0, inertia=0.1)
+    calls: list[str] = []
+
+    def compute(tag: str) -> str:
+        calls.append(tag)
+        return tag
+
+    assert kept_with(joint, "_v", (b1,), lambda _: compute("first")) == "first"
+    assert kept_with(joint, "_v", (b1,), lambda _: compute("again")) == "first"
+    assert kept_with(joint, "_v", (b2,), lambda _: compute("equal, not the same")) == "equal, not the same"
+    assert kept_with(joint, "_v", (b2, b1), lambda _: compute("more")) == "more"
+    loose = Mutable(1.0)
+    assert kept_with(joint, "_w", (loose,), lambda _: compute("mutable input")) == "mutable input"
+    assert kept_with(joint, "_w", (loose,), lambda _: compute("mutable input again")) == "mutable input again"
+    assert kept_with(loose, "_v", (b1,), lambda _: compute("mutable element")) == "mutable element"
+    assert "_v" not in vars(loose)
+    assert calls == ["first", "equal, not the same", "more", "mutable input", "mutable input again",
+                     "mutable element"]
+
+
+def test_kept_parameter_entries_follow_the_bodies_they_were_read_from():
+    """A joint given by a world point has body-fixed points that depend on where its bodies are
+    declared: a scene that shares the joint but moves a body gets the points of its own bodies (the
+    values kept on the joint are the first scene's), equal to those of a scene of new objects."""
+    from daeclear.assembly.assemble import scene_parameters
+
+    def scene(x_link: float, joint: dc.Revolute | None = None) -> dc.Scene:
+        link = dc.Body("link", mass=1.0, inertia=0.01, position=(x_link, 0.0))
+        pin = joint or dc.Revolute("A", "ground", "link", at=(0.0, 0.0))
+        return dc.Scene("pendulum", elements=[link, pin])
+
+    first = scene(0.5)
+    pin = first["A"]
+    table, key, _ = scene_parameters(first, "ggl", 5.0, 5.0, False)
+    np.testing.assert_array_equal(table.value("A.s_j"), [-0.5, 0.0])
+    moved, key2, _ = scene_parameters(scene(0.3, pin), "ggl", 5.0, 5.0, False)
+    np.testing.assert_array_equal(moved.value("A.s_j"), [-0.3, 0.0])
+    fresh, key3, _ = scene_parameters(scene(0.3), "ggl", 5.0, 5.0, False)
+    np.testing.assert_array_equal(moved.vector, fresh.vector)
+    assert key == key2 == key3  # numbers only
+    again, _, _ = scene_parameters(first, "ggl", 5.0, 5.0, False)
+    np.testing.assert_array_equal(again.vector, table.vector)
+
+
+def test_a_models_scene_description_is_the_scene_as_it_was_assembled():
+    """model.parameters["scene"] equals Scene.to_dict() at assembly, whatever happens to the scene
+    later (it is made at its first read from the elements the scene had); with a mutable element it
+    is made at once, so a later change of that element does not show either."""
+    scene = dc.mechanisms.slider_crank("revolute", clearance=1e-4)
+    expected = scene.to_dict()
+    model = dc.assemble(scene)
+    scene.name = "renamed"
+    scene.elements[0] = dataclasses.replace(scene.elements[0], mass=9.0)
+    described = model.parameters["scene"]
+    assert described == expected and dict(described) == expected
+    assert described["elements"]["crank"]["mass"] != 9.0
+
+    from daeclear.model.elements import Element
+
+    @dataclasses.dataclass
+    class Marker(Element):  # a mutable element (of a user's own)
+        name: str
+        value: float
+
+    loose = dc.Scene("loose", elements=[Marker("m", 1.0), dc.Body("link", mass=1.0, inertia=0.01)])
+    description = loose.description()
+    loose.elements[0].value = 2.0
+    assert description["elements"]["m"] == {"kind": "Marker", "name": "m", "value": 1.0}

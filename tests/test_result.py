@@ -15,6 +15,7 @@ import pytest
 
 from daeclear.errors import DaeclearError, DaeclearWarning, MissingDependencyError
 from daeclear.results.result import FORMAT_NAME, FORMAT_VERSION, ContactEvent, EventList, Result, load
+from daeclear.results.values import to_plain
 
 STATE_NAMES = ["crank.x", "crank.vx", "slider.x", "slider.vx", "lambda.A.x"]
 
@@ -655,3 +656,29 @@ def test_a_run_result_is_what_the_checked_constructor_makes() -> None:
     assert list(checked.events) == list(run.events) and checked.segments == run.segments
     assert all(type(a) is float and type(b) is float for a, b, _ in run.segments)
     assert checked.stats == run.stats and checked.parameters == run.parameters
+
+
+def test_a_run_results_parameters_are_its_own_plain_copy() -> None:
+    """A solver's Result makes its parameters at their first read: plain data (dicts, lists, numbers,
+    strings) equal to the scene's description and the run's options, and its own copy (changing it
+    changes no other result of the same model)."""
+    import daeclear as dc
+
+    scene = dc.mechanisms.slider_crank("revolute", clearance=0.2e-3)
+    model = dc.assemble(scene)
+    first, second = (dc.simulate(model, 1e-3, rtol=1e-6) for _ in range(2))
+
+    def plain(value: object) -> bool:
+        if isinstance(value, dict):
+            return type(value) is dict and all(type(k) is str and plain(v) for k, v in value.items())
+        if isinstance(value, list):
+            return type(value) is list and all(plain(v) for v in value)
+        return value is None or type(value) in (bool, int, float, str)
+
+    assert plain(first.parameters)
+    assert first.parameters["scene"] == json.loads(json.dumps(to_plain(scene.to_dict(), "scene")))
+    assert first.parameters["simulate"]["rtol"] == 1e-6 and first.parameters["formulation"] == "ggl"
+    first.parameters["scene"]["elements"]["clearance"]["clearance"] = 1.0
+    assert second.parameters["scene"]["elements"]["clearance"]["clearance"] == 0.2e-3
+    assert model.parameters["scene"]["elements"]["clearance"]["clearance"] == 0.2e-3
+    assert second.parameters is second.parameters  # copied once

@@ -34,7 +34,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import casadi as ca
 import numpy as np
@@ -42,9 +42,10 @@ from numpy.typing import NDArray
 
 from ..engine.build import memo_put_bounded, memo_table
 from ..errors import AssemblyError, SceneError
+from ..model.elements import kept_with
 from ..engine.session_base import DAEFunctions
 from ..options import DEFAULT_FORMULATION, FORMULATIONS
-from .parameters import ParameterTable, structure_key
+from .parameters import ParameterTable, entries, structure_key
 from ..model.scene import (GROUND, Body, Driver, Revolute, RevoluteClearance, Scene, Translational,
                            TranslationalClearance)
 from .revolute_joint import CONTACT_BUILDERS
@@ -88,39 +89,53 @@ def _translational(ctx: AssemblyContext, joint: Translational) -> tuple[list[Any
 
 
 def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
-                     track_work: bool) -> tuple[ParameterTable, str, dict[str, Any]]:
+                     track_work: bool) -> tuple[ParameterTable, str, Mapping[str, Any]]:
     """The scene's numbers as run-time parameters, the key of its structure and the scene's
-    plain-data description (``Scene.to_dict``, for the model's parameters).
+    plain-data description (``Scene.description``, for the model's parameters).
 
     Pure Python (no CasADi): this is all that a scene of a known structure costs to assemble.
+    Each element's entries are kept on it with the bodies (and a driver's joint) they were read
+    from, so the elements a sweep's scenes share are converted once.
     """
-    ref = Reference(scene.bodies, GROUND)
+    bodies = tuple(scene.bodies)
+    ref = Reference(bodies, GROUND)
     table = ParameterTable()
     if formulation == "index1":
         table.add("baumgarte.alpha", alpha)
         table.add("baumgarte.beta", beta)
     table.add("gravity", scene.gravity)
-    structure: list[Any] = [formulation, bool(track_work), _ENGINE_VERSION]
+    structure: list[Any] = [formulation, bool(track_work), _ENGINE_VERSION, table.layout]
     joints = {j.name: j for j in scene.joints}
     for element in scene.elements:
-        if isinstance(element, Body):
-            table.update(element.name, {"mass": element.mass, "inertia": element.inertia})
-        elif isinstance(element, Revolute):
-            table.update(element.name, _revolute_parameters(ref, element))
-        elif isinstance(element, Translational):
-            table.update(element.name, _translational_parameters(ref, element))
-        elif isinstance(element, Driver):
-            table.update(element.name, driver_parameters(ref, element, joints[element.joint]))
-        elif isinstance(element, Load):
-            table.update(element.name, load_parameters(ref, element))
-        elif type(element) in CONTACT_BUILDERS:
-            values, flags = CONTACT_BUILDERS[type(element)][0](ref, element)
-            table.update(element.name, values)
-            structure.append([element.name, flags])
-        else:
-            raise AssemblyError(f"{element.kind} '{element.name}': element type not supported by assemble().")
-    structure.append(table.layout)
-    return table, structure_key(scene.elements, structure), scene.to_dict()
+        inputs = (*bodies, joints[element.joint]) if isinstance(element, Driver) else bodies
+        named, shape = kept_with(element, "_parameter_entries", inputs,
+                                 lambda e: _element_parameters(ref, e, joints))
+        table.extend(named)
+        structure.append(shape)
+    return table, structure_key(scene.elements, structure), scene.description()
+
+
+def _element_parameters(ref: Reference, element: Any, joints: dict[str, Any]
+                        ) -> tuple[tuple[tuple[str, tuple[float, ...]], ...], str]:
+    """One element's parameter entries, and as text what of them is structure: the entries' names
+    and sizes and, for a clearance joint, its structural flags (see :func:`law_structure`)."""
+    flags = None
+    if isinstance(element, Body):
+        values = {"mass": element.mass, "inertia": element.inertia}
+    elif isinstance(element, Revolute):
+        values = _revolute_parameters(ref, element)
+    elif isinstance(element, Translational):
+        values = _translational_parameters(ref, element)
+    elif isinstance(element, Driver):
+        values = driver_parameters(ref, element, joints[element.joint])
+    elif isinstance(element, Load):
+        values = load_parameters(ref, element)
+    elif type(element) in CONTACT_BUILDERS:
+        values, flags = CONTACT_BUILDERS[type(element)][0](ref, element)
+    else:
+        raise AssemblyError(f"{element.kind} '{element.name}': element type not supported by assemble().")
+    named = entries(element.name, values)
+    return named, repr([element.name, flags, [(name, len(value)) for name, value in named]])
 
 
 @dataclass(frozen=True)
@@ -134,7 +149,7 @@ class _Template:
     # (root, term, gap-rate extra, needs approach speed, index of the contact logic) of simple pairs
     auto_pairs: tuple[tuple[int, int, int, bool, int], ...]
 
-    def bind(self, scene: Scene, table: ParameterTable, described: dict[str, Any], alpha: float,
+    def bind(self, scene: Scene, table: ParameterTable, described: Mapping[str, Any], alpha: float,
              beta: float) -> DAEModel:
         if table.layout != self.layout:  # a structure key collision would land here
             raise AssemblyError(f"scene '{scene.name}': its parameters do not match the cached structure.")

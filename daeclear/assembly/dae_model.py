@@ -68,6 +68,7 @@ class DAEModel:
     mass_diagonal: NDArray[np.float64]
     kinematics: ca.Function  # (q, v, t) -> (Phi, Phi_q, Phi_dot, gamma)
     base_force: ca.Function  # (t, q, v) -> Q (gravity and applied loads)
+    # the scene's description ("scene": a read-only mapping made at its first read) and the options
     parameters: dict[str, Any] = field(default_factory=dict)
     contacts: tuple[Any, ...] = ()  # contact elements' event logic (clearance joints)
     track_work: bool = False

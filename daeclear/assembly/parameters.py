@@ -34,8 +34,8 @@ from numpy.typing import NDArray
 
 from ..model.elements import kept
 
-__all__ = ["ParameterTable", "structure_key", "element_structure", "law_values", "symbolic_law", "law_structure",
-           "is_parametric"]
+__all__ = ["ParameterTable", "entries", "floats", "structure_key", "element_structure", "law_values", "symbolic_law",
+           "law_structure", "is_parametric"]
 
 
 class ParameterTable:
@@ -47,22 +47,22 @@ class ParameterTable:
 
     def __init__(self) -> None:
         # plain floats (one array at the end): a scene's table is made at every assembly
-        self._values: dict[str, list[float]] = {}
+        self._values: dict[str, tuple[float, ...]] = {}
 
     def add(self, name: str, value: Any) -> None:
         """Add one entry; ``value`` is a number or a sequence of numbers."""
-        if name in self._values:
-            raise KeyError(f"parameter {name!r} added twice")
-        kind = type(value)
-        if kind is float or kind is int:
-            self._values[name] = [float(value)]
-        else:
-            self._values[name] = np.asarray(value, dtype=float).ravel().tolist()
+        self.extend(((name, floats(value)),))
 
     def update(self, prefix: str, values: dict[str, Any]) -> None:
         """Add every ``values`` entry under ``prefix.<key>``."""
-        for key, value in values.items():
-            self.add(f"{prefix}.{key}", value)
+        self.extend(entries(prefix, values))
+
+    def extend(self, named: Iterable[tuple[str, tuple[float, ...]]]) -> None:
+        """Add entries made by :func:`entries` (kept entries of a shared element are added as they are)."""
+        for name, value in named:
+            if name in self._values:
+                raise KeyError(f"parameter {name!r} added twice")
+            self._values[name] = value
 
     @property
     def layout(self) -> tuple[tuple[str, int], ...]:
@@ -92,6 +92,19 @@ class ParameterTable:
         return out
 
 
+def floats(value: Any) -> tuple[float, ...]:
+    """A parameter entry's values: a number or a sequence of numbers as a tuple of floats."""
+    kind = type(value)
+    if kind is float or kind is int:
+        return (float(value),)
+    return tuple(np.asarray(value, dtype=float).ravel().tolist())
+
+
+def entries(prefix: str, values: dict[str, Any]) -> tuple[tuple[str, tuple[float, ...]], ...]:
+    """``values`` as parameter entries named ``prefix.<key>`` (see :meth:`ParameterTable.extend`)."""
+    return tuple((f"{prefix}.{key}", floats(value)) for key, value in values.items())
+
+
 # ---- structure -------------------------------------------------------------------------
 
 def _mask(value: Any) -> Any:
@@ -113,9 +126,13 @@ def _mask(value: Any) -> Any:
         return {str(k): _mask(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [_mask(v) for v in value]
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return [type(value).__name__, {f.name: _mask(getattr(value, f.name)) for f in dataclasses.fields(value)}]
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):  # a law or a material: kept on it
+        return kept(value, "_masked", _mask_fields)
     return repr(value)
+
+
+def _mask_fields(value: Any) -> list[Any]:
+    return [type(value).__name__, {f.name: _mask(getattr(value, f.name)) for f in dataclasses.fields(value)}]
 
 
 def element_structure(element: Any) -> str:
@@ -244,5 +261,5 @@ def _law_structure(law: Any) -> list[Any]:
     exponent = getattr(law, "effective_exponent", None)
     if exponent is not None:
         flags.append(("linear", exponent == 1.0))
-    flags.append(_mask(dataclasses.asdict(law)) if is_parametric(law) else repr(law))
+    flags.append(_mask(law) if is_parametric(law) else repr(law))
     return flags

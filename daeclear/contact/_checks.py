@@ -17,9 +17,12 @@ def check_number(owner: str, field: str, value: Any, *, low: float = -math.inf, 
     bounds are always open, so ``nan`` and ``inf`` are rejected.
     Example message: ``LankaraniNikravesh: restitution=1.2, must be in (0, 1].``
     """
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    if type(value) is float:  # the common case first: numbers.Real is an abstract class, slow to test
+        x = value
+    elif isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise SceneError(f"{owner}: {field}={value!r} is not a real number.")
-    x = float(value)
+    else:
+        x = float(value)
     suffix = f" {unit}" if unit else ""
     if math.isnan(x):
         raise SceneError(f"{owner}: {field}=nan{suffix}, must be a number.")

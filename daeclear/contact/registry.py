@@ -25,6 +25,8 @@ _NORMAL_ALIASES = {"ln": "lankarani-nikravesh", "esdu": "esdu-78035", "kv": "kel
 
 #: Friction laws by registry name.
 FRICTION_LAWS: dict[str, type[FrictionLaw]] = {cls.name: cls for cls in (NoFriction, Coulomb, ModifiedCoulomb)}
+# what ``friction=None`` means, one frozen law shared by every frictionless joint (its kept values with it)
+_NO_FRICTION = NoFriction()
 _FRICTION_ALIASES = {"ambrosio": "modified-coulomb", "frictionless": "none"}
 
 
@@ -124,7 +126,7 @@ def friction_law(name_or_coefficient: str | float | FrictionLaw | None, **params
             raise SceneError(f"friction_law: parameters {sorted(params)} given with a law instance.")
         return name_or_coefficient
     if name_or_coefficient is None:
-        return _build(NoFriction, params)
+        return _build(NoFriction, params) if params else _NO_FRICTION
     if isinstance(name_or_coefficient, numbers.Real) and not isinstance(name_or_coefficient, bool):
         return _build(ModifiedCoulomb, {"coefficient": float(name_or_coefficient), **params})
     return _build(_lookup("friction_law", name_or_coefficient, FRICTION_LAWS, _FRICTION_ALIASES), params)

@@ -468,8 +468,8 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
         raise SceneError(f"{label}: it is a {kind}; only an ideal Revolute or Translational joint can get a "
                          "clearance.")
     cls, required = _CLEARANCE_OF[type(joint)]
-    shared = {f.name for f in fields(type(joint))}
-    allowed = [f.name for f in fields(cls) if f.name not in shared]
+    shared = _field_names(type(joint))
+    allowed = [name for name in _field_names(cls) if name not in shared]
     unknown = sorted(set(fields_) - set(allowed))
     if unknown:
         hints = [f"{key} (shared with the ideal joint)" if key in shared else key for key in unknown]
@@ -478,7 +478,7 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
     missing = [" or ".join(group) for group in required if all(fields_.get(k) is None for k in group)]
     if missing:
         raise SceneError(f"{label}: missing {', '.join(missing)} (m), needed by a {cls.__name__}.")
-    shared_values = {f.name: getattr(joint, f.name) for f in fields(type(joint))}
+    shared_values = {name: getattr(joint, name) for name in shared}
     if bearing is not None:
         if cls is not RevoluteClearance:
             raise SceneError(f"{label}: bearing={bearing!r} applies to a revolute joint only; a translational "
@@ -496,6 +496,17 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
     if problems:
         raise SceneError(f"{label}: " + " ".join(problems))
     return element
+
+
+def _field_names(cls: type) -> tuple[str, ...]:
+    """The field names of a dataclass, in order (kept: a sweep makes a clearance joint per point)."""
+    names = _FIELD_NAMES.get(cls)
+    if names is None:
+        names = _FIELD_NAMES[cls] = tuple(f.name for f in fields(cls))
+    return names
+
+
+_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
 
 
 def ideal_joint(joint: Joint) -> Joint:

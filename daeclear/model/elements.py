@@ -36,8 +36,7 @@ def kept(element: Any, slot: str, compute: Callable[[Any], Any]) -> Any:
     (the value then follows from its fields alone: not a field, so equality, ``to_dict`` and
     ``dataclasses.replace`` ignore it; scenes that share the element share it); computed anew on
     any other element. A call that raises keeps nothing."""
-    params = getattr(type(element), "__dataclass_params__", None)
-    if params is None or not params.frozen:
+    if not is_frozen(element):
         return compute(element)
     try:
         return element.__dict__[slot]
@@ -45,6 +44,27 @@ def kept(element: Any, slot: str, compute: Callable[[Any], Any]) -> Any:
         value = compute(element)
         object.__setattr__(element, slot, value)
         return value
+
+
+def kept_with(element: Any, slot: str, inputs: tuple[Any, ...], compute: Callable[[Any], Any]) -> Any:
+    """``compute(element)``, a value that follows from a frozen element's fields and from other frozen
+    objects it reads (``inputs``, e.g. the scene's bodies): kept on the element with those objects
+    and reused while it is given the very same ones (the scenes of a sweep share their bodies);
+    computed anew when any of them differs or is not a frozen dataclass."""
+    held = getattr(element, "__dict__", {}).get(slot)  # kept only on frozen objects (below)
+    if held is not None and len(held[0]) == len(inputs) and all(a is b for a, b in zip(held[0], inputs)):
+        return held[1]
+    if not (is_frozen(element) and all(is_frozen(x) for x in inputs)):
+        return compute(element)
+    value = compute(element)
+    object.__setattr__(element, slot, (inputs, value))
+    return value
+
+
+def is_frozen(value: Any) -> bool:
+    """True for an instance of a frozen dataclass (its fields cannot change)."""
+    params = getattr(type(value), "__dataclass_params__", None)
+    return params is not None and params.frozen
 
 
 def computed_once(method: Callable[[Any], Any]) -> Callable[[Any], Any]:

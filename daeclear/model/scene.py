@@ -14,14 +14,15 @@ from __future__ import annotations
 import difflib
 from dataclasses import dataclass, field
 from typing import Any
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator, Mapping
 
 from ..errors import SceneError
 # the elements, re-exported: ``from daeclear.model.scene import Body`` keeps working
 from .clearance_joints import (SLIDER_MODELS, RevoluteClearance, TranslationalClearance,  # noqa: F401
                                clearance_joint, driven_coordinate, ideal_joint)
 from .elements import (GROUND, Body, Driver, Element, Ground, Joint, PointJoint, Revolute,  # noqa: F401
-                       Translational, Vector2, as_vector2, body_name, is_finite_number, own_problems)
+                       Translational, Vector2, as_vector2, body_name, is_finite_number, is_frozen,
+                       own_problems)
 from .profiles import PROFILES, ConstantSpeed, Profile  # noqa: F401  (re-exported, as before the split)
 
 
@@ -186,11 +187,47 @@ class Scene:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-data description of the scene (for result files)."""
-        return {
-            "name": self.name,
-            "gravity": list(self.gravity),
-            "elements": {e.name: e.to_dict() for e in self.elements},
-        }
+        return _describe(self.name, self.gravity, self.elements)
+
+    def description(self) -> Mapping[str, Any]:
+        """:meth:`to_dict` as a read-only mapping made at its first read (:class:`SceneDescription`):
+        what a model and its runs' results carry, which a sweep's runs seldom read."""
+        return SceneDescription(self)
+
+
+def _describe(name: str, gravity: Any, elements: Iterable[Element]) -> dict[str, Any]:
+    return {"name": name, "gravity": list(gravity), "elements": {e.name: e.to_dict() for e in elements}}
+
+
+class SceneDescription(Mapping[str, Any]):
+    """A scene's :meth:`Scene.to_dict`, made at the first read. It holds the scene's name, gravity
+    and elements as they are now (frozen elements cannot change; with any other element the
+    description is made at once), so a later change of the scene does not show in it."""
+
+    def __init__(self, scene: Scene) -> None:
+        self._parts: tuple[str, tuple[float, ...], tuple[Element, ...]] | None = (
+            scene.name, tuple(scene.gravity), tuple(scene.elements))
+        self._value: dict[str, Any] | None = None
+        if not all(is_frozen(e) for e in scene.elements):
+            self._described()
+
+    def _described(self) -> dict[str, Any]:
+        if self._value is None:
+            assert self._parts is not None
+            self._value, self._parts = _describe(*self._parts), None
+        return self._value
+
+    def __getitem__(self, key: str) -> Any:
+        return self._described()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._described())
+
+    def __len__(self) -> int:
+        return len(self._described())
+
+    def __repr__(self) -> str:
+        return repr(self._described())
 
 
 def with_clearance(scene: Scene, joint: str, *, bearing: str | None = None, name: str | None = None,

@@ -221,8 +221,8 @@ class Result:
         if bool(success) != (status >= 0):
             raise ValueError(f"Result: success={success} contradicts status={status} (only status -1 is a failure).")
         self._assign(t_arr, y_arr, yp_arr, names, chans, units, event_list, segs, steps, dict(
-            stats=stats, success=success, status=status, message=message, parameters=parameters,
-            scene_name=scene_name, method=method, formulation=formulation, warnings=warnings))
+            stats=stats, success=success, status=status, message=message, scene_name=scene_name, method=method,
+            formulation=formulation, warnings=warnings, parameters=to_plain(dict(parameters or {}), "parameters")))
 
     @classmethod
     def of_run(cls, *, t: NDArray, y: NDArray, yp: NDArray, state_names: Sequence[str], channels: Mapping[str, NDArray],
@@ -232,7 +232,7 @@ class Result:
         """A solver's Result, from the data its recorder joined: float64 arrays of matching shapes,
         channels and units of the model, events in time order, segments as (float, float, modes);
         ``outcome``: every other keyword of the constructor (stats ... warnings). The constructor's
-        checks of those (about a tenth of a millisecond a run) are skipped."""
+        checks are skipped, and ``parameters`` (the solver's plain data) are copied at their first read."""
         result = cls.__new__(cls)
         result._assign(t, y, yp, list(state_names), channels, units, EventList(events), segments,
                        (step_t, step_h, step_order), outcome)
@@ -255,13 +255,20 @@ class Result:
         self.success: bool = bool(outcome["success"])
         self.status: int = int(outcome["status"])
         self.message: str = str(outcome["message"])
-        self.parameters: dict[str, Any] = to_plain(dict(outcome["parameters"] or {}), "parameters")
+        self._parameters: dict[str, Any] | tuple[Mapping[str, Any] | None] = (outcome["parameters"],)  # to copy
         self.scene_name: str = str(outcome["scene_name"])
         self.method: str = str(outcome["method"])
         self.formulation: str = str(outcome["formulation"])
         self.warnings: list[dict[str, Any]] = to_plain([dict(w) for w in outcome["warnings"]], "warnings")
 
     # ------------------------------------------------------------------ access
+
+    @property
+    def parameters(self) -> dict[str, Any]:
+        """Nested parameters of the scene and the run (plain data: the result's own copy)."""
+        if isinstance(held := self._parameters, tuple):  # a solver's Result: copied at the first read
+            held = self._parameters = to_plain(dict(held[0] or {}), "parameters")
+        return held
 
     @property
     def channels(self) -> Mapping[str, np.ndarray]:
