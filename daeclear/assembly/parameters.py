@@ -32,6 +32,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ..engine.build import memo_put_bounded, memo_table
 from ..model.elements import kept
 
 __all__ = ["ParameterTable", "entries", "floats", "structure_key", "element_structure", "law_values", "symbolic_law",
@@ -152,7 +153,15 @@ def structure_key(elements: Iterable[Any], extra: Iterable[Any]) -> str:
     scene's order, plus ``extra`` (formulation, options and the laws' structural flags, see
     :func:`law_structure`). The scene's name and its numbers (gravity included) are no part of it."""
     text = repr([[(e.name, element_structure(e)) for e in elements], list(extra)])
-    return hashlib.sha256(text.encode()).hexdigest()
+    key = _KEYS.get(text)
+    if key is None:  # the digest of a structure seen before is looked up: hashing costs more in a sweep's loop
+        key = hashlib.sha256(text.encode()).hexdigest()
+        memo_put_bounded(_KEYS, text, key, 64)
+    return key
+
+
+# structure text -> its SHA-256 (the structures of this process's latest scenes)
+_KEYS: dict[str, str] = memo_table()
 
 
 # ---- laws ------------------------------------------------------------------------------
