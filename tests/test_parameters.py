@@ -510,6 +510,13 @@ def test_values_are_kept_on_frozen_elements_only():
     assert calls == [1.0]
     assert dataclasses.replace(body) == body and "_mass" not in dataclasses.replace(body).__dict__
 
+    @dataclasses.dataclass(frozen=True, slots=True)
+    class Slotted:  # frozen, but nowhere to keep a value: computed every time
+        x: float
+
+    calls.clear()
+    assert [kept(Slotted(3.0), "_x", compute) for _ in range(2)] == [3.0, 3.0] and calls == [3.0, 3.0]
+
 
 def test_values_kept_with_other_objects_follow_those_objects():
     """elements.kept_with reuses a value while the element is given the very same (frozen) objects,

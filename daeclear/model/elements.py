@@ -35,7 +35,7 @@ def kept(element: Any, slot: str, compute: Callable[[Any], Any]) -> Any:
     """``compute(element)``, kept on the element under ``slot`` when its class is a frozen dataclass
     (the value then follows from its fields alone: not a field, so equality, ``to_dict`` and
     ``dataclasses.replace`` ignore it; scenes that share the element share it); computed anew on
-    any other element. A call that raises keeps nothing."""
+    any other element (or one without a ``__dict__``: slots). A call that raises keeps nothing."""
     if not is_frozen(element):
         return compute(element)
     try:
@@ -62,9 +62,9 @@ def kept_with(element: Any, slot: str, inputs: tuple[Any, ...], compute: Callabl
 
 
 def is_frozen(value: Any) -> bool:
-    """True for an instance of a frozen dataclass (its fields cannot change)."""
+    """True for an instance of a frozen dataclass (its fields cannot change) that can hold kept values."""
     params = getattr(type(value), "__dataclass_params__", None)
-    return params is not None and params.frozen
+    return params is not None and params.frozen and hasattr(value, "__dict__")
 
 
 def computed_once(method: Callable[[Any], Any]) -> Callable[[Any], Any]:
