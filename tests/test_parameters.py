@@ -596,3 +596,23 @@ def test_a_models_scene_description_is_the_scene_as_it_was_assembled():
     description = loose.description()
     loose.elements[0].value = 2.0
     assert description["elements"]["m"] == {"kind": "Marker", "name": "m", "value": 1.0}
+
+
+def test_a_clearance_joints_checks_run_once(monkeypatch):
+    """clearance_joint checks the new joint (a bad value raises at once) and keeps the findings, so
+    the scene's validation (and the assembly) does not check the joint again."""
+    from daeclear.model.clearance_joints import RevoluteClearance
+
+    with pytest.raises(dc.SceneError, match="clearance"):
+        dc.mechanisms.slider_crank("revolute", clearance=0.02)  # larger than the bearing radius
+    scene = dc.mechanisms.slider_crank("revolute", clearance=1.5e-4)
+    calls: list[str] = []
+    original = RevoluteClearance.problems
+    monkeypatch.setattr(RevoluteClearance, "problems", lambda self: calls.append(self.name) or original(self))
+    scene.validate()
+    dc.assemble(scene)
+    assert calls == []
+    fresh = dataclasses.replace(scene["clearance"])  # a new object: nothing kept on it
+    scene.elements[scene.elements.index(scene["clearance"])] = fresh
+    scene.validate()
+    assert calls == ["clearance"]

@@ -152,7 +152,8 @@ def structure_key(elements: Iterable[Any], extra: Iterable[Any]) -> str:
     """SHA-256 of a scene's structure: each element's name and :func:`element_structure` in the
     scene's order, plus ``extra`` (formulation, options and the laws' structural flags, see
     :func:`law_structure`). The scene's name and its numbers (gravity included) are no part of it."""
-    text = repr([[(e.name, element_structure(e)) for e in elements], list(extra)])
+    # joined, not repr'd: the elements' texts are long and repr would scan them again
+    text = "\x00".join([f"{e.name}\x01{element_structure(e)}" for e in elements] + [str(x) for x in extra])
     key = _KEYS.get(text)
     if key is None:  # the digest of a structure seen before is looked up: hashing costs more in a sweep's loop
         key = hashlib.sha256(text.encode()).hexdigest()
