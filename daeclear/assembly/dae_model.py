@@ -153,7 +153,8 @@ class DAEModel:
         return StateLayout(
             n_q=self.n_q, n_constraints=self.n_constraints, ggl=self.formulation == "ggl", track_work=self.track_work,
             accel_extra=EXTRA_ACCEL, force_extra0=EXTRA_TERM0, kinematics_extra=EXTRA_KINEMATICS,
-            outputs_extra=EXTRA_OUTPUTS, project=project, tol=POSITION_TOL, max_iter=NEWTON_STEPS)
+            outputs_extra=EXTRA_OUTPUTS, project=project, tol=POSITION_TOL, max_iter=NEWTON_STEPS,
+            n_channels=len(self.channel_names))
 
     def __str__(self) -> str:
         n_q, m = self.n_q, self.n_constraints

@@ -75,9 +75,10 @@ def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, fir
     rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P], [gap, ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
     floor = approach_floor(ctx, law_numeric, f"{name}.law")
     discontinuous = not friction_numeric.frictionless and not friction_numeric.smooth
+    n_q = ctx.n_q  # read once: a CasADi call costs more inside a sweep's loop than the logic it makes
 
     def logic(P: NDArray[np.float64]) -> list[Any]:
-        return [PairLogic(name, first_root, first_term, BufferedFunction(rate, bound=(P,)), ctx.n_q,
+        return [PairLogic(name, first_root, first_term, BufferedFunction(rate, bound=(P,)), n_q,
                           law_numeric.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:

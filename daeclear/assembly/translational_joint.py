@@ -425,12 +425,14 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
     floor = approach_floor(ctx, law_numeric, f"{name}.law")
     face_floor = approach_floor(ctx, face_numeric, f"{name}.face_law") if face_numeric is not None else None
 
+    n_q = ctx.n_q  # read once (a CasADi call), not at every binding
+
     def logic(P: NDArray[np.float64]) -> list[Any]:
         return [SliderGuideLogic(
             name=name, pairs=pair_names, first_root=first_root,
             corner_terms=[first_term + i for i in range(n_corners)],
             face_names=face_names, face_terms=[first_term + n_corners + f for f in range(len(face_names))],
-            face_corners=face_corners, rate=BufferedFunction(rate, bound=(P,)), n_q=ctx.n_q,
+            face_corners=face_corners, rate=BufferedFunction(rate, bound=(P,)), n_q=n_q,
             needs_approach=law_numeric.needs_approach_speed, min_approach_speed=floor(P),
             face_needs_approach=bool(face_numeric is not None and face_numeric.needs_approach_speed),
             face_min_approach_speed=face_floor(P) if face_floor is not None else 0.0,

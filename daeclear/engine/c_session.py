@@ -296,7 +296,7 @@ class CSession(SessionBase):
                                      L.max_iter)
         if rc != 0:
             raise DaeclearError("configuring the state layout of the compiled model failed")
-        self._n_channels = int(self._model.extras[L.outputs_extra].numel_out(0))
+        self._n_channels = L.n_channels
         return True
 
     def report(self, t: np.ndarray, y: np.ndarray, switch: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

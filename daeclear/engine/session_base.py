@@ -130,6 +130,7 @@ class StateLayout:
     project: bool  # restarts after switches decided in C are projected on the constraint manifold
     tol: float
     max_iter: int
+    n_channels: int  # values the outputs extra returns per point (the model's channels)
 
 
 @dataclass
