@@ -136,6 +136,8 @@ class _Handle:
         self.actb = np.zeros(max(nt, 1), dtype=np.int32)
         self.rdb = np.zeros(max(nr, 1), dtype=np.int32)
         self.pcat = np.zeros(max(n_params, 1))
+        # the buffers of the switches the C loop decided (set_auto_events) and their addresses
+        self.auto_buf: tuple[tuple[np.ndarray, ...], tuple[int, ...]] | None = None
         self.addr = dict(
             st=self.st.ctypes.data, sy=None, syp=None,
             sh=self.sh.ctypes.data, sord=self.sord.ctypes.data, yout=self.yout.ctypes.data,
@@ -281,9 +283,11 @@ class CSession(SessionBase):
         if rc != 0:
             raise DaeclearError("configuring the events decided in C failed")
         self._auto_cap = capacity
-        self._auto_buf = (np.empty(capacity), np.empty(capacity, dtype=np.int32),
-                          np.empty((capacity, 4), dtype=np.int32), np.empty(capacity), np.empty(capacity),
-                          np.empty((capacity, self._n)))
+        if self._hd.auto_buf is None or self._hd.auto_buf[0][0].size != capacity:  # kept on the handle (pooled)
+            buf = (np.empty(capacity), np.empty(capacity, dtype=np.int32), np.empty((capacity, 4), dtype=np.int32),
+                   np.empty(capacity), np.empty(capacity), np.empty((capacity, self._n)))
+            self._hd.auto_buf = (buf, tuple(a.ctypes.data for a in buf))
+        self._auto_buf = self._hd.auto_buf
         return True
 
     def set_layout(self, layout: StateLayout) -> bool:
@@ -318,9 +322,8 @@ class CSession(SessionBase):
         buf = getattr(self, "_auto_buf", None)
         if buf is None:
             return None
-        t, pair, info, rate, latched, y = buf
-        k = self._lib.dc_take_events(self._h, self._auto_cap, t.ctypes.data, pair.ctypes.data, info.ctypes.data,
-                                     rate.ctypes.data, latched.ctypes.data, y.ctypes.data)
+        (t, pair, info, rate, latched, y), addresses = buf
+        k = self._lib.dc_take_events(self._h, self._auto_cap, *addresses)
         if not k:
             return None
         return AutoEvents(t[:k].copy(), pair[:k].copy(), info[:k].copy(), rate[:k].copy(), latched[:k].copy(),
