@@ -20,6 +20,7 @@ the union of the base and all term Jacobians' patterns). ``"auto"`` picks sparse
 from __future__ import annotations
 
 import ctypes
+import itertools
 import logging
 import time
 import weakref
@@ -213,7 +214,7 @@ class CSession(SessionBase):
         self._y0b, self._yp0b, self._actb, self._rdb, self._pcat = hd.y0b, hd.yp0b, hd.actb, hd.rdb, hd.pcat
         self._addr = hd.addr
         self._extra_meta: dict[int, tuple[Any, ...]] = {}
-        self._poff = np.concatenate([[0], np.cumsum(model.n_params)]).astype(int).tolist()
+        self._poff = list(itertools.accumulate(model.n_params, initial=0))
 
     def _pool_key(self) -> tuple[int, str, int, int]:
         """What a pooled handle must share with this session: library, linear solver, max_order, buffer_steps."""

@@ -13,6 +13,7 @@ running out of memory) the result holds what was computed (:meth:`SegmentLoop.fi
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from typing import Any
@@ -113,7 +114,7 @@ class SegmentLoop:
         # starting state of each pair come from its logic object; Python then only records
         if model.auto_pairs:
             owners = {root: logic for logic in model.contacts for root in logic.roots}
-            columns = np.cumsum([0] + [1 + term.n_params for term in model.terms]).tolist()
+            columns = list(itertools.accumulate((1 + term.n_params for term in model.terms), initial=0))
             self.auto_info = [(owners[root], root, owners[root].pair_name(root), columns[term], bool(needs))
                               for root, term, _, needs, _ in model.auto_pairs]
             self.c_decides = self.c_layout and session.set_auto_events(
