@@ -666,3 +666,32 @@ def test_a_pooled_c_session_runs_step_for_step_as_a_new_one():
     assert again[5] == counters
     pooled.close()
     assert open_session(model, **settings)._hd is pooled._hd  # and again
+
+
+def test_a_pooled_session_evaluates_extras_with_its_own_parameters():
+    """The extras' sizes stay with a pooled C session (asked of CasADi once per library); the
+    run-time parameters are each session's own: a session that took another's C session evaluates
+    the channels of its own numbers, as CasADi does."""
+    import daeclear as dc
+    from daeclear.engine import c_session
+
+    first, second = (dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=c)) for c in (1e-4, 3e-4))
+    assert first.functions is second.functions  # one library
+    y = np.concatenate([first.q_guess, first.v_guess, np.zeros(first.n_states - 2 * first.n_q)])
+    y[first.state_names.index("slider.x")] += 2e-4  # the journal off centre: the clearance shows
+    t, yp = np.zeros(1), np.zeros_like(y)
+    switch = first.switch_vector([False] * len(first.terms), [np.zeros(term.n_params) for term in first.terms])
+    c_session._POOL.clear()
+    channels, handles = {}, []
+    for model in (first, second):
+        session = open_session(model.functions, backend="c", rtol=1e-6, atol=1e-9,
+                               parameters=model.parameter_values)
+        channels[id(model)] = model.channels(t, y[None, :], yp[None, :], switch[None, :], session)
+        handles.append(session._hd)
+        session.close()
+        expected = model.channels(t, y[None, :], yp[None, :], switch[None, :])  # CasADi
+        for name in ("clearance.penetration", "clearance.eccentricity"):
+            np.testing.assert_allclose(channels[id(model)][name], expected[name], rtol=1e-12, atol=1e-15)
+    assert handles[0] is handles[1] and handles[0].extra_meta  # the second took the first's, sizes kept
+    difference = channels[id(first)]["clearance.penetration"] - channels[id(second)]["clearance.penetration"]
+    np.testing.assert_allclose(difference, 2e-4, rtol=1e-9)  # the clearances' difference

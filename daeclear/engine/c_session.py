@@ -139,6 +139,9 @@ class _Handle:
         self.pcat = np.zeros(max(n_params, 1))
         # the buffers of the switches the C loop decided (set_auto_events) and their addresses
         self.auto_buf: tuple[tuple[np.ndarray, ...], tuple[int, ...]] | None = None
+        # per extra: its input and output sizes (asked of CasADi once per library, not per session) and
+        # the ctypes arrays of its call (eval_extra)
+        self.extra_meta: dict[int, tuple[Any, ...]] = {}
         self.addr = dict(
             st=self.st.ctypes.data, sy=None, syp=None,
             sh=self.sh.ctypes.data, sord=self.sord.ctypes.data, yout=self.yout.ctypes.data,
@@ -213,7 +216,7 @@ class CSession(SessionBase):
         self._i_eval, self._n_stored, self._t_out, self._flag = hd.i_eval, hd.n_stored, hd.t_out, hd.flag
         self._y0b, self._yp0b, self._actb, self._rdb, self._pcat = hd.y0b, hd.yp0b, hd.actb, hd.rdb, hd.pcat
         self._addr = hd.addr
-        self._extra_meta: dict[int, tuple[Any, ...]] = {}
+        self._extra_meta = hd.extra_meta
         self._poff = list(itertools.accumulate(model.n_params, initial=0))
 
     def _pool_key(self) -> tuple[int, str, int, int]:
@@ -364,7 +367,7 @@ class CSession(SessionBase):
     def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
         inputs = [*inputs, self._opts.parameters]
         meta = self._extra_meta.get(k)
-        if meta is None:  # input sizes, output size and reusable ctypes arrays, once per function
+        if meta is None:  # input sizes, output size and reusable ctypes arrays, once per function and handle
             f = self._model.extras[k]
             sizes = [f.numel_in(j) for j in range(f.n_in())]
             meta = (sizes, f.numel_out(0), (ctypes.c_void_p * max(len(sizes), 1))(),

@@ -9,10 +9,11 @@ ideal joints, drivers) because these elements carry the contact laws, materials 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 from ..errors import SceneError
+from ..results.values import field_names
 from .elements import (Joint, PointJoint, Revolute, Translational, Vector2, as_vector2, computed_once,
                        own_problems)
 
@@ -469,8 +470,8 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
         raise SceneError(f"{label}: it is a {kind}; only an ideal Revolute or Translational joint can get a "
                          "clearance.")
     cls, required = _CLEARANCE_OF[type(joint)]
-    shared = _field_names(type(joint))
-    allowed = [name for name in _field_names(cls) if name not in shared]
+    shared = field_names(type(joint))
+    allowed = [name for name in field_names(cls) if name not in shared]
     unknown = sorted(set(fields_) - set(allowed))
     if unknown:
         hints = [f"{key} (shared with the ideal joint)" if key in shared else key for key in unknown]
@@ -497,17 +498,6 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
     if problems:
         raise SceneError(f"{label}: " + " ".join(problems))
     return element
-
-
-def _field_names(cls: type) -> tuple[str, ...]:
-    """The field names of a dataclass, in order (kept: a sweep makes a clearance joint per point)."""
-    names = _FIELD_NAMES.get(cls)
-    if names is None:
-        names = _FIELD_NAMES[cls] = tuple(f.name for f in fields(cls))
-    return names
-
-
-_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
 
 
 def ideal_joint(joint: Joint) -> Joint:

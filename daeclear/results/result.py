@@ -235,7 +235,7 @@ class Result:
         checks are skipped, and ``parameters`` (the solver's plain data) are copied at their first read."""
         result = cls.__new__(cls)
         result._assign(t, y, yp, list(state_names), channels, units, EventList(events), segments,
-                       (step_t, step_h, step_order), outcome)
+                       (step_t, step_h, step_order), {**outcome, "parameters": (outcome["parameters"],)})
         return result
 
     def _assign(self, t: NDArray, y: NDArray, yp: NDArray, names: list[str], channels: Mapping[str, NDArray],
@@ -255,7 +255,7 @@ class Result:
         self.success: bool = bool(outcome["success"])
         self.status: int = int(outcome["status"])
         self.message: str = str(outcome["message"])
-        self._parameters: dict[str, Any] | tuple[Mapping[str, Any] | None] = (outcome["parameters"],)  # to copy
+        self._parameters: dict[str, Any] | tuple[Mapping[str, Any] | None] = outcome["parameters"]  # or (a run's,)
         self.scene_name: str = str(outcome["scene_name"])
         self.method: str = str(outcome["method"])
         self.formulation: str = str(outcome["formulation"])

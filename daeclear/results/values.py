@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import DaeclearWarning
 
-__all__ = ["readonly", "time_window", "to_plain"]
+__all__ = ["field_names", "readonly", "time_window", "to_plain"]
 
 
 def readonly(a: np.ndarray) -> np.ndarray:
@@ -56,7 +56,15 @@ def to_plain(value: Any, where: str) -> Any:
     return _plain(value, (where,))
 
 
-# field names by dataclass type: the same few (Material, the contact laws) come back in every run
+def field_names(cls: type) -> tuple[str, ...]:
+    """The field names of a dataclass class, in order, kept per class: the same few (Material, the
+    contact laws, the clearance joints) come back in every run of a sweep."""
+    names = _FIELD_NAMES.get(cls)
+    if names is None:
+        names = _FIELD_NAMES[cls] = tuple(f.name for f in fields(cls))
+    return names
+
+
 _FIELD_NAMES: dict[type, tuple[str, ...]] = {}
 
 
@@ -105,10 +113,7 @@ def _plain(value: Any, path: tuple[Any, ...]) -> Any:
     if isinstance(value, os.PathLike):
         return os.fspath(value)
     if is_dataclass(value) and not isinstance(value, type):
-        names = _FIELD_NAMES.get(kind)
-        if names is None:
-            names = _FIELD_NAMES[kind] = tuple(f.name for f in fields(value))
-        out = {name: _plain(getattr(value, name), (*path, name)) for name in names}
+        out = {name: _plain(getattr(value, name), (*path, name)) for name in field_names(kind)}
         label = getattr(kind, "name", None)  # a contact law's registered name, e.g. "hunt-crossley"
         if isinstance(label, str) and "name" not in out:
             out = {"name": label, **out}
