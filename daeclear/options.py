@@ -200,7 +200,7 @@ def t_eval(value: ArrayLike | None, end: float, *, where: str = "simulate",
         fail(where, field, value, "at least one time: " + rule)
     # the common case in one pass: in range and strictly increasing (so finite: a NaN or inf
     # fails a comparison); anything else is looked at closely for the message
-    if start <= times[0] and times[-1] <= end and bool((np.diff(times) > 0).all()):
+    if start <= times[0] and times[-1] <= end and bool((times[1:] > times[:-1]).all()):
         return times
     bad = ~np.isfinite(times)
     if bad.any():

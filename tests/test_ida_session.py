@@ -546,6 +546,12 @@ def test_term_without_parameters_and_several_terms():
             assert s.jacobian(0.0, np.array([1.0]), np.array([0.0]), 10.0)[0, 0] == pytest.approx(k + 10.0)
             a = s.advance(0.5)
             assert a.y[0] == pytest.approx(np.exp(-k * 0.5), rel=1e-7)
+            if backend == "c":  # the C loop's terms as a switch vector: flag, then parameters, per term
+                expected = [float(active[0]), float(active[1]), 2.0, 0.0]
+                np.testing.assert_array_equal(s.active_switch(), expected)
+                flags, params = s.active_terms()
+                assert flags == active and params[0].size == 0
+                np.testing.assert_array_equal(params[1], [2.0, 0.0])
 
 
 def test_continue_after_root_to_a_time_inside_the_last_step():
@@ -632,16 +638,16 @@ def test_a_pooled_c_session_runs_step_for_step_as_a_new_one():
     library: whatever the run before it set (tolerances, step limits, root directions, Newton
     hints, stall rule, a first-step choice) and however it ended, the next one runs exactly as a
     freshly opened one."""
-    from daeclear.engine import c_session
+    from daeclear.engine import c_handle
 
     model = ball_model()
     settings = dict(backend="c", rtol=1e-8, atol=np.array([1e-12, 1e-10]))
-    c_session._POOL.clear()
+    c_handle._POOL.clear()
     fresh = open_session(model, **settings)
     status, t, roots, steps, y, counters = _bounce(fresh)
     assert status == "tstop" and t == 2.0 and len(roots) == 4
     fresh.close()
-    c_session._POOL.clear()  # the next session opens its own
+    c_handle._POOL.clear()  # the next session opens its own
     dirty = open_session(model, backend="c", rtol=1e-4, atol=1e-6, max_step=1e-3, max_steps=700,
                          root_directions=np.array([1]))
     dirty.set_hints(nonlin_conv_coef=0.01, jacobian_refresh=0.9, first_step=True)
@@ -653,7 +659,8 @@ def test_a_pooled_c_session_runs_step_for_step_as_a_new_one():
     assert pooled._hd is dirty._hd  # the same C session, reset
     # the closed session's handle now serves another session: every entry point refuses
     for call in (lambda: dirty.set_hints(jacobian_refresh=0.5), lambda: dirty.set_stall(1e-9, 5),
-                 lambda: dirty.active_terms(), lambda: dirty.advance(3.0), lambda: dirty.stats(),
+                 lambda: dirty.active_terms(), lambda: dirty.active_switch(), lambda: dirty.advance(3.0),
+                 lambda: dirty.stats(),
                  lambda: dirty.reinit(0.0, [1.0, 0.0], [0.0, -G], [False], [np.ones(1)]),
                  lambda: dirty.report(np.zeros(1), np.zeros((1, 2)), np.zeros((1, 2))),
                  lambda: dirty.residual(0.0, np.zeros(2), np.zeros(2))):
@@ -673,7 +680,7 @@ def test_a_pooled_session_evaluates_extras_with_its_own_parameters():
     run-time parameters are each session's own: a session that took another's C session evaluates
     the channels of its own numbers, as CasADi does."""
     import daeclear as dc
-    from daeclear.engine import c_session
+    from daeclear.engine import c_handle
 
     first, second = (dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=c)) for c in (1e-4, 3e-4))
     assert first.functions is second.functions  # one library
@@ -681,7 +688,7 @@ def test_a_pooled_session_evaluates_extras_with_its_own_parameters():
     y[first.state_names.index("slider.x")] += 2e-4  # the journal off centre: the clearance shows
     t, yp = np.zeros(1), np.zeros_like(y)
     switch = first.switch_vector([False] * len(first.terms), [np.zeros(term.n_params) for term in first.terms])
-    c_session._POOL.clear()
+    c_handle._POOL.clear()
     channels, handles = {}, []
     for model in (first, second):
         session = open_session(model.functions, backend="c", rtol=1e-6, atol=1e-9,

@@ -472,17 +472,17 @@ def test_a_run_on_a_pooled_c_session_equals_a_run_on_a_new_one(linear_solver: st
     and linear solver takes it (dc_reset): after a run with other numbers and settings that
     failed, a run equals the same run on a newly opened session, step for step (the sparse LU
     keeps its symbolic factorization, which depends on the pattern alone)."""
-    from daeclear.engine import c_session
+    from daeclear.engine import c_handle
 
     def handles() -> list:
-        return [h for pooled in c_session._POOL.values() for h in pooled]
+        return [h for pooled in c_handle._POOL.values() for h in pooled]
 
     scene, t_end = slider_crank("revolute", clearance=1e-4), 0.004
     settings = dict(t_end=t_end, t_eval=np.linspace(0.0, t_end, 41), rtol=1e-7, backend="c",
                     linear_solver=linear_solver)
-    c_session._POOL.clear()
+    c_handle._POOL.clear()
     fresh = dc.simulate(scene, **settings)
-    c_session._POOL.clear()  # the next run opens its own session
+    c_handle._POOL.clear()  # the next run opens its own session
     failed = dc.simulate(slider_crank("revolute", clearance=3e-4, restitution=0.5), t_end=t_end, rtol=1e-5,
                          max_step=1e-6, max_steps=300, backend="c", on_failure="return",
                          linear_solver=linear_solver)

@@ -30,7 +30,7 @@ the assembled :class:`~daeclear.assembly.dae_model.DAEModel` and what a solver a
 
 from __future__ import annotations
 
-import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -151,20 +151,19 @@ class _Template:
 
     def bind(self, scene: Scene, table: ParameterTable, described: Mapping[str, Any], alpha: float,
              beta: float) -> DAEModel:
-        if table.layout != self.layout:  # a structure key collision would land here
+        if not table.has_layout(*self.names_sizes):  # a structure key collision would land here
             raise AssemblyError(f"scene '{scene.name}': its parameters do not match the cached structure.")
         P = table.vector
-        P.setflags(write=False)
         bodies = scene.bodies
         contacts = tuple(logic for make in self.logic for logic in make(P))
         auto_pairs = tuple((root, term, extra, needs, float(getattr(contacts[i], "min_approach_speed", 0.0)))
                            for root, term, extra, needs, i in self.auto_pairs)
         formulation, track_work = self.model.formulation, self.model.track_work
-        return dataclasses.replace(
-            self.model, scene_name=scene.name, alpha=float(alpha), beta=float(beta),
-            q_guess=np.concatenate([[*b.position, b.angle] for b in bodies]),
-            v_guess=np.concatenate([[*b.velocity, b.angular_velocity] for b in bodies]),
-            mass_diagonal=np.concatenate([[b.mass, b.mass, b.inertia] for b in bodies]),
+        return self.model.copy_with(
+            scene_name=scene.name, alpha=float(alpha), beta=float(beta),
+            q_guess=[x for b in bodies for x in (*b.position, b.angle)],
+            v_guess=[x for b in bodies for x in (*b.velocity, b.angular_velocity)],
+            mass_diagonal=[x for b in bodies for x in (b.mass, b.mass, b.inertia)],
             parameters={"scene": described, "formulation": formulation, "alpha": alpha, "beta": beta,
                         "track_work": track_work},
             contacts=contacts, auto_pairs=auto_pairs, parameter_layout=self.layout, parameter_values=P,
@@ -173,6 +172,11 @@ class _Template:
                                    if isinstance(e, (RevoluteClearance, TranslationalClearance))
                                    and type(e) in CONTACT_BUILDERS),
         )
+
+    @functools.cached_property
+    def names_sizes(self) -> tuple[tuple[str, ...], tuple[int, ...]]:
+        """The layout's names and sizes (:meth:`ParameterTable.has_layout`)."""
+        return tuple(name for name, _ in self.layout), tuple(size for _, size in self.layout)
 
 
 # Templates built in this process, by structure key (a scene that differs only in numbers

@@ -57,6 +57,10 @@ class Storm:
         object.__setattr__(self, "window", float(self.window))
 
 
+#: The storm guard's default constants (frozen: every pair without its own shares them).
+DEFAULT_STORM: Final[Storm] = Storm()
+
+
 @dataclass(frozen=True)
 class PairState:
     """What the automaton remembers of one pair.

@@ -25,7 +25,7 @@ The rule, storm guard included, is defined once in :mod:`daeclear.assembly.autom
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 from collections.abc import Callable, Sequence
 
@@ -33,7 +33,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from .automaton import EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
+from .automaton import DEFAULT_STORM, EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
 from ..results.result import ContactEvent
 from .symbolic import AssemblyContext, BufferedFunction, Channel, Term
 
@@ -56,8 +56,8 @@ class PairLogic:
     needs_approach: bool
     min_approach_speed: float
     discontinuous_friction: bool = False
-    storm: Storm = field(default_factory=Storm)
-    state: PairState = field(default_factory=PairState)
+    storm: Storm = DEFAULT_STORM  # frozen: shared
+    state: PairState = PairState()  # frozen: shared
 
     @property
     def held(self) -> bool:

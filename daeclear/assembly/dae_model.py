@@ -9,7 +9,6 @@ scene: every solver uses the model, only assembly needs CasADi's symbolic constr
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal
 from collections.abc import Sequence
@@ -99,8 +98,19 @@ class DAEModel:
 
     def __post_init__(self) -> None:
         # frozen means frozen: the arrays are read-only (a copy when the caller's array is writable)
-        for name in ("q_guess", "v_guess", "mass_diagonal", "parameter_values"):
+        for name in _ARRAY_FIELDS:
             object.__setattr__(self, name, _read_only(getattr(self, name)))
+
+    def copy_with(self, **changes: Any) -> DAEModel:
+        """``dataclasses.replace(self, **changes)`` without the constructor's round of every field: a
+        template bound to a scene's numbers, a run's copy (a sweep makes both at every point)."""
+        model = object.__new__(type(self))
+        model.__dict__.update(self.__dict__)
+        model.__dict__.update(changes)
+        for name in _ARRAY_FIELDS:
+            if name in changes:
+                model.__dict__[name] = _read_only(changes[name])
+        return model
 
     def for_run(self, *, from_state: bool = False) -> DAEModel:
         """A copy of this model for one run: the same functions and numbers, its own contact logic.
@@ -111,8 +121,8 @@ class DAEModel:
         independent. ``from_state``: the run starts from a given state of a run (``simulate(...,
         y0=...)``), whose contacts at the start are no declaration error (:mod:`daeclear.solvers.physics`).
         """
-        run_model = copy.copy(self)  # every field shared (read-only arrays, the start memo) but the logic
-        object.__setattr__(run_model, "contacts", tuple(_run_copy(logic) for logic in self.contacts))
+        # every field shared (read-only arrays, the start memo) but the logic
+        run_model = self.copy_with(contacts=tuple(_run_copy(logic) for logic in self.contacts))
         if from_state:  # an instance value over the class's: this copy only (the class default stays)
             object.__setattr__(run_model, "start_is_declared", False)
         return run_model
@@ -481,11 +491,15 @@ def _mapped(function: ca.Function, n: int) -> ca.Function:
 def _run_copy(logic: Any) -> Any:
     """A contact logic object for one run: a shallow copy whose lists (pair states, faces) are its
     own (its buffered functions are shared: each thread evaluates them in its own buffers)."""
-    fresh = copy.copy(logic)
+    fresh = object.__new__(type(logic))  # copy.copy without its reduce protocol
+    fresh.__dict__.update(vars(logic))
     for name, value in vars(logic).items():
         if isinstance(value, list):
             setattr(fresh, name, list(value))
     return fresh
+
+
+_ARRAY_FIELDS = ("q_guess", "v_guess", "mass_diagonal", "parameter_values")
 
 
 def _read_only(values: ArrayLike) -> NDArray[np.float64]:

@@ -34,6 +34,7 @@ from numpy.typing import NDArray
 
 from ..engine.build import memo_put_bounded, memo_table
 from ..model.elements import kept
+from ..results.values import field_names
 
 __all__ = ["ParameterTable", "entries", "floats", "structure_key", "element_structure", "law_values", "symbolic_law",
            "law_structure", "is_parametric"]
@@ -69,6 +70,10 @@ class ParameterTable:
     def layout(self) -> tuple[tuple[str, int], ...]:
         return tuple((name, len(v)) for name, v in self._values.items())
 
+    def has_layout(self, names: tuple[str, ...], sizes: tuple[int, ...]) -> bool:
+        """The entries' names and sizes are these (:attr:`layout` compared without building it)."""
+        return tuple(self._values) == names and tuple(map(len, self._values.values())) == sizes
+
     @property
     def vector(self) -> NDArray[np.float64]:
         return np.array([x for v in self._values.values() for x in v], dtype=float)
@@ -98,6 +103,8 @@ def floats(value: Any) -> tuple[float, ...]:
     kind = type(value)
     if kind is float or kind is int:
         return (float(value),)
+    if (kind is tuple or kind is list) and all(type(v) is float or type(v) is int for v in value):
+        return tuple(map(float, value))  # a point or a vector: numpy is slower on a few numbers
     return tuple(np.asarray(value, dtype=float).ravel().tolist())
 
 
@@ -144,8 +151,30 @@ def element_structure(element: Any) -> str:
 
 
 def _element_structure(element: Any) -> str:
-    described = element.to_dict()
-    return repr(_mask({k: v for k, v in described.items() if k not in element.NOT_STRUCTURE}))
+    skip = element.NOT_STRUCTURE
+    return "\x02".join([type(element).__name__, *(f"{name}={_masked_text(getattr(element, name))}"
+                                                   for name in field_names(type(element)) if name not in skip)])
+
+
+def _masked_text(value: Any) -> str:
+    """One field of an element as text with every number masked (:func:`_mask`); a law's, a
+    material's or a body's text is kept on it: the elements of a sweep's scenes share those."""
+    kind = type(value)
+    if kind is float or kind is int or isinstance(value, (np.floating, np.integer)):
+        return "#"
+    if kind is str or kind is bool or value is None:
+        return repr(value)
+    if kind is tuple or kind is list:
+        return "[" + ",".join(map(_masked_text, value)) + "]"
+    if hasattr(value, "to_dict") or (dataclasses.is_dataclass(value) and not isinstance(value, type)):
+        return kept(value, "_masked_text", _described_text)
+    return repr(_mask(value))
+
+
+def _described_text(value: Any) -> str:
+    """A value with a description (``to_dict``: a body, a profile, a load's function, whose digest
+    is structure) or a dataclass (a law, a material) as masked text."""
+    return repr(_mask(value.to_dict() if hasattr(value, "to_dict") else value))
 
 
 def structure_key(elements: Iterable[Any], extra: Iterable[Any]) -> str:

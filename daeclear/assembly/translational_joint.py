@@ -87,7 +87,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from .automaton import EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
+from .automaton import DEFAULT_STORM, EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
 from .contact_pairs import ContactBuild, approach_floor
 from .parameters import law_structure, law_values, symbolic_law
 from ..results.result import ContactEvent
@@ -151,7 +151,7 @@ class SliderGuideLogic:
     min_approach_speed: float
     face_needs_approach: bool
     face_min_approach_speed: float
-    storm: Storm = field(default_factory=Storm)
+    storm: Storm = DEFAULT_STORM  # frozen: shared
     states: list[PairState] = field(default_factory=list)
     face_on: list[bool] = field(default_factory=list)
 

@@ -5,7 +5,7 @@ The model is generated as C with CasADi, compiled with the hand-written IDA driv
 scikit-sundae wheel (:mod:`daeclear.engine.codegen`), loaded by :mod:`daeclear.engine.library` and
 driven here through ctypes a few calls per segment. No Python runs per step or per model
 evaluation. A closed session's C session goes to a small pool, and the next session of the same
-library takes it reset (``dc_reset``) instead of opening another (see :class:`_Handle`).
+library takes it reset (``dc_reset``) instead of opening another (:mod:`daeclear.engine.c_handle`).
 Separate from the python backend (:mod:`daeclear.engine.python_session`), which has the same
 interface (:class:`daeclear.engine.session_base.Session`) but nothing else in common.
 
@@ -23,7 +23,6 @@ import ctypes
 import itertools
 import logging
 import time
-import weakref
 from pathlib import Path
 from typing import Any
 from collections.abc import Sequence
@@ -32,7 +31,8 @@ import numpy as np
 
 from ..assembly.automaton import Decision, PairState, Storm
 from ..errors import DaeclearError
-from .build import BuildResult, memo_put_bounded, memo_table
+from .build import BuildResult
+from .c_handle import STAT_KEYS, Handle, address, pointer, put_pooled, take_pooled
 from .codegen import NormalizedModel
 from .library import ModelLibrary
 from .session_base import (
@@ -63,17 +63,6 @@ _LS_CODES = {"dense": 0, "sparse": 1, "reduced": 2}  # dc_open's linear_solver a
 _LS_NAMES = {code: name for name, code in _LS_CODES.items()}
 log = logging.getLogger("daeclear")
 
-_STAT_KEYS = (
-    "n_steps",
-    "n_res_evals",
-    "n_jac_evals",
-    "n_lin_setups",
-    "n_nonlin_iters",
-    "n_nonlin_conv_fails",
-    "n_err_test_fails",
-    "n_root_evals",
-    "n_reinits",
-)
 
 
 def _resolve_linear_solver(requested: str, n: int, has_sparse: bool) -> str:
@@ -85,107 +74,6 @@ def _resolve_linear_solver(requested: str, n: int, has_sparse: bool) -> str:
         raise DaeclearError("linear_solver='sparse' is not available: the scikit-sundae wheel lacks "
                             f"lib{SPARSE_LIBS[0]} or lib{SPARSE_LIBS[1]}; use 'dense' or 'auto'")
     return requested
-
-
-def _free_c_session(lib: Any, handle: int) -> None:
-    lib.dc_free(handle)
-
-
-def _ptr(a: np.ndarray | None) -> int | None:
-    return None if a is None or a.size == 0 else a.ctypes.data
-
-
-#: rows of the times-only step buffers (time, size, order) per row of the state buffers
-TIMES_ROWS_PER_STATE_ROW = 16
-
-
-class _Handle:
-    """One C session (dc_open) and the buffers the loop fills: what depends on the library, its
-    linear solver, max_order and buffer_steps alone. A closed CSession's handle goes to a small
-    pool; the next session of the same library and settings takes it, re-armed by dc_reset (a
-    reset session runs step for step as a new one), instead of opening and freeing another:
-    dc_open and dc_free cost more than the Python around a short run. Freed when collected."""
-
-    def __init__(self, lib: Any, h: int, n: int, nr: int, nt: int, n_params: int, buffer_steps: int) -> None:
-        self.lib, self.h = lib, h
-        weakref.finalize(self, _free_c_session, lib, h)
-        self.jac_nnz = int(lib.dc_jac_nnz(h))
-        # rows of the step buffers: buffer_steps with the steps' states, TIMES_ROWS_PER_STATE_ROW
-        # times as many for times alone (20 bytes a row: a run of tens of thousands of steps with
-        # output times comes back in one piece, not in a piece per 4096 steps, each made consistent
-        # and checked apart)
-        self.cap = buffer_steps
-        cap = self.cap_times = buffer_steps * TIMES_ROWS_PER_STATE_ROW
-        # persistent buffers (addresses cached: ctypes calls stay cheap)
-        self.st = np.empty(cap)
-        # the steps' states (1 MB each at n = 32): made at the first advance that stores them
-        self.sy: np.ndarray | None = None
-        self.syp: np.ndarray | None = None
-        self.sh = np.empty(cap)
-        self.sord = np.empty(cap, dtype=np.int32)
-        self.yout = np.empty(n)
-        self.ypout = np.empty(n)
-        self.roots = np.zeros(max(nr, 1), dtype=np.int32)
-        self.i_eval = ctypes.c_int()
-        self.n_stored = ctypes.c_int()
-        self.t_out = ctypes.c_double()
-        self.flag = ctypes.c_int()
-        self.statbuf = np.zeros(len(_STAT_KEYS), dtype=np.int64)
-        # reinit inputs: copied into fixed arrays whose addresses are known
-        self.y0b = np.zeros(n)
-        self.yp0b = np.zeros(n)
-        self.actb = np.zeros(max(nt, 1), dtype=np.int32)
-        self.rdb = np.zeros(max(nr, 1), dtype=np.int32)
-        self.pcat = np.zeros(max(n_params, 1))
-        # the buffers of the switches the C loop decided (set_auto_events) and their addresses
-        self.auto_buf: tuple[tuple[np.ndarray, ...], tuple[int, ...]] | None = None
-        # per extra: its input and output sizes (asked of CasADi once per library, not per session) and
-        # the ctypes arrays of its call (eval_extra)
-        self.extra_meta: dict[int, tuple[Any, ...]] = {}
-        self.addr = dict(
-            st=self.st.ctypes.data, sy=None, syp=None,
-            sh=self.sh.ctypes.data, sord=self.sord.ctypes.data, yout=self.yout.ctypes.data,
-            ypout=self.ypout.ctypes.data, roots=self.roots.ctypes.data,
-            i_eval=ctypes.addressof(self.i_eval), n_stored=ctypes.addressof(self.n_stored),
-            t_out=ctypes.addressof(self.t_out), flag=ctypes.addressof(self.flag),
-            y0b=self.y0b.ctypes.data, yp0b=self.yp0b.ctypes.data, actb=self.actb.ctypes.data,
-            rdb=self.rdb.ctypes.data, pcat=self.pcat.ctypes.data,
-        )
-
-
-#: closed sessions' handles by (library, linear solver, max_order, buffer_steps): at most
-#: POOL_PER_KEY each (threads running the same model at once), for the POOL_KEYS newest keys
-POOL_PER_KEY = 2
-POOL_KEYS = 4
-_POOL: dict[tuple[int, str, int, int], list[_Handle]] = memo_table()
-
-
-def _take_pooled(key: tuple[int, str, int, int], opts: SessionOptions) -> _Handle | None:
-    """A pooled handle re-armed with ``opts`` (dc_reset), or None (none pooled, or its reset failed)."""
-    handles = _POOL.get(key)
-    try:
-        hd = handles.pop() if handles else None
-    except IndexError:  # another thread took the last one
-        return None
-    if hd is not None and hd.lib.dc_reset(hd.h, opts.rtol, opts.atol.ctypes.data, opts.max_step, opts.max_steps,
-                                          _ptr(opts.root_directions), _ptr(opts.parameters)) != 0:
-        log.info("daeclear: a pooled IDA session could not be reset (%s); opening a new one",
-                 hd.lib.dc_message(hd.h).decode())
-        return None  # freed when collected
-    return hd
-
-
-def _put_pooled(key: tuple[int, str, int, int], hd: _Handle) -> None:
-    """Keep a closed session's handle for the next session (or drop it: freed when collected),
-    without the steps' state buffers (2 x buffer_steps x n values: the next run that stores
-    states makes its own), so that the pool holds little more than IDA's memory."""
-    hd.sy = hd.syp = hd.addr["sy"] = hd.addr["syp"] = None
-    handles = _POOL.get(key)
-    if handles is None:
-        handles = []
-        memo_put_bounded(_POOL, key, handles, POOL_KEYS)
-    if len(handles) < POOL_PER_KEY:
-        handles.append(hd)
 
 
 class CSession(SessionBase):
@@ -206,7 +94,7 @@ class CSession(SessionBase):
         self._lib = clib.lib
         self._build = build
         self._linear_solver = _resolve_linear_solver(opts.linear_solver, n, clib.build_info.has_sparse)
-        hd = _take_pooled(self._pool_key(), opts)
+        hd = take_pooled(self._pool_key(), opts)
         if hd is None:
             hd = self._open(opts, n, nr)  # "auto" may fall back from the sparse LU to the reduced one
         self._hd = hd
@@ -223,14 +111,14 @@ class CSession(SessionBase):
         """What a pooled handle must share with this session: library, linear solver, max_order, buffer_steps."""
         return id(self._lib), self._linear_solver, self._opts.max_order, self._opts.buffer_steps
 
-    def _open(self, opts: SessionOptions, n: int, nr: int) -> _Handle:
+    def _open(self, opts: SessionOptions, n: int, nr: int) -> Handle:
         """A new C session (dc_open) with its buffers; the sparse solver falls back to the reduced
         LU when "auto" chose it and it cannot be set up."""
         err = ctypes.create_string_buffer(1024)
 
         def dc_open() -> Any:
             return self._lib.dc_open(opts.rtol, opts.atol.ctypes.data, opts.max_step, opts.max_order,
-                                     opts.max_steps, _ptr(opts.root_directions), _ptr(opts.parameters),
+                                     opts.max_steps, pointer(opts.root_directions), pointer(opts.parameters),
                                      _LS_CODES[self._linear_solver], err, 1024)
 
         h = dc_open()
@@ -241,7 +129,7 @@ class CSession(SessionBase):
             h = dc_open()
         if not h:
             raise DaeclearError(f"opening the compiled IDA session failed: {err.value.decode()}")
-        return _Handle(self._lib, h, n, nr, self._nt, sum(self._model.n_params), opts.buffer_steps)
+        return Handle(self._lib, h, n, nr, self._nt, sum(self._model.n_params), opts.buffer_steps)
 
     def set_hints(self, *, nonlin_conv_coef: float | None = None, jacobian_refresh: float | None = None,
                   first_step: bool | None = None) -> bool:
@@ -276,21 +164,24 @@ class CSession(SessionBase):
         def arr(values: Any, dt: Any) -> np.ndarray:
             return np.ascontiguousarray(list(values) or [0], dtype=dt)
 
-        self._auto_arrays = [
-            arr((p[0] for p in pairs), np.int32), arr((p[1] for p in pairs), np.int32),
-            arr((p[2] for p in pairs), np.int32), arr((p[3] for p in pairs), np.int32),
-            arr((p[4] for p in pairs), np.float64), arr((st.events for st in storms), np.int32),
-            arr((st.window for st in storms), np.float64), arr((st.contact for st in states), np.int32),
-            arr((st.held for st in states), np.int32), arr((st.latched for st in states), np.float64)]
-        ptr = [a.ctypes.data for a in self._auto_arrays]
-        rc = self._lib.dc_set_auto(self._h, np_, *ptr, capacity)
+        rules = (tuple(pairs), tuple(storms))
+        if self._hd.auto_rules is None or self._hd.auto_rules[0] != rules:  # a model's, kept on the handle (pooled)
+            arrays = [arr((p[0] for p in pairs), np.int32), arr((p[1] for p in pairs), np.int32),
+                      arr((p[2] for p in pairs), np.int32), arr((p[3] for p in pairs), np.int32),
+                      arr((p[4] for p in pairs), np.float64), arr((st.events for st in storms), np.int32),
+                      arr((st.window for st in storms), np.float64)]
+            self._hd.auto_rules = (rules, arrays, [address(a) for a in arrays])
+        starts = [arr((st.contact for st in states), np.int32), arr((st.held for st in states), np.int32),
+                  arr((st.latched for st in states), np.float64)]
+        self._auto_arrays = (self._hd.auto_rules[1], starts)  # alive while C reads them
+        rc = self._lib.dc_set_auto(self._h, np_, *self._hd.auto_rules[2], *map(address, starts), capacity)
         if rc != 0:
             raise DaeclearError("configuring the events decided in C failed")
         self._auto_cap = capacity
         if self._hd.auto_buf is None or self._hd.auto_buf[0][0].size != capacity:  # kept on the handle (pooled)
             buf = (np.empty(capacity), np.empty(capacity, dtype=np.int32), np.empty((capacity, 4), dtype=np.int32),
                    np.empty(capacity), np.empty(capacity), np.empty((capacity, self._n)))
-            self._hd.auto_buf = (buf, tuple(a.ctypes.data for a in buf))
+            self._hd.auto_buf = (buf, tuple(address(a) for a in buf))
         self._auto_buf = self._hd.auto_buf
         return True
 
@@ -317,8 +208,8 @@ class CSession(SessionBase):
         N = t.size
         y_out, yp_out = np.empty((N, self._n)), np.empty((N, self._n))
         channels = np.empty((N, self._n_channels))
-        if N and self._lib.dc_report(self._h, N, t.ctypes.data, y.ctypes.data, switch.ctypes.data,
-                                     y_out.ctypes.data, yp_out.ctypes.data, channels.ctypes.data) != 0:
+        if N and self._lib.dc_report(self._h, N, address(t), address(y), address(switch),
+                                     address(y_out), address(yp_out), address(channels)) != 0:
             raise DaeclearError("making the reported points consistent in the compiled model failed")
         return y_out, yp_out, channels
 
@@ -360,9 +251,28 @@ class CSession(SessionBase):
         self._check_open()
         act = np.zeros(max(self._nt, 1), dtype=np.int32)
         par = np.zeros(max(sum(self._model.n_params), 1))
-        self._lib.dc_get_active(self._h, act.ctypes.data, par.ctypes.data)
+        self._lib.dc_get_active(self._h, address(act), address(par))
         off = self._poff
         return [bool(a) for a in act[:self._nt]], [par[off[k]:off[k + 1]].copy() for k in range(self._nt)]
+
+    def active_switch(self) -> np.ndarray:
+        """:meth:`active_terms` as a switch vector (each term's flag, then its parameters: the outputs'
+        ``switch`` input, :meth:`daeclear.assembly.dae_model.DAEModel.switch_vector`)."""
+        self._check_open()
+        nt, n_par = self._nt, self._poff[-1]
+        act = np.zeros(max(nt, 1), dtype=np.int32)
+        par = np.zeros(max(n_par, 1))
+        self._lib.dc_get_active(self._h, address(act), address(par))
+        if self._hd.switch_columns is None:  # the library's, kept on the handle (pooled)
+            off = self._poff  # term k: its flag after the earlier terms' columns, then its parameters
+            self._hd.switch_columns = (np.array([k + off[k] for k in range(nt)], dtype=np.intp),
+                                       np.array([k + 1 + j for k in range(nt) for j in range(off[k], off[k + 1])],
+                                                dtype=np.intp))
+        flags, params = self._hd.switch_columns
+        switch = np.empty(nt + n_par)
+        switch[flags] = act[:nt] != 0
+        switch[params] = par[:n_par]
+        return switch
 
     def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
         inputs = [*inputs, self._opts.parameters]
@@ -386,7 +296,7 @@ class CSession(SessionBase):
             else:
                 raise ValueError(f"eval_extra({k}): input {j} has shape {a.shape}, "
                                  f"expected ({n_points}, {size}) or ({size},)")
-            ptrs[j] = a.__array_interface__["data"][0]
+            ptrs[j] = a.__array_interface__["data"][0]  # often read-only (P, a result's rows)
             keep.append(a)
         out = np.empty((n_points, n_out))
         rc = self._lib.dc_eval_extra(k, n_points, len(sizes), ptrs, strides, out.__array_interface__["data"][0], n_out)
@@ -433,7 +343,7 @@ class CSession(SessionBase):
         m = te.size
         ev_y = np.empty((m, n))
         ev_yp = np.empty((m, n))
-        te_p, evy_p, evyp_p = (te.ctypes.data, ev_y.ctypes.data, ev_yp.ctypes.data) if m else (None, None, None)
+        te_p, evy_p, evyp_p = (address(te), address(ev_y), address(ev_yp)) if m else (None, None, None)
         A = self._addr
         self._i_eval.value = 0
         chunks: list[tuple[np.ndarray, ...]] = []
@@ -441,7 +351,7 @@ class CSession(SessionBase):
         store = (STORE_TIMES | (STORE_STATES if store_states else 0)) if store_steps else 0
         if store & STORE_STATES and self._sy is None:  # kept by the handle for the sessions after this one
             self._sy, self._syp = self._hd.sy, self._hd.syp = np.empty((self._cap, n)), np.empty((self._cap, n))
-            A["sy"], A["syp"] = self._sy.ctypes.data, self._syp.ctypes.data
+            A["sy"], A["syp"] = address(self._sy), address(self._syp)
         # times only: the long buffers; without any steps cap counts IDA calls (a streamed run hands
         # its events over every buffer_steps calls, so its memory does not grow with its length)
         cap = self._cap_times if store == STORE_TIMES else self._cap
@@ -592,8 +502,8 @@ class CSession(SessionBase):
     # ---------------------------------------------------------------- stats and lifetime
     def stats(self) -> dict[str, int | float | str]:
         self._check_open()
-        self._lib.dc_stats(self._h, self._statbuf.ctypes.data)
-        out: dict[str, int | float | str] = {k: int(v) for k, v in zip(_STAT_KEYS, self._statbuf)}
+        self._lib.dc_stats(self._h, address(self._statbuf))
+        out: dict[str, int | float | str] = {k: int(v) for k, v in zip(STAT_KEYS, self._statbuf)}
         out["solve_time"] = self._solve_time
         out["compile_time"] = self._build.compile_time
         out["codegen_time"] = self._build.codegen_time
@@ -625,4 +535,4 @@ class CSession(SessionBase):
         session takes it with dc_reset instead of dc_open) or, the pool full, is freed."""
         if not self._closed:
             self._closed = True
-            _put_pooled(self._pool_key(), self._hd)
+            put_pooled(self._pool_key(), self._hd)

@@ -10,14 +10,14 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
-from typing import Literal, overload
+from typing import Any, Literal, overload
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .values import readonly
 
-__all__ = ["EVENT_KINDS", "ContactEvent", "EventKind", "EventList"]
+__all__ = ["EVENT_KINDS", "ContactEvent", "EventKind", "EventList", "EventRows", "flatten"]
 
 EventKind = Literal["onset", "separation"]
 EVENT_KINDS: tuple[str, ...] = ("onset", "separation")
@@ -114,6 +114,43 @@ class ContactEvent:
         )
 
 
+class EventRows(Sequence[ContactEvent]):
+    """Events of one advance of the compiled loop kept as columns (times, pairs, kinds, approach speeds
+    and the read-only block of their states), made into :class:`ContactEvent` objects when first read."""
+
+    __slots__ = ("_columns", "_made")
+
+    def __init__(self, t: list[float], pair: list[str], kind: list[str], approach_speed: list[float],
+                 y: NDArray[np.float64]) -> None:
+        self._columns = (t, pair, kind, approach_speed, y)
+        self._made: tuple[ContactEvent, ...] | None = None
+
+    def _events(self) -> tuple[ContactEvent, ...]:
+        if self._made is None:
+            self._made = tuple(map(ContactEvent.of_readonly_row, *self._columns))
+        return self._made
+
+    def __len__(self) -> int:
+        return len(self._columns[0])
+
+    def __getitem__(self, index: Any) -> Any:
+        return self._events()[index]
+
+    def __iter__(self) -> Iterator[ContactEvent]:
+        return iter(self._events())
+
+
+def flatten(parts: Iterable[ContactEvent | EventRows]) -> list[ContactEvent]:
+    """Events and blocks of events as one list of events, in order."""
+    out: list[ContactEvent] = []
+    for part in parts:
+        if type(part) is EventRows:
+            out.extend(part)
+        else:
+            out.append(part)  # type: ignore[arg-type]
+    return out
+
+
 class EventList(Sequence[ContactEvent]):
     """An immutable, list-like sequence of `ContactEvent`, in the solver's (time) order.
 
@@ -127,14 +164,30 @@ class EventList(Sequence[ContactEvent]):
     >>> onsets.t, onsets.approach_speed                # doctest: +SKIP
     """
 
-    __slots__ = ("_events",)
+    __slots__ = ("_items", "_parts")
 
     def __init__(self, events: Iterable[ContactEvent] = ()) -> None:
         items = tuple(events)
         for i, event in enumerate(items):
             if not isinstance(event, ContactEvent):
                 raise TypeError(f"events[{i}] is a {type(event).__name__}, expected a ContactEvent.")
-        self._events: tuple[ContactEvent, ...] = items
+        self._items: tuple[ContactEvent, ...] | None = items
+        self._parts: list[ContactEvent | EventRows] | None = None
+
+    @classmethod
+    def of_parts(cls, parts: list[ContactEvent | EventRows]) -> EventList:
+        """A solver's events, unchecked: events and blocks of them (:class:`EventRows`), in time order,
+        made one sequence at the first read (a sweep's runs are seldom asked for every event)."""
+        events = cls.__new__(cls)
+        events._items, events._parts = None, parts
+        return events
+
+    @property
+    def _events(self) -> tuple[ContactEvent, ...]:
+        if self._items is None:
+            assert self._parts is not None
+            self._items, self._parts = tuple(flatten(self._parts)), None
+        return self._items
 
     @overload
     def __getitem__(self, index: int) -> ContactEvent: ...

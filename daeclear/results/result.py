@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import DaeclearError
 from ..options import close_matches
 from . import export
-from .events import EVENT_KINDS, ContactEvent, EventKind, EventList
+from .events import EVENT_KINDS, ContactEvent, EventKind, EventList, EventRows
 from .hdf5_read import read_dataset, read_file, read_group
 from .hdf5_stream import STREAM_RUNNING, ResultWriter
 from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, save_result, write_result_group
@@ -226,15 +226,15 @@ class Result:
 
     @classmethod
     def of_run(cls, *, t: NDArray, y: NDArray, yp: NDArray, state_names: Sequence[str], channels: Mapping[str, NDArray],
-               units: Mapping[str, str], events: Iterable[ContactEvent],
+               units: Mapping[str, str], events: Iterable[ContactEvent | EventRows],
                segments: list[tuple[float, float, dict[str, str]]], step_t: NDArray, step_h: NDArray,
                step_order: NDArray, **outcome: Any) -> Result:
         """A solver's Result, from the data its recorder joined: float64 arrays of matching shapes,
-        channels and units of the model, events in time order, segments as (float, float, modes);
+        channels and units of the model, events (and blocks of them) in time order, segments as (float, float, modes);
         ``outcome``: every other keyword of the constructor (stats ... warnings). The constructor's
         checks are skipped, and ``parameters`` (the solver's plain data) are copied at their first read."""
         result = cls.__new__(cls)
-        result._assign(t, y, yp, list(state_names), channels, units, EventList(events), segments,
+        result._assign(t, y, yp, list(state_names), channels, units, EventList.of_parts(list(events)), segments,
                        (step_t, step_h, step_order), {**outcome, "parameters": (outcome["parameters"],)})
         return result
 

@@ -30,7 +30,8 @@ from ..engine.session_base import AutoEvents
 from ..errors import Interrupted, SolveError
 from .recorder import Recorder
 from ..progress import Progress
-from ..results.result import ContactEvent, Result
+from ..results.events import EventRows
+from ..results.result import Result
 
 #: Output times handed to the compiled loop at a time: their rows are emptied between windows.
 EVAL_WINDOW = 4096
@@ -184,7 +185,7 @@ class SegmentLoop:
         """Record the switches the compiled loop decided in one advance: events, modes and segments
         in time order, and each pair's final state in its logic. Return the restart times and the
         switch vectors before the first restart and after each."""
-        events, segments, modes, info = self.events, self.segments, self.modes, self.auto_info
+        segments, modes, info = self.segments, self.modes, self.auto_info
         switch = self.switch.tolist()  # plain floats while recording: one array at the end
         switches: list[list[float]] = [switch]
         times: list[float] = []
@@ -194,9 +195,10 @@ class SegmentLoop:
         term_on = (auto.info[:, 1] | auto.info[:, 2]).tolist()
         ys = auto.y
         ys.flags.writeable = False  # the events own its rows (read-only views)
-        new_event = ContactEvent.of_readonly_row
-        for i, (t, p, rate, latched, y) in enumerate(zip(auto.t.tolist(), auto.pair.tolist(), auto.rate.tolist(),
-                                                         auto.latched.tolist(), ys)):
+        event_t, pairs = auto.t.tolist(), auto.pair.tolist()
+        names = [info[p][2] for p in pairs]
+        self.rec.add_event_rows(EventRows(event_t, names, [EVENT_KINDS[k] for k in kinds], auto.rate.tolist(), ys))
+        for i, (t, p, latched) in enumerate(zip(event_t, pairs, auto.latched.tolist())):
             if not times or t != times[-1]:  # a restart: the segment before it ends
                 segments.append((self.seg_start, t, dict(modes)))
                 self.seg_start = t
@@ -205,7 +207,6 @@ class SegmentLoop:
                 switches.append(switch)
             _, _, name, column, needs = info[p]
             kind = kinds[i]
-            events.append(new_event(t, name, EVENT_KINDS[kind], rate, y))
             modes[name] = "contact" if kind == ONSET else "free"
             switch[column] = 1.0 if term_on[i] else 0.0  # as the compiled loop sets its term
             if needs:
@@ -225,7 +226,7 @@ class SegmentLoop:
     def check_decisions(self, adv: Any) -> None:
         """Turn the advance into an internal error when the compiled loop and Python disagree."""
         if adv.auto_events is not None and not (
-                _same_terms(self.session.active_terms(), self.active, self.params)
+                np.array_equal(self.session.active_switch(), self.switch)
                 and np.array_equal(self.switch, self.model.switch_vector(self.active, self.params))):
             adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
             adv.message = "internal: the compiled event loop and the recorded contact modes disagree"
@@ -340,11 +341,6 @@ def _eval_window(times: opts.OutputTimes, i: int, t: float, size: int) -> tuple[
             return i + lo, window[lo:]
         i += window.size
     return i, np.zeros(0)
-
-
-def _same_terms(c_terms: tuple[list[bool], list[NDArray]], active: Sequence[bool], params: Sequence[NDArray]) -> bool:
-    """The compiled loop's active terms and parameters are those recorded from its decisions."""
-    return c_terms[0] == list(active) and all(np.array_equal(a, b) for a, b in zip(c_terms[1], params))
 
 
 def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import physics
+from ..results.events import EventRows, flatten
 from ..results.result import ContactEvent, Result, ResultWriter, load
 
 
@@ -34,7 +35,8 @@ class Recorder:
                  stream_to: Path | None = None, keep_data: bool = True) -> None:
         self.model = model
         self.keep_data = keep_data
-        self.events: list[ContactEvent] = []
+        self.events: list[ContactEvent | EventRows] = []  # events, and blocks of the compiled loop's
+        self._in_blocks = 0  # events in the blocks of ``events`` beyond one a block
         self.segments: list[tuple[float, float, dict[str, str]]] = []
         self._written_events = 0
         self.interrupted = False  # a Ctrl-C arrived while finish() completed the file
@@ -50,7 +52,12 @@ class Recorder:
     @property
     def n_events(self) -> int:
         """Events of the run so far (written and pending)."""
-        return self._written_events + len(self.events)
+        return self._written_events + len(self.events) + self._in_blocks
+
+    def add_event_rows(self, rows: EventRows) -> None:
+        """A block of events (the compiled loop's of one advance), kept as columns."""
+        self.events.append(rows)
+        self._in_blocks += len(rows) - 1
 
     def add_points(self, t: NDArray, y: NDArray, yp: NDArray, channels: dict[str, NDArray]) -> None:
         """Reported points, consistent: one row per time of ``t``."""
@@ -74,9 +81,11 @@ class Recorder:
     def flush(self) -> None:
         """Write the events and segments added since the last flush (streamed only)."""
         if self.writer is not None and (self.events or self.segments):
-            self.writer.append(events=self.events, segments=self.segments)
-            self._written_events += len(self.events)
+            events = flatten(self.events)
+            self.writer.append(events=events, segments=self.segments)
+            self._written_events += len(events)
             self.events.clear()
+            self._in_blocks = 0
             self.segments.clear()
 
     def _keep_key_rows(self, t: NDArray, y: NDArray, channels: dict[str, NDArray]) -> None:

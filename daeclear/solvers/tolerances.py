@@ -7,6 +7,7 @@ for it.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -40,7 +41,6 @@ def positive(name: str, value: Any, unit: str, allow_zero: bool = False) -> floa
 
 def tolerance_vector(model: DAEModel, rtol: float, atol: float | ArrayLike | None) -> NDArray[np.float64]:
     """Absolute tolerances per state: q and v from ``atol``; multipliers out of the error test."""
-    kinds = np.array(model.state_kinds)
     if atol is None:
         vec = np.full(model.n_states, DEFAULT_ATOL_FACTOR * rtol)
     elif np.ndim(atol) == 0:
@@ -53,6 +53,13 @@ def tolerance_vector(model: DAEModel, rtol: float, atol: float | ArrayLike | Non
                 f"positive values (one per state: {', '.join(model.state_names[:4])}, ...)."
             )
         return vec
-    vec[kinds == KIND_MULTIPLIER] = max(MULTIPLIER_ATOL_FACTOR * rtol, MULTIPLIER_ATOL_FLOOR)
-    vec[kinds == KIND_WORK] = 1e30  # a pure quadrature: out of the error test, the solution is unchanged
+    multipliers, work = _out_of_error_test(model.state_kinds)
+    vec[multipliers] = max(MULTIPLIER_ATOL_FACTOR * rtol, MULTIPLIER_ATOL_FLOOR)
+    vec[work] = 1e30  # a pure quadrature: out of the error test, the solution is unchanged
     return vec
+
+
+@functools.lru_cache(maxsize=16)
+def _out_of_error_test(kinds: tuple[str, ...]) -> tuple[list[int], list[int]]:
+    """Indices of the multipliers and of the work state (a structure's, kept: a sweep's runs share them)."""
+    return [i for i, k in enumerate(kinds) if k == KIND_MULTIPLIER], [i for i, k in enumerate(kinds) if k == KIND_WORK]
