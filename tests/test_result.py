@@ -358,6 +358,35 @@ def test_event_list_filters_and_fields() -> None:
         ContactEvent(0.0, "C", "impact", 0.0, y)  # type: ignore[arg-type]
 
 
+def test_event_blocks_read_as_the_events_they_hold() -> None:
+    """A solver's events given as ContactEvents and column blocks (the compiled loop's EventRows) read
+    as one EventList in their order; a block makes its events only when read, with read-only states;
+    the recorder counts every event of a block."""
+    from daeclear.results.events import EventRows, flatten
+    from daeclear.solvers.recorder import Recorder
+
+    ys = np.arange(6.0).reshape(3, 2)
+    ys.flags.writeable = False
+    block = EventRows([0.2, 0.3, 0.3], ["C", "C", "D"], ["onset", "separation", "onset"], [0.5, math.nan, 0.1], ys)
+    first = ContactEvent(0.1, "C", "separation", math.nan, np.zeros(2))
+    assert len(block) == 3 and block._made is None  # nothing made by asking the length
+    events = EventList.of_parts([first, block, ContactEvent(0.4, "D", "separation", math.nan, np.ones(2))])
+    expected = [first, *(ContactEvent(t, p, k, a, y) for t, p, k, a, y in
+                         zip([0.2, 0.3, 0.3], "CCD", ["onset", "separation", "onset"], [0.5, math.nan, 0.1], ys))]
+    assert list(events)[:4] == expected and len(events) == 5 and events.t.tolist() == [0.1, 0.2, 0.3, 0.3, 0.4]
+    assert events.of("D").kind == ["onset", "separation"] and events[2].y.tolist() == [2.0, 3.0]
+    assert not events[1].y.flags.writeable and events[1:3] == expected[1:3]
+    assert flatten([block, first]) == [*expected[1:], first]
+
+    class _Model:
+        state_names, channel_units, scene_name, formulation, n_states = ("a", "b"), {}, "s", "ggl", 2
+
+    rec = Recorder(_Model(), parameters={}, method="ida")
+    rec.events.append(first)
+    rec.add_event_rows(block)
+    assert rec.n_events == 4
+
+
 def test_event_from_solver_equals_the_checked_constructor() -> None:
     """The contact logic's fast path builds the same event as the constructor: equal fields, a
     float time and speed, and a state that cannot be changed through the event."""

@@ -226,7 +226,8 @@ def _root_dirs(model: NormalizedModel, rd: Any, what: str = "root_directions") -
     arr = np.asarray(rd)
     if arr.shape != (model.n_roots,):
         raise ValueError(f"{what} must have shape ({model.n_roots},), got {arr.shape}")
-    if arr.size and (arr.min() < -1 or arr.max() > 1 or not np.array_equal(arr, np.round(arr))):
+    # (element-wise tests, not np.array_equal and min/max: this runs at every restart)
+    if not (((arr >= -1) & (arr <= 1)).all() and (arr.dtype.kind in "biu" or (arr == np.round(arr)).all())):
         raise ValueError(f"{what} values must be -1, 0 or +1, got {arr.tolist()}")
     return np.ascontiguousarray(arr, dtype=np.int32)
 

@@ -226,8 +226,8 @@ class SegmentLoop:
     def check_decisions(self, adv: Any) -> None:
         """Turn the advance into an internal error when the compiled loop and Python disagree."""
         if adv.auto_events is not None and not (
-                np.array_equal(self.session.active_switch(), self.switch)
-                and np.array_equal(self.switch, self.model.switch_vector(self.active, self.params))):
+                _equal(self.session.active_switch(), self.switch)
+                and _equal(self.switch, self.model.switch_vector(self.active, self.params))):
             adv.status, adv.flag_name = "error", "DC_EVENT_MISMATCH"
             adv.message = "internal: the compiled event loop and the recorded contact modes disagree"
         elif self.c_decides and adv.status == "root":
@@ -341,6 +341,11 @@ def _eval_window(times: opts.OutputTimes, i: int, t: float, size: int) -> tuple[
             return i + lo, window[lo:]
         i += window.size
     return i, np.zeros(0)
+
+
+def _equal(a: NDArray, b: NDArray) -> bool:
+    """np.array_equal of two float vectors, without its Python layers (checked at every advance)."""
+    return a.shape == b.shape and bool((a == b).all())
 
 
 def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:

@@ -99,7 +99,7 @@ def check_run(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channe
 def _worst_drift_row(drift: NDArray[np.float64]) -> int:
     """The row of the largest constraint drift, NaN never (np.nanargmax without its overhead): the
     first of equal ones. ``drift`` has a finite value."""
-    return int(np.argmax(np.where(np.isnan(drift), -np.inf, drift)))
+    return int(np.where(np.isnan(drift), -np.inf, drift).argmax())
 
 
 def key_rows(t: NDArray[np.float64], channels: dict[str, NDArray[np.float64]]) -> NDArray[np.intp]:
@@ -112,7 +112,7 @@ def key_rows(t: NDArray[np.float64], channels: dict[str, NDArray[np.float64]]) -
     rows = {0}
     for name, values in channels.items():
         if name.endswith(".penetration") and values.size:
-            rows.add(int(np.argmax(np.where(np.isfinite(values), values, -np.inf))))
+            rows.add(int(np.where(np.isfinite(values), values, -np.inf).argmax()))
     drift = channels.get("constraints.position")
     if drift is not None and drift.size and np.isfinite(drift).any():
         rows.add(_worst_drift_row(drift))

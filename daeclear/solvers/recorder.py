@@ -12,6 +12,7 @@ checked exactly as a run kept in memory.
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 from typing import Any
 from collections.abc import Mapping
@@ -89,7 +90,7 @@ class Recorder:
             self.segments.clear()
 
     def _keep_key_rows(self, t: NDArray, y: NDArray, channels: dict[str, NDArray]) -> None:
-        names = [c for c in channels if c.endswith(".penetration") or c == "constraints.position"]
+        names = _key_channels(tuple(channels))
         kt, ky, kc = self._key
         if kt.size:  # the rows kept so far compete with the new ones
             t2, y2 = np.concatenate([kt, t]), np.concatenate([ky, y])
@@ -148,3 +149,10 @@ class Recorder:
                 self.flush()
             finally:
                 self.writer.abort(f"stopped by {type(error).__name__}: {error}")
+
+
+@functools.lru_cache(maxsize=16)
+def _key_channels(names: tuple[str, ...]) -> tuple[str, ...]:
+    """The channels the physics checks read (:func:`daeclear.solvers.physics.key_rows`), of a model's
+    channel names (a structure's: a sweep's runs share them)."""
+    return tuple(c for c in names if c.endswith(".penetration") or c == "constraints.position")
