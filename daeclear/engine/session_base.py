@@ -226,8 +226,7 @@ def _root_dirs(model: NormalizedModel, rd: Any, what: str = "root_directions") -
     arr = np.asarray(rd)
     if arr.shape != (model.n_roots,):
         raise ValueError(f"{what} must have shape ({model.n_roots},), got {arr.shape}")
-    # (element-wise tests, not np.array_equal and min/max: this runs at every restart)
-    if not (((arr >= -1) & (arr <= 1)).all() and (arr.dtype.kind in "biu" or (arr == np.round(arr)).all())):
+    if not all(d in (-1, 0, 1) for d in arr.tolist()):  # (not numpy's min, max and round: at every restart)
         raise ValueError(f"{what} values must be -1, 0 or +1, got {arr.tolist()}")
     return np.ascontiguousarray(arr, dtype=np.int32)
 
@@ -248,7 +247,7 @@ def check_options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, m
         a = np.full(model.n, float(a))
     if a.shape != (model.n,):
         raise ValueError(f"atol must be a scalar or have shape ({model.n},), got {a.shape}")
-    if not np.all(np.isfinite(a) & (a > 0)):
+    if not (np.isfinite(a) & (a > 0)).all():
         raise ValueError(f"atol must be positive and finite, got {a.tolist()}")
     max_step = float(max_step)
     if not (max_step >= 0 and math.isfinite(max_step)):
@@ -441,10 +440,9 @@ class SessionBase:
         if t_eval is None:
             return _EMPTY
         te = np.asarray(t_eval, dtype=float).reshape(-1)
-        lo = int(np.searchsorted(te, self.eval_from, side="right"))
-        hi = int(np.searchsorted(te, t_stop, side="right"))
+        lo, hi = te.searchsorted((self.eval_from, t_stop), side="right").tolist()
         sel = np.ascontiguousarray(te[lo:hi])
-        if sel.size > 1 and np.any(np.diff(sel) < 0):
+        if sel.size > 1 and (sel[1:] < sel[:-1]).any():
             raise ValueError("t_eval must be sorted in increasing order")
         return sel
 

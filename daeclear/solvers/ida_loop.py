@@ -177,7 +177,7 @@ class SegmentLoop:
             switch = np.broadcast_to(self.switch, (rows[0].size, self.switch.size))
         else:  # a row at a restart's time belongs to the segment that ends there
             times, switches = self.record_switches(adv.auto_events)
-            ends = [0, *np.searchsorted(rows[0], times, side="right").tolist(), rows[0].size]
+            ends = [0, *rows[0].searchsorted(times, side="right").tolist(), rows[0].size]
             switch = np.repeat(switches, [b - a for a, b in zip(ends, ends[1:])], axis=0)
         self.raw.append((*rows, switch))
 
@@ -336,7 +336,7 @@ def _eval_window(times: opts.OutputTimes, i: int, t: float, size: int) -> tuple[
     """The output times after ``t`` from index ``i`` on, at most ``size``: (index of the first, times)."""
     while i < times.size:
         window = times.window(i, i + size)
-        lo = int(np.searchsorted(window, t, side="right"))
+        lo = int(window.searchsorted(t, side="right"))
         if lo < window.size:
             return i + lo, window[lo:]
         i += window.size
@@ -344,8 +344,9 @@ def _eval_window(times: opts.OutputTimes, i: int, t: float, size: int) -> tuple[
 
 
 def _equal(a: NDArray, b: NDArray) -> bool:
-    """np.array_equal of two float vectors, without its Python layers (checked at every advance)."""
-    return a.shape == b.shape and bool((a == b).all())
+    """np.array_equal of two short float vectors (NaN unequal), as lists: numpy's all() and
+    array_equal run Python layers, and this is checked at every advance."""
+    return a.shape == b.shape and a.tolist() == b.tolist()
 
 
 def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:
