@@ -702,3 +702,44 @@ def test_a_pooled_session_evaluates_extras_with_its_own_parameters():
     assert handles[0] is handles[1] and handles[0].extra_meta  # the second took the first's, sizes kept
     difference = channels[id(first)]["clearance.penetration"] - channels[id(second)]["clearance.penetration"]
     np.testing.assert_allclose(difference, 2e-4, rtol=1e-9)  # the clearances' difference
+
+
+def test_report_equals_the_models_python_evaluation_and_writes_into_given_arrays():
+    """dc_report makes reported points consistent and evaluates the channels, one contiguous row per
+    channel: equal to the model's own (CasADi) evaluation of the same points; written into the
+    caller's arrays (``into``, the state array itself included) it gives the same numbers, and an
+    array of another shape is refused before any work."""
+    import daeclear as dc
+
+    model = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=1e-4), "index1")
+    y0, yp0 = model.initial_state()
+    s = open_session(model.functions, backend="c", rtol=1e-8, atol=1e-10, parameters=model.parameter_values)
+    assert s.set_layout(model.layout(project=False))
+    active, params = [False] * len(model.terms), [np.full(term.n_params, 0.3) for term in model.terms]
+    s.reinit(0.0, y0, yp0, active, params)  # the journal centred: free flight (its force is NaN at e = 0)
+    times, rows = np.linspace(1e-4, 2e-3, 7), []
+    for _ in range(20):  # on through the roots (a gap crossing zero), in free flight
+        adv = s.advance(2e-3, t_eval=times)
+        assert adv.status in ("root", "tstop"), adv.message
+        rows.append((adv.eval_t, adv.eval_y))
+        if adv.status == "tstop":
+            break
+    t, y = (np.concatenate(column) for column in zip(*rows))
+    assert t.size == 7
+    switch = np.tile(model.switch_vector(active, params), (t.size, 1))
+    y_c, yp_c, channels = s.report(t, y, switch)
+    assert channels.shape == (len(model.channel_names), t.size) and channels[0].flags.c_contiguous
+    y_py, yp_py = model.consistent_state(t, y, model.term_forces_rows(t, y, switch, None), None)  # CasADi
+    np.testing.assert_allclose(y_c, y_py, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(yp_c, yp_py, rtol=1e-9, atol=1e-9)
+    by_model = model.channels(t, y_py, yp_py, switch, None)
+    for name, row in zip(model.channel_names, channels):
+        np.testing.assert_allclose(row, by_model[name], rtol=1e-9, atol=1e-12, err_msg=name)
+    y_own, yp_own = y.copy(), np.full_like(y, np.nan)
+    again = s.report(t, y_own, switch, into=(y_own, yp_own))
+    assert again[0] is y_own and again[1] is yp_own
+    for a, b in zip(again, (y_c, yp_c, channels)):
+        np.testing.assert_array_equal(a, b)
+    with pytest.raises(ValueError, match="into"):
+        s.report(t, y, switch, into=(y.copy(), np.empty((t.size + 1, model.n_states))))
+    s.close()

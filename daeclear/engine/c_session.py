@@ -198,16 +198,26 @@ class CSession(SessionBase):
         self._n_channels = L.n_channels
         return True
 
-    def report(self, t: np.ndarray, y: np.ndarray, switch: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The reported points made consistent in one C pass: (y with recomputed multipliers, yp,
-        output channels), one row per time (see ``dc_report``); after :meth:`set_layout`."""
+    def report(self, t: np.ndarray, y: np.ndarray, switch: np.ndarray, *,
+               into: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The reported points made consistent in one C pass: (y with recomputed multipliers and yp,
+        one row per time; the output channels, one contiguous row per channel; see ``dc_report``),
+        after :meth:`set_layout`. ``into``: the caller's own (y, yp) arrays to write them to (y may be
+        the ``y`` given), float64 and C-contiguous of shape (times, n): a run's output made no copy."""
         self._check_open()
         t = np.ascontiguousarray(t, dtype=float)
         y = np.ascontiguousarray(y, dtype=float)
         switch = np.ascontiguousarray(switch, dtype=float)
         N = t.size
-        y_out, yp_out = np.empty((N, self._n)), np.empty((N, self._n))
-        channels = np.empty((N, self._n_channels))
+        if into is None:
+            y_out, yp_out = np.empty((N, self._n)), np.empty((N, self._n))
+        else:
+            y_out, yp_out = into
+            for a in into:
+                if a.shape != (N, self._n) or a.dtype != np.float64 or not (a.flags.c_contiguous and a.flags.writeable):
+                    raise ValueError(f"report: into holds a {a.dtype} array of shape {a.shape}; each must be a "
+                                     f"writable C-contiguous float64 array of shape ({N}, {self._n})")
+        channels = np.empty((self._n_channels, N))
         if N and self._lib.dc_report(self._h, N, address(t), address(y), address(switch),
                                      address(y_out), address(yp_out), address(channels)) != 0:
             raise DaeclearError("making the reported points consistent in the compiled model failed")

@@ -267,17 +267,17 @@ class SegmentLoop:
         point's q and v with that point's contact modes (point by point: chunks change nothing)."""
         model, session, raw = self.model, self.session, self.raw
         if raw:
-            if len(raw) == 1:
-                out_t, out_y, out_yp, out_switch = raw[0]
-            else:
+            joined = len(raw) > 1  # joined arrays are the loop's own: made consistent in place
+            if joined:
                 out_t, out_y, out_yp, out_switch = (np.concatenate(column) for column in zip(*raw))
+            else:
+                out_t, out_y, out_yp, out_switch = raw[0]
             raw.clear()
             if self.c_layout:  # one pass in C
-                out_y, out_yp, values = session.report(out_t, out_y, out_switch)
-                # one transposed copy, read-only: each channel is a contiguous (read-only) row of it
-                block = values.T.copy()
-                block.flags.writeable = False
-                channels = dict(zip(model.channel_names, block))
+                out_y, out_yp, values = session.report(out_t, out_y, out_switch,
+                                                       into=(out_y, out_yp) if joined else None)
+                values.flags.writeable = False  # each channel is a contiguous (read-only) row of it
+                channels = dict(zip(model.channel_names, values))
             else:
                 out_y, out_yp = model.consistent_state(
                     out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)

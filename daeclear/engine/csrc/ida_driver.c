@@ -279,7 +279,7 @@ typedef struct {
   int proj_on;        /* restarts after a switch decided in C: project q and v on the manifold */
   int proj_iter;
   double proj_tol;    /* |Phi| < proj_tol * max(1, |q|) ends the position Newton */
-  double* lay_buf;    /* Qc, Fk (nq each), sol (nq + m + 1), K (2m + m nq), G (m m), x (m), par */
+  double* lay_buf;    /* Qc, Fk (nq each), sol (nq + m + 1), K (2m + m nq), G (m m), x (m), par, channels */
   const double** xarg; /* CasADi work memory for the extras, sized for the largest (dc_set_layout) */
   double** xres;
   dc_int* xiw;
@@ -1531,7 +1531,9 @@ DC_API int dc_set_layout(void* sp, int nq, int m, int ggl, int track_work, int a
   free(s->lay_on);
   int np = 0;
   for (int k = 0; k < s->n_terms; ++k) np += dc_model.n_params[k];
-  s->lay_buf = (double*)xcalloc((size_t)(3 * nq + m + 1 + 2 * m + m * nq + m * m + m + np), sizeof(double));
+  const dc_int* sp_out = dc_extra_tab[outputs_extra].sparsity_out(0);
+  const int nc = (int)(sp_out[0] * sp_out[1]);
+  s->lay_buf = (double*)xcalloc((size_t)(3 * nq + m + 1 + 2 * m + m * nq + m * m + m + np + nc), sizeof(double));
   s->lay_on = (int*)xcalloc((size_t)s->n_terms, sizeof(int));
   if (!s->lay_buf || !s->lay_on) return -1;
   s->lay_nq = nq;
@@ -1563,9 +1565,8 @@ DC_API int dc_set_layout(void* sp, int nq, int m, int ggl, int track_work, int a
     s->xw = (double*)xcalloc((size_t)sw, sizeof(double));
     s->xnz = (double*)xcalloc((size_t)snz, sizeof(double));
     if (!s->xarg || !s->xres || !s->xiw || !s->xw || !s->xnz) return -1;
-    const dc_int* sp_out = dc_extra_tab[outputs_extra].sparsity_out(0);
-    s->lay_n_channels = (int)(sp_out[0] * sp_out[1]);
   }
+  s->lay_n_channels = nc;
   if (s->lin_kind == DC_LS_REDUCED && rls_set_kinematic_rows(s->LS, nq) != 0) return -1;
   s->lay_ready = 1;
   return 0;
@@ -1573,19 +1574,21 @@ DC_API int dc_set_layout(void* sp, int nq, int m, int ggl, int track_work, int a
 
 /* The reported points of a run, made consistent in one pass: for each of the n_points rows of y
  * (IDA's states) with its switch row (per term: on flag, then its parameters), write the state
- * with recomputed multipliers to y_out, its derivative to yp_out and the output channels to
- * channels_out (dc_set_layout first). */
+ * with recomputed multipliers to y_out (which may be y itself), its derivative to yp_out and the
+ * output channels to channels_out, channel by channel: channel c of point i at c * n_points + i,
+ * so that each channel is one contiguous row (dc_set_layout first). */
 DC_API int dc_report(void* sp, int n_points, const double* t, const double* y, const double* sw, double* y_out,
                      double* yp_out, double* channels_out) {
   dc_session* s = (dc_session*)sp;
   if (!s->lay_ready || n_points < 0) return -1;
   const int n = s->n, ns = s->lay_n_switch, nc = s->lay_n_channels;
   double* par = s->lay_buf + 3 * s->lay_nq + 3 * s->lay_m + 1 + s->lay_m * s->lay_nq + s->lay_m * s->lay_m + s->lay_m;
+  double* row = par + s->lay_n_switch - s->n_terms; /* one point's channels (after the parameters) */
   for (int i = 0; i < n_points; ++i) {
     double* yi = y_out + (size_t)i * n;
     double* ypi = yp_out + (size_t)i * n;
     const double* si = sw + (size_t)i * ns;
-    memcpy(yi, y + (size_t)i * n, sizeof(double) * (size_t)n);
+    if (yi != y + (size_t)i * n) memcpy(yi, y + (size_t)i * n, sizeof(double) * (size_t)n);
     for (int k = 0, off = 0; k < s->n_terms; ++k) {
       s->lay_on[k] = si[off] > 0.0;
       memcpy(par + s->param_off[k], si + off + 1, sizeof(double) * (size_t)dc_model.n_params[k]);
@@ -1593,7 +1596,8 @@ DC_API int dc_report(void* sp, int n_points, const double* t, const double* y, c
     }
     if (make_consistent(s, t[i], yi, ypi, s->lay_on, par) != 0) return -1;
     const double* in_o[5] = {t + i, yi, ypi, si, s->P};
-    if (eval_extra1(s, s->lay_outputs, 5, in_o, channels_out + (size_t)i * nc) != 0) return -1;
+    if (eval_extra1(s, s->lay_outputs, 5, in_o, row) != 0) return -1;
+    for (int c = 0; c < nc; ++c) channels_out[(size_t)c * (size_t)n_points + (size_t)i] = row[c];
   }
   return 0;
 }
