@@ -135,7 +135,8 @@ def _element_parameters(ref: Reference, element: Any, joints: dict[str, Any]
     else:
         raise AssemblyError(f"{element.kind} '{element.name}': element type not supported by assemble().")
     named = entries(element.name, values)
-    return named, repr([element.name, flags, [(name, len(value)) for name, value in named]])
+    sizes = ",".join([f"{name}:{len(value)}" for name, value in named])
+    return named, "\x02".join([element.name, repr(flags), sizes])  # flags: texts (law_structure) or None
 
 
 @dataclass(frozen=True)

@@ -140,7 +140,7 @@ def _mask(value: Any) -> Any:
 
 
 def _mask_fields(value: Any) -> list[Any]:
-    return [type(value).__name__, {f.name: _mask(getattr(value, f.name)) for f in dataclasses.fields(value)}]
+    return [type(value).__name__, {name: _mask(getattr(value, name)) for name in field_names(type(value))}]
 
 
 def element_structure(element: Any) -> str:
@@ -197,8 +197,8 @@ _KEYS: dict[str, str] = memo_table()
 # ---- laws ------------------------------------------------------------------------------
 
 def _numeric_fields(law: Any) -> list[str]:
-    return [f.name for f in dataclasses.fields(law)
-            if isinstance(getattr(law, f.name), (int, float)) and not isinstance(getattr(law, f.name), bool)]
+    return [name for name in field_names(type(law))
+            if isinstance(value := getattr(law, name), (int, float)) and not isinstance(value, bool)]
 
 
 _PARAMETRIC: dict[type, bool] = {}
@@ -286,10 +286,10 @@ def symbolic_law(law: Any, symbols: dict[str, Any], prefix: str) -> Any:
     return _twin(law, {name: symbols[f"{prefix}.{name}"][0] for name in _numeric_fields(law)})
 
 
-def law_structure(law: Any) -> list[Any]:
-    """What of a law decides the equations' shape: its class, the flags the assembly branches
-    on, which fields are set, and all its numbers when it is baked (kept on the frozen law)."""
-    return kept(law, "_law_structure", _law_structure)
+def law_structure(law: Any) -> str:
+    """What of a law decides the equations' shape, as text: its class, the flags the assembly
+    branches on, which fields are set, and all its numbers when it is baked (kept on the frozen law)."""
+    return kept(law, "_law_structure", lambda each: repr(_law_structure(each)))
 
 
 def _law_structure(law: Any) -> list[Any]:

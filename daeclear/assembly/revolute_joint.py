@@ -22,7 +22,7 @@ from .translational_joint import (
     TranslationalClearance, build_translational_clearance, translational_clearance_parameters)
 
 
-def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> tuple[dict[str, Any], list[Any]]:
+def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> tuple[dict[str, Any], list[str]]:
     """The joint's numbers (run-time parameters) and what of it is structure."""
     law, friction = joint.resolved_law(), joint.resolved_friction()
     s_i, s_j = ref.joint_points(joint)
