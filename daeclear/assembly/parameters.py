@@ -144,9 +144,9 @@ def _mask_fields(value: Any) -> list[Any]:
 
 
 def element_structure(element: Any) -> str:
-    """An element's description (``to_dict``) without the fields of its ``NOT_STRUCTURE`` and with
-    every number masked, as text; kept on a frozen element (it follows from the fields alone), so
-    the elements the scenes of a sweep share are described once."""
+    """An element's class and fields, but those of its ``NOT_STRUCTURE``, with every number masked, as
+    text (a field with a description, ``to_dict``, as that description masked); kept on a frozen
+    element (it follows from the fields alone), so the elements a sweep's scenes share are described once."""
     return kept(element, "_structure_text", _element_structure)
 
 

@@ -61,10 +61,7 @@ TIMES_ROWS_PER_STATE_ROW = 16
 
 class Handle:
     """One C session (dc_open) and the buffers the loop fills: what depends on the library, its
-    linear solver, max_order and buffer_steps alone. A closed CSession's handle goes to a small
-    pool; the next session of the same library and settings takes it, re-armed by dc_reset (a
-    reset session runs step for step as a new one), instead of opening and freeing another:
-    dc_open and dc_free cost more than the Python around a short run. Freed when collected."""
+    linear solver, max_order and buffer_steps alone (see the module docstring). Freed when collected."""
 
     def __init__(self, lib: Any, h: int, n: int, nr: int, nt: int, n_params: int, buffer_steps: int) -> None:
         self.lib, self.h = lib, h

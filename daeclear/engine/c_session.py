@@ -64,7 +64,6 @@ _LS_NAMES = {code: name for name, code in _LS_CODES.items()}
 log = logging.getLogger("daeclear")
 
 
-
 def _resolve_linear_solver(requested: str, n: int, has_sparse: bool) -> str:
     """The linear solver a compiled session uses: "auto" is sparse from SPARSE_MIN_STATES states on
     (when the library has the sparse solver), the reduced dense LU below."""
@@ -256,32 +255,34 @@ class CSession(SessionBase):
         return [Decision(int(out_i[0, i]), bool(out_i[1, i]), bool(out_i[2, i]), float(out_l[i]), int(out_i[3, i]))
                 for i in range(n)]
 
-    def active_terms(self) -> tuple[list[bool], list[np.ndarray]]:
-        """The active flags and parameters the C loop integrates with now."""
+    def _terms_in_c(self) -> tuple[np.ndarray, np.ndarray]:
+        """The C loop's active flags (one per term) and its terms' parameters, concatenated (dc_get_active)."""
         self._check_open()
         act = np.zeros(max(self._nt, 1), dtype=np.int32)
-        par = np.zeros(max(sum(self._model.n_params), 1))
+        par = np.zeros(max(self._poff[-1], 1))
         self._lib.dc_get_active(self._h, address(act), address(par))
+        return act[:self._nt], par[:self._poff[-1]]
+
+    def active_terms(self) -> tuple[list[bool], list[np.ndarray]]:
+        """The active flags and parameters the C loop integrates with now."""
+        act, par = self._terms_in_c()
         off = self._poff
-        return [bool(a) for a in act[:self._nt]], [par[off[k]:off[k + 1]].copy() for k in range(self._nt)]
+        return [bool(a) for a in act], [par[off[k]:off[k + 1]].copy() for k in range(self._nt)]
 
     def active_switch(self) -> np.ndarray:
         """:meth:`active_terms` as a switch vector (each term's flag, then its parameters: the outputs'
         ``switch`` input, :meth:`daeclear.assembly.dae_model.DAEModel.switch_vector`)."""
-        self._check_open()
-        nt, n_par = self._nt, self._poff[-1]
-        act = np.zeros(max(nt, 1), dtype=np.int32)
-        par = np.zeros(max(n_par, 1))
-        self._lib.dc_get_active(self._h, address(act), address(par))
+        act, par = self._terms_in_c()
+        nt = self._nt
         if self._hd.switch_columns is None:  # the library's, kept on the handle (pooled)
             off = self._poff  # term k: its flag after the earlier terms' columns, then its parameters
             self._hd.switch_columns = (np.array([k + off[k] for k in range(nt)], dtype=np.intp),
                                        np.array([k + 1 + j for k in range(nt) for j in range(off[k], off[k + 1])],
                                                 dtype=np.intp))
         flags, params = self._hd.switch_columns
-        switch = np.empty(nt + n_par)
-        switch[flags] = act[:nt] != 0
-        switch[params] = par[:n_par]
+        switch = np.empty(nt + par.size)
+        switch[flags] = act != 0
+        switch[params] = par
         return switch
 
     def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:

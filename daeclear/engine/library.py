@@ -44,8 +44,9 @@ __all__ = [
 ]
 
 #: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
-#: and checked when a library is loaded: bump it when a dc_* signature changes.
-DRIVER_ABI = 6
+#: and checked when a library is loaded: bump it when a dc_* signature or what a dc_* call writes changes
+#: (7: dc_report writes the channels one row per channel).
+DRIVER_ABI = 7
 #: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
 ODE_DRIVER_ABI = 3
 
