@@ -15,7 +15,7 @@ import math
 import os
 from pathlib import Path
 from typing import Any, NamedTuple, NoReturn, TypeGuard
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -156,19 +156,45 @@ def rtol(value: Any, *, where: str = "simulate", field: str = "rtol") -> float:
     return float(value)
 
 
-def atol(value: Any, *, where: str = "simulate", field: str = "atol") -> float | NDArray[np.float64] | None:
-    """Absolute tolerance: None (default), a finite number > 0, or finite values > 0 (one per state)."""
+#: The quantities of the positions and velocities, and the ``atol`` keys that name them.
+ATOL_QUANTITIES: tuple[str, ...] = ("position", "angle", "velocity", "angular_velocity")
+#: ``atol`` keys for groups: "q" (positions and angles), "v" (velocities and angular velocities).
+ATOL_GROUPS: dict[str, tuple[str, ...]] = {"q": ("position", "angle"), "v": ("velocity", "angular_velocity")}
+
+
+def atol(value: Any, *, where: str = "simulate", field: str = "atol"
+         ) -> float | dict[str, float] | NDArray[np.float64] | None:
+    """Absolute tolerance: None (default), a finite number > 0, a mapping by quantity (keys from
+    ATOL_GROUPS and ATOL_QUANTITIES, values finite numbers > 0) or finite values > 0 (per state)."""
     if value is None:
         return None
     if is_real(value):
         return number(value, where=where, field=field, low=0.0)
+    if isinstance(value, Mapping):
+        return atol_by_quantity(value, where=where, field=field)
+    rule = "a finite number > 0, a mapping by quantity ({'q': ..., 'v': ...}) or a list of numbers > 0"
     try:
         values = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        fail(where, field, value, "a finite number > 0 or a list of them (one per state)")
+        fail(where, field, value, rule)
     if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)) or np.any(values <= 0):
-        fail(where, field, value, "a finite number > 0 or a list of them (one per state)")
+        fail(where, field, value, rule)
     return values.copy()
+
+
+def atol_by_quantity(value: Mapping[Any, Any], *, where: str, field: str) -> dict[str, float]:
+    """An ``atol`` mapping as {quantity: value}: each group key expanded, each quantity given once."""
+    out: dict[str, float] = {}
+    allowed = ", ".join(repr(k) for k in (*ATOL_GROUPS, *ATOL_QUANTITIES))
+    for key, item in value.items():
+        if key not in ATOL_GROUPS and key not in ATOL_QUANTITIES:
+            fail(where, f"{field} key", key, f"one of {allowed} (multipliers are always out of the error test)")
+        given = number(item, where=where, field=f"{field}[{key!r}]", low=0.0)
+        for quantity in ATOL_GROUPS.get(key, (key,)):
+            if quantity in out:
+                fail(where, field, dict(value), f"one value per quantity ({quantity!r} is given twice)")
+            out[quantity] = given
+    return out
 
 
 def max_step(value: Any, *, where: str = "simulate", field: str = "max_step") -> float:

@@ -265,7 +265,7 @@ def check_simulate(simulate: dict[str, Any], *, where: str) -> dict[str, Any]:
         out["rtol"] = options.rtol(out["rtol"], where=where)
     if "atol" in out:
         atol = options.atol(out["atol"], where=where)
-        out["atol"] = atol if atol is None or isinstance(atol, float) else atol.tolist()
+        out["atol"] = atol if atol is None or isinstance(atol, (float, dict)) else atol.tolist()
     if "max_step" in out:
         out["max_step"] = options.max_step(out["max_step"], where=where)
     if "allow_penetration" in out:

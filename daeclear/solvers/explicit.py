@@ -90,6 +90,7 @@ from __future__ import annotations
 import math
 import os
 import time
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -99,7 +100,7 @@ from ..assembly.assemble import DAEModel, assemble
 from .. import options
 from ..errors import Interrupted, SceneError, SolveError
 from .recorder import Recorder
-from .tolerances import tolerance_vector
+from .tolerances import atol_record, tolerance_vector
 from ..results.result import Result
 from ..model.scene import Scene
 from .ode_crossings import candidate, locate
@@ -382,7 +383,7 @@ def integrate(
     method: str,
     t_eval: ArrayLike | None = None,
     rtol: float = 1e-6,
-    atol: float | ArrayLike | None = None,
+    atol: float | Mapping[str, float] | ArrayLike | None = None,
     formulation: str | None = None,
     backend: str = "auto",
     max_step: float = 0.0,
@@ -447,14 +448,14 @@ def integrate(
     model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
     eval_times = None if out.times is None else out.times.values()  # checked by options.output
     n = model.n_q
-    atol_x = tolerance_vector(model, rtol, atol)[:2 * n]
+    atol_x = tolerance_vector(model, rtol, atol, newton=False)[:2 * n]
     ev = evaluator(model, backend)
     if given is not None:  # q and v as given (index-1: no projection), multipliers recomputed at t0
         y0, _ = model.consistent_state(t0, given)
     else:
         y0, _ = model.initial_state(start=start, allow_penetration=allow_penetration)
     x0 = np.array(y0[:2 * n])
-    sim_params = {"method": name, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
+    sim_params = {"method": name, "rtol": rtol, "atol": atol_record(atol),
                   "max_step": max_step, "t_end": t_end, "backend": ev.backend, "step": step}
     if from_state:
         sim_params["start"] = "state"

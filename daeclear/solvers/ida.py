@@ -13,9 +13,9 @@ from __future__ import annotations
 import logging
 import os
 import time
+from collections.abc import Mapping
 from typing import Any
 
-import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import options as opts
@@ -24,7 +24,7 @@ from ..assembly.assemble import DAEModel, assemble
 from ..engine.ida_session import open_session
 from .ida_loop import SegmentLoop
 from .recorder import Recorder
-from .tolerances import tolerance_vector
+from .tolerances import atol_record, tolerance_vector
 from ..results.result import Result
 from ..model.scene import Scene
 from ..solver_options import UNSET, SolverOptions
@@ -73,7 +73,7 @@ def simulate(
     t_eval: ArrayLike | None = None,
     t_eval_step: float | None = None,
     rtol: float = UNSET,
-    atol: float | ArrayLike | None = UNSET,
+    atol: float | Mapping[str, float] | ArrayLike | None = UNSET,
     method: str = UNSET,
     formulation: str | None = UNSET,
     backend: str = UNSET,
@@ -126,9 +126,15 @@ def simulate(
         (a long run never holds the whole grid). Give this or ``t_eval``, not both.
     rtol : float
         Relative tolerance (1e-6; the chapter's "integration tolerance").
-    atol : float, array or None
-        Absolute tolerance of positions and velocities (default ``1e-3 * rtol``) or one
-        value per state. Multipliers are always kept out of the error test.
+    atol : float, mapping, array or None
+        Absolute tolerance of positions and velocities. None: per quantity from the mechanism's
+        scales (:mod:`daeclear.solvers.tolerances`; on the chapter's slider-crank ``1e-3 * rtol``
+        in m, rad and m/s, ``5e-3 * rtol`` in rad/s). A number: every position and velocity. A
+        mapping by quantity, e.g. ``{"q": 1e-9, "v": 1e-6}`` or ``{"position": ..., "angle": ...,
+        "velocity": ..., "angular_velocity": ...}`` (the others keep their defaults). An array:
+        ``2 n_q`` values (positions, then velocities) or one per state. Values below the
+        round-off of their quantity are raised to it, with a warning. Multipliers are always kept
+        out of the error test.
     method : {"ida", "RK45", "DOP853", "Radau", "BDF", "LSODA", "rk4", "euler"}
         Integrator (case-insensitive). "ida": SUNDIALS IDA on the DAE. The others integrate the
         same model as an ODE in (q, v) (index-1 formulation only) with the same contact events
@@ -241,7 +247,7 @@ def simulate(
                                       allow_penetration=allow_penetration)
     setup_time = time.perf_counter() - setup_start
     sim_params = {"method": method, "start": "state" if from_state else start,
-                  "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
+                  "rtol": rtol, "atol": atol_record(atol),
                   "max_step": max_step, "t_end": t_end, "backend": session.backend}
     if t0 != 0.0:
         sim_params["t0"] = t0
