@@ -103,22 +103,24 @@ def scales(model: DAEModel) -> Scales:
     over L) and sqrt(|g| / L); 1 rad/s if all are 0.
     """
     n = model.n_q
-    q, v = np.asarray(model.q_guess, dtype=float), np.asarray(model.v_guess, dtype=float)
-    centres = np.hypot(q[0:n:3], q[1:n:3])
-    points = [math.hypot(*model.parameter(name)) for name in model.parameter_names
-              if name.endswith((".s_i", ".s_j"))]
-    gyration = [math.sqrt(float(model.parameter(f"{body}.inertia")[0]) / float(model.parameter(f"{body}.mass")[0]))
-                 for body in model.body_names]
-    length = max([*centres.tolist(), *points, *gyration, 0.0]) or 1.0
+    q, v = model.q_guess.tolist(), model.v_guess.tolist()
+    values, offset, entries = model.parameter_values.tolist(), 0, {}
+    for name, size in model.parameter_layout:  # one pass: name -> its values
+        entries[name] = values[offset:offset + size]
+        offset += size
+    lengths = [math.hypot(q[i], q[i + 1]) for i in range(0, n, 3)]
+    lengths += [math.hypot(*entries[name]) for name in entries if name.endswith((".s_i", ".s_j"))]
+    lengths += [math.sqrt(entries[f"{body}.inertia"][0] / entries[f"{body}.mass"][0]) for body in model.body_names]
+    length = max([*lengths, 0.0]) or 1.0
     clearances = [c for _, c, _ in model.clearance_joints]
     resolution = min([POSITION_FRACTION * length, *(CLEARANCE_SPAN * c for c in clearances)])
-    rates = [*np.abs(v[2:n:3]).tolist(), *(np.hypot(v[0:n:3], v[1:n:3]) / length).tolist()]
+    rates = [abs(v[i + 2]) for i in range(0, n, 3)] + [math.hypot(v[i], v[i + 1]) / length for i in range(0, n, 3)]
     for driver in model.driver_names:
-        if f"{driver}.speed" in model.parameter_names:
-            speed = abs(float(model.parameter(f"{driver}.speed")[0]))
-            rates.append(speed / length if f"{driver}.axis" in model.parameter_names else speed)
-    if "gravity" in model.parameter_names:
-        rates.append(math.sqrt(float(np.hypot(*model.parameter("gravity"))) / length))
+        if f"{driver}.speed" in entries:
+            speed = abs(entries[f"{driver}.speed"][0])
+            rates.append(speed / length if f"{driver}.axis" in entries else speed)
+    if "gravity" in entries:
+        rates.append(math.sqrt(math.hypot(*entries["gravity"]) / length))
     rate = max([*rates, 0.0]) or 1.0
     return Scales(length=float(length), resolution=float(resolution), rate=float(rate))
 
