@@ -114,3 +114,29 @@ def test_hertz_needs_the_modulus():
     h = history(11, 100.0, 0.0)
     with pytest.raises(SceneError, match="effective_modulus"):
         wear_increment(ArchardWear(coefficient=K, length=L, distribution="hertz"), h, bearing_radius=R, clearance=C)
+
+
+def test_the_history_of_a_run_matches_the_joint_s_own_channels():
+    """wear_history recomputes the sliding speed and the penetration in numpy from the bodies' states:
+    they equal the generated model's channels (with friction, sliding_velocity is one)."""
+    import daeclear as dc
+    from daeclear.studies.wear import wear_history
+
+    model = dc.assemble(dc.mechanisms.slider_crank("revolute", friction=0.05))
+    result = dc.simulate(model, 0.006, t_eval=np.linspace(0, 0.006, 601))
+    h = wear_history(result, model, "clearance")
+    contact = result["clearance.in_contact"] > 0
+    assert contact.sum() > 20
+    off_centre = result["clearance.eccentricity"] > 0  # the start is centred: no direction there
+    assert off_centre[1:].all()
+    np.testing.assert_allclose(h.slip_speed[off_centre], result["clearance.sliding_velocity"][off_centre], rtol=1e-9,
+                               atol=1e-12)
+    np.testing.assert_allclose(h.penetration[contact], result["clearance.penetration"][contact], rtol=1e-9, atol=1e-15)
+    direction = np.arctan2(result["clearance.ey"], result["clearance.ex"])
+    for angle, body in ((h.angle_bearing, "slider"), (h.angle_journal, "rod")):
+        world = angle + result[f"{body}.phi"]
+        np.testing.assert_allclose(np.cos(world[off_centre]), np.cos(direction[off_centre]), atol=1e-12)
+        np.testing.assert_allclose(np.sin(world[off_centre]), np.sin(direction[off_centre]), atol=1e-12)
+    assert np.array_equal(h.force, result["clearance.normal_force"])
+    with pytest.raises(SceneError, match="joint='B', must be a revolute clearance joint of the run \\(clearance\\)"):
+        wear_history(result, model, "B")
