@@ -35,19 +35,45 @@ def _parse_value(text: str) -> Any:
 
 
 def _parse_sets(items: Sequence[str]) -> dict[str, Any]:
+    """``--set KEY=VALUE`` items -> {key: value}; a key given twice is an error naming both values."""
     out: dict[str, Any] = {}
     for item in items:
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
             raise DaeclearError(f"--set {item!r}: expected KEY=VALUE, e.g. --set clearance=0.5e-3.")
-        out[key.strip()] = _parse_value(value.strip())
+        key = key.strip()
+        if key in out:
+            raise DaeclearError(f"--set {key}={value.strip()}: {key} is given twice (--set {key}={out[key]!r} "
+                                "before); give it once.")
+        out[key] = _parse_value(value.strip())
     return out
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _mechanism_keys(argv: Sequence[str]) -> str | None:
+    """For ``daeclear run|study|sweep MECH --help``: MECH's ``--set`` keys, each with its default and the
+    first sentence of its description (units included), read from the mechanism's signature and docstring."""
+    if not ({"-h", "--help"} & set(argv)) or len(argv) < 2 or argv[0] not in ("run", "study", "sweep"):
+        return None
+    from .model.mechanism_options import option_table
+    from .model.scenefile import MECHANISMS
+
+    if argv[1] not in MECHANISMS:
+        return None
+    lines = [f"--set keys of {argv[1]} (KEY=VALUE, a Python literal; default in brackets):"]
+    for name, default, text in option_table(MECHANISMS[argv[1]]):
+        lines.append(f"  --set {name}=...  [{default}]  {text}")
+    return "\n".join(lines)
+
+
+def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
+    """The command line's parser; ``argv`` (when asking for help) adds a mechanism's --set keys to its help."""
     parser = argparse.ArgumentParser(prog="daeclear", description="Planar mechanisms with clearance joints.")
     sub = parser.add_subparsers(dest="command", required=True)
-    run = sub.add_parser("run", help="simulate a named mechanism or a scene file (.toml)")
+    keys = _mechanism_keys(argv)
+    epilog = keys or "daeclear run MECH --help lists the --set keys of mechanism MECH with their defaults and units."
+    formatter = argparse.RawDescriptionHelpFormatter
+    run = sub.add_parser("run", help="simulate a named mechanism or a scene file (.toml)", epilog=epilog,
+                         formatter_class=formatter)
     run.add_argument("target", help="mechanism name (slider_crank, chain, four_bar, double_pendulum) or path to a "
                                     ".toml scene file")
     run.add_argument("--joint", help="slider_crank: which joint has clearance (ideal, revolute, translational)")
@@ -74,9 +100,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--no-figure", action="store_true", help="write the HDF5 result only")
     run.add_argument("--quiet", action="store_true", help="no progress line")
 
-    study = sub.add_parser("study", help="work-precision study: error against run time per method and tolerance")
+    study = sub.add_parser("study", help="work-precision study: error against run time per method and tolerance",
+                           epilog=epilog, formatter_class=formatter)
     study.add_argument("target", help="mechanism name (slider_crank)")
-    study.add_argument("--joint", default="revolute", help="slider_crank: which joint has clearance (default revolute)")
+    study.add_argument("--joint", help="slider_crank: which joint has clearance (default revolute)")
     study.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="mechanism parameter")
     study.add_argument("--t-end", type=float, default=0.012, help="end time, s (default one revolution at 5000 rpm)")
     study.add_argument("--methods", default="ida,DOP853,LSODA,rk4",
@@ -86,9 +113,23 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("--channels", default="slider.vx,drive.moment", help="channels whose error is measured")
     study.add_argument("--repeats", type=int, default=3, help="timed repeats per run (best kept)")
     study.add_argument("--out", type=Path, default=Path("results/study"), help="output directory")
-    _add_sweep_parser(sub)
+    _add_sweep_parser(sub, epilog)
     _add_animate_parser(sub)
     return parser
+
+
+def _add_joint(target: str, joint: str | None, params: dict[str, Any]) -> None:
+    """Put ``--joint`` into the mechanism's parameters: the slider-crank's option; the other mechanisms
+    choose their clearance joints with --set clearance_joints=..., and --set joint= with --joint is given twice."""
+    if joint is None:
+        return
+    if target != "slider_crank":
+        raise DaeclearError(f"--joint {joint}: --joint is the slider-crank's option; {target} chooses its clearance "
+                            f"joints with --set clearance_joints=A,B (see daeclear run {target} --help).")
+    if "joint" in params:
+        raise DaeclearError(f"--joint {joint}: joint is given twice (--set joint={params['joint']!r} too); "
+                            "give it once.")
+    params["joint"] = joint
 
 
 def _mechanism(mechanisms: dict[str, Any], name: str, params: dict[str, Any]) -> Any:
@@ -101,7 +142,7 @@ def _mechanism(mechanisms: dict[str, Any], name: str, params: dict[str, Any]) ->
 
 def _run(args: argparse.Namespace) -> int:
     from . import options
-    from .model.mechanisms import ideal_parameters
+    from .model.mechanism_options import ideal_parameters
     from .results.outputs import check_directory
     from .model.scene import RevoluteClearance, TranslationalClearance
     from .model.scenefile import MECHANISMS, read_scene_file
@@ -119,8 +160,7 @@ def _run(args: argparse.Namespace) -> int:
         if params or args.joint:
             raise DaeclearError("--set and --joint apply to named mechanisms; edit the scene file instead.")
     elif args.target in MECHANISMS:
-        if args.joint:
-            params["joint"] = args.joint
+        _add_joint(args.target, args.joint, params)
         scene = _mechanism(MECHANISMS, args.target, params)
         ideal = ideal_parameters(args.target, params)
         if ideal is not None:  # the chapter plots against the ideal mechanism
@@ -147,8 +187,11 @@ def _run(args: argparse.Namespace) -> int:
     elif not args.every_step:  # a long run stays affordable: a bounded number of points
         step = default_t_eval_step(t_end)
     base = args.name if args.name is not None else scene.name
-    if not base or Path(base).name != base or base in (".", ".."):
-        options.fail(where, "--name", args.name, "a plain file name without a directory (e.g. run1)")
+    if not base or Path(base).name != base or base in (".", ".."):  # blamed on where the name came from
+        field = "--name" if args.name is not None else "--set name" if "name" in params else "[scene] name"
+        named = "" if args.name is not None else ", as it names the output files (or give --name)"
+        options.fail(where if args.name is not None else f"{where} {args.target}", field, base,
+                     f"a plain file name without a directory (e.g. run1){named}")
     check_directory(args.out, "--out", files=[f"{base}.h5", f"{base}.png"])  # before any work
     run_options: dict[str, Any] = {"rtol": rtol, "backend": args.backend, "progress": not args.quiet,
                                    "on_failure": "return"}
@@ -267,7 +310,9 @@ def _study(args: argparse.Namespace) -> int:
     rtols = options.rtols(_floats(args.rtols, "rtols"), where=where, field="--rtols")
     steps = options.steps(_floats(args.steps, "steps"), t_end, where=where, field="--steps")
     params = _parse_sets(args.set)
-    params.setdefault("joint", args.joint)
+    _add_joint(args.target, args.joint, params)
+    if args.target == "slider_crank":
+        params.setdefault("joint", "revolute")
     scene = _mechanism(MECHANISMS, args.target, params)
     files = ("work_precision.csv", "work_precision.md", "work_precision.png")
     check_directory(args.out, "--out", files=files)  # before any work
@@ -319,11 +364,12 @@ def _write_study_tables(study: Any, out: Path) -> str:
 # --------------------------------------------------------------------------- daeclear sweep
 
 
-def _add_sweep_parser(sub: Any) -> None:
+def _add_sweep_parser(sub: Any, epilog: str) -> None:
     sweep = sub.add_parser("sweep", help="classify the motion over a grid of parameters into one HDF5 file",
                            description="Run and classify (periodic, quasi-periodic, chaotic) one scene per parameter "
                                        "point, in parallel, into one HDF5 file; an interrupted sweep resumes where it "
-                                       "stopped when the same command is run again.")
+                                       "stopped when the same command is run again.", epilog=epilog,
+                           formatter_class=argparse.RawDescriptionHelpFormatter)
     sweep.add_argument("target", help="mechanism name (slider_crank)")
     sweep.add_argument("out", type=Path, help="sweep file (.h5), created or resumed")
     sweep.add_argument("--joint", help="slider_crank: which joint has clearance (ideal, revolute, translational)")
@@ -374,6 +420,9 @@ def _grid_values(item: str) -> tuple[str, list[Any]]:
             raise DaeclearError(f"--grid {item!r}: N must be >= 1{rule}")
         values = np.linspace(start, stop, count) if kind == "lin" else np.geomspace(start, stop, count)
         return name, [float(v) for v in values]
+    if spec and kind.isidentifier():  # e.g. log:1e-5:5e-4:10, a kind that does not exist
+        raise DaeclearError(f"--grid {item!r}: unknown grid kind {kind!r}; the kinds are NAME=v1,v2,... (values), "
+                            "NAME=lin:START:STOP:N (evenly spaced) and NAME=geom:START:STOP:N (geometric).")
     return name, [_parse_value(v.strip()) for v in text.split(",") if v.strip()]
 
 
@@ -385,9 +434,17 @@ def _sweep(args: argparse.Namespace) -> int:
     from .studies.sweep import sweep
 
     fixed = _parse_sets(args.set)
-    if args.joint:
-        fixed["joint"] = args.joint
-    grid = dict(_grid_values(item) for item in args.grid)
+    _add_joint(args.target, args.joint, fixed)
+    grid: dict[str, list[Any]] = {}
+    for item in args.grid:  # a parameter swept twice, or swept and fixed, is a contradiction
+        key, swept = _grid_values(item)
+        if key in grid:
+            raise DaeclearError(f"--grid {item!r}: {key} is swept twice (--grid {key}={grid[key]!r} before); "
+                                "give it once.")
+        if key in fixed:
+            given = f"--joint {fixed[key]}" if key == "joint" and args.joint else f"--set {key}={fixed[key]!r}"
+            raise DaeclearError(f"--grid {item!r}: {key} is also fixed by {given}; sweep it or fix it, not both.")
+        grid[key] = swept
     points = None
     if args.points:
         try:
@@ -477,6 +534,7 @@ def _sweep(args: argparse.Namespace) -> int:
     if result.failed:
         print(f"daeclear: {len(result.failed)} run(s) failed (recorded in {args.out}; --retry-failed runs them "
               "again).", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -527,7 +585,8 @@ def _animate(args: argparse.Namespace) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="daeclear: %(message)s")
-    args = build_parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    args = build_parser(argv).parse_args(argv)
     try:
         if args.command == "run":
             return _run(args)

@@ -186,6 +186,13 @@ def step(value: Any, *, where: str = "simulate", field: str = "step") -> float:
     return number(value, where=where, field=field, unit="s", low=0.0)
 
 
+def step_within(value: float | None, t0: float, end: float, *, where: str = "simulate", field: str = "step") -> None:
+    """A fixed step (checked by :func:`step`) no longer than the run it steps over: a step past t_end
+    would take one stride over every contact of the run."""
+    if value is not None and value > end - t0:
+        fail(where, field, value, f"at most the run's length t_end - t0 = {end - t0:g} s (t_end={end:g} s)", "s")
+
+
 def t_eval(value: ArrayLike | None, end: float, *, where: str = "simulate",
            field: str = "t_eval", start: float = 0.0) -> NDArray[np.float64] | None:
     """Output times: None, or finite, strictly increasing values in [t0, t_end] (NaN is an error, not a cut)."""
@@ -193,9 +200,12 @@ def t_eval(value: ArrayLike | None, end: float, *, where: str = "simulate",
         return None
     rule = f"finite, strictly increasing values in [{'0' if start == 0 else f't0={start:g}'}, t_end={end:g}]"
     try:
-        times = np.asarray(value, dtype=float).ravel()
+        times = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         fail(where, field, value, rule)
+    if times.ndim > 1:  # a table of times is not flattened: which order was meant?
+        fail(where, field, value, "a 1-D sequence of times, " + rule, shown=f"array of shape {times.shape}")
+    times = times.reshape(-1)
     if times.size == 0:
         fail(where, field, value, "at least one time: " + rule)
     # the common case in one pass: in range and strictly increasing (so finite: a NaN or inf

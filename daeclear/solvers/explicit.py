@@ -105,6 +105,7 @@ from ..model.scene import Scene
 from .ode_crossings import candidate, locate
 from .ode_evaluators import FIXED_CHUNK, FX_CHUNK, FX_ERR, FX_MAXSTEPS, FX_TSTOP, evaluator
 from .ode_model import ode_spec
+from . import physics
 from .ode_run import (FIXED_STEP_METHODS, IMPLICIT_METHODS, METHOD_NAMES, SCIPY_METHODS, TINY_STEP_COUNT, TINY_STEP_REL,
                       Run)
 
@@ -450,7 +451,9 @@ def integrate(
     atol_x = tolerance_vector(model, rtol, atol)[:2 * n]
     ev = evaluator(model, backend)
     if given is not None:  # q and v as given (index-1: no projection), multipliers recomputed at t0
-        y0, _ = model.consistent_state(t0, given)
+        y0, yp0 = model.consistent_state(t0, given)
+        if not allow_penetration:  # held to the declared start's limit
+            physics.check_start_penetration(model, y0, yp0, given=True)
     else:
         y0, _ = model.initial_state(start=start, allow_penetration=allow_penetration)
     x0 = np.array(y0[:2 * n])

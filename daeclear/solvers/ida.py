@@ -168,13 +168,13 @@ def simulate(
         :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES`, reduced below).
         The python backend and the other methods ignore it. Reported in ``result.stats``.
     start : {"ideal", "declared"}
-        How the run starts without ``y0`` (ignored with ``y0``, as is ``allow_penetration``).
+        How the run starts without ``y0`` (ignored with ``y0``).
         "ideal" (the chapter's, section 4.4): every clearance joint centred
         and every position and velocity assembled on the mechanism whose clearance joints are
         ideal, from the declared state as a guess; "declared": the bodies' declared positions and
         velocities, corrected only for the scene's ideal joints.
     allow_penetration : bool
-        Start "declared" even with a contact pair deeper in its wall than
+        Start "declared" (or from ``y0``) even with a contact pair deeper in its wall than
         :data:`daeclear.solvers.physics.START_PENETRATION_FRACTION` of the clearance (refused otherwise).
 
     stream_to : str, path or None
@@ -201,6 +201,9 @@ def simulate(
         The initial positions cannot be assembled, the constraints are redundant (the
         message names the joints and drivers), or a declared start is in deep penetration.
     """
+    if not isinstance(scene, (Scene, DAEModel)):  # e.g. a mechanism's name: say what is wanted
+        opts.fail("simulate", "scene", scene, "a daeclear.Scene or an assembled model, e.g. "
+                  "dc.mechanisms.slider_crank('revolute') (a mechanism's name is not a scene)")
     if options is not None and not isinstance(options, SolverOptions):
         opts.fail("simulate", "options", options, "None or a daeclear.SolverOptions")
     settings = (DEFAULTS if options is None else options).merged(
@@ -215,6 +218,7 @@ def simulate(
         t_eval=t_eval, backend=settings.backend, on_failure=on_failure, store_steps=store_steps, progress=progress,
         track_work=settings.track_work)
     t0 = float(t0)  # checked by opts.run
+    opts.step_within(step, t0, t_end)
     out = opts.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data,
                       start=t0)
     if y0 is not None:  # checked before any work (a Scene's length: once it is assembled)
@@ -267,6 +271,8 @@ def _start_session(model: DAEModel, t0: float, y0: NDArray | None, *, rtol: floa
             y0, yp0 = model.initial_state(session=session, start=start, allow_penetration=allow_penetration)
         else:  # a given state: q and v kept (GGL: projected), multipliers and derivatives recomputed at t0
             y0, yp0 = model.consistent_state(t0, y0, session=session, project=True)
+            if not allow_penetration:  # held to the declared start's limit
+                physics.check_start_penetration(model, y0, yp0, session, given=True)
     except BaseException:
         session.close()
         raise

@@ -160,13 +160,15 @@ def start_penetration_limit(clearance: float, corner: float) -> float:
     return START_PENETRATION_FRACTION * (min(clearance, corner) if corner > 0 else clearance)
 
 
-def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np.float64], session: Any = None) -> None:
+def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np.float64], session: Any = None,
+                            *, given: bool = False) -> None:
     """Refuse a start with a contact pair deeper in its wall than :func:`start_penetration_limit`.
 
     Such a start is a declaration error (a journal declared inside the bearing wall): its first
     contact force is the law's force at that depth, e.g. 187 kN (elastic part) for the chapter's
     journal declared 0.2 mm deep, released as an artificial impact. Raises AssemblyError naming
-    the pair, the penetration and the clearance."""
+    the pair, the penetration and the clearance. ``given``: the state is simulate()'s ``y0``, held to
+    the same limit as a declared start."""
     if not model.clearance_joints:
         return
     channels = model.channels(np.zeros(1), np.asarray(y0)[None, :], np.asarray(yp0)[None, :], session=session)
@@ -176,6 +178,13 @@ def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np
         for pair in joint_pairs(model, joint):
             depth = float(channels.get(f"{pair}.penetration", np.zeros(1))[0])
             if depth > limit:
+                if given:
+                    raise AssemblyError(
+                        f"simulate: y0 puts clearance joint '{joint}' in deep penetration: '{pair}' is {depth:.3g} m "
+                        f"inside the wall, {depth / clearance:.0%} of the clearance {clearance:.3g} m (a start may "
+                        f"penetrate at most {START_PENETRATION_FRACTION:.0%} of the {basis}, {limit:.3g} m); give a "
+                        "state from a run of this model (a row of result.y), or pass allow_penetration=True to "
+                        "start there anyway.")
                 raise AssemblyError(
                     f"scene '{model.scene_name}': clearance joint '{joint}' starts in deep penetration: '{pair}' "
                     f"is {depth:.3g} m inside the wall at t=0, {depth / clearance:.0%} of the clearance "

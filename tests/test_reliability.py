@@ -1,0 +1,92 @@
+"""Issue 31 (reliability and the command line, round 3): the README's commands, the ideal reference
+of the command line, sweeps that fail early, fixed steps from scene files. The refusals themselves
+are rows of tests/test_bad_inputs.py."""
+
+from __future__ import annotations
+
+import pytest
+
+import daeclear as dc
+from daeclear.cli import main
+from daeclear.model.mechanism_options import ideal_parameters, option_table
+from scene_texts import PENDULUM
+
+
+@pytest.mark.parametrize("sets", [["--set", "contact_model=section-4.3"], ["--set", "reading='section-4.3'"],
+                                  ["--set", "pin_offset=(0.01, 0.0)"]])
+def test_readme_translational_command_runs_with_its_ideal_reference(sets, tmp_path, capsys):
+    """The README's `daeclear run slider_crank --joint translational --set contact_model=section-4.3` (and the
+    other translational-only options) runs, and draws the ideal mechanism as its reference."""
+    code = main(["run", "slider_crank", "--joint", "translational", *sets, "--t-end", "0.0005", "--out",
+                 str(tmp_path), "--quiet"])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    assert "no ideal-mechanism reference" not in captured.err
+    assert (tmp_path / "slider_crank_translational.png").stat().st_size > 10_000
+    assert dc.load(tmp_path / "slider_crank_translational.h5").t[-1] == pytest.approx(0.0005)
+
+
+def test_ideal_parameters_keep_only_what_the_ideal_mechanism_takes():
+    params = {"joint": "translational", "contact_model": "section-4.3", "rpm": 3000.0, "pin_offset": (0.01, 0.0),
+              "clearance": 1e-4, "friction": 0.1, "gravity": 0.0, "name": "mine"}
+    assert ideal_parameters("slider_crank", params) == {"joint": "ideal", "rpm": 3000.0, "gravity": 0.0}
+    assert ideal_parameters("four_bar", {"clearance_joints": "B,C", "law": "hertz", "rpm": 100.0}) == {
+        "clearance_joints": (), "rpm": 100.0}
+    assert ideal_parameters("slider_crank", {"rpm": 3000.0}) is None  # no clearance joint: no reference
+    assert ideal_parameters("chain", {"n_links": 3}) is None
+    # each result builds (the options left are the ideal mechanism's own)
+    dc.mechanisms.slider_crank(**ideal_parameters("slider_crank", params))
+    dc.mechanisms.four_bar(**ideal_parameters("four_bar", {"clearance_joints": "B,C", "law": "hertz"}))
+
+
+def test_mechanism_help_lists_each_set_key_with_default_and_unit(capsys):
+    rows = {name: (default, text) for name, default, text in option_table(dc.mechanisms.slider_crank)}
+    assert rows["rpm"][0] == "5000.0" and "rev/min" in rows["rpm"][1]
+    assert rows["gravity"][0] == "9.81" and "m/s^2" in rows["gravity"][1]
+    assert rows["slider_mass"][0] == "0.14" and "kg" in rows["slider_mass"][1]
+    assert rows["clearance"][0] == "0.0005" and ", m" in rows["clearance"][1]
+    with pytest.raises(SystemExit) as info:
+        main(["run", "four_bar", "--help"])
+    assert info.value.code == 0
+    out = capsys.readouterr().out
+    for key in ("clearance_joints", "rpm", "crank_angle", "gravity", "clearance", "bearing_radius"):
+        assert f"--set {key}=" in out, key
+    assert "rev/min" in out
+
+
+def test_rk4_from_a_scene_file(tmp_path, capsys):
+    """method = "rk4" with its step in [simulate] runs (it used to ask for step, which [simulate] refused)."""
+    path = tmp_path / "pendulum.toml"
+    path.write_text(PENDULUM + '\n[simulate]\nt_end = 0.01\nmethod = "rk4"\nstep = 1e-4\n')
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet", "--no-figure"]) == 0
+    result = dc.load(tmp_path / "out" / "pendulum.h5")
+    assert result.method == "rk4"
+    assert result.parameters["simulate"]["step"] == pytest.approx(1e-4)
+
+
+def test_sweep_exits_non_zero_when_a_run_fails(tmp_path, capsys, monkeypatch):
+    """A sweep whose runs fail says so and exits 1 (it used to exit 0)."""
+    import daeclear.studies.sweep_workers as workers
+
+    real = workers.run_task
+
+    def fail_second(task):
+        if task["parameters"]["clearance"] == 2e-4:
+            raise RuntimeError("injected failure")
+        return real(task)
+
+    import concurrent.futures as cf
+
+    import daeclear.studies.sweep as sweep_module
+
+    monkeypatch.setattr(sweep_module, "run_task", fail_second)  # in threads: the patch reaches the runs
+    monkeypatch.setattr(sweep_module.cf, "ProcessPoolExecutor",
+                        lambda max_workers, **_: cf.ThreadPoolExecutor(max_workers=max_workers))
+    code = main(["sweep", "slider_crank", str(tmp_path / "s.h5"), "--joint", "revolute", "--grid",
+                 "clearance=1e-4,2e-4", "--revolutions", "2", "--transient", "0", "--twin", "never", "--workers",
+                 "1", "--quiet", "--no-figure"])
+    captured = capsys.readouterr()
+    assert code == 1, captured.err
+    assert "1 run(s) failed" in captured.err and "injected failure" in captured.out
+    runs = dc.load_sweep(tmp_path / "s.h5").runs
+    assert sorted(r.ok for r in runs) == [False, True]
