@@ -92,6 +92,9 @@ def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
     points.add_argument("--every-step", action="store_true",
                         help="report every IDA step (memory and file grow with the run, ~1.7 MB per revolution "
                              "of the chapter's slider-crank)")
+    run.add_argument("--max-points", type=int, metavar="N",
+                     help="refuse before the run to report more than N points (default 1 000 000, about 1 GB for "
+                          "the chapter's slider-crank; the message gives the estimated size)")
     run.add_argument("--formulation", choices=["index1", "ggl"],
                      help="DAE formulation (default ggl; index1: the chapter's)")
     run.add_argument("--backend", choices=["auto", "c", "python"], default="auto")
@@ -200,6 +203,9 @@ def _run(args: argparse.Namespace) -> int:
     run_options.update(sim)
     if step is not None:  # reported points on a grid; the steps are not kept (bounded memory)
         run_options.update(t_eval_step=step, store_steps=False)
+    if args.max_points is not None:
+        run_options["max_output_points"] = options.max_output_points(args.max_points, where=where,
+                                                                     field="--max-points")
     if args.max_steps is not None:
         run_options["max_steps"] = options.max_steps(args.max_steps, where=where, field="--max-steps")
     else:  # memory no longer limits a long run: the cap only stops a runaway one

@@ -235,6 +235,55 @@ def t_eval_step(value: Any, end: float, *, where: str, field: str = "t_eval_step
 
 _spacing = t_eval_step  # for output(), whose argument of that name hides the function
 
+#: The most output points a run reports unless told otherwise (simulate's ``max_output_points``,
+#: ``daeclear run --max-points``): about 1 GB of file (or memory) for the chapter's slider-crank
+#: with a revolute clearance joint (~1 KB a point), so that a mistyped spacing (1e-12 s) is refused
+#: with an estimate instead of filling a disk (docs/reliability.md).
+MAX_OUTPUT_POINTS = 1_000_000
+
+
+def max_output_points(value: Any, *, where: str = "simulate", field: str = "max_output_points") -> int | None:
+    """The cap on a run's output points: an integer >= 1, or None (no cap)."""
+    return None if value is None else integer(value, where=where, field=field, low=1)
+
+
+def _size(n_bytes: float) -> str:
+    for unit, scale in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n_bytes >= scale:
+            return f"{n_bytes / scale:.3g} {unit}"
+    return f"{n_bytes:.0f} bytes"
+
+
+def output_size(out: OutputOptions, limit: int | None, *, t_eval_step: Any, step: float | None, start: float,
+                end: float, n_states: int, n_channels: int, where: str = "simulate") -> None:
+    """Refuse, before the run, an output of more than ``limit`` points, with the estimate of its size.
+
+    The points are those of ``t_eval``/``t_eval_step``, or, without them, of a fixed ``step`` (every
+    step reported); an adaptive method's steps are not known before the run (``max_steps`` bounds
+    them). Each point stores t, the states and their derivatives and every channel, 8 bytes each."""
+    if limit is None:
+        return
+    if out.times is not None:
+        points = out.times.size
+        source = (("t_eval_step", t_eval_step, repr(t_eval_step)) if t_eval_step is not None
+                  else ("t_eval", None, f"array of {points} times"))
+    elif step is not None:
+        points = int(math.floor((end - start) / step)) + 2
+        source = ("step", step, f"{step!r} (every step reported, no t_eval_step)")
+    else:
+        return
+    if points <= limit:
+        return
+    per_point = 8 * (1 + 2 * n_states + n_channels)
+    place = ("in the file and in memory" if out.stream_to is not None and out.keep_data
+             else "in the file" if out.stream_to is not None else "in memory")
+    field, value, shown = source
+    fail(where, field, value,
+         f"coarser: it gives {points:.4g} output points over {end - start:g} s, about {_size(points * per_point)} "
+         f"{place} ({per_point} bytes a point: t, {n_states} states and their derivatives, {n_channels} "
+         f"channels), more than max_output_points={limit}; or raise max_output_points (daeclear run: "
+         "--max-points; None: no limit) to run it anyway", shown=shown)
+
 
 def uniform_times(spacing: float, end: float, start: float = 0.0) -> NDArray[np.float64]:
     """Output times from ``start`` to ``end`` (both included), ``(end - start) / floor((end - start) / spacing)``

@@ -121,6 +121,16 @@ API_SIMULATE: list[tuple[str, dict[str, Any], str, str]] = [
     ("rk4 step longer than the run", {"method": "rk4", "step": 1.0}, "step", "step=1.0 s"),
     ("euler step longer than the run", {"method": "euler", "step": 0.5}, "step", "0.5"),
     ("rk4 step longer than t_end - t0", {"method": "rk4", "step": 8e-5, "t0": 5e-5}, "step", "8e-05"),
+    # issue 31: output size checked before the run
+    ("t_eval_step too fine", {"t_end": 0.002, "t_eval_step": 1e-12}, "t_eval_step", "t_eval_step=1e-12"),
+    ("t_eval_step above the cap", {"t_eval_step": 1e-5, "max_output_points": 5}, "t_eval_step", "11 output points"),
+    ("t_eval above the cap", {"t_eval": np.linspace(0.0, TINY, 10), "max_output_points": 9}, "t_eval",
+     "array of 10 times"),
+    ("rk4 every step above the cap", {"method": "rk4", "step": 1e-11}, "step", "1e-11"),
+    ("DOP853 t_eval_step too fine", {"method": "DOP853", "t_eval_step": 1e-12}, "t_eval_step", "1e+08 output points"),
+    ("max_output_points 0", {"max_output_points": 0}, "max_output_points", "0"),
+    ("max_output_points bool", {"max_output_points": True}, "max_output_points", "True"),
+    ("max_output_points float", {"max_output_points": 1e6}, "max_output_points", "1000000.0"),
 ]
 
 
@@ -372,6 +382,7 @@ CLI_RUN: list[tuple[str, list[str], str, str]] = [
      "contact_model", "'section-4.3'"),
     ("--set gravity=True", ["--set", "gravity=True"], "gravity", "True"),
     ("--set rpm=True", ["--set", "rpm=True"], "rpm", "True"),
+    ("--max-points 0", ["--max-points", "0"], "--max-points", "0"),
 ]
 
 
@@ -600,7 +611,7 @@ def test_there_are_at_least_100_cases():
     n = (len(API_SIMULATE) + len(API_MECHANISMS) + len(API_STUDY) + len(API_SWEEP) + 4 + 4 + 4 + 1 + len(CLI_RUN) + 5
          + len(CLI_STUDY) + 2 + len(CLI_SWEEP) + 4 + 2 * len(SCENE_FILE) + len(MECHANISM_FILE) + 2)
     assert n >= 100, n
-    issue_31 = (5 + len(API_CALLS) + len(LOAD_WINDOWS) + 20 + 4 + 11 + len(CLI_OTHER) + 6 + 2 * 3
+    issue_31 = (13 + len(API_CALLS) + len(LOAD_WINDOWS) + 20 + 4 + 12 + len(CLI_OTHER) + 6 + 2 * 3
                 + len(FILES))
     assert issue_31 >= 40, issue_31
 

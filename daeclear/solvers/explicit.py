@@ -400,6 +400,7 @@ def integrate(
     keep_data: bool = True,
     t0: float = 0.0,
     y0: ArrayLike | None = None,
+    max_output_points: int | None = options.MAX_OUTPUT_POINTS,
 ) -> Result:
     """Integrate with a non-IDA method; the arguments are those of :func:`daeclear.simulate`.
 
@@ -444,6 +445,9 @@ def integrate(
         raise SceneError(f"simulate: formulation={model.formulation!r} is integrated by IDA only; method={name!r} "
                          "integrates the chapter's index-1 formulation (formulation='index1').")
     given = None if y0 is None else options.state(y0, model.n_states)
+    options.output_size(out, options.max_output_points(max_output_points), t_eval_step=t_eval_step,
+                        step=step if out.times is None and store_steps else None, start=t0, end=t_end,
+                        n_states=model.n_states, n_channels=len(model.channel_names))  # before the grid is built
     from_state = given is not None
     model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
     eval_times = None if out.times is None else out.times.values()  # checked by options.output

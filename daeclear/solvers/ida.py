@@ -89,6 +89,7 @@ def simulate(
     allow_penetration: bool = UNSET,
     stream_to: str | os.PathLike[str] | None = None,
     keep_data: bool = True,
+    max_output_points: int | None = opts.MAX_OUTPUT_POINTS,
 ) -> Result:
     """Integrate a scene (or an assembled model) from ``t0`` (0 by default) to ``t_end``.
 
@@ -187,6 +188,10 @@ def simulate(
         ``daeclear.load(stream_to)``), or (False) a Result of the outcome alone (success, message,
         statistics, warnings; no time series, events or segments), so that not even the end of a
         long run holds its data in memory.
+    max_output_points : int or None
+        The most output points the run may report (:data:`daeclear.options.MAX_OUTPUT_POINTS`, 1e6,
+        about 1 GB for the chapter's slider-crank); more (``t_eval``, ``t_eval_step``, or a fixed
+        ``step`` without them) is refused before the run with the estimated size. None: no cap.
 
     Returns
     -------
@@ -221,6 +226,7 @@ def simulate(
     opts.step_within(step, t0, t_end)
     out = opts.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data,
                       start=t0)
+    limit = opts.max_output_points(max_output_points)
     if y0 is not None:  # checked before any work (a Scene's length: once it is assembled)
         y0 = opts.state(y0, scene.n_states if isinstance(scene, DAEModel) else None)
     from .explicit import integrate  # the non-IDA methods
@@ -230,7 +236,8 @@ def simulate(
                          backend=backend, max_step=max_step, max_steps=max_steps, step=step,
                          store_steps=store_steps, on_failure=on_failure, progress=progress,
                          track_work=track_work, start=start, t_eval_step=t_eval_step, stream_to=out.stream_to,
-                         keep_data=out.keep_data, allow_penetration=allow_penetration, t0=t0, y0=y0)
+                         keep_data=out.keep_data, allow_penetration=allow_penetration, t0=t0, y0=y0,
+                         max_output_points=limit)
 
     setup_start = time.perf_counter()
     if formulation is None:
@@ -238,6 +245,8 @@ def simulate(
     model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation, track_work=track_work)
     if y0 is not None:
         y0 = opts.state(y0, model.n_states)
+    opts.output_size(out, limit, t_eval_step=t_eval_step, step=None, start=t0, end=t_end, n_states=model.n_states,
+                     n_channels=len(model.channel_names))  # before the session: nothing compiled or run
     from_state = y0 is not None
     model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
     session, y0, yp0 = _start_session(model, t0, y0, rtol=rtol, atol=atol, backend=backend, max_step=max_step,
