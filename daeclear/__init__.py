@@ -18,8 +18,8 @@ from . import (  # type: ignore[attr-defined]  # noqa: F401
 from .studies import analysis  # noqa: F811  (the module of the new path wins over its alias)
 from .model import loads, mechanisms, profiles  # noqa: F811
 from .assembly.assemble import DAEModel, assemble
-from .errors import (AssemblyError, DaeclearError, DaeclearWarning, Interrupted, OutputError, PhysicsWarning,
-                     SceneError, SolveError)
+from .errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted, OutputError,
+                     PhysicsWarning, SceneError, SolveError)
 from .results.result import ContactEvent, Result, load
 from .contact import Material
 from .model.loads import Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
@@ -32,7 +32,7 @@ from .studies.sweep import load_sweep, sweep  # noqa: F811
 __version__ = "0.1.0"
 
 __all__ = [
-    "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "Driver",
+    "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "DiskFull", "Driver",
     "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "Scene",
     "SceneError", "SolveError", "SolverOptions", "Translational", "TranslationalClearance", "analysis", "assemble",
     "load", "load_sweep", "mechanisms", "profiles", "simulate", "sweep",

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 from collections.abc import Sequence
 
-from .errors import DaeclearError, Interrupted, PhysicsWarning, SolveError
+from .errors import DaeclearError, DiskFull, Interrupted, PhysicsWarning, SolveError
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by Ctrl-C
 #: ``daeclear run`` reports at most CLI_POINTS + 1 points by default (a run of any length stays
@@ -605,14 +605,24 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SolveError as exc:
         print(f"daeclear: {exc}", file=sys.stderr)
         return 1
+    except DiskFull as exc:  # the file named holds what was written before (a run: marked incomplete)
+        print(f"daeclear: error: {exc}", file=sys.stderr)
+        return 1
     except (DaeclearError, ValueError, KeyError) as exc:
         print(f"daeclear: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:  # Ctrl-C outside a run (assembly, compiling, a figure): nothing to save
         print("daeclear: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except OSError as exc:  # a write that failed after the checks (disk full, ...): a message, no traceback
-        print(f"daeclear: error: {exc}", file=sys.stderr)
+    except (OSError, RuntimeError) as exc:  # a write that failed after the checks (disk full, ...): one line
+        from .results.outputs import is_disk_full
+
+        if not isinstance(exc, OSError) and not is_disk_full(exc):
+            raise
+        name = getattr(exc, "filename", None)
+        where = f" writing '{name}'" if name else ""
+        cause = "no space left on the disk" if is_disk_full(exc) else str(exc).splitlines()[0]
+        print(f"daeclear: error{where}: {cause} ({type(exc).__name__}).", file=sys.stderr)
         return 1
     return 0
 

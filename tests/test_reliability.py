@@ -4,6 +4,7 @@ are rows of tests/test_bad_inputs.py."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import daeclear as dc
@@ -119,3 +120,127 @@ def test_output_estimate_matches_the_file_written(tmp_path):
     dc.simulate(scene, 0.002, t_eval_step=1e-7, stream_to=tmp_path / "x.h5", keep_data=False)
     size = (tmp_path / "x.h5").stat().st_size
     assert 0.9 * 20_001 * per_point < size < 20_001 * per_point + 2e6
+
+
+# --------------------------------------------------------------------------- a full disk, damaged files
+
+
+def _disk_fills_after(monkeypatch, calls: int) -> None:
+    """shutil.disk_usage (what daeclear asks before each write) reports a full disk after ``calls`` calls."""
+    import collections
+    import shutil
+
+    import daeclear.results.outputs as outputs
+
+    real, count = shutil.disk_usage, [0]
+
+    def usage(path):
+        count[0] += 1
+        total, used, free = real(path)
+        return collections.namedtuple("usage", "total used free")(total, used, free if count[0] <= calls else 4096)
+
+    monkeypatch.setattr(outputs.shutil, "disk_usage", usage)
+
+
+def _enospc_after(monkeypatch, calls: int) -> None:
+    """The streamed writer's dataset writes fail with ENOSPC after ``calls`` of them (space the
+    check before the write saw, taken meanwhile by another process)."""
+    import errno
+
+    from daeclear.results.hdf5_stream import ResultWriter
+
+    real, count = ResultWriter._extend, [0]
+
+    def extend(self, dataset, rows):
+        count[0] += 1
+        if count[0] > calls:
+            raise OSError(errno.ENOSPC, "No space left on device", str(self.path))
+        return real(self, dataset, rows)
+
+    monkeypatch.setattr(ResultWriter, "_extend", extend)
+
+
+@pytest.mark.parametrize("inject", [_disk_fills_after, _enospc_after])
+def test_a_full_disk_during_a_streamed_run_keeps_a_readable_prefix(inject, tmp_path, monkeypatch):
+    scene = dc.mechanisms.slider_crank("revolute")
+    path = tmp_path / "run.h5"
+    inject(monkeypatch, 3 if inject is _disk_fills_after else 200)
+    with pytest.raises(dc.DiskFull) as info:
+        dc.simulate(scene, 0.024, t_eval_step=1e-6, stream_to=path, keep_data=False)
+    assert str(path) in str(info.value) and "no space left" in str(info.value)
+    monkeypatch.undo()
+    prefix = dc.load(path)  # what was flushed before: readable, marked incomplete
+    assert not prefix.success and "DiskFull" in prefix.message
+    assert 0 < prefix.n_times < 24_001 and prefix.t[-1] < 0.024
+    full = dc.simulate(scene, prefix.t[-1], t_eval=prefix.t)  # the prefix is the run's own beginning
+    assert np.allclose(prefix["slider.vx"], full["slider.vx"], rtol=1e-6, atol=1e-6)
+
+
+@pytest.mark.parametrize("inject", [_disk_fills_after, _enospc_after])
+def test_cli_run_on_a_full_disk_says_one_line_and_exits_1(inject, tmp_path, monkeypatch, capsys):
+    inject(monkeypatch, 3 if inject is _disk_fills_after else 200)
+    code = main(["run", "slider_crank", "--joint", "revolute", "--out", str(tmp_path), "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 1 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert str(tmp_path / "slider_crank_revolute.h5") in err and "no space left" in err
+    monkeypatch.undo()
+    assert not dc.load(tmp_path / "slider_crank_revolute.h5").success
+
+
+def test_save_on_a_full_disk_keeps_the_old_file(tmp_path, monkeypatch):
+    result = dc.simulate(dc.mechanisms.slider_crank("revolute"), 0.002)
+    path = tmp_path / "run.h5"
+    result.slice(0.0, 0.001).save(path)
+    _disk_fills_after(monkeypatch, 0)
+    with pytest.raises(dc.DiskFull, match="Result.save.*run.h5.*no space left"):
+        result.save(path)
+    monkeypatch.undo()
+    assert dc.load(path).t[-1] == pytest.approx(0.001, abs=1e-5)  # the old file, whole
+    assert [p.name for p in tmp_path.iterdir()] == ["run.h5"]  # no temporary file left
+
+
+def test_cli_figure_on_a_full_disk_says_one_line(tmp_path, monkeypatch, capsys):
+    import errno
+
+    import matplotlib.figure
+
+    def full(self, fname, *args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device", str(fname))
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", full)
+    code = main(["run", "slider_crank", "--t-end", "0.001", "--out", str(tmp_path), "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 1 and err.count("\n") == 1, err
+    assert str(tmp_path / "slider_crank.png") in err and "no space left" in err
+    assert dc.load(tmp_path / "slider_crank.h5").success  # the result was written before
+
+
+def _flip(path, dataset: str) -> None:
+    """Flip 64 bytes in the middle of the data of ``dataset``'s first chunk."""
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        d = f[dataset]
+        info = d.id.get_chunk_info(0)
+        middle = min(d.chunks[0], d.shape[0]) * (d.dtype.itemsize * int(np.prod(d.shape[1:]))) // 2  # in the data
+    with open(path, "r+b") as fh:
+        fh.seek(info.byte_offset + middle)
+        data = bytearray(fh.read(64))
+        fh.seek(info.byte_offset + middle)
+        fh.write(bytes(b ^ 0xFF for b in data))
+
+
+@pytest.mark.parametrize("streamed", [False, True])
+@pytest.mark.parametrize("dataset", ["y", "channels/slider.vx", "t"])
+def test_load_refuses_a_damaged_dataset_by_name(streamed, dataset, tmp_path):
+    path = tmp_path / "run.h5"
+    scene = dc.mechanisms.slider_crank("revolute")
+    if streamed:
+        dc.simulate(scene, 0.002, t_eval_step=1e-6, stream_to=path, keep_data=False)
+    else:
+        dc.simulate(scene, 0.002, t_eval_step=1e-6).save(path)
+    dc.load(path)  # whole: reads
+    _flip(path, dataset)
+    with pytest.raises(dc.DaeclearError) as info:
+        dc.load(path)
+    assert f"'/{dataset}'" in str(info.value) and str(path) in str(info.value), str(info.value)

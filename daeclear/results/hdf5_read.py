@@ -65,7 +65,13 @@ def read_file(path: str | os.PathLike[str], t0: float | None = None, t1: float |
             if window[0] > last or window[1] < first:
                 raise SceneError(f"load('{path}'): t0={t0!r}, t1={t1!r} s, must overlap the run's output times "
                                  f"[{first:g}, {last:g}] s (the window would read no point).")
-        return _read(_Reader(f, path, window))
+        try:
+            return _read(_Reader(f, path, window))
+        except DaeclearError:
+            raise
+        except (OSError, RuntimeError, KeyError, ValueError) as exc:  # damaged metadata: named, not raw
+            raise DaeclearError(f"'{path}' is a damaged daeclear result ({type(exc).__name__}: "
+                                f"{str(exc).splitlines()[0] if str(exc) else 'unreadable'}).") from None
 
 
 def read_dataset(path: str | os.PathLike[str], name: str) -> np.ndarray:
@@ -105,7 +111,11 @@ class _Reader:
     def array(self, name: str, rows: slice | None = None) -> np.ndarray:
         if name not in self.f:
             raise self._missing(f"dataset '/{name}'")
-        return self.f[name][()] if rows is None else self.f[name][rows]
+        try:
+            return self.f[name][()] if rows is None else self.f[name][rows]
+        except (OSError, RuntimeError) as exc:  # a failed checksum (Fletcher-32) or a damaged chunk index
+            raise DaeclearError(f"'{self.path}' is a damaged daeclear result: dataset '/{name}' cannot be read "
+                                f"({str(exc).splitlines()[0]}).") from None
 
     def strings(self, name: str, rows: slice | None = None) -> list[str]:
         if name not in self.f:
