@@ -52,7 +52,8 @@ def _parse_sets(items: Sequence[str]) -> dict[str, Any]:
 def _mechanism_keys(argv: Sequence[str]) -> str | None:
     """For ``daeclear run|study|sweep MECH --help``: MECH's ``--set`` keys, each with its default and the
     first sentence of its description (units included), read from the mechanism's signature and docstring."""
-    if not ({"-h", "--help"} & set(argv)) or len(argv) < 2 or argv[0] not in ("run", "study", "sweep"):
+    if (not ({"-h", "--help"} & set(argv)) or len(argv) < 2 or argv[0] not in ("run", "study", "sweep")
+            or argv[1].startswith("-") or argv[1].endswith(".toml")):
         return None
     from .model.mechanism_options import option_table
     from .model.scenefile import MECHANISMS

@@ -244,3 +244,19 @@ def test_load_refuses_a_damaged_dataset_by_name(streamed, dataset, tmp_path):
     with pytest.raises(dc.DaeclearError) as info:
         dc.load(path)
     assert f"'/{dataset}'" in str(info.value) and str(path) in str(info.value), str(info.value)
+
+
+def test_help_and_import_load_no_numerical_library():
+    """`daeclear --help` and `import daeclear` import no CasADi, scipy, h5py or matplotlib (they took ~4 s):
+    measured in a fresh interpreter by what is imported, not by the clock of a shared machine."""
+    import subprocess
+    import sys
+
+    code = ("import sys, contextlib, io\nimport daeclear\nfrom daeclear.cli import main\n"
+            "with contextlib.suppress(SystemExit), contextlib.redirect_stdout(io.StringIO()):\n    main(['--help'])\n"
+            "print(sorted(m for m in ('casadi', 'scipy', 'h5py', 'matplotlib', 'numpy') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]", out
+    # the public names load on first use, and an old path does not replace the function daeclear.sweep
+    code = "import daeclear.sweep, daeclear\nassert callable(daeclear.sweep) and daeclear.Scene.__name__ == 'Scene'"
+    subprocess.run([sys.executable, "-c", code], check=True)
