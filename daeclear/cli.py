@@ -22,6 +22,9 @@ CLI_POINTS = 100_000
 CLI_FINEST_STEP = 1e-6
 #: ``daeclear run`` shows (summary, figure) at most this many of the last events of a run (the file has all).
 CLI_SHOWN_EVENTS = 20_000
+#: ``daeclear run``'s figure draws at most this many points a curve: min-max per bucket (two points a pixel
+#: column of a 1000-pixel-wide axes), so an impact's peak survives in a long run's figure.
+CLI_FIGURE_POINTS = 2000
 #: ``daeclear run``'s default step cap per simulated second (see default_max_steps).
 CLI_STEPS_PER_SECOND = 2_000_000
 
@@ -102,6 +105,9 @@ def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
     run.add_argument("--out", type=Path, default=Path("results"), help="output directory (default ./results)")
     run.add_argument("--name", help="base name of the output files (default: the scene name)")
     run.add_argument("--no-figure", action="store_true", help="write the HDF5 result only")
+    run.add_argument("--window", type=float, nargs=2, metavar=("T0", "T1"),
+                     help="the figure shows this time window, s (default: the whole run, min-max decimated to "
+                          f"{CLI_FIGURE_POINTS} points a curve so that peaks survive; the file has every point)")
     run.add_argument("--quiet", action="store_true", help="no progress line")
 
     study = sub.add_parser("study", help="work-precision study: error against run time per method and tolerance",
@@ -197,6 +203,10 @@ def _run(args: argparse.Namespace) -> int:
         options.fail(where if args.name is not None else f"{where} {args.target}", field, base,
                      f"a plain file name without a directory (e.g. run1){named}")
     check_directory(args.out, "--out", files=[f"{base}.h5", f"{base}.png"])  # before any work
+    if args.window is not None:  # the figure's window, inside the run
+        lo, hi = args.window
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 <= lo < hi and lo < t_end):
+            options.fail(where, "--window", tuple(args.window), f"T0 < T1 with 0 <= T0 < t_end={t_end:g} s", "s")
     run_options: dict[str, Any] = {"rtol": rtol, "backend": args.backend, "progress": not args.quiet,
                                    "on_failure": "return"}
     if args.formulation:
@@ -263,7 +273,8 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
             except DaeclearError as exc:  # e.g. an ideal mechanism with redundant constraints: no dashed lines
                 print(f"daeclear: no ideal-mechanism reference in the figure: {exc}", file=sys.stderr)
         # time plots chosen from what the scene holds, a journal orbit or slider path per clearance joint
-        png = save_run_figure(result, args.out / f"{base}.png", reference=reference)
+        png = save_run_figure(result, args.out / f"{base}.png", reference=reference,
+                              window=tuple(args.window) if args.window else None, max_points=CLI_FIGURE_POINTS)
         print(f"wrote {png}")
 
 

@@ -383,6 +383,9 @@ CLI_RUN: list[tuple[str, list[str], str, str]] = [
     ("--set gravity=True", ["--set", "gravity=True"], "gravity", "True"),
     ("--set rpm=True", ["--set", "rpm=True"], "rpm", "True"),
     ("--max-points 0", ["--max-points", "0"], "--max-points", "0"),
+    ("--window reversed", ["--window", "0.01", "0.005"], "--window", "(0.01, 0.005)"),
+    ("--window after the run", ["--t-end", "0.01", "--window", "0.02", "0.03"], "--window", "(0.02, 0.03)"),
+    ("--window nan", ["--window", "nan", "0.01"], "--window", "nan"),
 ]
 
 
@@ -611,7 +614,7 @@ def test_there_are_at_least_100_cases():
     n = (len(API_SIMULATE) + len(API_MECHANISMS) + len(API_STUDY) + len(API_SWEEP) + 4 + 4 + 4 + 1 + len(CLI_RUN) + 5
          + len(CLI_STUDY) + 2 + len(CLI_SWEEP) + 4 + 2 * len(SCENE_FILE) + len(MECHANISM_FILE) + 2)
     assert n >= 100, n
-    issue_31 = (13 + len(API_CALLS) + len(LOAD_WINDOWS) + 20 + 4 + 12 + len(CLI_OTHER) + 6 + 2 * 3
+    issue_31 = (13 + len(API_CALLS) + len(LOAD_WINDOWS) + 21 + 4 + 15 + len(CLI_OTHER) + 6 + 2 * 3
                 + len(FILES))
     assert issue_31 >= 40, issue_31
 

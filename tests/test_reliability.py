@@ -260,3 +260,27 @@ def test_help_and_import_load_no_numerical_library():
     # the public names load on first use, and an old path does not replace the function daeclear.sweep
     code = "import daeclear.sweep, daeclear\nassert callable(daeclear.sweep) and daeclear.Scene.__name__ == 'Scene'"
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_cli_figure_of_a_window_keeps_the_peaks(tmp_path, capsys, monkeypatch):
+    """--window draws that part of the run; the curves are min-max decimated, so the largest |value|
+    of the window is drawn (an impact's peak in a long run's figure)."""
+    import matplotlib.axes
+
+    drawn: list[np.ndarray] = []
+    real = matplotlib.axes.Axes.plot
+
+    def plot(self, *args, **kwargs):
+        if len(args) >= 2:
+            drawn.append(np.asarray(args[1], dtype=float))
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(matplotlib.axes.Axes, "plot", plot)
+    code = main(["run", "slider_crank", "--joint", "revolute", "--t-end", "0.006", "--window", "0.002", "0.005",
+                 "--out", str(tmp_path), "--quiet"])
+    assert code == 0, capsys.readouterr().err
+    result = dc.load(tmp_path / "slider_crank_revolute.h5")
+    inside = result.window_mask(0.002, 0.005)
+    peak = np.max(np.abs(result["slider.ax"][inside]))
+    assert any(c.size <= 2000 + 2 and np.max(np.abs(c)) == peak for c in drawn if c.size)
+    assert all(c.size <= 2000 + 2 for c in drawn)
