@@ -175,8 +175,9 @@ def simulate(
         ideal, from the declared state as a guess; "declared": the bodies' declared positions and
         velocities, corrected only for the scene's ideal joints.
     allow_penetration : bool
-        Start "declared" (or from ``y0``) even with a contact pair deeper in its wall than
-        :data:`daeclear.solvers.physics.START_PENETRATION_FRACTION` of the clearance (refused otherwise).
+        Start "declared" even with a contact pair deeper in its wall than
+        :data:`daeclear.solvers.physics.START_PENETRATION_FRACTION` of the clearance, or from a ``y0``
+        deeper than :data:`~daeclear.solvers.physics.GIVEN_PENETRATION_FRACTION` clearances (refused otherwise).
 
     stream_to : str, path or None
         Write the result to this HDF5 file while the run goes on (the layout of
