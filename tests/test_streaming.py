@@ -390,7 +390,13 @@ def test_load_of_a_window_equals_the_slice_of_the_whole(revolute, tmp_path, wind
     whole = dc.simulate(revolute, REV, stream_to=path)
     whole.save(tmp_path / "saved.h5")
     for file in (path, tmp_path / "saved.h5"):
-        part, expected = dc.load(file, *window), whole.slice(*window)
+        expected = whole.slice(*window)
+        if window == (1.0, 2.0):  # after the run: the slice is empty, and load refuses it (issue 31)
+            assert expected.n_times == 0
+            with pytest.raises(dc.SceneError, match="must overlap the run's output times"):
+                dc.load(file, *window)
+            continue
+        part = dc.load(file, *window)
         _same(part, expected)
         assert part.stats == expected.stats and part.parameters == expected.parameters
     assert len(whole.events) > 20 and np.array_equal(dc.results.result.load_times(path, "events"), whole.events.t)
