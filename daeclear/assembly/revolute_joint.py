@@ -18,12 +18,16 @@ from .parameters import law_structure, law_values, symbolic_law
 from ..model.scene import RevoluteClearance
 from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
 from .contact_pairs import PairLogic, ContactBuild, approach_floor
+from .lubricated_joint import build_lubricated_revolute, lubricated_parameters
+from ..contact.hydrodynamic import HydrodynamicBearing
 from .translational_joint import (
     TranslationalClearance, build_translational_clearance, translational_clearance_parameters)
 
 
 def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> tuple[dict[str, Any], list[str]]:
     """The joint's numbers (run-time parameters) and what of it is structure."""
+    if isinstance(joint.law, HydrodynamicBearing):
+        return lubricated_parameters(ref, joint)
     law, friction = joint.resolved_law(), joint.resolved_friction()
     s_i, s_j = ref.joint_points(joint)
     values: dict[str, Any] = {"s_i": s_i, "s_j": s_j, "clearance": joint.radial_clearance,
@@ -39,7 +43,10 @@ def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, fir
 
     Body i carries the bearing (radius R_i), body j the journal (R_j); c = R_i - R_j. Every
     number comes from the run-time parameters ``<joint>.*`` (see revolute_clearance_parameters).
+    A lubricated joint (law HydrodynamicBearing) is :func:`build_lubricated_revolute`'s.
     """
+    if isinstance(joint.law, HydrodynamicBearing):
+        return build_lubricated_revolute(ctx, joint, first_term, first_root)
     name = joint.name
     law_numeric, friction_numeric = joint.resolved_law(), joint.resolved_friction()
     law = symbolic_law(law_numeric, ctx.params, f"{name}.law")

@@ -27,8 +27,9 @@ arrays and CasADi symbols.
 from __future__ import annotations
 
 import math
+import dataclasses
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Self
 
 import numpy as np
 
@@ -116,6 +117,10 @@ class HydrodynamicBearing:
     film_threshold : float
         Minimum film thickness c (1 - eps) in m (> 0) below which the dry law takes over: of the
         order of the surfaces' combined roughness. Default 1 um.
+    hysteresis : float
+        The film forms again (the film force replaces the dry law) only when the minimum film
+        thickness exceeds ``film_threshold * (1 + hysteresis)``; >= 0, default 1. The band keeps
+        the two regimes from chattering at the threshold.
 
     Notes
     -----
@@ -130,6 +135,7 @@ class HydrodynamicBearing:
     cavitation: str = "half"
     dry: NormalLaw = LankaraniNikravesh(restitution=0.9)
     film_threshold: float = 1.0e-6
+    hysteresis: float = 1.0
 
     name: ClassVar[str] = "hydrodynamic"
 
@@ -144,6 +150,41 @@ class HydrodynamicBearing:
                              "LankaraniNikravesh(restitution=0.9)).")
         set_field(self, "film_threshold",
                   check_number(owner, "film_threshold", self.film_threshold, low=0.0, unit="m"))
+        set_field(self, "hysteresis", check_number(owner, "hysteresis", self.hysteresis, low=0.0, low_open=False))
+
+    # ---- what a revolute clearance joint asks of its law -----------------------------------
+    @property
+    def reform_threshold(self) -> float:
+        """Minimum film thickness (m) above which the film forms again after a dry contact."""
+        return self.film_threshold * (1.0 + self.hysteresis)
+
+    @property
+    def is_resolved(self) -> bool:
+        """True when the dry law has every number (see :meth:`resolve`)."""
+        return self.dry.is_resolved
+
+    @property
+    def needs_approach_speed(self) -> bool:
+        """The dry law's flag: its approach speed is latched when the film breaks down."""
+        return self.dry.needs_approach_speed
+
+    def resolve(self, kind: str, *, radii: Any = None, materials: Any = None, face_half_width: Any = None) -> Self:
+        """A copy whose dry law is resolved for the journal bearing (``kind="internal_cylinder"`` only)."""
+        if kind != "internal_cylinder":
+            raise SceneError(f"{type(self).__name__}.resolve: kind={kind!r}, must be 'internal_cylinder' "
+                             "(a lubricated journal bearing is a revolute clearance joint).")
+        dry = self.dry
+        if not dry.is_resolved:
+            dry = dry.resolve("internal_cylinder", radii=radii, materials=materials)
+        return dataclasses.replace(self, dry=dry)
+
+    def problems(self, clearance: float) -> list[str]:
+        """What is wrong with this law in a joint of radial clearance ``clearance`` (m)."""
+        owner = type(self).__name__
+        if not self.reform_threshold < clearance:
+            return [f"{owner}: film_threshold * (1 + hysteresis)={self.reform_threshold:g} m, must be < the "
+                    f"radial clearance {clearance:g} m (the film must be able to form)."]
+        return []
 
     # ---- the film --------------------------------------------------------------------------
     def film_force(self, eccentricity_ratio: Any, wedge_rate: Any, squeeze_rate: Any, radius: Any,
@@ -184,21 +225,23 @@ class HydrodynamicBearing:
             if np.any(bad):
                 raise SceneError(f"{owner}: eccentricity_ratio={eps_values[bad].flat[0]:g}, must be in [0, 1).")
         scalar, (eps, w, eps_dot) = B.as_numeric(eccentricity_ratio, wedge_rate, squeeze_rate)
-        if B.is_symbolic(eps):
-            eps = B.fmin(B.fmax(eps, 0.0), EPS_CAP)
-        radial, tangential = self._film(eps, w, eps_dot, radius, clearance)
+        radial, tangential = self.film_force_with(self.viscosity, self.length, eps, w, eps_dot, radius, clearance)
         if scalar:
             return float(radial), float(tangential)
         return radial, tangential
 
-    def _film(self, eps: Any, w: Any, eps_dot: Any, R: Any, c: Any) -> tuple[Any, Any]:
-        """(radial, tangential) from the closed forms; see the module docstring."""
+    def film_force_with(self, viscosity: Any, length: Any, eps: Any, w: Any, eps_dot: Any, R: Any,
+                        c: Any) -> tuple[Any, Any]:
+        """:meth:`film_force` with viscosity and length given (CasADi symbols of the run-time
+        parameters in an assembled model), no checks; a symbolic eps is clamped to [0, 1 - 1e-6]."""
+        if B.is_symbolic(eps):
+            eps = B.fmin(B.fmax(eps, 0.0), EPS_CAP)
         if self.cavitation == "full":
             theta1, theta2 = 0.0 * eps, 2.0 * math.pi + 0.0 * eps
         else:
             theta1 = _pressure_start(eps, w, eps_dot)
             theta2 = theta1 + math.pi
-        mu, L = self.viscosity, self.length
+        mu, L = viscosity, length
         I = film_integrals(eps, theta1, theta2)
         if self.theory == "short":
             # p = 3 mu (L^2/4 - z^2) (eps w sin - 2 eps_dot cos) / (c^2 (1 + eps cos)^3)

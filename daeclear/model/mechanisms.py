@@ -7,7 +7,7 @@ import math
 from typing import Any, TypeGuard
 
 from .. import options as rules
-from ..contact import Material, friction_law, normal_law
+from ..contact import HydrodynamicBearing, Material, friction_law, normal_law
 from ..contact.base import NormalLaw
 from ..errors import SceneError
 from ..engine.build import MemoTable, memo_by_values, memo_table
@@ -66,9 +66,10 @@ def _check(name: str, value: Any, rule: str, ok: bool) -> None:
 DEFAULT_RESTITUTION = 0.9  # Table 4.2, for the laws that take a coefficient of restitution
 
 
-def _contact_law(law: Any, restitution: float | None, length: float | None) -> NormalLaw:
-    """A law object from a law or a name; ``restitution``/``length`` fill the fields the law has."""
-    if isinstance(law, NormalLaw):
+def _contact_law(law: Any, restitution: float | None, length: float | None) -> NormalLaw | HydrodynamicBearing:
+    """A law object from a law or a name; ``restitution``/``length`` fill the fields the law has (a
+    HydrodynamicBearing, a lubricated revolute joint's law, is passed on as it is)."""
+    if isinstance(law, (NormalLaw, HydrodynamicBearing)):
         return law
     return memo_by_values(_LAWS, (str(law), restitution, length), _make_contact_law)
 
