@@ -144,3 +144,36 @@ def test_bad_lubricated_joints() -> None:
         dc.assemble(journal(0.01, 10.0, 1.0, film_threshold=5e-5))
     with pytest.raises(dc.SceneError, match="must be a normal contact law"):
         dc.assemble(slider_crank("translational", law=HydrodynamicBearing(viscosity=0.01, length=0.01)))
+
+
+def test_scene_file_with_a_lubricated_joint(tmp_path) -> None:
+    from daeclear.model.scenefile import read_scene_file
+
+    path = tmp_path / "journal.toml"
+    path.write_text("""
+[scene]
+name = "journal"
+gravity = [0.0, -9.81]
+
+[[body]]
+name = "journal"
+mass = 4.675
+inertia = 1e-4
+position = [0.0, 0.0]
+angular_velocity = 200.0
+
+[[revolute_clearance]]
+name = "bearing"
+body_i = "ground"
+body_j = "journal"
+at = [0.0, 0.0]
+bearing_radius = 0.01
+clearance = 5e-5
+material = { young = 207e9, poisson = 0.3 }
+law = { name = "hydrodynamic", viscosity = 0.01, length = 0.01, dry = { name = "hertz" } }
+""")
+    law = read_scene_file(path).scene["bearing"].law
+    assert law == HydrodynamicBearing(viscosity=0.01, length=0.01, dry=dc.contact.Hertz())
+    path.write_text(path.read_text().replace("length = 0.01,", "lenght = 0.01,"))
+    with pytest.raises(dc.SceneError, match="unknown parameter.s. lenght"):
+        read_scene_file(path)

@@ -39,7 +39,7 @@ from ._checks import check_number, set_field
 from .base import NormalLaw
 from .normal import LankaraniNikravesh
 
-__all__ = ["CAVITATION", "HydrodynamicBearing", "THEORIES", "film_integrals"]
+__all__ = ["CAVITATION", "HydrodynamicBearing", "THEORIES", "bearing_from_table", "film_integrals"]
 
 #: The film theories and the cavitation options (the first of each is the default).
 THEORIES: tuple[str, ...] = ("short", "long")
@@ -257,3 +257,25 @@ class HydrodynamicBearing:
             f_y = k * (6.0 * eps * w * I["cc"] + 12.0 * eps_dot * I["sc"] + m * I["c"])
         # f_x is along the eccentricity (the widest film is at theta = 0, opposite to it)
         return -f_x, f_y
+
+
+def bearing_from_table(params: dict[str, Any]) -> HydrodynamicBearing:
+    """A HydrodynamicBearing from a scene file's law table (``name = "hydrodynamic"`` already taken
+    out); ``dry`` may be a law name or a table ``{ name = ..., parameters }``."""
+    from .registry import normal_law
+
+    params = dict(params)
+    dry = params.get("dry")
+    if isinstance(dry, dict):
+        dry = dict(dry)
+        params["dry"] = normal_law(dry.pop("name", None), **dry)
+    elif isinstance(dry, str):
+        params["dry"] = normal_law(dry)
+    fields = [f.name for f in dataclasses.fields(HydrodynamicBearing)]
+    unknown = sorted(set(params) - set(fields))
+    if unknown:
+        raise SceneError(f"HydrodynamicBearing: unknown parameter(s) {', '.join(unknown)}; valid: {', '.join(fields)}.")
+    missing = [name for name in ("viscosity", "length") if name not in params]
+    if missing:
+        raise SceneError(f"HydrodynamicBearing: missing required parameter(s) {', '.join(missing)}.")
+    return HydrodynamicBearing(**params)
