@@ -177,3 +177,19 @@ law = { name = "hydrodynamic", viscosity = 0.01, length = 0.01, dry = { name = "
     path.write_text(path.read_text().replace("length = 0.01,", "lenght = 0.01,"))
     with pytest.raises(dc.SceneError, match="unknown parameter.s. lenght"):
         read_scene_file(path)
+
+
+def test_example_lubricated_joint_quick(tmp_path) -> None:
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "lubricated_joint.py"
+    spec = importlib.util.spec_from_file_location("example_lubricated_joint", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    lines = module.main(["--quick", "--out", str(tmp_path)])
+    for name in ("lubricated_joint.png", "viscosity_sweep.png"):
+        assert (tmp_path / name).stat().st_size > 5_000
+    rows = {line.split("|")[0].strip(): line for line in lines if "|" in line}
+    assert int(rows["mu=0.1"].split("|")[2]) == 0  # the reference oil carries the joint
+    assert int(rows["mu=0.006"].split("|")[2]) >= 1  # the thinnest one breaks down
