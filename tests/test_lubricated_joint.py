@@ -55,11 +55,11 @@ def test_journal_settles_at_the_static_eccentricity_and_attitude_angle() -> None
     attitude = math.atan(math.pi * math.sqrt(1 - eps**2) / (4 * eps))
     run = dc.simulate(journal(mu, omega, mass), 0.4, rtol=1e-8)
     assert run.success and not run.events  # the film carries throughout
-    assert run["bearing.eccentricity_ratio"][-1] == pytest.approx(eps, rel=2e-4)
+    assert run["bearing.eccentricity_ratio"][-1] == pytest.approx(eps, rel=1e-6)
     angle = math.atan2(run["bearing.ey"][-1], run["bearing.ex"][-1]) + math.pi / 2  # from the load line (-y)
-    assert angle == pytest.approx(attitude, rel=1e-3)
+    assert angle == pytest.approx(attitude, rel=1e-6)
     # the film's resultant is the load; pressure forces pass through the centre: the spin is kept
-    assert math.hypot(run["bearing.film_radial"][-1], run["bearing.film_tangential"][-1]) == pytest.approx(W, rel=1e-4)
+    assert math.hypot(run["bearing.film_radial"][-1], run["bearing.film_tangential"][-1]) == pytest.approx(W, rel=1e-6)
     assert run["journal.omega"][-1] == pytest.approx(omega, rel=1e-12)
     assert np.all(run["bearing.regime"] == 0.0)
 
