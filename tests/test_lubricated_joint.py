@@ -193,3 +193,14 @@ def test_example_lubricated_joint_quick(tmp_path) -> None:
     rows = {line.split("|")[0].strip(): line for line in lines if "|" in line}
     assert int(rows["mu=0.1"].split("|")[2]) == 0  # the reference oil carries the joint
     assert int(rows["mu=0.006"].split("|")[2]) >= 1  # the thinnest one breaks down
+
+
+def test_command_line_with_a_lubricant(tmp_path) -> None:
+    from daeclear.cli import main
+
+    law = "law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01, 'film_threshold': 2e-6}"
+    assert main(["run", "slider_crank", "--joint", "revolute", "--set", law, "--t-end", "0.003", "--out",
+                 str(tmp_path), "--no-figure", "--quiet"]) == 0
+    result = dc.load(tmp_path / "slider_crank_revolute.h5")
+    assert result.success and result["clearance.regime"].max() == 0.0
+    assert result["clearance.film_radial"].max() > 0.0

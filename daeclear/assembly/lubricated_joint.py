@@ -16,7 +16,7 @@ from chattering; the storm guard holds the dry regime in a cascade, as for a dry
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 from collections.abc import Sequence
 
@@ -26,9 +26,9 @@ from numpy.typing import NDArray
 
 from ..model.clearance_joints import RevoluteClearance
 from ..results.result import ContactEvent
-from .automaton import DEFAULT_STORM, EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
-from .contact_pairs import ContactBuild, approach_floor
-from .parameters import law_structure, law_values, symbolic_law
+from .automaton import ONSET, Decision, recorded, start, step
+from .contact_pairs import ContactBuild, PairLogic, approach_floor, journal_contact
+from .parameters import law_structure, law_values
 from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
 
 __all__ = ["FILM_REGULARISATION", "LubricatedLogic", "build_lubricated_revolute", "lubricated_parameters"]
@@ -58,35 +58,13 @@ def build_lubricated_revolute(ctx: AssemblyContext, joint: RevoluteClearance, fi
     name = joint.name
     bearing, friction_numeric = joint.resolved_law(), joint.resolved_friction()
     dry_numeric = bearing.dry
-    dry = symbolic_law(dry_numeric, ctx.params, f"{name}.law")
-    friction = symbolic_law(friction_numeric, ctx.params, f"{name}.friction")
-    c = ctx.p(name, "clearance")
-    R_i, R_j = ctx.p(name, "bearing_radius"), ctx.p(name, "journal_radius")
-    s_i, s_j = ctx.p(name, "s_i"), ctx.p(name, "s_j")
-    bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
-    P_i, P_j = bi.point(s_i), bj.point(s_j)
-    e = P_j - P_i
-    e_dot = bj.point_velocity(s_j) - bi.point_velocity(s_i)
-    ee = ca.dot(e, e)
+    # the dry term: the revolute clearance joint's contact, on only in the dry regime (|e| >= c - threshold > 0)
+    jc = journal_contact(ctx, joint, dry_numeric, friction_numeric)
+    e, e_dot, ee, e_norm, c, bi, bj = jc.e, jc.e_dot, jc.ee, jc.e_norm, jc.c, jc.bi, jc.bj
+    R_j = ctx.p(name, "journal_radius")
     r_break = c - ctx.p(name, "film.threshold")
     r_reform = c - ctx.p(name, "film.reform_threshold")
     gaps = [(ee - r_break * r_break) / (2.0 * r_break), (ee - r_reform * r_reform) / (2.0 * r_reform)]
-
-    # the dry term: the revolute clearance joint's contact (4.1)-(4.13); on only in the dry regime,
-    # where |e| >= c - film_threshold > 0
-    e_norm = ca.sqrt(ee)
-    n = e / e_norm
-    delta, delta_dot = e_norm - c, ca.dot(e_dot, n)
-    t_vec = perpendicular(n)
-    Q_i, Q_j = P_i + R_i * n, P_j + R_j * n
-    v_T = ca.dot(bj.world_point_velocity(Q_j) - bi.world_point_velocity(Q_i), t_vec)
-    n_params = 1 if dry_numeric.needs_approach_speed else 0
-    p = ca.SX.sym("p", n_params)
-    F_N = dry.force(delta, delta_dot, p[0] if n_params else None)
-    F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
-    f_dry = -F_N * n + F_T * t_vec
-    Q_dry = ctx.generalized_force([(joint.body_j, f_dry, Q_j), (joint.body_i, -f_dry, Q_i)])
-    dry_fn = ca.Function(f"{name}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P], [Q_dry], ["t", "q", "v", "p", "P"], ["Q"])
 
     # the film term: on in the film regime (regularised at e = 0, see FILM_REGULARISATION)
     reg = ca.sqrt(ee + (FILM_REGULARISATION * c) ** 2)
@@ -98,7 +76,7 @@ def build_lubricated_revolute(ctx: AssemblyContext, joint: RevoluteClearance, fi
     F_r, F_t = bearing.film_force_with(ctx.p(name, "film.viscosity"), ctx.p(name, "film.length"),
                                        eps, wedge, eps_dot, R_j, c)
     f_film = -F_r * n_f + F_t * perpendicular(n_f)  # pressure resultants through the two centres
-    Q_film = ctx.generalized_force([(joint.body_j, f_film, P_j), (joint.body_i, -f_film, P_i)])
+    Q_film = ctx.generalized_force([(joint.body_j, f_film, jc.P_j), (joint.body_i, -f_film, jc.P_i)])
     p0 = ca.SX.sym("p", 0)
     film_fn = ca.Function(f"{name}_film_force", [ctx.t, ctx.q, ctx.v, p0, ctx.P], [Q_film],
                           ["t", "q", "v", "p", "P"], ["Q"])
@@ -107,73 +85,42 @@ def build_lubricated_revolute(ctx: AssemblyContext, joint: RevoluteClearance, fi
                        [gaps[0], gaps[1], ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
     floor = approach_floor(ctx, dry_numeric, f"{name}.law")
     n_q = ctx.n_q
+    discontinuous = not friction_numeric.frictionless and not friction_numeric.smooth
 
     def logic(P: NDArray[np.float64]) -> list[Any]:
         return [LubricatedLogic(name, first_root, first_term, BufferedFunction(rate, bound=(P,)), n_q,
-                                dry_numeric.needs_approach_speed, floor(P))]
+                                dry_numeric.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
         (on, p_sym), (film_on, _) = switches
-        F_N_out = on * ca.substitute(F_N, p, p_sym) if n_params else on * F_N
-        out = [
-            Channel(f"{name}.ex", "m", e[0]),
-            Channel(f"{name}.ey", "m", e[1]),
-            Channel(f"{name}.eccentricity", "m", e_norm),
+        return jc.channels(name, on, p_sym, friction_numeric.frictionless) + [
             Channel(f"{name}.eccentricity_ratio", "", e_norm / c),
             Channel(f"{name}.film_thickness", "m", c - e_norm),
-            Channel(f"{name}.penetration", "m", e_norm - c),
-            Channel(f"{name}.penetration_rate", "m/s", ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)),
-            Channel(f"{name}.normal_force", "N", F_N_out),
-            Channel(f"{name}.in_contact", "", on),
             Channel(f"{name}.regime", "", on),  # 0 film, 1 dry
             Channel(f"{name}.film_radial", "N", film_on * F_r),
             Channel(f"{name}.film_tangential", "N", film_on * F_t),
             # the power the film's forces take from the mechanism (the pressure's share of the film's losses)
             Channel(f"{name}.film_dissipation", "W", -film_on * ca.dot(f_film, e_dot)),
         ]
-        if not friction_numeric.frictionless:
-            F_T_out = on * (ca.substitute(F_T, p, p_sym) if n_params else F_T)
-            out += [Channel(f"{name}.friction_force", "N", F_T_out),
-                    Channel(f"{name}.sliding_velocity", "m/s", v_T)]
-        return out
 
-    return ContactBuild(terms=[Term(name, dry_fn, n_params), Term(f"{name}.film", film_fn, 0)], gaps=gaps,
+    return ContactBuild(terms=[Term(name, jc.force, jc.n_params), Term(f"{name}.film", film_fn, 0)], gaps=gaps,
                         gap_names=[f"{name}.film_break", f"{name}.film_reform"], channels=channels, logic=logic,
                         ideal=[e[0], e[1]], ideal_names=[f"{name}.x", f"{name}.y"])
 
 
 @dataclass
-class LubricatedLogic:
+class LubricatedLogic(PairLogic):
     """Regime switching of one lubricated joint by the contact automaton (see the module docstring).
 
     Root ``root_index`` (film_break) is watched upward, ``root_index + 1`` (film_reform) downward; the
     dry term ``term_index`` is on while the automaton is in contact (or held), the film term
-    ``term_index + 1`` otherwise. The compiled loop hands these roots to Python (no simple pairs).
+    ``term_index + 1`` otherwise. ``rate`` gives (film_break gap, film_reform gap, penetration rate).
+    The compiled loop hands these roots to Python (no simple pairs).
     """
-
-    pair: str
-    root_index: int
-    term_index: int
-    rate: BufferedFunction  # (q, v) -> (film_break gap, film_reform gap, penetration rate)
-    n_q: int
-    needs_approach: bool
-    min_approach_speed: float
-    storm: Storm = DEFAULT_STORM
-    state: PairState = field(default_factory=PairState)
-
-    @property
-    def held(self) -> bool:
-        return self.state.held
 
     @property
     def roots(self) -> range:
         return range(self.root_index, self.root_index + 2)
-
-    def pair_state(self, root: int) -> PairState:
-        return self.state
-
-    def pair_name(self, root: int) -> str:
-        return self.pair
 
     def _values(self, y: NDArray) -> tuple[float, float, float]:
         out = self.rate(y[:self.n_q], y[self.n_q:2 * self.n_q])
@@ -182,7 +129,7 @@ class LubricatedLogic:
     def _switch(self, active: list[bool], params: list[NDArray], term_on: bool, onset: bool) -> None:
         active[self.term_index], active[self.term_index + 1] = term_on, not term_on
         if onset:
-            params[self.term_index] = np.array([self.state.latched]) if self.needs_approach else np.zeros(0)
+            params[self.term_index] = self._params()
 
     def initial_modes(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> dict[str, str]:
         broken, _, rate = self._values(y)
@@ -208,18 +155,11 @@ class LubricatedLogic:
                                     min_approach_speed=self.min_approach_speed)
         return self.record(self.root_index, t, y, rate, decision, active, params)
 
-    def record(self, root: int, t: float, y: NDArray, rate: float, decision: Decision,
-               active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
-        if decision.kind == NONE:
-            return []
-        self.apply(root, t, y, decision, active, params)
-        return [ContactEvent.from_solver(t, self.pair, EVENT_KINDS[decision.kind], rate, np.array(y, dtype=float))]
-
     def apply(self, root: int, t: float, y: NDArray, decision: Decision, active: list[bool],
               params: list[NDArray]) -> None:
         self.state = recorded(self.state, decision)
         self._switch(active, params, decision.term_on, decision.kind == ONSET)
 
-    def simple_pairs(self) -> None:
+    def simple_pairs(self) -> None:  # type: ignore[override]
         """None: two terms follow one pair, which the compiled loop's mirror does not do."""
         return None

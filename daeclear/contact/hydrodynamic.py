@@ -39,7 +39,7 @@ from ._checks import check_number, set_field
 from .base import NormalLaw
 from .normal import LankaraniNikravesh
 
-__all__ = ["CAVITATION", "HydrodynamicBearing", "THEORIES", "bearing_from_table", "film_integrals"]
+__all__ = ["CAVITATION", "HydrodynamicBearing", "THEORIES", "bearing_from_table", "film_integrals", "law_from_table"]
 
 #: The film theories and the cavitation options (the first of each is the default).
 THEORIES: tuple[str, ...] = ("short", "long")
@@ -279,3 +279,15 @@ def bearing_from_table(params: dict[str, Any]) -> HydrodynamicBearing:
     if missing:
         raise SceneError(f"HydrodynamicBearing: missing required parameter(s) {', '.join(missing)}.")
     return HydrodynamicBearing(**params)
+
+
+def law_from_table(table: dict[str, Any]) -> Any:
+    """A normal law or a HydrodynamicBearing from a table ``{name = ..., parameters}`` (scene files,
+    ``daeclear run --set law={...}``): ``name = "hydrodynamic"`` makes the bearing."""
+    from .registry import normal_law
+
+    params = dict(table)
+    name = params.pop("name", None)
+    if name == HydrodynamicBearing.name:
+        return bearing_from_table(params)
+    return normal_law(name, **params)

@@ -85,8 +85,8 @@ from collections.abc import Callable
 from . import mechanisms
 from .. import options
 from ..errors import SceneError
-from ..contact import HydrodynamicBearing, Material, friction_law, normal_law
-from ..contact.hydrodynamic import bearing_from_table
+from ..contact import Material, friction_law, normal_law
+from ..contact.hydrodynamic import law_from_table
 from .profiles import profile_from_dict
 from .loads import Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
 from .scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance,
@@ -121,11 +121,10 @@ def _law(value: Any, build: Any) -> Any:
     """A law given as a name, a number (friction coefficient) or a table {name = ..., parameters}
     (``name = "hydrodynamic"``: a lubricated revolute joint's HydrodynamicBearing)."""
     if isinstance(value, dict):
+        if build is normal_law:
+            return law_from_table(value)
         params = dict(value)
-        name = params.pop("name", None)
-        if build is normal_law and name == HydrodynamicBearing.name:
-            return bearing_from_table(params)
-        return build(name, **params)
+        return build(params.pop("name", None), **params)
     return value
 
 
