@@ -242,6 +242,40 @@ def test_short_theory_against_butenschoen_at_b_over_d_one_eighth() -> None:
         assert got_beta == pytest.approx(beta, abs=0.3)
 
 
+# ---- theory="finite": Butenschoen's tables as corrections of the short theory -----------------
+@pytest.mark.parametrize("key", sorted(BUTENSCHOEN_ROTATION))
+def test_finite_theory_is_butenschoens_table_at_its_nodes(key: tuple[float, float]) -> None:
+    (bd, eps), (so, beta) = key, BUTENSCHOEN_ROTATION[key]
+    length = bd * 2 * R
+    for w in (100.0, -60.0):
+        fr, ft = law(length, "finite").film_force(eps, w, 0.0, R, C)
+        got_so, got_beta = sommerfeld((fr, abs(ft)), length, abs(w))
+        assert got_so == pytest.approx(so, rel=1e-9) and got_beta == pytest.approx(beta, abs=1e-9)
+        assert math.copysign(1.0, ft) == math.copysign(1.0, w)
+    # squeeze (closing film, So_d = F psi^2 / (B D mu eps_dot)): Butenschoen's 3.675 at B/D = 1/2, eps = 0.5
+    fr, ft = law(R, "finite").film_force(0.5, 0.0, 10.0, R, C)
+    assert fr * (C / R) ** 2 / (R * 2 * R * MU * 10.0) == pytest.approx(3.675, rel=1e-9) and ft == 0.0
+
+
+@pytest.mark.parametrize("bd, eps, w, eps_dot", [
+    (0.3, 0.65, 100.0, 0.0), (0.7, 0.85, 100.0, 0.0), (0.3, 0.65, 0.0, 10.0), (0.7, 0.85, 0.0, 10.0),
+    (0.3, 0.65, 0.0, -10.0), (0.15, 0.5, 100.0, 5.0), (0.3, 0.7, 100.0, 10.0), (0.6, 0.6, -80.0, 8.0),
+])
+def test_finite_theory_against_the_reference_solver(bd: float, eps: float, w: float, eps_dot: float) -> None:
+    """Between the table's nodes and for combined motions, against the FD solution (Reynolds condition)."""
+    length = bd * 2 * R
+    reference = fd_force(eps, w, eps_dot, length, cavitation="reynolds")
+    assert rel(law(length, "finite").film_force(eps, w, eps_dot, R, C), reference) < 0.03
+
+
+def test_finite_theory_tends_to_the_short_one_and_rejects_the_full_film() -> None:
+    for length, tol in ((0.001, 0.01), (1e-4, 0.001)):  # B/D = 1/20, 1/200
+        short, finite = (law(length, theory).film_force(0.6, 90.0, 4.0, R, C) for theory in ("short", "finite"))
+        assert rel(finite, short) < tol
+    with pytest.raises(SceneError, match="cavitation='full' with theory='finite', must be 'half'"):
+        HydrodynamicBearing(viscosity=MU, length=0.01, theory="finite", cavitation="full")
+
+
 # ---- published closed forms and the half/full relationships ------------------------------
 @pytest.mark.parametrize("eps", [0.0, 0.1, 0.5, 0.9, 0.99])
 def test_rotation_closed_forms(eps: float) -> None:
@@ -315,8 +349,8 @@ def test_rotation_sense_and_scaling() -> None:
 
 
 # ---- numbers, arrays and CasADi from one definition --------------------------------------
-@pytest.mark.parametrize("theory", ["short", "long"])
-@pytest.mark.parametrize("cavitation", ["half", "full"])
+@pytest.mark.parametrize("theory, cavitation", [("short", "half"), ("short", "full"), ("long", "half"),
+                                               ("long", "full"), ("finite", "half")])
 def test_casadi_agrees_and_derivatives_are_finite(theory: str, cavitation: str) -> None:
     bearing = law(0.015, theory, cavitation)
     x = ca.SX.sym("x", 3)
@@ -342,7 +376,8 @@ def test_casadi_agrees_and_derivatives_are_finite(theory: str, cavitation: str) 
     ({"viscosity": -1.0, "length": 0.01}, "viscosity=-1 Pa s, must be > 0."),
     ({"viscosity": 0.01, "length": float("nan")}, "length=nan m, must be a number."),
     ({"viscosity": 0.01, "length": "2cm"}, "length='2cm' is not a real number."),
-    ({"viscosity": 0.01, "length": 0.01, "theory": "medium"}, "theory='medium', must be one of 'short', 'long'"),
+    ({"viscosity": 0.01, "length": 0.01, "theory": "medium"},
+     "theory='medium', must be one of 'short', 'long', 'finite'"),
     ({"viscosity": 0.01, "length": 0.01, "cavitation": "none"}, "cavitation='none', must be one of 'half', 'full'"),
     ({"viscosity": 0.01, "length": 0.01, "dry": "hertz"}, "dry='hertz', must be a normal contact law"),
     ({"viscosity": 0.01, "length": 0.01, "film_threshold": 0.0}, "film_threshold=0 m, must be > 0."),

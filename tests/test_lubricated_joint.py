@@ -64,6 +64,22 @@ def test_journal_settles_at_the_static_eccentricity_and_attitude_angle() -> None
     assert np.all(run["bearing.regime"] == 0.0)
 
 
+def test_finite_bearing_settles_at_butenschoens_eccentricity_and_angle() -> None:
+    """B/D = 1/2 (L = R_j): the load that Butenschoen's table carries at eps = 0.8 (So = 1.7339,
+    beta = 32.938 deg, So = W psi^2 / (B D mu omega), psi = c / R_j)."""
+    mu, omega = 0.01, 200.0
+    W = 1.7339 * R_J * 2 * R_J * mu * omega / (C / R_J) ** 2
+    scene = dc.Scene("journal", gravity=(0.0, -G))
+    body = scene.add(dc.Body("journal", mass=W / G, inertia=1e-4, position=(0.0, 0.0), angular_velocity=omega))
+    scene.add(dc.RevoluteClearance("bearing", scene.ground, body, at=(0.0, 0.0), bearing_radius=R, clearance=C,
+                                   material=STEEL, law=HydrodynamicBearing(viscosity=mu, length=R_J, theory="finite")))
+    run = dc.simulate(scene, 0.4, rtol=1e-8)
+    assert run.success and not run.events
+    assert run["bearing.eccentricity_ratio"][-1] == pytest.approx(0.8, rel=1e-5)
+    angle = math.atan2(run["bearing.ey"][-1], run["bearing.ex"][-1]) + math.pi / 2
+    assert math.degrees(angle) == pytest.approx(32.938, abs=1e-3)
+
+
 def squeeze_force(eps: float, eps_dot: float, mu: float) -> float:
     q = 1 - eps**2
     if eps_dot <= 0:  # the film opening (not reached while falling)

@@ -7,10 +7,12 @@ the sense of positive rotation; Reynolds' equation for an incompressible, isovis
     d/dtheta(h^3 dp/dtheta) / R^2 + d/dz(h^3 dp/dz) = -6 mu c eps w sin(theta) + 12 mu c eps_dot cos(theta)
 
 with ``w = omega_journal + omega_bearing - 2 dgamma/dt`` (the wedge rate) and ``eps_dot`` (the
-squeeze rate). Two closed forms:
+squeeze rate). Two closed forms, and a finite bearing:
 
 - ``theory="short"`` (Ocvirk, L/D -> 0: the theta derivative dropped, p = 0 at z = +-L/2);
-- ``theory="long"`` (Sommerfeld, L/D -> infinity: the z derivative dropped).
+- ``theory="long"`` (Sommerfeld, L/D -> infinity: the z derivative dropped);
+- ``theory="finite"``: the short forces corrected by Butenschoen's finite-width tables
+  (:mod:`daeclear.contact.finite_bearing`).
 
 Cavitation: ``"full"`` keeps the whole (partly negative) film; ``"half"`` keeps the half of the
 film ``theta1 < theta < theta1 + pi``, ``theta1 = atan2(2 eps_dot, eps w)``, where the combined
@@ -37,12 +39,13 @@ from ..errors import SceneError
 from . import _backend as B
 from ._checks import check_number, set_field
 from .base import NormalLaw
+from .finite_bearing import finite_film_force
 from .normal import LankaraniNikravesh
 
 __all__ = ["CAVITATION", "HydrodynamicBearing", "THEORIES", "bearing_from_table", "film_integrals", "law_from_table"]
 
 #: The film theories and the cavitation options (the first of each is the default).
-THEORIES: tuple[str, ...] = ("short", "long")
+THEORIES: tuple[str, ...] = ("short", "long", "finite")
 CAVITATION: tuple[str, ...] = ("half", "full")
 #: Largest eccentricity ratio the symbolic film force is evaluated at (the force diverges at 1;
 #: the dry law acts long before, at c (1 - eps) = film_threshold).
@@ -107,8 +110,9 @@ class HydrodynamicBearing:
         Dynamic viscosity mu of the oil in Pa s, > 0 (an SAE 30 oil at 60 C: about 0.03).
     length : float
         Axial length L of the bearing in m, > 0.
-    theory : {"short", "long"}
-        Ocvirk's infinitely short or Sommerfeld's infinitely long bearing.
+    theory : {"short", "long", "finite"}
+        Ocvirk's infinitely short or Sommerfeld's infinitely long bearing, or a finite bearing
+        (B/D = L / (2 R) <= 1) from Butenschoen's tables (:mod:`daeclear.contact.finite_bearing`).
     cavitation : {"half", "full"}
         "half": the film keeps only the half where pressure builds (Guembel); "full": the whole film.
     dry : NormalLaw
@@ -145,6 +149,9 @@ class HydrodynamicBearing:
         set_field(self, "length", check_number(owner, "length", self.length, low=0.0, unit="m"))
         set_field(self, "theory", _choice(owner, "theory", self.theory, THEORIES))
         set_field(self, "cavitation", _choice(owner, "cavitation", self.cavitation, CAVITATION))
+        if self.theory == "finite" and self.cavitation != "half":
+            raise SceneError(f"{owner}: cavitation={self.cavitation!r} with theory='finite', must be 'half' "
+                             "(Butenschoen's tables have the Reynolds cavitation condition).")
         if not isinstance(self.dry, NormalLaw):
             raise SceneError(f"{owner}: dry={self.dry!r}, must be a normal contact law (a NormalLaw, e.g. "
                              "LankaraniNikravesh(restitution=0.9)).")
@@ -178,13 +185,17 @@ class HydrodynamicBearing:
             dry = dry.resolve("internal_cylinder", radii=radii, materials=materials)
         return dataclasses.replace(self, dry=dry)
 
-    def problems(self, clearance: float) -> list[str]:
+    def problems(self, clearance: float, journal_radius: float) -> list[str]:
         """What is wrong with this law in a joint of radial clearance ``clearance`` (m)."""
         owner = type(self).__name__
+        out = []
         if not self.reform_threshold < clearance:
-            return [f"{owner}: film_threshold * (1 + hysteresis)={self.reform_threshold:g} m, must be < the "
-                    f"radial clearance {clearance:g} m (the film must be able to form)."]
-        return []
+            out.append(f"{owner}: film_threshold * (1 + hysteresis)={self.reform_threshold:g} m, must be < the "
+                       f"radial clearance {clearance:g} m (the film must be able to form).")
+        if self.theory == "finite" and self.length > 2.0 * journal_radius:
+            out.append(f"{owner}: length={self.length:g} m with theory='finite', must be <= the journal's diameter "
+                       f"{2.0 * journal_radius:g} m (Butenschoen's tables end at B/D = 1).")
+        return out
 
     # ---- the film --------------------------------------------------------------------------
     def film_force(self, eccentricity_ratio: Any, wedge_rate: Any, squeeze_rate: Any, radius: Any,
@@ -243,18 +254,20 @@ class HydrodynamicBearing:
             theta2 = theta1 + math.pi
         mu, L = viscosity, length
         I = film_integrals(eps, theta1, theta2)
-        if self.theory == "short":
-            # p = 3 mu (L^2/4 - z^2) (eps w sin - 2 eps_dot cos) / (c^2 (1 + eps cos)^3)
+        if self.theory != "long":
+            # p = 3 mu (L^2/4 - z^2) (eps w sin - 2 eps_dot cos) / (c^2 (1 + eps cos)^3): wedge and squeeze parts
             k = mu * R * L ** 3 / (2.0 * c * c)
-            f_x = k * (eps * w * I["sc"] - 2.0 * eps_dot * I["cc"])
-            f_y = k * (eps * w * I["ss"] - 2.0 * eps_dot * I["sc"])
-        else:
-            # dp/dtheta = mu R^2 (6 eps w cos + 12 eps_dot sin + m) / (c^2 (1 + eps cos)^3), m from
-            # p = 0 at both ends (half) or periodicity (full); the forces by parts (p = 0 or periodic there)
-            m = -(6.0 * eps * w * I["c"] + 12.0 * eps_dot * I["s"]) / I["1"]
-            k = mu * L * R ** 3 / (c * c)
-            f_x = -k * (6.0 * eps * w * I["sc"] + 12.0 * eps_dot * I["ss"] + m * I["s"])
-            f_y = k * (6.0 * eps * w * I["cc"] + 12.0 * eps_dot * I["sc"] + m * I["c"])
+            wedge = (-k * eps * w * I["sc"], k * eps * w * I["ss"])  # (radial, tangential)
+            squeeze = (2.0 * k * eps_dot * I["cc"], -2.0 * k * eps_dot * I["sc"])
+            if self.theory == "finite":
+                return finite_film_force(wedge, squeeze, eps, w, eps_dot, L / (2.0 * R))
+            return wedge[0] + squeeze[0], wedge[1] + squeeze[1]
+        # dp/dtheta = mu R^2 (6 eps w cos + 12 eps_dot sin + m) / (c^2 (1 + eps cos)^3), m from
+        # p = 0 at both ends (half) or periodicity (full); the forces by parts (p = 0 or periodic there)
+        m = -(6.0 * eps * w * I["c"] + 12.0 * eps_dot * I["s"]) / I["1"]
+        k = mu * L * R ** 3 / (c * c)
+        f_x = -k * (6.0 * eps * w * I["sc"] + 12.0 * eps_dot * I["ss"] + m * I["s"])
+        f_y = k * (6.0 * eps * w * I["cc"] + 12.0 * eps_dot * I["sc"] + m * I["c"])
         # f_x is along the eccentricity (the widest film is at theta = 0, opposite to it)
         return -f_x, f_y
 

@@ -40,7 +40,8 @@ def _law_problems(element: RevoluteClearance | TranslationalClearance) -> list[s
                 out.append(f"{element.kind} '{element.name}': law=HydrodynamicBearing(...), must be a normal "
                            "contact law (a lubricated film is a revolute clearance joint's law).")
             else:
-                out.extend(f"{element.kind} '{element.name}': {p}" for p in law.problems(element.radial_clearance))
+                problems = law.problems(element.radial_clearance, element.journal)
+                out.extend(f"{element.kind} '{element.name}': {p}" for p in problems)
                 element.resolved_law()
         elif not isinstance(law, NormalLaw):
             out.append(f"{element.kind} '{element.name}': law={law!r}, must be a daeclear.contact law or a law name.")
