@@ -17,7 +17,7 @@ import pytest
 
 import daeclear as dc
 from daeclear.engine.codegen import clear_memos
-from daeclear.contact import FRICTION_LAWS, NORMAL_LAWS, Material, friction_law, normal_law
+from daeclear.contact import FRICTION_LAWS, NORMAL_LAWS, HydrodynamicBearing, Material, friction_law, normal_law
 from daeclear.assembly.parameters import is_parametric, law_values, symbolic_law
 
 STEEL = Material(young=207e9, poisson=0.3)
@@ -54,6 +54,11 @@ VARIANTS = {
     "section-4.3": (dict(joint="translational", contact_model="section-4.3"),
                     dict(joint="translational", clearance=0.6e-3, contact_model="section-4.3", restitution=0.8)),
     "ideal": (dict(joint="ideal"), dict(joint="ideal", rpm=1234.0, gravity=3.0)),
+    # the lubricated joint: viscosity, bearing length, film thresholds and the dry law's numbers
+    "lubricated": (dict(joint="revolute", friction=0.1, law=HydrodynamicBearing(viscosity=0.04, length=0.02)),
+                   dict(joint="revolute", friction=0.05, clearance=0.3e-3, rpm=3000.0,
+                        law=HydrodynamicBearing(viscosity=0.01, length=0.015, film_threshold=2e-6, hysteresis=0.5,
+                                                dry=normal_law("lankarani-nikravesh", restitution=0.7)))),
     # readings of the translational joint (daeclear.model.readings): their K, n, c_e, the slider's mass and
     # inertia and the pin's place on it are numbers
     "reading-unified": (dict(joint="translational", reading="unified"),
@@ -133,6 +138,23 @@ def test_structure_changes_get_their_own_template():
     assert (dc.assemble(dc.mechanisms.slider_crank("revolute"), formulation="ggl").functions
             is not dc.assemble(dc.mechanisms.slider_crank("revolute"), formulation="index1").functions)
     assert dc.assemble(dc.mechanisms.slider_crank("revolute"), track_work=True).functions is not reference
+
+
+def test_lubricated_joint_numbers_are_parameters_and_its_theory_is_structure():
+    def scene(**law):
+        return dc.mechanisms.slider_crank("revolute", law=HydrodynamicBearing(**{"viscosity": 0.04, "length": 0.02,
+                                                                                 **law}))
+
+    reference = dc.assemble(scene())
+    assert reference.parameter("clearance.film.viscosity")[0] == 0.04
+    assert reference.parameter("clearance.film.length")[0] == 0.02
+    assert reference.parameter("clearance.film.threshold")[0] == 1e-6
+    assert reference.parameter("clearance.film.reform_threshold")[0] == 2e-6
+    assert reference.parameter("clearance.law.restitution")[0] == 0.9
+    for law in (dict(viscosity=0.002), dict(length=0.05), dict(film_threshold=3e-6, hysteresis=0.2)):
+        assert dc.assemble(scene(**law)).functions is reference.functions, law
+    for law in (dict(theory="long"), dict(cavitation="full"), dict(dry=normal_law("hertz"))):
+        assert dc.assemble(scene(**law)).functions is not reference.functions, law
 
 
 def test_translational_readings_change_the_structure_only_with_the_equations():

@@ -35,7 +35,8 @@ from numpy.typing import NDArray
 
 from .automaton import DEFAULT_STORM, EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
 from ..results.result import ContactEvent
-from .symbolic import AssemblyContext, BufferedFunction, Channel, Term
+from .parameters import symbolic_law
+from .symbolic import AssemblyContext, BufferedFunction, Channel, Term, perpendicular
 
 
 @dataclass
@@ -161,3 +162,82 @@ def approach_floor(ctx: AssemblyContext, law: Any, prefix: str) -> Callable[[NDA
         return lambda P: float(P[index])
     floor = float(getattr(law, "min_approach_speed", 0.0))
     return lambda P: floor
+
+
+@dataclass(frozen=True)
+class JournalContact:
+    """A revolute clearance joint's journal in its bearing, eqs. (4.1)-(4.13): the eccentricity and
+    the contact force term (normal law and friction), shared by the dry and the lubricated joint.
+
+    ``force`` maps (t, q, v, p, P) to the generalized force, ``p`` the latched approach speed
+    (``n_params`` 0 or 1); frames ``bi`` (bearing) and ``bj`` (journal).
+    """
+
+    e: Any
+    e_dot: Any
+    ee: Any
+    e_norm: Any
+    c: Any
+    bi: Any
+    bj: Any
+    P_i: Any
+    P_j: Any
+    F_N: Any
+    F_T: Any
+    v_T: Any
+    p: Any
+    n_params: int
+    force: ca.Function
+
+    def channels(self, name: str, on: Any, p_sym: Any, frictionless: bool) -> list[Channel]:
+        """The contact's channels: eccentricity, penetration, the force while ``on``."""
+        e, e_dot, e_norm, p = self.e, self.e_dot, self.e_norm, self.p
+        F_N_out = on * ca.substitute(self.F_N, p, p_sym) if self.n_params else on * self.F_N
+        out = [
+            Channel(f"{name}.ex", "m", e[0]),
+            Channel(f"{name}.ey", "m", e[1]),
+            Channel(f"{name}.eccentricity", "m", e_norm),
+            Channel(f"{name}.penetration", "m", e_norm - self.c),
+            Channel(f"{name}.penetration_rate", "m/s", ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)),
+            Channel(f"{name}.normal_force", "N", F_N_out),
+            Channel(f"{name}.in_contact", "", on),
+        ]
+        if not frictionless:
+            F_T_out = on * (ca.substitute(self.F_T, p, p_sym) if self.n_params else self.F_T)
+            out += [Channel(f"{name}.friction_force", "N", F_T_out),
+                    Channel(f"{name}.sliding_velocity", "m/s", self.v_T)]
+        return out
+
+
+def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction_numeric: Any) -> JournalContact:
+    """Journal-bearing contact (section 4.2) of ``joint`` with these laws, every number a run-time
+    parameter ``<joint>.*``. Body i carries the bearing (radius R_i), body j the journal (R_j)."""
+    name = joint.name
+    law = symbolic_law(law_numeric, ctx.params, f"{name}.law")
+    friction = symbolic_law(friction_numeric, ctx.params, f"{name}.friction")
+    c = ctx.p(name, "clearance")
+    R_i, R_j = ctx.p(name, "bearing_radius"), ctx.p(name, "journal_radius")
+    s_i, s_j = ctx.p(name, "s_i"), ctx.p(name, "s_j")
+    bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
+    P_i, P_j = bi.point(s_i), bj.point(s_j)  # (4.2)
+    e = P_j - P_i  # (4.1) eccentricity
+    e_dot = bj.point_velocity(s_j) - bi.point_velocity(s_i)
+    ee = ca.dot(e, e)
+    # in contact |e| >= c > 0: the normal and everything below are regular there
+    e_norm = ca.sqrt(ee)
+    n = e / e_norm  # (4.4)
+    delta = e_norm - c  # (4.5)
+    delta_dot = ca.dot(e_dot, n)  # (4.8): v_N = d|e|/dt
+    t_vec = perpendicular(n)
+    Q_i = P_i + R_i * n  # (4.6) contact points
+    Q_j = P_j + R_j * n
+    # (4.9) with the velocities of the material points at the contact (spin included)
+    v_T = ca.dot(bj.world_point_velocity(Q_j) - bi.world_point_velocity(Q_i), t_vec)
+    n_params = 1 if law_numeric.needs_approach_speed else 0
+    p = ca.SX.sym("p", n_params)
+    F_N = law.force(delta, delta_dot, p[0] if n_params else None)
+    F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
+    f_journal = -F_N * n + F_T * t_vec  # force on the journal (body j); the bearing gets the opposite
+    Q = ctx.generalized_force([(joint.body_j, f_journal, Q_j), (joint.body_i, -f_journal, Q_i)])
+    force = ca.Function(f"{name}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P], [Q], ["t", "q", "v", "p", "P"], ["Q"])
+    return JournalContact(e, e_dot, ee, e_norm, c, bi, bj, P_i, P_j, F_N, F_T, v_T, p, n_params, force)

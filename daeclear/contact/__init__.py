@@ -65,6 +65,10 @@ Materials and stiffness: :class:`Material`, :func:`internal_contact_stiffness`,
 :func:`sphere_plane_stiffness`, :func:`plane_face_stiffness`,
 :func:`external_contact_stiffness`. A single impact: :func:`simulate_impact`.
 
+Lubricated revolute joint: :class:`HydrodynamicBearing` (viscosity, length, theory "short"/"long",
+cavitation "half"/"full", the dry law below ``film_threshold``); ``film_force(eps, wedge_rate,
+squeeze_rate, radius, clearance) -> (radial, tangential)`` (docs/lubrication.md).
+
 Example
 -------
 >>> import daeclear.contact as dcc
@@ -85,13 +89,15 @@ from .geometry import (
     Material, external_contact_stiffness, internal_contact_stiffness, plane_face_stiffness,
     sphere_plane_stiffness,
 )
+from .hydrodynamic import HydrodynamicBearing
 from .impact import ImpactResult, simulate_impact
 from .normal import Flores, Hertz, HuntCrossley, KelvinVoigt, LankaraniNikravesh, LankaraniPlane
 from .registry import FRICTION_LAWS, NORMAL_LAWS, friction_law, normal_law
 
 __all__ = [
     "Coulomb", "DubowskyFreudenstein", "backend", "ESDU78035", "FRICTION_LAWS", "Flores", "FrictionLaw", "Goldsmith",
-    "Hertz", "HuntCrossley", "ImpactResult", "KINDS", "KelvinVoigt", "LankaraniNikravesh", "LankaraniPlane",
+    "Hertz", "HuntCrossley", "HydrodynamicBearing", "ImpactResult",
+    "KINDS", "KelvinVoigt", "LankaraniNikravesh", "LankaraniPlane",
     "Material", "ModifiedCoulomb", "NORMAL_LAWS", "NoFriction", "NormalLaw", "external_contact_stiffness",
     "friction_law", "internal_contact_stiffness", "normal_law", "plane_face_stiffness", "simulate_impact",
     "sphere_plane_stiffness",

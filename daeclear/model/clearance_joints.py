@@ -28,12 +28,22 @@ def _law_problems(element: RevoluteClearance | TranslationalClearance) -> list[s
     from ..contact import friction_law, normal_law
     from ..contact.base import NormalLaw
 
+    from ..contact.hydrodynamic import HydrodynamicBearing
+
     out: list[str] = []
     law = element.law
     try:
         if isinstance(law, str):
             law = normal_law(law)
-        if not isinstance(law, NormalLaw):
+        if isinstance(law, HydrodynamicBearing):
+            if not isinstance(element, RevoluteClearance):
+                out.append(f"{element.kind} '{element.name}': law=HydrodynamicBearing(...), must be a normal "
+                           "contact law (a lubricated film is a revolute clearance joint's law).")
+            else:
+                problems = law.problems(element.radial_clearance, element.journal)
+                out.extend(f"{element.kind} '{element.name}': {p}" for p in problems)
+                element.resolved_law()
+        elif not isinstance(law, NormalLaw):
             out.append(f"{element.kind} '{element.name}': law={law!r}, must be a daeclear.contact law or a law name.")
         else:
             element.resolved_law()
@@ -70,10 +80,12 @@ class RevoluteClearance(PointJoint):
     material : Material or (Material, Material) or None
         Materials of bearing and journal (one for both); needed when the law's stiffness
         is computed (``stiffness=None``).
-    law : NormalLaw or str
-        Normal contact law (default Lankarani-Nikravesh with c_e = 0.9, eq. 3.9).
+    law : NormalLaw, HydrodynamicBearing or str
+        Normal contact law (default Lankarani-Nikravesh with c_e = 0.9, eq. 3.9); a
+        :class:`~daeclear.contact.HydrodynamicBearing` makes a lubricated joint (film forces, its
+        dry law below the film threshold; docs/lubrication.md).
     friction : None, float, str or FrictionLaw
-        None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
+        None: frictionless; a float: modified Coulomb (3.16) with that coefficient (in dry contact).
     """
 
     bearing_radius: float = 0.0
@@ -95,7 +107,8 @@ class RevoluteClearance(PointJoint):
 
     @computed_once
     def resolved_law(self) -> Any:
-        """The normal law with its stiffness (or cylinder geometry) set from radii and materials."""
+        """The normal law with its stiffness (or cylinder geometry) set from radii and materials (a
+        HydrodynamicBearing: its dry law's)."""
         from ..contact import normal_law
 
         law = normal_law(self.law) if isinstance(self.law, str) else self.law

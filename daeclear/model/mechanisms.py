@@ -7,7 +7,8 @@ import math
 from typing import Any, TypeGuard
 
 from .. import options as rules
-from ..contact import Material, friction_law, normal_law
+from ..contact import HydrodynamicBearing, Material, friction_law, normal_law
+from ..contact.hydrodynamic import law_from_table
 from ..contact.base import NormalLaw
 from ..errors import SceneError
 from ..engine.build import MemoTable, memo_by_values, memo_table
@@ -67,12 +68,12 @@ def _check(name: str, value: Any, rule: str, ok: bool) -> None:
 DEFAULT_RESTITUTION = 0.9  # Table 4.2, for the laws that take a coefficient of restitution
 
 
-def _contact_law(law: Any, restitution: float | None, length: float | None) -> NormalLaw:
-    """A law object from a law or a name; ``restitution``/``length`` fill the fields the law has."""
+def _contact_law(law: Any, restitution: float | None, length: float | None) -> NormalLaw | HydrodynamicBearing:
+    """A law object from a law, a law table or a name; ``restitution``/``length`` fill the fields the law has."""
     if length is not None and not (_finite(length) and length > 0):
         raise SceneError(f"contact law: length={length!r}, must be None or a finite number > 0 m.")
-    if isinstance(law, NormalLaw):
-        return law
+    if isinstance(law, (NormalLaw, HydrodynamicBearing, dict)):  # a dict: a law table (--set "law={...}")
+        return law_from_table(law) if isinstance(law, dict) else law
     return memo_by_values(_LAWS, (str(law), restitution, length), _make_contact_law)
 
 
@@ -157,7 +158,7 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     clearance : float
         Radial clearance of the clearance joint, m (0.5 mm in Figs. 4.15 and 4.28); for
         the translational joint c = (H - W)/2.
-    law : str or NormalLaw
+    law : str, NormalLaw, HydrodynamicBearing (lubricated revolute joint) or a law table (dict)
         Normal contact law (name or object; stiffness computed from radii and material
         when not given). Default Lankarani-Nikravesh (3.9).
     restitution : float or None

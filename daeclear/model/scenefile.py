@@ -45,6 +45,10 @@ their materials and laws as tables::
     law = { name = "lankarani-nikravesh", restitution = 0.9 }
     friction = 0.05          # or "coulomb", or { name = "modified-coulomb", coefficient = 0.1 }
 
+A lubricated revolute joint takes the law table ``{ name = "hydrodynamic", viscosity = 0.03,
+length = 0.02, theory = "short", cavitation = "half", film_threshold = 1e-6, dry = { name =
+"lankarani-nikravesh", restitution = 0.9 } }`` (docs/lubrication.md).
+
 Drivers take their motion profile as a table (see :mod:`daeclear.profiles`)::
 
     [[driver]]
@@ -82,6 +86,7 @@ from . import mechanisms
 from .. import options
 from ..errors import SceneError
 from ..contact import Material, friction_law, normal_law
+from ..contact.hydrodynamic import law_from_table
 from .profiles import profile_from_dict
 from .loads import Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
 from .scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance,
@@ -113,8 +118,11 @@ class SceneFile:
 
 
 def _law(value: Any, build: Any) -> Any:
-    """A law given as a name, a number (friction coefficient) or a table {name = ..., parameters}."""
+    """A law given as a name, a number (friction coefficient) or a table {name = ..., parameters}
+    (``name = "hydrodynamic"``: a lubricated revolute joint's HydrodynamicBearing)."""
     if isinstance(value, dict):
+        if build is normal_law:
+            return law_from_table(value)
         params = dict(value)
         return build(params.pop("name", None), **params)
     return value

@@ -1,0 +1,165 @@
+"""The lubricated revolute clearance joint (law :class:`~daeclear.contact.HydrodynamicBearing`): its
+parameters, film and dry terms, gap functions, channels and regime logic.
+
+Two regimes, one pair of the contact automaton (:mod:`daeclear.assembly.automaton`):
+
+* *film* (the automaton's free mode): the film term acts, the dry term is off;
+* *dry* (contact mode): the dry contact law (and friction) acts, the film term is off.
+
+Two gap functions, both positive once the film is thinner than their level: ``film_break`` at the
+minimum film thickness ``c - |e| = film_threshold`` and ``film_reform`` at
+``film_threshold (1 + hysteresis)``. An upward crossing of ``film_break`` is the automaton's onset
+(film -> dry, the dry law's approach speed latched there), a downward crossing of ``film_reform``
+its separation (dry -> film); IDA locates both. The band between the two levels keeps the regimes
+from chattering; the storm guard holds the dry regime in a cascade, as for a dry joint.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+from collections.abc import Sequence
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from ..model.clearance_joints import RevoluteClearance
+from ..results.result import ContactEvent
+from .automaton import ONSET, Decision, recorded, start, step
+from .contact_pairs import ContactBuild, PairLogic, approach_floor, journal_contact
+from .parameters import law_structure, law_values
+from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
+
+__all__ = ["FILM_REGULARISATION", "LubricatedLogic", "build_lubricated_revolute", "lubricated_parameters"]
+
+#: |e| is regularised as sqrt(e.e + (FILM_REGULARISATION c)^2) in the film's directions and rates,
+#: so the film force and its Jacobian are finite at the centred journal (e = 0, the chapter's start).
+FILM_REGULARISATION = 1e-4
+
+
+def lubricated_parameters(ref: Reference, joint: RevoluteClearance) -> tuple[dict[str, Any], list[Any]]:
+    """The joint's numbers (run-time parameters, the film's under ``film.*``) and its structure."""
+    bearing, friction = joint.resolved_law(), joint.resolved_friction()
+    s_i, s_j = ref.joint_points(joint)
+    values: dict[str, Any] = {
+        "s_i": s_i, "s_j": s_j, "clearance": joint.radial_clearance,
+        "bearing_radius": float(joint.bearing_radius), "journal_radius": joint.journal,
+        "film.viscosity": bearing.viscosity, "film.length": bearing.length,
+        "film.threshold": bearing.film_threshold, "film.reform_threshold": bearing.reform_threshold}
+    values.update({f"law.{k}": v for k, v in law_values(bearing.dry).items()})
+    values.update({f"friction.{k}": v for k, v in law_values(friction).items()})
+    return values, [law_structure(bearing.dry), law_structure(friction), f"film:{bearing.theory}:{bearing.cavitation}"]
+
+
+def build_lubricated_revolute(ctx: AssemblyContext, joint: RevoluteClearance, first_term: int,
+                              first_root: int) -> ContactBuild:
+    """Terms ``<name>`` (dry) and ``<name>.film``, gaps ``<name>.film_break`` and ``<name>.film_reform``."""
+    name = joint.name
+    bearing, friction_numeric = joint.resolved_law(), joint.resolved_friction()
+    dry_numeric = bearing.dry
+    # the dry term: the revolute clearance joint's contact, on only in the dry regime (|e| >= c - threshold > 0)
+    jc = journal_contact(ctx, joint, dry_numeric, friction_numeric)
+    e, e_dot, ee, e_norm, c, bi, bj = jc.e, jc.e_dot, jc.ee, jc.e_norm, jc.c, jc.bi, jc.bj
+    R_j = ctx.p(name, "journal_radius")
+    r_break = c - ctx.p(name, "film.threshold")
+    r_reform = c - ctx.p(name, "film.reform_threshold")
+    gaps = [(ee - r_break * r_break) / (2.0 * r_break), (ee - r_reform * r_reform) / (2.0 * r_reform)]
+
+    # the film term: on in the film regime (regularised at e = 0, see FILM_REGULARISATION)
+    reg = ca.sqrt(ee + (FILM_REGULARISATION * c) ** 2)
+    n_f = e / reg
+    eps = ee / (c * reg)
+    eps_dot = ca.dot(e_dot, e) / (c * reg)
+    gamma_dot = (e[0] * e_dot[1] - e[1] * e_dot[0]) / (reg * reg)
+    wedge = bi.omega + bj.omega - 2.0 * gamma_dot
+    F_r, F_t = bearing.film_force_with(ctx.p(name, "film.viscosity"), ctx.p(name, "film.length"),
+                                       eps, wedge, eps_dot, R_j, c)
+    f_film = -F_r * n_f + F_t * perpendicular(n_f)  # pressure resultants through the two centres
+    Q_film = ctx.generalized_force([(joint.body_j, f_film, jc.P_j), (joint.body_i, -f_film, jc.P_i)])
+    p0 = ca.SX.sym("p", 0)
+    film_fn = ca.Function(f"{name}_film_force", [ctx.t, ctx.q, ctx.v, p0, ctx.P], [Q_film],
+                          ["t", "q", "v", "p", "P"], ["Q"])
+
+    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P],
+                       [gaps[0], gaps[1], ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
+    floor = approach_floor(ctx, dry_numeric, f"{name}.law")
+    n_q = ctx.n_q
+    discontinuous = not friction_numeric.frictionless and not friction_numeric.smooth
+
+    def logic(P: NDArray[np.float64]) -> list[Any]:
+        return [LubricatedLogic(name, first_root, first_term, BufferedFunction(rate, bound=(P,)), n_q,
+                                dry_numeric.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
+
+    def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
+        (on, p_sym), (film_on, _) = switches
+        return jc.channels(name, on, p_sym, friction_numeric.frictionless) + [
+            Channel(f"{name}.eccentricity_ratio", "", e_norm / c),
+            Channel(f"{name}.film_thickness", "m", c - e_norm),
+            Channel(f"{name}.regime", "", on),  # 0 film, 1 dry
+            Channel(f"{name}.film_radial", "N", film_on * F_r),
+            Channel(f"{name}.film_tangential", "N", film_on * F_t),
+            # the power the film's forces take from the mechanism (the pressure's share of the film's losses)
+            Channel(f"{name}.film_dissipation", "W", -film_on * ca.dot(f_film, e_dot)),
+        ]
+
+    return ContactBuild(terms=[Term(name, jc.force, jc.n_params), Term(f"{name}.film", film_fn, 0)], gaps=gaps,
+                        gap_names=[f"{name}.film_break", f"{name}.film_reform"], channels=channels, logic=logic,
+                        ideal=[e[0], e[1]], ideal_names=[f"{name}.x", f"{name}.y"])
+
+
+@dataclass
+class LubricatedLogic(PairLogic):
+    """Regime switching of one lubricated joint by the contact automaton (see the module docstring).
+
+    Root ``root_index`` (film_break) is watched upward, ``root_index + 1`` (film_reform) downward; the
+    dry term ``term_index`` is on while the automaton is in contact (or held), the film term
+    ``term_index + 1`` otherwise. ``rate`` gives (film_break gap, film_reform gap, penetration rate).
+    The compiled loop hands these roots to Python (no simple pairs).
+    """
+
+    @property
+    def roots(self) -> range:
+        return range(self.root_index, self.root_index + 2)
+
+    def _values(self, y: NDArray) -> tuple[float, float, float]:
+        out = self.rate(y[:self.n_q], y[self.n_q:2 * self.n_q])
+        return float(out[0][0]), float(out[1][0]), float(out[2][0])
+
+    def _switch(self, active: list[bool], params: list[NDArray], term_on: bool, onset: bool) -> None:
+        active[self.term_index], active[self.term_index + 1] = term_on, not term_on
+        if onset:
+            params[self.term_index] = self._params()
+
+    def initial_modes(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> dict[str, str]:
+        broken, _, rate = self._values(y)
+        self.state = start(broken > 0.0, rate, self.min_approach_speed)
+        self._switch(active, params, self.state.term_on, True)
+        return {self.pair: "contact" if self.state.contact else "free"}
+
+    def root_directions(self, active: Sequence[bool]) -> list[tuple[int, int]]:
+        """The film breaks upward through film_break, forms again downward through film_reform."""
+        return [(self.root_index, 1), (self.root_index + 1, -1)]
+
+    def on_roots(self, t: float, y: NDArray, yp: NDArray, roots_found: NDArray | None,
+                 active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+        if roots_found is None:
+            return []
+        up = roots_found[self.root_index] > 0
+        down = roots_found[self.root_index + 1] < 0
+        if not (up or down):
+            return []
+        rate = self._values(y)[2]
+        direction = 1 if up and not self.state.contact else -1 if down else 1
+        self.state, decision = step(self.state, t, direction, rate, storm=self.storm,
+                                    min_approach_speed=self.min_approach_speed)
+        return self.record(self.root_index, t, y, rate, decision, active, params)
+
+    def apply(self, root: int, t: float, y: NDArray, decision: Decision, active: list[bool],
+              params: list[NDArray]) -> None:
+        self.state = recorded(self.state, decision)
+        self._switch(active, params, decision.term_on, decision.kind == ONSET)
+
+    def simple_pairs(self) -> None:  # type: ignore[override]
+        """None: two terms follow one pair, which the compiled loop's mirror does not do."""
+        return None

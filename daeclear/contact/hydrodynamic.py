@@ -1,0 +1,306 @@
+"""Hydrodynamic film forces of a lubricated journal bearing (a lubricated revolute clearance joint).
+
+Model (docs/lubrication.md has the derivation and the validation). The film thickness is
+``h = c (1 + eps cos theta)``, ``theta`` measured from the line of centres at the widest film, in
+the sense of positive rotation; Reynolds' equation for an incompressible, isoviscous film is ::
+
+    d/dtheta(h^3 dp/dtheta) / R^2 + d/dz(h^3 dp/dz) = -6 mu c eps w sin(theta) + 12 mu c eps_dot cos(theta)
+
+with ``w = omega_journal + omega_bearing - 2 dgamma/dt`` (the wedge rate) and ``eps_dot`` (the
+squeeze rate). Two closed forms, and a finite bearing:
+
+- ``theory="short"`` (Ocvirk, L/D -> 0: the theta derivative dropped, p = 0 at z = +-L/2);
+- ``theory="long"`` (Sommerfeld, L/D -> infinity: the z derivative dropped);
+- ``theory="finite"``: the short forces corrected by Butenschoen's finite-width tables
+  (:mod:`daeclear.contact.finite_bearing`).
+
+Cavitation: ``"full"`` keeps the whole (partly negative) film; ``"half"`` keeps the half of the
+film ``theta1 < theta < theta1 + pi``, ``theta1 = atan2(2 eps_dot, eps w)``, where the combined
+wedge and squeeze action builds pressure, with p = 0 at both ends (Guembel's condition; for the
+short bearing it is exactly "negative pressures set to zero", for the long one it is the usual
+pi-film of Pinkus & Sternlicht and Flores et al. 2009, exact for pure rotation).
+
+Every integral of the forces is a trigonometric polynomial after the substitution
+``1 + eps cos theta = (1 - eps^2) / (1 - eps cos psi)`` (psi continuous and monotone in theta), so
+the forces are closed forms, written once with :mod:`daeclear.contact._backend` for floats, numpy
+arrays and CasADi symbols.
+"""
+
+from __future__ import annotations
+
+import math
+import dataclasses
+from dataclasses import dataclass
+from typing import Any, ClassVar, Self
+
+import numpy as np
+
+from ..errors import SceneError
+from . import _backend as B
+from ._checks import check_number, set_field
+from .base import NormalLaw
+from .finite_bearing import finite_film_force
+from .normal import LankaraniNikravesh
+
+__all__ = ["CAVITATION", "HydrodynamicBearing", "THEORIES", "bearing_from_table", "film_integrals", "law_from_table"]
+
+#: The film theories and the cavitation options (the first of each is the default).
+THEORIES: tuple[str, ...] = ("short", "long", "finite")
+CAVITATION: tuple[str, ...] = ("half", "full")
+#: Largest eccentricity ratio the symbolic film force is evaluated at (the force diverges at 1;
+#: the dry law acts long before, at c (1 - eps) = film_threshold).
+EPS_CAP = 1.0 - 1e-6
+
+
+def _anomaly(theta: Any, beta: Any) -> Any:
+    """psi(theta) with tan(psi/2) = sqrt((1-eps)/(1+eps)) tan(theta/2), continuous and monotone
+    (beta = eps / (1 + sqrt(1 - eps^2)) < 1, so the atan2 below never wraps)."""
+    return theta - 2.0 * B.atan2(beta * B.sin(theta), 1.0 + beta * B.cos(theta))
+
+
+def _trig(a0: Any, a1: Any, b1: Any, a2: Any, b2: Any, psi1: Any, psi2: Any) -> Any:
+    """Integral over (psi1, psi2) of a0 + a1 cos + b1 sin + a2 cos 2psi + b2 sin 2psi."""
+    def prim(psi: Any) -> Any:
+        return (a0 * psi + a1 * B.sin(psi) - b1 * B.cos(psi) + 0.5 * a2 * B.sin(2.0 * psi)
+                - 0.5 * b2 * B.cos(2.0 * psi))
+    return prim(psi2) - prim(psi1)
+
+
+def film_integrals(eps: Any, theta1: Any, theta2: Any) -> dict[str, Any]:
+    """Integrals over (theta1, theta2) of {1, cos, sin, cos^2, sin^2, sin cos} / (1 + eps cos)^3.
+
+    Keys ``"1", "c", "s", "cc", "ss", "sc"``; valid for 0 <= eps < 1 and any theta1 < theta2.
+    """
+    q = 1.0 - eps * eps
+    sq = B.sqrt(q)
+    beta = eps / (1.0 + sq)
+    p1, p2 = _anomaly(theta1, beta), _anomaly(theta2, beta)
+    q2, q3, q5 = q * q, q * sq, q * q * sq
+    return {
+        "1": _trig(1.0 + 0.5 * eps * eps, -2.0 * eps, 0.0, 0.5 * eps * eps, 0.0, p1, p2) / q5,
+        "c": _trig(-1.5 * eps, 1.0 + eps * eps, 0.0, -0.5 * eps, 0.0, p1, p2) / q5,
+        "s": _trig(0.0, 0.0, 1.0, 0.0, -0.5 * eps, p1, p2) / q2,
+        "cc": _trig(0.5 + eps * eps, -2.0 * eps, 0.0, 0.5, 0.0, p1, p2) / q5,
+        "ss": _trig(0.5, 0.0, 0.0, -0.5, 0.0, p1, p2) / q3,
+        "sc": _trig(0.0, 0.0, -eps, 0.0, 0.5, p1, p2) / q2,
+    }
+
+
+def _pressure_start(eps: Any, w: Any, eps_dot: Any) -> Any:
+    """theta1 = atan2(2 eps_dot, eps w): where the half film starts (0 when nothing moves;
+    the guard keeps the value and the CasADi derivative finite there)."""
+    x, y = eps * w, 2.0 * eps_dot
+    moving = x * x + y * y > 0.0
+    return B.atan2(B.if_else(moving, y, 0.0), B.if_else(moving, x, 1.0))
+
+
+def _choice(owner: str, field: str, value: Any, allowed: tuple[str, ...]) -> str:
+    if value not in allowed:
+        raise SceneError(f"{owner}: {field}={value!r}, must be one of {', '.join(map(repr, allowed))}.")
+    return str(value)
+
+
+@dataclass(frozen=True, kw_only=True)
+class HydrodynamicBearing:
+    """A lubricated revolute clearance joint's law: a hydrodynamic film, and a dry law below it.
+
+    Parameters
+    ----------
+    viscosity : float
+        Dynamic viscosity mu of the oil in Pa s, > 0 (an SAE 30 oil at 60 C: about 0.03).
+    length : float
+        Axial length L of the bearing in m, > 0.
+    theory : {"short", "long", "finite"}
+        Ocvirk's infinitely short or Sommerfeld's infinitely long bearing, or a finite bearing
+        (B/D = L / (2 R) <= 1) from Butenschoen's tables (:mod:`daeclear.contact.finite_bearing`).
+    cavitation : {"half", "full"}
+        "half": the film keeps only the half where pressure builds (Guembel); "full": the whole film.
+    dry : NormalLaw
+        The contact law once the film has broken down (default: Lankarani-Nikravesh, c_e = 0.9,
+        stiffness from the joint's materials).
+    film_threshold : float
+        Minimum film thickness c (1 - eps) in m (> 0) below which the dry law takes over: of the
+        order of the surfaces' combined roughness. Default 1 um.
+    hysteresis : float
+        The film forms again (the film force replaces the dry law) only when the minimum film
+        thickness exceeds ``film_threshold * (1 + hysteresis)``; >= 0, default 1. The band keeps
+        the two regimes from chattering at the threshold.
+
+    Notes
+    -----
+    :meth:`film_force` returns (radial, tangential): radial > 0 pushes the journal towards the
+    bearing's centre (against the eccentricity); tangential is along the eccentricity turned by
+    +90 degrees (the sense of positive rotation).
+    """
+
+    viscosity: float
+    length: float
+    theory: str = "short"
+    cavitation: str = "half"
+    dry: NormalLaw = LankaraniNikravesh(restitution=0.9)
+    film_threshold: float = 1.0e-6
+    hysteresis: float = 1.0
+
+    name: ClassVar[str] = "hydrodynamic"
+
+    def __post_init__(self) -> None:
+        owner = type(self).__name__
+        set_field(self, "viscosity", check_number(owner, "viscosity", self.viscosity, low=0.0, unit="Pa s"))
+        set_field(self, "length", check_number(owner, "length", self.length, low=0.0, unit="m"))
+        set_field(self, "theory", _choice(owner, "theory", self.theory, THEORIES))
+        set_field(self, "cavitation", _choice(owner, "cavitation", self.cavitation, CAVITATION))
+        if self.theory == "finite" and self.cavitation != "half":
+            raise SceneError(f"{owner}: cavitation={self.cavitation!r} with theory='finite', must be 'half' "
+                             "(Butenschoen's tables have the Reynolds cavitation condition).")
+        if not isinstance(self.dry, NormalLaw):
+            raise SceneError(f"{owner}: dry={self.dry!r}, must be a normal contact law (a NormalLaw, e.g. "
+                             "LankaraniNikravesh(restitution=0.9)).")
+        set_field(self, "film_threshold",
+                  check_number(owner, "film_threshold", self.film_threshold, low=0.0, unit="m"))
+        set_field(self, "hysteresis", check_number(owner, "hysteresis", self.hysteresis, low=0.0, low_open=False))
+
+    # ---- what a revolute clearance joint asks of its law -----------------------------------
+    @property
+    def reform_threshold(self) -> float:
+        """Minimum film thickness (m) above which the film forms again after a dry contact."""
+        return self.film_threshold * (1.0 + self.hysteresis)
+
+    @property
+    def is_resolved(self) -> bool:
+        """True when the dry law has every number (see :meth:`resolve`)."""
+        return self.dry.is_resolved
+
+    @property
+    def needs_approach_speed(self) -> bool:
+        """The dry law's flag: its approach speed is latched when the film breaks down."""
+        return self.dry.needs_approach_speed
+
+    def resolve(self, kind: str, *, radii: Any = None, materials: Any = None, face_half_width: Any = None) -> Self:
+        """A copy whose dry law is resolved for the journal bearing (``kind="internal_cylinder"`` only)."""
+        if kind != "internal_cylinder":
+            raise SceneError(f"{type(self).__name__}.resolve: kind={kind!r}, must be 'internal_cylinder' "
+                             "(a lubricated journal bearing is a revolute clearance joint).")
+        dry = self.dry
+        if not dry.is_resolved:
+            dry = dry.resolve("internal_cylinder", radii=radii, materials=materials)
+        return dataclasses.replace(self, dry=dry)
+
+    def problems(self, clearance: float, journal_radius: float) -> list[str]:
+        """What is wrong with this law in a joint of radial clearance ``clearance`` (m)."""
+        owner = type(self).__name__
+        out = []
+        if not self.reform_threshold < clearance:
+            out.append(f"{owner}: film_threshold * (1 + hysteresis)={self.reform_threshold:g} m, must be < the "
+                       f"radial clearance {clearance:g} m (the film must be able to form).")
+        if self.theory == "finite" and self.length > 2.0 * journal_radius:
+            out.append(f"{owner}: length={self.length:g} m with theory='finite', must be <= the journal's diameter "
+                       f"{2.0 * journal_radius:g} m (Butenschoen's tables end at B/D = 1).")
+        return out
+
+    # ---- the film --------------------------------------------------------------------------
+    def film_force(self, eccentricity_ratio: Any, wedge_rate: Any, squeeze_rate: Any, radius: Any,
+                   clearance: Any) -> tuple[Any, Any]:
+        """The film's force on the journal, (radial, tangential) in N.
+
+        Parameters
+        ----------
+        eccentricity_ratio : float, array_like or CasADi symbol
+            eps = e / c, in [0, 1) (a symbol is clamped to [0, 1 - 1e-6]).
+        wedge_rate : same types
+            omega_journal + omega_bearing - 2 x the line of centres' rate, rad/s.
+        squeeze_rate : same types
+            d eps / dt, 1/s (> 0 while the film thins).
+        radius : float or symbol
+            Journal radius R in m (> 0).
+        clearance : float or symbol
+            Radial clearance c in m (> 0).
+
+        Returns
+        -------
+        (radial, tangential)
+            Floats for scalar inputs; radial > 0 pushes the journal towards the centre.
+
+        Example
+        -------
+        >>> law = HydrodynamicBearing(viscosity=0.04, length=0.02)
+        >>> fr, ft = law.film_force(0.5, 100.0, 0.0, radius=0.01, clearance=5e-5)
+        >>> round(fr, 3), round(ft, 3)  # mu w R L^3 eps^2/(c^2 (1-eps^2)^2), pi mu w R L^3 eps/(4 c^2 (1-eps^2)^1.5)
+        (56.889, 77.389)
+        """
+        owner = f"{type(self).__name__}.film_force"
+        if not B.is_symbolic(eccentricity_ratio, wedge_rate, squeeze_rate, radius, clearance):
+            check_number(owner, "radius", radius, low=0.0, unit="m")
+            check_number(owner, "clearance", clearance, low=0.0, unit="m")
+            eps_values = np.asarray(eccentricity_ratio, dtype=float)
+            bad = ~((eps_values >= 0.0) & (eps_values < 1.0))
+            if np.any(bad):
+                raise SceneError(f"{owner}: eccentricity_ratio={eps_values[bad].flat[0]:g}, must be in [0, 1).")
+        scalar, (eps, w, eps_dot) = B.as_numeric(eccentricity_ratio, wedge_rate, squeeze_rate)
+        radial, tangential = self.film_force_with(self.viscosity, self.length, eps, w, eps_dot, radius, clearance)
+        if scalar:
+            return float(radial), float(tangential)
+        return radial, tangential
+
+    def film_force_with(self, viscosity: Any, length: Any, eps: Any, w: Any, eps_dot: Any, R: Any,
+                        c: Any) -> tuple[Any, Any]:
+        """:meth:`film_force` with viscosity and length given (CasADi symbols of the run-time
+        parameters in an assembled model), no checks; a symbolic eps is clamped to [0, 1 - 1e-6]."""
+        if B.is_symbolic(eps):
+            eps = B.fmin(B.fmax(eps, 0.0), EPS_CAP)
+        if self.cavitation == "full":
+            theta1, theta2 = 0.0 * eps, 2.0 * math.pi + 0.0 * eps
+        else:
+            theta1 = _pressure_start(eps, w, eps_dot)
+            theta2 = theta1 + math.pi
+        mu, L = viscosity, length
+        I = film_integrals(eps, theta1, theta2)
+        if self.theory != "long":
+            # p = 3 mu (L^2/4 - z^2) (eps w sin - 2 eps_dot cos) / (c^2 (1 + eps cos)^3): wedge and squeeze parts
+            k = mu * R * L ** 3 / (2.0 * c * c)
+            wedge = (-k * eps * w * I["sc"], k * eps * w * I["ss"])  # (radial, tangential)
+            squeeze = (2.0 * k * eps_dot * I["cc"], -2.0 * k * eps_dot * I["sc"])
+            if self.theory == "finite":
+                return finite_film_force(wedge, squeeze, eps, w, eps_dot, L / (2.0 * R))
+            return wedge[0] + squeeze[0], wedge[1] + squeeze[1]
+        # dp/dtheta = mu R^2 (6 eps w cos + 12 eps_dot sin + m) / (c^2 (1 + eps cos)^3), m from
+        # p = 0 at both ends (half) or periodicity (full); the forces by parts (p = 0 or periodic there)
+        m = -(6.0 * eps * w * I["c"] + 12.0 * eps_dot * I["s"]) / I["1"]
+        k = mu * L * R ** 3 / (c * c)
+        f_x = -k * (6.0 * eps * w * I["sc"] + 12.0 * eps_dot * I["ss"] + m * I["s"])
+        f_y = k * (6.0 * eps * w * I["cc"] + 12.0 * eps_dot * I["sc"] + m * I["c"])
+        # f_x is along the eccentricity (the widest film is at theta = 0, opposite to it)
+        return -f_x, f_y
+
+
+def bearing_from_table(params: dict[str, Any]) -> HydrodynamicBearing:
+    """A HydrodynamicBearing from a scene file's law table (``name = "hydrodynamic"`` already taken
+    out); ``dry`` may be a law name or a table ``{ name = ..., parameters }``."""
+    from .registry import normal_law
+
+    params = dict(params)
+    dry = params.get("dry")
+    if isinstance(dry, dict):
+        dry = dict(dry)
+        params["dry"] = normal_law(dry.pop("name", None), **dry)
+    elif isinstance(dry, str):
+        params["dry"] = normal_law(dry)
+    fields = [f.name for f in dataclasses.fields(HydrodynamicBearing)]
+    unknown = sorted(set(params) - set(fields))
+    if unknown:
+        raise SceneError(f"HydrodynamicBearing: unknown parameter(s) {', '.join(unknown)}; valid: {', '.join(fields)}.")
+    missing = [name for name in ("viscosity", "length") if name not in params]
+    if missing:
+        raise SceneError(f"HydrodynamicBearing: missing required parameter(s) {', '.join(missing)}.")
+    return HydrodynamicBearing(**params)
+
+
+def law_from_table(table: dict[str, Any]) -> Any:
+    """A normal law or a HydrodynamicBearing from a table ``{name = ..., parameters}`` (scene files,
+    ``daeclear run --set law={...}``): ``name = "hydrodynamic"`` makes the bearing."""
+    from .registry import normal_law
+
+    params = dict(table)
+    name = params.pop("name", None)
+    if name == HydrodynamicBearing.name:
+        return bearing_from_table(params)
+    return normal_law(name, **params)

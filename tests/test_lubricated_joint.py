@@ -1,0 +1,222 @@
+"""The lubricated revolute clearance joint (RevoluteClearance with a HydrodynamicBearing law) in a run.
+
+References, each independent of the assembled model:
+
+- static equilibrium of a journal (radius R_j) spinning at omega under a constant load W (short bearing, half
+  film, Ocvirk): W = mu omega R L^3 eps / (4 c^2 (1 - eps^2)^2) sqrt(16 eps^2 + pi^2 (1 - eps^2)),
+  attitude angle tan(phi) = pi sqrt(1 - eps^2) / (4 eps), measured from the load line in the sense of
+  rotation (textbook formulas, solved here by brentq);
+- pure squeeze: a journal that does not turn falls along the load line, a one-degree-of-freedom
+  motion m c eps'' = W - F_sq(eps, eps') with the short half-film squeeze force written here
+  (mu R L^3 eps' [(1 + 2 eps^2)(pi - acos eps) + 3 eps sqrt(1 - eps^2)] / (c^2 (1 - eps^2)^(5/2)),
+  checked against a finite-difference Reynolds solution in tests/test_contact_hydrodynamic.py),
+  integrated by scipy;
+- the regime switches are roots: at each one the minimum film thickness equals its threshold
+  (the time error, gap / gap rate, below 1e-9 relative);
+- energy: mechanical energy minus the work of the film and contact forces (track_work) is constant.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+import daeclear as dc
+from daeclear.contact import HydrodynamicBearing, Material
+from daeclear.model.mechanisms import slider_crank
+
+STEEL = Material(young=207e9, poisson=0.3)
+R, C, L, G = 0.01, 5.0e-5, 0.01, 9.81
+R_J = R - C  # the film forces take the journal's radius
+
+
+def journal(mu: float, omega: float, mass: float, **law: float | str) -> dc.Scene:
+    """A journal (centre of mass at its centre) in a bearing on the ground, under gravity, spinning at omega."""
+    scene = dc.Scene("journal", gravity=(0.0, -G))
+    body = scene.add(dc.Body("journal", mass=mass, inertia=1e-4, position=(0.0, 0.0), angular_velocity=omega))
+    scene.add(dc.RevoluteClearance("bearing", scene.ground, body, at=(0.0, 0.0), bearing_radius=R, clearance=C,
+                                   material=STEEL, law=HydrodynamicBearing(viscosity=mu, length=L, **law)))
+    return scene
+
+
+def ocvirk_load(eps: float, mu: float, omega: float) -> float:
+    q = 1 - eps**2
+    return mu * omega * R_J * L**3 * eps / (4 * C**2 * q**2) * math.sqrt(16 * eps**2 + math.pi**2 * q)
+
+
+def test_journal_settles_at_the_static_eccentricity_and_attitude_angle() -> None:
+    mu, omega, mass = 0.01, 200.0, 4.675
+    W = mass * G
+    eps = brentq(lambda x: ocvirk_load(x, mu, omega) - W, 1e-6, 1 - 1e-9)
+    attitude = math.atan(math.pi * math.sqrt(1 - eps**2) / (4 * eps))
+    run = dc.simulate(journal(mu, omega, mass), 0.4, rtol=1e-8)
+    assert run.success and not run.events  # the film carries throughout
+    assert run["bearing.eccentricity_ratio"][-1] == pytest.approx(eps, rel=1e-6)
+    angle = math.atan2(run["bearing.ey"][-1], run["bearing.ex"][-1]) + math.pi / 2  # from the load line (-y)
+    assert angle == pytest.approx(attitude, rel=1e-6)
+    # the film's resultant is the load; pressure forces pass through the centre: the spin is kept
+    assert math.hypot(run["bearing.film_radial"][-1], run["bearing.film_tangential"][-1]) == pytest.approx(W, rel=1e-6)
+    assert run["journal.omega"][-1] == pytest.approx(omega, rel=1e-12)
+    assert np.all(run["bearing.regime"] == 0.0)
+
+
+def test_finite_bearing_settles_at_butenschoens_eccentricity_and_angle() -> None:
+    """B/D = 1/2 (L = R_j): the load that Butenschoen's table carries at eps = 0.8 (So = 1.7339,
+    beta = 32.938 deg, So = W psi^2 / (B D mu omega), psi = c / R_j)."""
+    mu, omega = 0.01, 200.0
+    W = 1.7339 * R_J * 2 * R_J * mu * omega / (C / R_J) ** 2
+    scene = dc.Scene("journal", gravity=(0.0, -G))
+    body = scene.add(dc.Body("journal", mass=W / G, inertia=1e-4, position=(0.0, 0.0), angular_velocity=omega))
+    scene.add(dc.RevoluteClearance("bearing", scene.ground, body, at=(0.0, 0.0), bearing_radius=R, clearance=C,
+                                   material=STEEL, law=HydrodynamicBearing(viscosity=mu, length=R_J, theory="finite")))
+    run = dc.simulate(scene, 0.4, rtol=1e-8)
+    assert run.success and not run.events
+    assert run["bearing.eccentricity_ratio"][-1] == pytest.approx(0.8, rel=1e-5)
+    angle = math.atan2(run["bearing.ey"][-1], run["bearing.ex"][-1]) + math.pi / 2
+    assert math.degrees(angle) == pytest.approx(32.938, abs=1e-3)
+
+
+def squeeze_force(eps: float, eps_dot: float, mu: float) -> float:
+    q = 1 - eps**2
+    if eps_dot <= 0:  # the film opening (not reached while falling)
+        raise AssertionError("the reference covers the closing film only")
+    return (mu * R_J * L**3 * eps_dot * ((1 + 2 * eps**2) * (math.pi - math.acos(eps)) + 3 * eps * math.sqrt(q))
+            / (C**2 * q**2.5))
+
+
+def test_pure_squeeze_fall_against_the_one_degree_of_freedom_solution() -> None:
+    mu, mass = 0.02, 2.0
+    run = dc.simulate(journal(mu, 0.0, mass), 0.05, rtol=1e-9, atol=1e-13, t_eval=np.linspace(0.0, 0.05, 51))
+    assert run.success and not run.events
+
+    def rhs(t: float, x: np.ndarray) -> list[float]:
+        eps, rate = x
+        force = squeeze_force(eps, rate, mu) if rate > 0 else 0.0
+        return [rate, (mass * G - force) / (mass * C)]
+
+    ref = solve_ivp(rhs, (0.0, 0.05), [0.0, 0.0], t_eval=run.t, rtol=1e-11, atol=1e-13, method="LSODA")
+    eps = run["bearing.eccentricity_ratio"]
+    assert eps[-1] > 0.5  # the film has been squeezed far
+    np.testing.assert_allclose(eps[5:], ref.y[0][5:], rtol=2e-4)
+    np.testing.assert_allclose(run["bearing.ex"], 0.0, atol=1e-15)  # straight down the load line
+    np.testing.assert_allclose(run["bearing.film_tangential"], 0.0, atol=1e-9)
+
+
+@pytest.fixture(scope="module")
+def breaking_run() -> dc.Result:
+    """A film as thin as air's (1.8e-5 Pa s): it breaks, the journal hits the bearing dry, bounces, and
+    the film forms again, a few times."""
+    return dc.simulate(journal(1.8e-5, 0.0, 2.0, film_threshold=2e-6, hysteresis=1.0), 0.03, rtol=1e-10,
+                       track_work=True)
+
+
+def test_transitions_are_located_roots_with_hysteresis(breaking_run: dc.Result) -> None:
+    run = breaking_run
+    kinds = [event.kind for event in run.events]
+    assert run.success and kinds[:2] == ["onset", "separation"] and len(kinds) >= 4
+    assert all(a != b for a, b in zip(kinds, kinds[1:]))  # film and dry alternate
+    for event in run.events:
+        x, y = event.y[0], event.y[1]  # the journal body is (x, y, phi), its centre the joint point
+        vx, vy = event.y[3], event.y[4]
+        e = math.hypot(x, y)
+        level = 2e-6 if event.kind == "onset" else 4e-6  # the break, the re-formation threshold
+        film, film_rate = C - e, -(x * vx + y * vy) / e
+        assert (film - level) / film_rate == pytest.approx(0.0, abs=1e-9 * event.t)  # time error of the root
+    regime = run["bearing.regime"]
+    assert set(np.unique(regime)) == {0.0, 1.0}
+    film = run["bearing.film_thickness"]
+    assert np.all(film[regime == 0.0] > 2e-6 * (1 - 1e-6))  # the film carries only while thick enough
+    assert np.all(run["bearing.film_radial"][regime == 1.0] == 0.0)
+    assert np.all(run["bearing.normal_force"][regime == 0.0] == 0.0)
+    assert run["bearing.normal_force"].max() > 0.0  # a dry impact happened
+
+
+def test_energy_balance_with_film_dissipation(breaking_run: dc.Result) -> None:
+    run = breaking_run
+    balance = run["energy.mechanical"] - run["energy.work"]
+    scale = np.ptp(run["energy.mechanical"])
+    assert scale > 0 and np.ptp(balance) < 1e-6 * scale
+    # the film's losses: its power integrated is the work the film took from the falling journal
+    lost = np.trapezoid(run["bearing.film_dissipation"], run.t)
+    assert lost > 0.0
+
+
+def test_slider_crank_with_a_lubricated_joint_runs() -> None:
+    scene = slider_crank("revolute", law=HydrodynamicBearing(viscosity=0.04, length=0.02))
+    run = dc.simulate(scene, 0.012, rtol=1e-6)
+    assert run.success and not run.events  # at 40 mPa s the film carries the rod at 5000 rpm
+    assert 0.5 < run["clearance.eccentricity_ratio"].max() < 1.0
+    dry = dc.simulate(slider_crank("revolute"), 0.012, rtol=1e-6)
+    assert len(dry.events) > 2  # the dry joint's journal hits the bearing
+
+
+def test_bad_lubricated_joints() -> None:
+    with pytest.raises(dc.SceneError, match=r"film_threshold \* \(1 \+ hysteresis\)=0.0001 m, must be < the radial "
+                                            r"clearance 5e-05 m"):
+        dc.assemble(journal(0.01, 10.0, 1.0, film_threshold=5e-5))
+    with pytest.raises(dc.SceneError, match="must be a normal contact law"):
+        dc.assemble(slider_crank("translational", law=HydrodynamicBearing(viscosity=0.01, length=0.01)))
+
+
+def test_scene_file_with_a_lubricated_joint(tmp_path) -> None:
+    from daeclear.model.scenefile import read_scene_file
+
+    path = tmp_path / "journal.toml"
+    path.write_text("""
+[scene]
+name = "journal"
+gravity = [0.0, -9.81]
+
+[[body]]
+name = "journal"
+mass = 4.675
+inertia = 1e-4
+position = [0.0, 0.0]
+angular_velocity = 200.0
+
+[[revolute_clearance]]
+name = "bearing"
+body_i = "ground"
+body_j = "journal"
+at = [0.0, 0.0]
+bearing_radius = 0.01
+clearance = 5e-5
+material = { young = 207e9, poisson = 0.3 }
+law = { name = "hydrodynamic", viscosity = 0.01, length = 0.01, dry = { name = "hertz" } }
+""")
+    law = read_scene_file(path).scene["bearing"].law
+    assert law == HydrodynamicBearing(viscosity=0.01, length=0.01, dry=dc.contact.Hertz())
+    path.write_text(path.read_text().replace("length = 0.01,", "lenght = 0.01,"))
+    with pytest.raises(dc.SceneError, match="unknown parameter.s. lenght"):
+        read_scene_file(path)
+
+
+def test_example_lubricated_joint_quick(tmp_path) -> None:
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "lubricated_joint.py"
+    spec = importlib.util.spec_from_file_location("example_lubricated_joint", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    lines = module.main(["--quick", "--out", str(tmp_path)])
+    for name in ("lubricated_joint.png", "viscosity_sweep.png"):
+        assert (tmp_path / name).stat().st_size > 5_000
+    rows = {line.split("|")[0].strip(): line for line in lines if "|" in line}
+    assert int(rows["mu=0.1"].split("|")[2]) == 0  # the reference oil carries the joint
+    assert int(rows["mu=0.006"].split("|")[2]) >= 1  # the thinnest one breaks down
+
+
+def test_command_line_with_a_lubricant(tmp_path) -> None:
+    from daeclear.cli import main
+
+    law = "law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01, 'film_threshold': 2e-6}"
+    assert main(["run", "slider_crank", "--joint", "revolute", "--set", law, "--t-end", "0.003", "--out",
+                 str(tmp_path), "--no-figure", "--quiet"]) == 0
+    result = dc.load(tmp_path / "slider_crank_revolute.h5")
+    assert result.success and result["clearance.regime"].max() == 0.0
+    assert result["clearance.film_radial"].max() > 0.0
