@@ -64,6 +64,11 @@ def test_scales_follow_the_mechanism():
     scene.add(dc.Body("disc", mass=2.0, inertia=0.02, angular_velocity=3.0))
     disc = tol.scales(dc.assemble(scene))
     assert disc.length == pytest.approx(0.1) and disc.rate == pytest.approx(3.0)
+    # at rest, no gravity, a torque: the speed after one radian at the start's acceleration, sqrt(T / I)
+    scene = dc.Scene("spun", gravity=(0.0, 0.0))
+    scene.add(dc.Body("disc", mass=2.0, inertia=0.02))
+    scene.add(dc.Torque("drive", "disc", 0.5))
+    assert tol.scales(dc.assemble(scene)).rate == pytest.approx(math.sqrt(0.5 / 0.02))
 
 
 def test_defaults_are_never_below_round_off():

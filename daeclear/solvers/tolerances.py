@@ -100,7 +100,9 @@ def scales(model: DAEModel) -> Scales:
     L: the largest distance from the origin of a body's centre, of a joint point (body frame) and
     the largest radius of gyration sqrt(I / m); 1 m if all are 0. W: the largest of the start's
     angular velocities, its linear velocities over L, the drivers' speeds (a translational driver's
-    over L) and sqrt(|g| / L); 1 rad/s if all are 0.
+    over L), sqrt(|g| / L), and the speed each body reaches after a turn of one radian (a travel of L)
+    under the applied loads alone at the start, sqrt(|Q_phi| / I) (sqrt(|Q_xy| / (m L))); 1 rad/s if
+    all are 0.
     """
     n = model.n_q
     q, v = model.q_guess.tolist(), model.v_guess.tolist()
@@ -121,6 +123,12 @@ def scales(model: DAEModel) -> Scales:
             rates.append(speed / length if f"{driver}.axis" in entries else speed)
     if "gravity" in entries:
         rates.append(math.sqrt(math.hypot(*entries["gravity"]) / length))
+    # what the applied loads (springs, torques, motors, forces) would do to each body alone at the
+    # start: the speed after a turn of one radian (or a travel of L) at that acceleration
+    force = np.asarray(model.base_force(0.0, model.q_guess, model.v_guess, model.parameter_values)).ravel()
+    acceleration = np.abs(force / model.mass_diagonal).tolist()
+    rates += [math.sqrt(acceleration[i + 2]) for i in range(0, n, 3)]
+    rates += [math.sqrt(math.hypot(acceleration[i], acceleration[i + 1]) / length) for i in range(0, n, 3)]
     rate = max([*rates, 0.0]) or 1.0
     return Scales(length=float(length), resolution=float(resolution), rate=float(rate))
 
