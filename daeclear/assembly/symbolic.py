@@ -94,6 +94,12 @@ class Reference:
         dx, dy = world[0] - x0, world[1] - y0
         return np.array([c * dx + s * dy, -s * dx + c * dy])
 
+    def world_point(self, body: str, local: Sequence[float]) -> tuple[float, float]:
+        """World position of the body-fixed point ``local`` in the reference configuration."""
+        (x0, y0), phi0 = self.pose[body]
+        c, s = math.cos(phi0), math.sin(phi0)
+        return (x0 + c * local[0] - s * local[1], y0 + s * local[0] + c * local[1])
+
     def local_vector(self, body: str, world: Sequence[float]) -> NDArray[np.float64]:
         """Body-fixed components of a world direction (unit length) of the reference configuration."""
         phi0 = self.pose[body][1]
