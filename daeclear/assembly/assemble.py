@@ -50,6 +50,7 @@ from ..model.scene import (GROUND, Body, Driver, Revolute, RevoluteClearance, Sc
                            TranslationalClearance)
 from .revolute_joint import CONTACT_BUILDERS
 from .drivers import driver_constraint, driver_load, driver_parameters
+from .joint_coordinates import joint_channels
 from ..model.loads import Load, build_loads, load_parameters
 from .symbolic import AssemblyContext, BodyFrame, Channel, Reference, Term, rotation
 # the model and its constants, re-exported: ``from daeclear.assembly.assemble import DAEModel`` keeps working
@@ -185,7 +186,7 @@ class _Template:
 _TEMPLATES: dict[str, _Template] = memo_table()
 _TEMPLATE_LIMIT = 64
 # Part of every structure key: bump when the generated functions change meaning.
-_ENGINE_VERSION = "engine-2"
+_ENGINE_VERSION = "engine-3"
 
 
 def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: float = 5.0, beta: float = 5.0,
@@ -481,7 +482,8 @@ class _TemplateBuilder:
                 Channel("constraints.position", "m", ca.mmax(ca.fabs(self.Phi))),
                 Channel("constraints.velocity", "m/s", ca.mmax(ca.fabs(self.Phi_dot))),
             ]
-        self.channels = channels + self.contact_channels + list(self.loads.channels)
+        joint_readings = joint_channels(self.ctx, self.scene.joints)  # angles, displacements and their rates
+        self.channels = channels + self.contact_channels + list(self.loads.channels) + joint_readings
 
     def template(self, library_name: str) -> _Template:
         """The generated functions (outputs, accelerations, kinematics, the compiled loop's simple
