@@ -18,6 +18,7 @@ from . import (  # type: ignore[attr-defined]  # noqa: F401
 from .studies import analysis  # noqa: F811  (the module of the new path wins over its alias)
 from .model import loads, mechanisms, profiles  # noqa: F811
 from .assembly.assemble import DAEModel, assemble
+from .assembly import placement as _placement  # noqa: F401  (registers Scene.assembled)
 from .errors import (AssemblyError, DaeclearError, DaeclearWarning, Interrupted, OutputError, PhysicsWarning,
                      SceneError, SolveError)
 from .results.result import ContactEvent, Result, load

@@ -52,7 +52,7 @@ from .revolute_joint import CONTACT_BUILDERS
 from .drivers import driver_constraint, driver_load, driver_parameters
 from .joint_coordinates import joint_channels
 from ..model.loads import Load, build_loads, load_parameters
-from .symbolic import AssemblyContext, BodyFrame, Channel, Reference, Term, rotation
+from .symbolic import AssemblyContext, Channel, Reference, Term, body_frames, rotation
 # the model and its constants, re-exported: ``from daeclear.assembly.assemble import DAEModel`` keeps working
 from .dae_model import (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_START_KINEMATICS,  # noqa: F401
                         EXTRA_TERM0, KIND_MULTIPLIER, KIND_POSITION, KIND_VELOCITY, KIND_WORK, NEWTON_STEPS,
@@ -283,12 +283,7 @@ class _TemplateBuilder:
         P = ca.SX.sym("P", table.vector.size)
         self.t, self.q, self.v, self.a, self.P = t, q, v, a, P
         self.params = table.symbols(P)
-        frames: dict[str, BodyFrame] = {
-            GROUND: BodyFrame(GROUND, None, ca.DM.zeros(2), ca.DM(0.0), ca.DM.zeros(2), ca.DM(0.0))
-        }
-        for k, body in enumerate(self.bodies):
-            frames[body.name] = BodyFrame(body.name, k, q[3 * k:3 * k + 2], q[3 * k + 2], v[3 * k:3 * k + 2],
-                                          v[3 * k + 2])
+        frames = body_frames(self.bodies, q, v)
         self.ctx = AssemblyContext(t, q, v, a, P, frames, self.params, table.offsets())
         self.joints = {j.name: j for j in scene.joints}
 

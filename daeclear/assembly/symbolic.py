@@ -16,6 +16,8 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ..model.elements import GROUND
+
 
 def rotation(phi: Any) -> Any:
     """Planar rotation matrix A(phi) as a CasADi expression."""
@@ -50,6 +52,14 @@ class BodyFrame:
     def world_point_velocity(self, point: Any) -> Any:
         """Velocity of the body's material point at the world position ``point``."""
         return self.v + self.omega * perpendicular(point - self.r)
+
+
+def body_frames(bodies: Sequence[Any], q: Any, v: Any) -> dict[str, BodyFrame]:
+    """The symbolic frames of the ground and of ``bodies``, body k at ``q[3k:3k+3]``, ``v[3k:3k+3]``."""
+    frames = {GROUND: BodyFrame(GROUND, None, ca.DM.zeros(2), ca.DM(0.0), ca.DM.zeros(2), ca.DM(0.0))}
+    for k, body in enumerate(bodies):
+        frames[body.name] = BodyFrame(body.name, k, q[3 * k:3 * k + 2], q[3 * k + 2], v[3 * k:3 * k + 2], v[3 * k + 2])
+    return frames
 
 
 @dataclass(frozen=True)
