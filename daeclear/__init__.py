@@ -1,42 +1,106 @@
 """daeclear: dynamics of planar mechanisms with clearance joints.
 
 Scene --assemble--> DAEModel --simulate--> Result --> analysis | plot | io
+
+The public names are imported when first used (PEP 562): ``import daeclear`` and ``daeclear --help``
+load no numerical library (CasADi, scipy, h5py, matplotlib); ``daeclear.simulate`` loads what a run
+needs. ``python -X importtime -c "import daeclear"`` measures it.
 """
 
 from __future__ import annotations
 
-# Old module paths, thin aliases for one release (daeclear.old_paths): those `import daeclear` loaded
-# before the move are imported first, so that `daeclear.<old>.<name>` keeps working after
-# `import daeclear` and the names bound below win over the aliases (the function `sweep` over the
-# module `daeclear.sweep`).
-from . import old_paths  # noqa: F401  (installs the finder of the old paths)
-# the names below are served by the old-path finder (mypy cannot see them)
-from . import (  # type: ignore[attr-defined]  # noqa: F401
-    accuracy, analysis, automaton, codegen, ida_session, loads, mechanisms, outputs, physics, profiles,
-    recorder, result, scene, sweep)
+import importlib
+import importlib.util
+import sys
+import types
+from typing import TYPE_CHECKING, Any
 
-from .studies import analysis  # noqa: F811  (the module of the new path wins over its alias)
-from .model import loads, mechanisms, profiles  # noqa: F811
-from .assembly.assemble import DAEModel, assemble
-from .assembly import placement as _placement  # noqa: F401  (registers Scene.assembled)
-from .errors import (AssemblyError, DaeclearError, DaeclearWarning, Interrupted, OutputError, PhysicsWarning,
-                     SceneError, SolveError)
-from .results.result import ContactEvent, Result, load
-from .contact import Material
-from .model.loads import Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
-from .model.scene import Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance
-from .solver_options import SolverOptions
-from .solvers.ida import simulate
-# the function `sweep` shadows the module: import names from daeclear.studies.sweep
-from .studies.sweep import load_sweep, sweep  # noqa: F811
+# Old module paths, thin aliases for one release (daeclear.old_paths): the finder is installed now
+# (it imports nothing else); ``import daeclear.<old>`` loads an alias when asked.
+from . import old_paths  # noqa: F401  (installs the finder of the old paths)
+
+if TYPE_CHECKING:  # what the lazy names are, for type checkers and readers
+    from .studies import analysis
+    from .model import loads, mechanisms, profiles
+    from .assembly.assemble import DAEModel, assemble
+    from .errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted, OutputError,
+                         PhysicsWarning, SceneError, SolveError)
+    from .results.result import ContactEvent, Result, load
+    from .contact import Material
+    from .model.loads import Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
+    from .model.scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational,
+                              TranslationalClearance)
+    from .solver_options import SolverOptions
+    from .solvers.ida import simulate
+    from .studies.sweep import load_sweep, sweep
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "Driver",
+    "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "DiskFull", "Driver",
     "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "Scene",
     "SceneError", "SolveError", "SolverOptions", "Translational", "TranslationalClearance", "analysis", "assemble",
     "load", "load_sweep", "mechanisms", "profiles", "simulate", "sweep",
     # applied loads (daeclear.loads)
     "Expression", "Force", "Motor", "RotationalSpringDamper", "SpringDamper", "Table", "Torque", "loads",
 ]
+
+
+_loading: list[str] = []  # non-empty while _load_all runs
+
+
+def _load_all() -> dict[str, Any]:
+    """Every public name, imported as the eager package imported them (old paths first, so that the new
+    names win over the aliases: the function ``sweep`` over the module ``daeclear.sweep``)."""
+    from . import (  # noqa: F401  (old paths, served by the finder)
+        accuracy, analysis, automaton, codegen, ida_session, loads, mechanisms, outputs, physics, profiles,
+        recorder, result, scene, sweep)
+    from .studies import analysis  # noqa: F811, F401
+    from .model import loads, mechanisms, profiles  # noqa: F811, F401
+    from .assembly.assemble import DAEModel, assemble  # noqa: F401
+    from .errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted,  # noqa: F401
+                         OutputError, PhysicsWarning, SceneError, SolveError)
+    from .results.result import ContactEvent, Result, load  # noqa: F401
+    from .contact import Material  # noqa: F401
+    from .model.loads import (Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table,  # noqa: F401
+                              Torque)
+    from .model.scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational,  # noqa: F401
+                              TranslationalClearance)
+    from .solver_options import SolverOptions  # noqa: F401
+    from .solvers.ida import simulate  # noqa: F401
+    from .studies.sweep import load_sweep, sweep  # noqa: F811, F401
+    names = locals()
+    public = {name: names[name] for name in __all__}
+    globals().update(public)  # bound once: later uses do not come here
+    return public
+
+
+def __getattr__(name: str) -> Any:
+    """A public name: the first use imports them all. Another name is a sub-package or module
+    (``daeclear.plot``), imported alone (the package's own ``from .. import options`` comes here too)."""
+    if name in __all__ and not _loading:
+        _loading.append(name)
+        try:
+            return _load_all()[name]
+        finally:
+            _loading.clear()
+    if name.startswith("_") or importlib.util.find_spec(f"{__name__}.{name}") is None:
+        raise AttributeError(f"module 'daeclear' has no attribute {name!r}")
+    return importlib.import_module(f"{__name__}.{name}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})
+
+
+class _Package(types.ModuleType):
+    """The package module: an old path imported (``import daeclear.sweep``) does not replace the public
+    name it shares (the function ``daeclear.sweep``, the new modules ``daeclear.analysis``...)."""
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in __all__ and isinstance(value, types.ModuleType) and value.__name__ in old_paths.OLD_PATHS:
+            return  # the public name is bound by _load_all
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

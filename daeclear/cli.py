@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 from collections.abc import Sequence
 
-from .errors import DaeclearError, Interrupted, PhysicsWarning, SolveError
+from .errors import DaeclearError, DiskFull, Interrupted, PhysicsWarning, SolveError
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by Ctrl-C
 #: ``daeclear run`` reports at most CLI_POINTS + 1 points by default (a run of any length stays
@@ -22,6 +22,9 @@ CLI_POINTS = 100_000
 CLI_FINEST_STEP = 1e-6
 #: ``daeclear run`` shows (summary, figure) at most this many of the last events of a run (the file has all).
 CLI_SHOWN_EVENTS = 20_000
+#: ``daeclear run``'s figure draws at most this many points a curve: min-max per bucket (two points a pixel
+#: column of a 1000-pixel-wide axes), so an impact's peak survives in a long run's figure.
+CLI_FIGURE_POINTS = 2000
 #: ``daeclear run``'s default step cap per simulated second (see default_max_steps).
 CLI_STEPS_PER_SECOND = 2_000_000
 
@@ -35,19 +38,46 @@ def _parse_value(text: str) -> Any:
 
 
 def _parse_sets(items: Sequence[str]) -> dict[str, Any]:
+    """``--set KEY=VALUE`` items -> {key: value}; a key given twice is an error naming both values."""
     out: dict[str, Any] = {}
     for item in items:
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
             raise DaeclearError(f"--set {item!r}: expected KEY=VALUE, e.g. --set clearance=0.5e-3.")
-        out[key.strip()] = _parse_value(value.strip())
+        key = key.strip()
+        if key in out:
+            raise DaeclearError(f"--set {key}={value.strip()}: {key} is given twice (--set {key}={out[key]!r} "
+                                "before); give it once.")
+        out[key] = _parse_value(value.strip())
     return out
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _mechanism_keys(argv: Sequence[str]) -> str | None:
+    """For ``daeclear run|study|sweep MECH --help``: MECH's ``--set`` keys, each with its default and the
+    first sentence of its description (units included), read from the mechanism's signature and docstring."""
+    if (not ({"-h", "--help"} & set(argv)) or len(argv) < 2 or argv[0] not in ("run", "study", "sweep")
+            or argv[1].startswith("-") or argv[1].endswith(".toml")):
+        return None
+    from .model.mechanism_options import option_table
+    from .model.scenefile import MECHANISMS
+
+    if argv[1] not in MECHANISMS:
+        return None
+    lines = [f"--set keys of {argv[1]} (KEY=VALUE, a Python literal; default in brackets):"]
+    for name, default, text in option_table(MECHANISMS[argv[1]]):
+        lines.append(f"  --set {name}=...  [{default}]  {text}")
+    return "\n".join(lines)
+
+
+def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
+    """The command line's parser; ``argv`` (when asking for help) adds a mechanism's --set keys to its help."""
     parser = argparse.ArgumentParser(prog="daeclear", description="Planar mechanisms with clearance joints.")
     sub = parser.add_subparsers(dest="command", required=True)
-    run = sub.add_parser("run", help="simulate a named mechanism or a scene file (.toml)")
+    keys = _mechanism_keys(argv)
+    epilog = keys or "daeclear run MECH --help lists the --set keys of mechanism MECH with their defaults and units."
+    formatter = argparse.RawDescriptionHelpFormatter
+    run = sub.add_parser("run", help="simulate a named mechanism or a scene file (.toml)", epilog=epilog,
+                         formatter_class=formatter)
     run.add_argument("target", help="mechanism name (slider_crank, chain, four_bar, double_pendulum) or path to a "
                                     ".toml scene file")
     run.add_argument("--joint", help="slider_crank: which joint has clearance (ideal, revolute, translational)")
@@ -66,17 +96,24 @@ def build_parser() -> argparse.ArgumentParser:
     points.add_argument("--every-step", action="store_true",
                         help="report every IDA step (memory and file grow with the run, ~1.7 MB per revolution "
                              "of the chapter's slider-crank)")
+    run.add_argument("--max-points", type=int, metavar="N",
+                     help="refuse before the run to report more than N points (default 1 000 000, about 1 GB for "
+                          "the chapter's slider-crank; the message gives the estimated size)")
     run.add_argument("--formulation", choices=["index1", "ggl"],
                      help="DAE formulation (default ggl; index1: the chapter's)")
     run.add_argument("--backend", choices=["auto", "c", "python"], default="auto")
     run.add_argument("--out", type=Path, default=Path("results"), help="output directory (default ./results)")
     run.add_argument("--name", help="base name of the output files (default: the scene name)")
     run.add_argument("--no-figure", action="store_true", help="write the HDF5 result only")
+    run.add_argument("--window", type=float, nargs=2, metavar=("T0", "T1"),
+                     help="the figure shows this time window, s (default: the whole run, min-max decimated to "
+                          f"{CLI_FIGURE_POINTS} points a curve so that peaks survive; the file has every point)")
     run.add_argument("--quiet", action="store_true", help="no progress line")
 
-    study = sub.add_parser("study", help="work-precision study: error against run time per method and tolerance")
+    study = sub.add_parser("study", help="work-precision study: error against run time per method and tolerance",
+                           epilog=epilog, formatter_class=formatter)
     study.add_argument("target", help="mechanism name (slider_crank)")
-    study.add_argument("--joint", default="revolute", help="slider_crank: which joint has clearance (default revolute)")
+    study.add_argument("--joint", help="slider_crank: which joint has clearance (default revolute)")
     study.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="mechanism parameter")
     study.add_argument("--t-end", type=float, default=0.012, help="end time, s (default one revolution at 5000 rpm)")
     study.add_argument("--methods", default="ida,DOP853,LSODA,rk4",
@@ -86,9 +123,23 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("--channels", default="slider.vx,drive.moment", help="channels whose error is measured")
     study.add_argument("--repeats", type=int, default=3, help="timed repeats per run (best kept)")
     study.add_argument("--out", type=Path, default=Path("results/study"), help="output directory")
-    _add_sweep_parser(sub)
+    _add_sweep_parser(sub, epilog)
     _add_animate_parser(sub)
     return parser
+
+
+def _add_joint(target: str, joint: str | None, params: dict[str, Any]) -> None:
+    """Put ``--joint`` into the mechanism's parameters: the slider-crank's option; the other mechanisms
+    choose their clearance joints with --set clearance_joints=..., and --set joint= with --joint is given twice."""
+    if joint is None:
+        return
+    if target != "slider_crank":
+        raise DaeclearError(f"--joint {joint}: --joint is the slider-crank's option; {target} chooses its clearance "
+                            f"joints with --set clearance_joints=A,B (see daeclear run {target} --help).")
+    if "joint" in params:
+        raise DaeclearError(f"--joint {joint}: joint is given twice (--set joint={params['joint']!r} too); "
+                            "give it once.")
+    params["joint"] = joint
 
 
 def _mechanism(mechanisms: dict[str, Any], name: str, params: dict[str, Any]) -> Any:
@@ -101,7 +152,7 @@ def _mechanism(mechanisms: dict[str, Any], name: str, params: dict[str, Any]) ->
 
 def _run(args: argparse.Namespace) -> int:
     from . import options
-    from .model.mechanisms import ideal_parameters
+    from .model.mechanism_options import ideal_parameters
     from .results.outputs import check_directory
     from .model.scene import RevoluteClearance, TranslationalClearance
     from .model.scenefile import MECHANISMS, read_scene_file
@@ -119,8 +170,7 @@ def _run(args: argparse.Namespace) -> int:
         if params or args.joint:
             raise DaeclearError("--set and --joint apply to named mechanisms; edit the scene file instead.")
     elif args.target in MECHANISMS:
-        if args.joint:
-            params["joint"] = args.joint
+        _add_joint(args.target, args.joint, params)
         scene = _mechanism(MECHANISMS, args.target, params)
         ideal = ideal_parameters(args.target, params)
         if ideal is not None:  # the chapter plots against the ideal mechanism
@@ -147,9 +197,16 @@ def _run(args: argparse.Namespace) -> int:
     elif not args.every_step:  # a long run stays affordable: a bounded number of points
         step = default_t_eval_step(t_end)
     base = args.name if args.name is not None else scene.name
-    if not base or Path(base).name != base or base in (".", ".."):
-        options.fail(where, "--name", args.name, "a plain file name without a directory (e.g. run1)")
+    if not base or Path(base).name != base or base in (".", ".."):  # blamed on where the name came from
+        field = "--name" if args.name is not None else "--set name" if "name" in params else "[scene] name"
+        named = "" if args.name is not None else ", as it names the output files (or give --name)"
+        options.fail(where if args.name is not None else f"{where} {args.target}", field, base,
+                     f"a plain file name without a directory (e.g. run1){named}")
     check_directory(args.out, "--out", files=[f"{base}.h5", f"{base}.png"])  # before any work
+    if args.window is not None:  # the figure's window, inside the run
+        lo, hi = args.window
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 <= lo < hi and lo < t_end):
+            options.fail(where, "--window", tuple(args.window), f"T0 < T1 with 0 <= T0 < t_end={t_end:g} s", "s")
     run_options: dict[str, Any] = {"rtol": rtol, "backend": args.backend, "progress": not args.quiet,
                                    "on_failure": "return"}
     if args.formulation:
@@ -157,6 +214,9 @@ def _run(args: argparse.Namespace) -> int:
     run_options.update(sim)
     if step is not None:  # reported points on a grid; the steps are not kept (bounded memory)
         run_options.update(t_eval_step=step, store_steps=False)
+    if args.max_points is not None:
+        run_options["max_output_points"] = options.max_output_points(args.max_points, where=where,
+                                                                     field="--max-points")
     if args.max_steps is not None:
         run_options["max_steps"] = options.max_steps(args.max_steps, where=where, field="--max-steps")
     else:  # memory no longer limits a long run: the cap only stops a runaway one
@@ -213,7 +273,8 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
             except DaeclearError as exc:  # e.g. an ideal mechanism with redundant constraints: no dashed lines
                 print(f"daeclear: no ideal-mechanism reference in the figure: {exc}", file=sys.stderr)
         # time plots chosen from what the scene holds, a journal orbit or slider path per clearance joint
-        png = save_run_figure(result, args.out / f"{base}.png", reference=reference)
+        png = save_run_figure(result, args.out / f"{base}.png", reference=reference,
+                              window=tuple(args.window) if args.window else None, max_points=CLI_FIGURE_POINTS)
         print(f"wrote {png}")
 
 
@@ -267,7 +328,9 @@ def _study(args: argparse.Namespace) -> int:
     rtols = options.rtols(_floats(args.rtols, "rtols"), where=where, field="--rtols")
     steps = options.steps(_floats(args.steps, "steps"), t_end, where=where, field="--steps")
     params = _parse_sets(args.set)
-    params.setdefault("joint", args.joint)
+    _add_joint(args.target, args.joint, params)
+    if args.target == "slider_crank":
+        params.setdefault("joint", "revolute")
     scene = _mechanism(MECHANISMS, args.target, params)
     files = ("work_precision.csv", "work_precision.md", "work_precision.png")
     check_directory(args.out, "--out", files=files)  # before any work
@@ -319,11 +382,12 @@ def _write_study_tables(study: Any, out: Path) -> str:
 # --------------------------------------------------------------------------- daeclear sweep
 
 
-def _add_sweep_parser(sub: Any) -> None:
+def _add_sweep_parser(sub: Any, epilog: str) -> None:
     sweep = sub.add_parser("sweep", help="classify the motion over a grid of parameters into one HDF5 file",
                            description="Run and classify (periodic, quasi-periodic, chaotic) one scene per parameter "
                                        "point, in parallel, into one HDF5 file; an interrupted sweep resumes where it "
-                                       "stopped when the same command is run again.")
+                                       "stopped when the same command is run again.", epilog=epilog,
+                           formatter_class=argparse.RawDescriptionHelpFormatter)
     sweep.add_argument("target", help="mechanism name (slider_crank)")
     sweep.add_argument("out", type=Path, help="sweep file (.h5), created or resumed")
     sweep.add_argument("--joint", help="slider_crank: which joint has clearance (ideal, revolute, translational)")
@@ -374,6 +438,9 @@ def _grid_values(item: str) -> tuple[str, list[Any]]:
             raise DaeclearError(f"--grid {item!r}: N must be >= 1{rule}")
         values = np.linspace(start, stop, count) if kind == "lin" else np.geomspace(start, stop, count)
         return name, [float(v) for v in values]
+    if spec and kind.isidentifier():  # e.g. log:1e-5:5e-4:10, a kind that does not exist
+        raise DaeclearError(f"--grid {item!r}: unknown grid kind {kind!r}; the kinds are NAME=v1,v2,... (values), "
+                            "NAME=lin:START:STOP:N (evenly spaced) and NAME=geom:START:STOP:N (geometric).")
     return name, [_parse_value(v.strip()) for v in text.split(",") if v.strip()]
 
 
@@ -385,9 +452,17 @@ def _sweep(args: argparse.Namespace) -> int:
     from .studies.sweep import sweep
 
     fixed = _parse_sets(args.set)
-    if args.joint:
-        fixed["joint"] = args.joint
-    grid = dict(_grid_values(item) for item in args.grid)
+    _add_joint(args.target, args.joint, fixed)
+    grid: dict[str, list[Any]] = {}
+    for item in args.grid:  # a parameter swept twice, or swept and fixed, is a contradiction
+        key, swept = _grid_values(item)
+        if key in grid:
+            raise DaeclearError(f"--grid {item!r}: {key} is swept twice (--grid {key}={grid[key]!r} before); "
+                                "give it once.")
+        if key in fixed:
+            given = f"--joint {fixed[key]}" if key == "joint" and args.joint else f"--set {key}={fixed[key]!r}"
+            raise DaeclearError(f"--grid {item!r}: {key} is also fixed by {given}; sweep it or fix it, not both.")
+        grid[key] = swept
     points = None
     if args.points:
         try:
@@ -477,6 +552,7 @@ def _sweep(args: argparse.Namespace) -> int:
     if result.failed:
         print(f"daeclear: {len(result.failed)} run(s) failed (recorded in {args.out}; --retry-failed runs them "
               "again).", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -527,7 +603,8 @@ def _animate(args: argparse.Namespace) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="daeclear: %(message)s")
-    args = build_parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    args = build_parser(argv).parse_args(argv)
     try:
         if args.command == "run":
             return _run(args)
@@ -540,14 +617,24 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SolveError as exc:
         print(f"daeclear: {exc}", file=sys.stderr)
         return 1
+    except DiskFull as exc:  # the file named holds what was written before (a run: marked incomplete)
+        print(f"daeclear: error: {exc}", file=sys.stderr)
+        return 1
     except (DaeclearError, ValueError, KeyError) as exc:
         print(f"daeclear: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:  # Ctrl-C outside a run (assembly, compiling, a figure): nothing to save
         print("daeclear: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except OSError as exc:  # a write that failed after the checks (disk full, ...): a message, no traceback
-        print(f"daeclear: error: {exc}", file=sys.stderr)
+    except (OSError, RuntimeError) as exc:  # a write that failed after the checks (disk full, ...): one line
+        from .results.outputs import is_disk_full
+
+        if not isinstance(exc, OSError) and not is_disk_full(exc):
+            raise
+        name = getattr(exc, "filename", None)
+        where = f" writing '{name}'" if name else ""
+        cause = "no space left on the disk" if is_disk_full(exc) else str(exc).splitlines()[0]
+        print(f"daeclear: error{where}: {cause} ({type(exc).__name__}).", file=sys.stderr)
         return 1
     return 0
 

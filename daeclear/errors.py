@@ -42,6 +42,11 @@ class OutputError(DaeclearError, OSError):
     """An output place (file or directory) cannot be written; found before any work starts."""
 
 
+class DiskFull(OutputError):
+    """The disk (or quota) has no room for a write; the message names the file. What was written
+    before stays readable (a streamed result: marked incomplete)."""
+
+
 class OutputDirectoryMissing(OutputError, FileNotFoundError):
     """The directory an output file should go into does not exist."""
 

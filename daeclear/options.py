@@ -15,7 +15,7 @@ import math
 import os
 from pathlib import Path
 from typing import Any, NamedTuple, NoReturn, TypeGuard
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -156,19 +156,45 @@ def rtol(value: Any, *, where: str = "simulate", field: str = "rtol") -> float:
     return float(value)
 
 
-def atol(value: Any, *, where: str = "simulate", field: str = "atol") -> float | NDArray[np.float64] | None:
-    """Absolute tolerance: None (default), a finite number > 0, or finite values > 0 (one per state)."""
+#: The quantities of the positions and velocities, and the ``atol`` keys that name them.
+ATOL_QUANTITIES: tuple[str, ...] = ("position", "angle", "velocity", "angular_velocity")
+#: ``atol`` keys for groups: "q" (positions and angles), "v" (velocities and angular velocities).
+ATOL_GROUPS: dict[str, tuple[str, ...]] = {"q": ("position", "angle"), "v": ("velocity", "angular_velocity")}
+
+
+def atol(value: Any, *, where: str = "simulate", field: str = "atol"
+         ) -> float | dict[str, float] | NDArray[np.float64] | None:
+    """Absolute tolerance: None (default), a finite number > 0, a mapping by quantity (keys from
+    ATOL_GROUPS and ATOL_QUANTITIES, values finite numbers > 0) or finite values > 0 (per state)."""
     if value is None:
         return None
     if is_real(value):
         return number(value, where=where, field=field, low=0.0)
+    if isinstance(value, Mapping):
+        return atol_by_quantity(value, where=where, field=field)
+    rule = "a finite number > 0, a mapping by quantity ({'q': ..., 'v': ...}) or a list of numbers > 0"
     try:
         values = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        fail(where, field, value, "a finite number > 0 or a list of them (one per state)")
+        fail(where, field, value, rule)
     if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)) or np.any(values <= 0):
-        fail(where, field, value, "a finite number > 0 or a list of them (one per state)")
+        fail(where, field, value, rule)
     return values.copy()
+
+
+def atol_by_quantity(value: Mapping[Any, Any], *, where: str, field: str) -> dict[str, float]:
+    """An ``atol`` mapping as {quantity: value}: each group key expanded, each quantity given once."""
+    out: dict[str, float] = {}
+    allowed = ", ".join(repr(k) for k in (*ATOL_GROUPS, *ATOL_QUANTITIES))
+    for key, item in value.items():
+        if key not in ATOL_GROUPS and key not in ATOL_QUANTITIES:
+            fail(where, f"{field} key", key, f"one of {allowed} (multipliers are always out of the error test)")
+        given = number(item, where=where, field=f"{field}[{key!r}]", low=0.0)
+        for quantity in ATOL_GROUPS.get(key, (key,)):
+            if quantity in out:
+                fail(where, field, dict(value), f"one value per quantity ({quantity!r} is given twice)")
+            out[quantity] = given
+    return out
 
 
 def max_step(value: Any, *, where: str = "simulate", field: str = "max_step") -> float:
@@ -186,6 +212,13 @@ def step(value: Any, *, where: str = "simulate", field: str = "step") -> float:
     return number(value, where=where, field=field, unit="s", low=0.0)
 
 
+def step_within(value: float | None, t0: float, end: float, *, where: str = "simulate", field: str = "step") -> None:
+    """A fixed step (checked by :func:`step`) no longer than the run it steps over: a step past t_end
+    would take one stride over every contact of the run."""
+    if value is not None and value > end - t0:
+        fail(where, field, value, f"at most the run's length t_end - t0 = {end - t0:g} s (t_end={end:g} s)", "s")
+
+
 def t_eval(value: ArrayLike | None, end: float, *, where: str = "simulate",
            field: str = "t_eval", start: float = 0.0) -> NDArray[np.float64] | None:
     """Output times: None, or finite, strictly increasing values in [t0, t_end] (NaN is an error, not a cut)."""
@@ -193,9 +226,12 @@ def t_eval(value: ArrayLike | None, end: float, *, where: str = "simulate",
         return None
     rule = f"finite, strictly increasing values in [{'0' if start == 0 else f't0={start:g}'}, t_end={end:g}]"
     try:
-        times = np.asarray(value, dtype=float).ravel()
+        times = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         fail(where, field, value, rule)
+    if times.ndim > 1:  # a table of times is not flattened: which order was meant?
+        fail(where, field, value, "a 1-D sequence of times, " + rule, shown=f"array of shape {times.shape}")
+    times = times.reshape(-1)
     if times.size == 0:
         fail(where, field, value, "at least one time: " + rule)
     # the common case in one pass: in range and strictly increasing (so finite: a NaN or inf
@@ -224,6 +260,55 @@ def t_eval_step(value: Any, end: float, *, where: str, field: str = "t_eval_step
 
 
 _spacing = t_eval_step  # for output(), whose argument of that name hides the function
+
+#: The most output points a run reports unless told otherwise (simulate's ``max_output_points``,
+#: ``daeclear run --max-points``): about 1 GB of file (or memory) for the chapter's slider-crank
+#: with a revolute clearance joint (~1 KB a point), so that a mistyped spacing (1e-12 s) is refused
+#: with an estimate instead of filling a disk (docs/reliability.md).
+MAX_OUTPUT_POINTS = 1_000_000
+
+
+def max_output_points(value: Any, *, where: str = "simulate", field: str = "max_output_points") -> int | None:
+    """The cap on a run's output points: an integer >= 1, or None (no cap)."""
+    return None if value is None else integer(value, where=where, field=field, low=1)
+
+
+def _size(n_bytes: float) -> str:
+    for unit, scale in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n_bytes >= scale:
+            return f"{n_bytes / scale:.3g} {unit}"
+    return f"{n_bytes:.0f} bytes"
+
+
+def output_size(out: OutputOptions, limit: int | None, *, t_eval_step: Any, step: float | None, start: float,
+                end: float, n_states: int, n_channels: int, where: str = "simulate") -> None:
+    """Refuse, before the run, an output of more than ``limit`` points, with the estimate of its size.
+
+    The points are those of ``t_eval``/``t_eval_step``, or, without them, of a fixed ``step`` (every
+    step reported); an adaptive method's steps are not known before the run (``max_steps`` bounds
+    them). Each point stores t, the states and their derivatives and every channel, 8 bytes each."""
+    if limit is None:
+        return
+    if out.times is not None:
+        points = out.times.size
+        source = (("t_eval_step", t_eval_step, repr(t_eval_step)) if t_eval_step is not None
+                  else ("t_eval", None, f"array of {points} times"))
+    elif step is not None:
+        points = int(math.floor((end - start) / step)) + 2
+        source = ("step", step, f"{step!r} (every step reported, no t_eval_step)")
+    else:
+        return
+    if points <= limit:
+        return
+    per_point = 8 * (1 + 2 * n_states + n_channels)
+    place = ("in the file and in memory" if out.stream_to is not None and out.keep_data
+             else "in the file" if out.stream_to is not None else "in memory")
+    field, value, shown = source
+    fail(where, field, value,
+         f"coarser: it gives {points:.4g} output points over {end - start:g} s, about {_size(points * per_point)} "
+         f"{place} ({per_point} bytes a point: t, {n_states} states and their derivatives, {n_channels} "
+         f"channels), more than max_output_points={limit}; or raise max_output_points (daeclear run: "
+         "--max-points; None: no limit) to run it anyway", shown=shown)
 
 
 def uniform_times(spacing: float, end: float, start: float = 0.0) -> NDArray[np.float64]:

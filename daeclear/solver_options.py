@@ -49,14 +49,15 @@ class SolverOptions:
 
     Checked on construction: a bad value raises :class:`daeclear.SceneError` naming the field,
     the value and what is allowed. Names are normalised (``method="RK45"`` is stored as
-    ``"rk45"``), ``atol`` as a float or a tuple of floats. Immutable: derive variants with
+    ``"rk45"``), ``atol`` as a float, a tuple of floats or a tuple of (quantity, value) pairs
+    (a mapping by quantity). Immutable: derive variants with
     :meth:`replace`. Combinations that depend on the model (a GGL model with a non-IDA method,
     ``track_work`` with a non-IDA method) are checked by ``simulate`` before any work.
     """
 
     method: str = "ida"
     rtol: float = 1e-6
-    atol: float | tuple[float, ...] | None = None
+    atol: float | tuple[float, ...] | tuple[tuple[str, float], ...] | None = None
     formulation: str | None = None
     backend: str = "auto"
     max_step: float = 0.0
@@ -78,10 +79,12 @@ class SolverOptions:
         return dataclasses.replace(self, **changes)
 
     def to_dict(self) -> dict[str, Any]:
-        """Every setting as JSON types (``atol`` a float, a list or None): :meth:`from_dict` inverts it."""
+        """Every setting as JSON types (``atol`` a float, a list, a mapping or None): :meth:`from_dict`
+        inverts it."""
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
-        if isinstance(out["atol"], tuple):
-            out["atol"] = list(out["atol"])
+        out["atol"] = self.atol_value()
+        if isinstance(out["atol"], np.ndarray):
+            out["atol"] = out["atol"].tolist()
         return out
 
     @classmethod
@@ -118,9 +121,11 @@ class SolverOptions:
             memo_put_bounded(_MERGED, key, merged, _MERGED_LIMIT)
         return merged
 
-    def atol_value(self) -> float | np.ndarray | None:
-        """``atol`` as the solvers take it (one value, an array per state, or None)."""
-        return np.array(self.atol) if isinstance(self.atol, tuple) else self.atol
+    def atol_value(self) -> float | np.ndarray | dict[str, float] | None:
+        """``atol`` as the solvers take it (one value, a mapping by quantity, an array per state, or None)."""
+        if isinstance(self.atol, tuple):
+            return dict(self.atol) if self.atol and isinstance(self.atol[0], tuple) else np.array(self.atol)
+        return self.atol
 
 
 # merged() of plain keywords, by (options, where, (name, type, value)...): a keyword's exact type is
@@ -137,11 +142,14 @@ def checked(values: Mapping[str, Any], *, where: str) -> dict[str, Any]:
     from .solvers.explicit import check_step  # the fixed-step rule, defined once
 
     method = options.method(values["method"], where=where)
-    atol = options.atol(values["atol"], where=where)
+    raw = values["atol"]
+    pairs = isinstance(raw, tuple) and bool(raw) and isinstance(raw[0], tuple)  # a mapping as stored
+    atol = options.atol(dict(raw) if pairs else raw, where=where)
     return {
         "method": method,
         "rtol": options.rtol(values["rtol"], where=where),
-        "atol": atol if atol is None or isinstance(atol, float) else tuple(float(x) for x in atol),
+        "atol": (atol if atol is None or isinstance(atol, float) else tuple(sorted(atol.items()))
+                 if isinstance(atol, dict) else tuple(float(x) for x in atol)),
         "formulation": (None if values["formulation"] is None
                         else options.formulation(values["formulation"], where=where)),
         "backend": options.backend(values["backend"], where=where),

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 from collections.abc import Callable
 
+import numpy as np
 import pytest
 
 import daeclear as dc
@@ -23,6 +24,7 @@ from daeclear.model.scenefile import read_scene_file
 from scene_texts import PENDULUM as PENDULUM_FILE
 
 SCENE = dc.mechanisms.slider_crank("ideal")
+REVOLUTE = dc.mechanisms.slider_crank("revolute")
 TINY = 1e-4  # s
 
 
@@ -113,6 +115,22 @@ API_SIMULATE: list[tuple[str, dict[str, Any], str, str]] = [
     ("keep_data False without stream_to", {"keep_data": False}, "keep_data", "False"),
     ("keep_data text", {"keep_data": "no"}, "keep_data", "'no'"),
     ("stream_to int", {"stream_to": 3}, "stream_to", "3"),
+    # issue 31: contradictions that were silently accepted
+    ("t_eval 2-D", {"t_eval": [[0.0, 5e-5], [6e-5, TINY]]}, "t_eval", "shape (2, 2)"),
+    ("t_eval 3-D", {"t_eval": np.zeros((1, 1, 2))}, "t_eval", "shape (1, 1, 2)"),
+    ("rk4 step longer than the run", {"method": "rk4", "step": 1.0}, "step", "step=1.0 s"),
+    ("euler step longer than the run", {"method": "euler", "step": 0.5}, "step", "0.5"),
+    ("rk4 step longer than t_end - t0", {"method": "rk4", "step": 8e-5, "t0": 5e-5}, "step", "8e-05"),
+    # issue 31: output size checked before the run
+    ("t_eval_step too fine", {"t_end": 0.002, "t_eval_step": 1e-12}, "t_eval_step", "t_eval_step=1e-12"),
+    ("t_eval_step above the cap", {"t_eval_step": 1e-5, "max_output_points": 5}, "t_eval_step", "11 output points"),
+    ("t_eval above the cap", {"t_eval": np.linspace(0.0, TINY, 10), "max_output_points": 9}, "t_eval",
+     "array of 10 times"),
+    ("rk4 every step above the cap", {"method": "rk4", "step": 1e-11}, "step", "1e-11"),
+    ("DOP853 t_eval_step too fine", {"method": "DOP853", "t_eval_step": 1e-12}, "t_eval_step", "1e+08 output points"),
+    ("max_output_points 0", {"max_output_points": 0}, "max_output_points", "0"),
+    ("max_output_points bool", {"max_output_points": True}, "max_output_points", "True"),
+    ("max_output_points float", {"max_output_points": 1e6}, "max_output_points", "1000000.0"),
 ]
 
 
@@ -122,6 +140,43 @@ def test_simulate_refuses(case, kwargs, field, shown):
     with pytest.raises(SceneError) as info:
         dc.simulate(SCENE, kwargs.pop("t_end"), **kwargs)
     assert field in str(info.value) and shown in str(info.value)
+
+
+API_CALLS: list[tuple[str, Callable[[], Any], type, str, str]] = [
+    # (id, the call, error class, field, value as shown)
+    ("simulate a name", lambda: dc.simulate("slider_crank", TINY), SceneError, "scene", "'slider_crank'"),
+    ("simulate None", lambda: dc.simulate(None, TINY), SceneError, "scene", "None"),
+    ("simulate y0 deep in the wall", lambda: dc.simulate(REVOLUTE, TINY, y0=np.zeros(dc.assemble(REVOLUTE).n_states)),
+     dc.AssemblyError, "y0", "0.17 m"),
+    ("rk4 y0 deep in the wall", lambda: dc.simulate(REVOLUTE, TINY, method="rk4", step=1e-5,
+                                                    y0=np.zeros(dc.assemble(REVOLUTE, "index1").n_states)),
+     dc.AssemblyError, "y0", "of the clearance 0.0005 m"),
+]
+
+
+@pytest.mark.parametrize("case, call, exc, field, shown", API_CALLS, ids=[c[0] for c in API_CALLS])
+def test_api_calls_refuse(case, call, exc, field, shown):
+    with pytest.raises(exc) as info:
+        call()
+    assert field in str(info.value) and shown in str(info.value), str(info.value)
+
+
+LOAD_WINDOWS: list[tuple[str, tuple[Any, Any], str]] = [
+    ("after the run", (5.0, 6.0), "t0=5.0, t1=6.0"),
+    ("before the run", (-2.0, -1.0), "t0=-2.0, t1=-1.0"),
+    ("from after the end", (1.0, None), "t0=1.0, t1=None"),
+    ("up to before the start", (None, -1e-3), "t0=None, t1=-0.001"),
+]
+
+
+@pytest.mark.parametrize("case, window, shown", LOAD_WINDOWS, ids=[c[0] for c in LOAD_WINDOWS])
+def test_load_refuses_a_window_outside_the_run(case, window, shown, tmp_path, tiny_result):
+    path = tmp_path / "run.h5"
+    tiny_result.save(path)
+    with pytest.raises(SceneError) as info:
+        dc.load(path, *window)
+    text = str(info.value)
+    assert shown in text and str(path) in text and "[0, 0.0001]" in text, text
 
 
 API_MECHANISMS: list[tuple[str, Callable[[], Any], str, str]] = [
@@ -138,7 +193,44 @@ API_MECHANISMS: list[tuple[str, Callable[[], Any], str, str]] = [
     ("clearance 0", lambda: dc.mechanisms.slider_crank("revolute", clearance=0.0), "clearance", "0.0"),
     ("gravity < 0", lambda: dc.mechanisms.slider_crank("ideal", gravity=-9.81), "gravity", "-9.81"),
     ("joint", lambda: dc.mechanisms.slider_crank("cylindrical"), "joint", "'cylindrical'"),
+    # issue 31: a bool is not a number; an option of a clearance joint the mechanism does not have
+    ("gravity True", lambda: dc.mechanisms.slider_crank("ideal", gravity=True), "gravity", "True"),
+    ("rpm True", lambda: dc.mechanisms.slider_crank("ideal", rpm=True), "rpm", "True"),
+    ("crank_angle False", lambda: dc.mechanisms.slider_crank("ideal", crank_angle=False), "crank_angle", "False"),
+    ("clearance True", lambda: dc.mechanisms.slider_crank("revolute", clearance=True), "clearance", "True"),
+    ("translational clearance True", lambda: dc.mechanisms.slider_crank("translational", clearance=True),
+     "clearance", "True"),
+    ("pin_offset with a bool", lambda: dc.mechanisms.slider_crank("translational", pin_offset=(True, 0.0)),
+     "pin_offset", "(True, 0.0)"),
+    ("length True", lambda: dc.mechanisms.slider_crank("revolute", length=True), "length", "True"),
+    ("four_bar length True", lambda: dc.mechanisms.four_bar("B", length=True), "length", "True"),
+    ("chain length True", lambda: dc.mechanisms.chain(2, length=True), "length", "True"),
+    ("body position bool", lambda: _validated(dc.Body("extra", mass=1.0, inertia=1.0, position=(True, 0.0))),
+     "position", "(True, 0.0)"),
+    ("body velocity bool", lambda: _validated(dc.Body("extra", mass=1.0, inertia=1.0, velocity=(0.0, False))),
+     "velocity", "(0.0, False)"),
+    ("revolute at bool", lambda: _validated(dc.Revolute("E", "ground", "slider", at=(True, 0.0))), "at",
+     "(True, 0.0)"),
+    ("ideal with clearance", lambda: dc.mechanisms.slider_crank("ideal", clearance=1e-4), "clearance", "0.0001"),
+    ("ideal with friction", lambda: dc.mechanisms.slider_crank("ideal", friction=0.1), "friction", "0.1"),
+    ("ideal with law", lambda: dc.mechanisms.slider_crank("ideal", law="hertz"), "law", "'hertz'"),
+    ("ideal with restitution", lambda: dc.mechanisms.slider_crank("ideal", restitution=0.5), "restitution", "0.5"),
+    ("ideal with bearing_radius", lambda: dc.mechanisms.slider_crank("ideal", bearing_radius=0.02),
+     "bearing_radius", "0.02"),
+    ("ideal with face_law", lambda: dc.mechanisms.slider_crank("ideal", face_law="hertz"), "face_law", "'hertz'"),
+    ("ideal with contact_model", lambda: dc.mechanisms.slider_crank("ideal", contact_model="section-4.3"),
+     "contact_model", "'section-4.3'"),
+    ("ideal four_bar with clearance", lambda: dc.mechanisms.four_bar((), clearance=1e-4), "clearance", "0.0001"),
+    ("ideal double_pendulum with friction", lambda: dc.mechanisms.double_pendulum(friction=0.2), "friction", "0.2"),
 ]
+
+
+def _validated(element: Any) -> Any:
+    """The ideal slider-crank with ``element`` added, validated (an element's problems are found there)."""
+    scene = dc.mechanisms.slider_crank("ideal")
+    scene.add(element)
+    scene.validate()
+    return scene
 
 
 @pytest.mark.parametrize("case, build, field, shown", API_MECHANISMS, ids=[c[0] for c in API_MECHANISMS])
@@ -177,13 +269,19 @@ API_SWEEP: list[tuple[str, dict[str, Any], type, str, str]] = [
     ("max_workers 0", {"max_workers": 0}, SceneError, "max_workers", "0"),
     ("twin", {"twin": "maybe"}, SceneError, "twin", "'maybe'"),
     ("channels empty", {"channels": []}, SceneError, "channels", "[]"),
+    ("channels unknown", {"channels": ["slider.vz"]}, SceneError, "channels", "'slider.vz'"),
+    ("store_channels unknown", {"store_channels": ["slider.vx", "rod.q"]}, SceneError, "store_channels", "'rod.q'"),
+    ("grid for no joint", {"fixed": {"joint": "ideal"}}, SceneError, "clearance", "0.0001"),
+    ("no driver", {"mechanism": "double_pendulum", "fixed": {"clearance_joints": "A"}}, SceneError, "driver",
+     "double_pendulum_A"),
 ]
 
 
 @pytest.mark.parametrize("case, kwargs, exc, field, shown", API_SWEEP, ids=[c[0] for c in API_SWEEP])
 def test_sweep_refuses_options(case, kwargs, exc, field, shown, tmp_path):
+    kwargs = {"fixed": {"joint": "revolute"}, **kwargs}
     with pytest.raises(exc) as info:
-        dc.sweep(tmp_path / "s.h5", {"clearance": [1e-4]}, fixed={"joint": "revolute"}, progress=False, **kwargs)
+        dc.sweep(tmp_path / "s.h5", {"clearance": [1e-4]}, progress=False, **kwargs)
     assert field in str(info.value) and shown in str(info.value)
     assert list(tmp_path.iterdir()) == []  # nothing written
 
@@ -270,6 +368,24 @@ CLI_RUN: list[tuple[str, list[str], str, str]] = [
     ("--t-eval-step > t_end", ["--t-eval-step", "1"], "--t-eval-step", "1.0"),
     ("--max-steps 0", ["--max-steps", "0"], "--max-steps", "0"),
     ("--max-steps -5", ["--max-steps=-5"], "--max-steps", "-5"),
+    # issue 31: duplicates and contradictions
+    ("--set twice", ["--set", "rpm=1000", "--set", "rpm=2000"], "rpm", "rpm=1000"),
+    ("--set twice, same value", ["--set", "gravity=0", "--set", "gravity=0"], "gravity", "gravity=0"),
+    ("--set joint and --joint", ["--joint", "revolute", "--set", "joint='translational'"], "joint", "'translational'"),
+    ("--set clearance without --joint", ["--set", "clearance=1e-4"], "clearance", "0.0001"),
+    ("--set friction without --joint", ["--set", "friction=0.1"], "friction", "0.1"),
+    ("--set law without --joint", ["--set", "law='hertz'"], "law", "'hertz'"),
+    ("--set bearing_radius without --joint", ["--set", "bearing_radius=0.02"], "bearing_radius", "0.02"),
+    ("--set pin_offset with --joint revolute", ["--joint", "revolute", "--set", "pin_offset=(0.01,0.0)"],
+     "pin_offset", "(0.01, 0.0)"),
+    ("--set contact_model with --joint revolute", ["--joint", "revolute", "--set", "contact_model='section-4.3'"],
+     "contact_model", "'section-4.3'"),
+    ("--set gravity=True", ["--set", "gravity=True"], "gravity", "True"),
+    ("--set rpm=True", ["--set", "rpm=True"], "rpm", "True"),
+    ("--max-points 0", ["--max-points", "0"], "--max-points", "0"),
+    ("--window reversed", ["--window", "0.01", "0.005"], "--window", "(0.01, 0.005)"),
+    ("--window after the run", ["--t-end", "0.01", "--window", "0.02", "0.03"], "--window", "(0.02, 0.03)"),
+    ("--window nan", ["--window", "nan", "0.01"], "--window", "nan"),
 ]
 
 
@@ -291,6 +407,24 @@ def test_cli_run_refuses_out_before_work(place, tmp_path, capsys):
         (out / "slider_crank.png").mkdir(parents=True)
     err = _cli(["run", "slider_crank", "--out", str(out), "--quiet"], capsys)
     assert "--out" in err and str(out) in err
+
+
+CLI_OTHER: list[tuple[str, list[str], str, str]] = [
+    # (id, the whole command line but --out, field, value as shown)
+    ("run four_bar --joint", ["run", "four_bar", "--joint", "revolute"], "--joint", "four_bar"),
+    ("study four_bar --joint", ["study", "four_bar", "--joint", "revolute"], "--joint", "four_bar"),
+    ("run four_bar clearance without joints", ["run", "four_bar", "--set", "clearance=1e-4"], "clearance",
+     "clearance_joints=()"),
+    ("run double_pendulum friction without joints", ["run", "double_pendulum", "--set", "friction=0.1"], "friction",
+     "0.1"),
+    ("run --set name with a folder", ["run", "slider_crank", "--set", "name='a/b'"], "name", "'a/b'"),
+]
+
+
+@pytest.mark.parametrize("case, args, field, shown", CLI_OTHER, ids=[c[0] for c in CLI_OTHER])
+def test_cli_other_mechanisms_refuse(case, args, field, shown, tmp_path, capsys):
+    err = _cli([*args, "--out", str(tmp_path / "out")], capsys)
+    assert field in err and shown in err
 
 
 CLI_STUDY: list[tuple[str, list[str], str, str]] = [
@@ -336,6 +470,12 @@ CLI_SWEEP: list[tuple[str, list[str], str, str]] = [
     ("--channels empty", ["--channels", ","], "--channels", "[]"),
     ("--grid geom 0", ["--grid", "friction=geom:0:1:3"], "--grid", "geom:0:1:3"),
     ("--grid lin N", ["--grid", "friction=lin:0:1:0"], "--grid", "lin:0:1:0"),
+    ("--grid twice", ["--grid", "clearance=1e-4", "--grid", "clearance=2e-4,3e-4"], "clearance", "clearance=2e-4"),
+    ("--grid over --set", ["--set", "clearance=2e-4"], "clearance", "--set clearance=0.0002"),
+    ("--grid over --joint", ["--grid", "joint=revolute,translational"], "--joint", "revolute"),
+    ("--grid kind unknown", ["--grid", "clearance=log:1e-5:1e-4:3"], "'log'", "geom:START:STOP:N"),
+    ("--set twice", ["--set", "friction=0.1", "--set", "friction=0.2"], "friction", "friction=0.1"),
+    ("--channels unknown", ["--channels", "slider.vx,slider.vz"], "channels", "'slider.vz'"),
 ]
 
 
@@ -386,6 +526,9 @@ SCENE_FILE: list[tuple[str, str, str, str]] = [
     ("method", 'method = "rk5"', "method", "'rk5'"),
     ("formulation", 'formulation = "index3"', "formulation", "'index3'"),
     ("backend", 'backend = "gpu"', "backend", "'gpu'"),
+    ("rk4 step longer than t_end", 'method = "rk4"\nt_end = 0.1\nstep = 1.0', "step", "1.0"),
+    ("rk4 step = 0", 'method = "rk4"\nstep = 0.0', "step", "0.0"),
+    ("euler step text", 'method = "euler"\nstep = "1e-5"', "step", "'1e-5'"),
 ]
 
 MECHANISM_FILE: list[tuple[str, str, str, str]] = [
@@ -433,6 +576,23 @@ def test_mechanism_file_refuses(case, lines, field, shown, tmp_path, capsys):
     assert field in err and shown in err
 
 
+FILES: list[tuple[str, bytes, str, str]] = [
+    # (id, the file's bytes, field, value as shown): the file is named too
+    ("binary", b"\x00\xff\xfe\x00 not text", "UTF-8", "byte 1"),
+    ("latin-1", "[scene]\nname = 'p\xe9ndulum'\n".encode("latin-1"), "UTF-8", "byte"),
+    ("name with a folder", (PENDULUM.replace('name = "pendulum"', 'name = "a/b"', 1)).encode(), "[scene] name",
+     "'a/b'"),
+]
+
+
+@pytest.mark.parametrize("case, data, field, shown", FILES, ids=[c[0] for c in FILES])
+def test_cli_refuses_a_file(case, data, field, shown, tmp_path, capsys):
+    path = tmp_path / "scene.toml"
+    path.write_bytes(data)
+    err = _cli(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"], capsys)
+    assert field in err and shown in err and str(path) in err, err
+
+
 def test_cli_t_end_overrides_the_file_and_t_eval_step_is_checked_against_it(tmp_path, capsys):
     """The file's spacing fits its own t_end but not the end asked for on the command line."""
     path = _scene_file(tmp_path, "t_end = 0.5\nt_eval_step = 0.1")
@@ -454,6 +614,9 @@ def test_there_are_at_least_100_cases():
     n = (len(API_SIMULATE) + len(API_MECHANISMS) + len(API_STUDY) + len(API_SWEEP) + 4 + 4 + 4 + 1 + len(CLI_RUN) + 5
          + len(CLI_STUDY) + 2 + len(CLI_SWEEP) + 4 + 2 * len(SCENE_FILE) + len(MECHANISM_FILE) + 2)
     assert n >= 100, n
+    issue_31 = (13 + len(API_CALLS) + len(LOAD_WINDOWS) + 21 + 4 + 15 + len(CLI_OTHER) + 6 + 2 * 3
+                + len(FILES))
+    assert issue_31 >= 40, issue_31
 
 
 # --------------------------------------------------------------------------- loads (daeclear.loads)

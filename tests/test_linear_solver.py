@@ -124,13 +124,16 @@ def assert_same_run(a: dc.Result, b: dc.Result, t_tol: float, y_rtol: float) -> 
 # The slider-crank comparisons run 4 ms (22 events): after that the chaotic motion amplifies the
 # solvers' different rounding (the 5 ms they used to run ended 2-5e-9 s and 1-3e-6 apart when the
 # model was built with FMA contraction, 4e-10 s and 2e-7 without); up to 4 ms 2.6e-10 s and 2e-7.
+# With the per-quantity tolerances the 12th event (t = 1.7 ms) is a near-graze that puts sparse and
+# dense 1.4e-9 s apart (1.5e-11 s with the old uniform atol; 4e-12 s with a velocity atol of 1e-11
+# instead of 8.9e-12): the chaos amplifies rounding by 1e2 there, hence t_tol 3e-9.
 SLIDER_CRANK_WINDOW = 0.004
 
 
 def test_sparse_and_dense_agree_on_the_slider_crank():
     a, b = both(slider_crank("revolute"), SLIDER_CRANK_WINDOW)
     assert len(a.events) >= 20
-    assert_same_run(a, b, t_tol=1e-9, y_rtol=1e-6)
+    assert_same_run(a, b, t_tol=3e-9, y_rtol=1e-6)
 
 
 @pytest.mark.parametrize("formulation", ["ggl", "index1"])
@@ -309,7 +312,8 @@ def test_first_step_is_the_second_order_estimate(plain_ida):
     h_ida = 0.5 / np.sqrt(np.sum((w * yp) ** 2) / n)
     expected = max(1.0 / np.sqrt(np.sqrt(np.sum((w[:nq] * yp[nq:2 * nq]) ** 2) / n)), h_ida)
     plain = dc.simulate(model, 1e-4, rtol=rtol, backend="c", linear_solver=plain_ida)
-    assert plain.stats["first_step"] == pytest.approx(h_ida, rel=1e-6) and h_ida < 1e-15
+    # IDA's estimate: 1e-16 s with the old uniform atol (1e-3 rtol), 1e-14 s with the per-quantity defaults
+    assert plain.stats["first_step"] == pytest.approx(h_ida, rel=1e-6) and h_ida < 1e-13
     ida.FIRST_STEP_ESTIMATE = True  # undone by plain_ida's monkeypatch
     run = dc.simulate(model, 1e-4, rtol=rtol, backend="c", linear_solver=plain_ida)
     assert not run.events and run.stats["first_step"] == pytest.approx(expected, rel=1e-9) and expected > 1e-9

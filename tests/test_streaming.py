@@ -114,10 +114,11 @@ def _peak(run) -> int:
 
 
 def test_memory_of_a_decimated_or_streamed_run_does_not_grow_with_its_length(revolute, tmp_path):
-    """Runs of 2 and 8 revolutions: every IDA step kept grows ~4x; a fixed number of points without
-    steps, or a 1e-5 s grid streamed to a file, stays within 1.5x (measured ~1.0x)."""
+    """Runs of 3 and 12 revolutions: every IDA step kept grows ~4x; a fixed number of points without
+    steps, or a 1e-5 s grid streamed to a file, stays within 1.5x (measured ~1.2x). (The short run is
+    3 revolutions, not 2: the compiled loop's buffers reach their size within about 2.5 revolutions.)"""
     dc.simulate(revolute, REV / 4)  # compiled before measuring
-    short, long = 2 * REV, 8 * REV
+    short, long = 3 * REV, 12 * REV
 
     def ratio(**kwargs):
         return _peak(lambda: dc.simulate(revolute, long, **kwargs)) / _peak(lambda: dc.simulate(revolute, short,
@@ -389,7 +390,13 @@ def test_load_of_a_window_equals_the_slice_of_the_whole(revolute, tmp_path, wind
     whole = dc.simulate(revolute, REV, stream_to=path)
     whole.save(tmp_path / "saved.h5")
     for file in (path, tmp_path / "saved.h5"):
-        part, expected = dc.load(file, *window), whole.slice(*window)
+        expected = whole.slice(*window)
+        if window == (1.0, 2.0):  # after the run: the slice is empty, and load refuses it (issue 31)
+            assert expected.n_times == 0
+            with pytest.raises(dc.SceneError, match="must overlap the run's output times"):
+                dc.load(file, *window)
+            continue
+        part = dc.load(file, *window)
         _same(part, expected)
         assert part.stats == expected.stats and part.parameters == expected.parameters
     assert len(whole.events) > 20 and np.array_equal(dc.results.result.load_times(path, "events"), whole.events.t)

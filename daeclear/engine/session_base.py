@@ -324,6 +324,11 @@ class SessionBase:
 
     # ---------------------------------------------------------------- properties
     @property
+    def max_steps(self) -> int:
+        """The session's cap on the number of IDA steps of a run."""
+        return self._opts.max_steps
+
+    @property
     def n(self) -> int:
         return self._n
 

@@ -100,6 +100,8 @@ def _is_finite_number(value: Any) -> bool:
 def _as_vector2(value: Any) -> Vector2 | None:
     """Return ``value`` as a tuple of two finite floats, or None if it is not one."""
     try:
+        if any(isinstance(v, bool) for v in value):  # True is not a coordinate
+            return None
         items = tuple(float(v) for v in value)
     except (TypeError, ValueError):
         return None

@@ -11,6 +11,7 @@ from ..contact import Material, friction_law, normal_law
 from ..contact.base import NormalLaw
 from ..errors import SceneError
 from ..engine.build import MemoTable, memo_by_values, memo_table
+from .mechanism_options import joint_names, refuse_clearance_options
 from .scene import GROUND, Body, Driver, Element, Revolute, RevoluteClearance, Scene, Translational
 
 # Table 4.1: link lengths (m), masses (kg), moments of inertia (kg m^2)
@@ -68,6 +69,8 @@ DEFAULT_RESTITUTION = 0.9  # Table 4.2, for the laws that take a coefficient of 
 
 def _contact_law(law: Any, restitution: float | None, length: float | None) -> NormalLaw:
     """A law object from a law or a name; ``restitution``/``length`` fill the fields the law has."""
+    if length is not None and not (_finite(length) and length > 0):
+        raise SceneError(f"contact law: length={length!r}, must be None or a finite number > 0 m.")
     if isinstance(law, NormalLaw):
         return law
     return memo_by_values(_LAWS, (str(law), restitution, length), _make_contact_law)
@@ -191,16 +194,14 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     """
     joint = str(joint).lower()
     _check("joint", joint, f"must be one of {', '.join(JOINT_KINDS)}", joint in JOINT_KINDS)
-    _check("gravity", gravity, "must be a finite number >= 0 m/s^2",
-           isinstance(gravity, (int, float)) and math.isfinite(gravity) and gravity >= 0)
-    _check("rpm", rpm, "must be a finite number (rev/min)", isinstance(rpm, (int, float)) and math.isfinite(rpm))
-    _check("crank_angle", crank_angle, "must be a finite number (rad)",
-           isinstance(crank_angle, (int, float)) and math.isfinite(crank_angle))
+    _check("gravity", gravity, "must be a finite number >= 0 m/s^2", _finite(gravity) and gravity >= 0)
+    _check("rpm", rpm, "must be a finite number (rev/min)", _finite(rpm))
+    _check("crank_angle", crank_angle, "must be a finite number (rad)", _finite(crank_angle))
     if options:
         raise SceneError(f"slider_crank(joint={joint!r}): unknown option(s) {', '.join(sorted(options))}.")
     offset = tuple(pin_offset) if isinstance(pin_offset, (tuple, list)) else ()
     _check("pin_offset", pin_offset, "must be two finite numbers (m)",
-           len(offset) == 2 and all(isinstance(v, (int, float)) and math.isfinite(v) for v in offset))
+           len(offset) == 2 and all(_finite(v) for v in offset))
     _check("pin_offset", pin_offset, "must be (0, 0) unless joint='translational'",
            joint == "translational" or offset == (0.0, 0.0))
     _check("bearing", bearing, "must be 'slider' or 'rod' (joint='revolute' only)",
@@ -212,17 +213,18 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     numbers = (omega, crank_angle, slider_mass, slider_inertia, offset)
     scene = Scene(name or ("slider_crank" if joint == "ideal" else f"slider_crank_{joint}"), gravity=(0.0, -gravity),
                   elements=list(memo_by_values(_IDEAL_ELEMENTS, numbers, _make_ideal_elements)))
-    if joint == "ideal":
+    if joint == "ideal":  # an option of a clearance joint would be ignored: refused
+        refuse_clearance_options("slider_crank", slider_crank, locals(), "joint='ideal'")
         return scene
     rules.restitution(restitution, law, where="slider_crank")  # given for a law without one, it would be dropped
     if joint == "revolute":
         _check("clearance", clearance, "must be a number in (0, bearing_radius) m",
-               isinstance(clearance, (int, float)) and 0 < clearance < bearing_radius)
+               _finite(clearance) and 0 < clearance < bearing_radius)
         return scene.with_clearance(
             "C", name="clearance", bearing=bearing, bearing_radius=bearing_radius, clearance=clearance,
             material=material, law=_contact_law(law, restitution, length), friction=friction_law(friction))
     _check("clearance", clearance, "must be a number in (0, slider length) m",
-           isinstance(clearance, (int, float)) and 0 < clearance < SLIDER_LENGTH)
+           _finite(clearance) and 0 < clearance < SLIDER_LENGTH)
     # slider centre: x range
     inner, outer = ROD_LENGTH - CRANK_LENGTH - offset[0], ROD_LENGTH + CRANK_LENGTH - offset[0]
     reach = 0.5 * SLIDER_LENGTH + GUIDE_MARGIN
@@ -376,36 +378,12 @@ def _clearance_of_joint(clearance: Any, joint: str, where: str) -> float:
     return float(value)
 
 
-def _joint_names(joints: Any) -> tuple[Any, ...]:
-    """Joint names from a sequence or a comma-separated string (``"B,C"``, as the command line's --set gives)."""
-    if isinstance(joints, str):
-        return tuple(j.strip() for j in joints.split(",") if j.strip())
-    return tuple(joints)
-
-
-def ideal_parameters(mechanism: str, params: dict[str, Any]) -> dict[str, Any] | None:
-    """The parameters of the same ready mechanism with every joint ideal (the chapter's reference run),
-    or None when ``params`` give no clearance joint or no ideal counterpart (chain)."""
-    if mechanism == "slider_crank":
-        kept = {k: v for k, v in params.items() if k != "bearing"}  # an ideal joint has no bearing
-        return None if str(params.get("joint", "ideal")).lower() == "ideal" else {**kept, "joint": "ideal"}
-    if mechanism in ("four_bar", "double_pendulum"):
-        try:
-            chosen = _joint_names(params.get("clearance_joints", ()))
-        except TypeError:
-            return None
-        if not chosen:
-            return None
-        return {**{k: v for k, v in params.items() if k != "clearance"}, "clearance_joints": ()}
-    return None
-
-
 def _with_revolute_clearances(scene: Scene, joints: Any, allowed: tuple[str, ...], where: str, *,
                               clearance: Any, law: Any, restitution: float | None, friction: Any,
                               bearing_radius: float, material: Material, length: float | None) -> Scene:
     """``scene`` with a revolute clearance joint (same bearing, material and law) at each of ``joints``."""
     try:
-        chosen = _joint_names(joints)
+        chosen = joint_names(joints)
     except TypeError:
         raise SceneError(f"{where}: clearance_joints={joints!r}, must be a list of joint names from "
                          f"{', '.join(allowed)}.") from None
@@ -418,7 +396,10 @@ def _with_revolute_clearances(scene: Scene, joints: Any, allowed: tuple[str, ...
         if extra:
             raise SceneError(f"{where}: clearance={clearance!r} names joint(s) {', '.join(map(repr, extra))} "
                              f"not in clearance_joints={chosen!r}.")
-    if not chosen:
+    if not chosen:  # an option of a clearance joint would be ignored: refused
+        refuse_clearance_options(where, globals()[where], {
+            "clearance": clearance, "law": law, "restitution": restitution, "friction": friction,
+            "bearing_radius": bearing_radius, "material": material, "length": length}, "clearance_joints=()")
         return scene
     rules.restitution(restitution, law, where=where)
     contact_law = _contact_law(law, restitution, length)
@@ -546,7 +527,7 @@ def four_bar(clearance_joints: Any = (), *, rpm: float = 5000.0, crank_angle: fl
             raise SceneError(f"{where}: {field_name}={value!r}, {rule}.")
     omega = rpm_to_rad_s(rpm)
     state = ideal_four_bar_state(crank_angle, omega)
-    joints = _joint_names(clearance_joints) if isinstance(clearance_joints, (str, tuple, list)) else ()
+    joints = joint_names(clearance_joints) if isinstance(clearance_joints, (str, tuple, list)) else ()
     suffix = "".join(str(j) for j in joints)
     scene = Scene(name or (f"four_bar_{suffix}" if suffix else "four_bar"), gravity=(0.0, -gravity))
     links = {"crank": (CRANK_MASS, CRANK_INERTIA), "coupler": (ROD_MASS, ROD_INERTIA),
@@ -631,7 +612,7 @@ def double_pendulum(clearance_joints: Any = (), *, angles: Any = (0.0, 0.0), gra
             raise SceneError(f"{where}: {field_name}={value!r}, {rule}.")
     assert pair is not None
     inertia = link_mass * link_length ** 2 / 12.0 if link_inertia is None else float(link_inertia)
-    joints = _joint_names(clearance_joints) if isinstance(clearance_joints, (str, tuple, list)) else ()
+    joints = joint_names(clearance_joints) if isinstance(clearance_joints, (str, tuple, list)) else ()
     suffix = "".join(str(j) for j in joints)
     scene = Scene(name or (f"double_pendulum_{suffix}" if suffix else "double_pendulum"), gravity=(0.0, -gravity))
     pin = (0.0, 0.0)

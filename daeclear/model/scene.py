@@ -12,6 +12,7 @@ import Body`` keeps working.
 from __future__ import annotations
 
 import difflib
+import importlib
 from dataclasses import dataclass, field
 from typing import Any
 from collections.abc import Callable, Iterable, Iterator, Mapping
@@ -27,9 +28,11 @@ from .profiles import PROFILES, ConstantSpeed, Profile  # noqa: F401  (re-export
 
 
 #: What :meth:`Scene.assembled` runs: :func:`daeclear.assembly.placement.assembled`, which puts itself
-#: here when it is imported (with ``import daeclear``). It assembles the scene, so it lives in the
-#: assembly layer, which imports this module: the scene cannot import it (no import circles).
+#: here when its module is loaded. It assembles the scene, so it lives in the assembly layer, which
+#: imports this module: the scene does not import it (no import circle); the first call loads it
+#: by name, as ``daeclear``'s public names are loaded on first use.
 PLACEMENT: list[Callable[..., Scene]] = []
+PLACEMENT_MODULE = "daeclear.assembly.placement"
 
 
 @dataclass
@@ -121,8 +124,8 @@ class Scene:
         joints cannot close at them (the largest residuals and their joints).
         See :mod:`daeclear.assembly.placement`.
         """
-        if not PLACEMENT:  # pragma: no cover  (import daeclear registers it)
-            raise SceneError("Scene.assembled: import daeclear first (daeclear.assembly.placement).")
+        if not PLACEMENT:
+            importlib.import_module(PLACEMENT_MODULE)  # registers itself (see PLACEMENT)
         return PLACEMENT[0](self, start, speeds)
 
     def ideal(self) -> Scene:

@@ -11,7 +11,7 @@ A mechanism file::
     t_end = 0.024
     rtol = 1e-6
     # also: atol, formulation, method, backend, max_step, t_eval_step, start ("ideal" or "declared"),
-    # allow_penetration (true: a declared start deep in a wall is not refused)
+    # allow_penetration (true: a declared start deep in a wall is not refused), step (method = "rk4" or "euler")
 
 A scene file (tables map key for key onto the Python classes)::
 
@@ -98,7 +98,7 @@ ELEMENT_TABLES: dict[str, type] = {
     "rotational_spring_damper": RotationalSpringDamper, "motor": Motor,
 }
 SIMULATE_KEYS = ("t_end", "rtol", "atol", "formulation", "method", "backend", "max_step", "t_eval_step", "start",
-                 "allow_penetration")
+                 "allow_penetration", "step")
 #: Keys of loads whose value may be a table in time, ``{ times = [...], values = [...] }``.
 LOAD_VALUE_KEYS = ("fx", "fy", "value")
 
@@ -265,9 +265,12 @@ def check_simulate(simulate: dict[str, Any], *, where: str) -> dict[str, Any]:
         out["rtol"] = options.rtol(out["rtol"], where=where)
     if "atol" in out:
         atol = options.atol(out["atol"], where=where)
-        out["atol"] = atol if atol is None or isinstance(atol, float) else atol.tolist()
+        out["atol"] = atol if atol is None or isinstance(atol, (float, dict)) else atol.tolist()
     if "max_step" in out:
         out["max_step"] = options.max_step(out["max_step"], where=where)
+    if "step" in out:  # the fixed step of method = "rk4" / "euler" (simulate refuses it with the others)
+        out["step"] = options.step(out["step"], where=where)
+        options.step_within(out["step"], 0.0, out.get("t_end", math.inf), where=where)
     if "allow_penetration" in out:
         out["allow_penetration"] = options.flag(out["allow_penetration"], where=where, field="allow_penetration")
     for key, rule in (("method", options.method), ("formulation", options.formulation),
@@ -286,9 +289,14 @@ def read_scene_file(path: str | Path) -> SceneFile:
     """Read and validate a TOML scene file; raise SceneError naming the file, table and key."""
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise SceneError(f"scene file {path} does not exist.") from None
+    except UnicodeDecodeError as exc:  # a binary file, or another encoding
+        raise SceneError(f"{path}: not a text file in UTF-8 (byte {exc.start}: {exc.reason}); a scene file is "
+                         "TOML text.") from None
+    except OSError as exc:  # a folder, no permission
+        raise SceneError(f"scene file {path} cannot be read ({exc.strerror or exc}).") from None
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML ({exc}).") from None
     simulate = _single_table(path, data, "simulate")

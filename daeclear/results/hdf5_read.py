@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import DaeclearError
+from ..errors import DaeclearError, SceneError
 from .events import ContactEvent
 from .hdf5_write import FORMAT_NAME, FORMAT_VERSION
 from .values import time_window
@@ -27,8 +27,10 @@ if TYPE_CHECKING:  # h5py is imported lazily, only where a file is read
 __all__ = ["read_dataset", "read_file", "read_group"]
 
 
-def read_file(path: str | os.PathLike[str], t0: float | None = None, t1: float | None = None) -> dict[str, Any]:
-    """The `Result` keywords of the result file at ``path``, of the window [t0, t1]; see :func:`daeclear.load`."""
+def read_file(path: str | os.PathLike[str], t0: float | None = None, t1: float | None = None, *,
+              within: bool = True) -> dict[str, Any]:
+    """The `Result` keywords of the result file at ``path``, of the window [t0, t1]; see :func:`daeclear.load`.
+    ``within``: a window that misses the run's output times is an error (it would read nothing)."""
     import h5py
 
     path = Path(path)
@@ -57,7 +59,19 @@ def read_file(path: str | os.PathLike[str], t0: float | None = None, t1: float |
                 f"'{path}' is a daeclear result of format version {int(version)}; this daeclear reads "
                 f"versions up to {FORMAT_VERSION}. Upgrade daeclear to read it."
             )
-        return _read(_Reader(f, path, time_window(t0, t1)))
+        window = time_window(t0, t1)
+        if within and (t0 is not None or t1 is not None) and "t" in f and f["t"].shape[0]:
+            first, last = float(f["t"][0]), float(f["t"][-1])
+            if window[0] > last or window[1] < first:
+                raise SceneError(f"load('{path}'): t0={t0!r}, t1={t1!r} s, must overlap the run's output times "
+                                 f"[{first:g}, {last:g}] s (the window would read no point).")
+        try:
+            return _read(_Reader(f, path, window))
+        except DaeclearError:
+            raise
+        except (OSError, RuntimeError, KeyError, ValueError) as exc:  # damaged metadata: named, not raw
+            raise DaeclearError(f"'{path}' is a damaged daeclear result ({type(exc).__name__}: "
+                                f"{str(exc).splitlines()[0] if str(exc) else 'unreadable'}).") from None
 
 
 def read_dataset(path: str | os.PathLike[str], name: str) -> np.ndarray:
@@ -97,7 +111,11 @@ class _Reader:
     def array(self, name: str, rows: slice | None = None) -> np.ndarray:
         if name not in self.f:
             raise self._missing(f"dataset '/{name}'")
-        return self.f[name][()] if rows is None else self.f[name][rows]
+        try:
+            return self.f[name][()] if rows is None else self.f[name][rows]
+        except (OSError, RuntimeError) as exc:  # a failed checksum (Fletcher-32) or a damaged chunk index
+            raise DaeclearError(f"'{self.path}' is a damaged daeclear result: dataset '/{name}' cannot be read "
+                                f"({str(exc).splitlines()[0]}).") from None
 
     def strings(self, name: str, rows: slice | None = None) -> list[str]:
         if name not in self.f:

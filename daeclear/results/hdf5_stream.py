@@ -101,8 +101,12 @@ class ResultWriter:
     @staticmethod
     def _grow(group: h5py.Group, name: str, dtype: Any, rest: tuple[int, ...] = (),
               compress: bool = False) -> h5py.Dataset:
+        import h5py
+
         rows = _STREAM_ROWS if rest else 4 * _STREAM_ROWS
-        extra = {"compression": "gzip", "compression_opts": 1, "shuffle": True} if compress else {}
+        extra: dict[str, Any] = {"compression": "gzip", "compression_opts": 1, "shuffle": True} if compress else {}
+        if h5py.check_string_dtype(np.dtype(dtype)) is None:  # a checksum per chunk (not on strings: HDF5 cannot)
+            extra["fletcher32"] = True
         return group.create_dataset(name, shape=(0, *rest), maxshape=(None, *rest), dtype=dtype,
                                     chunks=(rows, *rest), **extra)
 
@@ -127,17 +131,25 @@ class ResultWriter:
         and steps; written whole (a Ctrl-C meanwhile is raised afterwards) and flushed."""
         from .outputs import deferred_sigint
 
+        from .outputs import check_space, disk_full, is_disk_full
+
         f = self._f
         t_arr = np.asarray(t, dtype=np.float64)
         self._touched = []
+        size = sum(np.asarray(a).nbytes for a in (t_arr, y if y is not None else (), yp if yp is not None else (),
+                                                   step_t, step_h, step_order, *(channels or {}).values()))
+        # room for this append and the file's completion, or nothing is written (the file stays whole)
+        check_space(self.path, size + 200 * (len(events) + len(segments)), "stream_to")
         with deferred_sigint():
             try:
                 self._append(f, t_arr, y, yp, channels, events, segments, step_t, step_h, step_order)
-            except BaseException:  # e.g. MemoryError: every dataset back to its length before, then go on
+                f.flush()
+            except BaseException as exc:  # e.g. MemoryError: every dataset back to its length before, then go on
                 for dataset, n in reversed(self._touched):
                     dataset.resize(n, axis=0)
+                if is_disk_full(exc):
+                    raise disk_full(self.path, "stream_to", exc) from None
                 raise
-            f.flush()
 
     def _append(self, f: h5py.File, t_arr: NDArray[np.float64], y: Any, yp: Any, channels: Any, events: Any,
                 segments: Any, step_t: Any, step_h: Any, step_order: Any) -> None:
@@ -198,4 +210,7 @@ class ResultWriter:
         try:
             self._outcome(False, -1, message)
         finally:
-            self._f.close()
+            try:
+                self._f.close()
+            except (OSError, RuntimeError):  # the disk is full: the file keeps its last complete append
+                pass

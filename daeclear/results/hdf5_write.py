@@ -39,7 +39,10 @@ bool and homogeneous list becomes an attribute (a dataset when longer than
 lossless source `load` reads. Arrays of more than 16384 values that compress
 cheaply (integers, bools, mostly-zero floats such as contact forces) are stored
 chunked with shuffle + gzip level 1, which any HDF5 tool reads; other float
-arrays stay contiguous and uncompressed (gzip would save ~20% at ~8x the time).
+arrays are chunked and uncompressed (gzip would save ~20% at ~8x the time). Every
+non-empty numeric dataset carries HDF5's Fletcher-32 checksum per chunk (strings
+and JSON cannot: HDF5 filters skip variable-length data); `load` refuses a dataset
+whose checksum fails, naming it.
 """
 
 from __future__ import annotations
@@ -82,10 +85,13 @@ def _compress(data: np.ndarray) -> bool:
 
 
 def _dataset(group: h5py.Group, name: str, data: np.ndarray) -> h5py.Dataset:
+    """A numeric dataset with a Fletcher-32 checksum per chunk (`load` refuses a damaged one by name)."""
+    if not data.size:  # HDF5 cannot chunk an empty array: nothing to check either
+        return group.create_dataset(name, data=data)
     if _compress(data):
         return group.create_dataset(name, data=data, chunks=True, compression="gzip",
-                                    compression_opts=1, shuffle=True)
-    return group.create_dataset(name, data=data)
+                                    compression_opts=1, shuffle=True, fletcher32=True)
+    return group.create_dataset(name, data=data, chunks=True, fletcher32=True)
 
 
 def string_dataset(group: h5py.Group, name: str, values: Sequence[str]) -> h5py.Dataset:
@@ -183,12 +189,19 @@ def save_result(r: Result, path: str | os.PathLike[str]) -> Path:
     """Write ``r`` to an HDF5 file, atomically: what :meth:`Result.save` does (see its docstring)."""
     import h5py
 
-    from .outputs import atomic_file, check_file, deferred_sigint
+    from .outputs import atomic_file, check_file, check_space, deferred_sigint, disk_full, is_disk_full
 
     path = check_file(path, "Result.save(path)")  # the one output-place rule (daeclear.results.outputs)
+    size = sum(np.asarray(a).nbytes for a in (r.t, r.y, r.yp, *r.channels.values()))
+    check_space(path, size + 200 * len(r.events) * (1 + r.n_states), "Result.save(path)")  # before writing
     # a Ctrl-C during the write arrives once the file is complete (and renamed into place)
-    with deferred_sigint(), atomic_file(path) as tmp, h5py.File(tmp, "x") as f:
-        _write(f, r)
+    try:
+        with deferred_sigint(), atomic_file(path) as tmp, h5py.File(tmp, "x") as f:
+            _write(f, r)
+    except (OSError, RuntimeError) as exc:  # a full disk meanwhile: any file at path is left as it was
+        if is_disk_full(exc):
+            raise disk_full(path, "Result.save(path)", exc) from None
+        raise
     return path
 
 

@@ -14,7 +14,9 @@ save of a partial result is delivered after the file is complete (and renamed in
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import shutil
 import signal
 import tempfile
 import threading
@@ -23,7 +25,40 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from types import FrameType
 
-from ..errors import OutputDirectoryMissing, OutputError
+from ..errors import DiskFull, OutputDirectoryMissing, OutputError
+
+#: Bytes a write leaves free beyond its own data: the HDF5 metadata flushed with each append and when
+#: a file is closed (its outcome, statistics and warnings), so that a file stopped for want of space
+#: can still be completed and read back.
+SPACE_MARGIN = 1 << 20
+_FULL_ERRNOS = (errno.ENOSPC, errno.EDQUOT)
+
+
+def check_space(path: str | os.PathLike[str], n_bytes: int, what: str) -> None:
+    """Raise :class:`DiskFull` when the file system holding ``path`` has less than ``n_bytes`` +
+    :data:`SPACE_MARGIN` free: checked before each write, so the write never starts half-way."""
+    p = Path(path)
+    try:
+        free = shutil.disk_usage(p.parent if not p.is_dir() else p).free
+    except OSError:  # cannot tell: the write itself will say
+        return
+    if free < n_bytes + SPACE_MARGIN:
+        raise DiskFull(f"{what} '{p}': no space left on the disk ({free / 1e6:.3g} MB free, about "
+                       f"{(n_bytes + SPACE_MARGIN) / 1e6:.3g} MB needed to write the next part).")
+
+
+def is_disk_full(exc: BaseException) -> bool:
+    """Whether ``exc`` is a write that failed for want of space (ENOSPC, EDQUOT; HDF5 says so in text)."""
+    if isinstance(exc, DiskFull) or (isinstance(exc, OSError) and exc.errno in _FULL_ERRNOS):
+        return True
+    text = str(exc)
+    return "No space left on device" in text or "Disk quota exceeded" in text or "errno = 28" in text
+
+
+def disk_full(path: str | os.PathLike[str], what: str, exc: BaseException) -> DiskFull:
+    """The one message of a write stopped by a full disk (or quota), naming the file."""
+    return DiskFull(f"{what} '{Path(path)}': no space left on the disk ({type(exc).__name__}: "
+                    f"{str(exc).splitlines()[0][:200]}).")
 
 
 def _probe(directory: Path, option: str, path: Path) -> None:
@@ -204,8 +239,10 @@ def atomic_file(path: str | os.PathLike[str], *, keep_suffix: bool = False) -> I
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
         os.replace(tmp, p)
-    except BaseException:
+    except BaseException as exc:
         tmp.unlink(missing_ok=True)
+        if not isinstance(exc, DiskFull) and is_disk_full(exc):  # named by the file meant, not the temporary one
+            raise disk_full(p, "writing", exc) from None
         raise
 
 

@@ -624,9 +624,9 @@ def load(path: str | os.PathLike[str], t0: float | None = None, t1: float | None
     FileNotFoundError
         If `path` does not exist.
     DaeclearError
-        If the file is not HDF5, not a daeclear result, written by a newer
-        daeclear, or lacks an item of the layout; the message names the file
-        and what is missing.
+        If the file is not HDF5, not a daeclear result, written by a newer daeclear, or lacks an
+        item of the layout (the message names the file and what is missing); SceneError if the
+        window [t0, t1] misses the run's output times.
     """
     return Result(**read_file(path, t0, t1))
 
@@ -640,7 +640,7 @@ def load_times(path: str | os.PathLike[str], of: str = "points") -> NDArray[np.f
     names = {"points": "t", "events": "events/t", "steps": "steps/t"}
     if of not in names:
         raise ValueError(f"load_times: of={of!r}, must be one of {', '.join(names)}.")
-    load(path, math.inf, math.inf)  # the file's checks (format, version, items), reading no rows
+    read_file(path, math.inf, math.inf, within=False)  # the file's checks (format, version, items), no rows
     return read_dataset(path, names[of])
 
 

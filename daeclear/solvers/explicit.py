@@ -90,6 +90,7 @@ from __future__ import annotations
 import math
 import os
 import time
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -99,12 +100,13 @@ from ..assembly.assemble import DAEModel, assemble
 from .. import options
 from ..errors import Interrupted, SceneError, SolveError
 from .recorder import Recorder
-from .tolerances import tolerance_vector
+from .tolerances import atol_record, tolerance_vector
 from ..results.result import Result
 from ..model.scene import Scene
 from .ode_crossings import candidate, locate
 from .ode_evaluators import FIXED_CHUNK, FX_CHUNK, FX_ERR, FX_MAXSTEPS, FX_TSTOP, evaluator
 from .ode_model import ode_spec
+from . import physics
 from .ode_run import (FIXED_STEP_METHODS, IMPLICIT_METHODS, METHOD_NAMES, SCIPY_METHODS, TINY_STEP_COUNT, TINY_STEP_REL,
                       Run)
 
@@ -382,7 +384,7 @@ def integrate(
     method: str,
     t_eval: ArrayLike | None = None,
     rtol: float = 1e-6,
-    atol: float | ArrayLike | None = None,
+    atol: float | Mapping[str, float] | ArrayLike | None = None,
     formulation: str | None = None,
     backend: str = "auto",
     max_step: float = 0.0,
@@ -399,6 +401,7 @@ def integrate(
     keep_data: bool = True,
     t0: float = 0.0,
     y0: ArrayLike | None = None,
+    max_output_points: int | None = options.MAX_OUTPUT_POINTS,
 ) -> Result:
     """Integrate with a non-IDA method; the arguments are those of :func:`daeclear.simulate`.
 
@@ -443,18 +446,23 @@ def integrate(
         raise SceneError(f"simulate: formulation={model.formulation!r} is integrated by IDA only; method={name!r} "
                          "integrates the chapter's index-1 formulation (formulation='index1').")
     given = None if y0 is None else options.state(y0, model.n_states)
+    options.output_size(out, options.max_output_points(max_output_points), t_eval_step=t_eval_step,
+                        step=step if out.times is None and store_steps else None, start=t0, end=t_end,
+                        n_states=model.n_states, n_channels=len(model.channel_names))  # before the grid is built
     from_state = given is not None
     model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
     eval_times = None if out.times is None else out.times.values()  # checked by options.output
     n = model.n_q
-    atol_x = tolerance_vector(model, rtol, atol)[:2 * n]
+    atol_x = tolerance_vector(model, rtol, atol, newton=False)[:2 * n]
     ev = evaluator(model, backend)
     if given is not None:  # q and v as given (index-1: no projection), multipliers recomputed at t0
-        y0, _ = model.consistent_state(t0, given)
+        y0, yp0 = model.consistent_state(t0, given)
+        if not allow_penetration:  # held to the declared start's limit
+            physics.check_start_penetration(model, y0, yp0, given=True)
     else:
         y0, _ = model.initial_state(start=start, allow_penetration=allow_penetration)
     x0 = np.array(y0[:2 * n])
-    sim_params = {"method": name, "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
+    sim_params = {"method": name, "rtol": rtol, "atol": atol_record(atol),
                   "max_step": max_step, "t_end": t_end, "backend": ev.backend, "step": step}
     if from_state:
         sim_params["start"] = "state"

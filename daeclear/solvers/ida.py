@@ -13,9 +13,9 @@ from __future__ import annotations
 import logging
 import os
 import time
+from collections.abc import Mapping
 from typing import Any
 
-import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import options as opts
@@ -24,7 +24,7 @@ from ..assembly.assemble import DAEModel, assemble
 from ..engine.ida_session import open_session
 from .ida_loop import SegmentLoop
 from .recorder import Recorder
-from .tolerances import tolerance_vector
+from .tolerances import atol_record, tolerance_vector
 from ..results.result import Result
 from ..model.scene import Scene
 from ..solver_options import UNSET, SolverOptions
@@ -73,7 +73,7 @@ def simulate(
     t_eval: ArrayLike | None = None,
     t_eval_step: float | None = None,
     rtol: float = UNSET,
-    atol: float | ArrayLike | None = UNSET,
+    atol: float | Mapping[str, float] | ArrayLike | None = UNSET,
     method: str = UNSET,
     formulation: str | None = UNSET,
     backend: str = UNSET,
@@ -89,6 +89,7 @@ def simulate(
     allow_penetration: bool = UNSET,
     stream_to: str | os.PathLike[str] | None = None,
     keep_data: bool = True,
+    max_output_points: int | None = opts.MAX_OUTPUT_POINTS,
 ) -> Result:
     """Integrate a scene (or an assembled model) from ``t0`` (0 by default) to ``t_end``.
 
@@ -126,9 +127,15 @@ def simulate(
         (a long run never holds the whole grid). Give this or ``t_eval``, not both.
     rtol : float
         Relative tolerance (1e-6; the chapter's "integration tolerance").
-    atol : float, array or None
-        Absolute tolerance of positions and velocities (default ``1e-3 * rtol``) or one
-        value per state. Multipliers are always kept out of the error test.
+    atol : float, mapping, array or None
+        Absolute tolerance of positions and velocities. None: per quantity from the mechanism's
+        scales (:mod:`daeclear.solvers.tolerances`; on the chapter's slider-crank ``1e-3 * rtol``
+        in m, rad and m/s, ``5e-3 * rtol`` in rad/s). A number: every position and velocity. A
+        mapping by quantity, e.g. ``{"q": 1e-9, "v": 1e-6}`` or ``{"position": ..., "angle": ...,
+        "velocity": ..., "angular_velocity": ...}`` (the others keep their defaults). An array:
+        ``2 n_q`` values (positions, then velocities) or one per state. Values below the
+        round-off of their quantity are raised to it, with a warning. Multipliers are always kept
+        out of the error test.
     method : {"ida", "RK45", "DOP853", "Radau", "BDF", "LSODA", "rk4", "euler"}
         Integrator (case-insensitive). "ida": SUNDIALS IDA on the DAE. The others integrate the
         same model as an ODE in (q, v) (index-1 formulation only) with the same contact events
@@ -168,14 +175,15 @@ def simulate(
         :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES`, reduced below).
         The python backend and the other methods ignore it. Reported in ``result.stats``.
     start : {"ideal", "declared"}
-        How the run starts without ``y0`` (ignored with ``y0``, as is ``allow_penetration``).
+        How the run starts without ``y0`` (ignored with ``y0``).
         "ideal" (the chapter's, section 4.4): every clearance joint centred
         and every position and velocity assembled on the mechanism whose clearance joints are
         ideal, from the declared state as a guess; "declared": the bodies' declared positions and
         velocities, corrected only for the scene's ideal joints.
     allow_penetration : bool
         Start "declared" even with a contact pair deeper in its wall than
-        :data:`daeclear.solvers.physics.START_PENETRATION_FRACTION` of the clearance (refused otherwise).
+        :data:`daeclear.solvers.physics.START_PENETRATION_FRACTION` of the clearance, or from a ``y0``
+        deeper than :data:`~daeclear.solvers.physics.GIVEN_PENETRATION_FRACTION` clearances (refused otherwise).
 
     stream_to : str, path or None
         Write the result to this HDF5 file while the run goes on (the layout of
@@ -187,6 +195,10 @@ def simulate(
         ``daeclear.load(stream_to)``), or (False) a Result of the outcome alone (success, message,
         statistics, warnings; no time series, events or segments), so that not even the end of a
         long run holds its data in memory.
+    max_output_points : int or None
+        The most output points the run may report (:data:`daeclear.options.MAX_OUTPUT_POINTS`, 1e6,
+        about 1 GB for the chapter's slider-crank); more (``t_eval``, ``t_eval_step``, or a fixed
+        ``step`` without them) is refused before the run with the estimated size. None: no cap.
 
     Returns
     -------
@@ -201,6 +213,9 @@ def simulate(
         The initial positions cannot be assembled, the constraints are redundant (the
         message names the joints and drivers), or a declared start is in deep penetration.
     """
+    if not isinstance(scene, (Scene, DAEModel)):  # e.g. a mechanism's name: say what is wanted
+        opts.fail("simulate", "scene", scene, "a daeclear.Scene or an assembled model, e.g. "
+                  "dc.mechanisms.slider_crank('revolute') (a mechanism's name is not a scene)")
     if options is not None and not isinstance(options, SolverOptions):
         opts.fail("simulate", "options", options, "None or a daeclear.SolverOptions")
     settings = (DEFAULTS if options is None else options).merged(
@@ -215,8 +230,10 @@ def simulate(
         t_eval=t_eval, backend=settings.backend, on_failure=on_failure, store_steps=store_steps, progress=progress,
         track_work=settings.track_work)
     t0 = float(t0)  # checked by opts.run
+    opts.step_within(step, t0, t_end)
     out = opts.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data,
                       start=t0)
+    limit = opts.max_output_points(max_output_points)
     if y0 is not None:  # checked before any work (a Scene's length: once it is assembled)
         y0 = opts.state(y0, scene.n_states if isinstance(scene, DAEModel) else None)
     from .explicit import integrate  # the non-IDA methods
@@ -226,7 +243,8 @@ def simulate(
                          backend=backend, max_step=max_step, max_steps=max_steps, step=step,
                          store_steps=store_steps, on_failure=on_failure, progress=progress,
                          track_work=track_work, start=start, t_eval_step=t_eval_step, stream_to=out.stream_to,
-                         keep_data=out.keep_data, allow_penetration=allow_penetration, t0=t0, y0=y0)
+                         keep_data=out.keep_data, allow_penetration=allow_penetration, t0=t0, y0=y0,
+                         max_output_points=limit)
 
     setup_start = time.perf_counter()
     if formulation is None:
@@ -234,6 +252,8 @@ def simulate(
     model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation, track_work=track_work)
     if y0 is not None:
         y0 = opts.state(y0, model.n_states)
+    opts.output_size(out, limit, t_eval_step=t_eval_step, step=None, start=t0, end=t_end, n_states=model.n_states,
+                     n_channels=len(model.channel_names))  # before the session: nothing compiled or run
     from_state = y0 is not None
     model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
     session, y0, yp0 = _start_session(model, t0, y0, rtol=rtol, atol=atol, backend=backend, max_step=max_step,
@@ -241,7 +261,7 @@ def simulate(
                                       allow_penetration=allow_penetration)
     setup_time = time.perf_counter() - setup_start
     sim_params = {"method": method, "start": "state" if from_state else start,
-                  "rtol": rtol, "atol": None if atol is None else np.ravel(atol).tolist(),
+                  "rtol": rtol, "atol": atol_record(atol),
                   "max_step": max_step, "t_end": t_end, "backend": session.backend}
     if t0 != 0.0:
         sim_params["t0"] = t0
@@ -267,6 +287,8 @@ def _start_session(model: DAEModel, t0: float, y0: NDArray | None, *, rtol: floa
             y0, yp0 = model.initial_state(session=session, start=start, allow_penetration=allow_penetration)
         else:  # a given state: q and v kept (GGL: projected), multipliers and derivatives recomputed at t0
             y0, yp0 = model.consistent_state(t0, y0, session=session, project=True)
+            if not allow_penetration:  # held to the declared start's limit
+                physics.check_start_penetration(model, y0, yp0, session, given=True)
     except BaseException:
         session.close()
         raise

@@ -71,8 +71,10 @@ class SegmentLoop:
             self.i_eval = 1
         self.events, self.segments = rec.events, rec.segments
         self.t, self.y, self.yp, self.y0 = t0, y, yp, y0
+        self.t_start = t0
         self.seg_start = t0  # nan once the last segment is closed
         self.success, self.status, self.message = True, 0, "end of the time span reached"
+        self.failure = ""  # a failure's when, where and why, without the advice
         self.n_restarts = 0
         self.interrupted = False
         self.c_layout = False  # the compiled loop makes the points consistent itself
@@ -139,7 +141,9 @@ class SegmentLoop:
             if adv.status == "error":
                 self.close_segment()
                 self.success, self.status = False, -1
-                self.message = _failure_message(self.model, adv, self.modes)
+                self.failure, advice = _failure_message(
+                    self.model, adv, self.modes, steps_needed(self.session.max_steps, self.t_start, adv.t, self.t_end))
+                self.message = f"{self.failure} {advice}"
                 return
             if adv.status == "tstop" or self.t >= self.t_end:
                 self.close_segment()
@@ -293,10 +297,11 @@ class SegmentLoop:
         t, message = self.t, self.message
         deep = [w for w in found if w["kind"] == "penetration" and w["t"] <= t]
         if not self.success and not self.interrupted and deep:  # the advice must fit the cause: not a tolerance problem
-            w = deep[0]
-            message += (f" Before it, '{w['where']}' penetrated {w['value']:.3g} m at t={w['t']:.6g} s, more than "
-                        f"its limit {w['limit']:.3g} m: the contact carries more than the joint can (friction, speed "
-                        "or load); tolerances will not fix that.")
+            w = deep[0]  # the solver's advice is left out: it would not help
+            message = self.failure + (
+                f" Before it, '{w['where']}' penetrated {w['value']:.3g} m at t={w['t']:.6g} s, more than "
+                f"its limit {w['limit']:.3g} m: the contact carries more than the joint can (friction, speed "
+                "or load); tolerances will not fix that.")
         result = self.rec.finish(stats=stats, success=self.success, status=self.status, message=message,
                                  warnings=found)
         if self.interrupted or self.rec.interrupted:
@@ -375,17 +380,26 @@ def _restart_state(model: DAEModel, session: Any, t: float, y: NDArray, yp: NDAr
     return projected
 
 
-def _failure_message(model: DAEModel, adv: Any, modes: dict[str, str]) -> str:
-    """Say when, where (contact modes) and why IDA failed, and what to try."""
+def steps_needed(cap: int, t0: float, t: float, t_end: float) -> int:
+    """A step cap that lets a run capped at ``cap`` steps at ``t`` reach ``t_end``: the steps so far in
+    proportion to the time still to go, with a margin of a half, on two significant digits."""
+    estimate = 1.5 * cap * (t_end - t0) / max(t - t0, 1e-300)
+    digits = max(int(math.floor(math.log10(estimate))) - 1, 0)
+    return int(math.ceil(estimate / 10 ** digits) * 10 ** digits)
+
+
+def _failure_message(model: DAEModel, adv: Any, modes: dict[str, str], max_steps_needed: int) -> tuple[str, str]:
+    """When, where (contact modes) and why IDA failed; and what to try (each advice made the failing
+    case of a test finish: tests/test_tolerances.py)."""
     in_contact = [pair for pair, mode in modes.items() if mode == "contact"]
     where = f" with {', '.join(repr(p) for p in in_contact)} in contact" if in_contact else ""
     flag = f" ({adv.flag_name})" if adv.flag_name else ""
-    detail = f": {adv.message}" if adv.message else ""
-    advice = "Try a smaller max_step, a tighter rtol" + (", or formulation='ggl'." if model.formulation != "ggl"
-                                                         else ".")
+    detail = f": {adv.message.rstrip('.')}" if adv.message else ""
+    other = "index1" if model.formulation == "ggl" else "ggl"
+    advice = f"Try formulation='{other}'."
     if adv.flag_name == "DC_MAX_STEPS":  # not an accuracy problem: the run needs more steps
-        advice = ("The run needs more steps than max_steps allows: raise max_steps (daeclear run: --max-steps) "
-                  "in proportion to the time still to go.")
+        advice = (f"The run needs more steps than max_steps allows: raise max_steps to about {max_steps_needed} "
+                  f"(daeclear run: --max-steps {max_steps_needed}).")
     # sticking under plain Coulomb: index-1 chatters until the stall guard stops it, GGL's Newton
     # iteration fails to converge (or its error test fails) at the sticking point
     elif adv.flag_name in STICKING_FLAGS and in_contact and any(
@@ -393,4 +407,4 @@ def _failure_message(model: DAEModel, adv: Any, modes: dict[str, str]) -> str:
         advice = ("The friction law is discontinuous at zero sliding speed (plain Coulomb) and the "
                   "contact is sticking: use the modified Coulomb law (friction=<coefficient> or "
                   "daeclear.contact.ModifiedCoulomb), which is continuous.")
-    return f"IDA failed at t={adv.t:.6g} s{flag}{where}{detail}. {advice}"
+    return f"IDA failed at t={adv.t:.6g} s{flag}{where}{detail}.", advice

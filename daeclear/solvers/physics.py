@@ -43,6 +43,12 @@ INITIAL_PENETRATION_FRACTION = 1e-2
 # smaller of the clearance and the corner radius) is refused before the run unless allowed
 # (``allow_penetration=True``): see check_start_penetration and docs/reliability.md.
 START_PENETRATION_FRACTION = 0.1
+# A state given as simulate()'s ``y0`` may be a computed one in contact (a restart, a twin run): the
+# chapter's runs at 0.01-0.02 mm clearance reach 20-40 % of it. Refused (unless allowed) only beyond
+# this many clearances (translational: of the smaller of clearance and corner radius), ten times what
+# the physics check already calls non-physical (PENETRATION_FRACTION): a state no run reaches, e.g.
+# ``y0=zeros`` with the journal 0.17 m (340 clearances) from its bearing.
+GIVEN_PENETRATION_FRACTION = 10.0
 # A clearance joint of a driven mechanism whose two sides move apart at t = 0 faster than this
 # fraction of the fastest body (and at least INITIAL_VELOCITY_FLOOR) starts with velocities
 # inconsistent with the joint: the journal flies across its play and its first impact is an
@@ -160,22 +166,33 @@ def start_penetration_limit(clearance: float, corner: float) -> float:
     return START_PENETRATION_FRACTION * (min(clearance, corner) if corner > 0 else clearance)
 
 
-def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np.float64], session: Any = None) -> None:
+def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np.float64], session: Any = None,
+                            *, given: bool = False) -> None:
     """Refuse a start with a contact pair deeper in its wall than :func:`start_penetration_limit`.
 
     Such a start is a declaration error (a journal declared inside the bearing wall): its first
     contact force is the law's force at that depth, e.g. 187 kN (elastic part) for the chapter's
     journal declared 0.2 mm deep, released as an artificial impact. Raises AssemblyError naming
-    the pair, the penetration and the clearance."""
+    the pair, the penetration and the clearance. ``given``: the state is simulate()'s ``y0``, held to
+    the same limit as a declared start."""
     if not model.clearance_joints:
         return
     channels = model.channels(np.zeros(1), np.asarray(y0)[None, :], np.asarray(yp0)[None, :], session=session)
     for joint, clearance, corner in model.clearance_joints:
         limit = start_penetration_limit(clearance, corner)
+        if given:
+            limit *= GIVEN_PENETRATION_FRACTION / START_PENETRATION_FRACTION
         basis = "corner radius" if 0 < corner < clearance else "clearance"
         for pair in joint_pairs(model, joint):
             depth = float(channels.get(f"{pair}.penetration", np.zeros(1))[0])
             if depth > limit:
+                if given:
+                    raise AssemblyError(
+                        f"simulate: y0 puts clearance joint '{joint}' in deep penetration: '{pair}' is {depth:.3g} m "
+                        f"inside the wall, {depth / clearance:.0%} of the clearance {clearance:.3g} m (a given state "
+                        f"may penetrate at most {GIVEN_PENETRATION_FRACTION:g} times the {basis}, {limit:.3g} m, "
+                        "deeper than any run reaches); give a state from a run of this model (a row of result.y), "
+                        "or pass allow_penetration=True to start there anyway.")
                 raise AssemblyError(
                     f"scene '{model.scene_name}': clearance joint '{joint}' starts in deep penetration: '{pair}' "
                     f"is {depth:.3g} m inside the wall at t=0, {depth / clearance:.0%} of the clearance "

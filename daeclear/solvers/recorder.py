@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import physics
+from ..errors import OutputError
 from ..results.events import EventRows, flatten
 from ..results.result import ContactEvent, Result, ResultWriter, load
 
@@ -147,6 +148,8 @@ class Recorder:
         if self.writer is not None:
             try:
                 self.flush()
+            except OutputError:  # no room for the last events: the file keeps what it holds
+                pass
             finally:
                 self.writer.abort(f"stopped by {type(error).__name__}: {error}")
 

@@ -1,21 +1,44 @@
-"""The absolute-tolerance rule shared by every method of :func:`daeclear.simulate`.
+"""Absolute tolerances per state, from the mechanism's own scales: the rule every method shares.
 
 IDA (``solvers.ida``) and the explicit and scipy methods (``solvers.explicit``) both turn the
-user's ``atol`` into one value per state here, so that neither solver module imports the other
-for it.
+user's ``atol`` into one value per state here.
+
+Each state is one of four quantities (a body's ``x``/``y``, ``phi``, ``vx``/``vy``, ``omega``), and
+each quantity's absolute tolerance is ``rtol`` times a fraction of its scale (docs/engine.md,
+"Tolerances"), with ``L`` the mechanism's size and ``W`` its angular rate (:func:`scales`):
+
+- ``position``: ``rtol * l``, ``l = POSITION_FRACTION * L`` (1 mm on the chapter's 0.17 m
+  slider-crank), or twice the smallest clearance where that is smaller;
+- ``angle``: ``rtol * ANGLE_FRACTION`` (1e-3 rad);
+- ``velocity``: ``rtol * VELOCITY_FRACTION * L * W`` and ``angular_velocity``:
+  ``rtol * VELOCITY_FRACTION * W``.
+
+On the chapter's scenes these are the 1e-3 * rtol of earlier releases for positions, angles and
+velocities (every test of accuracy was measured with them); elsewhere they follow the mechanism.
+
+No absolute tolerance of an IDA run is ever below the round-off of its quantity, ``ROUNDOFF_FACTOR * eps`` times
+its scale (``L``, 1 rad, ``L W``, ``W``): GGL puts the positions and velocities on the constraint
+manifold at every Newton iteration, so their corrections never fall below the round-off of the
+constraint equations; a weight finer than that cannot be met, and IDA's Newton iteration then
+fails at every step size (the collapse of GGL at tight rtol, docs/engine.md).
+
+Multipliers (and the work state of ``track_work``) are always out of the error test.
 """
 
 from __future__ import annotations
 
-import functools
 import math
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..assembly.assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel
-from ..errors import SceneError
+from ..errors import DaeclearWarning
+from ..options import ATOL_QUANTITIES as QUANTITIES, atol_by_quantity, fail
 
 # Multipliers are kept out of IDA's error test by a huge absolute tolerance (scikit-sundae has
 # no IDASetSuppressAlg): atol = MULTIPLIER_ATOL_FACTOR * rtol, see docs/performance.md.
@@ -23,43 +46,156 @@ MULTIPLIER_ATOL_FACTOR = 1e12
 # ... and never below this floor (N or N m): at rtol 1e-11, 1e12 * rtol = 10 N would put impact
 # multipliers of 1e3..1e5 N back into the error test, which breaks the index-2 GGL runs.
 MULTIPLIER_ATOL_FLOOR = 1e4
-# Default absolute tolerance of positions and velocities, relative to rtol: contact runs resolve
-# micrometre penetrations, so positions need an absolute floor well below the clearance.
-DEFAULT_ATOL_FACTOR = 1e-3
+# The round-off floor of an absolute tolerance, in units of eps times the quantity's scale. Measured
+# on the chapter's scenes (bench_convergence.py): GGL's Newton iteration fails at every step size
+# with a velocity atol of 1e-13 m/s (5 eps L W) and runs with 1e-12 (50 eps L W); positions need
+# 1e-14 m (260 eps L) in the translational clearance joint; 300 keeps a margin for both.
+ROUNDOFF_FACTOR = 300.0
+# The explicit and scipy methods integrate the index-1 ODE: no Newton on constraint equations, but
+# their error estimates still carry the round-off of each component (DOP853 at rtol 1e-10 on the
+# chapter's scene: an onset's approach speed 1.5e-4 off with a velocity atol of 9e-16 m/s, 1e-5 with
+# 1e-13 m/s). 10 eps times the scale keeps their error test above it.
+ODE_ROUNDOFF_FACTOR = 10.0
+EPS = float(np.finfo(float).eps)
+# The default absolute tolerances as fractions of each quantity's scale (per unit of rtol): see above.
+POSITION_FRACTION = 6e-3
+CLEARANCE_SPAN = 2.0
+ANGLE_FRACTION = 1e-3
+VELOCITY_FRACTION = 1e-5
+
+UNITS = {"position": "m", "angle": "rad", "velocity": "m/s", "angular_velocity": "rad/s"}
 
 
-def positive(name: str, value: Any, unit: str, allow_zero: bool = False) -> float:
-    """``value`` as a float if it is a finite number > 0 (>= 0 with ``allow_zero``), else a
-    SceneError naming ``name``, the value and the rule."""
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-    ok = ok and (value >= 0 if allow_zero else value > 0)
-    if not ok:
-        rule = ">= 0" if allow_zero else "> 0"
-        raise SceneError(f"simulate: {name}={value!r} {unit}, must be a finite number {rule}.")
-    return float(value)
+@dataclass(frozen=True)
+class Scales:
+    """The scales of a mechanism that its tolerances are made of.
+
+    length: its size L (m); resolution: the length a run must resolve (m: POSITION_FRACTION * L, or
+    twice the smallest clearance); rate: its angular rate W (rad/s).
+    """
+
+    length: float
+    resolution: float
+    rate: float
+
+    def default_atol(self, rtol: float, *, newton: bool = True) -> dict[str, float]:
+        """The default absolute tolerance of each quantity at ``rtol`` (never below round-off)."""
+        raw = {"position": rtol * self.resolution, "angle": rtol * ANGLE_FRACTION,
+               "velocity": rtol * VELOCITY_FRACTION * self.length * self.rate,
+               "angular_velocity": rtol * VELOCITY_FRACTION * self.rate}
+        lowest = self.roundoff(newton)
+        return {q: max(raw[q], lowest[q]) for q in QUANTITIES}
+
+    def roundoff(self, newton: bool = True) -> dict[str, float]:
+        """The smallest absolute tolerance of each quantity that a method's corrections (``newton``:
+        IDA's, on the DAE) or error estimates (the ODE methods') can meet."""
+        unit = (ROUNDOFF_FACTOR if newton else ODE_ROUNDOFF_FACTOR) * EPS
+        return {"position": unit * self.length, "angle": unit, "velocity": unit * self.length * self.rate,
+                "angular_velocity": unit * self.rate}
 
 
-def tolerance_vector(model: DAEModel, rtol: float, atol: float | ArrayLike | None) -> NDArray[np.float64]:
-    """Absolute tolerances per state: q and v from ``atol``; multipliers out of the error test."""
+def scales(model: DAEModel) -> Scales:
+    """The scales of an assembled mechanism, read from its numbers and its declared start.
+
+    L: the largest distance from the origin of a body's centre, of a joint point (body frame) and
+    the largest radius of gyration sqrt(I / m); 1 m if all are 0. W: the largest of the start's
+    angular velocities, its linear velocities over L, the drivers' speeds (a translational driver's
+    over L) and sqrt(|g| / L); 1 rad/s if all are 0.
+    """
+    n = model.n_q
+    q, v = model.q_guess.tolist(), model.v_guess.tolist()
+    values, offset, entries = model.parameter_values.tolist(), 0, {}
+    for name, size in model.parameter_layout:  # one pass: name -> its values
+        entries[name] = values[offset:offset + size]
+        offset += size
+    lengths = [math.hypot(q[i], q[i + 1]) for i in range(0, n, 3)]
+    lengths += [math.hypot(*entries[name]) for name in entries if name.endswith((".s_i", ".s_j"))]
+    lengths += [math.sqrt(entries[f"{body}.inertia"][0] / entries[f"{body}.mass"][0]) for body in model.body_names]
+    length = max([*lengths, 0.0]) or 1.0
+    clearances = [c for _, c, _ in model.clearance_joints]
+    resolution = min([POSITION_FRACTION * length, *(CLEARANCE_SPAN * c for c in clearances)])
+    rates = [abs(v[i + 2]) for i in range(0, n, 3)] + [math.hypot(v[i], v[i + 1]) / length for i in range(0, n, 3)]
+    for driver in model.driver_names:
+        if f"{driver}.speed" in entries:
+            speed = abs(entries[f"{driver}.speed"][0])
+            rates.append(speed / length if f"{driver}.axis" in entries else speed)
+    if "gravity" in entries:
+        rates.append(math.sqrt(math.hypot(*entries["gravity"]) / length))
+    rate = max([*rates, 0.0]) or 1.0
+    return Scales(length=float(length), resolution=float(resolution), rate=float(rate))
+
+
+def state_quantities(model: DAEModel) -> list[str]:
+    """The quantity of each position and velocity state (bodies' x, y, phi, then vx, vy, omega)."""
+    per_body = ("position", "position", "angle")
+    q = [per_body[i % 3] for i in range(model.n_q)]
+    return q + [{"position": "velocity", "angle": "angular_velocity"}[k] for k in q]
+
+
+def tolerance_vector(model: DAEModel, rtol: float, atol: float | Mapping[str, float] | ArrayLike | None,
+                     *, newton: bool = True) -> NDArray[np.float64]:
+    """Absolute tolerances per state from ``atol``; multipliers and work always out of the error test.
+
+    ``atol``: None (the defaults of :class:`Scales`), one number for every position and velocity,
+    a mapping by quantity (missing quantities take their defaults), or an array of ``2 n_q``
+    values (positions, then velocities) or of ``n_states`` (whose multiplier and work entries
+    are not used). Values below the round-off of their quantity are raised to it (with a warning
+    when given): for ``newton`` (IDA, Newton on the DAE) ROUNDOFF_FACTOR eps times the quantity's
+    scale, for the ODE methods ODE_ROUNDOFF_FACTOR eps.
+    """
+    n = 2 * model.n_q
+    vec = np.empty(model.n_states)
+    quantities = state_quantities(model)
+    mine = scales(model)
+    defaults = mine.default_atol(rtol, newton=newton)
     if atol is None:
-        vec = np.full(model.n_states, DEFAULT_ATOL_FACTOR * rtol)
+        vec[:n] = [defaults[k] for k in quantities]
+    elif isinstance(atol, Mapping):
+        given = {**defaults, **atol_by_quantity(atol, where="simulate", field="atol")}
+        vec[:n] = [given[k] for k in quantities]
     elif np.ndim(atol) == 0:
-        vec = np.full(model.n_states, positive("atol", float(atol), ""))  # type: ignore[arg-type]
+        value = float(atol)  # type: ignore[arg-type]
+        if not math.isfinite(value) or value <= 0:
+            fail("simulate", "atol", atol, "a finite number > 0")
+        vec[:n] = value
     else:
-        vec = np.asarray(atol, dtype=float).copy()
-        if vec.shape != (model.n_states,) or not np.all(np.isfinite(vec)) or np.any(vec <= 0):
-            raise SceneError(
-                f"simulate: atol has shape {vec.shape}; give a positive number or {model.n_states} "
-                f"positive values (one per state: {', '.join(model.state_names[:4])}, ...)."
-            )
-        return vec
+        given_vec = np.asarray(atol, dtype=float)  # checked by options.atol but for its length
+        if given_vec.shape not in ((n,), (model.n_states,)) or not np.all(np.isfinite(given_vec)) \
+                or np.any(given_vec[:n] <= 0):
+            fail("simulate", "atol", atol, f"a finite number > 0, a mapping by quantity, or {n} values > 0 "
+                 f"(positions and velocities: {', '.join(model.state_names[:3])}, ...) or {model.n_states} "
+                 "(one per state)", shown=f"array of shape {given_vec.shape}")
+        vec[:n] = given_vec[:n]
+    if atol is not None:
+        _raise_to_roundoff(vec[:n], quantities, mine.roundoff(newton))
     multipliers, work = _out_of_error_test(model.state_kinds)
     vec[multipliers] = max(MULTIPLIER_ATOL_FACTOR * rtol, MULTIPLIER_ATOL_FLOOR)
     vec[work] = 1e30  # a pure quadrature: out of the error test, the solution is unchanged
     return vec
 
 
-@functools.lru_cache(maxsize=16)
+def _raise_to_roundoff(vec: NDArray[np.float64], quantities: list[str], floor: dict[str, float]) -> None:
+    """Raise each given absolute tolerance below its quantity's round-off to it, and say so."""
+    raised = {}
+    for i, quantity in enumerate(quantities):
+        if vec[i] < floor[quantity]:
+            raised[quantity] = floor[quantity]
+            vec[i] = floor[quantity]
+    if raised:
+        parts = ", ".join(f"{q} to {v:.2g} {UNITS[q]}" for q, v in raised.items())
+        warnings.warn(f"simulate: atol below round-off raised ({parts}): Newton's corrections cannot be "
+                      "smaller (docs/engine.md, Tolerances).", DaeclearWarning, stacklevel=4)
+
+
 def _out_of_error_test(kinds: tuple[str, ...]) -> tuple[list[int], list[int]]:
-    """Indices of the multipliers and of the work state (a structure's, kept: a sweep's runs share them)."""
+    """Indices of the multipliers and of the work state."""
     return [i for i, k in enumerate(kinds) if k == KIND_MULTIPLIER], [i for i, k in enumerate(kinds) if k == KIND_WORK]
+
+
+def atol_record(atol: float | Mapping[str, float] | ArrayLike | None) -> Any:
+    """``atol`` as a run's parameters record it (JSON types: None, a number, a mapping or a list)."""
+    if atol is None or isinstance(atol, float):
+        return atol
+    if isinstance(atol, Mapping):
+        return {str(k): float(v) for k, v in atol.items()}
+    return np.ravel(atol).tolist()

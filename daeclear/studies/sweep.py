@@ -281,12 +281,14 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     points += [dict(p) for p in (runs or [])]
     if not points:
         raise SceneError("sweep: no parameter points; give grid= and/or runs=.")
+    first = {**base, **{str(k): _plain_value(str(k), v) for k, v in points[0].items()}}
+    first_scene = build_scene(mechanism, first)  # a bad fixed parameter fails here, before any run
     if channels is None:  # from what the mechanism holds (every point has its bodies)
-        first = {**base, **{str(k): _plain_value(str(k), v) for k, v in points[0].items()}}
-        channels = section_channels(build_scene(mechanism, first))
+        channels = section_channels(first_scene)
     analysis_options = {"channels": [str(c) for c in channels], "revolutions": revolutions, "transient": transient,
                         "per_revolution": per_revolution, "twin": twin, **extra}
     stored = [str(c) for c in (store_channels if store_channels is not None else channels)]
+    _preflight(first_scene, first, {"channels": analysis_options["channels"], "store_channels": stored}, solver)
     file_options = {**{k: _plain_value(k, v) for k, v in analysis_options.items()}, "keep": keep,
                     "store_channels": stored, SOLVER_KEY: solver.to_dict()}
     mech_name = _mechanism_name(mechanism)
@@ -335,6 +337,32 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     out = load_sweep(path) if path.is_file() else SweepResult(path, [], mech_name, file_options)
     out.n_computed, out.n_skipped = n_computed, n_skipped
     return out
+
+
+def _preflight(scene: Any, first: Mapping[str, Any], channels: Mapping[str, Sequence[str]],
+               solver: SolverOptions) -> None:
+    """What every run of a sweep needs, checked on the first point before any run: a crank period (one
+    constant-speed driver: the motion is classified revolution by revolution) and the channels' names.
+    Without it, every run would fail the same way after the whole sweep's work."""
+    from .poincare import crank_period
+    from ..assembly.assemble import assemble
+    from ..options import close_matches, default_formulation, fail
+
+    try:
+        crank_period(scene)
+    except DaeclearError as exc:
+        reason = str(exc).split(", so no crank period")[0].split(": pass period=")[0]
+        raise SceneError(f"sweep: mechanism at the first point {dict(first)!r}: {reason}, so no crank period; a "
+                         "sweep classifies the motion revolution by revolution and needs one constant-speed "
+                         "driver.") from None
+    model = assemble(scene, solver.formulation or default_formulation("ida"))
+    known = set(model.channel_names)
+    for field, names in channels.items():
+        for name in names:
+            if name not in known:
+                hint = close_matches(name, known)
+                fail("sweep", field, name, "channels of the mechanism (checked on the first point)"
+                           + (f"; close matches: {', '.join(hint)}" if hint else ""))
 
 
 def _execute(path: Path, todo: list[dict[str, Any]], executor: cf.Executor | None, max_workers: int | None,
