@@ -444,3 +444,25 @@ at = [1.0, 0.0]
     assert (tmp_path / "loose_pendulum.png").is_file() and (tmp_path / "loose_pendulum.h5").is_file()
     assert "no ideal-mechanism reference in the figure: scene 'loose_pendulum': redundant constraints" \
         in capsys.readouterr().err
+
+
+def test_one_bearing_convention_for_both_routes_to_a_clearance_at_C():
+    """slider_crank("revolute") and slider_crank().with_clearance("C") put the bearing on the same
+    body (the slider, the chapter's: C's body_i), so they run the same mechanism with the same
+    signs of ex/ey (journal centre minus bearing centre); bearing="rod" flips them."""
+    from daeclear.model.mechanisms import STEEL
+
+    library = M.slider_crank("revolute")
+    by_hand = M.slider_crank().with_clearance("C", name="clearance", bearing_radius=10e-3, clearance=0.5e-3,
+                                                material=STEEL)
+    flipped = M.slider_crank("revolute", bearing="rod")
+    assert (library["clearance"].body_i, by_hand["clearance"].body_i, flipped["clearance"].body_i) == (
+        "slider", "slider", "rod")
+    t = np.linspace(0.0, 4e-3, 81)
+    runs = [dc.simulate(scene, 4e-3, t_eval=t, rtol=1e-9) for scene in (library, by_hand, flipped)]
+    assert np.max(np.abs(runs[0]["clearance.ex"])) > 1e-4  # the journal moves in its play
+    for channel in ("clearance.ex", "clearance.ey"):
+        np.testing.assert_allclose(runs[1][channel], runs[0][channel], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(runs[2][channel], -runs[0][channel], rtol=0, atol=2e-6)
+    with pytest.raises(dc.SceneError, match="bearing='crank', must be 'slider' or 'rod'"):
+        M.slider_crank("revolute", bearing="crank")

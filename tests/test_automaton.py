@@ -235,3 +235,28 @@ def test_a_small_event_buffer_is_drained_between_chunks(monkeypatch):
     assert small.events.kind == normal.events.kind and len(normal.events) > 5
     np.testing.assert_array_equal(small.events.t, normal.events.t)
     np.testing.assert_array_equal(small.t, normal.t)
+
+
+@pytest.mark.parametrize("second_rate, gap, expected", [
+    (1.36, 1, [ONSET, NONE, NONE]),  # issue 34: logged onset, separation, onset 1-2 ulps apart while approaching
+    (-0.5, 1, [ONSET, SEPARATION, ONSET]),  # receding: a separation, however soon
+    (1.36, 10**6, [ONSET, SEPARATION, ONSET]),  # later than round-off of t can tell: decided as before
+], ids=["round-off", "receding", "later"])
+def test_a_crossing_at_the_instant_of_an_onset_while_approaching_is_no_separation(c_session, second_rate, gap,
+                                                                                    expected):
+    """A closing joint's gap at the restart after its onset is zero to round-off and may cross zero
+    again one ulp of t later: that downward root, with the pair still approaching, decides nothing
+    (Python and C alike), so the impact is counted once."""
+    t0 = 1.4e-3
+    t1 = t0
+    for _ in range(gap):
+        t1 = float(np.nextafter(t1, 1.0))
+    t2 = float(np.nextafter(t1, 1.0))
+    times, directions, rates = [t0, t1, t2], [1, -1, 1], [1.36, second_rate, 1.36]
+    start = PairState()
+    python = python_run(times, directions, rates, storm=Storm(), min_approach_speed=0.0, state=start)
+    compiled = c_session.automaton_run(times, directions, rates, storm=Storm(), min_approach_speed=0.0,
+                                       contact=False, held=False, latched=0.0)
+    assert [d.kind for d in python] == expected
+    assert compiled == python
+    assert python[-1].contact and python[-1].latched == 1.36

@@ -657,6 +657,16 @@ API_LOADS: list[tuple[str, Callable[[], Any], str, str]] = [
      "no_load_speed", "-300.0"),
     ("motor unknown body", lambda: dc.Motor("m", "gound", "crank", stall_torque=2.0, no_load_speed=300.0),
      "body_i", "'gound'"),
+    # a point of application is a world point or a body-fixed point, never both (issue 34)
+    ("force at and point", lambda: dc.Force("f", "slider", fx=1.0, at=(0.17, 0.0), point=(0.0, 0.01)),
+     "point", "(0.0, 0.01)"),
+    ("force point", lambda: dc.Force("f", "slider", fx=1.0, point=(NAN, 0.0)), "point", "(nan, 0.0)"),
+    ("spring at_j and point_j", lambda: dc.SpringDamper("s", "ground", "slider", at_i=(0.0, 0.0), at_j=(0.17, 0.0),
+                                                        point_j=(0.01, 0.0), stiffness=1.0), "point_j", "(0.01, 0.0)"),
+    ("spring end i missing", lambda: dc.SpringDamper("s", "ground", "slider", point_j=(0.0, 0.0), stiffness=1.0),
+     "at_i=None and point_i", "must give one"),
+    ("revolute at and point_i", lambda: dc.Revolute("E", "crank", "rod", at=(0.05, 0.0), point_i=(0.05, 0.0),
+                                                    point_j=(-0.06, 0.0)), "at=(0.05, 0.0) and point_i", "point_j"),
 ]
 
 

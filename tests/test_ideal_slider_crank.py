@@ -85,3 +85,46 @@ def test_power_balance_from_simulated_channels():
     power = result["drive.moment"] * OMEGA
     err = np.max(np.abs(dEdt - power)[5:-5]) / np.ptp(power)
     assert err < 1e-4
+
+
+def test_joint_channels_match_the_closed_form():
+    """<joint>.angle/.rate (body j relative to body i) and <joint>.displacement/.speed against the
+    closed-form kinematics: crank angle theta = omega t, rod angle beta = asin(-R sin(theta) / L),
+    beta' = -R cos(theta) omega / (L cos(beta)), slider x and x' from slider_kinematics."""
+    period = 2 * np.pi / OMEGA
+    t = np.linspace(0.0, 1.5 * period, 541)
+    scene = dc.mechanisms.slider_crank()
+    result = dc.simulate(scene, 1.5 * period, t_eval=t, rtol=1e-10)
+    theta = OMEGA * t
+    beta = np.arcsin(-R * np.sin(theta) / L)
+    beta_dot = -R * np.cos(theta) * OMEGA / (L * np.cos(beta))
+    angle = {"ground": (0.0 * t, 0.0 * t), "crank": (theta, OMEGA + 0.0 * t), "rod": (beta, beta_dot),
+             "slider": (0.0 * t, 0.0 * t)}
+    for joint in ("A", "B", "C"):
+        (phi_i, w_i), (phi_j, w_j) = angle[scene[joint].body_i], angle[scene[joint].body_j]
+        np.testing.assert_allclose(result[f"{joint}.angle"], phi_j - phi_i, rtol=0, atol=1e-7)
+        np.testing.assert_allclose(result[f"{joint}.rate"], w_j - w_i, rtol=0, atol=1e-7 * OMEGA)
+    assert result["A.angle"][-1] == pytest.approx(3 * np.pi, rel=1e-7)  # not wrapped: counts turns
+    x, vx, _ = slider_kinematics(theta)
+    np.testing.assert_allclose(result["D.displacement"], x, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(result["D.speed"], vx, rtol=0, atol=1e-8 * np.ptp(vx))
+    assert result.units["D.displacement"] == "m" and result.units["C.rate"] == "rad/s"
+
+
+@pytest.mark.parametrize("joint", ["revolute", "translational"])
+def test_joint_channels_of_clearance_joints(joint):
+    """A clearance joint has the same coordinate: the journal body's angle relative to the bearing
+    body's; the slider centre's displacement along the guide, which is the joint's own `.s`."""
+    scene = dc.mechanisms.slider_crank(joint)
+    result = dc.simulate(scene, 2e-3, rtol=1e-8, t_eval=np.linspace(0.0, 2e-3, 41))
+    clearance = scene["clearance"]
+    if joint == "revolute":
+        expected = result[f"{clearance.body_j}.phi"] - result[f"{clearance.body_i}.phi"]
+        np.testing.assert_allclose(result["clearance.angle"], expected, rtol=0, atol=1e-14)
+        rate = result[f"{clearance.body_j}.omega"] - result[f"{clearance.body_i}.omega"]
+        np.testing.assert_allclose(result["clearance.rate"], rate, rtol=0, atol=1e-12)
+    else:
+        np.testing.assert_allclose(result["clearance.displacement"], result["clearance.s"], rtol=0, atol=1e-14)
+        # the guide is the ground along X from the origin, the slider's centre its centre of mass
+        np.testing.assert_allclose(result["clearance.displacement"], result["slider.x"], rtol=0, atol=1e-14)
+        np.testing.assert_allclose(result["clearance.speed"], result["slider.vx"], rtol=0, atol=1e-12)

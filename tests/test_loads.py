@@ -429,3 +429,32 @@ def test_an_expression_function_and_the_numbers_it_reads_from_outside_are_struct
         assert dc.Expression(lambda t, s, p: scaled(t, s, p) + p.T, T=1.0).to_dict()["digest"] != calling
     finally:
         SCALE = 2.0
+
+
+def _pendulum_with_spring(**spring_end) -> dc.Scene:
+    """A link pinned to the ground at its left end (body-fixed joint points), declared off its
+    assembled pose (its centre 0.03 m too high), with a spring from the ground to the link."""
+    scene = dc.Scene("sprung pendulum", gravity=(0.0, -9.81))
+    link = scene.add(dc.Body("link", mass=1.0, inertia=1.0 / 12, position=(0.5, 0.03), angle=0.0))
+    scene.add(dc.Revolute("pin", scene.ground, link, point_i=(0.0, 0.0), point_j=(-0.5, 0.0)))
+    scene.add(dc.SpringDamper("spring", scene.ground, link, at_i=(1.0, 0.5), stiffness=5.0, damping=0.2,
+                              free_length=0.4, **spring_end))
+    return scene
+
+
+def test_a_body_fixed_spring_end_moves_with_its_body_when_the_declared_pose_is_off():
+    """point_j is a point of the link whatever its declared pose: the spring's length is the
+    distance from the ground point to that body point of the assembled (and moving) link at every
+    output; a world point at_j, read in the declared (wrong) pose, is another point of the link."""
+    tip = (0.5, 0.0)  # the link's free end, link coordinates
+    result = dc.simulate(_pendulum_with_spring(point_j=tip), t_end=0.5, rtol=1e-9, atol=1e-10,
+                         t_eval=np.linspace(0.0, 0.5, 51))
+    x, y, phi = result["link.x"], result["link.y"], result["link.phi"]
+    end = np.column_stack([x + np.cos(phi) * tip[0] - np.sin(phi) * tip[1],
+                           y + np.sin(phi) * tip[0] + np.cos(phi) * tip[1]])
+    assert abs(math.hypot(x[0] - 0.5 * math.cos(phi[0]), y[0] - 0.5 * math.sin(phi[0]))) < 1e-12  # pinned
+    assert abs(y[0] - 0.03) > 1e-3  # assembly did move the link off its declared pose
+    np.testing.assert_allclose(result["spring.length"], np.hypot(end[:, 0] - 1.0, end[:, 1] - 0.5), rtol=1e-12)
+    assert np.ptp(phi) > 0.05  # the link swings: the end was followed, not a fixed point
+    world = dc.simulate(_pendulum_with_spring(at_j=(1.0, 0.0)), t_end=1e-3, rtol=1e-9)
+    assert abs(world["spring.length"][0] - result["spring.length"][0]) > 1e-3

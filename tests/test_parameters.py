@@ -167,7 +167,7 @@ def test_translational_readings_change_the_structure_only_with_the_equations():
     assert reference.parameter("clearance.law.stiffness")[0] == pytest.approx(5.98612e9, rel=1e-5)  # (4.27)
     assert reference.parameter("clearance.law.exponent")[0] == 1.5
     moved = dc.assemble(dc.mechanisms.slider_crank(**base, pin_offset=(-0.025, 0.003), slider_mass=0.98))
-    assert moved.parameter("C.s_j").tolist() == pytest.approx([-0.025, 0.003])  # the pin, slider coordinates
+    assert moved.parameter("C.s_i").tolist() == pytest.approx([-0.025, 0.003])  # the pin, slider coordinates
     assert moved.parameter("slider.mass")[0] == 0.98
     linear = dc.assemble(dc.mechanisms.slider_crank(joint="translational", reading="pseudo-corners-linear"))
     assert linear.functions is not reference.functions  # n = 1: the law's linear branch

@@ -30,7 +30,7 @@ def free_mechanism(restitution):
 def test_model_holds_only_what_the_scene_declares():
     frictionless = dc.assemble(dc.mechanisms.slider_crank("revolute"), "index1")
     assert frictionless.summary() == {"bodies": 3, "states": 25, "constraints": 7, "terms": 1, "gaps": 1,
-                                      "channels": 43}
+                                      "channels": 43 + 8}  # + angle and rate (displacement, speed) of 4 joints
     assert dc.assemble(dc.mechanisms.slider_crank("revolute")).summary()["states"] == 25 + 7  # GGL: + mu
     assert frictionless.gap_names == ("clearance",)
     assert "clearance.friction_force" not in frictionless.channel_names

@@ -50,8 +50,9 @@ from ..model.scene import (GROUND, Body, Driver, Revolute, RevoluteClearance, Sc
                            TranslationalClearance)
 from .revolute_joint import CONTACT_BUILDERS
 from .drivers import driver_constraint, driver_load, driver_parameters
+from .joint_coordinates import joint_channels
 from ..model.loads import Load, build_loads, load_parameters
-from .symbolic import AssemblyContext, BodyFrame, Channel, Reference, Term, rotation
+from .symbolic import AssemblyContext, Channel, Reference, Term, body_frames, rotation
 # the model and its constants, re-exported: ``from daeclear.assembly.assemble import DAEModel`` keeps working
 from .dae_model import (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_START_KINEMATICS,  # noqa: F401
                         EXTRA_TERM0, KIND_MULTIPLIER, KIND_POSITION, KIND_VELOCITY, KIND_WORK, NEWTON_STEPS,
@@ -185,7 +186,7 @@ class _Template:
 _TEMPLATES: dict[str, _Template] = memo_table()
 _TEMPLATE_LIMIT = 64
 # Part of every structure key: bump when the generated functions change meaning.
-_ENGINE_VERSION = "engine-2"
+_ENGINE_VERSION = "engine-3"
 
 
 def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: float = 5.0, beta: float = 5.0,
@@ -282,12 +283,7 @@ class _TemplateBuilder:
         P = ca.SX.sym("P", table.vector.size)
         self.t, self.q, self.v, self.a, self.P = t, q, v, a, P
         self.params = table.symbols(P)
-        frames: dict[str, BodyFrame] = {
-            GROUND: BodyFrame(GROUND, None, ca.DM.zeros(2), ca.DM(0.0), ca.DM.zeros(2), ca.DM(0.0))
-        }
-        for k, body in enumerate(self.bodies):
-            frames[body.name] = BodyFrame(body.name, k, q[3 * k:3 * k + 2], q[3 * k + 2], v[3 * k:3 * k + 2],
-                                          v[3 * k + 2])
+        frames = body_frames(self.bodies, q, v)
         self.ctx = AssemblyContext(t, q, v, a, P, frames, self.params, table.offsets())
         self.joints = {j.name: j for j in scene.joints}
 
@@ -481,7 +477,8 @@ class _TemplateBuilder:
                 Channel("constraints.position", "m", ca.mmax(ca.fabs(self.Phi))),
                 Channel("constraints.velocity", "m/s", ca.mmax(ca.fabs(self.Phi_dot))),
             ]
-        self.channels = channels + self.contact_channels + list(self.loads.channels)
+        joint_readings = joint_channels(self.ctx, self.scene.joints)  # angles, displacements and their rates
+        self.channels = channels + self.contact_channels + list(self.loads.channels) + joint_readings
 
     def template(self, library_name: str) -> _Template:
         """The generated functions (outputs, accelerations, kinematics, the compiled loop's simple

@@ -14,12 +14,12 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import casadi as ca
 import numpy as np
 
 from ..model.profiles import motion
 from ..model.scene import Driver, driven_coordinate
-from .symbolic import AssemblyContext, Reference, rotation
+from .joint_coordinates import joint_coordinate
+from .symbolic import AssemblyContext, Reference
 
 #: Channel of the driver's load, by driven coordinate: (channel suffix, unit).
 LOADS: dict[str, tuple[str, str]] = {"rotation": ("moment", "N m"), "translation": ("force", "N")}
@@ -70,11 +70,11 @@ def driver_constraint(ctx: AssemblyContext, driver: Driver, joint: Any) -> Any:
     bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
     profile = driver.motion_profile
     if driven_coordinate(joint) == "translation":
-        u = ca.mtimes(rotation(bi.phi), ctx.p(name, "axis"))
-        coordinate = ca.dot(bj.point(ctx.p(name, "s_j")) - bi.point(ctx.p(name, "s_i")), u)
+        coordinate = joint_coordinate(bi, bj, "translation", ctx.p(name, "s_i"), ctx.p(name, "s_j"),
+                                      ctx.p(name, "axis"))
         start = "position0"
     else:
-        coordinate = bj.phi - bi.phi
+        coordinate = joint_coordinate(bi, bj, "rotation")
         start = "angle0"
     speed = ctx.p(name, "speed") if profile.uses_speed else None
     x = motion(profile, ctx.t, speed, lambda key: ctx.p(name, f"profile.{key}"))

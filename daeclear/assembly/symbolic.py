@@ -16,6 +16,8 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ..model.elements import GROUND
+
 
 def rotation(phi: Any) -> Any:
     """Planar rotation matrix A(phi) as a CasADi expression."""
@@ -50,6 +52,14 @@ class BodyFrame:
     def world_point_velocity(self, point: Any) -> Any:
         """Velocity of the body's material point at the world position ``point``."""
         return self.v + self.omega * perpendicular(point - self.r)
+
+
+def body_frames(bodies: Sequence[Any], q: Any, v: Any) -> dict[str, BodyFrame]:
+    """The symbolic frames of the ground and of ``bodies``, body k at ``q[3k:3k+3]``, ``v[3k:3k+3]``."""
+    frames = {GROUND: BodyFrame(GROUND, None, ca.DM.zeros(2), ca.DM(0.0), ca.DM.zeros(2), ca.DM(0.0))}
+    for k, body in enumerate(bodies):
+        frames[body.name] = BodyFrame(body.name, k, q[3 * k:3 * k + 2], q[3 * k + 2], v[3 * k:3 * k + 2], v[3 * k + 2])
+    return frames
 
 
 @dataclass(frozen=True)
@@ -93,6 +103,12 @@ class Reference:
         c, s = math.cos(phi0), math.sin(phi0)
         dx, dy = world[0] - x0, world[1] - y0
         return np.array([c * dx + s * dy, -s * dx + c * dy])
+
+    def world_point(self, body: str, local: Sequence[float]) -> tuple[float, float]:
+        """World position of the body-fixed point ``local`` in the reference configuration."""
+        (x0, y0), phi0 = self.pose[body]
+        c, s = math.cos(phi0), math.sin(phi0)
+        return (x0 + c * local[0] - s * local[1], y0 + s * local[0] + c * local[1])
 
     def local_vector(self, body: str, world: Sequence[float]) -> NDArray[np.float64]:
         """Body-fixed components of a world direction (unit length) of the reference configuration."""

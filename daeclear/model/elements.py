@@ -155,6 +155,15 @@ class Element:
         else:
             self._check_positive(out, first if a is not None else second, unit)
 
+    def _check_not_both(self, out: list[str], world: str, body: tuple[str, ...]) -> None:
+        """A world point and a body-fixed point are two ways to give one attachment: at most one."""
+        given = [name for name in body if getattr(self, name) is not None]
+        if getattr(self, world) is not None and given:
+            shown = " and ".join(f"{name}={getattr(self, name)!r}" for name in (world, *given))
+            out.append(f"{self.kind} '{self.name}': {shown} m given together, must be one of the two: the "
+                       f"world point {world} (declared configuration) or the body-fixed {' and '.join(body)} "
+                       "(body coordinates).")
+
     def _check_number(self, out: list[str], field_name: str, unit: str) -> None:
         value = getattr(self, field_name)
         if not _is_finite_number(value):
@@ -283,6 +292,7 @@ class PointJoint(Joint):
         self._check_vector(out, "point_i", "m", optional=True)
         self._check_vector(out, "point_j", "m", optional=True)
         local = (self.point_i is not None, self.point_j is not None)
+        self._check_not_both(out, "at", ("point_i", "point_j"))
         if self.at is None and not all(local):
             out.append(
                 f"{self.kind} '{self.name}': give the world point at=(x, y), "

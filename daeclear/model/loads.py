@@ -4,8 +4,9 @@ A load adds no state and no constraint: it adds to the applied generalized force
 of the equations of motion, like gravity. So the residual, the Schur-complement solve of the
 accelerations, ``base_force`` (the scipy methods) and the compiled loops all see it.
 
-Elements (frozen dataclasses, SI units, world points ``at`` given in the reference
-configuration as for joints):
+Elements (frozen dataclasses, SI units; a point of application is, as for joints, a world point
+``at`` of the reference (declared) configuration or a body-fixed point ``point`` in the body's
+frame, one of the two):
 
 * :class:`Force`: a point force on a body (world or body-fixed components);
 * :class:`Torque`: a torque on a body, optionally between two bodies (``reaction``);
@@ -121,8 +122,8 @@ FORCE_FRAMES: tuple[str, ...] = ("world", "body")
 
 @dataclass(frozen=True)
 class Force(Load):
-    """A point force on ``body`` at the world point ``at`` of the reference configuration (the
-    centre of mass when None); the point moves with the body.
+    """A point force on ``body`` at the world point ``at`` of the reference configuration or at the
+    body-fixed ``point`` (the centre of mass when neither is given); the point moves with the body.
 
     Parameters
     ----------
@@ -135,8 +136,11 @@ class Force(Load):
         Components, N: in the world frame (``frame="world"``) or in the body frame, turning
         with the body (``frame="body"``, a follower force).
     at : (float, float) or None
-        World point of application in the reference configuration, m.
+        World point of application in the reference (declared) configuration, m.
     frame : {"world", "body"}
+    point : (float, float) or None
+        Point of application in the body's frame, m (instead of ``at``; giving both is an
+        error). None with ``at`` None: the centre of mass.
     """
 
     name: str
@@ -145,11 +149,11 @@ class Force(Load):
     fy: Value = 0.0
     at: Vector2 | None = None
     frame: str = "world"
+    point: Vector2 | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "body", body_name(self.body))
-        if self.at is not None and as_vector2(self.at) is not None:
-            object.__setattr__(self, "at", as_vector2(self.at))
+        _points_as_vectors(self, ("at", "point"))
 
     def body_roles(self) -> tuple[tuple[str, str], ...]:
         return (("body", self.body),)
@@ -158,6 +162,8 @@ class Force(Load):
         out = super().problems()
         self._check_moving(out, "body")
         self._check_vector(out, "at", "m", optional=True)
+        self._check_vector(out, "point", "m", optional=True)
+        self._check_not_both(out, "at", ("point",))
         if self.frame not in FORCE_FRAMES:
             out.append(f"{self.kind} '{self.name}': frame={self.frame!r}, must be one of "
                        f"{', '.join(map(repr, FORCE_FRAMES))}.")
@@ -198,35 +204,46 @@ class Torque(Load):
 
 @dataclass(frozen=True)
 class SpringDamper(BetweenBodies):
-    """A linear spring-damper between point ``at_i`` of ``body_i`` and ``at_j`` of ``body_j``
-    (world points of the reference configuration; the points move with their bodies).
+    """A linear spring-damper between a point of ``body_i`` and a point of ``body_j``, each given
+    as a world point of the reference (declared) configuration (``at_i``, ``at_j``) or as a
+    body-fixed point in that body's frame (``point_i``, ``point_j``): exactly one of the two for
+    each end. The points move with their bodies; a body-fixed point stays where it is given on
+    its body whatever the declared pose (a world point is read in the declared pose, so a body
+    declared off its assembled pose moves it).
 
     Tension ``F = stiffness * (L - free_length) + damping * dL/dt`` along the line of the points
-    (positive pulls them together). ``free_length`` None: the reference distance. Channels
-    ``<name>.length``, ``<name>.elongation`` (L - free_length, m), ``<name>.force`` (tension, N),
-    ``<name>.elastic_energy`` (J, part of ``energy.potential``), ``<name>.power`` (the damper's
-    power, W, <= 0). The points must not coincide during a run (the line is undefined there).
+    (positive pulls them together). ``free_length`` None: the distance of the points in the
+    declared configuration. Channels ``<name>.length``, ``<name>.elongation`` (L - free_length,
+    m), ``<name>.force`` (tension, N), ``<name>.elastic_energy`` (J, part of
+    ``energy.potential``), ``<name>.power`` (the damper's power, W, <= 0). The points must not
+    coincide during a run (the line is undefined there).
     """
 
     name: str
     body_i: str
     body_j: str
-    at_i: Vector2 = (0.0, 0.0)
-    at_j: Vector2 = (0.0, 0.0)
+    at_i: Vector2 | None = None
+    at_j: Vector2 | None = None
     stiffness: float = 0.0
     damping: float = 0.0
     free_length: float | None = None
+    point_i: Vector2 | None = None
+    point_j: Vector2 | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        for name in ("at_i", "at_j"):
-            if as_vector2(getattr(self, name)) is not None:
-                object.__setattr__(self, name, as_vector2(getattr(self, name)))
+        _points_as_vectors(self, ("at_i", "at_j", "point_i", "point_j"))
 
     def problems(self) -> list[str]:
         out = super().problems()
-        self._check_vector(out, "at_i", "m")
-        self._check_vector(out, "at_j", "m")
+        for end in ("i", "j"):
+            world, local = f"at_{end}", f"point_{end}"
+            self._check_vector(out, world, "m", optional=True)
+            self._check_vector(out, local, "m", optional=True)
+            self._check_not_both(out, world, (local,))
+            if getattr(self, world) is None and getattr(self, local) is None:
+                out.append(f"{self.kind} '{self.name}': {world}=None and {local}=None, must give one: the world "
+                           f"point {world} (declared configuration) or the body-fixed {local} (body coordinates).")
         self._check_nonnegative(out, "stiffness", "N/m")
         self._check_nonnegative(out, "damping", "N s/m")
         if self.free_length is not None:
@@ -294,6 +311,26 @@ class Motor(BetweenBodies):
         return out
 
 
+def _points_as_vectors(element: Element, names: Iterable[str]) -> None:
+    """Store each given point field as a tuple of two floats (kept as given when it is not one,
+    for problems())."""
+    for name in names:
+        value = getattr(element, name)
+        if value is not None and as_vector2(value) is not None:
+            object.__setattr__(element, name, as_vector2(value))
+
+
+def attachment(ref: Any, body: str, world: Vector2 | None, local: Vector2 | None) -> tuple[float, float]:
+    """Body-fixed coordinates of a load's point: ``local`` when given, else the world point
+    ``world`` of the reference configuration ``ref``, else the centre of mass."""
+    if local is not None:
+        return (float(local[0]), float(local[1]))
+    if world is not None:
+        s = ref.local_point(body, world)
+        return (float(s[0]), float(s[1]))
+    return (0.0, 0.0)
+
+
 LOAD_TYPES: tuple[type, ...] = (Force, Torque, SpringDamper, RotationalSpringDamper, Motor)
 
 
@@ -303,15 +340,17 @@ def load_parameters(ref: Any, load: Load) -> dict[str, Any]:
     """The load's numbers as run-time parameters (``ref``: the scene's reference configuration)."""
     out: dict[str, Any] = {}
     if isinstance(load, Force):
-        out["point"] = (0.0, 0.0) if load.at is None else ref.local_point(load.body, load.at)
+        out["point"] = attachment(ref, load.body, load.at, load.point)
         for field_name in ("fx", "fy"):
             out.update(_keyed(field_name, _value_parameters(getattr(load, field_name))))
     elif isinstance(load, Torque):
         out.update(_keyed("value", _value_parameters(load.value)))
     elif isinstance(load, SpringDamper):
-        free = math.dist(load.at_i, load.at_j) if load.free_length is None else load.free_length
-        out.update(s_i=ref.local_point(load.body_i, load.at_i), s_j=ref.local_point(load.body_j, load.at_j),
-                   stiffness=load.stiffness, damping=load.damping, free_length=free)
+        s_i = attachment(ref, load.body_i, load.at_i, load.point_i)
+        s_j = attachment(ref, load.body_j, load.at_j, load.point_j)
+        free = (math.dist(ref.world_point(load.body_i, s_i), ref.world_point(load.body_j, s_j))
+                if load.free_length is None else load.free_length)
+        out.update(s_i=s_i, s_j=s_j, stiffness=load.stiffness, damping=load.damping, free_length=free)
     elif isinstance(load, RotationalSpringDamper):
         free = ref.angle(load.body_j) - ref.angle(load.body_i) if load.free_angle is None else load.free_angle
         out.update(stiffness=load.stiffness, damping=load.damping, free_angle=free)

@@ -15,7 +15,7 @@ from ..errors import SceneError
 #: Options that only a clearance joint uses, per ready mechanism (chain: every pin is one, none listed).
 CLEARANCE_ONLY: dict[str, tuple[str, ...]] = {
     "slider_crank": ("clearance", "law", "restitution", "friction", "bearing_radius", "material", "length",
-                     "contact_model", "face_law", "reading", "pin_offset"),
+                     "contact_model", "face_law", "reading", "pin_offset", "bearing"),
     "four_bar": ("clearance", "law", "restitution", "friction", "bearing_radius", "material", "length"),
     "double_pendulum": ("clearance", "law", "restitution", "friction", "bearing_radius", "material", "length"),
 }

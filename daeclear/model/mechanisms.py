@@ -112,7 +112,7 @@ def _make_ideal_elements(omega: float, crank_angle: float, slider_mass: float, s
     return (crank, rod, slider,
             Revolute("A", GROUND, crank.name, at=(0.0, 0.0)),
             Revolute("B", crank.name, rod.name, at=pin_b),
-            Revolute("C", rod.name, slider.name, at=pin_c),
+            Revolute("C", slider.name, rod.name, at=pin_c),  # body_i: the bearing body of a clearance at C
             # the guide's mid-line runs along X through the slider's centre (the X axis unless the pin is offset)
             Translational("D", GROUND, slider.name, point_i=(0.0, -offset[1]), point_j=(0.0, 0.0), axis=(1.0, 0.0)),
             Driver("drive", joint="A", speed=omega))
@@ -125,7 +125,7 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
                  length: float | None = None, contact_model: str = "corners",
                  face_law: Any = "lankarani-plane", reading: str | None = None, slider_mass: float = SLIDER_MASS,
                  slider_inertia: float = SLIDER_INERTIA, pin_offset: tuple[float, float] = (0.0, 0.0),
-                 **options: Any) -> Scene:
+                 bearing: str = "slider", **options: Any) -> Scene:
     """The chapter's slider-crank mechanism (Fig. 4.14, Table 4.1).
 
     Crank (body ``crank``) pinned to the ground at the origin by revolute ``A`` and driven
@@ -185,14 +185,13 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
         ``contact_model`` and ``face_law``.
     slider_mass, slider_inertia : float
         The slider's mass, kg, and moment of inertia, kg m^2 (Table 4.1: 0.14 and 1e-4).
+    bearing : {"slider", "rod"}
+        ``joint="revolute"``: the bearing body (the chapter's: the slider, ``C``'s body_i, as
+        ``.with_clearance("C")`` has it: both routes give the same ``ex``/``ey``).
     pin_offset : (float, float)
         Translational joint only: the rod-slider pin in slider coordinates from the slider's
         centre (its centre of mass), m; (0, 0): at the centre. The slider starts with the pin
         where the ideal mechanism has it, its centre midway between the guide surfaces.
-
-    Returns
-    -------
-    Scene
     """
     joint = str(joint).lower()
     _check("joint", joint, f"must be one of {', '.join(JOINT_KINDS)}", joint in JOINT_KINDS)
@@ -206,6 +205,8 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
            len(offset) == 2 and all(_finite(v) for v in offset))
     _check("pin_offset", pin_offset, "must be (0, 0) unless joint='translational'",
            joint == "translational" or offset == (0.0, 0.0))
+    _check("bearing", bearing, "must be 'slider' or 'rod' (joint='revolute' only)",
+           bearing == "slider" or (joint == "revolute" and bearing == "rod"))
     for field_name, value, default in (("reading", reading, None), ("contact_model", contact_model, "corners")):
         _check(field_name, value, "is for joint='translational' only", joint == "translational" or value == default)
 
@@ -221,7 +222,7 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
         _check("clearance", clearance, "must be a number in (0, bearing_radius) m",
                _finite(clearance) and 0 < clearance < bearing_radius)
         return scene.with_clearance(
-            "C", name="clearance", bearing="slider", bearing_radius=bearing_radius, clearance=clearance,
+            "C", name="clearance", bearing=bearing, bearing_radius=bearing_radius, clearance=clearance,
             material=material, law=_contact_law(law, restitution, length), friction=friction_law(friction))
     _check("clearance", clearance, "must be a number in (0, slider length) m",
            _finite(clearance) and 0 < clearance < SLIDER_LENGTH)
@@ -313,10 +314,6 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
         Axial contact length L, m, required by the cylindrical laws.
     name : str or None
         Scene name; defaults to ``"chain<N>"``.
-
-    Returns
-    -------
-    Scene
 
     Examples
     --------

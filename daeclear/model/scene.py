@@ -12,9 +12,10 @@ import Body`` keeps working.
 from __future__ import annotations
 
 import difflib
+import importlib
 from dataclasses import dataclass, field
 from typing import Any
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 
 from ..errors import SceneError
 # the elements, re-exported: ``from daeclear.model.scene import Body`` keeps working
@@ -24,6 +25,14 @@ from .elements import (GROUND, Body, Driver, Element, Ground, Joint, PointJoint,
                        Translational, Vector2, as_vector2, body_name, is_finite_number, is_frozen,
                        own_problems)
 from .profiles import PROFILES, ConstantSpeed, Profile  # noqa: F401  (re-exported, as before the split)
+
+
+#: What :meth:`Scene.assembled` runs: :func:`daeclear.assembly.placement.assembled`, which puts itself
+#: here when its module is loaded. It assembles the scene, so it lives in the assembly layer, which
+#: imports this module: the scene does not import it (no import circle); the first call loads it
+#: by name, as ``daeclear``'s public names are loaded on first use.
+PLACEMENT: list[Callable[..., Scene]] = []
+PLACEMENT_MODULE = "daeclear.assembly.placement"
 
 
 @dataclass
@@ -95,6 +104,29 @@ class Scene:
         ('RevoluteClearance', 'Revolute')
         """
         return with_clearance(self, joint, bearing=bearing, name=name, **fields_)
+
+    def assembled(self, start: Mapping[str, float] | None = None,
+                  speeds: Mapping[str, float] | None = None) -> Scene:
+        """A new scene, this mechanism with its bodies placed so that the joints named in ``start``
+        have the given coordinates (revolute: the angle ``phi_j - phi_i``, rad; translational: the
+        displacement along the axis, m; body j relative to body i, the ``<joint>.angle`` and
+        ``<joint>.displacement`` channels) and every joint, clearance joint (as ideal) and driver
+        closes; with ``speeds``, the joints' rates (rad/s, m/s) likewise, the drivers' speeds kept
+        (without: the declared velocities corrected to the joints and drivers, least norm).
+        The declared poses are the Newton guess: they pick the branch (elbow up or down).
+
+        Every number the declared configuration defines (world points ``at``, a translational axis,
+        free lengths and angles left None) is carried into the new scene as the body-fixed value it
+        stood for: the same equations, new initial poses. This scene is left unchanged.
+
+        Raises SceneError for an unknown joint or a bad value, AssemblyError when the chosen
+        coordinates do not fix the configuration (their rank, and the joints not named) or the
+        joints cannot close at them (the largest residuals and their joints).
+        See :mod:`daeclear.assembly.placement`.
+        """
+        if not PLACEMENT:
+            importlib.import_module(PLACEMENT_MODULE)  # registers itself (see PLACEMENT)
+        return PLACEMENT[0](self, start, speeds)
 
     def ideal(self) -> Scene:
         """A new scene, the same mechanism with every clearance joint ideal (see :func:`ideal_joint`):

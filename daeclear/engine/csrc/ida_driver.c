@@ -119,6 +119,8 @@ enum {
 #define DC_NONE 0
 #define DC_ONSET 1
 #define DC_SEPARATION (-1)
+/* two crossings of one pair closer than this, relative to t, are one instant (automaton.SAME_INSTANT) */
+#define DC_SAME_INSTANT (16 * DBL_EPSILON)
 
 typedef struct {
   int storm_events;    /* this many switches within storm_window s hold the term on (>= 1) */
@@ -180,6 +182,9 @@ static dc_decision pair_step(const dc_pair_rule* r, dc_pair_state* st, double t,
     pair_push(r, st, t);
     return decision_of(st, DC_ONSET);
   }
+  if (dir < 0 && st->contact && rate > 0 && st->n_recent > 0 &&
+      t - st->recent[st->n_recent - 1] <= fabs(t) * DC_SAME_INSTANT)
+    return decision_of(st, DC_NONE); /* the restart's round-off, not a separation */
   if (dir < 0 && st->contact) {
     int count = 1;
     for (int i = 0; i < st->n_recent; ++i)

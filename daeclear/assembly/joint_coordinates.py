@@ -1,0 +1,70 @@
+"""Joint coordinates: a revolute joint's angle and a translational joint's displacement, and their rates.
+
+One definition for the three places that read a joint's coordinate: the driver that prescribes it
+(:mod:`daeclear.assembly.drivers`), the joint channels ``<joint>.angle``/``<joint>.rate`` and
+``<joint>.displacement``/``<joint>.speed`` of every run, and the start from chosen coordinates
+(:mod:`daeclear.assembly.placement`). Body j relative to body i, for ideal and clearance joints alike:
+
+* revolute: ``theta = phi_j - phi_i`` (not wrapped: it counts turns), rate ``omega_j - omega_i``;
+* translational: ``s = (P_j - P_i) . u``, the displacement of joint point j from joint point i
+  along the axis ``u`` fixed to body i (on a clearance joint: of the slider's centre from the
+  guide's mid-line point), speed ``ds/dt``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+from collections.abc import Iterable
+
+import casadi as ca
+
+from ..model.scene import Revolute, RevoluteClearance, Translational, TranslationalClearance, driven_coordinate
+from .symbolic import AssemblyContext, BodyFrame, Channel, rotation
+
+#: Channels of a joint's coordinate and its rate, by driven coordinate: ((suffix, unit), (suffix, unit)).
+JOINT_CHANNELS: dict[str, tuple[tuple[str, str], tuple[str, str]]] = {
+    "rotation": (("angle", "rad"), ("rate", "rad/s")),
+    "translation": (("displacement", "m"), ("speed", "m/s")),
+}
+
+
+def joint_coordinate(bi: BodyFrame, bj: BodyFrame, kind: str, s_i: Any = None, s_j: Any = None,
+                     axis: Any = None) -> Any:
+    """The coordinate of body j relative to body i: ``kind`` "rotation" (the relative angle) or
+    "translation" (the displacement of the body-fixed point ``s_j`` from ``s_i`` along ``axis``,
+    a unit vector in body i's frame)."""
+    if kind == "rotation":
+        return bj.phi - bi.phi
+    u = ca.mtimes(rotation(bi.phi), axis)
+    return ca.dot(bj.point(s_j) - bi.point(s_i), u)
+
+
+def joint_axis(ctx: AssemblyContext, joint: Any) -> Any:
+    """A translational joint's unit axis in body i's frame, from the joint's own parameters (the
+    guide direction of a clearance joint; the normal's -90 degree turn for an ideal one)."""
+    if isinstance(joint, TranslationalClearance):
+        return ctx.p(joint.name, "t_guide")
+    normal = ctx.p(joint.name, "normal")
+    return ca.vertcat(normal[1], -normal[0])
+
+
+def joint_channels(ctx: AssemblyContext, joints: Iterable[Any]) -> list[Channel]:
+    """``<joint>.angle``, ``<joint>.rate`` of every revolute joint and ``<joint>.displacement``,
+    ``<joint>.speed`` of every translational joint, ideal or with clearance (the rate is the
+    coordinate's derivative along the velocities)."""
+    out: list[Channel] = []
+    for joint in joints:
+        if not isinstance(joint, (Revolute, RevoluteClearance, Translational, TranslationalClearance)):
+            continue
+        kind = driven_coordinate(joint)
+        assert kind is not None  # every revolute and translational joint has a coordinate
+        bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
+        if kind == "rotation":
+            value = joint_coordinate(bi, bj, kind)
+        else:
+            value = joint_coordinate(bi, bj, kind, ctx.p(joint.name, "s_i"), ctx.p(joint.name, "s_j"),
+                                     joint_axis(ctx, joint))
+        (name, unit), (rate_name, rate_unit) = JOINT_CHANNELS[kind]
+        out += [Channel(f"{joint.name}.{name}", unit, value),
+                Channel(f"{joint.name}.{rate_name}", rate_unit, ca.jtimes(value, ctx.q, ctx.v))]
+    return out
