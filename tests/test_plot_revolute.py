@@ -84,6 +84,18 @@ def test_journal_orbit_draws_eccentricity_in_micrometres_and_the_clearance_circl
     assert ax.get_aspect() == 1.0
 
 
+def test_journal_orbit_of_a_lubricated_joint_draws_the_film_threshold():
+    """A lubricated joint (law "hydrodynamic"): the eccentricity-ratio-1 circle |e| = c and the film
+    threshold's |e| = c - h_threshold, inside which the film carries."""
+    r = make_result()
+    r.parameters["scene"]["elements"]["clearance"]["law"] = {"name": "hydrodynamic", "film_threshold": 2e-6}
+    ax = plot_journal_orbit(r)
+    orbit, circle, threshold = ax.get_lines()
+    np.testing.assert_allclose(np.hypot(circle.get_xdata(), circle.get_ydata()), C * 1e6)
+    np.testing.assert_allclose(np.hypot(threshold.get_xdata(), threshold.get_ydata()), (C - 2e-6) * 1e6)
+    assert threshold.get_linestyle() == ":" and ax.get_legend() is not None
+
+
 def test_journal_orbit_options_axes_unit_markers_and_clearance():
     fig, ax = plt.subplots()
     r = make_result(clearance=None)

@@ -65,6 +65,14 @@ def _clearance_of(result: Result, joint: str) -> float | None:
     return float(value) if isinstance(value, (int, float)) else None
 
 
+def _film_threshold_of(result: Result, joint: str) -> float | None:
+    """The film threshold (m) of a lubricated joint (law "hydrodynamic"), from the scene parameters."""
+    element = result.parameters.get("scene", {}).get("elements", {}).get(joint, {})
+    law = element.get("law") if isinstance(element, dict) else None
+    value = law.get("film_threshold") if isinstance(law, dict) and law.get("name") == "hydrodynamic" else None
+    return float(value) if isinstance(value, (int, float)) else None
+
+
 def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | None = None, markers: bool = True,
                        clearance: float | None = None, unit: str = "um", window: Window = None,
                        max_points: int | None = None, title: str | bool | None = None, **line_kw: Any) -> Axes:
@@ -102,7 +110,9 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
     -------
     matplotlib.axes.Axes
         ``ax.lines[0]`` is the orbit (x: e_x, y: e_y in ``unit``), ``ax.lines[1]`` the
-        clearance circle |e| = c (dashed), when drawn. Equal aspect ratio.
+        clearance circle |e| = c (dashed), when drawn: for a lubricated joint the eccentricity
+        ratio 1, and ``ax.lines[2]`` the film threshold |e| = c - h_threshold (dotted), inside
+        which the film carries and outside which the dry law acts. Equal aspect ratio.
     """
     if unit not in _LENGTH_SCALE:
         raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTH_SCALE)}.")
@@ -120,7 +130,12 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
     c = clearance if clearance is not None else _clearance_of(result, joint)
     if c is not None:
         angle = np.linspace(0.0, 2.0 * np.pi, 361)
-        ax.plot(c * scale * np.cos(angle), c * scale * np.sin(angle), "k--", lw=0.8)
+        ax.plot(c * scale * np.cos(angle), c * scale * np.sin(angle), "k--", lw=0.8, label="eccentricity ratio 1")
+        threshold = _film_threshold_of(result, joint)
+        if threshold is not None:
+            inner = (c - threshold) * scale
+            ax.plot(inner * np.cos(angle), inner * np.sin(angle), "r:", lw=0.8, label="film threshold")
+            ax.legend(loc="upper right", fontsize="small")
     ax.set_aspect("equal", adjustable="datalim")
     label = _LENGTH_LABEL[unit]
     ax.set_xlabel(f"journal x rel. to bearing ({label})")
