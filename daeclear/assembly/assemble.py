@@ -533,6 +533,7 @@ class _TemplateBuilder:
             kinematics=self.kinematics, base_force=self.base_force, track_work=self.track_work,
             start_constraint_names=start_names, constraint_elements=tuple(self.owners),
             driver_names=tuple(self.driver_rows), start_parameters=start_parameters(functions),
+            has_loads=bool(self.scene.of_type(Load)),
         )  # numbers are bound per scene (_Template.bind)
         return _Template(model=model, layout=self.table.layout, logic=logic_makers, auto_pairs=tuple(auto_pairs))
 

@@ -83,6 +83,8 @@ class DAEModel:
     # (name, clearance m, corner radius m or 0) of each clearance joint: the limits of the physics checks
     clearance_joints: tuple[tuple[str, float, float], ...] = ()
     driver_names: tuple[str, ...] = ()
+    # whether the scene applies loads (forces, torques, springs, motors) besides gravity: structure
+    has_loads: bool = False
     # consistent starts found for this model, by (start, allow_penetration, evaluator, the numbers
     # and guesses they came from): kept so that a model run again (a study's repeated runs, a scene
     # seen before) skips assembling its start; shared by the run copies and by every model bound to

@@ -123,12 +123,12 @@ def scales(model: DAEModel) -> Scales:
             rates.append(speed / length if f"{driver}.axis" in entries else speed)
     if "gravity" in entries:
         rates.append(math.sqrt(math.hypot(*entries["gravity"]) / length))
-    # what the applied loads (springs, torques, motors, forces) would do to each body alone at the
-    # start: the speed after a turn of one radian (or a travel of L) at that acceleration
-    force = np.asarray(model.base_force(0.0, model.q_guess, model.v_guess, model.parameter_values)).ravel()
-    acceleration = np.abs(force / model.mass_diagonal).tolist()
-    rates += [math.sqrt(acceleration[i + 2]) for i in range(0, n, 3)]
-    rates += [math.sqrt(math.hypot(acceleration[i], acceleration[i + 1]) / length) for i in range(0, n, 3)]
+    if model.has_loads:  # what the applied loads (springs, torques, motors, forces, and gravity with
+        # them) do to each body alone at the start: the speed after a turn of one radian (or a travel of L)
+        force = np.asarray(model.base_force(0.0, model.q_guess, model.v_guess, model.parameter_values)).ravel()
+        acceleration = np.abs(force / model.mass_diagonal).tolist()
+        rates += [math.sqrt(acceleration[i + 2]) for i in range(0, n, 3)]
+        rates += [math.sqrt(math.hypot(acceleration[i], acceleration[i + 1]) / length) for i in range(0, n, 3)]
     rate = max([*rates, 0.0]) or 1.0
     return Scales(length=float(length), resolution=float(resolution), rate=float(rate))
 
