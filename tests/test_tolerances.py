@@ -23,16 +23,21 @@ from daeclear.solvers.ida_loop import steps_needed
 REV = 60.0 / 5000.0
 
 
-def pendulum(n_links: int = 5, length: float = 0.1, mass: float = 0.2) -> dc.Scene:
-    """An ideal n-link pendulum along +X from the origin, released from rest (as bench_convergence.py)."""
-    scene = dc.Scene(f"pendulum{n_links}", gravity=(0.0, -9.81))
-    previous = scene.ground
-    for k in range(1, n_links + 1):
-        link = scene.add(dc.Body(f"link{k}", mass=mass, inertia=mass * length ** 2 / 12,
-                                 position=((k - 0.5) * length, 0.0)))
-        scene.add(dc.Revolute(f"pin{k}", previous, link, at=((k - 1) * length, 0.0)))
-        previous = link
-    return scene
+def _bench_convergence():
+    """benchmarks/bench_convergence.py as a module: its five-link pendulum is the ideal scene here too."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "bench_convergence.py"
+    spec = importlib.util.spec_from_file_location("bench_convergence", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def pendulum() -> dc.Scene:
+    """The ideal five-link pendulum of bench_convergence.py (0.1 m links along +X, released from rest)."""
+    return _bench_convergence().pendulum()
 
 
 # ---------------------------------------------------------------- scales and defaults
