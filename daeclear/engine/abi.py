@@ -28,11 +28,13 @@ __all__ = [
     "DC_STORE_TIMES", "DC_STORE_STATES",
     "DC_NONE", "DC_ONSET", "DC_SEPARATION", "DC_SAME_INSTANT",
     "DC_EV_KIND", "DC_EV_CONTACT", "DC_EV_HELD", "DC_EV_WATCH", "DC_EV_N",
-    "DC_ST_STEPS", "DC_ST_REINITS", "DC_ST_N", "STAT_KEYS",
-    "DC_BI_N",
+    "DC_ST_STEPS", "DC_ST_RES", "DC_ST_JAC", "DC_ST_LSETUP", "DC_ST_NNI", "DC_ST_NCF", "DC_ST_NETF",
+    "DC_ST_GEVALS", "DC_ST_REINITS", "DC_ST_N", "STAT_KEYS",
+    "DC_BI_MAJOR", "DC_BI_MINOR", "DC_BI_PATCH", "DC_BI_INDEX_SIZE", "DC_BI_INDEX_BITS", "DC_BI_SPARSE", "DC_BI_N",
     "DCO_OK", "DCO_NONFINITE", "DCO_SINGULAR", "DCO_EVAL_ERR",
     "FX_CHUNK", "FX_TSTOP", "FX_CANDIDATE", "FX_ERR", "FX_MAXSTEPS",
-    "DCO_EULER", "DCO_RK4", "DCO_CNT_N", "ODE_COUNTER_KEYS",
+    "DCO_EULER", "DCO_RK4", "DCO_CNT_RHS", "DCO_CNT_JAC", "DCO_CNT_GAPS", "DCO_CNT_STEPS", "DCO_CNT_N",
+    "ODE_COUNTER_KEYS",
     "GROUPS", "table", "header_text", "HEADER",
 ]
 
@@ -68,21 +70,33 @@ DC_EV_HELD: Final = 2
 DC_EV_WATCH: Final = 3
 DC_EV_N: Final = 4
 
-#: dc_stats' counters in their slots: (C slot name, Python key)
+#: dc_stats' slots (IDA's counters summed over the restarts, and the restarts)
+DC_ST_STEPS: Final = 0
+DC_ST_RES: Final = 1
+DC_ST_JAC: Final = 2
+DC_ST_LSETUP: Final = 3
+DC_ST_NNI: Final = 4
+DC_ST_NCF: Final = 5
+DC_ST_NETF: Final = 6
+DC_ST_GEVALS: Final = 7
+DC_ST_REINITS: Final = 8
+DC_ST_N: Final = 9
+#: (C slot name, Python key) of dc_stats, in slot order
 _STATS: Final = (("DC_ST_STEPS", "n_steps"), ("DC_ST_RES", "n_res_evals"), ("DC_ST_JAC", "n_jac_evals"),
                  ("DC_ST_LSETUP", "n_lin_setups"), ("DC_ST_NNI", "n_nonlin_iters"),
                  ("DC_ST_NCF", "n_nonlin_conv_fails"), ("DC_ST_NETF", "n_err_test_fails"),
                  ("DC_ST_GEVALS", "n_root_evals"), ("DC_ST_REINITS", "n_reinits"))
 #: the keys of dc_stats' slots, in slot order
 STAT_KEYS: Final = tuple(key for _, key in _STATS)
-DC_ST_STEPS: Final = 0
-DC_ST_REINITS: Final = len(_STATS) - 1
-DC_ST_N: Final = len(_STATS)
 
-#: dc_build_info's slots: SUNDIALS major, minor, patch, DC_INDEX_SIZE, bits of sunindextype, DC_HAVE_SPARSE
-_BUILD_INFO: Final = ("DC_BI_MAJOR", "DC_BI_MINOR", "DC_BI_PATCH", "DC_BI_INDEX_SIZE", "DC_BI_INDEX_BITS",
-                      "DC_BI_SPARSE")
-DC_BI_N: Final = len(_BUILD_INFO)
+#: dc_build_info's slots
+DC_BI_MAJOR: Final = 0
+DC_BI_MINOR: Final = 1
+DC_BI_PATCH: Final = 2
+DC_BI_INDEX_SIZE: Final = 3
+DC_BI_INDEX_BITS: Final = 4
+DC_BI_SPARSE: Final = 5
+DC_BI_N: Final = 6
 
 # ---------------------------------------------------------------- ode_driver.c (dco_*)
 DCO_OK: Final = 0
@@ -99,17 +113,22 @@ FX_MAXSTEPS: Final = -2
 DCO_EULER: Final = 1
 DCO_RK4: Final = 4
 
-#: dco_counters' slots: (C slot name, Python key)
+#: dco_counters' slots
+DCO_CNT_RHS: Final = 0
+DCO_CNT_JAC: Final = 1
+DCO_CNT_GAPS: Final = 2
+DCO_CNT_STEPS: Final = 3
+DCO_CNT_N: Final = 4
+#: (C slot name, Python key) of dco_counters, in slot order
 _ODE_COUNTERS: Final = (("DCO_CNT_RHS", "n_res_evals"), ("DCO_CNT_JAC", "n_jac_evals"),
                         ("DCO_CNT_GAPS", "n_root_evals"), ("DCO_CNT_STEPS", "n_fixed_steps"))
 #: the keys of dco_counters' slots, in slot order
 ODE_COUNTER_KEYS: Final = tuple(key for _, key in _ODE_COUNTERS)
-DCO_CNT_N: Final = len(_ODE_COUNTERS)
 
 
-def _slots(names: tuple[str, ...], what: str) -> tuple[tuple[str, int | float, str], ...]:
-    return tuple((name, i, f"{what} slot {i}") for i, name in enumerate(names)) + (
-        (names[0].rsplit("_", 1)[0] + "_N", len(names), f"{what} slots"),)
+def _slots(names: tuple[tuple[str, str], ...], count: str) -> tuple[tuple[str, int | float, str], ...]:
+    """Slot i of each (name, comment), then the count: the values a slot table must have."""
+    return tuple((name, i, doc) for i, (name, doc) in enumerate(names)) + ((count, len(names), "slots"),)
 
 
 #: The table: (heading, ((C name, value, comment), ...)) per group, in the header's order.
@@ -140,9 +159,11 @@ GROUPS: Final[tuple[tuple[str, tuple[tuple[str, int | float, str], ...]], ...]] 
         ("DC_EV_HELD", DC_EV_HELD, "the pair's term is held on (storm guard)"),
         ("DC_EV_WATCH", DC_EV_WATCH, "root direction watched next"),
         ("DC_EV_N", DC_EV_N, "columns"))),
-    ("dc_stats' counters", tuple((name, i, key) for i, (name, key) in enumerate(_STATS))
-     + (("DC_ST_N", DC_ST_N, "counters"),)),
-    ("dc_build_info's values", _slots(_BUILD_INFO, "dc_build_info")),
+    ("dc_stats' slots (the Python keys)", _slots(_STATS, "DC_ST_N")),
+    ("dc_build_info's slots", _slots((("DC_BI_MAJOR", "SUNDIALS major version"), ("DC_BI_MINOR", "minor"),
+                                      ("DC_BI_PATCH", "patch"), ("DC_BI_INDEX_SIZE", "DC_INDEX_SIZE"),
+                                      ("DC_BI_INDEX_BITS", "bits of sunindextype as compiled"),
+                                      ("DC_BI_SPARSE", "DC_HAVE_SPARSE")), "DC_BI_N")),
     ("return codes of dco_rhs, dco_jac, dco_gaps, dco_step", (
         ("DCO_OK", DCO_OK, "success"),
         ("DCO_NONFINITE", DCO_NONFINITE, "a value is not finite"),
@@ -157,8 +178,7 @@ GROUPS: Final[tuple[tuple[str, tuple[tuple[str, int | float, str], ...]], ...]] 
     ("fixed-step schemes of dco_step and dco_fixed (their order)", (
         ("DCO_EULER", DCO_EULER, "explicit Euler"),
         ("DCO_RK4", DCO_RK4, "classical Runge-Kutta"))),
-    ("dco_counters' slots", tuple((name, i, key) for i, (name, key) in enumerate(_ODE_COUNTERS))
-     + (("DCO_CNT_N", DCO_CNT_N, "counters"),)),
+    ("dco_counters' slots (the Python keys)", _slots(_ODE_COUNTERS, "DCO_CNT_N")),
 )
 
 

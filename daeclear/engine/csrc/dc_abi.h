@@ -36,7 +36,7 @@
 #define DC_EV_WATCH 3 /* root direction watched next */
 #define DC_EV_N 4 /* columns */
 
-/* dc_stats' counters */
+/* dc_stats' slots (the Python keys) */
 #define DC_ST_STEPS 0 /* n_steps */
 #define DC_ST_RES 1 /* n_res_evals */
 #define DC_ST_JAC 2 /* n_jac_evals */
@@ -46,16 +46,16 @@
 #define DC_ST_NETF 6 /* n_err_test_fails */
 #define DC_ST_GEVALS 7 /* n_root_evals */
 #define DC_ST_REINITS 8 /* n_reinits */
-#define DC_ST_N 9 /* counters */
+#define DC_ST_N 9 /* slots */
 
-/* dc_build_info's values */
-#define DC_BI_MAJOR 0 /* dc_build_info slot 0 */
-#define DC_BI_MINOR 1 /* dc_build_info slot 1 */
-#define DC_BI_PATCH 2 /* dc_build_info slot 2 */
-#define DC_BI_INDEX_SIZE 3 /* dc_build_info slot 3 */
-#define DC_BI_INDEX_BITS 4 /* dc_build_info slot 4 */
-#define DC_BI_SPARSE 5 /* dc_build_info slot 5 */
-#define DC_BI_N 6 /* dc_build_info slots */
+/* dc_build_info's slots */
+#define DC_BI_MAJOR 0 /* SUNDIALS major version */
+#define DC_BI_MINOR 1 /* minor */
+#define DC_BI_PATCH 2 /* patch */
+#define DC_BI_INDEX_SIZE 3 /* DC_INDEX_SIZE */
+#define DC_BI_INDEX_BITS 4 /* bits of sunindextype as compiled */
+#define DC_BI_SPARSE 5 /* DC_HAVE_SPARSE */
+#define DC_BI_N 6 /* slots */
 
 /* return codes of dco_rhs, dco_jac, dco_gaps, dco_step */
 #define DCO_OK 0 /* success */
@@ -74,11 +74,11 @@
 #define DCO_EULER 1 /* explicit Euler */
 #define DCO_RK4 4 /* classical Runge-Kutta */
 
-/* dco_counters' slots */
+/* dco_counters' slots (the Python keys) */
 #define DCO_CNT_RHS 0 /* n_res_evals */
 #define DCO_CNT_JAC 1 /* n_jac_evals */
 #define DCO_CNT_GAPS 2 /* n_root_evals */
 #define DCO_CNT_STEPS 3 /* n_fixed_steps */
-#define DCO_CNT_N 4 /* counters */
+#define DCO_CNT_N 4 /* slots */
 
 #endif
