@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import casadi as ca
 import numpy as np
@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..engine.build import memo_put_bounded
 from ..engine.session_base import DAEFunctions, StateLayout
-from ..errors import AssemblyError
+from ..errors import AssemblyError, SceneError
 from ..solvers.physics import check_start_penetration
 from .symbolic import Term
 
@@ -95,6 +95,10 @@ class DAEModel:
     # numbers of its memo key: scenes that differ only in clearances or contact and friction laws
     # share one start (see start_parameters())
     start_parameters: NDArray[np.intp] | None = field(default=None, compare=False, repr=False)
+    # the structure this model binds numbers to (assembly.assemble.Structure) and the scene whose
+    # numbers they are: with_parameters makes a model with new numbers from both
+    structure: Any = field(default=None, compare=False, repr=False)
+    scene: Any = field(default=None, compare=False, repr=False)
     # False for a model that starts from a computed state (a restart), whose start is not checked
     start_is_declared: ClassVar[bool] = True
 
@@ -128,6 +132,23 @@ class DAEModel:
         if from_state:  # an instance value over the class's: this copy only (the class default stays)
             object.__setattr__(run_model, "start_is_declared", False)
         return run_model
+
+    def with_parameters(self, values: Mapping[str, Any]) -> DAEModel:
+        """This model with new numbers, as a new model (this one is unchanged), compiling nothing:
+        ``model.with_parameters({"clearance.clearance": 2e-4, "clearance.law.restitution": 0.5})``.
+
+        Names are the scene's values (:meth:`daeclear.Scene.with_values`: ``"<element>.<field>"``,
+        a law's ``"<element>.law.<field>"``, ``"gravity"``) and, for ``index1``, ``"baumgarte.alpha"``
+        and ``"baumgarte.beta"``. The changed elements are made again from their fields, so what they
+        derive (a journal radius, a contact stiffness from the materials) follows, and validated.
+        Raises SceneError for an unknown name, a bad value, or a change of the structure (e.g.
+        friction on a frictionless joint): assemble that scene instead."""
+        if self.structure is None or self.scene is None:
+            raise AssemblyError("with_parameters: this model was not made by assemble(); assemble the scene.")
+        if not isinstance(values, Mapping):
+            raise SceneError(f"with_parameters: values={values!r}, must be a mapping of names to numbers, "
+                             "e.g. {'clearance.clearance': 2e-4}.")
+        return self.structure.rebind(self, values)
 
     @property
     def parameter_names(self) -> tuple[str, ...]:

@@ -90,6 +90,7 @@ def simulate(
     stream_to: str | os.PathLike[str] | None = None,
     keep_data: bool = True,
     max_output_points: int | None = opts.MAX_OUTPUT_POINTS,
+    parameters: Mapping[str, Any] | None = None,
 ) -> Result:
     """Integrate a scene (or an assembled model) from ``t0`` (0 by default) to ``t_end``.
 
@@ -199,6 +200,10 @@ def simulate(
         The most output points the run may report (:data:`daeclear.options.MAX_OUTPUT_POINTS`, 1e6,
         about 1 GB for the chapter's slider-crank); more (``t_eval``, ``t_eval_step``, or a fixed
         ``step`` without them) is refused before the run with the estimated size. None: no cap.
+    parameters : mapping or None
+        New numbers for this run, by name, as :meth:`DAEModel.with_parameters` (e.g.
+        ``{"clearance.clearance": 2e-4, "clearance.law.restitution": 0.5}``): the scene is assembled
+        (a model is taken as it is) and run with them; nothing is compiled, the model is unchanged.
 
     Returns
     -------
@@ -236,6 +241,13 @@ def simulate(
     limit = opts.max_output_points(max_output_points)
     if y0 is not None:  # checked before any work (a Scene's length: once it is assembled)
         y0 = opts.state(y0, scene.n_states if isinstance(scene, DAEModel) else None)
+    if parameters is not None:  # new numbers: bound to the structure (checked before any run)
+        if not isinstance(parameters, Mapping):
+            opts.fail("simulate", "parameters", parameters, "None or a mapping of names to numbers, "
+                      "e.g. {'clearance.clearance': 2e-4}")
+        if isinstance(scene, Scene):
+            scene = assemble(scene, formulation or opts.default_formulation(method), track_work=track_work)
+        scene = scene.with_parameters(parameters)
     from .explicit import integrate  # the non-IDA methods
 
     if method != "ida":
