@@ -33,19 +33,22 @@ static int extra_dense(const dc_fun_t* f, const double** arg, double** res, dc_i
   return 0;
 }
 
-static int eval_res(dc_session* s, double t, const double* y, const double* yp, double* r) {
-  const dc_model_t* M = &dc_model;
-  s->arg[0] = &t;
+/* The first three inputs of every generated model function: t, y, yp. */
+static void point_args(dc_session* s, const double* t, const double* y, const double* yp) {
+  s->arg[0] = t;
   s->arg[1] = y;
   s->arg[2] = yp;
+}
+
+static int eval_res(dc_session* s, double t, const double* y, const double* yp, double* r) {
+  const dc_model_t* M = &dc_model;
+  point_args(s, &t, y, yp);
   s->arg[3] = s->P;
   s->res[0] = r;
   if (M->res.eval(s->arg, s->res, s->iw, s->w, s->mem_res)) return -1;
   for (int k = 0; k < s->n_terms; ++k) {
     if (!s->active[k]) continue;
-    s->arg[0] = &t;
-    s->arg[1] = y;
-    s->arg[2] = yp;
+    point_args(s, &t, y, yp);
     s->arg[3] = s->params + s->param_off[k];
     s->arg[4] = s->P;
     s->res[0] = s->tmp_r;
@@ -82,9 +85,7 @@ static int eval_jac(dc_session* s, double t, const double* y, const double* yp, 
                     double* J, int sparse, int zeroed) {
   const dc_model_t* M = &dc_model;
   if (!zeroed) memset(J, 0, sizeof(double) * (size_t)jac_len(s, sparse));
-  s->arg[0] = &t;
-  s->arg[1] = y;
-  s->arg[2] = yp;
+  point_args(s, &t, y, yp);
   s->arg[3] = &cj;
   s->arg[4] = s->P;
   s->res[0] = s->tmp_J;
@@ -92,9 +93,7 @@ static int eval_jac(dc_session* s, double t, const double* y, const double* yp, 
   add_part(s, 0, s->tmp_J, J, sparse);
   for (int k = 0; k < s->n_terms; ++k) {
     if (!s->active[k]) continue;
-    s->arg[0] = &t;
-    s->arg[1] = y;
-    s->arg[2] = yp;
+    point_args(s, &t, y, yp);
     s->arg[3] = s->params + s->param_off[k];
     s->arg[4] = &cj;
     s->arg[5] = s->P;
@@ -107,9 +106,7 @@ static int eval_jac(dc_session* s, double t, const double* y, const double* yp, 
 
 static int eval_roots(dc_session* s, double t, const double* y, const double* yp, double* g) {
   const dc_model_t* M = &dc_model;
-  s->arg[0] = &t;
-  s->arg[1] = y;
-  s->arg[2] = yp;
+  point_args(s, &t, y, yp);
   s->arg[3] = s->P;
   s->res[0] = g;
   return M->roots.eval(s->arg, s->res, s->iw, s->w, s->mem_roots) ? -1 : 0;
