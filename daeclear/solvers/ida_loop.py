@@ -3,12 +3,13 @@
 :func:`daeclear.solvers.ida.simulate` checks the options, opens the session and the recorder and
 hands them to a :class:`SegmentLoop`, which integrates segment by segment. Between two roots of
 the gap functions the set of active contact terms is fixed. The compiled loop may decide the
-switches of simple pairs itself (:meth:`SegmentLoop.record_advance` takes its decisions into the
-run's contact state); any other root returns to Python, where the contact rules decide the new
-state (:func:`daeclear.assembly.contact_state.decide`) and IDA restarts from a consistent state (:meth:`SegmentLoop.decide_roots`). The
-points go to the recorder chunk by chunk (:meth:`SegmentLoop.flush`), so a run that streams to a
-file and keeps no steps runs in bounded memory, and whatever stops the run (a failure, Ctrl-C,
-running out of memory) the result holds what was computed (:meth:`SegmentLoop.finish`).
+switches of simple pairs itself (:meth:`SegmentLoop.record_advance` takes its decisions into
+the run's contact state); any other root returns to Python, where the contact rules decide the
+new state (:func:`daeclear.assembly.contact_state.decide`) and IDA restarts from a consistent state
+(:meth:`SegmentLoop.decide_roots`). The points go to the recorder chunk by chunk
+(:meth:`SegmentLoop.flush`), so a run that streams to a file and keeps no steps runs in bounded
+memory, and whatever stops the run (a failure, Ctrl-C, running out of memory) the result holds
+what was computed (:meth:`SegmentLoop.finish`).
 """
 
 from __future__ import annotations
