@@ -173,3 +173,13 @@ def test_example_joint_wear_quick(tmp_path, capsys):
     assert metrics["cycles"] == 40 and metrics["volume_m3"] == pytest.approx(
         metrics["coefficient"] * metrics["sliding_work_Nm"], rel=1e-12)
     assert "wrote" in capsys.readouterr().out
+
+
+def test_wear_beyond_the_gap_model_stops_with_a_message(worn_crank):
+    """A depth beyond 5 % of the bearing radius (the normal's small-slope model) ends the history with a
+    warning and a message, keeping what was computed (k = 1e-8: 1 mm in the first cycle)."""
+    runaway = worn_crank.with_values({"clearance.wear.coefficient": 1e-8})
+    with pytest.warns(dc.PhysicsWarning, match="exceeds 0.05 of the bearing radius"):
+        history = simulate_wear(runaway, 5)
+    assert history.cycles[-1] < 5 and "stopped at" in history.message and history.max_depth[-1] > 5e-4
+    assert simulate_wear(worn_crank, 1).message == ""

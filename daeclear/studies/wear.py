@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import os
 import time
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,13 +25,18 @@ from ..assembly.assemble import assemble
 from ..assembly.dae_model import DAEModel
 from ..contact.geometry import material_pair
 from ..contact.wear import ArchardWear, WearHistoryArrays, wear_increment, worn_volume
-from ..errors import SceneError
+from ..errors import PhysicsWarning, SceneError
 from ..model.scene import RevoluteClearance, Scene
 from ..progress import Progress
 from ..results.result import Result
 from ..solver_options import SolverOptions
 from ..solvers.ida import simulate
 from .wear_file import WearFile
+
+
+#: The deepest wear a history goes on with, as a fraction of the bearing radius: beyond it the profile's
+#: slope tilts the contact normal by more than the gap's model (normal e / |e|) neglects.
+MAX_DEPTH_FRACTION = 0.05
 
 
 def _rotate(angle: NDArray[np.float64], point: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -101,6 +107,7 @@ class WearHistory:
     peak_force: NDArray[np.float64]
     surfaces: tuple[str, ...]
     wall_time: float = 0.0
+    message: str = ""  # why the history stopped before ``cycles`` (empty when it reached them)
 
     @property
     def max_depth(self) -> NDArray[np.float64]:
@@ -197,8 +204,16 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
     done, work = rows[-1][0], rows[-1][2]
     bar = Progress(float(cycles), unit="cycles", desc="wear", enabled=progress)
     name, radius, clearance = element.name, float(element.bearing_radius), element.radial_clearance
+    message = ""
     try:
         while done < cycles:
+            deepest = max(float(d.max()) for d in depth.values())
+            if deepest > MAX_DEPTH_FRACTION * radius:
+                message = (f"stopped at {done:g} cycles: the worn depth {deepest:.3g} m exceeds "
+                           f"{MAX_DEPTH_FRACTION:g} of the bearing radius {radius:g} m, where the gap's small-slope "
+                           "model no longer holds; a smaller wear coefficient, or fewer cycles.")
+                warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
+                break
             model = model.with_parameters({f"{name}.wear_depth": _depth_value(depth, wear.surfaces)})
             result = simulate(model, t0 + update_every * period, t0=t0, y0=y0, options=options)
             increment, block_work = wear_increment(wear, wear_history(result, model, name), bearing_radius=radius,
@@ -215,7 +230,7 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
             bar.update(min(done, cycles), f"max depth {max(float(d.max()) for d in depth.values()):.3g} m")
     finally:
         bar.close()
-    return _history(rows, wear, radius, time.perf_counter() - tic)
+    return _history(rows, wear, radius, time.perf_counter() - tic, message)
 
 
 def _depth_value(depth: dict[str, NDArray[np.float64]], surfaces: tuple[str, ...]) -> Any:
@@ -225,11 +240,11 @@ def _depth_value(depth: dict[str, NDArray[np.float64]], surfaces: tuple[str, ...
 
 
 def _history(rows: list[tuple[float, dict[str, NDArray[np.float64]], float, float]], wear: ArchardWear,
-             radius: float, wall_time: float) -> WearHistory:
+             radius: float, wall_time: float, message: str) -> WearHistory:
     surfaces = wear.surfaces
     depth = np.array([[row[1][s] for s in surfaces] for row in rows])
     volume = np.array([sum(worn_volume(row[1][s], radius, wear.length) for s in surfaces) for row in rows])
     return WearHistory(angles=wear.angles, cycles=np.array([row[0] for row in rows]),
                        depth=depth[:, 0] if len(surfaces) == 1 else depth, volume=volume,
                        sliding_work=np.array([row[2] for row in rows]), peak_force=np.array([row[3] for row in rows]),
-                       surfaces=surfaces, wall_time=wall_time)
+                       surfaces=surfaces, wall_time=wall_time, message=message)
