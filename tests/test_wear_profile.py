@@ -157,7 +157,7 @@ def test_simulate_wear_input_is_checked(worn_crank):
 
 
 def test_example_joint_wear_quick(tmp_path, capsys):
-    """The study's script: 40 cycles in blocks of 10, its figures, history file and metrics."""
+    """The study's script: 40 cycles in blocks of 10, its figures, animation, history file and metrics."""
     import importlib.util
     import json
     from pathlib import Path
@@ -166,8 +166,8 @@ def test_example_joint_wear_quick(tmp_path, capsys):
     spec = importlib.util.spec_from_file_location("example_joint_wear", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    assert module.main(["--quick", "--out", str(tmp_path)]) == 0
-    for name in ("wear_profile.png", "wear_impacts.png"):
+    assert module.main(["--quick", "--animate", "--out", str(tmp_path)]) == 0
+    for name in ("wear_profile.png", "wear_impacts.png", "wear_growth.gif"):
         assert (tmp_path / name).stat().st_size > 5_000
     metrics = json.loads((tmp_path / "metrics.json").read_text())
     assert metrics["cycles"] == 40 and metrics["volume_m3"] == pytest.approx(
