@@ -319,7 +319,10 @@ static int run_once(const driver_t* D, const setup_t* S, run_out_t* o, double* y
         syp = malloc(sizeof(double) * (size_t)cap * (size_t)n);
         yout = malloc(sizeof(double) * (size_t)n);
         ypout = malloc(sizeof(double) * (size_t)n);
-        if (!roots || !st || !sh || !sord || !sy || !syp || !yout || !ypout) { rc = fail(err, errlen, "out of memory", NULL); break; }
+        if (!roots || !st || !sh || !sord || !sy || !syp || !yout || !ypout) {
+          rc = fail(err, errlen, "out of memory", NULL);
+          break;
+        }
         const double tic = now();
         do {
           status = D->advance(h, op->d[0], NULL, 0, &i_eval, NULL, NULL, (int)op->i[0], cap, st, sy, syp, sh, sord,

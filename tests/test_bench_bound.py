@@ -94,3 +94,13 @@ def test_agreement_names_what_differs(bench, compared):
     other = dataclasses.replace(r.bound, steps=r.bound.steps + 100, events=r.bound.events + 1, y_end=y_end)
     problems = bench.agreement(other, recorder, result, r.n_q)
     assert [p.split(":")[0].split(" (")[0] for p in problems] == ["steps", "events", "end state"], problems
+
+
+def test_timings_are_recorded(compared):
+    """One timed repeat each: the C run, the simulate call and its parts (the report pass inside the call)."""
+    _, results = compared
+    for r in results:
+        assert len(r.c_walls) == len(r.walls) == len(r.reports) == 1
+        assert 0 < r.c_loops[0] <= r.c_walls[0]
+        assert 0 < r.reports[0] < r.walls[0]
+        assert 0 < r.solves[0] + r.setups[0] + r.reports[0] < r.walls[0]
