@@ -10,7 +10,7 @@ scene: every solver uses the model, only assembly needs CasADi's symbolic constr
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal
+from typing import Any, Literal
 from collections.abc import Mapping, Sequence
 
 import casadi as ca
@@ -69,7 +69,7 @@ class DAEModel:
     base_force: ca.Function  # (t, q, v) -> Q (gravity and applied loads)
     # the scene's description ("scene": a read-only mapping made at its first read) and the options
     parameters: dict[str, Any] = field(default_factory=dict)
-    contacts: tuple[Any, ...] = ()  # contact elements' event logic (clearance joints)
+    contacts: tuple[Any, ...] = ()  # contact elements' event rules (clearance joints; no run state)
     track_work: bool = False
     # (root, term, gap-rate extra, needs approach speed, min approach speed) of simple pairs
     auto_pairs: tuple[tuple[int, int, int, bool, float], ...] = ()
@@ -99,8 +99,6 @@ class DAEModel:
     # numbers they are: with_parameters makes a model with new numbers from both
     structure: Any = field(default=None, compare=False, repr=False)
     scene: Any = field(default=None, compare=False, repr=False)
-    # False for a model that starts from a computed state (a restart), whose start is not checked
-    start_is_declared: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         # frozen means frozen: the arrays are read-only (a copy when the caller's array is writable)
@@ -117,21 +115,6 @@ class DAEModel:
             if name in changes:
                 model.__dict__[name] = _read_only(changes[name])
         return model
-
-    def for_run(self, *, from_state: bool = False) -> DAEModel:
-        """A copy of this model for one run: the same functions and numbers, its own contact logic.
-
-        The contact logic objects hold a run's state (each pair's mode, latched approach speed and
-        storm history); a run works on its own copies, so that a model is never changed by a run
-        and runs of one model (one after the other, or at the same time in threads) are
-        independent. ``from_state``: the run starts from a given state of a run (``simulate(...,
-        y0=...)``), whose contacts at the start are no declaration error (:mod:`daeclear.solvers.physics`).
-        """
-        # every field shared (read-only arrays, the start memo) but the logic
-        run_model = self.copy_with(contacts=tuple(_run_copy(logic) for logic in self.contacts))
-        if from_state:  # an instance value over the class's: this copy only (the class default stays)
-            object.__setattr__(run_model, "start_is_declared", False)
-        return run_model
 
     def with_parameters(self, values: Mapping[str, Any]) -> DAEModel:
         """This model with new numbers, as a new model (this one is unchanged), compiling nothing:
@@ -509,17 +492,6 @@ def _mapped(function: ca.Function, n: int) -> ca.Function:
     """``function`` evaluated column-wise on n points (the function itself when n == 1; building a
     map costs about 0.1 ms, which matters on the per-event path)."""
     return function if n == 1 else function.map(n)
-
-
-def _run_copy(logic: Any) -> Any:
-    """A contact logic object for one run: a shallow copy whose lists (pair states, faces) are its
-    own (its buffered functions are shared: each thread evaluates them in its own buffers)."""
-    fresh = object.__new__(type(logic))  # copy.copy without its reduce protocol
-    fresh.__dict__.update(vars(logic))
-    for name, value in vars(logic).items():
-        if isinstance(value, list):
-            setattr(fresh, name, list(value))
-    return fresh
 
 
 _ARRAY_FIELDS = ("q_guess", "v_guess", "mass_diagonal", "parameter_values")

@@ -102,9 +102,9 @@ def simulate(
     Parameters
     ----------
     scene : Scene or DAEModel
-        The mechanism; a Scene is assembled with ``formulation`` first. A model is never changed
-        by a run (its contact logic is copied per run): runs of one model, one after the other or
-        at the same time in threads, are independent.
+        The mechanism; a Scene is assembled with ``formulation`` first. A model is a value that no
+        run changes (a run's contact state is its own, :mod:`daeclear.assembly.contact_state`): runs of
+        one model, one after the other or at the same time in threads, are independent.
     t_end : float
         End time, s (> t0).
     options : SolverOptions or None
@@ -267,7 +267,6 @@ def simulate(
     opts.output_size(out, limit, t_eval_step=t_eval_step, step=None, start=t0, end=t_end, n_states=model.n_states,
                      n_channels=len(model.channel_names))  # before the session: nothing compiled or run
     from_state = y0 is not None
-    model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
     session, y0, yp0 = _start_session(model, t0, y0, rtol=rtol, atol=atol, backend=backend, max_step=max_step,
                                       max_steps=max_steps, linear_solver=linear_solver, start=start,
                                       allow_penetration=allow_penetration)
