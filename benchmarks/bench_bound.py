@@ -51,7 +51,7 @@ import numpy as np
 
 import daeclear as dc
 from daeclear.engine.build import CSRC, compiler_command
-from daeclear.engine.c_handle import STAT_KEYS
+from daeclear.engine.abi import STAT_KEYS
 from daeclear.engine.c_session import CSession
 from daeclear.engine.codegen import build_model_library, clear_memos
 from daeclear.engine.library import DRIVER_ABI, ModelLibrary

@@ -224,6 +224,32 @@ def test_compiled_and_python_backends_decide_the_same_storms(kind, storm, plain_
         np.testing.assert_allclose(fast.channels[name], slow.channels[name], rtol=0, atol=1e-6 * scale, err_msg=name)
 
 
+@pytest.mark.parametrize("kind, storm", [("revolute", Storm(4, 5e-4)), ("translational", Storm(2, 1e-3))])
+def test_the_run_state_read_from_the_compiled_loop_gives_its_terms(kind, storm, monkeypatch):
+    """The compiled loop holds the states of the pairs it decides and the IDA loop reads them (no
+    replay): after every advance the terms and latched speeds that state implies are the loop's
+    own (dc_get_active), and the recorded switch vector is the same."""
+    from daeclear.assembly import contact_state
+    from daeclear.solvers.ida_loop import SegmentLoop
+
+    model = _slider_crank(kind, storm)
+    checked: list[int] = []
+    take = SegmentLoop.take_pair_states
+
+    def take_and_check(loop):
+        take(loop)
+        active, params = contact_state.switches(model, loop.state)
+        implied = model.switch_vector(active, params)
+        assert loop.session.active_switch().tolist() == implied.tolist() == loop.switch.tolist()
+        checked.append(sum(st.contact or st.held for states in loop.state for st in states))
+
+    monkeypatch.setattr(SegmentLoop, "take_pair_states", take_and_check)
+    monkeypatch.setattr(CSession, "set_auto_events",  # the loop returns after every switch: many checks
+                        functools.partialmethod(CSession.set_auto_events, capacity=1))
+    result = dc.simulate(model, 0.012, rtol=1e-8, backend="c")
+    assert result.success and len(result.events) > 5 and len(checked) > 5 and max(checked) >= 1
+
+
 def test_a_small_event_buffer_is_drained_between_chunks(monkeypatch):
     """An event buffer of one event per pair makes the C loop return after every switch; the run
     is the same."""

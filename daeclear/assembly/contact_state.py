@@ -8,20 +8,20 @@ is a :data:`ContactState`: one tuple of pair states per contact element, in the 
 Everything else the integrator needs follows from it: which terms are on and their parameters (the
 switch vector), the modes of pairs and faces, the directions of the roots to watch. A root is
 decided by :func:`decide`, which returns the new state and the events, as diffrax threads its
-``solver_state``; the compiled IDA loop decides the simple pairs itself, and its decisions are
-taken into the state by :func:`with_decisions`.
+``solver_state``; the compiled IDA loop decides the simple pairs itself and holds their states,
+which the IDA loop reads back into the run's state (:func:`with_pairs`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..results.result import ContactEvent
-from .automaton import Decision, PairState, recorded
+from .automaton import PairState
 
 #: One tuple of pair states per contact element of the model, in ``model.contacts`` order.
 ContactState = tuple[tuple[PairState, ...], ...]
@@ -81,12 +81,11 @@ def pair_state(model: Any, state: ContactState, root: int) -> PairState:
     raise IndexError(f"no contact pair watches root {root}")
 
 
-def with_decisions(model: Any, state: ContactState, decisions: Sequence[tuple[int, Decision]]) -> ContactState:
-    """The state after decisions taken by the compiled loop, ``(root, decision)`` in time order: each
-    pair's mode and latched speed (its storm history stays with the loop that decides it)."""
+def with_pairs(model: Any, state: ContactState, pairs: Mapping[int, PairState]) -> ContactState:
+    """The state with the pairs of the given roots replaced (the compiled loop's, which it decides)."""
     new = [list(states) for states in state]
-    where = {root: (k, logic.pair_index(root)) for k, logic in enumerate(model.contacts) for root in logic.roots}
-    for root, decision in decisions:
-        k, i = where[root]
-        new[k][i] = recorded(new[k][i], decision)
+    for k, logic in enumerate(model.contacts):
+        for root in logic.roots:
+            if root in pairs:
+                new[k][logic.pair_index(root)] = pairs[root]
     return tuple(tuple(states) for states in new)

@@ -15,23 +15,12 @@ from typing import Any
 
 import numpy as np
 
+from .abi import DC_ST_N
 from .build import memo_put_bounded, memo_table
 from .session_base import SessionOptions
 
 log = logging.getLogger("daeclear")
 
-#: the counters dc_stats writes, in its order
-STAT_KEYS = (
-    "n_steps",
-    "n_res_evals",
-    "n_jac_evals",
-    "n_lin_setups",
-    "n_nonlin_iters",
-    "n_nonlin_conv_fails",
-    "n_err_test_fails",
-    "n_root_evals",
-    "n_reinits",
-)
 
 
 def _free_c_session(lib: Any, handle: int) -> None:
@@ -87,7 +76,7 @@ class Handle:
         self.n_stored = ctypes.c_int()
         self.t_out = ctypes.c_double()
         self.flag = ctypes.c_int()
-        self.statbuf = np.zeros(len(STAT_KEYS), dtype=np.int64)
+        self.statbuf = np.zeros(DC_ST_N, dtype=np.int64)
         # reinit inputs: copied into fixed arrays whose addresses are known
         self.y0b = np.zeros(n)
         self.yp0b = np.zeros(n)

@@ -106,6 +106,7 @@ class CSession(SessionBase):
         self._addr = hd.addr
         self._extra_meta = hd.extra_meta
         self._poff = list(itertools.accumulate(model.n_params, initial=0))
+        self._auto_storms: tuple[Storm, ...] = ()  # the storm constants of the pairs C decides (set_auto_events)
 
     def _pool_key(self) -> tuple[int, str, int, int]:
         """What a pooled handle must share with this session: library, linear solver, max_order, buffer_steps."""
@@ -178,6 +179,7 @@ class CSession(SessionBase):
         if rc != 0:
             raise DaeclearError("configuring the events decided in C failed")
         self._auto_cap = capacity
+        self._auto_storms = tuple(storms)
         if self._hd.auto_buf is None or self._hd.auto_buf[0][0].size != capacity:  # kept on the handle (pooled)
             buf = (np.empty(capacity), np.empty(capacity, dtype=np.int32),
                    np.empty((capacity, DC_EV_N), dtype=np.int32), np.empty(capacity), np.empty(capacity),
@@ -185,6 +187,27 @@ class CSession(SessionBase):
             self._hd.auto_buf = (buf, tuple(address(a) for a in buf))
         self._auto_buf = self._hd.auto_buf
         return True
+
+    def pair_states(self) -> list[PairState]:
+        """The automaton state of every pair the C loop decides (:meth:`set_auto_events`'s order),
+        read from C, which holds them: mode, hold, flight start, latched speed and switch history."""
+        self._check_open()
+        storms = self._auto_storms
+        n = len(storms)
+        ints = [np.zeros(max(n, 1), dtype=np.int32) for _ in range(3)]
+        floats = [np.zeros(max(n, 1)) for _ in range(2)]
+        recent = np.zeros(max(sum(st.events for st in storms), 1))
+        contact, held, n_recent = ints
+        free_since, latched = floats
+        self._lib.dc_get_pairs(self._h, address(contact), address(held), address(free_since), address(latched),
+                               address(n_recent), address(recent))
+        out, offset = [], 0
+        for p, storm in enumerate(storms):
+            out.append(PairState(contact=bool(contact[p]), held=bool(held[p]), free_since=float(free_since[p]),
+                                 latched=float(latched[p]),
+                                 recent=tuple(recent[offset:offset + n_recent[p]].tolist())))
+            offset += storm.events
+        return out
 
     def set_layout(self, layout: StateLayout) -> bool:
         """The model's state layout and extras, so that C makes states consistent itself: restarts

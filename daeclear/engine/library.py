@@ -80,6 +80,7 @@ MODEL_PROTOTYPES: Prototypes = {
     "dc_automaton_run": (I, [I, P, P, P, I, D, D, I, I, D, P, P, P, P, P]),
     "dc_pending_events": (I, [P]),
     "dc_get_active": (None, [P, P, P]),
+    "dc_get_pairs": (None, [P, P, P, P, P, P, P]),
     "dc_set_layout": (I, [P, I, I, I, I, I, I, I, I, I, D, I]),
     "dc_report": (I, [P, I, P, P, P, P, P, P]),
     "dc_set_stall": (I, [P, D, I]),

@@ -118,6 +118,25 @@ DC_API void dc_get_active(void* sp, int* active, double* params) {
   memcpy(params, s->params, sizeof(double) * (size_t)np);
 }
 
+/* The automaton state of every pair the loop decides (the run's authority for them): contact, held,
+ * free_since, latched and the number of recent switch times [n_auto]; recent: each pair's times,
+ * oldest first, at the pair's offset in the concatenation of rings of storm_events[p] entries. */
+DC_API void dc_get_pairs(void* sp, int* contact, int* held, double* free_since, double* latched, int* n_recent,
+                         double* recent) {
+  dc_session* s = (dc_session*)sp;
+  size_t ring = 0;
+  for (int p = 0; p < s->n_auto; ++p) {
+    const dc_pair_state* st = &s->pair_state[p];
+    contact[p] = st->contact;
+    held[p] = st->held;
+    free_since[p] = st->free_since;
+    latched[p] = st->latched;
+    n_recent[p] = st->n_recent;
+    memcpy(recent + ring, st->recent, sizeof(double) * (size_t)st->n_recent);
+    ring += (size_t)s->pair_rule[p].storm_events;
+  }
+}
+
 /* Test hook: run one pair's automaton (pair_step, exactly as the loop does) over a root sequence
  * t[i], dir[i], rate[i] from the state (contact0, held0, latched0) with no history; write each
  * decision to kind, contact, held, watch, latched [n]. Returns 0, or -1 for bad arguments. */
