@@ -32,7 +32,6 @@ except ImportError:  # running from a checkout without installing
 
 import daeclear as dc  # noqa: E402
 import daeclear.solvers.explicit as integrators  # noqa: E402
-from daeclear.assembly.automaton import PairState  # noqa: E402
 
 T_END = 0.024
 WINDOW = 0.005
@@ -56,21 +55,10 @@ CASES_QUICK = [
 ]
 
 
-def reset_contact_logic(model):
-    """Start every run with fresh contact logic (initial_modes starts every run without storm
-    history too; this keeps a run from seeing the last one's automaton states even before that)."""
-    for logic in model.contacts:
-        if hasattr(logic, "state"):
-            logic.state = PairState()
-        if hasattr(logic, "states"):
-            logic.states = []
-
-
 def run(model, method, kind, value, te, repeat):
     kw = {kind: value}
     best, result = np.inf, None
     for _ in range(repeat):
-        reset_contact_logic(model)
         tic = time.perf_counter()
         result = dc.simulate(model, T_END, method=method, t_eval=te, on_failure="return", **kw)
         best = min(best, time.perf_counter() - tic)
@@ -87,7 +75,6 @@ def main() -> None:
     # output on the accuracy window only (the runs still go to T_END); t = 0 .. 5 ms every 5 us
     te = np.linspace(0.0, WINDOW, 1001)
     ref = dc.simulate(model, T_END, rtol=1e-10, t_eval=te)
-    reset_contact_logic(model)
     check = dc.simulate(model, T_END, method="DOP853", rtol=1e-12, t_eval=te)
     scale = np.max(np.abs(ref[CHANNEL]))
     ref_err = np.max(np.abs(check[CHANNEL] - ref[CHANNEL]))
@@ -148,7 +135,6 @@ def main() -> None:
     for method, kind, value in cases:
         for hermite in (True, False):
             integrators.HERMITE_GAP_CHECK = hermite
-            reset_contact_logic(model)
             try:
                 r = dc.simulate(model, T_END, method=method, on_failure="return", **{kind: value})
             finally:

@@ -27,7 +27,7 @@ import warnings
 import numpy as np
 
 import daeclear as dc
-from daeclear.assembly import automaton
+from daeclear.assembly import automaton, contact_state
 from daeclear.solvers import physics, ida as solve
 from daeclear.engine.ida_session import open_session
 
@@ -65,9 +65,9 @@ def parts(repeats: int) -> None:
 
     open_one = session()
     y0, _ = model.initial_state(session=open_one)
-    pair = model.contacts[0]
     onset = automaton.Decision(kind=automaton.ONSET, contact=True, held=False, latched=0.3, watch=-1)
-    active, params = [False] * len(model.terms), [np.zeros(term.n_params) for term in model.terms]
+    state = contact_state.start_state(model, 0.0, y0)
+    active, params = contact_state.switches(model, state)
     result = dc.simulate(model, t_end=0.002, rtol=1e-7, t_eval=np.linspace(0.0, 0.002, 400))
     # three output rows, their constraint drift set to 1 m: the checks take the drift warning's path,
     # which evaluates the constraints at the worst row to name the equation
@@ -78,7 +78,8 @@ def parts(repeats: int) -> None:
         "open and close a session": lambda: session().close(),
         "initial state": lambda: model.initial_state(session=open_one),
         "physics checks, drift warned": lambda: physics.check_run(model, *key, None, {}, open_one),
-        "record one contact switch": lambda: pair.record(pair.root_index, 0.001, y0, 0.3, onset, active, params),
+        "record one contact switch": lambda: contact_state.switches(
+            model, contact_state.with_decisions(model, state, [(0, onset)])),
         "switch vector": lambda: model.switch_vector(active, params),
         "Result of 400 points": lambda: dc.Result(
             t=result.t, y=result.y, yp=result.yp, state_names=result.state_names, channels=result.channels,

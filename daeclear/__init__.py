@@ -11,13 +11,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
-import sys
-import types
 from typing import TYPE_CHECKING, Any
-
-# Old module paths, thin aliases for one release (daeclear.old_paths): the finder is installed now
-# (it imports nothing else); ``import daeclear.<old>`` loads an alias when asked.
-from . import old_paths  # noqa: F401  (installs the finder of the old paths)
 
 if TYPE_CHECKING:  # what the lazy names are, for type checkers and readers
     from .studies import analysis
@@ -50,13 +44,9 @@ _loading: list[str] = []  # non-empty while _load_all runs
 
 
 def _load_all() -> dict[str, Any]:
-    """Every public name, imported as the eager package imported them (old paths first, so that the new
-    names win over the aliases: the function ``sweep`` over the module ``daeclear.sweep``)."""
-    from . import (  # noqa: F401  (old paths, served by the finder)
-        accuracy, analysis, automaton, codegen, ida_session, loads, mechanisms, outputs, physics, profiles,
-        recorder, result, scene, sweep)
-    from .studies import analysis  # noqa: F811, F401
-    from .model import loads, mechanisms, profiles  # noqa: F811, F401
+    """Every public name, imported at once on the first use of one."""
+    from .studies import analysis  # noqa: F401
+    from .model import loads, mechanisms, profiles  # noqa: F401
     from .assembly.assemble import DAEModel, assemble  # noqa: F401
     from .errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted,  # noqa: F401
                          OutputError, PhysicsWarning, SceneError, SolveError)
@@ -68,7 +58,7 @@ def _load_all() -> dict[str, Any]:
                               TranslationalClearance)
     from .solver_options import SolverOptions  # noqa: F401
     from .solvers.ida import simulate  # noqa: F401
-    from .studies.sweep import load_sweep, sweep  # noqa: F811, F401
+    from .studies.sweep import load_sweep, sweep  # noqa: F401
     names = locals()
     public = {name: names[name] for name in __all__}
     globals().update(public)  # bound once: later uses do not come here
@@ -91,16 +81,3 @@ def __getattr__(name: str) -> Any:
 
 def __dir__() -> list[str]:
     return sorted({*globals(), *__all__})
-
-
-class _Package(types.ModuleType):
-    """The package module: an old path imported (``import daeclear.sweep``) does not replace the public
-    name it shares (the function ``daeclear.sweep``, the new modules ``daeclear.analysis``...)."""
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        if name in __all__ and isinstance(value, types.ModuleType) and value.__name__ in old_paths.OLD_PATHS:
-            return  # the public name is bound by _load_all
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package

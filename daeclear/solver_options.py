@@ -14,7 +14,6 @@ or a sweep sets those per call, and they never change the computed trajectory.
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -23,7 +22,6 @@ from typing import Any
 import numpy as np
 
 from . import options
-from .engine.build import memo_put_bounded, memo_table
 from .options import fail
 
 WHERE = "SolverOptions"
@@ -106,34 +104,14 @@ class SolverOptions:
         given = {k: v for k, v in keywords.items() if v is not UNSET}
         if not given:
             return self
-        # the same plain keywords again (a loop of runs): the options checked the first time
-        key = (self, where, *((k, type(v), v) for k, v in given.items())) \
-            if all(type(v) in _MEMO_TYPES for v in given.values()) else None
-        known = _MERGED.get(key) if key is not None else None
-        if known is not None:
-            return known
         _check_names(given, "merged")
-        values = checked({**self.to_dict(), **given}, where=where)
-        merged = copy.copy(self)  # checked once (here, naming where), not again by the constructor
-        for name, value in values.items():
-            object.__setattr__(merged, name, value)
-        if key is not None:
-            memo_put_bounded(_MERGED, key, merged, _MERGED_LIMIT)
-        return merged
+        return dataclasses.replace(self, **checked({**self.to_dict(), **given}, where=where))
 
     def atol_value(self) -> float | np.ndarray | dict[str, float] | None:
         """``atol`` as the solvers take it (one value, a mapping by quantity, an array per state, or None)."""
         if isinstance(self.atol, tuple):
             return dict(self.atol) if self.atol and isinstance(self.atol[0], tuple) else np.array(self.atol)
         return self.atol
-
-
-# merged() of plain keywords, by (options, where, (name, type, value)...): a keyword's exact type is
-# in the key (True and 1, 1 and 1.0 are told apart; 0.0 and -0.0, equal keys, are both max_step's
-# "unbounded"); an invalid value raises before it is stored
-_MEMO_TYPES = frozenset({str, bool, int, float})
-_MERGED: dict[tuple[Any, ...], SolverOptions] = memo_table()
-_MERGED_LIMIT = 64
 
 
 def checked(values: Mapping[str, Any], *, where: str) -> dict[str, Any]:

@@ -10,6 +10,7 @@ same events.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 
@@ -151,10 +152,8 @@ def test_pair_logic_and_slider_corners_decide_by_the_automaton():
         logic = model.contacts[0]
         names = [term.name for term in model.terms]
         y0 = model.initial_state()[0]
-        active = [False] * len(model.terms)
-        params = [np.zeros(term.n_params) for term in model.terms]
-        logic.initial_modes(0.0, y0, active, params)
-        states = {root: logic.pair_state(root) for root in logic.roots}
+        own = logic.start(0.0, y0)  # the element's part of a run's contact state: passed in, returned
+        states = {root: own[logic.pair_index(root)] for root in logic.roots}
         t, kinds = 0.0, set()
         for _ in range(400):
             root = int(rng.choice(list(logic.roots)))
@@ -164,16 +163,18 @@ def test_pair_logic_and_slider_corners_decide_by_the_automaton():
             direction = states[root].watch or int(rng.choice([-1, 1]))
             found = np.zeros(len(model.gap_names), dtype=np.int32)
             found[root] = direction
-            events = logic.on_roots(t, y, y, found, active, params)
+            own, events = logic.decide(own, t, y, found)
             states[root], decision = step(states[root], t, direction, rate, storm=storm,
                                           min_approach_speed=logic.min_approach_speed)
             expected = {ONSET: ["onset"], SEPARATION: ["separation"]}.get(decision.kind, [])
             assert [e.kind for e in events if e.pair == model.gap_names[root]] == expected
+            assert own[logic.pair_index(root)] == states[root]  # the very state of the automaton
             term = names.index(model.gap_names[root])
-            assert active[term] == decision.term_on
-            assert dict(logic.root_directions(active))[root] == decision.watch
+            switches = {k: (on, p) for k, on, p in logic.terms(own)}
+            assert switches[term][0] == decision.term_on
+            assert dict(logic.root_directions(own))[root] == decision.watch
             if logic.needs_approach:
-                assert params[term][0] == states[root].latched
+                assert switches[term][1][0] == states[root].latched
             kinds.add((decision.kind, decision.held))
         assert {(ONSET, False), (SEPARATION, False), (SEPARATION, True), (NONE, True)} <= kinds
 
@@ -184,9 +185,8 @@ def test_pair_logic_and_slider_corners_decide_by_the_automaton():
 def _slider_crank(kind: str, storm: Storm | None) -> dc.DAEModel:
     scene = dc.mechanisms.slider_crank(kind, gravity=0.0) if kind == "revolute" else dc.mechanisms.slider_crank(kind)
     model = dc.assemble(scene, "index1")  # step for step on both backends (GGL's Newton coefficient: C only)
-    if storm is not None:
-        for logic in model.contacts:
-            logic.storm = storm
+    if storm is not None:  # the rules are frozen: a model with other rules is a new value
+        model = model.copy_with(contacts=tuple(dataclasses.replace(logic, storm=storm) for logic in model.contacts))
     return model
 
 

@@ -13,7 +13,6 @@ or private import across modules fails.
 from __future__ import annotations
 
 import ast
-import importlib
 import subprocess
 import sys
 from pathlib import Path
@@ -21,7 +20,6 @@ from pathlib import Path
 import pytest
 
 import daeclear
-from daeclear.old_paths import OLD_PATHS
 
 PACKAGE = Path(daeclear.__file__).resolve().parent
 
@@ -75,8 +73,6 @@ def imports() -> list[tuple[str, str, str | None]]:
                     full = f"{target}.{alias.name}"
                     if full in files:
                         out.append((name, full, None))
-                    elif full in OLD_PATHS:
-                        out.append((name, OLD_PATHS[full], None))
                     else:
                         out.append((name, target, alias.name))
     return out
@@ -161,33 +157,29 @@ def test_no_private_imports_across_modules():
 
 # ----------------------------------------------------------------------------- old paths and public API
 
-@pytest.mark.parametrize("old", sorted(OLD_PATHS))
-def test_old_module_paths_are_aliases(old):
-    """Every old path imports, says where it moved, and gives the new module's public objects."""
-    alias = importlib.import_module(old)
-    new = importlib.import_module(OLD_PATHS[old])
-    assert OLD_PATHS[old] in alias.__doc__
-    public = [n for n, v in vars(new).items() if not n.startswith("_") and not isinstance(v, type(sys))]
-    assert public and set(alias.__all__) == set(public)
-    for name in public:
-        assert getattr(alias, name) is getattr(new, name), name
+OLD_PATHS = ("accuracy", "analysis", "automaton", "codegen", "ida_session", "recorder", "result", "scene",
+             "style", "sweep")
 
 
-def test_old_paths_after_import_daeclear_in_a_fresh_interpreter():
-    """``import daeclear`` then the attribute paths and imports users wrote before the move; the
-    function ``daeclear.sweep`` stays the function after ``import daeclear.sweep``."""
+@pytest.mark.parametrize("old", OLD_PATHS)
+def test_old_module_paths_are_gone(old):
+    """The flat module paths of before the sub-packages are not importable: no import hook serves them
+    (the public names stay at ``daeclear.<name>``; the modules live in their sub-package)."""
+    code = (f"import importlib, daeclear\ntry:\n    importlib.import_module('daeclear.{old}')\n"
+            f"except ModuleNotFoundError:\n    pass\nelse:\n    raise SystemExit('daeclear.{old} still imports')")
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_public_names_in_a_fresh_interpreter():
+    """``import daeclear`` then the public names and the sub-packages' paths; ``__all__`` is the public API."""
     code = "\n".join([
         "import daeclear",
-        "assert daeclear.scene.Body is daeclear.Body and daeclear.result.Result is daeclear.Result",
-        "assert daeclear.result.load is daeclear.load and daeclear.loads.Force is daeclear.Force",
         "assert daeclear.analysis.classify_motion and daeclear.mechanisms.slider_crank",
-        "import daeclear.sweep",
-        "from daeclear.sweep import load_sweep",
-        "assert callable(daeclear.sweep) and daeclear.sweep.__name__ == 'sweep' and load_sweep is daeclear.load_sweep",
-        "from daeclear.scene import Scene, RevoluteClearance",
-        "from daeclear.mechanisms import slider_crank",
-        "from daeclear.style import caption",
-        "from daeclear.readings import JOINT_READINGS",
+        "assert callable(daeclear.sweep) and daeclear.sweep.__name__ == 'sweep'",
+        "from daeclear.studies.sweep import load_sweep",
+        "assert load_sweep is daeclear.load_sweep",
+        "from daeclear.model.scene import Scene, RevoluteClearance",
+        "assert Scene is daeclear.Scene and RevoluteClearance is daeclear.RevoluteClearance",
         "from daeclear.solvers import simulate",
         "assert simulate is daeclear.simulate",
         "import daeclear.plot, daeclear.plot.figures as figures",
@@ -195,6 +187,8 @@ def test_old_paths_after_import_daeclear_in_a_fresh_interpreter():
         "assert names and all(getattr(daeclear.plot, n) is getattr(figures, n) for n in names)",
         "assert daeclear.plot.save_response_figure is figures.save_response_figure",
         "from daeclear.contact import LankaraniNikravesh",
+        "assert all(not n.startswith('_') for n in daeclear.__all__)",
+        "assert not any(n in daeclear.__all__ for n in ('codegen', 'automaton', 'recorder', 'old_paths'))",
     ])
     subprocess.run([sys.executable, "-c", code], check=True)
 

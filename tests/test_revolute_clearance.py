@@ -14,6 +14,7 @@ from scipy.integrate import simpson
 
 import daeclear as dc
 from daeclear.assembly.assemble import EXTRA_TERM0
+from daeclear.assembly.automaton import PairState
 from daeclear.errors import SceneError
 from daeclear.model.scene import Driver, RevoluteClearance
 
@@ -200,21 +201,27 @@ def test_storm_guard_holds_then_releases(monkeypatch):
     logic = model.contacts[0]
     y = np.zeros(model.n_states)
     y[1] = -0.5e-3  # journal on the wall
-    active, params = [False], [np.zeros(1)]
+    state = (PairState(),)  # the pair's run state, free: passed in and returned by the rule
     up, down = np.array([1], dtype=np.int32), np.array([-1], dtype=np.int32)
     t = 0.0
+
+    def term(state):  # (on, parameters) of the pair's term
+        return logic.terms(state)[0][1:]
+
     for _ in range(clearance.STORM_EVENTS):
         t += 1e-8
-        logic.on_roots(t, y, y, up if not active[0] else down, active, params)
-    assert logic.held and active[0]  # the separation that completed the storm kept the term on
-    assert logic.root_directions(active) == [(0, 0)]
-    before = params[0].copy()
-    assert logic.on_roots(t + 1e-8, y, y, down, active, params) == []
-    assert logic.on_roots(t + 2e-8, y, y, up, active, params) == []  # quick re-contact: no change
-    assert active[0] and np.array_equal(params[0], before)
-    logic.on_roots(t + 3e-8, y, y, down, active, params)
-    events = logic.on_roots(t + 3e-8 + 2 * clearance.STORM_WINDOW, y, y, up, active, params)
-    assert [e.kind for e in events] == ["onset"] and not logic.held and active[0]
+        state, _ = logic.decide(state, t, y, up if not term(state)[0] else down)
+    assert state[0].held and term(state)[0]  # the separation that completed the storm kept the term on
+    assert logic.root_directions(state) == [(0, 0)]
+    before = term(state)[1].copy()
+    state, events = logic.decide(state, t + 1e-8, y, down)
+    assert events == []
+    state, events = logic.decide(state, t + 2e-8, y, up)
+    assert events == []  # quick re-contact: no change
+    assert term(state)[0] and np.array_equal(term(state)[1], before)
+    state, _ = logic.decide(state, t + 3e-8, y, down)
+    state, events = logic.decide(state, t + 3e-8 + 2 * clearance.STORM_WINDOW, y, up)
+    assert [e.kind for e in events] == ["onset"] and not state[0].held and term(state)[0]
 
 
 def test_energy_balance_with_driver_and_dissipation():

@@ -430,3 +430,20 @@ def test_journal_writes_go_through_the_one_atomic_write(tmp_path, monkeypatch):
     sweep_journal.consolidate(path, mechanism="slider_crank", options={"revolutions": 8},
                               order={"run-a": 0, "run-b": 1})
     assert [r.key for r in load_sweep(path).runs] == ["run-a", "run-b"] and not parts.exists()
+
+
+def test_a_sweep_over_scene_values(tmp_path):
+    """A grid parameter with a dot is a value of the built scene (Scene.with_values): the run is
+    the run of the scene with that value, bit for bit (here the same as the mechanism's option)."""
+    from daeclear.studies.sweep_workers import build_scene
+
+    scene = build_scene("slider_crank", {"joint": "revolute", "clearance.law.restitution": 0.6})
+    assert scene["clearance"].law.restitution == 0.6
+    with pytest.raises(SceneError, match="no field 'restitutio'"):
+        build_scene("slider_crank", {"joint": "revolute", "clearance.law.restitutio": 0.6})
+    out = dc.sweep(tmp_path / "restitution.h5", {"clearance.law.restitution": [0.6]}, fixed=FIXED, max_workers=1,
+                   keep="full", revolutions=2, transient=0, per_revolution=8, twin=False, progress=False)
+    assert out.runs[0].ok and out.runs[0].parameters["clearance.law.restitution"] == 0.6
+    direct = dc.analysis.classify_motion(dc.mechanisms.slider_crank("revolute", restitution=0.6),
+                                         revolutions=2, transient=0, per_revolution=8, twin=False)
+    assert np.array_equal(out.result(0)["slider.vx"], direct.result["slider.vx"])

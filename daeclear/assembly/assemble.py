@@ -23,7 +23,7 @@ Formulations
 
 where ``Phi' = Phi_q v + Phi_t`` and ``gamma = -(d Phi'/dq) v - d Phi'/dt``.
 
-This module builds the model (once per structure: the templates and the memo of scenes seen);
+This module builds the model (once per structure: :class:`Structure`, kept by structure key);
 the assembled :class:`~daeclear.assembly.dae_model.DAEModel` and what a solver asks of it live in
 :mod:`daeclear.assembly.dae_model` (re-exported here).
 """
@@ -141,10 +141,13 @@ def _element_parameters(ref: Reference, element: Any, joints: dict[str, Any]
 
 
 @dataclass(frozen=True)
-class _Template:
-    """What of an assembled model depends on the structure only, shared by every scene with that
-    structure: the model built for the first such scene, and how its numbers are bound."""
+class Structure:
+    """What of an assembled model depends on the structure only, built once per structure key and
+    shared by every model with that structure: the symbolic functions (the model built for the first
+    such scene) and how a scene's numbers are bound to them. A model keeps its structure, so new
+    numbers (:meth:`DAEModel.with_parameters`) are bound without recognising the scene again."""
 
+    key: str  # the structure key (:func:`daeclear.assembly.parameters.structure_key`)
     model: DAEModel  # the structure, with the numbers of the scene it was built from
     layout: tuple[tuple[str, int], ...]
     logic: tuple[Callable[[NDArray[np.float64]], list[Any]], ...]
@@ -162,7 +165,7 @@ class _Template:
                            for root, term, extra, needs, i in self.auto_pairs)
         formulation, track_work = self.model.formulation, self.model.track_work
         return self.model.copy_with(
-            scene_name=scene.name, alpha=float(alpha), beta=float(beta),
+            structure=self, scene=scene, scene_name=scene.name, alpha=float(alpha), beta=float(beta),
             q_guess=[x for b in bodies for x in (*b.position, b.angle)],
             v_guess=[x for b in bodies for x in (*b.velocity, b.angular_velocity)],
             mass_diagonal=[x for b in bodies for x in (b.mass, b.mass, b.inertia)],
@@ -175,16 +178,34 @@ class _Template:
                                    and type(e) in CONTACT_BUILDERS),
         )
 
+    def rebind(self, model: DAEModel, values: Mapping[str, Any]) -> DAEModel:
+        """``model`` with some of its scene's numbers replaced (:meth:`DAEModel.with_parameters`)."""
+        values = dict(values)
+        alpha = float(values.pop("baumgarte.alpha", model.alpha))
+        beta = float(values.pop("baumgarte.beta", model.beta))
+        if (alpha, beta) != (model.alpha, model.beta) and model.formulation != "index1":
+            raise SceneError(f"with_parameters: baumgarte.alpha/beta are numbers of the index1 formulation; "
+                             f"this model is {model.formulation}.")
+        _check_baumgarte(alpha, beta)
+        scene = model.scene.with_values(values)
+        table, key, described = scene_parameters(scene, model.formulation, alpha, beta, model.track_work)
+        if key != self.key:
+            raise SceneError(f"with_parameters: {', '.join(map(repr, values))} change the structure of the model "
+                             "(which terms and laws it has, not only their numbers: e.g. friction on a "
+                             "frictionless joint, or a number of a law that is compiled in); assemble the "
+                             "changed scene instead: assemble(model.scene.with_values(...)).")
+        return self.bind(scene, table, described, alpha, beta)
+
     @functools.cached_property
     def names_sizes(self) -> tuple[tuple[str, ...], tuple[int, ...]]:
         """The layout's names and sizes (:meth:`ParameterTable.has_layout`)."""
         return tuple(name for name, _ in self.layout), tuple(size for _, size in self.layout)
 
 
-# Templates built in this process, by structure key (a scene that differs only in numbers
+# Structures built in this process, by structure key (a scene that differs only in numbers
 # reuses one: no CasADi work, and the same compiled library).
-_TEMPLATES: dict[str, _Template] = memo_table()
-_TEMPLATE_LIMIT = 64
+_STRUCTURES: dict[str, Structure] = memo_table()
+_STRUCTURE_LIMIT = 64
 # Part of every structure key: bump when the generated functions change meaning.
 _ENGINE_VERSION = "engine-3"
 
@@ -229,44 +250,32 @@ def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: flo
     formulation = str(formulation).lower()
     if formulation not in FORMULATIONS:
         raise SceneError(f"formulation={formulation!r}, must be one of {', '.join(FORMULATIONS)}.")
+    _check_baumgarte(alpha, beta)
+    scene.validate()
+    table, key, described = scene_parameters(scene, formulation, alpha, beta, bool(track_work))
+    structure = _STRUCTURES.get(key)
+    if structure is None:
+        structure = _build_template(scene, formulation, bool(track_work), table, key)
+        memo_put_bounded(_STRUCTURES, key, structure, _STRUCTURE_LIMIT)
+    return structure.bind(scene, table, described, alpha, beta)
+
+
+def _check_baumgarte(alpha: Any, beta: Any) -> None:
     for label, value in (("alpha", alpha), ("beta", beta)):
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
             raise SceneError(f"{label}={value!r} 1/s, must be a finite number >= 0.")
-    elements = tuple(scene.elements)
-    identity = (scene.name, tuple(scene.gravity), scene.ground, formulation, alpha, beta, bool(track_work))
-    seen = _SEEN.get(id(scene))
-    if seen is not None and seen[1] == identity and len(seen[0]) == len(elements) \
-            and all(a is b for a, b in zip(seen[0], elements)):
-        return seen[2]  # the scene unchanged: its model (immutable) as it was bound
-    scene.validate()
-    table, key, described = scene_parameters(scene, formulation, alpha, beta, bool(track_work))
-    template = _TEMPLATES.get(key)
-    if template is None:
-        template = _build_template(scene, formulation, bool(track_work), table, f"mechanism_{key[:16]}")
-        memo_put_bounded(_TEMPLATES, key, template, _TEMPLATE_LIMIT)
-    model = template.bind(scene, table, described, alpha, beta)
-    memo_put_bounded(_SEEN, id(scene), (elements, identity, model), _SEEN_LIMIT)
-    return model
-
-
-# Scenes assembled before in this process: id -> (elements, (name, gravity, ground, options),
-# the bound model). The entry holds the very element objects (frozen dataclasses), so an
-# unchanged scene is recognised by identity and a changed one (an element added, replaced,
-# gravity or name reassigned) is not; validation, parameters and binding are then skipped.
-_SEEN: dict[int, tuple[Any, ...]] = memo_table()
-_SEEN_LIMIT = 32
 
 
 def _build_template(scene: Scene, formulation: str, track_work: bool, table: ParameterTable,
-                    library_name: str) -> _Template:
+                    key: str) -> Structure:
     """The symbolic DAE of the scene's structure, every number a symbol of the parameter vector P."""
-    build = _TemplateBuilder(scene, formulation, track_work, table)
+    build = _TemplateBuilder(scene, formulation, track_work, table, key)
     build.constraints()
     build.forces()
     build.equations()
     build.contact_terms()
     build.output_channels()
-    return build.template(library_name)
+    return build.template()
 
 
 class _TemplateBuilder:
@@ -275,8 +284,8 @@ class _TemplateBuilder:
     generated functions with the compiled loop's simple pairs. The symbols each step makes are
     attributes the later steps read."""
 
-    def __init__(self, scene: Scene, formulation: str, track_work: bool, table: ParameterTable) -> None:
-        self.scene, self.formulation, self.track_work, self.table = scene, formulation, track_work, table
+    def __init__(self, scene: Scene, formulation: str, track_work: bool, table: ParameterTable, key: str) -> None:
+        self.scene, self.formulation, self.track_work, self.table, self.key = scene, formulation, track_work, table, key
         self.bodies = scene.bodies
         self.n = n = 3 * len(self.bodies)
         t, q, v, a = ca.SX.sym("t"), ca.SX.sym("q", n), ca.SX.sym("v", n), ca.SX.sym("a", n)
@@ -480,9 +489,10 @@ class _TemplateBuilder:
         joint_readings = joint_channels(self.ctx, self.scene.joints)  # angles, displacements and their rates
         self.channels = channels + self.contact_channels + list(self.loads.channels) + joint_readings
 
-    def template(self, library_name: str) -> _Template:
+    def template(self) -> Structure:
         """The generated functions (outputs, accelerations, kinematics, the compiled loop's simple
-        pairs) and the model of the structure, its numbers bound per scene (:meth:`_Template.bind`)."""
+        pairs) and the model of the structure, its numbers bound per scene (:meth:`Structure.bind`)."""
+        library_name = f"mechanism_{self.key[:16]}"
         t, q, v, P, n, y, yp, channels = self.t, self.q, self.v, self.P, self.n, self.y, self.yp, self.channels
         switch = ca.vertcat(*self.switch_syms) if self.switch_syms else ca.SX(0, 1)
         outputs = ca.Function("outputs", [t, y, yp, switch, P], [ca.vertcat(*[c.expr for c in channels])],
@@ -534,8 +544,9 @@ class _TemplateBuilder:
             start_constraint_names=start_names, constraint_elements=tuple(self.owners),
             driver_names=tuple(self.driver_rows), start_parameters=start_parameters(functions),
             has_loads=bool(self.scene.of_type(Load)),
-        )  # numbers are bound per scene (_Template.bind)
-        return _Template(model=model, layout=self.table.layout, logic=logic_makers, auto_pairs=tuple(auto_pairs))
+        )  # numbers are bound per scene (Structure.bind)
+        return Structure(key=self.key, model=model, layout=self.table.layout, logic=logic_makers,
+                         auto_pairs=tuple(auto_pairs))
 
 
 def _c_identifier(name: str) -> str:

@@ -33,15 +33,23 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from .automaton import DEFAULT_STORM, EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
+from .automaton import DEFAULT_STORM, EVENT_KINDS, NONE, Decision, PairState, Storm, start, step
 from ..results.result import ContactEvent
 from .parameters import symbolic_law
 from .symbolic import AssemblyContext, BufferedFunction, Channel, Term, perpendicular
 
 
-@dataclass
+#: A contact element's part of a run's contact state: the automaton state of each of its pairs.
+PairStates = tuple[PairState, ...]
+#: (term index, on, parameters) of each of an element's terms, as its pairs' states make them.
+TermSwitch = tuple[int, bool, NDArray[np.float64]]
+
+
+@dataclass(frozen=True)
 class PairLogic:
-    """Mode switching of one contact pair: one gap (root) and one term.
+    """Mode switching of one contact pair: one gap (root) and one term. A rule, not a state: the
+    run's state of the pair (:class:`~daeclear.assembly.automaton.PairState`) is passed in and
+    returned (see :mod:`daeclear.assembly.contact_state`).
 
     ``rate`` evaluates ``(gap, penetration_rate)`` from ``(q, v)``; ``needs_approach`` says
     whether the term's parameter is the approach speed latched at onset. The rule, storm guard
@@ -58,72 +66,53 @@ class PairLogic:
     min_approach_speed: float
     discontinuous_friction: bool = False
     storm: Storm = DEFAULT_STORM  # frozen: shared
-    state: PairState = PairState()  # frozen: shared
-
-    @property
-    def held(self) -> bool:
-        """The storm guard holds the term on (see :mod:`daeclear.assembly.automaton`)."""
-        return self.state.held
 
     @property
     def roots(self) -> range:
         """Indices of the gaps (roots) of this element."""
         return range(self.root_index, self.root_index + 1)
 
-    def pair_state(self, root: int) -> PairState:
-        """The automaton state of the pair of gap ``root``."""
-        return self.state
+    def pair_index(self, root: int) -> int:
+        """The pair (index in this element's states) of gap ``root``."""
+        return 0
+
+    def pair_name(self, root: int) -> str:
+        """The name of the pair of gap ``root`` (its events' ``pair``)."""
+        return self.pair
 
     def _gap_rate(self, y: NDArray) -> tuple[float, float]:
         q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
         gap, rate = self.rate(q, v)
         return float(gap[0]), float(rate[0])
 
-    def _params(self) -> NDArray:
-        return np.array([self.state.latched]) if self.needs_approach else np.zeros(0)
+    def _params(self, state: PairState) -> NDArray:
+        return np.array([state.latched]) if self.needs_approach else np.zeros(0)
 
-    def initial_modes(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> dict[str, str]:
+    def start(self, t: float, y: NDArray) -> PairStates:
+        """The pair's state at the start of a run (mode from the gap, rate latched, no history)."""
         gap, rate = self._gap_rate(y)
-        self.state = start(gap > 0.0, rate, self.min_approach_speed)  # a new run starts without history
-        active[self.term_index] = self.state.term_on
-        params[self.term_index] = self._params()
-        return {self.pair: "contact" if self.state.contact else "free"}
+        return (start(gap > 0.0, rate, self.min_approach_speed),)
 
-    def root_directions(self, active: Sequence[bool]) -> list[tuple[int, int]]:
+    def terms(self, states: PairStates) -> list[TermSwitch]:
+        """The term is on in contact or held; its parameter the latched approach speed."""
+        return [(self.term_index, states[0].term_on, self._params(states[0]))]
+
+    def modes(self, states: PairStates) -> dict[str, str]:
+        return {self.pair: "contact" if states[0].contact else "free"}
+
+    def root_directions(self, states: PairStates) -> list[tuple[int, int]]:
         """While free watch onsets (+1), in contact separations (-1), held both (0)."""
-        return [(self.root_index, self.state.watch)]
+        return [(self.root_index, states[0].watch)]
 
-    def on_roots(self, t: float, y: NDArray, yp: NDArray, roots_found: NDArray | None,
-                 active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
-        """Decide a root of the pair's gap by the automaton; return the events it records."""
+    def decide(self, states: PairStates, t: float, y: NDArray, roots_found: NDArray | None
+               ) -> tuple[PairStates, list[ContactEvent]]:
+        """Decide a root of the pair's gap by the automaton: the new states and the events."""
         if roots_found is None or roots_found[self.root_index] == 0:
-            return []
+            return states, []
         rate = self._gap_rate(y)[1]
-        self.state, decision = step(self.state, t, int(roots_found[self.root_index]), rate, storm=self.storm,
-                                    min_approach_speed=self.min_approach_speed)
-        return self.record(self.root_index, t, y, rate, decision, active, params)
-
-    def record(self, root: int, t: float, y: NDArray, rate: float, decision: Decision,
-               active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
-        """Apply a decision taken at a root of gap ``root`` (here or by the compiled loop): the
-        pair's mode, its term and latched speed; return the event it makes, if any."""
-        if decision.kind == NONE:
-            return []
-        self.apply(root, t, y, decision, active, params)
-        return [ContactEvent.from_solver(t, self.pair, EVENT_KINDS[decision.kind], rate, np.array(y, dtype=float))]
-
-    def apply(self, root: int, t: float, y: NDArray, decision: Decision, active: list[bool],
-              params: list[NDArray]) -> None:
-        """Take a decision's mode, term and latched speed without recording its event (the compiled
-        loop's events of one advance are recorded by the IDA loop; see ``record``)."""
-        self.state = recorded(self.state, decision)
-        active[self.term_index] = decision.term_on
-        if decision.kind == ONSET:
-            params[self.term_index] = self._params()
-
-    def pair_name(self, root: int) -> str:
-        """The name of the pair of gap ``root`` (its events' ``pair``)."""
-        return self.pair
+        state, decision = step(states[0], t, int(roots_found[self.root_index]), rate, storm=self.storm,
+                               min_approach_speed=self.min_approach_speed)
+        return (state,), pair_event(self.pair, t, y, rate, decision)
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]]:
         """(root, term, (q, v, P) -> [gap; rate], needs approach speed, floor): the pairs whose
@@ -133,6 +122,13 @@ class PairLogic:
         gap, rate = fn(q, v, P)
         f = ca.Function(f"{self.pair.replace('.', '_')}_gap_rate", [q, v, P], [ca.vertcat(gap, rate)])
         return [(self.root_index, self.term_index, f, bool(self.needs_approach), float(self.min_approach_speed))]
+
+
+def pair_event(pair: str, t: float, y: NDArray, rate: float, decision: Decision) -> list[ContactEvent]:
+    """The event a pair's decision makes (none for NONE)."""
+    if decision.kind == NONE:
+        return []
+    return [ContactEvent.from_solver(t, pair, EVENT_KINDS[decision.kind], rate, np.array(y, dtype=float))]
 
 
 @dataclass(frozen=True)

@@ -10,8 +10,8 @@ scene: every solver uses the model, only assembly needs CasADi's symbolic constr
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal
-from collections.abc import Sequence
+from typing import Any, Literal
+from collections.abc import Mapping, Sequence
 
 import casadi as ca
 import numpy as np
@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..engine.build import memo_put_bounded
 from ..engine.session_base import DAEFunctions, StateLayout
-from ..errors import AssemblyError
+from ..errors import AssemblyError, SceneError
 from ..solvers.physics import check_start_penetration
 from .symbolic import Term
 
@@ -69,7 +69,7 @@ class DAEModel:
     base_force: ca.Function  # (t, q, v) -> Q (gravity and applied loads)
     # the scene's description ("scene": a read-only mapping made at its first read) and the options
     parameters: dict[str, Any] = field(default_factory=dict)
-    contacts: tuple[Any, ...] = ()  # contact elements' event logic (clearance joints)
+    contacts: tuple[Any, ...] = ()  # contact elements' event rules (clearance joints; no run state)
     track_work: bool = False
     # (root, term, gap-rate extra, needs approach speed, min approach speed) of simple pairs
     auto_pairs: tuple[tuple[int, int, int, bool, float], ...] = ()
@@ -95,8 +95,10 @@ class DAEModel:
     # numbers of its memo key: scenes that differ only in clearances or contact and friction laws
     # share one start (see start_parameters())
     start_parameters: NDArray[np.intp] | None = field(default=None, compare=False, repr=False)
-    # False for a model that starts from a computed state (a restart), whose start is not checked
-    start_is_declared: ClassVar[bool] = True
+    # the structure this model binds numbers to (assembly.assemble.Structure) and the scene whose
+    # numbers they are: with_parameters makes a model with new numbers from both
+    structure: Any = field(default=None, compare=False, repr=False)
+    scene: Any = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         # frozen means frozen: the arrays are read-only (a copy when the caller's array is writable)
@@ -114,20 +116,22 @@ class DAEModel:
                 model.__dict__[name] = _read_only(changes[name])
         return model
 
-    def for_run(self, *, from_state: bool = False) -> DAEModel:
-        """A copy of this model for one run: the same functions and numbers, its own contact logic.
+    def with_parameters(self, values: Mapping[str, Any]) -> DAEModel:
+        """This model with new numbers, as a new model (this one is unchanged), compiling nothing:
+        ``model.with_parameters({"clearance.clearance": 2e-4, "clearance.law.restitution": 0.5})``.
 
-        The contact logic objects hold a run's state (each pair's mode, latched approach speed and
-        storm history); a run works on its own copies, so that a model is never changed by a run
-        and runs of one model (one after the other, or at the same time in threads) are
-        independent. ``from_state``: the run starts from a given state of a run (``simulate(...,
-        y0=...)``), whose contacts at the start are no declaration error (:mod:`daeclear.solvers.physics`).
-        """
-        # every field shared (read-only arrays, the start memo) but the logic
-        run_model = self.copy_with(contacts=tuple(_run_copy(logic) for logic in self.contacts))
-        if from_state:  # an instance value over the class's: this copy only (the class default stays)
-            object.__setattr__(run_model, "start_is_declared", False)
-        return run_model
+        Names are the scene's values (:meth:`daeclear.Scene.with_values`: ``"<element>.<field>"``,
+        a law's ``"<element>.law.<field>"``, ``"gravity"``) and, for ``index1``, ``"baumgarte.alpha"``
+        and ``"baumgarte.beta"``. The changed elements are made again from their fields, so what they
+        derive (a journal radius, a contact stiffness from the materials) follows, and validated.
+        Raises SceneError for an unknown name, a bad value, or a change of the structure (e.g.
+        friction on a frictionless joint): assemble that scene instead."""
+        if self.structure is None or self.scene is None:
+            raise AssemblyError("with_parameters: this model was not made by assemble(); assemble the scene.")
+        if not isinstance(values, Mapping):
+            raise SceneError(f"with_parameters: values={values!r}, must be a mapping of names to numbers, "
+                             "e.g. {'clearance.clearance': 2e-4}.")
+        return self.structure.rebind(self, values)
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -488,17 +492,6 @@ def _mapped(function: ca.Function, n: int) -> ca.Function:
     """``function`` evaluated column-wise on n points (the function itself when n == 1; building a
     map costs about 0.1 ms, which matters on the per-event path)."""
     return function if n == 1 else function.map(n)
-
-
-def _run_copy(logic: Any) -> Any:
-    """A contact logic object for one run: a shallow copy whose lists (pair states, faces) are its
-    own (its buffered functions are shared: each thread evaluates them in its own buffers)."""
-    fresh = object.__new__(type(logic))  # copy.copy without its reduce protocol
-    fresh.__dict__.update(vars(logic))
-    for name, value in vars(logic).items():
-        if isinstance(value, list):
-            setattr(fresh, name, list(value))
-    return fresh
 
 
 _ARRAY_FIELDS = ("q_guess", "v_guess", "mass_diagonal", "parameter_values")

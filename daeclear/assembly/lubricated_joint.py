@@ -26,8 +26,8 @@ from numpy.typing import NDArray
 
 from ..model.clearance_joints import RevoluteClearance
 from ..results.result import ContactEvent
-from .automaton import ONSET, Decision, recorded, start, step
-from .contact_pairs import ContactBuild, PairLogic, approach_floor, journal_contact
+from .automaton import start, step
+from .contact_pairs import ContactBuild, PairLogic, PairStates, TermSwitch, approach_floor, journal_contact, pair_event
 from .parameters import law_structure, law_values
 from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
 
@@ -108,7 +108,7 @@ def build_lubricated_revolute(ctx: AssemblyContext, joint: RevoluteClearance, fi
                         ideal=[e[0], e[1]], ideal_names=[f"{name}.x", f"{name}.y"])
 
 
-@dataclass
+@dataclass(frozen=True)
 class LubricatedLogic(PairLogic):
     """Regime switching of one lubricated joint by the contact automaton (see the module docstring).
 
@@ -126,39 +126,32 @@ class LubricatedLogic(PairLogic):
         out = self.rate(y[:self.n_q], y[self.n_q:2 * self.n_q])
         return float(out[0][0]), float(out[1][0]), float(out[2][0])
 
-    def _switch(self, active: list[bool], params: list[NDArray], term_on: bool, onset: bool) -> None:
-        active[self.term_index], active[self.term_index + 1] = term_on, not term_on
-        if onset:
-            params[self.term_index] = self._params()
-
-    def initial_modes(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> dict[str, str]:
+    def start(self, t: float, y: NDArray) -> PairStates:
         broken, _, rate = self._values(y)
-        self.state = start(broken > 0.0, rate, self.min_approach_speed)
-        self._switch(active, params, self.state.term_on, True)
-        return {self.pair: "contact" if self.state.contact else "free"}
+        return (start(broken > 0.0, rate, self.min_approach_speed),)
 
-    def root_directions(self, active: Sequence[bool]) -> list[tuple[int, int]]:
+    def terms(self, states: PairStates) -> list[TermSwitch]:
+        """The dry term while the automaton is in contact (or held), the film term otherwise."""
+        on = states[0].term_on
+        return [(self.term_index, on, self._params(states[0])), (self.term_index + 1, not on, np.zeros(0))]
+
+    def root_directions(self, states: PairStates) -> list[tuple[int, int]]:
         """The film breaks upward through film_break, forms again downward through film_reform."""
         return [(self.root_index, 1), (self.root_index + 1, -1)]
 
-    def on_roots(self, t: float, y: NDArray, yp: NDArray, roots_found: NDArray | None,
-                 active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
+    def decide(self, states: PairStates, t: float, y: NDArray, roots_found: NDArray | None
+               ) -> tuple[PairStates, list[ContactEvent]]:
         if roots_found is None:
-            return []
+            return states, []
         up = roots_found[self.root_index] > 0
         down = roots_found[self.root_index + 1] < 0
         if not (up or down):
-            return []
+            return states, []
         rate = self._values(y)[2]
-        direction = 1 if up and not self.state.contact else -1 if down else 1
-        self.state, decision = step(self.state, t, direction, rate, storm=self.storm,
-                                    min_approach_speed=self.min_approach_speed)
-        return self.record(self.root_index, t, y, rate, decision, active, params)
-
-    def apply(self, root: int, t: float, y: NDArray, decision: Decision, active: list[bool],
-              params: list[NDArray]) -> None:
-        self.state = recorded(self.state, decision)
-        self._switch(active, params, decision.term_on, decision.kind == ONSET)
+        direction = 1 if up and not states[0].contact else -1 if down else 1
+        state, decision = step(states[0], t, direction, rate, storm=self.storm,
+                               min_approach_speed=self.min_approach_speed)
+        return (state,), pair_event(self.pair, t, y, rate, decision)
 
     def simple_pairs(self) -> None:  # type: ignore[override]
         """None: two terms follow one pair, which the compiled loop's mirror does not do."""

@@ -32,7 +32,6 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ..engine.build import memo_put_bounded, memo_table
 from ..model.elements import kept
 from ..results.values import field_names
 
@@ -183,15 +182,7 @@ def structure_key(elements: Iterable[Any], extra: Iterable[Any]) -> str:
     :func:`law_structure`). The scene's name and its numbers (gravity included) are no part of it."""
     # joined, not repr'd: the elements' texts are long and repr would scan them again
     text = "\x00".join([f"{e.name}\x01{element_structure(e)}" for e in elements] + [str(x) for x in extra])
-    key = _KEYS.get(text)
-    if key is None:  # the digest of a structure seen before is looked up: hashing costs more in a sweep's loop
-        key = hashlib.sha256(text.encode()).hexdigest()
-        memo_put_bounded(_KEYS, text, key, 64)
-    return key
-
-
-# structure text -> its SHA-256 (the structures of this process's latest scenes)
-_KEYS: dict[str, str] = memo_table()
+    return hashlib.sha256(text.encode()).hexdigest()
 
 
 # ---- laws ------------------------------------------------------------------------------

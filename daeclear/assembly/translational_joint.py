@@ -79,7 +79,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 from collections.abc import Sequence
 
@@ -87,8 +87,8 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from .automaton import DEFAULT_STORM, EVENT_KINDS, NONE, ONSET, Decision, PairState, Storm, recorded, start, step
-from .contact_pairs import ContactBuild, approach_floor
+from .automaton import DEFAULT_STORM, Storm, start, step
+from .contact_pairs import ContactBuild, PairStates, TermSwitch, approach_floor, pair_event
 from .parameters import law_structure, law_values, symbolic_law
 from ..results.result import ContactEvent
 from ..model.scene import TranslationalClearance
@@ -127,10 +127,11 @@ def _unit(v: Sequence[float]) -> NDArray[np.float64]:
     return a / math.hypot(*a)
 
 
-@dataclass
+@dataclass(frozen=True)
 class SliderGuideLogic:
     """Mode switching of one translational clearance joint: four corner pairs and, in the
-    ``section-4.3`` model, two faces.
+    ``section-4.3`` model, two faces. A rule, not a state: the corners' states are passed in and
+    returned (see :mod:`daeclear.assembly.contact_state`).
 
     Each corner is a pair of :mod:`daeclear.assembly.automaton` (free, contact or held, by the root of its
     gap); the terms follow from the modes: a face term is on while both its corners are in
@@ -139,12 +140,12 @@ class SliderGuideLogic:
     """
 
     name: str
-    pairs: list[str]
+    pairs: tuple[str, ...]
     first_root: int
-    corner_terms: list[int]
-    face_names: list[str]
-    face_terms: list[int]
-    face_corners: list[tuple[int, int]]
+    corner_terms: tuple[int, ...]
+    face_names: tuple[str, ...]
+    face_terms: tuple[int, ...]
+    face_corners: tuple[tuple[int, int], ...]
     rate: BufferedFunction  # (q, v) -> (gaps, penetration rates)
     n_q: int
     needs_approach: bool
@@ -152,118 +153,86 @@ class SliderGuideLogic:
     face_needs_approach: bool
     face_min_approach_speed: float
     storm: Storm = DEFAULT_STORM  # frozen: shared
-    states: list[PairState] = field(default_factory=list)
-    face_on: list[bool] = field(default_factory=list)
 
     @property
     def roots(self) -> range:
         """Indices of the gaps (roots) of this element: one per corner."""
         return range(self.first_root, self.first_root + len(self.pairs))
 
-    def pair_state(self, root: int) -> PairState:
-        """The automaton state of the corner of gap ``root``."""
-        return self.states[root - self.first_root]
+    def pair_index(self, root: int) -> int:
+        """The corner (index in this element's states) of gap ``root``."""
+        return root - self.first_root
+
+    def pair_name(self, root: int) -> str:
+        """The name of the corner of gap ``root`` (its events' ``pair``)."""
+        return self.pairs[root - self.first_root]
 
     def _evaluate(self, y: NDArray) -> tuple[NDArray, NDArray]:
         q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
         gaps, rates = self.rate(q, v)
         return np.asarray(gaps, dtype=float).ravel(), np.asarray(rates, dtype=float).ravel()
 
-    def _apply(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
-        """Set the terms from the modes; return the events of faces that formed or broke."""
-        events: list[ContactEvent] = []
+    def _faces_on(self, states: PairStates) -> list[bool]:
+        return [states[a].contact and states[b].contact for a, b in self.face_corners]
+
+    def start(self, t: float, y: NDArray) -> PairStates:
+        """Each corner's state at the start of a run (mode from its gap, rate latched, no history)."""
+        gaps, rates = self._evaluate(y)
+        return tuple(start(gaps[i] > 0.0, float(rates[i]), self.min_approach_speed) for i in range(len(self.pairs)))
+
+    def terms(self, states: PairStates) -> list[TermSwitch]:
+        """A face's term while both its corners are in contact (parameter: their mean latched speed,
+        floored); a corner's while its pair's term is on and its face is not."""
+        out: list[TermSwitch] = []
         in_face = [False] * len(self.pairs)
-        for f, (a, b) in enumerate(self.face_corners):
-            on = self.states[a].contact and self.states[b].contact
-            k = self.face_terms[f]
-            if on and not self.face_on[f]:
-                speed = 0.5 * (self.states[a].latched + self.states[b].latched)
-                params[k] = (np.array([max(speed, self.face_min_approach_speed)]) if self.face_needs_approach
-                             else np.zeros(0))
-                events.append(ContactEvent(t=t, pair=self.face_names[f], kind="onset", approach_speed=speed,
-                                           y=y.copy()))
-            elif not on and self.face_on[f]:
-                events.append(ContactEvent(t=t, pair=self.face_names[f], kind="separation",
-                                           approach_speed=float("nan"), y=y.copy()))
-            self.face_on[f] = on
-            active[k] = on
+        for f, ((a, b), on) in enumerate(zip(self.face_corners, self._faces_on(states))):
+            speed = max(0.5 * (states[a].latched + states[b].latched), self.face_min_approach_speed)
+            out.append((self.face_terms[f], on, np.array([speed]) if self.face_needs_approach else np.zeros(0)))
             in_face[a] = in_face[b] = on
         for i, k in enumerate(self.corner_terms):
-            active[k] = self.states[i].term_on and not in_face[i]
-        return events
+            params = np.array([states[i].latched]) if self.needs_approach else np.zeros(0)
+            out.append((k, states[i].term_on and not in_face[i], params))
+        return out
 
-    def _corner_params(self, i: int) -> NDArray:
-        return np.array([self.states[i].latched]) if self.needs_approach else np.zeros(0)
-
-    def initial_modes(self, t: float, y: NDArray, active: list[bool], params: list[NDArray]) -> dict[str, str]:
-        gaps, rates = self._evaluate(y)
-        # a new run starts without history
-        self.states = [start(gaps[i] > 0.0, float(rates[i]), self.min_approach_speed) for i in range(len(self.pairs))]
-        self.face_on = [False] * len(self.face_names)
-        for i, k in enumerate(self.corner_terms):
-            params[k] = self._corner_params(i)
-        self._apply(t, y, active, params)
-        modes = {p: ("contact" if st.contact else "free") for p, st in zip(self.pairs, self.states)}
-        modes.update({f: ("contact" if on else "free") for f, on in zip(self.face_names, self.face_on)})
+    def modes(self, states: PairStates) -> dict[str, str]:
+        modes = {p: ("contact" if st.contact else "free") for p, st in zip(self.pairs, states)}
+        modes.update({f: ("contact" if on else "free") for f, on in zip(self.face_names, self._faces_on(states))})
         return modes
 
-    def root_directions(self, active: Sequence[bool]) -> list[tuple[int, int]]:
+    def root_directions(self, states: PairStates) -> list[tuple[int, int]]:
         """While a corner is free watch its onsets (+1), in contact separations (-1), held both (0)."""
-        return [(self.first_root + i, st.watch) for i, st in enumerate(self.states)]
+        return [(self.first_root + i, st.watch) for i, st in enumerate(states)]
 
-    def on_roots(self, t: float, y: NDArray, yp: NDArray, roots_found: NDArray | None,
-                 active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
-        """Decide the roots of the corners' gaps by the automaton; return the events of corners and faces."""
+    def decide(self, states: PairStates, t: float, y: NDArray, roots_found: NDArray | None
+               ) -> tuple[PairStates, list[ContactEvent]]:
+        """Decide the roots of the corners' gaps by the automaton: the new states and the events of
+        corners and of faces that formed or broke."""
         if roots_found is None:
-            return []
+            return states, []
         found = roots_found[self.first_root:self.first_root + len(self.pairs)]
         if not np.any(found):
-            return []
+            return states, []
         gaps, rates = self._evaluate(y)
         events: list[ContactEvent] = []
+        new = list(states)
         for i, direction in enumerate(int(d) for d in found):
             if direction == 0:
                 continue
             rate = float(rates[i])
-            self.states[i], decision = step(self.states[i], t, direction, rate, storm=self.storm,
-                                            min_approach_speed=self.min_approach_speed)
-            events += self._record_corner(i, t, y, rate, decision, params)
-        events += self._apply(t, y, active, params)
-        return events
-
-    def record(self, root: int, t: float, y: NDArray, rate: float, decision: Decision,
-               active: list[bool], params: list[NDArray]) -> list[ContactEvent]:
-        """Apply a decision taken at a root of gap ``root`` (here or by the compiled loop) to its
-        corner and the terms; return the events of the corner and of faces that formed or broke."""
-        events = self._record_corner(root - self.first_root, t, y, rate, decision, params)
-        if events:
-            events += self._apply(t, y, active, params)
-        return events
-
-    def apply(self, root: int, t: float, y: NDArray, decision: Decision, active: list[bool],
-              params: list[NDArray]) -> None:
-        """Take a decision of a corner without recording its event (the compiled loop's events of
-        one advance are recorded by the IDA loop; it decides corners of joints without faces only)."""
-        if decision.kind != NONE:
-            self._take_decision(root - self.first_root, decision, params)
-            self._apply(t, y, active, params)
-
-    def pair_name(self, root: int) -> str:
-        """The name of the corner of gap ``root`` (its events' ``pair``)."""
-        return self.pairs[root - self.first_root]
-
-    def _take_decision(self, i: int, decision: Decision, params: list[NDArray]) -> None:
-        self.states[i] = recorded(self.states[i], decision)
-        if decision.kind == ONSET:
-            params[self.corner_terms[i]] = self._corner_params(i)
-
-    def _record_corner(self, i: int, t: float, y: NDArray, rate: float, decision: Decision,
-                       params: list[NDArray]) -> list[ContactEvent]:
-        """Set corner i's mode and latched speed from a decision; return its event, if any."""
-        if decision.kind == NONE:
-            return []
-        self._take_decision(i, decision, params)
-        return [ContactEvent.from_solver(t, self.pairs[i], EVENT_KINDS[decision.kind], rate, np.array(y, dtype=float))]
+            new[i], decision = step(new[i], t, direction, rate, storm=self.storm,
+                                    min_approach_speed=self.min_approach_speed)
+            events += pair_event(self.pairs[i], t, y, rate, decision)
+        after = tuple(new)
+        for f, (was, on) in enumerate(zip(self._faces_on(states), self._faces_on(after))):
+            a, b = self.face_corners[f]
+            if on and not was:
+                speed = 0.5 * (after[a].latched + after[b].latched)
+                events.append(ContactEvent(t=t, pair=self.face_names[f], kind="onset", approach_speed=speed,
+                                           y=y.copy()))
+            elif was and not on:
+                events.append(ContactEvent(t=t, pair=self.face_names[f], kind="separation",
+                                           approach_speed=float("nan"), y=y.copy()))
+        return after, events
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
         """Without faces (model ``corners``) every corner term follows its own pair, so the compiled
@@ -429,10 +398,10 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
 
     def logic(P: NDArray[np.float64]) -> list[Any]:
         return [SliderGuideLogic(
-            name=name, pairs=pair_names, first_root=first_root,
-            corner_terms=[first_term + i for i in range(n_corners)],
-            face_names=face_names, face_terms=[first_term + n_corners + f for f in range(len(face_names))],
-            face_corners=face_corners, rate=BufferedFunction(rate, bound=(P,)), n_q=n_q,
+            name=name, pairs=tuple(pair_names), first_root=first_root,
+            corner_terms=tuple(first_term + i for i in range(n_corners)),
+            face_names=tuple(face_names), face_terms=tuple(first_term + n_corners + f for f in range(len(face_names))),
+            face_corners=tuple(face_corners), rate=BufferedFunction(rate, bound=(P,)), n_q=n_q,
             needs_approach=law_numeric.needs_approach_speed, min_approach_speed=floor(P),
             face_needs_approach=bool(face_numeric is not None and face_numeric.needs_approach_speed),
             face_min_approach_speed=face_floor(P) if face_floor is not None else 0.0,

@@ -26,7 +26,6 @@ import subprocess
 import sysconfig
 import tempfile
 import time
-import weakref
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -44,8 +43,6 @@ __all__ = [
     "compile_cached",
     "MemoTable",
     "memo_table",
-    "memo_get",
-    "memo_put",
     "clear_memos",
 ]
 
@@ -137,7 +134,7 @@ _MEMO_TABLES: list[MemoTable] = []
 
 
 def memo_table() -> MemoTable:
-    """A new in-process memo (by object identity with memo_get/memo_put, or by any key);
+    """A new in-process memo (by any key);
     :func:`clear_memos` empties them all."""
     table: MemoTable = {}
     _MEMO_TABLES.append(table)
@@ -145,8 +142,9 @@ def memo_table() -> MemoTable:
 
 
 def clear_memos() -> None:
-    """Forget every assembled template, normalised model, generated spec and loaded library of
-    this process (the disk cache stays): the next run generates and loads again, e.g. after changing ``$CC``."""
+    """Forget every structure of this process, and with it (``DAEFunctions.compiled``) its normalised
+    model, generated specs and loaded libraries, for the models assembled from now on (the disk cache
+    stays): the next run generates and loads again, e.g. after changing ``$CC``."""
     for table in _MEMO_TABLES:
         table.clear()
 
@@ -173,23 +171,6 @@ def memo_by_values(table: MemoTable, values: tuple[Any, ...], make: Callable[...
         value = make(*values)
         memo_put_bounded(table, key, value, limit)
     return value
-
-
-def memo_get(table: MemoTable, obj: Any) -> Any:
-    """The value memoised for this very object (identity, kept only while the object lives)."""
-    entry = table.get(id(obj))
-    return entry[1] if entry is not None and entry[0]() is obj else None
-
-
-def memo_put(table: MemoTable, obj: Any, value: Any) -> None:
-    def forget(_ref: Any, key: int = id(obj)) -> None:  # the key only: the callback must not keep obj alive
-        table.pop(key, None)
-
-    try:
-        ref = weakref.ref(obj, forget)
-    except TypeError:
-        return
-    table[id(obj)] = (ref, value)
 
 
 # --------------------------------------------------------------------------- cached build

@@ -52,8 +52,6 @@ from .build import (
     clear_memos,
     compile_cached,
     compiler_command,
-    memo_get,
-    memo_put,
     memo_table,
 )
 from .library import DRIVER_ABI, ODE_DRIVER_ABI
@@ -102,8 +100,6 @@ __all__ = [
     "ODE_DRIVER_ABI",
     "MemoTable",
     "memo_table",
-    "memo_get",
-    "memo_put",
     "compile_cached",
 ]
 
@@ -340,18 +336,14 @@ def _files_digest(stamps: tuple[tuple[str, int, int], ...]) -> str:
     return "driver sources sha256 " + h.hexdigest()
 
 
-# Libraries already built in this process, by DAEFunctions identity (shared by every model of
-# one structure): simulating again skips code generation (tens of ms) as well as compilation.
-_BUILT = memo_table()
-
-
 def build_model_library(funcs: Any, *, model: NormalizedModel | None = None) -> BuildResult:
-    """Generate, compile (or find in the cache) the shared library for a DAEFunctions."""
-    known = memo_get(_BUILT, funcs)
+    """Generate, compile (or find in the cache) the shared library for a DAEFunctions (kept in
+    ``funcs.compiled``: a model of the same structure run again skips code generation, tens of ms)."""
+    known = funcs.compiled.get("built")
     if known is not None and known.path.exists():
         return dataclasses.replace(known, cache_hit=True, compile_time=0.0, codegen_time=0.0)
     result = _build_model_library(funcs, model=model)
-    memo_put(_BUILT, funcs, result)
+    funcs.compiled["built"] = result
     return result
 
 

@@ -63,7 +63,7 @@ import numpy as np
 
 from ..errors import DaeclearError, DaeclearWarning
 from ..options import BACKENDS, LINEAR_SOLVERS
-from .build import BuildResult, CompileError, CompilerUnavailable, memo_get, memo_put, memo_table
+from .build import BuildResult, CompileError, CompilerUnavailable
 from .c_session import SPARSE_MIN_STATES, CSession
 from .codegen import NormalizedModel, build_model_library, normalize_model
 from .library import ModelLibrary, StaleLibrary
@@ -108,9 +108,6 @@ __all__ = [
     "STORE_STATES",
 ]
 
-_NORMALIZED = memo_table()  # normalize_model results by DAEFunctions identity
-# libraries loaded in this process by DAEFunctions identity: (library, its BuildResult as a cache hit)
-_LOADED = memo_table()
 log = logging.getLogger("daeclear")
 
 _warned: set[str] = set()
@@ -189,20 +186,19 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
     if not isinstance(backend, str) or backend.lower() not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}: valid backends are {', '.join(map(repr, BACKENDS))}")
     b = backend.lower()
-    model = memo_get(_NORMALIZED, funcs)
+    model = funcs.compiled.get("normalized")
     if model is None:
-        model = normalize_model(funcs)
-        memo_put(_NORMALIZED, funcs, model)
+        model = funcs.compiled["normalized"] = normalize_model(funcs)
     opts = check_options(model, rtol, atol, max_step, max_order, max_steps, root_directions, buffer_steps,
                          parameters, linear_solver)
     if b == "python":
         return PythonSession(model, opts)
     try:
-        loaded = memo_get(_LOADED, funcs)
+        loaded = funcs.compiled.get("loaded")  # (library, its BuildResult as a cache hit)
         if loaded is None:
             clib, build = _load_library(funcs, model)
-            memo_put(_LOADED, funcs, (clib, dataclasses.replace(build, cache_hit=True, compile_time=0.0,
-                                                                codegen_time=0.0)))
+            funcs.compiled["loaded"] = (clib, dataclasses.replace(build, cache_hit=True, compile_time=0.0,
+                                                                  codegen_time=0.0))
         else:  # loaded before in this process: no file checks (the loaded library stays valid)
             clib, build = loaded
         return CSession(model, opts, clib, build)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 from collections.abc import Sequence
 
@@ -80,6 +80,10 @@ class DAEFunctions:
     name: str = "model"
     extras: tuple[casadi.Function, ...] = ()
     n_parameters: int = 0
+    # what this process made of these functions, once, by kind ("normalized", "built", "loaded",
+    # "ode_spec", "ode_library"): owned here, so the models of one structure (which share these
+    # functions) share it, and it goes when the functions go
+    compiled: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
 
 @dataclass(frozen=True)

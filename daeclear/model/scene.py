@@ -11,6 +11,7 @@ import Body`` keeps working.
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import importlib
 from dataclasses import dataclass, field
@@ -150,6 +151,46 @@ class Scene:
         elements = [e for e in self.elements if e.name not in names]
         return Scene(self.name, gravity=self.gravity, elements=elements, ground=self.ground)
 
+    def with_values(self, values: Mapping[str, Any]) -> Scene:
+        """A new scene with some of its numbers replaced, by name: ``"<element>.<field>"`` (e.g.
+        ``"clearance.clearance"``, ``"crank.mass"``, ``"drive.speed"``), ``"<element>.<field>.<field>"``
+        for a law, friction law or material (``"clearance.law.restitution"``), or ``"gravity"``.
+
+        Each changed element is made again from its fields (``dataclasses.replace``), so what it
+        derives from them (a journal radius from the bearing radius and the clearance, a contact
+        stiffness from the materials and radii) follows. The new scene is validated; this one is
+        left unchanged. Raises SceneError naming an unknown element or field.
+
+        >>> scene = Scene("pendulum")
+        >>> link = scene.add(Body("link", mass=1.0, inertia=0.01, position=(0.5, 0.0)))
+        >>> scene.with_values({"link.mass": 2.0})["link"].mass, scene["link"].mass
+        (2.0, 1.0)
+        """
+        if not isinstance(values, Mapping):
+            raise SceneError(f"scene '{self.name}': values={values!r}, must be a mapping of names "
+                             "('<element>.<field>', e.g. 'crank.mass') to new values.")
+        gravity, elements = self.gravity, list(self.elements)
+        index = {e.name: k for k, e in enumerate(elements)}
+        for key, value in values.items():
+            if key == "gravity" and key not in index:
+                gravity = value
+                continue
+            name, _, path = str(key).partition(".")
+            if name in index and not path:
+                element: Any = elements[index[name]]
+                fields_ = [f.name for f in dataclasses.fields(element) if f.name != "name"]
+                raise SceneError(f"scene '{self.name}': {key!r} is an element; name one of its fields, "
+                                 f"'{name}.<field>' with a field of {', '.join(fields_)}.")
+            if name not in index:
+                close = difflib.get_close_matches(name, list(index), n=3)
+                hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+                raise SceneError(f"scene '{self.name}': {key!r} names no value of the scene; a name is "
+                                 f"'gravity' or '<element>.<field>' with an element of {', '.join(index)}.{hint}")
+            elements[index[name]] = _replaced(elements[index[name]], path.split("."), value, key)
+        scene = Scene(self.name, gravity=gravity, elements=elements, ground=self.ground)
+        scene.validate()
+        return scene
+
     def of_type(self, cls: type) -> list[Any]:
         return [e for e in self.elements if isinstance(e, cls)]
 
@@ -225,6 +266,22 @@ class Scene:
         """:meth:`to_dict` as a read-only mapping made at its first read (:class:`SceneDescription`):
         what a model and its runs' results carry, which a sweep's runs seldom read."""
         return SceneDescription(self)
+
+
+def _replaced(obj: Any, path: list[str], value: Any, key: str) -> Any:
+    """``obj`` (a frozen element, law or material) made again with the field at ``path`` set to ``value``."""
+    names = [f.name for f in dataclasses.fields(obj)] if dataclasses.is_dataclass(obj) else []
+    field_name = path[0]
+    if field_name not in names or field_name == "name":
+        allowed = ", ".join(n for n in names if n != "name") or "none"
+        raise SceneError(f"scene value {key!r}: {type(obj).__name__} has no field {field_name!r} "
+                         f"(its fields: {allowed}).")
+    if len(path) > 1:
+        value = _replaced(getattr(obj, field_name), path[1:], value, key)
+    try:
+        return dataclasses.replace(obj, **{field_name: value})
+    except (TypeError, ValueError) as exc:
+        raise SceneError(f"scene value {key!r}={value!r}: {exc}") from None
 
 
 def _describe(name: str, gravity: Any, elements: Iterable[Element]) -> dict[str, Any]:

@@ -31,10 +31,10 @@ compiler) evaluates the same functions through ``casadi.FunctionBuffer`` and num
 
 Events
 ------
-The same contact logic objects as IDA (``model.contacts``): each segment watches every gap in the
-direction ``logic.root_directions(active)`` gives (+1 increasing, -1 decreasing, 0 both, as IDA),
-and at an event ``logic.on_roots`` gets ``roots_found`` with the direction of the crossing (+1/-1)
-and switches the modes. The ODE state (q, v) is kept at a restart (it is consistent by
+The same contact rules and run state as IDA (:mod:`daeclear.assembly.contact_state`): each segment
+watches every gap in the direction the run's contact state gives (+1 increasing, -1 decreasing, 0
+both, as IDA), and at an event ``contact_state.decide`` gets ``roots_found`` with the direction of
+the crossing (+1/-1) and returns the new state. The ODE state (q, v) is kept at a restart (it is consistent by
 construction) and the integrator restarts from the event time with fresh history (scipy: a new
 solver object with its own initial step selection; passing the last step size instead was
 measured and gained nothing).
@@ -96,6 +96,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..assembly import contact_state
 from ..assembly.assemble import DAEModel, assemble
 from .. import options
 from ..errors import Interrupted, SceneError, SolveError
@@ -450,7 +451,6 @@ def integrate(
                         step=step if out.times is None and store_steps else None, start=t0, end=t_end,
                         n_states=model.n_states, n_channels=len(model.channel_names))  # before the grid is built
     from_state = given is not None
-    model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
     eval_times = None if out.times is None else out.times.values()  # checked by options.output
     n = model.n_q
     atol_x = tolerance_vector(model, rtol, atol, newton=False)[:2 * n]
@@ -472,9 +472,9 @@ def integrate(
                    stream_to=out.stream_to, keep_data=out.keep_data)
     run = Run(model, ev, method_l, t_end, eval_times, store_steps, progress, max_steps, rec)
     run.y0, run.step = (y0 if start == "declared" and not from_state else None), step  # declared starts only
+    run.from_state = from_state
     run.t_last = t0
-    for logic in model.contacts:
-        run.modes.update(logic.initial_modes(t0, y0, run.active, run.params))
+    run.set_state(contact_state.start_state(model, t0, y0))
     setup_time = time.perf_counter() - setup_start
     tic = time.perf_counter()
     interrupted = False

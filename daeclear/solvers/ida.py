@@ -90,6 +90,7 @@ def simulate(
     stream_to: str | os.PathLike[str] | None = None,
     keep_data: bool = True,
     max_output_points: int | None = opts.MAX_OUTPUT_POINTS,
+    parameters: Mapping[str, Any] | None = None,
 ) -> Result:
     """Integrate a scene (or an assembled model) from ``t0`` (0 by default) to ``t_end``.
 
@@ -101,9 +102,9 @@ def simulate(
     Parameters
     ----------
     scene : Scene or DAEModel
-        The mechanism; a Scene is assembled with ``formulation`` first. A model is never changed
-        by a run (its contact logic is copied per run): runs of one model, one after the other or
-        at the same time in threads, are independent.
+        The mechanism; a Scene is assembled with ``formulation`` first. A model is a value that no
+        run changes (a run's contact state is its own, :mod:`daeclear.assembly.contact_state`): runs of
+        one model, one after the other or at the same time in threads, are independent.
     t_end : float
         End time, s (> t0).
     options : SolverOptions or None
@@ -199,6 +200,10 @@ def simulate(
         The most output points the run may report (:data:`daeclear.options.MAX_OUTPUT_POINTS`, 1e6,
         about 1 GB for the chapter's slider-crank); more (``t_eval``, ``t_eval_step``, or a fixed
         ``step`` without them) is refused before the run with the estimated size. None: no cap.
+    parameters : mapping or None
+        New numbers for this run, by name, as :meth:`DAEModel.with_parameters` (e.g.
+        ``{"clearance.clearance": 2e-4, "clearance.law.restitution": 0.5}``): the scene is assembled
+        (a model is taken as it is) and run with them; nothing is compiled, the model is unchanged.
 
     Returns
     -------
@@ -236,6 +241,13 @@ def simulate(
     limit = opts.max_output_points(max_output_points)
     if y0 is not None:  # checked before any work (a Scene's length: once it is assembled)
         y0 = opts.state(y0, scene.n_states if isinstance(scene, DAEModel) else None)
+    if parameters is not None:  # new numbers: bound to the structure (checked before any run)
+        if not isinstance(parameters, Mapping):
+            opts.fail("simulate", "parameters", parameters, "None or a mapping of names to numbers, "
+                      "e.g. {'clearance.clearance': 2e-4}")
+        if isinstance(scene, Scene):
+            scene = assemble(scene, formulation or opts.default_formulation(method), track_work=track_work)
+        scene = scene.with_parameters(parameters)
     from .explicit import integrate  # the non-IDA methods
 
     if method != "ida":
@@ -255,7 +267,6 @@ def simulate(
     opts.output_size(out, limit, t_eval_step=t_eval_step, step=None, start=t0, end=t_end, n_states=model.n_states,
                      n_channels=len(model.channel_names))  # before the session: nothing compiled or run
     from_state = y0 is not None
-    model = model.for_run(from_state=from_state)  # this run's own contact logic: the model stays unchanged
     session, y0, yp0 = _start_session(model, t0, y0, rtol=rtol, atol=atol, backend=backend, max_step=max_step,
                                       max_steps=max_steps, linear_solver=linear_solver, start=start,
                                       allow_penetration=allow_penetration)

@@ -3,12 +3,13 @@
 :func:`daeclear.solvers.ida.simulate` checks the options, opens the session and the recorder and
 hands them to a :class:`SegmentLoop`, which integrates segment by segment. Between two roots of
 the gap functions the set of active contact terms is fixed. The compiled loop may decide the
-switches of simple pairs itself (:meth:`SegmentLoop.record_advance` records its decisions in the
-pair logic); any other root returns to Python, where each contact element's event logic decides
-the new modes and IDA restarts from a consistent state (:meth:`SegmentLoop.decide_roots`). The
-points go to the recorder chunk by chunk (:meth:`SegmentLoop.flush`), so a run that streams to a
-file and keeps no steps runs in bounded memory, and whatever stops the run (a failure, Ctrl-C,
-running out of memory) the result holds what was computed (:meth:`SegmentLoop.finish`).
+switches of simple pairs itself (:meth:`SegmentLoop.record_advance` takes its decisions into
+the run's contact state); any other root returns to Python, where the contact rules decide the
+new state (:func:`daeclear.assembly.contact_state.decide`) and IDA restarts from a consistent state
+(:meth:`SegmentLoop.decide_roots`). The points go to the recorder chunk by chunk
+(:meth:`SegmentLoop.flush`), so a run that streams to a file and keeps no steps runs in bounded
+memory, and whatever stops the run (a failure, Ctrl-C, running out of memory) the result holds
+what was computed (:meth:`SegmentLoop.finish`).
 """
 
 from __future__ import annotations
@@ -17,7 +18,6 @@ import itertools
 import math
 import time
 from typing import Any
-from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 from .. import options as opts
 from . import physics
 from ..assembly.assemble import DAEModel
+from ..assembly import contact_state
 from ..assembly.automaton import EVENT_KINDS, ONSET
 from ..engine.session_base import AutoEvents
 from ..errors import Interrupted, SolveError
@@ -41,8 +42,9 @@ STICKING_FLAGS = ("DC_STEP_COLLAPSE", "IDA_CONV_FAIL", "IDA_ERR_FAIL")
 
 
 class SegmentLoop:
-    """One run's loop state: active terms and their parameters, contact modes, the switch vector,
-    the current segment's start and the reported points not yet made consistent."""
+    """One run's loop state: its contact state (:mod:`daeclear.assembly.contact_state`) and what
+    follows from it (active terms and their parameters, contact modes, the switch vector), the
+    current segment's start and the reported points not yet made consistent."""
 
     def __init__(self, model: DAEModel, session: Any, rec: Recorder, t0: float, y0: NDArray, yp0: NDArray,
                  t_end: float, eval_times: opts.OutputTimes | None, store_steps: bool, progress: bool) -> None:
@@ -51,11 +53,10 @@ class SegmentLoop:
         self.progress_line = Progress(t_end, unit="s", desc="simulate", enabled=progress)
         self.model, self.session, self.rec = model, session, rec
         self.t_end, self.eval_times, self.store_steps = t_end, eval_times, store_steps
-        self.active = [False] * len(model.terms)
-        self.params = [np.zeros(term.n_params) for term in model.terms]
+        self.active: list[bool] = []
+        self.params: list[NDArray] = []
         self.modes: dict[str, str] = {}
-        for logic in model.contacts:
-            self.modes.update(logic.initial_modes(t0, y0, self.active, self.params))
+        self.set_state(contact_state.start_state(model, t0, y0))
         y, yp = y0, yp0
         if any(self.active):
             y, yp = model.consistent_state(t0, y0, model.term_forces(t0, y0, self.active, self.params, session),
@@ -84,6 +85,12 @@ class SegmentLoop:
         # per pair the compiled loop decides: (its logic, root, name, switch vector column of its term, the
         # term's parameter is the latched approach speed)
         self.auto_info: list[tuple[Any, int, str, int, bool]] = []
+
+    def set_state(self, state: contact_state.ContactState) -> None:
+        """Take the run's new contact state, and the terms and modes that follow from it."""
+        self.state = state
+        self.active, self.params = contact_state.switches(self.model, state)
+        self.modes = contact_state.modes(self.model, state)
 
     def run(self, on_failure: str, setup_time: float, sim_params: dict[str, Any]) -> Result:
         """Integrate to the end, a failure or Ctrl-C; always return (or attach) what was computed."""
@@ -114,7 +121,8 @@ class SegmentLoop:
         # the compiled loop makes states consistent itself (restarts after its own switches, the
         # reported points); the python backend leaves that to the model's Python methods
         self.c_layout = session.set_layout(model.layout(project=model.formulation == "ggl"))
-        session.reinit(self.t, self.y, self.yp, self.active, self.params, _root_directions(model, self.active))
+        session.reinit(self.t, self.y, self.yp, self.active, self.params,
+                       contact_state.root_directions(model, self.state))
         # the compiled loop may decide every contact switch itself (simple pairs): the rule and the
         # starting state of each pair come from its logic object; Python then only records
         if model.auto_pairs:
@@ -124,7 +132,7 @@ class SegmentLoop:
                               for root, term, _, needs, _ in model.auto_pairs]
             self.c_decides = self.c_layout and session.set_auto_events(
                 model.auto_pairs, storms=[logic.storm for logic, *_ in self.auto_info],
-                states=[logic.pair_state(root) for logic, root, *_ in self.auto_info])
+                states=[contact_state.pair_state(model, self.state, root) for _, root, *_ in self.auto_info])
 
     def advance_to_end(self) -> None:
         """Advance chunk by chunk and segment by segment until the end, a failure or an exception."""
@@ -220,10 +228,9 @@ class SegmentLoop:
             last[p] = i
             if kind == ONSET:
                 onset[p] = i
-        for p, i in last.items():  # a pair's state is its last decision's, its latched speed its last onset's
-            logic, root = info[p][:2]
-            for j in sorted({onset.get(p, i), i}):
-                logic.apply(root, float(auto.t[j]), ys[j], auto.decision(j), self.active, self.params)
+        # a pair's state is its last decision's, its latched speed its last onset's
+        decisions = [(info[p][1], auto.decision(j)) for p, i in last.items() for j in sorted({onset.get(p, i), i})]
+        self.set_state(contact_state.with_decisions(self.model, self.state, decisions))
         rows = np.array(switches)
         self.switch = rows[-1].copy()
         self.n_restarts += len(times)
@@ -243,14 +250,13 @@ class SegmentLoop:
     def decide_roots(self, adv: Any) -> None:
         """At a root returned to Python let every contact element decide its new modes; restart IDA
         from a consistent state when anything switched (else it goes on in the same segment)."""
-        model, active, params, t = self.model, self.active, self.params, self.t
-        before = (list(active), [p.copy() for p in params], _root_directions(model, active), dict(self.modes))
-        for logic in model.contacts:
-            new_events = logic.on_roots(t, self.y, self.yp, adv.roots_found, active, params)
-            self.events.extend(new_events)
-            for event in new_events:
-                self.modes[event.pair] = "contact" if event.kind == "onset" else "free"
-        directions = _root_directions(model, active)
+        model, t = self.model, self.t
+        before = (self.active, self.params, contact_state.root_directions(model, self.state), self.modes)
+        state, new_events = contact_state.decide(model, self.state, t, self.y, adv.roots_found)
+        self.events.extend(new_events)
+        self.set_state(state)
+        active, params = self.active, self.params
+        directions = contact_state.root_directions(model, state)
         if (before[0] == active and all(np.array_equal(a, b) for a, b in zip(before[1], params))
                 and (directions is None or (before[2] is not None and np.array_equal(before[2], directions)))):
             return  # nothing switched: IDA goes on from the root without a restart, in the same segment
@@ -261,7 +267,7 @@ class SegmentLoop:
                                          model.term_forces(t, self.y, active, params, self.session),
                                          adv.roots_found)
         self.switch = model.switch_vector(active, params)
-        self.session.reinit(t, self.y, self.yp, active, params, _root_directions(model, active))
+        self.session.reinit(t, self.y, self.yp, active, params, directions)
         self.n_restarts += 1
         self.flush()
 
@@ -325,13 +331,14 @@ class SegmentLoop:
             stats.update(n_events=rec.n_events, n_restarts=self.n_restarts, setup_time=setup_time,
                          wall_time=setup_time + time.perf_counter() - self.run_start,
                          output_time=time.perf_counter() - post_start)
-            if model.gap_names:  # the run's end state of the storm guard (kept in this run's logic, not in the model)
+            if model.gap_names:  # the run's end state of the storm guard (in the run's contact state)
                 stats["held_pairs"] = [model.gap_names[root] for logic in model.contacts for root in logic.roots
-                                       if logic.pair_state(root).held]
+                                       if contact_state.pair_state(model, self.state, root).held]
             # the start checks concern a declared state: the chapter's start is consistent by construction
             key_t, key_y, key_channels = rec.key_rows()
             return physics.check_run(model, key_t, key_y, key_channels,
-                                     self.y0 if sim_params["start"] == "declared" else None, stats, session)
+                                     self.y0 if sim_params["start"] == "declared" else None, stats, session,
+                                     from_state=sim_params["start"] == "state")
         finally:
             rec.evaluate = None  # the session closes: later channels open their own
             session.close()
@@ -352,17 +359,6 @@ def _equal(a: NDArray, b: NDArray) -> bool:
     """np.array_equal of two short float vectors (NaN unequal), as lists: numpy's all() and
     array_equal run Python layers, and this is checked at every advance."""
     return a.shape == b.shape and a.tolist() == b.tolist()
-
-
-def _root_directions(model: DAEModel, active: Sequence[bool]) -> NDArray | None:
-    """Root directions for the next segment: each contact pair watches only its next switch."""
-    if not model.gap_names:
-        return None
-    directions = np.zeros(len(model.gap_names), dtype=np.int32)
-    for logic in model.contacts:
-        for index, direction in logic.root_directions(active):
-            directions[index] = direction
-    return directions
 
 
 def _restart_state(model: DAEModel, session: Any, t: float, y: NDArray, yp: NDArray, forces: NDArray | None,

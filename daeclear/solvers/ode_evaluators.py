@@ -30,9 +30,6 @@ from ..engine.codegen import (
     OdeSpec,
     build_ode_library,
     densified,
-    memo_get,
-    memo_put,
-    memo_table,
 )
 from ..engine.library import OdeLibrary
 from ..errors import DaeclearError, DaeclearWarning
@@ -465,13 +462,12 @@ def _model_channels(model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch
 
 
 _warned: set[str] = set()
-_LIB_BY_FUNCTIONS = memo_table()
 
 
 def evaluator(model: DAEModel, backend: str) -> Evaluator:
     """The model's ODE evaluator: compiled (cached per model object and on disk) or python."""
     spec = ode_spec(model)
-    compiled = memo_get(_LIB_BY_FUNCTIONS, model.functions)  # one library per structure
+    compiled = model.functions.compiled.get("ode_library")  # one library per structure
     if backend == "python":
         return _PyEvaluator(spec)
     try:
@@ -484,7 +480,7 @@ def evaluator(model: DAEModel, backend: str) -> Evaluator:
                 build = build_ode_library(spec)
                 clib = _CLib.load(build.path)
             compiled = (clib, build)
-            memo_put(_LIB_BY_FUNCTIONS, model.functions, compiled)
+            model.functions.compiled["ode_library"] = compiled
         else:
             clib, build = compiled
             compiled = (clib, BuildResult(build.path, build.key, True, 0.0, 0.0))

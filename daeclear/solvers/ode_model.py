@@ -16,7 +16,7 @@ import casadi as ca
 import numpy as np
 
 from ..assembly.assemble import DAEModel
-from ..engine.codegen import OdeSpec, memo_get, memo_put, memo_table
+from ..engine.codegen import OdeSpec
 from ..errors import SceneError
 
 __all__ = ["ode_spec"]
@@ -33,15 +33,11 @@ def ode_spec(model: DAEModel) -> OdeSpec:
     if getattr(model, "track_work", False) or model.n_states != 2 * model.n_q + model.n_constraints:
         raise SceneError(f"simulate: model '{model.scene_name}' has states besides q, v and the multipliers "
                          "(track_work); only method='ida' integrates it.")
-    spec = memo_get(_SPEC_BY_FUNCTIONS, model.functions)
+    spec = model.functions.compiled.get("ode_spec")
     if spec is None:  # once per structure: models of the same structure share their functions
-        spec = _symbolic_spec(model)
-        memo_put(_SPEC_BY_FUNCTIONS, model.functions, spec)
+        spec = model.functions.compiled["ode_spec"] = _symbolic_spec(model)
     return dataclasses.replace(spec, mass=tuple(float(mk) for mk in model.mass_diagonal),
                                parameters=tuple(float(x) for x in model.parameter_values))
-
-
-_SPEC_BY_FUNCTIONS = memo_table()
 
 
 def _symbolic_spec(model: DAEModel) -> OdeSpec:

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..assembly import contact_state
 from ..assembly.assemble import DAEModel
 from ..engine.hermite import cubic_hermite
 from ..engine.stall_guard import TINY_STEP_COUNT, TINY_STEP_REL, StallGuard
@@ -80,8 +81,8 @@ class Run:
         self.bar = Progress(t_end, unit="s", desc="simulate", enabled=progress)
         self.n = model.n_q
         self.m = model.n_constraints
-        nt = len(model.terms)
-        self.active = [False] * nt
+        self.state: contact_state.ContactState = ()  # the run's contact state (set by start)
+        self.active: list[bool] = [False] * len(model.terms)
         self.params: list[NDArray] = [np.zeros(term.n_params) for term in model.terms]
         self.modes: dict[str, str] = {}
         self.events: list[ContactEvent] = []
@@ -96,18 +97,19 @@ class Run:
         self.t_last = 0.0
         self.success, self.status, self.message = True, 0, "end of the time span reached"
         self.y0: NDArray | None = None  # a declared state at t = 0, for the physics checks
+        self.from_state = False  # the run starts from a given state of a run (physics checks)
         self.step: float | None = None  # the fixed step (rk4, euler)
         self.missed: list[tuple[float, float, str]] = []  # steps over which a gap changed sign, no event
 
     # ---------------------------------------------------------------- segments
+    def set_state(self, state: contact_state.ContactState) -> None:
+        """Take the run's new contact state, and the terms and modes that follow from it."""
+        self.state = state
+        self.active, self.params = contact_state.switches(self.model, state)
+        self.modes = contact_state.modes(self.model, state)
+
     def directions(self) -> NDArray | None:
-        if not self.model.gap_names:
-            return None
-        d = np.zeros(len(self.model.gap_names), dtype=np.int32)
-        for logic in self.model.contacts:
-            for index, direction in logic.root_directions(self.active):
-                d[index] = direction
-        return d
+        return contact_state.root_directions(self.model, self.state)
 
     def open_segment(self, t0: float, x0: NDArray) -> None:
         self.ev.set_terms(self.active, self.params)
@@ -223,11 +225,9 @@ class Run:
 
     def handle_event(self, t: float, x: NDArray, roots_found: NDArray) -> None:
         y, yp = self.full_state(t, x)
-        for logic in self.model.contacts:
-            new_events = logic.on_roots(t, y, yp, roots_found, self.active, self.params)
-            self.events.extend(new_events)
-            for event in new_events:
-                self.modes[event.pair] = "contact" if event.kind == "onset" else "free"
+        state, new_events = contact_state.decide(self.model, self.state, t, y, roots_found)
+        self.events.extend(new_events)
+        self.set_state(state)
         self.n_restarts += 1
         if t > self.last_event_t:
             self.stall = 0
@@ -280,7 +280,8 @@ class Run:
                      codegen_time=build.codegen_time if build else 0.0,
                      cache_hit=bool(build.cache_hit) if build else False)
         key_t, key_y, key_channels = self.rec.key_rows()
-        found = physics.check_run(self.model, key_t, key_y, key_channels, self.y0, stats)
+        found = physics.check_run(self.model, key_t, key_y, key_channels, self.y0, stats,
+                                  from_state=self.from_state)
         if self.step is not None:
             found += physics.check_fixed_steps(self.model, self.events, self.step, self.missed)
         physics.issue(found, stacklevel=5)  # issue <- result <- integrate <- simulate <- the caller

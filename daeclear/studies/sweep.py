@@ -179,7 +179,9 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
         The sweep file (``.h5``); its directory must exist. With ``resume=True`` an existing
         file (and its journal ``<path>.parts/``) is continued.
     grid : mapping of str to list, optional
-        Parameter name -> values; every combination is run (:func:`grid_points`).
+        Parameter name -> values; every combination is run (:func:`grid_points`). A name is an
+        option of ``mechanism`` (``"clearance"``) or, with a dot, a value of the built scene
+        (``"clearance.law.restitution"``, :meth:`daeclear.Scene.with_values`).
     runs : iterable of dict, optional
         Explicit parameter points, instead of or after the grid's.
     mechanism : str or callable

@@ -29,15 +29,22 @@ __all__ = ["build_scene", "ignore_sigint", "run_task", "terminate_pool"]
 
 
 def build_scene(mechanism: str | Callable[..., Any], parameters: Mapping[str, Any]) -> Any:
-    """The scene of one parameter point: ``mechanism(**parameters)`` (a callable or a ready mechanism's name)."""
+    """The scene of one parameter point: ``mechanism(**options)`` (a callable or a ready mechanism's
+    name) with the point's scene values set: a parameter whose name holds a dot (``"clearance.clearance"``,
+    ``"clearance.law.restitution"``, see :meth:`daeclear.Scene.with_values`) is a value of the built
+    scene, any other an option of the mechanism."""
+    options = {k: v for k, v in parameters.items() if "." not in k}
+    values = {k: v for k, v in parameters.items() if "." in k}
     if callable(mechanism):
-        return mechanism(**parameters)
-    from ..model.scenefile import MECHANISMS
+        scene = mechanism(**options)
+    else:
+        from ..model.scenefile import MECHANISMS
 
-    if mechanism not in MECHANISMS:
-        raise SceneError(f"sweep: mechanism={mechanism!r}, must be one of {', '.join(MECHANISMS)} or a callable "
-                         "returning a Scene.")
-    return MECHANISMS[mechanism](**parameters)
+        if mechanism not in MECHANISMS:
+            raise SceneError(f"sweep: mechanism={mechanism!r}, must be one of {', '.join(MECHANISMS)} or a callable "
+                             "returning a Scene.")
+        scene = MECHANISMS[mechanism](**options)
+    return scene.with_values(values) if values else scene
 
 
 def ignore_sigint(parent: int | None = None) -> None:

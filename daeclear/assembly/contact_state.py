@@ -1,0 +1,92 @@
+"""A run's contact state: one value, passed in and returned, never kept by the model.
+
+The contact elements of a model (``model.contacts``: :class:`~daeclear.assembly.contact_pairs.PairLogic`,
+the translational joint's :class:`~daeclear.assembly.translational_joint.SliderGuideLogic`, the
+lubricated joint's logic) are rules. What a run remembers of its contacts, each pair's automaton
+state (mode, held, latched approach speed, storm history: :class:`~daeclear.assembly.automaton.PairState`),
+is a :data:`ContactState`: one tuple of pair states per contact element, in the model's order.
+Everything else the integrator needs follows from it: which terms are on and their parameters (the
+switch vector), the modes of pairs and faces, the directions of the roots to watch. A root is
+decided by :func:`decide`, which returns the new state and the events, as diffrax threads its
+``solver_state``; the compiled IDA loop decides the simple pairs itself, and its decisions are
+taken into the state by :func:`with_decisions`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..results.result import ContactEvent
+from .automaton import Decision, PairState, recorded
+
+#: One tuple of pair states per contact element of the model, in ``model.contacts`` order.
+ContactState = tuple[tuple[PairState, ...], ...]
+
+
+def start_state(model: Any, t: float, y: NDArray) -> ContactState:
+    """Every pair's state at a run's start ``(t, y)``: its mode from its gap, its rate latched, no history."""
+    return tuple(logic.start(t, y) for logic in model.contacts)
+
+
+def switches(model: Any, state: ContactState) -> tuple[list[bool], list[NDArray]]:
+    """Which of the model's terms are on, and each term's parameters, in this state."""
+    active = [False] * len(model.terms)
+    params = [np.zeros(term.n_params) for term in model.terms]
+    for logic, states in zip(model.contacts, state):
+        for index, on, p in logic.terms(states):
+            active[index], params[index] = on, p
+    return active, params
+
+
+def modes(model: Any, state: ContactState) -> dict[str, str]:
+    """``"contact"`` or ``"free"`` of every pair (and face) by name."""
+    out: dict[str, str] = {}
+    for logic, states in zip(model.contacts, state):
+        out.update(logic.modes(states))
+    return out
+
+
+def root_directions(model: Any, state: ContactState) -> NDArray | None:
+    """The direction to watch of every root (+1 up, -1 down, 0 both); None without roots."""
+    if not model.gap_names:
+        return None
+    d = np.zeros(len(model.gap_names), dtype=np.int32)
+    for logic, states in zip(model.contacts, state):
+        for index, direction in logic.root_directions(states):
+            d[index] = direction
+    return d
+
+
+def decide(model: Any, state: ContactState, t: float, y: NDArray, roots_found: NDArray | None
+           ) -> tuple[ContactState, list[ContactEvent]]:
+    """Decide the roots found at ``t`` (each element those of its gaps): the new state and the events."""
+    new: list[tuple[PairState, ...]] = []
+    events: list[ContactEvent] = []
+    for logic, states in zip(model.contacts, state):
+        after, found = logic.decide(states, t, y, roots_found)
+        new.append(after)
+        events += found
+    return tuple(new), events
+
+
+def pair_state(model: Any, state: ContactState, root: int) -> PairState:
+    """The state of the pair of gap ``root``."""
+    for logic, states in zip(model.contacts, state):
+        if root in logic.roots:
+            return states[logic.pair_index(root)]
+    raise IndexError(f"no contact pair watches root {root}")
+
+
+def with_decisions(model: Any, state: ContactState, decisions: Sequence[tuple[int, Decision]]) -> ContactState:
+    """The state after decisions taken by the compiled loop, ``(root, decision)`` in time order: each
+    pair's mode and latched speed (its storm history stays with the loop that decides it)."""
+    new = [list(states) for states in state]
+    where = {root: (k, logic.pair_index(root)) for k, logic in enumerate(model.contacts) for root in logic.roots}
+    for root, decision in decisions:
+        k, i = where[root]
+        new[k][i] = recorded(new[k][i], decision)
+    return tuple(tuple(states) for states in new)
