@@ -167,3 +167,16 @@ def test_a_scene_description_rebuilds_the_scene(make):
     rebuilt = scene_from_description(description)
     assert to_plain(rebuilt.to_dict(), "scene") == description
     assert np.array_equal(dc.assemble(rebuilt).parameter_values, dc.assemble(scene).parameter_values)
+
+
+def test_a_result_pickles_with_its_channels(runs, tmp_path):
+    """A result sent to another process (sweeps, parallel studies) carries its channels and yp, not the
+    compiled functions that computed them."""
+    import pickle
+
+    loaded = dc.load(runs["index1"].save(tmp_path / "p.h5"))
+    for result in (runs["index1"], loaded):
+        again = pickle.loads(pickle.dumps(result))
+        assert again.channel_source.computed and np.array_equal(again.yp, runs["index1"].yp)
+        assert np.array_equal(again["clearance.normal_force"], runs["index1"]["clearance.normal_force"])
+        assert np.array_equal(again.slice(0.001, 0.002)["slider.vx"], result.slice(0.001, 0.002)["slider.vx"])

@@ -101,6 +101,14 @@ class LazyChannels:
                 self._values = {name: readonly(np.zeros(0)) for name in self.names}
         return self._values
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled (a result sent between processes: sweeps, parallel studies) with its channels and yp
+        computed, without what computes them (the model's compiled functions stay in this process)."""
+        self.values()
+        state = dict(self.__dict__)
+        state.update(_yp=self.yp, evaluate=None, derivatives=None, _rebuildable=self.can_rebuild())
+        return state
+
     def take(self, rows: Any) -> LazyChannels:
         """The channels of some rows (an index or a mask): computed ones cut, the others still lazy."""
         values = None if self._values is None else {n: v[rows] for n, v in self._values.items()}
