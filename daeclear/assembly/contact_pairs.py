@@ -205,13 +205,34 @@ class JournalContact:
         return out
 
 
+def worn_depths(ctx: AssemblyContext, joint: Any, direction: Any, bi: Any, bj: Any) -> tuple[Any, Any]:
+    """The worn depth of the bearing and of the journal along the contact ``direction`` (a unit
+    vector, world frame): each surface's smooth profile (:func:`daeclear.contact.wear.profile_coefficients`,
+    run-time parameters ``<joint>.wear.<surface>_cos/_sin``) at the direction's angle in that body's
+    frame; 0 for a surface that does not wear."""
+    wear = getattr(joint, "wear", None)
+    out: list[Any] = [0.0, 0.0]
+    for k, (surface, frame) in enumerate((("bearing", bi), ("journal", bj))):
+        if wear is None or surface not in wear.surfaces:
+            continue
+        # cos and sin of the direction's angle in the body's frame: A(phi)^T direction
+        c1 = ca.cos(frame.phi) * direction[0] + ca.sin(frame.phi) * direction[1]
+        s1 = -ca.sin(frame.phi) * direction[0] + ca.cos(frame.phi) * direction[1]
+        a, b = ctx.p(joint.name, f"wear.{surface}_cos"), ctx.p(joint.name, f"wear.{surface}_sin")
+        depth, cm, sm = a[0], c1, s1
+        for m in range(wear.modes):  # cos/sin of (m + 1) theta by the angle-sum rule: no atan2 (regular at e = 0)
+            depth = depth + a[m + 1] * cm + b[m] * sm
+            cm, sm = cm * c1 - sm * s1, sm * c1 + cm * s1
+        out[k] = depth
+    return out[0], out[1]
+
+
 def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction_numeric: Any) -> JournalContact:
     """Journal-bearing contact (section 4.2) of ``joint`` with these laws, every number a run-time
     parameter ``<joint>.*``. Body i carries the bearing (radius R_i), body j the journal (R_j)."""
     name = joint.name
     law = symbolic_law(law_numeric, ctx.params, f"{name}.law")
     friction = symbolic_law(friction_numeric, ctx.params, f"{name}.friction")
-    c = ctx.p(name, "clearance")
     R_i, R_j = ctx.p(name, "bearing_radius"), ctx.p(name, "journal_radius")
     s_i, s_j = ctx.p(name, "s_i"), ctx.p(name, "s_j")
     bi, bj = ctx.frames[joint.body_i], ctx.frames[joint.body_j]
@@ -222,11 +243,13 @@ def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction
     # in contact |e| >= c > 0: the normal and everything below are regular there
     e_norm = ca.sqrt(ee)
     n = e / e_norm  # (4.4)
+    worn = worn_depths(ctx, joint, e / ca.fmax(e_norm, 1e-300), bi, bj)  # 0 without wear
+    c = ctx.p(name, "clearance") + worn[0] + worn[1]  # the clearance along n, worn surfaces included
     delta = e_norm - c  # (4.5)
-    delta_dot = ca.dot(e_dot, n)  # (4.8): v_N = d|e|/dt
+    delta_dot = ca.dot(e_dot, n)  # (4.8): v_N = d|e|/dt (the profile's slope neglected: h' / R ~ 1e-4)
     t_vec = perpendicular(n)
-    Q_i = P_i + R_i * n  # (4.6) contact points
-    Q_j = P_j + R_j * n
+    Q_i = P_i + (R_i + worn[0]) * n  # (4.6) contact points, on the worn surfaces
+    Q_j = P_j + (R_j - worn[1]) * n
     # (4.9) with the velocities of the material points at the contact (spin included)
     v_T = ca.dot(bj.world_point_velocity(Q_j) - bi.world_point_velocity(Q_i), t_vec)
     n_params = 1 if law_numeric.needs_approach_speed else 0

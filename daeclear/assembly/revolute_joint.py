@@ -20,6 +20,7 @@ from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Ter
 from .contact_pairs import PairLogic, ContactBuild, approach_floor, journal_contact
 from .lubricated_joint import build_lubricated_revolute, lubricated_parameters
 from ..contact.hydrodynamic import HydrodynamicBearing
+from ..contact.wear import profile_coefficients
 from .translational_joint import (
     TranslationalClearance, build_translational_clearance, translational_clearance_parameters)
 
@@ -34,7 +35,13 @@ def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> t
                               "bearing_radius": float(joint.bearing_radius), "journal_radius": joint.journal}
     values.update({f"law.{k}": v for k, v in law_values(law).items()})
     values.update({f"friction.{k}": v for k, v in law_values(friction).items()})
-    return values, [law_structure(law), law_structure(friction)]
+    structure = [law_structure(law), law_structure(friction)]
+    if joint.wear is not None:  # the worn profiles' Fourier coefficients; how many is structure
+        for surface, depth in joint.worn_profiles().items():
+            a, b = profile_coefficients(depth, joint.wear.modes)
+            values[f"wear.{surface}_cos"], values[f"wear.{surface}_sin"] = a, b
+        structure.append(f"wear:{','.join(joint.wear.surfaces)}:{joint.wear.modes}")
+    return values, structure
 
 
 def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, first_term: int,

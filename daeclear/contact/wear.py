@@ -32,7 +32,8 @@ from ..errors import SceneError
 from ._checks import check_number
 
 __all__ = ["ArchardWear", "DISTRIBUTIONS", "SURFACES", "WearHistoryArrays", "half_angle_hertz",
-           "half_angle_overlap", "node_weights", "wear_increment", "worn_volume"]
+           "half_angle_overlap", "node_weights", "profile_coefficients", "spread", "profile_depth", "wear_increment",
+           "worn_volume"]
 
 SURFACES: tuple[str, ...] = ("bearing", "journal", "both")
 DISTRIBUTIONS: tuple[str, ...] = ("elastic-foundation", "hertz")
@@ -57,6 +58,9 @@ class ArchardWear:
         Which surfaces wear.
     distribution : {"elastic-foundation", "hertz"}
         Shape of the pressure over the contact arc (module docstring).
+    modes : int
+        Fourier modes of the worn profile in the joint's gap (:func:`profile_coefficients`), >= 1 and
+        below ``nodes / 2``; 48 by default (worn spots down to about 0.1 rad to 0.1 %).
     """
 
     coefficient: float
@@ -64,6 +68,7 @@ class ArchardWear:
     nodes: int = 360
     surface: Literal["bearing", "journal", "both"] = "bearing"
     distribution: Literal["elastic-foundation", "hertz"] = "elastic-foundation"
+    modes: int = 48
 
     def __post_init__(self) -> None:
         check_number("ArchardWear", "coefficient", self.coefficient, low=0.0, unit="m^2/N")
@@ -75,6 +80,15 @@ class ArchardWear:
         if self.distribution not in DISTRIBUTIONS:
             raise SceneError(f"ArchardWear: distribution={self.distribution!r}, must be one of "
                              f"{', '.join(DISTRIBUTIONS)}.")
+        if (isinstance(self.modes, bool) or not isinstance(self.modes, (int, np.integer))
+                or not 1 <= self.modes < self.nodes / 2):
+            raise SceneError(f"ArchardWear: modes={self.modes!r}, must be an integer >= 1 and < nodes / 2 "
+                             f"({self.nodes / 2:g}).")
+
+    @property
+    def surfaces(self) -> tuple[str, ...]:
+        """The worn surfaces: ("bearing",), ("journal",) or both."""
+        return ("bearing", "journal") if self.surface == "both" else (self.surface,)
 
     @property
     def angles(self) -> NDArray[np.float64]:
@@ -99,35 +113,50 @@ def half_angle_hertz(force: float, bearing_radius: float, journal_radius: float,
     return math.sqrt(4.0 * force * r_eff / (math.pi * length * effective_modulus)) / bearing_radius
 
 
-def _shape(distribution: str, phi: NDArray[np.float64], half_angle: float) -> NDArray[np.float64]:
-    """The pressure's shape over the arc (not normalised), 0 outside it."""
+def _shape(distribution: str, phi: NDArray[np.float64], half_angle: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The pressure's shape over the arc (not normalised), 0 outside it; ``half_angle`` > 0."""
     if distribution == "hertz":
         return np.sqrt(np.clip(1.0 - (phi / half_angle) ** 2, 0.0, None))
-    return np.clip(np.cos(phi) - math.cos(half_angle), 0.0, None)
+    return np.clip(np.cos(phi) - np.cos(half_angle), 0.0, None)
+
+
+def spread(centres: ArrayLike, half_angles: ArrayLike, loads: ArrayLike, nodes: int,
+           distribution: str = "elastic-foundation") -> NDArray[np.float64]:
+    """Loads spread over the nodes: ``sum_i loads[i] * weights(centres[i], half_angles[i])``.
+
+    Each contact's pressure shape is sampled at the midpoints of equal pieces of its arc
+    ``centre +- half_angle`` (as many for every contact: at least 64, and 16 per node spacing the
+    widest arc covers) and each sample is split between its two neighbouring nodes in proportion to
+    its distance (linear interpolation's weights), so that an arc narrower than a node's spacing
+    still loads the nodes around it smoothly; each contact's weights sum to one. An arc of zero
+    width puts the load on the nodes around its centre.
+    """
+    centre = np.asarray(centres, dtype=float).ravel()
+    half = np.asarray(half_angles, dtype=float).ravel()
+    load = np.asarray(loads, dtype=float).ravel()
+    if not centre.size:
+        return np.zeros(nodes)
+    spacing = 2.0 * math.pi / nodes
+    count = max(ARC_SAMPLES, int(math.ceil(16.0 * float(half.max()) / spacing)))
+    phi = np.outer(half, (np.arange(count) + 0.5) / count * 2.0 - 1.0)
+    wide = half > 0.0
+    shape = np.ones_like(phi)
+    shape[wide] = _shape(distribution, phi[wide], half[wide, None])
+    share = shape * (load / shape.sum(axis=1))[:, None]
+    position = ((centre[:, None] + phi) % (2.0 * math.pi)) / spacing
+    lower = np.floor(position)
+    upper_share = (position - lower).ravel()
+    lower_node = lower.astype(int).ravel() % nodes
+    share = share.ravel()
+    total = (np.bincount(lower_node, share * (1.0 - upper_share), minlength=nodes)
+             + np.bincount((lower_node + 1) % nodes, share * upper_share, minlength=nodes))
+    return np.asarray(total, dtype=float)
 
 
 def node_weights(centre: float, half_angle: float, nodes: int, distribution: str = "elastic-foundation"
                  ) -> NDArray[np.float64]:
-    """The share of a contact's load that each node carries (they sum to 1).
-
-    The pressure's shape is sampled at the midpoints of equal pieces of the arc ``centre +- half_angle``
-    and each sample is split between its two neighbouring nodes in proportion to its distance
-    (linear interpolation's weights), so that an arc narrower than a node's spacing still loads
-    the nodes around it smoothly. An arc of zero width puts the load on the nodes around ``centre``.
-    """
-    spacing = 2.0 * math.pi / nodes
-    if half_angle <= 0.0:
-        phi, shape = np.zeros(1), np.ones(1)
-    else:
-        count = max(ARC_SAMPLES, int(math.ceil(16.0 * half_angle / spacing)))
-        phi = (np.arange(count) + 0.5) / count * 2.0 * half_angle - half_angle
-        shape = _shape(distribution, phi, half_angle)
-    position = ((centre + phi) % (2.0 * math.pi)) / spacing
-    lower = np.floor(position).astype(int) % nodes
-    upper_share = position - np.floor(position)
-    weights = np.bincount(lower, shape * (1.0 - upper_share), minlength=nodes)
-    weights += np.bincount((lower + 1) % nodes, shape * upper_share, minlength=nodes)
-    return weights / weights.sum()
+    """The share of one contact's load that each node carries (they sum to 1): :func:`spread` of a unit load."""
+    return spread([centre], [half_angle], [1.0], nodes, distribution)
 
 
 @dataclass(frozen=True)
@@ -161,23 +190,48 @@ def wear_increment(wear: ArchardWear, history: WearHistoryArrays, *, bearing_rad
     delta = 0.5 * (history.penetration[1:] + history.penetration[:-1])
     active = np.flatnonzero((force > 0.0) & (ds > 0.0))
     area = bearing_radius * (2.0 * math.pi / wear.nodes) * wear.length  # one node's cell, m^2
-    surfaces = ("bearing", "journal") if wear.surface == "both" else (wear.surface,)
-    depth = {s: np.zeros(wear.nodes) for s in surfaces}
+    F, d = force[active], delta[active]
+    if wear.distribution == "hertz":
+        if effective_modulus is None:
+            raise SceneError("wear_increment: the 'hertz' distribution needs effective_modulus (Pa).")
+        journal = bearing_radius - clearance
+        r_eff = bearing_radius * journal / (bearing_radius - journal)
+        half = np.sqrt(4.0 * F * r_eff / (math.pi * wear.length * effective_modulus)) / bearing_radius
+    else:  # arccos(c / (c + delta)), 0 without penetration
+        half = np.arccos(clearance / (clearance + np.clip(d, 0.0, None)))
+    loads = wear.coefficient * F * ds[active] / area
     angles = {"bearing": history.angle_bearing, "journal": history.angle_journal}
-    for i in active.tolist():
-        if wear.distribution == "hertz":
-            if effective_modulus is None:
-                raise SceneError("wear_increment: the 'hertz' distribution needs effective_modulus (Pa).")
-            half = half_angle_hertz(force[i], bearing_radius, bearing_radius - clearance, wear.length,
-                                    effective_modulus)
-        else:
-            half = half_angle_overlap(delta[i], clearance)
-        for s in surfaces:
-            a, b = angles[s][i], angles[s][i + 1]
-            centre = a + 0.5 * math.remainder(b - a, 2.0 * math.pi)  # the shorter way round
-            depth[s] += wear.coefficient * force[i] * ds[i] / area * node_weights(centre, half, wear.nodes,
-                                                                                 wear.distribution)
+    depth = {}
+    for s in wear.surfaces:
+        a, b = np.asarray(angles[s][:-1], dtype=float)[active], np.asarray(angles[s][1:], dtype=float)[active]
+        step = b - a
+        centre = a + 0.5 * (step - 2.0 * math.pi * np.round(step / (2.0 * math.pi)))  # the shorter way round
+        depth[s] = spread(centre, half, loads, wear.nodes, wear.distribution)
     return depth, float(np.dot(force, ds))
+
+
+def profile_coefficients(depth: ArrayLike, modes: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The smooth profile of a nodal depth for the joint's gap: its Fourier series to ``modes`` (the
+    least-squares fit on the nodes). Returns (cosine coefficients a_0..a_modes, sine coefficients
+    b_1..b_modes) of ``h(theta) = a_0 + sum a_m cos(m theta) + b_m sin(m theta)``.
+
+    The mean depth (a_0), and so the worn volume, is kept exactly. A worn spot narrower than the
+    series resolves rings (negative depth beside it): with 48 modes a Gaussian spot of half-width
+    0.1 rad is reproduced to 0.1 % and rings by 0.04 %, one of 0.05 rad to 8 % and 5 % (worn spots
+    of a joint are the contact arcs, 0.1-0.3 rad, smeared over many impacts)."""
+    h = np.asarray(depth, dtype=float)
+    theta = 2.0 * np.pi * np.arange(h.size) / h.size
+    m = np.arange(1, modes + 1)
+    a = np.concatenate([[h.mean()], (2.0 / h.size) * (np.cos(np.outer(m, theta)) @ h)])
+    b = (2.0 / h.size) * (np.sin(np.outer(m, theta)) @ h)
+    return a, b
+
+
+def profile_depth(a: ArrayLike, b: ArrayLike, angles: ArrayLike) -> NDArray[np.float64]:
+    """The smooth profile's depth at ``angles`` (rad), from :func:`profile_coefficients`' output."""
+    a, b, theta = np.asarray(a, dtype=float), np.asarray(b, dtype=float), np.asarray(angles, dtype=float)
+    m = np.arange(1, b.size + 1)
+    return a[0] + np.cos(np.multiply.outer(theta, m)) @ a[1:] + np.sin(np.multiply.outer(theta, m)) @ b
 
 
 def worn_volume(depth: ArrayLike, bearing_radius: float, length: float) -> float:

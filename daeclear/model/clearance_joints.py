@@ -10,9 +10,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from ..errors import SceneError
+
+if TYPE_CHECKING:
+    from numpy.typing import NDArray
 from ..results.values import field_names
 from .elements import (Joint, PointJoint, Revolute, Translational, Vector2, as_vector2, computed_once,
                        own_problems)
@@ -86,6 +89,14 @@ class RevoluteClearance(PointJoint):
         dry law below the film threshold; docs/lubrication.md).
     friction : None, float, str or FrictionLaw
         None: frictionless; a float: modified Coulomb (3.16) with that coefficient (in dry contact).
+    wear : ArchardWear or None
+        Archard wear of the joint's surfaces (:class:`daeclear.contact.wear.ArchardWear`): the worn
+        profile ``wear_depth`` enters the gap (docs/wear.md); ``daeclear.studies.wear`` grows it.
+    wear_depth : sequence of float, or two of them, or None
+        The worn depth at the profile's nodes (``wear.nodes`` values, m, >= 0, node k at angle
+        ``2 pi k / nodes`` in the worn body's frame): one profile for ``surface`` "bearing" or
+        "journal", two rows (bearing, journal) for "both". None: unworn. Run-time data: a new
+        profile compiles nothing (``model.with_parameters({"<joint>.wear_depth": depth})``).
     """
 
     bearing_radius: float = 0.0
@@ -94,6 +105,36 @@ class RevoluteClearance(PointJoint):
     material: Any = None
     law: Any = field(default_factory=lambda: _default_law())
     friction: Any = None
+    wear: Any = None
+    wear_depth: Any = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        surfaces = getattr(self.wear, "surfaces", None)
+        if self.wear_depth is None and surfaces is not None:  # unworn: zeros (a profile is numbers, not structure)
+            zeros = (0.0,) * int(self.wear.nodes)
+            object.__setattr__(self, "wear_depth", zeros if len(surfaces) == 1 else (zeros,) * len(surfaces))
+        if self.wear_depth is not None and not isinstance(self.wear_depth, tuple):  # frozen: no array inside
+            import numpy as np  # (not at import: `import daeclear` loads no numerical library)
+
+            try:
+                depth = np.asarray(self.wear_depth, dtype=float)
+            except (TypeError, ValueError):
+                return  # problems() names it
+            value = tuple(map(tuple, depth.tolist())) if depth.ndim == 2 else tuple(depth.ravel().tolist())
+            object.__setattr__(self, "wear_depth", value)
+
+    def worn_profiles(self) -> dict[str, NDArray[Any]]:
+        """The nodal depth of each worn surface, by name ("bearing", "journal"); zeros when unworn."""
+        import numpy as np
+
+        if self.wear is None:
+            return {}
+        surfaces = self.wear.surfaces
+        if self.wear_depth is None:
+            return {s: np.zeros(self.wear.nodes) for s in surfaces}
+        depth = np.asarray(self.wear_depth, dtype=float).reshape(len(surfaces), -1)
+        return dict(zip(surfaces, depth))
 
     @property
     def radial_clearance(self) -> float:
@@ -134,7 +175,39 @@ class RevoluteClearance(PointJoint):
                            f"(0, bearing_radius={R!r} m): clearance {c!r} m, must be in (0, {R!r}).")
             else:
                 out.extend(_law_problems(self))
+        out.extend(_wear_problems(self))
         return out
+
+
+def _wear_problems(joint: RevoluteClearance) -> list[str]:
+    """What is wrong with a joint's wear and worn profile."""
+    import numpy as np
+
+    from ..contact.hydrodynamic import HydrodynamicBearing
+    from ..contact.wear import ArchardWear
+
+    where = f"{joint.kind} '{joint.name}'"
+    if joint.wear is None:
+        return [] if joint.wear_depth is None else [
+            f"{where}: wear_depth is given without wear; give wear=ArchardWear(...) too."]
+    if not isinstance(joint.wear, ArchardWear):
+        return [f"{where}: wear={joint.wear!r}, must be None or a daeclear.contact.wear.ArchardWear."]
+    if isinstance(joint.law, HydrodynamicBearing):
+        return [f"{where}: wear with a lubricated joint (law=HydrodynamicBearing) is not modelled; "
+                "give a dry contact law."]
+    if joint.wear_depth is None:
+        return []
+    rows = len(joint.wear.surfaces)
+    shape = (joint.wear.nodes,) if rows == 1 else (rows, joint.wear.nodes)
+    try:
+        depth = np.asarray(joint.wear_depth, dtype=float)
+    except (TypeError, ValueError):
+        depth = np.zeros(0)
+    if depth.shape != shape or not np.all(np.isfinite(depth)) or np.any(depth < 0):
+        shown = f"an array of shape {depth.shape}" if depth.size else repr(joint.wear_depth)[:60]
+        return [f"{where}: wear_depth={shown}, must be {shape[-1]} finite depths >= 0 (m)"
+                + (" for each of bearing and journal" if rows == 2 else "") + f", shape {shape}."]
+    return []
 
 
 def _default_face_law() -> Any:

@@ -1,21 +1,42 @@
-"""Joint wear from a run: what Archard's law needs, read from a Result (issue 33).
+"""Joint wear over many cycles: a run's contact history, and the cycle scheme that grows the profile.
 
 :func:`wear_history` turns a run of a revolute clearance joint into the arrays of
 :class:`daeclear.contact.wear.WearHistoryArrays`: the normal force, the contact direction in the
 bearing's and in the journal's frame, the sliding speed of the contacting material points and the
 penetration, at every output time. :func:`daeclear.contact.wear.wear_increment` spreads them over
-the worn profile.
+the worn profile. :func:`simulate_wear` runs the mechanism block by block, each block's wear
+(optionally extrapolated over more cycles) put into the joint's profile for the next block
+(the iterative scheme of Mukras et al. 2010), as new run-time numbers of the same model.
 """
 
 from __future__ import annotations
 
+import math
+import os
+import time
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 
+from ..assembly.assemble import assemble
 from ..assembly.dae_model import DAEModel
-from ..contact.wear import WearHistoryArrays
-from ..errors import SceneError
+from ..contact.geometry import material_pair
+from ..contact.wear import ArchardWear, WearHistoryArrays, wear_increment, worn_volume
+from ..errors import PhysicsWarning, SceneError
+from ..model.scene import RevoluteClearance, Scene
+from ..progress import Progress
 from ..results.result import Result
+from ..solver_options import SolverOptions
+from ..solvers.ida import simulate
+from .wear_file import WearFile
+
+
+#: The deepest wear a history goes on with, as a fraction of the bearing radius: beyond it the profile's
+#: slope tilts the contact normal by more than the gap's model (normal e / |e|) neglects.
+MAX_DEPTH_FRACTION = 0.05
 
 
 def _rotate(angle: NDArray[np.float64], point: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -46,7 +67,6 @@ def wear_history(result: Result, model: DAEModel, joint: str) -> WearHistoryArra
     s_i, s_j = model.parameter(f"{joint}.s_i"), model.parameter(f"{joint}.s_j")
     r_i = float(model.parameter(f"{joint}.bearing_radius")[0])
     r_j = float(model.parameter(f"{joint}.journal_radius")[0])
-    clearance = float(model.parameter(f"{joint}.clearance")[0])
 
     def body(name: str) -> tuple[NDArray, NDArray, NDArray, NDArray]:
         if name == "ground":
@@ -68,4 +88,163 @@ def wear_history(result: Result, model: DAEModel, joint: str) -> WearHistoryArra
     return WearHistoryArrays(
         t=np.asarray(result.t, dtype=float), force=np.asarray(result[f"{joint}.normal_force"], dtype=float),
         angle_bearing=np.unwrap(direction - phi_i), angle_journal=np.unwrap(direction - phi_j),
-        slip_speed=slip, penetration=np.clip(distance - clearance, 0.0, None))
+        slip_speed=slip, penetration=np.clip(np.asarray(result[f"{joint}.penetration"], dtype=float), 0.0, None))
+
+
+@dataclass(frozen=True)
+class WearHistory:
+    """The profile's growth: one row per profile (the first unworn), ``cycles`` the cycles worn into
+    it. ``depth`` is (profiles, nodes) for one worn surface, (profiles, 2, nodes) for both (bearing,
+    journal); ``volume`` the worn volume (m^3, both surfaces), ``sliding_work`` the integral of normal
+    force times sliding speed so far (N m; ``volume = coefficient * sliding_work``), ``peak_force``
+    the largest normal force of the block simulated after each profile (N; NaN for the last)."""
+
+    angles: NDArray[np.float64]
+    cycles: NDArray[np.float64]
+    depth: NDArray[np.float64]
+    volume: NDArray[np.float64]
+    sliding_work: NDArray[np.float64]
+    peak_force: NDArray[np.float64]
+    surfaces: tuple[str, ...]
+    wall_time: float = 0.0
+    message: str = ""  # why the history stopped before ``cycles`` (empty when it reached them)
+
+    @property
+    def max_depth(self) -> NDArray[np.float64]:
+        """The deepest point of each profile, m."""
+        return self.depth.reshape(self.depth.shape[0], -1).max(axis=1)
+
+
+def wear_joint(scene: Scene, joint: str | None) -> RevoluteClearance:
+    """The scene's revolute clearance joint that wears (``joint``, or the only one with ``wear``)."""
+    worn = [e for e in scene.elements if isinstance(e, RevoluteClearance) and e.wear is not None]
+    if joint is None:
+        if len(worn) != 1:
+            raise SceneError(f"simulate_wear: joint=None, must name the worn joint when the scene has "
+                             f"{len(worn)} revolute clearance joints with wear ({', '.join(e.name for e in worn)}).")
+        return worn[0]
+    for element in worn:
+        if element.name == joint:
+            return element
+    raise SceneError(f"simulate_wear: joint={joint!r}, must be a revolute clearance joint with wear of scene "
+                     f"'{scene.name}' ({', '.join(e.name for e in worn) or 'none has wear=ArchardWear(...)'}).")
+
+
+def cycle_period(scene: Scene) -> float:
+    """The period of one cycle: the time of one turn of the scene's (first) driver, s."""
+    speeds = [float(d.speed) for d in scene.drivers if d.speed]
+    if not speeds:
+        raise SceneError(f"simulate_wear: scene '{scene.name}' has no driver with a constant speed; give period=<s>.")
+    return 2.0 * math.pi / abs(speeds[0])
+
+
+def effective_modulus(joint: RevoluteClearance) -> float:
+    """E* of the joint's materials (the Hertz arc): ``1 / (sigma_i + sigma_j)``."""
+    if joint.material is None:
+        raise SceneError(f"simulate_wear: joint '{joint.name}' has no material; the 'hertz' distribution needs one.")
+    first, second = material_pair(joint.material, joint.name)
+    return 1.0 / (first.sigma + second.sigma)
+
+
+def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, update_every: int = 1,
+                  extrapolate: int = 1, period: float | None = None, path: str | os.PathLike[str] | None = None,
+                  options: SolverOptions | None = None, progress: bool = False) -> WearHistory:
+    """Wear a revolute clearance joint over ``cycles`` cycles of the mechanism.
+
+    The mechanism runs ``update_every`` cycles with the current profile; Archard's law over that
+    block (:func:`wear_history`, :func:`~daeclear.contact.wear.wear_increment`) times ``extrapolate``
+    is added to the profile, which counts as ``update_every * extrapolate`` cycles; the next block
+    continues from the block's last state with the new profile (new run-time numbers of the same
+    model: nothing is compiled). ``extrapolate=1`` simulates every cycle.
+
+    Parameters
+    ----------
+    scene : Scene
+        The mechanism; its joint ``joint`` has ``wear=ArchardWear(...)`` (and maybe a ``wear_depth`` to start from).
+    cycles : float
+        Cycles to wear (> 0); the last block may run past it (the cycles are counted in blocks).
+    update_every, extrapolate : int
+        Cycles simulated per profile update, and the factor each block's wear is extrapolated by (>= 1).
+    period : float or None
+        One cycle, s; None: one turn of the scene's driver.
+    path : str, path or None
+        An HDF5 file the history is appended to after every update (with the state to continue
+        from): a stopped run loses at most one block, and a call with the same file and settings
+        resumes where it stopped.
+    options : SolverOptions or None
+        The runs' solver settings (:class:`daeclear.SolverOptions`).
+    progress : bool
+        A progress line on stderr.
+    """
+    for label, value in (("update_every", update_every), ("extrapolate", extrapolate)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise SceneError(f"simulate_wear: {label}={value!r}, must be an integer >= 1.")
+    if not (isinstance(cycles, (int, float)) and math.isfinite(cycles) and cycles > 0):
+        raise SceneError(f"simulate_wear: cycles={cycles!r}, must be a finite number > 0.")
+    element = wear_joint(scene, joint)
+    wear = element.wear
+    period = cycle_period(scene) if period is None else period
+    if not (isinstance(period, (int, float)) and math.isfinite(period) and period > 0):
+        raise SceneError(f"simulate_wear: period={period!r} s, must be a finite number > 0.")
+    modulus = effective_modulus(element) if wear.distribution == "hertz" else None
+    settings = {"joint": element.name, "update_every": update_every, "extrapolate": extrapolate, "period": period,
+                "coefficient": wear.coefficient, "nodes": wear.nodes, "surface": wear.surface}
+    store = WearFile(path, settings) if path is not None else None
+    tic = time.perf_counter()
+    model = assemble(scene)
+    rows = store.read() if store is not None else None
+    if rows is None:
+        depth = element.worn_profiles()
+        rows = [(0.0, depth, 0.0, math.nan)]
+        t0, y0 = 0.0, None
+        if store is not None:
+            store.append(*rows[0], t0=t0, y0=None)
+    else:
+        depth, t0, y0 = rows[-1][1], store.t0, store.y0  # type: ignore[union-attr]
+    done, work = rows[-1][0], rows[-1][2]
+    bar = Progress(float(cycles), unit="cycles", desc="wear", enabled=progress)
+    name, radius, clearance = element.name, float(element.bearing_radius), element.radial_clearance
+    message = ""
+    try:
+        while done < cycles:
+            deepest = max(float(d.max()) for d in depth.values())
+            if deepest > MAX_DEPTH_FRACTION * radius:
+                message = (f"stopped at {done:g} cycles: the worn depth {deepest:.3g} m exceeds "
+                           f"{MAX_DEPTH_FRACTION:g} of the bearing radius {radius:g} m, where the gap's small-slope "
+                           "model no longer holds; a smaller wear coefficient, or fewer cycles.")
+                warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
+                break
+            model = model.with_parameters({f"{name}.wear_depth": _depth_value(depth, wear.surfaces)})
+            result = simulate(model, t0 + update_every * period, t0=t0, y0=y0, options=options)
+            increment, block_work = wear_increment(wear, wear_history(result, model, name), bearing_radius=radius,
+                                                   clearance=clearance, effective_modulus=modulus)
+            depth = {s: depth[s] + extrapolate * increment[s] for s in depth}
+            done += update_every * extrapolate
+            work += extrapolate * block_work
+            peak = float(np.max(result[f"{name}.normal_force"]))
+            rows[-1] = (*rows[-1][:3], peak)
+            rows.append((done, depth, work, math.nan))
+            t0, y0 = float(result.t[-1]), result.y[-1]
+            if store is not None:
+                store.append(done, depth, work, math.nan, t0=t0, y0=y0, peak_before=peak)
+            bar.update(min(done, cycles), f"max depth {max(float(d.max()) for d in depth.values()):.3g} m")
+    finally:
+        bar.close()
+    return _history(rows, wear, radius, time.perf_counter() - tic, message)
+
+
+def _depth_value(depth: dict[str, NDArray[np.float64]], surfaces: tuple[str, ...]) -> Any:
+    """The joint's ``wear_depth`` value of a profile by surface."""
+    return tuple(depth[surfaces[0]].tolist()) if len(surfaces) == 1 else tuple(
+        tuple(depth[s].tolist()) for s in surfaces)
+
+
+def _history(rows: list[tuple[float, dict[str, NDArray[np.float64]], float, float]], wear: ArchardWear,
+             radius: float, wall_time: float, message: str) -> WearHistory:
+    surfaces = wear.surfaces
+    depth = np.array([[row[1][s] for s in surfaces] for row in rows])
+    volume = np.array([sum(worn_volume(row[1][s], radius, wear.length) for s in surfaces) for row in rows])
+    return WearHistory(angles=wear.angles, cycles=np.array([row[0] for row in rows]),
+                       depth=depth[:, 0] if len(surfaces) == 1 else depth, volume=volume,
+                       sliding_work=np.array([row[2] for row in rows]), peak_force=np.array([row[3] for row in rows]),
+                       surfaces=surfaces, wall_time=wall_time, message=message)

@@ -1,0 +1,185 @@
+"""The worn profile in the joint's gap and the cycle scheme (issue 33, second part).
+
+Checks against independent computations: the profile's series against its closed form, the impact
+time of a journal flying at a worn spot against kinematics (c + h) / v, the worn volume against
+k times the sliding work, a resumed history against an uninterrupted one."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import daeclear as dc
+import daeclear.contact as dcc
+from daeclear.contact.wear import ArchardWear, profile_coefficients, profile_depth
+from daeclear.errors import SceneError
+from daeclear.model.scene import RevoluteClearance
+from daeclear.studies.wear import simulate_wear
+
+NODES, MODES = 360, 48
+THETA = 2.0 * np.pi * np.arange(NODES) / NODES
+CLEARANCE, SPEED = 0.5e-3, 0.1  # m, m/s
+
+
+def _bump(centre: float, depth: float = 40e-6, width: float = 0.25) -> np.ndarray:
+    return depth * np.exp(-(np.angle(np.exp(1j * (THETA - centre))) / width) ** 2)
+
+
+def flight(direction: float, *, surface: str = "bearing", depth=None, journal_angle: float = 0.0,
+           wear: bool = True) -> dc.Scene:
+    """A journal flying from the bearing's centre at SPEED along ``direction`` (no gravity)."""
+    scene = dc.Scene("flight", gravity=(0.0, 0.0))
+    journal = scene.add(dc.Body("journal", mass=0.1, inertia=1e-5, angle=journal_angle,
+                                velocity=(SPEED * math.cos(direction), SPEED * math.sin(direction))))
+    scene.add(RevoluteClearance(
+        "bearing", scene.ground, journal, at=(0, 0), bearing_radius=10e-3, clearance=CLEARANCE,
+        material=dcc.Material(young=207e9, poisson=0.3), law=dcc.LankaraniNikravesh(restitution=0.9),
+        wear=ArchardWear(coefficient=1e-14, length=0.02, nodes=NODES, modes=MODES, surface=surface) if wear else None,
+        wear_depth=depth))
+    return scene
+
+
+def _onset(scene: dc.Scene) -> float:
+    result = dc.simulate(scene, 0.01, rtol=1e-10, start="declared")
+    return result.events.of(kind="onset")[0].t
+
+
+def test_profile_series_of_a_smooth_profile():
+    """The series of a + b cos 2t + c sin 3t is exactly that; a worn spot of half-width 0.1 rad is
+    reproduced to 1e-3 of its depth with 48 modes, its mean (the worn volume) exactly."""
+    depth = 5e-6 + 2e-6 * np.cos(2 * THETA) - 1e-6 * np.sin(3 * THETA)
+    a, b = profile_coefficients(depth, MODES)
+    assert a[0] == pytest.approx(5e-6, rel=1e-12) and a[2] == pytest.approx(2e-6, rel=1e-9)
+    assert b[2] == pytest.approx(-1e-6, rel=1e-9)
+    assert np.max(np.abs(np.delete(a, [0, 2]))) < 1e-19 and np.max(np.abs(np.delete(b, 2))) < 1e-19  # round-off
+    np.testing.assert_allclose(profile_depth(a, b, THETA), depth, rtol=0, atol=1e-18)
+    spot = _bump(1.0, depth=1e-5, width=0.1)
+    smooth = profile_depth(*profile_coefficients(spot, MODES), THETA)
+    assert smooth.mean() == pytest.approx(spot.mean(), rel=1e-12)
+    assert np.max(np.abs(smooth - spot)) < 1e-3 * spot.max()
+    coarse = profile_depth(*profile_coefficients(spot, 16), THETA)  # too few modes: a visible error
+    assert np.max(np.abs(coarse - spot)) > 0.1 * spot.max()
+
+
+@pytest.mark.parametrize("surface", ["bearing", "journal", "both"])
+def test_impact_at_a_worn_spot_comes_when_kinematics_says(surface):
+    """The journal reaches the wall at |e| = c + h(theta): (c + h) / v, h the smooth profile at the
+    flight's angle in each worn body's frame (the journal turned by 0.5 rad carries its profile)."""
+    direction, turned = 0.3, 0.5 if surface != "bearing" else 0.0
+    bearing, journal = _bump(direction), _bump(direction - turned, depth=25e-6)
+    depth = {"bearing": bearing, "journal": journal, "both": np.array([bearing, journal])}[surface]
+    h = 0.0
+    if surface in ("bearing", "both"):
+        h += profile_depth(*profile_coefficients(bearing, MODES), [direction])[0]
+    if surface in ("journal", "both"):
+        h += profile_depth(*profile_coefficients(journal, MODES), [direction - turned])[0]
+    assert h > 20e-6
+    t = _onset(flight(direction, surface=surface, depth=depth, journal_angle=turned))
+    assert t == pytest.approx((CLEARANCE + h) / SPEED, rel=1e-9)
+    assert _onset(flight(direction + math.pi, surface=surface, depth=depth, journal_angle=turned)) \
+        == pytest.approx(CLEARANCE / SPEED, rel=1e-6)  # the unworn side: the nominal clearance
+
+
+def test_an_unworn_profile_is_the_joint_without_wear():
+    plain = dc.simulate(flight(0.3, wear=False), 0.01, rtol=1e-10, start="declared")
+    worn = dc.simulate(flight(0.3), 0.01, rtol=1e-10, start="declared")
+    np.testing.assert_array_equal(plain.t, worn.t)
+    np.testing.assert_array_equal(plain.y, worn.y)
+
+
+def test_a_new_profile_is_run_time_data():
+    model = dc.assemble(flight(0.3))
+    worn = model.with_parameters({"bearing.wear_depth": _bump(0.3)})
+    assert worn.functions is model.functions
+    assert not np.array_equal(worn.parameter("bearing.wear.bearing_cos"), model.parameter("bearing.wear.bearing_cos"))
+    assert worn.scene["bearing"].wear_depth == tuple(_bump(0.3).tolist())
+
+
+@pytest.mark.parametrize("change, words", [
+    (dict(wear_depth=np.zeros(10)), ["wear_depth=an array of shape (10,)", "shape (360,)"]),
+    (dict(wear_depth=-np.ones(NODES)), [">= 0"]),
+    (dict(wear=None, wear_depth=np.zeros(NODES)), ["wear_depth is given without wear"]),
+    (dict(wear="archard"), ["wear='archard'", "ArchardWear"]),
+    (dict(law=dcc.HydrodynamicBearing(viscosity=0.04, length=0.02)), ["lubricated joint", "not modelled"]),
+])
+def test_bad_wear_is_refused(change, words):
+    with pytest.raises(SceneError) as info:
+        flight(0.3).with_values({f"bearing.{k}": v for k, v in change.items()})
+    for word in words:
+        assert word in str(info.value)
+
+
+def test_archard_modes_are_checked():
+    with pytest.raises(SceneError, match="modes=200"):
+        ArchardWear(coefficient=1e-14, length=0.02, nodes=360, modes=200)
+
+
+@pytest.fixture(scope="module")
+def worn_crank():
+    scene = dc.mechanisms.slider_crank("revolute", friction=0.1)
+    return scene.with_values({"clearance.wear": ArchardWear(coefficient=1e-11, length=0.02, nodes=NODES)})
+
+
+def test_cycle_scheme_keeps_the_volume_and_converges_in_the_update_interval(worn_crank):
+    """Every profile's worn volume is k times the sliding work so far (round-off); the depth after
+    4 cycles moves less from the every-cycle update when the update interval halves."""
+    runs = {every: simulate_wear(worn_crank, 4, update_every=every) for every in (1, 2, 4)}
+    for history in runs.values():
+        np.testing.assert_allclose(history.volume, 1e-11 * history.sliding_work, rtol=1e-12, atol=0)
+        assert history.cycles[-1] == 4 and np.all(np.diff(history.volume) > 0)
+    base = runs[1].depth[-1]
+    gap = {every: np.max(np.abs(runs[every].depth[-1] - base)) for every in (2, 4)}
+    assert 0 < gap[2] < gap[4] < 0.05 * base.max()
+    assert np.all(np.isfinite(runs[1].peak_force[:-1])) and np.isnan(runs[1].peak_force[-1])
+
+
+def test_a_stopped_history_resumes_where_it_stopped(worn_crank, tmp_path):
+    path = tmp_path / "wear.h5"
+    first = simulate_wear(worn_crank, 2, path=path)
+    resumed = simulate_wear(worn_crank, 3, path=path)  # reads the two cycles, runs the third
+    whole = simulate_wear(worn_crank, 3)
+    assert first.cycles.tolist() == [0, 1, 2] and resumed.cycles.tolist() == [0, 1, 2, 3]
+    np.testing.assert_array_equal(resumed.depth, whole.depth)
+    np.testing.assert_array_equal(resumed.sliding_work, whole.sliding_work)
+    with pytest.raises(SceneError, match="update_every=1, now 2"):
+        simulate_wear(worn_crank, 4, path=path, update_every=2)
+
+
+def test_simulate_wear_input_is_checked(worn_crank):
+    for kwargs, word in ((dict(update_every=0), "update_every=0"), (dict(extrapolate=1.5), "extrapolate=1.5"),
+                         (dict(joint="C"), "joint='C'"), (dict(period=-1.0), "period=-1.0")):
+        with pytest.raises(SceneError, match=word):
+            simulate_wear(worn_crank, 2, **kwargs)
+    with pytest.raises(SceneError, match="cycles=0"):
+        simulate_wear(worn_crank, 0)
+
+
+def test_example_joint_wear_quick(tmp_path, capsys):
+    """The study's script: 40 cycles in blocks of 10, its figures, animation, history file and metrics."""
+    import importlib.util
+    import json
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "joint_wear.py"
+    spec = importlib.util.spec_from_file_location("example_joint_wear", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert module.main(["--quick", "--animate", "--out", str(tmp_path)]) == 0
+    for name in ("wear_profile.png", "wear_impacts.png", "wear_growth.gif"):
+        assert (tmp_path / name).stat().st_size > 5_000
+    metrics = json.loads((tmp_path / "metrics.json").read_text())
+    assert metrics["cycles"] == 40 and metrics["volume_m3"] == pytest.approx(
+        metrics["coefficient"] * metrics["sliding_work_Nm"], rel=1e-12)
+    assert "wrote" in capsys.readouterr().out
+
+
+def test_wear_beyond_the_gap_model_stops_with_a_message(worn_crank):
+    """A depth beyond 5 % of the bearing radius (the normal's small-slope model) ends the history with a
+    warning and a message, keeping what was computed (k = 1e-8: 1 mm in the first cycle)."""
+    runaway = worn_crank.with_values({"clearance.wear.coefficient": 1e-8})
+    with pytest.warns(dc.PhysicsWarning, match="exceeds 0.05 of the bearing radius"):
+        history = simulate_wear(runaway, 5)
+    assert history.cycles[-1] < 5 and "stopped at" in history.message and history.max_depth[-1] > 5e-4
+    assert simulate_wear(worn_crank, 1).message == ""
