@@ -50,7 +50,7 @@ from typing import Any
 import numpy as np
 
 import daeclear as dc
-from daeclear.engine.build import compiler_command
+from daeclear.engine.build import CSRC, compiler_command
 from daeclear.engine.c_handle import STAT_KEYS
 from daeclear.engine.c_session import CSession
 from daeclear.engine.codegen import build_model_library, clear_memos
@@ -224,8 +224,9 @@ def build_program(folder: Path) -> Program:
                            f"version {BOUND_ABI}: update its calls (see csrc and daeclear.engine.library)")
     cc = compiler_command()
     exe, so = folder / "bound", folder / "libbound.so"
-    for cmd in ([*cc, "-O2", str(SOURCE), "-o", str(exe), "-ldl"],
-                [*cc, "-O2", "-fPIC", "-shared", "-DBOUND_NO_MAIN", str(SOURCE), "-o", str(so), "-ldl"]):
+    inc = f"-I{CSRC}"  # dc_abi.h: the return codes and stats slots of the driver
+    for cmd in ([*cc, "-O2", inc, str(SOURCE), "-o", str(exe), "-ldl"],
+                [*cc, "-O2", "-fPIC", "-shared", "-DBOUND_NO_MAIN", inc, str(SOURCE), "-o", str(so), "-ldl"]):
         subprocess.run(cmd, check=True, capture_output=True, text=True)
     return Program(exe, so)
 

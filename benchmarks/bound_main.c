@@ -27,10 +27,9 @@
 #include <string.h>
 #include <time.h>
 
+#include "dc_abi.h" /* DC_CHUNK, DC_TSTOP, DC_ST_N: generated from daeclear/engine/abi.py (csrc on -I) */
+
 #define BOUND_ABI 7
-#define BOUND_N_STATS 9
-#define DC_CHUNK 0
-#define DC_TSTOP 1
 
 typedef int (*abi_fn)(void);
 typedef void* (*open_fn)(double, const double*, double, int, long long, const int*, const double*, int, char*,
@@ -355,7 +354,7 @@ static int run_once(const driver_t* D, const setup_t* S, run_out_t* o, double* y
 /*
  * The run `repeats` times. times[2 r], times[2 r + 1]: wall time of repeat r as a whole (dc_open to
  * dc_free, the kept arrays freed after the clock stops) and of its advance loop; counts: stored steps,
- * events, then IDA's counters (dc_stats, BOUND_N_STATS); y_end[n] (n <= y_len) and *t_end: the end state.
+ * events, then IDA's counters (dc_stats, DC_ST_N); y_end[n] (n <= y_len) and *t_end: the end state.
  * Returns 0, or -1 with the reason in err.
  */
 int bound_run(const char* lib_path, const char* setup_path, int repeats, double* times, long long* counts,
@@ -396,7 +395,7 @@ int main(int argc, char** argv) {
   }
   double* times = calloc((size_t)(2 * repeats), sizeof(double));
   double y_end[4096], t_end = 0.0;
-  long long counts[2 + BOUND_N_STATS] = {0};
+  long long counts[2 + DC_ST_N] = {0};
   char err[512];
   if (!times || bound_run(argv[1], argv[2], repeats, times, counts, y_end, 4096, &t_end, err, sizeof err) != 0) {
     fprintf(stderr, "bound: %s\n", times ? err : "out of memory");

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from daeclear.engine import stall_guard
-from daeclear.engine.codegen import CSRC
+from daeclear.engine.build import driver_files
 from daeclear.engine.stall_guard import TINY_STEP_COUNT, TINY_STEP_GROWTH, TINY_STEP_REL, StallGuard
 
 
@@ -57,7 +57,7 @@ def test_an_absolute_stall_step_and_its_normal_step_margin():
 
 def test_the_compiled_loop_takes_its_numbers_from_the_module():
     """The C driver defines none of the numbers itself: they come from the build's -D flags."""
-    source = (CSRC / "ida_driver.c").read_text()
+    source = "".join(path.read_text() for path in driver_files("ida_driver.c"))  # the driver and its parts
     assert "#define DC_TINY_REL" not in source and "#error" in source
     defines = dict(flag[2:].split("=", 1) for flag in stall_guard.c_defines())
     assert float(defines["DC_TINY_REL"]) == TINY_STEP_REL

@@ -20,6 +20,7 @@ import contextlib
 import functools
 import hashlib
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -41,6 +42,7 @@ __all__ = [
     "compiler_command",
     "cache_dir",
     "compile_cached",
+    "driver_files",
     "MemoTable",
     "memo_table",
     "clear_memos",
@@ -56,6 +58,25 @@ class CompilerUnavailable(DaeclearError):
 
 class CompileError(DaeclearError):
     """The C compiler failed on the generated model; the message holds its output."""
+
+
+_LOCAL_INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.MULTILINE)
+
+
+def driver_files(driver: str) -> tuple[Path, ...]:
+    """``csrc/<driver>`` and every file of ``csrc/`` it includes with ``#include "..."``, directly
+    or through another one, in a fixed order: what the cache key of a library built with that
+    driver hashes (a new part or header is in it once it is included)."""
+    seen: dict[str, Path] = {}
+    todo = [driver]
+    while todo:
+        name = todo.pop()
+        if name in seen:
+            continue
+        path = CSRC / name
+        seen[name] = path
+        todo += [inc for inc in _LOCAL_INCLUDE.findall(path.read_text()) if (CSRC / inc).is_file()]
+    return tuple(seen[name] for name in sorted(seen))
 
 
 # --------------------------------------------------------------------------- toolchain

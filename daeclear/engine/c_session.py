@@ -31,8 +31,10 @@ import numpy as np
 
 from ..assembly.automaton import Decision, PairState, Storm
 from ..errors import DaeclearError
+from .abi import (DC_CHUNK, DC_ERR_COLLAPSE, DC_ERR_MAXSTEPS, DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND, DC_EV_N,
+                  DC_EV_WATCH, DC_ROOT, DC_TSTOP, LINEAR_SOLVER_CODES, STAT_KEYS)
 from .build import BuildResult
-from .c_handle import STAT_KEYS, Handle, address, pointer, put_pooled, take_pooled
+from .c_handle import Handle, address, pointer, put_pooled, take_pooled
 from .codegen import NormalizedModel
 from .library import ModelLibrary
 from .session_base import (
@@ -59,8 +61,7 @@ __all__ = ["CSession", "SPARSE_MIN_STATES"]
 #: per factorization), sparse is faster from 360 on (whole simulate calls 1.04x at 360 states,
 #: 1.07x at 384).
 SPARSE_MIN_STATES = 360
-_LS_CODES = {"dense": 0, "sparse": 1, "reduced": 2}  # dc_open's linear_solver argument (DC_LS_*)
-_LS_NAMES = {code: name for name, code in _LS_CODES.items()}
+_LS_NAMES = {code: name for name, code in LINEAR_SOLVER_CODES.items()}
 log = logging.getLogger("daeclear")
 
 
@@ -118,7 +119,7 @@ class CSession(SessionBase):
         def dc_open() -> Any:
             return self._lib.dc_open(opts.rtol, opts.atol.ctypes.data, opts.max_step, opts.max_order,
                                      opts.max_steps, pointer(opts.root_directions), pointer(opts.parameters),
-                                     _LS_CODES[self._linear_solver], err, 1024)
+                                     LINEAR_SOLVER_CODES[self._linear_solver], err, 1024)
 
         h = dc_open()
         if not h and self._linear_solver == "sparse" and opts.linear_solver == "auto":
@@ -178,8 +179,9 @@ class CSession(SessionBase):
             raise DaeclearError("configuring the events decided in C failed")
         self._auto_cap = capacity
         if self._hd.auto_buf is None or self._hd.auto_buf[0][0].size != capacity:  # kept on the handle (pooled)
-            buf = (np.empty(capacity), np.empty(capacity, dtype=np.int32), np.empty((capacity, 4), dtype=np.int32),
-                   np.empty(capacity), np.empty(capacity), np.empty((capacity, self._n)))
+            buf = (np.empty(capacity), np.empty(capacity, dtype=np.int32),
+                   np.empty((capacity, DC_EV_N), dtype=np.int32), np.empty(capacity), np.empty(capacity),
+                   np.empty((capacity, self._n)))
             self._hd.auto_buf = (buf, tuple(address(a) for a in buf))
         self._auto_buf = self._hd.auto_buf
         return True
@@ -246,16 +248,16 @@ class CSession(SessionBase):
         n = t.size
         if d.size != n or r.size != n:
             raise ValueError("automaton_run: times, directions and rates differ in length")
-        out_i = np.zeros((4, max(n, 1)), dtype=np.int32)
+        out_i = np.zeros((DC_EV_N, max(n, 1)), dtype=np.int32)  # an event's info columns, one row each
         out_l = np.zeros(max(n, 1))
+        rows = (out_i[j].ctypes.data for j in (DC_EV_KIND, DC_EV_CONTACT, DC_EV_HELD, DC_EV_WATCH))
         rc = self._lib.dc_automaton_run(n, t.ctypes.data, d.ctypes.data, r.ctypes.data, storm.events,
                                         float(storm.window), float(min_approach_speed), int(contact), int(held),
-                                        float(latched), *(out_i[j].ctypes.data for j in range(4)),
-                                        out_l.ctypes.data)
+                                        float(latched), *rows, out_l.ctypes.data)
         if rc != 0:
             raise DaeclearError("dc_automaton_run rejected its arguments")
-        return [Decision(int(out_i[0, i]), bool(out_i[1, i]), bool(out_i[2, i]), float(out_l[i]), int(out_i[3, i]))
-                for i in range(n)]
+        return [Decision(int(out_i[DC_EV_KIND, i]), bool(out_i[DC_EV_CONTACT, i]), bool(out_i[DC_EV_HELD, i]),
+                         float(out_l[i]), int(out_i[DC_EV_WATCH, i])) for i in range(n)]
 
     def _terms_in_c(self) -> tuple[np.ndarray, np.ndarray]:
         """The C loop's active flags (one per term) and its terms' parameters, concatenated (dc_get_active)."""
@@ -408,27 +410,27 @@ class CSession(SessionBase):
             st, sy, syp, sh, so = e["step_t"], e["step_y"], e["step_yp"], e["step_h"], e["step_order"]
         ne = self._i_eval.value
         # the C loop stopped inside a step that has output times after the last row (see dc_advance)
-        self._eval_after = float(te[-1]) if rc == 0 and m and ne == m and te[-1] < self._t else None
+        self._eval_after = float(te[-1]) if rc == DC_CHUNK and m and ne == m and te[-1] < self._t else None
         adv = Advance(status="tstop", t=self._t, y=self._y, yp=self._yp, step_t=st,
                       step_y=sy, step_yp=syp, step_h=sh, step_order=so, eval_t=te[:ne].copy(),
                       eval_y=ev_y[:ne], eval_yp=ev_yp[:ne], auto_events=AutoEvents.join(auto_events))
         if interrupted:
             adv.status = "interrupted"
             return adv
-        if rc == 0:  # chunked: a buffer is full, the integration goes on at the next call
+        if rc == DC_CHUNK:  # chunked: a buffer is full, the integration goes on at the next call
             adv.status = "chunk"
             return adv
-        if rc == 1:
+        if rc == DC_TSTOP:
             return adv
-        if rc == 2:
+        if rc == DC_ROOT:
             adv.status = "root"
             adv.roots_found = self._roots[: self.n_roots].copy()
             return adv
         adv.status = "error"
         msg = self._lib.dc_message(h).decode()
-        if rc == -2:
+        if rc == DC_ERR_MAXSTEPS:
             adv.flag, adv.flag_name = FLAG_MAX_STEPS, OWN_FLAG_NAMES[FLAG_MAX_STEPS]
-        elif rc == -3:
+        elif rc == DC_ERR_COLLAPSE:
             adv.flag, adv.flag_name = FLAG_STEP_COLLAPSE, OWN_FLAG_NAMES[FLAG_STEP_COLLAPSE]
         else:
             adv.flag = self._flag.value

@@ -52,6 +52,7 @@ from .build import (
     clear_memos,
     compile_cached,
     compiler_command,
+    driver_files,
     memo_table,
 )
 from .library import DRIVER_ABI, ODE_DRIVER_ABI
@@ -103,7 +104,8 @@ __all__ = [
     "compile_cached",
 ]
 
-DRIVER_SOURCES = ("ida_driver.c", "dc_model.h", "dc_linalg.h", "dc_reduced_ls.h")
+#: The IDA driver and the csrc/ files it includes (its parts, dc_abi.h, the shared headers).
+DRIVER_SOURCES = tuple(p.name for p in driver_files("ida_driver.c"))
 CFLAGS = (f"-DDC_ABI_VERSION={DRIVER_ABI}", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
           "-Werror=incompatible-pointer-types", "-Werror=implicit-function-declaration", "-Wl,-z,defs")
 
@@ -373,7 +375,8 @@ def _build_model_library(funcs: Any, *, model: NormalizedModel | None = None) ->
 # --------------------------------------------------------------------------- ODE libraries
 # (for the explicit and scipy integrators of daeclear.solvers.explicit; no SUNDIALS involved)
 
-ODE_DRIVER_SOURCES = ("ode_driver.c", "dco_model.h", "dc_model.h", "dc_linalg.h")
+#: The ODE driver and the csrc/ files it includes.
+ODE_DRIVER_SOURCES = tuple(p.name for p in driver_files("ode_driver.c"))
 __all__ += ["OdeSpec", "generate_ode_source", "build_ode_library"]
 
 

@@ -28,6 +28,7 @@ from typing import Any, ClassVar
 from collections.abc import Mapping, Sequence
 
 from . import sundials
+from .abi import DC_BI_INDEX_BITS, DC_BI_INDEX_SIZE, DC_BI_MAJOR, DC_BI_MINOR, DC_BI_N, DC_BI_PATCH, DC_BI_SPARSE
 from ..errors import DaeclearError
 from .sundials import SundialsInfo
 
@@ -165,11 +166,13 @@ def _check_loaded(lib: ctypes.CDLL, tagged: SundialsInfo) -> tuple[SundialsInfo,
     buf = ctypes.create_string_buffer(64)
     lib.dc_sundials_version(buf, 64)
     loaded = buf.value.decode()
-    raw = (ctypes.c_int * 6)()
-    lib.dc_build_info(raw, 6)
-    info = SundialsInfo(f"{raw[0]}.{raw[1]}.{raw[2]}", raw[3], bool(raw[5]))
-    if info != tagged or raw[4] != info.index_size:
-        return info, loaded, (f"its dc_build_info ({info}, sunindextype {raw[4]} bits) contradicts its build tag "
+    raw = (ctypes.c_int * DC_BI_N)()
+    lib.dc_build_info(raw, DC_BI_N)
+    info = SundialsInfo(f"{raw[DC_BI_MAJOR]}.{raw[DC_BI_MINOR]}.{raw[DC_BI_PATCH]}", raw[DC_BI_INDEX_SIZE],
+                        bool(raw[DC_BI_SPARSE]))
+    bits = raw[DC_BI_INDEX_BITS]
+    if info != tagged or bits != info.index_size:
+        return info, loaded, (f"its dc_build_info ({info}, sunindextype {bits} bits) contradicts its build tag "
                               f"({tagged})")
     if _version_prefix(loaded) != info.version:
         return info, loaded, f"built for SUNDIALS {info.version}, but the SUNDIALS it loads reports version {loaded!r}"

@@ -21,6 +21,7 @@ import numpy as np
 from ..assembly.automaton import Decision, PairState, Storm
 from ..errors import DaeclearError
 from ..options import LINEAR_SOLVERS
+from .abi import DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND, DC_EV_WATCH, DC_STORE_STATES, DC_STORE_TIMES
 from .codegen import NormalizedModel
 from .stall_guard import TINY_STEP_COUNT, TINY_STEP_GROWTH, TINY_STEP_REL, StallGuard
 
@@ -106,8 +107,9 @@ class AutoEvents:
 
     def decision(self, i: int) -> Decision:
         """The decision of row ``i``."""
-        kind, contact, held, watch = self.info[i].tolist()
-        return Decision(kind, bool(contact), bool(held), float(self.latched[i]), watch)
+        row = self.info[i].tolist()
+        return Decision(row[DC_EV_KIND], bool(row[DC_EV_CONTACT]), bool(row[DC_EV_HELD]), float(self.latched[i]),
+                        row[DC_EV_WATCH])
 
     @staticmethod
     def join(parts: Sequence[AutoEvents]) -> AutoEvents | None:
@@ -273,8 +275,8 @@ def check_options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, m
 # =========================================================================== common base
 
 
-# dc_advance's store_steps flags (csrc/ida_driver.c DC_STORE_TIMES, DC_STORE_STATES)
-STORE_TIMES, STORE_STATES = 1, 2
+# dc_advance's store_steps flags (daeclear.engine.abi)
+STORE_TIMES, STORE_STATES = DC_STORE_TIMES, DC_STORE_STATES
 
 
 class _NoRows(dict):

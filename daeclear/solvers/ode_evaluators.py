@@ -31,6 +31,7 @@ from ..engine.codegen import (
     build_ode_library,
     densified,
 )
+from ..engine.abi import DCO_CNT_N, DCO_EULER, FX_CANDIDATE, FX_CHUNK, FX_ERR, FX_MAXSTEPS, FX_TSTOP, ODE_COUNTER_KEYS
 from ..engine.library import OdeLibrary
 from ..errors import DaeclearError, DaeclearWarning
 from .ode_crossings import candidate
@@ -40,11 +41,9 @@ __all__ = ["FIXED_CHUNK", "FX_CANDIDATE", "FX_CHUNK", "FX_ERR", "FX_MAXSTEPS", "
 
 # rows of the fixed-step C loop's step buffer per call
 FIXED_CHUNK = 8192
-#: status of one call of the fixed-step loop (``Evaluator.fixed``; FX_* of csrc/ode_driver.c): step
-#: buffer full (call again), t_stop reached, the last step may hold a gap crossing, model
-#: evaluation failed or the state is not finite, step cap reached
-FX_CHUNK, FX_TSTOP, FX_CANDIDATE, FX_ERR, FX_MAXSTEPS = 0, 1, 2, -1, -2
-
+# the status of one call of the fixed-step loop (``Evaluator.fixed``) is one of FX_* of daeclear.engine.abi
+# (dco_fixed's return codes): step buffer full (call again), t_stop reached, the last step may hold a
+# gap crossing, model evaluation failed or the state is not finite, step cap reached
 
 #: ctypes view of one compiled ODE library (opened, declared and checked in daeclear.engine.library)
 _CLib = OdeLibrary
@@ -145,7 +144,7 @@ class _CEvaluator(Evaluator):
         self._gd = np.zeros(ng)
         self._act = np.zeros(max(self.nt, 1), dtype=np.int32)
         self._par = np.zeros(max(int(self.poff[-1]), 1))
-        self._cnt = np.zeros(4, dtype=np.int64)
+        self._cnt = np.zeros(DCO_CNT_N, dtype=np.int64)
         self._a = {k: getattr(self, "_" + k).ctypes.data for k in ("xin", "xout", "J", "g", "gd", "act", "par", "cnt")}
         # fixed-step loop buffers
         self._st = np.zeros(FIXED_CHUNK)
@@ -247,7 +246,7 @@ class _CEvaluator(Evaluator):
 
     def counters(self) -> dict[str, int]:
         self.lib.dco_counters(self.h, self._a["cnt"])
-        return dict(zip(("n_res_evals", "n_jac_evals", "n_root_evals", "n_fixed_steps"), map(int, self._cnt)))
+        return dict(zip(ODE_COUNTER_KEYS, map(int, self._cnt)))
 
 
 class _Buffered:
@@ -289,7 +288,7 @@ class _PyEvaluator(Evaluator):
         self.minv = 1.0 / np.asarray(spec.mass)
         self.active = [False] * self.nt
         self.params: list[NDArray] = [np.zeros(p) for p in spec.n_params]
-        self.cnt = dict(n_res_evals=0, n_jac_evals=0, n_root_evals=0, n_fixed_steps=0)
+        self.cnt = dict.fromkeys(ODE_COUNTER_KEYS, 0)  # the C evaluator's counters
 
     def message(self) -> str:
         return self.last_message
@@ -366,7 +365,7 @@ class _PyEvaluator(Evaluator):
     def step(self, scheme: int, t: float, x: NDArray, h: float) -> NDArray | None:
         with np.errstate(all="ignore"):
             k1 = self.rhs(t, x)
-            if scheme == 1:
+            if scheme == DCO_EULER:
                 xn = x + h * k1
             else:
                 k2 = self.rhs(t + 0.5 * h, x + 0.5 * h * k1)

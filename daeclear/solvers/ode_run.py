@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 from ..assembly import contact_state
 from ..assembly.assemble import DAEModel
 from ..engine.hermite import cubic_hermite
+from ..engine.abi import DCO_EULER, DCO_RK4
 from ..engine.stall_guard import TINY_STEP_COUNT, TINY_STEP_REL, StallGuard
 from ..progress import Progress
 from ..results.result import ContactEvent, Result
@@ -41,7 +42,7 @@ METHOD_NAMES: dict[str, str] = {
 SCIPY_METHODS: tuple[str, ...] = ("rk45", "dop853", "radau", "bdf", "lsoda")
 IMPLICIT_METHODS: tuple[str, ...] = ("radau", "bdf", "lsoda")
 #: fixed-step methods and their C scheme codes (= their order)
-FIXED_STEP_METHODS: dict[str, int] = {"rk4": 4, "euler": 1}
+FIXED_STEP_METHODS: dict[str, int] = {"rk4": DCO_RK4, "euler": DCO_EULER}
 _ORDER = {"rk45": 5, "dop853": 8, "radau": 5, "bdf": -1, "lsoda": -1, "rk4": 4, "euler": 1}
 
 

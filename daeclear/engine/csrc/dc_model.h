@@ -3,7 +3,7 @@
  * model source, and that the IDA driver (ida_driver.c) reads.
  *
  * The generated functions use casadi_real = double and casadi_int = long long int (set
- * explicitly by daeclear.codegen), so the pointer types below match them exactly.
+ * explicitly by daeclear.engine.codegen), so the pointer types below match them exactly.
  */
 #ifndef DAECLEAR_DC_MODEL_H
 #define DAECLEAR_DC_MODEL_H

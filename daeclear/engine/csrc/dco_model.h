@@ -1,5 +1,5 @@
 /*
- * dco_model.h -- the table that daeclear.codegen.build_ode_library appends to the
+ * dco_model.h -- the table that daeclear.engine.codegen.build_ode_library appends to the
  * CasADi-generated functions of an index-1 mechanism written as an ODE in x = (q, v),
  * and that the ODE driver (ode_driver.c) reads.
  *

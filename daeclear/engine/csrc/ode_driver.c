@@ -2,8 +2,8 @@
  * ode_driver.c -- daeclear's compiled right-hand side for the explicit and scipy integrators.
  *
  * Compiled together with CasADi-generated functions and the table of dco_model.h (see
- * daeclear.codegen.build_ode_library) into one shared library, driven through ctypes by
- * daeclear/integrators.py. No SUNDIALS here.
+ * daeclear.engine.codegen.build_ode_library) into one shared library, driven through ctypes by
+ * daeclear/solvers/ode_evaluators.py. No SUNDIALS here.
  *
  * The index-1 mechanism is an ODE in x = (q, v): q' = v, v' = a with
  *
@@ -29,29 +29,17 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dc_abi.h"
+#include "dc_common.h"
 #include "dco_model.h"
 #include "dc_linalg.h"
 
 #define DCO_API __attribute__((visibility("default")))
-#ifndef DCO_ABI_VERSION /* given by daeclear.codegen (ODE_DRIVER_ABI) */
-#error "compile with -DDCO_ABI_VERSION=<daeclear.codegen.ODE_DRIVER_ABI>"
+#ifndef DCO_ABI_VERSION /* given by daeclear.engine.codegen (daeclear.engine.library.ODE_DRIVER_ABI) */
+#error "compile with -DDCO_ABI_VERSION=<daeclear.engine.library.ODE_DRIVER_ABI>"
 #endif
-#define MSG_LEN 1024
-
-/* model evaluation return codes */
-#define DCO_OK 0
-#define DCO_NONFINITE 1
-#define DCO_SINGULAR 2
-#define DCO_EVAL_ERR 3
-
-/* dco_fixed return codes */
-#define FX_CHUNK 0      /* step buffer full: call again */
-#define FX_TSTOP 1      /* t_stop reached */
-#define FX_CANDIDATE 2  /* the last step may hold a gap crossing */
-#define FX_ERR (-1)     /* model evaluation failed or the state is not finite */
-#define FX_MAXSTEPS (-2) /* step cap reached */
-
-enum { C_RHS, C_JAC, C_GAPS, C_STEPS, C_N };
+/* The return codes (DCO_*, FX_*), the schemes (DCO_EULER, DCO_RK4) and the counters' slots
+ * (DCO_CNT_*) are in dc_abi.h, generated from daeclear/engine/abi.py. */
 
 typedef struct {
   int n, m, nx, nt, ng;
@@ -71,18 +59,9 @@ typedef struct {
   double *minv, *Q, *Pq, *c, *f, *Fk, *S, *Sd, *r, *lam, *D, *Jk, *b, *zl;
   double *k1, *k2, *k3, *k4, *xt, *xcur, *g0, *gd0, *g1, *gd1;
   double* nz; /* the nonzeros of a call's sparse outputs, before call() scatters them */
-  long long cnt[C_N];
+  long long cnt[DCO_CNT_N];
   char msg[MSG_LEN];
 } dco_session;
-
-static void set_msg(dco_session* s, const char* fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(s->msg, MSG_LEN, fmt, ap);
-  va_end(ap);
-}
-
-static void* xcalloc(size_t n, size_t sz) { return calloc(n ? n : 1, sz); }
 
 /* Evaluate f into the dense (column-major) outputs out[0..nout). The generated functions keep
  * CasADi's sparsity (a term's force touches two bodies of a chain, its Jacobian their columns:
@@ -126,7 +105,7 @@ static int accel(dco_session* s, double t, const double* x, double* xdot) {
     const double* in[3] = {&t, q, v};
     double* out[3] = {s->Q, s->Pq, s->c};
     if (call(s, &M->sys, s->mem_sys, 3, in, 3, out)) {
-      set_msg(s, "the generated system function returned an error at t=%.17g", t);
+      set_msg(s->msg, "the generated system function returned an error at t=%.17g", t);
       return DCO_EVAL_ERR;
     }
   }
@@ -136,7 +115,7 @@ static int accel(dco_session* s, double t, const double* x, double* xdot) {
     const double* in[4] = {&t, q, v, s->params + s->poff[k]};
     double* out[1] = {s->Fk};
     if (call(s, &M->term_force[k], s->mem_tf[k], 4, in, 1, out)) {
-      set_msg(s, "the generated force of term %d returned an error at t=%.17g", k, t);
+      set_msg(s->msg, "the generated force of term %d returned an error at t=%.17g", k, t);
       return DCO_EVAL_ERR;
     }
     for (int i = 0; i < n; ++i) s->f[i] += s->Fk[i];
@@ -155,7 +134,7 @@ static int accel(dco_session* s, double t, const double* x, double* xdot) {
     }
     int rc = cholesky(s->S, s->Sd, m);
     if (rc) {
-      set_msg(s, "the constraint Jacobian is singular at t=%.17g (constraint %d depends on the "
+      set_msg(s->msg, "the constraint Jacobian is singular at t=%.17g (constraint %d depends on the "
               "others, or the state is not finite)", t, -rc - 1);
       return DCO_SINGULAR;
     }
@@ -171,7 +150,7 @@ static int accel(dco_session* s, double t, const double* x, double* xdot) {
     }
     int i = dc_first_nonfinite(xdot, s->nx);
     if (i >= 0) {
-      set_msg(s, "the right-hand side component %d is %g at t=%.17g (the state has diverged or "
+      set_msg(s->msg, "the right-hand side component %d is %g at t=%.17g (the state has diverged or "
               "is outside the model's domain)", i, xdot[i], t);
       return DCO_NONFINITE;
     }
@@ -182,15 +161,15 @@ static int accel(dco_session* s, double t, const double* x, double* xdot) {
 static int eval_gaps(dco_session* s, double t, const double* x, double* g, double* gd) {
   const double* in[3] = {&t, x, x + s->n};
   double* out[2] = {g, gd};
-  s->cnt[C_GAPS]++;
+  s->cnt[DCO_CNT_GAPS]++;
   if (call(s, &dco_model.gaps, s->mem_gaps, 3, in, 2, out)) {
-    set_msg(s, "the generated gap function returned an error at t=%.17g", t);
+    set_msg(s->msg, "the generated gap function returned an error at t=%.17g", t);
     return DCO_EVAL_ERR;
   }
   int i = dc_first_nonfinite(g, s->ng);
   if (i < 0) i = dc_first_nonfinite(gd, s->ng);
   if (i >= 0) {
-    set_msg(s, "gap function %d (or its rate) is not finite at t=%.17g", i, t);
+    set_msg(s->msg, "gap function %d (or its rate) is not finite at t=%.17g", i, t);
     return DCO_NONFINITE;
   }
   return DCO_OK;
@@ -206,7 +185,7 @@ static int eval_jac(dco_session* s, double t, const double* x, double* J) {
     const double* in[5] = {&t, x, x + n, s->xt + n, s->lam};
     double* out[1] = {s->D};
     if (call(s, &M->sys_jac, s->mem_sysj, 5, in, 1, out)) {
-      set_msg(s, "the generated system Jacobian returned an error at t=%.17g", t);
+      set_msg(s->msg, "the generated system Jacobian returned an error at t=%.17g", t);
       return DCO_EVAL_ERR;
     }
   }
@@ -215,7 +194,7 @@ static int eval_jac(dco_session* s, double t, const double* x, double* J) {
     const double* in[4] = {&t, x, x + n, s->params + s->poff[k]};
     double* out[1] = {s->Jk};
     if (call(s, &M->term_jac[k], s->mem_tj[k], 4, in, 1, out)) {
-      set_msg(s, "the generated Jacobian of term %d returned an error at t=%.17g", k, t);
+      set_msg(s->msg, "the generated Jacobian of term %d returned an error at t=%.17g", k, t);
       return DCO_EVAL_ERR;
     }
     for (int j = 0; j < nx; ++j)
@@ -240,30 +219,30 @@ static int eval_jac(dco_session* s, double t, const double* x, double* J) {
   }
   int i = dc_first_nonfinite(J, nx * nx);
   if (i >= 0) {
-    set_msg(s, "Jacobian entry (%d, %d) is %g at t=%.17g", i / nx, i % nx, J[i], t);
+    set_msg(s->msg, "Jacobian entry (%d, %d) is %g at t=%.17g", i / nx, i % nx, J[i], t);
     return DCO_NONFINITE;
   }
   return DCO_OK;
 }
 
-/* One step of explicit Euler (scheme 1) or classical RK4 (scheme 4) from (t, x) of size h. */
+/* One step of explicit Euler (DCO_EULER) or classical RK4 (DCO_RK4, any other scheme) from (t, x) of size h. */
 static int scheme_step(dco_session* s, int scheme, double t, const double* x, double h, double* xn) {
   const int nx = s->nx;
   int rc;
-  s->cnt[C_RHS]++;
+  s->cnt[DCO_CNT_RHS]++;
   if ((rc = accel(s, t, x, s->k1))) return rc;
-  if (scheme == 1) {
+  if (scheme == DCO_EULER) {
     for (int i = 0; i < nx; ++i) xn[i] = x[i] + h * s->k1[i];
   } else {
     const double h2 = 0.5 * h;
     for (int i = 0; i < nx; ++i) s->xt[i] = x[i] + h2 * s->k1[i];
-    s->cnt[C_RHS]++;
+    s->cnt[DCO_CNT_RHS]++;
     if ((rc = accel(s, t + h2, s->xt, s->k2))) return rc;
     for (int i = 0; i < nx; ++i) s->xt[i] = x[i] + h2 * s->k2[i];
-    s->cnt[C_RHS]++;
+    s->cnt[DCO_CNT_RHS]++;
     if ((rc = accel(s, t + h2, s->xt, s->k3))) return rc;
     for (int i = 0; i < nx; ++i) s->xt[i] = x[i] + h * s->k3[i];
-    s->cnt[C_RHS]++;
+    s->cnt[DCO_CNT_RHS]++;
     if ((rc = accel(s, t + h, s->xt, s->k4))) return rc;
     const double h6 = h / 6.0;
     for (int i = 0; i < nx; ++i)
@@ -271,7 +250,7 @@ static int scheme_step(dco_session* s, int scheme, double t, const double* x, do
   }
   int i = dc_first_nonfinite(xn, nx);
   if (i >= 0) {
-    set_msg(s, "state component %d became %g in the step from t=%.17g (h=%g)", i, xn[i], t, h);
+    set_msg(s->msg, "state component %d became %g in the step from t=%.17g (h=%g)", i, xn[i], t, h);
     return DCO_NONFINITE;
   }
   return DCO_OK;
@@ -280,7 +259,7 @@ static int scheme_step(dco_session* s, int scheme, double t, const double* x, do
 /* Far-side point s* in (0, h] of a possible crossing of G = dir * g from <= 0 to > 0 within a
  * step, from G and dG/dt at both ends: h when G1 > 0, or the first interior maximum of the cubic
  * Hermite interpolant that lies above zero (if earlier). -1: no crossing expected. Must match
- * integrators._candidate. */
+ * daeclear.solvers.ode_crossings.candidate. */
 static double candidate(double G0, double Gd0, double G1, double Gd1, double h, int hermite) {
   if (G0 > 0.0) return -1.0;
   double best = G1 > 0.0 ? h : -1.0;
@@ -331,15 +310,6 @@ DCO_API int dco_info(int* n, int* m, int* n_terms, int* n_gaps, int* n_params) {
 }
 
 DCO_API const char* dco_message(void* sp) { return sp ? ((dco_session*)sp)->msg : ""; }
-
-static void work_max(const dc_fun_t* f, dc_int* a, dc_int* r, dc_int* iw, dc_int* w) {
-  dc_int sa = 0, sr = 0, si = 0, sw = 0;
-  f->work(&sa, &sr, &si, &sw);
-  if (sa > *a) *a = sa;
-  if (sr > *r) *r = sr;
-  if (si > *iw) *iw = si;
-  if (sw > *w) *w = sw;
-}
 
 DCO_API void dco_free(void* sp) {
   dco_session* s = (dco_session*)sp;
@@ -500,7 +470,7 @@ DCO_API void dco_set_hermite(void* sp, int on) { ((dco_session*)sp)->hermite = o
 /* x' at (t, x): 0 on success, else a DCO_* code (message in dco_message; xdot may hold NaN). */
 DCO_API int dco_rhs(void* sp, double t, const double* x, double* xdot) {
   dco_session* s = (dco_session*)sp;
-  s->cnt[C_RHS]++;
+  s->cnt[DCO_CNT_RHS]++;
   int rc = accel(s, t, x, xdot);
   if (rc && rc != DCO_NONFINITE)
     for (int i = 0; i < s->nx; ++i) xdot[i] = NAN;
@@ -509,7 +479,7 @@ DCO_API int dco_rhs(void* sp, double t, const double* x, double* xdot) {
 
 DCO_API int dco_jac(void* sp, double t, const double* x, double* J) {
   dco_session* s = (dco_session*)sp;
-  s->cnt[C_JAC]++;
+  s->cnt[DCO_CNT_JAC]++;
   int rc = eval_jac(s, t, x, J);
   if (rc && rc != DCO_NONFINITE)
     for (int i = 0; i < s->nx * s->nx; ++i) J[i] = NAN;
@@ -570,7 +540,7 @@ DCO_API int dco_fixed(void* sp, int scheme, double t0, const double* x0, double 
     if (tn >= t_stop - 1e-9 * hstep) tn = t_stop;
     const double h = tn - *ta;
     if (scheme_step(s, scheme, *ta, xa, h, xb)) return FX_ERR;
-    s->cnt[C_STEPS]++;
+    s->cnt[DCO_CNT_STEPS]++;
     ++k;
     if (watch) {
       if (eval_gaps(s, tn, xb, s->g1, s->gd1)) {
@@ -631,5 +601,5 @@ DCO_API void dco_output_sizes(int* n_y, int* n_switch, int* n_channels) {
 /* counters: rhs evaluations, Jacobians, gap evaluations, fixed steps */
 DCO_API void dco_counters(void* sp, long long* out) {
   dco_session* s = (dco_session*)sp;
-  for (int i = 0; i < C_N; ++i) out[i] = s->cnt[i];
+  for (int i = 0; i < DCO_CNT_N; ++i) out[i] = s->cnt[i];
 }
