@@ -7,8 +7,9 @@ the events and the segments to the file as it goes (``stream_to``), returning on
 (``keep_data=False``): its memory does not grow with the number of revolutions, and a failure or
 Ctrl-C leaves the file with what was computed (docs/reliability.md, section 6).
 
-The last two revolutions are then read from the file alone, with h5py slicing (no whole array is
-loaded), and plotted: slider velocity and the journal's normal force.
+The last two revolutions are then read from the file alone, with ``daeclear.load``'s window (only
+those rows are read; their channels are computed from the stored states when read), and plotted:
+slider velocity and the journal's normal force.
 
 Writes into ``--out`` (default ``results/long_run_streamed/``): ``long_run.h5`` (the whole run,
 readable with ``daeclear.load``) and ``long_run_last_revolutions.png``.
@@ -35,15 +36,11 @@ T_EVAL_STEP = 1e-5  # s
 
 def read_last(path: Path, span: float, channels: Sequence[str]) -> dict[str, np.ndarray]:
     """Times and channels of the last ``span`` seconds of a result file, reading only those rows."""
-    import h5py
+    from daeclear.results.result import load_times
 
-    with h5py.File(path, "r") as f:
-        t = f["t"][()]  # the times alone: 8 bytes a point
-        i0 = int(np.searchsorted(t, t[-1] - span, side="left"))
-        out = {"t": t[i0:]}
-        for name in channels:
-            out[name] = f["channels"][name][i0:]
-    return out
+    t = load_times(path)  # the times alone: 8 bytes a point
+    window = dc.load(path, t[-1] - span, None)  # the window's rows; channels computed when read
+    return {"t": window.t, **{name: window[name] for name in channels}}
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -241,7 +241,7 @@ def test_load_rejects_newer_version(tmp_path: Path) -> None:
     path = make_result().save(tmp_path / "run.h5")
     with h5py.File(path, "a") as f:
         f.attrs["version"] = FORMAT_VERSION + 1
-    with pytest.raises(DaeclearError, match="version 2"):
+    with pytest.raises(DaeclearError, match=f"version {FORMAT_VERSION + 1}"):
         load(path)
 
 
@@ -587,6 +587,8 @@ def test_missing_optional_dependency_names_the_extra(monkeypatch: pytest.MonkeyP
 # ----------------------------------------------------------------------------- the documented HDF5 layout
 
 LAYOUT_DOC = Path(__file__).resolve().parents[1] / "docs" / "hdf5_layout.md"
+#: items of a run's file only: each point's switch vector and the names of the channels computed when read
+STATES_ONLY = {"/switch", "/channel_names", "/channel_units"}
 
 
 def _documented_items() -> list[tuple[str, bool]]:
@@ -625,15 +627,27 @@ def test_hdf5_layout_document_lists_every_item_and_only_those(tmp_path: Path) ->
         in_file = _file_items(f)
     undocumented = [i for i in in_file if not any(p.match(i) for p, _, _ in patterns)]
     assert not undocumented, f"items written by Result.save but missing from {LAYOUT_DOC.name}: {undocumented}"
-    absent = [item for p, item, _ in patterns if not any(p.match(i) for i in in_file)]
+    # a result built from arrays stores yp and its channels, not a run's switch rows (STATES_ONLY)
+    absent = [item for p, item, _ in patterns if not any(p.match(i) for i in in_file) and item not in STATES_ONLY]
     assert not absent, f"items in {LAYOUT_DOC.name} that Result.save does not write: {absent}"
     # the optional items are the steps, which a result without recorded steps lacks
     path = make_result(step_t=None, step_h=None, step_order=None).save(tmp_path / "no_steps.h5")
     with h5py.File(path, "r") as f:
         in_file = _file_items(f)
-    absent = {item for p, item, _ in patterns if not any(p.match(i) for i in in_file)}
+    absent = {item for p, item, _ in patterns if not any(p.match(i) for i in in_file)} - STATES_ONLY
     assert absent == {"/steps", "/steps/t", "/steps/h", "/steps/order"}
-    assert {item for item, optional in documented if optional} == {"/steps"}
+    assert {item for item, optional in documented if optional} - STATES_ONLY - {"/yp"} == {"/steps"}
+    # a run's file: its states and switch rows, its channels and yp computed when read
+    import daeclear as dc
+
+    run = dc.simulate(dc.mechanisms.slider_crank("revolute"), t_end=0.002)
+    with h5py.File(run.save(tmp_path / "run_states.h5"), "r") as f:
+        in_file = _file_items(f)
+    undocumented = [i for i in in_file if not any(p.match(i) for p, _, _ in patterns)]
+    assert not undocumented, f"items of a run's file missing from {LAYOUT_DOC.name}: {undocumented}"
+    absent = {item for p, item, _ in patterns if not any(p.match(i) for i in in_file)}
+    assert absent == {"/yp", "/channels/<name>", "/channels/<name>@units"}
+    assert STATES_ONLY <= {item for item, optional in documented if optional}
 
 
 def test_hdf5_layout_document_snippet_reads_a_file_with_plain_h5py(tmp_path: Path,

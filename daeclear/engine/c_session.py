@@ -223,11 +223,13 @@ class CSession(SessionBase):
         return True
 
     def report(self, t: np.ndarray, y: np.ndarray, switch: np.ndarray, *,
-               into: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+               into: tuple[np.ndarray, np.ndarray] | None = None,
+               channels: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The reported points made consistent in one C pass: (y with recomputed multipliers and yp,
         one row per time; the output channels, one contiguous row per channel; see ``dc_report``),
         after :meth:`set_layout`. ``into``: the caller's own (y, yp) arrays to write them to (y may be
-        the ``y`` given), float64 and C-contiguous of shape (times, n): a run's output made no copy."""
+        the ``y`` given), float64 and C-contiguous of shape (times, n): a run's output made no copy.
+        ``channels=False``: states only (the channels come back with no row; a Result computes them when read)."""
         self._check_open()
         t = np.ascontiguousarray(t, dtype=float)
         y = np.ascontiguousarray(y, dtype=float)
@@ -241,11 +243,11 @@ class CSession(SessionBase):
                 if a.shape != (N, self._n) or a.dtype != np.float64 or not (a.flags.c_contiguous and a.flags.writeable):
                     raise ValueError(f"report: into holds a {a.dtype} array of shape {a.shape}; each must be a "
                                      f"writable C-contiguous float64 array of shape ({N}, {self._n})")
-        channels = np.empty((self._n_channels, N))
-        if N and self._lib.dc_report(self._h, N, address(t), address(y), address(switch),
-                                     address(y_out), address(yp_out), address(channels)) != 0:
+        values = np.empty((self._n_channels, N) if channels else (0, N))
+        if N and self._lib.dc_report(self._h, N, address(t), address(y), address(switch), address(y_out),
+                                     address(yp_out), address(values) if channels else None) != 0:
             raise DaeclearError("making the reported points consistent in the compiled model failed")
-        return y_out, yp_out, channels
+        return y_out, yp_out, values
 
     def _take_auto_events(self) -> AutoEvents | None:
         buf = getattr(self, "_auto_buf", None)

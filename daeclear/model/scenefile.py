@@ -80,11 +80,12 @@ import re
 import tomllib
 from pathlib import Path
 from typing import Any
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 from . import mechanisms
 from .. import options
 from ..errors import SceneError
+from ..results.values import to_plain
 from ..contact import Material, friction_law, normal_law
 from ..contact.hydrodynamic import law_from_table
 from .profiles import profile_from_dict
@@ -360,3 +361,27 @@ def read_scene_file(path: str | Path) -> SceneFile:
             text = f"[scene]: key gravity: {text}"
         raise SceneError(text if text.startswith(str(path)) else f"{path}: {text}") from None
     return SceneFile(scene, simulate, data)
+
+
+def scene_from_description(description: Mapping[str, Any]) -> Scene:
+    """The scene that :meth:`Scene.to_dict` described (a result file's ``parameters["scene"]``), element
+    by element as a scene file's tables; SceneError when an element cannot be rebuilt from plain data
+    (its kind unknown, or a value that was not plain data, such as a Python callable)."""
+    tables = {cls.__name__: (table, cls) for table, cls in ELEMENT_TABLES.items()}
+    where = Path(f"scene '{description.get('name', '')}'")
+    scene = Scene(str(description["name"]), gravity=tuple(description["gravity"]))
+    for i, entry in enumerate(description["elements"].values()):
+        entry = dict(entry)
+        kind = entry.pop("kind", None)
+        if kind not in tables:
+            raise SceneError(f"{where}: element {entry.get('name')!r} has kind={kind!r}, must be one of "
+                             f"{', '.join(tables)} to be rebuilt.")
+        table, cls = tables[kind]
+        if cls is Driver and entry.get("profile") is None:
+            entry.pop("profile", None)
+        scene.add(_element(where, table, i, cls, entry))
+    scene.validate()
+    if to_plain(scene.to_dict(), "scene") != to_plain(dict(description), "scene"):
+        raise SceneError(f"{where}: the scene rebuilt from its description differs from it (a value that is "
+                         "not plain data).")
+    return scene

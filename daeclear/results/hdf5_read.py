@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import DaeclearError, SceneError
 from .events import ContactEvent
 from .hdf5_write import FORMAT_NAME, FORMAT_VERSION
+from .lazy_channels import LazyChannels, rebuilt_evaluator
 from .values import time_window
 
 if TYPE_CHECKING:  # h5py is imported lazily, only where a file is read
@@ -143,9 +144,18 @@ def _read(r: _Reader) -> dict[str, Any]:
     if "channels" not in r.f:
         raise r._missing("group '/channels'")
     points = r.rows("t")
-    channels: dict[str, np.ndarray] = {}
+    t, y = r.array("t", points), r.array("y", points)
+    yp = r.array("yp", points) if r.has("yp") or not r.has("channel_names") else None  # None: computed
+    parameters = r.json("parameters_json")
+    channels: dict[str, np.ndarray] | LazyChannels = {}
+    if r.has("channel_names"):  # states only (version 2): the channels are computed when read
+        names = r.strings("channel_names")
+        switch = r.array("switch", points) if r.has("switch") else np.zeros((t.size, 0))  # no point written
+        units.update(zip(names, r.strings("channel_units")))
+        evaluate, derivatives = rebuilt_evaluator(parameters)
+        channels = LazyChannels(names, evaluate, t, y, yp, switch, derivatives=derivatives, rebuildable=True)
     for name in r.f["channels"]:
-        channels[name] = r.array(f"channels/{name}", points)
+        channels[name] = r.array(f"channels/{name}", points)  # type: ignore[index]
         units[name] = r.attr("units", f"/channels/{name}")
 
     rows = r.rows("events/t")
@@ -173,9 +183,9 @@ def _read(r: _Reader) -> dict[str, Any]:
                  "step_order": r.array("steps/order", rows)}
 
     return dict(
-        t=r.array("t", points),
-        y=r.array("y", points),
-        yp=r.array("yp", points),
+        t=t,
+        y=y,
+        yp=yp,
         state_names=state_names,
         channels=channels,
         units=units,
@@ -185,7 +195,7 @@ def _read(r: _Reader) -> dict[str, Any]:
         success=bool(r.attr("success")),
         status=int(r.attr("status")),
         message=str(r.attr("message")),
-        parameters=r.json("parameters_json"),
+        parameters=parameters,
         scene_name=str(r.attr("scene_name")),
         method=str(r.attr("method")),
         formulation=str(r.attr("formulation")),

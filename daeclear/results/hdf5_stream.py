@@ -49,10 +49,14 @@ class ResultWriter:
         The file, created or replaced (check it with :func:`daeclear.results.outputs.check_file` first).
     state_names, units, parameters, scene_name, method, formulation
         As in `Result`.
+    channel_names : sequence of str, optional
+        Given: the file keeps the states alone (``/switch``, ``/channel_names``, ``/channel_units``;
+        no ``/yp``: `load` computes the channels and yp from them) and `append` takes no channels.
     """
 
     def __init__(self, path: str | os.PathLike[str], *, state_names: Sequence[str], units: Mapping[str, str],
-                 parameters: Mapping[str, Any], scene_name: str, method: str, formulation: str) -> None:
+                 parameters: Mapping[str, Any], scene_name: str, method: str, formulation: str,
+                 channel_names: Sequence[str] | None = None) -> None:
         import h5py
 
         self.path = Path(path)
@@ -69,10 +73,14 @@ class ResultWriter:
             self._outcome(False, -1, STREAM_RUNNING)
             self._grow(f, "t", np.float64).attrs["units"] = "s"
             self._grow(f, "y", np.float64, (self._n,))
-            self._grow(f, "yp", np.float64, (self._n,))
+            if channel_names is None:  # states only: the reader computes yp from y
+                self._grow(f, "yp", np.float64, (self._n,))
             string_dataset(f, "state_names", list(state_names))
             string_dataset(f, "state_units", [self._units.get(str(n), "") for n in state_names])
             f.create_group("channels")
+            if channel_names is not None:  # states only: the reader computes the channels
+                string_dataset(f, "channel_names", list(channel_names))
+                string_dataset(f, "channel_units", [self._units.get(str(n), "") for n in channel_names])
             events = f.create_group("events")
             self._grow(events, "t", np.float64)
             self._grow(events, "pair", h5py.string_dtype())
@@ -124,11 +132,12 @@ class ResultWriter:
             dataset[n:n + k] = rows
 
     def append(self, *, t: ArrayLike = (), y: ArrayLike | None = None, yp: ArrayLike | None = None,
-               channels: Mapping[str, ArrayLike] | None = None, events: Sequence[ContactEvent] = (),
+               switch: ArrayLike | None = None, channels: Mapping[str, ArrayLike] | None = None,
+               events: Sequence[ContactEvent] = (),
                segments: Sequence[tuple[float, float, Mapping[str, str]]] = (), step_t: ArrayLike = (),
                step_h: ArrayLike = (), step_order: ArrayLike = ()) -> None:
-        """Add output rows (``t``, ``y``, ``yp``, ``channels``: one row per time), events, segments
-        and steps; written whole (a Ctrl-C meanwhile is raised afterwards) and flushed."""
+        """Add output rows (``t``, ``y``, ``yp``, ``switch``, ``channels``: one row per time), events,
+        segments and steps; written whole (a Ctrl-C meanwhile is raised afterwards) and flushed."""
         from .outputs import deferred_sigint
 
         from .outputs import check_space, disk_full, is_disk_full
@@ -142,7 +151,7 @@ class ResultWriter:
         check_space(self.path, size + 200 * (len(events) + len(segments)), "stream_to")
         with deferred_sigint():
             try:
-                self._append(f, t_arr, y, yp, channels, events, segments, step_t, step_h, step_order)
+                self._append(f, t_arr, y, yp, switch, channels, events, segments, step_t, step_h, step_order)
                 f.flush()
             except BaseException as exc:  # e.g. MemoryError: every dataset back to its length before, then go on
                 for dataset, n in reversed(self._touched):
@@ -151,12 +160,18 @@ class ResultWriter:
                     raise disk_full(self.path, "stream_to", exc) from None
                 raise
 
-    def _append(self, f: h5py.File, t_arr: NDArray[np.float64], y: Any, yp: Any, channels: Any, events: Any,
-                segments: Any, step_t: Any, step_h: Any, step_order: Any) -> None:
+    def _append(self, f: h5py.File, t_arr: NDArray[np.float64], y: Any, yp: Any, switch: Any, channels: Any,
+                events: Any, segments: Any, step_t: Any, step_h: Any, step_order: Any) -> None:
         if t_arr.size:
             self._extend(f["t"], t_arr)
             self._extend(f["y"], np.asarray(y, dtype=np.float64))
-            self._extend(f["yp"], np.asarray(yp, dtype=np.float64))
+            if "yp" in f:
+                self._extend(f["yp"], np.asarray(yp, dtype=np.float64))
+            rows = np.asarray(switch if switch is not None else np.zeros((t_arr.size, 0)), dtype=np.float64)
+            if rows.shape[1:] != (0,):  # one row per point, repeated over a segment: gzip makes it small
+                if "switch" not in f:
+                    self._grow(f, "switch", np.float64, rows.shape[1:], compress=True)
+                self._extend(f["switch"], rows)
             group = f["channels"]
             for name, values in (channels or {}).items():
                 arr = np.asarray(values)

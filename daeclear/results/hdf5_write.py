@@ -7,15 +7,18 @@ with the helpers and constants here. h5py is imported only when a file is writte
 docs/hdf5_layout.md documents the file item by item for readers without daeclear
 (a test keeps it in step with `_write`).
 
-HDF5 layout (root attributes ``format="daeclear-result"``, ``version=1``)::
+HDF5 layout (root attributes ``format="daeclear-result"``, ``version=2``)::
 
     /                     attrs: format, version, scene_name, method, formulation,
                                  success, status, message
     /t                    (n_times,)            attr units="s"
-    /y, /yp               (n_times, n_states)   time first
+    /y, /yp               (n_times, n_states)   time first (/yp absent when the channels are)
     /state_names          (n_states,)           strings, e.g. "crank.x", "lambda.A.x"
     /state_units          (n_states,)           strings ("" when unknown)
-    /channels/<name>      (n_times, ...)        attr units; one dataset per channel
+    /switch               (n_times, n_switch)   each point's contact switch vector (a run's result)
+    /channel_names        (n_channels,)         strings: the channels computed when read (then
+    /channel_units        (n_channels,)         strings   /channels is empty)
+    /channels/<name>      (n_times, ...)        attr units; one dataset per channel (when stored)
     /events/t             (n_events,)
     /events/pair          (n_events,)           strings
     /events/kind          (n_events,)           "onset" | "separation"
@@ -60,14 +63,15 @@ if TYPE_CHECKING:  # h5py is imported lazily, only where a file is written
 
     from .result import Result
 
-__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "json_dataset", "mirror", "save_result", "string_dataset",
-           "write_result_group"]
+__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "json_dataset", "mirror", "save_result", "stores_states_only",
+           "string_dataset", "write_result_group"]
 
 FORMAT_NAME = "daeclear-result"
 """Value of the root ``format`` attribute of every file written by `Result.save`."""
 
-FORMAT_VERSION = 1
-"""Version of the HDF5 layout written by this daeclear; `load` reads versions <= this."""
+FORMAT_VERSION = 2
+"""Version of the HDF5 layout written by this daeclear; `load` reads versions <= this (version 1: every
+channel stored, no ``/switch``)."""
 
 _COMPRESS_MIN_SIZE = 16384  # values; smaller arrays are stored contiguous, uncompressed
 _MIRROR_ATTR_MAX_LEN = 1024  # longer lists become datasets (HDF5 attributes are limited to 64 KiB)
@@ -84,11 +88,12 @@ def _compress(data: np.ndarray) -> bool:
     return bool(data.dtype.kind in "biu" or np.count_nonzero(data) <= data.size // 2)
 
 
-def _dataset(group: h5py.Group, name: str, data: np.ndarray) -> h5py.Dataset:
-    """A numeric dataset with a Fletcher-32 checksum per chunk (`load` refuses a damaged one by name)."""
+def _dataset(group: h5py.Group, name: str, data: np.ndarray, compress: bool = False) -> h5py.Dataset:
+    """A numeric dataset with a Fletcher-32 checksum per chunk (`load` refuses a damaged one by name);
+    ``compress``: gzip whatever its size (the switch rows: one row repeated over a segment)."""
     if not data.size:  # HDF5 cannot chunk an empty array: nothing to check either
         return group.create_dataset(name, data=data)
-    if _compress(data):
+    if compress or _compress(data):
         return group.create_dataset(name, data=data, chunks=True, compression="gzip",
                                     compression_opts=1, shuffle=True, fletcher32=True)
     return group.create_dataset(name, data=data, chunks=True, fletcher32=True)
@@ -138,8 +143,9 @@ def mirror(group: h5py.Group, tree: Mapping[str, Any]) -> None:
             continue  # an int beyond 64 bits: JSON only
 
 
-def _write(f: h5py.File | h5py.Group, r: Result) -> None:
-    """Write ``r`` in the layout of a result file into an open HDF5 file or group."""
+def _write(f: h5py.File | h5py.Group, r: Result, channels: bool = False) -> None:
+    """Write ``r`` in the layout of a result file into an open HDF5 file or group (``channels``: every
+    channel and yp, even when the reader could compute them)."""
     f.attrs["format"] = FORMAT_NAME
     f.attrs["version"] = FORMAT_VERSION
     f.attrs["scene_name"] = r.scene_name
@@ -151,13 +157,22 @@ def _write(f: h5py.File | h5py.Group, r: Result) -> None:
 
     _dataset(f, "t", np.asarray(r.t)).attrs["units"] = "s"
     _dataset(f, "y", np.asarray(r.y))
-    _dataset(f, "yp", np.asarray(r.yp))
+    states_only = not channels and stores_states_only(r)
+    if not states_only:  # else the reader computes yp from y (the run's consistency pass)
+        _dataset(f, "yp", np.asarray(r.yp))
     string_dataset(f, "state_names", r.state_names)
     string_dataset(f, "state_units", [r.units[n] for n in r.state_names])
 
-    channels = f.create_group("channels")
-    for name in r.channel_names:
-        _dataset(channels, name, np.asarray(r.channels[name])).attrs["units"] = r.units[name]
+    source = r.channel_source
+    if source is not None:
+        _dataset(f, "switch", np.asarray(source.switch, dtype=np.float64), compress=True)
+    group = f.create_group("channels")
+    if states_only:  # the reader computes the channels from the states (load)
+        string_dataset(f, "channel_names", r.channel_names)
+        string_dataset(f, "channel_units", [r.units[n] for n in r.channel_names])
+    else:
+        for name in r.channel_names:
+            _dataset(group, name, np.asarray(r.channels[name])).attrs["units"] = r.units[name]
 
     events = f.create_group("events")
     _dataset(events, "t", r.events.t)
@@ -185,19 +200,30 @@ def _write(f: h5py.File | h5py.Group, r: Result) -> None:
     json_dataset(f, "warnings_json", r.warnings)
 
 
-def save_result(r: Result, path: str | os.PathLike[str]) -> Path:
+def stores_states_only(r: Result) -> bool:
+    """Whether ``r``'s file keeps its states without the channels: a run's result whose model its
+    parameters rebuild (else, e.g. a scene holding a Python callable, the channels are written)."""
+    source = r.channel_source
+    return source is not None and source.can_rebuild()
+
+
+def save_result(r: Result, path: str | os.PathLike[str], channels: bool = False) -> Path:
     """Write ``r`` to an HDF5 file, atomically: what :meth:`Result.save` does (see its docstring)."""
     import h5py
 
     from .outputs import atomic_file, check_file, check_space, deferred_sigint, disk_full, is_disk_full
 
     path = check_file(path, "Result.save(path)")  # the one output-place rule (daeclear.results.outputs)
-    size = sum(np.asarray(a).nbytes for a in (r.t, r.y, r.yp, *r.channels.values()))
+    size = sum(np.asarray(a).nbytes for a in (r.t, r.y)) + (
+        8 * r.n_times * (r.n_states + len(r.channel_names)) if channels or not stores_states_only(r) else 0)
     check_space(path, size + 200 * len(r.events) * (1 + r.n_states), "Result.save(path)")  # before writing
     # a Ctrl-C during the write arrives once the file is complete (and renamed into place)
     try:
         with deferred_sigint(), atomic_file(path) as tmp, h5py.File(tmp, "x") as f:
-            _write(f, r)
+            if channels:
+                _write(f, r, channels=True)
+            else:
+                _write(f, r)
     except (OSError, RuntimeError) as exc:  # a full disk meanwhile: any file at path is left as it was
         if is_disk_full(exc):
             raise disk_full(path, "Result.save(path)", exc) from None

@@ -28,6 +28,8 @@ from .events import EVENT_KINDS, ContactEvent, EventKind, EventList, EventRows
 from .hdf5_read import read_dataset, read_file, read_group
 from .hdf5_stream import STREAM_RUNNING, ResultWriter
 from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, save_result, write_result_group
+from .lazy_channels import LazyChannels
+from .result_checks import checked_fields
 from .values import readonly, time_window, to_plain
 
 if TYPE_CHECKING:  # h5py, pandas and xarray are imported lazily, only where they are used
@@ -66,13 +68,16 @@ class Result:
         Output times (s), non-decreasing (an event time may appear twice,
         before and after a restart).
     y, yp : array_like, shape (n_times, n_states)
-        States and their time derivatives, time first.
+        States and their time derivatives, time first. ``yp`` may be None with lazy
+        channels that compute it (a loaded file's: the run's consistency pass).
     state_names : list of str
         Name of each state, e.g. ``"crank.x"``, ``"crank.vx"``, ``"lambda.A.x"``.
-    channels : mapping of str to array_like
+    channels : mapping of str to array_like, or LazyChannels
         Named outputs ``"<object>.<quantity>"`` (e.g. ``"slider.vx"``,
         ``"motor.moment"``), each with first dimension n_times. Dtypes are kept.
-        Names must not contain "/".
+        Names must not contain "/". A run's result holds a
+        :class:`~daeclear.results.lazy_channels.LazyChannels`: its channels are computed
+        from the stored states at their first read (docs/results.md).
     units : mapping of str to str
         Unit of channels and states (e.g. ``"m/s"``). Names without a unit get
         ``""``; a name that is neither a channel nor a state is an error.
@@ -134,9 +139,9 @@ class Result:
         *,
         t: ArrayLike,
         y: ArrayLike,
-        yp: ArrayLike,
+        yp: ArrayLike | None,
         state_names: Sequence[str],
-        channels: Mapping[str, ArrayLike],
+        channels: Mapping[str, ArrayLike] | LazyChannels,
         units: Mapping[str, str],
         events: Iterable[ContactEvent] = (),
         segments: Iterable[tuple[float, float, Mapping[str, str]]] = (),
@@ -153,79 +158,15 @@ class Result:
         formulation: str = "",
         warnings: Iterable[Mapping[str, Any]] = (),
     ) -> None:
-        t_arr = np.asarray(t, dtype=np.float64)
-        if t_arr.ndim != 1:
-            raise ValueError(f"Result: t has shape {t_arr.shape}, must be (n_times,).")
-        if np.any(np.diff(t_arr) < 0):
-            i = int(np.argmax(np.diff(t_arr) < 0))
-            raise ValueError(f"Result: t must be non-decreasing; t[{i}]={t_arr[i]} > t[{i + 1}]={t_arr[i + 1]}.")
-        n_times = t_arr.shape[0]
-
-        names = [str(n) for n in state_names]
-        if len(set(names)) != len(names):
-            dup = sorted({n for n in names if names.count(n) > 1})
-            raise ValueError(f"Result: state names {dup} appear more than once.")
-        shape = (n_times, len(names))
-        y_arr = np.asarray(y, dtype=np.float64)
-        yp_arr = np.asarray(yp, dtype=np.float64)
-        for label, arr in (("y", y_arr), ("yp", yp_arr)):
-            if arr.shape != shape:
-                raise ValueError(f"Result: {label} has shape {arr.shape}, expected (n_times, n_states) = {shape} "
-                                 "from t and state_names.")
-
-        chans: dict[str, np.ndarray] = {}
-        for name, values in channels.items():
-            if not isinstance(name, str) or not name or "/" in name or name == ".":
-                raise ValueError(f"Result: channel name {name!r} is invalid; use '<object>.<quantity>' without '/'.")
-            arr = np.asarray(values)
-            if arr.ndim == 0 or arr.shape[0] != n_times:
-                raise ValueError(f"Result: channel {name!r} has shape {arr.shape}, its first dimension must be "
-                                 f"n_times={n_times}.")
-            chans[name] = arr
-
-        known = set(chans) | set(names)
-        for name, unit in units.items():
-            if name not in known:
-                close = close_matches(name, sorted(known), n=3)
-                hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
-                raise ValueError(f"Result: units given for {name!r}, which is neither a channel nor a state.{hint}")
-            if not isinstance(unit, str):
-                raise ValueError(f"Result: unit of {name!r} is {unit!r}, must be a string such as 'm/s'.")
-
-        event_list = EventList(events)
-        for e in event_list:
-            if e.y.shape != (len(names),):
-                raise ValueError(f"Result: event {e!r} has a state of shape {e.y.shape}, expected ({len(names)},).")
-
-        segs: list[tuple[float, float, dict[str, str]]] = []
-        for i, (t_start, t_end, modes) in enumerate(segments):
-            if not t_start <= t_end:
-                raise ValueError(f"Result: segment {i} runs from t={t_start} to t={t_end}, must not run backwards.")
-            segs.append((float(t_start), float(t_end), {str(k): str(v) for k, v in modes.items()}))
-
-        given = [a is not None for a in (step_t, step_h, step_order)]
-        if any(given) and not all(given):
-            raise ValueError("Result: step_t, step_h and step_order are given together or not at all.")
-        steps: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        if all(given):
-            st = np.asarray(step_t, dtype=np.float64)
-            sh = np.asarray(step_h, dtype=np.float64)
-            so = np.asarray(step_order, dtype=np.int64)
-            if st.ndim != 1 or sh.shape != st.shape or so.shape != st.shape:
-                raise ValueError(f"Result: step_t, step_h, step_order have shapes {st.shape}, {sh.shape}, "
-                                 f"{so.shape}; they must be equal and one-dimensional.")
-            steps = (st, sh, so)
-
-        if status not in (-1, 0, 1):
-            raise ValueError(f"Result: status={status!r}, must be 0 (end reached), 1 (terminal event) or -1 (failed).")
-        if bool(success) != (status >= 0):
-            raise ValueError(f"Result: success={success} contradicts status={status} (only status -1 is a failure).")
+        t_arr, y_arr, yp_arr, names, chans, event_list, segs, steps = checked_fields(
+            t, y, yp, state_names, channels, units, events, segments, step_t, step_h, step_order, success, status)
         self._assign(t_arr, y_arr, yp_arr, names, chans, units, event_list, segs, steps, dict(
             stats=stats, success=success, status=status, message=message, scene_name=scene_name, method=method,
             formulation=formulation, warnings=warnings, parameters=to_plain(dict(parameters or {}), "parameters")))
 
     @classmethod
-    def of_run(cls, *, t: NDArray, y: NDArray, yp: NDArray, state_names: Sequence[str], channels: Mapping[str, NDArray],
+    def of_run(cls, *, t: NDArray, y: NDArray, yp: NDArray | None, state_names: Sequence[str],
+               channels: Mapping[str, NDArray] | LazyChannels,
                units: Mapping[str, str], events: Iterable[ContactEvent | EventRows],
                segments: list[tuple[float, float, dict[str, str]]], step_t: NDArray, step_h: NDArray,
                step_order: NDArray, **outcome: Any) -> Result:
@@ -238,16 +179,21 @@ class Result:
                        (step_t, step_h, step_order), {**outcome, "parameters": (outcome["parameters"],)})
         return result
 
-    def _assign(self, t: NDArray, y: NDArray, yp: NDArray, names: list[str], channels: Mapping[str, NDArray],
+    def _assign(self, t: NDArray, y: NDArray, yp: NDArray | None, names: list[str],
+                channels: Mapping[str, NDArray] | LazyChannels,
                 units: Mapping[str, str], events: EventList, segments: list[tuple[float, float, dict[str, str]]],
                 steps: tuple[NDArray, NDArray, NDArray] | None, outcome: Mapping[str, Any]) -> None:
         """Set the fields from checked data: arrays as read-only views, values as plain data."""
         self.t: NDArray[np.float64] = readonly(t)
         self.y: NDArray[np.float64] = readonly(y)
-        self.yp: NDArray[np.float64] = readonly(yp)
+        self._yp = None if yp is None else readonly(yp)
         self.state_names: list[str] = names
-        self._channels = {name: readonly(values) for name, values in channels.items()}
-        self.units: dict[str, str] = {name: units.get(name, "") for name in [*names, *sorted(channels)]}
+        # the channels: arrays, or computed from the states at their first read (_channel_values)
+        self._lazy = channels if isinstance(channels, LazyChannels) else None
+        self._channels: dict[str, np.ndarray] | None = None if isinstance(channels, LazyChannels) else {
+            name: readonly(values) for name, values in channels.items()}
+        self._names = frozenset(channels.names if isinstance(channels, LazyChannels) else channels)
+        self.units: dict[str, str] = {name: units.get(name, "") for name in [*names, *sorted(self._names)]}
         self._events = events
         self.segments: list[tuple[float, float, dict[str, str]]] = segments
         self._steps = None if steps is None else (readonly(steps[0]), readonly(steps[1]), readonly(steps[2]))
@@ -271,14 +217,37 @@ class Result:
         return held
 
     @property
+    def yp(self) -> NDArray[np.float64]:
+        """Time derivatives of the states (n_times, n_states); a loaded file's are computed at the
+        first read from `y` (the run's consistency pass) and kept."""
+        if self._yp is None:
+            assert self._lazy is not None
+            self._yp = self._lazy.yp
+        return self._yp
+
+    def _channel_values(self) -> dict[str, np.ndarray]:
+        """The channels: a run's computed from its states at the first read, in one call, and kept."""
+        if self._channels is None:
+            assert self._lazy is not None
+            self._channels = self._lazy.values()
+        return self._channels
+
+    @property
     def channels(self) -> Mapping[str, np.ndarray]:
-        """Read-only mapping of channel name to array (first dimension n_times)."""
-        return MappingProxyType(self._channels)
+        """Read-only mapping of channel name to array (first dimension n_times); a run's channels
+        are computed from its states at the first read of any (all at once) and kept."""
+        return MappingProxyType(self._channel_values())
+
+    @property
+    def channel_source(self) -> LazyChannels | None:
+        """What the channels are computed from (states, switch rows, the model's output function),
+        or None when they were given as arrays."""
+        return self._lazy
 
     @property
     def channel_names(self) -> list[str]:
         """Channel names, sorted (state names not included; see `state_names`)."""
-        return sorted(self._channels)
+        return sorted(self._names)
 
     @property
     def events(self) -> EventList:
@@ -323,20 +292,20 @@ class Result:
                 f"Result[...] takes a channel or state name (str), got {type(name).__name__}; "
                 f"use result.t, result.y for the arrays."
             )
-        if name in self._channels:
-            return self._channels[name]
+        if name in self._names:
+            return self._channel_values()[name]
         if name in self.state_names:
             return self.y[:, self.state_names.index(name)]
-        candidates = sorted(set(self._channels) | set(self.state_names))
+        candidates = sorted(self._names | set(self.state_names))
         close = close_matches(name, candidates)
         if close:
             hint = "Close matches: " + ", ".join(repr(c) for c in close) + "."
         else:
-            hint = f"See result.channel_names ({len(self._channels)}) and result.state_names ({self.n_states})."
+            hint = f"See result.channel_names ({len(self._names)}) and result.state_names ({self.n_states})."
         raise ChannelKeyError(f"no channel {name!r}. {hint}")
 
     def __contains__(self, name: object) -> bool:
-        return isinstance(name, str) and (name in self._channels or name in self.state_names)
+        return isinstance(name, str) and (name in self._names or name in self.state_names)
 
     # A Result is not iterable: iterate over result.channel_names or result.state_names.
     __iter__ = None
@@ -425,12 +394,13 @@ class Result:
         """
         lo, hi = time_window(t0, t1)
         mask = self.window_mask(t0, t1)
-        kw = self.to_dict()
+        kw = self.to_dict(channels=False)
         kw.update(
             t=self.t[mask],
             y=self.y[mask],
-            yp=self.yp[mask],
-            channels={name: arr[mask] for name, arr in self._channels.items()},
+            yp=None if self._yp is None else self._yp[mask],
+            channels=self._lazy.take(mask) if self._lazy is not None else {
+                name: arr[mask] for name, arr in self._channel_values().items()},
             events=[e for e in self._events if lo <= e.t <= hi],
             segments=[(max(a, lo), min(b, hi), m) for a, b, m in self.segments if a < hi and b > lo],
         )
@@ -440,21 +410,22 @@ class Result:
                       step_order=self._steps[2][inside])
         return Result(**kw)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self, *, channels: bool = True) -> dict[str, Any]:
         """The constructor keywords: ``Result(**result.to_dict())`` rebuilds the result.
 
         Returns
         -------
         dict
-            Arrays are the result's own read-only arrays; `events` is a list of
-            `ContactEvent`; `stats` and `parameters` are copies.
+            Arrays are the result's own read-only arrays (the channels computed if not yet;
+            ``channels=False``: not computed, the result's own channel source or arrays); `events`
+            is a list of `ContactEvent`; `stats` and `parameters` are copies.
         """
         return {
             "t": self.t,
             "y": self.y,
             "yp": self.yp,
             "state_names": list(self.state_names),
-            "channels": dict(self._channels),
+            "channels": dict(self._channel_values()) if channels or self._lazy is None else self._lazy,
             "units": dict(self.units),
             "events": list(self._events),
             "segments": [(a, b, dict(m)) for a, b, m in self.segments],
@@ -568,8 +539,13 @@ class Result:
 
     # ------------------------------------------------------------------ HDF5
 
-    def save(self, path: str | os.PathLike[str]) -> Path:
+    def save(self, path: str | os.PathLike[str], *, channels: bool = False) -> Path:
         """Write the result to an HDF5 file, atomically.
+
+        A run's result is stored as its states (``t``, ``y``, each point's switch vector) when
+        its scene can be rebuilt from its description: `load` computes the channels and ``yp``
+        when they are first read, equal bit for bit. ``channels=True`` stores them too (for
+        tools without daeclear: MATLAB, h5py); a result built from arrays always stores them.
 
         The file is written under a temporary name in the same directory and
         renamed over `path` (`os.replace`) only once complete: an existing file
@@ -581,6 +557,8 @@ class Result:
         ----------
         path : str or path-like
             Destination file, e.g. ``"run.h5"``. Its directory must exist.
+        channels : bool
+            Store every channel and ``yp`` even when `load` could compute them.
 
         Returns
         -------
@@ -595,7 +573,7 @@ class Result:
             If `path` is a directory or its directory cannot be written (an ``OutputError``,
             checked before writing), or the write fails.
         """
-        return save_result(self, path)
+        return save_result(self, path, channels)
 
 
 # --------------------------------------------------------------------------- reading

@@ -30,6 +30,7 @@ from ..assembly.automaton import EVENT_KINDS, ONSET
 from ..engine.abi import DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND
 from ..engine.session_base import AutoEvents
 from ..errors import Interrupted, SolveError
+from .channel_eval import session_evaluator
 from .recorder import Recorder
 from ..progress import Progress
 from ..results.events import EventRows
@@ -72,6 +73,7 @@ class SegmentLoop:
             self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
             self.i_eval = 1
         self.events, self.segments = rec.events, rec.segments
+        rec.evaluate = session_evaluator(model, session)  # channels in the run's library while it is open
         self.t, self.y, self.yp, self.y0 = t0, y, yp, y0
         self.t_start = t0
         self.seg_start = t0  # nan once the last segment is closed
@@ -281,16 +283,13 @@ class SegmentLoop:
             else:
                 out_t, out_y, out_yp, out_switch = raw[0]
             raw.clear()
-            if self.c_layout:  # one pass in C
-                out_y, out_yp, values = session.report(out_t, out_y, out_switch,
-                                                       into=(out_y, out_yp) if joined else None)
-                values.flags.writeable = False  # each channel is a contiguous (read-only) row of it
-                channels = dict(zip(model.channel_names, values))
+            if self.c_layout:  # one pass in C, states only (the Result computes the channels when read)
+                out_y, out_yp, _ = session.report(out_t, out_y, out_switch,
+                                                  into=(out_y, out_yp) if joined else None, channels=False)
             else:
                 out_y, out_yp = model.consistent_state(
                     out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)
-                channels = model.channels(out_t, out_y, out_yp, out_switch, session)
-            self.rec.add_points(out_t, out_y, out_yp, channels)
+            self.rec.add_points(out_t, out_y, out_yp, out_switch)
         self.rec.flush()
 
     def finish(self, on_failure: str, setup_time: float, sim_params: dict[str, Any]) -> Result:
@@ -339,6 +338,7 @@ class SegmentLoop:
                                      self.y0 if sim_params["start"] == "declared" else None, stats, session,
                                      from_state=sim_params["start"] == "state")
         finally:
+            rec.evaluate = None  # the session closes: later channels open their own
             session.close()
 
 

@@ -199,8 +199,9 @@ class Run:
             yp[:, :2 * n] = Xd
             sw = self.model.switch_vector(seg.active, seg.params)
             ch = ev.channels(self.model, ot, y, yp, sw)
-            self.rec.add_points(ot, y, yp, {name: np.ascontiguousarray(ch[:, i])
-                                            for i, name in enumerate(self.model.channel_names)})
+            names = self.model.channel_names
+            self.rec.add_points(ot, y, yp, np.broadcast_to(sw, (N, sw.size)),
+                                {name: np.ascontiguousarray(ch[:, i]) for i, name in enumerate(names)})
         seg.st, seg.sx, seg.et, seg.ex = [], [], [], []  # handed over: a long run keeps no segment's data
         self.hand_over(seg)
         ev.set_terms(self.active, self.params)

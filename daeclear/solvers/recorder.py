@@ -1,13 +1,17 @@
 """Where a run's output goes while it runs: kept in memory, or streamed to an HDF5 file.
 
 The solvers (:mod:`daeclear.solvers.ida`, :mod:`daeclear.solvers.explicit`) hand a :class:`Recorder` their
-reported points chunk by chunk, already made consistent (multipliers, accelerations, channels),
-and their steps, events and segments. In memory the chunks are kept and joined into the
-`Result` at the end. Streamed (``stream_to``), each chunk is appended to the file and dropped,
-so the run's memory does not grow with its length, and the file holds what was computed
-whatever stops the run (see :class:`daeclear.results.result.ResultWriter`). Either way the recorder keeps
-the few rows the physics checks read (:func:`daeclear.solvers.physics.key_rows`), so a streamed run is
-checked exactly as a run kept in memory.
+reported points chunk by chunk, already made consistent (multipliers, accelerations), each with
+the switch vector of its segment, and their steps, events and segments. The IDA loop's points come
+without channels: the run's `Result` computes them from its states when they are first read
+(:class:`daeclear.results.lazy_channels.LazyChannels`); the explicit methods compute them as they go.
+In memory the chunks are kept and joined into the `Result` at the end. Streamed (``stream_to``),
+each chunk is appended to the file and dropped, so the run's memory does not grow with its length,
+and the file holds what was computed whatever stops the run (see
+:class:`daeclear.results.result.ResultWriter`); a scene that can be rebuilt from its description
+streams its states only (the file's reader computes the channels). Either way the physics checks
+read the few rows of :func:`daeclear.solvers.physics.key_rows`, so a streamed run is checked
+exactly as a run kept in memory.
 """
 
 from __future__ import annotations
@@ -21,9 +25,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import physics
+from .channel_eval import model_evaluator, rebuildable
 from ..errors import OutputError
 from ..results.events import EventRows, flatten
+from ..results.lazy_channels import Evaluate, LazyChannels
 from ..results.result import ContactEvent, Result, ResultWriter, load
+
+#: a chunk of points: t, y, yp, switch rows and the channels when the solver computed them
+Points = tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray] | None]
 
 
 class Recorder:
@@ -31,6 +40,8 @@ class Recorder:
 
     ``events`` and ``segments`` are the lists the solver appends to; :meth:`flush` writes the new
     ones (streamed: and empties the lists; :attr:`n_events` counts every event of the run).
+    :attr:`evaluate` computes channels in the run's open session (set by the IDA loop): points
+    added without channels get theirs from it when the physics checks or a streamed file need them.
     """
 
     def __init__(self, model: Any, *, parameters: Mapping[str, Any], method: str,
@@ -45,8 +56,14 @@ class Recorder:
         self._header = dict(state_names=list(model.state_names), units=dict(model.channel_units),
                             parameters=parameters, scene_name=model.scene_name, method=method,
                             formulation=model.formulation)
-        self.writer = ResultWriter(stream_to, **self._header) if stream_to is not None else None
-        self._points: list[tuple[NDArray, NDArray, NDArray, dict[str, NDArray]]] = []
+        self.evaluate: Evaluate | None = None
+        self._backend = str(parameters.get("simulate", {}).get("backend", "auto"))
+        # the states alone make the channels again (IDA's output function; the scene rebuilt from its
+        # description): decided at the first need (a streamed file, a saved result)
+        self._rebuildable: bool | None = None
+        self.writer = None if stream_to is None else ResultWriter(
+            stream_to, **self._header, channel_names=list(model.channel_names) if self.rebuildable() else None)
+        self._points: list[Points] = []
         self._steps: list[tuple[NDArray, NDArray, NDArray]] = []
         n = model.n_states
         self._key: tuple[NDArray, NDArray, dict[str, NDArray]] = (np.zeros(0), np.zeros((0, n)), {})
@@ -61,15 +78,26 @@ class Recorder:
         self.events.append(rows)
         self._in_blocks += len(rows) - 1
 
-    def add_points(self, t: NDArray, y: NDArray, yp: NDArray, channels: dict[str, NDArray]) -> None:
-        """Reported points, consistent: one row per time of ``t``."""
+    def rebuildable(self) -> bool:
+        """Whether the result's channels can be made again from its states and parameters alone: an
+        IDA run (its output function) of a scene that its description rebuilds."""
+        if self._rebuildable is None:
+            self._rebuildable = self._header["method"] == "ida" and rebuildable(self._header["parameters"])
+        return self._rebuildable
+
+    def add_points(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray,
+                   channels: dict[str, NDArray] | None = None) -> None:
+        """Reported points, consistent: one row per time of ``t``, with its switch vector (one row per
+        time) and, when the solver computed them, its channels."""
         if not t.size:
             return
-        self._keep_key_rows(t, y, channels)
         if self.writer is not None:
-            self.writer.append(t=t, y=y, yp=yp, channels=channels)
+            if channels is None:  # the physics checks read the chunk's key channels
+                channels = self._evaluated(t, y, yp, switch)
+            self._keep_key_rows(t, y, channels)
+            self.writer.append(t=t, y=y, yp=yp, switch=switch, channels=None if self.rebuildable() else channels)
         else:
-            self._points.append((t, y, yp, channels))
+            self._points.append((t, y, yp, switch, channels))
 
     def add_steps(self, t: NDArray, h: NDArray, order: NDArray) -> None:
         """The integrator's steps: time, size and order of each."""
@@ -101,8 +129,42 @@ class Recorder:
         rows = physics.key_rows(t2, c2)
         self._key = (t2[rows], y2[rows], {c: v[rows] for c, v in c2.items()})
 
+    def _evaluated(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> dict[str, NDArray]:
+        evaluate = self.evaluate or model_evaluator(self.model, self._backend)
+        out = evaluate(t, y, yp, switch)
+        return {name: np.ascontiguousarray(out[name]) for name in self.model.channel_names}
+
+    def _joined(self) -> tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray]]:
+        """The points kept in memory as one chunk, their channels computed (in one call) if not given."""
+        n = self.model.n_states
+        points = self._points
+        channels: dict[str, NDArray] | None
+        if len(points) == 1:  # one chunk (a short run): nothing to join
+            t, y, yp, switch, channels = points[0]
+        elif points:
+            t, y, yp, switch = (np.concatenate([p[k] for p in points]) for k in range(4))
+            given = [p[4] for p in points]
+            channels = None
+            if all(g is not None for g in given):
+                chunks = [g for g in given if g is not None]
+                channels = {c: np.concatenate([g[c] for g in chunks]) for c in chunks[0]}
+        else:
+            n_switch = self.model.outputs.size1_in(3)
+            t, y, yp, switch = np.zeros(0), np.zeros((0, n)), np.zeros((0, n)), np.zeros((0, n_switch))
+            channels = {c: np.zeros(0) for c in self.model.channel_names}
+        if channels is None:
+            channels = self._evaluated(t, y, yp, switch)
+        self._points[:] = [(t, y, yp, switch, channels)]
+        return t, y, yp, switch, channels
+
     def key_rows(self) -> tuple[NDArray, NDArray, dict[str, NDArray]]:
-        """(t, y, channels) of the rows the physics checks read (:func:`daeclear.solvers.physics.key_rows`)."""
+        """(t, y, channels) of the rows the physics checks read (:func:`daeclear.solvers.physics.key_rows`);
+        in memory, the run's channels are computed for them (all at once: the Result keeps them)."""
+        if self.writer is None:
+            t, y, _, _, channels = self._joined()
+            names = _key_channels(tuple(channels))
+            rows = physics.key_rows(t, {c: channels[c] for c in names})
+            return t[rows], y[rows], {c: channels[c][rows] for c in names}
         return self._key
 
     def finish(self, *, stats: Mapping[str, Any], success: bool, status: int, message: str,
@@ -124,22 +186,13 @@ class Recorder:
             header = {**self._header, "units": {s: u for s, u in self._header["units"].items()
                                                 if s in self._header["state_names"]}}
             return Result(t=np.zeros(0), y=np.zeros((0, n)), yp=np.zeros((0, n)), channels={}, **header, **outcome)
-        n = self.model.n_states
-        names = list(self.model.channel_names)
-        if len(self._points) == 1:  # one chunk (a short run): nothing to join
-            t, y, yp, channels = self._points[0]
-        elif self._points:
-            t = np.concatenate([p[0] for p in self._points])
-            y = np.concatenate([p[1] for p in self._points])
-            yp = np.concatenate([p[2] for p in self._points])
-            channels = {c: np.concatenate([p[3][c] for p in self._points]) for c in self._points[0][3]}
-        else:
-            t, y, yp = np.zeros(0), np.zeros((0, n)), np.zeros((0, n))
-            channels = {c: np.zeros(0) for c in names}
+        t, y, yp, switch, channels = self._joined()
         self._points.clear()
+        lazy = LazyChannels(self.model.channel_names, model_evaluator(self.model, self._backend), t, y, yp,
+                            np.asarray(switch), values=channels, rebuildable=self.rebuildable)
         steps = [np.concatenate(c) for c in zip(*self._steps)] if self._steps else [
             np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)]
-        return Result.of_run(t=t, y=y, yp=yp, channels=channels, events=self.events, segments=self.segments,
+        return Result.of_run(t=t, y=y, yp=yp, channels=lazy, events=self.events, segments=self.segments,
                              step_t=steps[0], step_h=steps[1], step_order=steps[2].astype(np.int64, copy=False),
                              **self._header, **outcome)
 

@@ -48,7 +48,7 @@ DC_API int dc_eval_extra(int k, int n_points, int n_in, const double* const* inp
  * (IDA's states) with its switch row (per term: on flag, then its parameters), write the state
  * with recomputed multipliers to y_out (which may be y itself), its derivative to yp_out and the
  * output channels to channels_out, channel by channel: channel c of point i at c * n_points + i,
- * so that each channel is one contiguous row (dc_set_layout first). */
+ * so that each channel is one contiguous row (dc_set_layout first); channels_out NULL: states only. */
 DC_API int dc_report(void* sp, int n_points, const double* t, const double* y, const double* sw, double* y_out,
                      double* yp_out, double* channels_out) {
   dc_session* s = (dc_session*)sp;
@@ -67,6 +67,7 @@ DC_API int dc_report(void* sp, int n_points, const double* t, const double* y, c
       off += 1 + dc_model.n_params[k];
     }
     if (make_consistent(s, t[i], yi, ypi, s->lay_on, par) != 0) return -1;
+    if (!channels_out) continue; /* states only: the channels are computed when read */
     const double* in_o[5] = {t + i, yi, ypi, si, s->P};
     if (eval_extra1(s, s->lay_outputs, 5, in_o, row) != 0) return -1;
     for (int c = 0; c < nc; ++c) channels_out[(size_t)c * (size_t)n_points + (size_t)i] = row[c];

@@ -1,0 +1,137 @@
+"""Channels computed when read: a run's (or a result file's) states, and what computes its channels.
+
+A run stores its states only: the times ``t``, the consistent states ``y`` and ``yp`` and, per
+point, the switch vector of its segment (the contact terms' on flags and parameters, the outputs'
+``switch`` input). Its channels (positions, forces, energies, ...) are one function of these, the
+model's generated output function, so :class:`LazyChannels` evaluates them all at once in one
+vectorised call at the first read and keeps them: the `Result` that holds it is their owner.
+The values are those the run would have computed point by point (the same generated function on
+the same inputs: equal bit for bit, see tests/test_lazy_channels.py).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .values import readonly
+
+__all__ = ["Derivatives", "Evaluate", "LazyChannels", "rebuilt_evaluator"]
+
+#: Computes every channel at the rows of (t, y, yp, switch): name -> array of the rows.
+Evaluate = Callable[[NDArray, NDArray, NDArray, NDArray], Mapping[str, NDArray]]
+#: Computes yp at the rows of (t, y, switch): the run's consistency pass (accelerations from q and v).
+Derivatives = Callable[[NDArray, NDArray, NDArray], NDArray]
+
+
+class LazyChannels:
+    """The channels of stored states, computed at the first :meth:`values`.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The channel names (known without computing them).
+    evaluate : Evaluate
+        Computes every channel at given rows (the model's output function).
+    t, y, yp : arrays
+        The stored states, time first; ``yp`` None: computed by ``derivatives`` when first read
+        (a file keeps t, y and the switch rows alone).
+    switch : array, shape (n_times, n_switch)
+        Each point's switch vector (its segment's contact terms).
+    derivatives : Derivatives, optional
+        Computes ``yp`` when it is None.
+    values : mapping, optional
+        The channels when already computed (e.g. for the run's physics checks).
+    rebuildable : bool or callable returning bool
+        Whether ``evaluate`` can be made again from the result's parameters alone (the scene
+        rebuilt from its description): a file may then store the states without the channels
+        (a callable is asked at the first :meth:`can_rebuild`).
+    """
+
+    def __init__(self, names: Sequence[str], evaluate: Evaluate, t: NDArray, y: NDArray, yp: NDArray | None,
+                 switch: NDArray, *, derivatives: Derivatives | None = None,
+                 values: Mapping[str, NDArray] | None = None, rebuildable: bool | Callable[[], bool] = False) -> None:
+        if switch.ndim != 2 or switch.shape[0] != t.shape[0]:
+            raise ValueError(f"LazyChannels: switch has shape {switch.shape}, must be (n_times={t.shape[0]}, "
+                             "n_switch).")
+        self.names = tuple(names)
+        self.evaluate = evaluate
+        if yp is None and derivatives is None:
+            raise ValueError("LazyChannels: yp is None and no derivatives compute it.")
+        self.t, self.y, self._yp, self.switch = t, y, yp, readonly(switch)
+        self.derivatives = derivatives
+        self._rebuildable = rebuildable
+        self._values = None if values is None else {n: readonly(values[n]) for n in self.names}
+
+    @property
+    def yp(self) -> NDArray:
+        """The states' derivatives: stored, or computed at the first read (the run's consistency pass)."""
+        if self._yp is None:
+            assert self.derivatives is not None
+            self._yp = readonly(self.derivatives(self.t, self.y, self.switch) if self.t.size else
+                                np.zeros(self.y.shape))
+        return self._yp
+
+    @property
+    def has_yp(self) -> bool:
+        """Whether ``yp`` is at hand (stored or computed already)."""
+        return self._yp is not None
+
+    def can_rebuild(self) -> bool:
+        """Whether the channels can be made again from the result's parameters alone (see above)."""
+        if not isinstance(self._rebuildable, bool):
+            self._rebuildable = bool(self._rebuildable())
+        return self._rebuildable
+
+    @property
+    def computed(self) -> bool:
+        """Whether the channels have been computed."""
+        return self._values is not None
+
+    def values(self) -> dict[str, NDArray]:
+        """Every channel (read-only arrays, first dimension n_times), computed at the first call."""
+        if self._values is None:
+            if self.t.size:
+                out = self.evaluate(self.t, self.y, self.yp, self.switch)
+                self._values = {name: readonly(np.ascontiguousarray(out[name])) for name in self.names}
+            else:
+                self._values = {name: readonly(np.zeros(0)) for name in self.names}
+        return self._values
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled (a result sent between processes: sweeps, parallel studies) with its channels and yp
+        computed, without what computes them (the model's compiled functions stay in this process)."""
+        self.values()
+        state = dict(self.__dict__)
+        state.update(_yp=self.yp, evaluate=None, derivatives=None, _rebuildable=self.can_rebuild())
+        return state
+
+    def take(self, rows: Any) -> LazyChannels:
+        """The channels of some rows (an index or a mask): computed ones cut, the others still lazy."""
+        values = None if self._values is None else {n: v[rows] for n, v in self._values.items()}
+        yp = None if self._yp is None else self._yp[rows]
+        return LazyChannels(self.names, self.evaluate, self.t[rows], self.y[rows], yp, self.switch[rows],
+                            derivatives=self.derivatives, values=values, rebuildable=self._rebuildable)
+
+
+def rebuilt_evaluator(parameters: Mapping[str, Any]) -> tuple[Evaluate, Derivatives]:
+    """:data:`Evaluate` and :data:`Derivatives` for a result file's states: the model rebuilt from the
+    file's parameters (scene description, formulation, run options) when they are first used.
+
+    The solvers own the model and its compiled functions, and import this package: they are
+    imported here at the first evaluation, by name, so that daeclear.results stays below them."""
+    def rebuilt() -> Any:
+        import importlib
+
+        return importlib.import_module("daeclear.solvers.channel_eval").evaluator_from_parameters(parameters)
+
+    def evaluate(t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> Mapping[str, NDArray]:
+        return rebuilt().channels(t, y, yp, switch)
+
+    def derivatives(t: NDArray, y: NDArray, switch: NDArray) -> NDArray:
+        return rebuilt().derivatives(t, y, switch)
+
+    return evaluate, derivatives
