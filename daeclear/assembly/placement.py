@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from ..errors import AssemblyError, SceneError
 from ..model.loads import Force, RotationalSpringDamper, SpringDamper, attachment
-from ..model.scene import (GROUND, PLACEMENT, Body, PointJoint, Scene, Translational,
+from ..model.scene import (GROUND, Body, PointJoint, Scene, Translational,
                            TranslationalClearance, driven_coordinate, is_finite_number)
 from .assemble import assemble
 from .dae_model import NEWTON_STEPS, POSITION_TOL, RANK_TOL, DAEModel
@@ -117,8 +117,6 @@ def assembled(scene: Scene, start: Mapping[str, float] | None = None,
         v = np.linalg.lstsq(J, b, rcond=None)[0]
     return _placed(scene, ref, q, v)
 
-
-PLACEMENT.append(assembled)  # Scene.assembled (the scene module cannot import the assembly layer)
 
 
 def _checked(scene: Scene, field_name: str, values: Mapping[str, float] | None, joints: dict[str, Any]

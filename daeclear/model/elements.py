@@ -63,16 +63,10 @@ def kept_with(element: Any, slot: str, inputs: tuple[Any, ...], compute: Callabl
 
 def is_frozen(value: Any) -> bool:
     """True for an instance of a frozen dataclass (its fields cannot change) that can hold kept values."""
-    kind = type(value)
-    frozen = _FROZEN.get(kind)
-    if frozen is None:
-        params = getattr(kind, "__dataclass_params__", None)
-        frozen = _FROZEN[kind] = bool(params is not None and params.frozen and hasattr(value, "__dict__"))
-    return frozen
+    params = getattr(type(value), "__dataclass_params__", None)
+    return bool(params is not None and params.frozen and hasattr(value, "__dict__"))
 
 
-# class -> is_frozen of its instances (a class's dataclass parameters and slots do not change)
-_FROZEN: dict[type, bool] = {}
 
 
 def computed_once(method: Callable[[Any], Any]) -> Callable[[Any], Any]:

@@ -16,7 +16,7 @@ import difflib
 import importlib
 from dataclasses import dataclass, field
 from typing import Any
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 
 from ..errors import SceneError
 # the elements, re-exported: ``from daeclear.model.scene import Body`` keeps working
@@ -28,11 +28,9 @@ from .elements import (GROUND, Body, Driver, Element, Ground, Joint, PointJoint,
 from .profiles import PROFILES, ConstantSpeed, Profile  # noqa: F401  (re-exported, as before the split)
 
 
-#: What :meth:`Scene.assembled` runs: :func:`daeclear.assembly.placement.assembled`, which puts itself
-#: here when its module is loaded. It assembles the scene, so it lives in the assembly layer, which
-#: imports this module: the scene does not import it (no import circle); the first call loads it
-#: by name, as ``daeclear``'s public names are loaded on first use.
-PLACEMENT: list[Callable[..., Scene]] = []
+#: The module of what :meth:`Scene.assembled` runs (its ``assembled``). It assembles the scene, so it
+#: lives in the assembly layer, which imports this module: the scene does not import it (no import
+#: circle) but loads it by name at the first call, as ``daeclear``'s public names are loaded on first use.
 PLACEMENT_MODULE = "daeclear.assembly.placement"
 
 
@@ -125,9 +123,8 @@ class Scene:
         joints cannot close at them (the largest residuals and their joints).
         See :mod:`daeclear.assembly.placement`.
         """
-        if not PLACEMENT:
-            importlib.import_module(PLACEMENT_MODULE)  # registers itself (see PLACEMENT)
-        return PLACEMENT[0](self, start, speeds)
+        placement: Any = importlib.import_module(PLACEMENT_MODULE)  # by name: see PLACEMENT_MODULE
+        return placement.assembled(self, start, speeds)
 
     def ideal(self) -> Scene:
         """A new scene, the same mechanism with every clearance joint ideal (see :func:`ideal_joint`):

@@ -57,15 +57,8 @@ def to_plain(value: Any, where: str) -> Any:
 
 
 def field_names(cls: type) -> tuple[str, ...]:
-    """The field names of a dataclass class, in order, kept per class: the same few (Material, the
-    contact laws, the clearance joints) come back in every run of a sweep."""
-    names = _FIELD_NAMES.get(cls)
-    if names is None:
-        names = _FIELD_NAMES[cls] = tuple(f.name for f in fields(cls))
-    return names
-
-
-_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
+    """The field names of a dataclass class, in order."""
+    return tuple(f.name for f in fields(cls))
 
 
 def _location(path: tuple[Any, ...]) -> str:
