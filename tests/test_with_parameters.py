@@ -60,6 +60,10 @@ def test_model_with_parameters_equals_the_assembled_scene(scene):
     assert new.clearance_joints == (("clearance", 2e-4, 0.0),)
     assert new.structure is model.structure and new.functions is model.functions  # nothing rebuilt
     assert model.parameter("clearance.clearance")[0] == 5e-4  # the model is a value: unchanged
+    mutable = dc.mechanisms.slider_crank("revolute")
+    held = dc.assemble(mutable)
+    mutable.elements.clear()  # the caller's scene changes afterwards: the model's copy does not
+    assert held.with_parameters({"crank.mass": 0.4}).parameter("crank.mass")[0] == 0.4
     for name in ("clearance", "drive"):  # (the bodies' declared velocities follow rpm, not the driver alone)
         assert new.parameters["scene"]["elements"][name] == built.parameters["scene"]["elements"][name]
 

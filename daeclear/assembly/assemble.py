@@ -165,7 +165,9 @@ class Structure:
                            for root, term, extra, needs, i in self.auto_pairs)
         formulation, track_work = self.model.formulation, self.model.track_work
         return self.model.copy_with(
-            structure=self, scene=scene, scene_name=scene.name, alpha=float(alpha), beta=float(beta),
+            structure=self, scene_name=scene.name, alpha=float(alpha), beta=float(beta),
+            # the model's own copy of the scene (a Scene is mutable; its elements are frozen)
+            scene=Scene(scene.name, gravity=scene.gravity, elements=list(scene.elements), ground=scene.ground),
             q_guess=[x for b in bodies for x in (*b.position, b.angle)],
             v_guess=[x for b in bodies for x in (*b.velocity, b.angular_velocity)],
             mass_diagonal=[x for b in bodies for x in (b.mass, b.mass, b.inertia)],
