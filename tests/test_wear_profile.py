@@ -196,3 +196,12 @@ def test_wear_beyond_the_gap_model_stops_with_a_message(worn_crank):
         history = simulate_wear(runaway, 5)
     assert history.cycles[-1] < 5 and "stopped at" in history.message and history.max_depth[-1] > 5e-4
     assert simulate_wear(worn_crank, 1).message == ""
+
+
+def test_a_failing_block_ends_the_history_with_what_it_computed(worn_crank):
+    """A block whose run fails (a step cap too small for a cycle) ends the history with a warning;
+    the profiles before it are returned."""
+    tight = dc.SolverOptions(max_steps=300)
+    with pytest.warns(dc.PhysicsWarning, match="the run of the next block failed"):
+        history = simulate_wear(worn_crank, 3, options=tight)
+    assert history.cycles.tolist() == [0.0] and "max_steps" in history.message

@@ -25,7 +25,7 @@ from ..assembly.assemble import assemble
 from ..assembly.dae_model import DAEModel
 from ..contact.geometry import material_pair
 from ..contact.wear import ArchardWear, WearHistoryArrays, wear_increment, worn_volume
-from ..errors import PhysicsWarning, SceneError
+from ..errors import PhysicsWarning, SceneError, SolveError
 from ..model.scene import RevoluteClearance, Scene
 from ..progress import Progress
 from ..results.result import Result
@@ -175,6 +175,9 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
         The runs' solver settings (:class:`daeclear.SolverOptions`).
     progress : bool
         A progress line on stderr.
+
+    A block whose run fails, or a depth beyond :data:`MAX_DEPTH_FRACTION` of the bearing radius, ends
+    the history early with a :class:`~daeclear.PhysicsWarning`; ``WearHistory.message`` says why.
     """
     for label, value in (("update_every", update_every), ("extrapolate", extrapolate)):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
@@ -215,7 +218,12 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
                 warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
                 break
             model = model.with_parameters({f"{name}.wear_depth": _depth_value(depth, wear.surfaces)})
-            result = simulate(model, t0 + update_every * period, t0=t0, y0=y0, options=options)
+            try:
+                result = simulate(model, t0 + update_every * period, t0=t0, y0=y0, options=options)
+            except SolveError as exc:  # the history so far is the result (and, with a path, in the file)
+                message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
+                warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
+                break
             increment, block_work = wear_increment(wear, wear_history(result, model, name), bearing_radius=radius,
                                                    clearance=clearance, effective_modulus=modulus)
             depth = {s: depth[s] + extrapolate * increment[s] for s in depth}
