@@ -71,3 +71,12 @@ def test_skips_with_a_message_when_exudyn_is_absent(capsys):
     script.exu = None
     assert script.main(["--quick"]) == 0
     assert "pip install" in capsys.readouterr().out
+
+
+def test_install_flag_says_when_the_install_fails(capsys, monkeypatch):
+    """--install tries pip (here: a failed install, no network in tests) and skips with a message."""
+    script = _script()
+    script.exu = None
+    monkeypatch.setattr(script, "install_exudyn", lambda: False)
+    assert script.main(["--quick", "--install"]) == 0
+    assert "failed" in capsys.readouterr().out

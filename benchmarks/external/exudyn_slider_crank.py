@@ -2,9 +2,9 @@
 side by side with daeclear's ``simulate``.
 
 Exudyn (Gerstmayr, https://github.com/jgerstmayr/EXUDYN) is a C++ multibody code with a Python
-interface; it is not a dependency of daeclear. Install it into the environment that runs this
-script: ``pip install "exudyn>=1.13,<1.14"`` (1.13.6 measured). Without it the script says so and
-exits with status 0.
+interface; it is not a dependency of daeclear. ``--install`` installs it from PyPI into the
+environment that runs this script (``pip install "exudyn>=1.13,<1.14"``; 1.13.6 measured) when it is
+missing. Without it and without ``--install`` the script says so and exits with status 0.
 
 The Exudyn model is written here from the chapter's numbers alone (Tables 4.1-4.2, section 4.4),
 with no daeclear code in it:
@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import subprocess
 import sys
 import time
 from dataclasses import dataclass
@@ -57,11 +58,26 @@ from typing import Any
 
 import numpy as np
 
+EXUDYN = "exudyn>=1.13,<1.14"  # the versions measured (docs/validation.md)
+
 try:
     import exudyn as exu
     from exudyn import itemInterface as items
 except ImportError:  # an optional external package
     exu = None
+
+
+def install_exudyn() -> bool:
+    """Install Exudyn from PyPI into this interpreter's environment (pip) and import it; True when it imports."""
+    global exu, items
+    print(f"installing {EXUDYN} from PyPI ...", flush=True)
+    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", EXUDYN], check=False)
+    try:
+        import exudyn as exu
+        from exudyn import itemInterface as items
+    except ImportError:
+        return False
+    return True
 
 # Table 4.1 (crank, rod: length, mass, moment of inertia; slider: mass, moment of inertia) and Table 4.2
 CRANK_L, CRANK_M, CRANK_J = 0.05, 0.30, 1.0e-4
@@ -370,10 +386,14 @@ def main(argv: list[str] | None = None) -> int:
                         help="orbit distance (fraction of c) that ends a converged window (default 0.02)")
     parser.add_argument("--friction", type=float, default=0.0, help="c_f of (3.16) in both codes (default 0)")
     parser.add_argument("--figure", type=Path, default=Path("docs/figures/exudyn_fig415.png"))
+    parser.add_argument("--install", action="store_true", help=f"install {EXUDYN} from PyPI (pip) when it is missing")
     args = parser.parse_args(argv)
+    if exu is None and args.install and not install_exudyn():
+        print(f"installing {EXUDYN} failed (no network, or no wheel for this platform): the comparison is skipped.")
+        return 0
     if exu is None:
-        print("exudyn is not installed: this comparison is skipped. Install it with "
-              "pip install \"exudyn>=1.13,<1.14\" and run again.")
+        print(f"exudyn is not installed: this comparison is skipped. Run with --install, or pip install "
+              f"\"{EXUDYN}\", and run again.")
         return 0
     if args.quick:
         args.revolutions, args.step = 0.25, 2e-6
