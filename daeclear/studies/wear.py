@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from ..assembly.assemble import assemble
 from ..assembly.dae_model import DAEModel
-from ..contact.geometry import material_pair
+from ..contact.geometry import sigma_sum
 from ..contact.wear import ArchardWear, WearHistoryArrays, wear_increment, worn_volume
 from ..errors import PhysicsWarning, SceneError, SolveError
 from ..model.scene import RevoluteClearance, Scene
@@ -31,6 +31,7 @@ from ..progress import Progress
 from ..results.result import Result
 from ..solver_options import SolverOptions
 from ..solvers.ida import simulate
+from .poincare import crank_period
 from .wear_file import WearFile
 
 
@@ -130,20 +131,11 @@ def wear_joint(scene: Scene, joint: str | None) -> RevoluteClearance:
                      f"'{scene.name}' ({', '.join(e.name for e in worn) or 'none has wear=ArchardWear(...)'}).")
 
 
-def cycle_period(scene: Scene) -> float:
-    """The period of one cycle: the time of one turn of the scene's (first) driver, s."""
-    speeds = [float(d.speed) for d in scene.drivers if d.speed]
-    if not speeds:
-        raise SceneError(f"simulate_wear: scene '{scene.name}' has no driver with a constant speed; give period=<s>.")
-    return 2.0 * math.pi / abs(speeds[0])
-
-
 def effective_modulus(joint: RevoluteClearance) -> float:
     """E* of the joint's materials (the Hertz arc): ``1 / (sigma_i + sigma_j)``."""
     if joint.material is None:
         raise SceneError(f"simulate_wear: joint '{joint.name}' has no material; the 'hertz' distribution needs one.")
-    first, second = material_pair(joint.material, joint.name)
-    return 1.0 / (first.sigma + second.sigma)
+    return 1.0 / sigma_sum(joint.material)
 
 
 def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, update_every: int = 1,
@@ -186,7 +178,7 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
         raise SceneError(f"simulate_wear: cycles={cycles!r}, must be a finite number > 0.")
     element = wear_joint(scene, joint)
     wear = element.wear
-    period = cycle_period(scene) if period is None else period
+    period = crank_period(scene) if period is None else period
     if not (isinstance(period, (int, float)) and math.isfinite(period) and period > 0):
         raise SceneError(f"simulate_wear: period={period!r} s, must be a finite number > 0.")
     modulus = effective_modulus(element) if wear.distribution == "hertz" else None
