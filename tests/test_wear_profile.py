@@ -205,3 +205,15 @@ def test_a_failing_block_ends_the_history_with_what_it_computed(worn_crank):
     with pytest.warns(dc.PhysicsWarning, match="the run of the next block failed"):
         history = simulate_wear(worn_crank, 3, options=tight)
     assert history.cycles.tolist() == [0.0] and "max_steps" in history.message
+
+
+def test_spread_in_passes_equals_one_pass(monkeypatch):
+    """Many contacts are spread in passes of bounded size (memory); the depth is the one-pass depth."""
+    from daeclear.contact import wear
+
+    rng = np.random.default_rng(3)
+    centres, halves, loads = rng.uniform(0, 2 * np.pi, 500), rng.uniform(0, 0.3, 500), rng.uniform(0, 1e-9, 500)
+    whole = wear.spread(centres, halves, loads, NODES)
+    monkeypatch.setattr(wear, "SPREAD_SAMPLES", 1000)  # passes of a handful of contacts
+    np.testing.assert_allclose(wear.spread(centres, halves, loads, NODES), whole, rtol=1e-12, atol=1e-24)
+    assert whole.sum() == pytest.approx(loads.sum(), rel=1e-12)

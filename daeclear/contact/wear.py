@@ -40,6 +40,8 @@ DISTRIBUTIONS: tuple[str, ...] = ("elastic-foundation", "hertz")
 # samples of the pressure over one contact arc when it is spread onto the nodes (at least this many,
 # and at least 8 per node the arc covers): the spread weights are exact in sum whatever the number
 ARC_SAMPLES = 64
+# samples spread in one pass (contacts x samples per contact): about 8 MB a sample array
+SPREAD_SAMPLES = 1 << 20
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -138,6 +140,18 @@ def spread(centres: ArrayLike, half_angles: ArrayLike, loads: ArrayLike, nodes: 
         return np.zeros(nodes)
     spacing = 2.0 * math.pi / nodes
     count = max(ARC_SAMPLES, int(math.ceil(16.0 * float(half.max()) / spacing)))
+    rows = max(1, SPREAD_SAMPLES // count)  # contacts per pass: the samples' arrays stay a few MB
+    total = np.zeros(nodes)
+    for first in range(0, centre.size, rows):
+        part = slice(first, first + rows)
+        total += _spread_rows(centre[part], half[part], load[part], nodes, distribution, count)
+    return total
+
+
+def _spread_rows(centre: NDArray[np.float64], half: NDArray[np.float64], load: NDArray[np.float64], nodes: int,
+                 distribution: str, count: int) -> NDArray[np.float64]:
+    """:func:`spread` of some contacts, ``count`` samples each."""
+    spacing = 2.0 * math.pi / nodes
     phi = np.outer(half, (np.arange(count) + 0.5) / count * 2.0 - 1.0)
     wide = half > 0.0
     shape = np.ones_like(phi)
