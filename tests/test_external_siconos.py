@@ -92,6 +92,23 @@ def test_digits_against_a_hand_computation(tmp_path):
     assert lines[2].startswith("| run vs ref | 0 to 0.2 | 3.5 |")
 
 
+def test_mechanical_energy_against_a_hand_computation(tmp_path):
+    """Row 0 (q = 0, rates 150, -75, 0): T = M11 150^2/2 + M22 75^2/2 - M12 150 75, V = 0, with
+    M11 = J1 + (m1/4 + m2 + m3) l1^2, M22 = J2 + (m2/4 + m3) l2^2, M12 = (m2/2 + m3) l1 l2."""
+    script = _script()
+    ref = script.read_reference(_write_ref(tmp_path / "r.ref", ROWS))
+    m11 = 7.4e-5 + (0.038 / 4 + 0.038 + 0.076) * 0.153**2
+    m22 = 5.9e-4 + (0.038 / 4 + 0.076) * 0.306**2
+    m12 = (0.038 / 2 + 0.076) * 0.153 * 0.306
+    assert script.mechanical_energy(ref)[0] == pytest.approx(0.5 * m11 * 150**2 + 0.5 * m22 * 75**2 - m12 * 150 * 75,
+                                                             rel=1e-14)
+    # row 2: q = (pi, 0.25), rates (100, 50, -1); V = g [(m1/2 + m2 + m3) l1 sin q1 + (m2/2 + m3) l2 sin q2]
+    q1, q2 = math.pi, 0.25
+    kinetic = 0.5 * m11 * 100**2 + 0.5 * m22 * 50**2 + m12 * math.cos(q1 - q2) * 100 * 50 + 0.5 * 2.7e-6
+    potential = 9.81 * ((0.038 / 2 + 0.038 + 0.076) * 0.153 * math.sin(q1) + (0.038 / 2 + 0.076) * 0.306 * math.sin(q2))
+    assert script.mechanical_energy(ref)[2] == pytest.approx(kinetic + potential, rel=1e-14)
+
+
 def test_contact_law_is_calibrated_to_the_newton_restitution():
     """The Flores law's c_e for e_N = 0.4, between the table's 0.3 -> 0.2562 and 0.5 -> 0.4704; its
     single impact at another mass, speed and stiffness leaves at 0.4 of the entry speed."""

@@ -30,7 +30,8 @@ mu = 0.01 (zero below 1e-4 m/s of slip, full from 2e-4).
 
 scipy integrates the same compliant model in the problem's own coordinates (the three angles: the
 mass matrix and forces of the Lagrangian written out below, corner heights and their Jacobians) with
-DOP853 and Radau, event location on the four corner gaps (the approach speed latched at each onset).
+DOP853, Radau and BDF and event location on the four corner gaps (the approach speed latched at each
+onset), to ``--scipy-until`` (50 ms), where daeclear is timed alongside.
 
 Impacts make the motion sensitive (the two Siconos schemes part after the first impact), so the
 comparison is over windows from t = 0 that grow to the whole run; digits are -log10 of the largest
@@ -38,7 +39,7 @@ difference over the window divided by the reference's largest magnitude there, p
 
 Run: ``python benchmarks/external/siconos_slider_crank.py --download`` (fetches the two files at the
 pinned commit into ~/.cache/daeclear-external) or ``--reference FILE.ref`` (repeatable), ``--quick``
-(to 20 ms). Prints Markdown tables (docs/validation.md, "External references") and writes
+(to 20 ms, 16 s). Prints Markdown tables (docs/validation.md, "External references") and writes
 ``--figure`` (default docs/figures/siconos_slider_crank.png).
 """
 
@@ -301,12 +302,23 @@ def digits(run: Channels, ref: Channels, until: float) -> dict[str, float]:
     return out
 
 
+def mechanical_energy(run: Channels) -> np.ndarray:
+    """Kinetic plus potential energy of the three-angle model, J (zero height at y = 0); a compliant run's
+    contact energy is not in it. Newton's law with e_N <= 1 and friction can only lower it."""
+    q1, q2, w1, w2 = run["crank.angle"], run["rod.angle"], run["crank.rate"], run["rod.rate"]
+    kinetic = (0.5 * M11 * w1**2 + 0.5 * M22 * w2**2 + M12 * np.cos(q1 - q2) * w1 * w2
+               + 0.5 * J3 * run["slider.rate"] ** 2)
+    return kinetic + G1 * np.sin(q1) + G2 * np.sin(q2)
+
+
 def table(rows: list[tuple[str, Channels, Channels]], windows: list[float]) -> list[str]:
     """Markdown: one line per compared pair and window end."""
     lines = ["| compared | window (ms) | " + " | ".join(label for _, label, _ in QUANTITIES) + " |",
              "|---|---|" + "---|" * len(QUANTITIES)]
     for label, run, ref in rows:
         for until in windows:
+            if until > min(run["t"][-1], ref["t"][-1]) + 1e-12:
+                continue  # past one of the two runs
             got = digits(run, ref, until)
             cells = " | ".join(f"{got[n]:.1f}" for n, _, _ in QUANTITIES)
             lines.append(f"| {label} | 0 to {until * 1e3:.1f} | {cells} |")
@@ -314,7 +326,7 @@ def table(rows: list[tuple[str, Channels, Channels]], windows: list[float]) -> l
 
 
 def figure(path: Path, refs: dict[str, Channels], runs: dict[str, Channels], window: float) -> None:
-    """Crank rate, slider height, slider x and the slider's angle against t, all runs."""
+    """Crank rate, slider height, mechanical energy and the slider's angle against t, all runs."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -322,20 +334,24 @@ def figure(path: Path, refs: dict[str, Channels], runs: dict[str, Channels], win
 
     fig, axes = plt.subplots(2, 2, figsize=(10.0, 6.4))
     panels = (("crank.rate", "crank rate (rad/s)", 1.0), ("slider.y", "slider y / c", 1.0 / C),
-              ("slider.x", "slider x (m)", 1.0), ("slider.angle", "slider angle (mrad)", 1e3))
+              ("energy", "mechanical energy (J)", 1.0), ("slider.angle", "slider angle (mrad)", 1e3))
+
+    def values(run: Channels, name: str) -> np.ndarray:
+        return mechanical_energy(run) if name == "energy" else run[name]
+
     styles = {"Combined": "k-", "Direct": "C2:"}
     for ax, (name, label, scale), tag in zip(axes.flat, panels, "abcd"):
         for key, ref in refs.items():
-            ax.plot(ref["t"] * 1e3, ref[name] * scale, styles.get(key, "k-"), lw=1.0, label=f"Siconos {key}")
+            ax.plot(ref["t"] * 1e3, values(ref, name) * scale, styles.get(key, "k-"), lw=1.0, label=f"Siconos {key}")
         for (key, run), style in zip(runs.items(), ("C0--", "C3-.")):
-            ax.plot(run["t"] * 1e3, run[name] * scale, style, lw=0.9, label=key)
+            ax.plot(run["t"] * 1e3, values(run, name) * scale, style, lw=0.9, label=key)
         ax.axvspan(0.0, window * 1e3, color="0.92", zorder=0)
         ax.set_xlabel("t (ms)")
         ax.set_ylabel(label)
         ax.set_title(f"({tag}) {label.split(' (')[0]}", fontsize=9)
     axes[0, 0].legend(fontsize=7)
-    fig.suptitle("Flores-Leine-Glocker slider-crank (c = 1 mm, e_N = 0.4, mu = 0.01): Siconos (rigid) against "
-                 "daeclear and scipy (compliant); shaded: the window of the headline digits", fontsize=9)
+    fig.suptitle("Flores-Leine-Glocker slider-crank (c = 1 mm, e_N = 0.4, mu = 0.01): Siconos (rigid, h = 0.1 ms)\n"
+                 "against daeclear and scipy (compliant); shaded: the window of the headline digits", fontsize=9)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=80)
@@ -368,6 +384,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--window", type=float, default=0.02, help="headline window end, s (default 0.02)")
     parser.add_argument("--repeat", type=int, default=2, help="runs per method; the best wall time counts")
     parser.add_argument("--no-scipy", action="store_true", help="skip the scipy runs")
+    parser.add_argument("--scipy-until", type=float, default=0.05,
+                        help="end of the scipy runs (and of a daeclear run timed alongside), s (default 0.05)")
     parser.add_argument("--figure", type=Path, default=Path("docs/figures/siconos_slider_crank.png"))
     args = parser.parse_args(argv)
     refs: dict[str, Channels] = {}
@@ -390,10 +408,8 @@ def main(argv: list[str] | None = None) -> int:
     ce = calibrated_restitution()
     first_ref = next(iter(refs.values()))
     impact = first_contact(first_ref)
-    windows = sorted({round(impact - STEP, 6), *[w for w in WINDOWS if w < args.t_end], round(args.t_end, 6)})
     print(f"Flores-Leine-Glocker slider-crank to {args.t_end * 1e3:g} ms; Flores law c_e = {ce:.6f} (single-impact "
-          f"restitution {RESTITUTION}), K = {args.stiffness:g} N/m^1.5, mu = {FRICTION}; rtol {args.rtol:g}; "
-          f"Siconos' first contact at {impact * 1e3:.1f} ms\n")
+          f"restitution {RESTITUTION}), K = {args.stiffness:g} N/m^1.5, mu = {FRICTION}; rtol {args.rtol:g}\n")
     scene = siconos_scene(args.stiffness, ce)
     began = time.perf_counter()
     dc.simulate(scene, 1e-4, rtol=args.rtol)  # builds (or loads) the compiled library
@@ -405,37 +421,61 @@ def main(argv: list[str] | None = None) -> int:
         plan[f"daeclear K x {factor:g}"] = (args.rtol, lambda f=factor: daeclear_run(
             siconos_scene(args.stiffness * f, ce), args.t_end, args.rtol), 1)
     if not args.no_scipy:
-        for method in ("Radau", "BDF"):
-            plan[f"scipy {method}"] = (args.rtol, lambda m=method: scipy_run(m, args.t_end, args.rtol, args.stiffness,
-                                                                             ce), 1)
+        short = min(args.scipy_until, args.t_end)
+        plan[f"daeclear to {short * 1e3:g} ms"] = (args.rtol, lambda: daeclear_run(scene, short, args.rtol),
+                                                   args.repeat)
+        for method in ("DOP853", "Radau", "BDF"):
+            plan[f"scipy {method} to {short * 1e3:g} ms"] = (
+                args.rtol, lambda m=method: scipy_run(m, short, args.rtol, args.stiffness, ce), 1)
     runs: dict[str, tuple[Channels, float, int]] = {}
-    print("\n| run | rtol | wall time (s) | corner onsets | deepest corner penetration (um) |\n|---|---|---|---|---|")
+    lines: list[str | tuple[str, float]] = []
     for label, (rtol, run, repeat) in plan.items():
         try:
             runs[label] = timed(run, repeat)
         except dc.SolveError as error:  # reported, left out of the comparisons
-            print(f"| {label} | {rtol:g} | failed: {str(error).splitlines()[0][:300]} | | |")
+            lines.append(f"| {label} | {rtol:g} | failed: {str(error).splitlines()[0][:300]} | | | |")
             continue
-        channels, wall, onsets = runs[label]
-        print(f"| {label} | {rtol:g} | {wall:.3g} | {onsets} | {np.max(channels['penetration']) * 1e6:.2f} |")
+        lines.append((label, rtol))
     if "daeclear" not in runs:
+        print("\n".join(line for line in lines if isinstance(line, str)))
         return 1
     main_run = runs["daeclear"][0]
+    free = min(impact, float(main_run["t"][np.argmax(main_run["penetration"] > 0.0)]))
+    edge = int(round(free / STEP)) - 1  # the last sample before the first contact of Siconos or daeclear
+    windows = sorted({round(edge * STEP, 6), *[w for w in WINDOWS if w < args.t_end], round(args.t_end, 6)})
+    print(f"first contact: Siconos {impact * 1e3:.1f} ms, daeclear {free * 1e3:.2f} ms")
+    print("\n| run | rtol | wall time (s) | corner onsets | deepest corner penetration (um) | mechanical energy (J) at "
+          f"0, {edge * STEP * 1e3:.1f} ms, the end |\n|---|---|---|---|---|---|")
+    end = int(round(args.t_end / STEP))
+    for key, ref in refs.items():
+        energy = mechanical_energy(ref)
+        print(f"| Siconos {key} | h = {STEP:g} s | | | 0 (projected) | {energy[0]:.4f}, {energy[edge]:.4f}, "
+              f"{energy[min(end, energy.size - 1)]:.4f} |")
+    for line in lines:
+        if isinstance(line, str):
+            print(line)
+            continue
+        label, rtol = line
+        channels, wall, onsets = runs[label]
+        energy = mechanical_energy(channels)
+        print(f"| {label} | {rtol:g} | {wall:.3g} | {onsets} | {np.max(channels['penetration']) * 1e6:.2f} | "
+              f"{energy[0]:.4f}, {energy[edge]:.4f}, {energy[-1]:.4f} |")
     rows = [(f"daeclear vs Siconos {key}", main_run, ref) for key, ref in refs.items()]
     if len(refs) == 2:
         rows.append(("Siconos Direct vs Combined", refs["Direct"], refs["Combined"]))
     if "daeclear tight" in runs:  # the compliant model's solution, which daeclear and scipy approximate
         tight = runs["daeclear tight"][0]
         rows.append((f"daeclear vs daeclear rtol {args.tight_rtol:g}", main_run, tight))
-        rows += [(f"{label} vs daeclear rtol {args.tight_rtol:g}", run, tight) for label, (run, _, _) in runs.items()
-                 if label.startswith("scipy")]
+        rows += [(f"{label.split(' to ')[0]} vs daeclear rtol {args.tight_rtol:g}", run, tight)
+                 for label, (run, _, _) in runs.items() if label.startswith("scipy")]
     rows += [(f"{label} vs daeclear", run, main_run) for label, (run, _, _) in runs.items() if " K x " in label]
     print("\ndigits: -log10(largest difference over the window / the second's largest magnitude there)\n")
     print("\n".join(table(rows, windows)))
     print("\nlargest |slider angle| (rad): " + ", ".join(
         f"{k} {np.max(np.abs(r['slider.angle'])):.1e}" for k, r in {**{f'Siconos {k}': r for k, r in refs.items()},
                                                                  **{k: r[0] for k, r in runs.items()}}.items()))
-    figure(args.figure, refs, {k: runs[k][0] for k in runs if k in ("daeclear", "scipy Radau")}, args.window)
+    figure(args.figure, refs, {k: runs[k][0] for k in runs if k == "daeclear" or k.startswith("scipy DOP853")},
+           args.window)
     print(f"wrote {args.figure}")
     return 0
 
