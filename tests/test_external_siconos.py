@@ -127,12 +127,13 @@ def test_scene_holds_the_examples_numbers():
     guide = scene["guide"]
     assert (guide.length, guide.width, guide.clearance) == pytest.approx((0.10, 0.05, 0.001), rel=1e-15)
     assert guide.model == "corners" and guide.law.restitution == 0.43 and guide.law.stiffness == 1e11
-    assert guide.friction is not None and scene.gravity == (0.0, -9.81)
+    assert guide.friction == 0.01 and scene.gravity == (0.0, -9.81)  # a float: modified Coulomb (3.16)
     # assembled at crank angle 0 (crank and rod along +X) with the example's rates
     crank, rod, slider = scene["crank"], scene["rod"], scene["slider"]
     assert crank.position == pytest.approx((0.0765, 0.0), abs=1e-12) and slider.position == pytest.approx((0.459, 0.0))
     assert crank.angular_velocity == pytest.approx(150.0) and rod.angular_velocity == pytest.approx(-75.0)
     assert slider.velocity == pytest.approx((0.0, 0.0), abs=1e-10)
+    assert rod.velocity == pytest.approx((0.0, 0.153 * 150.0 - 0.153 * 75.0), abs=1e-10)  # pin up, rod turning back
 
 
 def test_minimal_formulation_conserves_energy_without_contact():
@@ -200,6 +201,23 @@ def test_corner_jacobians_and_contact_laws():
     for slip in (5e-5, 1.5e-4, -1.5e-4, 3.0, -2.0):
         expected = 0.01 * math.copysign(float(friction.correction(abs(slip))), slip)
         assert script.coulomb_factor(slip, 0.01) == pytest.approx(expected, abs=1e-15), slip
+
+
+def test_download_fetches_the_pinned_file_once(tmp_path, monkeypatch):
+    """--download's fetch and cache, from a file:// URL standing in for GitHub (no network)."""
+    script = _script()
+    assert script.URL.format(commit=script.SICONOS_COMMIT, dir=script.SICONOS_DIR, file="x.ref") == (
+        "https://raw.githubusercontent.com/siconos/siconos/00664d315f875027ed30c83a2e5df1f20aa5e391/"
+        "examples/Mechanics/SliderCrank/x.ref")
+    source = tmp_path / "github" / script.SICONOS_COMMIT / script.SICONOS_DIR
+    source.mkdir(parents=True)
+    _write_ref(source / script.REFERENCES["Combined"], ROWS)
+    monkeypatch.setattr(script, "URL", (tmp_path / "github").as_uri() + "/{commit}/{dir}/{file}")
+    cached = script.download_reference("Combined", tmp_path / "cache")
+    assert cached.parent.parent == tmp_path / "cache" and cached.read_text() == (source / cached.name).read_text()
+    (source / cached.name).unlink()  # a second call reads the cache, not the source
+    assert script.download_reference("Combined", tmp_path / "cache") == cached
+    assert script.read_reference(cached)["crank.angle"][2] == pytest.approx(math.pi)
 
 
 def test_says_what_to_do_without_a_reference(capsys, monkeypatch):

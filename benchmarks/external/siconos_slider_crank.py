@@ -107,6 +107,11 @@ def read_reference(path: Path) -> Channels:
             "slider.vx": -L1 * np.sin(crank) * data[:, 4] - L2 * np.sin(rod) * data[:, 5]}
 
 
+def output_grid(t_end: float) -> np.ndarray:
+    """Siconos' output times k h up to ``t_end`` (the last one clipped to it)."""
+    return np.minimum(np.arange(int(round(t_end / STEP)) + 1) * STEP, t_end)
+
+
 def download_reference(name: str, cache: Path = CACHE) -> Path:
     """The .ref file ``REFERENCES[name]`` at the pinned commit, downloaded into ``cache`` once."""
     target = cache / SICONOS_COMMIT[:12] / REFERENCES[name]
@@ -157,7 +162,7 @@ def siconos_scene(stiffness: float = STIFFNESS, restitution: float | None = None
 def daeclear_run(scene: dc.Scene, t_end: float, rtol: float) -> tuple[Channels, float, int]:
     """``simulate`` on Siconos' output grid: channels (with ``penetration``, the deepest corner's),
     wall time (assembly included, the compiled library cached before) and the number of corner onsets."""
-    grid = np.arange(int(round(t_end / STEP)) + 1) * STEP
+    grid = output_grid(t_end)
     began = time.perf_counter()
     result = dc.simulate(scene, t_end, rtol=rtol, t_eval=grid)
     wall = time.perf_counter() - began
@@ -249,7 +254,7 @@ def scipy_run(method: str, t_end: float, rtol: float, stiffness: float = STIFFNE
     separations (located as events; the approach speed latched at the onset): channels on Siconos'
     grid, wall time, onsets."""
     ce = calibrated_restitution() if ce is None else ce
-    grid = np.arange(int(round(t_end / STEP)) + 1) * STEP
+    grid = output_grid(t_end)
     approach: list[float | None] = [None] * 4
     atol = rtol * np.array([1e-3, 1e-3, 1e-4, 1.0, 1.0, 1.0])
     t, z = 0.0, np.array([0.0, 0.0, 0.0, CRANK_RATE, ROD_RATE, 0.0])
