@@ -6,7 +6,8 @@ Each tree given (``--trees OLD NEW``, e.g. a worktree of main and this one) is m
 interpreter (a package cannot be imported twice in one process), the trees interleaved pass by
 pass so that the shared machine's load falls on both alike. Per tree and formulation: the median
 wall time of ``simulate`` alone, of ``simulate`` followed by reading one channel (what a user's
-script does), and the size of the file of ``daeclear run``'s main job (24 001 points streamed).
+script does), and the size of a streamed file of the main job's run on a 1 us grid (24 001 points;
+``daeclear run``'s default grid is 2 us now).
 
 Run: ``python benchmarks/bench_lazy.py --trees /path/to/main .`` (default: this tree alone).
 """

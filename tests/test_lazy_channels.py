@@ -109,9 +109,10 @@ def test_a_streamed_run_writes_states_and_reads_back_its_channels(scene, tmp_pat
 
 
 def test_the_main_jobs_file_is_a_few_mb(tmp_path, monkeypatch):
-    """`daeclear run slider_crank --joint revolute` (README's first command): two revolutions on a 1 us
-    grid, 24 001 points. The file holds t and y (8 bytes x (1 + 32 states) = 264 bytes a point: 6.3 MB),
-    the steps, events and segments; version 1 stored yp and 51 channels besides (864 bytes a point, 21 MB)."""
+    """`daeclear run slider_crank --joint revolute` (README's first command): two revolutions on a 2 us
+    grid, 12 001 points. The file holds t and y (8 bytes x (1 + 32 states) = 264 bytes a point: 3.2 MB),
+    the steps, events and segments in small chunks; version 1 stored yp and 51 channels besides (864
+    bytes a point), and chunks of 4096 events (0.6 MB for the run's 61)."""
     from daeclear.cli import main
 
     assert main(["run", "slider_crank", "--joint", "revolute", "--out", str(tmp_path), "--quiet",
@@ -119,10 +120,10 @@ def test_the_main_jobs_file_is_a_few_mb(tmp_path, monkeypatch):
     path = tmp_path / "slider_crank_revolute.h5"
     result = dc.load(path)
     per_point = 8 * (1 + result.n_states)
-    assert result.n_times == 24_001 and per_point == 264
+    assert result.n_times == 12_001 and per_point == 264
     size = path.stat().st_size
-    assert result.n_times * per_point < size < result.n_times * per_point + 1.5e6  # the fixed parts: < 1.5 MB
-    assert size < 8e6 and 8 * (1 + 2 * result.n_states + len(result.channel_names)) * result.n_times > 2.5 * size
+    assert result.n_times * per_point < size < result.n_times * per_point + 0.25e6  # the fixed parts: < 0.25 MB
+    assert size < 3.5e6 and 8 * (1 + 2 * result.n_states + len(result.channel_names)) * result.n_times > 3 * size
 
 
 def test_a_scene_that_cannot_be_rebuilt_stores_its_channels(tmp_path):
