@@ -53,6 +53,38 @@ def test_lazy_channels_equal_the_one_pass_report_value_for_value(runs, scene, fo
         assert np.array_equal(result[name], row), name
 
 
+@pytest.mark.parametrize("joint", ["revolute", "translational", "ideal"])
+def test_the_checked_channels_are_the_outputs_own(joint):
+    """The model's checks function (the penetrations and the constraint drift the physics checks read)
+    equals, bit for bit, those channels of the whole output function at a run's rows, in the compiled
+    library and in CasADi; a model without contact pairs checks the drift alone."""
+    scene = dc.mechanisms.slider_crank(joint)
+    result = dc.simulate(scene, TWO_REVOLUTIONS / 8, rtol=1e-8)
+    model = dc.assemble(scene, "ggl")
+    expected = [c for c in model.channel_names if c.endswith(".penetration") or c == "constraints.position"]
+    assert model.checked_names == tuple(expected) and "constraints.position" in expected
+    assert {f"{g}.penetration" for g in model.gap_names} <= set(expected)  # every contact pair's
+    switch = np.array(result.channel_source.switch)
+    whole = model.channels(result.t, result.y, result.yp, switch)
+    session = open_session(model.functions, rtol=1e-8, atol=1.0, parameters=model.parameter_values)
+    try:
+        compiled = model.checks(result.t, result.y, result.yp, switch, session)
+    finally:
+        session.close()
+    for checked in (compiled, model.checks(result.t, result.y, result.yp, switch)):
+        assert tuple(checked) == model.checked_names
+        for name, values in checked.items():
+            assert np.array_equal(values, whole[name]), name
+    assert np.max(compiled["constraints.position"]) > 0.0  # values, not zeros: GGL's drift is round-off
+
+
+def test_a_run_in_memory_computes_its_channels_when_read(scene):
+    """simulate checks the run on its checked channels alone: the others wait for the first read."""
+    result = dc.simulate(scene, TWO_REVOLUTIONS / 4, rtol=1e-8)
+    assert result.channel_source is not None and not result.channel_source.computed
+    assert result["clearance.normal_force"].max() > 1e3 and result.channel_source.computed
+
+
 def test_the_switch_rows_follow_the_segments(runs):
     """Each point's switch vector is its segment's: the contact term on inside contact segments only."""
     result = runs["ggl"]

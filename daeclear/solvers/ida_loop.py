@@ -30,7 +30,6 @@ from ..assembly.automaton import EVENT_KINDS, ONSET
 from ..engine.abi import DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND
 from ..engine.session_base import AutoEvents
 from ..errors import Interrupted, SolveError
-from .channel_eval import session_evaluator
 from .recorder import Recorder
 from ..progress import Progress
 from ..results.events import EventRows
@@ -73,7 +72,7 @@ class SegmentLoop:
             self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
             self.i_eval = 1
         self.events, self.segments = rec.events, rec.segments
-        rec.evaluate = session_evaluator(model, session)  # channels in the run's library while it is open
+        rec.session = session  # the checked channels in the run's library while it is open
         self.t, self.y, self.yp, self.y0 = t0, y, yp, y0
         self.t_start = t0
         self.seg_start = t0  # nan once the last segment is closed
@@ -338,7 +337,7 @@ class SegmentLoop:
                                      self.y0 if sim_params["start"] == "declared" else None, stats, session,
                                      from_state=sim_params["start"] == "state")
         finally:
-            rec.evaluate = None  # the session closes: later channels open their own
+            rec.session = None  # the session closes: later channels open their own
             session.close()
 
 
