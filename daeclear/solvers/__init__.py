@@ -13,7 +13,7 @@ def __getattr__(name: str) -> Any:
     """``simulate`` on first use: importing the package must not load the IDA loop, which imports
     the assembly, which uses this package's run checks (physics)."""
     if name == "simulate":
-        from .ida import simulate
+        from .dispatch import simulate
 
         return simulate
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -105,8 +105,8 @@ class SegmentLoop:
         except MemoryError:  # keep (and, streamed, save) what was computed: the chunks before this one
             self.raw.clear()
             self.success, self.status = False, -1
-            self.message = (f"out of memory at t={self.t:.6g} s. Report fewer points (t_eval_step), keep no steps "
-                            "(store_steps=False) and stream the run to a file (stream_to).")
+            self.message = (f"out of memory at t={self.t:.6g} s. Report fewer points (SaveAt.every), keep no steps "
+                            "(SaveAt.steps=False) and stream the run to a file (SaveAt.stream_to).")
         except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on
             self.progress_line.close()
             self.rec.abort(exc)
@@ -296,7 +296,7 @@ class SegmentLoop:
         """Flush, check the physics, build the Result; raise (with it) on Ctrl-C or a failure when asked."""
         stats = dict(self.session.stats())
         found = self.checked_output(stats, setup_time, sim_params)
-        physics.issue(found, stacklevel=5)  # issue <- finish <- run <- simulate <- the caller
+        physics.issue(found, stacklevel=6)  # issue <- finish <- run <- IDA.run <- simulate <- the caller
         t, message = self.t, self.message
         deep = [w for w in found if w["kind"] == "penetration" and w["t"] <= t]
         if not self.success and not self.interrupted and deep:  # the advice must fit the cause: not a tolerance problem

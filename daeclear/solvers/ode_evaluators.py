@@ -491,5 +491,5 @@ def evaluator(model: DAEModel, backend: str) -> Evaluator:
         if reason not in _warned:
             _warned.add(reason)
             warnings.warn("daeclear: the compiled right-hand side is unavailable, using casadi.FunctionBuffer "
-                          f"and numpy (several times slower). Reason: {reason}", DaeclearWarning, stacklevel=4)
+                          f"and numpy (several times slower). Reason: {reason}", DaeclearWarning, stacklevel=5)
         return _PyEvaluator(spec)
