@@ -1,5 +1,6 @@
-"""DAEModel -> Result: the IDA loop (:func:`simulate`, ida), the explicit and scipy methods (explicit)
-and the run checks (physics).
+"""DAEModel -> Result: :func:`simulate` (dispatch) hands a run to its method's solver (the contract:
+base; the methods: registry), IDA (ida, ida_loop) or the explicit and scipy methods (explicit), and
+checks every finished run (physics).
 """
 
 from __future__ import annotations

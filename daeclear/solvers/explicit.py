@@ -70,8 +70,8 @@ from
 
 Output
 ------
-Without ``t_eval`` the result holds every accepted step (and every event point); with
-``t_eval`` the scipy methods use their dense output and the fixed-step schemes a cubic Hermite
+Without output times (``SaveAt.times`` or ``every``) the result holds every accepted step (and
+every event point); with them the scipy methods use their dense output and the fixed-step schemes a cubic Hermite
 interpolant between steps. Multipliers and accelerations at output points are recomputed from
 (t, q, v) with the segment's active terms. Statistics: ``n_steps`` (accepted steps),
 ``n_res_evals`` (right-hand side evaluations: scheme stages, event location re-steps; output

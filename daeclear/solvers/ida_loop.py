@@ -1,6 +1,6 @@
 """The IDA segment loop of one run: advance, record contact switches, restart, finish.
 
-:func:`daeclear.solvers.ida.simulate` checks the options, opens the session and the recorder and
+:meth:`daeclear.solvers.ida.IDA.run` opens the session and the recorder (the options are checked) and
 hands them to a :class:`SegmentLoop`, which integrates segment by segment. Between two roots of
 the gap functions the set of active contact terms is fixed. The compiled loop may decide the
 switches of simple pairs itself (:meth:`SegmentLoop.record_advance` takes its decisions into
