@@ -85,3 +85,32 @@ def test_simulate_takes_at_most_fourteen_parameters() -> None:
     import inspect
 
     assert len(inspect.signature(dc.simulate).parameters) <= 14
+
+
+def test_the_custom_solver_example_estimates_rk4s_error() -> None:
+    """examples/custom_solver.py: a user's class (rk4 twice, Richardson) passed as method; its error
+    estimate of the finer run agrees with the true error against DOP853 at rtol 1e-12."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "custom_solver.py"
+    spec = importlib.util.spec_from_file_location("custom_solver", path)
+    assert spec is not None and spec.loader is not None
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    assert example.main(["--quick"]) == 0
+    span = example.REVOLUTION / 4
+    model = dc.assemble(dc.mechanisms.slider_crank("ideal"), "index1")
+    save = dc.SaveAt(every=span / 60)
+    cls = example.RichardsonRK4
+    fine = dc.simulate(model, span, options=dc.SolverOptions(method=cls, step=2e-4), save=save)
+    direct = dc.simulate(model, span, options=dc.SolverOptions(method="rk4", step=1e-4), save=save)
+    np.testing.assert_array_equal(fine.y, direct.y)  # the finer run is rk4 at half the step
+    reference = dc.simulate(model, span, method="DOP853", rtol=1e-12, save=save)
+    k = model.state_names.index("slider.x")
+    true = np.max(np.abs(fine.y[:, k] - reference.y[:, k]))
+    estimated = np.max(np.abs(cls.estimate[:, k]))
+    assert true > 1e-10  # well above the reference's error
+    assert 0.8 < estimated / true < 1.25
+    with pytest.raises(SceneError, match=r"rk4-richardson: needs output times"):
+        dc.simulate(model, span, options=dc.SolverOptions(method=cls, step=2e-4))
