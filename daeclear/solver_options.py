@@ -115,9 +115,11 @@ class SolverOptions:
     start: str = "ideal"
     allow_penetration: bool = False
     track_work: bool = False
+    #: who the settings were given to, for the messages (not stored): "simulate" for its keywords
+    where: dataclasses.InitVar[str] = WHERE
 
-    def __post_init__(self) -> None:
-        values = checked({f.name: getattr(self, f.name) for f in dataclasses.fields(self)}, where=WHERE)
+    def __post_init__(self, where: str = WHERE) -> None:
+        values = checked({f.name: getattr(self, f.name) for f in dataclasses.fields(self)}, where=where)
         for name, value in values.items():
             object.__setattr__(self, name, value)
         from .solvers.registry import solver_class
@@ -158,7 +160,7 @@ class SolverOptions:
         if not given:
             return self
         _check_names(given, "merged")
-        return dataclasses.replace(self, **checked({**self.to_dict(), **given}, where=where))
+        return dataclasses.replace(self, where=where, **given)  # checked once, by __post_init__
 
     def atol_value(self) -> float | np.ndarray | dict[str, float] | None:
         """``atol`` as the solvers take it (one value, a mapping by quantity, an array per state, or None)."""
