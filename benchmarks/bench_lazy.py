@@ -30,17 +30,22 @@ T = 2 * 60.0 / 5000.0
 scene = dc.mechanisms.slider_crank("revolute")
 out = {}
 for form in ("index1", "ggl"):
-    dc.simulate(scene, T, rtol=1e-8, formulation=form)  # builds or loads the structure
+    settings = dc.SolverOptions(formulation=form)
+    dc.simulate(scene, T, rtol=1e-8, options=settings)  # builds or loads the structure
     alone, read = [], []
     for _ in range(int(sys.argv[1])):
-        tic = time.perf_counter(); dc.simulate(scene, T, rtol=1e-8, formulation=form)
+        tic = time.perf_counter(); dc.simulate(scene, T, rtol=1e-8, options=settings)
         alone.append(time.perf_counter() - tic)
-        tic = time.perf_counter(); dc.simulate(scene, T, rtol=1e-8, formulation=form)["slider.vx"]
+        tic = time.perf_counter(); dc.simulate(scene, T, rtol=1e-8, options=settings)["slider.vx"]
         read.append(time.perf_counter() - tic)
     out[form] = (statistics.median(alone), statistics.median(read))
 with tempfile.TemporaryDirectory() as tmp:
     path = os.path.join(tmp, "run.h5")
-    dc.simulate(scene, T, t_eval=np.linspace(0.0, T, 24001), stream_to=path, keep_data=False)
+    output = dict(times=np.linspace(0.0, T, 24001), stream_to=path, keep_data=False)
+    if hasattr(dc, "SaveAt"):  # the output as one value (issue 35)
+        dc.simulate(scene, T, save=dc.SaveAt(**output))
+    else:  # a tree before it: the same output as keywords
+        dc.simulate(scene, T, t_eval=output.pop("times"), **output)
     out["file"] = os.path.getsize(path)
 print(json.dumps(out))
 """

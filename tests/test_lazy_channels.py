@@ -30,7 +30,8 @@ def scene() -> dc.Scene:
 @pytest.fixture(scope="module")
 def runs(scene: dc.Scene) -> dict[str, dc.Result]:
     """Two revolutions of the Fig. 4.15 scene (51 impacts), both formulations, rtol 1e-8."""
-    return {form: dc.simulate(scene, TWO_REVOLUTIONS, rtol=1e-8, formulation=form) for form in ("index1", "ggl")}
+    return {form: dc.simulate(scene, TWO_REVOLUTIONS, rtol=1e-8,
+                              options=dc.SolverOptions(formulation=form)) for form in ("index1", "ggl")}
 
 
 @pytest.mark.parametrize("formulation", ["index1", "ggl"])
@@ -132,8 +133,9 @@ def test_a_file_in_the_old_layout_loads(runs, tmp_path):
 def test_a_streamed_run_writes_states_and_reads_back_its_channels(scene, tmp_path):
     path = tmp_path / "s.h5"
     grid = np.linspace(0.0, 0.004, 4001)
-    streamed = dc.simulate(scene, 0.004, t_eval=grid, stream_to=path)  # keep_data: read back from the file
-    memory = dc.simulate(scene, 0.004, t_eval=grid)
+    streamed = dc.simulate(scene, 0.004,
+                           save=dc.SaveAt(times=grid, stream_to=path))  # keep_data: read back from the file
+    memory = dc.simulate(scene, 0.004, save=dc.SaveAt(times=grid))
     assert np.array_equal(streamed.y, memory.y) and np.array_equal(streamed.yp, memory.yp)
     for name in memory.channel_names:
         assert np.array_equal(streamed[name], memory[name]), name

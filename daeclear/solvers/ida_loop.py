@@ -1,6 +1,6 @@
 """The IDA segment loop of one run: advance, record contact switches, restart, finish.
 
-:func:`daeclear.solvers.ida.simulate` checks the options, opens the session and the recorder and
+:meth:`daeclear.solvers.ida.IDA.run` opens the session and the recorder (the options are checked) and
 hands them to a :class:`SegmentLoop`, which integrates segment by segment. Between two roots of
 the gap functions the set of active contact terms is fixed. The compiled loop may decide the
 switches of simple pairs itself (:meth:`SegmentLoop.record_advance` takes its decisions into
@@ -104,8 +104,8 @@ class SegmentLoop:
         except MemoryError:  # keep (and, streamed, save) what was computed: the chunks before this one
             self.raw.clear()
             self.success, self.status = False, -1
-            self.message = (f"out of memory at t={self.t:.6g} s. Report fewer points (t_eval_step), keep no steps "
-                            "(store_steps=False) and stream the run to a file (stream_to).")
+            self.message = (f"out of memory at t={self.t:.6g} s. Report fewer points (SaveAt.every), keep no steps "
+                            "(SaveAt.steps=False) and stream the run to a file (SaveAt.stream_to).")
         except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on
             self.progress_line.close()
             self.rec.abort(exc)
@@ -295,7 +295,7 @@ class SegmentLoop:
         """Flush, check the physics, build the Result; raise (with it) on Ctrl-C or a failure when asked."""
         stats = dict(self.session.stats())
         found = self.checked_output(stats, setup_time, sim_params)
-        physics.issue(found, stacklevel=5)  # issue <- finish <- run <- simulate <- the caller
+        physics.issue(found, stacklevel=6)  # issue <- finish <- run <- IDA.run <- simulate <- the caller
         t, message = self.t, self.message
         deep = [w for w in found if w["kind"] == "penetration" and w["t"] <= t]
         if not self.success and not self.interrupted and deep:  # the advice must fit the cause: not a tolerance problem

@@ -485,5 +485,5 @@ def evaluator(model: DAEModel, backend: str) -> Evaluator:
             raise DaeclearError(f"the compiled ODE backend cannot be built or loaded: {exc}") from exc
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         warn_once("daeclear: the compiled right-hand side is unavailable, using casadi.FunctionBuffer "
-                  f"and numpy (several times slower). Reason: {reason}", stacklevel=4)
+                  f"and numpy (several times slower). Reason: {reason}", stacklevel=5)
         return _PyEvaluator(spec)
