@@ -42,7 +42,8 @@ def main() -> None:
             start = time.perf_counter()
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                runs[backend] = dc.simulate(scene, t_end, rtol=rtol, backend=backend, t_eval=grid)
+                runs[backend] = dc.simulate(scene, t_end, rtol=rtol, options=dc.SolverOptions(backend=backend),
+                                            save=dc.SaveAt(times=grid))
             runs[backend].stats["wall"] = time.perf_counter() - start
         onsets = {b: r.events.of("clearance", kind="onset").t for b, r in runs.items()}
         k = min(5, onsets["c"].size, onsets["python"].size)

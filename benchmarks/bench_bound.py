@@ -296,7 +296,7 @@ def timed_simulate(t_end: float, formulation: str) -> tuple[float, float, Any]:
     clock = ReportClock()
     with clock.installed():
         tic = time.perf_counter()
-        result = dc.simulate(sc, t_end, rtol=RTOL, formulation=formulation)
+        result = dc.simulate(sc, t_end, rtol=RTOL, options=dc.SolverOptions(formulation=formulation))
         wall = time.perf_counter() - tic
     return wall, clock.total, result
 
@@ -328,10 +328,12 @@ class Comparison:
 def prepare(formulation: str, t_end: float, folder: Path) -> tuple[Path, Path, Any, Any]:
     """Build and warm the structure, record one simulate call: (library, setup file, recorder, result)."""
     model = dc.assemble(scene(), formulation)
-    dc.simulate(scene(), t_end, rtol=RTOL, formulation=formulation)  # compiled and cached beforehand
+    dc.simulate(scene(), t_end, rtol=RTOL,
+                options=dc.SolverOptions(formulation=formulation))  # compiled and cached beforehand
     with recording(model) as rec:
-        result = dc.simulate(scene(), t_end, rtol=RTOL, formulation=formulation)
-    dc.simulate(scene(), t_end, rtol=RTOL, formulation=formulation)  # warm again: recording emptied the memos
+        result = dc.simulate(scene(), t_end, rtol=RTOL, options=dc.SolverOptions(formulation=formulation))
+    dc.simulate(scene(), t_end, rtol=RTOL,
+                options=dc.SolverOptions(formulation=formulation))  # warm again: recording emptied the memos
     setup = folder / f"setup_{formulation}.txt"
     rec.write(setup)
     return build_model_library(model.functions).path, setup, rec, result

@@ -6,7 +6,8 @@ Each tree given (``--trees OLD NEW``, e.g. a worktree of main and this one) is m
 interpreter (a package cannot be imported twice in one process), the trees interleaved pass by
 pass so that the shared machine's load falls on both alike. Per tree and formulation: the median
 wall time of ``simulate`` alone, of ``simulate`` followed by reading one channel (what a user's
-script does), and the size of the file of ``daeclear run``'s main job (24 001 points streamed).
+script does), and the size of a streamed file of the main job's run on a 1 us grid (24 001 points;
+``daeclear run``'s default grid is 2 us now).
 
 Run: ``python benchmarks/bench_lazy.py --trees /path/to/main .`` (default: this tree alone).
 """
@@ -29,17 +30,22 @@ T = 2 * 60.0 / 5000.0
 scene = dc.mechanisms.slider_crank("revolute")
 out = {}
 for form in ("index1", "ggl"):
-    dc.simulate(scene, T, rtol=1e-8, formulation=form)  # builds or loads the structure
+    settings = dc.SolverOptions(formulation=form)
+    dc.simulate(scene, T, rtol=1e-8, options=settings)  # builds or loads the structure
     alone, read = [], []
     for _ in range(int(sys.argv[1])):
-        tic = time.perf_counter(); dc.simulate(scene, T, rtol=1e-8, formulation=form)
+        tic = time.perf_counter(); dc.simulate(scene, T, rtol=1e-8, options=settings)
         alone.append(time.perf_counter() - tic)
-        tic = time.perf_counter(); dc.simulate(scene, T, rtol=1e-8, formulation=form)["slider.vx"]
+        tic = time.perf_counter(); dc.simulate(scene, T, rtol=1e-8, options=settings)["slider.vx"]
         read.append(time.perf_counter() - tic)
     out[form] = (statistics.median(alone), statistics.median(read))
 with tempfile.TemporaryDirectory() as tmp:
     path = os.path.join(tmp, "run.h5")
-    dc.simulate(scene, T, t_eval=np.linspace(0.0, T, 24001), stream_to=path, keep_data=False)
+    output = dict(times=np.linspace(0.0, T, 24001), stream_to=path, keep_data=False)
+    if hasattr(dc, "SaveAt"):  # the output as one value (issue 35)
+        dc.simulate(scene, T, save=dc.SaveAt(**output))
+    else:  # a tree before it: the same output as keywords
+        dc.simulate(scene, T, t_eval=output.pop("times"), **output)
     out["file"] = os.path.getsize(path)
 print(json.dumps(out))
 """

@@ -32,7 +32,7 @@ SOLVERS = ("reduced", "dense", "sparse")
 def timed(scene: Any, t_end: float, rtol: float, solver: str) -> tuple[float, dict[str, Any]]:
     """Wall time of one whole simulate call and its statistics."""
     tic = time.perf_counter()
-    result = dc.simulate(scene, t_end, rtol=rtol, backend="c", linear_solver=solver)
+    result = dc.simulate(scene, t_end, rtol=rtol, options=dc.SolverOptions(backend="c", linear_solver=solver))
     wall = time.perf_counter() - tic
     if not result.success:
         raise SystemExit(f"{scene.name} with {solver} LU failed: {result.message}")

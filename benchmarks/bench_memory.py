@@ -65,15 +65,15 @@ def child(config: str, revolutions: int, rpm: float) -> dict:
             rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
             n_times = _points(Path(tmp) / "slider_crank_revolute.h5") if code == 0 else -1
         else:
-            kwargs: dict = {"rtol": 1e-6}
+            kwargs: dict = {}
             if config != "steps":
-                kwargs["t_eval_step"] = GRID
+                kwargs["every"] = GRID
             if config in ("grid-nosteps", "stream"):
-                kwargs["store_steps"] = False
+                kwargs["steps"] = False
             if config == "stream":
                 kwargs["stream_to"] = Path(tmp) / "run.h5"
                 kwargs["keep_data"] = False
-            result = dc.simulate(scene, t_end, **kwargs)
+            result = dc.simulate(scene, t_end, rtol=1e-6, save=dc.SaveAt(**kwargs))
             _, peak = tracemalloc.get_traced_memory()
             tracemalloc.stop()
             rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss

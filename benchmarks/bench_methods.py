@@ -55,12 +55,17 @@ CASES_QUICK = [
 ]
 
 
+def settings(method, kind, value):
+    """The solver settings of a case: ``kind`` is "rtol" or "step"."""
+    return dc.SolverOptions(method=method, **{kind: value})
+
+
 def run(model, method, kind, value, te, repeat):
-    kw = {kind: value}
     best, result = np.inf, None
     for _ in range(repeat):
         tic = time.perf_counter()
-        result = dc.simulate(model, T_END, method=method, t_eval=te, on_failure="return", **kw)
+        result = dc.simulate(model, T_END, options=settings(method, kind, value), on_failure="return",
+                             save=dc.SaveAt(times=te))
         best = min(best, time.perf_counter() - tic)
     return best, result
 
@@ -74,8 +79,8 @@ def main() -> None:
     model = dc.assemble(dc.mechanisms.slider_crank("revolute", gravity=0.0), "index1")  # every method: index-1
     # output on the accuracy window only (the runs still go to T_END); t = 0 .. 5 ms every 5 us
     te = np.linspace(0.0, WINDOW, 1001)
-    ref = dc.simulate(model, T_END, rtol=1e-10, t_eval=te)
-    check = dc.simulate(model, T_END, method="DOP853", rtol=1e-12, t_eval=te)
+    ref = dc.simulate(model, T_END, rtol=1e-10, save=dc.SaveAt(times=te))
+    check = dc.simulate(model, T_END, method="DOP853", rtol=1e-12, save=dc.SaveAt(times=te))
     scale = np.max(np.abs(ref[CHANNEL]))
     ref_err = np.max(np.abs(check[CHANNEL] - ref[CHANNEL]))
     n_window = int(np.sum(ref.events.t <= WINDOW))
@@ -85,7 +90,7 @@ def main() -> None:
           f"reference vs DOP853 rtol 1e-12 there: {ref_err:.1e} m/s")
     # warm-up: compile or load every library once
     for method, kind, values in CASES_FULL:
-        dc.simulate(model, 1e-4, method=method, **{kind: values[0]})
+        dc.simulate(model, 1e-4, options=settings(method, kind, values[0]))
 
     rows = []
     header = (f"{'method':<7} {'tol/step':>8} {'wall s':>8} {'steps':>8} {'f evals':>8} {'J evals':>7} "
@@ -136,7 +141,7 @@ def main() -> None:
         for hermite in (True, False):
             integrators.HERMITE_GAP_CHECK = hermite
             try:
-                r = dc.simulate(model, T_END, method=method, on_failure="return", **{kind: value})
+                r = dc.simulate(model, T_END, options=settings(method, kind, value), on_failure="return")
             finally:
                 integrators.HERMITE_GAP_CHECK = True
             print(f"{method:<7} {value:>8.0e} {'hermite' if hermite else 'ends':>8} {len(r.events):>6d} "

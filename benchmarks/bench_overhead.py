@@ -36,12 +36,12 @@ REV = 60.0 / 5000.0
 
 def measure(label: str, make, t_end: float, repeats: int) -> None:
     t_eval = np.linspace(0.0, t_end, 400)
-    dc.simulate(make(0), t_end=t_end, rtol=1e-7, t_eval=t_eval)  # builds or loads the structure
+    dc.simulate(make(0), t_end=t_end, rtol=1e-7, save=dc.SaveAt(times=t_eval))  # builds or loads the structure
     rows = []
     for i in range(repeats):
         target = make(i + 1)
         start = time.perf_counter()
-        result = dc.simulate(target, t_end=t_end, rtol=1e-7, t_eval=t_eval)
+        result = dc.simulate(target, t_end=t_end, rtol=1e-7, save=dc.SaveAt(times=t_eval))
         wall = time.perf_counter() - start
         rows.append((wall, result.stats["solve_time"], result.stats["setup_time"]))
     wall, solve, setup = min(rows)
@@ -68,7 +68,7 @@ def parts(repeats: int) -> None:
     onset = automaton.Decision(kind=automaton.ONSET, contact=True, held=False, latched=0.3, watch=-1)
     state = contact_state.start_state(model, 0.0, y0)
     active, params = contact_state.switches(model, state)
-    result = dc.simulate(model, t_end=0.002, rtol=1e-7, t_eval=np.linspace(0.0, 0.002, 400))
+    result = dc.simulate(model, t_end=0.002, rtol=1e-7, save=dc.SaveAt(times=np.linspace(0.0, 0.002, 400)))
     # three output rows, their constraint drift set to 1 m: the checks take the drift warning's path,
     # which evaluates the constraints at the worst row to name the equation
     key = (result.t[:3], result.y[:3], {name: values[:3] for name, values in result.channels.items()}

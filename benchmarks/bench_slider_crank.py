@@ -24,11 +24,12 @@ def run(label: str, scene: dc.Scene, t_end: float, rtol: float, repeats: int, ba
     start = time.perf_counter()
     model = dc.assemble(scene)
     assembly = time.perf_counter() - start
-    first = dc.simulate(model, t_end, rtol=rtol, backend=backend)  # compiles (or hits the cache)
+    first = dc.simulate(model, t_end, rtol=rtol,
+                        options=dc.SolverOptions(backend=backend))  # compiles (or hits the cache)
     best, best_wall = None, float("inf")
     for _ in range(repeats):
         start = time.perf_counter()
-        result = dc.simulate(model, t_end, rtol=rtol, backend=backend)
+        result = dc.simulate(model, t_end, rtol=rtol, options=dc.SolverOptions(backend=backend))
         wall = time.perf_counter() - start
         if wall < best_wall:
             best, best_wall = result, wall

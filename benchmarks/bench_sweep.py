@@ -105,7 +105,7 @@ def _one_pass(dc: Any, clearances: NDArray, t_end: float, rtol: float, t_eval: N
     for c in clearances:
         scene = dc.mechanisms.slider_crank("revolute", clearance=float(c))
         run_start = time.perf_counter()
-        result = dc.simulate(scene, t_end=t_end, rtol=rtol, t_eval=t_eval)
+        result = dc.simulate(scene, t_end=t_end, rtol=rtol, save=dc.SaveAt(times=t_eval))
         walls.append(time.perf_counter() - run_start)
         solves.append(result.stats["solve_time"])
         compiled = result.stats.get("compile_time", 0.0)

@@ -37,7 +37,7 @@ def main() -> None:
                                            for logic in model.contacts))
     for backend in ("c", "python"):
         tic = time.perf_counter()
-        r = dc.simulate(model, args.t_end, rtol=1e-8, backend=backend, on_failure="return")
+        r = dc.simulate(model, args.t_end, rtol=1e-8, on_failure="return", options=dc.SolverOptions(backend=backend))
         onsets = sum(e.kind == "onset" for e in r.events)
         print(f"{args.joint} {Storm(args.events, args.window)} {backend:6s}: success={r.success} "
               f"events={len(r.events)} onsets={onsets} steps={r.stats['n_steps']} "

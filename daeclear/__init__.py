@@ -24,17 +24,18 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and readers
     from .model.loads import Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
     from .model.scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational,
                               TranslationalClearance)
+    from .save_at import SaveAt
     from .solver_options import SolverOptions
-    from .solvers.ida import simulate
+    from .solvers.dispatch import simulate
     from .studies.sweep import load_sweep, sweep
 
 __version__ = "0.1.0"
 
 __all__ = [
     "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "DiskFull", "Driver",
-    "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "Scene",
-    "SceneError", "SolveError", "SolverOptions", "Translational", "TranslationalClearance", "analysis", "assemble",
-    "load", "load_sweep", "mechanisms", "profiles", "simulate", "sweep",
+    "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "SaveAt",
+    "Scene", "SceneError", "SolveError", "SolverOptions", "Translational", "TranslationalClearance", "analysis",
+    "assemble", "load", "load_sweep", "mechanisms", "profiles", "simulate", "sweep",
     # applied loads (daeclear.loads)
     "Expression", "Force", "Motor", "RotationalSpringDamper", "SpringDamper", "Table", "Torque", "loads",
 ]
@@ -56,8 +57,9 @@ def _load_all() -> dict[str, Any]:
                               Torque)
     from .model.scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational,  # noqa: F401
                               TranslationalClearance)
+    from .save_at import SaveAt  # noqa: F401
     from .solver_options import SolverOptions  # noqa: F401
-    from .solvers.ida import simulate  # noqa: F401
+    from .solvers.dispatch import simulate  # noqa: F401
     from .studies.sweep import load_sweep, sweep  # noqa: F401
     names = locals()
     public = {name: names[name] for name in __all__}

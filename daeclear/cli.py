@@ -18,8 +18,9 @@ EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by 
 #: ``daeclear run`` reports at most CLI_POINTS + 1 points by default (a run of any length stays
 #: affordable: memory and file) ...
 CLI_POINTS = 100_000
-#: ... spaced no finer than this (s): the chapter's two revolutions get 24 001 points, 1 us apart.
-CLI_FINEST_STEP = 1e-6
+#: ... spaced no finer than this (s): the chapter's two revolutions get 12 001 points, 2 us apart
+#: (each impact's peak force within 0.5 % of a grid 8 times finer; tests/test_streaming.py).
+CLI_FINEST_STEP = 2e-6
 #: ``daeclear run`` shows (summary, figure) at most this many of the last events of a run (the file has all).
 CLI_SHOWN_EVENTS = 20_000
 #: ``daeclear run``'s figure draws at most this many points a curve: min-max per bucket (two points a pixel
@@ -156,7 +157,9 @@ def _run(args: argparse.Namespace) -> int:
     from .results.outputs import check_directory
     from .model.scene import RevoluteClearance, TranslationalClearance
     from .model.scenefile import MECHANISMS, read_scene_file
-    from .solvers.ida import simulate
+    from .save_at import SaveAt
+    from .solver_options import SolverOptions
+    from .solvers.dispatch import simulate
 
     where = "daeclear run"
     params = _parse_sets(args.set)
@@ -207,27 +210,29 @@ def _run(args: argparse.Namespace) -> int:
         lo, hi = args.window
         if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 <= lo < hi and lo < t_end):
             options.fail(where, "--window", tuple(args.window), f"T0 < T1 with 0 <= T0 < t_end={t_end:g} s", "s")
-    run_options: dict[str, Any] = {"rtol": rtol, "backend": args.backend, "progress": not args.quiet,
-                                   "on_failure": "return"}
+    # the command line and the file's [simulate] table as the call's solver settings and output
+    settings: dict[str, Any] = {"backend": args.backend}
     if args.formulation:
         sim["formulation"] = args.formulation
-    run_options.update(sim)
-    if step is not None:  # reported points on a grid; the steps are not kept (bounded memory)
-        run_options.update(t_eval_step=step, store_steps=False)
-    if args.max_points is not None:
-        run_options["max_output_points"] = options.max_output_points(args.max_points, where=where,
-                                                                     field="--max-points")
-    if args.max_steps is not None:
-        run_options["max_steps"] = options.max_steps(args.max_steps, where=where, field="--max-steps")
-    else:  # memory no longer limits a long run: the cap only stops a runaway one
-        run_options.setdefault("max_steps", default_max_steps(t_end))
+    settings.update(sim)
     h5 = args.out / f"{base}.h5"
+    # streamed: the file holds what was computed whatever stops the run (Ctrl-C, a failure,
+    # running out of memory), and the run's memory does not grow with its length
+    output: dict[str, Any] = {"stream_to": h5, "keep_data": False}
+    if step is not None:  # reported points on a grid; the steps are not kept (bounded memory)
+        output.update(every=step, steps=False)
+    if args.max_points is not None:
+        output["max_points"] = options.max_output_points(args.max_points, where=where, field="--max-points")
+    if args.max_steps is not None:
+        settings["max_steps"] = options.max_steps(args.max_steps, where=where, field="--max-steps")
+    else:  # memory no longer limits a long run: the cap only stops a runaway one
+        settings.setdefault("max_steps", default_max_steps(t_end))
+    solver, save = SolverOptions(**settings), SaveAt(**output)
     try:
         with warnings.catch_warnings():  # shown once, from the result, after the run
             warnings.simplefilter("ignore", PhysicsWarning)
-            # streamed: the file holds what was computed whatever stops the run (Ctrl-C, a failure,
-            # running out of memory), and the run's memory does not grow with its length
-            outcome = simulate(scene, t_end, stream_to=h5, keep_data=False, **run_options)
+            outcome = simulate(scene, t_end, rtol=rtol, options=solver, save=save, progress=not args.quiet,
+                               on_failure="return")
         shown_from, result = _read_back(h5)
     except Interrupted as exc:
         message = exc.result.message if exc.result is not None else "interrupted"
@@ -244,7 +249,7 @@ def _run(args: argparse.Namespace) -> int:
     print(f"wrote {h5}")
     _print_physics_warnings(result)
     try:
-        _run_figure(args, result, scene, reference_scene, t_end, run_options["rtol"], base)
+        _run_figure(args, result, scene, reference_scene, t_end, rtol, base)
     except KeyboardInterrupt:  # the result is saved already; only the figure is missing
         print(f"daeclear: interrupted, result saved to {h5} (no figure)", file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -257,7 +262,9 @@ def _run(args: argparse.Namespace) -> int:
 def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_scene: Any, t_end: float, rtol: float,
                 base: str) -> None:
     """The response figure of ``daeclear run`` (against the ideal joint when there is one)."""
-    from .solvers.ida import simulate
+    from .save_at import SaveAt
+    from .solver_options import SolverOptions
+    from .solvers.dispatch import simulate
 
     if not args.no_figure:
         import matplotlib
@@ -266,10 +273,10 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
         reference = None
         if reference_scene is not None:  # on the run's own output grid: bounded, as the run
             every_step = result.step_t is not None and result.step_t.size == result.n_times
-            grid = {} if every_step or not result.n_times else {"t_eval": result.t, "store_steps": False}
+            grid = None if every_step or not result.n_times else SaveAt(times=result.t, steps=False)
             try:
-                reference = simulate(reference_scene, t_end, rtol=rtol, backend=args.backend, on_failure="return",
-                                     **grid)
+                reference = simulate(reference_scene, t_end, rtol=rtol, on_failure="return",
+                                     options=SolverOptions(backend=args.backend), save=grid)
             except DaeclearError as exc:  # e.g. an ideal mechanism with redundant constraints: no dashed lines
                 print(f"daeclear: no ideal-mechanism reference in the figure: {exc}", file=sys.stderr)
         # time plots chosen from what the scene holds, a journal orbit or slider path per clearance joint

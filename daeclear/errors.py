@@ -61,3 +61,17 @@ class Interrupted(KeyboardInterrupt):
     def __init__(self, message: str, result: Any = None) -> None:
         super().__init__(message)
         self.result = result
+
+
+_WARNED: set[str] = set()  # the messages warn_once has issued in this process
+
+
+def warn_once(message: str, stacklevel: int = 2) -> None:
+    """Issue a :class:`DaeclearWarning` the first time this process meets ``message`` (a fallback
+    named once, not at every run of a sweep); ``stacklevel`` counts from the caller of warn_once."""
+    if message in _WARNED:
+        return
+    _WARNED.add(message)
+    import warnings
+
+    warnings.warn(message, DaeclearWarning, stacklevel=stacklevel + 1)

@@ -12,9 +12,7 @@ from __future__ import annotations
 
 import difflib
 import math
-import os
-from pathlib import Path
-from typing import Any, NamedTuple, NoReturn, TypeGuard
+from typing import Any, NoReturn, TypeGuard
 from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
@@ -219,12 +217,16 @@ def step_within(value: float | None, t0: float, end: float, *, where: str = "sim
         fail(where, field, value, f"at most the run's length t_end - t0 = {end - t0:g} s (t_end={end:g} s)", "s")
 
 
-def t_eval(value: ArrayLike | None, end: float, *, where: str = "simulate",
+def t_eval(value: ArrayLike | None, end: float | None, *, where: str = "simulate",
            field: str = "t_eval", start: float = 0.0) -> NDArray[np.float64] | None:
-    """Output times: None, or finite, strictly increasing values in [t0, t_end] (NaN is an error, not a cut)."""
+    """Output times: None, or finite, strictly increasing values in [t0, t_end] (NaN is an error, not a cut;
+    ``end`` None: any time >= ``start``, for a check made before the run's end is known)."""
     if value is None:
         return None
-    rule = f"finite, strictly increasing values in [{'0' if start == 0 else f't0={start:g}'}, t_end={end:g}]"
+    low = '0' if start == 0 else f't0={start:g}'
+    rule = (f"finite, strictly increasing values in [{low}, t_end={end:g}]" if end is not None
+            else f"finite, strictly increasing values >= {low}")
+    top = math.inf if end is None else end
     try:
         times = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -236,13 +238,13 @@ def t_eval(value: ArrayLike | None, end: float, *, where: str = "simulate",
         fail(where, field, value, "at least one time: " + rule)
     # the common case in one pass: in range and strictly increasing (so finite: a NaN or inf
     # fails a comparison); anything else is looked at closely for the message
-    if start <= times[0] and times[-1] <= end and bool((times[1:] > times[:-1]).all()):
+    if start <= times[0] and times[-1] <= top and times[-1] < math.inf and bool((times[1:] > times[:-1]).all()):
         return times
     bad = ~np.isfinite(times)
     if bad.any():
         index = int(np.argmax(bad))
         fail(where, field, value, rule + f" ({float(times[index])!r} at index {index})", shown=_show(times))
-    if np.any(np.diff(times) <= 0) or times[0] < start or times[-1] > end:
+    if np.any(np.diff(times) <= 0) or times[0] < start or times[-1] > top:  # (inf: caught above as not finite)
         fail(where, field, value, rule, shown=_show(times))
     return times
 
@@ -259,9 +261,7 @@ def t_eval_step(value: Any, end: float, *, where: str, field: str = "t_eval_step
     return number(value, where=where, field=field, unit="s", low=0.0, high=end)
 
 
-_spacing = t_eval_step  # for output(), whose argument of that name hides the function
-
-#: The most output points a run reports unless told otherwise (simulate's ``max_output_points``,
+#: The most output points a run reports unless told otherwise (``SaveAt.max_points``,
 #: ``daeclear run --max-points``): about 1 GB of file (or memory) for the chapter's slider-crank
 #: with a revolute clearance joint (~1 KB a point), so that a mistyped spacing (1e-12 s) is refused
 #: with an estimate instead of filling a disk (docs/reliability.md).
@@ -271,44 +271,6 @@ MAX_OUTPUT_POINTS = 1_000_000
 def max_output_points(value: Any, *, where: str = "simulate", field: str = "max_output_points") -> int | None:
     """The cap on a run's output points: an integer >= 1, or None (no cap)."""
     return None if value is None else integer(value, where=where, field=field, low=1)
-
-
-def _size(n_bytes: float) -> str:
-    for unit, scale in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
-        if n_bytes >= scale:
-            return f"{n_bytes / scale:.3g} {unit}"
-    return f"{n_bytes:.0f} bytes"
-
-
-def output_size(out: OutputOptions, limit: int | None, *, t_eval_step: Any, step: float | None, start: float,
-                end: float, n_states: int, n_channels: int, where: str = "simulate") -> None:
-    """Refuse, before the run, an output of more than ``limit`` points, with the estimate of its size.
-
-    The points are those of ``t_eval``/``t_eval_step``, or, without them, of a fixed ``step`` (every
-    step reported); an adaptive method's steps are not known before the run (``max_steps`` bounds
-    them). Each point stores t, the states and their derivatives and every channel, 8 bytes each."""
-    if limit is None:
-        return
-    if out.times is not None:
-        points = out.times.size
-        source = (("t_eval_step", t_eval_step, repr(t_eval_step)) if t_eval_step is not None
-                  else ("t_eval", None, f"array of {points} times"))
-    elif step is not None:
-        points = int(math.floor((end - start) / step)) + 2
-        source = ("step", step, f"{step!r} (every step reported, no t_eval_step)")
-    else:
-        return
-    if points <= limit:
-        return
-    per_point = 8 * (1 + 2 * n_states + n_channels)
-    place = ("in the file and in memory" if out.stream_to is not None and out.keep_data
-             else "in the file" if out.stream_to is not None else "in memory")
-    field, value, shown = source
-    fail(where, field, value,
-         f"coarser: it gives {points:.4g} output points over {end - start:g} s, about {_size(points * per_point)} "
-         f"{place} ({per_point} bytes a point: t, {n_states} states and their derivatives, {n_channels} "
-         f"channels), more than max_output_points={limit}; or raise max_output_points (daeclear run: "
-         "--max-points; None: no limit) to run it anyway", shown=shown)
 
 
 def uniform_times(spacing: float, end: float, start: float = 0.0) -> NDArray[np.float64]:
@@ -346,37 +308,6 @@ class OutputTimes:
         return self.window(0, self.size)
 
 
-class OutputOptions(NamedTuple):
-    """What a run reports and where it goes (see :func:`output`)."""
-
-    times: OutputTimes | None  # None: every integrator step
-    stream_to: Path | None
-    keep_data: bool
-
-
-def output(*, t_eval: NDArray[np.float64] | None, t_eval_step: Any, end: float, stream_to: Any, keep_data: Any,
-           where: str = "simulate", start: float = 0.0) -> OutputOptions:
-    """Check the output options of a run: ``t_eval`` (checked by :func:`t_eval`) or ``t_eval_step``
-    (one or the other), ``stream_to`` (None or an HDF5 file, checked as an output place before any
-    work) and ``keep_data`` (True or False; False only with ``stream_to``, else the data would be lost)."""
-    times = None if t_eval is None else OutputTimes(t_eval)
-    if t_eval_step is not None:
-        if t_eval is not None:
-            fail(where, "t_eval_step", t_eval_step, "left out when t_eval is given (give one or the other)")
-        times = OutputTimes(spacing=_spacing(t_eval_step, end - start, where=where), end=end, start=start)
-    keep = flag(keep_data, where=where, field="keep_data")
-    path = None
-    if stream_to is not None:
-        if not isinstance(stream_to, (str, os.PathLike)):
-            fail(where, "stream_to", stream_to, "None or the path of an HDF5 file (str or pathlib.Path), e.g. 'run.h5'")
-        from .results.outputs import check_file
-
-        path = check_file(stream_to, f"{where}: stream_to")
-    elif not keep:
-        fail(where, "keep_data", keep_data, "True when stream_to is not given (the data would be lost)")
-    return OutputOptions(times=times, stream_to=path, keep_data=keep)
-
-
 def method(value: Any, *, where: str = "simulate", field: str = "method") -> str:
     """Integrator name (case-insensitive)."""
     return choice(value, METHODS, where=where, field=field)
@@ -387,9 +318,12 @@ def formulation(value: Any, *, where: str = "simulate", field: str = "formulatio
     return choice(value, FORMULATIONS, where=where, field=field)
 
 
-def default_formulation(method_name: str) -> str:
+def default_formulation(method_name: Any) -> str:
     """The formulation used when none is given: :data:`DEFAULT_FORMULATION` for IDA, the chapter's
-    index-1 for the other methods (they integrate the index-1 ODE only)."""
+    index-1 for the other methods (they integrate the index-1 ODE only); a solver class's own
+    ``formulation``."""
+    if isinstance(method_name, type):
+        return str(getattr(method_name, "formulation", DEFAULT_FORMULATION))
     return DEFAULT_FORMULATION if str(method_name).lower() == "ida" else CHAPTER_FORMULATION
 
 
@@ -411,36 +345,6 @@ def linear_solver(value: Any, *, where: str = "simulate", field: str = "linear_s
 def start(value: Any, *, where: str = "simulate", field: str = "start") -> str:
     """How a run starts (case-insensitive), see :data:`STARTS`."""
     return choice(value, STARTS, where=where, field=field)
-
-
-class RunOptions(NamedTuple):
-    """The options every integrator shares, checked and normalised (see :func:`run`)."""
-
-    t_end: float
-    rtol: float
-    max_step: float
-    max_steps: int
-    t_eval: NDArray[np.float64] | None
-    backend: str
-    on_failure: str
-    store_steps: bool
-    progress: bool
-    track_work: bool
-
-
-def run(**values: Any) -> RunOptions:
-    """Check the options shared by :func:`daeclear.simulate` and every integrator (the fields of
-    :class:`RunOptions`, plus ``atol``, checked here and converted per model by the solver)."""
-    end = t_end(values["t_end"])
-    begin = t0(values.get("t0", 0.0), end)
-    atol(values["atol"])
-    return RunOptions(
-        t_end=end, rtol=rtol(values["rtol"]), max_step=max_step(values["max_step"]),
-        max_steps=max_steps(values["max_steps"]), t_eval=t_eval(values["t_eval"], end, start=begin),
-        backend=backend(values["backend"]), on_failure=on_failure(values["on_failure"]),
-        store_steps=flag(values["store_steps"], field="store_steps"),
-        progress=flag(values["progress"], field="progress"),
-        track_work=flag(values["track_work"], field="track_work"))
 
 
 # --------------------------------------------------------------------------- studies and sweeps

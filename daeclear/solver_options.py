@@ -7,9 +7,9 @@ and round-trips through a plain dict (``to_dict``/``from_dict``: JSON types only
 
 What belongs: every setting that decides the model assembled and the trajectory computed (method,
 tolerances, formulation, backend, step bounds, linear solver, how the run starts, the work state).
-What does not: what a call reports and where it goes (``t_eval``, ``t_eval_step``, ``store_steps``,
-``stream_to``, ``keep_data``, ``progress``) and what it does on failure (``on_failure``): a study
-or a sweep sets those per call, and they never change the computed trajectory.
+What does not: what a call reports and where it goes (``save``, a :class:`daeclear.SaveAt`, and
+``progress``) and what it does on failure (``on_failure``): a study or a sweep sets those per call,
+and they never change the computed trajectory.
 """
 
 from __future__ import annotations
@@ -43,14 +43,64 @@ UNSET: Any = _Unset()
 
 @dataclass(frozen=True)
 class SolverOptions:
-    """The solver settings of a run (see :func:`daeclear.simulate` for each one's meaning).
+    """The solver settings of a run: ``options=`` of :func:`daeclear.simulate`.
 
     Checked on construction: a bad value raises :class:`daeclear.SceneError` naming the field,
-    the value and what is allowed. Names are normalised (``method="RK45"`` is stored as
-    ``"rk45"``), ``atol`` as a float, a tuple of floats or a tuple of (quantity, value) pairs
-    (a mapping by quantity). Immutable: derive variants with
-    :meth:`replace`. Combinations that depend on the model (a GGL model with a non-IDA method,
-    ``track_work`` with a non-IDA method) are checked by ``simulate`` before any work.
+    the value and what is allowed; whether the method takes ``step`` is its solver's rule
+    (:meth:`daeclear.solvers.base.Solver.check`, called here). Names are normalised
+    (``method="RK45"`` is stored as ``"rk45"``; a solver class as given), ``atol`` as a float, a
+    tuple of floats or a tuple of (quantity, value) pairs (a mapping by quantity). Immutable:
+    derive variants with :meth:`replace`. Combinations that depend on the model (a GGL model with a
+    non-IDA method, ``track_work`` with a non-IDA method) are checked by the solver before any work.
+
+    Parameters
+    ----------
+    method : str or a solver class
+        "ida", "RK45", "DOP853", "Radau", "BDF", "LSODA", "rk4" or "euler" (case-insensitive;
+        :data:`daeclear.solvers.registry.SOLVERS`), or a class implementing
+        :class:`daeclear.solvers.base.Solver`.
+    rtol : float
+        Relative tolerance (the chapter's "integration tolerance"), in [1e-14, 1e-2].
+    atol : float, mapping, array or None
+        Absolute tolerance of positions and velocities. None: per quantity from the mechanism's
+        scales (:mod:`daeclear.solvers.tolerances`; on the chapter's slider-crank ``1e-3 * rtol``
+        in m, rad and m/s, ``5e-3 * rtol`` in rad/s). A number: every position and velocity. A
+        mapping by quantity, e.g. ``{"q": 1e-9, "v": 1e-6}`` or ``{"position": ..., "angle": ...,
+        "velocity": ..., "angular_velocity": ...}`` (the others keep their defaults). An array:
+        ``2 n_q`` values (positions, then velocities) or one per state. Values below the
+        round-off of their quantity are raised to it, with a warning. Multipliers are always kept
+        out of the error test.
+    formulation : {"ggl", "index1"} or None
+        Used when a Scene is run. None: the solver's own ("ggl", stabilised index 2, for IDA;
+        "index1", the chapter's Baumgarte alpha = beta = 5, for the other methods, which integrate
+        that one only).
+    backend : {"auto", "c", "python"}
+        "c": generated C and an IDA loop in C (fast); "python": scikit-sundae with CasADi
+        callbacks; "auto": C when a compiler works, else python with a warning.
+    max_step : float
+        Largest step, s (0: unbounded); IDA and the scipy methods.
+    max_steps : int
+        Cap on the total number of steps; the run fails cleanly beyond it.
+    step : float or None
+        Step size, s, of the fixed-step methods "rk4" and "euler" (required there, e.g. the
+        chapter's 1e-5); refused by the other methods.
+    linear_solver : {"auto", "reduced", "dense", "sparse"}
+        LU of IDA's Newton iteration in the compiled backend: "reduced" (dense LU of the system
+        left after eliminating the position rows), "dense", "sparse" (SuperLU_MT), or "auto"
+        (sparse for large models, :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES`, reduced
+        below). The python backend and the other methods ignore it.
+    start : {"ideal", "declared"}
+        How a run starts without ``y0``: "ideal" (the chapter's, section 4.4: every clearance joint
+        centred, positions and velocities assembled on the mechanism whose clearance joints are
+        ideal) or "declared" (the bodies' declared state, corrected only for the ideal joints).
+    allow_penetration : bool
+        Start "declared" even with a contact pair deeper in its wall than
+        :data:`daeclear.solvers.physics.START_PENETRATION_FRACTION` of the clearance, or from a
+        ``y0`` deeper than :data:`~daeclear.solvers.physics.GIVEN_PENETRATION_FRACTION` (refused
+        otherwise).
+    track_work : bool
+        Used when a Scene is run (IDA only): integrate the work of drivers and contact forces as
+        the state ``work.input`` (channel ``energy.work``), see :func:`daeclear.assemble`.
     """
 
     method: str = "ida"
@@ -65,11 +115,16 @@ class SolverOptions:
     start: str = "ideal"
     allow_penetration: bool = False
     track_work: bool = False
+    #: who the settings were given to, for the messages (not stored): "simulate" for its keywords
+    where: dataclasses.InitVar[str] = WHERE
 
-    def __post_init__(self) -> None:
-        values = checked({f.name: getattr(self, f.name) for f in dataclasses.fields(self)}, where=WHERE)
+    def __post_init__(self, where: str = WHERE) -> None:
+        values = checked({f.name: getattr(self, f.name) for f in dataclasses.fields(self)}, where=where)
         for name, value in values.items():
             object.__setattr__(self, name, value)
+        from .solvers.registry import solver_class
+
+        solver_class(self.method)().check(self)  # what the method takes: its solver's rule
 
     def replace(self, **changes: Any) -> SolverOptions:
         """A copy with ``changes`` (checked as on construction); unknown names are an error."""
@@ -105,7 +160,7 @@ class SolverOptions:
         if not given:
             return self
         _check_names(given, "merged")
-        return dataclasses.replace(self, **checked({**self.to_dict(), **given}, where=where))
+        return dataclasses.replace(self, where=where, **given)  # checked once, by __post_init__
 
     def atol_value(self) -> float | np.ndarray | dict[str, float] | None:
         """``atol`` as the solvers take it (one value, a mapping by quantity, an array per state, or None)."""
@@ -116,10 +171,11 @@ class SolverOptions:
 
 def checked(values: Mapping[str, Any], *, where: str) -> dict[str, Any]:
     """Every setting of ``values`` (all of SolverOptions' fields) checked and normalised by the rules
-    of :mod:`daeclear.options`; errors name ``where``."""
-    from .solvers.explicit import check_step  # the fixed-step rule, defined once
+    of :mod:`daeclear.options`; errors name ``where``. Whether the method takes ``step`` is its
+    solver's rule (:meth:`daeclear.solvers.base.Solver.check`, called by :class:`SolverOptions`)."""
+    from .solvers.registry import method as method_rule
 
-    method = options.method(values["method"], where=where)
+    method = method_rule(values["method"], where=where)
     raw = values["atol"]
     pairs = isinstance(raw, tuple) and bool(raw) and isinstance(raw[0], tuple)  # a mapping as stored
     atol = options.atol(dict(raw) if pairs else raw, where=where)
@@ -133,7 +189,7 @@ def checked(values: Mapping[str, Any], *, where: str) -> dict[str, Any]:
         "backend": options.backend(values["backend"], where=where),
         "max_step": options.max_step(values["max_step"], where=where),
         "max_steps": options.max_steps(values["max_steps"], where=where),
-        "step": check_step(method, values["step"]),
+        "step": None if values["step"] is None else options.step(values["step"], where=where),
         "linear_solver": options.linear_solver(values["linear_solver"], where=where),
         "start": options.start(values["start"], where=where),
         "allow_penetration": options.flag(values["allow_penetration"], where=where, field="allow_penetration"),

@@ -17,11 +17,11 @@ a start-up transient):
   and acceleration once per revolution, at crank angle 0) and the per-revolution statistics
   come from all of them, the time-history figures and the HDF5 files from the last two.
 
-Two runs per case, from the same assembled model: one with a uniform ``t_eval`` over the
+Two runs per case, from the same assembled model: one with a uniform ``SaveAt.times`` over the
 analysed span (``--dt``, 5 us by default), on the same grid as the ideal joint's run (moment
 differences, Poincaré points at exact revolution times), and one with output at every IDA step
-(``t_eval=None``), used for the journal orbit with one marker per step and for the step sizes.
-``t_eval`` does not change IDA's steps, so both runs take the same steps and find the same
+(``SaveAt()``, every step), used for the journal orbit with one marker per step and for the step sizes.
+``times`` does not change IDA's steps, so both runs take the same steps and find the same
 events (:func:`run_case` warns otherwise).
 
 ``--quick`` simulates 5 ms from t = 0, without transient and Poincaré points (smoke tests).
@@ -181,7 +181,7 @@ def run_case(label: str, scene: dc.Scene, span: Span, args: argparse.Namespace, 
     """
     start = time.perf_counter()
     model = dc.assemble(scene, "index1")  # the chapter's formulation (Tables 4.2, 4.3: Baumgarte 5, 5)
-    dense = dc.simulate(model, span.t_end, t_eval=span.t_eval, rtol=args.rtol)
+    dense = dc.simulate(model, span.t_end, rtol=args.rtol, save=dc.SaveAt(times=span.t_eval))
     per_step = dc.simulate(model, span.t_end, rtol=args.rtol)
     if check_events and not np.array_equal(dense.events.t, per_step.events.t):  # also when the counts differ
         warnings.warn(f"{label}: the dense and per-step runs found different events "
@@ -249,7 +249,7 @@ def first_impact(scene: dc.Scene, rtol: float, t_end: float, n_points: int) -> t
     coarse = dc.simulate(model, t_end, rtol=rtol)
     onset = coarse.events.of(PAIR, "onset")[0]
     separation = [e for e in coarse.events.of(PAIR, "separation") if e.t > onset.t][0]
-    fine = dc.simulate(model, t_end, rtol=rtol, t_eval=np.linspace(onset.t, separation.t, n_points))
+    fine = dc.simulate(model, t_end, rtol=rtol, save=dc.SaveAt(times=np.linspace(onset.t, separation.t, n_points)))
     return fine.slice(onset.t, separation.t), onset, separation
 
 

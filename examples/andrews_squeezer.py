@@ -91,7 +91,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     scene = andrews_squeezer()
     t_end = QUICK_T_END if args.quick else T_END
-    result = dc.simulate(scene, t_end, rtol=RTOL, t_eval=np.linspace(0.0, t_end, 301))
+    result = dc.simulate(scene, t_end, rtol=RTOL, save=dc.SaveAt(times=np.linspace(0.0, t_end, 301)))
     print(result)
     if not args.quick:
         print(f"{'joint':>6} {'daeclear':>22} {'reference':>22} {'error':>9} {'digits':>6}")

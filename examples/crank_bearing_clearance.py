@@ -54,7 +54,7 @@ def run(clearance: float, revolutions: int, points: int = 400) -> dict[str, dc.R
     scenes = {"ideal": dc.mechanisms.slider_crank("ideal", rpm=RPM),
               "rod-slider": dc.mechanisms.slider_crank("revolute", clearance=clearance, rpm=RPM),
               "both": crank_bearing_clearance(clearance)}
-    return {label: dc.simulate(scene, t_end, rtol=1e-7, t_eval=t) for label, scene in scenes.items()}
+    return {label: dc.simulate(scene, t_end, rtol=1e-7, save=dc.SaveAt(times=t)) for label, scene in scenes.items()}
 
 
 def summary(results: dict[str, dc.Result]) -> list[str]:

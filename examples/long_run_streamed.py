@@ -1,10 +1,10 @@
 """A long run in bounded memory: 200 crank revolutions streamed to HDF5, then a window read back.
 
 The slider-crank of section 4.4 with its revolute clearance joint (c = 0.5 mm, 5000 rpm, IDA at
-rtol 1e-6) is simulated for ``--revolutions`` revolutions. The run reports a point every 10 us
-(``t_eval_step``), keeps no IDA steps (``store_steps=False``) and appends each chunk of points,
-the events and the segments to the file as it goes (``stream_to``), returning only its outcome
-(``keep_data=False``): its memory does not grow with the number of revolutions, and a failure or
+rtol 1e-6) is simulated for ``--revolutions`` revolutions. Its output, one ``daeclear.SaveAt``,
+reports a point every 10 us (``every``), keeps no IDA steps (``steps=False``) and appends each
+chunk of points, the events and the segments to the file as it goes (``stream_to``), returning only
+its outcome (``keep_data=False``): its memory does not grow with the number of revolutions, and a failure or
 Ctrl-C leaves the file with what was computed (docs/reliability.md, section 6).
 
 The last two revolutions are then read from the file alone, with ``daeclear.load``'s window (only
@@ -54,8 +54,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     path = args.out / "long_run.h5"
     scene = dc.mechanisms.slider_crank("revolute", rpm=RPM)
     tic = time.perf_counter()
-    outcome = dc.simulate(scene, revolutions * REVOLUTION, t_eval_step=T_EVAL_STEP, store_steps=False,
-                          stream_to=path, keep_data=False, on_failure="return", progress=sys.stderr.isatty())
+    outcome = dc.simulate(scene, revolutions * REVOLUTION, on_failure="return", progress=sys.stderr.isatty(),
+                          save=dc.SaveAt(every=T_EVAL_STEP, steps=False, stream_to=path, keep_data=False))
     print(f"{revolutions} revolutions in {time.perf_counter() - tic:.1f} s: {outcome.message}; "
           f"{outcome.stats['n_steps']} steps, {outcome.stats['n_events']} events; "
           f"{path} ({path.stat().st_size / 1e6:.1f} MB)")

@@ -58,7 +58,7 @@ def run(revolutions: int, sweep: Sequence[float], points: int = 600) -> dict[str
     scenes = {"ideal": dc.mechanisms.slider_crank("ideal", rpm=RPM),
               "dry": dc.mechanisms.slider_crank("revolute", clearance=CLEARANCE, rpm=RPM)}
     scenes.update({f"mu={mu:g}": lubricated(mu) for mu in sorted({VISCOSITY, *sweep}, reverse=True)})
-    return {label: dc.simulate(scene, t_end, rtol=1e-7, t_eval=t) for label, scene in scenes.items()}
+    return {label: dc.simulate(scene, t_end, rtol=1e-7, save=dc.SaveAt(times=t)) for label, scene in scenes.items()}
 
 
 def summary(results: dict[str, dc.Result]) -> list[str]:

@@ -43,7 +43,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     model = dc.assemble(dc.mechanisms.slider_crank("revolute"))
     options = dc.SolverOptions(rtol=1e-6)
-    first = dc.simulate(model, span, options=options, t_eval_step=span / 1000)
+    first = dc.simulate(model, span, options=options, save=dc.SaveAt(every=span / 1000))
 
     # the middle of the last free flight of the first part, on its output grid
     flights = [(a, b) for a, b, modes in first.segments if modes["clearance"] == "free" and b - a > 1e-5]
@@ -55,12 +55,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     t0, y0 = float(first.t[row]), first.y[row]
 
     tight = options.replace(rtol=1e-9)
-    second = dc.simulate(model, 2 * span, t0=t0, y0=y0, options=tight, t_eval_step=span / 1000)
-    whole = dc.simulate(model, 2 * span, options=tight, t_eval=second.t)
+    second = dc.simulate(model, 2 * span, t0=t0, y0=y0, options=tight, save=dc.SaveAt(every=span / 1000))
+    whole = dc.simulate(model, 2 * span, options=tight, save=dc.SaveAt(times=second.t))
 
     # the restart itself: continued at the first part's settings, against one run at those settings
-    same = dc.simulate(model, 2 * span, t0=t0, y0=y0, options=options, t_eval_step=span / 1000)
-    single = dc.simulate(model, 2 * span, options=options, t_eval=same.t)
+    same = dc.simulate(model, 2 * span, t0=t0, y0=y0, options=options, save=dc.SaveAt(every=span / 1000))
+    single = dc.simulate(model, 2 * span, options=options, save=dc.SaveAt(times=same.t))
 
     before = sum(e.t <= t0 for e in first.events)
     stroke = float(np.ptp(whole["slider.x"]))

@@ -93,7 +93,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(f"motor: stall torque {STALL_TORQUE:g} N m, no-load speed {NO_LOAD_SPEED * 30 / math.pi:g} rpm; "
           f"crank inertia {FLYWHEEL_INERTIA:g} kg m^2; t_end {t_end:g} s, rtol {RTOL:g}, GGL")
     for label, joint in cases.items():
-        result = dc.simulate(torque_driven_crank(joint), t_end=t_end, rtol=RTOL, track_work=True, formulation="ggl")
+        result = dc.simulate(torque_driven_crank(joint), t_end=t_end, rtol=RTOL,
+                             options=dc.SolverOptions(track_work=True, formulation="ggl"))
         numbers = summary(result)
         print(f"{label:32s} mean {numbers['mean_rpm']:7.1f} rpm, fluctuation {numbers['fluctuation']:.3f}, "
               f"impacts {numbers['impacts']:5d}, energy residual {numbers['energy_residual']:.1e}")

@@ -74,7 +74,7 @@ def _simulate(scene: dc.Scene, t_eval: np.ndarray, rtol: float) -> tuple[dc.Resu
     start = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", dc.PhysicsWarning)
-        result = dc.simulate(scene, float(t_eval[-1]), t_eval=t_eval, rtol=rtol)
+        result = dc.simulate(scene, float(t_eval[-1]), rtol=rtol, save=dc.SaveAt(times=t_eval))
     found = [str(w.message) for w in caught if issubclass(w.category, dc.PhysicsWarning)]
     return result, time.perf_counter() - start, found
 

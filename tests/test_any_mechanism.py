@@ -194,7 +194,7 @@ def test_ideal_four_bar_follows_the_closed_form_and_the_rocker_limits():
     scene = M.four_bar()
     w = M.rpm_to_rad_s(5000.0)
     t = np.linspace(0.0, 2 * np.pi / w, 721)
-    run = dc.simulate(scene, t_end=float(t[-1]), rtol=1e-9, t_eval=t)
+    run = dc.simulate(scene, t_end=float(t[-1]), rtol=1e-9, save=dc.SaveAt(times=t))
     exact = np.array([[M.ideal_four_bar_state(w * ti, w)[body][k] for body, k in
                        (("coupler", 2), ("rocker", 2), ("rocker", 5))] for ti in run.t])
     np.testing.assert_allclose(np.unwrap(run["coupler.phi"]), np.unwrap(exact[:, 0]), atol=2e-6)
@@ -212,12 +212,12 @@ def test_four_bar_clearance_tends_to_the_ideal_mechanism():
     one by less as the clearance shrinks, in proportion (a few times c over the rocker length)."""
     t_end = 3e-3
     t = np.linspace(0.0, t_end, 301)
-    ideal = dc.simulate(M.four_bar(), t_end=t_end, rtol=1e-8, t_eval=t)["rocker.phi"]
+    ideal = dc.simulate(M.four_bar(), t_end=t_end, rtol=1e-8, save=dc.SaveAt(times=t))["rocker.phi"]
     clearances = (0.4e-3, 0.1e-3, 0.025e-3)
     for joints in (("B",), ("C",), ("D",), ("B", "C")):
         errors = []
         for clearance in clearances:
-            run = dc.simulate(M.four_bar(joints, clearance=clearance), t_end=t_end, rtol=1e-8, t_eval=t)
+            run = dc.simulate(M.four_bar(joints, clearance=clearance), t_end=t_end, rtol=1e-8, save=dc.SaveAt(times=t))
             assert run.success
             errors.append(float(np.max(np.abs(run["rocker.phi"] - ideal))))
         assert errors[1] < 0.5 * errors[0] and errors[2] < 0.5 * errors[1], (joints, errors)
@@ -258,7 +258,8 @@ def test_four_bar_bad_input():
 def test_conservative_double_pendulum_keeps_its_energy():
     """Restitution 1, no friction, no driver, both pins loose: the mechanical energy dips while the
     contacts store energy (the journals hit their bearings) and the energy balance closes."""
-    run = dc.simulate(M.double_pendulum(("A", "B"), restitution=1.0), t_end=0.2, rtol=1e-8, track_work=True)
+    run = dc.simulate(M.double_pendulum(("A", "B"), restitution=1.0), t_end=0.2, rtol=1e-8,
+                      options=dc.SolverOptions(track_work=True))
     assert len(run.events.of("A", kind="onset")) > 3 and len(run.events.of("B", kind="onset")) > 3
     mechanical = np.asarray(run["energy.mechanical"])
     balance = mechanical - np.asarray(run["energy.work"])
@@ -266,17 +267,19 @@ def test_conservative_double_pendulum_keeps_its_energy():
     assert swing > 0.05
     assert np.max(np.abs(mechanical - mechanical[0])) > 1e-5  # the contacts hold energy at times
     assert np.max(np.abs(balance - balance[0])) < 1e-6
-    lossy = dc.simulate(M.double_pendulum(("A", "B"), restitution=0.5), t_end=0.2, rtol=1e-8, track_work=True)
+    lossy = dc.simulate(M.double_pendulum(("A", "B"), restitution=0.5), t_end=0.2, rtol=1e-8,
+                        options=dc.SolverOptions(track_work=True))
     assert lossy["energy.mechanical"][-1] < mechanical[0] - 1e-5  # the same check sees a dissipating law
 
 
 def test_double_pendulum_with_tiny_clearance_follows_the_ideal_one():
     t = np.linspace(0.0, 0.3, 301)
-    ideal = dc.simulate(M.double_pendulum(), t_end=0.3, rtol=1e-8, t_eval=t)
+    ideal = dc.simulate(M.double_pendulum(), t_end=0.3, rtol=1e-8, save=dc.SaveAt(times=t))
     assert abs(ideal["link2.phi"][-1]) > 1.0  # rad: the links swing through a large angle
     errors = []
     for clearance in (50e-6, 5e-6):
-        run = dc.simulate(M.double_pendulum(("A", "B"), clearance=clearance), t_end=0.3, rtol=1e-8, t_eval=t)
+        run = dc.simulate(M.double_pendulum(("A", "B"), clearance=clearance), t_end=0.3, rtol=1e-8,
+                          save=dc.SaveAt(times=t))
         errors.append(max(float(np.max(np.abs(run[f"link{k}.phi"] - ideal[f"link{k}.phi"]))) for k in (1, 2)))
     assert errors[1] < 0.2 * errors[0]  # about in proportion to the clearance
     assert errors[1] < 1e-3
@@ -416,8 +419,9 @@ def test_formulations_and_methods_agree_on_the_four_bars_first_impacts():
     B and C: the same first three impacts (joint, time, approach speed)."""
     scene = M.four_bar(("B", "C"))
     firsts = []
-    for options in (dict(formulation="index1"), dict(formulation="ggl"), dict(method="DOP853")):
-        run = dc.simulate(scene, t_end=0.6e-3, rtol=1e-8, **options)
+    for options in (dc.SolverOptions(formulation="index1"), dc.SolverOptions(formulation="ggl"),
+                    dc.SolverOptions(method="DOP853")):
+        run = dc.simulate(scene, t_end=0.6e-3, rtol=1e-8, options=options)
         assert run.success, options
         firsts.append([(e.pair, e.t, e.approach_speed) for e in run.events.of(kind="onset")[:3]])
     assert [pair for pair, _, _ in firsts[0]] == ["B", "C", "B"]
@@ -459,7 +463,7 @@ def test_one_bearing_convention_for_both_routes_to_a_clearance_at_C():
     assert (library["clearance"].body_i, by_hand["clearance"].body_i, flipped["clearance"].body_i) == (
         "slider", "slider", "rod")
     t = np.linspace(0.0, 4e-3, 81)
-    runs = [dc.simulate(scene, 4e-3, t_eval=t, rtol=1e-9) for scene in (library, by_hand, flipped)]
+    runs = [dc.simulate(scene, 4e-3, rtol=1e-9, save=dc.SaveAt(times=t)) for scene in (library, by_hand, flipped)]
     assert np.max(np.abs(runs[0]["clearance.ex"])) > 1e-4  # the journal moves in its play
     for channel in ("clearance.ex", "clearance.ey"):
         np.testing.assert_allclose(runs[1][channel], runs[0][channel], rtol=0, atol=1e-12)

@@ -199,11 +199,11 @@ def test_compiled_and_python_backends_decide_the_same_storms(kind, storm, plain_
     revolute run with Storm(4, 5e-4) gave 8 events compiled and 12 in Python, both successful.)"""
     model = _slider_crank(kind, storm)
     assert model.auto_pairs
-    fast = dc.simulate(model, 0.012, rtol=1e-8, backend="c", linear_solver=plain_ida)
+    fast = dc.simulate(model, 0.012, rtol=1e-8, options=dc.SolverOptions(backend="c", linear_solver=plain_ida))
     held_fast = fast.stats["held_pairs"]  # pairs held at the end (a run's state: the model keeps none)
-    slow = dc.simulate(model, 0.012, rtol=1e-8, backend="python")
+    slow = dc.simulate(model, 0.012, rtol=1e-8, options=dc.SolverOptions(backend="python"))
     held_slow = slow.stats["held_pairs"]
-    unguarded = dc.simulate(_slider_crank(kind, None), 0.012, rtol=1e-8, backend="c")
+    unguarded = dc.simulate(_slider_crank(kind, None), 0.012, rtol=1e-8, options=dc.SolverOptions(backend="c"))
     assert len(fast.events) < len(unguarded.events)  # the storm guard held pairs through bounces
     assert fast.success and slow.success and held_fast == held_slow
     assert len(fast.events) == len(slow.events) > 5
@@ -246,7 +246,7 @@ def test_the_run_state_read_from_the_compiled_loop_gives_its_terms(kind, storm, 
     monkeypatch.setattr(SegmentLoop, "take_pair_states", take_and_check)
     monkeypatch.setattr(CSession, "set_auto_events",  # the loop returns after every switch: many checks
                         functools.partialmethod(CSession.set_auto_events, capacity=1))
-    result = dc.simulate(model, 0.012, rtol=1e-8, backend="c")
+    result = dc.simulate(model, 0.012, rtol=1e-8, options=dc.SolverOptions(backend="c"))
     assert result.success and len(result.events) > 5 and len(checked) > 5 and max(checked) >= 1
 
 

@@ -34,14 +34,14 @@ def no_work(monkeypatch):
     import sys
 
     import daeclear.studies.accuracy
-    import daeclear.solvers.ida
+    import daeclear.solvers.dispatch
 
     sweep_module = sys.modules["daeclear.studies.sweep"]  # daeclear.sweep is the function
 
     def guard(*args: Any, **kwargs: Any) -> Any:
         raise AssertionError("a bad input reached the computation")
 
-    monkeypatch.setattr(daeclear.solvers.ida, "simulate", guard)
+    monkeypatch.setattr(daeclear.solvers.dispatch, "simulate", guard)
     monkeypatch.setattr(daeclear.studies.accuracy, "simulate", guard)
     monkeypatch.setattr(sweep_module, "_execute", guard)
 
@@ -81,14 +81,14 @@ API_SIMULATE: list[tuple[str, dict[str, Any], str, str]] = [
     ("max_steps=0", {"max_steps": 0}, "max_steps", "max_steps=0"),
     ("max_steps<0", {"max_steps": -5}, "max_steps", "-5"),
     ("max_steps float", {"max_steps": 1.5}, "max_steps", "1.5"),
-    ("t_eval nan", {"t_eval": [0.0, NAN, TINY]}, "t_eval", "nan"),
-    ("t_eval inf", {"t_eval": [0.0, INF]}, "t_eval", "inf"),
-    ("t_eval empty", {"t_eval": []}, "t_eval", "[]"),
-    ("t_eval decreasing", {"t_eval": [TINY, 0.0]}, "t_eval", "0.0001"),
-    ("t_eval repeated", {"t_eval": [0.0, 0.0]}, "t_eval", "[0.0, 0.0]"),
-    ("t_eval negative", {"t_eval": [-1.0, 0.0]}, "t_eval", "-1.0"),
-    ("t_eval beyond t_end", {"t_eval": [0.0, 1.0]}, "t_eval", "1.0"),
-    ("t_eval str", {"t_eval": "0.0,0.01"}, "t_eval", "'0.0,0.01'"),
+    ("times nan", {"times": [0.0, NAN, TINY]}, "times", "nan"),
+    ("times inf", {"times": [0.0, INF]}, "times", "inf"),
+    ("times empty", {"times": []}, "times", "[]"),
+    ("times decreasing", {"times": [TINY, 0.0]}, "times", "0.0001"),
+    ("times repeated", {"times": [0.0, 0.0]}, "times", "[0.0, 0.0]"),
+    ("times negative", {"times": [-1.0, 0.0]}, "times", "-1.0"),
+    ("times beyond t_end", {"times": [0.0, 1.0]}, "times", "1.0"),
+    ("times str", {"times": "0.0,0.01"}, "times", "'0.0,0.01'"),
     ("method", {"method": "rk5"}, "method", "'rk5'"),
     ("method int", {"method": 4}, "method", "4"),
     ("formulation", {"formulation": "index3"}, "formulation", "'index3'"),
@@ -99,46 +99,56 @@ API_SIMULATE: list[tuple[str, dict[str, Any], str, str]] = [
     ("rk4 step<0", {"method": "rk4", "step": -1e-5}, "step", "-1e-05"),
     ("rk4 step=nan", {"method": "rk4", "step": NAN}, "step", "nan"),
     ("ida with step", {"step": 1e-5}, "step", "1e-05"),
-    ("DOP853 t_eval nan", {"method": "DOP853", "t_eval": [0.0, NAN]}, "t_eval", "nan"),
+    ("DOP853 times nan", {"method": "DOP853", "times": [0.0, NAN]}, "times", "nan"),
     ("DOP853 rtol=0", {"method": "DOP853", "rtol": 0.0}, "rtol", "0.0"),
     ("DOP853 t_end=0", {"method": "DOP853", "t_end": 0.0}, "t_end", "0.0"),
     ("progress text", {"progress": "no"}, "progress", "'no'"),
-    ("store_steps None", {"store_steps": None}, "store_steps", "None"),
+    ("steps None", {"steps": None}, "steps", "None"),
     ("track_work 1", {"track_work": 1}, "track_work", "1"),
     ("DOP853 progress text", {"method": "DOP853", "progress": "yes"}, "progress", "'yes'"),
-    ("t_eval_step 0", {"t_eval_step": 0.0}, "t_eval_step", "0.0"),
-    ("t_eval_step > t_end", {"t_eval_step": 1.0}, "t_eval_step", "1.0"),
-    ("t_eval_step nan", {"t_eval_step": NAN}, "t_eval_step", "nan"),
-    ("t_eval_step str", {"t_eval_step": "1e-5"}, "t_eval_step", "'1e-5'"),
-    ("t_eval_step with t_eval", {"t_eval_step": 1e-5, "t_eval": [0.0, TINY]}, "t_eval_step", "1e-05"),
-    ("DOP853 t_eval_step 0", {"method": "DOP853", "t_eval_step": 0.0}, "t_eval_step", "0.0"),
+    ("every 0", {"every": 0.0}, "every", "0.0"),
+    ("every > t_end", {"every": 1.0}, "every", "1.0"),
+    ("every nan", {"every": NAN}, "every", "nan"),
+    ("every str", {"every": "1e-5"}, "every", "'1e-5'"),
+    ("every with times", {"every": 1e-5, "times": [0.0, TINY]}, "every", "1e-05"),
+    ("DOP853 every 0", {"method": "DOP853", "every": 0.0}, "every", "0.0"),
     ("keep_data False without stream_to", {"keep_data": False}, "keep_data", "False"),
     ("keep_data text", {"keep_data": "no"}, "keep_data", "'no'"),
     ("stream_to int", {"stream_to": 3}, "stream_to", "3"),
     # issue 31: contradictions that were silently accepted
-    ("t_eval 2-D", {"t_eval": [[0.0, 5e-5], [6e-5, TINY]]}, "t_eval", "shape (2, 2)"),
-    ("t_eval 3-D", {"t_eval": np.zeros((1, 1, 2))}, "t_eval", "shape (1, 1, 2)"),
+    ("times 2-D", {"times": [[0.0, 5e-5], [6e-5, TINY]]}, "times", "shape (2, 2)"),
+    ("times 3-D", {"times": np.zeros((1, 1, 2))}, "times", "shape (1, 1, 2)"),
     ("rk4 step longer than the run", {"method": "rk4", "step": 1.0}, "step", "step=1.0 s"),
     ("euler step longer than the run", {"method": "euler", "step": 0.5}, "step", "0.5"),
     ("rk4 step longer than t_end - t0", {"method": "rk4", "step": 8e-5, "t0": 5e-5}, "step", "8e-05"),
     # issue 31: output size checked before the run
-    ("t_eval_step too fine", {"t_end": 0.002, "t_eval_step": 1e-12}, "t_eval_step", "t_eval_step=1e-12"),
-    ("t_eval_step above the cap", {"t_eval_step": 1e-5, "max_output_points": 5}, "t_eval_step", "11 output points"),
-    ("t_eval above the cap", {"t_eval": np.linspace(0.0, TINY, 10), "max_output_points": 9}, "t_eval",
+    ("every too fine", {"t_end": 0.002, "every": 1e-12}, "every", "every=1e-12"),
+    ("every above the cap", {"every": 1e-5, "max_points": 5}, "every", "11 output points"),
+    ("times above the cap", {"times": np.linspace(0.0, TINY, 10), "max_points": 9}, "times",
      "array of 10 times"),
     ("rk4 every step above the cap", {"method": "rk4", "step": 1e-11}, "step", "1e-11"),
-    ("DOP853 t_eval_step too fine", {"method": "DOP853", "t_eval_step": 1e-12}, "t_eval_step", "1e+08 output points"),
-    ("max_output_points 0", {"max_output_points": 0}, "max_output_points", "0"),
-    ("max_output_points bool", {"max_output_points": True}, "max_output_points", "True"),
-    ("max_output_points float", {"max_output_points": 1e6}, "max_output_points", "1000000.0"),
+    ("DOP853 every too fine", {"method": "DOP853", "every": 1e-12}, "every", "1e+08 output points"),
+    ("max_points 0", {"max_points": 0}, "max_points", "0"),
+    ("max_points bool", {"max_points": True}, "max_points", "True"),
+    ("max_points float", {"max_points": 1e6}, "max_points", "1000000.0"),
 ]
+
+
+SIMULATE_KEYWORDS = ("t_end", "t0", "y0", "method", "rtol", "atol", "on_failure", "progress", "parameters")
+SAVE_FIELDS = ("times", "every", "steps", "stream_to", "keep_data", "max_points")
 
 
 @pytest.mark.parametrize("case, kwargs, field, shown", API_SIMULATE, ids=[c[0] for c in API_SIMULATE])
 def test_simulate_refuses(case, kwargs, field, shown):
+    """A call's keywords, its solver settings (SolverOptions) and its output (SaveAt): each refused."""
     kwargs = {"t_end": TINY, **kwargs}
     with pytest.raises(SceneError) as info:
-        dc.simulate(SCENE, kwargs.pop("t_end"), **kwargs)
+        save = {k: kwargs.pop(k) for k in list(kwargs) if k in SAVE_FIELDS}
+        settings = {k: kwargs.pop(k) for k in list(kwargs) if k not in SIMULATE_KEYWORDS}
+        if "step" in settings and "method" in kwargs:  # a method and its step: one SolverOptions
+            settings["method"] = kwargs.pop("method")
+        dc.simulate(SCENE, kwargs.pop("t_end"), **kwargs, options=dc.SolverOptions(**settings) if settings else None,
+                    save=dc.SaveAt(**save) if save else None)
     assert field in str(info.value) and shown in str(info.value)
 
 
@@ -148,8 +158,9 @@ API_CALLS: list[tuple[str, Callable[[], Any], type, str, str]] = [
     ("simulate None", lambda: dc.simulate(None, TINY), SceneError, "scene", "None"),
     ("simulate y0 deep in the wall", lambda: dc.simulate(REVOLUTE, TINY, y0=np.zeros(dc.assemble(REVOLUTE).n_states)),
      dc.AssemblyError, "y0", "0.17 m"),
-    ("rk4 y0 deep in the wall", lambda: dc.simulate(REVOLUTE, TINY, method="rk4", step=1e-5,
-                                                    y0=np.zeros(dc.assemble(REVOLUTE, "index1").n_states)),
+    ("rk4 y0 deep in the wall", lambda: dc.simulate(REVOLUTE, TINY,
+                                                    y0=np.zeros(dc.assemble(REVOLUTE, "index1").n_states),
+                                                        options=dc.SolverOptions(method="rk4", step=1e-5)),
      dc.AssemblyError, "y0", "of the clearance 0.0005 m"),
 ]
 

@@ -61,7 +61,7 @@ def test_c_program_counts_are_simulates(bench, compared, formulation):
     _, results = compared
     (r,) = [r for r in results if r.formulation == formulation]
     # an independent simulate call, not the one the setup was recorded from
-    result = dc.simulate(bench.scene(), T_END, rtol=bench.RTOL, formulation=formulation)
+    result = dc.simulate(bench.scene(), T_END, rtol=bench.RTOL, options=dc.SolverOptions(formulation=formulation))
     steps = len(result.step_t) - 1
     assert steps > 100 and len(result.events) > 0  # the window has contacts: events are compared
     assert r.bound.steps == steps
@@ -86,7 +86,7 @@ def test_agreement_names_what_differs(bench, compared):
     """The check can fail: a run with other counts or another end state is reported, item by item."""
     _, results = compared
     r = results[0]
-    result = dc.simulate(bench.scene(), T_END, rtol=bench.RTOL, formulation=r.formulation)
+    result = dc.simulate(bench.scene(), T_END, rtol=bench.RTOL, options=dc.SolverOptions(formulation=r.formulation))
     recorder = dataclasses.replace(bench.Recorder(1, 0, 0, 0, 0), stored=[len(result.step_t) - 1])
     assert bench.agreement(r.bound, recorder, result, r.n_q) == []
     y_end = r.bound.y_end.copy()

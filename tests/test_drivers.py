@@ -94,7 +94,8 @@ def test_profile_constraint_against_the_closed_form(kind):
 @pytest.mark.parametrize("kind", sorted(PROFILES))
 def test_profile_simulated_against_the_closed_form(kind):
     profile, speed, closed = PROFILES[kind]
-    result = dc.simulate(disc_scene(profile, speed), 0.19, rtol=1e-9, formulation="ggl", t_eval=T_CHECK)
+    result = dc.simulate(disc_scene(profile, speed), 0.19, rtol=1e-9, options=dc.SolverOptions(formulation="ggl"),
+                         save=dc.SaveAt(times=T_CHECK))
     angle, omega, alpha = closed(T_CHECK)
     scale = max(1.0, float(np.max(np.abs(alpha))))
     np.testing.assert_allclose(result["disc.phi"], angle, rtol=0, atol=1e-9)
@@ -159,7 +160,8 @@ def test_driven_translational_joint_force_by_hand():
     """Force along the guide = m a + m g sin(incline); the block moves as prescribed; the driver's
     work closes the energy balance (track_work)."""
     t = np.linspace(0.0, 0.4, 41)
-    result = dc.simulate(inclined_block("ideal"), 0.4, rtol=1e-10, formulation="ggl", t_eval=t, track_work=True)
+    result = dc.simulate(inclined_block("ideal"), 0.4, rtol=1e-10,
+                         options=dc.SolverOptions(formulation="ggl", track_work=True), save=dc.SaveAt(times=t))
     x, speed, acc = push_closed(t)
     np.testing.assert_allclose(result["push.force"], 2.0 * acc + 2.0 * 9.81 * math.sin(INCLINE), rtol=1e-6)
     along = (result["block.x"] - 0.1) * math.cos(INCLINE) + (result["block.y"] - 0.2) * math.sin(INCLINE)
@@ -175,7 +177,7 @@ def test_slider_driven_along_a_guide_with_play():
     contact forces are normal to the guide, so the driving force is still m a + m g sin(incline),
     while the slider rattles across the play (contact events) and stays inside it."""
     t = np.linspace(0.0, 0.2, 41)
-    result = dc.simulate(inclined_block("clearance"), 0.2, rtol=1e-8, t_eval=t)
+    result = dc.simulate(inclined_block("clearance"), 0.2, rtol=1e-8, save=dc.SaveAt(times=t))
     x, _, acc = push_closed(t)
     assert result.events, "gravity has a component across the guide: the slider must reach a surface"
     np.testing.assert_allclose(result["push.force"], 2.0 * acc + 2.0 * 9.81 * math.sin(INCLINE), rtol=1e-5)
@@ -209,11 +211,11 @@ def test_crank_driven_through_a_clearance_bearing_tends_to_the_ideal_mechanism()
     moment 172 %, 88 %, 42 %: impact spikes; GGL, the default), and the impacts at the pivot get softer. The crank
     keeps its prescribed speed although its journal moves in the play."""
     t = np.linspace(0.0, REVOLUTION, 601)
-    ideal = dc.simulate(dc.mechanisms.slider_crank("ideal"), REVOLUTION, rtol=1e-8, t_eval=t)
+    ideal = dc.simulate(dc.mechanisms.slider_crank("ideal"), REVOLUTION, rtol=1e-8, save=dc.SaveAt(times=t))
     rms = lambda x: float(np.sqrt(np.mean(x**2)))  # noqa: E731
     velocity, moment, depth = [], [], []
     for clearance in (0.4e-3, 0.1e-3, 0.025e-3):
-        result = dc.simulate(crank_bearing_clearance(clearance), REVOLUTION, rtol=1e-7, t_eval=t)
+        result = dc.simulate(crank_bearing_clearance(clearance), REVOLUTION, rtol=1e-7, save=dc.SaveAt(times=t))
         assert result.success and result.events.of("A", kind="onset"), clearance  # the crank journal impacts
         depth.append(float(np.max(result["A.penetration"])))
         np.testing.assert_allclose(np.diff(result["crank.phi"]) / np.diff(t), 5000 * math.pi / 30, rtol=1e-6)
@@ -243,23 +245,24 @@ def test_a_declared_start_in_deep_penetration_is_refused():
     with pytest.raises(AssemblyError, match=r"clearance joint 'clearance' starts in deep penetration: 'clearance' "
                        r"is 0\.0002 m inside the wall at t=0, 40% of the clearance 0\.0005 m .* at most 10% .* "
                        r"5e-05 m.*allow_penetration=True"):
-        dc.simulate(deep, 1e-4, start="declared")
+        dc.simulate(deep, 1e-4, options=dc.SolverOptions(start="declared"))
     with pytest.raises(AssemblyError, match="deep penetration"):
         dc.assemble(deep).initial_state(start="declared")
     with pytest.raises(AssemblyError, match="deep penetration"):
-        dc.simulate(deep, 1e-4, start="declared", method="rk4", step=1e-6)
-    allowed = dc.simulate(deep, 1e-4, start="declared", allow_penetration=True)
+        dc.simulate(deep, 1e-4, options=dc.SolverOptions(method="rk4", start="declared", step=1e-6))
+    allowed = dc.simulate(deep, 1e-4, options=dc.SolverOptions(start="declared", allow_penetration=True))
     assert allowed["clearance.penetration"][0] == pytest.approx(0.2e-3, rel=1e-6)
     assert dc.simulate(deep, 1e-4).success  # the chapter's start centres the journal
-    shallow = dc.simulate(journal_off_centre(0.54e-3), 1e-4, start="declared")
+    shallow = dc.simulate(journal_off_centre(0.54e-3), 1e-4, options=dc.SolverOptions(start="declared"))
     assert shallow["clearance.penetration"][0] == pytest.approx(0.04e-3, rel=1e-6)
     with pytest.raises(AssemblyError, match="deep penetration"):
-        dc.simulate(journal_off_centre(0.56e-3), 1e-4, start="declared")  # 0.06 mm: 12 %
+        dc.simulate(journal_off_centre(0.56e-3), 1e-4, options=dc.SolverOptions(start="declared"))  # 0.06 mm: 12 %
 
 
 def test_allow_penetration_is_validated():
-    with pytest.raises(SceneError, match=r"simulate: allow_penetration='yes', must be True or False"):
-        dc.simulate(journal_off_centre(0.7e-3), 1e-4, start="declared", allow_penetration="yes")
+    with pytest.raises(SceneError, match=r"SolverOptions: allow_penetration='yes', must be True or False"):
+        dc.simulate(journal_off_centre(0.7e-3), 1e-4,
+                    options=dc.SolverOptions(start="declared", allow_penetration="yes"))
 
 
 # ---------------------------------------------------------------- inputs and scene files
@@ -390,7 +393,7 @@ def test_translational_driver_start_from_body_fixed_points():
     scene.add(dc.Driver("push", "G", speed=2.0))
     model = dc.assemble(scene)
     assert model.parameter("push.position0")[0] == pytest.approx((0.3 - 0.1) * 0.6 + 0.4 * 0.8, rel=1e-14)
-    result = dc.simulate(model, 0.1, rtol=1e-9, t_eval=[0.0, 0.1])
+    result = dc.simulate(model, 0.1, rtol=1e-9, save=dc.SaveAt(times=[0.0, 0.1]))
     along = (result["block.x"] - 0.1) * 0.6 + result["block.y"] * 0.8
     np.testing.assert_allclose(along, [0.44, 0.64], atol=1e-9)
     np.testing.assert_allclose(result["push.force"], 0.0, atol=1e-9)  # no gravity, constant speed
@@ -405,12 +408,13 @@ def test_profile_is_saved_with_the_result(tmp_path: Path):
 
 def test_deep_penetration_is_refused_by_the_python_backend_too():
     with pytest.raises(AssemblyError, match="deep penetration"):
-        dc.simulate(journal_off_centre(0.7e-3), 1e-4, start="declared", backend="python")
+        dc.simulate(journal_off_centre(0.7e-3), 1e-4, options=dc.SolverOptions(start="declared", backend="python"))
 
 
 def test_work_of_a_driver_through_a_clearance_bearing_closes_the_energy_balance():
     """track_work: the driver's and the contact forces' work equals the change of mechanical energy."""
-    result = dc.simulate(crank_bearing_clearance(0.1e-3), REVOLUTION, rtol=1e-8, track_work=True)
+    result = dc.simulate(crank_bearing_clearance(0.1e-3), REVOLUTION, rtol=1e-8,
+                         options=dc.SolverOptions(track_work=True))
     assert result.events.of("A", kind="onset")
     work = result["energy.work"]
     balance = result["energy.mechanical"] - result["energy.mechanical"][0] - work
@@ -432,8 +436,9 @@ def test_slider_declared_in_its_guide_wall_is_refused():
 
     with pytest.raises(AssemblyError, match=r"clearance joint 'g' starts in deep penetration: 'g\.\w+' is 0\.0002 m "
                        r"inside the wall at t=0, 40% of the clearance 0\.0005 m .* 5e-05 m"):
-        dc.simulate(slider(0.2e-3), 1e-4, start="declared")
-    result = dc.simulate(slider(0.04e-3), 1e-4, start="declared", t_eval=[0.0, 1e-4])
+        dc.simulate(slider(0.2e-3), 1e-4, options=dc.SolverOptions(start="declared"))
+    result = dc.simulate(slider(0.04e-3), 1e-4, options=dc.SolverOptions(start="declared"),
+                         save=dc.SaveAt(times=[0.0, 1e-4]))
     depths = [result[name][0] for name in result.channel_names
               if name.startswith("g.") and name.endswith(".penetration")]
     assert len(depths) >= 2 and max(depths) == pytest.approx(0.04e-3, rel=1e-6)  # 8 %: started
@@ -454,7 +459,7 @@ def test_crank_period_needs_a_constant_speed_rotation():
 def test_four_bar_driven_through_a_clearance_bearing():
     """mechanisms.four_bar(("A",)): the driven joint itself has clearance; the crank keeps its speed."""
     t = np.linspace(0.0, REVOLUTION, 121)
-    result = dc.simulate(dc.mechanisms.four_bar(("A",)), REVOLUTION, rtol=1e-7, t_eval=t)
+    result = dc.simulate(dc.mechanisms.four_bar(("A",)), REVOLUTION, rtol=1e-7, save=dc.SaveAt(times=t))
     assert isinstance(dc.mechanisms.four_bar(("A",))["A"], dc.RevoluteClearance)
     assert result.success and result.events.of("A", kind="onset")
     np.testing.assert_allclose(result["crank.omega"], 5000 * math.pi / 30, rtol=1e-6)

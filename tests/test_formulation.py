@@ -31,8 +31,8 @@ def test_the_default_is_ggl_for_ida_and_index1_for_the_other_methods(scene):
     assert options.DEFAULT_FORMULATION == "ggl" and options.CHAPTER_FORMULATION == "index1"
     assert dc.assemble(scene).formulation == "ggl"
     assert dc.simulate(scene, 1e-4).formulation == "ggl"
-    assert dc.simulate(scene, 1e-4, method="rk4", step=1e-6).formulation == "index1"
-    assert dc.simulate(scene, 1e-4, formulation="index1").formulation == "index1"
+    assert dc.simulate(scene, 1e-4, options=dc.SolverOptions(method="rk4", step=1e-6)).formulation == "index1"
+    assert dc.simulate(scene, 1e-4, options=dc.SolverOptions(formulation="index1")).formulation == "index1"
 
 
 def test_first_onset_converges_at_a_small_clearance(scene):
@@ -46,7 +46,8 @@ def test_index1_first_onset_at_a_tiny_clearance_is_accurate(scene):
     takes, its first onset at c = 0.01 mm and rtol 1e-6 came 7.3e-3 (relative) late."""
     reference = dc.simulate(scene, 5e-5, method="DOP853", rtol=1e-12).events.of(kind="onset")[0].t
     for rtol in (1e-6, 1e-8):
-        onset = dc.simulate(scene, 5e-5, rtol=rtol, formulation="index1").events.of(kind="onset")[0].t
+        onset = dc.simulate(scene, 5e-5, rtol=rtol,
+                            options=dc.SolverOptions(formulation="index1")).events.of(kind="onset")[0].t
         assert abs(onset - reference) / reference < 1e-5  # measured 7.7e-7 and 1.0e-6
 
 
@@ -64,7 +65,7 @@ def translational_twin() -> tuple[dc.DAEModel, dc.Result, int]:
 
     model = dc.assemble(dc.mechanisms.slider_crank("translational", clearance=CLEARANCE))
     period = crank_period(model)
-    base = dc.simulate(model, 25 * period, t_eval=sampling_times(period, 25), store_steps=False)
+    base = dc.simulate(model, 25 * period, save=dc.SaveAt(times=sampling_times(period, 25), steps=False))
     return model, base, int(abs(base.t - 5 * period).argmin())
 
 
@@ -80,7 +81,7 @@ def test_a_projected_restart_does_not_skip_a_contact(translational_twin, backend
 
     model, base, index = translational_twin
     start = restart_state(model, base, index, perturbation=DEFAULT_PERTURBATION)
-    twin = dc.simulate(model, start.t0 + 0.025, t0=start.t0, y0=start.y0, backend=backend)
+    twin = dc.simulate(model, start.t0 + 0.025, t0=start.t0, y0=start.y0, options=dc.SolverOptions(backend=backend))
     corners = [name for name in twin.channel_names if name.endswith(("_lower.penetration", "_upper.penetration"))]
     assert len(corners) == 4 and len(twin.events) > 45  # measured 52 on both backends (38 with the contact missed)
     assert max(float(twin[name].max()) for name in corners) < 3 * CLEARANCE  # measured 2.7e-5 m

@@ -60,8 +60,8 @@ def moment_closed_form(theta, g):
 def test_one_revolution_matches_closed_form(formulation, gravity):
     period = 2 * np.pi / OMEGA
     t = np.linspace(0.0, period, 721)
-    result = dc.simulate(dc.mechanisms.slider_crank(gravity=gravity), period, t_eval=t, rtol=1e-9,
-                         formulation=formulation)
+    result = dc.simulate(dc.mechanisms.slider_crank(gravity=gravity), period, rtol=1e-9,
+                         options=dc.SolverOptions(formulation=formulation), save=dc.SaveAt(times=t))
     assert result.success
     theta = OMEGA * t
     x, vx, ax = slider_kinematics(theta)
@@ -79,7 +79,7 @@ def test_power_balance_from_simulated_channels():
     """M omega = d(T + V)/dt using only the simulated energy channel (independent of the closed form)."""
     period = 2 * np.pi / OMEGA
     t = np.linspace(0.0, period, 4001)
-    result = dc.simulate(dc.mechanisms.slider_crank(), period, t_eval=t, rtol=1e-10)
+    result = dc.simulate(dc.mechanisms.slider_crank(), period, rtol=1e-10, save=dc.SaveAt(times=t))
     energy = result["energy.mechanical"]
     dEdt = np.gradient(energy, t, edge_order=2)
     power = result["drive.moment"] * OMEGA
@@ -94,7 +94,7 @@ def test_joint_channels_match_the_closed_form():
     period = 2 * np.pi / OMEGA
     t = np.linspace(0.0, 1.5 * period, 541)
     scene = dc.mechanisms.slider_crank()
-    result = dc.simulate(scene, 1.5 * period, t_eval=t, rtol=1e-10)
+    result = dc.simulate(scene, 1.5 * period, rtol=1e-10, save=dc.SaveAt(times=t))
     theta = OMEGA * t
     beta = np.arcsin(-R * np.sin(theta) / L)
     beta_dot = -R * np.cos(theta) * OMEGA / (L * np.cos(beta))
@@ -116,7 +116,7 @@ def test_joint_channels_of_clearance_joints(joint):
     """A clearance joint has the same coordinate: the journal body's angle relative to the bearing
     body's; the slider centre's displacement along the guide, which is the joint's own `.s`."""
     scene = dc.mechanisms.slider_crank(joint)
-    result = dc.simulate(scene, 2e-3, rtol=1e-8, t_eval=np.linspace(0.0, 2e-3, 41))
+    result = dc.simulate(scene, 2e-3, rtol=1e-8, save=dc.SaveAt(times=np.linspace(0.0, 2e-3, 41)))
     clearance = scene["clearance"]
     if joint == "revolute":
         expected = result[f"{clearance.body_j}.phi"] - result[f"{clearance.body_i}.phi"]

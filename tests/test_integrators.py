@@ -43,13 +43,13 @@ def clearance():
 def test_ideal_one_revolution_matches_closed_form(ideal, method):
     te = np.linspace(0.0, REV, 121)
     rtol = 1e-8
-    result = dc.simulate(ideal, REV, method=method.lower(), rtol=rtol, t_eval=te)  # case-insensitive
+    result = dc.simulate(ideal, REV, method=method.lower(), rtol=rtol, save=dc.SaveAt(times=te))  # case-insensitive
     assert result.success, result.message
     assert result.method == method
     np.testing.assert_array_equal(result.t, te)
     assert np.max(np.abs(result["slider.x"] - slider_x(te))) < 50 * rtol * 0.17
     # the multipliers come from the same system as IDA's: the driving moment agrees
-    ref = dc.simulate(ideal, REV, rtol=1e-10, t_eval=te)
+    ref = dc.simulate(ideal, REV, rtol=1e-10, save=dc.SaveAt(times=te))
     moment = ref["drive.moment"]
     assert np.max(np.abs(result["drive.moment"] - moment)) < 1e-5 * np.max(np.abs(moment))
     stats = result.stats
@@ -65,7 +65,7 @@ def test_ideal_one_revolution_matches_closed_form(ideal, method):
 
 @pytest.mark.parametrize("method, step, bound", [("rk4", 1e-5, 1e-10), ("euler", 1e-6, 2e-4)])
 def test_ideal_fixed_step_matches_closed_form(ideal, method, step, bound):
-    result = dc.simulate(ideal, REV, method=method, step=step)
+    result = dc.simulate(ideal, REV, options=dc.SolverOptions(method=method, step=step))
     assert result.success, result.message
     # every step is an output point; the last one lands on t_end
     assert result.t[-1] == REV and result.stats["n_steps"] == round(REV / step)
@@ -80,7 +80,7 @@ def test_fixed_step_orders_of_convergence(ideal):
     exact = slider_x(te)
 
     def error(method, step):
-        result = dc.simulate(ideal, t_end, method=method, step=step, t_eval=te)
+        result = dc.simulate(ideal, t_end, options=dc.SolverOptions(method=method, step=step), save=dc.SaveAt(times=te))
         return np.max(np.abs(result["slider.x"] - exact))
 
     rk4 = [error("rk4", h) for h in (1e-4, 5e-5)]
@@ -105,9 +105,9 @@ def test_first_impact_agrees_across_methods(clearance):
     te = np.concatenate([[0.0], np.linspace(2.2e-4, 3.0e-4, 8001)])  # 10 ns resolution of the peaks
     ggl = dc.assemble(dc.mechanisms.slider_crank("revolute", gravity=0.0), "ggl")
     runs = {
-        "ida/index1": dc.simulate(clearance, t_end, rtol=1e-10, t_eval=te),
-        "ida/ggl": dc.simulate(ggl, t_end, rtol=1e-10, t_eval=te),
-        "DOP853": dc.simulate(clearance, t_end, method="DOP853", rtol=1e-10, t_eval=te),
+        "ida/index1": dc.simulate(clearance, t_end, rtol=1e-10, save=dc.SaveAt(times=te)),
+        "ida/ggl": dc.simulate(ggl, t_end, rtol=1e-10, save=dc.SaveAt(times=te)),
+        "DOP853": dc.simulate(clearance, t_end, method="DOP853", rtol=1e-10, save=dc.SaveAt(times=te)),
     }
     values = {name: first_impact(r) for name, r in runs.items()}
     onset, force, penetration = values["ida/index1"]
@@ -128,8 +128,10 @@ def test_same_event_sequence_as_ida_before_chaos(clearance):
     t_end = 5e-3
     ref = dc.simulate(clearance, t_end, rtol=1e-11)
     assert len(ref.events) >= 10
-    for method, kw in [("DOP853", dict(rtol=1e-10)), ("LSODA", dict(rtol=1e-9)), ("rk4", dict(step=2e-7))]:
-        result = dc.simulate(clearance, t_end, method=method, **kw)
+    for settings in [dc.SolverOptions(method="DOP853", rtol=1e-10), dc.SolverOptions(method="LSODA", rtol=1e-9),
+                     dc.SolverOptions(method="rk4", step=2e-7)]:
+        method = settings.method
+        result = dc.simulate(clearance, t_end, options=settings)
         assert result.success, result.message
         assert result.events.kind == ref.events.kind, method
         np.testing.assert_allclose(result.events.t, ref.events.t, rtol=0, atol=2e-8, err_msg=method)
@@ -142,7 +144,7 @@ def test_same_event_sequence_as_ida_before_chaos(clearance):
 
 
 def test_event_times_are_not_quantised_to_the_step(clearance):
-    result = dc.simulate(clearance, 4e-4, method="rk4", step=1e-5)
+    result = dc.simulate(clearance, 4e-4, options=dc.SolverOptions(method="rk4", step=1e-5))
     t_onset = result.events.t[0]
     assert abs(t_onset / 1e-5 - round(t_onset / 1e-5)) > 1e-3  # not on the step grid
     # the event point is an output point of the run, with the state at the event
@@ -154,9 +156,9 @@ def test_event_times_are_not_quantised_to_the_step(clearance):
 
 
 def test_python_backend_matches_compiled(clearance):
-    kw = dict(method="rk4", step=1e-6, t_eval=np.linspace(0.0, 3e-4, 31))
-    c = dc.simulate(clearance, 3e-4, backend="c", **kw)
-    py = dc.simulate(clearance, 3e-4, backend="python", **kw)
+    settings, save = dc.SolverOptions(method="rk4", step=1e-6), dc.SaveAt(times=np.linspace(0.0, 3e-4, 31))
+    c = dc.simulate(clearance, 3e-4, options=settings.replace(backend="c"), save=save)
+    py = dc.simulate(clearance, 3e-4, options=settings.replace(backend="python"), save=save)
     assert c.stats["backend"] == "c" and py.stats["backend"] == "python"
     np.testing.assert_allclose(py.events.t, c.events.t, rtol=0, atol=1e-15)
     np.testing.assert_allclose(py.y, c.y, rtol=1e-9, atol=1e-12)
@@ -165,13 +167,13 @@ def test_python_backend_matches_compiled(clearance):
 
 def test_t_eval_and_store_steps(clearance):
     te = np.linspace(0.0, 4e-4, 41)
-    for method, kw in [("RK45", dict(rtol=1e-9)), ("rk4", dict(step=1e-6))]:
-        result = dc.simulate(clearance, 4e-4, method=method, t_eval=te, **kw)
+    for settings in [dc.SolverOptions(method="RK45", rtol=1e-9), dc.SolverOptions(method="rk4", step=1e-6)]:
+        result = dc.simulate(clearance, 4e-4, options=settings, save=dc.SaveAt(times=te))
         np.testing.assert_array_equal(result.t, te)
         assert result.step_t.size > te.size  # the steps are recorded too
-        dense = dc.simulate(clearance, 4e-4, rtol=1e-10, t_eval=te)
+        dense = dc.simulate(clearance, 4e-4, rtol=1e-10, save=dc.SaveAt(times=te))
         np.testing.assert_allclose(result["slider.vx"], dense["slider.vx"], rtol=0, atol=5e-5)  # |vx| < 10 m/s
-    bare = dc.simulate(clearance, 4e-4, method="DOP853", store_steps=False)
+    bare = dc.simulate(clearance, 4e-4, method="DOP853", save=dc.SaveAt(steps=False))
     np.testing.assert_array_equal(bare.t, [0.0])
     assert len(bare.events) == 2
 
@@ -186,29 +188,29 @@ def test_bad_method_step_and_formulation(ideal):
     with pytest.raises(dc.SceneError, match="step="):
         dc.simulate(ideal, 0.01, method="rk4")
     with pytest.raises(dc.SceneError, match="step="):
-        dc.simulate(ideal, 0.01, method="euler", step=-1e-5)
+        dc.simulate(ideal, 0.01, options=dc.SolverOptions(method="euler", step=-1e-5))
     with pytest.raises(dc.SceneError, match="only for the fixed-step"):
-        dc.simulate(ideal, 0.01, method="DOP853", step=1e-5)
+        dc.simulate(ideal, 0.01, options=dc.SolverOptions(method="DOP853", step=1e-5))
     with pytest.raises(dc.SceneError, match="only for the fixed-step"):
-        dc.simulate(ideal, 0.01, step=1e-5)  # IDA chooses its own steps
+        dc.simulate(ideal, 0.01, options=dc.SolverOptions(step=1e-5))  # IDA chooses its own steps
     with pytest.raises(dc.SceneError, match="IDA only"):
-        dc.simulate(scene, 0.01, method="Radau", formulation="ggl")
+        dc.simulate(scene, 0.01, method="Radau", options=dc.SolverOptions(formulation="ggl"))
     with pytest.raises(dc.SceneError, match="IDA only"):
-        dc.simulate(dc.assemble(scene, "ggl"), 0.01, method="rk4", step=1e-5)
+        dc.simulate(dc.assemble(scene, "ggl"), 0.01, options=dc.SolverOptions(method="rk4", step=1e-5))
 
 
 def test_failing_run_returns_partial_result():
     # a model of its own: a run that ends in a blow-up may leave its contact logic in a storm state
     clearance = dc.assemble(dc.mechanisms.slider_crank("revolute", gravity=0.0), "index1")
-    result = dc.simulate(clearance, 0.024, method="euler", step=1e-4, on_failure="return")
+    result = dc.simulate(clearance, 0.024, on_failure="return", options=dc.SolverOptions(method="euler", step=1e-4))
     assert not result.success and result.status == -1
     assert result.message.startswith("euler failed at t=")
     assert "'clearance' in contact" in result.message and "smaller step" in result.message
     assert 0.0 < result.t[-1] < 0.024 and len(result.events) >= 1
     with pytest.raises(dc.SolveError, match="euler failed") as info:
-        dc.simulate(clearance, 0.024, method="euler", step=1e-4)
+        dc.simulate(clearance, 0.024, options=dc.SolverOptions(method="euler", step=1e-4))
     assert info.value.result.success is False
-    capped = dc.simulate(clearance, 0.024, method="DOP853", max_steps=30, on_failure="return")
+    capped = dc.simulate(clearance, 0.024, method="DOP853", on_failure="return", options=dc.SolverOptions(max_steps=30))
     assert not capped.success and "max_steps=30" in capped.message
     assert capped.stats["n_steps"] == 30
 
@@ -231,8 +233,8 @@ def test_without_a_compiler_falls_back_to_python(monkeypatch, tmp_path):
     clear_memos()  # nor loaded in this process (models of one structure share their library)
     model = dc.assemble(dc.mechanisms.slider_crank("ideal", gravity=0.0), "index1")
     with pytest.warns(dc.DaeclearWarning, match="compiled right-hand side is unavailable"):
-        result = dc.simulate(model, 1e-3, method="rk4", step=1e-5)
+        result = dc.simulate(model, 1e-3, options=dc.SolverOptions(method="rk4", step=1e-5))
     assert result.success and result.stats["backend"] == "python"
     assert np.max(np.abs(result["slider.x"] - slider_x(result.t))) < 1e-10
     with pytest.raises(dc.DaeclearError, match="compiled ODE backend"):
-        dc.simulate(model, 1e-3, method="rk4", step=1e-5, backend="c")
+        dc.simulate(model, 1e-3, options=dc.SolverOptions(method="rk4", step=1e-5, backend="c"))

@@ -198,7 +198,7 @@ def test_public_api_unchanged():
     from daeclear.assembly.assemble import DAEModel, assemble
     from daeclear.model.scene import Scene
     from daeclear.results.result import Result
-    from daeclear.solvers.ida import simulate
+    from daeclear.solvers.dispatch import simulate
     from daeclear.studies.sweep import sweep
 
     for name in daeclear.__all__:

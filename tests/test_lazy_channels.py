@@ -30,7 +30,8 @@ def scene() -> dc.Scene:
 @pytest.fixture(scope="module")
 def runs(scene: dc.Scene) -> dict[str, dc.Result]:
     """Two revolutions of the Fig. 4.15 scene (51 impacts), both formulations, rtol 1e-8."""
-    return {form: dc.simulate(scene, TWO_REVOLUTIONS, rtol=1e-8, formulation=form) for form in ("index1", "ggl")}
+    return {form: dc.simulate(scene, TWO_REVOLUTIONS, rtol=1e-8,
+                              options=dc.SolverOptions(formulation=form)) for form in ("index1", "ggl")}
 
 
 @pytest.mark.parametrize("formulation", ["index1", "ggl"])
@@ -51,6 +52,38 @@ def test_lazy_channels_equal_the_one_pass_report_value_for_value(runs, scene, fo
     assert values.shape == (len(model.channel_names), result.n_times)
     for name, row in zip(model.channel_names, values):
         assert np.array_equal(result[name], row), name
+
+
+@pytest.mark.parametrize("joint", ["revolute", "translational", "ideal"])
+def test_the_checked_channels_are_the_outputs_own(joint):
+    """The model's checks function (the penetrations and the constraint drift the physics checks read)
+    equals, bit for bit, those channels of the whole output function at a run's rows, in the compiled
+    library and in CasADi; a model without contact pairs checks the drift alone."""
+    scene = dc.mechanisms.slider_crank(joint)
+    result = dc.simulate(scene, TWO_REVOLUTIONS / 8, rtol=1e-8)
+    model = dc.assemble(scene, "ggl")
+    expected = [c for c in model.channel_names if c.endswith(".penetration") or c == "constraints.position"]
+    assert model.checked_names == tuple(expected) and "constraints.position" in expected
+    assert {f"{g}.penetration" for g in model.gap_names} <= set(expected)  # every contact pair's
+    switch = np.array(result.channel_source.switch)
+    whole = model.channels(result.t, result.y, result.yp, switch)
+    session = open_session(model.functions, rtol=1e-8, atol=1.0, parameters=model.parameter_values)
+    try:
+        compiled = model.checks(result.t, result.y, result.yp, switch, session)
+    finally:
+        session.close()
+    for checked in (compiled, model.checks(result.t, result.y, result.yp, switch)):
+        assert tuple(checked) == model.checked_names
+        for name, values in checked.items():
+            assert np.array_equal(values, whole[name]), name
+    assert np.max(compiled["constraints.position"]) > 0.0  # values, not zeros: GGL's drift is round-off
+
+
+def test_a_run_in_memory_computes_its_channels_when_read(scene):
+    """simulate checks the run on its checked channels alone: the others wait for the first read."""
+    result = dc.simulate(scene, TWO_REVOLUTIONS / 4, rtol=1e-8)
+    assert result.channel_source is not None and not result.channel_source.computed
+    assert result["clearance.normal_force"].max() > 1e3 and result.channel_source.computed
 
 
 def test_the_switch_rows_follow_the_segments(runs):
@@ -100,8 +133,9 @@ def test_a_file_in_the_old_layout_loads(runs, tmp_path):
 def test_a_streamed_run_writes_states_and_reads_back_its_channels(scene, tmp_path):
     path = tmp_path / "s.h5"
     grid = np.linspace(0.0, 0.004, 4001)
-    streamed = dc.simulate(scene, 0.004, t_eval=grid, stream_to=path)  # keep_data: read back from the file
-    memory = dc.simulate(scene, 0.004, t_eval=grid)
+    streamed = dc.simulate(scene, 0.004,
+                           save=dc.SaveAt(times=grid, stream_to=path))  # keep_data: read back from the file
+    memory = dc.simulate(scene, 0.004, save=dc.SaveAt(times=grid))
     assert np.array_equal(streamed.y, memory.y) and np.array_equal(streamed.yp, memory.yp)
     for name in memory.channel_names:
         assert np.array_equal(streamed[name], memory[name]), name
@@ -109,9 +143,10 @@ def test_a_streamed_run_writes_states_and_reads_back_its_channels(scene, tmp_pat
 
 
 def test_the_main_jobs_file_is_a_few_mb(tmp_path, monkeypatch):
-    """`daeclear run slider_crank --joint revolute` (README's first command): two revolutions on a 1 us
-    grid, 24 001 points. The file holds t and y (8 bytes x (1 + 32 states) = 264 bytes a point: 6.3 MB),
-    the steps, events and segments; version 1 stored yp and 51 channels besides (864 bytes a point, 21 MB)."""
+    """`daeclear run slider_crank --joint revolute` (README's first command): two revolutions on a 2 us
+    grid, 12 001 points. The file holds t and y (8 bytes x (1 + 32 states) = 264 bytes a point: 3.2 MB),
+    the steps, events and segments in small chunks; version 1 stored yp and 51 channels besides (864
+    bytes a point), and chunks of 4096 events (0.6 MB for the run's 61)."""
     from daeclear.cli import main
 
     assert main(["run", "slider_crank", "--joint", "revolute", "--out", str(tmp_path), "--quiet",
@@ -119,10 +154,10 @@ def test_the_main_jobs_file_is_a_few_mb(tmp_path, monkeypatch):
     path = tmp_path / "slider_crank_revolute.h5"
     result = dc.load(path)
     per_point = 8 * (1 + result.n_states)
-    assert result.n_times == 24_001 and per_point == 264
+    assert result.n_times == 12_001 and per_point == 264
     size = path.stat().st_size
-    assert result.n_times * per_point < size < result.n_times * per_point + 1.5e6  # the fixed parts: < 1.5 MB
-    assert size < 8e6 and 8 * (1 + 2 * result.n_states + len(result.channel_names)) * result.n_times > 2.5 * size
+    assert result.n_times * per_point < size < result.n_times * per_point + 0.25e6  # the fixed parts: < 0.25 MB
+    assert size < 3.5e6 and 8 * (1 + 2 * result.n_states + len(result.channel_names)) * result.n_times > 3 * size
 
 
 def test_a_scene_that_cannot_be_rebuilt_stores_its_channels(tmp_path):

@@ -53,7 +53,7 @@ def test_option_is_validated_with_a_clear_message():
                                          r"'auto', 'reduced', 'dense', 'sparse'"):
         open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="banded")
     with pytest.raises(SceneError, match=r"linear_solver='lu', must be one of auto, reduced, dense, sparse"):
-        dc.simulate(chain(1), 1e-3, linear_solver="lu")
+        dc.simulate(chain(1), 1e-3, options=dc.SolverOptions(linear_solver="lu"))
     s = open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="SPARSE")
     assert s.linear_solver == "sparse" and s.stats()["linear_solver"] == "sparse"
 
@@ -106,7 +106,8 @@ def test_union_pattern_holds_every_term_and_fills_like_the_dense_matrix():
 
 def both(scene, t_end: float, rtol: float = 1e-8, solvers: tuple[str, str] = ("dense", "sparse"),
          formulation: str = "ggl") -> tuple[dc.Result, dc.Result]:
-    out = [dc.simulate(scene, t_end, rtol=rtol, backend="c", linear_solver=ls, formulation=formulation)
+    out = [dc.simulate(scene, t_end, rtol=rtol,
+                       options=dc.SolverOptions(backend="c", linear_solver=ls, formulation=formulation))
            for ls in solvers]
     assert [r.stats["linear_solver"] for r in out] == list(solvers)
     return out[0], out[1]
@@ -276,7 +277,8 @@ def test_restarts_reuse_the_factorization_storage():
     ordering and allocate new L/U storage each time without freeing the old: 100 kB per event
     here (60 MB over this run). The driver keeps the first factorization's storage."""
     scene = chain(8)
-    run = dict(rtol=1e-6, backend="c", linear_solver="sparse", store_steps=False, t_eval=[0.1])
+    run = dict(rtol=1e-6, options=dc.SolverOptions(backend="c", linear_solver="sparse"),
+               save=dc.SaveAt(steps=False, times=[0.1]))
     dc.simulate(scene, 0.1, **run)  # warm: compiled, first allocations done
     before = _rss_mb()
     result = dc.simulate(scene, 0.1, **run)
@@ -311,9 +313,9 @@ def test_first_step_is_the_second_order_estimate(plain_ida):
     nq, n = model.layout(project=False).n_q, model.n_states
     h_ida = 0.5 / np.sqrt(np.sum((w * yp) ** 2) / n)
     expected = max(1.0 / np.sqrt(np.sqrt(np.sum((w[:nq] * yp[nq:2 * nq]) ** 2) / n)), h_ida)
-    plain = dc.simulate(model, 1e-4, rtol=rtol, backend="c", linear_solver=plain_ida)
+    plain = dc.simulate(model, 1e-4, rtol=rtol, options=dc.SolverOptions(backend="c", linear_solver=plain_ida))
     # IDA's estimate: 1e-16 s with the old uniform atol (1e-3 rtol), 1e-14 s with the per-quantity defaults
     assert plain.stats["first_step"] == pytest.approx(h_ida, rel=1e-6) and h_ida < 1e-13
     ida.FIRST_STEP_ESTIMATE = True  # undone by plain_ida's monkeypatch
-    run = dc.simulate(model, 1e-4, rtol=rtol, backend="c", linear_solver=plain_ida)
+    run = dc.simulate(model, 1e-4, rtol=rtol, options=dc.SolverOptions(backend="c", linear_solver=plain_ida))
     assert not run.events and run.stats["first_step"] == pytest.approx(expected, rel=1e-9) and expected > 1e-9

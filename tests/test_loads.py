@@ -43,8 +43,8 @@ def _upward_crossings(t: np.ndarray, x: np.ndarray) -> np.ndarray:
 def test_mass_on_a_spring_has_the_closed_form_period_and_amplitude(guided):
     k, m = 800.0, 2.0
     omega = math.sqrt(k / m)
-    result = dc.simulate(_oscillator(k, m, guided), t_end=2.0, rtol=1e-9, track_work=True,
-                         t_eval=np.linspace(0.0, 2.0, 8001))
+    result = dc.simulate(_oscillator(k, m, guided), t_end=2.0, rtol=1e-9, options=dc.SolverOptions(track_work=True),
+                         save=dc.SaveAt(times=np.linspace(0.0, 2.0, 8001)))
     x = result["mass.x"] - 0.25
     np.testing.assert_allclose(x, 0.05 * np.cos(omega * result.t), atol=2e-7)
     periods = np.diff(_upward_crossings(result.t, x))
@@ -64,12 +64,14 @@ def test_the_spring_runs_the_same_on_the_scipy_and_python_paths():
     k, m = 800.0, 2.0
     omega = math.sqrt(k / m)
     t_eval = np.linspace(0.0, 0.2, 201)
-    scipy_run = dc.simulate(_oscillator(k, m), t_end=0.2, method="RK45", rtol=1e-10, atol=1e-12, t_eval=t_eval)
+    scipy_run = dc.simulate(_oscillator(k, m), t_end=0.2, method="RK45", rtol=1e-10, atol=1e-12,
+                            save=dc.SaveAt(times=t_eval))
     np.testing.assert_allclose(scipy_run["mass.x"] - 0.25, 0.05 * np.cos(omega * t_eval), atol=1e-7)
     # rtol 1e-10: the energy balance of a 1 J oscillator closes to ~1e-8 (at 1e-9 GGL's python run is at 1.4e-6)
-    python_run = dc.simulate(_oscillator(k, m, damping=2.0), t_end=0.2, backend="python", rtol=1e-10, t_eval=t_eval,
-                             track_work=True)
-    compiled = dc.simulate(_oscillator(k, m, damping=2.0), t_end=0.2, rtol=1e-10, t_eval=t_eval, track_work=True)
+    python_run = dc.simulate(_oscillator(k, m, damping=2.0), t_end=0.2, rtol=1e-10,
+                             options=dc.SolverOptions(backend="python", track_work=True), save=dc.SaveAt(times=t_eval))
+    compiled = dc.simulate(_oscillator(k, m, damping=2.0), t_end=0.2, rtol=1e-10,
+                           options=dc.SolverOptions(track_work=True), save=dc.SaveAt(times=t_eval))
     np.testing.assert_allclose(python_run["mass.x"], compiled["mass.x"], atol=1e-7)
     assert energy_balance(python_run)["max_residual"] < 1e-6
 
@@ -90,7 +92,8 @@ def test_damped_rotational_spring_follows_the_exact_damped_solution():
     zeta = c / (2.0 * math.sqrt(k * inertia))
     wd = wn * math.sqrt(1.0 - zeta ** 2)
     t = np.linspace(0.0, 0.8, 8001)
-    result = dc.simulate(_torsion(k, c, theta0, inertia), t_end=0.8, rtol=1e-9, t_eval=t, track_work=True)
+    result = dc.simulate(_torsion(k, c, theta0, inertia), t_end=0.8, rtol=1e-9,
+                         options=dc.SolverOptions(track_work=True), save=dc.SaveAt(times=t))
     exact = theta0 * np.exp(-zeta * wn * t) * (np.cos(wd * t) + zeta * wn / wd * np.sin(wd * t))
     np.testing.assert_allclose(result["spring.deflection"], exact, atol=1e-6 * theta0)
     # logarithmic decrement of successive maxima: 2 pi zeta / sqrt(1 - zeta^2)
@@ -117,7 +120,8 @@ def _spinning_disc(torque, inertia: float = 0.05) -> dc.Scene:
 def test_work_of_an_applied_torque_equals_the_energy_change():
     T0, inertia, t_end = 2.0, 0.05, 0.5
     t = np.linspace(0.0, t_end, 101)
-    result = dc.simulate(_spinning_disc(T0, inertia), t_end=t_end, rtol=1e-9, t_eval=t, track_work=True)
+    result = dc.simulate(_spinning_disc(T0, inertia), t_end=t_end, rtol=1e-9, options=dc.SolverOptions(track_work=True),
+                         save=dc.SaveAt(times=t))
     np.testing.assert_allclose(result["disc.omega"], T0 * t / inertia, rtol=1e-8, atol=1e-10)
     np.testing.assert_allclose(result["energy.work"], (T0 * t) ** 2 / (2 * inertia), rtol=1e-7, atol=1e-10)
     np.testing.assert_allclose(result["energy.mechanical"], result["energy.work"], rtol=1e-7, atol=1e-10)
@@ -129,22 +133,24 @@ def test_tabulated_and_expression_torques_match_their_closed_forms():
     T0, inertia, tau = 2.0, 0.05, 0.1
     t = np.linspace(0.0, 0.6, 121)
     runs = {
-        "constant": dc.simulate(_spinning_disc(T0, inertia), t_end=0.6, rtol=1e-9, t_eval=t),
+        "constant": dc.simulate(_spinning_disc(T0, inertia), t_end=0.6, rtol=1e-9, save=dc.SaveAt(times=t)),
         "flat table": dc.simulate(_spinning_disc(dc.Table((0.0, 1.0), (T0, T0)), inertia), t_end=0.6, rtol=1e-9,
-                                  t_eval=t),
+                                  save=dc.SaveAt(times=t)),
         "flat expression": dc.simulate(_spinning_disc(dc.Expression(lambda t, s, p: p.T, T=T0), inertia),
-                                       t_end=0.6, rtol=1e-9, t_eval=t),
+                                       t_end=0.6, rtol=1e-9, save=dc.SaveAt(times=t)),
     }
     for name, run in runs.items():
         np.testing.assert_allclose(run["disc.omega"], T0 * t / inertia, rtol=1e-8, atol=1e-10, err_msg=name)
     # a ramp to T0 over 0.2 s, then held (and before 0: held at 0): omega = T0 t^2 / (0.4 I), then linear
-    ramp = dc.simulate(_spinning_disc(dc.Table((0.0, 0.2), (0.0, T0)), inertia), t_end=0.6, rtol=1e-9, t_eval=t)
+    ramp = dc.simulate(_spinning_disc(dc.Table((0.0, 0.2), (0.0, T0)), inertia), t_end=0.6, rtol=1e-9,
+                       save=dc.SaveAt(times=t))
     expected = np.where(t < 0.2, T0 * t ** 2 / (0.4 * inertia), T0 * 0.1 / inertia + T0 * (t - 0.2) / inertia)
     np.testing.assert_allclose(ramp["disc.omega"], expected, rtol=1e-7, atol=1e-9)
     np.testing.assert_allclose(ramp["torque.torque"], np.interp(t, (0.0, 0.2), (0.0, T0)), atol=1e-12)
     # a decaying torque T0 exp(-t/tau): omega = T0 tau (1 - exp(-t/tau)) / I
     decay = dc.Expression(lambda t, s, p: p.T0 * exp(-t / p.tau), T0=T0, tau=tau)
-    run = dc.simulate(_spinning_disc(decay, inertia), t_end=0.6, rtol=1e-9, t_eval=t, track_work=True)
+    run = dc.simulate(_spinning_disc(decay, inertia), t_end=0.6, rtol=1e-9, options=dc.SolverOptions(track_work=True),
+                      save=dc.SaveAt(times=t))
     np.testing.assert_allclose(run["disc.omega"], T0 * tau * (1 - np.exp(-t / tau)) / inertia, rtol=1e-7, atol=1e-9)
     assert energy_balance(run)["max_residual"] < 1e-6
 
@@ -160,8 +166,8 @@ def test_a_state_expression_equals_the_element_it_imitates():
     law = dc.Expression(lambda t, s, p: -p.k * (s.angle - p.a0) - p.c * s.speed, k=k, c=c, a0=-theta0)
     imitation.add(dc.Torque("spring", disc, law, reaction=imitation.ground))
     t = np.linspace(0.0, 0.3, 301)
-    a = dc.simulate(spring, t_end=0.3, rtol=1e-9, t_eval=t)
-    b = dc.simulate(imitation, t_end=0.3, rtol=1e-9, t_eval=t)
+    a = dc.simulate(spring, t_end=0.3, rtol=1e-9, save=dc.SaveAt(times=t))
+    b = dc.simulate(imitation, t_end=0.3, rtol=1e-9, save=dc.SaveAt(times=t))
     np.testing.assert_allclose(b["disc.phi"], a["disc.phi"], atol=1e-8)
     np.testing.assert_allclose(b["spring.torque"], a["spring.torque"], atol=1e-6)
 
@@ -178,8 +184,8 @@ def test_a_force_equal_to_the_weight_moves_the_pendulum_as_gravity_does():
     weighted = _pendulum(0.0)
     weighted.add(dc.Force("weight", "link", fy=-1.2 * g))  # at the centre of mass
     t = np.linspace(0.0, 1.0, 201)
-    a = dc.simulate(_pendulum(g), t_end=1.0, rtol=1e-9, t_eval=t)
-    b = dc.simulate(weighted, t_end=1.0, rtol=1e-9, t_eval=t, track_work=True)
+    a = dc.simulate(_pendulum(g), t_end=1.0, rtol=1e-9, save=dc.SaveAt(times=t))
+    b = dc.simulate(weighted, t_end=1.0, rtol=1e-9, options=dc.SolverOptions(track_work=True), save=dc.SaveAt(times=t))
     np.testing.assert_allclose(b["link.phi"], a["link.phi"], atol=1e-7)
     # with gravity a force, its work is the change of kinetic energy (there is no potential)
     scale = np.max(b["energy.kinetic"])
@@ -206,7 +212,8 @@ def test_a_follower_force_turns_with_its_body():
     scene.add(dc.Body("puck", mass=m, inertia=0.01, angular_velocity=w))
     scene.add(dc.Force("thrust", "puck", fx=F, frame="body"))
     t = np.linspace(0.0, 0.5, 101)
-    result = dc.simulate(scene, t_end=0.5, rtol=1e-10, t_eval=t, track_work=True)
+    result = dc.simulate(scene, t_end=0.5, rtol=1e-10, options=dc.SolverOptions(track_work=True),
+                         save=dc.SaveAt(times=t))
     np.testing.assert_allclose(result["puck.vx"], F * np.sin(w * t) / (m * w), atol=1e-8)
     np.testing.assert_allclose(result["puck.vy"], F * (1 - np.cos(w * t)) / (m * w), atol=1e-8)
     np.testing.assert_allclose(result["puck.omega"], w, rtol=1e-12)
@@ -220,7 +227,8 @@ def test_a_damped_linear_spring_dissipates_what_the_work_counts():
     wn = math.sqrt(k / m)
     wd = wn * math.sqrt(1 - zeta ** 2)
     t = np.linspace(0.0, 0.5, 501)
-    result = dc.simulate(_oscillator(k, m, damping=c), t_end=0.5, rtol=1e-9, t_eval=t, track_work=True)
+    result = dc.simulate(_oscillator(k, m, damping=c), t_end=0.5, rtol=1e-9, options=dc.SolverOptions(track_work=True),
+                         save=dc.SaveAt(times=t))
     exact = 0.05 * np.exp(-zeta * wn * t) * (np.cos(wd * t) + zeta * wn / wd * np.sin(wd * t))
     np.testing.assert_allclose(result["spring.elongation"], exact, atol=1e-7)
     np.testing.assert_allclose(result["spring.power"], -c * result["mass.vx"] ** 2, atol=1e-9)
@@ -255,7 +263,7 @@ def _revolution_means(result: dc.Result) -> list[tuple[float, float]]:
 def test_a_torque_driven_crank_reaches_its_steady_speed_and_closes_the_energy_balance():
     """Started at rest; at the periodic steady state the motor's work over a revolution is zero:
     mean(T omega) = T_s (mean(omega) - mean(omega^2) / omega_0) = 0 (the linear characteristic)."""
-    result = dc.simulate(torque_driven_crank(), t_end=0.35, rtol=1e-10, track_work=True)
+    result = dc.simulate(torque_driven_crank(), t_end=0.35, rtol=1e-10, options=dc.SolverOptions(track_work=True))
     assert result["crank.omega"][0] == 0.0
     balance = energy_balance(result)
     assert balance["max_residual"] < 1e-7, balance
@@ -272,7 +280,8 @@ def test_a_torque_driven_crank_reaches_its_steady_speed_and_closes_the_energy_ba
 
 
 def test_a_torque_driven_crank_through_a_clearance_joint_closes_the_energy_balance():
-    result = dc.simulate(torque_driven_crank("revolute"), t_end=0.1, rtol=1e-9, track_work=True)
+    result = dc.simulate(torque_driven_crank("revolute"), t_end=0.1, rtol=1e-9,
+                         options=dc.SolverOptions(track_work=True))
     assert len(result.events) > 0
     assert energy_balance(result)["max_residual"] < 1e-6
 
@@ -360,8 +369,8 @@ def test_scene_file_loads_round_trip(tmp_path: Path):
     assert from_file.elements == built.elements
     assert from_file.to_dict() == built.to_dict()
     t = np.linspace(0.0, 0.5, 51)
-    a = dc.simulate(from_file, t_end=0.5, rtol=1e-8, t_eval=t, track_work=True)
-    b = dc.simulate(built, t_end=0.5, rtol=1e-8, t_eval=t, track_work=True)
+    a = dc.simulate(from_file, t_end=0.5, rtol=1e-8, options=dc.SolverOptions(track_work=True), save=dc.SaveAt(times=t))
+    b = dc.simulate(built, t_end=0.5, rtol=1e-8, options=dc.SolverOptions(track_work=True), save=dc.SaveAt(times=t))
     np.testing.assert_array_equal(a["link.phi"], b["link.phi"])
     assert energy_balance(a)["max_residual"] < 1e-6
     power = sum(a[f"{name}.power"] for name in ("push", "twist", "spring", "torsion", "motor"))
@@ -448,7 +457,7 @@ def test_a_body_fixed_spring_end_moves_with_its_body_when_the_declared_pose_is_o
     output; a world point at_j, read in the declared (wrong) pose, is another point of the link."""
     tip = (0.5, 0.0)  # the link's free end, link coordinates
     result = dc.simulate(_pendulum_with_spring(point_j=tip), t_end=0.5, rtol=1e-9, atol=1e-10,
-                         t_eval=np.linspace(0.0, 0.5, 51))
+                         save=dc.SaveAt(times=np.linspace(0.0, 0.5, 51)))
     x, y, phi = result["link.x"], result["link.y"], result["link.phi"]
     end = np.column_stack([x + np.cos(phi) * tip[0] - np.sin(phi) * tip[1],
                            y + np.sin(phi) * tip[0] + np.cos(phi) * tip[1]])

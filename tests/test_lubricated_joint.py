@@ -90,7 +90,8 @@ def squeeze_force(eps: float, eps_dot: float, mu: float) -> float:
 
 def test_pure_squeeze_fall_against_the_one_degree_of_freedom_solution() -> None:
     mu, mass = 0.02, 2.0
-    run = dc.simulate(journal(mu, 0.0, mass), 0.05, rtol=1e-9, atol=1e-13, t_eval=np.linspace(0.0, 0.05, 51))
+    run = dc.simulate(journal(mu, 0.0, mass), 0.05, rtol=1e-9, atol=1e-13,
+                      save=dc.SaveAt(times=np.linspace(0.0, 0.05, 51)))
     assert run.success and not run.events
 
     def rhs(t: float, x: np.ndarray) -> list[float]:
@@ -111,7 +112,7 @@ def breaking_run() -> dc.Result:
     """A film as thin as air's (1.8e-5 Pa s): it breaks, the journal hits the bearing dry, bounces, and
     the film forms again, a few times."""
     return dc.simulate(journal(1.8e-5, 0.0, 2.0, film_threshold=2e-6, hysteresis=1.0), 0.03, rtol=1e-10,
-                       track_work=True)
+                       options=dc.SolverOptions(track_work=True))
 
 
 def test_transitions_are_located_roots_with_hysteresis(breaking_run: dc.Result) -> None:

@@ -237,14 +237,15 @@ def test_drift_against_the_smallest_clearance_is_reported():
     over 4 ms."""
     scene = dc.mechanisms.slider_crank("revolute", clearance=1e-5)
     with pytest.warns(dc.DaeclearWarning, match="constraints drifted"):
-        drifting = dc.simulate(scene, t_end=0.012, rtol=1e-6, formulation="index1")
+        drifting = dc.simulate(scene, t_end=0.012, rtol=1e-6, options=dc.SolverOptions(formulation="index1"))
     assert drifting.stats["max_constraint_drift"] > 5e-8
     import warnings
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", dc.DaeclearWarning)
-        exact = dc.simulate(scene, t_end=0.012, rtol=1e-6, formulation="ggl")
-        chapter = dc.simulate(dc.mechanisms.slider_crank("revolute"), t_end=0.004, rtol=1e-6, formulation="index1")
+        exact = dc.simulate(scene, t_end=0.012, rtol=1e-6, options=dc.SolverOptions(formulation="ggl"))
+        chapter = dc.simulate(dc.mechanisms.slider_crank("revolute"), t_end=0.004, rtol=1e-6,
+                              options=dc.SolverOptions(formulation="index1"))
     assert exact.stats["max_constraint_drift"] < 1e-2 * drifting.stats["max_constraint_drift"]
     assert chapter.stats["max_constraint_drift"] < 1e-3 * 0.5e-3
 

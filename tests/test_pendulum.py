@@ -30,8 +30,8 @@ def energy_drift(result):
 
 @pytest.mark.parametrize("formulation", ["index1", "ggl"])
 def test_energy_conserved_over_100_periods(formulation):
-    coarse = dc.simulate(pendulum(), T_END, rtol=1e-8, formulation=formulation)
-    fine = dc.simulate(pendulum(), T_END, rtol=1e-10, formulation=formulation)
+    coarse = dc.simulate(pendulum(), T_END, rtol=1e-8, options=dc.SolverOptions(formulation=formulation))
+    fine = dc.simulate(pendulum(), T_END, rtol=1e-10, options=dc.SolverOptions(formulation=formulation))
     assert coarse.success and fine.success
     omega = fine["link.omega"]
     periods = np.count_nonzero((omega[:-1] < 0) & (omega[1:] >= 0))
@@ -43,7 +43,7 @@ def test_energy_conserved_over_100_periods(formulation):
 
 @pytest.mark.parametrize("formulation, bound", [("index1", 1e-8), ("ggl", 5e-12)])
 def test_constraint_drift(formulation, bound):
-    result = dc.simulate(pendulum(), T_END, rtol=1e-10, formulation=formulation)
+    result = dc.simulate(pendulum(), T_END, rtol=1e-10, options=dc.SolverOptions(formulation=formulation))
     # reported as channels; Baumgarte keeps index1 bounded (5e-10 measured), GGL enforces Phi = 0
     # at every step to IDA's Newton tolerance (1.2e-12 measured, position scale 0.5 m)
     assert np.max(result["constraints.position"]) < bound

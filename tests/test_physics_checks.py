@@ -91,26 +91,27 @@ def test_heavy_friction_on_the_translational_joint_penetrates_beyond_the_corner(
 def test_constraint_drift_is_one_of_the_warnings():
     """The drift warning (above 1e-3 of the smallest clearance) is a record like the others."""
     with pytest.warns(PhysicsWarning, match="constraints drifted"):
-        result = dc.simulate(dc.mechanisms.slider_crank("revolute"), 0.024, formulation="index1")
+        result = dc.simulate(dc.mechanisms.slider_crank("revolute"), 0.024,
+                             options=dc.SolverOptions(formulation="index1"))
     w = kinds(result)["constraint_drift"]
     assert w["value"] == result.stats["max_constraint_drift"] and w["limit"] == pytest.approx(1e-3 * CLEARANCE)
     assert w["where"].split(".")[0] in ("A", "B", "D", "drive")  # a constraint equation of an ideal joint
     i = int(np.argmax(result["constraints.position"]))
     assert w["t"] == pytest.approx(result.t[i])
-    exact = quiet_simulate(dc.mechanisms.slider_crank("revolute"), 0.024, formulation="ggl")
+    exact = quiet_simulate(dc.mechanisms.slider_crank("revolute"), 0.024, options=dc.SolverOptions(formulation="ggl"))
     assert "constraint_drift" not in kinds(exact)
 
 
 def test_fixed_step_run_that_steps_through_a_contact():
     """rk4 at 4e-5 s: contacts of 30 us are crossed in one step (then the run blows up)."""
     scene = dc.mechanisms.slider_crank("revolute")
-    result = quiet_simulate(scene, 0.024, method="rk4", step=4e-5, on_failure="return")
+    result = quiet_simulate(scene, 0.024, on_failure="return", options=dc.SolverOptions(method="rk4", step=4e-5))
     w = kinds(result)["contact_within_one_step"]
     assert w["where"] == "clearance" and w["unit"] == "s" and w["limit"] == 4e-5
     assert w["value"] < 4e-5
     onset = [e.t for e in result.events if e.kind == "onset"]
     assert any(t == pytest.approx(w["t"]) for t in onset)
-    fine = quiet_simulate(scene, 0.024, method="rk4", step=1e-5)
+    fine = quiet_simulate(scene, 0.024, options=dc.SolverOptions(method="rk4", step=1e-5))
     assert fine.success and "contact_within_one_step" not in kinds(fine)
 
 
@@ -119,7 +120,7 @@ def test_fixed_step_gap_sign_change_without_an_event(monkeypatch):
     steps with no event: warned as a missed contact, with the step's times."""
     monkeypatch.setattr(integrators, "locate", lambda *args, **kw: None)
     scene = dc.mechanisms.slider_crank("revolute")
-    result = quiet_simulate(scene, 0.004, method="rk4", step=1e-5, on_failure="return")
+    result = quiet_simulate(scene, 0.004, on_failure="return", options=dc.SolverOptions(method="rk4", step=1e-5))
     assert not result.events
     w = kinds(result)["missed_contact"]
     assert w["where"] == "clearance" and w["value"] >= 1
@@ -139,7 +140,8 @@ def journal_inside_the_wall(offset: float = 0.7e-3) -> dc.Scene:
 
 def test_journal_that_starts_inside_the_bearing_wall():
     """0.2 mm deep (40 % of the clearance) is refused by default (tests/test_drivers.py); allowed, it runs and warns."""
-    result = quiet_simulate(journal_inside_the_wall(), 0.002, start="declared", allow_penetration=True)
+    result = quiet_simulate(journal_inside_the_wall(), 0.002,
+                            options=dc.SolverOptions(start="declared", allow_penetration=True))
     w = kinds(result)["initial_penetration"]
     assert w["where"] == "clearance" and w["t"] == 0.0
     assert w["value"] == pytest.approx(0.2e-3, rel=1e-6) and w["limit"] == pytest.approx(1e-2 * CLEARANCE)
@@ -151,13 +153,13 @@ def test_velocities_inconsistent_with_the_joint():
     """The slider declared at rest while the rod's end moves at 26 m/s: a 26 m/s artificial first impact."""
     scene = replace_element(dc.mechanisms.slider_crank("revolute", crank_angle=math.pi / 2), "slider",
                             velocity=(0.0, 0.0))
-    result = quiet_simulate(scene, 0.002, start="declared")
+    result = quiet_simulate(scene, 0.002, options=dc.SolverOptions(start="declared"))
     w = kinds(result)["initial_velocity"]
     assert w["where"] == "clearance" and w["t"] == 0.0 and w["unit"] == "m/s"
     assert w["value"] == pytest.approx(26.18, rel=1e-3)
     assert result.events[0].approach_speed == pytest.approx(26.0, rel=0.01)
     assert "initial_velocity" not in kinds(quiet_simulate(scene, 0.002))  # start="ideal"
-    declared = quiet_simulate(dc.mechanisms.slider_crank("revolute"), 0.002, start="declared")
+    declared = quiet_simulate(dc.mechanisms.slider_crank("revolute"), 0.002, options=dc.SolverOptions(start="declared"))
     assert not {"initial_velocity", "initial_penetration"} & set(kinds(declared))
 
 
@@ -166,8 +168,8 @@ def test_a_restart_from_a_computed_state_may_start_in_contact():
     from daeclear.studies.analysis import restart_state
 
     model = dc.assemble(journal_inside_the_wall())
-    declared = quiet_simulate(model, 0.002, start="declared", t_eval=np.linspace(0.0, 0.002, 21),
-                              allow_penetration=True)
+    declared = quiet_simulate(model, 0.002, options=dc.SolverOptions(start="declared", allow_penetration=True),
+                              save=dc.SaveAt(times=np.linspace(0.0, 0.002, 21)))
     assert "initial_penetration" in kinds(declared)
     start = restart_state(model, declared, 0)
     again = quiet_simulate(model, 0.002, t0=start.t0, y0=start.y0)
@@ -181,12 +183,13 @@ def test_an_undriven_drop_is_an_experiment_not_an_inconsistent_start():
     link = scene.add(dc.Body("link", mass=1.0, inertia=0.01, position=(0.0, -0.1), velocity=(0.0, -0.2)))
     scene.add(dc.RevoluteClearance("pin", scene.ground, link, at=(0.0, 0.0), bearing_radius=0.01,
                                    clearance=CLEARANCE, material=dc.mechanisms.STEEL))
-    result = quiet_simulate(scene, 0.01, start="declared")
+    result = quiet_simulate(scene, 0.01, options=dc.SolverOptions(start="declared"))
     assert result.events and "initial_velocity" not in kinds(result)
 
 
 def test_warnings_are_saved_and_loaded(tmp_path: Path):
-    result = quiet_simulate(dc.mechanisms.slider_crank("revolute", rpm=50000), 0.0024, formulation="index1")
+    result = quiet_simulate(dc.mechanisms.slider_crank("revolute", rpm=50000), 0.0024,
+                            options=dc.SolverOptions(formulation="index1"))
     assert result.warnings
     again = dc.load(result.save(tmp_path / "run.h5"))
     assert again.warnings == result.warnings
@@ -247,7 +250,8 @@ def test_four_bar_runs():
 @pytest.mark.parametrize("method", ["ida", "rk4"])
 def test_four_bar_with_an_extra_revolute_is_redundant(method):
     with pytest.raises(AssemblyError, match="redundant constraints") as info:
-        dc.simulate(four_bar(extra_revolute=True), 0.1, method=method, step=1e-4 if method == "rk4" else None)
+        dc.simulate(four_bar(extra_revolute=True), 0.1,
+                    options=dc.SolverOptions(method=method, step=1e-4 if method == "rk4" else None))
     text = str(info.value)
     assert "'E'" in text and "Removing any one of 'O', 'A', 'E'" in text
     assert "rank 9 for 11 equations on 9 coordinates" in text
@@ -282,16 +286,17 @@ def test_stall_threshold_does_not_scale_with_t_end(monkeypatch):
 
     monkeypatch.setattr(solve, "open_session", spy)
     scene = dc.mechanisms.slider_crank("ideal")
-    dc.simulate(scene, 0.01, store_steps=False, t_eval=[0.0, 0.01])
+    dc.simulate(scene, 0.01, save=dc.SaveAt(steps=False, times=[0.0, 0.01]))
     # the setting only
-    dc.simulate(scene, 1.0, store_steps=False, t_eval=[0.0, 1.0], max_steps=200, on_failure="return")
+    dc.simulate(scene, 1.0, on_failure="return", options=dc.SolverOptions(max_steps=200),
+                save=dc.SaveAt(steps=False, times=[0.0, 1.0]))
     assert seen[0] == seen[1] == (solve.STALL_STEP, solve.STALL_COUNT)
 
 
 def test_long_smooth_run_is_not_a_stall():
     """The ideal slider-crank for 100 s (8333 revolutions) with a coarse output: no 'collapsed'."""
     scene = dc.mechanisms.slider_crank("ideal")
-    result = dc.simulate(scene, 100.0, store_steps=False, t_eval=np.linspace(0.0, 100.0, 101))
+    result = dc.simulate(scene, 100.0, save=dc.SaveAt(steps=False, times=np.linspace(0.0, 100.0, 101)))
     assert result.success, result.message
     assert result.t[-1] == 100.0 and "collapsed" not in result.message
 
@@ -301,8 +306,8 @@ def test_long_clearance_run_is_not_a_stall_in_contact():
     The first 0.3 s of such a run (max_steps ends it, 0.1 s wall) are in and out of contact: the run ends
     on max_steps, never on a collapse."""
     scene = dc.mechanisms.slider_crank("revolute")
-    result = quiet_simulate(scene, 100.0, store_steps=False, t_eval=np.linspace(0.0, 100.0, 1001),
-                            max_steps=60_000, on_failure="return")
+    result = quiet_simulate(scene, 100.0, on_failure="return", options=dc.SolverOptions(max_steps=60_000),
+                            save=dc.SaveAt(steps=False, times=np.linspace(0.0, 100.0, 1001)))
     assert "collapsed" not in result.message and "max_steps" in result.message
 
 
@@ -310,8 +315,9 @@ def test_genuine_stall_is_still_caught():
     import daeclear.contact as dcc
 
     scene = dc.mechanisms.slider_crank("revolute", friction=dcc.Coulomb(coefficient=0.5))
-    result = dc.simulate(scene, 100.0, store_steps=False, t_eval=np.linspace(0.0, 100.0, 11), on_failure="return",
-                         formulation="index1")  # the stall guard: index-1 chatters (GGL fails Newton, same advice)
+    # the stall guard: index-1 chatters (GGL fails Newton, same advice)
+    result = dc.simulate(scene, 100.0, on_failure="return", options=dc.SolverOptions(formulation="index1"),
+                         save=dc.SaveAt(steps=False, times=np.linspace(0.0, 100.0, 11)))
     assert not result.success and "DC_STEP_COLLAPSE" in result.message and "modified Coulomb" in result.message
 
 

@@ -33,8 +33,8 @@ def test_slider_crank_placed_at_a_crank_angle_is_the_closed_form():
         np.testing.assert_allclose(pose[3:], expected[name][3:], rtol=0, atol=1e-11 * OMEGA)
     # the driver starts from the new coordinate: the run is the library's at crank_angle=0.7
     t = np.linspace(0.0, 2e-3, 21)
-    a = dc.simulate(placed, 2e-3, t_eval=t, rtol=1e-9)
-    b = dc.simulate(dc.mechanisms.slider_crank(crank_angle=0.7), 2e-3, t_eval=t, rtol=1e-9)
+    a = dc.simulate(placed, 2e-3, rtol=1e-9, save=dc.SaveAt(times=t))
+    b = dc.simulate(dc.mechanisms.slider_crank(crank_angle=0.7), 2e-3, rtol=1e-9, save=dc.SaveAt(times=t))
     np.testing.assert_allclose(a["slider.x"], b["slider.x"], rtol=0, atol=1e-10)
     np.testing.assert_allclose(a["A.angle"], 0.7 + OMEGA * t, rtol=0, atol=1e-9)
 
@@ -71,7 +71,7 @@ def test_double_pendulum_in_relative_angles():
     poses = _poses(placed)
     np.testing.assert_allclose(poses["link1"], (*p1, a, *v1, wa), rtol=0, atol=1e-13)
     np.testing.assert_allclose(poses["link2"], (*p2, a + b, *v2, wa + wb), rtol=0, atol=1e-13)
-    result = dc.simulate(placed, 1e-3, rtol=1e-9, start="declared")
+    result = dc.simulate(placed, 1e-3, rtol=1e-9, options=dc.SolverOptions(start="declared"))
     assert result["A.angle"][0] == pytest.approx(a, abs=1e-12) and result["B.angle"][0] == pytest.approx(b, abs=1e-12)
     assert result["B.rate"][0] == pytest.approx(wb, abs=1e-9)
 
@@ -94,7 +94,7 @@ def test_clearance_joints_close_as_ideal_and_the_equations_are_kept():
             np.testing.assert_allclose(after.parameter(name), before.parameter(name), rtol=1e-13, atol=1e-15,
                                        err_msg=name)
     assert after.parameter("drive.angle0")[0] == pytest.approx(0.7, abs=1e-14)
-    run = dc.simulate(placed, 1e-4, rtol=1e-8, start="declared")
+    run = dc.simulate(placed, 1e-4, rtol=1e-8, options=dc.SolverOptions(start="declared"))
     assert run["clearance.eccentricity"][0] < 1e-12  # journal centred: the ideal joint closed
 
 
@@ -152,7 +152,8 @@ def test_andrews_squeezer_starts_at_and_reaches_the_published_values(tmp_path, c
     scene = andrews.andrews_squeezer()
     initial = (andrews.BETA0, 0.0, 0.455279819163070380255912382449, 0.222668390165885884674473185609,
                0.487364979543842550225598953530, -0.222668390165885884674473185609, 1.23054744454982119249735015568)
-    result = dc.simulate(scene, andrews.T_END, rtol=1e-10, formulation=formulation, start="declared")
+    result = dc.simulate(scene, andrews.T_END, rtol=1e-10,
+                         options=dc.SolverOptions(formulation=formulation, start="declared"))
     for joint, start, end in zip(andrews.COORDINATES, initial, andrews.REFERENCE):
         assert result[f"{joint}.angle"][0] == pytest.approx(start, abs=1e-12), joint
         assert result[f"{joint}.angle"][-1] == pytest.approx(end, abs=1e-7), joint

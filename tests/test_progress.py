@@ -127,8 +127,8 @@ def test_a_run_shows_simulated_time_percent_and_events_in_a_few_lines(method, ca
     import daeclear.solvers.ida as solve
 
     monkeypatch.setattr(solve, "open_session", functools.partial(solve.open_session, buffer_steps=64))
-    kwargs = {"method": "rk4", "step": 1e-6} if method == "rk4" else {}
-    result = dc.simulate(dc.mechanisms.slider_crank("revolute"), T_END, progress=True, **kwargs)
+    settings = dc.SolverOptions(method="rk4", step=1e-6) if method == "rk4" else None
+    result = dc.simulate(dc.mechanisms.slider_crank("revolute"), T_END, progress=True, options=settings)
     err = capsys.readouterr().err
     lines = [line for line in err.splitlines() if line.startswith("  simulate:")]
     assert "\r" not in err and 2 <= len(lines) <= PLAIN_STEPS + 2

@@ -145,7 +145,8 @@ def test_elastic_flat_drop_reaches_the_readings_closed_form_peak(name):
         peak = ((n_face + 1.0) * M * v ** 2 / (2.0 * k_face)) ** (1.0 / (n_face + 1.0))
     t_end = 4e-4 if n > 1.0 and face_cls is None or n_face == 1.5 else 6e-5
     t = np.linspace(0.0, t_end, 40001)
-    run = dc.simulate(_drop(name, v), t_end, t_eval=t, start="declared", rtol=1e-10)
+    run = dc.simulate(_drop(name, v), t_end, rtol=1e-10, options=dc.SolverOptions(start="declared"),
+                      save=dc.SaveAt(times=t))
     measured = np.max(run["g.C_lower.penetration"])
     assert measured == pytest.approx(peak, rel=1e-4), (measured, peak)
     onsets = {e.pair for e in run.events.of("g", "onset")}

@@ -95,14 +95,14 @@ def test_sweep_exits_non_zero_when_a_run_fails(tmp_path, capsys, monkeypatch):
 
 @pytest.mark.parametrize("args, shown", [
     (["--t-end", "0.002", "--t-eval-step", "1e-12"], "2e+09 output points"),
-    (["--t-end", "0.002", "--t-eval-step", "1e-6", "--max-points", "1000"], "max_output_points=1000"),
+    (["--t-end", "0.002", "--t-eval-step", "1e-6", "--max-points", "1000"], "save.max_points=1000"),
 ])
 def test_cli_refuses_an_output_too_large_before_the_run(args, shown, tmp_path, capsys):
     """The issue's `--t-end 0.002 --t-eval-step 1e-12` (2e9 points, ~1.7 TB) is refused at once with the
     estimate and the option that lifts the cap; nothing is written."""
     assert main(["run", "slider_crank", *args, "--out", str(tmp_path / "o"), "--quiet"]) == 2
     err = capsys.readouterr().err
-    assert "t_eval_step" in err and shown in err and "--max-points" in err and " in the file" in err, err
+    assert "save.every" in err and shown in err and "--max-points" in err and " in the file" in err, err
     assert not list((tmp_path / "o").glob("*.h5"))
 
 
@@ -113,11 +113,11 @@ def test_output_estimate_matches_the_file_written(tmp_path):
 
     scene = dc.mechanisms.slider_crank("revolute")
     with pytest.raises(dc.SceneError) as info:
-        dc.simulate(scene, 0.002, t_eval_step=1e-7, max_output_points=20_000, stream_to=tmp_path / "x.h5")
+        dc.simulate(scene, 0.002, save=dc.SaveAt(every=1e-7, max_points=20_000, stream_to=tmp_path / "x.h5"))
     per_point = int(re.search(r"\((\d+) bytes a point", str(info.value)).group(1))
     model = dc.assemble(scene)
     assert per_point == 8 * (1 + 2 * model.n_states + len(model.channel_names))
-    dc.simulate(scene, 0.002, t_eval_step=1e-7, stream_to=tmp_path / "x.h5", keep_data=False)
+    dc.simulate(scene, 0.002, save=dc.SaveAt(every=1e-7, stream_to=tmp_path / "x.h5", keep_data=False))
     size = (tmp_path / "x.h5").stat().st_size
     # the estimate counts what a run holds in memory (states, derivatives, channels): an upper bound of
     # its file, which keeps t and y alone (the channels and yp are computed when read)
@@ -169,19 +169,19 @@ def test_a_full_disk_during_a_streamed_run_keeps_a_readable_prefix(inject, tmp_p
     path = tmp_path / "run.h5"
     inject(monkeypatch, 3 if inject is _disk_fills_after else 40)
     with pytest.raises(dc.DiskFull) as info:
-        dc.simulate(scene, 0.024, t_eval_step=1e-6, stream_to=path, keep_data=False)
+        dc.simulate(scene, 0.024, save=dc.SaveAt(every=1e-6, stream_to=path, keep_data=False))
     assert str(path) in str(info.value) and "no space left" in str(info.value)
     monkeypatch.undo()
     prefix = dc.load(path)  # what was flushed before: readable, marked incomplete
     assert not prefix.success and "DiskFull" in prefix.message
     assert 0 < prefix.n_times < 24_001 and prefix.t[-1] < 0.024
-    full = dc.simulate(scene, prefix.t[-1], t_eval=prefix.t)  # the prefix is the run's own beginning
+    full = dc.simulate(scene, prefix.t[-1], save=dc.SaveAt(times=prefix.t))  # the prefix is the run's own beginning
     assert np.allclose(prefix["slider.vx"], full["slider.vx"], rtol=1e-6, atol=1e-6)
 
 
 @pytest.mark.parametrize("inject", [_disk_fills_after, _enospc_after])
 def test_cli_run_on_a_full_disk_says_one_line_and_exits_1(inject, tmp_path, monkeypatch, capsys):
-    inject(monkeypatch, 3 if inject is _disk_fills_after else 40)
+    inject(monkeypatch, 3 if inject is _disk_fills_after else 20)  # the whole run writes 36 times
     code = main(["run", "slider_crank", "--joint", "revolute", "--out", str(tmp_path), "--quiet"])
     err = capsys.readouterr().err
     assert code == 1 and err.count("\n") == 1 and "Traceback" not in err, err
@@ -240,12 +240,12 @@ def test_load_refuses_a_damaged_dataset_by_name(streamed, dataset, tmp_path):
     scene = dc.mechanisms.slider_crank("revolute")
     if streamed and dataset.startswith("channels/"):  # a run streams its states only: a stored channel
         full = tmp_path / "full.h5"
-        dc.simulate(scene, 0.002, t_eval_step=1e-6, stream_to=full, keep_data=False)
+        dc.simulate(scene, 0.002, save=dc.SaveAt(every=1e-6, stream_to=full, keep_data=False))
         dc.load(full).save(path, channels=True)
     elif streamed:
-        dc.simulate(scene, 0.002, t_eval_step=1e-6, stream_to=path, keep_data=False)
+        dc.simulate(scene, 0.002, save=dc.SaveAt(every=1e-6, stream_to=path, keep_data=False))
     else:
-        dc.simulate(scene, 0.002, t_eval_step=1e-6).save(path, channels=dataset.startswith("channels/"))
+        dc.simulate(scene, 0.002, save=dc.SaveAt(every=1e-6)).save(path, channels=dataset.startswith("channels/"))
     dc.load(path)  # whole: reads
     _flip(path, dataset)
     with pytest.raises(dc.DaeclearError) as info:

@@ -58,7 +58,7 @@ def test_energy_lost_equals_contact_work_impact_by_impact():
     """No driver, no gravity: between two free-flight instants around an impact the mechanical
     energy changes by exactly the work of the contact force (Simpson on a 0.1 us output grid)."""
     t_eval = np.linspace(0.0, 0.004, 40001)
-    result = dc.simulate(free_mechanism(0.9), 0.004, t_eval=t_eval, rtol=1e-10)
+    result = dc.simulate(free_mechanism(0.9), 0.004, rtol=1e-10, save=dc.SaveAt(times=t_eval))
     t, energy = result.t, result["energy.mechanical"]
     power = -result["clearance.normal_force"] * result["clearance.penetration_rate"]
     onsets = result.events.of(kind="onset").t
@@ -75,13 +75,13 @@ def test_energy_lost_equals_contact_work_impact_by_impact():
 @pytest.fixture(scope="module")
 def ideal_window():
     t = np.linspace(3 * PERIOD, 5 * PERIOD, 2001)
-    return t, dc.simulate(dc.mechanisms.slider_crank(), 5 * PERIOD, t_eval=np.r_[0.0, t], rtol=1e-8)
+    return t, dc.simulate(dc.mechanisms.slider_crank(), 5 * PERIOD, rtol=1e-8, save=dc.SaveAt(times=np.r_[0.0, t]))
 
 
 def test_small_clearance_tends_to_the_ideal_joint(ideal_window):
     t, ideal = ideal_window
-    result = dc.simulate(dc.mechanisms.slider_crank("revolute", clearance=0.01e-3), 5 * PERIOD,
-                         t_eval=np.r_[0.0, t], rtol=1e-8)
+    result = dc.simulate(dc.mechanisms.slider_crank("revolute", clearance=0.01e-3), 5 * PERIOD, rtol=1e-8,
+                         save=dc.SaveAt(times=np.r_[0.0, t]))
     v, v_ideal = result["slider.vx"][1:], ideal["slider.vx"][1:]
     m, m_ideal = result["drive.moment"][1:], ideal["drive.moment"][1:]
     assert np.max(np.abs(v - v_ideal)) / np.ptp(v_ideal) < 3e-3
@@ -97,8 +97,8 @@ def test_large_clearance_flies_impacts_and_follows(ideal_window):
     five revolutions every run measured (index1 and GGL, rtol 1e-6 to 1e-9) shows all three."""
     _, ideal = ideal_window
     t = np.linspace(3 * PERIOD, 8 * PERIOD, 5001)
-    result = dc.simulate(dc.mechanisms.slider_crank("revolute", clearance=0.5e-3), 8 * PERIOD,
-                         t_eval=np.r_[0.0, t], rtol=1e-8)
+    result = dc.simulate(dc.mechanisms.slider_crank("revolute", clearance=0.5e-3), 8 * PERIOD, rtol=1e-8,
+                         save=dc.SaveAt(times=np.r_[0.0, t]))
     late = [(a, b, modes["clearance"]) for a, b, modes in result.segments if a >= 3 * PERIOD]
     contact = [b - a for a, b, mode in late if mode == "contact"]
     flight = [b - a for a, b, mode in late if mode == "free"]
@@ -157,14 +157,14 @@ def test_sticking_with_plain_coulomb_fails_fast_with_advice():
     default = dc.simulate(scene, 0.024, on_failure="return")
     assert not default.success and "'clearance' in contact" in default.message
     assert "modified Coulomb" in default.message and default.stats["n_steps"] < 20_000
-    result = dc.simulate(scene, 0.024, on_failure="return", formulation="index1")
+    result = dc.simulate(scene, 0.024, on_failure="return", options=dc.SolverOptions(formulation="index1"))
     assert not result.success and result.status == -1
     assert "DC_STEP_COLLAPSE" in result.message and "'clearance' in contact" in result.message
     assert "modified Coulomb" in result.message
     assert result.stats["n_steps"] < 20_000
     assert np.all(np.isfinite(result.y))  # the partial result is kept
     with pytest.raises(dc.SolveError, match="modified Coulomb") as info:
-        dc.simulate(scene, 0.024, formulation="index1")
+        dc.simulate(scene, 0.024, options=dc.SolverOptions(formulation="index1"))
     assert info.value.result.t[-1] == pytest.approx(result.t[-1])
 
 
@@ -230,7 +230,7 @@ def test_energy_balance_with_driver_and_dissipation():
     from daeclear.studies.accuracy import energy_balance
 
     scene = dc.mechanisms.slider_crank("revolute")
-    dense = dc.simulate(scene, 0.012, t_eval=np.linspace(0.0, 0.012, 24001), rtol=1e-8)
+    dense = dc.simulate(scene, 0.012, rtol=1e-8, save=dc.SaveAt(times=np.linspace(0.0, 0.012, 24001)))
     balance = energy_balance(dense)
     assert balance["max_residual"] < 2e-5  # measured 5.8e-6
     steps = dc.simulate(scene, 0.012, rtol=1e-8)
@@ -244,8 +244,8 @@ def test_compiled_event_loop_matches_python_event_handling(plain_ida):
     backend cannot set GGL's Newton coefficient, see test_compiled_ggl_restarts_match_python)."""
     model = dc.assemble(dc.mechanisms.slider_crank("revolute", gravity=0.0), "index1")
     assert model.auto_pairs == ((0, 0, EXTRA_TERM0 + len(model.terms), True, 1e-4),)  # gap-rate extra after the forces
-    fast = dc.simulate(model, 0.006, rtol=1e-8, backend="c", linear_solver=plain_ida)
-    slow = dc.simulate(model, 0.006, rtol=1e-8, backend="python")
+    fast = dc.simulate(model, 0.006, rtol=1e-8, options=dc.SolverOptions(backend="c", linear_solver=plain_ida))
+    slow = dc.simulate(model, 0.006, rtol=1e-8, options=dc.SolverOptions(backend="python"))
     assert fast.stats["n_steps"] == slow.stats["n_steps"]
     assert fast.events.kind == slow.events.kind and len(fast.events) > 20
     np.testing.assert_allclose(fast.events.t, slow.events.t, rtol=0, atol=1e-15)
@@ -262,8 +262,8 @@ def test_compiled_ggl_restarts_match_python(joint):
     events on both backends, and the drift stays at Newton's tolerance."""
     model = dc.assemble(dc.mechanisms.slider_crank(joint, gravity=0.0), formulation="ggl")
     assert model.auto_pairs
-    fast = dc.simulate(model, 0.006, rtol=1e-8, backend="c")
-    slow = dc.simulate(model, 0.006, rtol=1e-8, backend="python")
+    fast = dc.simulate(model, 0.006, rtol=1e-8, options=dc.SolverOptions(backend="c"))
+    slow = dc.simulate(model, 0.006, rtol=1e-8, options=dc.SolverOptions(backend="python"))
     assert len(fast.events) > 10
     # the python backend cannot set IDA's Newton coefficient (GGL asks for 1e-3): not step for step,
     # so the contact sequences agree until the motion's sensitivity amplifies the difference
@@ -310,11 +310,11 @@ def test_runs_with_output_times_come_back_in_long_pieces(monkeypatch):
     advance = CSession.advance
     monkeypatch.setattr(CSession, "advance", lambda self, *a, **k: calls.append(1) or advance(self, *a, **k))
     t_eval = np.linspace(0.0, 0.024, 129)
-    whole = dc.simulate(model, 0.024, t_eval=t_eval)
+    whole = dc.simulate(model, 0.024, save=dc.SaveAt(times=t_eval))
     assert whole.stats["n_steps"] > 4096 and len(whole.events) > 20 and len(calls) == 1
     calls.clear()
     monkeypatch.setattr(solve_module, "open_session", functools.partial(open_session, buffer_steps=3))
-    pieces = dc.simulate(model, 0.024, t_eval=t_eval)
+    pieces = dc.simulate(model, 0.024, save=dc.SaveAt(times=t_eval))
     assert len(calls) > 80
     assert pieces.stats["n_steps"] == whole.stats["n_steps"]
     np.testing.assert_array_equal(pieces.step_t, whole.step_t)

@@ -166,8 +166,8 @@ def test_bad_start_time_and_state_are_refused_before_any_work(ideal_model) -> No
     with pytest.raises(SceneError,
                        match=r"simulate: y0=array of shape \(2, 36\), must be 36 finite numbers .*not shape \(2, 36\)"):
         dc.simulate(ideal_model, T, y0=np.vstack([y, y]))
-    with pytest.raises(SceneError, match=r"simulate: t_eval=.*values in \[t0=0.003, t_end=0.024\]"):
-        dc.simulate(ideal_model, T, t0=T / 8, y0=y, t_eval=[0.0, T])
+    with pytest.raises(SceneError, match=r"simulate: save.times=.*values in \[t0=0.003, t_end=0.024\]"):
+        dc.simulate(ideal_model, T, t0=T / 8, y0=y, save=dc.SaveAt(times=[0.0, T]))
     with pytest.raises(SceneError, match=r"simulate: y0=.*must be 27 finite numbers"):  # a Scene: after assembly
         dc.simulate(slider_crank(), T, method="rk45", t0=T / 8, y0=np.zeros(3))
 
@@ -189,10 +189,11 @@ def test_a_bad_state_for_a_scene_is_refused_before_assembly(monkeypatch) -> None
 def test_ida_restart_from_the_last_state_continues_the_run(ideal_model, backend: str) -> None:
     """Ideal joints (GGL): 0 -> T against 0 -> T/2 then T/2 -> T, compared on one output grid."""
     grid = np.linspace(0.0, T, 97)
-    full = dc.simulate(ideal_model, T, rtol=1e-9, t_eval=grid, backend=backend)
-    half = dc.simulate(ideal_model, T / 2, rtol=1e-9, t_eval=grid[grid <= T / 2], backend=backend)
-    rest = dc.simulate(ideal_model, T, rtol=1e-9, t0=T / 2, y0=half.y[-1], t_eval=grid[grid >= T / 2],
-                       backend=backend)
+    full = dc.simulate(ideal_model, T, rtol=1e-9, options=dc.SolverOptions(backend=backend), save=dc.SaveAt(times=grid))
+    half = dc.simulate(ideal_model, T / 2, rtol=1e-9, options=dc.SolverOptions(backend=backend),
+                       save=dc.SaveAt(times=grid[grid <= T / 2]))
+    rest = dc.simulate(ideal_model, T, rtol=1e-9, t0=T / 2, y0=half.y[-1], options=dc.SolverOptions(backend=backend),
+                       save=dc.SaveAt(times=grid[grid >= T / 2]))
     assert rest.t[0] == T / 2 and rest.t[-1] == T and rest.success
     if backend == "c":  # a restart is numbers only: nothing compiled
         assert rest.stats["compile_time"] == 0.0 and rest.stats["cache_hit"]
@@ -210,9 +211,9 @@ def test_ode_methods_restart_from_the_last_state(method: str, options: dict) -> 
     model = dc.assemble(slider_crank(), "index1")
     grid = np.linspace(0.0, T, 49)
     settings = dc.SolverOptions(method=method, rtol=1e-9, **options)
-    full = dc.simulate(model, T, t_eval=grid, options=settings)
-    half = dc.simulate(model, T / 2, t_eval=grid[grid <= T / 2], options=settings)
-    rest = dc.simulate(model, T, t0=T / 2, y0=half.y[-1], t_eval=grid[grid >= T / 2], options=settings)
+    full = dc.simulate(model, T, options=settings, save=dc.SaveAt(times=grid))
+    half = dc.simulate(model, T / 2, options=settings, save=dc.SaveAt(times=grid[grid <= T / 2]))
+    rest = dc.simulate(model, T, t0=T / 2, y0=half.y[-1], options=settings, save=dc.SaveAt(times=grid[grid >= T / 2]))
     assert rest.t[0] == T / 2 and rest.t[-1] == T
     if method == "rk4":  # the same fixed steps from T/2 on (T/2 is a whole number of steps): equal to round-off
         assert np.abs(rest["slider.x"] - full["slider.x"][grid >= T / 2]).max() < 1e-12
@@ -230,24 +231,24 @@ def test_drivers_are_evaluated_at_the_true_start_time(method: str) -> None:
     omega = float(model.parameter("drive.speed")[0])
     t0 = 0.37 * T
     y = dc.simulate(model, t0, rtol=1e-9, method=method).y[-1]
-    rest = dc.simulate(model, T, t0=t0, y0=y, rtol=1e-9, method=method, t_eval_step=T / 50)
+    rest = dc.simulate(model, T, t0=t0, y0=y, rtol=1e-9, method=method, save=dc.SaveAt(every=T / 50))
     assert rest.t[0] == t0 and rest.t[-1] == T
     np.testing.assert_allclose(np.diff(rest.t), (T - t0) / np.floor((T - t0) / (T / 50)), rtol=1e-9)
     np.testing.assert_allclose(rest["crank.phi"], omega * rest.t, rtol=1e-8, atol=1e-9)
     if method == "ida":  # off the driver by 0.01 rad: projected back onto it at the true time
         off = y.copy()
         off[model.state_names.index("crank.phi")] += 0.01
-        moved = dc.simulate(model, T, t0=t0, y0=off, rtol=1e-9, t_eval_step=T / 50)
+        moved = dc.simulate(model, T, t0=t0, y0=off, rtol=1e-9, save=dc.SaveAt(every=T / 50))
         np.testing.assert_allclose(moved["crank.phi"][0], omega * t0, rtol=1e-12)
         np.testing.assert_allclose(moved["slider.x"], rest["slider.x"], atol=1e-7)
 
 
 def test_contact_restart_in_free_flight_reproduces_the_events(clearance_model) -> None:
-    full = dc.simulate(clearance_model, T, rtol=1e-9, t_eval_step=T / 240)
+    full = dc.simulate(clearance_model, T, rtol=1e-9, save=dc.SaveAt(every=T / 240))
     free = [(a, b) for a, b, modes in full.segments if modes["clearance"] == "free" and b - a > 2e-4 and a > 2e-3]
     t0 = round(0.5 * (free[0][0] + free[0][1]), 5)  # the middle of the first long flight after the start
     head = dc.simulate(clearance_model, t0, rtol=1e-9)
-    rest = dc.simulate(clearance_model, T, rtol=1e-9, t0=t0, y0=head.y[-1], t_eval=full.t[full.t >= t0])
+    rest = dc.simulate(clearance_model, T, rtol=1e-9, t0=t0, y0=head.y[-1], save=dc.SaveAt(times=full.t[full.t >= t0]))
     after = [e for e in full.events if e.t > t0]
     assert len(after) >= 10 and len(rest.events) == len(after)
     assert all(a.kind == b.kind and b.t >= t0 for a, b in zip(after, rest.events))
@@ -334,10 +335,10 @@ def test_model_arrays_are_read_only(ideal_model) -> None:
 
 def test_runs_leave_the_model_unchanged_and_are_independent(clearance_model) -> None:
     before = _snapshot(clearance_model)
-    first = dc.simulate(clearance_model, T / 2, rtol=1e-7, t_eval_step=T / 200)
+    first = dc.simulate(clearance_model, T / 2, rtol=1e-7, save=dc.SaveAt(every=T / 200))
     assert first.stats["n_events"] >= 10  # the contact logic did work
     assert _same(_snapshot(clearance_model), before)
-    second = dc.simulate(clearance_model, T / 2, rtol=1e-7, t_eval_step=T / 200)
+    second = dc.simulate(clearance_model, T / 2, rtol=1e-7, save=dc.SaveAt(every=T / 200))
     np.testing.assert_array_equal(first.y, second.y)
     assert [(e.t, e.kind) for e in first.events] == [(e.t, e.kind) for e in second.events]
     for e in first.events:  # the compiled loop's events: plain floats, a read-only state of their own run
@@ -348,14 +349,16 @@ def test_runs_leave_the_model_unchanged_and_are_independent(clearance_model) -> 
         results: dict[int, dc.Result] = {}
 
         def run(k: int, backend: str, results: dict[int, dc.Result]) -> None:
-            results[k] = dc.simulate(clearance_model, T / 4, rtol=1e-7, t_eval_step=T / 200, backend=backend)
+            results[k] = dc.simulate(clearance_model, T / 4, rtol=1e-7, options=dc.SolverOptions(backend=backend),
+                                     save=dc.SaveAt(every=T / 200))
 
         threads = [threading.Thread(target=run, args=(k, backend, results)) for k in range(2)]
         for thread in threads:
             thread.start()
         for thread in threads:
             thread.join()
-        alone = dc.simulate(clearance_model, T / 4, rtol=1e-7, t_eval_step=T / 200, backend=backend)
+        alone = dc.simulate(clearance_model, T / 4, rtol=1e-7, options=dc.SolverOptions(backend=backend),
+                            save=dc.SaveAt(every=T / 200))
         for k in range(2):
             np.testing.assert_array_equal(results[k].y, alone.y)
             assert [(e.t, e.kind) for e in results[k].events] == [(e.t, e.kind) for e in alone.events]
@@ -463,9 +466,9 @@ def test_the_work_state_carries_over_a_restart() -> None:
     model = dc.assemble(slider_crank(), track_work=True)
     k = model.state_names.index("work.input")
     grid = np.linspace(0.0, T, 49)
-    full = dc.simulate(model, T, rtol=1e-9, t_eval=grid)
-    head = dc.simulate(model, T / 2, rtol=1e-9, t_eval=grid[grid <= T / 2])
-    rest = dc.simulate(model, T, rtol=1e-9, t0=T / 2, y0=head.y[-1], t_eval=grid[grid >= T / 2])
+    full = dc.simulate(model, T, rtol=1e-9, save=dc.SaveAt(times=grid))
+    head = dc.simulate(model, T / 2, rtol=1e-9, save=dc.SaveAt(times=grid[grid <= T / 2]))
+    rest = dc.simulate(model, T, rtol=1e-9, t0=T / 2, y0=head.y[-1], save=dc.SaveAt(times=grid[grid >= T / 2]))
     assert rest.y[0, k] == head.y[-1, k] and abs(head.y[-1, k]) > 0
     scale = np.ptp(full.y[:, k])
     assert np.abs(rest.y[:, k] - full.y[grid >= T / 2, k]).max() < 1e-6 * scale
@@ -485,14 +488,15 @@ def test_a_run_on_a_pooled_c_session_equals_a_run_on_a_new_one(linear_solver: st
         return [h for pooled in c_handle._POOL.values() for h in pooled]
 
     scene, t_end = slider_crank("revolute", clearance=1e-4), 0.004
-    settings = dict(t_end=t_end, t_eval=np.linspace(0.0, t_end, 41), rtol=1e-7, backend="c",
-                    linear_solver=linear_solver)
+    settings = dict(t_end=t_end, save=dc.SaveAt(times=np.linspace(0.0, t_end, 41)), rtol=1e-7,
+                    options=dc.SolverOptions(backend="c", linear_solver=linear_solver))
     c_handle._POOL.clear()
     fresh = dc.simulate(scene, **settings)
     c_handle._POOL.clear()  # the next run opens its own session
     failed = dc.simulate(slider_crank("revolute", clearance=3e-4, restitution=0.5), t_end=t_end, rtol=1e-5,
-                         max_step=1e-6, max_steps=300, backend="c", on_failure="return",
-                         linear_solver=linear_solver)
+                         on_failure="return",
+                         options=dc.SolverOptions(max_step=1e-6, max_steps=300, backend="c",
+                                                  linear_solver=linear_solver))
     assert not failed.success and "max_steps" in failed.message
     (handle,) = handles()
     again = dc.simulate(scene, **settings)

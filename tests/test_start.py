@@ -53,7 +53,7 @@ def test_declared_start_keeps_the_declared_state():
     first impact: the artificial start the chapter's start avoids."""
     scene = hand_built("revolute")
     chapter = dc.simulate(scene, t_end=0.0015, rtol=1e-8)
-    declared = dc.simulate(scene, t_end=0.0015, rtol=1e-8, start="declared")
+    declared = dc.simulate(scene, t_end=0.0015, rtol=1e-8, options=dc.SolverOptions(start="declared"))
     assert declared.parameters["simulate"]["start"] == "declared"
     peak = lambda r: float(np.max(r["clearance.normal_force"]))  # noqa: E731
     assert peak(declared) > 2.0 * peak(chapter)
@@ -86,4 +86,4 @@ def test_a_journal_declared_off_centre_starts_centred():
 
 def test_start_is_validated():
     with pytest.raises(dc.SceneError, match="start='centred'"):
-        dc.simulate(hand_built("revolute"), t_end=1e-3, start="centred")
+        dc.simulate(hand_built("revolute"), t_end=1e-3, options=dc.SolverOptions(start="centred"))

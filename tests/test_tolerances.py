@@ -166,7 +166,7 @@ def test_the_chapter_scenes_finish_at_tight_rtol(scene, rtol):
     joint = scene.split(",")[0]
     gravity = 0.0 if "no gravity" in scene else 9.81
     result = dc.simulate(dc.mechanisms.slider_crank(joint, gravity=gravity), 2 * REV, rtol=rtol,
-                         t_eval=np.linspace(0, 2 * REV, 201))
+                         save=dc.SaveAt(times=np.linspace(0, 2 * REV, 201)))
     assert result.success and result.t[-1] == 2 * REV
     assert len(result.events.of(kind="onset")) > 10
     assert np.all(np.isfinite(result.y))
@@ -176,8 +176,9 @@ def test_the_chapter_scenes_finish_at_tight_rtol(scene, rtol):
 @pytest.mark.parametrize("rtol", [1e-10, 1e-12])
 def test_ideal_mechanisms_finish_at_tight_rtol(formulation, rtol):
     """The ideal four-bar failed from rtol 1e-10 (GGL) and at 1e-12 (index1); the pendulum at 1e-12."""
-    four_bar = dc.simulate(dc.mechanisms.four_bar(), 0.1, rtol=rtol, formulation=formulation)
-    chain = dc.simulate(pendulum(), 1.0, rtol=rtol, formulation=formulation, t_eval=np.linspace(0, 1, 101))
+    four_bar = dc.simulate(dc.mechanisms.four_bar(), 0.1, rtol=rtol, options=dc.SolverOptions(formulation=formulation))
+    chain = dc.simulate(pendulum(), 1.0, rtol=rtol, options=dc.SolverOptions(formulation=formulation),
+                        save=dc.SaveAt(times=np.linspace(0, 1, 101)))
     assert four_bar.success and chain.success
     assert np.max(np.abs(chain["energy.mechanical"] - chain["energy.mechanical"][0])) < 1e-6
 
@@ -192,7 +193,7 @@ def test_without_the_floor_ggl_collapses_and_the_advice_makes_the_run_finish(mon
     failed = dc.simulate(scene, 2 * REV, rtol=1e-10, atol=old, on_failure="return")
     assert not failed.success and "IDA_CONV_FAIL" in failed.message and "in contact" in failed.message
     assert failed.message.endswith("Try formulation='index1'.")
-    advised = dc.simulate(scene, 2 * REV, rtol=1e-10, atol=old, formulation="index1")
+    advised = dc.simulate(scene, 2 * REV, rtol=1e-10, atol=old, options=dc.SolverOptions(formulation="index1"))
     assert advised.success
     monkeypatch.undo()
     with warnings.catch_warnings():
@@ -204,12 +205,12 @@ def test_without_the_floor_ggl_collapses_and_the_advice_makes_the_run_finish(mon
 def test_the_step_cap_advice_is_enough_to_finish():
     """A run that hits max_steps is told a cap that lets it finish; the cap it names does."""
     scene = dc.mechanisms.slider_crank("revolute")
-    capped = dc.simulate(scene, REV, max_steps=800, on_failure="return")
+    capped = dc.simulate(scene, REV, on_failure="return", options=dc.SolverOptions(max_steps=800))
     assert not capped.success and "DC_MAX_STEPS" in capped.message
     cap = int(capped.message.split("raise max_steps to about ")[1].split(" ")[0])
     assert cap == steps_needed(800, 0.0, capped.t[-1], REV) and cap > 800
     assert f"--max-steps {cap}" in capped.message
-    assert dc.simulate(scene, REV, max_steps=cap).success
+    assert dc.simulate(scene, REV, options=dc.SolverOptions(max_steps=cap)).success
 
 
 def test_steps_needed_rounds_up_on_two_digits():

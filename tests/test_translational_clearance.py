@@ -78,7 +78,7 @@ def test_model_holds_only_what_the_scene_declares():
 
 def test_flat_drop_on_a_face_matches_the_linear_law():
     """section-4.3: both lower corners touch at once (a simultaneous root), the face takes over."""
-    result = dc.simulate(flat_drop("section-4.3"), 5e-5, start="declared", rtol=1e-10)
+    result = dc.simulate(flat_drop("section-4.3"), 5e-5, rtol=1e-10, options=dc.SolverOptions(start="declared"))
     kinds = [(e.pair, e.kind) for e in result.events]
     assert kinds == [("g.C_lower", "onset"), ("g.D_lower", "onset"), ("g.lower_face", "onset"),
                      ("g.C_lower", "separation"), ("g.D_lower", "separation"), ("g.lower_face", "separation")]
@@ -92,7 +92,8 @@ def test_flat_drop_on_a_face_matches_the_linear_law():
 
 def test_flat_drop_on_corners_matches_two_hertz_contacts():
     # the largest penetration on a 10 ns grid: the steps alone sample the peak only to about 1e-5
-    result = dc.simulate(flat_drop("corners"), 3e-4, start="declared", rtol=1e-10, t_eval=np.linspace(0, 3e-4, 30001))
+    result = dc.simulate(flat_drop("corners"), 3e-4, rtol=1e-10, options=dc.SolverOptions(start="declared"),
+                         save=dc.SaveAt(times=np.linspace(0, 3e-4, 30001)))
     assert [e.pair for e in result.events.of(kind="onset")] == ["g.C_lower", "g.D_lower"]
     d_max = (5.0 * M * 0.1**2 / (8.0 * K_CORNER)) ** 0.4
     duration = 2.0 * d_max / 0.1 * math.gamma(0.4) * math.gamma(0.5) / (2.5 * math.gamma(0.9))
@@ -104,7 +105,8 @@ def test_flat_drop_on_corners_matches_two_hertz_contacts():
 
 def test_flat_drop_with_dissipation_matches_a_single_impact():
     """c_e = 0.9: the drop is one impact of m on the law with 2 K_c (its approach speed latched at onset)."""
-    result = dc.simulate(flat_drop("corners", restitution=0.9), 3e-4, start="declared", rtol=1e-10)
+    result = dc.simulate(flat_drop("corners", restitution=0.9), 3e-4, rtol=1e-10,
+                         options=dc.SolverOptions(start="declared"))
     law = dcc.LankaraniNikravesh(restitution=0.9, stiffness=2 * K_CORNER)
     impact = dcc.simulate_impact(law, mass=M, speed=0.1)
     t_on, t_off = contact_of(result, "g.D_lower")
@@ -118,7 +120,7 @@ def test_flat_drop_with_dissipation_matches_a_single_impact():
 def test_tilted_drop_hits_one_corner_then_the_face(model):
     tilt = 1e-4  # rad: the rear lower corner C is 5 um below the front one, D
     result = dc.simulate(guide_scene(model, tilt=tilt, y0=-C + 1e-6 + 0.5 * L * tilt, velocity=(0.0, -0.1)),
-                         1e-4, start="declared", rtol=1e-10)
+                         1e-4, rtol=1e-10, options=dc.SolverOptions(start="declared"))
     onsets = result.events.of(kind="onset")
     expected = ["g.C_lower", "g.D_lower"] + (["g.lower_face"] if model == "section-4.3" else [])
     assert [e.pair for e in onsets] == expected
@@ -136,7 +138,8 @@ def test_face_switch_of_the_section_4_3_model_changes_the_stored_energy():
     and is conserved in between (this is why `corners` is the model for tilted, rough runs)."""
     tilt = 1e-4
     result = dc.simulate(guide_scene("section-4.3", tilt=tilt, y0=-C + 1e-6 + 0.5 * L * tilt,
-                                     velocity=(0.0, -0.1)), 1e-4, start="declared", rtol=1e-10)
+                                     velocity=(0.0, -0.1)), 1e-4, rtol=1e-10,
+                                         options=dc.SolverOptions(start="declared"))
     total = result["energy.mechanical"] + result["g.elastic_energy"]
     t_face = result.events.of("g.lower_face", "onset")[0].t
     before, after = total[result.t < t_face], total[result.t > t_face]
@@ -153,7 +156,7 @@ def test_energy_conserved_through_many_elastic_corner_impacts():
     chaotic: whether it wedges within 0.2 s depends on the tolerance (with the per-quantity atol it
     does at rtol 1e-9 and 3e-10, not at 1e-10 or 3e-11; with the old uniform atol at 1e-10 only)."""
     scene = guide_scene("corners", velocity=(0.0, 0.5), spin=5.0)
-    result = dc.simulate(scene, 0.2, start="declared", rtol=3e-10)
+    result = dc.simulate(scene, 0.2, rtol=3e-10, options=dc.SolverOptions(start="declared"))
     onsets = result.events.of(kind="onset")
     assert len(onsets) > 150
     assert {e.pair for e in onsets} == {"g.A_upper", "g.B_upper", "g.C_lower", "g.D_lower"}
@@ -180,7 +183,7 @@ def test_moving_tilted_guide_conserves_momentum(friction):
     scene.add(TranslationalClearance("g", guide, slider, at=(0.0, 0.0), axis=u, length=L, width=W, corner_radius=R_C,
                                      clearance=C, material=STEEL, law=dcc.LankaraniNikravesh(restitution=1.0),
                                      friction=friction))
-    r = dc.simulate(scene, 0.05, start="declared", rtol=1e-10)
+    r = dc.simulate(scene, 0.05, rtol=1e-10, options=dc.SolverOptions(start="declared"))
     assert len(r.events.of(kind="onset")) > 20
     momentum, spin = np.zeros((r.n_times, 2)), np.zeros(r.n_times)
     for body, mass, inertia in (("guide", 1.0, 1e-3), ("slider", M, 1e-4)):
@@ -201,7 +204,7 @@ def test_energy_conserved_in_the_free_slider_crank(formulation, rtol):
     phases, not at its projected restarts) and 1.1e-6 at 1e-9: GGL needs one decade more here."""
     scene = dc.mechanisms.slider_crank("translational", gravity=0.0, restitution=1.0)
     scene.elements = [e for e in scene.elements if not isinstance(e, Driver)]
-    result = dc.simulate(scene, 0.05, start="declared", rtol=rtol, formulation=formulation)
+    result = dc.simulate(scene, 0.05, rtol=rtol, options=dc.SolverOptions(start="declared", formulation=formulation))
     assert len(result.events.of(kind="onset")) > 50
     total = result["energy.mechanical"] + result["clearance.elastic_energy"]
     assert np.ptp(total) / total[0] < 2e-6
@@ -209,7 +212,7 @@ def test_energy_conserved_in_the_free_slider_crank(formulation, rtol):
 
 def test_resting_slider_settles_at_the_static_penetration():
     scene = guide_scene("corners", restitution=0.9, gravity=9.81, y0=-C + 2e-6)
-    result = dc.simulate(scene, 0.05, start="declared", rtol=1e-8)
+    result = dc.simulate(scene, 0.05, rtol=1e-8, options=dc.SolverOptions(start="declared"))
     static = (M * 9.81 / (2 * K_CORNER)) ** (2 / 3)  # two corners carry m g
     assert result["g.C_lower.penetration"][-1] == pytest.approx(static, rel=1e-4)
     assert result["g.D_lower.in_contact"][-1] == 1 and result["g.A_upper.in_contact"][-1] == 0
@@ -249,7 +252,7 @@ def test_penetration_bounded_and_slider_stays_in_the_guide(chapter_run):
 @pytest.fixture(scope="module")
 def ideal_window():
     t = np.linspace(3 * PERIOD, 5 * PERIOD, 2001)
-    return t, dc.simulate(dc.mechanisms.slider_crank(), 5 * PERIOD, t_eval=np.r_[0.0, t], rtol=1e-8)
+    return t, dc.simulate(dc.mechanisms.slider_crank(), 5 * PERIOD, rtol=1e-8, save=dc.SaveAt(times=np.r_[0.0, t]))
 
 
 def test_small_clearance_tends_to_the_ideal_joint(ideal_window):
@@ -257,8 +260,8 @@ def test_small_clearance_tends_to_the_ideal_joint(ideal_window):
     v_ideal, m_ideal = ideal["slider.vx"][1:], ideal["drive.moment"][1:]
     deviations = []
     for c in (0.5e-3, 0.1e-3, 0.01e-3):
-        r = dc.simulate(dc.mechanisms.slider_crank("translational", clearance=c), 5 * PERIOD,
-                        t_eval=np.r_[0.0, t], rtol=1e-8)
+        r = dc.simulate(dc.mechanisms.slider_crank("translational", clearance=c), 5 * PERIOD, rtol=1e-8,
+                        save=dc.SaveAt(times=np.r_[0.0, t]))
         dv = np.max(np.abs(r["slider.vx"][1:] - v_ideal)) / np.ptp(v_ideal)
         dm = np.sqrt(np.mean((r["drive.moment"][1:] - m_ideal) ** 2)) / np.ptp(m_ideal)
         deviations.append((dv, dm))
@@ -282,7 +285,7 @@ def test_corners_outside_the_contact_segment_do_not_touch():
     for x0, expected in ((-0.1, []), (0.0, ["g.D_lower"])):
         scene = guide_scene(lower_limits=(0.0, 0.3), y0=-C + 1e-6, velocity=(0.0, -0.1))
         scene.elements[0] = dataclasses.replace(scene.elements[0], position=(x0, -C + 1e-6))
-        result = dc.simulate(scene, 2e-4, start="declared", rtol=1e-8)
+        result = dc.simulate(scene, 2e-4, rtol=1e-8, options=dc.SolverOptions(start="declared"))
         assert [e.pair for e in result.events.of(kind="onset")] == expected
 
 

@@ -123,7 +123,7 @@ def test_the_history_of_a_run_matches_the_joint_s_own_channels():
     from daeclear.studies.wear import wear_history
 
     model = dc.assemble(dc.mechanisms.slider_crank("revolute", friction=0.05))
-    result = dc.simulate(model, 0.006, t_eval=np.linspace(0, 0.006, 601))
+    result = dc.simulate(model, 0.006, save=dc.SaveAt(times=np.linspace(0, 0.006, 601)))
     h = wear_history(result, model, "clearance")
     contact = result["clearance.in_contact"] > 0
     assert contact.sum() > 20

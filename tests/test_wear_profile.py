@@ -42,7 +42,7 @@ def flight(direction: float, *, surface: str = "bearing", depth=None, journal_an
 
 
 def _onset(scene: dc.Scene) -> float:
-    result = dc.simulate(scene, 0.01, rtol=1e-10, start="declared")
+    result = dc.simulate(scene, 0.01, rtol=1e-10, options=dc.SolverOptions(start="declared"))
     return result.events.of(kind="onset")[0].t
 
 
@@ -83,8 +83,8 @@ def test_impact_at_a_worn_spot_comes_when_kinematics_says(surface):
 
 
 def test_an_unworn_profile_is_the_joint_without_wear():
-    plain = dc.simulate(flight(0.3, wear=False), 0.01, rtol=1e-10, start="declared")
-    worn = dc.simulate(flight(0.3), 0.01, rtol=1e-10, start="declared")
+    plain = dc.simulate(flight(0.3, wear=False), 0.01, rtol=1e-10, options=dc.SolverOptions(start="declared"))
+    worn = dc.simulate(flight(0.3), 0.01, rtol=1e-10, options=dc.SolverOptions(start="declared"))
     np.testing.assert_array_equal(plain.t, worn.t)
     np.testing.assert_array_equal(plain.y, worn.y)
 

@@ -83,7 +83,7 @@ def car_axis_scene() -> dc.Scene:
 
 
 def daeclear_state(scene: dc.Scene, rtol: float) -> np.ndarray:
-    result = dc.simulate(scene, T_END, rtol=rtol, atol=rtol, t_eval=[0.0, T_END])
+    result = dc.simulate(scene, T_END, rtol=rtol, atol=rtol, save=dc.SaveAt(times=[0.0, T_END]))
     names = ("left_wheel.x", "left_wheel.y", "axle.x", "axle.y", "left_wheel.vx", "left_wheel.vy", "axle.vx", "axle.vy")
     return np.array([result[n][-1] for n in names])
 

@@ -281,7 +281,7 @@ def daeclear_run(clearance: bool, t_end: float, rtol: float, grid: np.ndarray,
              if clearance else slider_crank("ideal", gravity=GRAVITY))
     dc.simulate(scene, 1e-4, rtol=rtol)  # builds (or loads) the compiled library: not timed
     began = time.perf_counter()
-    result = dc.simulate(scene, t_end, rtol=rtol, t_eval=grid)
+    result = dc.simulate(scene, t_end, rtol=rtol, save=dc.SaveAt(times=grid))
     wall = time.perf_counter() - began
     channels = {"t": result.t, "slider.vx": result["slider.vx"], "slider.ax": result["slider.ax"],
                 "drive.moment": result["drive.moment"]}

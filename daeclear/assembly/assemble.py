@@ -54,6 +54,7 @@ from .joint_coordinates import joint_channels
 from ..model.loads import Load, build_loads, load_parameters
 from .symbolic import AssemblyContext, Channel, Reference, Term, body_frames, rotation
 # the model and its constants, re-exported: ``from daeclear.assembly.assemble import DAEModel`` keeps working
+from ..solvers.physics import checked_channel
 from .dae_model import (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_START_KINEMATICS,  # noqa: F401
                         EXTRA_TERM0, KIND_MULTIPLIER, KIND_POSITION, KIND_VELOCITY, KIND_WORK, NEWTON_STEPS,
                         NULL_WEIGHT, POSITION_TOL, RANK_TOL, DAEModel, Formulation, check_independent,
@@ -518,7 +519,11 @@ class _TemplateBuilder:
         start_flat = ca.Function("start_kinematics_flat", [q, v, t, P],
                                  [ca.vertcat(Phi_s, ca.vec(Phi_s_q), Phi_s_dot)],
                                  ["q", "v", "t", "P"], ["K"])
-        extras = [outputs, accel, kinematics_flat, start_flat] + [term.force for term in self.terms]
+        # the channels the physics checks read, alone: a run is checked without computing the others
+        checked = [c.expr for c in channels if checked_channel(c.name)]
+        checks = ca.Function("checks", [t, y, yp, switch, P], [ca.vertcat(*checked) if checked else ca.SX(0, 1)],
+                             ["t", "y", "yp", "switch", "P"], ["checked"])
+        extras = [outputs, accel, kinematics_flat, start_flat, checks] + [term.force for term in self.terms]
         # simple contact pairs whose switches the compiled loop may handle itself (see ida_driver.c)
         logic_makers = tuple(build.logic for build in builds)
         sample = [logic for make in logic_makers for logic in make(self.table.vector)]

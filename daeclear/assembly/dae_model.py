@@ -20,15 +20,16 @@ from numpy.typing import ArrayLike, NDArray
 from ..engine.build import memo_put_bounded
 from ..engine.session_base import DAEFunctions, StateLayout
 from ..errors import AssemblyError, SceneError
-from ..solvers.physics import check_start_penetration
+from ..solvers.physics import check_start_penetration, checked_channel
 from .symbolic import Term
 
 Formulation = Literal["index1", "ggl"]
 
 # Extra functions compiled with the model (DAEFunctions.extras), evaluated over many points.
 # kinematics: (q, v, t) -> [Phi; Phi_q (column-major); Phi_dot]; start kinematics: the same with
-# every clearance joint's ideal joint added (the chapter's start); term k's force: EXTRA_TERM0 + k
-EXTRA_OUTPUTS, EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_START_KINEMATICS, EXTRA_TERM0 = 0, 1, 2, 3, 4
+# every clearance joint's ideal joint added (the chapter's start); checks: the outputs' channels the
+# physics checks read (physics.checked_channel), in order; term k's force: EXTRA_TERM0 + k
+EXTRA_OUTPUTS, EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_START_KINEMATICS, EXTRA_CHECKS, EXTRA_TERM0 = 0, 1, 2, 3, 4, 5
 
 
 # Projection onto the constraint manifold (initial state and restarts, in Python and in C):
@@ -416,6 +417,24 @@ class DAEModel:
         S = np.zeros((t.size, n_s)) if switch is None else np.asarray(switch, dtype=float).reshape(t.size, n_s)
         values = self.evaluate(EXTRA_OUTPUTS, [t.reshape(-1, 1), np.asarray(y), np.asarray(yp), S], t.size, session)
         return {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(self.channel_names)}
+
+    @property
+    def checked_names(self) -> tuple[str, ...]:
+        """The channels the physics checks read (:func:`daeclear.solvers.physics.checked_channel`), in order."""
+        return tuple(name for name in self.channel_names if checked_channel(name))
+
+    def checks(self, t: NDArray[np.float64], y: NDArray[np.float64], yp: NDArray[np.float64],
+               switch: NDArray[np.float64], session: Any = None) -> dict[str, NDArray[np.float64]]:
+        """The channels the physics checks read at the rows of ``y`` (as :meth:`channels`, whose values they
+        are, bit for bit): a function of a few outputs, so a run is checked without computing the others."""
+        names = self.checked_names
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        if t.size == 0 or not names:
+            return {name: np.zeros(t.size) for name in names}
+        n_s = self.outputs.size1_in(3)
+        S = np.asarray(switch, dtype=float).reshape(t.size, n_s)
+        values = self.evaluate(EXTRA_CHECKS, [t.reshape(-1, 1), np.asarray(y), np.asarray(yp), S], t.size, session)
+        return {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(names)}
 
 
 # Starts kept per structure (see DAEModel.start_memo); a start is ~0.3 ms to compute again.

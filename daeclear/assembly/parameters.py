@@ -212,7 +212,6 @@ def _evaluate(law: Any, x: Any, y: Any, z: Any) -> Any:
 
 #: Properties the assembly branches on: a twin answers them with the numeric law's values.
 _FLAGS = ("needs_approach_speed", "dissipative", "is_resolved", "frictionless")
-_TWIN_CLASSES: dict[type, type] = {}
 
 
 def _fixed_flag(flag: str) -> property:
@@ -221,11 +220,10 @@ def _fixed_flag(flag: str) -> property:
 
 
 def _twin_class(cls: type) -> type:
-    """A subclass whose structural flags are fixed numbers, not expressions of its fields."""
-    if cls not in _TWIN_CLASSES:
-        fixed = {flag: _fixed_flag(flag) for flag in _FLAGS if hasattr(cls, flag)}
-        _TWIN_CLASSES[cls] = type(cls.__name__, (cls,), fixed)
-    return _TWIN_CLASSES[cls]
+    """A subclass whose structural flags are fixed numbers, not expressions of its fields (made when a
+    structure is built: once per law of a new structure, and per law class for :func:`is_parametric`)."""
+    fixed = {flag: _fixed_flag(flag) for flag in _FLAGS if hasattr(cls, flag)}
+    return type(cls.__name__, (cls,), fixed)
 
 
 def _check_parametric(law: Any) -> bool:

@@ -30,7 +30,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 
 from ..errors import DaeclearError
 
@@ -180,18 +180,6 @@ def memo_put_bounded(table: MemoTable, key: Any, value: Any, limit: int) -> None
         except (RuntimeError, StopIteration):  # the table changed under the iterator
             break
     table[key] = value
-
-
-def memo_by_values(table: MemoTable, values: tuple[Any, ...], make: Callable[..., Any], limit: int = 64) -> Any:
-    """``make(*values)``, kept in ``table`` by the exact values (type and repr: 1 and 1.0, 0.0 and
-    -0.0 differ) for the next call with the same ones. For values that make frozen objects (scene
-    elements, contact laws), which the callers then share."""
-    key = tuple((type(v), repr(v)) for v in values)
-    value = table.get(key)
-    if value is None:
-        value = make(*values)
-        memo_put_bounded(table, key, value, limit)
-    return value
 
 
 # --------------------------------------------------------------------------- cached build

@@ -56,12 +56,11 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import DaeclearError, DaeclearWarning
+from ..errors import DaeclearError, warn_once
 from ..options import BACKENDS, LINEAR_SOLVERS
 from .build import BuildResult, CompileError, CompilerUnavailable
 from .c_session import SPARSE_MIN_STATES, CSession
@@ -110,21 +109,15 @@ __all__ = [
 
 log = logging.getLogger("daeclear")
 
-_warned: set[str] = set()
-
-
-def _warn_once(reason: str) -> None:
-    if reason in _warned:
-        return
-    _warned.add(reason)
-    warnings.warn(
+def _warn_fallback(reason: str) -> None:
+    """Name the fallback to the python backend, once per reason in a process."""
+    warn_once(
         "daeclear: the compiled IDA backend is unavailable, using the pure-Python backend "
         "(scikit-sundae with CasADi FunctionBuffer callbacks), typically 10-70x slower. Its results agree with "
         "the compiled loop's to the integration tolerance, not digit for digit: on the chapter's slider-crank "
         "the same impacts at rtol <= 1e-8, but 35 against 26 over two revolutions at rtol 1e-6 (a contact "
         "sequence amplifies the small differences of the two step sequences); tighten rtol to compare runs "
         f"(docs/reliability.md). Reason: {reason}",
-        DaeclearWarning,
         stacklevel=3,
     )
 
@@ -210,5 +203,5 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         if isinstance(exc, CompileError):
             reason = str(exc).strip()[:2000]
-        _warn_once(reason)
+        _warn_fallback(reason)
         return PythonSession(model, opts, fallback_reason=str(exc))

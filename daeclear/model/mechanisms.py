@@ -11,7 +11,6 @@ from ..contact import HydrodynamicBearing, Material, friction_law, normal_law
 from ..contact.hydrodynamic import law_from_table
 from ..contact.base import NormalLaw
 from ..errors import SceneError
-from ..engine.build import MemoTable, memo_by_values, memo_table
 from .mechanism_options import joint_names, refuse_clearance_options
 from .scene import GROUND, Body, Driver, Element, Revolute, RevoluteClearance, Scene, Translational
 
@@ -74,7 +73,7 @@ def _contact_law(law: Any, restitution: float | None, length: float | None) -> N
         raise SceneError(f"contact law: length={length!r}, must be None or a finite number > 0 m.")
     if isinstance(law, (NormalLaw, HydrodynamicBearing, dict)):  # a dict: a law table (--set "law={...}")
         return law_from_table(law) if isinstance(law, dict) else law
-    return memo_by_values(_LAWS, (str(law), restitution, length), _make_contact_law)
+    return _make_contact_law(str(law), restitution, length)
 
 
 def _make_contact_law(name: str, restitution: float | None, length: float | None) -> NormalLaw:
@@ -83,13 +82,6 @@ def _make_contact_law(name: str, restitution: float | None, length: float | None
 
     accepted = set(getattr(normal_law_class(name), "__dataclass_fields__", {}))
     return normal_law(name, **{k: v for k, v in fields.items() if k in accepted and v is not None})
-
-
-# Laws and the ideal mechanism's elements, kept by the values they are made of. They are frozen, so
-# scenes share them: a sweep's scenes differ in the clearance joint alone, and what is kept per
-# element or law (its structure text, its problems) is computed once.
-_LAWS: MemoTable = memo_table()
-_IDEAL_ELEMENTS: MemoTable = memo_table()
 
 
 def _make_ideal_elements(omega: float, crank_angle: float, slider_mass: float, slider_inertia: float,
@@ -213,7 +205,7 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     omega = rpm_to_rad_s(rpm)
     numbers = (omega, crank_angle, slider_mass, slider_inertia, offset)
     scene = Scene(name or ("slider_crank" if joint == "ideal" else f"slider_crank_{joint}"), gravity=(0.0, -gravity),
-                  elements=list(memo_by_values(_IDEAL_ELEMENTS, numbers, _make_ideal_elements)))
+                  elements=list(_make_ideal_elements(*numbers)))
     if joint == "ideal":  # an option of a clearance joint would be ignored: refused
         refuse_clearance_options("slider_crank", slider_crank, locals(), "joint='ideal'")
         return scene

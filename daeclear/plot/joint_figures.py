@@ -231,7 +231,7 @@ def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None 
 
     if result.step_t is None or result.step_h is None:
         raise ValueError(f"plot_step_sizes: result of scene {result.scene_name!r} has no recorded steps "
-                         f"(simulate(..., store_steps=True) records them).")
+                         f"(simulate(..., save=SaveAt(steps=True)) records them).")
     created = ax is None
     ax = style.new_axes(ax)
     h = np.asarray(result.step_h)

@@ -580,7 +580,7 @@ class Result:
 
 
 def load(path: str | os.PathLike[str], t0: float | None = None, t1: float | None = None) -> Result:
-    """Read a result written by `Result.save` (or streamed by a run, ``simulate(stream_to=...)``).
+    """Read a result written by `Result.save` (or streamed by a run, ``simulate(save=SaveAt(stream_to=...))``).
 
     Parameters
     ----------

@@ -21,15 +21,7 @@ from ..errors import SceneError
 from ..model.scenefile import scene_from_description
 from ..results.lazy_channels import Evaluate
 
-__all__ = ["ModelEvaluator", "evaluator_from_parameters", "model_evaluator", "rebuildable", "session_evaluator"]
-
-
-def session_evaluator(model: DAEModel, session: Any) -> Evaluate:
-    """The channels in an open session's library (a run's, while it is open)."""
-    def evaluate(t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> Mapping[str, NDArray]:
-        return model.channels(t, y, yp, switch, session)
-
-    return evaluate
+__all__ = ["ModelEvaluator", "evaluator_from_parameters", "model_evaluator", "rebuildable"]
 
 
 class ModelEvaluator:

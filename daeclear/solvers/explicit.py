@@ -1,12 +1,12 @@
 """The same assembled model integrated by other schemes than IDA, for accuracy studies.
 
-``simulate(..., method=...)`` dispatches here for every method but ``"ida"``:
+The solvers (:class:`daeclear.solvers.base.Solver`) of every method but ``"ida"``:
 
 * explicit adaptive (scipy): ``"RK45"``, ``"DOP853"``;
 * implicit (scipy): ``"Radau"``, ``"BDF"``, ``"LSODA"`` (with the generated Jacobian);
 * fixed step: ``"rk4"`` (classical Runge-Kutta) and ``"euler"`` (explicit Euler), with ``step=``.
 
-This module holds the entry point and the two integration loops (scipy, fixed step); the parts
+This module holds the solver classes and the two integration loops (scipy, fixed step); the parts
 they use live beside it: :mod:`~daeclear.solvers.ode_model` (the model as an ODE, symbolic),
 :mod:`~daeclear.solvers.ode_evaluators` (its compiled or Python evaluation),
 :mod:`~daeclear.solvers.ode_crossings` (gap crossings within a step) and
@@ -70,8 +70,8 @@ from
 
 Output
 ------
-Without ``t_eval`` the result holds every accepted step (and every event point); with
-``t_eval`` the scipy methods use their dense output and the fixed-step schemes a cubic Hermite
+Without output times (``SaveAt.times`` or ``every``) the result holds every accepted step (and
+every event point); with them the scipy methods use their dense output and the fixed-step schemes a cubic Hermite
 interpolant between steps. Multipliers and accelerations at output points are recomputed from
 (t, q, v) with the segment's active terms. Statistics: ``n_steps`` (accepted steps),
 ``n_res_evals`` (right-hand side evaluations: scheme stages, event location re-steps; output
@@ -88,13 +88,11 @@ advance (``STALL_EVENTS`` events at the same time).
 from __future__ import annotations
 
 import math
-import os
 import time
-from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from ..assembly import contact_state
 from ..assembly.assemble import DAEModel, assemble
@@ -108,16 +106,27 @@ from .ode_crossings import candidate, locate
 from .ode_evaluators import FIXED_CHUNK, FX_CHUNK, FX_ERR, FX_MAXSTEPS, FX_TSTOP, evaluator
 from .ode_model import ode_spec
 from . import physics
+from .base import step_rule
 from .ode_run import (FIXED_STEP_METHODS, IMPLICIT_METHODS, METHOD_NAMES, SCIPY_METHODS, TINY_STEP_COUNT, TINY_STEP_REL,
                       Run)
+
+if TYPE_CHECKING:
+    from ..save_at import Output
+    from ..solver_options import SolverOptions
 
 __all__ = [
     "METHOD_NAMES",
     "SCIPY_METHODS",
     "FIXED_STEP_METHODS",
-    "check_step",
+    "ODESolver",
+    "RK45",
+    "DOP853",
+    "Radau",
+    "BDF",
+    "LSODA",
+    "RK4",
+    "Euler",
     "ode_spec",
-    "integrate",
     # re-exported from the modules that now own them (ode_run, ode_evaluators)
     "IMPLICIT_METHODS",
     "TINY_STEP_REL",
@@ -130,24 +139,6 @@ __all__ = [
 HERMITE_GAP_CHECK = True
 # an event loop that produces STALL_EVENTS events without the time advancing is a failure
 STALL_EVENTS = 50
-
-
-# =========================================================================== validation
-
-
-def check_step(method: str, step: Any) -> float | None:
-    """Validate ``step`` for ``method`` (lower-case): required by rk4/euler, rejected otherwise."""
-    if method in FIXED_STEP_METHODS:
-        if step is None:
-            raise SceneError(f"simulate: method={METHOD_NAMES[method]!r} is a fixed-step scheme and needs "
-                             "step=<step size in s> (the chapter uses 1e-5 s).")
-        return options.step(step)
-    if step is not None:
-        name = METHOD_NAMES.get(method, method)
-        raise SceneError(f"simulate: step={step!r} is only for the fixed-step methods "
-                         f"({', '.join(repr(m) for m in FIXED_STEP_METHODS)}); method={name!r} chooses its "
-                         "own steps (use max_step to bound them).")
-    return None
 
 
 # =========================================================================== the run
@@ -378,65 +369,60 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
         t, x, _ = restart  # the next segment starts at the event
 
 
-def integrate(
-    scene: Scene | DAEModel,
-    t_end: float,
-    *,
-    method: str,
-    t_eval: ArrayLike | None = None,
-    rtol: float = 1e-6,
-    atol: float | Mapping[str, float] | ArrayLike | None = None,
-    formulation: str | None = None,
-    backend: str = "auto",
-    max_step: float = 0.0,
-    max_steps: int = 5_000_000,
-    step: float | None = None,
-    store_steps: bool = True,
-    on_failure: str = "raise",
-    progress: bool = False,
-    track_work: bool = False,
-    start: str = "ideal",
-    allow_penetration: bool = False,
-    t_eval_step: float | None = None,
-    stream_to: str | os.PathLike[str] | None = None,
-    keep_data: bool = True,
-    t0: float = 0.0,
-    y0: ArrayLike | None = None,
-    max_output_points: int | None = options.MAX_OUTPUT_POINTS,
-) -> Result:
-    """Integrate with a non-IDA method; the arguments are those of :func:`daeclear.simulate`.
+class ODESolver:
+    """A method that integrates the index-1 model as an ODE in (q, v) with the contact events of
+    the module docstring; a subclass names the scheme (``name``: scipy's class, or "rk4"/"euler")."""
 
-    Output (``t_eval``/``t_eval_step``, ``store_steps``, ``stream_to``, ``keep_data``) goes to a
-    :class:`daeclear.solvers.recorder.Recorder` segment by segment (a segment runs between two contact
-    events): streamed, each segment's points are written when it ends and dropped, so memory
-    grows with the longest segment and the events (kept for the fixed-step checks), not with
-    the run; the grid of ``t_eval_step`` is built whole (8 bytes per point).
+    name: ClassVar[str]
+    formulation: ClassVar[str] = options.CHAPTER_FORMULATION
+    fixed_step: ClassVar[bool] = False  # rk4, euler: the step is the option ``step``
 
-    ``method`` is one of RK45, DOP853, Radau, BDF, LSODA, rk4, euler (case-insensitive);
-    ``step`` (s) is required by rk4 and euler and rejected by the others; ``max_step`` bounds
-    the scipy methods' steps (0: unbounded); ``backend`` "c" (generated C), "python"
-    (FunctionBuffer) or "auto". See the module docstring for events, outputs and failures.
-    """
-    method_l = str(method).lower()
-    if method_l not in METHOD_NAMES:
-        valid = ", ".join(["ida", *METHOD_NAMES.values()])
-        raise SceneError(f"simulate: method={method!r}, must be one of {valid} (case-insensitive).")
-    step = check_step(method_l, step)
-    t_end, rtol, max_step, max_steps, t_eval, backend, on_failure, store_steps, progress, track_work = options.run(
-        t_end=t_end, t0=t0, rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, t_eval=t_eval,
-        backend=backend, on_failure=on_failure, store_steps=store_steps, progress=progress, track_work=track_work)
-    t0 = float(t0)  # checked by options.run
-    out = options.output(t_eval=t_eval, t_eval_step=t_eval_step, end=t_end, stream_to=stream_to, keep_data=keep_data,
-                         start=t0)
-    name = METHOD_NAMES[method_l]
-    if track_work:
+    def check(self, settings: SolverOptions) -> None:
+        """``step`` is required by the fixed-step schemes and refused by the others."""
+        step_rule(self.name, settings.step, fixed=self.fixed_step)
+
+    def run(self, model: Scene | DAEModel, t_end: float, t0: float, y0: NDArray | None, save: Output,
+            settings: SolverOptions, on_failure: str, progress: bool) -> Result:
+        """Integrate from ``t0`` to ``t_end`` (the :class:`daeclear.solvers.base.Solver` contract).
+
+        Output goes to a :class:`daeclear.solvers.recorder.Recorder` segment by segment (a segment
+        runs between two contact events): streamed, each segment's points are written when it ends
+        and dropped, so memory grows with the longest segment and the events (kept for the
+        fixed-step checks), not with the run; the grid of ``save.every`` is built whole (8 bytes
+        per point). ``max_step`` bounds the scipy methods' steps (0: unbounded); ``backend`` "c"
+        (generated C), "python" (FunctionBuffer) or "auto".
+        """
+        return _integrate(self, model, t_end, t0, y0, save, settings, on_failure, progress)
+
+
+def _solver(key: str, doc: str, *, fixed: bool = False) -> type[ODESolver]:
+    """The solver class of the method ``key`` (a subclass of ODESolver named as the method)."""
+    name = METHOD_NAMES[key]
+    return type(name, (ODESolver,), {"name": name, "fixed_step": fixed, "__doc__": doc, "__module__": __name__})
+
+
+RK45 = _solver("rk45", "scipy's explicit Runge-Kutta 5(4).")
+DOP853 = _solver("dop853", "scipy's explicit Runge-Kutta 8(5,3).")
+Radau = _solver("radau", "scipy's implicit Radau IIA (order 5), with the generated Jacobian.")
+BDF = _solver("bdf", "scipy's implicit BDF (orders 1-5), with the generated Jacobian.")
+LSODA = _solver("lsoda", "scipy's LSODA (Adams / BDF switching), with the generated Jacobian.")
+RK4 = _solver("rk4", "Classical fixed-step Runge-Kutta (order 4), its step loop in C.", fixed=True)
+Euler = _solver("euler", "Explicit Euler with a fixed step, its step loop in C.", fixed=True)
+
+
+def _integrate(solver: ODESolver, scene: Scene | DAEModel, t_end: float, t0: float, y0: NDArray | None,
+               out: Output, settings: SolverOptions, on_failure: str, progress: bool) -> Result:
+    """The run of an :class:`ODESolver`: checks that need the model, set-up, the loop, the Result."""
+    method_l, name = solver.name.lower(), solver.name
+    rtol, atol, step, max_step = settings.rtol, settings.atol_value(), settings.step, settings.max_step
+    start, allow_penetration = settings.start, settings.allow_penetration
+    if settings.track_work:
         raise SceneError(f"simulate: track_work=True is supported by method='ida' only, not by method={name!r}.")
-    if formulation is None:
-        formulation = options.default_formulation(method_l)
+    formulation = settings.formulation or solver.formulation
     if isinstance(scene, DAEModel):
         model = scene
     else:
-        if str(formulation).lower() == "ggl":
+        if formulation == "ggl":
             raise SceneError(f"simulate: formulation={formulation!r} is integrated by IDA only; method={name!r} "
                              "integrates the chapter's index-1 formulation (formulation='index1').")
         model = None
@@ -447,14 +433,13 @@ def integrate(
         raise SceneError(f"simulate: formulation={model.formulation!r} is integrated by IDA only; method={name!r} "
                          "integrates the chapter's index-1 formulation (formulation='index1').")
     given = None if y0 is None else options.state(y0, model.n_states)
-    options.output_size(out, options.max_output_points(max_output_points), t_eval_step=t_eval_step,
-                        step=step if out.times is None and store_steps else None, start=t0, end=t_end,
-                        n_states=model.n_states, n_channels=len(model.channel_names))  # before the grid is built
+    out.check_size(step=step, n_states=model.n_states,
+                   n_channels=len(model.channel_names))  # before the grid is built
     from_state = given is not None
-    eval_times = None if out.times is None else out.times.values()  # checked by options.output
+    eval_times = None if out.times is None else out.times.values()  # checked by SaveAt.plan
     n = model.n_q
     atol_x = tolerance_vector(model, rtol, atol, newton=False)[:2 * n]
-    ev = evaluator(model, backend)
+    ev = evaluator(model, settings.backend)
     if given is not None:  # q and v as given (index-1: no projection), multipliers recomputed at t0
         y0, yp0 = model.consistent_state(t0, given)
         if not allow_penetration:  # held to the declared start's limit
@@ -470,7 +455,7 @@ def integrate(
         sim_params["t0"] = t0
     rec = Recorder(model, parameters={**model.parameters, "simulate": sim_params}, method=name,
                    stream_to=out.stream_to, keep_data=out.keep_data)
-    run = Run(model, ev, method_l, t_end, eval_times, store_steps, progress, max_steps, rec)
+    run = Run(model, ev, method_l, t_end, eval_times, out.steps, progress, settings.max_steps, rec)
     run.y0, run.step = (y0 if start == "declared" and not from_state else None), step  # declared starts only
     run.from_state = from_state
     run.t_last = t0
@@ -491,8 +476,8 @@ def integrate(
         interrupted = True
     except MemoryError:  # keep (and, streamed, save) the segments closed before
         run.success, run.status = False, -1
-        run.message = (f"out of memory at t={run.t_last:.6g} s. Report fewer points (t_eval_step), keep no "
-                       "steps (store_steps=False) and stream the run to a file (stream_to).")
+        run.message = (f"out of memory at t={run.t_last:.6g} s. Report fewer points (SaveAt.every), keep no "
+                       "steps (SaveAt.steps=False) and stream the run to a file (SaveAt.stream_to).")
         if run.seg is not None:
             run.seg.st, run.seg.sx, run.seg.pt, run.seg.px, run.seg.et, run.seg.ex = [], [], [], [], [], []
     except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on

@@ -1,6 +1,6 @@
 """The IDA segment loop of one run: advance, record contact switches, restart, finish.
 
-:func:`daeclear.solvers.ida.simulate` checks the options, opens the session and the recorder and
+:meth:`daeclear.solvers.ida.IDA.run` opens the session and the recorder (the options are checked) and
 hands them to a :class:`SegmentLoop`, which integrates segment by segment. Between two roots of
 the gap functions the set of active contact terms is fixed. The compiled loop may decide the
 switches of simple pairs itself (:meth:`SegmentLoop.record_advance` takes its decisions into
@@ -30,7 +30,6 @@ from ..assembly.automaton import EVENT_KINDS, ONSET
 from ..engine.abi import DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND
 from ..engine.session_base import AutoEvents
 from ..errors import Interrupted, SolveError
-from .channel_eval import session_evaluator
 from .recorder import Recorder
 from ..progress import Progress
 from ..results.events import EventRows
@@ -73,7 +72,7 @@ class SegmentLoop:
             self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
             self.i_eval = 1
         self.events, self.segments = rec.events, rec.segments
-        rec.evaluate = session_evaluator(model, session)  # channels in the run's library while it is open
+        rec.session = session  # the checked channels in the run's library while it is open
         self.t, self.y, self.yp, self.y0 = t0, y, yp, y0
         self.t_start = t0
         self.seg_start = t0  # nan once the last segment is closed
@@ -105,8 +104,8 @@ class SegmentLoop:
         except MemoryError:  # keep (and, streamed, save) what was computed: the chunks before this one
             self.raw.clear()
             self.success, self.status = False, -1
-            self.message = (f"out of memory at t={self.t:.6g} s. Report fewer points (t_eval_step), keep no steps "
-                            "(store_steps=False) and stream the run to a file (stream_to).")
+            self.message = (f"out of memory at t={self.t:.6g} s. Report fewer points (SaveAt.every), keep no steps "
+                            "(SaveAt.steps=False) and stream the run to a file (SaveAt.stream_to).")
         except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on
             self.progress_line.close()
             self.rec.abort(exc)
@@ -296,7 +295,7 @@ class SegmentLoop:
         """Flush, check the physics, build the Result; raise (with it) on Ctrl-C or a failure when asked."""
         stats = dict(self.session.stats())
         found = self.checked_output(stats, setup_time, sim_params)
-        physics.issue(found, stacklevel=5)  # issue <- finish <- run <- simulate <- the caller
+        physics.issue(found, stacklevel=6)  # issue <- finish <- run <- IDA.run <- simulate <- the caller
         t, message = self.t, self.message
         deep = [w for w in found if w["kind"] == "penetration" and w["t"] <= t]
         if not self.success and not self.interrupted and deep:  # the advice must fit the cause: not a tolerance problem
@@ -338,7 +337,7 @@ class SegmentLoop:
                                      self.y0 if sim_params["start"] == "declared" else None, stats, session,
                                      from_state=sim_params["start"] == "state")
         finally:
-            rec.evaluate = None  # the session closes: later channels open their own
+            rec.session = None  # the session closes: later channels open their own
             session.close()
 
 

@@ -13,7 +13,6 @@ place that knows how the model is evaluated.
 from __future__ import annotations
 
 import ctypes
-import warnings
 import weakref
 from collections.abc import Sequence
 from typing import Any
@@ -33,7 +32,7 @@ from ..engine.codegen import (
 )
 from ..engine.abi import DCO_CNT_N, DCO_EULER, FX_CANDIDATE, FX_CHUNK, FX_ERR, FX_MAXSTEPS, FX_TSTOP, ODE_COUNTER_KEYS
 from ..engine.library import OdeLibrary
-from ..errors import DaeclearError, DaeclearWarning
+from ..errors import DaeclearError, warn_once
 from .ode_crossings import candidate
 from .ode_model import ode_spec
 
@@ -460,9 +459,6 @@ def _model_channels(model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch
     return np.array(out).reshape(n_ch, N).T
 
 
-_warned: set[str] = set()
-
-
 def evaluator(model: DAEModel, backend: str) -> Evaluator:
     """The model's ODE evaluator: compiled (cached per model object and on disk) or python."""
     spec = ode_spec(model)
@@ -488,8 +484,6 @@ def evaluator(model: DAEModel, backend: str) -> Evaluator:
         if backend == "c":
             raise DaeclearError(f"the compiled ODE backend cannot be built or loaded: {exc}") from exc
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        if reason not in _warned:
-            _warned.add(reason)
-            warnings.warn("daeclear: the compiled right-hand side is unavailable, using casadi.FunctionBuffer "
-                          f"and numpy (several times slower). Reason: {reason}", DaeclearWarning, stacklevel=4)
+        warn_once("daeclear: the compiled right-hand side is unavailable, using casadi.FunctionBuffer "
+                  f"and numpy (several times slower). Reason: {reason}", stacklevel=5)
         return _PyEvaluator(spec)

@@ -285,7 +285,7 @@ class Run:
                                   from_state=self.from_state)
         if self.step is not None:
             found += physics.check_fixed_steps(self.model, self.events, self.step, self.missed)
-        physics.issue(found, stacklevel=5)  # issue <- result <- integrate <- simulate <- the caller
+        physics.issue(found, stacklevel=6)  # issue <- result <- _integrate <- ODESolver.run <- simulate <- the caller
         return self.rec.finish(stats=stats, success=self.success, status=self.status, message=self.message,
                                warnings=found)
 

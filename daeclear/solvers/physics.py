@@ -61,6 +61,12 @@ DRIFT_FRACTION = 1e-3
 GAP_ROUNDING = 1e-12
 
 
+def checked_channel(name: str) -> bool:
+    """Whether :func:`check_run` reads a channel: every ``<pair>.penetration`` and ``constraints.position``
+    (the model compiles these alone as its ``checks`` function, so a run is checked without its other channels)."""
+    return name.endswith(".penetration") or name == "constraints.position"
+
+
 def record(kind: str, quantity: str, value: float, limit: float, unit: str, where: str, t: float,
            message: str) -> dict[str, Any]:
     """One warning record (see the module docstring)."""

@@ -16,7 +16,6 @@ exactly as a run kept in memory.
 
 from __future__ import annotations
 
-import functools
 from pathlib import Path
 from typing import Any
 from collections.abc import Mapping
@@ -28,7 +27,7 @@ from . import physics
 from .channel_eval import model_evaluator, rebuildable
 from ..errors import OutputError
 from ..results.events import EventRows, flatten
-from ..results.lazy_channels import Evaluate, LazyChannels
+from ..results.lazy_channels import LazyChannels
 from ..results.result import ContactEvent, Result, ResultWriter, load
 
 #: a chunk of points: t, y, yp, switch rows and the channels when the solver computed them
@@ -40,8 +39,9 @@ class Recorder:
 
     ``events`` and ``segments`` are the lists the solver appends to; :meth:`flush` writes the new
     ones (streamed: and empties the lists; :attr:`n_events` counts every event of the run).
-    :attr:`evaluate` computes channels in the run's open session (set by the IDA loop): points
-    added without channels get theirs from it when the physics checks or a streamed file need them.
+    :attr:`session` is the run's open session (set by the IDA loop while it is open): points added
+    without channels get the few the physics checks read (:meth:`DAEModel.checks`) from its library,
+    and every channel only where a streamed file must store them.
     """
 
     def __init__(self, model: Any, *, parameters: Mapping[str, Any], method: str,
@@ -56,7 +56,7 @@ class Recorder:
         self._header = dict(state_names=list(model.state_names), units=dict(model.channel_units),
                             parameters=parameters, scene_name=model.scene_name, method=method,
                             formulation=model.formulation)
-        self.evaluate: Evaluate | None = None
+        self.session: Any = None
         self._backend = str(parameters.get("simulate", {}).get("backend", "auto"))
         # the states alone make the channels again (IDA's output function; the scene rebuilt from its
         # description): decided at the first need (a streamed file, a saved result)
@@ -92,9 +92,9 @@ class Recorder:
         if not t.size:
             return
         if self.writer is not None:
-            if channels is None:  # the physics checks read the chunk's key channels
+            if channels is None and not self.rebuildable():  # the file stores every channel
                 channels = self._evaluated(t, y, yp, switch)
-            self._keep_key_rows(t, y, channels)
+            self._keep_key_rows(t, y, self._checked(t, y, yp, switch, channels))
             self.writer.append(t=t, y=y, yp=yp, switch=switch, channels=None if self.rebuildable() else channels)
         else:
             self._points.append((t, y, yp, switch, channels))
@@ -118,8 +118,16 @@ class Recorder:
             self._in_blocks = 0
             self.segments.clear()
 
+    def _checked(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray,
+                 channels: dict[str, NDArray] | None) -> dict[str, NDArray]:
+        """The channels the physics checks read at the rows: taken from ``channels`` when given, else
+        the model's checks function (in the run's session while it is open)."""
+        if channels is not None:
+            return {c: channels[c] for c in self.model.checked_names}
+        return self.model.checks(t, y, yp, switch, self.session)
+
     def _keep_key_rows(self, t: NDArray, y: NDArray, channels: dict[str, NDArray]) -> None:
-        names = _key_channels(tuple(channels))
+        names = self.model.checked_names
         kt, ky, kc = self._key
         if kt.size:  # the rows kept so far compete with the new ones
             t2, y2 = np.concatenate([kt, t]), np.concatenate([ky, y])
@@ -130,12 +138,14 @@ class Recorder:
         self._key = (t2[rows], y2[rows], {c: v[rows] for c, v in c2.items()})
 
     def _evaluated(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> dict[str, NDArray]:
-        evaluate = self.evaluate or model_evaluator(self.model, self._backend)
-        out = evaluate(t, y, yp, switch)
+        if self.session is not None:
+            return self.model.channels(t, y, yp, switch, self.session)
+        out = model_evaluator(self.model, self._backend)(t, y, yp, switch)
         return {name: np.ascontiguousarray(out[name]) for name in self.model.channel_names}
 
-    def _joined(self) -> tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray]]:
-        """The points kept in memory as one chunk, their channels computed (in one call) if not given."""
+    def _joined(self) -> tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray] | None]:
+        """The points kept in memory as one chunk, with their channels when the solver gave them (else
+        None: the Result computes them when they are first read)."""
         n = self.model.n_states
         points = self._points
         channels: dict[str, NDArray] | None
@@ -152,19 +162,17 @@ class Recorder:
             n_switch = self.model.outputs.size1_in(3)
             t, y, yp, switch = np.zeros(0), np.zeros((0, n)), np.zeros((0, n)), np.zeros((0, n_switch))
             channels = {c: np.zeros(0) for c in self.model.channel_names}
-        if channels is None:
-            channels = self._evaluated(t, y, yp, switch)
         self._points[:] = [(t, y, yp, switch, channels)]
         return t, y, yp, switch, channels
 
     def key_rows(self) -> tuple[NDArray, NDArray, dict[str, NDArray]]:
         """(t, y, channels) of the rows the physics checks read (:func:`daeclear.solvers.physics.key_rows`);
-        in memory, the run's channels are computed for them (all at once: the Result keeps them)."""
+        in memory, the checked channels are computed at every point for them (the others are not)."""
         if self.writer is None:
-            t, y, _, _, channels = self._joined()
-            names = _key_channels(tuple(channels))
-            rows = physics.key_rows(t, {c: channels[c] for c in names})
-            return t[rows], y[rows], {c: channels[c][rows] for c in names}
+            t, y, yp, switch, channels = self._joined()
+            checked = self._checked(t, y, yp, switch, channels)
+            rows = physics.key_rows(t, checked)
+            return t[rows], y[rows], {c: v[rows] for c, v in checked.items()}
         return self._key
 
     def finish(self, *, stats: Mapping[str, Any], success: bool, status: int, message: str,
@@ -205,10 +213,3 @@ class Recorder:
                 pass
             finally:
                 self.writer.abort(f"stopped by {type(error).__name__}: {error}")
-
-
-@functools.lru_cache(maxsize=16)
-def _key_channels(names: tuple[str, ...]) -> tuple[str, ...]:
-    """The channels the physics checks read (:func:`daeclear.solvers.physics.key_rows`), of a model's
-    channel names (a structure's: a sweep's runs share them)."""
-    return tuple(c for c in names if c.endswith(".penetration") or c == "constraints.position")

@@ -192,7 +192,7 @@ def _raise_to_roundoff(vec: NDArray[np.float64], quantities: list[str], floor: d
     if raised:
         parts = ", ".join(f"{q} to {v:.2g} {UNITS[q]}" for q, v in raised.items())
         warnings.warn(f"simulate: atol below round-off raised ({parts}): Newton's corrections cannot be "
-                      "smaller (docs/engine.md, Tolerances).", DaeclearWarning, stacklevel=4)
+                      "smaller (docs/engine.md, Tolerances).", DaeclearWarning, stacklevel=5)
 
 
 def _out_of_error_test(kinds: tuple[str, ...]) -> tuple[list[int], list[int]]:

@@ -29,8 +29,9 @@ from ..progress import Progress
 from ..results.outputs import atomic_write_text, check_file
 from ..results.result import Result
 from ..model.scene import Scene
+from ..save_at import SaveAt
 from ..solver_options import SolverOptions
-from ..solvers.ida import simulate
+from ..solvers.dispatch import simulate
 
 FIXED_STEP_METHODS = ("rk4", "euler")
 COLUMNS = ("label", "method", "tolerance", "error", "event_time_error", "events", "solve_time", "wall_time",
@@ -170,9 +171,9 @@ def converged_window(reference: Result, check: Result, channels: Sequence[str], 
 Settings = Mapping[str, Any] | SolverOptions  # the options of one run: simulate keywords or a SolverOptions
 
 
-def _keywords(settings: Settings) -> dict[str, Any]:
-    """``settings`` as keywords of :func:`simulate` (a SolverOptions goes in as ``options``)."""
-    return {"options": settings} if isinstance(settings, SolverOptions) else dict(settings)
+def _solver_options(settings: Settings) -> SolverOptions:
+    """``settings`` as the ``options`` of :func:`simulate` (a mapping: the fields of SolverOptions, checked)."""
+    return settings if isinstance(settings, SolverOptions) else SolverOptions.from_dict(settings)
 
 
 def _method_of(settings: Settings) -> str:
@@ -192,23 +193,24 @@ def _describe(settings: Settings) -> str:
     return ", ".join(f"{k}={v}" for k, v in items.items())
 
 
-def _with(settings: Settings, name: str, value: float) -> dict[str, Any]:
-    """Keywords of ``settings`` with the tolerance or step ``name`` set to ``value``."""
+def _with(settings: Settings, name: str, value: float) -> Settings:
+    """``settings`` with the tolerance or step ``name`` set to ``value``."""
     if isinstance(settings, SolverOptions):
-        return {"options": settings.replace(**{name: value})}
+        return settings.replace(**{name: value})
     opts = {k: v for k, v in settings.items() if k not in ("rtol", "step")}
     opts[name] = value
     return opts
 
 
-def _timed(model: Scene | DAEModel, t_end: float, t_eval: NDArray, options: dict[str, Any], repeats: int
+def _timed(model: Scene | DAEModel, t_end: float, t_eval: NDArray, settings: Settings, repeats: int
            ) -> tuple[Result, float]:
     """Best-of-repeats wall time of the whole ``simulate`` call, a Scene (assembled in the call,
     as users run it) or a model (first run warms the cache)."""
     best_result, best_time = None, math.inf
+    solver, save = _solver_options(settings), SaveAt(times=t_eval)
     for i in range(repeats + 1):
         start = time.perf_counter()
-        result = simulate(model, t_end, t_eval=t_eval, on_failure="return", **options)
+        result = simulate(model, t_end, options=solver, on_failure="return", save=save)
         elapsed = time.perf_counter() - start
         if i == 0 and repeats > 0:
             continue  # the warm-up run compiles or loads the model
@@ -300,10 +302,12 @@ def work_precision(
     check_settings = check if check is not None else {"method": "ida", "rtol": 1e-12, "formulation": "index1"}
     ref_options = ref_settings.to_dict() if isinstance(ref_settings, SolverOptions) else dict(ref_settings)
     scene_for_ref = scene if isinstance(scene, Scene) else model
-    ref = simulate(scene_for_ref, t_end, t_eval=t_eval, on_failure="raise", **_keywords(ref_settings))
+    ref = simulate(scene_for_ref, t_end, options=_solver_options(ref_settings), on_failure="raise",
+                   save=SaveAt(times=t_eval))
     notes = []
     if window is None:
-        other = simulate(scene_for_ref, t_end, t_eval=t_eval, on_failure="return", **_keywords(check_settings))
+        other = simulate(scene_for_ref, t_end, options=_solver_options(check_settings), on_failure="return",
+                         save=SaveAt(times=t_eval))
         if not other.success:  # without the check nothing says where the reference is converged
             raise DaeclearError(
                 f"work_precision: the check run ({_describe(check_settings)}) that finds where the reference is "

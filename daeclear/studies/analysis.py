@@ -187,7 +187,7 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
         :func:`daeclear.simulate`. ``formulation`` is used when ``scene`` is a Scene.
     **simulate_options
         Passed to :func:`daeclear.simulate`: solver settings (``atol``, ``max_step``, ``backend``,
-        ``formulation``, ...) and what a run reports (``store_steps``, ``progress``).
+        ``formulation``, ...), ``store_steps`` (:class:`daeclear.SaveAt`'s ``steps``) and ``progress``.
 
     Returns
     -------
@@ -199,7 +199,8 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
         If a run fails (partial result in ``.result``).
     """
     from ..assembly.assemble import assemble
-    from ..solvers.ida import simulate
+    from ..save_at import SaveAt
+    from ..solvers.dispatch import simulate
 
     revolutions = _check_int("revolutions", revolutions, 2)
     transient = _check_int("transient", transient, 0)
@@ -222,11 +223,13 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
     offset = (float(phase) % (2.0 * math.pi)) / (2.0 * math.pi) * T
     if offset > T * (1.0 - TIME_MATCH):
         offset = 0.0
-    simulate_options.setdefault("store_steps", False)
+    output = {"steps": simulate_options.pop("store_steps", False)}  # what SaveAt takes besides the times
+    output.update({k: simulate_options.pop(k) for k in ("stream_to", "keep_data", "max_points")
+                   if k in simulate_options})
     n_total = transient + revolutions
-    result = simulate(model, n_total * T, t_eval=sampling_times(T, n_total, per_revolution=per_revolution,
-                                                                offset=offset), options=settings,
-                      **simulate_options)
+    result = simulate(model, n_total * T, options=settings, **simulate_options,
+                      save=SaveAt(times=sampling_times(T, n_total, per_revolution=per_revolution, offset=offset),
+                                  **output))
     t0 = transient * T + offset
     section = poincare_section(result, channels, t0=t0, period=T)
     recorded = {"channels": list(section.channels), "revolutions": revolutions, "transient": transient,
@@ -248,8 +251,8 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
         runs = []
         for p in (0.0, perturbation):
             start = restart_state(model, result, index, perturbation=p, seed=seed)
-            runs.append(simulate(model, t_end, t0=start.t0, y0=start.y0, t_eval=grid, options=settings,
-                                 **simulate_options))
+            runs.append(simulate(model, t_end, t0=start.t0, y0=start.y0, options=settings, **simulate_options,
+                                 save=SaveAt(times=grid, **output)))
         twins = (runs[0], runs[1])
         divergence = twin_divergence(runs[0], runs[1], section, reference=result, restart_time=t_r,
                                      restart_in_contact=not free, perturbation=perturbation, offset=offset)

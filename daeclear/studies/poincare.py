@@ -248,8 +248,8 @@ def match_times(result: Result, times: NDArray[np.floating[Any]], period: float)
         bad = times[0] if t.size == 0 else times[np.argmax(np.abs(t[idx] - times) > tol)]
         raise DaeclearError(
             f"Poincaré section: the result has no output at t = {bad:.9g} s (section times t0 + k T, "
-            f"T = {period:.6g} s). Simulate with t_eval=daeclear.analysis.sampling_times(...) so that "
-            "the section times are output points (values from IDA's interpolant, multipliers recomputed)."
+            f"T = {period:.6g} s). Simulate with save=daeclear.SaveAt(times=daeclear.analysis.sampling_times(...)) "
+            "so that the section times are output points (values from IDA's interpolant, multipliers recomputed)."
         )
     return idx
 

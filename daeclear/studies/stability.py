@@ -24,8 +24,9 @@ from ..errors import DaeclearError
 from ..progress import Progress
 from ..model.mechanisms import STEEL, slider_crank
 from ..model.scene import Body, RevoluteClearance, Scene
+from ..save_at import SaveAt
 from ..solver_options import SolverOptions
-from ..solvers.ida import simulate
+from ..solvers.dispatch import simulate
 
 REV = 60.0 / 5000.0
 ENERGY_BOUND = 1e-3  # largest energy-balance residual, relative to the energy scale
@@ -111,8 +112,8 @@ def run_case(case: Case, rtol: float | None = None, n_eval: int = 20001, *,
     t_eval = np.linspace(0.0, case.t_end, n_eval)
     tolerance = {} if rtol is None else {"rtol": rtol}
     try:
-        result = simulate(case.scene(), case.t_end, t_eval=t_eval, options=options, on_failure="return",
-                          track_work=True, **{**tolerance, **case.options})
+        settings = (options or SolverOptions()).replace(track_work=True, **{**tolerance, **case.options})
+        result = simulate(case.scene(), case.t_end, options=settings, on_failure="return", save=SaveAt(times=t_eval))
     except DaeclearError as exc:
         return {"case": case.name, "group": case.group, "finished": False, "passed": case.expect_failure,
                 "message": f"{type(exc).__name__}: {exc}", "wall_time": time.perf_counter() - start}

@@ -30,7 +30,7 @@ from ..model.scene import RevoluteClearance, Scene
 from ..progress import Progress
 from ..results.result import Result
 from ..solver_options import SolverOptions
-from ..solvers.ida import simulate
+from ..solvers.dispatch import simulate
 from .poincare import crank_period
 from .wear_file import WearFile
 

@@ -1,0 +1,59 @@
+"""The one contract every integrator of :func:`daeclear.simulate` implements (as scipy's ``OdeSolver``).
+
+A solver is a class: :func:`daeclear.simulate` picks it by name from
+:data:`daeclear.solvers.registry.SOLVERS` (``method="ida"``, ``"RK45"``, ... case-insensitive) or
+takes it as given (``method=MySolver``), and calls, on an instance, :meth:`Solver.check` (once,
+when the :class:`daeclear.SolverOptions` naming it are made) and :meth:`Solver.run` (once per run,
+after every check of the call). The options a solver consumes are checked where it consumes them:
+an option it does not take is refused naming the method and the option.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol, runtime_checkable
+
+from numpy.typing import NDArray
+
+from ..errors import SceneError
+from .ode_run import FIXED_STEP_METHODS
+
+if TYPE_CHECKING:
+    from ..assembly.assemble import DAEModel
+    from ..model.scene import Scene
+    from ..results.result import Result
+    from ..save_at import Output
+    from ..solver_options import SolverOptions
+
+
+@runtime_checkable
+class Solver(Protocol):
+    """An integrator of an assembled model from t0 to t_end.
+
+    ``name`` is what ``result.method`` reports; ``formulation`` the DAE formulation a Scene is
+    assembled with when the options name none ("ggl" for IDA, "index1" for the ODE methods).
+    """
+
+    name: ClassVar[str]
+    formulation: ClassVar[str]
+
+    def check(self, settings: SolverOptions) -> None:
+        """Refuse (SceneError) a setting this method does not take or needs and lacks (e.g. ``step``)."""
+
+    def run(self, model: Scene | DAEModel, t_end: float, t0: float, y0: NDArray | None, save: Output,
+            settings: SolverOptions, on_failure: str, progress: bool) -> Result:
+        """Integrate ``model`` (a Scene is assembled with ``settings.formulation`` or this solver's own)
+        from ``t0`` to ``t_end``; everything given is checked (``y0``'s length once the model is known).
+        A failed run raises :class:`daeclear.SolveError` (``on_failure="raise"``) or returns its partial
+        Result with ``success=False``."""
+
+
+def step_rule(name: str, step: Any, *, fixed: bool) -> None:
+    """The rule of ``step`` (its value is checked by :class:`daeclear.SolverOptions`): required by a
+    fixed-step method, refused by one that chooses its own steps; ``name`` is the method's."""
+    if fixed and step is None:
+        raise SceneError(f"simulate: method={name!r} is a fixed-step scheme and needs "
+                         "step=<step size in s> (the chapter uses 1e-5 s).")
+    if not fixed and step is not None:
+        raise SceneError(f"simulate: step={step!r} is only for the fixed-step methods "
+                         f"({', '.join(repr(m) for m in FIXED_STEP_METHODS)}); method={name!r} chooses its "
+                         "own steps (use max_step to bound them).")
