@@ -170,7 +170,7 @@ def test_scene_and_minimal_formulation_agree_before_the_first_contact():
 
     script = _script()
     result = dc.simulate(script.siconos_scene(stiffness=1e11, restitution=0.43), 2.5e-3, rtol=1e-10,
-                         t_eval=[0.0, 1e-3, 2.5e-3])
+                         save=dc.SaveAt(times=[0.0, 1e-3, 2.5e-3]))
     sol = solve_ivp(lambda _t, z: script.minimal_rhs(z, [None] * 4, 1e11, 0.43, 0.01), (0.0, 2.5e-3),
                     [0.0, 0.0, 0.0, 150.0, -75.0, 0.0], method="DOP853", rtol=1e-12, atol=1e-12, t_eval=[1e-3, 2.5e-3])
     assert max(np.max(result[f"guide.{p}.penetration"]) for p in script.PAIRS) < 0.0  # no contact yet

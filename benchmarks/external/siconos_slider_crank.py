@@ -164,7 +164,7 @@ def daeclear_run(scene: dc.Scene, t_end: float, rtol: float) -> tuple[Channels, 
     wall time (assembly included, the compiled library cached before) and the number of corner onsets."""
     grid = output_grid(t_end)
     began = time.perf_counter()
-    result = dc.simulate(scene, t_end, rtol=rtol, t_eval=grid)
+    result = dc.simulate(scene, t_end, rtol=rtol, save=dc.SaveAt(times=grid))
     wall = time.perf_counter() - began
     channels = {"t": result.t, "crank.angle": result["A.angle"], "rod.angle": result["rod.phi"],
                 "slider.angle": result["slider.phi"], "crank.rate": result["A.rate"],
