@@ -10,12 +10,18 @@ direction (+1 upward, -1 downward, 0 none) and the penetration rate there, and d
   a storm (``storm.events`` switches within ``storm.window`` seconds, this one included): then the
   pair is *held*, its term stays on (the force is zero with a zero derivative while the gap is
   open, so nothing physical changes) and both crossings are watched;
-* contact, downward crossing at the instant of the pair's last switch (within ``SAME_INSTANT``
-  relative, a few units of round-off of t) while the pair is still approaching (rate > 0):
-  nothing. The gap evaluated at a restart just after an onset is zero to round-off, and its noise
-  can cross zero again one ulp of t later: at rtol 1e-12 a closing joint was logged onset,
-  separation, onset within 2e-19 s while approaching at 1.36 m/s. A real separation has the
-  penetration shrinking, or comes later than round-off of the time can tell;
+* a crossing against the sign of the rate at the instant of the pair's last switch (within
+  ``SAME_INSTANT`` relative to t): a downward one while the pair still approaches (rate > 0), an
+  upward one while it still recedes (rate < 0): nothing. Exactly, a gap cannot cross against its own
+  rate; the gap at the restart after a switch is zero to round-off, and its noise crosses zero again
+  until the motion outgrows it. IDA's first steps after a restart are a few ulps of t and its root
+  location tolerance is about 100 ulps of t, so that noise spans from 1 ulp (at rtol 1e-12 a closing
+  joint was logged onset, separation, onset within 2e-19 s while approaching at 1.36 m/s) to about
+  6.5e4 ulps for a corner leaving its wall at 0.3 mm/s (Siconos slider-crank, rtol 1e-10). Decided as
+  a separation, such a root left a corner free inside its wall: the restart found its gap exactly
+  zero, IDA masked it, saw it positive a step later and never reported the onset again. A genuine
+  crossing has the rate's sign, or comes later than the window (only a grazing crossing, its rate
+  within the solver's error of zero, could be taken for round-off, and only inside the window);
 * held: a downward crossing restarts the flight clock (``free_since``); an upward one changes
   nothing unless the flight lasted longer than ``storm.window``, in which case the hold ends and
   the crossing is a genuine onset with a freshly latched speed;
@@ -39,8 +45,10 @@ from typing import Final, Literal
 STORM_EVENTS: Final[int] = 20
 STORM_WINDOW: Final[float] = 1e-6
 
-#: Two crossings of one pair closer than this, relative to t, are one instant (16 ulps; C: 16 * DBL_EPSILON).
-SAME_INSTANT: Final[float] = 16 * 2.220446049250313e-16
+#: A crossing against the rate closer than this to the pair's last switch, relative to t, is the gap's
+#: round-off at that switch (2**20 ulps, 2.3e-10: 2.3e-11 s at t = 0.1 s, in which a pair moving at
+#: 1 m/s moves 2.3e-11 m; the noise measured spans up to 6.5e4 ulps; C: dc_abi.h's DC_SAME_INSTANT).
+SAME_INSTANT: Final[float] = 2**20 * 2.220446049250313e-16
 
 #: Decision kinds (the values the C loop reports) and the event kinds they make.
 NONE: Final[int] = 0
@@ -140,12 +148,14 @@ def step(state: PairState, t: float, direction: int, rate: float, *, storm: Stor
             direction = 0  # a re-contact inside the storm: the held term stays as it is
         else:
             state = replace(state, held=False)  # a genuine onset after a real flight
+    if direction > 0 and not state.contact and rate < 0 and _same_instant(state, t):
+        return state, decision_of(state, NONE)  # the round-off of the gap after a separation, not an onset
     if direction > 0 and not state.contact:
         state = replace(state, contact=True, latched=floor_speed(rate, min_approach_speed),
                         recent=_push(state.recent, t, storm))
         return state, decision_of(state, ONSET)
-    if direction < 0 and state.contact and rate > 0 and state.recent and t - state.recent[-1] <= abs(t) * SAME_INSTANT:
-        return state, decision_of(state, NONE)  # the restart's round-off, not a separation
+    if direction < 0 and state.contact and rate > 0 and _same_instant(state, t):
+        return state, decision_of(state, NONE)  # the round-off of the gap after an onset, not a separation
     if direction < 0 and state.contact:
         hold = 1 + sum(1 for s in state.recent if t - s < storm.window) >= storm.events
         state = replace(state, contact=False, held=hold, free_since=t if hold else state.free_since,
@@ -160,6 +170,11 @@ def recorded(state: PairState, decision: Decision) -> PairState:
     # the constructor, not dataclasses.replace: this runs at every event of a compiled run
     return PairState(contact=decision.contact, held=decision.held, free_since=state.free_since,
                      latched=decision.latched, recent=state.recent)
+
+
+def _same_instant(state: PairState, t: float) -> bool:
+    """Whether ``t`` is within round-off of the pair's last switch (``SAME_INSTANT`` relative to t)."""
+    return bool(state.recent) and t - state.recent[-1] <= abs(t) * SAME_INSTANT
 
 
 def _push(recent: tuple[float, ...], t: float, storm: Storm) -> tuple[float, ...]:

@@ -152,7 +152,7 @@ GROUPS: Final[tuple[tuple[str, tuple[tuple[str, int | float, str], ...]], ...]] 
         ("DC_NONE", DC_NONE, "nothing changes"),
         ("DC_ONSET", DC_ONSET, "contact starts"),
         ("DC_SEPARATION", DC_SEPARATION, "contact ends"),
-        ("DC_SAME_INSTANT", DC_SAME_INSTANT, "two crossings closer than this relative to t are one instant"))),
+        ("DC_SAME_INSTANT", DC_SAME_INSTANT, "against the rate, this near the last switch (rel. to t): round-off"))),
     ("columns of an event's info row (dc_take_events)", (
         ("DC_EV_KIND", DC_EV_KIND, "the decision's kind"),
         ("DC_EV_CONTACT", DC_EV_CONTACT, "the pair is in contact"),

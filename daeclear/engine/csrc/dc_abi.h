@@ -27,7 +27,7 @@
 #define DC_NONE 0 /* nothing changes */
 #define DC_ONSET 1 /* contact starts */
 #define DC_SEPARATION (-1) /* contact ends */
-#define DC_SAME_INSTANT 3.552713678800501e-15 /* two crossings closer than this relative to t are one instant */
+#define DC_SAME_INSTANT 2.3283064365386963e-10 /* against the rate, this near the last switch (rel. to t): round-off */
 
 /* columns of an event's info row (dc_take_events) */
 #define DC_EV_KIND 0 /* the decision's kind */

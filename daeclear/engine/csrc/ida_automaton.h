@@ -16,8 +16,9 @@
  * The C mirror of daeclear/assembly/automaton.py (step): the decision of one contact pair at a root of
  * its gap. Keep the two identical, branch for branch; tests/test_automaton.py drives both
  * with the same random root sequences through dc_automaton_run. */
-/* The decision kinds DC_NONE, DC_ONSET, DC_SEPARATION and DC_SAME_INSTANT (two crossings of one
- * pair closer than this, relative to t, are one instant) are the automaton's, in dc_abi.h. */
+/* The decision kinds DC_NONE, DC_ONSET, DC_SEPARATION and DC_SAME_INSTANT (a crossing against the
+ * rate closer than this to the pair's last switch, relative to t, is round-off) are the
+ * automaton's, in dc_abi.h. */
 
 typedef struct {
   int storm_events;    /* this many switches within storm_window s hold the term on (>= 1) */
@@ -59,6 +60,11 @@ static void pair_push(const dc_pair_rule* r, dc_pair_state* st, double t) {
   }
 }
 
+/* whether t is within round-off of the pair's last switch (DC_SAME_INSTANT relative to t) */
+static int same_instant(const dc_pair_state* st, double t) {
+  return st->n_recent > 0 && t - st->recent[st->n_recent - 1] <= fabs(t) * DC_SAME_INSTANT;
+}
+
 /* Decide a root at time t (non-decreasing per pair) crossed in direction dir (+1, -1, 0) with
  * penetration rate `rate`; update the state and return the decision. */
 static dc_decision pair_step(const dc_pair_rule* r, dc_pair_state* st, double t, int dir,
@@ -73,15 +79,16 @@ static dc_decision pair_step(const dc_pair_rule* r, dc_pair_state* st, double t,
       st->held = 0; /* a genuine onset after a real flight */
     }
   }
+  if (dir > 0 && !st->contact && rate < 0 && same_instant(st, t))
+    return decision_of(st, DC_NONE); /* the round-off of the gap after a separation, not an onset */
   if (dir > 0 && !st->contact) {
     st->contact = 1;
     st->latched = floor_speed(rate, r->vmin);
     pair_push(r, st, t);
     return decision_of(st, DC_ONSET);
   }
-  if (dir < 0 && st->contact && rate > 0 && st->n_recent > 0 &&
-      t - st->recent[st->n_recent - 1] <= fabs(t) * DC_SAME_INSTANT)
-    return decision_of(st, DC_NONE); /* the restart's round-off, not a separation */
+  if (dir < 0 && st->contact && rate > 0 && same_instant(st, t))
+    return decision_of(st, DC_NONE); /* the round-off of the gap after an onset, not a separation */
   if (dir < 0 && st->contact) {
     int count = 1;
     for (int i = 0; i < st->n_recent; ++i)
