@@ -219,6 +219,36 @@ def test_failure_advice_fits_a_penetration_beyond_the_joint():
     assert not result.success
     assert "penetrated" in result.message and "tolerances will not fix that" in result.message
     assert kinds(result)["penetration"]["value"] > 0.01
+    assert "defect" not in result.message  # the deep corner is past the guide's end: free by the gap IDA watches
+
+
+def test_failure_message_calls_a_pair_deep_in_its_wall_while_free_a_solver_defect(monkeypatch):
+    """A lost onset (the automaton made to ignore every onset after the first separation, as the
+    same-instant guard once did for one corner of the Siconos slider-crank): a corner goes 9 cm into
+    its wall with no force and IDA fails at its step cap. The message says the solver lost the onset,
+    not that the joint carries too much load."""
+    from daeclear.assembly import automaton, translational_joint
+
+    seen: list[int] = []
+
+    def lossy(state, t, direction, rate, **kw):
+        new, decision = automaton.step(state, t, direction, rate, **kw)
+        if decision.kind == automaton.ONSET and seen:
+            return state, automaton.decision_of(state, automaton.NONE)
+        if decision.kind == automaton.SEPARATION:
+            seen.append(1)
+        return new, decision
+
+    monkeypatch.setattr(translational_joint, "step", lossy)
+    model = dc.assemble(dc.mechanisms.slider_crank("translational"), "index1")
+    result = quiet_simulate(model, 0.02, rtol=1e-8, on_failure="return",
+                            options=dc.SolverOptions(backend="python", max_steps=800))
+    assert not result.success and "DC_MAX_STEPS" in result.message and seen
+    deep = kinds(result)["penetration"]
+    assert deep["value"] > 0.01 and result[f"{deep['where']}.in_contact"][result.t == deep["t"]].max() == 0.0
+    assert f"'{deep['where']}' was {deep['value']:.3g} m inside its wall" in result.message
+    assert "while free" in result.message and "a defect of daeclear" in result.message
+    assert "load the joint cannot carry" in result.message and "tolerances will not fix" not in result.message
 
 
 # ---------------------------------------------------------------- item 6: redundant constraints

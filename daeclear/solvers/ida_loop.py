@@ -56,7 +56,12 @@ class SegmentLoop:
         self.active: list[bool] = []
         self.params: list[NDArray] = []
         self.modes: dict[str, str] = {}
+        # (t, pair, term on) of every switch, for the failure message: was a deep pair carrying a force?
+        self.term_log: list[tuple[float, str, bool]] = []
+        self.checked_rows: tuple[NDArray, NDArray] = (np.zeros(0), np.zeros((0, 0)))  # (t, y) the checks read
         self.set_state(contact_state.start_state(model, t0, y0))
+        self.first_terms = {name: contact_state.pair_state(model, self.state, root).term_on  # for term_on_at
+                            for root, name in enumerate(model.gap_names)}
         y, yp = y0, yp0
         if any(self.active):
             y, yp = model.consistent_state(t0, y0, model.term_forces(t0, y0, self.active, self.params, session),
@@ -222,6 +227,7 @@ class SegmentLoop:
             _, _, name, column, needs = info[p]
             kind = kinds[i]
             modes[name] = "contact" if kind == ONSET else "free"
+            self.term_log.append((t, name, bool(term_on[i])))
             switch[column] = 1.0 if term_on[i] else 0.0  # as the compiled loop sets its term
             if needs:
                 switch[column + 1] = latched
@@ -252,6 +258,8 @@ class SegmentLoop:
         state, new_events = contact_state.decide(model, self.state, t, self.y, adv.roots_found)
         self.events.extend(new_events)
         self.set_state(state)
+        self.term_log += [(e.t, e.pair, contact_state.pair_state(model, state, model.gap_names.index(e.pair)).term_on)
+                          for e in new_events]
         active, params = self.active, self.params
         directions = contact_state.root_directions(model, state)
         if (before[0] == active and all(np.array_equal(a, b) for a, b in zip(before[1], params))
@@ -300,10 +308,7 @@ class SegmentLoop:
         deep = [w for w in found if w["kind"] == "penetration" and w["t"] <= t]
         if not self.success and not self.interrupted and deep:  # the advice must fit the cause: not a tolerance problem
             w = deep[0]  # the solver's advice is left out: it would not help
-            message = self.failure + (
-                f" Before it, '{w['where']}' penetrated {w['value']:.3g} m at t={w['t']:.6g} s, more than "
-                f"its limit {w['limit']:.3g} m: the contact carries more than the joint can (friction, speed "
-                "or load); tolerances will not fix that.")
+            message = self.failure + penetration_advice(w, self.lost_onset(w["where"], w["t"]))
         result = self.rec.finish(stats=stats, success=self.success, status=self.status, message=message,
                                  warnings=found)
         if self.interrupted or self.rec.interrupted:
@@ -311,6 +316,16 @@ class SegmentLoop:
         if not self.success and on_failure == "raise":
             raise SolveError(message + " Partial result in .result.", result)
         return result
+
+    def lost_onset(self, pair: str, t: float) -> bool:
+        """Whether ``pair`` was free at ``t`` (its force term off) with its gap (the root IDA watches,
+        guide ends included) in contact beyond round-off: an onset the solver did not report."""
+        key_t, key_y = self.checked_rows
+        rows = np.flatnonzero(key_t == t)
+        if term_on_at(self.term_log, self.first_terms, pair, t) or not rows.size:
+            return False
+        gap = gap_at(self.model, pair, key_y[rows[0]])
+        return gap is not None and gap > physics.GAP_ROUNDING
 
     def checked_output(self, stats: dict[str, Any], setup_time: float, sim_params: dict[str, Any]) -> list[dict]:
         """Hand over the last points, complete ``stats`` and run the physics checks (their findings);
@@ -333,6 +348,7 @@ class SegmentLoop:
                                        if contact_state.pair_state(model, self.state, root).held]
             # the start checks concern a declared state: the chapter's start is consistent by construction
             key_t, key_y, key_channels = rec.key_rows()
+            self.checked_rows = (key_t, key_y)  # the failure message reads the deepest pair's gap there
             return physics.check_run(model, key_t, key_y, key_channels,
                                      self.y0 if sim_params["start"] == "declared" else None, stats, session,
                                      from_state=sim_params["start"] == "state")
@@ -365,6 +381,42 @@ def _restart_state(model: DAEModel, session: Any, t: float, y: NDArray, yp: NDAr
     if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
         return model.consistent_state(t, y, forces, session, project=False)
     return projected
+
+
+def term_on_at(log: list[tuple[float, str, bool]], first: dict[str, bool], pair: str, t: float) -> bool:
+    """Whether ``pair``'s force term was on at ``t``: its last switch of ``log`` at or before ``t``, else
+    its state at the start (``first``; a name that is no pair counts as on)."""
+    on = first.get(pair, True)
+    for when, name, state in log:
+        if when > t:
+            break
+        if name == pair:
+            on = state
+    return on
+
+
+def gap_at(model: DAEModel, pair: str, y: NDArray) -> float | None:
+    """The gap IDA watches for ``pair`` (> 0 in contact) at state ``y``; None for a name that is no pair."""
+    for logic in model.contacts:
+        for i, root in enumerate(logic.roots):
+            if model.gap_names[root] == pair:
+                gaps = logic.rate(y[:model.n_q], y[model.n_q:2 * model.n_q])[0]
+                return float(np.ravel(gaps)[i])
+    return None
+
+
+def penetration_advice(warning: dict[str, Any], lost_onset: bool) -> str:
+    """The failure message's sentence on a penetration beyond the joint's limit (``warning``, a physics
+    record). Normally the contact carried more than the joint can; a pair inside its wall while free
+    (``lost_onset``) had no force, which no load causes: the solver missed its onset, a defect."""
+    w = warning
+    if lost_onset:
+        return (f" Before it, '{w['where']}' was {w['value']:.3g} m inside its wall at t={w['t']:.6g} s while free "
+                f"(no contact force; limit {w['limit']:.3g} m): the solver lost that contact's onset, a defect of "
+                "daeclear, not a load the joint cannot carry; please report it with the scene and rtol.")
+    return (f" Before it, '{w['where']}' penetrated {w['value']:.3g} m at t={w['t']:.6g} s, more than "
+            f"its limit {w['limit']:.3g} m: the contact carries more than the joint can (friction, speed "
+            "or load); tolerances will not fix that.")
 
 
 def steps_needed(cap: int, t0: float, t: float, t_end: float) -> int:
