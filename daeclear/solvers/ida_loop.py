@@ -258,8 +258,9 @@ class SegmentLoop:
         state, new_events = contact_state.decide(model, self.state, t, self.y, adv.roots_found)
         self.events.extend(new_events)
         self.set_state(state)
-        self.term_log += [(e.t, e.pair, contact_state.pair_state(model, state, model.gap_names.index(e.pair)).term_on)
-                          for e in new_events]
+        roots = {name: root for root, name in enumerate(model.gap_names)}  # faces' events have no root
+        self.term_log += [(e.t, e.pair, contact_state.pair_state(model, state, roots[e.pair]).term_on)
+                          for e in new_events if e.pair in roots]
         active, params = self.active, self.params
         directions = contact_state.root_directions(model, state)
         if (before[0] == active and all(np.array_equal(a, b) for a, b in zip(before[1], params))
