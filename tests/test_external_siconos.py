@@ -182,18 +182,21 @@ def test_scene_and_minimal_formulation_agree_before_the_first_contact():
 
 
 @pytest.mark.slow
-def test_tight_run_keeps_every_corner_out_of_its_wall_while_free():
+@pytest.mark.parametrize("rtol", [1e-9, 1e-10, 1e-11])
+def test_tight_run_keeps_every_corner_out_of_its_wall_while_free(rtol):
     """At rtol 1e-10 a corner's onset at t = 0.0665368513 was followed 51 ulps later by a downward
     root of the gap's round-off while the corner still approached; taken as a separation, it left
-    the corner free inside its wall (3.25 mm deep, no force, IDA failing at 0.1726 s). Now no corner
-    is free deeper than round-off, and no crossing of one corner is logged twice at one instant."""
+    the corner free inside its wall (3.25 mm deep, no force, IDA failing at 0.1726 s; at 1e-11 IDA
+    failed at 0.015 s). Now the whole run ends, no corner is free deeper than round-off, and no
+    crossing of one corner is logged twice at one instant. (The runs part from each other after about
+    20 ms, so the root sequence of that impact is tests/test_automaton.py's, not this run's.)"""
     import daeclear as dc
     from daeclear.assembly.automaton import SAME_INSTANT
     from daeclear.solvers.physics import GAP_ROUNDING
 
     script = _script()
-    result = dc.simulate(script.siconos_scene(1e11, script.calibrated_restitution()), 0.0667, rtol=1e-10)
-    assert result.success
+    result = dc.simulate(script.siconos_scene(1e11, script.calibrated_restitution()), 0.2, rtol=rtol)
+    assert result.success and result.t[-1] == 0.2
     for pair in script.PAIRS:
         name = f"guide.{pair}"
         free = result[f"{name}.in_contact"] == 0
@@ -201,8 +204,6 @@ def test_tight_run_keeps_every_corner_out_of_its_wall_while_free():
         times = result.events.of(name).t
         assert len(times) > 10, name  # the corner hit its wall many times: the check saw them
         assert np.all(np.diff(times) > SAME_INSTANT * times[1:]), name
-    onsets = result.events.of("guide.C_lower", "onset").t
-    assert np.any(np.abs(onsets - 0.0665368513406839) < 1e-9)  # that impact is there (its path moved 8e-12 s)
 
 
 def test_corner_jacobians_and_contact_laws():

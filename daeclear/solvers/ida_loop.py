@@ -263,18 +263,20 @@ class SegmentLoop:
                           for e in new_events if e.pair in roots]
         active, params = self.active, self.params
         directions = contact_state.root_directions(model, state)
-        if (before[0] == active and all(np.array_equal(a, b) for a, b in zip(before[1], params))
-                and (directions is None or (before[2] is not None and np.array_equal(before[2], directions)))):
-            return  # nothing switched: IDA goes on from the root without a restart, in the same segment
-        self.segments.append((self.seg_start, t, before[3]))
-        self.seg_start = t
         assert adv.roots_found is not None  # a root return always says which roots
+        unchanged = (before[0] == active and all(np.array_equal(a, b) for a, b in zip(before[1], params))
+                     and (directions is None or (before[2] is not None and np.array_equal(before[2], directions))))
+        if unchanged and not guarded_root(before[2], adv.roots_found):
+            return  # nothing switched: IDA goes on from the root without a restart, in the same segment
+        if not unchanged:
+            self.segments.append((self.seg_start, t, before[3]))
+            self.seg_start = t
         self.y, self.yp = _restart_state(model, self.session, t, self.y, self.yp,
                                          model.term_forces(t, self.y, active, params, self.session),
                                          adv.roots_found)
         self.switch = model.switch_vector(active, params)
         self.session.reinit(t, self.y, self.yp, active, params, directions)
-        self.n_restarts += 1
+        self.n_restarts += not unchanged  # a switch's restart (the compiled loop counts them by its events)
         self.flush()
 
     def flush(self) -> None:
@@ -382,6 +384,18 @@ def _restart_state(model: DAEModel, session: Any, t: float, y: NDArray, yp: NDAr
     if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
         return model.consistent_state(t, y, forces, session, project=False)
     return projected
+
+
+def guarded_root(watched: NDArray | None, found: NDArray) -> bool:
+    """Whether a root was found in the direction its pair watched (``watched``, the root directions
+    before it) and decided nothing: the automaton's same-instant guard. IDA then restarts though
+    nothing switched: going on from a root whose gap is exactly zero, IDA reports "root found at and
+    very near t" (an error) when the gap is still zero a root tolerance later, while a restart masks
+    such a gap until it moves (the compiled loop restarts alike)."""
+    if watched is None:
+        return False
+    found = np.ravel(found)
+    return bool(np.any((found != 0) & (found == np.ravel(watched))))
 
 
 def term_on_at(log: list[tuple[float, str, bool]], first: dict[str, bool], pair: str, t: float) -> bool:

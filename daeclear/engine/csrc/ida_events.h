@@ -177,15 +177,19 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
   const double* q = y;
   const double* v = y + nq;
   double* gr = s->auto_gr;
-  int switched = 0;
+  int switched = 0, guarded = 0;
   for (int i = 0; i < s->n_roots; ++i) {
     int dir = s->rootsfound[i];
     if (!dir) continue;
     int p = s->root_to_auto[i], k = s->auto_term[p];
     const double* in_rate[3] = {q, v, s->P};
     if (eval_extra1(s, s->auto_rate[p], 3, in_rate, gr) != 0) goto eval_failed;
+    const int watched = dir == pair_watch(&s->pair_state[p]); /* held pairs watch 0: never */
     dc_decision d = pair_step(&s->pair_rule[p], &s->pair_state[p], t, dir, gr[1]);
-    if (d.kind == DC_NONE) continue;
+    if (d.kind == DC_NONE) {
+      guarded |= watched; /* the same-instant guard: restart all the same (see below) */
+      continue;
+    }
     int* info = s->ev_info + DC_EV_N * (size_t)s->ev_n;
     s->ev_t[s->ev_n] = t;
     s->ev_pair[s->ev_n] = p;
@@ -202,7 +206,10 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
     s->rootdir[i] = d.watch;
     switched = 1;
   }
-  if (!switched) return 2;
+  /* A root of the same-instant guard restarts IDA though nothing switched: going on from a root
+   * whose gap is exactly zero, IDA fails ("root found at and very near t") when the gap is still
+   * zero a root tolerance later; a restart masks such a gap until it moves (ida_loop.guarded_root). */
+  if (!switched && !guarded) return 2;
   /* consistent restart: GGL on the constraint manifold with mu = 0; then multipliers and
    * derivatives from the generated solve with the new set of contact forces */
   if (s->proj_on) {
