@@ -21,11 +21,14 @@ direction (+1 upward, -1 downward, 0 none) and the penetration rate there, and d
   a separation, such a root left a corner free inside its wall: the restart found its gap exactly
   zero, IDA masked it, saw it positive a step later and never reported the onset again. A genuine
   crossing has the rate's sign, or comes later than the window (only a grazing crossing, its rate
-  within the solver's error of zero, could be taken for round-off, and only inside the window);
+  within the solver's error of zero, could be taken for round-off, and only inside the window).
+  The loops restart IDA in the same modes after such a root (a root found in the watched direction
+  that decided nothing: ``solvers.ida_loop.guarded_root``), because IDA, going on from a gap that is
+  exactly zero, fails when it is still zero a root tolerance later;
 * held: a downward crossing restarts the flight clock (``free_since``); an upward one changes
   nothing unless the flight lasted longer than ``storm.window``, in which case the hold ends and
   the crossing is a genuine onset with a freshly latched speed;
-* anything else decides nothing (no event, no restart).
+* anything else decides nothing (no event, no restart; held pairs' roots are watched both ways).
 
 :func:`step` is pure. The compiled IDA loop runs a line-by-line C mirror of it (``pair_step`` in
 ``csrc/ida_driver.c``) for the pairs it switches itself and reports each decision; the Python
@@ -108,7 +111,7 @@ class PairState:
 class Decision:
     """The outcome of one root: event ``kind`` (ONSET, SEPARATION or NONE) and the pair's new mode.
 
-    A decision of kind NONE changes nothing the integrator sees (no event, no restart).
+    A decision of kind NONE changes no mode and makes no event (the same-instant guard's restarts IDA).
     """
 
     kind: int
