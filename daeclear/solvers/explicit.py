@@ -98,7 +98,7 @@ from ..assembly import contact_state
 from ..assembly.assemble import DAEModel, assemble
 from .. import options
 from ..errors import Interrupted, SceneError, SolveError
-from .recorder import Recorder
+from .recorder import Recorder, out_of_memory
 from .tolerances import atol_record, tolerance_vector
 from ..results.result import Result
 from ..model.scene import Scene
@@ -476,8 +476,7 @@ def _integrate(solver: ODESolver, scene: Scene | DAEModel, t_end: float, t0: flo
         interrupted = True
     except MemoryError:  # keep (and, streamed, save) the segments closed before
         run.success, run.status = False, -1
-        run.message = (f"out of memory at t={run.t_last:.6g} s. Report fewer points (SaveAt.every), keep no "
-                       "steps (SaveAt.steps=False) and stream the run to a file (SaveAt.stream_to).")
+        run.message = out_of_memory(run.t_last)
         if run.seg is not None:
             run.seg.st, run.seg.sx, run.seg.pt, run.seg.px, run.seg.et, run.seg.ex = [], [], [], [], [], []
     except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on

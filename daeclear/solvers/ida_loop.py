@@ -30,7 +30,7 @@ from ..assembly.automaton import EVENT_KINDS, ONSET
 from ..engine.abi import DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND
 from ..engine.session_base import AutoEvents
 from ..errors import Interrupted, SolveError
-from .recorder import Recorder
+from .recorder import Recorder, out_of_memory
 from ..progress import Progress
 from ..results.events import EventRows
 from ..results.result import Result
@@ -109,8 +109,7 @@ class SegmentLoop:
         except MemoryError:  # keep (and, streamed, save) what was computed: the chunks before this one
             self.raw.clear()
             self.success, self.status = False, -1
-            self.message = (f"out of memory at t={self.t:.6g} s. Report fewer points (SaveAt.every), keep no steps "
-                            "(SaveAt.steps=False) and stream the run to a file (SaveAt.stream_to).")
+            self.message = out_of_memory(self.t)
         except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on
             self.progress_line.close()
             self.rec.abort(exc)

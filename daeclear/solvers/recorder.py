@@ -34,6 +34,12 @@ from ..results.result import ContactEvent, Result, ResultWriter, load
 Points = tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray] | None]
 
 
+def out_of_memory(t: float) -> str:
+    """The message of a run stopped by a MemoryError at time ``t`` (any method): what to change in its output."""
+    return (f"out of memory at t={t:.6g} s. Report fewer points (SaveAt.every), keep no steps "
+            "(SaveAt.steps=False) and stream the run to a file (SaveAt.stream_to).")
+
+
 class Recorder:
     """The output of one run (see the module docstring).
 
