@@ -429,3 +429,15 @@ def test_physics_limits_are_the_documented_ones():
     assert physics.PENETRATION_FRACTION == 1.0 and physics.DRIFT_FRACTION == solve.DRIFT_FRACTION == 1e-3
     assert set(physics.KINDS) == {"penetration", "initial_penetration", "initial_velocity", "constraint_drift",
                                   "contact_within_one_step", "missed_contact"}
+
+
+def test_term_on_at_knows_a_pair_from_its_last_switch_on():
+    """The failure message's record of the terms keeps one switch a pair (bounded memory): from the
+    switch on its state is known; before it, or for a name that is no pair, the term counts as on, so
+    that no lost onset is claimed."""
+    from daeclear.solvers.ida_loop import term_on_at
+
+    last = {"A": (0.5, False), "B": (0.2, True)}
+    assert term_on_at(last, "A", 0.7) is False and term_on_at(last, "A", 0.5) is False
+    assert term_on_at(last, "A", 0.4) is True  # before its last switch: not known
+    assert term_on_at(last, "B", 0.3) is True and term_on_at(last, "C", 1.0) is True

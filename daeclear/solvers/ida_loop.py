@@ -56,12 +56,12 @@ class SegmentLoop:
         self.active: list[bool] = []
         self.params: list[NDArray] = []
         self.modes: dict[str, str] = {}
-        # (t, pair, term on) of every switch, for the failure message: was a deep pair carrying a force?
-        self.term_log: list[tuple[float, str, bool]] = []
         self.checked_rows: tuple[NDArray, NDArray] = (np.zeros(0), np.zeros((0, 0)))  # (t, y) the checks read
         self.set_state(contact_state.start_state(model, t0, y0))
-        self.first_terms = {name: contact_state.pair_state(model, self.state, root).term_on  # for term_on_at
-                            for root, name in enumerate(model.gap_names)}
+        # each pair's last switch (t, term on), for the failure message: was a deep pair carrying a force?
+        # (one entry a pair: a long run's memory does not grow with its events)
+        self.last_terms = {name: (t0, contact_state.pair_state(model, self.state, root).term_on)
+                           for root, name in enumerate(model.gap_names)}
         y, yp = y0, yp0
         if any(self.active):
             y, yp = model.consistent_state(t0, y0, model.term_forces(t0, y0, self.active, self.params, session),
@@ -226,7 +226,7 @@ class SegmentLoop:
             _, _, name, column, needs = info[p]
             kind = kinds[i]
             modes[name] = "contact" if kind == ONSET else "free"
-            self.term_log.append((t, name, bool(term_on[i])))
+            self.last_terms[name] = (t, bool(term_on[i]))
             switch[column] = 1.0 if term_on[i] else 0.0  # as the compiled loop sets its term
             if needs:
                 switch[column + 1] = latched
@@ -258,8 +258,8 @@ class SegmentLoop:
         self.events.extend(new_events)
         self.set_state(state)
         roots = {name: root for root, name in enumerate(model.gap_names)}  # faces' events have no root
-        self.term_log += [(e.t, e.pair, contact_state.pair_state(model, state, roots[e.pair]).term_on)
-                          for e in new_events if e.pair in roots]
+        self.last_terms.update((e.pair, (e.t, contact_state.pair_state(model, state, roots[e.pair]).term_on))
+                               for e in new_events if e.pair in roots)
         active, params = self.active, self.params
         directions = contact_state.root_directions(model, state)
         assert adv.roots_found is not None  # a root return always says which roots
@@ -324,7 +324,7 @@ class SegmentLoop:
         guide ends included) in contact beyond round-off: an onset the solver did not report."""
         key_t, key_y = self.checked_rows
         rows = np.flatnonzero(key_t == t)
-        if term_on_at(self.term_log, self.first_terms, pair, t) or not rows.size:
+        if term_on_at(self.last_terms, pair, t) or not rows.size:
             return False
         gap = gap_at(self.model, pair, key_y[rows[0]])
         return gap is not None and gap > physics.GAP_ROUNDING
@@ -397,16 +397,12 @@ def guarded_root(watched: NDArray | None, found: NDArray) -> bool:
     return bool(np.any((found != 0) & (found == np.ravel(watched))))
 
 
-def term_on_at(log: list[tuple[float, str, bool]], first: dict[str, bool], pair: str, t: float) -> bool:
-    """Whether ``pair``'s force term was on at ``t``: its last switch of ``log`` at or before ``t``, else
-    its state at the start (``first``; a name that is no pair counts as on)."""
-    on = first.get(pair, True)
-    for when, name, state in log:
-        if when > t:
-            break
-        if name == pair:
-            on = state
-    return on
+def term_on_at(last: dict[str, tuple[float, bool]], pair: str, t: float) -> bool:
+    """Whether ``pair``'s force term was on at ``t``, from its last switch (time, term on) in ``last``:
+    known from that switch on; before it, or for a name that is no pair, counted as on (so that a lost
+    onset is claimed only for a pair that stayed free from its last switch to ``t``)."""
+    when, on = last.get(pair, (math.inf, True))
+    return on if when <= t else True
 
 
 def gap_at(model: DAEModel, pair: str, y: NDArray) -> float | None:
