@@ -215,3 +215,18 @@ def test_a_result_pickles_with_its_channels(runs, tmp_path):
         assert again.channel_source.computed and np.array_equal(again.yp, runs["index1"].yp)
         assert np.array_equal(again["clearance.normal_force"], runs["index1"]["clearance.normal_force"])
         assert np.array_equal(again.slice(0.001, 0.002)["slider.vx"], result.slice(0.001, 0.002)["slider.vx"])
+
+
+def test_a_runs_states_are_made_consistent_when_first_read(scene, tmp_path):
+    """A run kept in memory stores IDA's own states: its multipliers and yp are made consistent at the
+    first read, equal bit for bit to those a streamed run makes consistent before writing them."""
+    kept = dc.simulate(scene, TWO_REVOLUTIONS / 4)
+    source = kept.channel_source
+    assert source is not None and source.raw and not source.has_yp  # the run made nothing consistent
+    idas = np.array(source._y)
+    streamed = dc.simulate(scene, TWO_REVOLUTIONS / 4, save=dc.SaveAt(stream_to=tmp_path / "s.h5"))
+    assert np.array_equal(kept.y, streamed.y) and np.array_equal(kept.yp, streamed.yp)
+    assert not source.raw and source.has_yp
+    multipliers = np.array([name.startswith("lambda.") for name in kept.state_names])
+    assert np.array_equal(idas[:, ~multipliers], kept.y[:, ~multipliers])  # q, v (and GGL's mu) are IDA's
+    assert not np.array_equal(idas[:, multipliers], kept.y[:, multipliers])  # the multipliers are not

@@ -152,8 +152,8 @@ def _read(r: _Reader) -> dict[str, Any]:
         names = r.strings("channel_names")
         switch = r.array("switch", points) if r.has("switch") else np.zeros((t.size, 0))  # no point written
         units.update(zip(names, r.strings("channel_units")))
-        evaluate, derivatives = rebuilt_evaluator(parameters)
-        channels = LazyChannels(names, evaluate, t, y, yp, switch, derivatives=derivatives, rebuildable=True)
+        evaluate, consistent = rebuilt_evaluator(parameters)
+        channels = LazyChannels(names, evaluate, t, y, yp, switch, consistent=consistent, rebuildable=True)
     for name in r.f["channels"]:
         channels[name] = r.array(f"channels/{name}", points)  # type: ignore[index]
         units[name] = r.attr("units", f"/channels/{name}")

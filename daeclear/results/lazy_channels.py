@@ -1,8 +1,9 @@
 """Channels computed when read: a run's (or a result file's) states, and what computes its channels.
 
-A run stores its states only: the times ``t``, the consistent states ``y`` and ``yp`` and, per
-point, the switch vector of its segment (the contact terms' on flags and parameters, the outputs'
-``switch`` input). Its channels (positions, forces, energies, ...) are one function of these, the
+A run stores its states only: the times ``t``, the states ``y`` and, per point, the switch vector
+of its segment (the contact terms' on flags and parameters, the outputs' ``switch`` input). A run
+kept in memory stores IDA's own ``y``, whose multipliers IDA does not converge: the multipliers
+and ``yp`` are made consistent (the run's consistency pass) at the first read of either. Its channels (positions, forces, energies, ...) are one function of these, the
 model's generated output function, so :class:`LazyChannels` evaluates them all at once in one
 vectorised call at the first read and keeps them: the `Result` that holds it is their owner.
 The values are those the run would have computed point by point (the same generated function on
@@ -19,12 +20,12 @@ from numpy.typing import NDArray
 
 from .values import readonly
 
-__all__ = ["Derivatives", "Evaluate", "LazyChannels", "rebuilt_evaluator"]
+__all__ = ["Consistent", "Evaluate", "LazyChannels", "rebuilt_evaluator"]
 
 #: Computes every channel at the rows of (t, y, yp, switch): name -> array of the rows.
 Evaluate = Callable[[NDArray, NDArray, NDArray, NDArray], Mapping[str, NDArray]]
-#: Computes yp at the rows of (t, y, switch): the run's consistency pass (accelerations from q and v).
-Derivatives = Callable[[NDArray, NDArray, NDArray], NDArray]
+#: (y, yp) at the rows of (t, y, switch): the run's consistency pass (multipliers and accelerations from q and v).
+Consistent = Callable[[NDArray, NDArray, NDArray], tuple[NDArray, NDArray]]
 
 
 class LazyChannels:
@@ -37,12 +38,15 @@ class LazyChannels:
     evaluate : Evaluate
         Computes every channel at given rows (the model's output function).
     t, y, yp : arrays
-        The stored states, time first; ``yp`` None: computed by ``derivatives`` when first read
+        The stored states, time first; ``yp`` None: computed by ``consistent`` when first read
         (a file keeps t, y and the switch rows alone).
     switch : array, shape (n_times, n_switch)
         Each point's switch vector (its segment's contact terms).
-    derivatives : Derivatives, optional
-        Computes ``yp`` when it is None.
+    consistent : Consistent, optional
+        Makes the states consistent: computes ``yp`` when it is None (and ``y``'s multipliers when raw).
+    raw : bool
+        ``y`` holds IDA's own multipliers (a run kept in memory, ``yp`` None): ``y`` too is read
+        from ``consistent``.
     values : mapping, optional
         The channels when already computed (e.g. for the run's physics checks).
     rebuildable : bool or callable returning bool
@@ -52,27 +56,43 @@ class LazyChannels:
     """
 
     def __init__(self, names: Sequence[str], evaluate: Evaluate, t: NDArray, y: NDArray, yp: NDArray | None,
-                 switch: NDArray, *, derivatives: Derivatives | None = None,
+                 switch: NDArray, *, consistent: Consistent | None = None, raw: bool = False,
                  values: Mapping[str, NDArray] | None = None, rebuildable: bool | Callable[[], bool] = False) -> None:
         if switch.ndim != 2 or switch.shape[0] != t.shape[0]:
             raise ValueError(f"LazyChannels: switch has shape {switch.shape}, must be (n_times={t.shape[0]}, "
                              "n_switch).")
         self.names = tuple(names)
         self.evaluate = evaluate
-        if yp is None and derivatives is None:
-            raise ValueError("LazyChannels: yp is None and no derivatives compute it.")
-        self.t, self.y, self._yp, self.switch = t, y, yp, readonly(switch)
-        self.derivatives = derivatives
+        if yp is None and consistent is None:
+            raise ValueError("LazyChannels: yp is None and no consistent states compute it.")
+        if raw and yp is not None:
+            raise ValueError("LazyChannels: raw states come without yp (both are made consistent together).")
+        self.t, self._y, self._yp, self.switch = t, y, yp, readonly(switch)
+        self.consistent, self.raw = consistent, raw
         self._rebuildable = rebuildable
         self._values = None if values is None else {n: readonly(values[n]) for n in self.names}
+
+    def _make_consistent(self) -> None:
+        """The run's consistency pass over every row: yp, and y's multipliers when raw."""
+        assert self.consistent is not None
+        y, yp = self.consistent(self.t, self._y, self.switch) if self.t.size else (self._y, np.zeros(self._y.shape))
+        if self.raw:
+            self._y, self.raw = readonly(y), False
+        self._yp = readonly(yp)
+
+    @property
+    def y(self) -> NDArray:
+        """The states: stored, or (raw) made consistent at the first read."""
+        if self.raw:
+            self._make_consistent()
+        return self._y
 
     @property
     def yp(self) -> NDArray:
         """The states' derivatives: stored, or computed at the first read (the run's consistency pass)."""
         if self._yp is None:
-            assert self.derivatives is not None
-            self._yp = readonly(self.derivatives(self.t, self.y, self.switch) if self.t.size else
-                                np.zeros(self.y.shape))
+            self._make_consistent()
+        assert self._yp is not None
         return self._yp
 
     @property
@@ -106,19 +126,19 @@ class LazyChannels:
         computed, without what computes them (the model's compiled functions stay in this process)."""
         self.values()
         state = dict(self.__dict__)
-        state.update(_yp=self.yp, evaluate=None, derivatives=None, _rebuildable=self.can_rebuild())
+        state.update(_yp=self.yp, evaluate=None, consistent=None, _rebuildable=self.can_rebuild())
         return state
 
     def take(self, rows: Any) -> LazyChannels:
         """The channels of some rows (an index or a mask): computed ones cut, the others still lazy."""
         values = None if self._values is None else {n: v[rows] for n, v in self._values.items()}
         yp = None if self._yp is None else self._yp[rows]
-        return LazyChannels(self.names, self.evaluate, self.t[rows], self.y[rows], yp, self.switch[rows],
-                            derivatives=self.derivatives, values=values, rebuildable=self._rebuildable)
+        return LazyChannels(self.names, self.evaluate, self.t[rows], self._y[rows], yp, self.switch[rows],
+                            consistent=self.consistent, raw=self.raw, values=values, rebuildable=self._rebuildable)
 
 
-def rebuilt_evaluator(parameters: Mapping[str, Any]) -> tuple[Evaluate, Derivatives]:
-    """:data:`Evaluate` and :data:`Derivatives` for a result file's states: the model rebuilt from the
+def rebuilt_evaluator(parameters: Mapping[str, Any]) -> tuple[Evaluate, Consistent]:
+    """:data:`Evaluate` and :data:`Consistent` for a result file's states: the model rebuilt from the
     file's parameters (scene description, formulation, run options) when they are first used.
 
     The solvers own the model and its compiled functions, and import this package: they are
@@ -131,7 +151,7 @@ def rebuilt_evaluator(parameters: Mapping[str, Any]) -> tuple[Evaluate, Derivati
     def evaluate(t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> Mapping[str, NDArray]:
         return rebuilt().channels(t, y, yp, switch)
 
-    def derivatives(t: NDArray, y: NDArray, switch: NDArray) -> NDArray:
-        return rebuilt().derivatives(t, y, switch)
+    def consistent(t: NDArray, y: NDArray, switch: NDArray) -> tuple[NDArray, NDArray]:
+        return rebuilt().consistent(t, y, switch)
 
-    return evaluate, derivatives
+    return evaluate, consistent

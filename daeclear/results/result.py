@@ -69,7 +69,7 @@ class Result:
         before and after a restart).
     y, yp : array_like, shape (n_times, n_states)
         States and their time derivatives, time first. ``yp`` may be None with lazy
-        channels that compute it (a loaded file's: the run's consistency pass).
+        channels that compute it (the run's consistency pass; a run's also gives `y`'s multipliers).
     state_names : list of str
         Name of each state, e.g. ``"crank.x"``, ``"crank.vx"``, ``"lambda.A.x"``.
     channels : mapping of str to array_like, or LazyChannels
@@ -185,11 +185,11 @@ class Result:
                 steps: tuple[NDArray, NDArray, NDArray] | None, outcome: Mapping[str, Any]) -> None:
         """Set the fields from checked data: arrays as read-only views, values as plain data."""
         self.t: NDArray[np.float64] = readonly(t)
-        self.y: NDArray[np.float64] = readonly(y)
-        self._yp = None if yp is None else readonly(yp)
-        self.state_names: list[str] = names
         # the channels: arrays, or computed from the states at their first read (_channel_values)
         self._lazy = channels if isinstance(channels, LazyChannels) else None
+        self._y = None if self._lazy is not None and self._lazy.raw else readonly(y)  # None: made consistent when read
+        self._yp = None if yp is None else readonly(yp)
+        self.state_names: list[str] = names
         self._channels: dict[str, np.ndarray] | None = None if isinstance(channels, LazyChannels) else {
             name: readonly(values) for name, values in channels.items()}
         self._names = frozenset(channels.names if isinstance(channels, LazyChannels) else channels)
@@ -217,9 +217,18 @@ class Result:
         return held
 
     @property
+    def y(self) -> NDArray[np.float64]:
+        """States (n_times, n_states); a run's multipliers (IDA does not converge them) are made
+        consistent at the first read of ``y`` or ``yp`` (the run's consistency pass) and kept."""
+        if self._y is None:
+            assert self._lazy is not None
+            self._y = self._lazy.y
+        return self._y
+
+    @property
     def yp(self) -> NDArray[np.float64]:
-        """Time derivatives of the states (n_times, n_states); a loaded file's are computed at the
-        first read from `y` (the run's consistency pass) and kept."""
+        """Time derivatives of the states (n_times, n_states); a run's and a loaded file's are computed
+        at the first read from `y` (the run's consistency pass) and kept."""
         if self._yp is None:
             assert self._lazy is not None
             self._yp = self._lazy.yp

@@ -42,7 +42,7 @@ def checked_fields(t: ArrayLike, y: ArrayLike, yp: ArrayLike | None, state_names
     y_arr = np.asarray(y, dtype=np.float64)
     yp_arr = None if yp is None else np.asarray(yp, dtype=np.float64)
     if yp is None and not isinstance(channels, LazyChannels):
-        raise ValueError("Result: yp=None, must be given (computed only by lazy channels' derivatives).")
+        raise ValueError("Result: yp=None, must be given (computed only by lazy channels' consistency pass).")
     for label, arr in (("y", y_arr), ("yp", y_arr if yp_arr is None else yp_arr)):
         if arr.shape != shape:
             raise ValueError(f"Result: {label} has shape {arr.shape}, expected (n_times, n_states) = {shape} "

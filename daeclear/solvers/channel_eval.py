@@ -44,14 +44,15 @@ class ModelEvaluator:
         finally:
             session.close()
 
-    def derivatives(self, t: NDArray, y: NDArray, switch: NDArray) -> NDArray:
-        """yp at consistent rows, by the run's own consistency pass (accelerations and multipliers from
-        q and v with each row's switch vector): equal bit for bit to the yp the run stored."""
+    def consistent(self, t: NDArray, y: NDArray, switch: NDArray) -> tuple[NDArray, NDArray]:
+        """(y, yp) at the rows by the run's own consistency pass: multipliers and accelerations from q
+        and v with each row's switch vector (q and v kept; rows made consistent before come back equal)."""
         model, session = self.model, self._session()
         try:
             if session.set_layout(model.layout(project=model.formulation == "ggl")):
-                return session.report(t, y, switch, channels=False)[1]
-            return model.consistent_state(t, y, model.term_forces_rows(t, y, switch, session), session)[1]
+                y_out, yp_out, _ = session.report(t, y, switch, channels=False)
+                return y_out, yp_out
+            return model.consistent_state(t, y, model.term_forces_rows(t, y, switch, session), session)
         finally:
             session.close()
 

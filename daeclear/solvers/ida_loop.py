@@ -187,8 +187,9 @@ class SegmentLoop:
         advance's points, each with the switch vector of the segment it belongs to."""
         if self.store_steps and adv.step_t.size:  # the steps of every segment at once
             self.rec.add_steps(adv.step_t, adv.step_h, adv.step_order)
+        # an output window's rows are copied: they view a buffer of the window's size, which a kept row would hold
         rows = (adv.step_t, adv.step_y, adv.step_yp) if self.eval_times is None else (
-            adv.eval_t, adv.eval_y, adv.eval_yp)
+            adv.eval_t, adv.eval_y.copy(), adv.eval_yp.copy())
         if (self.eval_times is None and not self.store_steps) or not rows[0].size:  # no points to keep
             if adv.auto_events is not None:
                 self.record_switches(adv.auto_events)
@@ -279,26 +280,30 @@ class SegmentLoop:
         self.flush()
 
     def flush(self) -> None:
-        """Make the raw points consistent and hand them, the events and the segments to the recorder.
+        """Hand the raw points, the events and the segments to the recorder; points for a file are
+        made consistent first (kept in memory, the Result makes them consistent when first read).
 
         IDA does not converge the multipliers (out of its error test) and its interpolant of them is
         not controlled: multipliers, accelerations (and the work rate) are recomputed from every
         point's q and v with that point's contact modes (point by point: chunks change nothing)."""
         model, session, raw = self.model, self.session, self.raw
-        if raw:
+        if self.rec.consistent_when_read:  # as IDA left them, joined once (by the recorder)
+            for chunk in raw:
+                self.rec.add_points(*chunk)
+        elif raw:
             joined = len(raw) > 1  # joined arrays are the loop's own: made consistent in place
             if joined:
                 out_t, out_y, out_yp, out_switch = (np.concatenate(column) for column in zip(*raw))
             else:
                 out_t, out_y, out_yp, out_switch = raw[0]
-            raw.clear()
-            if self.c_layout:  # one pass in C, states only (the Result computes the channels when read)
+            if self.c_layout:  # one pass in C, states only (the file's reader computes the channels)
                 out_y, out_yp, _ = session.report(out_t, out_y, out_switch,
                                                   into=(out_y, out_yp) if joined else None, channels=False)
             else:
                 out_y, out_yp = model.consistent_state(
                     out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)
             self.rec.add_points(out_t, out_y, out_yp, out_switch)
+        raw.clear()
         self.rec.flush()
 
     def finish(self, on_failure: str, setup_time: float, sim_params: dict[str, Any]) -> Result:

@@ -1,9 +1,10 @@
 """Where a run's output goes while it runs: kept in memory, or streamed to an HDF5 file.
 
 The solvers (:mod:`daeclear.solvers.ida`, :mod:`daeclear.solvers.explicit`) hand a :class:`Recorder` their
-reported points chunk by chunk, already made consistent (multipliers, accelerations), each with
-the switch vector of its segment, and their steps, events and segments. The IDA loop's points come
-without channels: the run's `Result` computes them from its states when they are first read
+reported points chunk by chunk, each with the switch vector of its segment, and their steps, events
+and segments. The IDA loop's points come without channels, and, kept in memory, as IDA left them
+(:attr:`Recorder.consistent_when_read`): the run's `Result` makes their multipliers and yp
+consistent and computes the channels when they are first read
 (:class:`daeclear.results.lazy_channels.LazyChannels`); the explicit methods compute them as they go.
 In memory the chunks are kept and joined into the `Result` at the end. Streamed (``stream_to``),
 each chunk is appended to the file and dropped, so the run's memory does not grow with its length,
@@ -24,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import physics
-from .channel_eval import model_evaluator, rebuildable
+from .channel_eval import ModelEvaluator, model_evaluator, rebuildable
 from ..errors import OutputError
 from ..results.events import EventRows, flatten
 from ..results.lazy_channels import LazyChannels
@@ -63,6 +64,9 @@ class Recorder:
                             parameters=parameters, scene_name=model.scene_name, method=method,
                             formulation=model.formulation)
         self.session: Any = None
+        #: IDA's points kept in memory are stored as IDA left them (its multipliers are not converged):
+        #: the Result makes them consistent when first read; a file stores consistent points
+        self.consistent_when_read = method == "ida" and stream_to is None
         self._backend = str(parameters.get("simulate", {}).get("backend", "auto"))
         # the states alone make the channels again (IDA's output function; the scene rebuilt from its
         # description): decided at the first need (a streamed file, a saved result)
@@ -93,8 +97,8 @@ class Recorder:
 
     def add_points(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray,
                    channels: dict[str, NDArray] | None = None) -> None:
-        """Reported points, consistent: one row per time of ``t``, with its switch vector (one row per
-        time) and, when the solver computed them, its channels."""
+        """Reported points, consistent (unless :attr:`consistent_when_read`: IDA's own): one row per time of
+        ``t``, with its switch vector (one row per time) and, when the solver computed them, its channels."""
         if not t.size:
             return
         if self.writer is not None:
@@ -202,8 +206,13 @@ class Recorder:
             return Result(t=np.zeros(0), y=np.zeros((0, n)), yp=np.zeros((0, n)), channels={}, **header, **outcome)
         t, y, yp, switch, channels = self._joined()
         self._points.clear()
-        lazy = LazyChannels(self.model.channel_names, model_evaluator(self.model, self._backend), t, y, yp,
-                            np.asarray(switch), values=channels, rebuildable=self.rebuildable)
+        evaluator = ModelEvaluator(self.model, self._backend)
+        raw = self.consistent_when_read
+        if raw:
+            yp = None  # IDA's: made consistent with y when either is first read
+        lazy = LazyChannels(self.model.channel_names, evaluator.channels, t, y, yp,
+                            np.asarray(switch), consistent=evaluator.consistent, raw=raw, values=channels,
+                            rebuildable=self.rebuildable)
         steps = [np.concatenate(c) for c in zip(*self._steps)] if self._steps else [
             np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)]
         return Result.of_run(t=t, y=y, yp=yp, channels=lazy, events=self.events, segments=self.segments,
