@@ -1,0 +1,101 @@
+"""Two trees of the package side by side: the same benchmark scripts, interleaved, and the ratio of their times.
+
+    python benchmarks/bench_trees.py OLD NEW [--rounds 3] [--only overhead sweep work_precision]
+
+OLD and NEW are two checkouts (e.g. ``git worktree add /tmp/base <rev>`` and this one). Each round
+runs, for each benchmark, OLD's own script in OLD's package and NEW's own script in NEW's package
+(each in its own interpreter: a package cannot be imported twice in one process), the order of the
+two swapped every round so that the machine's load falls on both alike. Every time a script prints
+(a number followed by ``ms`` or ``s``) is matched between the trees by its line (the line with its
+numbers blanked, and its place among lines alike), the best of the rounds kept for each, as the
+scripts themselves keep the best of their repeats. Printed per benchmark: each time, old and new,
+and new / old; then the geometric mean and the largest ratio.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+from collections import defaultdict
+from pathlib import Path
+
+#: benchmark -> (script, its arguments): the runs the redesign of issue 35 must keep within 10 %
+BENCHMARKS: dict[str, tuple[str, list[str]]] = {
+    "overhead": ("bench_overhead.py", ["--repeats", "20"]),
+    "sweep": ("bench_sweep.py", ["--points", "30", "--passes", "3"]),
+    "work_precision": ("bench_work_precision.py", ["--repeats", "2"]),
+}
+NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
+TIME = re.compile(r"(\d+(?:\.\d+)?(?:e[-+]?\d+)?)\s*(ms|s)\b")
+
+
+def times_by_line(output: str) -> dict[tuple[str, int], list[float]]:
+    """Each line's times in seconds, keyed by (the line with its numbers blanked, its place among lines alike)."""
+    seen: dict[str, int] = defaultdict(int)
+    out: dict[tuple[str, int], list[float]] = {}
+    for line in output.splitlines():
+        found = [float(v) * (1e-3 if unit == "ms" else 1.0) for v, unit in TIME.findall(line)]
+        if not found:
+            continue
+        key = NUMBER.sub("#", line.strip())
+        out[(key, seen[key])] = found
+        seen[key] += 1
+    return out
+
+
+def run(tree: Path, script: str, args: list[str], cache: Path) -> str:
+    """One benchmark script of ``tree`` in ``tree``'s package; its standard output (stderr dropped)."""
+    env = {**os.environ, "PYTHONPATH": str(tree), "DAECLEAR_CACHE_DIR": str(cache), "MPLBACKEND": "Agg"}
+    done = subprocess.run([sys.executable, str(tree / "benchmarks" / script), *args], cwd=tree, env=env,
+                          capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        raise SystemExit(f"{tree / 'benchmarks' / script} failed ({done.returncode}):\n{done.stderr[-2000:]}")
+    return done.stdout
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("old", type=Path)
+    parser.add_argument("new", type=Path)
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--only", nargs="+", choices=sorted(BENCHMARKS), default=list(BENCHMARKS))
+    args = parser.parse_args()
+    trees = {"old": args.old.resolve(), "new": args.new.resolve()}
+    with tempfile.TemporaryDirectory() as tmp:
+        caches = {label: Path(tmp) / label for label in trees}
+        for name in args.only:
+            script, script_args = BENCHMARKS[name]
+            best: dict[str, dict[tuple[str, int], list[float]]] = {"old": {}, "new": {}}
+            for r in range(args.rounds):
+                for label in (("old", "new") if r % 2 == 0 else ("new", "old")):
+                    print(f"[{name}] round {r + 1}/{args.rounds}: {label} ({trees[label]})", file=sys.stderr, flush=True)
+                    for key, values in times_by_line(run(trees[label], script, script_args, caches[label])).items():
+                        held = best[label].setdefault(key, values)
+                        best[label][key] = [min(a, b) for a, b in zip(held, values)]
+            report(name, best)
+
+
+def report(name: str, best: dict[str, dict[tuple[str, int], list[float]]]) -> None:
+    """Each time both trees printed, old and new, the ratio; the geometric mean and the largest ratio."""
+    print(f"\n## {name}: best of the rounds, new / old\n")
+    print("| line | old | new | new / old |\n|---|---:|---:|---:|")
+    ratios = []
+    for key in best["old"]:
+        if key not in best["new"]:
+            continue
+        for old, new in zip(best["old"][key], best["new"][key]):
+            if old > 0:
+                ratios.append(new / old)
+                print(f"| {key[0][:90]} | {old * 1e3:.2f} ms | {new * 1e3:.2f} ms | {new / old:.3f} |")
+    if ratios:
+        mean = math.exp(sum(math.log(r) for r in ratios) / len(ratios))
+        print(f"\n{name}: {len(ratios)} times, geometric mean new / old {mean:.3f}, largest {max(ratios):.3f}")
+
+
+if __name__ == "__main__":
+    main()
