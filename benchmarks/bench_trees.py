@@ -73,7 +73,8 @@ def main() -> None:
             best: dict[str, dict[tuple[str, int], list[float]]] = {"old": {}, "new": {}}
             for r in range(args.rounds):
                 for label in (("old", "new") if r % 2 == 0 else ("new", "old")):
-                    print(f"[{name}] round {r + 1}/{args.rounds}: {label} ({trees[label]})", file=sys.stderr, flush=True)
+                    print(f"[{name}] round {r + 1}/{args.rounds}: {label} ({trees[label]})", file=sys.stderr,
+                          flush=True)
                     for key, values in times_by_line(run(trees[label], script, script_args, caches[label])).items():
                         held = best[label].setdefault(key, values)
                         best[label][key] = [min(a, b) for a, b in zip(held, values)]
