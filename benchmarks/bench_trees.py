@@ -5,9 +5,11 @@
 OLD and NEW are two checkouts (e.g. ``git worktree add /tmp/base <rev>`` and this one). Each round
 runs, for each benchmark, OLD's own script in OLD's package and NEW's own script in NEW's package
 (each in its own interpreter: a package cannot be imported twice in one process), the order of the
-two swapped every round so that the machine's load falls on both alike. Every time a script prints
-(a number followed by ``ms`` or ``s``) is matched between the trees by its line (the line with its
-numbers blanked, and its place among lines alike), the best of the rounds kept for each, as the
+two swapped every round so that the machine's load falls on both alike. ``work_precision`` runs the
+study of ``bench_work_precision.py`` (``daeclear.studies.accuracy.work_precision``, the same calls in
+both trees) and prints every run's wall time, not only the fastest rival's. Every time printed (a
+number followed by ``ms`` or ``s``) is matched between the trees by its line (the line with its
+times blanked, and its place among lines alike), the best of the rounds kept for each, as the
 scripts themselves keep the best of their repeats. Printed per benchmark: each time, old and new,
 and new / old; then the geometric mean and the largest ratio.
 """
@@ -24,13 +26,29 @@ import tempfile
 from collections import defaultdict
 from pathlib import Path
 
-#: benchmark -> (script, its arguments): the runs the redesign of issue 35 must keep within 10 %
+#: every run of bench_work_precision.py's study, its wall time (the script prints the fastest rival's alone)
+WORK_PRECISION = r"""
+import sys
+import numpy as np
+import daeclear as dc
+from daeclear.studies.accuracy import work_precision
+scene = dc.mechanisms.slider_crank("revolute", gravity=0.0)
+methods = {"IDA GGL": {"method": "ida"}, "IDA index1": {"method": "ida", "formulation": "index1"},
+           **{name: {"method": name} for name in ("RK45", "DOP853", "Radau", "BDF", "LSODA")}}
+for window, t_end, channels in (("first 2 ms", 0.002, ["slider.vx", "drive.moment"]),
+                                ("two revolutions", 0.024, ["slider.vx"])):
+    wp = work_precision(scene, t_end, channels=channels, rtols=np.logspace(-5, -9, 5), methods=methods,
+                        repeats=int(sys.argv[1]), n_eval=400)
+    for r in wp.rows:
+        print(f"{window}: {r['label']} rtol {r['tolerance']:.0e} error {r['error']:.3e} "
+              f"wall {r['wall_time'] * 1e3:.2f} ms", flush=True)
+"""
+#: benchmark -> (its script, or the code of a worker, and the arguments): what issue 35 keeps within 10 %
 BENCHMARKS: dict[str, tuple[str, list[str]]] = {
     "overhead": ("bench_overhead.py", ["--repeats", "20"]),
     "sweep": ("bench_sweep.py", ["--points", "30", "--passes", "3"]),
-    "work_precision": ("bench_work_precision.py", ["--repeats", "2"]),
+    "work_precision": (WORK_PRECISION, ["3"]),
 }
-NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
 TIME = re.compile(r"(\d+(?:\.\d+)?(?:e[-+]?\d+)?)\s*(ms|s)\b")
 
 
@@ -42,19 +60,20 @@ def times_by_line(output: str) -> dict[tuple[str, int], list[float]]:
         found = [float(v) * (1e-3 if unit == "ms" else 1.0) for v, unit in TIME.findall(line)]
         if not found:
             continue
-        key = NUMBER.sub("#", line.strip())
+        key = " ".join(TIME.sub(r"# \2", line).split())
         out[(key, seen[key])] = found
         seen[key] += 1
     return out
 
 
 def run(tree: Path, script: str, args: list[str], cache: Path) -> str:
-    """One benchmark script of ``tree`` in ``tree``'s package; its standard output (stderr dropped)."""
+    """One benchmark script of ``tree`` (or a worker's code) in ``tree``'s package; its standard output."""
     env = {**os.environ, "PYTHONPATH": str(tree), "DAECLEAR_CACHE_DIR": str(cache), "MPLBACKEND": "Agg"}
-    done = subprocess.run([sys.executable, str(tree / "benchmarks" / script), *args], cwd=tree, env=env,
-                          capture_output=True, text=True, check=False)
+    command = ["-c", script] if "\n" in script else [str(tree / "benchmarks" / script)]
+    done = subprocess.run([sys.executable, *command, *args], cwd=tree, env=env, capture_output=True, text=True,
+                          check=False)
     if done.returncode != 0:
-        raise SystemExit(f"{tree / 'benchmarks' / script} failed ({done.returncode}):\n{done.stderr[-2000:]}")
+        raise SystemExit(f"{tree}: {command[-1][:80]} failed ({done.returncode}):\n{done.stderr[-2000:]}")
     return done.stdout
 
 
@@ -85,7 +104,7 @@ def report(name: str, best: dict[str, dict[tuple[str, int], list[float]]]) -> No
     """Each time both trees printed, old and new, the ratio; the geometric mean and the largest ratio."""
     print(f"\n## {name}: best of the rounds, new / old\n")
     print("| line | old | new | new / old |\n|---|---:|---:|---:|")
-    ratios = []
+    ratios, unmatched = [], [key for key in best["old"] if key not in best["new"]]
     for key in best["old"]:
         if key not in best["new"]:
             continue
@@ -95,7 +114,8 @@ def report(name: str, best: dict[str, dict[tuple[str, int], list[float]]]) -> No
                 print(f"| {key[0][:90]} | {old * 1e3:.2f} ms | {new * 1e3:.2f} ms | {new / old:.3f} |")
     if ratios:
         mean = math.exp(sum(math.log(r) for r in ratios) / len(ratios))
-        print(f"\n{name}: {len(ratios)} times, geometric mean new / old {mean:.3f}, largest {max(ratios):.3f}")
+        print(f"\n{name}: {len(ratios)} times, geometric mean new / old {mean:.3f}, largest {max(ratios):.3f}"
+              f"; {len(unmatched)} lines of the old tree without a match")
 
 
 if __name__ == "__main__":
