@@ -196,25 +196,15 @@ def _array_of_tables(path: Path, data: dict[str, Any], table: str) -> list[dict[
     return value
 
 
+#: The TOML names of value types, for messages (bool before int: True is an int).
+TOML_TYPES: tuple[tuple[type | tuple[type, ...], str], ...] = (
+    (bool, "boolean"), ((int, float), "number"), (str, "string"), (list, "array"), (dict, "table"))
+
+
 def _a(value: Any) -> str:
     """'a number', 'an array', ...: the TOML type of a value with its article."""
-    kind = _toml_type(value)
+    kind = next((name for types, name in TOML_TYPES if isinstance(value, types)), type(value).__name__)
     return f"an {kind}" if kind[0] in "aeiou" else f"a {kind}"
-
-
-def _toml_type(value: Any) -> str:
-    """The TOML name of a value's type, for messages."""
-    if isinstance(value, bool):
-        return "boolean"
-    if isinstance(value, (int, float)):
-        return "number"
-    if isinstance(value, str):
-        return "string"
-    if isinstance(value, list):
-        return "array"
-    if isinstance(value, dict):
-        return "table"
-    return type(value).__name__
 
 
 def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any]) -> Any:
@@ -268,24 +258,21 @@ def check_simulate(simulate: dict[str, Any], *, where: str) -> dict[str, Any]:
     """The [simulate] table checked by the rules simulate() applies (daeclear.options), none ignored:
     ``t_end = 0`` or ``t_eval_step = 0`` are errors, not "use the default"."""
     out = dict(simulate)
-    if "t_end" in out:
-        out["t_end"] = options.t_end(out["t_end"], where=where)
-    if "rtol" in out:
-        out["rtol"] = options.rtol(out["rtol"], where=where)
-    if "atol" in out:
-        atol = options.atol(out["atol"], where=where)
-        out["atol"] = atol if atol is None or isinstance(atol, (float, dict)) else atol.tolist()
-    if "max_step" in out:
-        out["max_step"] = options.max_step(out["max_step"], where=where)
+    for key, rule in (("t_end", options.t_end), ("rtol", options.rtol), ("atol", options.atol),
+                      ("max_step", options.max_step)):
+        if key in out:
+            out[key] = rule(out[key], where=where)
+    if out.get("atol") is not None and not isinstance(out["atol"], (float, dict)):  # an array: a list
+        out["atol"] = out["atol"].tolist()
     if "step" in out:  # the fixed step of method = "rk4" / "euler" (simulate refuses it with the others)
         out["step"] = options.step(out["step"], where=where)
         options.step_within(out["step"], 0.0, out.get("t_end", math.inf), where=where)
     if "allow_penetration" in out:
         out["allow_penetration"] = options.flag(out["allow_penetration"], where=where, field="allow_penetration")
-    for key, rule in (("method", options.method), ("formulation", options.formulation),
-                      ("backend", options.backend), ("start", options.start)):
+    for key, name_rule in (("method", options.method), ("formulation", options.formulation),
+                           ("backend", options.backend), ("start", options.start)):
         if key in out:
-            out[key] = rule(out[key], where=where)
+            out[key] = name_rule(out[key], where=where)
     if "t_eval_step" in out:
         # against the file's t_end when it has one (the command line checks it again against the end it runs)
         end = out.get("t_end", math.inf)
