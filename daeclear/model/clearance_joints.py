@@ -71,10 +71,9 @@ def _friction(joint: RevoluteClearance | TranslationalClearance) -> Any:
 class RevoluteClearance(PointJoint):
     """Revolute joint with radial clearance: a journal (body j) inside a bearing (body i).
 
-    The joint adds no constraint; the journal moves freely inside the bearing and a
-    contact-impact force acts when the eccentricity exceeds the clearance (section 4.2,
-    eqs. 4.1-4.13). ``at`` is the common centre of bearing and journal in the reference
-    configuration (or give ``point_i``/``point_j`` in body coordinates).
+    No constraint: a contact-impact force acts when the eccentricity exceeds the clearance (section
+    4.2, eqs. 4.1-4.13). ``at`` is the common centre of bearing and journal in the reference
+    configuration (or give ``point_i``/``point_j``).
 
     Parameters
     ----------
@@ -89,22 +88,18 @@ class RevoluteClearance(PointJoint):
     journal_radius : float or None
         Journal radius R_j, m.
     material : Material or (Material, Material) or None
-        Materials of bearing and journal (one for both); needed when the law's stiffness
-        is computed (``stiffness=None``).
+        Materials of bearing and journal (one for both); needed when a stiffness is computed.
     law : NormalLaw, HydrodynamicBearing or str
         Normal contact law (default Lankarani-Nikravesh with c_e = 0.9, eq. 3.9); a
-        :class:`~daeclear.contact.HydrodynamicBearing` makes a lubricated joint (film forces, its
-        dry law below the film threshold; docs/lubrication.md).
+        HydrodynamicBearing makes a lubricated joint (docs/lubrication.md).
     friction : None, float, str or FrictionLaw
         None: frictionless; a float: modified Coulomb (3.16) with that coefficient (in dry contact).
     wear : ArchardWear or None
-        Archard wear of the joint's surfaces (:class:`daeclear.contact.wear.ArchardWear`): the worn
-        profile ``wear_depth`` enters the gap (docs/wear.md); ``daeclear.studies.wear`` grows it.
+        Archard wear of the joint's surfaces: the worn profile ``wear_depth`` enters the gap
+        (docs/wear.md).
     wear_depth : sequence of float, or two of them, or None
-        The worn depth at the profile's nodes (``wear.nodes`` values, m, >= 0, node k at angle
-        ``2 pi k / nodes`` in the worn body's frame): one profile for ``surface`` "bearing" or
-        "journal", two rows (bearing, journal) for "both". None: unworn. Run-time data: a new
-        profile compiles nothing (``model.with_parameters({"<joint>.wear_depth": depth})``).
+        The worn depth at the profile's ``wear.nodes`` nodes (m, >= 0, node k at angle ``2 pi k /
+        nodes`` in the worn body's frame); two rows (bearing, journal) for "both". None: unworn.
     """
 
     bearing_radius: float = 0.0
@@ -243,46 +238,36 @@ class TranslationalClearance(PointJoint):
     axis : (float, float)
         Guide direction, world frame, reference configuration (need not be unit).
     slider_axis : (float, float) or None
-        The slider's length direction in slider coordinates; None: ``axis`` (the slider starts
-        parallel to the guide). E.g. ``(1, 0)`` with the slider body at ``angle=tilt``.
+        The slider's length direction in slider coordinates; None: ``axis`` (starts parallel).
     length, width : float
         Slider length L (along the guide) and width W (across), m.
     corner_radius : float
-        Corner radius R_c, m, in (0, min(L, W)/2): the corner stiffness (sphere on a plane, eq.
-        3.5); the penetration is measured at the sharp corner (eqs. 4.16-4.20).
+        Corner radius R_c, m, in (0, min(L, W)/2), for the corner stiffness (eq. 3.5).
     clearance : float or None
         c = (H - W)/2, m (give this or ``guide_height``).
     guide_height : float or None
         Distance H between the guide surfaces, m.
     thickness : float or None
-        Slider thickness (out of plane), m; None means ``length``. Eq. (4.27) takes the half side
-        of the square of a face's area, ``a = sqrt(length * thickness) / 2``.
+        Slider thickness (out of plane), m; None means ``length`` (eq. 4.27's a = sqrt(L t) / 2).
     upper_limits, lower_limits : (float, float) or None
-        Segment limits (P, Q) of the upper and (R, S) of the lower surface, as ``s`` coordinates,
-        m: a corner touches a surface only between them. None: unbounded.
+        ``s`` limits of the upper and lower surfaces, m, between which a corner touches; None: unbounded.
     stroke : (float, float) or None
-        ``s`` of the slider centre at xi = 0 and xi = 1 (channel ``<name>.xi``); None:
-        ``upper_limits`` if given, else no ``xi`` channel.
+        ``s`` of the slider centre at xi = 0 and 1 (channel ``<name>.xi``); None: ``upper_limits``.
     material : Material or (Material, Material) or None
         Materials of guide and slider; needed when a stiffness is computed.
     law : NormalLaw or str
-        Corner law (sphere of radius R_c on a plane), default Lankarani-Nikravesh with c_e = 0.9
-        (eq. 3.9), stiffness from (3.5) when not given.
+        Corner law, default Lankarani-Nikravesh with c_e = 0.9 (eq. 3.9), stiffness (3.5).
     face_law : NormalLaw or str
-        ``section-4.3`` model: the law of a face in contact, on its corners' average penetration;
-        default Lankarani's linear law (4.26) with the stiffness (4.27) (a Hertz-type law is
-        resolved with n = 1).
+        ``section-4.3`` model: a face's law on its corners' mean penetration; default Lankarani's
+        linear law (4.26) with the stiffness (4.27).
     friction : None, float, str or FrictionLaw
-        None: frictionless; a float: modified Coulomb (3.16) with that coefficient, at every
-        active contact.
+        None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
     model : {"corners", "section-4.3"}
-        ``"corners"``: every touching corner is a sphere on a plane. ``"section-4.3"``: two
-        adjacent corners on one surface (a face) use ``face_law`` at the centre of the penetrated
-        area; one corner or two opposite corners use ``law``.
+        ``"corners"``: every touching corner is a sphere on a plane. ``"section-4.3"``: a face (two
+        adjacent corners on one surface) uses ``face_law``, other contacts ``law``.
     reading : str or None
         A named reading of the chapter's model (:data:`daeclear.model.readings.JOINT_READINGS`):
-        it sets the model, the corner law's stiffness and exponent and the face law, keeping the
-        restitution of ``law``. None: ``model``, ``law`` and ``face_law`` as given.
+        it sets the model and the laws' stiffness and exponent, keeping the restitution of ``law``.
 
     Notes
     -----
@@ -321,8 +306,7 @@ class TranslationalClearance(PointJoint):
     friction: Any = None
     model: str = "corners"
     reading: str | None = None
-    # the structure flags state the contact model in use and the laws' structure (a reading that
-    # only changes numbers compiles nothing)
+    # a reading that only changes numbers compiles nothing
     NOT_STRUCTURE: ClassVar[frozenset[str]] = frozenset({"model", "reading"})
 
     def __post_init__(self) -> None:
@@ -339,7 +323,6 @@ class TranslationalClearance(PointJoint):
 
         return self.model if self.reading is None else joint_reading(self.reading).model
 
-    # ---- derived geometry ----------------------------------------------------------
     @property
     def radial_clearance(self) -> float:
         """c = (H - W) / 2, m."""
@@ -465,8 +448,6 @@ def _face_law_problems(element: TranslationalClearance) -> list[str]:
     return []
 
 
-# ---- clearance as a property of a joint ------------------------------------------------
-
 #: The clearance joint each ideal joint becomes, and the fields it needs besides the shared ones.
 _CLEARANCE_OF: dict[type, tuple[type, tuple[tuple[str, ...], ...]]] = {
     Revolute: (RevoluteClearance, (("bearing_radius",), ("clearance", "journal_radius"))),
@@ -480,9 +461,8 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
     """The clearance joint that replaces the ideal ``joint``: same bodies, point and axis.
 
     Ideal and clearance joints share their kinematic data (Ambrósio and Pombo, Multibody Syst. Dyn.
-    42, 2018): a :class:`Revolute`'s point becomes the bearing and journal centres; a
-    :class:`Translational`'s point the guide's mid-line point and the slider centre, its ``axis``
-    the guide direction (guide body i, slider body j).
+    42, 2018): the joint's point becomes the bearing and journal centres, or the guide's mid-line
+    point and the slider centre (``axis`` the guide direction).
 
     Parameters
     ----------

@@ -100,19 +100,16 @@ class Force(Load):
     Parameters
     ----------
     name : str
-        Unique name; channels ``<name>.fx``, ``<name>.fy`` (world components, N) and
-        ``<name>.power`` (W).
+        Unique name; channels ``<name>.fx``, ``<name>.fy`` (world, N) and ``<name>.power`` (W).
     body : str or Body
         The loaded body (not the ground).
     fx, fy : float, Table or Expression
-        Components, N: in the world frame (``frame="world"``) or in the body frame, turning
-        with the body (``frame="body"``, a follower force).
+        Components, N, in the world frame or (``frame="body"``, a follower force) the body's.
     at : (float, float) or None
         World point of application in the reference (declared) configuration, m.
     frame : {"world", "body"}
     point : (float, float) or None
-        Point of application in the body's frame, m (instead of ``at``; giving both is an
-        error). None with ``at`` None: the centre of mass.
+        Point of application in the body's frame, m (instead of ``at``).
     """
 
     name: str
@@ -248,14 +245,10 @@ class RotationalSpringDamper(BetweenBodies):
 
 @dataclass(frozen=True)
 class Motor(BetweenBodies):
-    """A motor between a stator ``body_i`` (e.g. the ground) and a rotor ``body_j`` (e.g. a crank),
-    with the linear torque-speed characteristic of a DC motor::
-
-        T = stall_torque * (1 - omega_rel / no_load_speed),   omega_rel = omega_j - omega_i
-
-    T acts on body j, -T on body i. Give ``stall_torque`` and ``no_load_speed`` the same sign
-    (negative: a clockwise motor). Above the no-load speed the torque brakes. Channels
-    ``<name>.torque`` (N m), ``<name>.speed`` (rad/s), ``<name>.power`` (W).
+    """A DC motor between a stator ``body_i`` and a rotor ``body_j``: ``T = stall_torque * (1 -
+    omega_rel / no_load_speed)`` on body j (-T on body i), ``omega_rel = omega_j - omega_i``; both
+    constants of one sign (negative: clockwise). Channels ``<name>.torque`` (N m), ``<name>.speed``
+    (rad/s), ``<name>.power`` (W).
     """
 
     name: str

@@ -128,25 +128,18 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
                  bearing: str = "slider", **options: Any) -> Scene:
     """The chapter's slider-crank mechanism (Fig. 4.14, Table 4.1).
 
-    Crank (body ``crank``) pinned to the ground at the origin by revolute ``A`` and driven
-    at constant speed by driver ``drive``; connecting rod ``rod`` joined to the crank by
-    revolute ``B`` and to the slider by joint ``C``; slider ``slider`` on the X axis by
-    translational joint ``D``. The crank turns counter-clockwise from the collinear
-    position (crank angle 0, slider at x = 0.17 m). Centres of mass at link mid-lengths.
+    Crank ``crank`` pinned to the ground at the origin by revolute ``A``, driven by driver ``drive``;
+    rod ``rod`` joined to the crank by revolute ``B`` and to the slider by joint ``C``; slider
+    ``slider`` on the X axis by translational joint ``D``. The crank turns counter-clockwise from
+    the collinear position (slider at x = 0.17 m).
 
     Parameters
     ----------
     joint : {"ideal", "revolute", "translational"}
         Which joint has clearance; "ideal" has none. "revolute": joint ``C`` becomes the
-        revolute clearance joint ``clearance`` (bearing on the slider, journal on the rod,
-        Table 4.2), journal and bearing centres coincident at the start. "translational":
-        joint ``D`` becomes the translational clearance joint ``clearance`` (Fig. 4.27,
-        Table 4.3): a 50 x 50 x 50 mm slider with 1 mm corner radius, its centre at the
-        rod-slider pin ``C`` (ideal), inside a guide on the ground whose mid-line is the X
-        axis, with contact segment x in [l - r - L/2 - 5 mm, l + r + L/2 + 5 mm] =
-        [0.04, 0.20] m on both surfaces (the slider never reaches its ends) and the
-        dimensionless stroke xi = 0 at x = l - r = 0.07 m, 1 at x = l + r = 0.17 m. The
-        slider starts midway between the surfaces and parallel to them.
+        revolute clearance joint ``clearance`` (Table 4.2), journal centred at the start.
+        "translational": joint ``D`` becomes the translational clearance joint ``clearance``
+        (Fig. 4.27, Table 4.3; its geometry in docs/validation.md), the slider centred in its guide.
     gravity : float
         Magnitude of gravity along -Y, m/s^2 (0 to switch it off).
     rpm : float
@@ -159,11 +152,11 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
         Radial clearance of the clearance joint, m (0.5 mm in Figs. 4.15 and 4.28); for
         the translational joint c = (H - W)/2.
     law : str, NormalLaw, HydrodynamicBearing (lubricated revolute joint) or a law table (dict)
-        Normal contact law (name or object; stiffness computed from radii and material
-        when not given). Default Lankarani-Nikravesh (3.9).
+        Normal contact law (name or object; stiffness computed when not given). Default
+        Lankarani-Nikravesh (3.9).
     restitution : float or None
-        Coefficient of restitution c_e for laws that take one (None: 0.9, Table 4.2). Given with a
-        law that has none (e.g. law="hertz"), it is an error, not ignored.
+        Coefficient of restitution c_e for laws that take one (None: 0.9, Table 4.2); an error with
+        a law that has none.
     friction : None, float, str or FrictionLaw
         None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
     bearing_radius : float
@@ -173,25 +166,20 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     length : float or None
         Axial contact length L, m, required by the cylindrical laws.
     contact_model : {"corners", "section-4.3"}
-        Translational joint only: every touching corner a sphere on a plane
-        ("corners", Figs. 4.28-4.34), or a face in contact on ``face_law``
-        ("section-4.3", Fig. 4.35b). See :class:`~daeclear.model.scene.TranslationalClearance`.
+        Translational joint only: every touching corner a sphere on a plane ("corners"), or a face in
+        contact on ``face_law`` ("section-4.3"); see :class:`~daeclear.model.scene.TranslationalClearance`.
     face_law : str or NormalLaw
-        Translational joint, "section-4.3" only: the law of a face in contact, default
-        Lankarani's linear law (4.26) with the stiffness (4.27).
+        Translational joint, "section-4.3" only: the law of a face in contact (default (4.26)).
     reading : str or None
         Translational joint only: a named reading of the chapter's contact model
-        (``TranslationalClearance(reading=...)``, :mod:`daeclear.model.readings`); it replaces
-        ``contact_model`` and ``face_law``.
+        (:mod:`daeclear.model.readings`); it replaces ``contact_model`` and ``face_law``.
     slider_mass, slider_inertia : float
         The slider's mass, kg, and moment of inertia, kg m^2 (Table 4.1: 0.14 and 1e-4).
     bearing : {"slider", "rod"}
-        ``joint="revolute"``: the bearing body (the chapter's: the slider, ``C``'s body_i, as
-        ``.with_clearance("C")`` has it: both routes give the same ``ex``/``ey``).
+        ``joint="revolute"``: the bearing body (the chapter's: the slider, ``C``'s body_i).
     pin_offset : (float, float)
         Translational joint only: the rod-slider pin in slider coordinates from the slider's
-        centre (its centre of mass), m; (0, 0): at the centre. The slider starts with the pin
-        where the ideal mechanism has it, its centre midway between the guide surfaces.
+        centre, m; (0, 0): at the centre.
     """
     joint, where = str(joint).lower(), "slider_crank"
     _check(where, ("joint", joint, f"must be one of {', '.join(JOINT_KINDS)}", joint in JOINT_KINDS),
@@ -227,7 +215,6 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
             material=material, law=_contact_law(law, restitution, length), friction=friction_law(friction))
     _check(where, ("clearance", clearance, "must be a number in (0, slider length) m",
                    is_finite_number(clearance) and 0 < clearance < SLIDER_LENGTH))
-    # slider centre: x range
     inner, outer = ROD_LENGTH - CRANK_LENGTH - offset[0], ROD_LENGTH + CRANK_LENGTH - offset[0]
     reach = 0.5 * SLIDER_LENGTH + GUIDE_MARGIN
     return scene.with_clearance(
@@ -270,32 +257,17 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
     gravity : float
         Magnitude of gravity along -Y, m/s^2 (0 to switch it off).
     rpm : float or None
-        None: free chain, all pins clearance joints. A number: the ground pin is an ideal
-        revolute driven at this speed, rev/min, counter-clockwise.
+        None: free chain. A number: the ground pin's speed, rev/min, counter-clockwise.
     angle : float
-        Initial angle of the (straight) chain from the X axis, rad (0: horizontal, so a free
-        chain swings down; -pi/2: hanging at rest).
+        Initial angle of the straight chain from the X axis, rad (-pi/2: hanging at rest).
     link_length : float
         Distance between a link's pins, m (0.1).
     link_mass : float
         Mass of a link, kg (0.196: steel, 0.1 m x 25 mm x 10 mm).
     link_inertia : float or None
-        Moment of inertia of a link about its centre of mass, kg m^2; None: slender bar
-        ``link_mass * link_length**2 / 12``.
-    law : str or NormalLaw
-        Normal contact law of every clearance joint (name or object; stiffness computed from
-        the radii and material when not given). Default Lankarani-Nikravesh (3.9).
-    restitution : float or None
-        Coefficient of restitution c_e for laws that take one (None: 0.9); an error with a law
-        that has none.
-    friction : None, float, str or FrictionLaw
-        None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
-    bearing_radius : float
-        Bearing radius of every joint, m (10 mm, as the slider-crank's, Table 4.2).
-    material : Material
-        Material of bearings and journals (steel, 207 GPa, 0.3).
-    length : float or None
-        Axial contact length L, m, required by the cylindrical laws.
+        Moment of inertia of a link about its centre of mass, kg m^2; None: slender bar.
+    law, restitution, friction, bearing_radius, material, length
+        As in :func:`slider_crank`, for every clearance joint.
     name : str or None
         Scene name; defaults to ``"chain<N>"``.
 
@@ -345,8 +317,6 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
     return scene
 
 
-# --------------------------------------------------------------------------- clearance on any subset of joints
-
 def _clearance_of_joint(clearance: Any, joint: str, where: str) -> float:
     """The clearance of ``joint``: one number for every joint, or a mapping joint -> number."""
     value = clearance.get(joint) if isinstance(clearance, dict) else clearance
@@ -388,9 +358,7 @@ def _with_revolute_clearances(scene: Scene, joints: Any, allowed: tuple[str, ...
     return scene
 
 
-# Four-bar: the slider-crank's crank and connecting rod (Table 4.1) as crank and coupler, a rocker
-# of the rod's section (m = 0.21 kg * 0.10 / 0.12, slender bar m L^2 / 12) and a ground link chosen
-# for a crank-rocker with transmission angles between 41 and 110 degrees.
+# Four-bar (docs/mechanisms.md): a rocker of the rod's section, a crank-rocker ground link.
 FOUR_BAR_CRANK, FOUR_BAR_COUPLER, FOUR_BAR_ROCKER, FOUR_BAR_GROUND = CRANK_LENGTH, ROD_LENGTH, 0.10, 0.13
 ROCKER_MASS = ROD_MASS * FOUR_BAR_ROCKER / ROD_LENGTH
 ROCKER_INERTIA = ROCKER_MASS * FOUR_BAR_ROCKER ** 2 / 12.0
@@ -412,13 +380,9 @@ def ideal_four_bar_state(theta: float, omega: float, crank: float = FOUR_BAR_CRA
                          ) -> dict[str, tuple[float, float, float, float, float, float]]:
     """Positions and velocities (x, y, phi, vx, vy, omega) of the ideal four-bar's links, closed form.
 
-    Crank pivot at the origin, rocker pivot at (``ground``, 0); crank at angle ``theta`` turning at
-    ``omega``; the open assembly (coupler-rocker pin above the line from the crank pin to the rocker
-    pivot). Coupler angle beta from the triangle crank pin - rocker pivot - coupler pin (law of
-    cosines), rocker angle psi from the coupler pin; the angular velocities from the loop closure
-    a w e'(theta) + b w3 e'(beta) = c w4 e'(psi):
-    w3 = a w sin(psi - theta) / (b sin(beta - psi)), w4 = a w sin(beta - theta) / (c sin(beta - psi)).
-    Centres of mass at the links' mid-lengths.
+    Crank pivot at the origin, rocker pivot at (``ground``, 0), crank at ``theta`` turning at ``omega``;
+    the open assembly. Coupler angle beta by the law of cosines, rocker angle psi from the coupler
+    pin; the rates from the loop closure a w e'(theta) + b w3 e'(beta) = c w4 e'(psi).
     """
     a, b, c, d = crank, coupler, rocker, ground
     bx, by = a * math.cos(theta), a * math.sin(theta)
@@ -521,14 +485,11 @@ def double_pendulum(clearance_joints: Any = (), *, angles: Any = (0.0, 0.0), gra
                     **options: Any) -> Scene:
     """A double pendulum released from rest, with clearance at any subset of its two pins.
 
-    Links ``link1`` and ``link2`` (the chain's steel links: 0.1 m between pins, 0.196 kg, slender
-    bar inertia), pin ``A`` joining the ground (bearing) to ``link1`` at the origin and pin ``B``
-    joining ``link1`` (bearing) to ``link2`` at its far end; no driver. A pin named in
-    ``clearance_joints`` becomes a :class:`~daeclear.model.scene.RevoluteClearance` of the same name
-    (10 mm steel bearing, Lankarani-Nikravesh). It starts as in the chapter: journals centred,
-    at rest. With ``restitution=1`` and no friction nothing dissipates: the mechanical energy
-    plus the energy stored in the contacts is conserved (``simulate(..., track_work=True)``:
-    ``energy.mechanical - energy.work`` stays constant).
+    Links ``link1`` and ``link2`` (the chain's), pin ``A`` from the ground (bearing) to ``link1`` at
+    the origin, pin ``B`` from ``link1`` (bearing) to ``link2``; no driver. A pin named in
+    ``clearance_joints`` becomes a RevoluteClearance of the same name, journal centred. With
+    ``restitution=1`` and no friction, ``energy.mechanical - energy.work`` (``track_work=True``) is
+    conserved.
 
     Parameters
     ----------

@@ -31,23 +31,10 @@ A scene file (tables map key for key onto the Python classes)::
     body_j = "link"
     at = [0.0, 0.0]
 
-Clearance joints (tables ``[[revolute_clearance]]`` and ``[[translational_clearance]]``) take
-their materials and laws as tables::
-
-    [[revolute_clearance]]
-    name = "clearance"
-    body_i = "slider"
-    body_j = "rod"
-    at = [0.17, 0.0]
-    bearing_radius = 0.01
-    clearance = 0.5e-3
-    material = { young = 207e9, poisson = 0.3 }
-    law = { name = "lankarani-nikravesh", restitution = 0.9 }
-    friction = 0.05          # or "coulomb", or { name = "modified-coulomb", coefficient = 0.1 }
-
-A lubricated revolute joint takes the law table ``{ name = "hydrodynamic", viscosity = 0.03,
-length = 0.02, theory = "short", cavitation = "half", film_threshold = 1e-6, dry = { name =
-"lankarani-nikravesh", restitution = 0.9 } }`` (docs/lubrication.md).
+Clearance joints (``[[revolute_clearance]]``, ``[[translational_clearance]]``) take their materials
+and laws as inline tables (docs/user_guide.md: ``material = { young = 207e9, poisson = 0.3 }``,
+``law = { name = "lankarani-nikravesh", restitution = 0.9 }``, ``friction = 0.05`` or a table); a
+lubricated joint's law table is ``{ name = "hydrodynamic", ... }`` (docs/lubrication.md).
 
 Drivers take their motion profile as a table (see :mod:`daeclear.profiles`)::
 
@@ -86,7 +73,7 @@ from . import mechanisms
 from .. import options
 from ..errors import SceneError
 from ..results.values import to_plain
-from ..contact import Material, friction_law, normal_law
+from ..contact import Material, friction_law
 from ..contact.hydrodynamic import law_from_table
 from .profiles import profile_from_dict
 from .loads import Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
@@ -118,17 +105,6 @@ class SceneFile:
     source: dict[str, Any]
 
 
-def _law(value: Any, build: Any) -> Any:
-    """A law given as a name, a number (friction coefficient) or a table {name = ..., parameters}
-    (``name = "hydrodynamic"``: a lubricated revolute joint's HydrodynamicBearing)."""
-    if isinstance(value, dict):
-        if build is normal_law:
-            return law_from_table(value)
-        params = dict(value)
-        return build(params.pop("name", None), **params)
-    return value
-
-
 def _contact_fields(entry: dict[str, Any]) -> dict[str, Any]:
     """Clearance joints: material tables -> Material, law tables -> law objects; an error names its key."""
     out = dict(entry)
@@ -139,12 +115,13 @@ def _contact_fields(entry: dict[str, Any]) -> dict[str, Any]:
             out["material"] = Material(**material)
         elif isinstance(material, list):
             out["material"] = tuple(Material(**m) if isinstance(m, dict) else m for m in material)
-        for key in ("law", "face_law"):
-            if key in out:
-                out[key] = _law(out[key], normal_law)
+        for key in ("law", "face_law"):  # a table {name = ..., parameters}; "hydrodynamic": a HydrodynamicBearing
+            if isinstance(out.get(key), dict):
+                out[key] = law_from_table(out[key])
         key = "friction"
         if isinstance(out.get("friction"), dict):
-            out["friction"] = _law(out["friction"], friction_law)
+            params = dict(out["friction"])
+            out["friction"] = friction_law(params.pop("name", None), **params)
     except (TypeError, ValueError, SceneError) as exc:
         raise SceneError(f"key {key}: {exc}") from None
     return out
