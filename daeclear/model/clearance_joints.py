@@ -469,19 +469,17 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
     joint : Revolute or Translational
         The ideal joint.
     bearing : str or None
-        Revolute only: the body that holds the bearing (body_i or body_j of the joint); None
-        keeps body i, the other body carries the journal.
+        Revolute only: the body that holds the bearing (one of the joint's); None: body i.
     name : str or None
-        Name of the clearance joint (its channels are ``<name>.ex``, ...); None keeps the joint's.
+        Name of the clearance joint; None keeps the joint's.
     **fields_
-        Fields of the clearance joint, e.g. ``clearance=0.5e-3, bearing_radius=10e-3,
-        material=Material(...), law="lankarani-nikravesh", friction=0.05``.
+        The clearance joint's own fields, e.g. ``clearance=0.5e-3, bearing_radius=10e-3``.
 
     Raises
     ------
     SceneError
-        A joint that is not an ideal revolute or translational one (e.g. already a clearance
-        joint), an unknown or shared field, a missing one, or an invalid value.
+        Not an ideal revolute or translational joint, an unknown, shared or missing field, or an
+        invalid value.
     """
     label = f"clearance on joint '{getattr(joint, 'name', joint)}'"
     if isinstance(joint, (RevoluteClearance, TranslationalClearance)):

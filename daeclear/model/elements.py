@@ -262,10 +262,8 @@ class PointJoint(Joint):
         local = (self.point_i is not None, self.point_j is not None)
         self._check_not_both(out, "at", ("point_i", "point_j"))
         if self.at is None and not all(local):
-            out.append(
-                f"{self.kind} '{self.name}': give the world point at=(x, y), "
-                "or both body-fixed points point_i and point_j."
-            )
+            out.append(f"{self.kind} '{self.name}': give the world point at=(x, y), "
+                       "or both body-fixed points point_i and point_j.")
         return out
 
 

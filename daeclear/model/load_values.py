@@ -167,9 +167,8 @@ class Expression:
 
 
 def _function_digest(function: Any, seen: frozenset[int] = frozenset()) -> str:
-    """A digest that changes when the function's code, a number it reads from outside, or a Python
-    function it calls (by a global or closure name, recursively) changes: all of that is structure
-    (give numbers as named numbers to make them run-time parameters)."""
+    """A digest of what is structure in a function: its code, the numbers it reads from outside, and the
+    Python functions it calls (by a global or closure name, recursively)."""
     code = getattr(function, "__code__", None)
     try:
         text = inspect.getsource(function)

@@ -142,12 +142,9 @@ class Force(Load):
 
 @dataclass(frozen=True)
 class Torque(Load):
-    """A torque on ``body`` (counter-clockwise positive); with a ``reaction`` body the opposite
-    torque acts on it (a torque between two bodies, e.g. a motor on a frame).
-
-    Channels ``<name>.torque`` (N m) and ``<name>.power`` (W: torque times the speed of ``body``
-    relative to ``reaction``). ``value``: a number, a :class:`Table` or an :class:`Expression`
-    (whose state's ``angle`` and ``speed`` are relative to ``reaction``).
+    """A torque ``value`` on ``body`` (counter-clockwise positive), the opposite on ``reaction`` if given
+    (an Expression's ``angle`` and ``speed`` are then relative to it). Channels ``<name>.torque``
+    (N m) and ``<name>.power`` (W).
     """
 
     name: str
@@ -220,11 +217,10 @@ class SpringDamper(BetweenBodies):
 
 @dataclass(frozen=True)
 class RotationalSpringDamper(BetweenBodies):
-    """A torsional spring-damper between ``body_i`` and ``body_j``: the torque on body j is
-    ``-stiffness * (theta - free_angle) - damping * dtheta/dt`` with ``theta = phi_j - phi_i``
-    (the opposite on body i). ``free_angle`` None: the reference relative angle. Channels
-    ``<name>.deflection`` (rad), ``<name>.torque`` (on body j, N m), ``<name>.elastic_energy``
-    (J, part of ``energy.potential``), ``<name>.power`` (the damper's power, W, <= 0).
+    """A torsional spring-damper: torque ``-stiffness * (theta - free_angle) - damping * dtheta/dt`` on
+    body j (the opposite on body i), ``theta = phi_j - phi_i``; ``free_angle`` None: the reference
+    one. Channels ``<name>.deflection`` (rad), ``<name>.torque`` (N m), ``<name>.elastic_energy``
+    (J), ``<name>.power`` (W, <= 0).
     """
 
     name: str

@@ -41,8 +41,7 @@ def _same(value: Any, default: Any) -> bool:
 def refuse_clearance_options(mechanism: str, function: Callable[..., Any], given: dict[str, Any],
                              without: str) -> None:
     """Raise SceneError when ``given`` (the call's keyword values) sets an option that only a clearance
-    joint uses while the mechanism has none (``without`` says which choice made it so): the option would
-    be silently ignored."""
+    joint uses while the mechanism has none (``without``: the choice that made it so)."""
     defaults = {p.name: p.default for p in inspect.signature(function).parameters.values()}
     for key in CLEARANCE_ONLY[mechanism]:
         if key in given and not _same(given[key], defaults[key]):

@@ -41,11 +41,8 @@ def rpm_to_rad_s(rpm: float) -> float:
 
 def ideal_slider_crank_state(theta: float, omega: float, crank: float = CRANK_LENGTH,
                              rod: float = ROD_LENGTH) -> dict[str, tuple[float, float, float, float, float, float]]:
-    """Positions and velocities (x, y, phi, vx, vy, omega) of the ideal slider-crank's bodies.
-
-    Crank pinned at the origin at angle ``theta`` turning at ``omega``; rod from the
-    crank pin to the slider on the X axis; centres of mass at link mid-lengths.
-    """
+    """Positions and velocities (x, y, phi, vx, vy, omega) of the ideal slider-crank's bodies: crank at
+    ``theta`` turning at ``omega``, slider on the X axis, centres of mass at link mid-lengths."""
     s, c = math.sin(theta), math.cos(theta)
     beta = math.asin(-crank * s / rod)  # rod angle (slider on the X axis)
     beta_dot = -crank * c * omega / (rod * math.cos(beta))
@@ -200,9 +197,8 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
            ("contact_model", contact_model, translational_only, joint == "translational" or contact_model == "corners"))
 
     omega = rpm_to_rad_s(rpm)
-    numbers = (omega, crank_angle, slider_mass, slider_inertia, offset)
     scene = Scene(name or ("slider_crank" if joint == "ideal" else f"slider_crank_{joint}"), gravity=(0.0, -gravity),
-                  elements=list(_make_ideal_elements(*numbers)))
+                  elements=list(_make_ideal_elements(omega, crank_angle, slider_mass, slider_inertia, offset)))
     if joint == "ideal":  # an option of a clearance joint would be ignored: refused
         refuse_clearance_options("slider_crank", slider_crank, locals(), "joint='ideal'")
         return scene
@@ -366,11 +362,8 @@ FOUR_BAR_JOINTS = ("A", "B", "C", "D")
 
 
 def grashof_crank_rocker(crank: float, coupler: float, rocker: float, ground: float) -> bool:
-    """Grashof's condition for a crank-rocker: s + l <= p + q with the crank the shortest link.
-
-    The shortest link (the crank, next to the ground link) then turns fully and the rocker
-    oscillates between two limit positions.
-    """
+    """Grashof's condition for a crank-rocker: s + l <= p + q with the crank the shortest link (it then
+    turns fully and the rocker oscillates)."""
     lengths = (crank, coupler, rocker, ground)
     return crank == min(lengths) and min(lengths) + max(lengths) <= sum(lengths) - min(lengths) - max(lengths)
 

@@ -57,9 +57,8 @@ class Scene:
     def add(self, element: Element) -> Any:
         """Add an element and return it (so ``crank = scene.add(Body(...))`` reads well)."""
         if not isinstance(element, Element):
-            raise SceneError(
-                f"scene '{self.name}': cannot add {element!r}; expected a Body, joint, Driver or load (daeclear.loads)."
-            )
+            raise SceneError(f"scene '{self.name}': cannot add {element!r}; expected a Body, joint, Driver or load "
+                             "(daeclear.loads).")
         self.elements.append(element)
         return element
 
@@ -107,15 +106,11 @@ class Scene:
     def assembled(self, start: Mapping[str, float] | None = None,
                   speeds: Mapping[str, float] | None = None) -> Scene:
         """A new scene, its bodies placed so that the joints named in ``start`` have the given
-        coordinates (revolute: ``phi_j - phi_i``, rad; translational: the displacement along the axis,
-        m) and every joint (clearance joints as ideal) and driver closes; ``speeds``: the joints' rates
-        (rad/s, m/s), else the declared velocities corrected (least norm). The declared poses are the
-        Newton guess (they pick the branch). Numbers the declared configuration defines become the
-        body-fixed values they stood for. This scene is left unchanged.
-
-        Raises SceneError for an unknown joint or a bad value, AssemblyError when the coordinates do
-        not fix the configuration or the joints cannot close at them
-        (:mod:`daeclear.assembly.placement`).
+        coordinates (rad, or m along a translational axis) and every joint (clearance joints as
+        ideal) and driver closes; ``speeds``: the joints' rates, else the declared velocities
+        corrected (least norm). The declared poses are the Newton guess. This scene is left unchanged.
+        Raises SceneError for an unknown joint or a bad value, AssemblyError when the joints cannot
+        close (:mod:`daeclear.assembly.placement`).
         """
         placement: Any = importlib.import_module(PLACEMENT_MODULE)
         return placement.assembled(self, start, speeds)
@@ -198,8 +193,7 @@ class Scene:
             if element.name in seen:
                 out.append(f"{element.kind} '{element.name}': duplicate name; every name in a scene must be unique.")
             seen.add(element.name)
-        body_names = [b.name for b in self.bodies]
-        known = set(body_names) | {GROUND}
+        known = {b.name for b in self.bodies} | {GROUND}
         referring: list[tuple[Element, Any]] = [(j, (("body_i", j.body_i), ("body_j", j.body_j)))
                                                 for j in self.joints]
         referring += [(e, e.body_roles()) for e in self.elements if hasattr(e, "body_roles")]  # loads
@@ -208,10 +202,8 @@ class Scene:
                 if body not in known:
                     close = difflib.get_close_matches(str(body), sorted(known), n=1)
                     hint = f" Did you mean '{close[0]}'?" if close else ""
-                    out.append(
-                        f"{joint.kind} '{joint.name}': {role} refers to body '{body}', "
-                        f"not in scene '{self.name}'.{hint}"
-                    )
+                    out.append(f"{joint.kind} '{joint.name}': {role} refers to body '{body}', "
+                               f"not in scene '{self.name}'.{hint}")
         joints = {j.name: j for j in self.joints}
         driven: set[str] = set()
         for driver in self.drivers:
