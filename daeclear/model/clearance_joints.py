@@ -379,8 +379,7 @@ class TranslationalClearance(PointJoint):
                 out.append(f"{self.kind} '{self.name}': {name}={value!r}, must be a non-zero 2-vector.")
         for name in ("length", "width", "corner_radius"):
             self._check_positive(out, name, "m")
-        if self.thickness is not None:
-            self._check_positive(out, "thickness", "m")
+        self._check_positive(out, "thickness", "m", optional=True)
         self._check_one_positive(out, "clearance", "guide_height", "m")
         for name in ("upper_limits", "lower_limits", "stroke"):
             value = getattr(self, name)

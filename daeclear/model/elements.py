@@ -114,9 +114,9 @@ class Element:
             return [f"{self.kind} '{self.name}': name must not contain '.' or '/' (used in channel names)."]
         return []
 
-    def _check_positive(self, out: list[str], field_name: str, unit: str) -> None:
+    def _check_positive(self, out: list[str], field_name: str, unit: str, optional: bool = False) -> None:
         value = getattr(self, field_name)
-        if not is_finite_number(value) or value <= 0:
+        if (not is_finite_number(value) or value <= 0) and not (optional and value is None):
             out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number > 0.")
 
     def _check_vector(self, out: list[str], field_name: str, unit: str, optional: bool = False) -> None:
@@ -142,9 +142,9 @@ class Element:
                        f"world point {world} (declared configuration) or the body-fixed {' and '.join(body)} "
                        "(body coordinates).")
 
-    def _check_number(self, out: list[str], field_name: str, unit: str) -> None:
+    def _check_number(self, out: list[str], field_name: str, unit: str, optional: bool = False) -> None:
         value = getattr(self, field_name)
-        if not is_finite_number(value):
+        if not is_finite_number(value) and not (optional and value is None):
             out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number.")
 
     def to_dict(self) -> dict[str, Any]:
@@ -348,10 +348,8 @@ class Driver(Element):
                 if getattr(self, name) is not None:
                     out.append(f"{self.kind} '{self.name}': {name}={getattr(self, name)!r} is given by the "
                                f"{type(profile).__name__} profile's values; leave it out.")
-        if self.initial_angle is not None:
-            self._check_number(out, "initial_angle", "rad")
-        if self.initial_position is not None:
-            self._check_number(out, "initial_position", "m")
+        self._check_number(out, "initial_angle", "rad", optional=True)
+        self._check_number(out, "initial_position", "m", optional=True)
         out.extend(profile.problems(self.name))
         return out
 

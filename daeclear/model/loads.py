@@ -63,9 +63,9 @@ class Load(Element):
             out.append(f"{self.kind} '{self.name}': {field_name}='{GROUND}', must be a moving body "
                        "(a load on the fixed ground does nothing).")
 
-    def _check_nonnegative(self, out: list[str], field_name: str, unit: str) -> None:
+    def _check_nonnegative(self, out: list[str], field_name: str, unit: str, optional: bool = False) -> None:
         value = getattr(self, field_name)
-        if not is_finite_number(value) or value < 0:
+        if (not is_finite_number(value) or value < 0) and not (optional and value is None):
             out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number >= 0.")
 
 
@@ -206,8 +206,7 @@ class SpringDamper(BetweenBodies):
                            f"point {world} (declared configuration) or the body-fixed {local} (body coordinates).")
         self._check_nonnegative(out, "stiffness", "N/m")
         self._check_nonnegative(out, "damping", "N s/m")
-        if self.free_length is not None:
-            self._check_nonnegative(out, "free_length", "m")
+        self._check_nonnegative(out, "free_length", "m", optional=True)
         a, b = as_vector2(self.at_i), as_vector2(self.at_j)
         if a is not None and b is not None and math.dist(a, b) < 1e-12:
             out.append(f"{self.kind} '{self.name}': at_i={self.at_i!r} and at_j={self.at_j!r} m coincide; the "
@@ -234,8 +233,7 @@ class RotationalSpringDamper(BetweenBodies):
         out = super().problems()
         self._check_nonnegative(out, "stiffness", "N m/rad")
         self._check_nonnegative(out, "damping", "N m s/rad")
-        if self.free_angle is not None:
-            self._check_number(out, "free_angle", "rad")
+        self._check_number(out, "free_angle", "rad", optional=True)
         return out
 
 
