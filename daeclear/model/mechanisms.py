@@ -417,9 +417,8 @@ def four_bar(clearance_joints: Any = (), *, rpm: float = 5000.0, crank_angle: fl
     Parameters
     ----------
     clearance_joints : sequence of {"A", "B", "C", "D"}
-        Joints with clearance; () is the ideal four-bar. With a clearance at ``A``, the driven joint,
-        the driver ``drive`` drives the crank through its clearance bearing (the crank's rotation is
-        prescribed, its journal moves in the play).
+        Joints with clearance; () is the ideal four-bar. At ``A`` the driver still prescribes the
+        crank's rotation, its journal moving in the play.
     rpm : float
         Crank speed, rev/min, counter-clockwise (5000, the chapter's crank speed).
     crank_angle : float
