@@ -1,9 +1,6 @@
-"""Clearance joints: a revolute joint with radial play and a translational joint with a loose slider.
-
-:class:`RevoluteClearance` and :class:`TranslationalClearance` add no constraint but contact-impact
-forces (section 4.2 and 4.3 of the chapter); :func:`clearance_joint` and :func:`ideal_joint` turn an
-ideal joint into its clearance joint and back. Separate from :mod:`daeclear.model.elements` (bodies,
-ideal joints, drivers) because these elements carry the contact laws, materials and readings.
+"""Clearance joints: a revolute joint with radial play and a translational joint with a loose slider
+(sections 4.2 and 4.3 of the chapter), and :func:`clearance_joint` / :func:`ideal_joint` between an
+ideal joint and its clearance joint.
 """
 
 from __future__ import annotations
@@ -18,7 +15,8 @@ if TYPE_CHECKING:
     from numpy.typing import NDArray
 from ..results.values import field_names
 from .elements import (Joint, PointJoint, Revolute, Translational, Vector2, as_vector2, computed_once,
-                       own_problems)
+                       own_problems, store_vectors)
+
 
 def _default_law() -> Any:
     from ..contact import LankaraniNikravesh
@@ -28,16 +26,13 @@ def _default_law() -> Any:
 
 def _law_problems(element: RevoluteClearance | TranslationalClearance) -> list[str]:
     """Resolve the joint's contact and friction laws once, reporting what is wrong."""
-    from ..contact import friction_law, normal_law
+    from ..contact import friction_law
     from ..contact.base import NormalLaw
-
     from ..contact.hydrodynamic import HydrodynamicBearing
 
     out: list[str] = []
-    law = element.law
     try:
-        if isinstance(law, str):
-            law = normal_law(law)
+        law = _law_object(element.law)
         if isinstance(law, HydrodynamicBearing):
             if not isinstance(element, RevoluteClearance):
                 out.append(f"{element.kind} '{element.name}': law=HydrodynamicBearing(...), must be a normal "
@@ -59,14 +54,26 @@ def _law_problems(element: RevoluteClearance | TranslationalClearance) -> list[s
     return out
 
 
+def _law_object(law: Any) -> Any:
+    """A law given by name as the law object (anything else as given)."""
+    from ..contact import normal_law
+
+    return normal_law(law) if isinstance(law, str) else law
+
+
+def _friction(joint: RevoluteClearance | TranslationalClearance) -> Any:
+    from ..contact import friction_law
+
+    return friction_law(joint.friction)
+
+
 @dataclass(frozen=True)
 class RevoluteClearance(PointJoint):
     """Revolute joint with radial clearance: a journal (body j) inside a bearing (body i).
 
-    The joint adds no constraint; the journal moves freely inside the bearing and a
-    contact-impact force acts when the eccentricity exceeds the clearance (section 4.2,
-    eqs. 4.1-4.13). ``at`` is the common centre of bearing and journal in the reference
-    configuration (or give ``point_i``/``point_j`` in body coordinates).
+    No constraint: a contact-impact force acts when the eccentricity exceeds the clearance (section
+    4.2, eqs. 4.1-4.13). ``at`` is the common centre of bearing and journal in the reference
+    configuration (or give ``point_i``/``point_j``).
 
     Parameters
     ----------
@@ -81,29 +88,25 @@ class RevoluteClearance(PointJoint):
     journal_radius : float or None
         Journal radius R_j, m.
     material : Material or (Material, Material) or None
-        Materials of bearing and journal (one for both); needed when the law's stiffness
-        is computed (``stiffness=None``).
+        Materials of bearing and journal (one for both); needed when a stiffness is computed.
     law : NormalLaw, HydrodynamicBearing or str
         Normal contact law (default Lankarani-Nikravesh with c_e = 0.9, eq. 3.9); a
-        :class:`~daeclear.contact.HydrodynamicBearing` makes a lubricated joint (film forces, its
-        dry law below the film threshold; docs/lubrication.md).
+        HydrodynamicBearing makes a lubricated joint (docs/lubrication.md).
     friction : None, float, str or FrictionLaw
         None: frictionless; a float: modified Coulomb (3.16) with that coefficient (in dry contact).
     wear : ArchardWear or None
-        Archard wear of the joint's surfaces (:class:`daeclear.contact.wear.ArchardWear`): the worn
-        profile ``wear_depth`` enters the gap (docs/wear.md); ``daeclear.studies.wear`` grows it.
+        Archard wear of the joint's surfaces: the worn profile ``wear_depth`` enters the gap
+        (docs/wear.md).
     wear_depth : sequence of float, or two of them, or None
-        The worn depth at the profile's nodes (``wear.nodes`` values, m, >= 0, node k at angle
-        ``2 pi k / nodes`` in the worn body's frame): one profile for ``surface`` "bearing" or
-        "journal", two rows (bearing, journal) for "both". None: unworn. Run-time data: a new
-        profile compiles nothing (``model.with_parameters({"<joint>.wear_depth": depth})``).
+        The worn depth at the profile's ``wear.nodes`` nodes (m, >= 0, node k at angle ``2 pi k /
+        nodes`` in the worn body's frame); two rows (bearing, journal) for "both". None: unworn.
     """
 
     bearing_radius: float = 0.0
     clearance: float | None = None
     journal_radius: float | None = None
     material: Any = None
-    law: Any = field(default_factory=lambda: _default_law())
+    law: Any = field(default_factory=_default_law)
     friction: Any = None
     wear: Any = None
     wear_depth: Any = None
@@ -130,9 +133,7 @@ class RevoluteClearance(PointJoint):
 
         if self.wear is None:
             return {}
-        surfaces = self.wear.surfaces
-        if self.wear_depth is None:
-            return {s: np.zeros(self.wear.nodes) for s in surfaces}
+        surfaces = self.wear.surfaces  # an unworn profile is zeros (__post_init__)
         depth = np.asarray(self.wear_depth, dtype=float).reshape(len(surfaces), -1)
         return dict(zip(surfaces, depth))
 
@@ -150,19 +151,13 @@ class RevoluteClearance(PointJoint):
     def resolved_law(self) -> Any:
         """The normal law with its stiffness (or cylinder geometry) set from radii and materials (a
         HydrodynamicBearing: its dry law's)."""
-        from ..contact import normal_law
-
-        law = normal_law(self.law) if isinstance(self.law, str) else self.law
+        law = _law_object(self.law)
         if law.is_resolved:
             return law
         return law.resolve("internal_cylinder", radii=(float(self.bearing_radius), self.journal),
                            materials=self.material)
 
-    @computed_once
-    def resolved_friction(self) -> Any:
-        from ..contact import friction_law
-
-        return friction_law(self.friction)
+    resolved_friction = computed_once(_friction)
 
     def problems(self) -> list[str]:
         out = super().problems()
@@ -224,25 +219,15 @@ SLIDER_MODELS: tuple[str, ...] = ("corners", "section-4.3")
 class TranslationalClearance(PointJoint):
     """Translational joint with clearance: a rectangular slider (body j) free inside a guide (body i).
 
-    The joint adds no constraint; each slider corner that reaches a guide surface is
-    pushed back by a contact-impact force (section 4.3, eqs. 4.14-4.27). The guide is two
-    parallel surfaces a distance ``H`` apart, symmetric about the guide's *mid-line*; the
-    slider is an ``L x W`` rectangle (``thickness`` out of plane) with rounded corners.
-
-    Geometry and names. ``at`` is, in the reference configuration (bodies at their
-    declared positions and angles), both a point of the guide's mid-line and the slider's
-    centre, the slider parallel to the guide; or give ``point_i`` (a mid-line point, guide
-    coordinates) and ``point_j`` (the slider centre, slider coordinates). ``axis`` is the
-    guide direction (world, reference configuration), fixed to the guide, and the slider's
-    length direction in the reference configuration. Coordinates along the guide, ``s``,
-    are measured from the mid-line point along ``axis``; "upper" is the surface on the
-    left of ``axis`` (+90 degrees). Corners, counter-clockwise from the front upper one
-    (front = +axis): ``A`` (+L/2, +W/2), ``B`` (-L/2, +W/2), ``C`` (-L/2, -W/2),
-    ``D`` (+L/2, -W/2). Contact pairs are named ``<name>.A_upper``, ``<name>.B_upper``,
-    ``<name>.C_lower``, ``<name>.D_lower``; faces ``<name>.upper_face`` (A, B) and
-    ``<name>.lower_face`` (C, D). The chapter calls the slider body i and the guide
-    body j; here, as for :class:`Translational` and :class:`RevoluteClearance`, the
-    outer part is body i.
+    No constraint: each slider corner that reaches a guide surface is pushed back by a contact-impact
+    force (section 4.3, eqs. 4.14-4.27). The guide is two parallel surfaces ``H`` apart, symmetric
+    about its mid-line; the slider an ``L x W`` rectangle with rounded corners. ``at`` is, in the
+    reference configuration, a point of the mid-line and the slider's centre (or give ``point_i``,
+    guide coordinates, and ``point_j``, slider coordinates). Coordinates ``s`` along the guide run
+    from that point along ``axis``; "upper" is the surface left of ``axis``. Corners A (+L/2, +W/2),
+    B (-L/2, +W/2), C (-L/2, -W/2), D (+L/2, -W/2); pairs ``<name>.A_upper``, ``<name>.B_upper``,
+    ``<name>.C_lower``, ``<name>.D_lower``; faces ``<name>.upper_face`` and ``<name>.lower_face``
+    (docs/validation.md). Unlike the chapter, the guide (outer part) is body i.
 
     Parameters
     ----------
@@ -253,67 +238,43 @@ class TranslationalClearance(PointJoint):
     axis : (float, float)
         Guide direction, world frame, reference configuration (need not be unit).
     slider_axis : (float, float) or None
-        The slider's length direction in slider body coordinates; None: ``axis`` in the
-        reference configuration (the slider starts parallel to the guide). Give it to
-        start tilted: e.g. ``(1, 0)`` with the slider body at ``angle=tilt``.
+        The slider's length direction in slider coordinates; None: ``axis`` (starts parallel).
     length, width : float
         Slider length L (along the guide) and width W (across), m.
     corner_radius : float
-        Corner radius R_c, m, in (0, min(L, W)/2): the stiffness of a corner contact
-        (sphere on a plane, eq. 3.5). The penetration is measured at the sharp corner
-        of the L x W rectangle, as in eqs. (4.16)-(4.20).
+        Corner radius R_c, m, in (0, min(L, W)/2), for the corner stiffness (eq. 3.5).
     clearance : float or None
         c = (H - W)/2, m (give this or ``guide_height``).
     guide_height : float or None
         Distance H between the guide surfaces, m.
     thickness : float or None
-        Slider thickness (out of plane), m; None means ``length``. A face in contact
-        is ``length x thickness``; eq. (4.27) takes the half side of the square of the
-        same area, ``a = sqrt(length * thickness) / 2`` (25 mm for Table 4.3).
+        Slider thickness (out of plane), m; None means ``length`` (eq. 4.27's a = sqrt(L t) / 2).
     upper_limits, lower_limits : (float, float) or None
-        Segment limits (P, Q) of the upper and (R, S) of the lower surface, as ``s``
-        coordinates, m: a corner can touch a surface only while its projection lies
-        between them. None: unbounded.
+        ``s`` limits of the upper and lower surfaces, m, between which a corner touches; None: unbounded.
     stroke : (float, float) or None
-        ``s`` coordinates of the slider centre mapped to xi = 0 and xi = 1 in the
-        dimensionless path (channel ``<name>.xi``); None: ``upper_limits`` if given,
-        else no ``xi`` channel.
+        ``s`` of the slider centre at xi = 0 and 1 (channel ``<name>.xi``); None: ``upper_limits``.
     material : Material or (Material, Material) or None
         Materials of guide and slider; needed when a stiffness is computed.
     law : NormalLaw or str
-        Corner law (sphere of radius R_c on a plane), default Lankarani-Nikravesh with
-        c_e = 0.9 (eq. 3.9), stiffness from (3.5) when not given.
+        Corner law, default Lankarani-Nikravesh with c_e = 0.9 (eq. 3.9), stiffness (3.5).
     face_law : NormalLaw or str
-        Law of a face in contact in the ``section-4.3`` model, on the average
-        penetration of its two corners; default Lankarani's linear law (4.26) with the
-        stiffness (4.27). A Hertz-type law given here is resolved with n = 1 (the
-        "unified" damped model). Unused by the ``corners`` model.
+        ``section-4.3`` model: a face's law on its corners' mean penetration; default Lankarani's
+        linear law (4.26) with the stiffness (4.27).
     friction : None, float, str or FrictionLaw
-        None: frictionless; a float: modified Coulomb (3.16) with that coefficient, at
-        every active contact.
+        None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
     model : {"corners", "section-4.3"}
-        ``"corners"``: every touching corner is a sphere on a plane, whatever the
-        scenario of Fig. 4.9. ``"section-4.3"``: two adjacent corners on the same surface
-        (a face) use ``face_law`` at the geometric centre of the penetrated area; one
-        corner or two opposite corners use ``law``.
+        ``"corners"``: every touching corner is a sphere on a plane. ``"section-4.3"``: a face (two
+        adjacent corners on one surface) uses ``face_law``, other contacts ``law``.
     reading : str or None
-        A named reading of the chapter's model (:data:`daeclear.model.readings.JOINT_READINGS`:
-        ``corners``, ``pseudo-corners``, ``pseudo-corners-linear``, ``section-4.3``,
-        ``unified``, ``unified-hertz``): it sets the model, the corner law's stiffness
-        ((3.5) or (4.27)) and exponent, and the face law, keeping the restitution of
-        ``law``. None: ``model``, ``law`` and ``face_law`` as given.
+        A named reading of the chapter's model (:data:`daeclear.model.readings.JOINT_READINGS`):
+        it sets the model and the laws' stiffness and exponent, keeping the restitution of ``law``.
 
     Notes
     -----
-    The slider must not be able to turn over in the guide (``sqrt(L^2 + W^2) > H``):
-    then the upper corners can only ever touch the upper surface and the lower corners
-    the lower one, and these four pairs are all the contacts there are.
-
-    The ``section-4.3`` model switches between two laws of very different stiffness: when
-    a face forms under a corner that is already deep (a tilted slider), the stored elastic
-    energy jumps up (channel ``<name>.elastic_energy``; docs/validation.md, section 4.5). It
-    is the chapter's model for a slider that lands flat (frictionless, pin at the slider's
-    centre, Fig. 4.35b); for tilting sliders (friction) use ``corners``.
+    The slider must not be able to turn over (``sqrt(L^2 + W^2) > H``): then these four pairs
+    are all the contacts there are. The ``section-4.3`` model is the chapter's for a slider that
+    lands flat (Fig. 4.35b): a face forming under an already deep corner makes the stored elastic
+    energy jump (docs/validation.md, section 4.5); for tilting sliders use ``corners``.
 
     Example
     -------
@@ -340,22 +301,17 @@ class TranslationalClearance(PointJoint):
     lower_limits: Vector2 | None = None
     stroke: Vector2 | None = None
     material: Any = None
-    law: Any = field(default_factory=lambda: _default_law())
-    face_law: Any = field(default_factory=lambda: _default_face_law())
+    law: Any = field(default_factory=_default_law)
+    face_law: Any = field(default_factory=_default_face_law)
     friction: Any = None
     model: str = "corners"
     reading: str | None = None
-    # the structure flags state the contact model in use and the laws' structure (a reading that
-    # only changes numbers compiles nothing)
+    # a reading that only changes numbers compiles nothing
     NOT_STRUCTURE: ClassVar[frozenset[str]] = frozenset({"model", "reading"})
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        for name in ("axis", "slider_axis", "upper_limits", "lower_limits", "stroke"):
-            value = getattr(self, name)
-            vec = as_vector2(value) if value is not None else None
-            if vec is not None:
-                object.__setattr__(self, name, vec)
+        store_vectors(self, ("axis", "slider_axis", "upper_limits", "lower_limits", "stroke"))
         for name in ("model", "reading"):
             if isinstance(getattr(self, name), str):
                 object.__setattr__(self, name, getattr(self, name).strip().lower())
@@ -367,7 +323,6 @@ class TranslationalClearance(PointJoint):
 
         return self.model if self.reading is None else joint_reading(self.reading).model
 
-    # ---- derived geometry ----------------------------------------------------------
     @property
     def radial_clearance(self) -> float:
         """c = (H - W) / 2, m."""
@@ -389,9 +344,7 @@ class TranslationalClearance(PointJoint):
     @computed_once
     def resolved_law(self) -> Any:
         """The corner law with its stiffness set (kind ``"sphere_plane"``, radius R_c)."""
-        from ..contact import normal_law
-
-        law = normal_law(self.law) if isinstance(self.law, str) else self.law
+        law = _law_object(self.law)
         if self.reading is not None:
             from . import joint_readings as readings
 
@@ -406,23 +359,16 @@ class TranslationalClearance(PointJoint):
     def resolved_face_law(self) -> Any:
         """The face law with its stiffness set (kind ``"plane_face"``, half side a); with a reading
         its face law (None for a reading of the ``corners`` model)."""
-        from ..contact import normal_law
-
         if self.reading is not None:
             from . import joint_readings as readings
 
-            return readings.face_law(readings.joint_reading(self.reading),
-                                     normal_law(self.law) if isinstance(self.law, str) else self.law,
+            return readings.face_law(readings.joint_reading(self.reading), _law_object(self.law),
                                      owner=f"{self.kind} '{self.name}'", face_half_width=self.face_half_width,
                                      materials=self.material)
-        law = normal_law(self.face_law) if isinstance(self.face_law, str) else self.face_law
-        return law.resolve("plane_face", face_half_width=self.face_half_width, materials=self.material)
+        return _law_object(self.face_law).resolve("plane_face", face_half_width=self.face_half_width,
+                                                  materials=self.material)
 
-    @computed_once
-    def resolved_friction(self) -> Any:
-        from ..contact import friction_law
-
-        return friction_law(self.friction)
+    resolved_friction = computed_once(_friction)
 
     def problems(self) -> list[str]:
         out = super().problems()
@@ -433,8 +379,7 @@ class TranslationalClearance(PointJoint):
                 out.append(f"{self.kind} '{self.name}': {name}={value!r}, must be a non-zero 2-vector.")
         for name in ("length", "width", "corner_radius"):
             self._check_positive(out, name, "m")
-        if self.thickness is not None:
-            self._check_positive(out, "thickness", "m")
+        self._check_positive(out, "thickness", "m", optional=True)
         self._check_one_positive(out, "clearance", "guide_height", "m")
         for name in ("upper_limits", "lower_limits", "stroke"):
             value = getattr(self, name)
@@ -489,13 +434,10 @@ def _reading_problems(element: TranslationalClearance) -> list[str]:
 
 
 def _face_law_problems(element: TranslationalClearance) -> list[str]:
-    from ..contact import normal_law
     from ..contact.base import NormalLaw
 
-    law = element.face_law
     try:
-        if isinstance(law, str):
-            law = normal_law(law)
+        law = _law_object(element.face_law)
         if not isinstance(law, NormalLaw):
             return [f"{element.kind} '{element.name}': face_law={law!r}, must be a daeclear.contact law or a "
                     "law name."]
@@ -504,8 +446,6 @@ def _face_law_problems(element: TranslationalClearance) -> list[str]:
         return [f"{element.kind} '{element.name}': face_law: {exc}"]
     return []
 
-
-# ---- clearance as a property of a joint ------------------------------------------------
 
 #: The clearance joint each ideal joint becomes, and the fields it needs besides the shared ones.
 _CLEARANCE_OF: dict[type, tuple[type, tuple[tuple[str, ...], ...]]] = {
@@ -519,33 +459,26 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
                     **fields_: Any) -> Joint:
     """The clearance joint that replaces the ideal ``joint``: same bodies, point and axis.
 
-    Perfect and clearance joints share their kinematic data (Ambrósio and Pombo, "A unified
-    formulation for mechanical joints with and without clearances/bushings and/or stops",
-    Multibody Syst. Dyn. 42, 2018): a :class:`Revolute` becomes a :class:`RevoluteClearance`
-    whose bearing and journal centres are the joint's point (``at`` or ``point_i``/``point_j``);
-    a :class:`Translational` becomes a :class:`TranslationalClearance` whose guide is body i,
-    slider body j, with the joint's ``axis`` as the guide direction and the joint's point as
-    both the mid-line point and the slider centre. ``fields_`` are the clearance fields only
-    (clearance, geometry, material, law, friction, ...), never the shared ones.
+    Ideal and clearance joints share their kinematic data (Ambrósio and Pombo, Multibody Syst. Dyn.
+    42, 2018): the joint's point becomes the bearing and journal centres, or the guide's mid-line
+    point and the slider centre (``axis`` the guide direction).
 
     Parameters
     ----------
     joint : Revolute or Translational
         The ideal joint.
     bearing : str or None
-        Revolute only: the body that holds the bearing (body_i or body_j of the joint); None
-        keeps body i, the other body carries the journal.
+        Revolute only: the body that holds the bearing (one of the joint's); None: body i.
     name : str or None
-        Name of the clearance joint (its channels are ``<name>.ex``, ...); None keeps the joint's.
+        Name of the clearance joint; None keeps the joint's.
     **fields_
-        Fields of the clearance joint, e.g. ``clearance=0.5e-3, bearing_radius=10e-3,
-        material=Material(...), law="lankarani-nikravesh", friction=0.05``.
+        The clearance joint's own fields, e.g. ``clearance=0.5e-3, bearing_radius=10e-3``.
 
     Raises
     ------
     SceneError
-        A joint that is not an ideal revolute or translational one (e.g. already a clearance
-        joint), an unknown or shared field, a missing one, or an invalid value.
+        Not an ideal revolute or translational joint, an unknown, shared or missing field, or an
+        invalid value.
     """
     label = f"clearance on joint '{getattr(joint, 'name', joint)}'"
     if isinstance(joint, (RevoluteClearance, TranslationalClearance)):

@@ -1,28 +1,19 @@
 """The elements of a scene: the :class:`Element` base and its checks, bodies, ideal joints and drivers.
 
-Plain data (frozen dataclasses, SI units, planar 2-vectors) that knows nothing of CasADi or
-of the solver; each element lists its own problems. Separate from :mod:`daeclear.model.scene`
-(the container that checks elements against each other) so that every element module
-(:mod:`daeclear.model.clearance_joints`, :mod:`daeclear.model.loads`) builds on this one.
-
-Conventions
------------
-* Every body has generalized coordinates ``(x, y, phi)`` of its centre of mass.
-* Joints join two bodies at a world point ``at`` given in the *reference
-  configuration*, i.e. with the bodies at their declared ``position`` and
-  ``angle``. The body-fixed attachment points are taken from that configuration.
-  Alternatively give them directly in body coordinates with ``point_i`` and
-  ``point_j``; then the declared positions are only guesses that assembly corrects.
-* The ground is the body named ``"ground"``: fixed at the origin, angle zero.
+Plain data (frozen dataclasses, SI units, planar 2-vectors), no CasADi; each element lists its own
+problems. Every body has coordinates ``(x, y, phi)`` of its centre of mass. A joint's point is a
+world point ``at`` of the reference configuration (the bodies at their declared ``position`` and
+``angle``), or body-fixed ``point_i``/``point_j`` (then the declared poses are guesses that assembly
+corrects). The ground is the body named ``"ground"``: fixed at the origin, angle zero.
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, fields
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeGuard
 
 from .profiles import PROFILES, ConstantSpeed, Profile
 
@@ -32,10 +23,8 @@ Vector2 = tuple[float, float]
 
 
 def kept(element: Any, slot: str, compute: Callable[[Any], Any]) -> Any:
-    """``compute(element)``, kept on the element under ``slot`` when its class is a frozen dataclass
-    (the value then follows from its fields alone: not a field, so equality, ``to_dict`` and
-    ``dataclasses.replace`` ignore it; scenes that share the element share it); computed anew on
-    any other element (or one without a ``__dict__``: slots). A call that raises keeps nothing."""
+    """``compute(element)``, kept on a frozen dataclass element under ``slot`` (not a field: equality,
+    ``to_dict`` and ``dataclasses.replace`` ignore it); computed anew on any other element."""
     if not is_frozen(element):
         return compute(element)
     try:
@@ -47,17 +36,14 @@ def kept(element: Any, slot: str, compute: Callable[[Any], Any]) -> Any:
 
 
 def kept_with(element: Any, slot: str, inputs: tuple[Any, ...], compute: Callable[[Any], Any]) -> Any:
-    """``compute(element)``, a value that follows from a frozen element's fields and from other frozen
-    objects it reads (``inputs``, e.g. the scene's bodies): kept on the element with those objects
-    and reused while it is given the very same ones (the scenes of a sweep share their bodies);
-    computed anew when any of them differs or is not a frozen dataclass."""
+    """``compute(element)`` of a frozen element that also reads other frozen objects ``inputs`` (e.g. the
+    scene's bodies): kept and reused while it is given the very same objects."""
     held = getattr(element, "__dict__", {}).get(slot)  # kept only on frozen objects (below)
     if held is not None and len(held[0]) == len(inputs) and all(a is b for a, b in zip(held[0], inputs)):
         return held[1]
-    if not (is_frozen(element) and all(is_frozen(x) for x in inputs)):
-        return compute(element)
     value = compute(element)
-    object.__setattr__(element, slot, (inputs, value))
+    if is_frozen(element) and all(is_frozen(x) for x in inputs):
+        object.__setattr__(element, slot, (inputs, value))
     return value
 
 
@@ -67,11 +53,8 @@ def is_frozen(value: Any) -> bool:
     return bool(params is not None and params.frozen and hasattr(value, "__dict__"))
 
 
-
-
 def computed_once(method: Callable[[Any], Any]) -> Callable[[Any], Any]:
-    """A method of a frozen element whose result follows from its fields alone (a resolved contact
-    law): computed at the first call and kept on the instance (see :func:`kept`)."""
+    """A method of a frozen element whose result follows from its fields alone, kept (see :func:`kept`)."""
     slot = f"_computed_{method.__name__}"
 
     @functools.wraps(method)
@@ -82,16 +65,15 @@ def computed_once(method: Callable[[Any], Any]) -> Callable[[Any], Any]:
 
 
 def own_problems(element: Element) -> tuple[str, ...]:
-    """``element.problems()``, kept on a frozen element: a scene validated again, or another scene
-    sharing the element (a sweep's), does not check it again."""
+    """``element.problems()``, kept on a frozen element (a sweep's scenes share their elements)."""
     return kept(element, "_own_problems", lambda e: tuple(e.problems()))
 
 
-def _is_finite_number(value: Any) -> bool:
+def is_finite_number(value: Any) -> TypeGuard[float]:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
-def _as_vector2(value: Any) -> Vector2 | None:
+def as_vector2(value: Any) -> Vector2 | None:
     """Return ``value`` as a tuple of two finite floats, or None if it is not one."""
     try:
         if any(isinstance(v, bool) for v in value):  # True is not a coordinate
@@ -104,16 +86,20 @@ def _as_vector2(value: Any) -> Vector2 | None:
     return items
 
 
-# public names of the helpers above, for the elements defined in other modules (clearance joints, loads)
-is_finite_number, as_vector2 = _is_finite_number, _as_vector2
+def store_vectors(element: Any, names: Iterable[str]) -> None:
+    """Store each named field that is a 2-vector as a tuple of two floats (anything else is kept as
+    given, for problems())."""
+    for name in names:
+        vec = as_vector2(getattr(element, name))
+        if vec is not None:
+            object.__setattr__(element, name, vec)
 
 
 class Element:
     """Base class of every scene element: a name, and a list of own problems."""
 
     name: str
-    #: fields whose effect on the equations the element's structure flags already state (the
-    #: compiled engine leaves them out of the structure key: a name for numbers compiles nothing)
+    #: fields the element's structure flags already state (left out of the compiled structure key)
     NOT_STRUCTURE: ClassVar[frozenset[str]] = frozenset()
 
     @property
@@ -128,16 +114,14 @@ class Element:
             return [f"{self.kind} '{self.name}': name must not contain '.' or '/' (used in channel names)."]
         return []
 
-    def _check_positive(self, out: list[str], field_name: str, unit: str) -> None:
+    def _check_positive(self, out: list[str], field_name: str, unit: str, optional: bool = False) -> None:
         value = getattr(self, field_name)
-        if not _is_finite_number(value) or value <= 0:
+        if (not is_finite_number(value) or value <= 0) and not (optional and value is None):
             out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number > 0.")
 
     def _check_vector(self, out: list[str], field_name: str, unit: str, optional: bool = False) -> None:
         value = getattr(self, field_name)
-        if optional and value is None:
-            return
-        if _as_vector2(value) is None:
+        if as_vector2(value) is None and not (optional and value is None):
             out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be two finite numbers (x, y).")
 
     def _check_one_positive(self, out: list[str], first: str, second: str, unit: str) -> None:
@@ -158,9 +142,9 @@ class Element:
                        f"world point {world} (declared configuration) or the body-fixed {' and '.join(body)} "
                        "(body coordinates).")
 
-    def _check_number(self, out: list[str], field_name: str, unit: str) -> None:
+    def _check_number(self, out: list[str], field_name: str, unit: str, optional: bool = False) -> None:
         value = getattr(self, field_name)
-        if not _is_finite_number(value):
+        if not is_finite_number(value) and not (optional and value is None):
             out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number.")
 
     def to_dict(self) -> dict[str, Any]:
@@ -176,13 +160,10 @@ class Element:
         return out
 
 
-def _body_name(body: str | Body | Ground) -> str:
+def body_name(body: str | Body | Ground) -> str:
     """The name of a body given by name or as the element (anything else is kept, for problems())."""
     given: Any = body
     return given if isinstance(given, str) else getattr(given, "name", given)
-
-
-body_name = _body_name  # public name, for the elements defined in other modules
 
 
 @dataclass(frozen=True)
@@ -216,10 +197,7 @@ class Body(Element):
     angular_velocity: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("position", "velocity"):
-            vec = _as_vector2(getattr(self, name))
-            if vec is not None:
-                object.__setattr__(self, name, vec)
+        store_vectors(self, ("position", "velocity"))
 
     def problems(self) -> list[str]:
         out = super().problems()
@@ -250,8 +228,8 @@ class Joint(Element):
     body_j: str
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "body_i", _body_name(self.body_i))
-        object.__setattr__(self, "body_j", _body_name(self.body_j))
+        object.__setattr__(self, "body_i", body_name(self.body_i))
+        object.__setattr__(self, "body_j", body_name(self.body_j))
 
     @property
     def bodies(self) -> tuple[str, str]:
@@ -266,8 +244,7 @@ class Joint(Element):
 
 @dataclass(frozen=True)
 class PointJoint(Joint):
-    """A joint located by a world point ``at`` or by body-fixed points ``point_i``/``point_j``
-    (the base of the ideal and of the clearance revolute and translational joints)."""
+    """A joint located by a world point ``at`` or by body-fixed points ``point_i``/``point_j``."""
 
     at: Vector2 | None = None
     point_i: Vector2 | None = None
@@ -275,10 +252,7 @@ class PointJoint(Joint):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        for name in ("at", "point_i", "point_j"):
-            vec = _as_vector2(getattr(self, name)) if getattr(self, name) is not None else None
-            if vec is not None:
-                object.__setattr__(self, name, vec)
+        store_vectors(self, ("at", "point_i", "point_j"))
 
     def problems(self) -> list[str]:
         out = super().problems()
@@ -288,10 +262,8 @@ class PointJoint(Joint):
         local = (self.point_i is not None, self.point_j is not None)
         self._check_not_both(out, "at", ("point_i", "point_j"))
         if self.at is None and not all(local):
-            out.append(
-                f"{self.kind} '{self.name}': give the world point at=(x, y), "
-                "or both body-fixed points point_i and point_j."
-            )
+            out.append(f"{self.kind} '{self.name}': give the world point at=(x, y), "
+                       "or both body-fixed points point_i and point_j.")
         return out
 
 
@@ -305,24 +277,18 @@ class Revolute(PointJoint):
 
 @dataclass(frozen=True)
 class Translational(PointJoint):
-    """Ideal translational (prismatic) joint: body j slides on body i along ``axis``.
-
-    ``axis`` is a world direction in the reference configuration (fixed to body i);
-    the two constraints keep the joint point of body j on the line through the joint
-    point of body i along ``axis``, and keep the relative angle constant.
-    """
+    """Ideal translational (prismatic) joint: body j slides on body i along ``axis`` (a world direction
+    of the reference configuration, fixed to body i); the relative angle stays constant."""
 
     axis: Vector2 = (1.0, 0.0)
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        vec = _as_vector2(self.axis)
-        if vec is not None:
-            object.__setattr__(self, "axis", vec)
+        store_vectors(self, ("axis",))
 
     def problems(self) -> list[str]:
         out = super().problems()
-        vec = _as_vector2(self.axis)
+        vec = as_vector2(self.axis)
         if vec is None or math.hypot(*vec) < 1e-12:
             out.append(f"{self.kind} '{self.name}': axis={self.axis!r}, must be a non-zero 2-vector.")
         return out
@@ -332,17 +298,12 @@ class Translational(PointJoint):
 class Driver(Element):
     """Prescribed motion of one joint coordinate (a kinematic driver constraint).
 
-    On a revolute joint (:class:`Revolute` or :class:`RevoluteClearance`) the coordinate is
-    the relative angle ``phi_j - phi_i``; on a translational joint (:class:`Translational` or
-    :class:`TranslationalClearance`) it is the displacement of point j from point i along the
-    joint's axis (fixed to body i). The driver imposes ``x(t) = x0 + motion(t)`` with the
-    ``profile``'s motion (constant speed by default: ``x0 + speed t``; see
-    :mod:`daeclear.profiles`), where ``x0`` is the coordinate of the reference configuration
-    unless ``initial_angle`` (revolute) or ``initial_position`` (translational) is given. On a
-    clearance joint only this coordinate is prescribed: the journal (slider) stays free in its
-    play. Channels: ``<name>.moment`` (N m, revolute) or ``<name>.force`` (N, translational),
-    the load the driver applies to body j (counter-clockwise / along the axis positive), and
-    ``<name>.power`` (W).
+    The coordinate is a revolute joint's relative angle ``phi_j - phi_i`` or a translational joint's
+    displacement of point j from point i along its axis (with or without clearance: a clearance
+    joint's journal or slider stays free in its play). The driver imposes ``x(t) = x0 +
+    motion(t)`` (constant speed by default; :mod:`daeclear.profiles`), ``x0`` the reference
+    configuration's coordinate unless ``initial_angle`` or ``initial_position`` is given. Channels:
+    ``<name>.moment`` (N m) or ``<name>.force`` (N) on body j, and ``<name>.power`` (W).
 
     Parameters
     ----------
@@ -387,10 +348,8 @@ class Driver(Element):
                 if getattr(self, name) is not None:
                     out.append(f"{self.kind} '{self.name}': {name}={getattr(self, name)!r} is given by the "
                                f"{type(profile).__name__} profile's values; leave it out.")
-        if self.initial_angle is not None:
-            self._check_number(out, "initial_angle", "rad")
-        if self.initial_position is not None:
-            self._check_number(out, "initial_position", "m")
+        self._check_number(out, "initial_angle", "rad", optional=True)
+        self._check_number(out, "initial_position", "m", optional=True)
         out.extend(profile.problems(self.name))
         return out
 

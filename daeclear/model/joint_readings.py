@@ -1,11 +1,7 @@
-"""The joint readings of the chapter's translational clearance joint (section 4.3): the contact laws
-of each reading the text supports (table and units: :mod:`daeclear.model.readings`).
-
-A :class:`~daeclear.model.clearance_joints.TranslationalClearance` with ``reading=`` takes its corner
-and face laws from here. The mechanism readings of Fig. 4.28, which build scenes from the mechanism
-library, live in :mod:`daeclear.model.readings`, which also re-exports everything here: the clearance
-joints import this module, not that one, so that the mechanism library (which imports the scene)
-stays out of the scene's imports.
+"""The joint readings of the chapter's translational clearance joint (section 4.3): each reading's
+contact laws (see :mod:`daeclear.model.readings`, which re-exports everything here and adds the
+mechanism readings; the clearance joints import this module, so the scene stays out of the
+mechanism library's imports).
 """
 
 from __future__ import annotations

@@ -1,12 +1,5 @@
-"""The values of a load: a number, a :class:`Table` in time or an :class:`Expression`, and their math.
-
-A :class:`~daeclear.model.loads.Force` component or a :class:`~daeclear.model.loads.Torque` is a
-number, a :class:`Table` (linear interpolation in time, held constant outside its times) or an
-:class:`Expression` (a function of time, the loaded body's :class:`LoadState` and named numbers),
-written once with the math functions here (``sin``, ``exp``, ``fmax``, ...) so that it runs on
-numbers and on CasADi symbols. Separate from :mod:`daeclear.model.loads` (the load elements and
-their generalized forces), which re-exports everything here: ``from daeclear.model.loads import
-exp`` keeps working.
+"""The values of a load (a number, a :class:`Table` in time or an :class:`Expression`) and their math,
+written once for numbers and CasADi symbols; :mod:`daeclear.model.loads` re-exports everything here.
 """
 
 from __future__ import annotations
@@ -35,12 +28,8 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Table:
-    """A value tabulated in time: linear interpolation between ``(times[k], values[k])``, held at
-    the first and last value outside ``[times[0], times[-1]]``.
-
-    The interpolant is continuous (its slope jumps at the table's times, which IDA's step
-    control handles); the times and values are run-time parameters, their number is structure.
-    """
+    """A value tabulated in time: linear interpolation between ``(times[k], values[k])``, held at the
+    end values outside them. Times and values are run-time parameters, their number is structure."""
 
     times: tuple[float, ...]
     values: tuple[float, ...]
@@ -66,8 +55,7 @@ class Table:
         return []
 
     def __call__(self, t: Any) -> Any:
-        """The interpolated value at ``t`` (numbers or CasADi symbols): one formula for both,
-        ``v0 + sum_k (s_k - s_{k-1}) max(t - t_k, 0)`` with ``s_k`` the slope after ``t_k``."""
+        """The interpolated value at ``t`` (numbers or CasADi symbols)."""
         return interpolate(self.times, self.values, t)
 
     def to_dict(self) -> dict[str, Any]:
@@ -75,8 +63,8 @@ class Table:
 
 
 def interpolate(times: Sequence[Any], values: Sequence[Any], t: Any) -> Any:
-    """Piecewise-linear interpolation, constant outside the table, branch-free (see :class:`Table`);
-    public because the load builder interpolates a table whose times and values are symbols."""
+    """Piecewise-linear interpolation, constant outside the table, branch-free:
+    ``v0 + sum_k (s_k - s_{k-1}) max(t - t_k, 0)`` with ``s_k`` the slope after ``t_k``."""
     n = len(times)
     slopes = [(values[k + 1] - values[k]) / (times[k + 1] - times[k]) for k in range(n - 1)] + [0.0]
     out = values[0] + 0.0 * t
@@ -110,10 +98,9 @@ class Expression:
 
         Expression(lambda t, s, p: p.T0 * exp(-t / p.tau), T0=10.0, tau=0.2)
 
-    The function is structure: it is traced once with CasADi symbols, so it must use the math
-    functions of :mod:`daeclear.loads` (``sin``, ``exp``, ``fmax``, ``if_else``, ...), not
-    ``math`` or Python ``if`` on the state. Its numbers are run-time parameters: give every
-    number that may change as a named number, not inside the function.
+    The function is structure, traced with CasADi symbols: write it with the math functions of
+    :mod:`daeclear.loads`, not ``math`` or Python ``if`` on the state. The named numbers are
+    run-time parameters.
     """
 
     function: Callable[..., Any]
@@ -180,9 +167,8 @@ class Expression:
 
 
 def _function_digest(function: Any, seen: frozenset[int] = frozenset()) -> str:
-    """A digest that changes when the function's code, a number it reads from outside, or a Python
-    function it calls (by a global or closure name, recursively) changes: all of that is structure
-    (give numbers as named numbers to make them run-time parameters)."""
+    """A digest of what is structure in a function: its code, the numbers it reads from outside, and the
+    Python functions it calls (by a global or closure name, recursively)."""
     code = getattr(function, "__code__", None)
     try:
         text = inspect.getsource(function)
@@ -198,7 +184,7 @@ def _function_digest(function: Any, seen: frozenset[int] = frozenset()) -> str:
         seen = seen | {id(function)}
         for item in outside:
             value = item[1] if isinstance(item, tuple) else item
-            if _is_number(value):
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
                 captured.append(item)
             elif inspect.isfunction(value) and id(value) not in seen:
                 captured.append(_function_digest(value, seen))
@@ -211,10 +197,6 @@ def _has_contents(cell: Any) -> bool:
     except ValueError:  # an empty cell (a name not yet bound)
         return False
     return True
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 Value = float | Table | Expression

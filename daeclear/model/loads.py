@@ -1,35 +1,12 @@
 """Applied loads: point forces, torques, spring-dampers and motors acting on the bodies of a scene.
 
-A load adds no state and no constraint: it adds to the applied generalized force ``Q(t, q, v)``
-of the equations of motion, like gravity. So the residual, the Schur-complement solve of the
-accelerations, ``base_force`` (the scipy methods) and the compiled loops all see it.
-
-Elements (frozen dataclasses, SI units; a point of application is, as for joints, a world point
-``at`` of the reference (declared) configuration or a body-fixed point ``point`` in the body's
-frame, one of the two):
-
-* :class:`Force`: a point force on a body (world or body-fixed components);
-* :class:`Torque`: a torque on a body, optionally between two bodies (``reaction``);
-* :class:`SpringDamper`: a linear spring-damper between two body points (free length);
-* :class:`RotationalSpringDamper`: a torsional spring-damper between two bodies (free angle);
-* :class:`Motor`: a torque between two bodies with the linear torque-speed characteristic
-  ``T = stall_torque * (1 - omega_rel / no_load_speed)`` of a DC motor.
-
-The value of a :class:`Force` component or a :class:`Torque` is a number, a :class:`Table` in
-time (linear interpolation, held constant outside its times) or an :class:`Expression`: a
-function of time, the body's state and named numbers, written once with the functions of
-this module (``sin``, ``exp``, ``fmax``, ...) so that it runs on numbers and on CasADi symbols.
-
-Every number (forces, table points, an expression's named numbers, stiffnesses, free lengths,
-body-fixed points) is a run-time parameter: changing it compiles nothing. The structure is which
-elements there are, the kind of each value, a table's number of points and an expression's
-function (its source code).
-
-Energy bookkeeping: the elastic energy of the springs is part of ``energy.potential`` (so an
-undamped spring conserves ``energy.mechanical``); every other power (applied forces and torques,
-motors, the dampers) is part of ``energy.input_power`` and of the work ``work.input``
-(``track_work=True``). Each element's channel ``<name>.power`` is that non-conservative power, so
-``energy.input_power`` is the sum of the ``.power`` channels of drivers, contacts and loads.
+A load adds no state and no constraint, only a term of the applied generalized force ``Q(t, q, v)``
+(docs/user_guide.md, section 1.1). A point of application is a world point ``at`` of the reference
+configuration or a body-fixed ``point``, one of the two. A force component or a torque is a number,
+a :class:`Table` in time or an :class:`Expression` (:mod:`daeclear.model.load_values`). Every number
+is a run-time parameter; structure is which elements there are, each value's kind, a table's number
+of points and an expression's function. The springs' elastic energy is part of ``energy.potential``;
+every other power is in ``energy.input_power`` and each element's ``<name>.power`` channel.
 """
 
 from __future__ import annotations
@@ -37,9 +14,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from typing import Any
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 
-from .elements import GROUND, Element, Vector2, as_vector2, body_name, is_finite_number
+from .elements import GROUND, Element, Vector2, as_vector2, body_name, is_finite_number, store_vectors
 # the values of a load and their math, re-exported: ``from daeclear.model.loads import exp`` keeps working
 from .load_values import (Expression, LoadState, Table, Value, atan2, cos, exp, fabs, fmax, fmin,  # noqa: F401
                           if_else, interpolate, log, sign, sin, sqrt, tanh)
@@ -48,8 +25,6 @@ __all__ = [
     "Expression", "Force", "Load", "LoadState", "Motor", "RotationalSpringDamper", "SpringDamper", "Table",
     "Torque", "atan2", "cos", "exp", "fabs", "fmax", "fmin", "if_else", "log", "sign", "sin", "sqrt", "tanh",
 ]
-
-# ---------------------------------------------------------------------------- values (daeclear.model.load_values)
 
 
 def _value_problems(element: Element, field_name: str, unit: str) -> list[str]:
@@ -62,16 +37,13 @@ def _value_problems(element: Element, field_name: str, unit: str) -> list[str]:
     return []
 
 
-def _value_parameters(value: Any) -> dict[str, Any]:
-    """A value's numbers, keyed under the value's field: '' (a number), 'times'/'values', or names."""
+def _value_parameters(field_name: str, value: Any) -> dict[str, Any]:
+    """A value's numbers: ``<field>`` (a number), ``<field>.times``/``.values`` or ``<field>.<name>``."""
     if isinstance(value, Table):
-        return {"times": value.times, "values": value.values}
+        return {f"{field_name}.times": value.times, f"{field_name}.values": value.values}
     if isinstance(value, Expression):
-        return dict(value.parameters)
-    return {"": float(value)}
-
-
-# ---------------------------------------------------------------------------- elements
+        return {f"{field_name}.{k}": v for k, v in value.parameters}
+    return {field_name: float(value)}
 
 
 class Load(Element):
@@ -91,9 +63,9 @@ class Load(Element):
             out.append(f"{self.kind} '{self.name}': {field_name}='{GROUND}', must be a moving body "
                        "(a load on the fixed ground does nothing).")
 
-    def _check_nonnegative(self, out: list[str], field_name: str, unit: str) -> None:
+    def _check_nonnegative(self, out: list[str], field_name: str, unit: str, optional: bool = False) -> None:
         value = getattr(self, field_name)
-        if not is_finite_number(value) or value < 0:
+        if (not is_finite_number(value) or value < 0) and not (optional and value is None):
             out.append(f"{self.kind} '{self.name}': {field_name}={value!r} {unit}, must be a finite number >= 0.")
 
 
@@ -128,19 +100,16 @@ class Force(Load):
     Parameters
     ----------
     name : str
-        Unique name; channels ``<name>.fx``, ``<name>.fy`` (world components, N) and
-        ``<name>.power`` (W).
+        Unique name; channels ``<name>.fx``, ``<name>.fy`` (world, N) and ``<name>.power`` (W).
     body : str or Body
         The loaded body (not the ground).
     fx, fy : float, Table or Expression
-        Components, N: in the world frame (``frame="world"``) or in the body frame, turning
-        with the body (``frame="body"``, a follower force).
+        Components, N, in the world frame or (``frame="body"``, a follower force) the body's.
     at : (float, float) or None
         World point of application in the reference (declared) configuration, m.
     frame : {"world", "body"}
     point : (float, float) or None
-        Point of application in the body's frame, m (instead of ``at``; giving both is an
-        error). None with ``at`` None: the centre of mass.
+        Point of application in the body's frame, m (instead of ``at``).
     """
 
     name: str
@@ -153,7 +122,7 @@ class Force(Load):
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "body", body_name(self.body))
-        _points_as_vectors(self, ("at", "point"))
+        store_vectors(self, ("at", "point"))
 
     def body_roles(self) -> tuple[tuple[str, str], ...]:
         return (("body", self.body),)
@@ -173,12 +142,9 @@ class Force(Load):
 
 @dataclass(frozen=True)
 class Torque(Load):
-    """A torque on ``body`` (counter-clockwise positive); with a ``reaction`` body the opposite
-    torque acts on it (a torque between two bodies, e.g. a motor on a frame).
-
-    Channels ``<name>.torque`` (N m) and ``<name>.power`` (W: torque times the speed of ``body``
-    relative to ``reaction``). ``value``: a number, a :class:`Table` or an :class:`Expression`
-    (whose state's ``angle`` and ``speed`` are relative to ``reaction``).
+    """A torque ``value`` on ``body`` (counter-clockwise positive), the opposite on ``reaction`` if given
+    (an Expression's ``angle`` and ``speed`` are then relative to it). Channels ``<name>.torque``
+    (N m) and ``<name>.power`` (W).
     """
 
     name: str
@@ -204,19 +170,13 @@ class Torque(Load):
 
 @dataclass(frozen=True)
 class SpringDamper(BetweenBodies):
-    """A linear spring-damper between a point of ``body_i`` and a point of ``body_j``, each given
-    as a world point of the reference (declared) configuration (``at_i``, ``at_j``) or as a
-    body-fixed point in that body's frame (``point_i``, ``point_j``): exactly one of the two for
-    each end. The points move with their bodies; a body-fixed point stays where it is given on
-    its body whatever the declared pose (a world point is read in the declared pose, so a body
-    declared off its assembled pose moves it).
+    """A linear spring-damper between a point of ``body_i`` and a point of ``body_j``, each a world
+    point of the declared configuration (``at_i``, ``at_j``) or body-fixed (``point_i``, ``point_j``).
 
     Tension ``F = stiffness * (L - free_length) + damping * dL/dt`` along the line of the points
-    (positive pulls them together). ``free_length`` None: the distance of the points in the
-    declared configuration. Channels ``<name>.length``, ``<name>.elongation`` (L - free_length,
-    m), ``<name>.force`` (tension, N), ``<name>.elastic_energy`` (J, part of
-    ``energy.potential``), ``<name>.power`` (the damper's power, W, <= 0). The points must not
-    coincide during a run (the line is undefined there).
+    (positive pulls them together); ``free_length`` None: the points' declared distance. Channels
+    ``<name>.length``, ``<name>.elongation`` (m), ``<name>.force`` (N), ``<name>.elastic_energy`` (J),
+    ``<name>.power`` (the damper's, W, <= 0). The points must not coincide during a run.
     """
 
     name: str
@@ -232,7 +192,7 @@ class SpringDamper(BetweenBodies):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        _points_as_vectors(self, ("at_i", "at_j", "point_i", "point_j"))
+        store_vectors(self, ("at_i", "at_j", "point_i", "point_j"))
 
     def problems(self) -> list[str]:
         out = super().problems()
@@ -246,8 +206,7 @@ class SpringDamper(BetweenBodies):
                            f"point {world} (declared configuration) or the body-fixed {local} (body coordinates).")
         self._check_nonnegative(out, "stiffness", "N/m")
         self._check_nonnegative(out, "damping", "N s/m")
-        if self.free_length is not None:
-            self._check_nonnegative(out, "free_length", "m")
+        self._check_nonnegative(out, "free_length", "m", optional=True)
         a, b = as_vector2(self.at_i), as_vector2(self.at_j)
         if a is not None and b is not None and math.dist(a, b) < 1e-12:
             out.append(f"{self.kind} '{self.name}': at_i={self.at_i!r} and at_j={self.at_j!r} m coincide; the "
@@ -257,11 +216,10 @@ class SpringDamper(BetweenBodies):
 
 @dataclass(frozen=True)
 class RotationalSpringDamper(BetweenBodies):
-    """A torsional spring-damper between ``body_i`` and ``body_j``: the torque on body j is
-    ``-stiffness * (theta - free_angle) - damping * dtheta/dt`` with ``theta = phi_j - phi_i``
-    (the opposite on body i). ``free_angle`` None: the reference relative angle. Channels
-    ``<name>.deflection`` (rad), ``<name>.torque`` (on body j, N m), ``<name>.elastic_energy``
-    (J, part of ``energy.potential``), ``<name>.power`` (the damper's power, W, <= 0).
+    """A torsional spring-damper: torque ``-stiffness * (theta - free_angle) - damping * dtheta/dt`` on
+    body j (the opposite on body i), ``theta = phi_j - phi_i``; ``free_angle`` None: the reference
+    one. Channels ``<name>.deflection`` (rad), ``<name>.torque`` (N m), ``<name>.elastic_energy``
+    (J), ``<name>.power`` (W, <= 0).
     """
 
     name: str
@@ -275,21 +233,16 @@ class RotationalSpringDamper(BetweenBodies):
         out = super().problems()
         self._check_nonnegative(out, "stiffness", "N m/rad")
         self._check_nonnegative(out, "damping", "N m s/rad")
-        if self.free_angle is not None:
-            self._check_number(out, "free_angle", "rad")
+        self._check_number(out, "free_angle", "rad", optional=True)
         return out
 
 
 @dataclass(frozen=True)
 class Motor(BetweenBodies):
-    """A motor between a stator ``body_i`` (e.g. the ground) and a rotor ``body_j`` (e.g. a crank),
-    with the linear torque-speed characteristic of a DC motor::
-
-        T = stall_torque * (1 - omega_rel / no_load_speed),   omega_rel = omega_j - omega_i
-
-    T acts on body j, -T on body i. Give ``stall_torque`` and ``no_load_speed`` the same sign
-    (negative: a clockwise motor). Above the no-load speed the torque brakes. Channels
-    ``<name>.torque`` (N m), ``<name>.speed`` (rad/s), ``<name>.power`` (W).
+    """A DC motor between a stator ``body_i`` and a rotor ``body_j``: ``T = stall_torque * (1 -
+    omega_rel / no_load_speed)`` on body j (-T on body i), ``omega_rel = omega_j - omega_i``; both
+    constants of one sign (negative: clockwise). Channels ``<name>.torque`` (N m), ``<name>.speed``
+    (rad/s), ``<name>.power`` (W).
     """
 
     name: str
@@ -311,15 +264,6 @@ class Motor(BetweenBodies):
         return out
 
 
-def _points_as_vectors(element: Element, names: Iterable[str]) -> None:
-    """Store each given point field as a tuple of two floats (kept as given when it is not one,
-    for problems())."""
-    for name in names:
-        value = getattr(element, name)
-        if value is not None and as_vector2(value) is not None:
-            object.__setattr__(element, name, as_vector2(value))
-
-
 def attachment(ref: Any, body: str, world: Vector2 | None, local: Vector2 | None) -> tuple[float, float]:
     """Body-fixed coordinates of a load's point: ``local`` when given, else the world point
     ``world`` of the reference configuration ``ref``, else the centre of mass."""
@@ -331,20 +275,14 @@ def attachment(ref: Any, body: str, world: Vector2 | None, local: Vector2 | None
     return (0.0, 0.0)
 
 
-LOAD_TYPES: tuple[type, ...] = (Force, Torque, SpringDamper, RotationalSpringDamper, Motor)
-
-
-# ---------------------------------------------------------------------------- assembly
-
 def load_parameters(ref: Any, load: Load) -> dict[str, Any]:
     """The load's numbers as run-time parameters (``ref``: the scene's reference configuration)."""
     out: dict[str, Any] = {}
     if isinstance(load, Force):
         out["point"] = attachment(ref, load.body, load.at, load.point)
-        for field_name in ("fx", "fy"):
-            out.update(_keyed(field_name, _value_parameters(getattr(load, field_name))))
+        out.update(_value_parameters("fx", load.fx) | _value_parameters("fy", load.fy))
     elif isinstance(load, Torque):
-        out.update(_keyed("value", _value_parameters(load.value)))
+        out.update(_value_parameters("value", load.value))
     elif isinstance(load, SpringDamper):
         s_i = attachment(ref, load.body_i, load.at_i, load.point_i)
         s_j = attachment(ref, load.body_j, load.at_j, load.point_j)
@@ -359,10 +297,6 @@ def load_parameters(ref: Any, load: Load) -> dict[str, Any]:
     else:
         raise TypeError(f"load_parameters: {load.kind} '{load.name}' is not a known load kind")
     return out
-
-
-def _keyed(field_name: str, values: dict[str, Any]) -> dict[str, Any]:
-    return {(f"{field_name}.{k}" if k else field_name): v for k, v in values.items()}
 
 
 @dataclass(frozen=True)
@@ -439,7 +373,9 @@ def build_loads(ctx: Any, loads: Iterable[Load]) -> LoadBuild:
                 p = -c * speed**2
                 channels += [Channel(f"{name}.deflection", "rad", deflection),
                              Channel(f"{name}.elastic_energy", "J", elastic)]
-            Q += _generalized_torque(ctx, [(body, torque), (other, -torque)])
+            for frame, moment in ((fj, torque), (fi, -torque)):  # the ground's is dropped
+                if frame.index is not None:
+                    Q[3 * frame.index + 2] += moment
             channels.append(Channel(f"{name}.torque", "N m", torque))
         power += p
         channels.append(Channel(f"{name}.power", "W", p))
@@ -463,14 +399,3 @@ def _value(ctx: Any, owner: str, field_name: str, value: Any, state: LoadState) 
         return value(ctx.t, state, numbers)
     return ctx.p(owner, field_name)
 
-
-def _generalized_torque(ctx: Any, torques: Sequence[tuple[str, Any]]) -> Any:
-    """Generalized force (length n_q) of torques ``(body, torque)``; the ground's is dropped."""
-    import casadi as ca
-
-    Q = ca.SX.zeros(ctx.n_q)
-    for body, torque in torques:
-        frame = ctx.frames[body]
-        if frame.index is not None:
-            Q[3 * frame.index + 2] += torque
-    return Q

@@ -41,8 +41,7 @@ def _same(value: Any, default: Any) -> bool:
 def refuse_clearance_options(mechanism: str, function: Callable[..., Any], given: dict[str, Any],
                              without: str) -> None:
     """Raise SceneError when ``given`` (the call's keyword values) sets an option that only a clearance
-    joint uses while the mechanism has none (``without`` says which choice made it so): the option would
-    be silently ignored."""
+    joint uses while the mechanism has none (``without``: the choice that made it so)."""
     defaults = {p.name: p.default for p in inspect.signature(function).parameters.values()}
     for key in CLEARANCE_ONLY[mechanism]:
         if key in given and not _same(given[key], defaults[key]):
@@ -50,27 +49,20 @@ def refuse_clearance_options(mechanism: str, function: Callable[..., Any], given
                              f"leave {key} out or choose a clearance joint ({CHOOSER[mechanism][0]}=...).")
 
 
-def has_clearance(mechanism: str, params: dict[str, Any]) -> bool:
-    """Whether ``params`` give the ready mechanism a clearance joint (chain: always)."""
-    if mechanism not in CHOOSER:
-        return mechanism == "chain"
-    key, none = CHOOSER[mechanism]
-    value = params.get(key, none)
-    if key == "joint":
-        return str(value).lower() != "ideal"
-    try:
-        return bool(joint_names(value))
-    except TypeError:
-        return True  # a bad value: the mechanism itself says what is wrong
-
-
 def ideal_parameters(mechanism: str, params: dict[str, Any]) -> dict[str, Any] | None:
     """The parameters of the same ready mechanism with every joint ideal (the chapter's reference run): the
     options that apply to it only (its clearance joints' options and its name left out), or None when
     ``params`` give no clearance joint or the mechanism has no ideal counterpart (chain)."""
-    if mechanism not in CHOOSER or not has_clearance(mechanism, params):
+    if mechanism not in CHOOSER:
         return None
     key, none = CHOOSER[mechanism]
+    value = params.get(key, none)
+    try:
+        ideal = str(value).lower() == "ideal" if key == "joint" else not joint_names(value)
+    except TypeError:  # a bad value: the mechanism itself says what is wrong
+        ideal = False
+    if ideal:
+        return None
     dropped = {*CLEARANCE_ONLY[mechanism], "name"}
     return {**{k: v for k, v in params.items() if k not in dropped}, key: none}
 

@@ -4,7 +4,8 @@ crank-rocker four-bar and a double pendulum with clearance at any subset of thei
 from __future__ import annotations
 
 import math
-from typing import Any, TypeGuard
+from collections.abc import Mapping
+from typing import Any
 
 from .. import options as rules
 from ..contact import HydrodynamicBearing, Material, friction_law, normal_law
@@ -12,7 +13,8 @@ from ..contact.hydrodynamic import law_from_table
 from ..contact.base import NormalLaw
 from ..errors import SceneError
 from .mechanism_options import joint_names, refuse_clearance_options
-from .scene import GROUND, Body, Driver, Element, Revolute, RevoluteClearance, Scene, Translational
+from .scene import (GROUND, Body, Driver, Element, Revolute, RevoluteClearance, Scene, Translational,
+                    is_finite_number)
 
 # Table 4.1: link lengths (m), masses (kg), moments of inertia (kg m^2)
 CRANK_LENGTH, CRANK_MASS, CRANK_INERTIA = 0.05, 0.30, 1.0e-4
@@ -39,11 +41,8 @@ def rpm_to_rad_s(rpm: float) -> float:
 
 def ideal_slider_crank_state(theta: float, omega: float, crank: float = CRANK_LENGTH,
                              rod: float = ROD_LENGTH) -> dict[str, tuple[float, float, float, float, float, float]]:
-    """Positions and velocities (x, y, phi, vx, vy, omega) of the ideal slider-crank's bodies.
-
-    Crank pinned at the origin at angle ``theta`` turning at ``omega``; rod from the
-    crank pin to the slider on the X axis; centres of mass at link mid-lengths.
-    """
+    """Positions and velocities (x, y, phi, vx, vy, omega) of the ideal slider-crank's bodies: crank at
+    ``theta`` turning at ``omega``, slider on the X axis, centres of mass at link mid-lengths."""
     s, c = math.sin(theta), math.cos(theta)
     beta = math.asin(-crank * s / rod)  # rod angle (slider on the X axis)
     beta_dot = -crank * c * omega / (rod * math.cos(beta))
@@ -59,9 +58,25 @@ def ideal_slider_crank_state(theta: float, omega: float, crank: float = CRANK_LE
     }
 
 
-def _check(name: str, value: Any, rule: str, ok: bool) -> None:
-    if not ok:
-        raise SceneError(f"slider_crank: {name}={value!r}, {rule}.")
+def _check(where: str, *rows: tuple[str, Any, str, bool]) -> None:
+    """Raise SceneError for the first row (field, value, rule, whether it holds) that does not hold."""
+    for field_name, value, rule, ok in rows:
+        if not ok:
+            raise SceneError(f"{where}: {field_name}={value!r}, {rule}.")
+
+
+def _link_rows(length: Any, mass: Any, inertia: Any) -> tuple[tuple[str, Any, str, bool], ...]:
+    """The checks of a chain's or double pendulum's link length, mass and inertia (for :func:`_check`)."""
+    return (("link_length", length, "must be a finite number > 0 m", is_finite_number(length) and length > 0),
+            ("link_mass", mass, "must be a finite number > 0 kg", is_finite_number(mass) and mass > 0),
+            ("link_inertia", inertia, "must be None or a finite number > 0 kg m^2",
+             inertia is None or (is_finite_number(inertia) and inertia > 0)))
+
+
+def _body(name: str, mass: float, inertia: float, state: Mapping[str, tuple[float, ...]]) -> Body:
+    """Body ``name`` at its (x, y, phi, vx, vy, omega) in ``state``."""
+    x, y, phi, vx, vy, w = state[name]
+    return Body(name, mass=mass, inertia=inertia, position=(x, y), angle=phi, velocity=(vx, vy), angular_velocity=w)
 
 
 DEFAULT_RESTITUTION = 0.9  # Table 4.2, for the laws that take a coefficient of restitution
@@ -69,36 +84,26 @@ DEFAULT_RESTITUTION = 0.9  # Table 4.2, for the laws that take a coefficient of 
 
 def _contact_law(law: Any, restitution: float | None, length: float | None) -> NormalLaw | HydrodynamicBearing:
     """A law object from a law, a law table or a name; ``restitution``/``length`` fill the fields the law has."""
-    if length is not None and not (_finite(length) and length > 0):
+    from ..contact.registry import normal_law_class  # one source of names
+
+    if length is not None and not (is_finite_number(length) and length > 0):
         raise SceneError(f"contact law: length={length!r}, must be None or a finite number > 0 m.")
     if isinstance(law, (NormalLaw, HydrodynamicBearing, dict)):  # a dict: a law table (--set "law={...}")
         return law_from_table(law) if isinstance(law, dict) else law
-    return _make_contact_law(str(law), restitution, length)
-
-
-def _make_contact_law(name: str, restitution: float | None, length: float | None) -> NormalLaw:
     fields = {"restitution": DEFAULT_RESTITUTION if restitution is None else restitution, "length": length}
-    from ..contact.registry import normal_law_class  # one source of names
-
-    accepted = set(getattr(normal_law_class(name), "__dataclass_fields__", {}))
-    return normal_law(name, **{k: v for k, v in fields.items() if k in accepted and v is not None})
+    accepted = set(getattr(normal_law_class(str(law)), "__dataclass_fields__", {}))
+    return normal_law(str(law), **{k: v for k, v in fields.items() if k in accepted and v is not None})
 
 
 def _make_ideal_elements(omega: float, crank_angle: float, slider_mass: float, slider_inertia: float,
                          offset: tuple[float, ...]) -> tuple[Element, ...]:
     """Bodies crank, rod, slider; revolutes A, B, C; translational D; driver drive (see slider_crank)."""
     state = ideal_slider_crank_state(crank_angle, omega)
-
-    def body(body_name: str, mass: float, inertia: float) -> Body:
-        x, y, phi, vx, vy, w = state[body_name]
-        return Body(body_name, mass=mass, inertia=inertia, position=(x, y), angle=phi, velocity=(vx, vy),
-                    angular_velocity=w)
-
-    crank = body("crank", CRANK_MASS, CRANK_INERTIA)
-    rod = body("rod", ROD_MASS, ROD_INERTIA)
+    crank = _body("crank", CRANK_MASS, CRANK_INERTIA, state)
+    rod = _body("rod", ROD_MASS, ROD_INERTIA, state)
     if offset != (0.0, 0.0):  # the slider's centre, from the pin where the ideal mechanism has it
         state["slider"] = (state["slider"][0] - offset[0], -offset[1], *state["slider"][2:])
-    slider = body("slider", slider_mass, slider_inertia)
+    slider = _body("slider", slider_mass, slider_inertia, state)
     pin_b = (CRANK_LENGTH * math.cos(crank_angle), CRANK_LENGTH * math.sin(crank_angle))
     pin_c = (state["slider"][0] + offset[0], 0.0)
     return (crank, rod, slider,
@@ -120,25 +125,18 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
                  bearing: str = "slider", **options: Any) -> Scene:
     """The chapter's slider-crank mechanism (Fig. 4.14, Table 4.1).
 
-    Crank (body ``crank``) pinned to the ground at the origin by revolute ``A`` and driven
-    at constant speed by driver ``drive``; connecting rod ``rod`` joined to the crank by
-    revolute ``B`` and to the slider by joint ``C``; slider ``slider`` on the X axis by
-    translational joint ``D``. The crank turns counter-clockwise from the collinear
-    position (crank angle 0, slider at x = 0.17 m). Centres of mass at link mid-lengths.
+    Crank ``crank`` pinned to the ground at the origin by revolute ``A``, driven by driver ``drive``;
+    rod ``rod`` joined to the crank by revolute ``B`` and to the slider by joint ``C``; slider
+    ``slider`` on the X axis by translational joint ``D``. The crank turns counter-clockwise from
+    the collinear position (slider at x = 0.17 m).
 
     Parameters
     ----------
     joint : {"ideal", "revolute", "translational"}
         Which joint has clearance; "ideal" has none. "revolute": joint ``C`` becomes the
-        revolute clearance joint ``clearance`` (bearing on the slider, journal on the rod,
-        Table 4.2), journal and bearing centres coincident at the start. "translational":
-        joint ``D`` becomes the translational clearance joint ``clearance`` (Fig. 4.27,
-        Table 4.3): a 50 x 50 x 50 mm slider with 1 mm corner radius, its centre at the
-        rod-slider pin ``C`` (ideal), inside a guide on the ground whose mid-line is the X
-        axis, with contact segment x in [l - r - L/2 - 5 mm, l + r + L/2 + 5 mm] =
-        [0.04, 0.20] m on both surfaces (the slider never reaches its ends) and the
-        dimensionless stroke xi = 0 at x = l - r = 0.07 m, 1 at x = l + r = 0.17 m. The
-        slider starts midway between the surfaces and parallel to them.
+        revolute clearance joint ``clearance`` (Table 4.2), journal centred at the start.
+        "translational": joint ``D`` becomes the translational clearance joint ``clearance``
+        (Fig. 4.27, Table 4.3; its geometry in docs/validation.md), the slider centred in its guide.
     gravity : float
         Magnitude of gravity along -Y, m/s^2 (0 to switch it off).
     rpm : float
@@ -151,11 +149,11 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
         Radial clearance of the clearance joint, m (0.5 mm in Figs. 4.15 and 4.28); for
         the translational joint c = (H - W)/2.
     law : str, NormalLaw, HydrodynamicBearing (lubricated revolute joint) or a law table (dict)
-        Normal contact law (name or object; stiffness computed from radii and material
-        when not given). Default Lankarani-Nikravesh (3.9).
+        Normal contact law (name or object; stiffness computed when not given). Default
+        Lankarani-Nikravesh (3.9).
     restitution : float or None
-        Coefficient of restitution c_e for laws that take one (None: 0.9, Table 4.2). Given with a
-        law that has none (e.g. law="hertz"), it is an error, not ignored.
+        Coefficient of restitution c_e for laws that take one (None: 0.9, Table 4.2); an error with
+        a law that has none.
     friction : None, float, str or FrictionLaw
         None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
     bearing_radius : float
@@ -165,60 +163,54 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     length : float or None
         Axial contact length L, m, required by the cylindrical laws.
     contact_model : {"corners", "section-4.3"}
-        Translational joint only: every touching corner a sphere on a plane
-        ("corners", Figs. 4.28-4.34), or a face in contact on ``face_law``
-        ("section-4.3", Fig. 4.35b). See :class:`~daeclear.model.scene.TranslationalClearance`.
+        Translational joint only: every touching corner a sphere on a plane ("corners"), or a face in
+        contact on ``face_law`` ("section-4.3"); see :class:`~daeclear.model.scene.TranslationalClearance`.
     face_law : str or NormalLaw
-        Translational joint, "section-4.3" only: the law of a face in contact, default
-        Lankarani's linear law (4.26) with the stiffness (4.27).
+        Translational joint, "section-4.3" only: the law of a face in contact (default (4.26)).
     reading : str or None
         Translational joint only: a named reading of the chapter's contact model
-        (``TranslationalClearance(reading=...)``, :mod:`daeclear.model.readings`); it replaces
-        ``contact_model`` and ``face_law``.
+        (:mod:`daeclear.model.readings`); it replaces ``contact_model`` and ``face_law``.
     slider_mass, slider_inertia : float
         The slider's mass, kg, and moment of inertia, kg m^2 (Table 4.1: 0.14 and 1e-4).
     bearing : {"slider", "rod"}
-        ``joint="revolute"``: the bearing body (the chapter's: the slider, ``C``'s body_i, as
-        ``.with_clearance("C")`` has it: both routes give the same ``ex``/``ey``).
+        ``joint="revolute"``: the bearing body (the chapter's: the slider, ``C``'s body_i).
     pin_offset : (float, float)
         Translational joint only: the rod-slider pin in slider coordinates from the slider's
-        centre (its centre of mass), m; (0, 0): at the centre. The slider starts with the pin
-        where the ideal mechanism has it, its centre midway between the guide surfaces.
+        centre, m; (0, 0): at the centre.
     """
-    joint = str(joint).lower()
-    _check("joint", joint, f"must be one of {', '.join(JOINT_KINDS)}", joint in JOINT_KINDS)
-    _check("gravity", gravity, "must be a finite number >= 0 m/s^2", _finite(gravity) and gravity >= 0)
-    _check("rpm", rpm, "must be a finite number (rev/min)", _finite(rpm))
-    _check("crank_angle", crank_angle, "must be a finite number (rad)", _finite(crank_angle))
+    joint, where = str(joint).lower(), "slider_crank"
+    _check(where, ("joint", joint, f"must be one of {', '.join(JOINT_KINDS)}", joint in JOINT_KINDS),
+           ("gravity", gravity, "must be a finite number >= 0 m/s^2", is_finite_number(gravity) and gravity >= 0),
+           ("rpm", rpm, "must be a finite number (rev/min)", is_finite_number(rpm)),
+           ("crank_angle", crank_angle, "must be a finite number (rad)", is_finite_number(crank_angle)))
     if options:
         raise SceneError(f"slider_crank(joint={joint!r}): unknown option(s) {', '.join(sorted(options))}.")
     offset = tuple(pin_offset) if isinstance(pin_offset, (tuple, list)) else ()
-    _check("pin_offset", pin_offset, "must be two finite numbers (m)",
-           len(offset) == 2 and all(_finite(v) for v in offset))
-    _check("pin_offset", pin_offset, "must be (0, 0) unless joint='translational'",
-           joint == "translational" or offset == (0.0, 0.0))
-    _check("bearing", bearing, "must be 'slider' or 'rod' (joint='revolute' only)",
-           bearing == "slider" or (joint == "revolute" and bearing == "rod"))
-    for field_name, value, default in (("reading", reading, None), ("contact_model", contact_model, "corners")):
-        _check(field_name, value, "is for joint='translational' only", joint == "translational" or value == default)
+    translational_only = "is for joint='translational' only"
+    _check(where, ("pin_offset", pin_offset, "must be two finite numbers (m)",
+                   len(offset) == 2 and all(is_finite_number(v) for v in offset)),
+           ("pin_offset", pin_offset, "must be (0, 0) unless joint='translational'",
+            joint == "translational" or offset == (0.0, 0.0)),
+           ("bearing", bearing, "must be 'slider' or 'rod' (joint='revolute' only)",
+            bearing == "slider" or (joint == "revolute" and bearing == "rod")),
+           ("reading", reading, translational_only, joint == "translational" or reading is None),
+           ("contact_model", contact_model, translational_only, joint == "translational" or contact_model == "corners"))
 
     omega = rpm_to_rad_s(rpm)
-    numbers = (omega, crank_angle, slider_mass, slider_inertia, offset)
     scene = Scene(name or ("slider_crank" if joint == "ideal" else f"slider_crank_{joint}"), gravity=(0.0, -gravity),
-                  elements=list(_make_ideal_elements(*numbers)))
+                  elements=list(_make_ideal_elements(omega, crank_angle, slider_mass, slider_inertia, offset)))
     if joint == "ideal":  # an option of a clearance joint would be ignored: refused
         refuse_clearance_options("slider_crank", slider_crank, locals(), "joint='ideal'")
         return scene
     rules.restitution(restitution, law, where="slider_crank")  # given for a law without one, it would be dropped
     if joint == "revolute":
-        _check("clearance", clearance, "must be a number in (0, bearing_radius) m",
-               _finite(clearance) and 0 < clearance < bearing_radius)
+        _check(where, ("clearance", clearance, "must be a number in (0, bearing_radius) m",
+                       is_finite_number(clearance) and 0 < clearance < bearing_radius))
         return scene.with_clearance(
             "C", name="clearance", bearing=bearing, bearing_radius=bearing_radius, clearance=clearance,
             material=material, law=_contact_law(law, restitution, length), friction=friction_law(friction))
-    _check("clearance", clearance, "must be a number in (0, slider length) m",
-           _finite(clearance) and 0 < clearance < SLIDER_LENGTH)
-    # slider centre: x range
+    _check(where, ("clearance", clearance, "must be a number in (0, slider length) m",
+                   is_finite_number(clearance) and 0 < clearance < SLIDER_LENGTH))
     inner, outer = ROD_LENGTH - CRANK_LENGTH - offset[0], ROD_LENGTH + CRANK_LENGTH - offset[0]
     reach = 0.5 * SLIDER_LENGTH + GUIDE_MARGIN
     return scene.with_clearance(
@@ -237,11 +229,6 @@ CHAIN_LINK_MASS = 0.196
 CHAIN_LINK_INERTIA = CHAIN_LINK_MASS * CHAIN_LINK_LENGTH ** 2 / 12.0
 
 
-def _finite(value: Any) -> TypeGuard[float]:
-    """A finite int or float (not a bool)."""
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
 def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm: float | None = None,
           angle: float = 0.0, link_length: float = CHAIN_LINK_LENGTH, link_mass: float = CHAIN_LINK_MASS,
           link_inertia: float | None = None, law: Any = "lankarani-nikravesh",
@@ -250,24 +237,12 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
           length: float | None = None, name: str | None = None, **options: Any) -> Scene:
     """A planar chain of ``n_links`` rigid links with a revolute clearance joint at every pin.
 
-    A multi-link pendulum whose size is one integer: the scalable mechanism of the benchmarks
-    (states, generated code and build time grow with ``n_links``). Links ``link1`` ...
-    ``link<N>`` lie end to end from the origin along the direction ``angle``, centres of mass at
-    mid-length; pin ``pin<k>`` joins link k-1 (the bearing; the ground for k = 1) to link k
-    (the journal) at their common end, journal and bearing centres coincident at the start.
-
-    Two variants:
-
-    * ``rpm=None`` (default): a free chain hanging from the ground and released from rest;
-      every pin, the ground pin too, is a :class:`~daeclear.model.scene.RevoluteClearance`, so the
-      model has no constraint at all (6 N states: q 3N + v 3N). The whole chain first falls
-      through the ground pin's clearance (about 4.5 ms for 0.1 mm), then swings; every
-      joint sees impacts followed by following contact under the links' weight and the
-      centripetal loads.
-    * ``rpm`` a number: the ground pin ``pin1`` is an ideal :class:`~daeclear.model.scene.Revolute`
-      driven at constant speed by driver ``drive`` (a crank), pins 2..N are clearance joints
-      (6 N + 3 states: two pin and one driver constraint). The links start as one rigid bar
-      turning at that speed; with ``n_links=1`` there is no clearance joint left.
+    The scalable mechanism of the benchmarks. Links ``link1`` ... ``link<N>`` lie end to end from
+    the origin along ``angle``; pin ``pin<k>`` joins link k-1 (the bearing; the ground for k = 1) to
+    link k, journals centred at the start. ``rpm=None``: a free chain released from rest, every pin a
+    clearance joint (6 N states, no constraint). ``rpm`` a number: ``pin1`` is an ideal revolute
+    driven by driver ``drive`` (6 N + 3 states), the links start as one rigid bar turning at that
+    speed.
 
     Parameters
     ----------
@@ -278,32 +253,17 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
     gravity : float
         Magnitude of gravity along -Y, m/s^2 (0 to switch it off).
     rpm : float or None
-        None: free chain, all pins clearance joints. A number: the ground pin is an ideal
-        revolute driven at this speed, rev/min, counter-clockwise.
+        None: free chain. A number: the ground pin's speed, rev/min, counter-clockwise.
     angle : float
-        Initial angle of the (straight) chain from the X axis, rad (0: horizontal, so a free
-        chain swings down; -pi/2: hanging at rest).
+        Initial angle of the straight chain from the X axis, rad (-pi/2: hanging at rest).
     link_length : float
         Distance between a link's pins, m (0.1).
     link_mass : float
         Mass of a link, kg (0.196: steel, 0.1 m x 25 mm x 10 mm).
     link_inertia : float or None
-        Moment of inertia of a link about its centre of mass, kg m^2; None: slender bar
-        ``link_mass * link_length**2 / 12``.
-    law : str or NormalLaw
-        Normal contact law of every clearance joint (name or object; stiffness computed from
-        the radii and material when not given). Default Lankarani-Nikravesh (3.9).
-    restitution : float or None
-        Coefficient of restitution c_e for laws that take one (None: 0.9); an error with a law
-        that has none.
-    friction : None, float, str or FrictionLaw
-        None: frictionless; a float: modified Coulomb (3.16) with that coefficient.
-    bearing_radius : float
-        Bearing radius of every joint, m (10 mm, as the slider-crank's, Table 4.2).
-    material : Material
-        Material of bearings and journals (steel, 207 GPa, 0.3).
-    length : float or None
-        Axial contact length L, m, required by the cylindrical laws.
+        Moment of inertia of a link about its centre of mass, kg m^2; None: slender bar.
+    law, restitution, friction, bearing_radius, material, length
+        As in :func:`slider_crank`, for every clearance joint.
     name : str or None
         Scene name; defaults to ``"chain<N>"``.
 
@@ -313,28 +273,21 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
     >>> dc.assemble(dc.mechanisms.chain(3)).summary()["states"]
     18
     """
-
-    def check(field_name: str, value: Any, rule: str, ok: bool) -> None:
-        if not ok:
-            raise SceneError(f"chain: {field_name}={value!r}, {rule}.")
-
     if options:  # e.g. the command line's --joint, which is the slider-crank's
         raise SceneError(f"chain: unknown option(s) {', '.join(sorted(options))}.")
-    check("n_links", n_links, "must be an integer >= 1",
-          isinstance(n_links, int) and not isinstance(n_links, bool) and n_links >= 1)
-    check("gravity", gravity, "must be a finite number >= 0 m/s^2", _finite(gravity) and gravity >= 0)
-    check("rpm", rpm, "must be None (free chain) or a finite number (rev/min)", rpm is None or _finite(rpm))
-    check("angle", angle, "must be a finite number (rad)", _finite(angle))
-    check("link_length", link_length, "must be a finite number > 0 m", _finite(link_length) and link_length > 0)
-    check("link_mass", link_mass, "must be a finite number > 0 kg", _finite(link_mass) and link_mass > 0)
-    check("link_inertia", link_inertia, "must be None or a finite number > 0 kg m^2",
-          link_inertia is None or (_finite(link_inertia) and link_inertia > 0))
-    check("bearing_radius", bearing_radius, "must be a finite number > 0 m",
-          _finite(bearing_radius) and bearing_radius > 0)
-    check("clearance", clearance, f"must be a number in (0, bearing_radius={bearing_radius!r}) m",
-          _finite(clearance) and 0 < clearance < bearing_radius)
-    check("bearing_radius", bearing_radius, f"must be smaller than half the link length ({link_length!r} m)",
-          2.0 * bearing_radius < link_length)
+    _check("chain", ("n_links", n_links, "must be an integer >= 1",
+                     isinstance(n_links, int) and not isinstance(n_links, bool) and n_links >= 1),
+           ("gravity", gravity, "must be a finite number >= 0 m/s^2", is_finite_number(gravity) and gravity >= 0),
+           ("rpm", rpm, "must be None (free chain) or a finite number (rev/min)",
+            rpm is None or is_finite_number(rpm)),
+           ("angle", angle, "must be a finite number (rad)", is_finite_number(angle)),
+           *_link_rows(link_length, link_mass, link_inertia),
+           ("bearing_radius", bearing_radius, "must be a finite number > 0 m",
+            is_finite_number(bearing_radius) and bearing_radius > 0))
+    _check("chain", ("clearance", clearance, f"must be a number in (0, bearing_radius={bearing_radius!r}) m",
+                     is_finite_number(clearance) and 0 < clearance < bearing_radius),
+           ("bearing_radius", bearing_radius, f"must be smaller than half the link length ({link_length!r} m)",
+            2.0 * bearing_radius < link_length))
 
     inertia = link_mass * link_length ** 2 / 12.0 if link_inertia is None else float(link_inertia)
     omega = 0.0 if rpm is None else rpm_to_rad_s(rpm)
@@ -360,12 +313,10 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
     return scene
 
 
-# --------------------------------------------------------------------------- clearance on any subset of joints
-
 def _clearance_of_joint(clearance: Any, joint: str, where: str) -> float:
     """The clearance of ``joint``: one number for every joint, or a mapping joint -> number."""
     value = clearance.get(joint) if isinstance(clearance, dict) else clearance
-    if not _finite(value) or value <= 0:
+    if not is_finite_number(value) or value <= 0:
         raise SceneError(f"{where}: clearance={clearance!r}, must be a number > 0 m or a mapping joint name -> "
                          f"number (none given for joint {joint!r}).")
     return float(value)
@@ -403,9 +354,7 @@ def _with_revolute_clearances(scene: Scene, joints: Any, allowed: tuple[str, ...
     return scene
 
 
-# Four-bar: the slider-crank's crank and connecting rod (Table 4.1) as crank and coupler, a rocker
-# of the rod's section (m = 0.21 kg * 0.10 / 0.12, slender bar m L^2 / 12) and a ground link chosen
-# for a crank-rocker with transmission angles between 41 and 110 degrees.
+# Four-bar (docs/mechanisms.md): a rocker of the rod's section, a crank-rocker ground link.
 FOUR_BAR_CRANK, FOUR_BAR_COUPLER, FOUR_BAR_ROCKER, FOUR_BAR_GROUND = CRANK_LENGTH, ROD_LENGTH, 0.10, 0.13
 ROCKER_MASS = ROD_MASS * FOUR_BAR_ROCKER / ROD_LENGTH
 ROCKER_INERTIA = ROCKER_MASS * FOUR_BAR_ROCKER ** 2 / 12.0
@@ -413,11 +362,8 @@ FOUR_BAR_JOINTS = ("A", "B", "C", "D")
 
 
 def grashof_crank_rocker(crank: float, coupler: float, rocker: float, ground: float) -> bool:
-    """Grashof's condition for a crank-rocker: s + l <= p + q with the crank the shortest link.
-
-    The shortest link (the crank, next to the ground link) then turns fully and the rocker
-    oscillates between two limit positions.
-    """
+    """Grashof's condition for a crank-rocker: s + l <= p + q with the crank the shortest link (it then
+    turns fully and the rocker oscillates)."""
     lengths = (crank, coupler, rocker, ground)
     return crank == min(lengths) and min(lengths) + max(lengths) <= sum(lengths) - min(lengths) - max(lengths)
 
@@ -427,13 +373,9 @@ def ideal_four_bar_state(theta: float, omega: float, crank: float = FOUR_BAR_CRA
                          ) -> dict[str, tuple[float, float, float, float, float, float]]:
     """Positions and velocities (x, y, phi, vx, vy, omega) of the ideal four-bar's links, closed form.
 
-    Crank pivot at the origin, rocker pivot at (``ground``, 0); crank at angle ``theta`` turning at
-    ``omega``; the open assembly (coupler-rocker pin above the line from the crank pin to the rocker
-    pivot). Coupler angle beta from the triangle crank pin - rocker pivot - coupler pin (law of
-    cosines), rocker angle psi from the coupler pin; the angular velocities from the loop closure
-    a w e'(theta) + b w3 e'(beta) = c w4 e'(psi):
-    w3 = a w sin(psi - theta) / (b sin(beta - psi)), w4 = a w sin(beta - theta) / (c sin(beta - psi)).
-    Centres of mass at the links' mid-lengths.
+    Crank pivot at the origin, rocker pivot at (``ground``, 0), crank at ``theta`` turning at ``omega``;
+    the open assembly. Coupler angle beta by the law of cosines, rocker angle psi from the coupler
+    pin; the rates from the loop closure a w e'(theta) + b w3 e'(beta) = c w4 e'(psi).
     """
     a, b, c, d = crank, coupler, rocker, ground
     bx, by = a * math.cos(theta), a * math.sin(theta)
@@ -465,31 +407,18 @@ def four_bar(clearance_joints: Any = (), *, rpm: float = 5000.0, crank_angle: fl
     """A crank-rocker four-bar driven at constant speed, with clearance at any subset of its joints.
 
     Bodies ``crank``, ``coupler`` and ``rocker``; revolute joints ``A`` (ground - crank, at the
-    origin, driven by driver ``drive``), ``B`` (crank - coupler), ``C`` (coupler - rocker) and ``D``
-    (ground - rocker, at (0.13, 0) m). A joint named in ``clearance_joints`` becomes a
-    :class:`~daeclear.model.scene.RevoluteClearance` of the same name (bearing on the joint's first
-    body: ground, crank, coupler, ground; journal on the second) through
-    :meth:`Scene.with_clearance <daeclear.model.scene.Scene.with_clearance>`; every joint, clearance or
-    not, starts as in the chapter (section 4.4): journals centred, velocities from the ideal
-    mechanism.
-
-    Dimensions (m): crank 0.05, coupler 0.12, rocker 0.10, ground 0.13: Grashof's crank-rocker
-    (0.05 + 0.13 <= 0.12 + 0.10), transmission angle between 41 and 110 degrees. Crank and coupler
-    are the slider-crank's crank and connecting rod (Table 4.1: 0.30 kg, 1.0e-4 kg m^2 and 0.21 kg,
-    2.5e-4 kg m^2), the rocker a bar of the rod's section (0.175 kg, 1.46e-4 kg m^2); bearings and
-    contact law as the slider-crank's revolute clearance joint (Table 4.2: 10 mm bearing radius,
-    steel, Lankarani-Nikravesh with c_e = 0.9). These numbers are this package's choice, for a
-    four-bar comparable with the chapter's slider-crank, not taken from a paper; four-bars with
-    several clearance joints are studied with other dimensions e.g. by X. Liu, J. Ding and C. Wang,
-    "Design framework for motion generation of planar four-bar linkage considering clearance joints
-    and dynamics performance", Machines 10 (2022) 136, doi:10.3390/machines10020136.
+    origin, driven by driver ``drive``), ``B``, ``C`` and ``D`` (ground - rocker, at (0.13, 0) m).
+    A joint named in ``clearance_joints`` becomes a RevoluteClearance of the same name (bearing on
+    the joint's first body), journals centred and velocities from the ideal mechanism at the start.
+    Dimensions (this package's choice, docs/mechanisms.md): crank 0.05, coupler 0.12, rocker 0.10,
+    ground 0.13 m, a Grashof crank-rocker; crank and coupler are the slider-crank's links (Table 4.1),
+    bearings and law its revolute clearance joint's (Table 4.2).
 
     Parameters
     ----------
     clearance_joints : sequence of {"A", "B", "C", "D"}
-        Joints with clearance; () is the ideal four-bar. With a clearance at ``A``, the driven joint,
-        the driver ``drive`` drives the crank through its clearance bearing (the crank's rotation is
-        prescribed, its journal moves in the play).
+        Joints with clearance; () is the ideal four-bar. At ``A`` the driver still prescribes the
+        crank's rotation, its journal moving in the play.
     rpm : float
         Crank speed, rev/min, counter-clockwise (5000, the chapter's crank speed).
     crank_angle : float
@@ -510,25 +439,19 @@ def four_bar(clearance_joints: Any = (), *, rpm: float = 5000.0, crank_angle: fl
     where = "four_bar"
     if options:  # e.g. the command line's --joint, which is the slider-crank's
         raise SceneError(f"{where}: unknown option(s) {', '.join(sorted(options))}.")
-    for field_name, value, rule, ok in (
-            ("rpm", rpm, "must be a finite number (rev/min)", _finite(rpm)),
-            ("crank_angle", crank_angle, "must be a finite number (rad)", _finite(crank_angle)),
-            ("gravity", gravity, "must be a finite number >= 0 m/s^2", _finite(gravity) and gravity >= 0),
-            ("bearing_radius", bearing_radius, "must be a finite number > 0 m",
-             _finite(bearing_radius) and bearing_radius > 0)):
-        if not ok:
-            raise SceneError(f"{where}: {field_name}={value!r}, {rule}.")
+    _check(where, ("rpm", rpm, "must be a finite number (rev/min)", is_finite_number(rpm)),
+           ("crank_angle", crank_angle, "must be a finite number (rad)", is_finite_number(crank_angle)),
+           ("gravity", gravity, "must be a finite number >= 0 m/s^2", is_finite_number(gravity) and gravity >= 0),
+           ("bearing_radius", bearing_radius, "must be a finite number > 0 m",
+            is_finite_number(bearing_radius) and bearing_radius > 0))
     omega = rpm_to_rad_s(rpm)
     state = ideal_four_bar_state(crank_angle, omega)
     joints = joint_names(clearance_joints) if isinstance(clearance_joints, (str, tuple, list)) else ()
     suffix = "".join(str(j) for j in joints)
     scene = Scene(name or (f"four_bar_{suffix}" if suffix else "four_bar"), gravity=(0.0, -gravity))
-    links = {"crank": (CRANK_MASS, CRANK_INERTIA), "coupler": (ROD_MASS, ROD_INERTIA),
-             "rocker": (ROCKER_MASS, ROCKER_INERTIA)}
-    for body_name, (mass, inertia) in links.items():
-        x, y, phi, vx, vy, w = state[body_name]
-        scene.add(Body(body_name, mass=mass, inertia=inertia, position=(x, y), angle=phi, velocity=(vx, vy),
-                       angular_velocity=w))
+    scene.add(_body("crank", CRANK_MASS, CRANK_INERTIA, state))
+    scene.add(_body("coupler", ROD_MASS, ROD_INERTIA, state))
+    scene.add(_body("rocker", ROCKER_MASS, ROCKER_INERTIA, state))
     a, b = FOUR_BAR_CRANK, FOUR_BAR_COUPLER
     pin_b = (a * math.cos(crank_angle), a * math.sin(crank_angle))
     beta = state["coupler"][2]
@@ -554,14 +477,11 @@ def double_pendulum(clearance_joints: Any = (), *, angles: Any = (0.0, 0.0), gra
                     **options: Any) -> Scene:
     """A double pendulum released from rest, with clearance at any subset of its two pins.
 
-    Links ``link1`` and ``link2`` (the chain's steel links: 0.1 m between pins, 0.196 kg, slender
-    bar inertia), pin ``A`` joining the ground (bearing) to ``link1`` at the origin and pin ``B``
-    joining ``link1`` (bearing) to ``link2`` at its far end; no driver. A pin named in
-    ``clearance_joints`` becomes a :class:`~daeclear.model.scene.RevoluteClearance` of the same name
-    (10 mm steel bearing, Lankarani-Nikravesh). It starts as in the chapter: journals centred,
-    at rest. With ``restitution=1`` and no friction nothing dissipates: the mechanical energy
-    plus the energy stored in the contacts is conserved (``simulate(..., track_work=True)``:
-    ``energy.mechanical - energy.work`` stays constant).
+    Links ``link1`` and ``link2`` (the chain's), pin ``A`` from the ground (bearing) to ``link1`` at
+    the origin, pin ``B`` from ``link1`` (bearing) to ``link2``; no driver. A pin named in
+    ``clearance_joints`` becomes a RevoluteClearance of the same name, journal centred. With
+    ``restitution=1`` and no friction, ``energy.mechanical - energy.work`` (``track_work=True``) is
+    conserved.
 
     Parameters
     ----------
@@ -593,16 +513,10 @@ def double_pendulum(clearance_joints: Any = (), *, angles: Any = (0.0, 0.0), gra
         pair = tuple(float(v) for v in angles)
     except (TypeError, ValueError):
         pass
-    for field_name, value, rule, ok in (
-            ("angles", angles, "must be two finite numbers (rad)",
-             pair is not None and len(pair) == 2 and all(map(math.isfinite, pair))),
-            ("gravity", gravity, "must be a finite number >= 0 m/s^2", _finite(gravity) and gravity >= 0),
-            ("link_length", link_length, "must be a finite number > 0 m", _finite(link_length) and link_length > 0),
-            ("link_mass", link_mass, "must be a finite number > 0 kg", _finite(link_mass) and link_mass > 0),
-            ("link_inertia", link_inertia, "must be None or a finite number > 0 kg m^2",
-             link_inertia is None or (_finite(link_inertia) and link_inertia > 0))):
-        if not ok:
-            raise SceneError(f"{where}: {field_name}={value!r}, {rule}.")
+    _check(where, ("angles", angles, "must be two finite numbers (rad)",
+                   pair is not None and len(pair) == 2 and all(map(math.isfinite, pair))),
+           ("gravity", gravity, "must be a finite number >= 0 m/s^2", is_finite_number(gravity) and gravity >= 0),
+           *_link_rows(link_length, link_mass, link_inertia))
     assert pair is not None
     inertia = link_mass * link_length ** 2 / 12.0 if link_inertia is None else float(link_inertia)
     joints = joint_names(clearance_joints) if isinstance(clearance_joints, (str, tuple, list)) else ()

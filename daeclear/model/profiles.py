@@ -1,26 +1,18 @@
 """Motion profiles of drivers: how a driven joint coordinate moves in time.
 
-A :class:`~daeclear.model.scene.Driver` prescribes one coordinate of a joint, the relative angle
-``phi_j - phi_i`` of a revolute joint or the displacement along the axis of a translational
-one, as ``x0 + speed * f(t)`` (or, for :class:`Tabulated`, the table itself). The profile's
-*kind* is structure (it decides the equations' shape, and a tabulated profile's number of
-points too); its numbers are run-time parameters (``<driver>.profile.<field>``), so changing a
-ramp time or a table value compiles nothing.
-
-The index reduction differentiates the driver constraint twice in time (the acceleration
-equation holds ``x''(t)``), so every profile is C2 in time at least:
+A :class:`~daeclear.model.scene.Driver` prescribes ``x0 + speed * f(t)`` (a :class:`Tabulated`
+profile: the coordinate itself). The profile's kind is structure, its numbers are run-time
+parameters (``<driver>.profile.<field>``). The index reduction differentiates the driver constraint
+twice, so every profile is C2 in time at least:
 
 * :class:`ConstantSpeed` ``x(t) = speed t`` (the default);
-* :class:`Ramp` from rest to ``speed`` over ``time`` with the quintic blend
-  ``s(u) = 10u^3 - 15u^4 + 6u^5``, ``u = t/time``: ``x'(t) = speed s(u)``, whose first and second
-  derivatives vanish at both ends, so x is C3; after the ramp ``x = speed (t - time/2)``;
-* :class:`Harmonic` ``x'(t) = speed (1 + amplitude sin(2 pi frequency t + phase))``, integrated:
-  ``x(t) = speed (t + amplitude (cos(phase) - cos(2 pi frequency t + phase)) / (2 pi frequency))``;
-* :class:`Tabulated` the natural cubic spline through ``(times, values)`` (C2, second derivative
-  zero at both ends), continued after the last time at its end slope (a straight line, so still
-  C2): the driven coordinate itself, not an increment.
+* :class:`Ramp` from rest to ``speed`` over ``time``, ``x'(t) = speed s(u)`` with the quintic blend
+  ``s(u) = 10u^3 - 15u^4 + 6u^5``, ``u = t/time`` (x is C3); after the ramp ``x = speed (t - time/2)``;
+* :class:`Harmonic` ``x'(t) = speed (1 + amplitude sin(2 pi frequency t + phase))``, integrated;
+* :class:`Tabulated` the natural cubic spline through ``(times, values)``, continued after the last
+  time at its end slope.
 
-Plain data here (no CasADi at import); :func:`motion` writes a profile as a CasADi expression.
+Plain data (no CasADi at import); :func:`motion` writes a profile as a CasADi expression.
 """
 
 from __future__ import annotations
@@ -53,7 +45,7 @@ class Profile:
 
     def parameters(self) -> dict[str, Any]:
         """The profile's numbers as run-time parameters (keys under ``<driver>.profile.``)."""
-        return {}
+        return {f.name: float(getattr(self, f.name)) for f in fields(self)}
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"kind": self.kind}
@@ -88,9 +80,6 @@ class Ramp(Profile):
         self._number(out, owner, "time", "s", positive=True)
         return out
 
-    def parameters(self) -> dict[str, Any]:
-        return {"time": float(self.time)}
-
 
 @dataclass(frozen=True)
 class Harmonic(Profile):
@@ -107,9 +96,6 @@ class Harmonic(Profile):
         self._number(out, owner, "frequency", "Hz", positive=True)
         self._number(out, owner, "phase", "rad")
         return out
-
-    def parameters(self) -> dict[str, Any]:
-        return {"amplitude": float(self.amplitude), "frequency": float(self.frequency), "phase": float(self.phase)}
 
 
 @dataclass(frozen=True)
@@ -157,14 +143,8 @@ def natural_spline_curvature(t: NDArray[np.float64], x: NDArray[np.float64]) -> 
     if n < 3:
         return M
     h = np.diff(t)
-    A = np.zeros((n - 2, n - 2))
+    A = np.diag(2.0 * (h[:-1] + h[1:])) + np.diag(h[1:-1], 1) + np.diag(h[1:-1], -1)  # tridiagonal
     rhs = 6.0 * (np.diff(x[1:]) / h[1:] - np.diff(x[:-1]) / h[:-1])
-    for k in range(n - 2):
-        A[k, k] = 2.0 * (h[k] + h[k + 1])
-        if k > 0:
-            A[k, k - 1] = h[k]
-        if k < n - 3:
-            A[k, k + 1] = h[k + 1]
     M[1:-1] = np.linalg.solve(A, rhs)
     return M
 

@@ -1,36 +1,13 @@
 """Readings of the chapter's translational clearance joint (section 4.3) and of its Fig. 4.28 run.
 
-The chapter's text admits several models for the slider-crank of Fig. 4.28; each one it
-supports is a named *reading* here, with the sentence it comes from (``source``) and what we
-had to choose where the text is silent (``note``).
-
-Joint readings (:data:`JOINT_READINGS`, ``TranslationalClearance(reading=...)``) decide the
-contact model: which stiffness the corner law (3.9) has, with which exponent, and how a face
-(two adjacent corners on one surface) is treated:
-
-============================ =========== ============================ ==========================
-name                          model       corner law (3.9)              face in contact
-============================ =========== ============================ ==========================
-``corners``                   corners     K (3.5), R_c = 1 mm, n 1.5    two corner spheres
-``pseudo-corners``            corners     K (4.27), a = 25 mm, n 1.5    two corner "spheres"
-``pseudo-corners-linear``     corners     K (4.27), n 1                 two corners
-``section-4.3``               section-4.3 K (3.5), n 1.5                (4.26): K (4.27) d_mean
-``unified``                   section-4.3 K (3.5), n 1.5                (3.9) with K (4.27), n 1
-``unified-hertz``             section-4.3 K (3.5), n 1.5                (3.9) with K (4.27), n 1.5
-============================ =========== ============================ ==========================
-
-The restitution coefficient (and the approach-speed floor) of the joint's ``law`` is kept;
-stiffness and exponent come from the reading. Every number (K, n, c_e, a, R_c) is a run-time
-parameter of the compiled model; only the contact model, the law classes and whether an
-exponent is 1 are structure. K of (4.27) is in N/m; used with n = 1.5 its number is taken in
-N/m^1.5 (the chapter does not say which units the "pseudo-stiffness" has in (3.9)).
-
-The joint readings are defined in :mod:`daeclear.model.joint_readings` (what the scene imports)
-and re-exported here.
-
-Mechanism readings (:data:`MECHANISM_READINGS`, :func:`slider_crank_scene`) change the rest
-of the Fig. 4.28 scene: gravity, the slider's mass and inertia, where the rod is pinned on the
-slider, friction.
+Each model the chapter's text supports for Fig. 4.28 is a named *reading*, with the sentence it
+comes from (``source``) and what the text leaves open and we chose (``note``); the table is in
+docs/validation.md. Joint readings (:data:`JOINT_READINGS`, ``TranslationalClearance(reading=...)``,
+defined in :mod:`daeclear.model.joint_readings` and re-exported here) set the corner law's stiffness
+(3.5) or (4.27) and exponent and the face law, keeping the restitution of the joint's ``law``; K of
+(4.27) is in N/m, taken in N/m^1.5 with n = 1.5. Mechanism readings (:data:`MECHANISM_READINGS`,
+:func:`slider_crank_scene`) change the rest of the scene: gravity, the slider's mass and inertia,
+where the rod is pinned on the slider, friction.
 """
 
 from __future__ import annotations
@@ -45,8 +22,6 @@ from .mechanisms import SLIDER_LENGTH, SLIDER_THICKNESS, SLIDER_WIDTH, slider_cr
 __all__ = ["JointReading", "MechanismReading", "JOINT_READINGS", "MECHANISM_READINGS", "joint_reading",
            "mechanism_reading", "mechanism_options", "corner_law", "face_law", "slider_crank_scene", "STEEL_DENSITY"]
 
-
-# ---------------------------------------------------------------------------- mechanism
 
 #: Density of the steel of a solid 50 mm slider block, kg/m^3 (not in the chapter: Table 4.3
 #: gives only the steel's E and nu).

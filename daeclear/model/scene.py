@@ -1,12 +1,8 @@
 """Scene: the container of a planar mechanism's bodies, joints, drivers and loads, with its gravity.
 
-A scene is plain data; it knows nothing of CasADi or of the solver. ``Scene.validate()`` collects
-every problem of the scene (each element's own and those between elements: unknown bodies,
-duplicate names, drivers on joints they cannot drive) and raises one
-:class:`~daeclear.errors.SceneError` listing them all. The elements live in
-:mod:`daeclear.model.elements` (bodies, ideal joints, drivers) and
-:mod:`daeclear.model.clearance_joints`; this module re-exports them, so ``from daeclear.model.scene
-import Body`` keeps working.
+Plain data, no CasADi. ``Scene.validate()`` raises one :class:`~daeclear.errors.SceneError` listing
+every problem (each element's own and those between elements). The elements
+(:mod:`daeclear.model.elements`, :mod:`daeclear.model.clearance_joints`) are re-exported here.
 """
 
 from __future__ import annotations
@@ -20,18 +16,18 @@ from collections.abc import Iterable, Iterator, Mapping
 
 from ..errors import SceneError
 # the elements, re-exported: ``from daeclear.model.scene import Body`` keeps working
-from .clearance_joints import (SLIDER_MODELS, RevoluteClearance, TranslationalClearance,  # noqa: F401
-                               clearance_joint, driven_coordinate, ideal_joint)
+from .clearance_joints import (RevoluteClearance, TranslationalClearance, clearance_joint,  # noqa: F401
+                               driven_coordinate, ideal_joint)
 from .elements import (GROUND, Body, Driver, Element, Ground, Joint, PointJoint, Revolute,  # noqa: F401
-                       Translational, Vector2, as_vector2, body_name, is_finite_number, is_frozen,
-                       own_problems)
-from .profiles import PROFILES, ConstantSpeed, Profile  # noqa: F401  (re-exported, as before the split)
+                       Translational, Vector2, as_vector2, is_finite_number, is_frozen, own_problems)
 
-
-#: The module of what :meth:`Scene.assembled` runs (its ``assembled``). It assembles the scene, so it
-#: lives in the assembly layer, which imports this module: the scene does not import it (no import
-#: circle) but loads it by name at the first call, as ``daeclear``'s public names are loaded on first use.
+#: The module of :meth:`Scene.assembled`, loaded by name: the assembly layer imports this module.
 PLACEMENT_MODULE = "daeclear.assembly.placement"
+
+
+def _did_you_mean(name: str, names: Iterable[str]) -> str:
+    close = difflib.get_close_matches(name, list(names), n=3)
+    return f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
 
 
 @dataclass
@@ -61,9 +57,8 @@ class Scene:
     def add(self, element: Element) -> Any:
         """Add an element and return it (so ``crank = scene.add(Body(...))`` reads well)."""
         if not isinstance(element, Element):
-            raise SceneError(
-                f"scene '{self.name}': cannot add {element!r}; expected a Body, joint, Driver or load (daeclear.loads)."
-            )
+            raise SceneError(f"scene '{self.name}': cannot add {element!r}; expected a Body, joint, Driver or load "
+                             "(daeclear.loads).")
         self.elements.append(element)
         return element
 
@@ -84,14 +79,9 @@ class Scene:
 
     def with_clearance(self, joint: str, *, bearing: str | None = None, name: str | None = None,
                        **fields_: Any) -> Scene:
-        """A new scene in which the ideal revolute or translational ``joint`` has a clearance.
-
-        The joint's bodies, point and axis are kept; ``fields_`` are the clearance joint's own
-        fields (``clearance``, ``bearing_radius``, ``material``, ``law``, ``friction``, ...;
-        ``length``, ``width``, ``corner_radius`` for a translational joint). ``bearing`` names
-        the body holding a revolute joint's bearing (default body_i); ``name`` renames the
-        joint. This scene is left unchanged (it stays the ideal reference). See
-        :func:`clearance_joint`.
+        """A new scene in which the ideal revolute or translational ``joint`` has a clearance, in its
+        place in the element order (see :func:`clearance_joint` for ``bearing``, ``name`` and
+        ``fields_``). This scene is left unchanged: it stays the ideal reference of its variants.
 
         >>> scene = Scene("pendulum")
         >>> link = scene.add(Body("link", mass=1.0, inertia=0.01, position=(0.5, 0.0)))
@@ -102,28 +92,27 @@ class Scene:
         >>> loose["A"].kind, scene["A"].kind
         ('RevoluteClearance', 'Revolute')
         """
-        return with_clearance(self, joint, bearing=bearing, name=name, **fields_)
+        names = [e.name for e in self.elements]
+        if joint not in names:
+            joints = ", ".join(repr(j.name) for j in self.joints)
+            raise SceneError(f"scene '{self.name}': with_clearance: no joint named {joint!r} (joints: {joints})."
+                             f"{_did_you_mean(str(joint), names)}")
+        elements = list(self.elements)
+        index = names.index(joint)
+        elements[index] = clearance_joint(elements[index], bearing=bearing, name=name,  # type: ignore[arg-type]
+                                          **fields_)
+        return Scene(self.name, gravity=self.gravity, elements=elements, ground=self.ground)
 
     def assembled(self, start: Mapping[str, float] | None = None,
                   speeds: Mapping[str, float] | None = None) -> Scene:
-        """A new scene, this mechanism with its bodies placed so that the joints named in ``start``
-        have the given coordinates (revolute: the angle ``phi_j - phi_i``, rad; translational: the
-        displacement along the axis, m; body j relative to body i, the ``<joint>.angle`` and
-        ``<joint>.displacement`` channels) and every joint, clearance joint (as ideal) and driver
-        closes; with ``speeds``, the joints' rates (rad/s, m/s) likewise, the drivers' speeds kept
-        (without: the declared velocities corrected to the joints and drivers, least norm).
-        The declared poses are the Newton guess: they pick the branch (elbow up or down).
-
-        Every number the declared configuration defines (world points ``at``, a translational axis,
-        free lengths and angles left None) is carried into the new scene as the body-fixed value it
-        stood for: the same equations, new initial poses. This scene is left unchanged.
-
-        Raises SceneError for an unknown joint or a bad value, AssemblyError when the chosen
-        coordinates do not fix the configuration (their rank, and the joints not named) or the
-        joints cannot close at them (the largest residuals and their joints).
-        See :mod:`daeclear.assembly.placement`.
+        """A new scene, its bodies placed so that the joints named in ``start`` have the given
+        coordinates (rad, or m along a translational axis) and every joint (clearance joints as
+        ideal) and driver closes; ``speeds``: the joints' rates, else the declared velocities
+        corrected (least norm). The declared poses are the Newton guess. This scene is left unchanged.
+        Raises SceneError for an unknown joint or a bad value, AssemblyError when the joints cannot
+        close (:mod:`daeclear.assembly.placement`).
         """
-        placement: Any = importlib.import_module(PLACEMENT_MODULE)  # by name: see PLACEMENT_MODULE
+        placement: Any = importlib.import_module(PLACEMENT_MODULE)
         return placement.assembled(self, start, speeds)
 
     def ideal(self) -> Scene:
@@ -149,14 +138,11 @@ class Scene:
         return Scene(self.name, gravity=self.gravity, elements=elements, ground=self.ground)
 
     def with_values(self, values: Mapping[str, Any]) -> Scene:
-        """A new scene with some of its numbers replaced, by name: ``"<element>.<field>"`` (e.g.
-        ``"clearance.clearance"``, ``"crank.mass"``, ``"drive.speed"``), ``"<element>.<field>.<field>"``
-        for a law, friction law or material (``"clearance.law.restitution"``), or ``"gravity"``.
-
-        Each changed element is made again from its fields (``dataclasses.replace``), so what it
-        derives from them (a journal radius from the bearing radius and the clearance, a contact
-        stiffness from the materials and radii) follows. The new scene is validated; this one is
-        left unchanged. Raises SceneError naming an unknown element or field.
+        """A new, validated scene with some numbers replaced, by name: ``"<element>.<field>"`` (e.g.
+        ``"crank.mass"``), ``"<element>.<field>.<field>"`` for a law, friction law or material
+        (``"clearance.law.restitution"``), or ``"gravity"``. Changed elements are made again
+        (``dataclasses.replace``), so what they derive follows. Raises SceneError naming an unknown
+        element or field; this scene is left unchanged.
 
         >>> scene = Scene("pendulum")
         >>> link = scene.add(Body("link", mass=1.0, inertia=0.01, position=(0.5, 0.0)))
@@ -179,10 +165,9 @@ class Scene:
                 raise SceneError(f"scene '{self.name}': {key!r} is an element; name one of its fields, "
                                  f"'{name}.<field>' with a field of {', '.join(fields_)}.")
             if name not in index:
-                close = difflib.get_close_matches(name, list(index), n=3)
-                hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
                 raise SceneError(f"scene '{self.name}': {key!r} names no value of the scene; a name is "
-                                 f"'gravity' or '<element>.<field>' with an element of {', '.join(index)}.{hint}")
+                                 f"'gravity' or '<element>.<field>' with an element of {', '.join(index)}."
+                                 f"{_did_you_mean(name, index)}")
             elements[index[name]] = _replaced(elements[index[name]], path.split("."), value, key)
         scene = Scene(self.name, gravity=gravity, elements=elements, ground=self.ground)
         scene.validate()
@@ -195,10 +180,7 @@ class Scene:
         for element in self.elements:
             if element.name == name:
                 return element
-        names = [e.name for e in self.elements]
-        close = difflib.get_close_matches(name, names, n=3)
-        hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
-        raise KeyError(f"no element '{name}' in scene '{self.name}'.{hint}")
+        raise KeyError(f"no element '{name}' in scene '{self.name}'.{_did_you_mean(name, (e.name for e in self))}")
 
     def problems(self) -> list[str]:
         """Every problem of the scene (empty when valid)."""
@@ -211,8 +193,7 @@ class Scene:
             if element.name in seen:
                 out.append(f"{element.kind} '{element.name}': duplicate name; every name in a scene must be unique.")
             seen.add(element.name)
-        body_names = [b.name for b in self.bodies]
-        known = set(body_names) | {GROUND}
+        known = {b.name for b in self.bodies} | {GROUND}
         referring: list[tuple[Element, Any]] = [(j, (("body_i", j.body_i), ("body_j", j.body_j)))
                                                 for j in self.joints]
         referring += [(e, e.body_roles()) for e in self.elements if hasattr(e, "body_roles")]  # loads
@@ -221,10 +202,8 @@ class Scene:
                 if body not in known:
                     close = difflib.get_close_matches(str(body), sorted(known), n=1)
                     hint = f" Did you mean '{close[0]}'?" if close else ""
-                    out.append(
-                        f"{joint.kind} '{joint.name}': {role} refers to body '{body}', "
-                        f"not in scene '{self.name}'.{hint}"
-                    )
+                    out.append(f"{joint.kind} '{joint.name}': {role} refers to body '{body}', "
+                               f"not in scene '{self.name}'.{hint}")
         joints = {j.name: j for j in self.joints}
         driven: set[str] = set()
         for driver in self.drivers:
@@ -260,8 +239,7 @@ class Scene:
         return _describe(self.name, self.gravity, self.elements)
 
     def description(self) -> Mapping[str, Any]:
-        """:meth:`to_dict` as a read-only mapping made at its first read (:class:`SceneDescription`):
-        what a model and its runs' results carry, which a sweep's runs seldom read."""
+        """:meth:`to_dict` as a read-only mapping made at its first read (a sweep's runs seldom read it)."""
         return SceneDescription(self)
 
 
@@ -286,9 +264,8 @@ def _describe(name: str, gravity: Any, elements: Iterable[Element]) -> dict[str,
 
 
 class SceneDescription(Mapping[str, Any]):
-    """A scene's :meth:`Scene.to_dict`, made at the first read. It holds the scene's name, gravity
-    and elements as they are now (frozen elements cannot change; with any other element the
-    description is made at once), so a later change of the scene does not show in it."""
+    """A scene's :meth:`Scene.to_dict`, made at the first read from the scene as it was (at once when an
+    element is not frozen): a later change of the scene does not show in it."""
 
     def __init__(self, scene: Scene) -> None:
         self._parts: tuple[str, tuple[float, ...], tuple[Element, ...]] | None = (
@@ -314,26 +291,4 @@ class SceneDescription(Mapping[str, Any]):
 
     def __repr__(self) -> str:
         return repr(self._described())
-
-
-def with_clearance(scene: Scene, joint: str, *, bearing: str | None = None, name: str | None = None,
-                   **fields_: Any) -> Scene:
-    """A new scene in which the ideal joint named ``joint`` is a clearance joint (see :func:`clearance_joint`).
-
-    The scene itself is left unchanged: one ideal mechanism serves as the reference of its
-    clearance variants (the chapter plots every clearance run against the ideal one) and a
-    sweep builds many variants from one scene. Elements are frozen, so the new scene shares
-    them; the clearance joint takes the ideal joint's place in the element order.
-    """
-    names = [e.name for e in scene.elements]
-    if joint not in names:
-        close = difflib.get_close_matches(str(joint), names, n=3)
-        hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
-        joints = ", ".join(repr(j.name) for j in scene.joints)
-        raise SceneError(f"scene '{scene.name}': with_clearance: no joint named {joint!r} (joints: {joints}).{hint}")
-    index = names.index(joint)
-    element = clearance_joint(scene.elements[index], bearing=bearing, name=name, **fields_)  # type: ignore[arg-type]
-    elements = list(scene.elements)
-    elements[index] = element
-    return Scene(scene.name, gravity=scene.gravity, elements=elements, ground=scene.ground)
 

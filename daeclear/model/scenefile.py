@@ -31,23 +31,10 @@ A scene file (tables map key for key onto the Python classes)::
     body_j = "link"
     at = [0.0, 0.0]
 
-Clearance joints (tables ``[[revolute_clearance]]`` and ``[[translational_clearance]]``) take
-their materials and laws as tables::
-
-    [[revolute_clearance]]
-    name = "clearance"
-    body_i = "slider"
-    body_j = "rod"
-    at = [0.17, 0.0]
-    bearing_radius = 0.01
-    clearance = 0.5e-3
-    material = { young = 207e9, poisson = 0.3 }
-    law = { name = "lankarani-nikravesh", restitution = 0.9 }
-    friction = 0.05          # or "coulomb", or { name = "modified-coulomb", coefficient = 0.1 }
-
-A lubricated revolute joint takes the law table ``{ name = "hydrodynamic", viscosity = 0.03,
-length = 0.02, theory = "short", cavitation = "half", film_threshold = 1e-6, dry = { name =
-"lankarani-nikravesh", restitution = 0.9 } }`` (docs/lubrication.md).
+Clearance joints (``[[revolute_clearance]]``, ``[[translational_clearance]]``) take their materials
+and laws as inline tables (docs/user_guide.md: ``material = { young = 207e9, poisson = 0.3 }``,
+``law = { name = "lankarani-nikravesh", restitution = 0.9 }``, ``friction = 0.05`` or a table); a
+lubricated joint's law table is ``{ name = "hydrodynamic", ... }`` (docs/lubrication.md).
 
 Drivers take their motion profile as a table (see :mod:`daeclear.profiles`)::
 
@@ -86,7 +73,7 @@ from . import mechanisms
 from .. import options
 from ..errors import SceneError
 from ..results.values import to_plain
-from ..contact import Material, friction_law, normal_law
+from ..contact import Material, friction_law
 from ..contact.hydrodynamic import law_from_table
 from .profiles import profile_from_dict
 from .loads import Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
@@ -118,17 +105,6 @@ class SceneFile:
     source: dict[str, Any]
 
 
-def _law(value: Any, build: Any) -> Any:
-    """A law given as a name, a number (friction coefficient) or a table {name = ..., parameters}
-    (``name = "hydrodynamic"``: a lubricated revolute joint's HydrodynamicBearing)."""
-    if isinstance(value, dict):
-        if build is normal_law:
-            return law_from_table(value)
-        params = dict(value)
-        return build(params.pop("name", None), **params)
-    return value
-
-
 def _contact_fields(entry: dict[str, Any]) -> dict[str, Any]:
     """Clearance joints: material tables -> Material, law tables -> law objects; an error names its key."""
     out = dict(entry)
@@ -139,12 +115,13 @@ def _contact_fields(entry: dict[str, Any]) -> dict[str, Any]:
             out["material"] = Material(**material)
         elif isinstance(material, list):
             out["material"] = tuple(Material(**m) if isinstance(m, dict) else m for m in material)
-        for key in ("law", "face_law"):
-            if key in out:
-                out[key] = _law(out[key], normal_law)
+        for key in ("law", "face_law"):  # a table {name = ..., parameters}; "hydrodynamic": a HydrodynamicBearing
+            if isinstance(out.get(key), dict):
+                out[key] = law_from_table(out[key])
         key = "friction"
         if isinstance(out.get("friction"), dict):
-            out["friction"] = _law(out["friction"], friction_law)
+            params = dict(out["friction"])
+            out["friction"] = friction_law(params.pop("name", None), **params)
     except (TypeError, ValueError, SceneError) as exc:
         raise SceneError(f"key {key}: {exc}") from None
     return out
@@ -196,25 +173,15 @@ def _array_of_tables(path: Path, data: dict[str, Any], table: str) -> list[dict[
     return value
 
 
+#: The TOML names of value types, for messages (bool before int: True is an int).
+TOML_TYPES: tuple[tuple[type | tuple[type, ...], str], ...] = (
+    (bool, "boolean"), ((int, float), "number"), (str, "string"), (list, "array"), (dict, "table"))
+
+
 def _a(value: Any) -> str:
     """'a number', 'an array', ...: the TOML type of a value with its article."""
-    kind = _toml_type(value)
+    kind = next((name for types, name in TOML_TYPES if isinstance(value, types)), type(value).__name__)
     return f"an {kind}" if kind[0] in "aeiou" else f"a {kind}"
-
-
-def _toml_type(value: Any) -> str:
-    """The TOML name of a value's type, for messages."""
-    if isinstance(value, bool):
-        return "boolean"
-    if isinstance(value, (int, float)):
-        return "number"
-    if isinstance(value, str):
-        return "string"
-    if isinstance(value, list):
-        return "array"
-    if isinstance(value, dict):
-        return "table"
-    return type(value).__name__
 
 
 def _element(path: Path, table: str, index: int, cls: type, entry: dict[str, Any]) -> Any:
@@ -268,24 +235,21 @@ def check_simulate(simulate: dict[str, Any], *, where: str) -> dict[str, Any]:
     """The [simulate] table checked by the rules simulate() applies (daeclear.options), none ignored:
     ``t_end = 0`` or ``t_eval_step = 0`` are errors, not "use the default"."""
     out = dict(simulate)
-    if "t_end" in out:
-        out["t_end"] = options.t_end(out["t_end"], where=where)
-    if "rtol" in out:
-        out["rtol"] = options.rtol(out["rtol"], where=where)
-    if "atol" in out:
-        atol = options.atol(out["atol"], where=where)
-        out["atol"] = atol if atol is None or isinstance(atol, (float, dict)) else atol.tolist()
-    if "max_step" in out:
-        out["max_step"] = options.max_step(out["max_step"], where=where)
+    for key, rule in (("t_end", options.t_end), ("rtol", options.rtol), ("atol", options.atol),
+                      ("max_step", options.max_step)):
+        if key in out:
+            out[key] = rule(out[key], where=where)
+    if out.get("atol") is not None and not isinstance(out["atol"], (float, dict)):  # an array: a list
+        out["atol"] = out["atol"].tolist()
     if "step" in out:  # the fixed step of method = "rk4" / "euler" (simulate refuses it with the others)
         out["step"] = options.step(out["step"], where=where)
         options.step_within(out["step"], 0.0, out.get("t_end", math.inf), where=where)
     if "allow_penetration" in out:
         out["allow_penetration"] = options.flag(out["allow_penetration"], where=where, field="allow_penetration")
-    for key, rule in (("method", options.method), ("formulation", options.formulation),
-                      ("backend", options.backend), ("start", options.start)):
+    for key, name_rule in (("method", options.method), ("formulation", options.formulation),
+                           ("backend", options.backend), ("start", options.start)):
         if key in out:
-            out[key] = rule(out[key], where=where)
+            out[key] = name_rule(out[key], where=where)
     if "t_eval_step" in out:
         # against the file's t_end when it has one (the command line checks it again against the end it runs)
         end = out.get("t_end", math.inf)
