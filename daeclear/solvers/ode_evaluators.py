@@ -40,8 +40,8 @@ __all__ = ["FIXED_CHUNK", "FX_CANDIDATE", "FX_CHUNK", "FX_ERR", "FX_MAXSTEPS", "
 FIXED_CHUNK = 8192
 
 
-class Evaluator:
-    """Common interface of the compiled and the python evaluation of an OdeSpec."""
+class _Shared:
+    """What the compiled and the python evaluation of an OdeSpec share."""
 
     backend = "?"
 
@@ -55,46 +55,8 @@ class Evaluator:
         #: what compiled the model (None for the python evaluation)
         self.build: BuildResult | None = None
 
-    # the interface both evaluations implement (declared here so that callers type-check against it)
-    def set_terms(self, active: Sequence[bool], params: Sequence[NDArray]) -> None:
-        """Switch the optional force terms on/off and set their parameters."""
-        raise NotImplementedError
 
-    def rhs(self, t: float, x: NDArray) -> NDArray:
-        """Right-hand side dx/dt of the first-order ODE at (t, x)."""
-        raise NotImplementedError
-
-    def jac(self, t: float, x: NDArray) -> NDArray:
-        """Jacobian d(rhs)/dx at (t, x)."""
-        raise NotImplementedError
-
-    def gaps(self, t: float, x: NDArray) -> tuple[NDArray, NDArray] | None:
-        """Gaps and their rates at (t, x), None when the evaluation failed."""
-        raise NotImplementedError
-
-    def step(self, scheme: int, t: float, x: NDArray, h: float) -> NDArray | None:
-        """One step of length h of a fixed-step scheme, None when the evaluation failed."""
-        raise NotImplementedError
-
-    def batch(self, t: NDArray, X: NDArray) -> tuple[NDArray, NDArray]:
-        """State derivatives and multipliers at N points (t[i], X[i])."""
-        raise NotImplementedError
-
-    def fixed(self, scheme: int, t0: float, x0: NDArray, step: float, t_stop: float, max_steps: int,
-              rootdir: NDArray | None, hermite: bool) -> dict[str, Any]:
-        """The fixed-step loop up to t_stop, a full step buffer, a gap-crossing candidate or an error."""
-        raise NotImplementedError
-
-    def channels(self, model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> NDArray:
-        """Output channels (N, n_channels) at N points with one switch vector."""
-        raise NotImplementedError
-
-    def counters(self) -> dict[str, int]:
-        """Call counters of the evaluation."""
-        raise NotImplementedError
-
-
-class _CEvaluator(Evaluator):
+class _CEvaluator(_Shared):
     backend = "c"
 
     def __init__(self, spec: OdeSpec, clib: OdeLibrary, build: BuildResult) -> None:
@@ -239,7 +201,7 @@ class _Buffered:
         return [o.reshape(s[1], s[0]).T.copy() if min(s) > 1 else o.copy() for o, s in zip(self.outs, self.shapes)]
 
 
-class _PyEvaluator(Evaluator):
+class _PyEvaluator(_Shared):
     """The same model evaluated through casadi.FunctionBuffer and numpy (no compiler needed)."""
 
     backend = "python"
@@ -410,6 +372,13 @@ class _PyEvaluator(Evaluator):
 
     def counters(self) -> dict[str, int]:
         return dict(self.cnt)
+
+
+#: Either evaluation: set_terms (the active force terms and their parameters), rhs and jac (dx/dt and
+#: its Jacobian), gaps (gaps and rates, None on failure), step (one fixed step, None on failure), batch
+#: (dx/dt and multipliers at N points), fixed (the fixed-step loop up to t_stop, a full buffer, a
+#: crossing candidate or an error), channels (N points, one switch vector) and counters.
+Evaluator = _CEvaluator | _PyEvaluator
 
 
 def _model_channels(model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> NDArray:
