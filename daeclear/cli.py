@@ -179,12 +179,10 @@ def _run(args: argparse.Namespace) -> int:
         raise DaeclearError(f"run: {args.target!r} is neither a scene file nor a mechanism "
                             f"({', '.join(MECHANISMS)}).")
     # an option given is checked, never replaced by a default (--t-end 0 is an error, not "two revolutions")
+    t_end = sim.pop("t_end", None)
     if args.t_end is not None:
         t_end = options.t_end(args.t_end, where=where, field="--t-end")
-        sim.pop("t_end", None)
-    elif "t_end" in sim:
-        t_end = sim.pop("t_end")
-    else:  # two revolutions of the first driver; 24 ms (two at the chapter's 5000 rpm) without one or its speed
+    elif t_end is None:  # two revolutions of the first driver; 24 ms (two at the chapter's 5000 rpm) without one
         speed = abs(float(scene.drivers[0].speed or 0.0)) if scene.drivers else 0.0
         t_end = 4.0 * math.pi / speed if speed else 0.024
     rtol = options.rtol(args.rtol, where=where, field="--rtol") if args.rtol is not None else sim.pop("rtol", 1e-6)
@@ -208,13 +206,11 @@ def _run(args: argparse.Namespace) -> int:
         if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 <= lo < hi and lo < t_end):
             options.fail(where, "--window", tuple(args.window), f"T0 < T1 with 0 <= T0 < t_end={t_end:g} s", "s")
     # the command line and the file's [simulate] table as the call's solver settings and output
-    settings: dict[str, Any] = {"backend": args.backend}
+    settings: dict[str, Any] = {"backend": args.backend, **sim}
     if args.formulation:
-        sim["formulation"] = args.formulation
-    settings.update(sim)
+        settings["formulation"] = args.formulation
     h5 = args.out / f"{base}.h5"
-    # streamed: the file holds what was computed whatever stops the run (Ctrl-C, a failure,
-    # running out of memory), and the run's memory does not grow with its length
+    # streamed: the file holds what was computed whatever stops the run, in bounded memory
     output: dict[str, Any] = {"stream_to": h5, "keep_data": False}
     if step is not None:  # reported points on a grid; the steps are not kept (bounded memory)
         output.update(every=step, steps=False)
@@ -497,8 +493,7 @@ def _sweep(args: argparse.Namespace) -> int:
     if not args.out.parent.exists():
         check_directory(args.out.parent, "daeclear sweep OUT (its directory)")
     check_file(args.out, "daeclear sweep OUT", what="a sweep file (.h5)", example="sweep.h5")  # before any work
-    client = cluster = None
-    executor = None
+    client = cluster = executor = None
     if args.dask:
         try:
             from dask.distributed import Client, LocalCluster
@@ -511,8 +506,7 @@ def _sweep(args: argparse.Namespace) -> int:
         else:
             client = Client(args.dask)
         executor = client.get_executor()
-    twins: dict[str, bool | str] = {"auto": "auto", "always": True, "never": False}
-    twin = twins[args.twin]
+    twin = "auto" if args.twin == "auto" else args.twin == "always"
     try:
         result = sweep(args.out, grid or None, runs=points, mechanism=args.target, fixed=fixed,
                        channels=channels, keep=args.keep,

@@ -166,11 +166,9 @@ class _CEvaluator(_Shared):
         sw = np.zeros(max(n_sw, 1))
         sw[:switch.size] = switch
         out = np.empty((t.size, n_ch))
-        if n_ch == 0 or y.shape[1] != n_y or switch.size != n_sw:
-            return _model_channels(model, t, y, yp, switch)
-        if t.size and self.lib.dco_outputs(self.h, t.size, t.ctypes.data, y.ctypes.data, yp.ctypes.data,
-                                           sw.ctypes.data, out.ctypes.data):
-            return _model_channels(model, t, y, yp, switch)
+        if n_ch == 0 or y.shape[1] != n_y or switch.size != n_sw or (t.size and self.lib.dco_outputs(
+                self.h, t.size, t.ctypes.data, y.ctypes.data, yp.ctypes.data, sw.ctypes.data, out.ctypes.data)):
+            return _model_channels(model, t, y, yp, switch)  # no compiled outputs, or they failed
         return out
 
     def counters(self) -> dict[str, int]:
