@@ -385,9 +385,6 @@ def _write_study_tables(study: Any, out: Path) -> str:
     return text
 
 
-# --------------------------------------------------------------------------- daeclear sweep
-
-
 def _add_sweep_parser(sub: Any, epilog: str) -> None:
     sweep = sub.add_parser("sweep", help="classify the motion over a grid of parameters into one HDF5 file",
                            description="Run and classify (periodic, quasi-periodic, chaotic) one scene per parameter "
@@ -551,10 +548,6 @@ def _sweep(args: argparse.Namespace) -> int:
               "again).", file=sys.stderr)
         return 1
     return 0
-
-
-
-# --------------------------------------------------------------------------- daeclear animate
 
 
 def _add_animate_parser(sub: Any) -> None:

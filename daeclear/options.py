@@ -99,9 +99,6 @@ def choice(value: Any, allowed: Sequence[str], *, where: str, field: str) -> str
     return text  # type: ignore[return-value]
 
 
-# --------------------------------------------------------------------------- the run options
-
-
 def t_end(value: Any, *, where: str = "simulate", field: str = "t_end") -> float:
     """End time of a run: a finite number > 0, s."""
     return number(value, where=where, field=field, unit="s", low=0.0)
@@ -324,9 +321,6 @@ def linear_solver(value: Any, *, where: str = "simulate", field: str = "linear_s
 def start(value: Any, *, where: str = "simulate", field: str = "start") -> str:
     """How a run starts (case-insensitive), see :data:`STARTS`."""
     return choice(value, STARTS, where=where, field=field)
-
-
-# --------------------------------------------------------------------------- studies and sweeps
 
 
 def repeats(value: Any, *, where: str = "work_precision", field: str = "repeats") -> int:

@@ -29,7 +29,6 @@ def _clock(seconds: float) -> str:
     return f"{seconds // 3600}:{seconds // 60 % 60:02d}:{seconds % 60:02d}"
 
 
-
 def is_terminal(stream: Any) -> bool:
     """Whether ``stream`` is an interactive terminal (False when it cannot say)."""
     try:
@@ -55,14 +54,12 @@ class Progress:
         self.note = ""
         self.closed = not enabled
         self.start = time.perf_counter()
-        self.bar: Any = None
         self._next = 0.0  # plain: the fraction of the total at which the next line is due
         self._last_line = self.start
         self._step = (total / TTY_STEPS) if total > 0 else 0.0  # terminal: the smallest change drawn
         self._drawn: float = -1.0
         self._shown: tuple[float, str] | None = None  # plain: the last line's work and note
-        if enabled and is_terminal(self.stream):
-            self.bar = _bar(total, unit, desc, self.stream)
+        self.bar: Any = _bar(total, unit, desc, self.stream) if enabled and is_terminal(self.stream) else None
 
     @property
     def mode(self) -> str:

@@ -195,11 +195,8 @@ def _event_in_step(run: Run, solver: Any, watch: _Watch, t_prev: float, t1: floa
         return "failed", None
     g0, gd0, (g1, gd1) = watch.g, watch.gd, gg
     h = t1 - t_prev
-    cands = []
-    for i, d in watch.watched:
-        s = candidate(d * g0[i], d * gd0[i], d * g1[i], d * gd1[i], h, HERMITE_GAP_CHECK)
-        if s > 0.0:
-            cands.append((i, d, s))
+    cands = [(i, d, s) for i, d in watch.watched
+             if (s := candidate(d * g0[i], d * gd0[i], d * g1[i], d * gd1[i], h, HERMITE_GAP_CHECK)) > 0.0]
     sol = None
     if cands:
         sol = solver.dense_output()
@@ -212,11 +209,10 @@ def _event_in_step(run: Run, solver: Any, watch: _Watch, t_prev: float, t1: floa
             run.fail(t_prev, found, _SCIPY_HINT)
             return "failed", sol
         if found is not None:
-            t_ev, x_ev, roots = found
-            te = run.pending_upto(t_ev)
+            te = run.pending_upto(found[0])
             if te.size:
                 run.add_evals(te, np.atleast_2d(np.array(sol(te), dtype=float).T))
-            return (t_ev, x_ev, roots), sol
+            return found, sol
     watch.g, watch.gd = g1, gd1
     return "none", sol
 
@@ -285,9 +281,8 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
                 run.add_steps(np.array([tb]), xb[None, :])
                 t, x = tb, xb
                 continue
-            t_ev, x_ev, roots = found
-            run.add_steps(np.array([t_ev]), x_ev[None, :])
-            restart = (t_ev, x_ev, roots)
+            run.add_steps(np.array([found[0]]), found[1][None, :])
+            restart = found
             break
         if not _end_segment(run, restart, True):
             return

@@ -91,7 +91,6 @@ class Run:
         self.step: float | None = None  # the fixed step (rk4, euler)
         self.missed: list[tuple[float, float, str]] = []  # steps over which a gap changed sign, no event
 
-    # ---------------------------------------------------------------- segments
     def set_state(self, state: contact_state.ContactState) -> None:
         """Take the run's new contact state, and the terms and modes that follow from it."""
         self.state = state
@@ -163,8 +162,7 @@ class Run:
                 Xd = ev.batch(T, X)[0]
                 seg.et.append(te)
                 seg.ex.append(_hermite(T, X, Xd, te))
-        # recorded steps: every step (the first segment also its start point, with h = 0, as
-        # IDA's results); with store_steps=False only the start point of the run
+        # recorded steps: every step (the first segment's start too, h = 0); store_steps=False: the start only
         if seg.include_start:
             kt, kx, kh = T, X, np.concatenate([[0.0], np.diff(T)])
         else:
@@ -196,7 +194,6 @@ class Run:
         self._handed = len(self.events)
         self.rec.flush()
 
-    # ---------------------------------------------------------------- events
     def dae_rows(self, t: NDArray, X: NDArray) -> tuple[NDArray, NDArray]:
         """(y, yp) rows of the DAE at ODE states X (rows (q, v)), with the evaluator's current terms."""
         Xd, Lam = self.ev.batch(t, X)
@@ -245,12 +242,10 @@ class Run:
     def _progress(self, t: float) -> None:
         self.bar.update(t, f"events {len(self.events)}")
 
-    # ---------------------------------------------------------------- result
     def result(self, setup_time: float, solve_time: float) -> Result:
         self.hand_over(self.seg)  # a segment left open by a failure at its start has no output points
         self.seg = None
-        stats: dict[str, Any] = {"n_steps": self.n_steps}
-        stats.update(self.ev.counters())
+        stats: dict[str, Any] = {"n_steps": self.n_steps, **self.ev.counters()}
         stats.pop("n_fixed_steps", None)
         if self.method in ("radau", "bdf"):
             stats["n_lu"] = self.n_lu
