@@ -21,16 +21,17 @@ segment watches every gap in the direction the contact state gives, ``contact_st
 modes at a crossing, and the integrator restarts from the event with fresh history, the state (q, v)
 kept. A step may hold a crossing of G = direction * g from <= 0 to > 0 when G changed sign over it,
 or when the cubic Hermite interpolant of G has an interior maximum above zero (a quick re-contact
-within one step, confirmed on the scheme's own state); the crossing is bracketed by Illinois regula
-falsi down to IDA's root tolerance (:mod:`~daeclear.solvers.ode_crossings`). The state at the event
-comes from the dense output (scipy) or a re-step from the step's start (rk4, euler: event times are
-not quantised to the step).
+within one step, confirmed on the scheme's own state; one the cubic does not predict is still missed);
+the crossing is bracketed by Illinois regula falsi down to IDA's root tolerance
+(:mod:`~daeclear.solvers.ode_crossings`). The state at the event comes from the dense output (scipy)
+or a re-step from the step's start (rk4, euler: event times are not quantised to the step).
 
 Output: every accepted step and event point, or (``SaveAt.times``/``every``) dense output / cubic
-Hermite interpolation; multipliers and accelerations are recomputed at the output points. A run
-fails (``success=False``, a message saying when, which pairs were in contact and why) on the
-scheme's own failure, a non-finite state, a step-size collapse (:mod:`daeclear.engine.stall_guard`),
-``max_steps`` steps, or ``STALL_EVENTS`` events at the same time.
+Hermite interpolation; multipliers and accelerations are recomputed at the output points. Statistics
+as IDA's (``n_res_evals``: scheme stages and event re-steps; ``n_lu``: Radau, BDF). A run fails
+(``success=False``, a message saying when, which pairs were in contact and why) on the scheme's own
+failure, a non-finite state, a step-size collapse (:mod:`daeclear.engine.stall_guard`), ``max_steps``
+steps, or ``STALL_EVENTS`` events at the same time.
 """
 
 from __future__ import annotations
