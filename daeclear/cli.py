@@ -62,8 +62,7 @@ def _mechanism_keys(argv: Sequence[str]) -> str | None:
     if argv[1] not in MECHANISMS:
         return None
     lines = [f"--set keys of {argv[1]} (KEY=VALUE, a Python literal; default in brackets):"]
-    for name, default, text in option_table(MECHANISMS[argv[1]]):
-        lines.append(f"  --set {name}=...  [{default}]  {text}")
+    lines += [f"  --set {name}=...  [{default}]  {text}" for name, default, text in option_table(MECHANISMS[argv[1]])]
     return "\n".join(lines)
 
 

@@ -68,9 +68,7 @@ def number(value: Any, *, where: str, field: str, unit: str = "", low: float | N
     if ok and high is not None:
         ok = float(value) <= high
     if not ok:
-        parts = []
-        if low is not None:
-            parts.append(f"{'>' if low_open else '>='} {low:g}")
+        parts = [f"{'>' if low_open else '>='} {low:g}"] if low is not None else []
         if high is not None:
             parts.append(f"<= {high:g}")
         fail(where, field, value, "a finite number" + (" " + " and ".join(parts) if parts else ""), unit)

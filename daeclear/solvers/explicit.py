@@ -95,10 +95,9 @@ def _run_scipy(run: Run, x0: NDArray, rtol: float, atol: NDArray, max_step: floa
             return
         lu0 = getattr(solver, "nlu", 0)
         t_last, restart = _scipy_segment(run, solver, watch, t)
-        seg = run.seg
-        assert seg is not None
-        seg.t1 = t_last if restart is None else restart[0]
-        run.t_last = seg.t1
+        run.t_last = t_last if restart is None else restart[0]
+        assert run.seg is not None
+        run.seg.t1 = run.t_last
         run.n_lu += getattr(solver, "nlu", 0) - lu0
         if not _end_segment(run, restart, False):
             return
@@ -119,7 +118,7 @@ class _Watch:
     @classmethod
     def start(cls, run: Run, t: float, x: NDArray) -> _Watch | None:
         """The watch at the segment's start; None (the run failed) when the gaps cannot be evaluated."""
-        dirs = run.directions()
+        dirs = contact_state.root_directions(run.model, run.state)
         if dirs is None:
             return cls(None, np.empty(0), np.empty(0))  # g and gd are read only when enabled
         gg = run.ev.gaps(t, x)
@@ -238,7 +237,7 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
     t, x = t0, x0
     while True:
         run.open_segment(t, x)
-        dirs = run.directions()
+        dirs = contact_state.root_directions(run.model, run.state)
         restart: tuple[float, NDArray, Any] | None = None
         while True:
             left = run.max_steps - run.n_steps
@@ -246,9 +245,8 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
                 run.fail(t, f"max_steps={run.max_steps} steps reached", "Raise max_steps or use a larger step.")
                 break
             out = ev.fixed(scheme, t, x, step, t_end, left, dirs, HERMITE_GAP_CHECK)
-            st, sx = out["st"], out["sx"]
-            run.n_steps += st.size
-            run.add_steps(st, sx)
+            run.n_steps += out["st"].size
+            run.add_steps(out["st"], out["sx"])
             t, x = out["ta"], out["xa"]
             status = out["status"]
             if status == FX_TSTOP:
@@ -269,12 +267,11 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
             if gg_a is None or gg_b is None:
                 run.fail(t, ev.last_message, hint)
                 break
-            ta, xa = t, x
 
-            def restep(tt: float, ta: float = ta, xa: NDArray = xa) -> NDArray | None:
+            def restep(tt: float, ta: float = t, xa: NDArray = x) -> NDArray | None:
                 return ev.step(scheme, ta, xa, tt - ta)
 
-            found = locate(ev, restep, ta, gg_a, tb, xb, gg_b, cands, ev.ng)
+            found = locate(ev, restep, t, gg_a, tb, xb, gg_b, cands, ev.ng)
             if isinstance(found, str):
                 run.fail(t, found, hint)
                 break
@@ -365,8 +362,7 @@ def _integrate(solver: ODESolver, scene: Scene | DAEModel, t_end: float, t0: flo
                    stream_to=out.stream_to, keep_data=out.keep_data)
     run = Run(model, ev, method_l, t_end, eval_times, out.steps, progress, settings.max_steps, rec)
     run.y0, run.step = (y0 if start == "declared" and not from_state else None), step  # declared starts only
-    run.from_state = from_state
-    run.t_last = t0
+    run.from_state, run.t_last = from_state, t0
     run.set_state(contact_state.start_state(model, t0, y0))
     setup_time = time.perf_counter() - setup_start
     tic = time.perf_counter()

@@ -7,7 +7,6 @@ history. The segment loop itself is :class:`daeclear.solvers.ida_loop.SegmentLoo
 
 from __future__ import annotations
 
-import logging
 import time
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -28,8 +27,7 @@ if TYPE_CHECKING:
     from ..save_at import Output
     from ..solver_options import SolverOptions
 
-log = logging.getLogger("daeclear")
-DRIFT_FRACTION = physics.DRIFT_FRACTION
+DRIFT_FRACTION = physics.DRIFT_FRACTION  # physics' limit, named here too
 # IDA's settings (docs/engine.md): GGL's Newton test coefficient (IDA's default 0.33; the python backend
 # cannot set it), a new Jacobian when cj = alpha / h changed by JACOBIAN_REFRESH (IDA's own 0.25, which
 # costs contact runs stale-matrix failures), and for GGL the compiled driver's second-order first step.

@@ -46,10 +46,8 @@ class _Shared:
     backend = "?"
 
     def __init__(self, spec: OdeSpec) -> None:
-        self.n, self.m = spec.n, spec.m
-        self.nx = 2 * spec.n
-        self.nt = len(spec.term_force)
-        self.ng = spec.n_gaps
+        self.n, self.m, self.nx = spec.n, spec.m, 2 * spec.n
+        self.nt, self.ng = len(spec.term_force), spec.n_gaps
         self.poff = np.concatenate([[0], np.cumsum(spec.n_params)]).astype(int)
         self.last_message = ""
         #: what compiled the model (None for the python evaluation)
@@ -127,8 +125,7 @@ class _CEvaluator(_Shared):
         return self._xout.copy()
 
     def batch(self, t: NDArray, X: NDArray) -> tuple[NDArray, NDArray]:
-        t = np.ascontiguousarray(t, dtype=float)
-        X = np.ascontiguousarray(X, dtype=float)
+        t, X = (np.ascontiguousarray(a, dtype=float) for a in (t, X))
         N = t.size
         Xd = np.empty((N, self.nx))
         Lam = np.empty((N, max(self.m, 1)))
@@ -160,9 +157,7 @@ class _CEvaluator(_Shared):
         sizes = [ctypes.c_int() for _ in range(3)]
         self.lib.dco_output_sizes(*(ctypes.addressof(c) for c in sizes))
         n_y, n_sw, n_ch = (c.value for c in sizes)
-        t = np.ascontiguousarray(t, dtype=float)
-        y = np.ascontiguousarray(y, dtype=float)
-        yp = np.ascontiguousarray(yp, dtype=float)
+        t, y, yp = (np.ascontiguousarray(a, dtype=float) for a in (t, y, yp))
         sw = np.zeros(max(n_sw, 1))
         sw[:switch.size] = switch
         out = np.empty((t.size, n_ch))

@@ -68,8 +68,7 @@ class Run:
         self.model, self.ev, self.method, self.t_end = model, ev, method, t_end
         self.rec = rec  # where each closed segment's output goes (kept, or streamed to a file)
         self._handed = 0  # events handed to rec so far
-        self.eval_times = eval_times
-        self.pending = eval_times
+        self.eval_times = self.pending = eval_times
         self.store_steps = store_steps
         self.max_steps = max_steps
         self.progress = progress
@@ -97,19 +96,15 @@ class Run:
         self.active, self.params = contact_state.switches(self.model, state)
         self.modes = contact_state.modes(self.model, state)
 
-    def directions(self) -> NDArray | None:
-        return contact_state.root_directions(self.model, self.state)
-
     def open_segment(self, t0: float, x0: NDArray) -> None:
         self.ev.set_terms(self.active, self.params)
         self.seg = Segment(t0, np.array(x0, dtype=float), list(self.active), [p.copy() for p in self.params],
-                            dict(self.modes), include_start=not self.n_segments)
+                            dict(self.modes), include_start=not self.n_segments, t1=t0)
         self.n_segments += 1
         if self.seg.include_start and self.pending is not None and self.pending.size and self.pending[0] <= t0:
             self.seg.et.append(self.pending[:1].copy())
             self.seg.ex.append(self.seg.x0[None, :].copy())
             self.pending = self.pending[1:]
-        self.seg.t1 = t0
         self.t_last = t0
 
     def add_steps(self, t: NDArray, X: NDArray) -> None:

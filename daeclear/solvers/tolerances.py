@@ -125,10 +125,8 @@ def tolerance_vector(model: DAEModel, rtol: float, atol: float | Mapping[str, fl
     quantities = state_quantities(model)
     mine = scales(model)
     defaults = mine.default_atol(rtol, newton=newton)
-    if atol is None:
-        vec[:n] = [defaults[k] for k in quantities]
-    elif isinstance(atol, Mapping):
-        given = {**defaults, **atol_by_quantity(atol, where="simulate", field="atol")}
+    if atol is None or isinstance(atol, Mapping):  # a mapping: the quantities it does not name keep their defaults
+        given = defaults if atol is None else {**defaults, **atol_by_quantity(atol, where="simulate", field="atol")}
         vec[:n] = [given[k] for k in quantities]
     elif np.ndim(atol) == 0:
         value = float(atol)  # type: ignore[arg-type]
