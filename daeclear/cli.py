@@ -10,21 +10,18 @@ import sys
 import warnings
 from pathlib import Path
 from typing import Any
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from .errors import DaeclearError, DiskFull, Interrupted, PhysicsWarning, SolveError
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by Ctrl-C
-#: ``daeclear run`` reports at most CLI_POINTS + 1 points by default (a run of any length stays
-#: affordable: memory and file) ...
+#: ``daeclear run`` reports at most CLI_POINTS + 1 points by default, spaced no finer than
+#: CLI_FINEST_STEP (s: each impact's peak force within 0.5 % of a grid 8 times finer).
 CLI_POINTS = 100_000
-#: ... spaced no finer than this (s): the chapter's two revolutions get 12 001 points, 2 us apart
-#: (each impact's peak force within 0.5 % of a grid 8 times finer; tests/test_streaming.py).
 CLI_FINEST_STEP = 2e-6
 #: ``daeclear run`` shows (summary, figure) at most this many of the last events of a run (the file has all).
 CLI_SHOWN_EVENTS = 20_000
-#: ``daeclear run``'s figure draws at most this many points a curve: min-max per bucket (two points a pixel
-#: column of a 1000-pixel-wide axes), so an impact's peak survives in a long run's figure.
+#: ``daeclear run``'s figure draws at most this many points a curve (min-max per bucket: peaks survive).
 CLI_FIGURE_POINTS = 2000
 #: ``daeclear run``'s default step cap per simulated second (see default_max_steps).
 CLI_STEPS_PER_SECOND = 2_000_000
@@ -65,8 +62,7 @@ def _mechanism_keys(argv: Sequence[str]) -> str | None:
     if argv[1] not in MECHANISMS:
         return None
     lines = [f"--set keys of {argv[1]} (KEY=VALUE, a Python literal; default in brackets):"]
-    for name, default, text in option_table(MECHANISMS[argv[1]]):
-        lines.append(f"  --set {name}=...  [{default}]  {text}")
+    lines += [f"  --set {name}=...  [{default}]  {text}" for name, default, text in option_table(MECHANISMS[argv[1]])]
     return "\n".join(lines)
 
 
@@ -182,12 +178,10 @@ def _run(args: argparse.Namespace) -> int:
         raise DaeclearError(f"run: {args.target!r} is neither a scene file nor a mechanism "
                             f"({', '.join(MECHANISMS)}).")
     # an option given is checked, never replaced by a default (--t-end 0 is an error, not "two revolutions")
+    t_end = sim.pop("t_end", None)
     if args.t_end is not None:
         t_end = options.t_end(args.t_end, where=where, field="--t-end")
-        sim.pop("t_end", None)
-    elif "t_end" in sim:
-        t_end = sim.pop("t_end")
-    else:  # two revolutions of the first driver; 24 ms (two at the chapter's 5000 rpm) without one or its speed
+    elif t_end is None:  # two revolutions of the first driver; 24 ms (two at the chapter's 5000 rpm) without one
         speed = abs(float(scene.drivers[0].speed or 0.0)) if scene.drivers else 0.0
         t_end = 4.0 * math.pi / speed if speed else 0.024
     rtol = options.rtol(args.rtol, where=where, field="--rtol") if args.rtol is not None else sim.pop("rtol", 1e-6)
@@ -211,13 +205,11 @@ def _run(args: argparse.Namespace) -> int:
         if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 <= lo < hi and lo < t_end):
             options.fail(where, "--window", tuple(args.window), f"T0 < T1 with 0 <= T0 < t_end={t_end:g} s", "s")
     # the command line and the file's [simulate] table as the call's solver settings and output
-    settings: dict[str, Any] = {"backend": args.backend}
+    settings: dict[str, Any] = {"backend": args.backend, **sim}
     if args.formulation:
-        sim["formulation"] = args.formulation
-    settings.update(sim)
+        settings["formulation"] = args.formulation
     h5 = args.out / f"{base}.h5"
-    # streamed: the file holds what was computed whatever stops the run (Ctrl-C, a failure,
-    # running out of memory), and the run's memory does not grow with its length
+    # streamed: the file holds what was computed whatever stops the run, in bounded memory
     output: dict[str, Any] = {"stream_to": h5, "keep_data": False}
     if step is not None:  # reported points on a grid; the steps are not kept (bounded memory)
         output.update(every=step, steps=False)
@@ -247,7 +239,8 @@ def _run(args: argparse.Namespace) -> int:
         print(f"(the summary above and the figure show t >= {shown_from:.6g} s, the last {CLI_SHOWN_EVENTS} "
               f"of {outcome.stats['n_events']} events; the whole run is in the file)")
     print(f"wrote {h5}")
-    _print_physics_warnings(result)
+    for rec in result.warnings:  # also in the HDF5 file
+        print(f"daeclear: warning: {rec['kind']}: {rec['message']}", file=sys.stderr)
     try:
         _run_figure(args, result, scene, reference_scene, t_end, rtol, base)
     except KeyboardInterrupt:  # the result is saved already; only the figure is missing
@@ -262,27 +255,26 @@ def _run(args: argparse.Namespace) -> int:
 def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_scene: Any, t_end: float, rtol: float,
                 base: str) -> None:
     """The response figure of ``daeclear run`` (against the ideal joint when there is one)."""
+    if args.no_figure:
+        return
     from .save_at import SaveAt
     from .solver_options import SolverOptions
     from .solvers.dispatch import simulate
-
-    if not args.no_figure:
-        import matplotlib
-        matplotlib.use("Agg")
-        from .plot import save_run_figure
-        reference = None
-        if reference_scene is not None:  # on the run's own output grid: bounded, as the run
-            every_step = result.step_t is not None and result.step_t.size == result.n_times
-            grid = None if every_step or not result.n_times else SaveAt(times=result.t, steps=False)
-            try:
-                reference = simulate(reference_scene, t_end, rtol=rtol, on_failure="return",
-                                     options=SolverOptions(backend=args.backend), save=grid)
-            except DaeclearError as exc:  # e.g. an ideal mechanism with redundant constraints: no dashed lines
-                print(f"daeclear: no ideal-mechanism reference in the figure: {exc}", file=sys.stderr)
-        # time plots chosen from what the scene holds, a journal orbit or slider path per clearance joint
-        png = save_run_figure(result, args.out / f"{base}.png", reference=reference,
-                              window=tuple(args.window) if args.window else None, max_points=CLI_FIGURE_POINTS)
-        print(f"wrote {png}")
+    import matplotlib
+    matplotlib.use("Agg")
+    from .plot import save_run_figure
+    reference = None
+    if reference_scene is not None:  # on the run's own output grid: bounded, as the run
+        every_step = result.step_t is not None and result.step_t.size == result.n_times
+        grid = None if every_step or not result.n_times else SaveAt(times=result.t, steps=False)
+        try:
+            reference = simulate(reference_scene, t_end, rtol=rtol, on_failure="return",
+                                 options=SolverOptions(backend=args.backend), save=grid)
+        except DaeclearError as exc:  # e.g. an ideal mechanism with redundant constraints: no dashed lines
+            print(f"daeclear: no ideal-mechanism reference in the figure: {exc}", file=sys.stderr)
+    png = save_run_figure(result, args.out / f"{base}.png", reference=reference,
+                          window=tuple(args.window) if args.window else None, max_points=CLI_FIGURE_POINTS)
+    print(f"wrote {png}")
 
 
 def _read_back(h5: Path) -> tuple[float | None, Any]:
@@ -356,16 +348,9 @@ def _study(args: argparse.Namespace) -> int:
             print("daeclear: interrupted before the first study run finished; nothing saved", file=sys.stderr)
         return EXIT_INTERRUPTED
     text = _write_study_tables(study, args.out)
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from .plot import plot_work_precision
-    fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    plot_work_precision(study, ax=ax)
-    fig.tight_layout()
-    fig.savefig(args.out / "work_precision.png", dpi=120)
-    plt.close(fig)
+
+    _save_figure(args.out / "work_precision.png", (6.5, 4.5), plot_work_precision, study)
     print(text)
     others = [label for label in methods if label.lower() != "ida"]
     for row in study.speed_ratio("ida", others) if "ida" in methods else []:
@@ -373,6 +358,19 @@ def _study(args: argparse.Namespace) -> int:
               f"equal or better accuracy: {row['rival']} ({row['rival_wall_time']:.4f} s): ratio {row['ratio']:.1f}")
     print(f"wrote {args.out / 'work_precision.csv'}, .md and .png")
     return 0
+
+
+def _save_figure(png: Path, size: tuple[float, float], plot: Callable[..., Any], *args: Any, **kwargs: Any) -> None:
+    """One figure of ``size`` inches drawn by ``plot(*args, ax=ax, **kwargs)``, saved to ``png`` at 120 dpi."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=size)
+    plot(*args, ax=ax, **kwargs)
+    fig.tight_layout()
+    fig.savefig(png, dpi=120)
+    plt.close(fig)
 
 
 def _write_study_tables(study: Any, out: Path) -> str:
@@ -384,9 +382,6 @@ def _write_study_tables(study: Any, out: Path) -> str:
         atomic_write_text(out / "work_precision.csv", study.to_csv())
         atomic_write_text(out / "work_precision.md", text)
     return text
-
-
-# --------------------------------------------------------------------------- daeclear sweep
 
 
 def _add_sweep_parser(sub: Any, epilog: str) -> None:
@@ -494,8 +489,7 @@ def _sweep(args: argparse.Namespace) -> int:
     if not args.out.parent.exists():
         check_directory(args.out.parent, "daeclear sweep OUT (its directory)")
     check_file(args.out, "daeclear sweep OUT", what="a sweep file (.h5)", example="sweep.h5")  # before any work
-    client = cluster = None
-    executor = None
+    client = cluster = executor = None
     if args.dask:
         try:
             from dask.distributed import Client, LocalCluster
@@ -508,8 +502,7 @@ def _sweep(args: argparse.Namespace) -> int:
         else:
             client = Client(args.dask)
         executor = client.get_executor()
-    twins: dict[str, bool | str] = {"auto": "auto", "always": True, "never": False}
-    twin = twins[args.twin]
+    twin = "auto" if args.twin == "auto" else args.twin == "always"
     try:
         result = sweep(args.out, grid or None, runs=points, mechanism=args.target, fixed=fixed,
                        channels=channels, keep=args.keep,
@@ -540,36 +533,20 @@ def _sweep(args: argparse.Namespace) -> int:
     numeric = [n for n in names if all(isinstance(r.parameters.get(n), (int, float))
                                        and not isinstance(r.parameters.get(n), bool) for r in result.runs)]
     if not args.no_figure and result.runs and 1 <= len(names) <= 2:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         from .plot import plot_bifurcation, plot_motion_map
-        fig, ax = plt.subplots(figsize=(7.0, 4.5))
+
         if len(names) == 1 and numeric:
-            plot_bifurcation(result, names[0], ax=ax, title=True)
             png = args.out.with_name(args.out.stem + "_bifurcation.png")
+            _save_figure(png, (7.0, 4.5), plot_bifurcation, result, names[0], title=True)
         else:
-            plot_motion_map(result, names[0], names[-1], ax=ax, title=True)
             png = args.out.with_name(args.out.stem + "_motion_map.png")
-        fig.tight_layout()
-        fig.savefig(png, dpi=120)
-        plt.close(fig)
+            _save_figure(png, (7.0, 4.5), plot_motion_map, result, names[0], names[-1], title=True)
         print(f"wrote {png}")
     if result.failed:
         print(f"daeclear: {len(result.failed)} run(s) failed (recorded in {args.out}; --retry-failed runs them "
               "again).", file=sys.stderr)
         return 1
     return 0
-
-
-def _print_physics_warnings(result: Any) -> None:
-    """The run's physics warnings (``result.warnings``, also in its HDF5 file), one line each on stderr."""
-    for rec in result.warnings:
-        print(f"daeclear: warning: {rec['kind']}: {rec['message']}", file=sys.stderr)
-
-
-# --------------------------------------------------------------------------- daeclear animate
 
 
 def _add_animate_parser(sub: Any) -> None:

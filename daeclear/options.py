@@ -1,11 +1,8 @@
 """One validation rule per run option, shared by every entry (Python API, command line, scene files).
 
-Each function checks one option and returns its normalised value, or raises :class:`SceneError`
-with one message shape everywhere: ``<where>: <field>=<value> [unit], must be <rule>.``. ``where``
-names the entry (``simulate``, ``daeclear run``, ``<file>: [simulate]``) and ``field`` the option
-as the user wrote it there (``t_end``, ``--t-end``), so the same mistake gets the same rule
-wherever it is made. Nothing is silently replaced: a zero, a NaN or a value of the wrong type is
-an error, never "use the default".
+Each function returns the option's normalised value or raises :class:`SceneError` shaped
+``<where>: <field>=<value> [unit], must be <rule>.`` (``where``: the entry, ``field``: the option as
+the user wrote it there). Nothing is silently replaced: a zero or NaN is an error, never the default.
 """
 
 from __future__ import annotations
@@ -22,29 +19,22 @@ from .errors import SceneError
 
 METHODS: tuple[str, ...] = ("ida", "rk45", "dop853", "radau", "bdf", "lsoda", "rk4", "euler")
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
-#: The default formulation: GGL (stabilised index 2) holds the joints closed to Newton's tolerance,
-#: so contact times converge with rtol at any clearance; index-1 Baumgarte drifts by more than a
-#: 0.01 mm clearance over 10 revolutions at rtol 1e-6 and its first contact onset stays about 1e-6
-#: (relative) off at every rtol from 1e-6 to 1e-9 (docs/engine.md, benchmarks/bench_formulation.py).
+#: GGL (stabilised index 2) holds the joints closed to Newton's tolerance, so contact times converge
+#: with rtol at any clearance; index-1 Baumgarte drifts (docs/engine.md).
 DEFAULT_FORMULATION = "ggl"
-#: The chapter's formulation (Tables 4.2 and 4.3: index-1 with Baumgarte alpha = beta = 5): what the
-#: chapter's reproductions use, and the only one the non-IDA methods integrate.
+#: The chapter's (Tables 4.2, 4.3: index-1, Baumgarte alpha = beta = 5), the only one of the non-IDA methods.
 CHAPTER_FORMULATION = "index1"
 BACKENDS: tuple[str, ...] = ("auto", "c", "python")
 ON_FAILURE: tuple[str, ...] = ("raise", "return")
 LINEAR_SOLVERS: tuple[str, ...] = ("auto", "reduced", "dense", "sparse")
-#: How a run starts: "ideal" (the chapter's: clearance joints centred, positions and velocities
-#: assembled on the mechanism whose clearance joints are ideal) or "declared" (the bodies' own
-#: positions and velocities, corrected only for the ideal joints the scene has).
+#: How a run starts: "ideal" (the chapter's: clearance joints centred) or "declared" (the bodies' own
+#: state, corrected only for the ideal joints).
 STARTS: tuple[str, ...] = ("ideal", "declared")
 RTOL_RANGE: tuple[float, float] = (1e-14, 1e-2)
 
 
 def fail(where: str, field: str, value: Any, rule: str, unit: str = "", *, shown: str | None = None) -> NoReturn:
-    """Raise the one error shape of a bad option: where, field, value (unit) and the rule.
-
-    ``shown`` replaces ``repr(value)`` for values too long to repeat (arrays).
-    """
+    """Raise the one error shape of a bad option; ``shown`` replaces ``repr(value)`` (arrays)."""
     if isinstance(value, (np.floating, np.integer)):
         value = value.item()
     shown = shown if shown is not None else repr(value)
@@ -53,8 +43,7 @@ def fail(where: str, field: str, value: Any, rule: str, unit: str = "", *, shown
 
 
 def close_matches(name: str, candidates: Iterable[str], n: int = 5) -> list[str]:
-    """Up to `n` candidates similar to `name`, best first, ties in alphabetical order: the "close
-    matches" hint of a message about an unknown name (a channel, a state, a unit's channel)."""
+    """Up to `n` candidates similar to `name`, best first, ties alphabetical (the hint of a message)."""
     matcher = difflib.SequenceMatcher(b=name)
     scored = []
     for c in candidates:
@@ -79,9 +68,7 @@ def number(value: Any, *, where: str, field: str, unit: str = "", low: float | N
     if ok and high is not None:
         ok = float(value) <= high
     if not ok:
-        parts = []
-        if low is not None:
-            parts.append(f"{'>' if low_open else '>='} {low:g}")
+        parts = [f"{'>' if low_open else '>='} {low:g}"] if low is not None else []
         if high is not None:
             parts.append(f"<= {high:g}")
         fail(where, field, value, "a finite number" + (" " + " and ".join(parts) if parts else ""), unit)
@@ -110,9 +97,6 @@ def choice(value: Any, allowed: Sequence[str], *, where: str, field: str) -> str
     return text  # type: ignore[return-value]
 
 
-# --------------------------------------------------------------------------- the run options
-
-
 def t_end(value: Any, *, where: str = "simulate", field: str = "t_end") -> float:
     """End time of a run: a finite number > 0, s."""
     return number(value, where=where, field=field, unit="s", low=0.0)
@@ -127,8 +111,7 @@ def t0(value: Any, end: float, *, where: str = "simulate", field: str = "t0") ->
 
 
 def state(value: Any, size: int | None, *, where: str = "simulate", field: str = "y0") -> NDArray[np.float64]:
-    """A full state vector: ``size`` finite numbers (a row of ``result.y`` of the same model; None:
-    any length, checked again once the model, and so its size, is known)."""
+    """A full state vector: ``size`` finite numbers (None: any length, checked once the model is known)."""
     rule = (f"{size} finite numbers (a row of result.y of the same model: model.n_states = {size})" if size is not None
             else "finite numbers (a row of result.y of the same model)")
     try:
@@ -162,8 +145,8 @@ ATOL_GROUPS: dict[str, tuple[str, ...]] = {"q": ("position", "angle"), "v": ("ve
 
 def atol(value: Any, *, where: str = "simulate", field: str = "atol"
          ) -> float | dict[str, float] | NDArray[np.float64] | None:
-    """Absolute tolerance: None (default), a finite number > 0, a mapping by quantity (keys from
-    ATOL_GROUPS and ATOL_QUANTITIES, values finite numbers > 0) or finite values > 0 (per state)."""
+    """Absolute tolerance: None, a number > 0, a mapping by quantity (ATOL_GROUPS, ATOL_QUANTITIES) or
+    finite values > 0 (per state)."""
     if value is None:
         return None
     if is_real(value):
@@ -211,16 +194,14 @@ def step(value: Any, *, where: str = "simulate", field: str = "step") -> float:
 
 
 def step_within(value: float | None, t0: float, end: float, *, where: str = "simulate", field: str = "step") -> None:
-    """A fixed step (checked by :func:`step`) no longer than the run it steps over: a step past t_end
-    would take one stride over every contact of the run."""
+    """A fixed step no longer than the run (one stride would step over every contact)."""
     if value is not None and value > end - t0:
         fail(where, field, value, f"at most the run's length t_end - t0 = {end - t0:g} s (t_end={end:g} s)", "s")
 
 
 def t_eval(value: ArrayLike | None, end: float | None, *, where: str = "simulate",
            field: str = "t_eval", start: float = 0.0) -> NDArray[np.float64] | None:
-    """Output times: None, or finite, strictly increasing values in [t0, t_end] (NaN is an error, not a cut;
-    ``end`` None: any time >= ``start``, for a check made before the run's end is known)."""
+    """Output times: None, or finite, strictly increasing values in [start, end] (``end`` None: any)."""
     if value is None:
         return None
     low = '0' if start == 0 else f't0={start:g}'
@@ -236,8 +217,7 @@ def t_eval(value: ArrayLike | None, end: float | None, *, where: str = "simulate
     times = times.reshape(-1)
     if times.size == 0:
         fail(where, field, value, "at least one time: " + rule)
-    # the common case in one pass: in range and strictly increasing (so finite: a NaN or inf
-    # fails a comparison); anything else is looked at closely for the message
+    # the common case in one pass (a NaN or inf fails a comparison); anything else is looked at for the message
     if start <= times[0] and times[-1] <= top and times[-1] < math.inf and bool((times[1:] > times[:-1]).all()):
         return times
     bad = ~np.isfinite(times)
@@ -261,10 +241,8 @@ def t_eval_step(value: Any, end: float, *, where: str, field: str = "t_eval_step
     return number(value, where=where, field=field, unit="s", low=0.0, high=end)
 
 
-#: The most output points a run reports unless told otherwise (``SaveAt.max_points``,
-#: ``daeclear run --max-points``): about 1 GB of file (or memory) for the chapter's slider-crank
-#: with a revolute clearance joint (~1 KB a point), so that a mistyped spacing (1e-12 s) is refused
-#: with an estimate instead of filling a disk (docs/reliability.md).
+#: The most output points a run reports unless told otherwise (``SaveAt.max_points``): about 1 GB for
+#: the chapter's slider-crank, so a mistyped spacing is refused instead of filling a disk.
 MAX_OUTPUT_POINTS = 1_000_000
 
 
@@ -274,16 +252,13 @@ def max_output_points(value: Any, *, where: str = "simulate", field: str = "max_
 
 
 def uniform_times(spacing: float, end: float, start: float = 0.0) -> NDArray[np.float64]:
-    """Output times from ``start`` to ``end`` (both included), ``(end - start) / floor((end - start) / spacing)``
-    apart."""
+    """Output times from ``start`` to ``end`` (both included) in ``floor((end - start) / spacing)`` intervals."""
     return np.linspace(start, end, int(math.floor((end - start) / spacing)) + 1)
 
 
 class OutputTimes:
-    """The reported times of a run: given values, or the uniform grid of :func:`uniform_times` made
-    window by window (a long run on a fine grid never holds the whole grid: 8 bytes per point).
-
-    ``window(i, j)`` equals ``uniform_times(spacing, end)[i:j]`` value for value."""
+    """The reported times of a run: given values, or the grid of :func:`uniform_times` made window by
+    window (``window(i, j)`` equals ``uniform_times(spacing, end)[i:j]``)."""
 
     def __init__(self, values: NDArray[np.float64] | None = None, *, spacing: float = 0.0, end: float = 0.0,
                  start: float = 0.0) -> None:
@@ -319,9 +294,8 @@ def formulation(value: Any, *, where: str = "simulate", field: str = "formulatio
 
 
 def default_formulation(method_name: Any) -> str:
-    """The formulation used when none is given: :data:`DEFAULT_FORMULATION` for IDA, the chapter's
-    index-1 for the other methods (they integrate the index-1 ODE only); a solver class's own
-    ``formulation``."""
+    """The formulation used when none is given: IDA's :data:`DEFAULT_FORMULATION`, the chapter's for
+    the other methods, a solver class's own ``formulation``."""
     if isinstance(method_name, type):
         return str(getattr(method_name, "formulation", DEFAULT_FORMULATION))
     return DEFAULT_FORMULATION if str(method_name).lower() == "ida" else CHAPTER_FORMULATION
@@ -345,9 +319,6 @@ def linear_solver(value: Any, *, where: str = "simulate", field: str = "linear_s
 def start(value: Any, *, where: str = "simulate", field: str = "start") -> str:
     """How a run starts (case-insensitive), see :data:`STARTS`."""
     return choice(value, STARTS, where=where, field=field)
-
-
-# --------------------------------------------------------------------------- studies and sweeps
 
 
 def repeats(value: Any, *, where: str = "work_precision", field: str = "repeats") -> int:

@@ -1,9 +1,7 @@
 """The one progress display of daeclear: runs, sweeps and animations all report through it.
 
-On a terminal it is a tqdm bar (rewritten in place, with elapsed time and an estimate of the time
-left). Anywhere else (CI logs, pipes, files) it prints plain lines, rate-limited so that a long run
-writes a bounded number of them: one when the work reaches each tenth of the total, and at most one
-every ``interval`` seconds in between, with no carriage returns. Disabled, it prints nothing.
+On a terminal a tqdm bar; anywhere else (CI logs, pipes) plain lines, one at each tenth of the
+total and at most one every ``interval`` seconds in between. Disabled, it prints nothing.
 
 >>> import io
 >>> out = io.StringIO()
@@ -21,23 +19,14 @@ import sys
 import time
 from typing import Any, TextIO
 
-PLAIN_STEPS = 10
-"""Plain mode: a line each time the work reaches the next 1/PLAIN_STEPS of the total."""
-
-PLAIN_INTERVAL = 30.0
-"""Plain mode: the longest a long step stays silent, in seconds (a line at least this often)."""
-
-TTY_STEPS = 1000
-"""Terminal mode: the bar is redrawn at most once per 1/TTY_STEPS of the total (and tqdm's own rate limit)."""
+PLAIN_STEPS = 10  # plain mode: a line at each 1/PLAIN_STEPS of the total ...
+PLAIN_INTERVAL = 30.0  # ... and at least every PLAIN_INTERVAL seconds
+TTY_STEPS = 1000  # terminal mode: redrawn at most once per 1/TTY_STEPS of the total
 
 
 def _clock(seconds: float) -> str:
     seconds = int(round(seconds))
     return f"{seconds // 3600}:{seconds // 60 % 60:02d}:{seconds % 60:02d}"
-
-
-def _number(x: float) -> str:
-    return f"{x:.6g}"
 
 
 def is_terminal(stream: Any) -> bool:
@@ -51,10 +40,9 @@ def is_terminal(stream: Any) -> bool:
 class Progress:
     """Progress of ``total`` units of work (seconds simulated, runs, frames) on ``stream`` (stderr).
 
-    ``update(done, note)`` reports the work done so far (absolute, not an increment) and a short
-    note (the events so far, the last run's label); ``close(note)`` ends the display with a final
-    line. Both are cheap when nothing is due, so a solver can call ``update`` every step, and both
-    do nothing when ``enabled`` is False. ``close`` may be called more than once.
+    ``update(done, note)`` reports the work done so far (absolute) and a short note; ``close(note)``
+    ends the display (again: nothing). Both are cheap when nothing is due (a solver calls ``update``
+    every step).
     """
 
     def __init__(self, total: float, *, unit: str = "", desc: str = "", enabled: bool = True,
@@ -66,14 +54,12 @@ class Progress:
         self.note = ""
         self.closed = not enabled
         self.start = time.perf_counter()
-        self.bar: Any = None
         self._next = 0.0  # plain: the fraction of the total at which the next line is due
         self._last_line = self.start
         self._step = (total / TTY_STEPS) if total > 0 else 0.0  # terminal: the smallest change drawn
         self._drawn: float = -1.0
         self._shown: tuple[float, str] | None = None  # plain: the last line's work and note
-        if enabled and is_terminal(self.stream):
-            self.bar = _bar(total, unit, desc, self.stream)
+        self.bar: Any = _bar(total, unit, desc, self.stream) if enabled and is_terminal(self.stream) else None
 
     @property
     def mode(self) -> str:
@@ -122,7 +108,7 @@ class Progress:
         left = f", ~{_clock(elapsed / frac * (1 - frac))} left" if 0 < frac < 1 else ""
         head = f"{self.desc}: " if self.desc else ""
         unit = f" {self.unit}" if self.unit else ""
-        text = (f"  {head}{_number(done)}/{_number(self.total)}{unit}  {100 * frac:5.1f} %"
+        text = (f"  {head}{done:.6g}/{self.total:.6g}{unit}  {100 * frac:5.1f} %"
                 f" | {_clock(elapsed)} elapsed{left}" + (f" | {note}" if note else ""))
         self.stream.write(text + "\n")
         self.stream.flush()

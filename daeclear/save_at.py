@@ -1,11 +1,7 @@
 """SaveAt: what a run reports and where it goes, as one checked, immutable value (as diffrax's SaveAt).
 
-:func:`daeclear.simulate` takes it as ``save=``: the output times (given ``times`` or a grid
-``every`` seconds), whether the integrator's own steps are kept, an HDF5 file the run is written to
-while it goes on, and the cap on the points reported. Its fields are checked once, on construction
-(``SaveAt: every=-1.0, must be ...``); what needs the run's span (times inside ``[t0, t_end]``, a grid
-step no longer than the run, the file's place on disk) is checked once by :meth:`SaveAt.plan`, and
-the size estimate once the model's size is known by :meth:`Output.check_size`: both before any work.
+Fields are checked on construction; what needs the run's span by :meth:`SaveAt.plan`, and the size
+estimate by :meth:`Output.check_size` once the model is known: all before any work.
 """
 
 from __future__ import annotations
@@ -32,28 +28,25 @@ class SaveAt:
     Parameters
     ----------
     times : array_like or None
-        Output times (finite, strictly increasing, >= 0; inside ``[t0, t_end]`` of the run). None:
-        every internal step (or the grid of ``every``).
+        Output times (finite, strictly increasing, inside ``[t0, t_end]``). None: every internal step
+        (or the grid of ``every``).
     every : float or None
-        Output times every ``every`` seconds from t0 to t_end (both included; the spacing is
-        ``(t_end - t0) / floor((t_end - t0) / every)``), made window by window as the run goes (a
-        long run never holds the whole grid). Give this or ``times``, not both.
+        Output times every ``every`` seconds from t0 to t_end, both included (spacing
+        ``(t_end - t0) / floor((t_end - t0) / every)``), made window by window. Not with ``times``.
     steps : bool
         Keep every internal step's time, size and order (``result.step_t``...). Without ``times``
-        and ``every`` the steps are also the output points; False then reports the start point only.
-        With them, False keeps the run's memory from growing with its length.
+        and ``every`` the steps are the output points (False: the start point only); with them,
+        False keeps the run's memory from growing with its length.
     stream_to : str, path or None
-        Write the result to this HDF5 file while the run goes on (the layout of :meth:`Result.save`,
-        docs/hdf5_layout.md), chunk by chunk, dropping each chunk from memory. The file holds what
-        was computed whatever stops the run (its root ``message`` says why).
+        Write the result to this HDF5 file chunk by chunk while the run goes on (docs/hdf5_layout.md);
+        the file holds what was computed whatever stops the run.
     keep_data : bool
-        With ``stream_to``: return the result read back from the file (True), or (False) a Result
-        of the outcome alone (success, message, statistics, warnings; no time series, events or
-        segments). False needs ``stream_to``.
+        With ``stream_to``: return the result read back from the file (True), or (False) the outcome
+        alone (success, message, statistics, warnings). False needs ``stream_to``.
     max_points : int or None
-        The most output points the run may report (:data:`daeclear.options.MAX_OUTPUT_POINTS`, 1e6,
-        about 1 GB for the chapter's slider-crank); more (``times``, ``every``, or a fixed ``step``
-        without them) is refused before the run with the estimated size. None: no cap.
+        The most output points the run may report (:data:`daeclear.options.MAX_OUTPUT_POINTS`, about
+        1 GB for the chapter's slider-crank); more is refused before the run with the estimated size.
+        None: no cap.
     """
 
     times: ArrayLike | None = None
@@ -85,8 +78,7 @@ class SaveAt:
             object.__setattr__(self, name, value)
 
     def plan(self, t0: float, t_end: float, *, where: str = "simulate") -> Output:
-        """The output of a run from ``t0`` to ``t_end`` (checked: both finite, t0 < t_end): the checks
-        that need the run's span, made once before any work (``<where>: save.times=...``)."""
+        """The output of a run from ``t0`` to ``t_end`` (both checked): the checks that need the span."""
         times = None
         if self.times is not None:
             times = OutputTimes(options.t_eval(self.times, t_end, where=where, field="save.times", start=t0))
@@ -115,12 +107,8 @@ class Output(NamedTuple):
     end: float
 
     def check_size(self, *, step: float | None, n_states: int, n_channels: int, where: str = "simulate") -> None:
-        """Refuse, before the run, an output of more than ``max_points`` points, with the estimate of its size.
-
-        The points are those of ``times``/``every``, or, without them, of a fixed ``step`` when the
-        steps are kept (every step reported); an adaptive method's steps are not known before the run
-        (``max_steps`` bounds them). Each point stores t, the states and their derivatives and every
-        channel, 8 bytes each."""
+        """Refuse, before the run, more than ``max_points`` points (those of ``times``/``every``, or of a
+        kept fixed ``step``), with the estimate of their size (t, states, derivatives, channels: 8 bytes each)."""
         limit, start, end = self.max_points, self.start, self.end
         if limit is None:
             return

@@ -1,15 +1,9 @@
 """SolverOptions: the settings that decide what a run computes, as one checked, immutable value.
 
-:func:`daeclear.simulate`, the studies (:func:`daeclear.studies.accuracy.work_precision`, the
-stability suite) and sweeps take the same settings; an options object carries them from one to
-the other, is checked once on construction (by the one rule per option of :mod:`daeclear.options`)
-and round-trips through a plain dict (``to_dict``/``from_dict``: JSON types only, for files).
-
-What belongs: every setting that decides the model assembled and the trajectory computed (method,
-tolerances, formulation, backend, step bounds, linear solver, how the run starts, the work state).
-What does not: what a call reports and where it goes (``save``, a :class:`daeclear.SaveAt`, and
-``progress``) and what it does on failure (``on_failure``): a study or a sweep sets those per call,
-and they never change the computed trajectory.
+:func:`daeclear.simulate`, the studies and sweeps take the same settings; checked once on
+construction (the rules of :mod:`daeclear.options`), round-tripped through a dict of JSON types.
+What a call reports (``save``, ``progress``) and does on failure are not settings: they never
+change the computed trajectory.
 """
 
 from __future__ import annotations
@@ -45,62 +39,49 @@ UNSET: Any = _Unset()
 class SolverOptions:
     """The solver settings of a run: ``options=`` of :func:`daeclear.simulate`.
 
-    Checked on construction: a bad value raises :class:`daeclear.SceneError` naming the field,
-    the value and what is allowed; whether the method takes ``step`` is its solver's rule
-    (:meth:`daeclear.solvers.base.Solver.check`, called here). Names are normalised
-    (``method="RK45"`` is stored as ``"rk45"``; a solver class as given), ``atol`` as a float, a
-    tuple of floats or a tuple of (quantity, value) pairs (a mapping by quantity). Immutable:
-    derive variants with :meth:`replace`. Combinations that depend on the model (a GGL model with a
-    non-IDA method, ``track_work`` with a non-IDA method) are checked by the solver before any work.
+    Checked on construction (:class:`daeclear.SceneError` naming the field, the value and what is
+    allowed; ``step`` by the method's solver, :meth:`daeclear.solvers.base.Solver.check`); names
+    normalised (``"RK45"`` stored as ``"rk45"``), ``atol`` as a float, a tuple of floats or of
+    (quantity, value) pairs. Immutable: derive variants with :meth:`replace`.
 
     Parameters
     ----------
     method : str or a solver class
-        "ida", "RK45", "DOP853", "Radau", "BDF", "LSODA", "rk4" or "euler" (case-insensitive;
-        :data:`daeclear.solvers.registry.SOLVERS`), or a class implementing
-        :class:`daeclear.solvers.base.Solver`.
+        "ida", "RK45", "DOP853", "Radau", "BDF", "LSODA", "rk4" or "euler" (case-insensitive), or a
+        class implementing :class:`daeclear.solvers.base.Solver`.
     rtol : float
         Relative tolerance (the chapter's "integration tolerance"), in [1e-14, 1e-2].
     atol : float, mapping, array or None
         Absolute tolerance of positions and velocities. None: per quantity from the mechanism's
-        scales (:mod:`daeclear.solvers.tolerances`; on the chapter's slider-crank ``1e-3 * rtol``
-        in m, rad and m/s, ``5e-3 * rtol`` in rad/s). A number: every position and velocity. A
-        mapping by quantity, e.g. ``{"q": 1e-9, "v": 1e-6}`` or ``{"position": ..., "angle": ...,
-        "velocity": ..., "angular_velocity": ...}`` (the others keep their defaults). An array:
-        ``2 n_q`` values (positions, then velocities) or one per state. Values below the
-        round-off of their quantity are raised to it, with a warning. Multipliers are always kept
-        out of the error test.
+        scales (:mod:`daeclear.solvers.tolerances`). A number: all of them. A mapping by quantity,
+        e.g. ``{"q": 1e-9, "v": 1e-6}`` or by ``"position"``, ``"angle"``, ``"velocity"``,
+        ``"angular_velocity"`` (the others default). An array: ``2 n_q`` values or one per state.
+        Values below round-off are raised to it, with a warning; multipliers are never tested.
     formulation : {"ggl", "index1"} or None
-        Used when a Scene is run. None: the solver's own ("ggl", stabilised index 2, for IDA;
-        "index1", the chapter's Baumgarte alpha = beta = 5, for the other methods, which integrate
-        that one only).
+        Used when a Scene is run. None: the solver's own ("ggl" for IDA; "index1", the chapter's
+        Baumgarte alpha = beta = 5, for the other methods, which integrate that one only).
     backend : {"auto", "c", "python"}
-        "c": generated C and an IDA loop in C (fast); "python": scikit-sundae with CasADi
-        callbacks; "auto": C when a compiler works, else python with a warning.
+        "c": generated C and an IDA loop in C; "python": scikit-sundae with CasADi callbacks;
+        "auto": C when a compiler works, else python with a warning.
     max_step : float
         Largest step, s (0: unbounded); IDA and the scipy methods.
     max_steps : int
         Cap on the total number of steps; the run fails cleanly beyond it.
     step : float or None
-        Step size, s, of the fixed-step methods "rk4" and "euler" (required there, e.g. the
-        chapter's 1e-5); refused by the other methods.
+        Step size, s, of "rk4" and "euler" (required there, e.g. 1e-5); refused by the others.
     linear_solver : {"auto", "reduced", "dense", "sparse"}
-        LU of IDA's Newton iteration in the compiled backend: "reduced" (dense LU of the system
-        left after eliminating the position rows), "dense", "sparse" (SuperLU_MT), or "auto"
-        (sparse for large models, :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES`, reduced
-        below). The python backend and the other methods ignore it.
+        LU of IDA's Newton iteration in the compiled backend: "reduced" (the system left after
+        eliminating the position rows), "dense", "sparse" (SuperLU_MT) or "auto" (sparse from
+        :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES` states).
     start : {"ideal", "declared"}
-        How a run starts without ``y0``: "ideal" (the chapter's, section 4.4: every clearance joint
-        centred, positions and velocities assembled on the mechanism whose clearance joints are
-        ideal) or "declared" (the bodies' declared state, corrected only for the ideal joints).
+        How a run starts without ``y0``: "ideal" (the chapter's, section 4.4: clearance joints
+        centred) or "declared" (the bodies' declared state, corrected for the ideal joints only).
     allow_penetration : bool
-        Start "declared" even with a contact pair deeper in its wall than
-        :data:`daeclear.solvers.physics.START_PENETRATION_FRACTION` of the clearance, or from a
-        ``y0`` deeper than :data:`~daeclear.solvers.physics.GIVEN_PENETRATION_FRACTION` (refused
-        otherwise).
+        Start even deeper in a wall than :data:`daeclear.solvers.physics.START_PENETRATION_FRACTION`
+        of the clearance (a ``y0``: :data:`~daeclear.solvers.physics.GIVEN_PENETRATION_FRACTION`).
     track_work : bool
-        Used when a Scene is run (IDA only): integrate the work of drivers and contact forces as
-        the state ``work.input`` (channel ``energy.work``), see :func:`daeclear.assemble`.
+        IDA only: integrate the work of drivers and contact forces as the state ``work.input``
+        (channel ``energy.work``), see :func:`daeclear.assemble`.
     """
 
     method: str = "ida"
@@ -152,10 +133,8 @@ class SolverOptions:
         return cls(**values)
 
     def merged(self, *, where: str = "simulate", **keywords: Any) -> SolverOptions:
-        """These options with every keyword that is not :data:`UNSET` put in its place; a bad
-        keyword is reported as given to ``where`` (``simulate: rtol=2.0, must be ...``).
-
-        The rule of :func:`daeclear.simulate`: a keyword given explicitly overrides the options object."""
+        """These options with every keyword that is not :data:`UNSET` put in its place (a bad one
+        reported as given to ``where``): a keyword given to :func:`daeclear.simulate` overrides them."""
         given = {k: v for k, v in keywords.items() if v is not UNSET}
         if not given:
             return self
@@ -170,9 +149,8 @@ class SolverOptions:
 
 
 def checked(values: Mapping[str, Any], *, where: str) -> dict[str, Any]:
-    """Every setting of ``values`` (all of SolverOptions' fields) checked and normalised by the rules
-    of :mod:`daeclear.options`; errors name ``where``. Whether the method takes ``step`` is its
-    solver's rule (:meth:`daeclear.solvers.base.Solver.check`, called by :class:`SolverOptions`)."""
+    """Every field of SolverOptions in ``values`` checked and normalised (:mod:`daeclear.options`);
+    errors name ``where``."""
     from .solvers.registry import method as method_rule
 
     method = method_rule(values["method"], where=where)

@@ -1,11 +1,8 @@
 """The one contract every integrator of :func:`daeclear.simulate` implements (as scipy's ``OdeSolver``).
 
-A solver is a class: :func:`daeclear.simulate` picks it by name from
-:data:`daeclear.solvers.registry.SOLVERS` (``method="ida"``, ``"RK45"``, ... case-insensitive) or
-takes it as given (``method=MySolver``), and calls, on an instance, :meth:`Solver.check` (once,
-when the :class:`daeclear.SolverOptions` naming it are made) and :meth:`Solver.run` (once per run,
-after every check of the call). The options a solver consumes are checked where it consumes them:
-an option it does not take is refused naming the method and the option.
+A solver is a class, named (:data:`daeclear.solvers.registry.SOLVERS`) or given (``method=MySolver``);
+on an instance :meth:`Solver.check` is called when the :class:`daeclear.SolverOptions` naming it are
+made, :meth:`Solver.run` once per run after every check of the call.
 """
 
 from __future__ import annotations
@@ -48,8 +45,7 @@ class Solver(Protocol):
 
 
 def step_rule(name: str, step: Any, *, fixed: bool) -> None:
-    """The rule of ``step`` (its value is checked by :class:`daeclear.SolverOptions`): required by a
-    fixed-step method, refused by one that chooses its own steps; ``name`` is the method's."""
+    """``step`` is required by a fixed-step method and refused by the others (``name``: the method's)."""
     if fixed and step is None:
         raise SceneError(f"simulate: method={name!r} is a fixed-step scheme and needs "
                          "step=<step size in s> (the chapter uses 1e-5 s).")

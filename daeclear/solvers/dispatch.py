@@ -1,5 +1,4 @@
-"""simulate(): a scene or model, the run's span and start, the solver settings and the output ->
-a Result. Checks every argument once, before any work, then hands the run to the method's solver
+"""simulate(): checks every argument once, before any work, then hands the run to the method's solver
 (:mod:`daeclear.solvers.registry`, the contract of :mod:`daeclear.solvers.base`)."""
 
 from __future__ import annotations
@@ -36,73 +35,59 @@ def simulate(
     progress: bool = False,
     parameters: Mapping[str, Any] | None = None,
 ) -> Result:
-    """Integrate a scene (or an assembled model) from ``t0`` (0 by default) to ``t_end``.
+    """Integrate a scene (or an assembled model) from ``t0`` to ``t_end``.
 
-    ``method``, ``rtol`` and ``atol`` are the settings most often changed; every other solver setting
-    (formulation, backend, max_step, max_steps, step, track_work, linear_solver, start,
-    allow_penetration) is a field of ``options``, and a keyword given explicitly overrides the same
-    setting of ``options``: ``simulate(m, T, options=o, rtol=1e-8)`` is
-    ``simulate(m, T, options=o.replace(rtol=1e-8))``. What the run reports and where it goes is ``save``.
+    ``method``, ``rtol`` and ``atol`` override the same settings of ``options`` (every other solver
+    setting is a field of :class:`daeclear.SolverOptions`); what the run reports is ``save``.
 
     Parameters
     ----------
     scene : Scene or DAEModel
-        The mechanism; a Scene is assembled with ``options.formulation`` first. A model is a value that
-        no run changes (a run's contact state is its own, :mod:`daeclear.assembly.contact_state`): runs
-        of one model, one after the other or at the same time in threads, are independent.
+        The mechanism; a Scene is assembled with ``options.formulation`` first. No run changes a
+        model: runs of one model (also in threads) are independent.
     t_end : float
         End time, s (> t0).
     t0 : float
-        Start time, s (finite, >= 0, < t_end). Drivers and time-dependent loads are evaluated at
-        the true time: a run from t0 continues a run that reached t0.
+        Start time, s (>= 0, < t_end); drivers and loads see the true time.
     y0 : array_like or None
-        The full state at ``t0`` (a row of ``result.y`` of a run of the same model, ``model.n_states``
-        values): positions and velocities are kept as given (GGL: projected onto the constraint
-        manifold, as at every restart), multipliers and accelerations recomputed, the contact
-        modes set from the gaps at ``t0`` (a pair starting in contact latches its penetration
-        rate there). None: the start of ``options.start``. Restarting from the last state of a run
-        continues it to the integration tolerance; a run's history (contact storm guard, BDF
-        history) starts afresh.
+        The full state at ``t0`` (a row of ``result.y`` of the same model): positions and velocities
+        kept (GGL: projected), multipliers and accelerations recomputed, contact modes set from the
+        gaps. None: the start of ``options.start``. A run's history (storm guard, BDF) starts afresh.
     method : str or a solver class
-        "ida" (default), "RK45", "DOP853", "Radau", "BDF", "LSODA", "rk4" or "euler" (case-insensitive;
-        :data:`daeclear.solvers.registry.SOLVERS`), or a class implementing
-        :class:`daeclear.solvers.base.Solver`. "ida": SUNDIALS IDA on the DAE. The others integrate
-        the same model as an ODE in (q, v) (index-1 formulation only) with the same contact events
-        (:mod:`daeclear.solvers.explicit`); "rk4" and "euler" need ``options.step``.
+        "ida" (default), "RK45", "DOP853", "Radau", "BDF", "LSODA", "rk4" or "euler" (case-insensitive),
+        or a class implementing :class:`daeclear.solvers.base.Solver`. All but "ida" integrate the
+        index-1 model as an ODE in (q, v) (:mod:`daeclear.solvers.explicit`); "rk4", "euler" need ``step``.
     rtol : float
         Relative tolerance (1e-6; the chapter's "integration tolerance").
     atol : float, mapping, array or None
-        Absolute tolerance of positions and velocities (see :class:`daeclear.SolverOptions`). None
-        (the default): per quantity from the mechanism's scales (:mod:`daeclear.solvers.tolerances`).
+        Absolute tolerance of positions and velocities (:class:`daeclear.SolverOptions`; None: from the
+        mechanism's scales, :mod:`daeclear.solvers.tolerances`).
     options : SolverOptions or None
-        The solver settings as one checked value (None: the defaults).
+        The solver settings (None: the defaults).
     save : SaveAt or None
-        The output: times or a grid, the steps kept or not, a file streamed to, the cap on points
-        (:class:`daeclear.SaveAt`; None: every internal step, in memory).
+        The output (:class:`daeclear.SaveAt`; None: every internal step, in memory).
     on_failure : {"raise", "return"}
-        On an integrator failure raise :class:`SolveError` (its ``.result`` holds the
-        partial result) or return the partial result with ``success=False``.
+        On an integrator failure raise :class:`SolveError` (``.result`` holds the partial result) or
+        return the partial result with ``success=False``.
     progress : bool
         Show a progress line on stderr.
     parameters : mapping or None
-        New numbers for this run, by name, as :meth:`DAEModel.with_parameters` (e.g.
-        ``{"clearance.clearance": 2e-4, "clearance.law.restitution": 0.5}``): the scene is assembled
-        (a model is taken as it is) and run with them; nothing is compiled, the model is unchanged.
+        New numbers for this run by name, as :meth:`DAEModel.with_parameters` (e.g.
+        ``{"clearance.clearance": 2e-4}``); nothing is compiled, the model is unchanged.
 
     Returns
     -------
     Result
-        ``result.warnings`` lists what the physics checks found (penetration beyond the
-        clearance, an impossible start, constraint drift, contacts stepped over by a fixed step);
-        each is also issued as a :class:`daeclear.PhysicsWarning`. See :mod:`daeclear.solvers.physics`.
+        ``result.warnings`` lists the physics checks' findings (:mod:`daeclear.solvers.physics`), each
+        also issued as a :class:`daeclear.PhysicsWarning`.
 
     Raises
     ------
     SceneError
         A bad argument (naming it, its value and what is allowed), before any work.
     AssemblyError
-        The initial positions cannot be assembled, the constraints are redundant (the
-        message names the joints and drivers), or a declared start is in deep penetration.
+        The initial positions cannot be assembled, the constraints are redundant, or a declared
+        start is in deep penetration.
     """
     if not isinstance(scene, (Scene, DAEModel)):  # e.g. a mechanism's name: say what is wanted
         opts.fail("simulate", "scene", scene, "a daeclear.Scene or an assembled model, e.g. "

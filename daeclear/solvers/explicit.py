@@ -1,88 +1,37 @@
 """The same assembled model integrated by other schemes than IDA, for accuracy studies.
 
-The solvers (:class:`daeclear.solvers.base.Solver`) of every method but ``"ida"``:
+Solvers (:class:`daeclear.solvers.base.Solver`) of every method but ``"ida"``: explicit adaptive
+``"RK45"``, ``"DOP853"``; implicit ``"Radau"``, ``"BDF"``, ``"LSODA"`` (scipy, with the generated
+Jacobian); fixed step ``"rk4"`` and ``"euler"`` (``step=``, the step loop in C). This module holds the
+solver classes and the two integration loops; the model as an ODE is in
+:mod:`~daeclear.solvers.ode_model`, its evaluation in :mod:`~daeclear.solvers.ode_evaluators`, gap
+crossings in :mod:`~daeclear.solvers.ode_crossings`, the run's bookkeeping in :mod:`~daeclear.solvers.ode_run`.
 
-* explicit adaptive (scipy): ``"RK45"``, ``"DOP853"``;
-* implicit (scipy): ``"Radau"``, ``"BDF"``, ``"LSODA"`` (with the generated Jacobian);
-* fixed step: ``"rk4"`` (classical Runge-Kutta) and ``"euler"`` (explicit Euler), with ``step=``.
-
-This module holds the solver classes and the two integration loops (scipy, fixed step); the parts
-they use live beside it: :mod:`~daeclear.solvers.ode_model` (the model as an ODE, symbolic),
-:mod:`~daeclear.solvers.ode_evaluators` (its compiled or Python evaluation),
-:mod:`~daeclear.solvers.ode_crossings` (gap crossings within a step) and
-:mod:`~daeclear.solvers.ode_run` (the run's segments, events, failure and Result).
-
-The model
----------
-The index-1 DAE is an ODE in ``x = (q, v)``: ``q' = v``, ``v' = a(t, q, v)`` with ``a`` and the
-multipliers from the linear system of the chapter's formulation (Baumgarte, alpha = beta = 5 by
-default, the values the model was assembled with)::
+The index-1 DAE is an ODE in ``x = (q, v)``: ``q' = v``, ``v' = a(t, q, v)``, with ``a`` and the
+multipliers from the chapter's linear system (Baumgarte alpha, beta as assembled)::
 
     [M  Phi_q^T] [a  ]   [Q + sum of the active contact terms' forces]
     [Phi_q   0 ] [lam] = [gamma - 2 alpha Phi' - beta^2 Phi          ]
 
-The GGL formulation is IDA-only. The right-hand side, its Jacobian ``dx'/dx`` (implicit
-differentiation of the same system) and the gap functions with their time derivatives are
-generated as C (:func:`daeclear.engine.codegen.build_ode_library`, ``csrc/ode_driver.c``: the Schur
-complement ``Phi_q M^-1 Phi_q^T`` solved by Cholesky, M diagonal) and called through ctypes,
-about 1.5 us per call from Python; an inactive contact term is never evaluated. The fixed-step
-schemes run their whole step loop in C. ``backend="python"`` (or ``"auto"`` without a working C
-compiler) evaluates the same functions through ``casadi.FunctionBuffer`` and numpy instead.
+GGL is IDA-only. ``backend="python"`` (or ``"auto"`` without a C compiler) evaluates the same
+functions through ``casadi.FunctionBuffer`` and numpy.
 
-Events
-------
-The same contact rules and run state as IDA (:mod:`daeclear.assembly.contact_state`): each segment
-watches every gap in the direction the run's contact state gives (+1 increasing, -1 decreasing, 0
-both, as IDA), and at an event ``contact_state.decide`` gets ``roots_found`` with the direction of
-the crossing (+1/-1) and returns the new state. The ODE state (q, v) is kept at a restart (it is consistent by
-construction) and the integrator restarts from the event time with fresh history (scipy: a new
-solver object with its own initial step selection; passing the last step size instead was
-measured and gained nothing).
+Events follow the contact rules and run state of IDA (:mod:`daeclear.assembly.contact_state`): each
+segment watches every gap in the direction the contact state gives, ``contact_state.decide`` switches
+modes at a crossing, and the integrator restarts from the event with fresh history, the state (q, v)
+kept. A step may hold a crossing of G = direction * g from <= 0 to > 0 when G changed sign over it,
+or when the cubic Hermite interpolant of G has an interior maximum above zero (a quick re-contact
+within one step, confirmed on the scheme's own state; one the cubic does not predict is still missed);
+the crossing is bracketed by Illinois regula falsi down to IDA's root tolerance
+(:mod:`~daeclear.solvers.ode_crossings`). The state at the event comes from the dense output (scipy)
+or a re-step from the step's start (rk4, euler: event times are not quantised to the step).
 
-A step may contain a crossing of a watched gap, G = direction * g from <= 0 to > 0, when G has
-changed sign over the step, *or* when the cubic Hermite interpolant of G built from G and dG/dt
-at the two ends of the step has an interior maximum above zero. The second test is what keeps
-quick re-contacts (a contact that closes and opens again within one step, docs/performance.md)
-from being stepped over: such a predicted excursion is checked on the scheme's own state at the
-predicted maximum and becomes an event when it is confirmed. Residual risk: an excursion that the
-cubic does not predict (a gap with large higher derivatives over the step) is still missed.
-Measured on the chapter's slider-crank (benchmarks/bench_methods.py): its contacts last 40 us or
-more, so over two revolutions the naive end-of-step test finds the same events as the Hermite test
-with rk4 at 1e-5 and 4e-5 s, and 87 instead of 91 with DOP853 at rtol 1e-6 (72 against 74 with
-RK45 at 1e-4); the test costs no measurable time.
-
-Just after an event the newly watched G is at rounding level (|g| ~ 1e-19 m) and moving away from
-zero; the error of an interpolant (or of a tiny re-step) could then fake a crossing right at the
-start of the next step, which DOP853 did when one long free-flight step ended inside the bearing
-wall. When G starts downwards, the bracket therefore starts where the state confirms G < 0 (at the
-cubic's first minimum, or at 1/4, 1/16, ... of it).
-
-The crossing is located by the Illinois variant of regula falsi on a bracket whose far end is
-always past the crossing, down to ``100 eps (|t| + |h|)`` (IDA's root tolerance). The state at the
-event is the far end of the final bracket (the gap has changed sign, as IDA returns it), taken
-from
-
-* scipy methods: the solver's dense output on the step;
-* rk4 / euler: a re-step of size ``t - t_k`` from the start of the step: the scheme's own state
-  at the event time. Event times are therefore not quantised to the step; after the event the
-  fixed-step grid continues from the event time (the last step before ``t_end`` is shortened to
-  land on it).
-
-Output
-------
-Without output times (``SaveAt.times`` or ``every``) the result holds every accepted step (and
-every event point); with them the scipy methods use their dense output and the fixed-step schemes a cubic Hermite
-interpolant between steps. Multipliers and accelerations at output points are recomputed from
-(t, q, v) with the segment's active terms. Statistics: ``n_steps`` (accepted steps),
-``n_res_evals`` (right-hand side evaluations: scheme stages, event location re-steps; output
-points not counted), ``n_jac_evals``, ``n_root_evals`` (gap evaluations), ``n_lu`` (Radau, BDF),
-``n_events``, ``n_restarts``, ``solve_time``, ``setup_time``.
-
-Failures (``success=False`` with a message that says when, which pairs were in contact and why):
-the scheme's own failure (scipy's step-size underflow, a singular Newton matrix), a non-finite
-state or right-hand side, a step-size collapse (the rule of every integrator,
-:mod:`daeclear.engine.stall_guard`), ``max_steps`` accepted steps, or an event loop that does not
-advance (``STALL_EVENTS`` events at the same time).
+Output: every accepted step and event point, or (``SaveAt.times``/``every``) dense output / cubic
+Hermite interpolation; multipliers and accelerations are recomputed at the output points. Statistics
+as IDA's (``n_res_evals``: scheme stages and event re-steps; ``n_lu``: Radau, BDF). A run fails
+(``success=False``, a message saying when, which pairs were in contact and why) on the scheme's own
+failure, a non-finite state, a step-size collapse (:mod:`daeclear.engine.stall_guard`), ``max_steps``
+steps, or ``STALL_EVENTS`` events at the same time.
 """
 
 from __future__ import annotations
@@ -103,45 +52,23 @@ from .tolerances import atol_record, tolerance_vector
 from ..results.result import Result
 from ..model.scene import Scene
 from .ode_crossings import candidate, locate
-from .ode_evaluators import FIXED_CHUNK, FX_CHUNK, FX_ERR, FX_MAXSTEPS, FX_TSTOP, evaluator
+from .ode_evaluators import FX_CHUNK, FX_ERR, FX_MAXSTEPS, FX_TSTOP, evaluator
 from .ode_model import ode_spec
 from . import physics
 from .base import step_rule
-from .ode_run import (FIXED_STEP_METHODS, IMPLICIT_METHODS, METHOD_NAMES, SCIPY_METHODS, TINY_STEP_COUNT, TINY_STEP_REL,
-                      Run)
+from .ode_run import FIXED_STEP_METHODS, IMPLICIT_METHODS, METHOD_NAMES, SCIPY_METHODS, Run
 
 if TYPE_CHECKING:
     from ..save_at import Output
     from ..solver_options import SolverOptions
 
-__all__ = [
-    "METHOD_NAMES",
-    "SCIPY_METHODS",
-    "FIXED_STEP_METHODS",
-    "ODESolver",
-    "RK45",
-    "DOP853",
-    "Radau",
-    "BDF",
-    "LSODA",
-    "RK4",
-    "Euler",
-    "ode_spec",
-    # re-exported from the modules that now own them (ode_run, ode_evaluators)
-    "IMPLICIT_METHODS",
-    "TINY_STEP_REL",
-    "TINY_STEP_COUNT",
-    "FIXED_CHUNK",
-]
+__all__ = ["METHOD_NAMES", "SCIPY_METHODS", "FIXED_STEP_METHODS", "ODESolver", "RK45", "DOP853", "Radau", "BDF",
+           "LSODA", "RK4", "Euler", "ode_spec"]
 
-# Look for gap crossings inside a step from the cubic Hermite interpolant of the gap (True), or
-# only from sign changes at the step ends (False: the naive check, kept for measurements).
+# Look for gap crossings with the cubic Hermite test (True) or sign changes only (False: for measurements).
 HERMITE_GAP_CHECK = True
 # an event loop that produces STALL_EVENTS events without the time advancing is a failure
 STALL_EVENTS = 50
-
-
-# =========================================================================== the run
 
 
 _SCIPY_HINT = "Try a smaller max_step, a looser rtol or another method."
@@ -168,12 +95,11 @@ def _run_scipy(run: Run, x0: NDArray, rtol: float, atol: NDArray, max_step: floa
             return
         lu0 = getattr(solver, "nlu", 0)
         t_last, restart = _scipy_segment(run, solver, watch, t)
-        seg = run.seg
-        assert seg is not None
-        seg.t1 = t_last if restart is None else restart[0]
-        run.t_last = seg.t1
+        run.t_last = t_last if restart is None else restart[0]
+        assert run.seg is not None
+        run.seg.t1 = run.t_last
         run.n_lu += getattr(solver, "nlu", 0) - lu0
-        if not _end_segment(run, restart, False, run.t_end):
+        if not _end_segment(run, restart, False):
             return
         assert restart is not None  # _end_segment goes on only after an event
         t, x, _ = restart  # the next segment starts at the event
@@ -192,7 +118,7 @@ class _Watch:
     @classmethod
     def start(cls, run: Run, t: float, x: NDArray) -> _Watch | None:
         """The watch at the segment's start; None (the run failed) when the gaps cannot be evaluated."""
-        dirs = run.directions()
+        dirs = contact_state.root_directions(run.model, run.state)
         if dirs is None:
             return cls(None, np.empty(0), np.empty(0))  # g and gd are read only when enabled
         gg = run.ev.gaps(t, x)
@@ -269,11 +195,8 @@ def _event_in_step(run: Run, solver: Any, watch: _Watch, t_prev: float, t1: floa
         return "failed", None
     g0, gd0, (g1, gd1) = watch.g, watch.gd, gg
     h = t1 - t_prev
-    cands = []
-    for i, d in watch.watched:
-        s = candidate(d * g0[i], d * gd0[i], d * g1[i], d * gd1[i], h, HERMITE_GAP_CHECK)
-        if s > 0.0:
-            cands.append((i, d, s))
+    cands = [(i, d, s) for i, d in watch.watched
+             if (s := candidate(d * g0[i], d * gd0[i], d * g1[i], d * gd1[i], h, HERMITE_GAP_CHECK)) > 0.0]
     sol = None
     if cands:
         sol = solver.dense_output()
@@ -286,16 +209,15 @@ def _event_in_step(run: Run, solver: Any, watch: _Watch, t_prev: float, t1: floa
             run.fail(t_prev, found, _SCIPY_HINT)
             return "failed", sol
         if found is not None:
-            t_ev, x_ev, roots = found
-            te = run.pending_upto(t_ev)
+            te = run.pending_upto(found[0])
             if te.size:
                 run.add_evals(te, np.atleast_2d(np.array(sol(te), dtype=float).T))
-            return (t_ev, x_ev, roots), sol
+            return found, sol
     watch.g, watch.gd = g1, gd1
     return "none", sol
 
 
-def _end_segment(run: Run, restart: Any, hermite: bool, t_end: float) -> bool:
+def _end_segment(run: Run, restart: Any, hermite: bool) -> bool:
     """Close the segment; on an event let the logic switch modes. True when the run goes on."""
     run.close_segment(hermite=hermite)
     if restart is None or not run.success:
@@ -305,7 +227,7 @@ def _end_segment(run: Run, restart: Any, hermite: bool, t_end: float) -> bool:
     if run.stall >= STALL_EVENTS:
         run.fail(t, f"{run.stall} events at the same time: the event loop does not advance", "")
         return False
-    return t < t_end
+    return t < run.t_end
 
 
 def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
@@ -315,7 +237,7 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
     t, x = t0, x0
     while True:
         run.open_segment(t, x)
-        dirs = run.directions()
+        dirs = contact_state.root_directions(run.model, run.state)
         restart: tuple[float, NDArray, Any] | None = None
         while True:
             left = run.max_steps - run.n_steps
@@ -323,9 +245,8 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
                 run.fail(t, f"max_steps={run.max_steps} steps reached", "Raise max_steps or use a larger step.")
                 break
             out = ev.fixed(scheme, t, x, step, t_end, left, dirs, HERMITE_GAP_CHECK)
-            st, sx = out["st"], out["sx"]
-            run.n_steps += st.size
-            run.add_steps(st, sx)
+            run.n_steps += out["st"].size
+            run.add_steps(out["st"], out["sx"])
             t, x = out["ta"], out["xa"]
             status = out["status"]
             if status == FX_TSTOP:
@@ -346,12 +267,11 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
             if gg_a is None or gg_b is None:
                 run.fail(t, ev.last_message, hint)
                 break
-            ta, xa = t, x
 
-            def restep(tt: float, ta: float = ta, xa: NDArray = xa) -> NDArray | None:
+            def restep(tt: float, ta: float = t, xa: NDArray = x) -> NDArray | None:
                 return ev.step(scheme, ta, xa, tt - ta)
 
-            found = locate(ev, restep, ta, gg_a, tb, xb, gg_b, cands, ev.ng)
+            found = locate(ev, restep, t, gg_a, tb, xb, gg_b, cands, ev.ng)
             if isinstance(found, str):
                 run.fail(t, found, hint)
                 break
@@ -359,11 +279,10 @@ def _run_fixed(run: Run, x0: NDArray, step: float, t0: float = 0.0) -> None:
                 run.add_steps(np.array([tb]), xb[None, :])
                 t, x = tb, xb
                 continue
-            t_ev, x_ev, roots = found
-            run.add_steps(np.array([t_ev]), x_ev[None, :])
-            restart = (t_ev, x_ev, roots)
+            run.add_steps(np.array([found[0]]), found[1][None, :])
+            restart = found
             break
-        if not _end_segment(run, restart, True, t_end):
+        if not _end_segment(run, restart, True):
             return
         assert restart is not None  # _end_segment goes on only after an event
         t, x, _ = restart  # the next segment starts at the event
@@ -385,13 +304,8 @@ class ODESolver:
             settings: SolverOptions, on_failure: str, progress: bool) -> Result:
         """Integrate from ``t0`` to ``t_end`` (the :class:`daeclear.solvers.base.Solver` contract).
 
-        Output goes to a :class:`daeclear.solvers.recorder.Recorder` segment by segment (a segment
-        runs between two contact events): streamed, each segment's points are written when it ends
-        and dropped, so memory grows with the longest segment and the events (kept for the
-        fixed-step checks), not with the run; the grid of ``save.every`` is built whole (8 bytes
-        per point). ``max_step`` bounds the scipy methods' steps (0: unbounded); ``backend`` "c"
-        (generated C), "python" (FunctionBuffer) or "auto".
-        """
+        Output goes to a :class:`daeclear.solvers.recorder.Recorder` segment by segment (streamed: memory
+        grows with the longest segment and the events, not with the run)."""
         return _integrate(self, model, t_end, t0, y0, save, settings, on_failure, progress)
 
 
@@ -418,30 +332,21 @@ def _integrate(solver: ODESolver, scene: Scene | DAEModel, t_end: float, t0: flo
     start, allow_penetration = settings.start, settings.allow_penetration
     if settings.track_work:
         raise SceneError(f"simulate: track_work=True is supported by method='ida' only, not by method={name!r}.")
-    formulation = settings.formulation or solver.formulation
-    if isinstance(scene, DAEModel):
-        model = scene
-    else:
-        if formulation == "ggl":
-            raise SceneError(f"simulate: formulation={formulation!r} is integrated by IDA only; method={name!r} "
-                             "integrates the chapter's index-1 formulation (formulation='index1').")
-        model = None
-    setup_start = time.perf_counter()
-    if model is None:
-        model = assemble(scene, formulation)  # type: ignore[arg-type]  # validates the name
-    if model.formulation != "index1":
-        raise SceneError(f"simulate: formulation={model.formulation!r} is integrated by IDA only; method={name!r} "
+    formulation = scene.formulation if isinstance(scene, DAEModel) else settings.formulation or solver.formulation
+    if formulation != "index1":
+        raise SceneError(f"simulate: formulation={formulation!r} is integrated by IDA only; method={name!r} "
                          "integrates the chapter's index-1 formulation (formulation='index1').")
-    given = None if y0 is None else options.state(y0, model.n_states)
-    out.check_size(step=step, n_states=model.n_states,
-                   n_channels=len(model.channel_names))  # before the grid is built
-    from_state = given is not None
+    setup_start = time.perf_counter()
+    model = scene if isinstance(scene, DAEModel) else assemble(scene, formulation)
+    y0 = None if y0 is None else options.state(y0, model.n_states)
+    out.check_size(step=step, n_states=model.n_states, n_channels=len(model.channel_names))  # before the grid
+    from_state = y0 is not None
     eval_times = None if out.times is None else out.times.values()  # checked by SaveAt.plan
     n = model.n_q
     atol_x = tolerance_vector(model, rtol, atol, newton=False)[:2 * n]
     ev = evaluator(model, settings.backend)
-    if given is not None:  # q and v as given (index-1: no projection), multipliers recomputed at t0
-        y0, yp0 = model.consistent_state(t0, given)
+    if y0 is not None:  # q and v as given (index-1: no projection), multipliers recomputed at t0
+        y0, yp0 = model.consistent_state(t0, y0)
         if not allow_penetration:  # held to the declared start's limit
             physics.check_start_penetration(model, y0, yp0, given=True)
     else:
@@ -457,8 +362,7 @@ def _integrate(solver: ODESolver, scene: Scene | DAEModel, t_end: float, t0: flo
                    stream_to=out.stream_to, keep_data=out.keep_data)
     run = Run(model, ev, method_l, t_end, eval_times, out.steps, progress, settings.max_steps, rec)
     run.y0, run.step = (y0 if start == "declared" and not from_state else None), step  # declared starts only
-    run.from_state = from_state
-    run.t_last = t0
+    run.from_state, run.t_last = from_state, t0
     run.set_state(contact_state.start_state(model, t0, y0))
     setup_time = time.perf_counter() - setup_start
     tic = time.perf_counter()

@@ -1,13 +1,9 @@
 """Gap crossings inside one step of the non-IDA methods: which steps may hold one, and where it is.
 
-:func:`candidate` decides from the gaps and their rates at the two ends of a step whether a watched
-gap may have crossed zero inside it (a sign change, or an interior maximum of its cubic Hermite
-interpolant above zero: the same rule as ``candidate()`` in ``csrc/ode_driver.c``);
-:func:`locate` confirms such a crossing on the scheme's own state and brackets it down to IDA's
-root tolerance. The method (and its measured risks) is described in :mod:`daeclear.solvers.explicit`,
-whose switch ``HERMITE_GAP_CHECK`` the callers pass as ``hermite``.
-Separate from the integration loops that call it because it is pure numerics on one step: it only
-needs gap values and a way to get the state at a time inside the step.
+:func:`candidate` decides from the gaps and rates at a step's ends whether a watched gap may have
+crossed zero inside it (the rule of ``candidate()`` in ``csrc/ode_driver.c``); :func:`locate` confirms
+the crossing on the scheme's own state and brackets it to IDA's root tolerance (the method:
+:mod:`daeclear.solvers.explicit`).
 """
 
 from __future__ import annotations
@@ -28,12 +24,8 @@ _EPS = float(np.finfo(float).eps)
 
 
 def candidate(G0: float, Gd0: float, G1: float, Gd1: float, h: float, hermite: bool = True) -> float:
-    """Far-side point s* in (0, h] of a possible crossing of G from <= 0 to > 0 within a step.
-
-    h when G1 > 0, or the first interior maximum of the cubic Hermite interpolant of G that lies
-    above zero (if earlier); -1 when no crossing is expected. Same rule as candidate() in
-    csrc/ode_driver.c.
-    """
+    """Far-side point s* in (0, h] of a possible crossing of G from <= 0 to > 0 within a step: h when
+    G1 > 0, or the first interior maximum above zero of G's cubic Hermite interpolant if earlier; -1: none."""
     if G0 > 0.0:
         return -1.0
     best = h if G1 > 0.0 else -1.0
@@ -76,13 +68,9 @@ def cubic_extrema(G0: float, Gd0: float, G1: float, Gd1: float, h: float) -> lis
 def locate(ev: Evaluator, X_of: Callable[[float], NDArray | None], ta0: float, g_a: tuple[NDArray, NDArray],
             tb_end: float, x_end: NDArray, g_end: tuple[NDArray, NDArray], cands: list[tuple[int, int, float]],
             n_gaps: int) -> tuple[float, NDArray, NDArray] | None | str:
-    """Locate the earliest confirmed crossing among the candidates of one step [ta0, tb_end].
-
-    ``g_a`` and ``g_end`` are (gaps, rates) at the ends of the step; ``cands`` (gap, direction,
-    far-side point) from :func:`candidate`. Returns (t_event, x_event,
-    roots_found), None when no candidate is confirmed, or an error message when the model could
-    not be evaluated.
-    """
+    """The earliest confirmed crossing among ``cands`` (gap, direction, far-side point) of the step
+    [ta0, tb_end] with (gaps, rates) ``g_a``, ``g_end`` at its ends: (t_event, x_event, roots_found),
+    None when none is confirmed, or an error message when the model could not be evaluated."""
     h = tb_end - ta0
     ttol = 100.0 * _EPS * (abs(ta0) + abs(h))
     best: tuple[float, NDArray, list[tuple[int, int]]] | None = None
@@ -105,10 +93,9 @@ def locate(ev: Evaluator, X_of: Callable[[float], NDArray | None], ta0: float, g
             continue  # a predicted excursion that the scheme's state does not confirm
         ta, Ga = ta0, G0
         if Gd0 < 0.0:
-            # G starts by moving away from zero: typically just after the opposite event, where
-            # |G| is at rounding level and the error of an interpolant (or of a tiny re-step) can
-            # fake a crossing right at the start. Start the bracket where the state confirms G < 0
-            # on the way down: at the cubic's first minimum, or closer to the start (1/4, 1/16, ...).
+            # G starts away from zero, typically just after the opposite event (|G| at rounding level,
+            # where an interpolant's error can fake a crossing): start the bracket where the state
+            # confirms G < 0, at the cubic's first minimum or at 1/4, 1/16, ... of it.
             ext = [u for u, is_max, _ in cubic_extrema(G0, Gd0, G1, Gd1, h)[:1] if not is_max]
             u = min(ext[0] if ext else 0.5, (tb - ta0) / h)
             while u * h > 1e3 * ttol:

@@ -1,13 +1,11 @@
 """Numeric evaluation of a model's ODE for the non-IDA methods: generated C through ctypes, or Python.
 
-:func:`evaluator` gives an :class:`Evaluator` of a model's :func:`~daeclear.solvers.ode_model.ode_spec`:
-the right-hand side, its Jacobian, the gaps and their rates, single steps and the whole fixed-step
-loop of rk4/euler, output channels and call counters. The compiled one calls the library that
-:func:`daeclear.engine.codegen.build_ode_library` builds from ``csrc/ode_driver.c`` (once per
-structure, cached); the Python one (``backend="python"``, or ``"auto"`` without a working C
-compiler) evaluates the same CasADi functions through ``casadi.FunctionBuffer`` and numpy.
-Separate from the integration loops (:mod:`daeclear.solvers.explicit`) because it is the only
-place that knows how the model is evaluated.
+:func:`evaluator` gives an :class:`Evaluator` of :func:`~daeclear.solvers.ode_model.ode_spec`: the
+right-hand side, its Jacobian, the gaps and their rates, single steps and the fixed-step loop of
+rk4/euler, output channels and call counters. The compiled one calls the library
+:func:`daeclear.engine.codegen.build_ode_library` builds from ``csrc/ode_driver.c``; the Python one
+(``backend="python"``, or ``"auto"`` without a C compiler) evaluates the same CasADi functions
+through ``casadi.FunctionBuffer`` and numpy.
 """
 
 from __future__ import annotations
@@ -38,86 +36,28 @@ from .ode_model import ode_spec
 
 __all__ = ["FIXED_CHUNK", "FX_CANDIDATE", "FX_CHUNK", "FX_ERR", "FX_MAXSTEPS", "FX_TSTOP", "Evaluator", "evaluator"]
 
-# rows of the fixed-step C loop's step buffer per call
+# rows of the fixed-step C loop's step buffer per call; the status of a call is one of FX_* (engine.abi)
 FIXED_CHUNK = 8192
-# the status of one call of the fixed-step loop (``Evaluator.fixed``) is one of FX_* of daeclear.engine.abi
-# (dco_fixed's return codes): step buffer full (call again), t_stop reached, the last step may hold a
-# gap crossing, model evaluation failed or the state is not finite, step cap reached
-
-#: ctypes view of one compiled ODE library (opened, declared and checked in daeclear.engine.library)
-_CLib = OdeLibrary
 
 
-class Evaluator:
-    """Common interface of the compiled and the python evaluation of an OdeSpec."""
+class _Shared:
+    """What the compiled and the python evaluation of an OdeSpec share."""
 
     backend = "?"
 
     def __init__(self, spec: OdeSpec) -> None:
-        self.spec = spec
-        self.n, self.m = spec.n, spec.m
-        self.nx = 2 * spec.n
-        self.nt = len(spec.term_force)
-        self.ng = spec.n_gaps
+        self.n, self.m, self.nx = spec.n, spec.m, 2 * spec.n
+        self.nt, self.ng = len(spec.term_force), spec.n_gaps
         self.poff = np.concatenate([[0], np.cumsum(spec.n_params)]).astype(int)
         self.last_message = ""
         #: what compiled the model (None for the python evaluation)
         self.build: BuildResult | None = None
 
-    # the interface both evaluations implement (declared here so that callers type-check against it)
-    def message(self) -> str:
-        """The last error message of the evaluation."""
-        raise NotImplementedError
 
-    def set_terms(self, active: Sequence[bool], params: Sequence[NDArray]) -> None:
-        """Switch the optional force terms on/off and set their parameters."""
-        raise NotImplementedError
-
-    def rhs(self, t: float, x: NDArray) -> NDArray:
-        """Right-hand side dx/dt of the first-order ODE at (t, x)."""
-        raise NotImplementedError
-
-    def jac(self, t: float, x: NDArray) -> NDArray:
-        """Jacobian d(rhs)/dx at (t, x)."""
-        raise NotImplementedError
-
-    def gaps(self, t: float, x: NDArray) -> tuple[NDArray, NDArray] | None:
-        """Gaps and their rates at (t, x), None when the evaluation failed."""
-        raise NotImplementedError
-
-    def step(self, scheme: int, t: float, x: NDArray, h: float) -> NDArray | None:
-        """One step of length h of a fixed-step scheme, None when the evaluation failed."""
-        raise NotImplementedError
-
-    def batch(self, t: NDArray, X: NDArray) -> tuple[NDArray, NDArray]:
-        """State derivatives and multipliers at N points (t[i], X[i])."""
-        raise NotImplementedError
-
-    def fixed(self, scheme: int, t0: float, x0: NDArray, step: float, t_stop: float, max_steps: int,
-              rootdir: NDArray | None, hermite: bool) -> dict[str, Any]:
-        """The fixed-step loop up to t_stop, a full step buffer, a gap-crossing candidate or an error."""
-        raise NotImplementedError
-
-    def channels(self, model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> NDArray:
-        """Output channels (N, n_channels) at N points with one switch vector."""
-        raise NotImplementedError
-
-    def counters(self) -> dict[str, int]:
-        """Call counters of the evaluation."""
-        raise NotImplementedError
-
-    def _pcat(self, params: Sequence[NDArray]) -> NDArray:
-        out = np.zeros(max(int(self.poff[-1]), 1))
-        for k in range(self.nt):
-            if self.poff[k + 1] > self.poff[k]:
-                out[self.poff[k]:self.poff[k + 1]] = np.asarray(params[k], dtype=float).ravel()
-        return out
-
-
-class _CEvaluator(Evaluator):
+class _CEvaluator(_Shared):
     backend = "c"
 
-    def __init__(self, spec: OdeSpec, clib: _CLib, build: BuildResult) -> None:
+    def __init__(self, spec: OdeSpec, clib: OdeLibrary, build: BuildResult) -> None:
         super().__init__(spec)
         lib = clib.lib
         ints = [ctypes.c_int() for _ in range(4)]
@@ -136,69 +76,56 @@ class _CEvaluator(Evaluator):
         self.lib, self.h, self.build = lib, h, build
         self._finalizer = weakref.finalize(self, lib.dco_free, h)
         nx, ng = self.nx, max(self.ng, 1)
-        self._xin = np.zeros(nx)
-        self._xout = np.zeros(nx)
-        self._J = np.zeros((nx, nx))
-        self._g = np.zeros(ng)
-        self._gd = np.zeros(ng)
+        self._xin, self._xout, self._xa, self._xb = (np.zeros(nx) for _ in range(4))
+        self._J, self._g, self._gd = np.zeros((nx, nx)), np.zeros(ng), np.zeros(ng)
         self._act = np.zeros(max(self.nt, 1), dtype=np.int32)
         self._par = np.zeros(max(int(self.poff[-1]), 1))
         self._cnt = np.zeros(DCO_CNT_N, dtype=np.int64)
-        self._a = {k: getattr(self, "_" + k).ctypes.data for k in ("xin", "xout", "J", "g", "gd", "act", "par", "cnt")}
-        # fixed-step loop buffers
-        self._st = np.zeros(FIXED_CHUNK)
-        self._sx = np.zeros((FIXED_CHUNK, nx))
-        self._xa = np.zeros(nx)
-        self._xb = np.zeros(nx)
-        self._sstar = np.zeros(2 * ng)
-        self._rd = np.zeros(ng, dtype=np.int32)
-        self._nst = ctypes.c_int()
-        self._ta = ctypes.c_double()
-        self._tb = ctypes.c_double()
-        for k in ("st", "sx", "xa", "xb", "sstar", "rd"):
-            self._a[k] = getattr(self, "_" + k).ctypes.data
-        self._a["nst"] = ctypes.addressof(self._nst)
-        self._a["ta"] = ctypes.addressof(self._ta)
-        self._a["tb"] = ctypes.addressof(self._tb)
+        self._st, self._sx = np.zeros(FIXED_CHUNK), np.zeros((FIXED_CHUNK, nx))  # the fixed-step loop's buffers
+        self._sstar, self._rd = np.zeros(2 * ng), np.zeros(ng, dtype=np.int32)
+        self._nst, self._ta, self._tb = ctypes.c_int(), ctypes.c_double(), ctypes.c_double()
+        self._a = {k: getattr(self, "_" + k).ctypes.data
+                   for k in ("xin", "xout", "J", "g", "gd", "act", "par", "cnt", "st", "sx", "xa", "xb", "sstar", "rd")}
+        self._a.update((k, ctypes.addressof(getattr(self, "_" + k))) for k in ("nst", "ta", "tb"))
 
-    def message(self) -> str:
+    def _message(self) -> str:
         return self.lib.dco_message(self.h).decode()
 
     def set_terms(self, active: Sequence[bool], params: Sequence[NDArray]) -> None:
         if self.nt:
-            self._act[:self.nt] = [1 if a else 0 for a in active]
-            self._par[:] = self._pcat(params)
+            self._act[:self.nt] = active
+            if self.poff[-1]:
+                self._par[:self.poff[-1]] = np.concatenate([np.asarray(p, dtype=float).ravel() for p in params])
         self.lib.dco_set_terms(self.h, self._a["act"], self._a["par"])
 
     def rhs(self, t: float, x: NDArray) -> NDArray:
         self._xin[:] = x
         if self.lib.dco_rhs(self.h, t, self._a["xin"], self._a["xout"]):
-            self.last_message = self.message()
+            self.last_message = self._message()
         return self._xout.copy()
 
     def jac(self, t: float, x: NDArray) -> NDArray:
         self._xin[:] = x
         if self.lib.dco_jac(self.h, t, self._a["xin"], self._a["J"]):
-            self.last_message = self.message()
+            self.last_message = self._message()
         return self._J.copy()
 
     def gaps(self, t: float, x: NDArray) -> tuple[NDArray, NDArray] | None:
         self._xin[:] = x
         if self.lib.dco_gaps(self.h, t, self._a["xin"], self._a["g"], self._a["gd"]):
-            self.last_message = self.message()
+            self.last_message = self._message()
             return None
         return self._g[:self.ng].copy(), self._gd[:self.ng].copy()
 
     def step(self, scheme: int, t: float, x: NDArray, h: float) -> NDArray | None:
         self._xin[:] = x
         if self.lib.dco_step(self.h, scheme, t, self._a["xin"], h, self._a["xout"]):
-            self.last_message = self.message()
+            self.last_message = self._message()
             return None
         return self._xout.copy()
 
     def batch(self, t: NDArray, X: NDArray) -> tuple[NDArray, NDArray]:
-        t = np.ascontiguousarray(t, dtype=float)
-        X = np.ascontiguousarray(X, dtype=float)
+        t, X = (np.ascontiguousarray(a, dtype=float) for a in (t, X))
         N = t.size
         Xd = np.empty((N, self.nx))
         Lam = np.empty((N, max(self.m, 1)))
@@ -222,7 +149,7 @@ class _CEvaluator(Evaluator):
             out.update(tb=self._tb.value, xb=self._xb.copy(),
                        sstar=self._sstar[:2 * self.ng].reshape(self.ng, 2).copy())
         if rc == FX_ERR:
-            self.last_message = self.message()
+            self.last_message = self._message()
         return out
 
     def channels(self, model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> NDArray:
@@ -230,17 +157,13 @@ class _CEvaluator(Evaluator):
         sizes = [ctypes.c_int() for _ in range(3)]
         self.lib.dco_output_sizes(*(ctypes.addressof(c) for c in sizes))
         n_y, n_sw, n_ch = (c.value for c in sizes)
-        t = np.ascontiguousarray(t, dtype=float)
-        y = np.ascontiguousarray(y, dtype=float)
-        yp = np.ascontiguousarray(yp, dtype=float)
+        t, y, yp = (np.ascontiguousarray(a, dtype=float) for a in (t, y, yp))
         sw = np.zeros(max(n_sw, 1))
         sw[:switch.size] = switch
         out = np.empty((t.size, n_ch))
-        if n_ch == 0 or y.shape[1] != n_y or switch.size != n_sw:
-            return _model_channels(model, t, y, yp, switch)
-        if t.size and self.lib.dco_outputs(self.h, t.size, t.ctypes.data, y.ctypes.data, yp.ctypes.data,
-                                           sw.ctypes.data, out.ctypes.data):
-            return _model_channels(model, t, y, yp, switch)
+        if n_ch == 0 or y.shape[1] != n_y or switch.size != n_sw or (t.size and self.lib.dco_outputs(
+                self.h, t.size, t.ctypes.data, y.ctypes.data, yp.ctypes.data, sw.ctypes.data, out.ctypes.data)):
+            return _model_channels(model, t, y, yp, switch)  # no compiled outputs, or they failed
         return out
 
     def counters(self) -> dict[str, int]:
@@ -271,7 +194,7 @@ class _Buffered:
         return [o.reshape(s[1], s[0]).T.copy() if min(s) > 1 else o.copy() for o, s in zip(self.outs, self.shapes)]
 
 
-class _PyEvaluator(Evaluator):
+class _PyEvaluator(_Shared):
     """The same model evaluated through casadi.FunctionBuffer and numpy (no compiler needed)."""
 
     backend = "python"
@@ -288,9 +211,6 @@ class _PyEvaluator(Evaluator):
         self.active = [False] * self.nt
         self.params: list[NDArray] = [np.zeros(p) for p in spec.n_params]
         self.cnt = dict.fromkeys(ODE_COUNTER_KEYS, 0)  # the C evaluator's counters
-
-    def message(self) -> str:
-        return self.last_message
 
     def set_terms(self, active: Sequence[bool], params: Sequence[NDArray]) -> None:
         self.active = [bool(a) for a in active]
@@ -447,6 +367,13 @@ class _PyEvaluator(Evaluator):
         return dict(self.cnt)
 
 
+#: Either evaluation: set_terms (the active force terms and their parameters), rhs and jac (dx/dt and
+#: its Jacobian), gaps (gaps and rates, None on failure), step (one fixed step, None on failure), batch
+#: (dx/dt and multipliers at N points), fixed (the fixed-step loop up to t_stop, a full buffer, a
+#: crossing candidate or an error), channels (N points, one switch vector) and counters.
+Evaluator = _CEvaluator | _PyEvaluator
+
+
 def _model_channels(model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> NDArray:
     """Output channels (N, n_channels) through CasADi (no compiled library)."""
     N = t.size
@@ -469,11 +396,11 @@ def evaluator(model: DAEModel, backend: str) -> Evaluator:
         if compiled is None:
             build = build_ode_library(spec)
             try:
-                clib = _CLib.load(build.path)
+                clib = OdeLibrary.load(build.path)
             except OSError:
                 build.path.unlink(missing_ok=True)  # a damaged cache entry: build once more
                 build = build_ode_library(spec)
-                clib = _CLib.load(build.path)
+                clib = OdeLibrary.load(build.path)
             compiled = (clib, build)
             model.functions.compiled["ode_library"] = compiled
         else:

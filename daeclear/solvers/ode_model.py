@@ -1,11 +1,9 @@
 """The assembled DAE model as an ODE in ``x = (q, v)``: the symbolic functions of the non-IDA methods.
 
-:func:`ode_spec` turns a :class:`~daeclear.assembly.assemble.DAEModel` (index-1 formulation) into
-the :class:`~daeclear.engine.codegen.OdeSpec` that :mod:`daeclear.solvers.ode_evaluators`
-evaluates, compiled or in Python: the linear system of the accelerations and multipliers, its
-Jacobian, each contact term's force and Jacobian, and the gaps with their time derivatives, every
-number a run-time parameter. Separate from the evaluators because it is symbolic (CasADi, built
-once per structure) where they are numeric (once per run).
+:func:`ode_spec` turns an index-1 :class:`~daeclear.assembly.assemble.DAEModel` into the
+:class:`~daeclear.engine.codegen.OdeSpec` that :mod:`daeclear.solvers.ode_evaluators` evaluates: the
+accelerations' linear system and its Jacobian, each contact term's force and Jacobian, and the gaps
+with their rates, every number a run-time parameter (built once per structure).
 """
 
 from __future__ import annotations

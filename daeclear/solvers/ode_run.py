@@ -1,13 +1,9 @@
-"""The record of one non-IDA run: its method, segments, contact modes, events and failure, and its Result.
+"""The record of one non-IDA run: its segments, contact modes, events and failure, and its Result.
 
-A :class:`Run` holds what the integration loops of :mod:`daeclear.solvers.explicit` produce between
-two contact events (a :class:`Segment`): it opens and closes segments, hands each closed segment's
-steps and output points (multipliers, accelerations and channels recomputed at them; fixed-step
-``t_eval`` by cubic Hermite interpolation) to the :class:`~daeclear.solvers.recorder.Recorder`,
-lets the contact logic switch modes at an event, words the failure message and builds the
-:class:`~daeclear.results.result.Result` with its statistics and run checks. It also holds the
-table of the methods (their names, kinds and orders). Separate from the loops because it is the
-bookkeeping common to the scipy and the fixed-step schemes, not the stepping.
+A :class:`Run` opens and closes the segments (:class:`Segment`, between two contact events) that the
+loops of :mod:`daeclear.solvers.explicit` step, hands each closed segment's steps and output points to
+the :class:`~daeclear.solvers.recorder.Recorder`, switches modes at an event, words the failure and
+builds the :class:`~daeclear.results.result.Result`; it also holds the table of the methods.
 """
 
 from __future__ import annotations
@@ -24,15 +20,14 @@ from ..assembly import contact_state
 from ..assembly.assemble import DAEModel
 from ..engine.hermite import cubic_hermite
 from ..engine.abi import DCO_EULER, DCO_RK4
-from ..engine.stall_guard import TINY_STEP_COUNT, TINY_STEP_REL, StallGuard
+from ..engine.stall_guard import StallGuard
 from ..progress import Progress
 from ..results.result import ContactEvent, Result
 from . import physics
 from .ode_evaluators import Evaluator
 from .recorder import Recorder
 
-__all__ = ["FIXED_STEP_METHODS", "IMPLICIT_METHODS", "METHOD_NAMES", "SCIPY_METHODS", "TINY_STEP_COUNT",
-           "TINY_STEP_REL", "Run", "Segment"]
+__all__ = ["FIXED_STEP_METHODS", "IMPLICIT_METHODS", "METHOD_NAMES", "SCIPY_METHODS", "Run", "Segment"]
 
 #: lower-case method name -> the name reported in Result.method
 METHOD_NAMES: dict[str, str] = {
@@ -44,7 +39,6 @@ IMPLICIT_METHODS: tuple[str, ...] = ("radau", "bdf", "lsoda")
 #: fixed-step methods and their C scheme codes (= their order)
 FIXED_STEP_METHODS: dict[str, int] = {"rk4": DCO_RK4, "euler": DCO_EULER}
 _ORDER = {"rk45": 5, "dop853": 8, "radau": 5, "bdf": -1, "lsoda": -1, "rk4": 4, "euler": 1}
-
 
 
 @dataclass
@@ -74,25 +68,19 @@ class Run:
         self.model, self.ev, self.method, self.t_end = model, ev, method, t_end
         self.rec = rec  # where each closed segment's output goes (kept, or streamed to a file)
         self._handed = 0  # events handed to rec so far
-        self.eval_times = eval_times
-        self.pending = eval_times
+        self.eval_times = self.pending = eval_times
         self.store_steps = store_steps
         self.max_steps = max_steps
         self.progress = progress
         self.bar = Progress(t_end, unit="s", desc="simulate", enabled=progress)
-        self.n = model.n_q
-        self.m = model.n_constraints
+        self.n, self.m = model.n_q, model.n_constraints
         self.state: contact_state.ContactState = ()  # the run's contact state (set by start)
         self.active: list[bool] = [False] * len(model.terms)
         self.params: list[NDArray] = [np.zeros(term.n_params) for term in model.terms]
         self.modes: dict[str, str] = {}
         self.events: list[ContactEvent] = []
-        self.segments: list[Segment] = []
-        self.n_steps = 0
-        self.n_restarts = 0
-        self.n_lu = 0
+        self.n_segments = self.n_steps = self.n_restarts = self.n_lu = self.stall = 0
         self.stall_guard = StallGuard()  # step-size collapse (daeclear.engine.stall_guard)
-        self.stall = 0
         self.last_event_t = -math.inf
         self.seg: Segment | None = None
         self.t_last = 0.0
@@ -102,26 +90,21 @@ class Run:
         self.step: float | None = None  # the fixed step (rk4, euler)
         self.missed: list[tuple[float, float, str]] = []  # steps over which a gap changed sign, no event
 
-    # ---------------------------------------------------------------- segments
     def set_state(self, state: contact_state.ContactState) -> None:
         """Take the run's new contact state, and the terms and modes that follow from it."""
         self.state = state
         self.active, self.params = contact_state.switches(self.model, state)
         self.modes = contact_state.modes(self.model, state)
 
-    def directions(self) -> NDArray | None:
-        return contact_state.root_directions(self.model, self.state)
-
     def open_segment(self, t0: float, x0: NDArray) -> None:
         self.ev.set_terms(self.active, self.params)
         self.seg = Segment(t0, np.array(x0, dtype=float), list(self.active), [p.copy() for p in self.params],
-                            dict(self.modes), include_start=not self.segments)
-        self.segments.append(self.seg)
+                            dict(self.modes), include_start=not self.n_segments, t1=t0)
+        self.n_segments += 1
         if self.seg.include_start and self.pending is not None and self.pending.size and self.pending[0] <= t0:
             self.seg.et.append(self.pending[:1].copy())
             self.seg.ex.append(self.seg.x0[None, :].copy())
             self.pending = self.pending[1:]
-        self.seg.t1 = t0
         self.t_last = t0
 
     def add_steps(self, t: NDArray, X: NDArray) -> None:
@@ -155,7 +138,7 @@ class Run:
         if seg is None:
             return
         self.seg = None
-        ev, n, m = self.ev, self.n, self.m
+        ev, n = self.ev, self.n
         ev.set_terms(seg.active, seg.params)
         if seg.pt:
             seg.st.append(np.array(seg.pt))
@@ -174,8 +157,7 @@ class Run:
                 Xd = ev.batch(T, X)[0]
                 seg.et.append(te)
                 seg.ex.append(_hermite(T, X, Xd, te))
-        # recorded steps: every step (the first segment also its start point, with h = 0, as
-        # IDA's results); with store_steps=False only the start point of the run
+        # recorded steps: every step (the first segment's start too, h = 0); store_steps=False: the start only
         if seg.include_start:
             kt, kx, kh = T, X, np.concatenate([[0.0], np.diff(T)])
         else:
@@ -190,18 +172,11 @@ class Run:
             ot = np.concatenate(seg.et) if seg.et else np.zeros(0)
             ox = np.concatenate(seg.ex) if seg.ex else np.zeros((0, 2 * n))
         if ot.size:
-            Xd, Lam = ev.batch(ot, ox)
-            N = ot.size
-            y = np.zeros((N, self.model.n_states))
-            yp = np.zeros((N, self.model.n_states))
-            y[:, :2 * n] = ox
-            y[:, 2 * n:2 * n + m] = Lam
-            yp[:, :2 * n] = Xd
+            y, yp = self.dae_rows(ot, ox)
             sw = self.model.switch_vector(seg.active, seg.params)
             ch = ev.channels(self.model, ot, y, yp, sw)
-            names = self.model.channel_names
-            self.rec.add_points(ot, y, yp, np.broadcast_to(sw, (N, sw.size)),
-                                {name: np.ascontiguousarray(ch[:, i]) for i, name in enumerate(names)})
+            self.rec.add_points(ot, y, yp, np.broadcast_to(sw, (ot.size, sw.size)),
+                                {k: np.ascontiguousarray(ch[:, i]) for i, k in enumerate(self.model.channel_names)})
         seg.st, seg.sx, seg.et, seg.ex = [], [], [], []  # handed over: a long run keeps no segment's data
         self.hand_over(seg)
         ev.set_terms(self.active, self.params)
@@ -214,18 +189,17 @@ class Run:
         self._handed = len(self.events)
         self.rec.flush()
 
-    # ---------------------------------------------------------------- events
-    def full_state(self, t: float, x: NDArray) -> tuple[NDArray, NDArray]:
-        """(y, yp) of the DAE at one ODE state, with the current terms."""
-        Xd, Lam = self.ev.batch(np.array([t]), x[None, :])
-        y = np.zeros(self.model.n_states)
-        yp = np.zeros(self.model.n_states)
+    def dae_rows(self, t: NDArray, X: NDArray) -> tuple[NDArray, NDArray]:
+        """(y, yp) rows of the DAE at ODE states X (rows (q, v)), with the evaluator's current terms."""
+        Xd, Lam = self.ev.batch(t, X)
         n2 = 2 * self.n
-        y[:n2], y[n2:n2 + self.m], yp[:n2] = x, Lam[0], Xd[0]
+        y = np.zeros((t.size, self.model.n_states))
+        yp = np.zeros((t.size, self.model.n_states))
+        y[:, :n2], y[:, n2:n2 + self.m], yp[:, :n2] = X, Lam, Xd
         return y, yp
 
     def handle_event(self, t: float, x: NDArray, roots_found: NDArray) -> None:
-        y, yp = self.full_state(t, x)
+        y = self.dae_rows(np.array([t]), x[None, :])[0][0]
         state, new_events = contact_state.decide(self.model, self.state, t, y, roots_found)
         self.events.extend(new_events)
         self.set_state(state)
@@ -263,12 +237,10 @@ class Run:
     def _progress(self, t: float) -> None:
         self.bar.update(t, f"events {len(self.events)}")
 
-    # ---------------------------------------------------------------- result
     def result(self, setup_time: float, solve_time: float) -> Result:
         self.hand_over(self.seg)  # a segment left open by a failure at its start has no output points
         self.seg = None
-        stats: dict[str, Any] = {"n_steps": self.n_steps}
-        stats.update(self.ev.counters())
+        stats: dict[str, Any] = {"n_steps": self.n_steps, **self.ev.counters()}
         stats.pop("n_fixed_steps", None)
         if self.method in ("radau", "bdf"):
             stats["n_lu"] = self.n_lu

@@ -1,10 +1,8 @@
 """Physics checks of a finished run: results no real mechanism could produce are warned of.
 
-A run can end with ``success=True`` and still be meaningless: a journal pushed deeper into its
-bearing than the whole clearance, constraints that drifted by a visible part of the play, a
-fixed-step scheme that crossed a whole contact in one step, a start inside the bearing wall or
-with a journal flying across its bearing. Each finding is a record (a plain dict, stored in
-``Result.warnings`` and in the result's HDF5 file) with the keys
+A run can end with ``success=True`` and still be meaningless (penetration beyond the clearance,
+constraint drift, a contact crossed in one fixed step, a start inside the wall or flying across the
+play). Each finding is a record (a dict, in ``Result.warnings`` and the HDF5 file) with the keys
 
 ``kind``      one of :data:`KINDS`
 ``quantity``  what was measured, e.g. ``"penetration"``
@@ -34,25 +32,18 @@ from ..errors import AssemblyError, PhysicsWarning
 KINDS: tuple[str, ...] = ("penetration", "initial_penetration", "initial_velocity", "constraint_drift",
                           "contact_within_one_step", "missed_contact")
 
-# Penetration above PENETRATION_FRACTION of the clearance (translational joints: of the smaller of
-# the clearance and the corner radius) is outside every contact law's validity (small deformations).
+# Limits as fractions of the clearance (translational joints: of the smaller of clearance and corner
+# radius; docs/reliability.md). Beyond PENETRATION_FRACTION no contact law (small deformations) holds.
 PENETRATION_FRACTION = 1.0
-# A run that starts with a penetration above this fraction of the clearance starts inside the wall.
+# A run starting deeper than this starts inside the wall (warned).
 INITIAL_PENETRATION_FRACTION = 1e-2
-# A declared start deeper in a wall than this fraction of the clearance (translational joints: of the
-# smaller of the clearance and the corner radius) is refused before the run unless allowed
-# (``allow_penetration=True``): see check_start_penetration and docs/reliability.md.
+# A declared start deeper than this is refused before the run unless allow_penetration=True.
 START_PENETRATION_FRACTION = 0.1
-# A state given as simulate()'s ``y0`` may be a computed one in contact (a restart, a twin run): the
-# chapter's runs at 0.01-0.02 mm clearance reach 20-40 % of it. Refused (unless allowed) only beyond
-# this many clearances (translational: of the smaller of clearance and corner radius), ten times what
-# the physics check already calls non-physical (PENETRATION_FRACTION): a state no run reaches, e.g.
-# ``y0=zeros`` with the journal 0.17 m (340 clearances) from its bearing.
+# A given y0 may be a computed state in contact (runs reach 20-40 %): refused only beyond ten times
+# what the check calls non-physical, a state no run reaches (e.g. y0=zeros).
 GIVEN_PENETRATION_FRACTION = 10.0
-# A clearance joint of a driven mechanism whose two sides move apart at t = 0 faster than this
-# fraction of the fastest body (and at least INITIAL_VELOCITY_FLOOR) starts with velocities
-# inconsistent with the joint: the journal flies across its play and its first impact is an
-# artefact of the start.
+# A driven mechanism's clearance joint whose sides move apart at t = 0 faster than this fraction of
+# the fastest body (and INITIAL_VELOCITY_FLOOR) has velocities inconsistent with the joint.
 INITIAL_VELOCITY_FRACTION = 1e-2
 INITIAL_VELOCITY_FLOOR = 1e-3  # m/s
 # Constraint drift (largest |Phi| of a run) above this fraction of the smallest clearance.
@@ -94,12 +85,9 @@ def check_run(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channe
               y0: NDArray[np.float64] | None, stats: dict[str, Any], session: Any = None, *,
               from_state: bool = False) -> list[dict[str, Any]]:
     """Every check on a run's output (times ``t``, states ``y``, channels): penetrations, the start
-    (``y0``: the declared state at t = 0; None after the chapter's start, consistent by
-    construction) and drift. An open ``session`` evaluates the constraints (the run's compiled
-    library instead of a CasADi call). ``from_state``: the run started from a state of a run
-    (``simulate(..., y0=...)``), whose contacts at the start are no declaration error.
-
-    Sets ``stats["max_constraint_drift"]``. Returns the warning records (not issued)."""
+    (``y0``: the declared state at t = 0, None after the chapter's start) and drift; ``session``
+    evaluates the constraints; ``from_state``: the run started from a given ``y0`` (contacts at the
+    start are no error). Sets ``stats["max_constraint_drift"]``; returns the records (not issued)."""
     out: list[dict[str, Any]] = []
     declared = not from_state  # a restart from a run's state may start in contact
     for name, clearance, corner in model.clearance_joints:
@@ -111,16 +99,14 @@ def check_run(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channe
 
 
 def _worst_drift_row(drift: NDArray[np.float64]) -> int:
-    """The row of the largest constraint drift, NaN never (np.nanargmax without its overhead): the
-    first of equal ones. ``drift`` has a finite value."""
+    """The row of the largest (finite) constraint drift, the first of equal ones (np.nanargmax, faster)."""
     return int(np.where(np.isnan(drift), -np.inf, drift).argmax())
 
 
 def key_rows(t: NDArray[np.float64], channels: dict[str, NDArray[np.float64]]) -> NDArray[np.intp]:
-    """The rows of a run's output that :func:`check_run` reads: the first, and the worst of every
-    ``<pair>.penetration`` channel and of ``constraints.position`` (the earliest of equal ones, as
-    check_run picks). check_run on these rows alone finds what it finds on the whole output, so a
-    run can be checked chunk by chunk in bounded memory (see :class:`daeclear.solvers.recorder.Recorder`)."""
+    """The rows :func:`check_run` reads: the first, and the worst of every ``<pair>.penetration`` and of
+    ``constraints.position`` (the earliest of equal ones); check_run on them finds what it finds on the
+    whole output, so a run is checked chunk by chunk (:class:`daeclear.solvers.recorder.Recorder`)."""
     if t.size == 0:
         return np.zeros(0, dtype=np.intp)
     rows = {0}
@@ -169,27 +155,18 @@ def _penetration(model: Any, joint: str, clearance: float, corner: float, t: NDA
     return out
 
 
-def start_penetration_limit(clearance: float, corner: float) -> float:
-    """The deepest penetration a declared start may have, m (see START_PENETRATION_FRACTION)."""
-    return START_PENETRATION_FRACTION * (min(clearance, corner) if corner > 0 else clearance)
-
-
 def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np.float64], session: Any = None,
                             *, given: bool = False) -> None:
-    """Refuse a start with a contact pair deeper in its wall than :func:`start_penetration_limit`.
-
-    Such a start is a declaration error (a journal declared inside the bearing wall): its first
-    contact force is the law's force at that depth, e.g. 187 kN (elastic part) for the chapter's
-    journal declared 0.2 mm deep, released as an artificial impact. Raises AssemblyError naming
-    the pair, the penetration and the clearance. ``given``: the state is simulate()'s ``y0``, held to
-    the same limit as a declared start."""
+    """Refuse (AssemblyError naming the pair, the depth and the clearance) a start with a contact pair
+    deeper in its wall than START_PENETRATION_FRACTION of the clearance: a declaration error whose first contact
+    force would be an artificial impact. ``given``: the state is simulate()'s ``y0``
+    (GIVEN_PENETRATION_FRACTION)."""
     if not model.clearance_joints:
         return
     channels = model.channels(np.zeros(1), np.asarray(y0)[None, :], np.asarray(yp0)[None, :], session=session)
     for joint, clearance, corner in model.clearance_joints:
-        limit = start_penetration_limit(clearance, corner)
-        if given:
-            limit *= GIVEN_PENETRATION_FRACTION / START_PENETRATION_FRACTION
+        fraction = GIVEN_PENETRATION_FRACTION if given else START_PENETRATION_FRACTION
+        limit = fraction * (min(clearance, corner) if corner > 0 else clearance)
         basis = "corner radius" if 0 < corner < clearance else "clearance"
         for pair in joint_pairs(model, joint):
             depth = float(channels.get(f"{pair}.penetration", np.zeros(1))[0])
@@ -211,11 +188,8 @@ def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np
 
 
 def _initial_velocity(model: Any, y0: NDArray[np.float64], session: Any = None) -> list[dict[str, Any]]:
-    """Speed at which each clearance joint's two sides move apart at t = 0 (0 for an ideal start).
-
-    Checked for driven mechanisms only: their velocities follow from the driver, so a joint whose
-    sides fly apart was declared inconsistently. Without a driver (a drop test, a free chain) a
-    relative velocity is the experiment's initial condition."""
+    """Speed at which each clearance joint's two sides move apart at t = 0, for driven mechanisms only
+    (without a driver a relative velocity is the experiment's initial condition)."""
     if not model.clearance_joints:
         return []
     n = model.n_q
@@ -271,9 +245,8 @@ def _drift(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels:
 
 def check_fixed_steps(model: Any, events: Sequence[Any], step: float,
                       missed: Sequence[tuple[float, float, str]]) -> list[dict[str, Any]]:
-    """Fixed-step runs: whole contacts shorter than one step, and gap sign changes without an event.
-
-    ``missed``: (t_start, t_end, pair) of every step over which a gap changed sign with no event."""
+    """Fixed-step runs: whole contacts shorter than one step, and ``missed`` (t_start, t_end, pair) steps
+    over which a gap changed sign without an event."""
     out: list[dict[str, Any]] = []
     onset: dict[str, float] = {}
     short: dict[str, list[tuple[float, float]]] = {}

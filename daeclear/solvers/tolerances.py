@@ -1,28 +1,13 @@
 """Absolute tolerances per state, from the mechanism's own scales: the rule every method shares.
 
-IDA (``solvers.ida``) and the explicit and scipy methods (``solvers.explicit``) both turn the
-user's ``atol`` into one value per state here.
-
-Each state is one of four quantities (a body's ``x``/``y``, ``phi``, ``vx``/``vy``, ``omega``), and
-each quantity's absolute tolerance is ``rtol`` times a fraction of its scale (docs/engine.md,
-"Tolerances"), with ``L`` the mechanism's size and ``W`` its angular rate (:func:`scales`):
-
-- ``position``: ``rtol * l``, ``l = POSITION_FRACTION * L`` (1 mm on the chapter's 0.17 m
-  slider-crank), or twice the smallest clearance where that is smaller;
-- ``angle``: ``rtol * ANGLE_FRACTION`` (1e-3 rad);
-- ``velocity``: ``rtol * VELOCITY_FRACTION * L * W`` and ``angular_velocity``:
-  ``rtol * VELOCITY_FRACTION * W``.
-
-On the chapter's scenes these are the 1e-3 * rtol of earlier releases for positions, angles and
-velocities (every test of accuracy was measured with them); elsewhere they follow the mechanism.
-
-No absolute tolerance of an IDA run is ever below the round-off of its quantity, ``ROUNDOFF_FACTOR * eps`` times
-its scale (``L``, 1 rad, ``L W``, ``W``): GGL puts the positions and velocities on the constraint
-manifold at every Newton iteration, so their corrections never fall below the round-off of the
-constraint equations; a weight finer than that cannot be met, and IDA's Newton iteration then
-fails at every step size (the collapse of GGL at tight rtol, docs/engine.md).
-
-Multipliers (and the work state of ``track_work``) are always out of the error test.
+Each position and velocity state is one of four quantities (a body's ``x``/``y``, ``phi``,
+``vx``/``vy``, ``omega``); its default absolute tolerance is ``rtol`` times a fraction of its scale,
+with ``L`` the mechanism's size and ``W`` its angular rate (:func:`scales`; docs/engine.md,
+"Tolerances"): ``position`` ``rtol * POSITION_FRACTION * L`` or twice the smallest clearance if
+smaller, ``angle`` ``rtol * ANGLE_FRACTION``, ``velocity`` ``rtol * VELOCITY_FRACTION * L * W``,
+``angular_velocity`` ``rtol * VELOCITY_FRACTION * W``. No absolute tolerance is below the round-off
+of its quantity (``ROUNDOFF_FACTOR * eps`` times its scale: GGL's Newton corrections cannot be
+smaller). Multipliers (and the work state of ``track_work``) are always out of the error test.
 """
 
 from __future__ import annotations
@@ -40,24 +25,17 @@ from ..assembly.assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel
 from ..errors import DaeclearWarning
 from ..options import ATOL_QUANTITIES as QUANTITIES, atol_by_quantity, fail
 
-# Multipliers are kept out of IDA's error test by a huge absolute tolerance (scikit-sundae has
-# no IDASetSuppressAlg): atol = MULTIPLIER_ATOL_FACTOR * rtol, see docs/performance.md.
+# Multipliers are kept out of IDA's error test (scikit-sundae has no IDASetSuppressAlg) by
+# atol = max(MULTIPLIER_ATOL_FACTOR * rtol, MULTIPLIER_ATOL_FLOOR N): below the floor impact
+# multipliers (1e3..1e5 N) would be back in the test, which breaks GGL (docs/performance.md).
 MULTIPLIER_ATOL_FACTOR = 1e12
-# ... and never below this floor (N or N m): at rtol 1e-11, 1e12 * rtol = 10 N would put impact
-# multipliers of 1e3..1e5 N back into the error test, which breaks the index-2 GGL runs.
 MULTIPLIER_ATOL_FLOOR = 1e4
-# The round-off floor of an absolute tolerance, in units of eps times the quantity's scale. Measured
-# on the chapter's scenes (bench_convergence.py): GGL's Newton iteration fails at every step size
-# with a velocity atol of 1e-13 m/s (5 eps L W) and runs with 1e-12 (50 eps L W); positions need
-# 1e-14 m (260 eps L) in the translational clearance joint; 300 keeps a margin for both.
+# Round-off floor of an absolute tolerance, in eps times the quantity's scale: GGL's Newton fails
+# below 5-260 eps (bench_convergence.py); the ODE methods' error estimates need ~10 eps.
 ROUNDOFF_FACTOR = 300.0
-# The explicit and scipy methods integrate the index-1 ODE: no Newton on constraint equations, but
-# their error estimates still carry the round-off of each component (DOP853 at rtol 1e-10 on the
-# chapter's scene: an onset's approach speed 1.5e-4 off with a velocity atol of 9e-16 m/s, 1e-5 with
-# 1e-13 m/s). 10 eps times the scale keeps their error test above it.
 ODE_ROUNDOFF_FACTOR = 10.0
 EPS = float(np.finfo(float).eps)
-# The default absolute tolerances as fractions of each quantity's scale (per unit of rtol): see above.
+# The default absolute tolerances as fractions of each quantity's scale (per unit of rtol).
 POSITION_FRACTION = 6e-3
 CLEARANCE_SPAN = 2.0
 ANGLE_FRACTION = 1e-3
@@ -68,11 +46,8 @@ UNITS = {"position": "m", "angle": "rad", "velocity": "m/s", "angular_velocity":
 
 @dataclass(frozen=True)
 class Scales:
-    """The scales of a mechanism that its tolerances are made of.
-
-    length: its size L (m); resolution: the length a run must resolve (m: POSITION_FRACTION * L, or
-    twice the smallest clearance); rate: its angular rate W (rad/s).
-    """
+    """A mechanism's size L (``length``, m), the length a run must resolve (``resolution``, m) and its
+    angular rate W (``rate``, rad/s)."""
 
     length: float
     resolution: float
@@ -87,22 +62,19 @@ class Scales:
         return {q: max(raw[q], lowest[q]) for q in QUANTITIES}
 
     def roundoff(self, newton: bool = True) -> dict[str, float]:
-        """The smallest absolute tolerance of each quantity that a method's corrections (``newton``:
-        IDA's, on the DAE) or error estimates (the ODE methods') can meet."""
+        """The smallest absolute tolerance of each quantity that IDA's Newton corrections (``newton``)
+        or the ODE methods' error estimates can meet."""
         unit = (ROUNDOFF_FACTOR if newton else ODE_ROUNDOFF_FACTOR) * EPS
         return {"position": unit * self.length, "angle": unit, "velocity": unit * self.length * self.rate,
                 "angular_velocity": unit * self.rate}
 
 
 def scales(model: DAEModel) -> Scales:
-    """The scales of an assembled mechanism, read from its numbers and its declared start.
+    """The scales of an assembled mechanism, from its numbers and its declared start.
 
-    L: the largest distance from the origin of a body's centre, of a joint point (body frame) and
-    the largest radius of gyration sqrt(I / m); 1 m if all are 0. W: the largest of the start's
-    angular velocities, its linear velocities over L, the drivers' speeds (a translational driver's
-    over L), sqrt(|g| / L), and the speed each body reaches after a turn of one radian (a travel of L)
-    under the applied loads alone at the start, sqrt(|Q_phi| / I) (sqrt(|Q_xy| / (m L))); 1 rad/s if
-    all are 0.
+    L: the largest of the bodies' centres' and joint points' distances and radii of gyration (1 m if
+    all are 0). W: the largest of the start's angular velocities and linear velocities over L, the
+    drivers' speeds, sqrt(|g| / L) and the loads' sqrt(|Q_phi| / I), sqrt(|Q_xy| / (m L)) (1 rad/s).
     """
     n = model.n_q
     q, v = model.q_guess.tolist(), model.v_guess.tolist()
@@ -123,8 +95,7 @@ def scales(model: DAEModel) -> Scales:
             rates.append(speed / length if f"{driver}.axis" in entries else speed)
     if "gravity" in entries:
         rates.append(math.sqrt(math.hypot(*entries["gravity"]) / length))
-    if model.has_loads:  # what the applied loads (springs, torques, motors, forces, and gravity with
-        # them) do to each body alone at the start: the speed after a turn of one radian (or a travel of L)
+    if model.has_loads:  # each body's speed after a turn of one radian (a travel of L) under the loads alone
         force = np.asarray(model.base_force(0.0, model.q_guess, model.v_guess, model.parameter_values)).ravel()
         acceleration = np.abs(force / model.mass_diagonal).tolist()
         rates += [math.sqrt(acceleration[i + 2]) for i in range(0, n, 3)]
@@ -144,22 +115,18 @@ def tolerance_vector(model: DAEModel, rtol: float, atol: float | Mapping[str, fl
                      *, newton: bool = True) -> NDArray[np.float64]:
     """Absolute tolerances per state from ``atol``; multipliers and work always out of the error test.
 
-    ``atol``: None (the defaults of :class:`Scales`), one number for every position and velocity,
-    a mapping by quantity (missing quantities take their defaults), or an array of ``2 n_q``
-    values (positions, then velocities) or of ``n_states`` (whose multiplier and work entries
-    are not used). Values below the round-off of their quantity are raised to it (with a warning
-    when given): for ``newton`` (IDA, Newton on the DAE) ROUNDOFF_FACTOR eps times the quantity's
-    scale, for the ODE methods ODE_ROUNDOFF_FACTOR eps.
+    ``atol``: None (the defaults of :class:`Scales`), one number, a mapping by quantity (the others
+    default), or ``2 n_q`` values (positions, then velocities) or ``n_states``. Given values below
+    the round-off of their quantity (``newton``: IDA's) are raised to it with a warning.
     """
+
     n = 2 * model.n_q
     vec = np.empty(model.n_states)
     quantities = state_quantities(model)
     mine = scales(model)
     defaults = mine.default_atol(rtol, newton=newton)
-    if atol is None:
-        vec[:n] = [defaults[k] for k in quantities]
-    elif isinstance(atol, Mapping):
-        given = {**defaults, **atol_by_quantity(atol, where="simulate", field="atol")}
+    if atol is None or isinstance(atol, Mapping):  # a mapping: the quantities it does not name keep their defaults
+        given = defaults if atol is None else {**defaults, **atol_by_quantity(atol, where="simulate", field="atol")}
         vec[:n] = [given[k] for k in quantities]
     elif np.ndim(atol) == 0:
         value = float(atol)  # type: ignore[arg-type]
@@ -176,9 +143,9 @@ def tolerance_vector(model: DAEModel, rtol: float, atol: float | Mapping[str, fl
         vec[:n] = given_vec[:n]
     if atol is not None:
         _raise_to_roundoff(vec[:n], quantities, mine.roundoff(newton))
-    multipliers, work = _out_of_error_test(model.state_kinds)
-    vec[multipliers] = max(MULTIPLIER_ATOL_FACTOR * rtol, MULTIPLIER_ATOL_FLOOR)
-    vec[work] = 1e30  # a pure quadrature: out of the error test, the solution is unchanged
+    kinds = np.array(model.state_kinds)
+    vec[kinds == KIND_MULTIPLIER] = max(MULTIPLIER_ATOL_FACTOR * rtol, MULTIPLIER_ATOL_FLOOR)
+    vec[kinds == KIND_WORK] = 1e30  # a pure quadrature: out of the error test, the solution is unchanged
     return vec
 
 
@@ -193,11 +160,6 @@ def _raise_to_roundoff(vec: NDArray[np.float64], quantities: list[str], floor: d
         parts = ", ".join(f"{q} to {v:.2g} {UNITS[q]}" for q, v in raised.items())
         warnings.warn(f"simulate: atol below round-off raised ({parts}): Newton's corrections cannot be "
                       "smaller (docs/engine.md, Tolerances).", DaeclearWarning, stacklevel=5)
-
-
-def _out_of_error_test(kinds: tuple[str, ...]) -> tuple[list[int], list[int]]:
-    """Indices of the multipliers and of the work state."""
-    return [i for i, k in enumerate(kinds) if k == KIND_MULTIPLIER], [i for i, k in enumerate(kinds) if k == KIND_WORK]
 
 
 def atol_record(atol: float | Mapping[str, float] | ArrayLike | None) -> Any:
