@@ -1,11 +1,8 @@
 """What a simulation returns: the `Result` container (time series, named channels, events, statistics).
 
-A `Result` is a pure data container filled by the solver (`solvers/ida.py`, `solvers/explicit.py`);
-it computes nothing about mechanics. Its HDF5 round trip (`Result.save`, `load`, `load_times`) and
-hand-off to pandas and xarray are done by the other modules of daeclear.results, one job each
-(events, values, hdf5_write, hdf5_stream, hdf5_read, export); every public name users import from
-here (``ContactEvent``, ``EventList``, ``ResultWriter``, ``write_result_group``, ...) stays here.
-The file layout: docs/hdf5_layout.md and daeclear.results.hdf5_write.
+A pure data container filled by the solvers; its HDF5 round trip and hand-off to pandas and xarray
+live in the other modules of daeclear.results (one job each), whose public names are re-exported
+here. The file layout: docs/hdf5_layout.md.
 """
 
 from __future__ import annotations
@@ -65,34 +62,25 @@ class Result:
     Parameters
     ----------
     t : array_like, shape (n_times,)
-        Output times (s), non-decreasing (an event time may appear twice,
-        before and after a restart).
+        Output times (s), non-decreasing (an event time may appear twice: before and after a restart).
     y, yp : array_like, shape (n_times, n_states)
-        States and their time derivatives, time first. ``yp`` may be None with lazy
-        channels that compute it (the run's consistency pass; a run's also gives `y`'s multipliers).
+        States and their time derivatives. ``yp`` may be None with lazy channels that compute it
+        (the run's consistency pass).
     state_names : list of str
         Name of each state, e.g. ``"crank.x"``, ``"crank.vx"``, ``"lambda.A.x"``.
     channels : mapping of str to array_like, or LazyChannels
-        Named outputs ``"<object>.<quantity>"`` (e.g. ``"slider.vx"``,
-        ``"motor.moment"``), each with first dimension n_times. Dtypes are kept.
-        Names must not contain "/". A run's result holds a
-        :class:`~daeclear.results.lazy_channels.LazyChannels`: its channels are computed
-        from the stored states at their first read (docs/results.md).
+        Named outputs ``"<object>.<quantity>"`` (no "/"), each with first dimension n_times; a run's
+        :class:`~daeclear.results.lazy_channels.LazyChannels` computes them at their first read.
     units : mapping of str to str
-        Unit of channels and states (e.g. ``"m/s"``). Names without a unit get
-        ``""``; a name that is neither a channel nor a state is an error.
+        Unit of channels and states (``""`` when not given); a name that is neither is an error.
     events : sequence of ContactEvent, optional
         Contact transitions, in time order.
     segments : sequence of (t_start, t_end, modes), optional
-        Integration segments between restarts; ``modes`` maps each contact pair
-        to ``"free"`` or ``"contact"``.
+        Integration segments between restarts; ``modes``: contact pair -> ``"free"`` or ``"contact"``.
     step_t, step_h, step_order : array_like, shape (n_steps,), optional
-        IDA's internal steps: time reached, step size, BDF order. Given
-        together or not at all; they differ from `t` when `t_eval` was given.
+        IDA's internal steps (time reached, size, BDF order), given together or not at all.
     stats : mapping, optional
-        Solver statistics as given by the solver (``n_steps``,
-        ``n_res_evals``, ``n_jac_evals``, ``n_events``, ``n_restarts``,
-        ``setup_time``, ``solve_time``, ...).
+        Solver statistics (``n_steps``, ``n_res_evals``, ``n_events``, ``solve_time``, ...).
     success : bool, default True
         False when the run failed (``status == -1``).
     status : {0, 1, -1}, default 0
@@ -100,14 +88,10 @@ class Result:
     message : str, default ""
         The solver's last word, e.g. why it failed.
     parameters : mapping, optional
-        Nested parameters of the scene and the run, e.g.
-        ``{"scene": {...}, "simulate": {"rtol": 1e-6, ...}}``: numbers,
-        strings, bools, None, lists and dicts. numpy scalars and arrays,
-        tuples and paths are converted to plain floats, ints, lists and
-        strings, dataclass instances to dicts of their fields.
+        Nested parameters of the scene and the run (``{"scene": {...}, "simulate": {...}}``), made plain
+        data (numpy values, tuples, paths and dataclasses converted).
     scene_name, method, formulation : str, default ""
-        Where the result came from: the scene's name, the integrator
-        (``"ida"``, ``"DOP853"``, ...) and the DAE formulation (``"index1"``, ``"ggl"``).
+        The scene's name, the integrator (``"ida"``, ``"DOP853"``, ...) and the formulation.
     warnings : sequence of dict, optional
         What the run's physics checks found (see :mod:`daeclear.solvers.physics`): each a dict with
         ``kind``, ``quantity``, ``value``, ``limit``, ``unit``, ``where``, ``t``, ``message``.
@@ -122,9 +106,7 @@ class Result:
     Warns
     -----
     DaeclearWarning
-        When a value in `parameters` or `stats` is none of the storable types
-        (nor a dataclass, which becomes a dict of its fields); it is stored as
-        its ``repr``.
+        When a value in `parameters` or `stats` is none of the storable types (stored as its ``repr``).
 
     Examples
     --------
@@ -358,41 +340,16 @@ class Result:
     # ------------------------------------------------------------------ windows
 
     def window_mask(self, t0: float | None = None, t1: float | None = None) -> NDArray[np.bool_]:
-        """Boolean mask of the output times in the closed window [t0, t1].
-
-        Parameters
-        ----------
-        t0, t1 : float, optional
-            Window bounds (s); None leaves that side open.
-
-        Returns
-        -------
-        ndarray of bool, shape (n_times,)
-
-        Raises
-        ------
-        ValueError
-            If ``t0 > t1``.
-        """
+        """Boolean mask of the output times in the closed window [t0, t1] (s; None: that side open).
+        ValueError if ``t0 > t1``."""
         lo, hi = time_window(t0, t1)
         return (self.t >= lo) & (self.t <= hi)
 
     def slice(self, t0: float | None = None, t1: float | None = None) -> Result:
-        """A new Result restricted to the closed time window [t0, t1].
+        """A new Result restricted to the closed time window [t0, t1] (s; None: that side open).
 
-        Output times, `y`, `yp`, channels, events and internal steps inside the
-        window are kept; segments overlapping it are clipped to it. `stats`,
-        `parameters`, `success`, `status` and `message` describe the whole run
-        and are copied unchanged.
-
-        Parameters
-        ----------
-        t0, t1 : float, optional
-            Window bounds (s); None leaves that side open.
-
-        Returns
-        -------
-        Result
+        Points, channels, events and steps inside the window are kept, overlapping segments
+        clipped; `stats`, `parameters` and the outcome describe the whole run and are copied.
 
         Examples
         --------
@@ -420,15 +377,9 @@ class Result:
         return Result(**kw)
 
     def to_dict(self, *, channels: bool = True) -> dict[str, Any]:
-        """The constructor keywords: ``Result(**result.to_dict())`` rebuilds the result.
-
-        Returns
-        -------
-        dict
-            Arrays are the result's own read-only arrays (the channels computed if not yet;
-            ``channels=False``: not computed, the result's own channel source or arrays); `events`
-            is a list of `ContactEvent`; `stats` and `parameters` are copies.
-        """
+        """The constructor keywords: ``Result(**result.to_dict())`` rebuilds the result. Arrays are the
+        result's own (the channels computed; ``channels=False``: its channel source); `stats` and
+        `parameters` are copies."""
         return {
             "t": self.t,
             "y": self.y,
@@ -455,74 +406,33 @@ class Result:
     # ------------------------------------------------------------------ hand-off to pandas and xarray
 
     def to_pandas(self, *, states: bool = False) -> pd.DataFrame:
-        """The channels as a pandas DataFrame, one column per channel, indexed by time.
+        """The channels as a pandas DataFrame (copies), one column per channel, indexed by time ``"t"``.
 
-        The hand-off to pandas-based tools: the index is named ``"t"`` (s) and may hold an
-        event time twice (before and after a restart). A channel with more than one value per
-        time (shape (n_times, k)) becomes the columns ``"name[0]"`` ... ``"name[k-1]"``.
-        Dtypes are kept; values are copies.
-
-        Parameters
-        ----------
-        states : bool
-            Also add one column per state (``y``) whose name is not already a channel.
-
-        Returns
-        -------
-        pandas.DataFrame
-            ``df.attrs["units"]`` maps every column and ``"t"`` to its unit (``""`` when
-            unknown); ``df.attrs`` also holds scene_name, method, formulation, success,
-            status and message. Events are in `events_frame`.
-
-        Raises
-        ------
-        MissingDependencyError
-            (an ImportError) if pandas is not installed: ``pip install "daeclear[data]"``.
+        An event time may appear twice (before and after a restart); a channel of shape (n_times, k)
+        becomes the columns ``"name[0]"`` ... ``"name[k-1]"``; ``states=True`` adds the states that
+        are not channels. ``df.attrs`` holds ``"units"`` (per column and ``"t"``), scene_name, method,
+        formulation, success, status and message. MissingDependencyError (an ImportError) without
+        pandas: ``pip install "daeclear[data]"``.
         """
         return export.to_pandas(self, states=states)
 
     def events_frame(self, *, states: bool = False) -> pd.DataFrame:
-        """The contact events as a pandas DataFrame, one row per event, in time order.
-
-        Columns ``t`` (s), ``pair``, ``kind`` (``"onset"`` or ``"separation"``) and
-        ``approach_speed`` (m/s, nan where meaningless); with ``states=True`` also the state
-        at each event, one column per state name. ``df.attrs["units"]`` gives the units.
-
-        Raises
-        ------
-        MissingDependencyError
-            (an ImportError) if pandas is not installed: ``pip install "daeclear[data]"``.
-        """
+        """The contact events as a pandas DataFrame in time order: ``t`` (s), ``pair``, ``kind`` and
+        ``approach_speed`` (m/s, nan where meaningless), with ``states=True`` the state at each event;
+        ``df.attrs["units"]``. MissingDependencyError (an ImportError) without pandas."""
         return export.events_frame(self, states=states)
 
     def to_xarray(self, *, states: bool = True) -> xr.Dataset:
         """The result as an xarray Dataset: channels over ``t``, events over ``event``.
 
-        Every channel is a variable over the dimension ``t`` (extra dimensions of a
-        multi-dimensional channel are named ``"<channel>_dim_1"``, ...) with its unit in
-        ``attrs["units"]``; the coordinate ``t`` has ``units="s"`` and may hold an event time
-        twice (select by position, ``ds.isel``). The events are the variables
-        ``event_t``, ``event_pair``, ``event_kind``, ``event_approach_speed`` (and
-        ``event_y`` with states) over the dimension ``event``; the segments are
-        ``segment_t_start``, ``segment_t_end``, ``segment_modes`` (JSON) over ``segment``.
-        Attributes are netCDF-safe: scene_name, method, formulation, success (0/1),
-        status, message, every scalar statistic as ``stats.<name>``, and the full
-        statistics and parameters as JSON strings ``stats_json``, ``parameters_json``.
-
-        Parameters
-        ----------
-        states : bool
-            Include ``y`` and ``yp`` over (``t``, ``state``), with the coordinates
-            ``state`` (names) and ``state_units``.
-
-        Returns
-        -------
-        xarray.Dataset
-
-        Raises
-        ------
-        MissingDependencyError
-            (an ImportError) if xarray is not installed: ``pip install "daeclear[data]"``.
+        Each channel is a variable over ``t`` (more dimensions named ``"<channel>_dim_1"``, ...) with
+        ``attrs["units"]``; ``t`` may hold an event time twice (select by position, ``ds.isel``). The
+        events are ``event_t``, ``event_pair``, ``event_kind``, ``event_approach_speed`` (and
+        ``event_y`` with states) over ``event``; the segments ``segment_t_start``, ``segment_t_end``,
+        ``segment_modes`` (JSON) over ``segment``. Attributes are netCDF-safe (success as 0/1, each
+        scalar statistic as ``stats.<name>``, ``stats_json``, ``parameters_json``). ``states=True``
+        adds ``y`` and ``yp`` over (``t``, ``state``). MissingDependencyError (an ImportError) without
+        xarray: ``pip install "daeclear[data]"``.
         """
         return export.to_xarray(self, states=states)
 
