@@ -29,3 +29,19 @@ def test_example_scene_runs(path, tmp_path, capsys):
     assert result.success and result.t[-1] == pytest.approx(0.002)
     assert result.method.lower() == spec.simulate.get("method", "ida").lower()
     assert next(tmp_path.glob("*.png")).stat().st_size > 10_000
+
+
+def test_the_format_pages_whole_files_read(tmp_path):
+    """docs/scene_files.md's two whole files (a mechanism with [simulate], a scene element by element) read."""
+    import re
+
+    page = (Path(__file__).resolve().parent.parent / "docs" / "scene_files.md").read_text()
+    blocks = re.findall(r"```toml\n(.*?)```", page, re.S)
+    whole = [b for b in blocks if b.startswith(("[mechanism]", "[scene]"))]
+    assert len(whole) == 2
+    for i, text in enumerate(whole):
+        path = tmp_path / f"page{i}.toml"
+        path.write_text(text)
+        spec = read_scene_file(path)
+        assert spec.scene.bodies
+    assert read_scene_file(tmp_path / "page0.toml").simulate == {"t_end": 0.024, "rtol": 1e-6}

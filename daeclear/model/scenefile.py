@@ -1,62 +1,7 @@
 """Scene files (TOML): a named mechanism with its parameters, or a scene element by element.
 
-A mechanism file::
-
-    [mechanism]
-    name = "slider_crank"
-    joint = "ideal"
-    rpm = 5000.0
-
-    [simulate]
-    t_end = 0.024
-    rtol = 1e-6
-    # also: atol, formulation, method, backend, max_step, t_eval_step, start ("ideal" or "declared"),
-    # allow_penetration (true: a declared start deep in a wall is not refused), step (method = "rk4" or "euler")
-
-A scene file (tables map key for key onto the Python classes)::
-
-    [scene]
-    name = "pendulum"
-    gravity = [0.0, -9.81]
-
-    [[body]]
-    name = "link"
-    mass = 1.0
-    inertia = 0.01
-    position = [0.5, 0.0]
-
-    [[revolute]]
-    name = "A"
-    body_i = "ground"
-    body_j = "link"
-    at = [0.0, 0.0]
-
-Clearance joints (``[[revolute_clearance]]``, ``[[translational_clearance]]``) take their materials
-and laws as inline tables (docs/user_guide.md: ``material = { young = 207e9, poisson = 0.3 }``,
-``law = { name = "lankarani-nikravesh", restitution = 0.9 }``, ``friction = 0.05`` or a table); a
-lubricated joint's law table is ``{ name = "hydrodynamic", ... }`` (docs/lubrication.md).
-
-Drivers take their motion profile as a table (see :mod:`daeclear.profiles`)::
-
-    [[driver]]
-    name = "drive"
-    joint = "A"                # a revolute or translational joint, with or without clearance
-    speed = 523.6
-    profile = { kind = "ramp", time = 0.01 }   # or "harmonic" (amplitude, frequency, phase),
-                                               # "tabulated" (times, values), "constant"
-
-An ideal ``[[revolute]]`` or ``[[translational]]`` joint becomes a clearance joint with a
-``clearance`` table: its bodies, point and axis stay, the table gives the clearance joint's own
-fields (``bearing`` names a revolute joint's bearing body, ``name`` renames the joint)::
-
-    [[revolute]]
-    name = "B"
-    body_i = "crank"
-    body_j = "rod"
-    at = [0.05, 0.0]
-    clearance = { clearance = 0.5e-3, bearing_radius = 0.01, material = { young = 207e9, poisson = 0.3 } }
-
-Unknown tables or keys are errors that name the file, the table and the key.
+The format, with examples: docs/scene_files.md. Unknown tables or keys are errors that name the
+file, the table and the key.
 """
 
 from __future__ import annotations
