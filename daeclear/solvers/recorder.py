@@ -1,18 +1,12 @@
 """Where a run's output goes while it runs: kept in memory, or streamed to an HDF5 file.
 
-The solvers (:mod:`daeclear.solvers.ida`, :mod:`daeclear.solvers.explicit`) hand a :class:`Recorder` their
-reported points chunk by chunk, each with the switch vector of its segment, and their steps, events
-and segments. The IDA loop's points come without channels, and, kept in memory, as IDA left them
-(:attr:`Recorder.consistent_when_read`): the run's `Result` makes their multipliers and yp
-consistent and computes the channels when they are first read
-(:class:`daeclear.results.lazy_channels.LazyChannels`); the explicit methods compute them as they go.
-In memory the chunks are kept and joined into the `Result` at the end. Streamed (``stream_to``),
-each chunk is appended to the file and dropped, so the run's memory does not grow with its length,
-and the file holds what was computed whatever stops the run (see
-:class:`daeclear.results.result.ResultWriter`); a scene that can be rebuilt from its description
-streams its states only (the file's reader computes the channels). Either way the physics checks
-read the few rows of :func:`daeclear.solvers.physics.key_rows`, so a streamed run is checked
-exactly as a run kept in memory.
+The solvers hand a :class:`Recorder` their reported points chunk by chunk, each with the switch
+vector of its segment, and their steps, events and segments. IDA's points come without channels
+and, kept in memory, as IDA left them: the run's `Result` makes their multipliers and yp consistent
+and computes the channels at the first read (:class:`~daeclear.results.lazy_channels.LazyChannels`).
+Streamed (``stream_to``), each chunk is appended to the file and dropped, so the run's memory does
+not grow with its length and the file holds what was computed whatever stops the run. Either way
+the physics checks read the few rows of :func:`daeclear.solvers.physics.key_rows`.
 """
 
 from __future__ import annotations
@@ -42,14 +36,9 @@ def out_of_memory(t: float) -> str:
 
 
 class Recorder:
-    """The output of one run (see the module docstring).
-
-    ``events`` and ``segments`` are the lists the solver appends to; :meth:`flush` writes the new
-    ones (streamed: and empties the lists; :attr:`n_events` counts every event of the run).
-    :attr:`session` is the run's open session (set by the IDA loop while it is open): points added
-    without channels get the few the physics checks read (:meth:`DAEModel.checks`) from its library,
-    and every channel only where a streamed file must store them.
-    """
+    """The output of one run. ``events`` and ``segments`` are the lists the solver appends to
+    (:meth:`flush` writes and, streamed, empties them); :attr:`session` is the run's open session,
+    in whose library the checked channels are evaluated while it is open."""
 
     def __init__(self, model: Any, *, parameters: Mapping[str, Any], method: str,
                  stream_to: Path | None = None, keep_data: bool = True) -> None:
