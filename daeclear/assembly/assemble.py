@@ -528,7 +528,7 @@ class _TemplateBuilder:
         logic_makers = tuple(build.logic for build in builds)
         sample = [logic for make in logic_makers for logic in make(self.table.vector)]
         auto_pairs = []
-        simple = [getattr(logic, "simple_pairs", lambda: None)() for logic in sample]
+        simple = [logic.simple_pairs() for logic in sample]
         given = [pairs for pairs in simple if pairs is not None]
         if sample and len(given) == len(simple):
             for index, pairs in enumerate(given):

@@ -47,20 +47,20 @@ TermSwitch = tuple[int, bool, NDArray[np.float64]]
 
 @dataclass(frozen=True)
 class PairLogic:
-    """Mode switching of one contact pair: one gap (root) and one term. A rule, not a state: the
-    run's state of the pair (:class:`~daeclear.assembly.automaton.PairState`) is passed in and
-    returned (see :mod:`daeclear.assembly.contact_state`).
+    """Mode switching of contact pairs, each with one gap (root ``first_root + i``) and one term
+    (``pair_terms[i]``). A rule, not a state: the run's pair states
+    (:class:`~daeclear.assembly.automaton.PairState`) are passed in and returned
+    (:mod:`daeclear.assembly.contact_state`).
 
-    ``rate`` evaluates ``(gap, penetration_rate)`` from ``(q, v)``; ``needs_approach`` says
-    whether the term's parameter is the approach speed latched at onset. The rule, storm guard
-    included, is :func:`daeclear.assembly.automaton.step` with this pair's ``storm`` constants; the term
-    is on while the pair is in contact or held.
+    ``rate`` maps ``(q, v)`` to the gaps and the penetration rates; ``needs_approach``: a term's
+    parameter is the approach speed latched at onset. Each root is decided by
+    :func:`daeclear.assembly.automaton.step`; a term is on while its pair is in contact or held.
     """
 
-    pair: str
-    root_index: int
-    term_index: int
-    rate: BufferedFunction  # (q, v) -> (gap, penetration rate)
+    pairs: tuple[str, ...]
+    first_root: int
+    pair_terms: tuple[int, ...]
+    rate: BufferedFunction  # (q, v) -> (gaps, penetration rates)
     n_q: int
     needs_approach: bool
     min_approach_speed: float
@@ -70,58 +70,67 @@ class PairLogic:
     @property
     def roots(self) -> range:
         """Indices of the gaps (roots) of this element."""
-        return range(self.root_index, self.root_index + 1)
+        return range(self.first_root, self.first_root + len(self.pairs))
 
     def pair_index(self, root: int) -> int:
         """The pair (index in this element's states) of gap ``root``."""
-        return 0
+        return root - self.first_root
 
     def pair_name(self, root: int) -> str:
         """The name of the pair of gap ``root`` (its events' ``pair``)."""
-        return self.pair
+        return self.pairs[self.pair_index(root)]
 
-    def _gap_rate(self, y: NDArray) -> tuple[float, float]:
-        q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
-        gap, rate = self.rate(q, v)
-        return float(gap[0]), float(rate[0])
+    def _evaluate(self, y: NDArray) -> tuple[NDArray, NDArray]:
+        gaps, rates = self.rate(y[:self.n_q], y[self.n_q:2 * self.n_q])
+        return np.ravel(gaps), np.ravel(rates)
 
     def _params(self, state: PairState) -> NDArray:
         return np.array([state.latched]) if self.needs_approach else np.zeros(0)
 
     def start(self, t: float, y: NDArray) -> PairStates:
-        """The pair's state at the start of a run (mode from the gap, rate latched, no history)."""
-        gap, rate = self._gap_rate(y)
-        return (start(gap > 0.0, rate, self.min_approach_speed),)
+        """Each pair's state at the start of a run (mode from its gap, rate latched, no history)."""
+        gaps, rates = self._evaluate(y)
+        return tuple(start(gap > 0.0, float(rate), self.min_approach_speed) for gap, rate in zip(gaps, rates))
 
     def terms(self, states: PairStates) -> list[TermSwitch]:
-        """The term is on in contact or held; its parameter the latched approach speed."""
-        return [(self.term_index, states[0].term_on, self._params(states[0]))]
+        """A term is on in contact or held; its parameter the latched approach speed."""
+        return [(k, st.term_on, self._params(st)) for k, st in zip(self.pair_terms, states)]
 
     def modes(self, states: PairStates) -> dict[str, str]:
-        return {self.pair: "contact" if states[0].contact else "free"}
+        return {p: ("contact" if st.contact else "free") for p, st in zip(self.pairs, states)}
 
     def root_directions(self, states: PairStates) -> list[tuple[int, int]]:
         """While free watch onsets (+1), in contact separations (-1), held both (0)."""
-        return [(self.root_index, states[0].watch)]
+        return [(self.first_root + i, st.watch) for i, st in enumerate(states)]
 
     def decide(self, states: PairStates, t: float, y: NDArray, roots_found: NDArray | None
                ) -> tuple[PairStates, list[ContactEvent]]:
-        """Decide a root of the pair's gap by the automaton: the new states and the events."""
-        if roots_found is None or roots_found[self.root_index] == 0:
+        """Decide the roots of the pairs' gaps by the automaton: the new states and the events."""
+        if roots_found is None:
             return states, []
-        rate = self._gap_rate(y)[1]
-        state, decision = step(states[0], t, int(roots_found[self.root_index]), rate, storm=self.storm,
-                               min_approach_speed=self.min_approach_speed)
-        return (state,), pair_event(self.pair, t, y, rate, decision)
+        found = roots_found[self.first_root:self.first_root + len(self.pairs)]
+        if not np.any(found):
+            return states, []
+        rates = self._evaluate(y)[1]
+        events: list[ContactEvent] = []
+        new = list(states)
+        for i, direction in enumerate(int(d) for d in found):
+            if direction:
+                new[i], decision = step(new[i], t, direction, float(rates[i]), storm=self.storm,
+                                        min_approach_speed=self.min_approach_speed)
+                events += pair_event(self.pairs[i], t, y, float(rates[i]), decision)
+        return tuple(new), events
 
-    def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]]:
+    def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
         """(root, term, (q, v, P) -> [gap; rate], needs approach speed, floor): the pairs whose
         switches the compiled IDA loop decides itself, by the C mirror of the automaton."""
         fn = self.rate.function
         q, v, P = (ca.SX.sym(label, fn.numel_in(i)) for i, label in enumerate(("q", "v", "P")))
-        gap, rate = fn(q, v, P)
-        f = ca.Function(f"{self.pair.replace('.', '_')}_gap_rate", [q, v, P], [ca.vertcat(gap, rate)])
-        return [(self.root_index, self.term_index, f, bool(self.needs_approach), float(self.min_approach_speed))]
+        gaps, rates = fn(q, v, P)
+        return [(self.first_root + i, k, ca.Function(f"{pair.replace('.', '_')}_gap_rate", [q, v, P],
+                                                      [ca.vertcat(gaps[i], rates[i])]),
+                 bool(self.needs_approach), float(self.min_approach_speed))
+                for i, (pair, k) in enumerate(zip(self.pairs, self.pair_terms))]
 
 
 def pair_event(pair: str, t: float, y: NDArray, rate: float, decision: Decision) -> list[ContactEvent]:

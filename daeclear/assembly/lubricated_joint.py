@@ -88,7 +88,7 @@ def build_lubricated_revolute(ctx: AssemblyContext, joint: RevoluteClearance, fi
     discontinuous = not friction_numeric.frictionless and not friction_numeric.smooth
 
     def logic(P: NDArray[np.float64]) -> list[Any]:
-        return [LubricatedLogic(name, first_root, first_term, BufferedFunction(rate, bound=(P,)), n_q,
+        return [LubricatedLogic((name,), first_root, (first_term,), BufferedFunction(rate, bound=(P,)), n_q,
                                 dry_numeric.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
@@ -112,15 +112,18 @@ def build_lubricated_revolute(ctx: AssemblyContext, joint: RevoluteClearance, fi
 class LubricatedLogic(PairLogic):
     """Regime switching of one lubricated joint by the contact automaton (see the module docstring).
 
-    Root ``root_index`` (film_break) is watched upward, ``root_index + 1`` (film_reform) downward; the
-    dry term ``term_index`` is on while the automaton is in contact (or held), the film term
-    ``term_index + 1`` otherwise. ``rate`` gives (film_break gap, film_reform gap, penetration rate).
-    The compiled loop hands these roots to Python (no simple pairs).
+    Its one pair watches two roots: ``first_root`` (film_break) upward, ``first_root + 1``
+    (film_reform) downward; the dry term ``pair_terms[0]`` is on while the automaton is in contact
+    (or held), the film term (the next one) otherwise. ``rate`` gives (film_break gap, film_reform
+    gap, penetration rate). The compiled loop hands these roots to Python (no simple pairs).
     """
 
     @property
     def roots(self) -> range:
-        return range(self.root_index, self.root_index + 2)
+        return range(self.first_root, self.first_root + 2)
+
+    def pair_index(self, root: int) -> int:
+        return 0
 
     def _values(self, y: NDArray) -> tuple[float, float, float]:
         out = self.rate(y[:self.n_q], y[self.n_q:2 * self.n_q])
@@ -132,27 +135,27 @@ class LubricatedLogic(PairLogic):
 
     def terms(self, states: PairStates) -> list[TermSwitch]:
         """The dry term while the automaton is in contact (or held), the film term otherwise."""
-        on = states[0].term_on
-        return [(self.term_index, on, self._params(states[0])), (self.term_index + 1, not on, np.zeros(0))]
+        on, k = states[0].term_on, self.pair_terms[0]
+        return [(k, on, self._params(states[0])), (k + 1, not on, np.zeros(0))]
 
     def root_directions(self, states: PairStates) -> list[tuple[int, int]]:
         """The film breaks upward through film_break, forms again downward through film_reform."""
-        return [(self.root_index, 1), (self.root_index + 1, -1)]
+        return [(self.first_root, 1), (self.first_root + 1, -1)]
 
     def decide(self, states: PairStates, t: float, y: NDArray, roots_found: NDArray | None
                ) -> tuple[PairStates, list[ContactEvent]]:
         if roots_found is None:
             return states, []
-        up = roots_found[self.root_index] > 0
-        down = roots_found[self.root_index + 1] < 0
+        up = roots_found[self.first_root] > 0
+        down = roots_found[self.first_root + 1] < 0
         if not (up or down):
             return states, []
         rate = self._values(y)[2]
         direction = 1 if up and not states[0].contact else -1 if down else 1
         state, decision = step(states[0], t, direction, rate, storm=self.storm,
                                min_approach_speed=self.min_approach_speed)
-        return (state,), pair_event(self.pair, t, y, rate, decision)
+        return (state,), pair_event(self.pairs[0], t, y, rate, decision)
 
-    def simple_pairs(self) -> None:  # type: ignore[override]
+    def simple_pairs(self) -> None:
         """None: two terms follow one pair, which the compiled loop's mirror does not do."""
         return None

@@ -65,7 +65,7 @@ def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, fir
     n_q = ctx.n_q  # read once: a CasADi call costs more inside a sweep's loop than the logic it makes
 
     def logic(P: NDArray[np.float64]) -> list[Any]:
-        return [PairLogic(name, first_root, first_term, BufferedFunction(rate, bound=(P,)), n_q,
+        return [PairLogic((name,), first_root, (first_term,), BufferedFunction(rate, bound=(P,)), n_q,
                           law_numeric.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:

@@ -87,8 +87,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from .automaton import DEFAULT_STORM, Storm, start, step
-from .contact_pairs import ContactBuild, PairStates, TermSwitch, approach_floor, pair_event
+from .contact_pairs import ContactBuild, PairLogic, PairStates, TermSwitch, approach_floor
 from .parameters import law_structure, law_values, symbolic_law
 from ..results.result import ContactEvent
 from ..model.scene import TranslationalClearance
@@ -128,57 +127,20 @@ def _unit(v: Sequence[float]) -> NDArray[np.float64]:
 
 
 @dataclass(frozen=True)
-class SliderGuideLogic:
-    """Mode switching of one translational clearance joint: four corner pairs and, in the
-    ``section-4.3`` model, two faces. A rule, not a state: the corners' states are passed in and
-    returned (see :mod:`daeclear.assembly.contact_state`).
+class SliderGuideLogic(PairLogic):
+    """Mode switching of one translational clearance joint: its four corner pairs
+    (:class:`~daeclear.assembly.contact_pairs.PairLogic`) and, in the ``section-4.3`` model, two
+    faces. A face term is on while both its corners are in contact, and then their corner terms
+    are off."""
 
-    Each corner is a pair of :mod:`daeclear.assembly.automaton` (free, contact or held, by the root of its
-    gap); the terms follow from the modes: a face term is on while both its corners are in
-    contact, a corner term while its corner's term is on (in contact or held) and its face is
-    not. ``rate`` maps ``(q, v)`` to the four gaps and the four penetration rates.
-    """
-
-    name: str
-    pairs: tuple[str, ...]
-    first_root: int
-    corner_terms: tuple[int, ...]
-    face_names: tuple[str, ...]
-    face_terms: tuple[int, ...]
-    face_corners: tuple[tuple[int, int], ...]
-    rate: BufferedFunction  # (q, v) -> (gaps, penetration rates)
-    n_q: int
-    needs_approach: bool
-    min_approach_speed: float
-    face_needs_approach: bool
-    face_min_approach_speed: float
-    storm: Storm = DEFAULT_STORM  # frozen: shared
-
-    @property
-    def roots(self) -> range:
-        """Indices of the gaps (roots) of this element: one per corner."""
-        return range(self.first_root, self.first_root + len(self.pairs))
-
-    def pair_index(self, root: int) -> int:
-        """The corner (index in this element's states) of gap ``root``."""
-        return root - self.first_root
-
-    def pair_name(self, root: int) -> str:
-        """The name of the corner of gap ``root`` (its events' ``pair``)."""
-        return self.pairs[root - self.first_root]
-
-    def _evaluate(self, y: NDArray) -> tuple[NDArray, NDArray]:
-        q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
-        gaps, rates = self.rate(q, v)
-        return np.asarray(gaps, dtype=float).ravel(), np.asarray(rates, dtype=float).ravel()
+    face_names: tuple[str, ...] = ()
+    face_terms: tuple[int, ...] = ()
+    face_corners: tuple[tuple[int, int], ...] = ()
+    face_needs_approach: bool = False
+    face_min_approach_speed: float = 0.0
 
     def _faces_on(self, states: PairStates) -> list[bool]:
         return [states[a].contact and states[b].contact for a, b in self.face_corners]
-
-    def start(self, t: float, y: NDArray) -> PairStates:
-        """Each corner's state at the start of a run (mode from its gap, rate latched, no history)."""
-        gaps, rates = self._evaluate(y)
-        return tuple(start(gaps[i] > 0.0, float(rates[i]), self.min_approach_speed) for i in range(len(self.pairs)))
 
     def terms(self, states: PairStates) -> list[TermSwitch]:
         """A face's term while both its corners are in contact (parameter: their mean latched speed,
@@ -189,40 +151,17 @@ class SliderGuideLogic:
             speed = max(0.5 * (states[a].latched + states[b].latched), self.face_min_approach_speed)
             out.append((self.face_terms[f], on, np.array([speed]) if self.face_needs_approach else np.zeros(0)))
             in_face[a] = in_face[b] = on
-        for i, k in enumerate(self.corner_terms):
-            params = np.array([states[i].latched]) if self.needs_approach else np.zeros(0)
-            out.append((k, states[i].term_on and not in_face[i], params))
-        return out
+        return out + [(k, on and not face, p) for (k, on, p), face in zip(super().terms(states), in_face)]
 
     def modes(self, states: PairStates) -> dict[str, str]:
-        modes = {p: ("contact" if st.contact else "free") for p, st in zip(self.pairs, states)}
+        modes = super().modes(states)
         modes.update({f: ("contact" if on else "free") for f, on in zip(self.face_names, self._faces_on(states))})
         return modes
 
-    def root_directions(self, states: PairStates) -> list[tuple[int, int]]:
-        """While a corner is free watch its onsets (+1), in contact separations (-1), held both (0)."""
-        return [(self.first_root + i, st.watch) for i, st in enumerate(states)]
-
     def decide(self, states: PairStates, t: float, y: NDArray, roots_found: NDArray | None
                ) -> tuple[PairStates, list[ContactEvent]]:
-        """Decide the roots of the corners' gaps by the automaton: the new states and the events of
-        corners and of faces that formed or broke."""
-        if roots_found is None:
-            return states, []
-        found = roots_found[self.first_root:self.first_root + len(self.pairs)]
-        if not np.any(found):
-            return states, []
-        gaps, rates = self._evaluate(y)
-        events: list[ContactEvent] = []
-        new = list(states)
-        for i, direction in enumerate(int(d) for d in found):
-            if direction == 0:
-                continue
-            rate = float(rates[i])
-            new[i], decision = step(new[i], t, direction, rate, storm=self.storm,
-                                    min_approach_speed=self.min_approach_speed)
-            events += pair_event(self.pairs[i], t, y, rate, decision)
-        after = tuple(new)
+        """The corners' decisions, then the events of the faces that formed or broke."""
+        after, events = super().decide(states, t, y, roots_found)
         for f, (was, on) in enumerate(zip(self._faces_on(states), self._faces_on(after))):
             a, b = self.face_corners[f]
             if on and not was:
@@ -235,21 +174,8 @@ class SliderGuideLogic:
         return after, events
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
-        """Without faces (model ``corners``) every corner term follows its own pair, so the compiled
-        IDA loop may decide its switches itself; with faces the terms depend on two corners."""
-        if self.face_names:
-            return None
-        fn = getattr(self.rate, "function", None)
-        if fn is None:
-            return None
-        q, v, P = (ca.SX.sym(label, fn.numel_in(i)) for i, label in enumerate(("q", "v", "P")))
-        gaps, rates = fn(q, v, P)
-        out = []
-        for i, pair in enumerate(self.pairs):
-            f = ca.Function(f"{pair.replace('.', '_')}_gap_rate", [q, v, P], [ca.vertcat(gaps[i], rates[i])])
-            out.append((self.first_root + i, self.corner_terms[i], f, bool(self.needs_approach),
-                        float(self.min_approach_speed)))
-        return out
+        """None with faces (their terms depend on two corners); else every corner's pair."""
+        return None if self.face_names else super().simple_pairs()
 
 
 def translational_clearance_parameters(ref: Reference,
@@ -398,8 +324,7 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
 
     def logic(P: NDArray[np.float64]) -> list[Any]:
         return [SliderGuideLogic(
-            name=name, pairs=tuple(pair_names), first_root=first_root,
-            corner_terms=tuple(first_term + i for i in range(n_corners)),
+            pairs=tuple(pair_names), first_root=first_root, pair_terms=tuple(first_term + i for i in range(n_corners)),
             face_names=tuple(face_names), face_terms=tuple(first_term + n_corners + f for f in range(len(face_names))),
             face_corners=tuple(face_corners), rate=BufferedFunction(rate, bound=(P,)), n_q=n_q,
             needs_approach=law_numeric.needs_approach_speed, min_approach_speed=floor(P),
