@@ -1,26 +1,9 @@
 """Clearance joints as contact elements: symbolic forces, gap functions, channels, event logic.
 
-A clearance joint adds no constraint. It brings
-
-* *terms*: generalized contact forces that the solver switches on only while the pair is
-  in contact (inactive terms are never evaluated);
-* *gaps*: root functions watched by IDA, positive in penetration;
-* *channels*: output quantities (eccentricity, penetration, forces);
-* *logic*: what happens at a root (mode switch, approach speed latched at onset).
-
-Event rule (documented in docs/user_guide.md, "Contact events")
----------------------------------------------------------------
-A pair is *free* or in *contact*. While free, only upward crossings of its gap are
-watched (onset); while in contact only downward ones (separation). At an onset the
-approach speed (the penetration rate at the located root) is latched, floored at the
-law's ``min_approach_speed`` so the damping term stays bounded for grazing contacts,
-and the term is switched on; at a separation it is switched off. Every switch restarts
-IDA from a consistent state. The contact force is exactly zero with a zero derivative
-at zero penetration for every continuous law, so a switch never jumps the force; and
-because IDA returns a root just past the crossing, a restart never reports the same
-crossing twice. Following (continuous) contact keeps the pair in contact mode with no
-events at all; a Zeno-like cascade of ever shorter bounces is cut by the storm guard.
-The rule, storm guard included, is defined once in :mod:`daeclear.assembly.automaton`.
+A clearance joint adds no constraint but *terms* (generalized contact forces, on only while a pair
+is in contact), *gaps* (root functions watched by IDA, positive in penetration), *channels* and
+*logic* (what a root decides: mode switch, approach speed latched at onset). The event rule, storm
+guard included, is :mod:`daeclear.assembly.automaton`'s (docs/user_guide.md, "Contact events").
 """
 
 from __future__ import annotations
@@ -142,19 +125,15 @@ def pair_event(pair: str, t: float, y: NDArray, rate: float, decision: Decision)
 
 @dataclass(frozen=True)
 class ContactBuild:
-    """What a clearance joint contributes to the assembled model.
-
-    ``logic(P)`` makes the joint's event logic for one parameter vector (the structure is
-    built once; each bound model gets its own logic with its own numbers and run state).
-    """
+    """What a clearance joint contributes to the assembled model; ``logic(P)`` makes its event logic
+    for one parameter vector (each bound model gets its own)."""
 
     terms: list[Term]
     gaps: list[Any]
     gap_names: list[str]
     channels: Callable[[Sequence[tuple[Any, Any]]], list[Channel]]
     logic: Callable[[NDArray[np.float64]], list[Any]]
-    # the constraints of the ideal joint the clearance joint replaces (the chapter's start:
-    # clearance joints centred, the mechanism assembled as if they were ideal), with their names
+    # the constraints of the ideal joint it stands for (the chapter's start), with their names
     ideal: list[Any]
     ideal_names: list[str]
 
@@ -171,12 +150,8 @@ def approach_floor(ctx: AssemblyContext, law: Any, prefix: str) -> Callable[[NDA
 
 @dataclass(frozen=True)
 class JournalContact:
-    """A revolute clearance joint's journal in its bearing, eqs. (4.1)-(4.13): the eccentricity and
-    the contact force term (normal law and friction), shared by the dry and the lubricated joint.
-
-    ``force`` maps (t, q, v, p, P) to the generalized force, ``p`` the latched approach speed
-    (``n_params`` 0 or 1); frames ``bi`` (bearing) and ``bj`` (journal).
-    """
+    """A journal in its bearing, eqs. (4.1)-(4.13), for the dry and the lubricated joint: the
+    eccentricity and ``force``, (t, q, v, p, P) -> generalized force, ``p`` the latched approach speed."""
 
     e: Any
     e_dot: Any
@@ -215,10 +190,8 @@ class JournalContact:
 
 
 def worn_depths(ctx: AssemblyContext, joint: Any, direction: Any, bi: Any, bj: Any) -> tuple[Any, Any]:
-    """The worn depth of the bearing and of the journal along the contact ``direction`` (a unit
-    vector, world frame): each surface's smooth profile (:func:`daeclear.contact.wear.profile_coefficients`,
-    run-time parameters ``<joint>.wear.<surface>_cos/_sin``) at the direction's angle in that body's
-    frame; 0 for a surface that does not wear."""
+    """The worn depths of the bearing and of the journal along the unit ``direction`` (world frame):
+    each surface's profile (parameters ``<joint>.wear.<surface>_cos/_sin``), 0 if it does not wear."""
     wear = getattr(joint, "wear", None)
     out: list[Any] = [0.0, 0.0]
     for k, (surface, frame) in enumerate((("bearing", bi), ("journal", bj))):
@@ -237,8 +210,7 @@ def worn_depths(ctx: AssemblyContext, joint: Any, direction: Any, bi: Any, bj: A
 
 
 def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction_numeric: Any) -> JournalContact:
-    """Journal-bearing contact (section 4.2) of ``joint`` with these laws, every number a run-time
-    parameter ``<joint>.*``. Body i carries the bearing (radius R_i), body j the journal (R_j)."""
+    """Journal-bearing contact (section 4.2) of ``joint``: body i the bearing (R_i), j the journal (R_j)."""
     name = joint.name
     law = symbolic_law(law_numeric, ctx.params, f"{name}.law")
     friction = symbolic_law(friction_numeric, ctx.params, f"{name}.friction")
