@@ -229,8 +229,10 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         if limit is not None:
             lo, hi = limit[0], limit[1]
             gap = ca.fmin(d_k, ca.fmin(s_k - lo, hi - s_k))
-        for values, value in ((corner_s, s_k), (corner_d, d_k), (corner_gap, gap), (corner_rate, d_dot)):
-            values.append(value)
+        corner_s.append(s_k)
+        corner_d.append(d_k)
+        corner_gap.append(gap)
+        corner_rate.append(d_dot)
         pair_names.append(f"{name}.{label}_{surface}")
         add_term(f"{label}_{surface}", law, n_params, d_k, d_dot, r_k, surface_point(s_k, surface), surface)
         energies.append(_elastic_energy(law_numeric, law, d_k))
