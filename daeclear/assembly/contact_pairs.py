@@ -18,8 +18,8 @@ from numpy.typing import NDArray
 
 from .automaton import DEFAULT_STORM, EVENT_KINDS, NONE, Decision, PairState, Storm, start, step
 from ..results.result import ContactEvent
-from .parameters import symbolic_law
-from .symbolic import AssemblyContext, BufferedFunction, Channel, Term, perpendicular
+from .parameters import law_values, symbolic_law
+from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
 
 
 #: A contact element's part of a run's contact state: the automaton state of each of its pairs.
@@ -187,6 +187,18 @@ class JournalContact:
             out += [Channel(f"{name}.friction_force", "N", F_T_out),
                     Channel(f"{name}.sliding_velocity", "m/s", self.v_T)]
         return out
+
+
+def journal_parameters(ref: Reference, joint: Any, law: Any, friction: Any, film: dict[str, Any] | None = None
+                       ) -> dict[str, Any]:
+    """A revolute clearance joint's points, clearance and radii, ``film``'s entries, and its laws' numbers."""
+    s_i, s_j = ref.joint_points(joint)
+    values: dict[str, Any] = {"s_i": s_i, "s_j": s_j, "clearance": joint.radial_clearance,
+                              "bearing_radius": float(joint.bearing_radius), "journal_radius": joint.journal,
+                              **(film or {})}
+    values.update({f"law.{k}": v for k, v in law_values(law).items()})
+    values.update({f"friction.{k}": v for k, v in law_values(friction).items()})
+    return values
 
 
 def worn_depths(ctx: AssemblyContext, joint: Any, direction: Any, bi: Any, bj: Any) -> tuple[Any, Any]:

@@ -1,17 +1,10 @@
-"""The lubricated revolute clearance joint (law :class:`~daeclear.contact.HydrodynamicBearing`): its
-parameters, film and dry terms, gap functions, channels and regime logic.
+"""The lubricated revolute clearance joint (law :class:`~daeclear.contact.HydrodynamicBearing`).
 
-Two regimes, one pair of the contact automaton (:mod:`daeclear.assembly.automaton`):
-
-* *film* (the automaton's free mode): the film term acts, the dry term is off;
-* *dry* (contact mode): the dry contact law (and friction) acts, the film term is off.
-
-Two gap functions, both positive once the film is thinner than their level: ``film_break`` at the
-minimum film thickness ``c - |e| = film_threshold`` and ``film_reform`` at
-``film_threshold (1 + hysteresis)``. An upward crossing of ``film_break`` is the automaton's onset
-(film -> dry, the dry law's approach speed latched there), a downward crossing of ``film_reform``
-its separation (dry -> film); IDA locates both. The band between the two levels keeps the regimes
-from chattering; the storm guard holds the dry regime in a cascade, as for a dry joint.
+Two regimes, one pair of the contact automaton: *film* (its free mode; the film term acts) and
+*dry* (contact mode; the dry law and friction act). Two gaps, positive once the film is thinner
+than their level: ``film_break`` (``c - |e| = film_threshold``), whose upward crossing is the
+onset, and ``film_reform`` (``film_threshold (1 + hysteresis)``), whose downward crossing is the
+separation; the band between them keeps the regimes from chattering (docs/lubrication.md).
 """
 
 from __future__ import annotations
@@ -27,8 +20,9 @@ from numpy.typing import NDArray
 from ..model.clearance_joints import RevoluteClearance
 from ..results.result import ContactEvent
 from .automaton import start, step
-from .contact_pairs import ContactBuild, PairLogic, PairStates, TermSwitch, approach_floor, journal_contact, pair_event
-from .parameters import law_structure, law_values
+from .contact_pairs import (ContactBuild, PairLogic, PairStates, TermSwitch, approach_floor, journal_contact,
+                            journal_parameters, pair_event)
+from .parameters import law_structure
 from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
 
 __all__ = ["FILM_REGULARISATION", "LubricatedLogic", "build_lubricated_revolute", "lubricated_parameters"]
@@ -41,14 +35,9 @@ FILM_REGULARISATION = 1e-4
 def lubricated_parameters(ref: Reference, joint: RevoluteClearance) -> tuple[dict[str, Any], list[Any]]:
     """The joint's numbers (run-time parameters, the film's under ``film.*``) and its structure."""
     bearing, friction = joint.resolved_law(), joint.resolved_friction()
-    s_i, s_j = ref.joint_points(joint)
-    values: dict[str, Any] = {
-        "s_i": s_i, "s_j": s_j, "clearance": joint.radial_clearance,
-        "bearing_radius": float(joint.bearing_radius), "journal_radius": joint.journal,
+    values = journal_parameters(ref, joint, bearing.dry, friction, {
         "film.viscosity": bearing.viscosity, "film.length": bearing.length,
-        "film.threshold": bearing.film_threshold, "film.reform_threshold": bearing.reform_threshold}
-    values.update({f"law.{k}": v for k, v in law_values(bearing.dry).items()})
-    values.update({f"friction.{k}": v for k, v in law_values(friction).items()})
+        "film.threshold": bearing.film_threshold, "film.reform_threshold": bearing.reform_threshold})
     return values, [law_structure(bearing.dry), law_structure(friction), f"film:{bearing.theory}:{bearing.cavitation}"]
 
 

@@ -1,7 +1,5 @@
-"""The revolute clearance joint: a journal in a bearing as a contact pair (its parameters, force,
-gap, output channels and event logic), and the registry of the clearance joints' builders.
-
-The contact-pair machinery it shares with the translational joint is :mod:`daeclear.assembly.contact_pairs`.
+"""The revolute clearance joint as a contact pair (parameters, force, gap, channels, logic), and the
+registry of the clearance joints' builders.
 """
 
 from __future__ import annotations
@@ -14,10 +12,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .automaton import STORM_EVENTS, STORM_WINDOW  # noqa: F401  (re-exported: the storm guard's defaults)
-from .parameters import law_structure, law_values
+from .parameters import law_structure
 from ..model.scene import RevoluteClearance
 from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term
-from .contact_pairs import PairLogic, ContactBuild, approach_floor, journal_contact
+from .contact_pairs import PairLogic, ContactBuild, approach_floor, journal_contact, journal_parameters
 from .lubricated_joint import build_lubricated_revolute, lubricated_parameters
 from ..contact.hydrodynamic import HydrodynamicBearing
 from ..contact.wear import profile_coefficients
@@ -30,11 +28,7 @@ def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> t
     if isinstance(joint.law, HydrodynamicBearing):
         return lubricated_parameters(ref, joint)
     law, friction = joint.resolved_law(), joint.resolved_friction()
-    s_i, s_j = ref.joint_points(joint)
-    values: dict[str, Any] = {"s_i": s_i, "s_j": s_j, "clearance": joint.radial_clearance,
-                              "bearing_radius": float(joint.bearing_radius), "journal_radius": joint.journal}
-    values.update({f"law.{k}": v for k, v in law_values(law).items()})
-    values.update({f"friction.{k}": v for k, v in law_values(friction).items()})
+    values = journal_parameters(ref, joint, law, friction)
     structure = [law_structure(law), law_structure(friction)]
     if joint.wear is not None:  # the worn profiles' Fourier coefficients; how many is structure
         for surface, depth in joint.worn_profiles().items():
@@ -46,12 +40,8 @@ def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> t
 
 def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, first_term: int,
                              first_root: int) -> ContactBuild:
-    """Journal-bearing contact (section 4.2): eqs. (4.1)-(4.13) with the joint's laws.
-
-    Body i carries the bearing (radius R_i), body j the journal (R_j); c = R_i - R_j. Every
-    number comes from the run-time parameters ``<joint>.*`` (see revolute_clearance_parameters).
-    A lubricated joint (law HydrodynamicBearing) is :func:`build_lubricated_revolute`'s.
-    """
+    """Journal-bearing contact (section 4.2), eqs. (4.1)-(4.13); a lubricated joint is
+    :func:`build_lubricated_revolute`'s."""
     if isinstance(joint.law, HydrodynamicBearing):
         return build_lubricated_revolute(ctx, joint, first_term, first_root)
     name = joint.name
