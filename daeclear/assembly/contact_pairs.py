@@ -189,6 +189,23 @@ class JournalContact:
         return out
 
 
+def journal_logic(ctx: AssemblyContext, jc: JournalContact, cls: type[PairLogic], name: str, first_root: int,
+                  first_term: int, gaps: list[Any], law: Any, friction: Any
+                  ) -> Callable[[NDArray[np.float64]], list[Any]]:
+    """A journal's logic maker: one pair ``name`` of class ``cls``, its rate function (q, v, P) ->
+    (``gaps``..., penetration rate) bound to each parameter vector."""
+    penetration_rate = ca.dot(jc.e_dot, jc.e) / ca.fmax(jc.e_norm, 1e-300)
+    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P], [*gaps, penetration_rate])
+    floor = approach_floor(ctx, law, f"{name}.law")
+    discontinuous = not friction.frictionless and not friction.smooth
+    n_q = ctx.n_q  # read once: a CasADi call costs more inside a sweep's loop than the logic it makes
+
+    def logic(P: NDArray[np.float64]) -> list[Any]:
+        return [cls((name,), first_root, (first_term,), BufferedFunction(rate, bound=(P,)), n_q,
+                    law.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
+    return logic
+
+
 def journal_parameters(ref: Reference, joint: Any, law: Any, friction: Any, film: dict[str, Any] | None = None
                        ) -> dict[str, Any]:
     """A revolute clearance joint's points, clearance and radii, ``film``'s entries, and its laws' numbers."""

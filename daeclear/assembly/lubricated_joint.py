@@ -20,10 +20,10 @@ from numpy.typing import NDArray
 from ..model.clearance_joints import RevoluteClearance
 from ..results.result import ContactEvent
 from .automaton import start, step
-from .contact_pairs import (ContactBuild, PairLogic, PairStates, TermSwitch, approach_floor, journal_contact,
+from .contact_pairs import (ContactBuild, PairLogic, PairStates, TermSwitch, journal_contact, journal_logic,
                             journal_parameters, pair_event)
 from .parameters import law_structure
-from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
+from .symbolic import AssemblyContext, Channel, Reference, Term, perpendicular
 
 __all__ = ["FILM_REGULARISATION", "LubricatedLogic", "build_lubricated_revolute", "lubricated_parameters"]
 
@@ -70,15 +70,7 @@ def build_lubricated_revolute(ctx: AssemblyContext, joint: RevoluteClearance, fi
     film_fn = ca.Function(f"{name}_film_force", [ctx.t, ctx.q, ctx.v, p0, ctx.P], [Q_film],
                           ["t", "q", "v", "p", "P"], ["Q"])
 
-    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P],
-                       [gaps[0], gaps[1], ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
-    floor = approach_floor(ctx, dry_numeric, f"{name}.law")
-    n_q = ctx.n_q
-    discontinuous = not friction_numeric.frictionless and not friction_numeric.smooth
-
-    def logic(P: NDArray[np.float64]) -> list[Any]:
-        return [LubricatedLogic((name,), first_root, (first_term,), BufferedFunction(rate, bound=(P,)), n_q,
-                                dry_numeric.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
+    logic = journal_logic(ctx, jc, LubricatedLogic, name, first_root, first_term, gaps, dry_numeric, friction_numeric)
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
         (on, p_sym), (film_on, _) = switches

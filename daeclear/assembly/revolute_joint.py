@@ -7,15 +7,11 @@ from __future__ import annotations
 from typing import Any
 from collections.abc import Callable, Sequence
 
-import casadi as ca
-import numpy as np
-from numpy.typing import NDArray
-
 from .automaton import STORM_EVENTS, STORM_WINDOW  # noqa: F401  (re-exported: the storm guard's defaults)
 from .parameters import law_structure
 from ..model.scene import RevoluteClearance
-from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term
-from .contact_pairs import PairLogic, ContactBuild, approach_floor, journal_contact, journal_parameters
+from .symbolic import AssemblyContext, Channel, Reference, Term
+from .contact_pairs import PairLogic, ContactBuild, journal_contact, journal_logic, journal_parameters
 from .lubricated_joint import build_lubricated_revolute, lubricated_parameters
 from ..contact.hydrodynamic import HydrodynamicBearing
 from ..contact.wear import profile_coefficients
@@ -47,16 +43,9 @@ def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, fir
     name = joint.name
     law_numeric, friction_numeric = joint.resolved_law(), joint.resolved_friction()
     jc = journal_contact(ctx, joint, law_numeric, friction_numeric)
-    e, e_dot, e_norm, c = jc.e, jc.e_dot, jc.e_norm, jc.c
+    e, c = jc.e, jc.c
     gap = (jc.ee - c * c) / (2.0 * c)  # smooth at e = 0; equals delta (1 + delta / 2c) near contact
-    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P], [gap, ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
-    floor = approach_floor(ctx, law_numeric, f"{name}.law")
-    discontinuous = not friction_numeric.frictionless and not friction_numeric.smooth
-    n_q = ctx.n_q  # read once: a CasADi call costs more inside a sweep's loop than the logic it makes
-
-    def logic(P: NDArray[np.float64]) -> list[Any]:
-        return [PairLogic((name,), first_root, (first_term,), BufferedFunction(rate, bound=(P,)), n_q,
-                          law_numeric.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
+    logic = journal_logic(ctx, jc, PairLogic, name, first_root, first_term, [gap], law_numeric, friction_numeric)
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
         on, p_sym = switches[0]

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -86,21 +86,18 @@ class ArchardWear:
         return 2.0 * math.pi * np.arange(self.nodes) / self.nodes
 
 
-def half_angle_overlap(penetration: float, clearance: float) -> float:
-    """Half-angle of the arc where a journal at eccentricity ``c + delta`` overlaps its bearing, rad."""
-    if penetration <= 0.0:
-        return 0.0
-    return math.acos(clearance / (clearance + penetration))
+def half_angle_overlap(penetration: ArrayLike, clearance: float) -> Any:
+    """Half-angle (rad) of the arc where a journal at eccentricity ``c + delta`` overlaps its bearing;
+    0 without penetration."""
+    return np.arccos(clearance / (clearance + np.clip(penetration, 0.0, None)))
 
 
-def half_angle_hertz(force: float, bearing_radius: float, journal_radius: float, length: float,
-                     effective_modulus: float) -> float:
+def half_angle_hertz(force: ArrayLike, bearing_radius: float, journal_radius: float, length: float,
+                     effective_modulus: float) -> Any:
     """Half-angle of the Hertz line contact of a journal in its bearing, rad: ``b / R_b``,
-    ``b = sqrt(4 F R_eff / (pi L E*))``, ``R_eff = R_b R_j / (R_b - R_j)``."""
-    if force <= 0.0:
-        return 0.0
+    ``b = sqrt(4 F R_eff / (pi L E*))``, ``R_eff = R_b R_j / (R_b - R_j)``; 0 without force."""
     r_eff = bearing_radius * journal_radius / (bearing_radius - journal_radius)
-    return math.sqrt(4.0 * force * r_eff / (math.pi * length * effective_modulus)) / bearing_radius
+    return np.sqrt(4.0 * np.clip(force, 0.0, None) * r_eff / (math.pi * length * effective_modulus)) / bearing_radius
 
 
 def _shape(distribution: str, phi: NDArray[np.float64], half_angle: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -187,11 +184,9 @@ def wear_increment(wear: ArchardWear, history: WearHistoryArrays, *, bearing_rad
     if wear.distribution == "hertz":
         if effective_modulus is None:
             raise SceneError("wear_increment: the 'hertz' distribution needs effective_modulus (Pa).")
-        journal = bearing_radius - clearance
-        r_eff = bearing_radius * journal / (bearing_radius - journal)
-        half = np.sqrt(4.0 * F * r_eff / (math.pi * wear.length * effective_modulus)) / bearing_radius
-    else:  # arccos(c / (c + delta)), 0 without penetration
-        half = np.arccos(clearance / (clearance + np.clip(d, 0.0, None)))
+        half = half_angle_hertz(F, bearing_radius, bearing_radius - clearance, wear.length, effective_modulus)
+    else:
+        half = half_angle_overlap(d, clearance)
     loads = wear.coefficient * F * ds[active] / area
     angles = {"bearing": history.angle_bearing, "journal": history.angle_journal}
     depth = {}
