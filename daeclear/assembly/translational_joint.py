@@ -308,29 +308,20 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
             on_f = switches[n_corners + f][0]
             in_face[a] = in_face[a] + on_f
             in_face[b] = in_face[b] + on_f
-        for i, pair in enumerate(pair_names):
-            F_N = switched(i, forces[i][0])
-            total = total + F_N
-            in_contact = switches[i][0] + in_face[i]
-            any_contact = ca.fmax(any_contact, in_contact)
-            out += [
-                Channel(f"{pair}.penetration", "m", corner_d[i]),
-                Channel(f"{pair}.penetration_rate", "m/s", corner_rate[i]),
-                Channel(f"{pair}.normal_force", "N", F_N),
-                Channel(f"{pair}.in_contact", "", in_contact),
-                *friction_channels(pair, i),
-            ]
-        for f, face in enumerate(face_names):
-            k = n_corners + f
-            a, b = face_corners[f]
+        for k, label in enumerate(pair_names + face_names):  # the corners, then the faces
             F_N = switched(k, forces[k][0])
             total = total + F_N
-            out += [
-                Channel(f"{face}.penetration", "m", 0.5 * (corner_d[a] + corner_d[b])),
-                Channel(f"{face}.normal_force", "N", F_N),
-                Channel(f"{face}.in_contact", "", switches[k][0]),
-                *friction_channels(face, k),
-            ]
+            if k < n_corners:
+                in_contact = switches[k][0] + in_face[k]
+                any_contact = ca.fmax(any_contact, in_contact)
+                out += [Channel(f"{label}.penetration", "m", corner_d[k]),
+                        Channel(f"{label}.penetration_rate", "m/s", corner_rate[k])]
+            else:
+                a, b = face_corners[k - n_corners]
+                in_contact = switches[k][0]
+                out.append(Channel(f"{label}.penetration", "m", 0.5 * (corner_d[a] + corner_d[b])))
+            out += [Channel(f"{label}.normal_force", "N", F_N), Channel(f"{label}.in_contact", "", in_contact),
+                    *friction_channels(label, k)]
         if all(e is not None for e in energies):
             stored = sum(switches[k][0] * e for k, e in enumerate(energies))
             out.append(Channel(f"{name}.elastic_energy", "J", stored))
