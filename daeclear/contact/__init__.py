@@ -30,10 +30,8 @@ from . import _backend as backend  # the math of laws written once for numbers a
 from .base import KINDS, NormalLaw
 from .cylindrical import DubowskyFreudenstein, ESDU78035, Goldsmith
 from .friction import Coulomb, FrictionLaw, ModifiedCoulomb, NoFriction
-from .geometry import (
-    Material, external_contact_stiffness, internal_contact_stiffness, plane_face_stiffness,
-    sphere_plane_stiffness,
-)
+from .geometry import (Material, external_contact_stiffness, internal_contact_stiffness, plane_face_stiffness,
+                       sphere_plane_stiffness)
 from .hydrodynamic import HydrodynamicBearing
 from .impact import ImpactResult, simulate_impact
 from .normal import Flores, Hertz, HuntCrossley, KelvinVoigt, LankaraniNikravesh, LankaraniPlane

@@ -20,9 +20,8 @@ import numpy as np
 from ..errors import DaeclearWarning, SceneError
 from . import _backend as B
 from ._checks import check_number
-from .geometry import (
-    MaterialPair, internal_contact_stiffness, material_pair, plane_face_stiffness, sphere_plane_stiffness,
-)
+from .geometry import (MaterialPair, internal_contact_stiffness, material_pair, plane_face_stiffness,
+                       sphere_plane_stiffness)
 
 __all__ = ["KINDS", "Geometry", "Kind", "NormalLaw", "bearing_radii", "computed_stiffness"]
 

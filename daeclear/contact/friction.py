@@ -66,14 +66,8 @@ def _coefficient(owner: str, value: Any) -> float:
 class Coulomb(FrictionLaw):
     """Plain Coulomb friction, ``F_T = -c_f F_N sign(v_T)``.
 
-    Parameters
-    ----------
-    coefficient : float
-        Friction coefficient c_f >= 0.
-
-    Notes
-    -----
-    Discontinuous at ``v_T = 0``: an integrator chatters across reversals; prefer :class:`ModifiedCoulomb`.
+    ``coefficient``: c_f >= 0. Discontinuous at ``v_T = 0``: an integrator chatters across reversals;
+    prefer :class:`ModifiedCoulomb`.
     """
 
     coefficient: float

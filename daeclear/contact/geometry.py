@@ -79,12 +79,8 @@ def _radius(owner: str, field: str, value: float) -> float:
 
 
 def internal_contact_stiffness(bearing_radius: float, journal_radius: float, materials: MaterialPair) -> float:
-    """Generalized stiffness K of a journal inside a bearing, eq. (3.5) with ``R_i - R_j``.
-
-    ``K = 4 / (3 (sigma_i + sigma_j)) * sqrt(R_i R_j / (R_i - R_j))`` in N/m^1.5.
-
-    ``R_i > R_j > 0`` in m; the sphere formula on the cylinder pair, as the chapter uses it with (3.9).
-    """
+    """Generalized stiffness of a journal (R_j) inside a bearing (R_i > R_j > 0, m), eq. (3.5) with
+    ``R_i - R_j`` as the chapter uses it with (3.9): ``K = 4 / (3 sigma_s) sqrt(R_i R_j / (R_i - R_j))``, N/m^1.5."""
     owner = "internal_contact_stiffness"
     r_i = _radius(owner, "bearing_radius", bearing_radius)
     r_j = _radius(owner, "journal_radius", journal_radius)
@@ -102,18 +98,14 @@ def external_contact_stiffness(radius_i: float, radius_j: float, materials: Mate
 
 
 def sphere_plane_stiffness(radius: float, materials: MaterialPair) -> float:
-    """Generalized stiffness K of a sphere (e.g. a rounded slider corner) on a plane, in N/m^1.5.
-
-    Eq. (3.5) with ``R_j -> infinity``: ``K = 4 / (3 (sigma_i + sigma_j)) * sqrt(R)``.
-    """
+    """Generalized stiffness of a sphere (a rounded slider corner) on a plane, eq. (3.5) with
+    ``R_j -> infinity``: ``K = 4 / (3 (sigma_i + sigma_j)) * sqrt(R)``, N/m^1.5."""
     r = _radius("sphere_plane_stiffness", "radius", radius)
     return 4.0 / (3.0 * sigma_sum(materials)) * math.sqrt(r)
 
 
 def plane_face_stiffness(half_width: float, materials: MaterialPair) -> float:
-    """Linear stiffness of two square plane surfaces, eq. (4.27), in N/m.
-
-    ``K = a / (0.475 (sigma_i + sigma_j))``, ``a`` half the side of the square contact (Lankarani 1988).
-    """
+    """Linear stiffness of two square plane surfaces, eq. (4.27) (Lankarani 1988), in N/m:
+    ``K = a / (0.475 (sigma_i + sigma_j))``, ``a`` half the side of the square contact."""
     a = check_number("plane_face_stiffness", "half_width", half_width, low=0.0, unit="m")
     return a / (0.475 * sigma_sum(materials))

@@ -48,10 +48,8 @@ def _trig(a0: Any, a1: Any, b1: Any, a2: Any, b2: Any, psi1: Any, psi2: Any) -> 
 
 
 def film_integrals(eps: Any, theta1: Any, theta2: Any) -> dict[str, Any]:
-    """Integrals over (theta1, theta2) of {1, cos, sin, cos^2, sin^2, sin cos} / (1 + eps cos)^3.
-
-    Keys ``"1", "c", "s", "cc", "ss", "sc"``; valid for 0 <= eps < 1 and any theta1 < theta2.
-    """
+    """Integrals over (theta1, theta2) of {1, cos, sin, cos^2, sin^2, sin cos} / (1 + eps cos)^3, keys
+    ``"1", "c", "s", "cc", "ss", "sc"`` (0 <= eps < 1)."""
     q = 1.0 - eps * eps
     sq = B.sqrt(q)
     beta = eps / (1.0 + sq)

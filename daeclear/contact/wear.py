@@ -109,12 +109,8 @@ def _shape(distribution: str, phi: NDArray[np.float64], half_angle: NDArray[np.f
 
 def spread(centres: ArrayLike, half_angles: ArrayLike, loads: ArrayLike, nodes: int,
            distribution: str = "elastic-foundation") -> NDArray[np.float64]:
-    """Loads spread over the nodes: ``sum_i loads[i] * weights(centres[i], half_angles[i])``.
-
-    Each arc's pressure is sampled at equal pieces (at least 64, and 16 per node spacing of the widest
-    arc), each sample split between its two neighbouring nodes by linear interpolation's weights;
-    each contact's weights sum to one.
-    """
+    """Loads spread over the nodes: ``sum_i loads[i] * weights(centres[i], half_angles[i])``; each arc's
+    pressure sampled at equal pieces, each sample split between its two neighbouring nodes linearly."""
     centre = np.asarray(centres, dtype=float).ravel()
     half = np.asarray(half_angles, dtype=float).ravel()
     load = np.asarray(loads, dtype=float).ravel()
