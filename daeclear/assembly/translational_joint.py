@@ -116,14 +116,11 @@ class SliderGuideLogic(PairLogic):
         """The corners' decisions, then the events of the faces that formed or broke."""
         after, events = super().decide(states, t, y, roots_found)
         for f, (was, on) in enumerate(zip(self._faces_on(states), self._faces_on(after))):
-            a, b = self.face_corners[f]
-            if on and not was:
-                speed = 0.5 * (after[a].latched + after[b].latched)
-                events.append(ContactEvent(t=t, pair=self.face_names[f], kind="onset", approach_speed=speed,
-                                           y=y.copy()))
-            elif was and not on:
-                events.append(ContactEvent(t=t, pair=self.face_names[f], kind="separation",
-                                           approach_speed=float("nan"), y=y.copy()))
+            if on != was:
+                a, b = self.face_corners[f]
+                speed = 0.5 * (after[a].latched + after[b].latched) if on else float("nan")
+                events.append(ContactEvent.from_solver(t, self.face_names[f], "onset" if on else "separation", speed,
+                                                       np.array(y, dtype=float)))
         return after, events
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
@@ -192,9 +189,6 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
     def surface_point(s: Any, surface: str) -> Any:
         return O + s * t_vec + side[surface] * 0.5 * H * n_vec  # (4.16) on the surface line
 
-    def sliding_velocity(point: Any) -> Any:
-        return ca.dot(slider.world_point_velocity(point) - guide.world_point_velocity(point), t_vec)
-
     terms: list[Term] = []
     forces: list[tuple[Any, Any, Any, Any]] = []  # per term: (F_N, F_T, v_T, p)
 
@@ -205,7 +199,7 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         p = ca.SX.sym("p", n_p)
         F_N = law_.force(d, d_dot, p[0] if n_p else None)
         n_in = -side[surface] * n_vec  # surface normal pointing into the guide
-        v_T = sliding_velocity(point_guide)
+        v_T = ca.dot(slider.world_point_velocity(point_guide) - guide.world_point_velocity(point_guide), t_vec)
         F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
         f_slider = F_N * n_in + F_T * t_vec
         Q = ctx.generalized_force([(joint.body_j, f_slider, point_slider), (joint.body_i, -f_slider, point_guide)])

@@ -168,16 +168,10 @@ class HydrodynamicBearing:
         """The film's force on the journal, (radial, tangential) in N: radial > 0 towards the bearing's
         centre, tangential along the eccentricity turned by +90 degrees.
 
-        Parameters
-        ----------
-        eccentricity_ratio : float, array_like or CasADi symbol
-            eps = e / c, in [0, 1) (a symbol is clamped to [0, 1 - 1e-6]).
-        wedge_rate : same types
-            omega_journal + omega_bearing - 2 x the line of centres' rate, rad/s.
-        squeeze_rate : same types
-            d eps / dt, 1/s (> 0 while the film thins).
-        radius, clearance : float or symbol
-            Journal radius R and radial clearance c in m (> 0).
+        ``eccentricity_ratio`` eps in [0, 1) (a symbol is clamped to [0, 1 - 1e-6]), ``wedge_rate``
+        (omega_journal + omega_bearing - 2 x the line of centres' rate, rad/s), ``squeeze_rate``
+        (d eps / dt, 1/s, > 0 while the film thins): floats, arrays or CasADi symbols; journal
+        ``radius`` and radial ``clearance`` in m.
 
         Example
         -------

@@ -76,25 +76,9 @@ def _penetration_scale(law: NormalLaw, mass: float, speed: float) -> float:
 
 def simulate_impact(law: NormalLaw, *, mass: float, speed: float, rtol: float = 1e-12,
                     n_points: int = 2001) -> ImpactResult:
-    """Simulate one impact of a mass on a contact law.
-
-    Parameters
-    ----------
-    law : NormalLaw
-        A resolved law (``law.is_resolved``); its ``approach_speed`` is ``speed``.
-    mass : float
-        m in kg, > 0.
-    speed : float
-        Approach speed v in m/s, > 0.
-    rtol : float
-        Relative tolerance of DOP853 (absolute: ``rtol`` times the penetration and speed scales).
-    n_points : int
-        Number of uniform samples returned.
-
-    Raises
-    ------
-    SceneError
-        Invalid mass or speed, unresolved law, or no separation.
+    """Simulate one impact of a ``mass`` (kg) at ``speed`` (m/s, also the law's approach speed) on a
+    resolved ``law``; ``rtol`` of DOP853 (absolute: ``rtol`` times the penetration and speed scales),
+    ``n_points`` uniform samples. Raises SceneError for a bad argument or no separation.
 
     Example
     -------

@@ -252,19 +252,10 @@ class _FaceLaw(NormalLaw):
 class LankaraniPlane(_FaceLaw):
     """Lankarani (1988) linear law for two square plane surfaces, eqs. (4.26)-(4.27).
 
-    ``F_N = K delta`` with ``K = a / (0.475 (sigma_i + sigma_j))``, ``a`` half the side
-    of the square contact area (steel, a = 25 mm: 5.99e9 N/m).
-
-    Parameters
-    ----------
-    stiffness : float or None
-        K in N/m, > 0, or None to compute it with ``resolve(kind="plane_face",
-        face_half_width=a, materials=...)``.
-
-    Notes
-    -----
-    Elastic; the translational joint applies it to a face (Fig. 4.13a). The damped "unified" face
-    model is ``LankaraniNikravesh(restitution=...).resolve(kind="plane_face", ...)``.
+    ``F_N = K delta``, ``stiffness`` K in N/m (> 0), or None: ``K = a / (0.475 (sigma_i + sigma_j))``
+    from ``resolve(kind="plane_face", face_half_width=a, materials=...)``. Elastic; the translational
+    joint applies it to a face (Fig. 4.13a). The damped "unified" face model is
+    ``LankaraniNikravesh(restitution=...).resolve(kind="plane_face", ...)``.
     """
 
     name: ClassVar[str] = "lankarani-plane"
@@ -280,8 +271,7 @@ class KelvinVoigt(_FaceLaw):
     Parameters
     ----------
     stiffness : float or None
-        Linear stiffness K in N/m (> 0); None is only computable for
-        ``kind="plane_face"`` (eq. 4.27), otherwise give it.
+        K in N/m (> 0); None is only computable for ``kind="plane_face"`` (eq. 4.27).
     damping : float
         D in N s/m, >= 0. Default 0.
 

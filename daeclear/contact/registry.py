@@ -71,20 +71,9 @@ def build_law(cls: type, params: dict[str, Any]) -> Any:
 
 
 def normal_law(name: str | NormalLaw, **params: Any) -> NormalLaw:
-    """Build a normal contact law from its name.
-
-    Parameters
-    ----------
-    name : str or NormalLaw
-        A name of :data:`NORMAL_LAWS` or an alias (ln, esdu, kv, hc, df), case, hyphens, underscores
-        and spaces ignored; a NormalLaw instance is returned as is (no params allowed).
-    **params
-        The law's constructor keywords, e.g. ``restitution=0.9``.
-
-    Raises
-    ------
-    SceneError
-        Unknown name (lists the valid ones), unknown or missing parameter, bad value.
+    """Build a normal contact law from its name (:data:`NORMAL_LAWS` or an alias: ln, esdu, kv, hc, df;
+    case, hyphens, underscores and spaces ignored) and its constructor keywords ``params``; a NormalLaw
+    instance is returned as is. Raises SceneError for an unknown name or parameter, or a bad value.
 
     Example
     -------
@@ -99,18 +88,9 @@ def normal_law(name: str | NormalLaw, **params: Any) -> NormalLaw:
 
 
 def friction_law(name_or_coefficient: str | float | FrictionLaw | None, **params: Any) -> FrictionLaw:
-    """Build a friction law.
-
-    Parameters
-    ----------
-    name_or_coefficient : str, float, FrictionLaw or None
-        ``None``: :class:`NoFriction`; a number: :class:`ModifiedCoulomb` with that coefficient; a
-        name ("none"/"frictionless", "coulomb", "modified-coulomb"/"ambrosio"); a FrictionLaw as is.
-
-    Raises
-    ------
-    SceneError
-        Unknown name (lists the valid ones), unknown parameter or bad value.
+    """Build a friction law: ``None``, :class:`NoFriction`; a number, :class:`ModifiedCoulomb` with that
+    coefficient; a name ("none"/"frictionless", "coulomb", "modified-coulomb"/"ambrosio") with
+    ``params``; a FrictionLaw as is. Raises SceneError for an unknown name or parameter, or a bad value.
 
     Example
     -------
