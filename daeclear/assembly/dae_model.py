@@ -63,24 +63,21 @@ class DAEModel:
     mass_diagonal: NDArray[np.float64]
     kinematics: ca.Function  # (q, v, t) -> (Phi, Phi_q, Phi_dot, gamma)
     base_force: ca.Function  # (t, q, v) -> Q (gravity and applied loads)
-    # the scene's description and the options
-    parameters: dict[str, Any] = field(default_factory=dict)
+    parameters: dict[str, Any] = field(default_factory=dict)  # the scene's description and the options
     contacts: tuple[Any, ...] = ()  # contact elements' event rules (clearance joints; no run state)
     track_work: bool = False
     # (root, term, gap-rate extra, needs approach speed, min approach speed) of simple pairs
     auto_pairs: tuple[tuple[int, int, int, bool, float], ...] = ()
     # constraints of the chapter's start: the ideal joints, then each clearance joint's ideal joint
     start_constraint_names: tuple[str, ...] = ()
-    # run-time parameters: the last input of every function (daeclear.assembly.parameters)
-    parameter_layout: tuple[tuple[str, int], ...] = ()  # (name, size) of each entry
+    # run-time parameters, the last input of every function: (name, size) of each entry, values
+    parameter_layout: tuple[tuple[str, int], ...] = ()
     parameter_values: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
-    # the scene element (joint or driver name) of each constraint row, for messages
-    constraint_elements: tuple[str, ...] = ()
+    constraint_elements: tuple[str, ...] = ()  # the scene element of each constraint row
     # (name, clearance m, corner radius m or 0) of each clearance joint: the limits of the physics checks
     clearance_joints: tuple[tuple[str, float, float], ...] = ()
     driver_names: tuple[str, ...] = ()
-    # whether the scene applies loads besides gravity
-    has_loads: bool = False
+    has_loads: bool = False  # loads besides gravity
     # consistent starts by (start, allow_penetration, evaluator, numbers, guesses), shared by the models
     # of one structure: a model run again skips assembling its start
     start_memo: dict[tuple[Any, ...], tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
@@ -343,10 +340,8 @@ class DAEModel:
         q = self.assemble_positions(self.q_guess, session=session, ideal=ideal)
         check_independent(self, q, session)
         v = self.assemble_velocities(q, self.v_guess, session=session, ideal=ideal)
-        y = np.zeros(self.n_states)
-        y[: self.n_q] = q
-        y[self.n_q: 2 * self.n_q] = v
-        y, yp = self.consistent_state(0.0, y, session=session)
+        y, yp = self.consistent_state(0.0, np.concatenate([q, v, np.zeros(self.n_states - 2 * self.n_q)]),
+                                      session=session)
         if not ideal and not allow_penetration:
             check_start_penetration(self, y, yp, session)
         memo_put_bounded(self.start_memo, key, (_read_only(y), _read_only(yp)), START_MEMO_LIMIT)

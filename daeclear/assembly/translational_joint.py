@@ -1,26 +1,19 @@
 """Translational clearance joint (section 4.3): a slider free inside a guide, contact at its corners.
 
-Body i the guide, body j the slider (the chapter swaps the letters). The guide's mid-line runs
-through ``O`` (``point_i``) along the unit vector ``t`` (4.14); ``n = perp(t)`` points to the upper
-surface at ``+H/2``, the lower one is at ``-H/2``. For a slider corner ``r_k`` (4.15)::
+Body i the guide, body j the slider. The guide's mid-line runs through ``O`` (``point_i``) along the
+unit vector ``t`` (4.14); ``n = perp(t)`` points to the upper surface at ``+H/2``. For a corner ``r_k``
+(4.15), ``s_k = t . (r_k - O)`` along the guide and ``d_k = +-n . (r_k - O) - H/2`` the penetration
+(4.16)-(4.20), > 0 in contact, at the sharp corner (R_c only sets the corner law's stiffness, 3.5);
+the rate is ``(d d_k / dq) v`` (4.21); the force acts on the slider at the corner and on the guide
+at the closest surface point (4.22)-(4.25). Corners A, B touch the upper surface, C, D the lower:
+four pairs, each gap ``min(d_k, s_k - s_P, s_Q - s_k)`` with contact limits (s_P, s_Q).
 
-    s_k = t . (r_k - O)            coordinate along the guide
-    A_j = O + s_k t +- (H/2) n     closest guide point (4.16), on the surface
-    d_k = +-n . (r_k - O) - H/2    signed penetration (4.17)-(4.20), > 0 in contact
-
-measured at the sharp corner; the corner radius R_c only sets the corner law's stiffness (3.5).
-The rate is ``(d d_k / dq) v`` (4.21); the force acts on the slider at the corner and the opposite
-one on the guide at ``A_j`` (4.22)-(4.25). Corners A, B touch the upper surface, C, D the lower
-one: four pairs, four gaps, each ``min(d_k, s_k - s_P, s_Q - s_k)`` with contact limits (s_P, s_Q).
-
-Models (``TranslationalClearance.contact_model``): ``corners``, one term per corner (its law with
-the approach speed latched at onset); ``section-4.3``, also one term per face, on (instead of its
-two corner terms) while both its corners touch: ``face_law(d_mean, d_mean_dot)``,
-``d_mean = (d_1 + d_2)/2``, applied at the centroid of the penetrated trapezoid (Fig. 4.13a), the
-resultant of a Winkler pressure with potential ``K (d_1^2 + d_1 d_2 + d_2^2) / 6``; its approach
-speed is the mean of its corners' (docs/contact_laws.md). Friction, when declared, acts along
-``t`` on the sliding velocity at each contact. Events follow :mod:`daeclear.assembly.automaton`;
-a face's switches are events of ``<name>.upper_face`` / ``<name>.lower_face``.
+Models (``contact_model``): ``corners``, one term per corner (its law, approach speed latched at
+onset); ``section-4.3``, also one term per face, on instead of its corners' while both touch:
+``face_law(d_mean, d_mean_dot)``, ``d_mean = (d_1 + d_2)/2``, at the centroid of the penetrated
+trapezoid (Fig. 4.13a), the resultant of a Winkler pressure (potential ``K (d_1^2 + d_1 d_2 +
+d_2^2) / 6``); approach speed the mean of its corners' (docs/contact_laws.md). Friction acts along
+``t``. A face's switches are events of ``<name>.upper_face`` / ``<name>.lower_face``.
 
 Channels: ``<name>.s``, ``.y`` (m; along the guide, off the mid-line), ``.tilt`` (rad), ``.eta`` =
 y / (2c), ``.xi`` (0..1 along ``stroke``, Fig. 4.28d); per pair ``<name>.A_upper`` ...
