@@ -28,7 +28,6 @@ The model is built once per structure (:class:`Structure`); :class:`DAEModel` is
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -150,12 +149,12 @@ class Structure:
 
     def bind(self, scene: Scene, table: ParameterTable, described: Mapping[str, Any], alpha: float,
              beta: float) -> DAEModel:
-        if not table.has_layout(*self.names_sizes):  # a structure key collision would land here
+        if not table.has_layout(*zip(*self.layout)):  # a structure key collision would land here
             raise AssemblyError(f"scene '{scene.name}': its parameters do not match the cached structure.")
         P = table.vector
         bodies = scene.bodies
         contacts = tuple(logic for make in self.logic for logic in make(P))
-        auto_pairs = tuple((root, term, extra, needs, float(getattr(contacts[i], "min_approach_speed", 0.0)))
+        auto_pairs = tuple((root, term, extra, needs, float(contacts[i].min_approach_speed))
                            for root, term, extra, needs, i in self.auto_pairs)
         formulation, track_work = self.model.formulation, self.model.track_work
         return self.model.copy_with(
@@ -191,11 +190,6 @@ class Structure:
                              "frictionless joint, or a number of a law that is compiled in); assemble the "
                              "changed scene instead: assemble(model.scene.with_values(...)).")
         return self.bind(scene, table, described, alpha, beta)
-
-    @functools.cached_property
-    def names_sizes(self) -> tuple[tuple[str, ...], tuple[int, ...]]:
-        """The layout's names and sizes (:meth:`ParameterTable.has_layout`)."""
-        return tuple(name for name, _ in self.layout), tuple(size for _, size in self.layout)
 
 
 # Structures built in this process, by structure key.
@@ -504,11 +498,10 @@ class _TemplateBuilder:
         extras = [outputs, accel, kinematics_flat, start_flat, checks] + [term.force for term in self.terms]
         # simple contact pairs, whose switches the compiled loop may decide itself (ida_driver.c)
         logic_makers = tuple(build.logic for build in builds)
-        sample = [logic for make in logic_makers for logic in make(self.table.vector)]
-        auto_pairs = []
-        simple = [logic.simple_pairs() for logic in sample]
+        simple = [logic.simple_pairs() for make in logic_makers for logic in make(self.table.vector)]
         given = [pairs for pairs in simple if pairs is not None]
-        if sample and len(given) == len(simple):
+        auto_pairs = []
+        if simple and len(given) == len(simple):
             for index, pairs in enumerate(given):
                 for root, term_index, gap_rate, needs, _floor in pairs:
                     extras.append(gap_rate)
