@@ -227,7 +227,7 @@ def test_failure_message_calls_a_pair_deep_in_its_wall_while_free_a_solver_defec
     same-instant guard once did for one corner of the Siconos slider-crank): a corner goes 9 cm into
     its wall with no force and IDA fails at its step cap. The message says the solver lost the onset,
     not that the joint carries too much load."""
-    from daeclear.assembly import automaton, translational_joint
+    from daeclear.assembly import automaton, contact_pairs
 
     seen: list[int] = []
 
@@ -239,7 +239,7 @@ def test_failure_message_calls_a_pair_deep_in_its_wall_while_free_a_solver_defec
             seen.append(1)
         return new, decision
 
-    monkeypatch.setattr(translational_joint, "step", lossy)
+    monkeypatch.setattr(contact_pairs, "step", lossy)  # the corners' decisions: PairLogic.decide
     model = dc.assemble(dc.mechanisms.slider_crank("translational"), "index1")
     result = quiet_simulate(model, 0.02, rtol=1e-8, on_failure="return",
                             options=dc.SolverOptions(backend="python", max_steps=800))

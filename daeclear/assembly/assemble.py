@@ -23,14 +23,11 @@ Formulations
 
 where ``Phi' = Phi_q v + Phi_t`` and ``gamma = -(d Phi'/dq) v - d Phi'/dt``.
 
-This module builds the model (once per structure: :class:`Structure`, kept by structure key);
-the assembled :class:`~daeclear.assembly.dae_model.DAEModel` and what a solver asks of it live in
-:mod:`daeclear.assembly.dae_model` (re-exported here).
+The model is built once per structure (:class:`Structure`); :class:`DAEModel` is re-exported.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -53,7 +50,6 @@ from .drivers import driver_constraint, driver_load, driver_parameters
 from .joint_coordinates import joint_channels
 from ..model.loads import Load, build_loads, load_parameters
 from .symbolic import AssemblyContext, Channel, Reference, Term, body_frames, rotation
-# the model and its constants, re-exported: ``from daeclear.assembly.assemble import DAEModel`` keeps working
 from ..solvers.physics import checked_channel
 from .dae_model import (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_START_KINEMATICS,  # noqa: F401
                         EXTRA_TERM0, KIND_MULTIPLIER, KIND_POSITION, KIND_VELOCITY, KIND_WORK, NEWTON_STEPS,
@@ -92,12 +88,10 @@ def _translational(ctx: AssemblyContext, joint: Translational) -> tuple[list[Any
 
 def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
                      track_work: bool) -> tuple[ParameterTable, str, Mapping[str, Any]]:
-    """The scene's numbers as run-time parameters, the key of its structure and the scene's
-    plain-data description (``Scene.description``, for the model's parameters).
+    """The scene's numbers as run-time parameters, its structure key and its plain-data description.
 
-    Pure Python (no CasADi): this is all that a scene of a known structure costs to assemble.
-    Each element's entries are kept on it with the bodies (and a driver's joint) they were read
-    from, so the elements a sweep's scenes share are converted once.
+    Pure Python: all that a scene of a known structure costs to assemble. Each element's entries are
+    kept on it (with the bodies they were read from), so a sweep's shared elements are converted once.
     """
     bodies = tuple(scene.bodies)
     ref = Reference(bodies, GROUND)
@@ -119,8 +113,8 @@ def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
 
 def _element_parameters(ref: Reference, element: Any, joints: dict[str, Any]
                         ) -> tuple[tuple[tuple[str, tuple[float, ...]], ...], str]:
-    """One element's parameter entries, and as text what of them is structure: the entries' names
-    and sizes and, for a clearance joint, its structural flags (see :func:`law_structure`)."""
+    """One element's parameter entries, and as text its structure: the entries' names and sizes and a
+    clearance joint's structural flags."""
     flags = None
     if isinstance(element, Body):
         values = {"mass": element.mass, "inertia": element.inertia}
@@ -138,15 +132,13 @@ def _element_parameters(ref: Reference, element: Any, joints: dict[str, Any]
         raise AssemblyError(f"{element.kind} '{element.name}': element type not supported by assemble().")
     named = entries(element.name, values)
     sizes = ",".join([f"{name}:{len(value)}" for name, value in named])
-    return named, "\x02".join([element.name, repr(flags), sizes])  # flags: texts (law_structure) or None
+    return named, "\x02".join([element.name, repr(flags), sizes])
 
 
 @dataclass(frozen=True)
 class Structure:
-    """What of an assembled model depends on the structure only, built once per structure key and
-    shared by every model with that structure: the symbolic functions (the model built for the first
-    such scene) and how a scene's numbers are bound to them. A model keeps its structure, so new
-    numbers (:meth:`DAEModel.with_parameters`) are bound without recognising the scene again."""
+    """What of an assembled model depends on the structure only, built once per structure key: the
+    model built for its first scene, and how a scene's numbers are bound to it."""
 
     key: str  # the structure key (:func:`daeclear.assembly.parameters.structure_key`)
     model: DAEModel  # the structure, with the numbers of the scene it was built from
@@ -157,17 +149,17 @@ class Structure:
 
     def bind(self, scene: Scene, table: ParameterTable, described: Mapping[str, Any], alpha: float,
              beta: float) -> DAEModel:
-        if not table.has_layout(*self.names_sizes):  # a structure key collision would land here
+        if not table.has_layout(*zip(*self.layout)):  # a structure key collision would land here
             raise AssemblyError(f"scene '{scene.name}': its parameters do not match the cached structure.")
         P = table.vector
         bodies = scene.bodies
         contacts = tuple(logic for make in self.logic for logic in make(P))
-        auto_pairs = tuple((root, term, extra, needs, float(getattr(contacts[i], "min_approach_speed", 0.0)))
+        auto_pairs = tuple((root, term, extra, needs, float(contacts[i].min_approach_speed))
                            for root, term, extra, needs, i in self.auto_pairs)
         formulation, track_work = self.model.formulation, self.model.track_work
         return self.model.copy_with(
             structure=self, scene_name=scene.name, alpha=float(alpha), beta=float(beta),
-            # the model's own copy of the scene (a Scene is mutable; its elements are frozen)
+            # its own copy of the (mutable) scene
             scene=Scene(scene.name, gravity=scene.gravity, elements=list(scene.elements), ground=scene.ground),
             q_guess=[x for b in bodies for x in (*b.position, b.angle)],
             v_guess=[x for b in bodies for x in (*b.velocity, b.angular_velocity)],
@@ -199,14 +191,8 @@ class Structure:
                              "changed scene instead: assemble(model.scene.with_values(...)).")
         return self.bind(scene, table, described, alpha, beta)
 
-    @functools.cached_property
-    def names_sizes(self) -> tuple[tuple[str, ...], tuple[int, ...]]:
-        """The layout's names and sizes (:meth:`ParameterTable.has_layout`)."""
-        return tuple(name for name, _ in self.layout), tuple(size for _, size in self.layout)
 
-
-# Structures built in this process, by structure key (a scene that differs only in numbers
-# reuses one: no CasADi work, and the same compiled library).
+# Structures built in this process, by structure key.
 _STRUCTURES: dict[str, Structure] = memo_table()
 _STRUCTURE_LIMIT = 64
 # Part of every structure key: bump when the generated functions change meaning.
@@ -217,27 +203,21 @@ def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: flo
              track_work: bool = False) -> DAEModel:
     """Assemble a validated scene into a :class:`DAEModel`.
 
-    Only the scene's structure (bodies, joints, clearance joints and their laws) is built
-    symbolically, once per process; every number is run-time parameter data
-    (``model.parameter_values``), so scenes that differ only in numbers share the symbolic
-    functions and the compiled library.
+    Only the scene's structure is built symbolically, once per process; every number is run-time
+    data (``model.parameter_values``), so scenes that differ only in numbers share the compiled library.
 
     Parameters
     ----------
     scene : Scene
         The mechanism; validated first (all problems reported at once).
     formulation : {"ggl", "index1"}
-        ``ggl`` (the default): stabilised index-2, drift-free in positions and velocities;
-        ``index1``: acceleration-level constraints with Baumgarte stabilisation (the chapter's,
-        Tables 4.2 and 4.3; the only one the non-IDA methods integrate).
+        ``ggl`` (default): stabilised index 2, drift-free; ``index1``: acceleration-level constraints
+        with Baumgarte stabilisation (Tables 4.2-4.3; the only one the non-IDA methods integrate).
     alpha, beta : float
         Baumgarte parameters of ``index1`` (1/s), 5 and 5 by default (Table 4.2).
     track_work : bool
-        Add the state ``work.input``: the work done on the mechanism by drivers, contact
-        forces and loads (daeclear.loads; springs' elastic energy is potential energy),
-        W' = driver power + contact power + load power, integrated with the equations (kept out of
-        the error test, so it does not change the solution). ``energy.mechanical - work`` is then
-        conserved up to the integration error: channel ``energy.work``.
+        Add the state ``work.input`` (channel ``energy.work``): the work of drivers, contact forces and
+        loads, integrated out of the error test; ``energy.mechanical - work`` is then conserved.
 
     Returns
     -------
@@ -282,9 +262,7 @@ def _build_template(scene: Scene, formulation: str, track_work: bool, table: Par
 
 
 class _TemplateBuilder:
-    """The steps of :func:`_build_template`, one method each, in this order: constraints, masses
-    and forces, the state vector and residual, the contact terms, the output channels, and the
-    generated functions with the compiled loop's simple pairs. The symbols each step makes are
+    """The steps of :func:`_build_template`, one method each, in order; each step's symbols are
     attributes the later steps read."""
 
     def __init__(self, scene: Scene, formulation: str, track_work: bool, table: ParameterTable, key: str) -> None:
@@ -373,9 +351,8 @@ class _TemplateBuilder:
             state_names += [f"mu.{c}" for c in names]
             kinds += [KIND_MULTIPLIER] * m
         drive_power = sum((-lam[row] * ca.mtimes(Phi_q[row, :], v) for row in self.driver_rows.values()), ca.SX(0.0))
-        # Multipliers from (t, q, v) and extra generalized forces Fc, by the Schur complement of the
-        # KKT system [M Phi_q^T; Phi_q 0][a; lam] = [Q + Fc; c] (M is diagonal). Used for consistent
-        # states and for the work rate, which must not depend on IDA's unconverged multipliers.
+        # Multipliers from (t, q, v, Fc) by the Schur complement of [M Phi_q^T; Phi_q 0][a; lam] = [Q + Fc; c]
+        # (M diagonal): consistent states, and a work rate free of IDA's unconverged multipliers
         Minv = 1.0 / self.mass_diag
         rhs_c = gamma - 2 * alpha * Phi_dot - beta**2 * Phi if self.formulation == "index1" else gamma
         self.Fc = Fc = ca.SX.sym("Fc", n)
@@ -401,8 +378,7 @@ class _TemplateBuilder:
         self.jacobian = ca.Function("jacobian", [t, y, yp, cj, P], [jac], ["t", "y", "yp", "cj", "P"], ["J"])
 
     def contact_terms(self) -> None:
-        """Each contact term's generalized force added to the equations of motion rows (its residual
-        and Jacobian), its switch inputs, channels and power, and the gap functions (IDA's roots)."""
+        """Each contact term's residual and Jacobian, switch inputs, channels and power; the gaps (roots)."""
         t, q, v, P, n, n_y, y, yp, cj = self.t, self.q, self.v, self.P, self.n, self.n_y, self.y, self.yp, self.cj
         self.terms: list[Term] = []
         self.term_res: list[ca.Function] = []
@@ -446,7 +422,7 @@ class _TemplateBuilder:
             self.roots = ca.Function("roots", [t, y, yp, P], [ca.vertcat(*gaps)], ["t", "y", "yp", "P"], ["g"])
 
     def output_channels(self) -> None:
-        """The channels of every reported point: bodies, drivers, energy, constraints, contacts, loads."""
+        """The output channels: bodies, drivers, energy, constraints, contacts, loads, joints."""
         q, v, a, params, bodies, gx, gy = self.q, self.v, self.a, self.params, self.bodies, self.gx, self.gy
         channels: list[Channel] = []
         for k, b in enumerate(bodies):
@@ -461,8 +437,7 @@ class _TemplateBuilder:
                 Channel(f"{b.name}.alpha", "rad/s^2", ak[2]),
             ]
         for name, row in self.driver_rows.items():
-            # The driver's constraint enters body j's equation of its coordinate with +lam; the moment
-            # (force along the axis) it applies to body j is therefore -lam (positive counter-clockwise).
+            # the constraint enters body j's equation with +lam: the driver's moment (force) on it is -lam
             driver = self.scene[name]
             assert isinstance(driver, Driver)  # driver_rows holds the names of the scene's drivers only
             load, unit = driver_load(self.joints[driver.joint])
@@ -493,15 +468,13 @@ class _TemplateBuilder:
         self.channels = channels + self.contact_channels + list(self.loads.channels) + joint_readings
 
     def template(self) -> Structure:
-        """The generated functions (outputs, accelerations, kinematics, the compiled loop's simple
-        pairs) and the model of the structure, its numbers bound per scene (:meth:`Structure.bind`)."""
+        """The generated functions and the structure's model (numbers bound per scene by :meth:`Structure.bind`)."""
         library_name = f"mechanism_{self.key[:16]}"
         t, q, v, P, n, y, yp, channels = self.t, self.q, self.v, self.P, self.n, self.y, self.yp, self.channels
         switch = ca.vertcat(*self.switch_syms) if self.switch_syms else ca.SX(0, 1)
         outputs = ca.Function("outputs", [t, y, yp, switch, P], [ca.vertcat(*[c.expr for c in channels])],
                               ["t", "y", "yp", "switch", "P"], ["channels"])
-        # accelerations, multipliers (and work rate) from (t, q, v, contact forces) as generated code:
-        # consistent states at restarts and at every reported point cost ~1 us
+        # accelerations, multipliers (and work rate) from (t, q, v, contact forces): consistent states
         work_rate = [self.drive_power_of + ca.dot(self.Fc, v) + self.loads.power] if self.track_work else []
         accel = ca.Function("accel", [t, q, v, self.Fc, P],
                             [ca.densify(ca.vertcat(self.a_sol, self.lam_sol, *work_rate))],
@@ -519,18 +492,16 @@ class _TemplateBuilder:
         start_flat = ca.Function("start_kinematics_flat", [q, v, t, P],
                                  [ca.vertcat(Phi_s, ca.vec(Phi_s_q), Phi_s_dot)],
                                  ["q", "v", "t", "P"], ["K"])
-        # the channels the physics checks read, alone: a run is checked without computing the others
         checked = [c.expr for c in channels if checked_channel(c.name)]
         checks = ca.Function("checks", [t, y, yp, switch, P], [ca.vertcat(*checked) if checked else ca.SX(0, 1)],
                              ["t", "y", "yp", "switch", "P"], ["checked"])
         extras = [outputs, accel, kinematics_flat, start_flat, checks] + [term.force for term in self.terms]
-        # simple contact pairs whose switches the compiled loop may handle itself (see ida_driver.c)
+        # simple contact pairs, whose switches the compiled loop may decide itself (ida_driver.c)
         logic_makers = tuple(build.logic for build in builds)
-        sample = [logic for make in logic_makers for logic in make(self.table.vector)]
-        auto_pairs = []
-        simple = [getattr(logic, "simple_pairs", lambda: None)() for logic in sample]
+        simple = [logic.simple_pairs() for make in logic_makers for logic in make(self.table.vector)]
         given = [pairs for pairs in simple if pairs is not None]
-        if sample and len(given) == len(simple):
+        auto_pairs = []
+        if simple and len(given) == len(simple):
             for index, pairs in enumerate(given):
                 for root, term_index, gap_rate, needs, _floor in pairs:
                     extras.append(gap_rate)

@@ -1,40 +1,25 @@
 """The contact-mode automaton of one pair: the one definition of the event rule.
 
-A contact pair (one gap function, positive in penetration) is *free* or in *contact*, and may be
-*held* by the storm guard. At every root of its gap the automaton takes the crossing's time,
-direction (+1 upward, -1 downward, 0 none) and the penetration rate there, and decides:
+A pair (one gap, positive in penetration) is *free* or in *contact*, and may be *held* by the storm
+guard. At a root of its gap, given the time, the direction (+1 up, -1 down, 0 none) and the
+penetration rate there, :func:`step` decides:
 
-* free, upward crossing: *onset*; the approach speed ``max(rate, min_approach_speed)`` is
-  latched (the floor keeps the damping bounded for grazing contacts) and the term goes on;
-* contact, downward crossing: *separation*; the term goes off, unless this separation completes
-  a storm (``storm.events`` switches within ``storm.window`` seconds, this one included): then the
-  pair is *held*, its term stays on (the force is zero with a zero derivative while the gap is
-  open, so nothing physical changes) and both crossings are watched;
-* a crossing against the sign of the rate at the instant of the pair's last switch (within
-  ``SAME_INSTANT`` relative to t): a downward one while the pair still approaches (rate > 0), an
-  upward one while it still recedes (rate < 0): nothing. Exactly, a gap cannot cross against its own
-  rate; the gap at the restart after a switch is zero to round-off, and its noise crosses zero again
-  until the motion outgrows it. IDA's first steps after a restart are a few ulps of t and its root
-  location tolerance is about 100 ulps of t, so that noise spans from 1 ulp (at rtol 1e-12 a closing
-  joint was logged onset, separation, onset within 2e-19 s while approaching at 1.36 m/s) to about
-  6.5e4 ulps for a corner leaving its wall at 0.3 mm/s (Siconos slider-crank, rtol 1e-10). Decided as
-  a separation, such a root left a corner free inside its wall: the restart found its gap exactly
-  zero, IDA masked it, saw it positive a step later and never reported the onset again. A genuine
-  crossing has the rate's sign, or comes later than the window (only a grazing crossing, its rate
-  within the solver's error of zero, could be taken for round-off, and only inside the window).
-  The loops restart IDA in the same modes after such a root (a root found in the watched direction
-  that decided nothing: ``solvers.ida_loop.guarded_root``), because IDA, going on from a gap that is
-  exactly zero, fails when it is still zero a root tolerance later;
-* held: a downward crossing restarts the flight clock (``free_since``); an upward one changes
-  nothing unless the flight lasted longer than ``storm.window``, in which case the hold ends and
-  the crossing is a genuine onset with a freshly latched speed;
-* anything else decides nothing (no event, no restart; held pairs' roots are watched both ways).
+* free, upward: *onset*; the approach speed ``max(rate, min_approach_speed)`` is latched, the term
+  goes on;
+* contact, downward: *separation*; the term goes off, unless this switch completes a storm
+  (``storm.events`` switches within ``storm.window`` s): then the pair is *held*, its term stays on
+  (the force is zero while the gap is open) and both directions are watched;
+* a crossing against the sign of the rate within ``SAME_INSTANT`` (relative to t) of the pair's
+  last switch: nothing. It is the gap's round-off at the restart after that switch (a gap cannot
+  cross against its own rate); the loops restart IDA in the same modes
+  (``solvers.ida_loop.guarded_root``);
+* held: a downward crossing restarts the flight clock (``free_since``); an upward one ends the hold
+  (a genuine onset) only after a flight longer than ``storm.window``;
+* anything else: nothing.
 
-:func:`step` is pure. The compiled IDA loop runs a line-by-line C mirror of it (``pair_step`` in
-``csrc/ida_driver.c``) for the pairs it switches itself and reports each decision; the Python
-logic objects (:mod:`daeclear.assembly.revolute_joint`, :mod:`daeclear.assembly.translational_joint`) run
-:func:`step` for the other backends and only record the compiled loop's decisions. ``tests/test_automaton.py`` drives
-both with the same random root sequences and requires identical decisions.
+:func:`step` is pure. The compiled IDA loop runs its line-by-line C mirror (``pair_step`` in
+``csrc/ida_driver.c``) for the pairs it switches itself; ``tests/test_automaton.py`` requires
+identical decisions from both (docs/user_guide.md, "Contact events").
 """
 
 from __future__ import annotations
@@ -48,16 +33,14 @@ from typing import Final, Literal
 STORM_EVENTS: Final[int] = 20
 STORM_WINDOW: Final[float] = 1e-6
 
-#: A crossing against the rate closer than this to the pair's last switch, relative to t, is the gap's
-#: round-off at that switch (2**20 ulps, 2.3e-10: 2.3e-11 s at t = 0.1 s, in which a pair moving at
-#: 1 m/s moves 2.3e-11 m; the noise measured spans up to 6.5e4 ulps; C: dc_abi.h's DC_SAME_INSTANT).
+#: A crossing against the rate this close to the pair's last switch, relative to t, is the gap's
+#: round-off at that switch (2**20 ulps: 2.3e-11 s at t = 0.1 s; C: dc_abi.h's DC_SAME_INSTANT).
 SAME_INSTANT: Final[float] = 2**20 * 2.220446049250313e-16
 
 #: Decision kinds (the values the C loop reports) and the event kinds they make.
 NONE: Final[int] = 0
 ONSET: Final[int] = 1
 SEPARATION: Final[int] = -1
-# (the kinds are daeclear.results.result.EventKind, spelled here: this module imports nothing of the package)
 EVENT_KINDS: Final[dict[int, Literal["onset", "separation"]]] = {ONSET: "onset", SEPARATION: "separation"}
 
 
@@ -83,12 +66,9 @@ DEFAULT_STORM: Final[Storm] = Storm()
 
 @dataclass(frozen=True)
 class PairState:
-    """What the automaton remembers of one pair.
-
-    ``recent`` holds the times of the last ``storm.events`` switches (oldest first), ``free_since``
-    the start of the current flight of a held pair, ``latched`` the approach speed latched at the
-    last onset (floored).
-    """
+    """What the automaton remembers of one pair: ``recent``, the times of the last ``storm.events``
+    switches (oldest first); ``free_since``, the start of a held pair's flight; ``latched``, the
+    approach speed latched at the last onset (floored)."""
 
     contact: bool = False
     held: bool = False
@@ -109,10 +89,7 @@ class PairState:
 
 @dataclass(frozen=True)
 class Decision:
-    """The outcome of one root: event ``kind`` (ONSET, SEPARATION or NONE) and the pair's new mode.
-
-    A decision of kind NONE changes no mode and makes no event (the same-instant guard's restarts IDA).
-    """
+    """The outcome of one root: event ``kind`` (ONSET, SEPARATION or NONE) and the pair's new mode."""
 
     kind: int
     contact: bool
@@ -168,8 +145,7 @@ def step(state: PairState, t: float, direction: int, rate: float, *, storm: Stor
 
 
 def recorded(state: PairState, decision: Decision) -> PairState:
-    """The state after a decision taken elsewhere (the compiled loop): its mode and latched speed.
-    The storm history stays with the side that decides."""
+    """The state after a decision taken by the compiled loop (which keeps the storm history)."""
     # the constructor, not dataclasses.replace: this runs at every event of a compiled run
     return PairState(contact=decision.contact, held=decision.held, free_since=state.free_since,
                      latched=decision.latched, recent=state.recent)

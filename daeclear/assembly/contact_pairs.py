@@ -1,26 +1,9 @@
 """Clearance joints as contact elements: symbolic forces, gap functions, channels, event logic.
 
-A clearance joint adds no constraint. It brings
-
-* *terms*: generalized contact forces that the solver switches on only while the pair is
-  in contact (inactive terms are never evaluated);
-* *gaps*: root functions watched by IDA, positive in penetration;
-* *channels*: output quantities (eccentricity, penetration, forces);
-* *logic*: what happens at a root (mode switch, approach speed latched at onset).
-
-Event rule (documented in docs/user_guide.md, "Contact events")
----------------------------------------------------------------
-A pair is *free* or in *contact*. While free, only upward crossings of its gap are
-watched (onset); while in contact only downward ones (separation). At an onset the
-approach speed (the penetration rate at the located root) is latched, floored at the
-law's ``min_approach_speed`` so the damping term stays bounded for grazing contacts,
-and the term is switched on; at a separation it is switched off. Every switch restarts
-IDA from a consistent state. The contact force is exactly zero with a zero derivative
-at zero penetration for every continuous law, so a switch never jumps the force; and
-because IDA returns a root just past the crossing, a restart never reports the same
-crossing twice. Following (continuous) contact keeps the pair in contact mode with no
-events at all; a Zeno-like cascade of ever shorter bounces is cut by the storm guard.
-The rule, storm guard included, is defined once in :mod:`daeclear.assembly.automaton`.
+A clearance joint adds no constraint but *terms* (generalized contact forces, on only while a pair
+is in contact), *gaps* (root functions watched by IDA, positive in penetration), *channels* and
+*logic* (what a root decides: mode switch, approach speed latched at onset). The event rule, storm
+guard included, is :mod:`daeclear.assembly.automaton`'s (docs/user_guide.md, "Contact events").
 """
 
 from __future__ import annotations
@@ -35,8 +18,8 @@ from numpy.typing import NDArray
 
 from .automaton import DEFAULT_STORM, EVENT_KINDS, NONE, Decision, PairState, Storm, start, step
 from ..results.result import ContactEvent
-from .parameters import symbolic_law
-from .symbolic import AssemblyContext, BufferedFunction, Channel, Term, perpendicular
+from .parameters import law_values, symbolic_law
+from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
 
 
 #: A contact element's part of a run's contact state: the automaton state of each of its pairs.
@@ -47,20 +30,20 @@ TermSwitch = tuple[int, bool, NDArray[np.float64]]
 
 @dataclass(frozen=True)
 class PairLogic:
-    """Mode switching of one contact pair: one gap (root) and one term. A rule, not a state: the
-    run's state of the pair (:class:`~daeclear.assembly.automaton.PairState`) is passed in and
-    returned (see :mod:`daeclear.assembly.contact_state`).
+    """Mode switching of contact pairs, each with one gap (root ``first_root + i``) and one term
+    (``pair_terms[i]``). A rule, not a state: the run's pair states
+    (:class:`~daeclear.assembly.automaton.PairState`) are passed in and returned
+    (:mod:`daeclear.assembly.contact_state`).
 
-    ``rate`` evaluates ``(gap, penetration_rate)`` from ``(q, v)``; ``needs_approach`` says
-    whether the term's parameter is the approach speed latched at onset. The rule, storm guard
-    included, is :func:`daeclear.assembly.automaton.step` with this pair's ``storm`` constants; the term
-    is on while the pair is in contact or held.
+    ``rate`` maps ``(q, v)`` to the gaps and the penetration rates; ``needs_approach``: a term's
+    parameter is the approach speed latched at onset. Each root is decided by
+    :func:`daeclear.assembly.automaton.step`; a term is on while its pair is in contact or held.
     """
 
-    pair: str
-    root_index: int
-    term_index: int
-    rate: BufferedFunction  # (q, v) -> (gap, penetration rate)
+    pairs: tuple[str, ...]
+    first_root: int
+    pair_terms: tuple[int, ...]
+    rate: BufferedFunction  # (q, v) -> (gaps, penetration rates)
     n_q: int
     needs_approach: bool
     min_approach_speed: float
@@ -70,58 +53,67 @@ class PairLogic:
     @property
     def roots(self) -> range:
         """Indices of the gaps (roots) of this element."""
-        return range(self.root_index, self.root_index + 1)
+        return range(self.first_root, self.first_root + len(self.pairs))
 
     def pair_index(self, root: int) -> int:
         """The pair (index in this element's states) of gap ``root``."""
-        return 0
+        return root - self.first_root
 
     def pair_name(self, root: int) -> str:
         """The name of the pair of gap ``root`` (its events' ``pair``)."""
-        return self.pair
+        return self.pairs[self.pair_index(root)]
 
-    def _gap_rate(self, y: NDArray) -> tuple[float, float]:
-        q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
-        gap, rate = self.rate(q, v)
-        return float(gap[0]), float(rate[0])
+    def _evaluate(self, y: NDArray) -> tuple[NDArray, NDArray]:
+        gaps, rates = self.rate(y[:self.n_q], y[self.n_q:2 * self.n_q])
+        return np.ravel(gaps), np.ravel(rates)
 
     def _params(self, state: PairState) -> NDArray:
         return np.array([state.latched]) if self.needs_approach else np.zeros(0)
 
     def start(self, t: float, y: NDArray) -> PairStates:
-        """The pair's state at the start of a run (mode from the gap, rate latched, no history)."""
-        gap, rate = self._gap_rate(y)
-        return (start(gap > 0.0, rate, self.min_approach_speed),)
+        """Each pair's state at the start of a run (mode from its gap, rate latched, no history)."""
+        gaps, rates = self._evaluate(y)
+        return tuple(start(gap > 0.0, float(rate), self.min_approach_speed) for gap, rate in zip(gaps, rates))
 
     def terms(self, states: PairStates) -> list[TermSwitch]:
-        """The term is on in contact or held; its parameter the latched approach speed."""
-        return [(self.term_index, states[0].term_on, self._params(states[0]))]
+        """A term is on in contact or held; its parameter the latched approach speed."""
+        return [(k, st.term_on, self._params(st)) for k, st in zip(self.pair_terms, states)]
 
     def modes(self, states: PairStates) -> dict[str, str]:
-        return {self.pair: "contact" if states[0].contact else "free"}
+        return {p: ("contact" if st.contact else "free") for p, st in zip(self.pairs, states)}
 
     def root_directions(self, states: PairStates) -> list[tuple[int, int]]:
         """While free watch onsets (+1), in contact separations (-1), held both (0)."""
-        return [(self.root_index, states[0].watch)]
+        return [(self.first_root + i, st.watch) for i, st in enumerate(states)]
 
     def decide(self, states: PairStates, t: float, y: NDArray, roots_found: NDArray | None
                ) -> tuple[PairStates, list[ContactEvent]]:
-        """Decide a root of the pair's gap by the automaton: the new states and the events."""
-        if roots_found is None or roots_found[self.root_index] == 0:
+        """Decide the roots of the pairs' gaps by the automaton: the new states and the events."""
+        if roots_found is None:
             return states, []
-        rate = self._gap_rate(y)[1]
-        state, decision = step(states[0], t, int(roots_found[self.root_index]), rate, storm=self.storm,
-                               min_approach_speed=self.min_approach_speed)
-        return (state,), pair_event(self.pair, t, y, rate, decision)
+        found = roots_found[self.first_root:self.first_root + len(self.pairs)]
+        if not np.any(found):
+            return states, []
+        rates = self._evaluate(y)[1]
+        events: list[ContactEvent] = []
+        new = list(states)
+        for i, direction in enumerate(int(d) for d in found):
+            if direction:
+                new[i], decision = step(new[i], t, direction, float(rates[i]), storm=self.storm,
+                                        min_approach_speed=self.min_approach_speed)
+                events += pair_event(self.pairs[i], t, y, float(rates[i]), decision)
+        return tuple(new), events
 
-    def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]]:
+    def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
         """(root, term, (q, v, P) -> [gap; rate], needs approach speed, floor): the pairs whose
         switches the compiled IDA loop decides itself, by the C mirror of the automaton."""
         fn = self.rate.function
         q, v, P = (ca.SX.sym(label, fn.numel_in(i)) for i, label in enumerate(("q", "v", "P")))
-        gap, rate = fn(q, v, P)
-        f = ca.Function(f"{self.pair.replace('.', '_')}_gap_rate", [q, v, P], [ca.vertcat(gap, rate)])
-        return [(self.root_index, self.term_index, f, bool(self.needs_approach), float(self.min_approach_speed))]
+        gaps, rates = fn(q, v, P)
+        return [(self.first_root + i, k, ca.Function(f"{pair.replace('.', '_')}_gap_rate", [q, v, P],
+                                                      [ca.vertcat(gaps[i], rates[i])]),
+                 bool(self.needs_approach), float(self.min_approach_speed))
+                for i, (pair, k) in enumerate(zip(self.pairs, self.pair_terms))]
 
 
 def pair_event(pair: str, t: float, y: NDArray, rate: float, decision: Decision) -> list[ContactEvent]:
@@ -133,19 +125,15 @@ def pair_event(pair: str, t: float, y: NDArray, rate: float, decision: Decision)
 
 @dataclass(frozen=True)
 class ContactBuild:
-    """What a clearance joint contributes to the assembled model.
-
-    ``logic(P)`` makes the joint's event logic for one parameter vector (the structure is
-    built once; each bound model gets its own logic with its own numbers and run state).
-    """
+    """What a clearance joint contributes to the assembled model; ``logic(P)`` makes its event logic
+    for one parameter vector (each bound model gets its own)."""
 
     terms: list[Term]
     gaps: list[Any]
     gap_names: list[str]
     channels: Callable[[Sequence[tuple[Any, Any]]], list[Channel]]
     logic: Callable[[NDArray[np.float64]], list[Any]]
-    # the constraints of the ideal joint the clearance joint replaces (the chapter's start:
-    # clearance joints centred, the mechanism assembled as if they were ideal), with their names
+    # the constraints of the ideal joint it stands for (the chapter's start), with their names
     ideal: list[Any]
     ideal_names: list[str]
 
@@ -162,12 +150,8 @@ def approach_floor(ctx: AssemblyContext, law: Any, prefix: str) -> Callable[[NDA
 
 @dataclass(frozen=True)
 class JournalContact:
-    """A revolute clearance joint's journal in its bearing, eqs. (4.1)-(4.13): the eccentricity and
-    the contact force term (normal law and friction), shared by the dry and the lubricated joint.
-
-    ``force`` maps (t, q, v, p, P) to the generalized force, ``p`` the latched approach speed
-    (``n_params`` 0 or 1); frames ``bi`` (bearing) and ``bj`` (journal).
-    """
+    """A journal in its bearing, eqs. (4.1)-(4.13), for the dry and the lubricated joint: the
+    eccentricity and ``force``, (t, q, v, p, P) -> generalized force, ``p`` the latched approach speed."""
 
     e: Any
     e_dot: Any
@@ -205,11 +189,38 @@ class JournalContact:
         return out
 
 
+def journal_logic(ctx: AssemblyContext, jc: JournalContact, cls: type[PairLogic], name: str, first_root: int,
+                  first_term: int, gaps: list[Any], law: Any, friction: Any
+                  ) -> Callable[[NDArray[np.float64]], list[Any]]:
+    """A journal's logic maker: one pair ``name`` of class ``cls``, its rate function (q, v, P) ->
+    (``gaps``..., penetration rate) bound to each parameter vector."""
+    penetration_rate = ca.dot(jc.e_dot, jc.e) / ca.fmax(jc.e_norm, 1e-300)
+    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P], [*gaps, penetration_rate])
+    floor = approach_floor(ctx, law, f"{name}.law")
+    discontinuous = not friction.frictionless and not friction.smooth
+    n_q = ctx.n_q  # read once: a CasADi call costs more inside a sweep's loop than the logic it makes
+
+    def logic(P: NDArray[np.float64]) -> list[Any]:
+        return [cls((name,), first_root, (first_term,), BufferedFunction(rate, bound=(P,)), n_q,
+                    law.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
+    return logic
+
+
+def journal_parameters(ref: Reference, joint: Any, law: Any, friction: Any, film: dict[str, Any] | None = None
+                       ) -> dict[str, Any]:
+    """A revolute clearance joint's points, clearance and radii, ``film``'s entries, and its laws' numbers."""
+    s_i, s_j = ref.joint_points(joint)
+    values: dict[str, Any] = {"s_i": s_i, "s_j": s_j, "clearance": joint.radial_clearance,
+                              "bearing_radius": float(joint.bearing_radius), "journal_radius": joint.journal,
+                              **(film or {})}
+    values.update({f"law.{k}": v for k, v in law_values(law).items()})
+    values.update({f"friction.{k}": v for k, v in law_values(friction).items()})
+    return values
+
+
 def worn_depths(ctx: AssemblyContext, joint: Any, direction: Any, bi: Any, bj: Any) -> tuple[Any, Any]:
-    """The worn depth of the bearing and of the journal along the contact ``direction`` (a unit
-    vector, world frame): each surface's smooth profile (:func:`daeclear.contact.wear.profile_coefficients`,
-    run-time parameters ``<joint>.wear.<surface>_cos/_sin``) at the direction's angle in that body's
-    frame; 0 for a surface that does not wear."""
+    """The worn depths of the bearing and of the journal along the unit ``direction`` (world frame):
+    each surface's profile (parameters ``<joint>.wear.<surface>_cos/_sin``), 0 if it does not wear."""
     wear = getattr(joint, "wear", None)
     out: list[Any] = [0.0, 0.0]
     for k, (surface, frame) in enumerate((("bearing", bi), ("journal", bj))):
@@ -228,8 +239,7 @@ def worn_depths(ctx: AssemblyContext, joint: Any, direction: Any, bi: Any, bj: A
 
 
 def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction_numeric: Any) -> JournalContact:
-    """Journal-bearing contact (section 4.2) of ``joint`` with these laws, every number a run-time
-    parameter ``<joint>.*``. Body i carries the bearing (radius R_i), body j the journal (R_j)."""
+    """Journal-bearing contact (section 4.2) of ``joint``: body i the bearing (R_i), j the journal (R_j)."""
     name = joint.name
     law = symbolic_law(law_numeric, ctx.params, f"{name}.law")
     friction = symbolic_law(friction_numeric, ctx.params, f"{name}.friction")

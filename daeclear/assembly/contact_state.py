@@ -1,15 +1,10 @@
 """A run's contact state: one value, passed in and returned, never kept by the model.
 
-The contact elements of a model (``model.contacts``: :class:`~daeclear.assembly.contact_pairs.PairLogic`,
-the translational joint's :class:`~daeclear.assembly.translational_joint.SliderGuideLogic`, the
-lubricated joint's logic) are rules. What a run remembers of its contacts, each pair's automaton
-state (mode, held, latched approach speed, storm history: :class:`~daeclear.assembly.automaton.PairState`),
-is a :data:`ContactState`: one tuple of pair states per contact element, in the model's order.
-Everything else the integrator needs follows from it: which terms are on and their parameters (the
-switch vector), the modes of pairs and faces, the directions of the roots to watch. A root is
-decided by :func:`decide`, which returns the new state and the events, as diffrax threads its
-``solver_state``; the compiled IDA loop decides the simple pairs itself and holds their states,
-which the IDA loop reads back into the run's state (:func:`with_pairs`).
+The contact elements of a model (``model.contacts``, :class:`~daeclear.assembly.contact_pairs.PairLogic`
+and its subclasses) are rules; a :data:`ContactState` holds each pair's automaton state
+(:class:`~daeclear.assembly.automaton.PairState`), one tuple per element. The terms, modes and root
+directions follow from it; :func:`decide` returns the new state and the events; the compiled loop's
+own decisions are read back by :func:`with_pairs`.
 """
 
 from __future__ import annotations

@@ -1,10 +1,8 @@
-"""The assembled mechanism, :class:`DAEModel`: its compiled functions and what interprets them.
+"""The assembled mechanism, :class:`DAEModel`: its compiled functions and what a solver asks of them.
 
-What a solver needs from a mechanism once it is assembled: the state layout (``y = [q, v, lam]``
-for ``index1``, ``[q, v, lam, mu]`` for ``ggl``, see :mod:`daeclear.assembly.assemble` for the
-equations), consistent initial states and restarts, contact forces and output channels evaluated
-at many points. Separate from :mod:`daeclear.assembly.assemble`, which builds a DAEModel from a
-scene: every solver uses the model, only assembly needs CasADi's symbolic construction.
+The state layout (``y = [q, v, lam]`` for ``index1``, ``[q, v, lam, mu]`` for ``ggl``; equations in
+:mod:`daeclear.assembly.assemble`, which builds the model), consistent states, contact forces and
+output channels at many points.
 """
 
 from __future__ import annotations
@@ -25,15 +23,13 @@ from .symbolic import Term
 
 Formulation = Literal["index1", "ggl"]
 
-# Extra functions compiled with the model (DAEFunctions.extras), evaluated over many points.
-# kinematics: (q, v, t) -> [Phi; Phi_q (column-major); Phi_dot]; start kinematics: the same with
-# every clearance joint's ideal joint added (the chapter's start); checks: the outputs' channels the
-# physics checks read (physics.checked_channel), in order; term k's force: EXTRA_TERM0 + k
+# Extra functions compiled with the model (DAEFunctions.extras). kinematics: (q, v, t) -> [Phi; Phi_q
+# (column-major); Phi_dot]; start kinematics: the same with the clearance joints' ideal joints; checks: the
+# channels the physics checks read; term k's force: EXTRA_TERM0 + k
 EXTRA_OUTPUTS, EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_START_KINEMATICS, EXTRA_CHECKS, EXTRA_TERM0 = 0, 1, 2, 3, 4, 5
 
 
-# Projection onto the constraint manifold (initial state and restarts, in Python and in C):
-# |Phi| < POSITION_TOL * max(1, |q|) within NEWTON_STEPS least-norm Newton steps.
+# Projection onto the constraint manifold: |Phi| < POSITION_TOL * max(1, |q|) within NEWTON_STEPS steps.
 POSITION_TOL = 1e-13
 NEWTON_STEPS = 50
 
@@ -43,10 +39,9 @@ KIND_POSITION, KIND_VELOCITY, KIND_MULTIPLIER, KIND_WORK = "q", "v", "lambda", "
 
 @dataclass(frozen=True)
 class DAEModel:
-    """An assembled mechanism: CasADi functions for the solver plus everything to interpret them.
+    """An assembled mechanism: CasADi functions for the solver and what interprets them.
 
-    Build it with :func:`~daeclear.assembly.assemble.assemble`; it is frozen and independent of the scene object.
-    ``print(model)`` summarises its sizes.
+    Made by :func:`~daeclear.assembly.assemble.assemble`; frozen. ``print(model)`` summarises its sizes.
     """
 
     scene_name: str
@@ -68,47 +63,37 @@ class DAEModel:
     mass_diagonal: NDArray[np.float64]
     kinematics: ca.Function  # (q, v, t) -> (Phi, Phi_q, Phi_dot, gamma)
     base_force: ca.Function  # (t, q, v) -> Q (gravity and applied loads)
-    # the scene's description ("scene": a read-only mapping made at its first read) and the options
-    parameters: dict[str, Any] = field(default_factory=dict)
+    parameters: dict[str, Any] = field(default_factory=dict)  # the scene's description and the options
     contacts: tuple[Any, ...] = ()  # contact elements' event rules (clearance joints; no run state)
     track_work: bool = False
     # (root, term, gap-rate extra, needs approach speed, min approach speed) of simple pairs
     auto_pairs: tuple[tuple[int, int, int, bool, float], ...] = ()
     # constraints of the chapter's start: the ideal joints, then each clearance joint's ideal joint
     start_constraint_names: tuple[str, ...] = ()
-    # run-time parameters: the last input of every function above (see daeclear.assembly.parameters)
-    parameter_layout: tuple[tuple[str, int], ...] = ()  # (name, size) of each entry
+    # run-time parameters, the last input of every function: (name, size) of each entry, values
+    parameter_layout: tuple[tuple[str, int], ...] = ()
     parameter_values: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
-    # the scene element (joint or driver name) of each constraint row, for messages
-    constraint_elements: tuple[str, ...] = ()
+    constraint_elements: tuple[str, ...] = ()  # the scene element of each constraint row
     # (name, clearance m, corner radius m or 0) of each clearance joint: the limits of the physics checks
     clearance_joints: tuple[tuple[str, float, float], ...] = ()
     driver_names: tuple[str, ...] = ()
-    # whether the scene applies loads (forces, torques, springs, motors) besides gravity: structure
-    has_loads: bool = False
-    # consistent starts found for this model, by (start, allow_penetration, evaluator, the numbers
-    # and guesses they came from): kept so that a model run again (a study's repeated runs, a scene
-    # seen before) skips assembling its start; shared by the run copies and by every model bound to
-    # one structure (the numbers in the key keep a model with other numbers from reading a stale start)
+    has_loads: bool = False  # loads besides gravity
+    # consistent starts by (start, allow_penetration, evaluator, numbers, guesses), shared by the models
+    # of one structure: a model run again skips assembling its start
     start_memo: dict[tuple[Any, ...], tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
         default_factory=dict, compare=False, repr=False)
-    # indices of the parameters the chapter's ("ideal") start depends on (None: all of them), the
-    # numbers of its memo key: scenes that differ only in clearances or contact and friction laws
-    # share one start (see start_parameters())
+    # the parameters the chapter's start depends on (None: all), its memo key's numbers (start_parameters())
     start_parameters: NDArray[np.intp] | None = field(default=None, compare=False, repr=False)
-    # the structure this model binds numbers to (assembly.assemble.Structure) and the scene whose
-    # numbers they are: with_parameters makes a model with new numbers from both
+    # the structure (assembly.assemble.Structure) and the scene whose numbers are bound: with_parameters
     structure: Any = field(default=None, compare=False, repr=False)
     scene: Any = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
-        # frozen means frozen: the arrays are read-only (a copy when the caller's array is writable)
         for name in _ARRAY_FIELDS:
             object.__setattr__(self, name, _read_only(getattr(self, name)))
 
     def copy_with(self, **changes: Any) -> DAEModel:
-        """``dataclasses.replace(self, **changes)`` without the constructor's round of every field: a
-        template bound to a scene's numbers, a run's copy (a sweep makes both at every point)."""
+        """``dataclasses.replace(self, **changes)`` without the constructor's round of every field."""
         model = object.__new__(type(self))
         model.__dict__.update(self.__dict__)
         model.__dict__.update(changes)
@@ -118,15 +103,13 @@ class DAEModel:
         return model
 
     def with_parameters(self, values: Mapping[str, Any]) -> DAEModel:
-        """This model with new numbers, as a new model (this one is unchanged), compiling nothing:
+        """A new model with new numbers, compiling nothing:
         ``model.with_parameters({"clearance.clearance": 2e-4, "clearance.law.restitution": 0.5})``.
 
-        Names are the scene's values (:meth:`daeclear.Scene.with_values`: ``"<element>.<field>"``,
-        a law's ``"<element>.law.<field>"``, ``"gravity"``) and, for ``index1``, ``"baumgarte.alpha"``
-        and ``"baumgarte.beta"``. The changed elements are made again from their fields, so what they
-        derive (a journal radius, a contact stiffness from the materials) follows, and validated.
-        Raises SceneError for an unknown name, a bad value, or a change of the structure (e.g.
-        friction on a frictionless joint): assemble that scene instead."""
+        Names are the scene's values (:meth:`daeclear.Scene.with_values`) and, for ``index1``,
+        ``"baumgarte.alpha"`` and ``"baumgarte.beta"``; the changed elements are made again from their
+        fields and validated. Raises SceneError for an unknown name, a bad value, or a change of the
+        structure (e.g. friction on a frictionless joint): assemble that scene instead."""
         if self.structure is None or self.scene is None:
             raise AssemblyError("with_parameters: this model was not made by assemble(); assemble the scene.")
         if not isinstance(values, Mapping):
@@ -159,14 +142,9 @@ class DAEModel:
     def n_states(self) -> int:
         return len(self.state_names)
 
-    @property
-    def differential(self) -> NDArray[np.bool_]:
-        """True for differential states (q, v), False for algebraic ones (multipliers)."""
-        return np.array([k != KIND_MULTIPLIER for k in self.state_kinds])
-
     def layout(self, project: bool) -> StateLayout:
-        """Where q, v, the multipliers (and mu, work) are in y and which extras make a state
-        consistent, for the compiled loop; ``project``: restarts on the constraint manifold."""
+        """The state layout and the extras of consistent states, for the compiled loop; ``project``:
+        restarts on the constraint manifold."""
         return StateLayout(
             n_q=self.n_q, n_constraints=self.n_constraints, ggl=self.formulation == "ggl", track_work=self.track_work,
             accel_extra=EXTRA_ACCEL, force_extra0=EXTRA_TERM0, kinematics_extra=EXTRA_KINEMATICS,
@@ -201,7 +179,6 @@ class DAEModel:
             "channels": len(self.channel_names),
         }
 
-    # ---- consistent states -------------------------------------------------------------
     def constraints(self, q: NDArray[np.float64], v: NDArray[np.float64], t: float, session: Any = None,
                      ideal: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """(Phi, Phi_q, Phi_dot) at one state, through the compiled library when a session is open;
@@ -248,11 +225,8 @@ class DAEModel:
         return v + dv
 
     def evaluate(self, k: int, inputs: Sequence[Any], n_points: int, session: Any = None) -> NDArray[np.float64]:
-        """Evaluate ``functions.extras[k]`` at ``n_points`` points (inputs (n_points, size) or (size,)).
-
-        With an open compiled ``session`` the loop runs in C (~1 us a point); otherwise CasADi.
-        Every extra takes the run-time parameters as its last input; they are appended here.
-        """
+        """Evaluate ``functions.extras[k]`` at ``n_points`` points (inputs (n_points, size) or (size,)),
+        in C with an open compiled ``session``, else CasADi; the parameters are appended as last input."""
         if session is not None:
             return session.eval_extra(k, inputs, n_points)
         f = self.functions.extras[k]
@@ -260,7 +234,8 @@ class DAEModel:
         cols = [np.zeros((0, n_points)) if f.numel_in(j) == 0 else
                 np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, f.numel_in(j)), (n_points, f.numel_in(j))).T
                 for j, x in enumerate(inputs)]
-        return np.array(_mapped(f, n_points)(*cols)).reshape(-1, n_points).T
+        # a map costs ~0.1 ms to build: none for one point (the per-event path)
+        return np.array((f if n_points == 1 else f.map(n_points))(*cols)).reshape(-1, n_points).T
 
     def term_forces(self, t: ArrayLike, y: NDArray[np.float64], active: Sequence[bool],
                     params: Sequence[NDArray[np.float64]], session: Any = None) -> NDArray[np.float64] | None:
@@ -270,8 +245,7 @@ class DAEModel:
         n = self.n_q
         y2 = np.atleast_2d(y)
         N = y2.shape[0]
-        t_arr = np.asarray(t, dtype=float)
-        t_col = t_arr.reshape(N, 1) if t_arr.size == N else np.full((N, 1), float(t_arr.ravel()[0]))
+        t_col = _time_column(t, N)
         total = np.zeros((N, n))
         for k, (on, p) in enumerate(zip(active, params)):
             if on:
@@ -300,12 +274,9 @@ class DAEModel:
     def accelerations(self, t: ArrayLike, q: NDArray[np.float64], v: NDArray[np.float64],
                       generalized_force: NDArray[np.float64] | None = None, session: Any = None
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Solve [M Phi_q^T; Phi_q 0] [v'; lam] = [Q; c] for v' and lam (generated code, see assemble).
-
-        ``c = gamma - 2 alpha Phi' - beta^2 Phi`` (index1) or ``gamma`` (ggl). Works on one state
-        (``q``, ``v`` of shape (n,)) or on many (N, n) with ``t`` of shape (N,).
-        ``generalized_force`` adds contact forces to the base forces (gravity).
-        """
+        """Solve [M Phi_q^T; Phi_q 0] [v'; lam] = [Q + generalized_force; c] for v' and lam, at one state
+        or many ((N, n), ``t`` of shape (N,)); ``c = gamma - 2 alpha Phi' - beta^2 Phi`` (index1) or
+        ``gamma`` (ggl)."""
         single = np.ndim(q) == 1
         n, m = self.n_q, self.n_constraints
         sol = self._accel_solution(t, np.atleast_2d(q), np.atleast_2d(v), generalized_force, session)
@@ -315,33 +286,21 @@ class DAEModel:
     def _accel_solution(self, t: ArrayLike, q: NDArray, v: NDArray, generalized_force: NDArray | None,
                         session: Any) -> NDArray[np.float64]:
         """[a, lam(, work rate)] per row, from the generated Schur-complement solve."""
-        N = q.shape[0]
-        t_arr = np.asarray(t, dtype=float)
-        t_col = t_arr.reshape(N, 1) if t_arr.size == N else np.full((N, 1), float(t_arr.ravel()[0]))
-        Qc = self._zero_force if generalized_force is None else generalized_force
-        return self.evaluate(EXTRA_ACCEL, [t_col, q, v, Qc], N, session)
-
-    @property
-    def _zero_force(self) -> NDArray[np.float64]:
-        return np.zeros(self.n_q)
+        Qc = np.zeros(self.n_q) if generalized_force is None else generalized_force
+        return self.evaluate(EXTRA_ACCEL, [_time_column(t, q.shape[0]), q, v, Qc], q.shape[0], session)
 
     def consistent_state(self, t: ArrayLike, y: NDArray[np.float64],
                          generalized_force: NDArray[np.float64] | None = None, session: Any = None,
                          project: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Keep q and v of ``y``; recompute multipliers and derivatives so that F(t, y, y') = 0.
-
-        ``y`` is one state (n_states,) or many (N, n_states) with ``t`` of shape (N,).
-        ``project`` (GGL restarts): first put q and v exactly on the constraint manifold, mu = 0.
-        (index-1 restarts keep their Baumgarte-controlled drift: the chapter's formulation, and
-        restarted twins of a run must follow it; see ``stats["max_constraint_drift"]``.)
-        """
+        """Keep q and v of ``y`` (one state or (N, n_states)); recompute multipliers and derivatives so
+        that F(t, y, y') = 0. ``project`` (GGL restarts): first put q and v on the constraint manifold,
+        mu = 0 (index-1 restarts keep their Baumgarte-controlled drift, the chapter's formulation)."""
         n, m = self.n_q, self.n_constraints
         y = np.array(y, dtype=float)
         single = y.ndim == 1
         y2 = np.atleast_2d(y)
         if self.formulation == "ggl" and m and single and project:
-            # restart on the constraint manifold with mu = 0, its exact value: GGL holds Phi and
-            # Phi' only to Newton's tolerance, and a restart at a tight rtol must not inherit that
+            # GGL holds Phi and Phi' only to Newton's tolerance: a restart at a tight rtol must not inherit that
             t0 = float(np.ravel(t)[0])
             y2[0, :n] = self.assemble_positions(y2[0, :n], t0, session=session)
             y2[0, n:2 * n] = self.assemble_velocities(y2[0, :n], y2[0, n:2 * n], t0, session=session)
@@ -357,8 +316,7 @@ class DAEModel:
         if self.formulation == "ggl" and m:
             mu = y2[:, 2 * n + m:2 * n + 2 * m]
             N = y2.shape[0]
-            t_arr = np.broadcast_to(np.atleast_1d(np.asarray(t, dtype=float)), (N,))
-            flat = self.evaluate(EXTRA_KINEMATICS, [q, v, t_arr.reshape(N, 1)], N, session)
+            flat = self.evaluate(EXTRA_KINEMATICS, [q, v, _time_column(t, N)], N, session)
             Phi_q = flat[:, m:m + m * n].reshape(N, n, m).transpose(0, 2, 1)
             yp[:, :n] = v - np.einsum("kmn,km->kn", Phi_q, mu)
         return (y2[0], yp[0]) if single else (y2, yp)
@@ -367,13 +325,9 @@ class DAEModel:
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Consistent (y0, yp0) at t = 0: assembled positions and velocities, then v' and lam.
 
-        ``start="ideal"`` (the chapter's, section 4.4): positions and velocities assembled on the
-        mechanism whose clearance joints are ideal (journals centred in their bearings, sliders
-        on their guides' mid-lines, every velocity from the kinematics of that mechanism);
-        ``"declared"``: the bodies' declared state, corrected only for the scene's ideal joints.
-        With an open compiled ``session`` every evaluation runs in C. A declared start with a contact
-        pair in deep penetration raises AssemblyError unless ``allow_penetration``
-        (:func:`daeclear.solvers.physics.check_start_penetration`)."""
+        ``start="ideal"`` (section 4.4): assembled with the clearance joints ideal (journals centred,
+        sliders on their mid-lines); ``"declared"``: the bodies' declared state, corrected for the ideal
+        joints only; with a pair in deep penetration it raises AssemblyError unless ``allow_penetration``."""
         ideal = start == "ideal"
         # a declared start is checked against the gaps (penetration): every number is in its key
         numbers = self.parameter_values if not ideal or self.start_parameters is None else \
@@ -386,13 +340,10 @@ class DAEModel:
         q = self.assemble_positions(self.q_guess, session=session, ideal=ideal)
         check_independent(self, q, session)
         v = self.assemble_velocities(q, self.v_guess, session=session, ideal=ideal)
-        y = np.zeros(self.n_states)
-        y[: self.n_q] = q
-        y[self.n_q: 2 * self.n_q] = v
-        y, yp = self.consistent_state(0.0, y, session=session)
+        y, yp = self.consistent_state(0.0, np.concatenate([q, v, np.zeros(self.n_states - 2 * self.n_q)]),
+                                      session=session)
         if not ideal and not allow_penetration:
             check_start_penetration(self, y, yp, session)
-        # a long sweep of masses or lengths: the oldest starts go
         memo_put_bounded(self.start_memo, key, (_read_only(y), _read_only(yp)), START_MEMO_LIMIT)
         return y, yp
 
@@ -406,17 +357,9 @@ class DAEModel:
 
     def channels(self, t: NDArray[np.float64], y: NDArray[np.float64], yp: NDArray[np.float64],
                  switch: NDArray[np.float64] | None = None, session: Any = None) -> dict[str, NDArray[np.float64]]:
-        """Evaluate every output channel at the rows of ``y`` and ``yp`` (time first).
-
-        ``switch`` holds one row per time of :meth:`switch_vector` (contact terms' modes).
-        """
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        if t.size == 0:
-            return {name: np.zeros(0) for name in self.channel_names}
-        n_s = self.outputs.size1_in(3)
-        S = np.zeros((t.size, n_s)) if switch is None else np.asarray(switch, dtype=float).reshape(t.size, n_s)
-        values = self.evaluate(EXTRA_OUTPUTS, [t.reshape(-1, 1), np.asarray(y), np.asarray(yp), S], t.size, session)
-        return {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(self.channel_names)}
+        """Every output channel at the rows of ``y`` and ``yp``; ``switch`` holds one
+        :meth:`switch_vector` per row (contact terms' modes; None: all off)."""
+        return self._rows(EXTRA_OUTPUTS, self.channel_names, t, y, yp, switch, session)
 
     @property
     def checked_names(self) -> tuple[str, ...]:
@@ -425,15 +368,18 @@ class DAEModel:
 
     def checks(self, t: NDArray[np.float64], y: NDArray[np.float64], yp: NDArray[np.float64],
                switch: NDArray[np.float64], session: Any = None) -> dict[str, NDArray[np.float64]]:
-        """The channels the physics checks read at the rows of ``y`` (as :meth:`channels`, whose values they
-        are, bit for bit): a function of a few outputs, so a run is checked without computing the others."""
-        names = self.checked_names
+        """The channels the physics checks read (as :meth:`channels`, bit for bit), without the others."""
+        return self._rows(EXTRA_CHECKS, self.checked_names, t, y, yp, switch, session)
+
+    def _rows(self, k: int, names: tuple[str, ...], t: ArrayLike, y: ArrayLike, yp: ArrayLike,
+              switch: ArrayLike | None, session: Any) -> dict[str, NDArray[np.float64]]:
+        """The channels ``names`` of the outputs' extra ``k`` at the rows of ``y`` and ``yp``."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         if t.size == 0 or not names:
             return {name: np.zeros(t.size) for name in names}
         n_s = self.outputs.size1_in(3)
-        S = np.asarray(switch, dtype=float).reshape(t.size, n_s)
-        values = self.evaluate(EXTRA_CHECKS, [t.reshape(-1, 1), np.asarray(y), np.asarray(yp), S], t.size, session)
+        S = np.zeros((t.size, n_s)) if switch is None else np.asarray(switch, dtype=float).reshape(t.size, n_s)
+        values = self.evaluate(k, [t.reshape(-1, 1), np.asarray(y), np.asarray(yp), S], t.size, session)
         return {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(names)}
 
 
@@ -442,11 +388,8 @@ START_MEMO_LIMIT = 256
 
 
 def start_parameters(functions: DAEFunctions) -> NDArray[np.intp]:
-    """Indices of the run-time parameters that the chapter's start reads: the parameter inputs on
-    which the kinematics (with and without the clearance joints' ideal joints) and the
-    accelerations depend, found from CasADi's sparsity. Clearances, radii and contact and friction
-    law numbers are not among them: the start of the mechanism with ideal joints and every contact
-    open is the same for all of them."""
+    """Indices of the run-time parameters the chapter's start reads (the kinematics' and the
+    accelerations' dependencies, from CasADi's sparsity): no clearance, radius or law number."""
     used = np.zeros(functions.n_parameters, dtype=bool)
     for k in (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_START_KINEMATICS):
         f = functions.extras[k]
@@ -456,21 +399,15 @@ def start_parameters(functions: DAEFunctions) -> NDArray[np.intp]:
     return index
 
 
-# Constraint rows are dependent when the constraint Jacobian's singular value falls below RANK_TOL
-# times its largest one (its entries are 1 and lever arms of 1 mm..1 m; round-off is ~1e-16).
+# Constraint rows are dependent below RANK_TOL times the Jacobian's largest singular value
 RANK_TOL = 1e-9
 # a row takes part in a dependency when its weight in a left null vector of the Jacobian is above this
 NULL_WEIGHT = 1e-6
 
 
 def check_independent(model: DAEModel, q: NDArray[np.float64], session: Any = None) -> None:
-    """Raise AssemblyError when the constraint Jacobian is rank deficient at the initial positions ``q``.
-
-    Redundant constraints (a joint that repeats what others already impose, a second driver of a
-    one-degree-of-freedom mechanism) make the multipliers undetermined: IDA would fail at t = 0 with
-    a singular matrix and unrelated advice. The message names the joints and drivers whose rows are
-    dependent. Called by :meth:`DAEModel.initial_state` once the positions are assembled.
-    """
+    """Raise AssemblyError, naming the joints and drivers involved, when the constraint Jacobian is rank
+    deficient at the initial positions ``q`` (redundant constraints: undetermined multipliers)."""
     m, n = model.n_constraints, model.n_q
     if not m:
         return
@@ -507,10 +444,10 @@ def check_independent(model: DAEModel, q: NDArray[np.float64], session: Any = No
         "from another position.")
 
 
-def _mapped(function: ca.Function, n: int) -> ca.Function:
-    """``function`` evaluated column-wise on n points (the function itself when n == 1; building a
-    map costs about 0.1 ms, which matters on the per-event path)."""
-    return function if n == 1 else function.map(n)
+def _time_column(t: ArrayLike, n: int) -> NDArray[np.float64]:
+    """``t`` as a column of n times (one time repeated, or n of them)."""
+    t_arr = np.asarray(t, dtype=float)
+    return t_arr.reshape(n, 1) if t_arr.size == n else np.full((n, 1), float(t_arr.ravel()[0]))
 
 
 _ARRAY_FIELDS = ("q_guess", "v_guess", "mass_diagonal", "parameter_values")

@@ -1,12 +1,8 @@
-"""Driver constraints: a joint coordinate prescribed in time (see :class:`daeclear.model.scene.Driver`).
+"""Driver constraints: a joint coordinate (:mod:`daeclear.assembly.joint_coordinates`) prescribed in time.
 
-The coordinate is the relative angle ``phi_j - phi_i`` of a revolute joint, or the displacement
-``(P_j - P_i) . u`` of joint point j from joint point i along the axis ``u`` (fixed to body i) of
-a translational joint. A clearance joint is driven the same way: its journal or slider stays
-free in the play, only this coordinate is prescribed (the clearance joint adds no constraint of
-its own). The constraint ``coordinate - x0 - motion(t) = 0`` (``coordinate - table(t)`` for a
-tabulated profile) enters the equations with a multiplier ``lam``; the load the driver applies to
-body j is ``-lam`` (moment, or force along ``u``).
+The constraint ``coordinate - x0 - motion(t) = 0`` (``coordinate - table(t)`` for a tabulated
+profile; a clearance joint's play stays free) has the multiplier ``lam``; the driver's load on
+body j is ``-lam`` (moment, or force along the axis).
 """
 
 from __future__ import annotations
@@ -31,8 +27,7 @@ def driver_load(joint: Any) -> tuple[str, str]:
 
 
 def driver_parameters(ref: Reference, driver: Driver, joint: Any) -> dict[str, Any]:
-    """The driver's numbers (run-time parameters): start value, speed, profile numbers (and the
-    axis and points of a translational joint)."""
+    """The driver's numbers: start value, speed, profile numbers (a translational joint's axis, points)."""
     profile = driver.motion_profile
     values: dict[str, Any] = {}
     if driven_coordinate(joint) == "translation":
@@ -53,15 +48,10 @@ def driver_parameters(ref: Reference, driver: Driver, joint: Any) -> dict[str, A
 
 def _reference_displacement(ref: Reference, joint: Any, s_i: Any, s_j: Any, u_local: Any) -> float:
     """(P_j - P_i) . u in the reference configuration (0 when the joint is given by ``at``)."""
-    def world(body: str, s: Any) -> np.ndarray:
-        (x, y), phi = ref.pose[body]
-        c, s_ = math.cos(phi), math.sin(phi)
-        return np.array([x + c * s[0] - s_ * s[1], y + s_ * s[0] + c * s[1]])
-
     phi_i = ref.angle(joint.body_i)
     u = np.array([math.cos(phi_i) * u_local[0] - math.sin(phi_i) * u_local[1],
                   math.sin(phi_i) * u_local[0] + math.cos(phi_i) * u_local[1]])
-    return float(np.dot(world(joint.body_j, s_j) - world(joint.body_i, s_i), u))
+    return float(np.dot(np.subtract(ref.world_point(joint.body_j, s_j), ref.world_point(joint.body_i, s_i)), u))
 
 
 def driver_constraint(ctx: AssemblyContext, driver: Driver, joint: Any) -> Any:

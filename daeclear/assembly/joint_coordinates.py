@@ -1,14 +1,7 @@
-"""Joint coordinates: a revolute joint's angle and a translational joint's displacement, and their rates.
+"""Joint coordinates and their rates, one definition for drivers, joint channels and placement.
 
-One definition for the three places that read a joint's coordinate: the driver that prescribes it
-(:mod:`daeclear.assembly.drivers`), the joint channels ``<joint>.angle``/``<joint>.rate`` and
-``<joint>.displacement``/``<joint>.speed`` of every run, and the start from chosen coordinates
-(:mod:`daeclear.assembly.placement`). Body j relative to body i, for ideal and clearance joints alike:
-
-* revolute: ``theta = phi_j - phi_i`` (not wrapped: it counts turns), rate ``omega_j - omega_i``;
-* translational: ``s = (P_j - P_i) . u``, the displacement of joint point j from joint point i
-  along the axis ``u`` fixed to body i (on a clearance joint: of the slider's centre from the
-  guide's mid-line point), speed ``ds/dt``.
+Body j relative to body i, ideal and clearance joints alike: revolute ``theta = phi_j - phi_i``
+(not wrapped); translational ``s = (P_j - P_i) . u``, along the axis ``u`` fixed to body i.
 """
 
 from __future__ import annotations
@@ -30,9 +23,8 @@ JOINT_CHANNELS: dict[str, tuple[tuple[str, str], tuple[str, str]]] = {
 
 def joint_coordinate(bi: BodyFrame, bj: BodyFrame, kind: str, s_i: Any = None, s_j: Any = None,
                      axis: Any = None) -> Any:
-    """The coordinate of body j relative to body i: ``kind`` "rotation" (the relative angle) or
-    "translation" (the displacement of the body-fixed point ``s_j`` from ``s_i`` along ``axis``,
-    a unit vector in body i's frame)."""
+    """The coordinate of body j relative to body i: ``kind`` "rotation" or "translation" (of the
+    body-fixed point ``s_j`` from ``s_i`` along ``axis``, a unit vector in body i's frame)."""
     if kind == "rotation":
         return bj.phi - bi.phi
     u = ca.mtimes(rotation(bi.phi), axis)
@@ -40,8 +32,7 @@ def joint_coordinate(bi: BodyFrame, bj: BodyFrame, kind: str, s_i: Any = None, s
 
 
 def joint_axis(ctx: AssemblyContext, joint: Any) -> Any:
-    """A translational joint's unit axis in body i's frame, from the joint's own parameters (the
-    guide direction of a clearance joint; the normal's -90 degree turn for an ideal one)."""
+    """A translational joint's unit axis in body i's frame, from its own parameters."""
     if isinstance(joint, TranslationalClearance):
         return ctx.p(joint.name, "t_guide")
     normal = ctx.p(joint.name, "normal")
@@ -49,9 +40,8 @@ def joint_axis(ctx: AssemblyContext, joint: Any) -> Any:
 
 
 def joint_channels(ctx: AssemblyContext, joints: Iterable[Any]) -> list[Channel]:
-    """``<joint>.angle``, ``<joint>.rate`` of every revolute joint and ``<joint>.displacement``,
-    ``<joint>.speed`` of every translational joint, ideal or with clearance (the rate is the
-    coordinate's derivative along the velocities)."""
+    """``<joint>.angle``/``.rate`` of every revolute joint, ``<joint>.displacement``/``.speed`` of
+    every translational one."""
     out: list[Channel] = []
     for joint in joints:
         if not isinstance(joint, (Revolute, RevoluteClearance, Translational, TranslationalClearance)):

@@ -1,17 +1,10 @@
-"""The lubricated revolute clearance joint (law :class:`~daeclear.contact.HydrodynamicBearing`): its
-parameters, film and dry terms, gap functions, channels and regime logic.
+"""The lubricated revolute clearance joint (law :class:`~daeclear.contact.HydrodynamicBearing`).
 
-Two regimes, one pair of the contact automaton (:mod:`daeclear.assembly.automaton`):
-
-* *film* (the automaton's free mode): the film term acts, the dry term is off;
-* *dry* (contact mode): the dry contact law (and friction) acts, the film term is off.
-
-Two gap functions, both positive once the film is thinner than their level: ``film_break`` at the
-minimum film thickness ``c - |e| = film_threshold`` and ``film_reform`` at
-``film_threshold (1 + hysteresis)``. An upward crossing of ``film_break`` is the automaton's onset
-(film -> dry, the dry law's approach speed latched there), a downward crossing of ``film_reform``
-its separation (dry -> film); IDA locates both. The band between the two levels keeps the regimes
-from chattering; the storm guard holds the dry regime in a cascade, as for a dry joint.
+Two regimes, one pair of the contact automaton: *film* (its free mode; the film term acts) and
+*dry* (contact mode; the dry law and friction act). Two gaps, positive once the film is thinner
+than their level: ``film_break`` (``c - |e| = film_threshold``), whose upward crossing is the
+onset, and ``film_reform`` (``film_threshold (1 + hysteresis)``), whose downward crossing is the
+separation; the band between them keeps the regimes from chattering (docs/lubrication.md).
 """
 
 from __future__ import annotations
@@ -27,9 +20,10 @@ from numpy.typing import NDArray
 from ..model.clearance_joints import RevoluteClearance
 from ..results.result import ContactEvent
 from .automaton import start, step
-from .contact_pairs import ContactBuild, PairLogic, PairStates, TermSwitch, approach_floor, journal_contact, pair_event
-from .parameters import law_structure, law_values
-from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
+from .contact_pairs import (ContactBuild, PairLogic, PairStates, TermSwitch, journal_contact, journal_logic,
+                            journal_parameters, pair_event)
+from .parameters import law_structure
+from .symbolic import AssemblyContext, Channel, Reference, Term, perpendicular
 
 __all__ = ["FILM_REGULARISATION", "LubricatedLogic", "build_lubricated_revolute", "lubricated_parameters"]
 
@@ -41,14 +35,9 @@ FILM_REGULARISATION = 1e-4
 def lubricated_parameters(ref: Reference, joint: RevoluteClearance) -> tuple[dict[str, Any], list[Any]]:
     """The joint's numbers (run-time parameters, the film's under ``film.*``) and its structure."""
     bearing, friction = joint.resolved_law(), joint.resolved_friction()
-    s_i, s_j = ref.joint_points(joint)
-    values: dict[str, Any] = {
-        "s_i": s_i, "s_j": s_j, "clearance": joint.radial_clearance,
-        "bearing_radius": float(joint.bearing_radius), "journal_radius": joint.journal,
+    values = journal_parameters(ref, joint, bearing.dry, friction, {
         "film.viscosity": bearing.viscosity, "film.length": bearing.length,
-        "film.threshold": bearing.film_threshold, "film.reform_threshold": bearing.reform_threshold}
-    values.update({f"law.{k}": v for k, v in law_values(bearing.dry).items()})
-    values.update({f"friction.{k}": v for k, v in law_values(friction).items()})
+        "film.threshold": bearing.film_threshold, "film.reform_threshold": bearing.reform_threshold})
     return values, [law_structure(bearing.dry), law_structure(friction), f"film:{bearing.theory}:{bearing.cavitation}"]
 
 
@@ -81,15 +70,7 @@ def build_lubricated_revolute(ctx: AssemblyContext, joint: RevoluteClearance, fi
     film_fn = ca.Function(f"{name}_film_force", [ctx.t, ctx.q, ctx.v, p0, ctx.P], [Q_film],
                           ["t", "q", "v", "p", "P"], ["Q"])
 
-    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P],
-                       [gaps[0], gaps[1], ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
-    floor = approach_floor(ctx, dry_numeric, f"{name}.law")
-    n_q = ctx.n_q
-    discontinuous = not friction_numeric.frictionless and not friction_numeric.smooth
-
-    def logic(P: NDArray[np.float64]) -> list[Any]:
-        return [LubricatedLogic(name, first_root, first_term, BufferedFunction(rate, bound=(P,)), n_q,
-                                dry_numeric.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
+    logic = journal_logic(ctx, jc, LubricatedLogic, name, first_root, first_term, gaps, dry_numeric, friction_numeric)
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
         (on, p_sym), (film_on, _) = switches
@@ -112,15 +93,18 @@ def build_lubricated_revolute(ctx: AssemblyContext, joint: RevoluteClearance, fi
 class LubricatedLogic(PairLogic):
     """Regime switching of one lubricated joint by the contact automaton (see the module docstring).
 
-    Root ``root_index`` (film_break) is watched upward, ``root_index + 1`` (film_reform) downward; the
-    dry term ``term_index`` is on while the automaton is in contact (or held), the film term
-    ``term_index + 1`` otherwise. ``rate`` gives (film_break gap, film_reform gap, penetration rate).
-    The compiled loop hands these roots to Python (no simple pairs).
+    Its one pair watches two roots: ``first_root`` (film_break) upward, ``first_root + 1``
+    (film_reform) downward; the dry term ``pair_terms[0]`` is on while the automaton is in contact
+    (or held), the film term (the next one) otherwise. ``rate`` gives (film_break gap, film_reform
+    gap, penetration rate). The compiled loop hands these roots to Python (no simple pairs).
     """
 
     @property
     def roots(self) -> range:
-        return range(self.root_index, self.root_index + 2)
+        return range(self.first_root, self.first_root + 2)
+
+    def pair_index(self, root: int) -> int:
+        return 0
 
     def _values(self, y: NDArray) -> tuple[float, float, float]:
         out = self.rate(y[:self.n_q], y[self.n_q:2 * self.n_q])
@@ -132,27 +116,27 @@ class LubricatedLogic(PairLogic):
 
     def terms(self, states: PairStates) -> list[TermSwitch]:
         """The dry term while the automaton is in contact (or held), the film term otherwise."""
-        on = states[0].term_on
-        return [(self.term_index, on, self._params(states[0])), (self.term_index + 1, not on, np.zeros(0))]
+        on, k = states[0].term_on, self.pair_terms[0]
+        return [(k, on, self._params(states[0])), (k + 1, not on, np.zeros(0))]
 
     def root_directions(self, states: PairStates) -> list[tuple[int, int]]:
         """The film breaks upward through film_break, forms again downward through film_reform."""
-        return [(self.root_index, 1), (self.root_index + 1, -1)]
+        return [(self.first_root, 1), (self.first_root + 1, -1)]
 
     def decide(self, states: PairStates, t: float, y: NDArray, roots_found: NDArray | None
                ) -> tuple[PairStates, list[ContactEvent]]:
         if roots_found is None:
             return states, []
-        up = roots_found[self.root_index] > 0
-        down = roots_found[self.root_index + 1] < 0
+        up = roots_found[self.first_root] > 0
+        down = roots_found[self.first_root + 1] < 0
         if not (up or down):
             return states, []
         rate = self._values(y)[2]
         direction = 1 if up and not states[0].contact else -1 if down else 1
         state, decision = step(states[0], t, direction, rate, storm=self.storm,
                                min_approach_speed=self.min_approach_speed)
-        return (state,), pair_event(self.pair, t, y, rate, decision)
+        return (state,), pair_event(self.pairs[0], t, y, rate, decision)
 
-    def simple_pairs(self) -> None:  # type: ignore[override]
+    def simple_pairs(self) -> None:
         """None: two terms follow one pair, which the compiled loop's mirror does not do."""
         return None

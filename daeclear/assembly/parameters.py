@@ -1,23 +1,13 @@
 """Run-time parameters of an assembled model: what is compiled versus what is data.
 
-The compiled engine depends only on a scene's *structure* (which bodies, joints, clearance
-joints and laws it has, and the switches that change the shape of the equations). Every
-number (masses, inertias, joint points, clearances, radii, law and friction parameters,
-driver speeds, gravity, Baumgarte constants) is a run-time parameter: one entry of the
-vector ``P`` that every generated function takes as its last input. So a sweep, a study or a
-second call with other numbers reuses the compiled library (and, in one process, the
-assembled template) and compiles nothing.
+The compiled engine depends only on a scene's *structure*; every number is an entry of the vector
+``P``, the last input of every generated function, so a scene with other numbers compiles nothing.
 
-Three pieces live here:
-
-* :class:`ParameterTable`: the named entries of ``P`` (values, and while a template is
-  built, their CasADi symbols);
-* :func:`structure_key`: the hashable description of a scene with every number masked, which
-  picks the template and the compiled library;
-* :func:`law_values` / :func:`symbolic_law`: a contact or friction law's numbers as
-  parameters, and a twin of the law whose numbers are those symbols. A law whose formula
-  cannot run on symbolic numbers (it computes constants with ``math``) is *baked*: its
-  numbers become part of the structure key instead (checked once per law class).
+* :class:`ParameterTable`: the named entries of ``P``;
+* :func:`structure_key`: the scene with every number masked, which picks the compiled library;
+* :func:`law_values` / :func:`symbolic_law`: a law's numbers as parameters, and a twin of the law
+  whose numbers are symbols. A law whose formula cannot run on symbols is *baked*: its numbers
+  join the structure key (checked once per law class).
 """
 
 from __future__ import annotations
@@ -40,11 +30,8 @@ __all__ = ["ParameterTable", "entries", "floats", "structure_key", "element_stru
 
 
 class ParameterTable:
-    """Ordered named parameters: name -> values (a float or a short vector).
-
-    Built by the element parameter functions; ``layout`` (names and sizes) belongs to the
-    structure, ``vector`` is the run-time data.
-    """
+    """Ordered named parameters (a float or a short vector each): ``layout`` (names and sizes) is
+    structure, ``vector`` the run-time data."""
 
     def __init__(self) -> None:
         # plain floats (one array at the end): a scene's table is made at every assembly
@@ -53,10 +40,6 @@ class ParameterTable:
     def add(self, name: str, value: Any) -> None:
         """Add one entry; ``value`` is a number or a sequence of numbers."""
         self.extend(((name, floats(value)),))
-
-    def update(self, prefix: str, values: dict[str, Any]) -> None:
-        """Add every ``values`` entry under ``prefix.<key>``."""
-        self.extend(entries(prefix, values))
 
     def extend(self, named: Iterable[tuple[str, tuple[float, ...]]]) -> None:
         """Add entries made by :func:`entries` (kept entries of a shared element are added as they are)."""
@@ -82,11 +65,8 @@ class ParameterTable:
 
     def symbols(self, P: Any) -> dict[str, Any]:
         """Name -> the slice of the symbol vector ``P`` that holds it (scalars as 1x1)."""
-        out, offset = {}, 0
-        for name, size in self.layout:
-            out[name] = P[offset:offset + size]
-            offset += size
-        return out
+        offsets = self.offsets()
+        return {name: P[offsets[name]:offsets[name] + size] for name, size in self.layout}
 
     def offsets(self) -> dict[str, int]:
         """Name -> index of the entry's first element in :attr:`vector`."""
@@ -143,9 +123,8 @@ def _mask_fields(value: Any) -> list[Any]:
 
 
 def element_structure(element: Any) -> str:
-    """An element's class and fields, but those of its ``NOT_STRUCTURE``, with every number masked, as
-    text (a field with a description, ``to_dict``, as that description masked); kept on a frozen
-    element (it follows from the fields alone), so the elements a sweep's scenes share are described once."""
+    """An element's class and fields (but its ``NOT_STRUCTURE``) as text, every number masked; kept on
+    the frozen element, so a sweep's shared elements are described once."""
     return kept(element, "_structure_text", _element_structure)
 
 
@@ -156,8 +135,7 @@ def _element_structure(element: Any) -> str:
 
 
 def _masked_text(value: Any) -> str:
-    """One field of an element as text with every number masked (:func:`_mask`); a law's, a
-    material's or a body's text is kept on it: the elements of a sweep's scenes share those."""
+    """One field of an element as text with every number masked (a law's or a body's kept on it)."""
     kind = type(value)
     if kind is float or kind is int or isinstance(value, (np.floating, np.integer)):
         return "#"
@@ -171,16 +149,13 @@ def _masked_text(value: Any) -> str:
 
 
 def _described_text(value: Any) -> str:
-    """A value with a description (``to_dict``: a body, a profile, a load's function, whose digest
-    is structure) or a dataclass (a law, a material) as masked text."""
+    """A value with a description (``to_dict``) or a dataclass (a law, a material) as masked text."""
     return repr(_mask(value.to_dict() if hasattr(value, "to_dict") else value))
 
 
 def structure_key(elements: Iterable[Any], extra: Iterable[Any]) -> str:
-    """SHA-256 of a scene's structure: each element's name and :func:`element_structure` in the
-    scene's order, plus ``extra`` (formulation, options and the laws' structural flags, see
-    :func:`law_structure`). The scene's name and its numbers (gravity included) are no part of it."""
-    # joined, not repr'd: the elements' texts are long and repr would scan them again
+    """SHA-256 of a scene's structure: each element's name and :func:`element_structure`, plus
+    ``extra`` (formulation, options, the laws' structural flags); no name or number is part of it."""
     text = "\x00".join([f"{e.name}\x01{element_structure(e)}" for e in elements] + [str(x) for x in extra])
     return hashlib.sha256(text.encode()).hexdigest()
 
@@ -220,8 +195,7 @@ def _fixed_flag(flag: str) -> property:
 
 
 def _twin_class(cls: type) -> type:
-    """A subclass whose structural flags are fixed numbers, not expressions of its fields (made when a
-    structure is built: once per law of a new structure, and per law class for :func:`is_parametric`)."""
+    """A subclass whose structural flags are fixed values, not expressions of its fields."""
     fixed = {flag: _fixed_flag(flag) for flag in _FLAGS if hasattr(cls, flag)}
     return type(cls.__name__, (cls,), fixed)
 
@@ -252,8 +226,8 @@ def _check_parametric(law: Any) -> bool:
 
 
 def _twin(law: Any, symbols: dict[str, Any]) -> Any:
-    """A copy of ``law`` with some numeric fields replaced by symbols (no validation: the
-    numeric law was validated already; its structural flags are kept as numbers)."""
+    """A copy of ``law`` with some numeric fields replaced by symbols (not validated again; its
+    structural flags kept as values)."""
     twin: Any = object.__new__(_twin_class(type(law)))
     object.__setattr__(twin, "_fixed_flags", {flag: getattr(law, flag) for flag in _FLAGS if hasattr(law, flag)})
     for f in dataclasses.fields(law):
@@ -276,8 +250,8 @@ def symbolic_law(law: Any, symbols: dict[str, Any], prefix: str) -> Any:
 
 
 def law_structure(law: Any) -> str:
-    """What of a law decides the equations' shape, as text: its class, the flags the assembly
-    branches on, which fields are set, and all its numbers when it is baked (kept on the frozen law)."""
+    """What of a law decides the equations' shape, as text: its class, the flags the assembly branches
+    on, which fields are set, and all its numbers when it is baked (kept on the frozen law)."""
     return kept(law, "_law_structure", lambda each: repr(_law_structure(each)))
 
 

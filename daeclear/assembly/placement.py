@@ -1,22 +1,14 @@
 """A scene placed at chosen joint coordinates: :meth:`Scene.assembled` (``start=``, ``speeds=``).
 
-A published mechanism is usually given by its links and the angles between them, not by where
-every body's centre of mass is. ``scene.assembled(start={"A": 0.5}, speeds={"A": 2.0})`` solves
-for the bodies' poses so that the named joints' coordinates (:mod:`daeclear.assembly.joint_coordinates`:
-a revolute joint's angle ``phi_j - phi_i``, a translational joint's displacement) have the given
-values and every joint closes, as the run's start would close it: the ideal joints, the ideal
-joints the clearance joints stand for (journals centred, sliders on their mid-lines) and the
-drivers at t = 0, a driver's row replaced by the chosen value when its joint is named. Newton
-with least-norm steps from the declared poses, then one check that the rows fix every
-coordinate (their Jacobian has full column rank); velocities likewise from ``speeds``, a linear
-solve with the drivers' speeds (without ``speeds``: the declared velocities corrected, least norm,
-to the joints and drivers, as a run's start corrects them).
+``scene.assembled(start={"A": 0.5}, speeds={"A": 2.0})`` solves for the bodies' poses so that the
+named joints' coordinates have these values and every joint closes as at a run's start (ideal
+joints, the clearance joints' ideal joints, drivers at t = 0, a named joint's driver replaced):
+least-norm Newton from the declared poses, then a check that the rows fix every coordinate.
+Velocities likewise from ``speeds`` (without: the declared ones corrected, least norm).
 
-The returned scene is the same mechanism: every number the declared configuration defined
-(joint and load points given as world points ``at``, a translational joint's axis, free lengths
-and free angles left None) is written into the new scene as the body-fixed value it stood for,
-so its equations are those of the given scene and only the bodies' poses (and velocities) differ.
-A driver without an initial value starts from its joint's coordinate in the new poses.
+The returned scene is the same mechanism: every number the declared configuration defined (world
+points ``at``, an axis, free lengths and angles left None) is written as the body-fixed value it
+stood for; only the poses (and velocities) differ.
 """
 
 from __future__ import annotations
@@ -42,10 +34,9 @@ from .symbolic import Reference, body_frames
 
 def assembled(scene: Scene, start: Mapping[str, float] | None = None,
               speeds: Mapping[str, float] | None = None) -> Scene:
-    """The scene with its bodies placed at the joint coordinates ``start`` (joint name -> angle, rad,
-    or displacement, m) and, when ``speeds`` is given, moving at the joint rates ``speeds``
-    (rad/s, m/s); see the module's docstring. Raises SceneError for a bad argument and
-    AssemblyError when the joints cannot close or the coordinates do not fix the configuration."""
+    """The scene with its bodies at the joint coordinates ``start`` (name -> rad or m) and moving at the
+    joint rates ``speeds`` (rad/s, m/s). Raises SceneError for a bad argument, AssemblyError when the
+    joints cannot close or the coordinates do not fix the configuration."""
     scene.validate()
     joints = {j.name: j for j in scene.joints if driven_coordinate(j) is not None}
     start_values = _checked(scene, "start", start, joints)
@@ -116,7 +107,6 @@ def assembled(scene: Scene, start: Mapping[str, float] | None = None,
                      list(speed_values), joints)
         v = np.linalg.lstsq(J, b, rcond=None)[0]
     return _placed(scene, ref, q, v)
-
 
 
 def _checked(scene: Scene, field_name: str, values: Mapping[str, float] | None, joints: dict[str, Any]

@@ -1,7 +1,5 @@
-"""The revolute clearance joint: a journal in a bearing as a contact pair (its parameters, force,
-gap, output channels and event logic), and the registry of the clearance joints' builders.
-
-The contact-pair machinery it shares with the translational joint is :mod:`daeclear.assembly.contact_pairs`.
+"""The revolute clearance joint as a contact pair (parameters, force, gap, channels, logic), and the
+registry of the clearance joints' builders.
 """
 
 from __future__ import annotations
@@ -9,15 +7,11 @@ from __future__ import annotations
 from typing import Any
 from collections.abc import Callable, Sequence
 
-import casadi as ca
-import numpy as np
-from numpy.typing import NDArray
-
 from .automaton import STORM_EVENTS, STORM_WINDOW  # noqa: F401  (re-exported: the storm guard's defaults)
-from .parameters import law_structure, law_values
+from .parameters import law_structure
 from ..model.scene import RevoluteClearance
-from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term
-from .contact_pairs import PairLogic, ContactBuild, approach_floor, journal_contact
+from .symbolic import AssemblyContext, Channel, Reference, Term
+from .contact_pairs import PairLogic, ContactBuild, journal_contact, journal_logic, journal_parameters
 from .lubricated_joint import build_lubricated_revolute, lubricated_parameters
 from ..contact.hydrodynamic import HydrodynamicBearing
 from ..contact.wear import profile_coefficients
@@ -30,11 +24,7 @@ def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> t
     if isinstance(joint.law, HydrodynamicBearing):
         return lubricated_parameters(ref, joint)
     law, friction = joint.resolved_law(), joint.resolved_friction()
-    s_i, s_j = ref.joint_points(joint)
-    values: dict[str, Any] = {"s_i": s_i, "s_j": s_j, "clearance": joint.radial_clearance,
-                              "bearing_radius": float(joint.bearing_radius), "journal_radius": joint.journal}
-    values.update({f"law.{k}": v for k, v in law_values(law).items()})
-    values.update({f"friction.{k}": v for k, v in law_values(friction).items()})
+    values = journal_parameters(ref, joint, law, friction)
     structure = [law_structure(law), law_structure(friction)]
     if joint.wear is not None:  # the worn profiles' Fourier coefficients; how many is structure
         for surface, depth in joint.worn_profiles().items():
@@ -46,27 +36,16 @@ def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> t
 
 def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, first_term: int,
                              first_root: int) -> ContactBuild:
-    """Journal-bearing contact (section 4.2): eqs. (4.1)-(4.13) with the joint's laws.
-
-    Body i carries the bearing (radius R_i), body j the journal (R_j); c = R_i - R_j. Every
-    number comes from the run-time parameters ``<joint>.*`` (see revolute_clearance_parameters).
-    A lubricated joint (law HydrodynamicBearing) is :func:`build_lubricated_revolute`'s.
-    """
+    """Journal-bearing contact (section 4.2), eqs. (4.1)-(4.13); a lubricated joint is
+    :func:`build_lubricated_revolute`'s."""
     if isinstance(joint.law, HydrodynamicBearing):
         return build_lubricated_revolute(ctx, joint, first_term, first_root)
     name = joint.name
     law_numeric, friction_numeric = joint.resolved_law(), joint.resolved_friction()
     jc = journal_contact(ctx, joint, law_numeric, friction_numeric)
-    e, e_dot, e_norm, c = jc.e, jc.e_dot, jc.e_norm, jc.c
+    e, c = jc.e, jc.c
     gap = (jc.ee - c * c) / (2.0 * c)  # smooth at e = 0; equals delta (1 + delta / 2c) near contact
-    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P], [gap, ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)])
-    floor = approach_floor(ctx, law_numeric, f"{name}.law")
-    discontinuous = not friction_numeric.frictionless and not friction_numeric.smooth
-    n_q = ctx.n_q  # read once: a CasADi call costs more inside a sweep's loop than the logic it makes
-
-    def logic(P: NDArray[np.float64]) -> list[Any]:
-        return [PairLogic(name, first_root, first_term, BufferedFunction(rate, bound=(P,)), n_q,
-                          law_numeric.needs_approach_speed, floor(P), discontinuous_friction=discontinuous)]
+    logic = journal_logic(ctx, jc, PairLogic, name, first_root, first_term, [gap], law_numeric, friction_numeric)
 
     def channels(switches: Sequence[tuple[Any, Any]]) -> list[Channel]:
         on, p_sym = switches[0]

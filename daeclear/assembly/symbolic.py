@@ -1,7 +1,5 @@
-"""Symbolic building blocks shared by the assembly and the contact elements (CasADi SX).
-
-Body kinematics, switchable force terms, output channels and the context handed to
-element builders. Nothing here knows a particular joint.
+"""Symbolic building blocks of the assembly (CasADi SX): body kinematics, switchable force terms,
+output channels and the context handed to element builders.
 """
 
 from __future__ import annotations
@@ -64,11 +62,8 @@ def body_frames(bodies: Sequence[Any], q: Any, v: Any) -> dict[str, BodyFrame]:
 
 @dataclass(frozen=True)
 class Term:
-    """A switchable generalized force (e.g. one contact pair), added to the equations of motion.
-
-    ``force`` maps ``(t, q, v, p)`` to the generalized force vector (length n_q);
-    ``n_params`` is the size of ``p`` (e.g. the approach speed latched at onset).
-    """
+    """A switchable generalized force (e.g. one contact pair): ``force`` maps ``(t, q, v, p, P)`` to
+    the generalized force (length n_q), ``p`` of size ``n_params`` (e.g. the latched approach speed)."""
 
     name: str
     force: ca.Function
@@ -85,9 +80,7 @@ class Channel:
 
 
 class Reference:
-    """The scene's reference configuration (numbers only): where every body and joint point is
-    when the scene is declared. Element parameter functions turn world data into body-fixed
-    parameters with it."""
+    """The scene's declared configuration (numbers only), to turn world data into body-fixed parameters."""
 
     def __init__(self, bodies: Sequence[Any], ground: str) -> None:
         self.pose: dict[str, tuple[tuple[float, float], float]] = {ground: ((0.0, 0.0), 0.0)}
@@ -129,12 +122,8 @@ class Reference:
 
 @dataclass
 class AssemblyContext:
-    """Symbols and per-body kinematics handed to element builders during assembly.
-
-    Builders read every number from ``params`` (run-time parameters, see
-    :mod:`daeclear.assembly.parameters`), never from the scene: the same build serves every scene of
-    the same structure.
-    """
+    """Symbols and per-body kinematics handed to element builders. Builders read every number from
+    ``params`` (run-time parameters), never from the scene: one build serves a whole structure."""
 
     t: Any
     q: Any
@@ -155,12 +144,8 @@ class AssemblyContext:
         return value[0] if value.numel() == 1 else value
 
     def generalized_force(self, loads: Sequence[tuple[str, Any, Any]]) -> Any:
-        """Generalized force vector (length n_q) of point loads ``(body, force (2x1), point (2x1))``.
-
-        Each force acts at a world point; it is transported to the body's centre of mass with
-        its moment m = (x_P - x) f_y - (y_P - y) f_x (eqs. 4.10-4.13, 4.22-4.25). Loads on the
-        ground are dropped.
-        """
+        """Generalized force (length n_q) of point loads ``(body, force, world point)``, moved to the
+        centres of mass with m = (x_P - x) f_y - (y_P - y) f_x (eqs. 4.10-4.13, 4.22-4.25); none on the ground."""
         Q = ca.SX(self.n_q, 1)  # structural zeros: only the loaded bodies' entries are nonzeros
         for body, force, point in loads:
             frame = self.frames[body]
@@ -182,8 +167,7 @@ class _FunctionBuffer:
         self.inputs = [np.zeros(function.numel_in(i)) for i in range(function.n_in())]
         self.outputs = [np.zeros(function.numel_out(i)) for i in range(function.n_out())]
         self.buffer, self.evaluate = function.buffer()
-        # (CasADi's stub asks a size the binding takes from the memoryview; numpy types arrays as buffers
-        # only from Python 3.12 on)
+        # (the ignores: CasADi's stub asks a size the binding takes from the memoryview)
         for i, a in enumerate(self.inputs):
             self.buffer.set_arg(i, memoryview(a))  # type: ignore[call-arg, arg-type]
         for i, r in enumerate(self.outputs):
@@ -197,14 +181,9 @@ _BUFFER_LIMIT = 256
 
 
 class BufferedFunction:
-    """A CasADi Function called through a FunctionBuffer on fixed numpy arrays (~1 us a call
-    instead of ~50-100 us for a plain call): for small functions on the per-event path.
-
-    ``bound`` fills the function's last inputs (the model parameters); calls pass the rest. Each
-    thread has one buffer per Function, shared by the BufferedFunctions of that Function (the
-    models of one structure, with their own parameters): runs of one model in threads share the
-    object, a run copies none of it, and a new model of a known structure makes no buffer.
-    """
+    """A CasADi Function called through a FunctionBuffer on fixed arrays (~1 us a call instead of
+    ~50-100 us): small functions on the per-event path. ``bound`` fills its last inputs (the model
+    parameters). Each thread has one buffer per Function, shared by the models of one structure."""
 
     def __init__(self, function: ca.Function, bound: Sequence[Any] = ()) -> None:
         self.function = function
@@ -230,9 +209,3 @@ class BufferedFunction:
             a[:] = np.ravel(x)
         entry.evaluate()
         return tuple(r.copy() for r in entry.outputs)
-
-    def __getstate__(self) -> dict[str, Any]:  # picklable for process pools: no buffers
-        return {"function": self.function, "bound": self.bound}
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__init__(state["function"], state.get("bound", ()))  # type: ignore[misc]

@@ -1,78 +1,25 @@
 """Translational clearance joint (section 4.3): a slider free inside a guide, contact at its corners.
 
-Geometry (eqs. 4.14-4.20), body i the guide, body j the slider (the chapter swaps the
-letters). The guide has a mid-line through the point ``O`` (``point_i``) along the unit
-vector ``t`` (4.14) fixed to the guide; ``n = perp(t)`` points to the *upper* surface,
-at ``+H/2``, the lower one is at ``-H/2``. For a slider corner ``r_k`` (4.15)
+Body i the guide, body j the slider. The guide's mid-line runs through ``O`` (``point_i``) along the
+unit vector ``t`` (4.14); ``n = perp(t)`` points to the upper surface at ``+H/2``. For a corner ``r_k``
+(4.15), ``s_k = t . (r_k - O)`` along the guide and ``d_k = +-n . (r_k - O) - H/2`` the penetration
+(4.16)-(4.20), > 0 in contact, at the sharp corner (R_c only sets the corner law's stiffness, 3.5);
+the rate is ``(d d_k / dq) v`` (4.21); the force acts on the slider at the corner and on the guide
+at the closest surface point (4.22)-(4.25). Corners A, B touch the upper surface, C, D the lower:
+four pairs, each gap ``min(d_k, s_k - s_P, s_Q - s_k)`` with contact limits (s_P, s_Q).
 
-    s_k = t . (r_k - O)            coordinate along the guide
-    A_j = O + s_k t +- (H/2) n     closest guide point (4.16), on the surface
-    d_k = +-n . (r_k - O) - H/2    signed penetration, > 0 in contact
+Models (``contact_model``): ``corners``, one term per corner (its law, approach speed latched at
+onset); ``section-4.3``, also one term per face, on instead of its corners' while both touch:
+``face_law(d_mean, d_mean_dot)``, ``d_mean = (d_1 + d_2)/2``, at the centroid of the penetrated
+trapezoid (Fig. 4.13a), the resultant of a Winkler pressure (potential ``K (d_1^2 + d_1 d_2 +
+d_2^2) / 6``); approach speed the mean of its corners' (docs/contact_laws.md). Friction acts along
+``t``. A face's switches are events of ``<name>.upper_face`` / ``<name>.lower_face``.
 
-``d_k = -n_k . delta`` with ``delta = A_j - r_k`` (4.17) and ``n_k`` the surface's normal
-pointing out of the guide (the chapter's ``n`` of (4.18)), so ``d_k > 0`` is the chapter's
-condition (4.19) and ``d_k = |delta|`` (4.20) in contact. The penetration is measured at the sharp corner of
-the ``L x W`` rectangle as in the chapter; the corner radius R_c only sets the stiffness
-of the corner contact (a sphere of radius R_c on a plane, eq. 3.5). The penetration rate
-is ``(d d_k / dq) v`` (4.21). The force on the slider acts at the corner, the opposite
-one on the guide at ``A_j``, both transported to the centres of mass (4.22)-(4.25).
-
-Pairs and gaps: corners A, B (upper) against the upper surface and C, D (lower) against
-the lower one: 4 pairs, 4 gap functions watched by IDA. A slider that cannot turn over
-in its guide (checked by the scene) can touch nothing else. The gap of a pair is
-``min(d_k, s_k - s_P, s_Q - s_k)`` when the surface has contact limits ``(s_P, s_Q)``:
-negative (no contact) while the corner's projection is outside the segment, so a corner
-that leaves the segment separates there.
-
-Models
-------
-``corners``: one term per pair, the joint's corner law (sphere on a plane, eq. 3.9 with
-(3.5) by default) with the approach speed latched at the pair's onset, in every scenario
-of Fig. 4.9.
-
-``section-4.3``: in addition one term per face (A-B on the upper surface, C-D on the
-lower). While both corners of a face are in contact the face term is on and their two
-corner terms are off: force ``face_law(d_mean, d_mean_dot)`` with the average penetration
-``d_mean = (d_1 + d_2)/2`` (Lankarani's linear law (4.26) with the stiffness (4.27) by
-default). Our reading of "the geometric centre of the penetrated area" (Fig. 4.13a): the
-penetrated region of the slider beyond the surface line is the trapezoid with parallel
-sides ``d_1`` and ``d_2`` a slider length apart; the force acts normal to the surface
-through its centroid, at ``s = s_1 + (s_2 - s_1)(d_1 + 2 d_2)/(3 (d_1 + d_2))`` on the
-surface line. This is exactly the resultant of a linear (Winkler) pressure proportional
-to the local penetration, so the face force derives from the potential
-``K (d_1^2 + d_1 d_2 + d_2^2) / 6``. One corner, or two opposite corners, use the corner
-law. When a face forms or breaks, the force switches between the two laws (the
-chapter's model: not continuous, not energy-conserving at the switch). A face law that
-needs an approach speed gets the mean of the approach speeds latched by its two corners
-(docs/contact_laws.md).
-
-A joint's ``reading`` (:mod:`daeclear.model.readings`) picks one of these models, the corner law's
-stiffness ((3.5) or the pseudo-stiffness (4.27)) and exponent, and the face law
-(``TranslationalClearance.contact_model``, ``resolved_law``, ``resolved_face_law``).
-
-Friction (only when declared): at every active contact, the modified Coulomb law (or the
-joint's law) on the sliding velocity of the slider's material point at the contact
-relative to the guide's, along ``t``.
-
-Events follow the rule of :mod:`daeclear.assembly.automaton` (onset watched while free, separation
-while in contact, approach speed latched at the located onset and floored, the same
-storm guard per corner). A face's switches are reported as events of the pair
-``<name>.upper_face`` / ``<name>.lower_face``, after the corner events that caused them.
-
-Channels (``<name>`` the joint's name, ``<pair>`` ``<name>.A_upper`` ... ``<name>.D_lower``)
----------------------------------------------------------------------------------------
-``<name>.s``, ``<name>.y`` (m): slider centre along the guide and its offset from the
-mid-line; ``<name>.tilt`` (rad): angle from the guide to the slider; ``<name>.eta`` =
-y / (2c) (+-0.5 where a parallel slider touches a surface); ``<name>.xi`` = 0..1 along the
-joint's ``stroke`` (dimensionless path of Fig. 4.28d); per pair ``<pair>.penetration``,
-``.penetration_rate``, ``.normal_force``, ``.in_contact`` (1 also while its face carries
-it), with friction ``.friction_force`` and ``.sliding_velocity``; per face (``section-4.3``)
-``<name>.upper_face.penetration`` (the average), ``.normal_force``, ``.in_contact`` and the
-friction channels; ``<name>.penetration`` (largest corner penetration),
-``<name>.normal_force`` (sum over pairs and faces), ``<name>.in_contact`` (any), and
-``<name>.elastic_energy`` (J): the energy stored in the elastic part of the active laws
-(K d^(n+1)/(n+1) per corner, the Winkler potential per face), so that mechanical plus
-elastic energy is conserved by elastic laws.
+Channels: ``<name>.s``, ``.y`` (m; along the guide, off the mid-line), ``.tilt`` (rad), ``.eta`` =
+y / (2c), ``.xi`` (0..1 along ``stroke``, Fig. 4.28d); per pair ``<name>.A_upper`` ...
+``.D_lower`` and per face ``.penetration``, ``.penetration_rate`` (pairs), ``.normal_force``,
+``.in_contact`` (friction: ``.friction_force``, ``.sliding_velocity``); ``<name>.penetration``
+(largest), ``.normal_force`` (sum), ``.in_contact`` (any) and ``.elastic_energy`` (J).
 """
 
 from __future__ import annotations
@@ -87,8 +34,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from .automaton import DEFAULT_STORM, Storm, start, step
-from .contact_pairs import ContactBuild, PairStates, TermSwitch, approach_floor, pair_event
+from .contact_pairs import ContactBuild, PairLogic, PairStates, TermSwitch, approach_floor
 from .parameters import law_structure, law_values, symbolic_law
 from ..results.result import ContactEvent
 from ..model.scene import TranslationalClearance
@@ -99,8 +45,7 @@ CORNERS: tuple[tuple[str, int, int, str], ...] = (
     ("A", +1, +1, "upper"), ("B", -1, +1, "upper"), ("C", -1, -1, "lower"), ("D", +1, -1, "lower"))
 #: Faces: name and the indices (in CORNERS) of its two corners, rear first.
 FACES: tuple[tuple[str, int, int], ...] = (("upper_face", 1, 0), ("lower_face", 2, 3))
-# Keeps the centroid of the penetrated trapezoid finite when both penetrations vanish
-# (only reached while Newton iterates; the term is off otherwise), m.
+# keeps the trapezoid's centroid finite when both penetrations vanish (only while Newton iterates), m
 _CENTROID_EPS = 1e-18
 
 
@@ -111,8 +56,8 @@ def _identifier(name: str) -> str:
 
 
 def _elastic_energy(numeric: Any, law: Any, d: Any) -> Any | None:
-    """Energy stored by the elastic part ``K d^n`` of a law, ``K d^(n+1)/(n+1)``; None if unknown.
-    ``numeric`` decides (structure), ``law`` (possibly with symbolic numbers) gives the formula."""
+    """``K d^(n+1)/(n+1)``, the energy of a law's elastic part ``K d^n`` (None if unknown); ``numeric``
+    decides, ``law`` (possibly with symbolic numbers) gives the formula."""
     if getattr(numeric, "stiffness", None) is None:
         return None
     n_value = float(getattr(numeric, "effective_exponent", 1.0 if numeric.geometry == "face" else math.nan))
@@ -128,57 +73,20 @@ def _unit(v: Sequence[float]) -> NDArray[np.float64]:
 
 
 @dataclass(frozen=True)
-class SliderGuideLogic:
-    """Mode switching of one translational clearance joint: four corner pairs and, in the
-    ``section-4.3`` model, two faces. A rule, not a state: the corners' states are passed in and
-    returned (see :mod:`daeclear.assembly.contact_state`).
+class SliderGuideLogic(PairLogic):
+    """Mode switching of one translational clearance joint: its four corner pairs
+    (:class:`~daeclear.assembly.contact_pairs.PairLogic`) and, in the ``section-4.3`` model, two
+    faces. A face term is on while both its corners are in contact, and then their corner terms
+    are off."""
 
-    Each corner is a pair of :mod:`daeclear.assembly.automaton` (free, contact or held, by the root of its
-    gap); the terms follow from the modes: a face term is on while both its corners are in
-    contact, a corner term while its corner's term is on (in contact or held) and its face is
-    not. ``rate`` maps ``(q, v)`` to the four gaps and the four penetration rates.
-    """
-
-    name: str
-    pairs: tuple[str, ...]
-    first_root: int
-    corner_terms: tuple[int, ...]
-    face_names: tuple[str, ...]
-    face_terms: tuple[int, ...]
-    face_corners: tuple[tuple[int, int], ...]
-    rate: BufferedFunction  # (q, v) -> (gaps, penetration rates)
-    n_q: int
-    needs_approach: bool
-    min_approach_speed: float
-    face_needs_approach: bool
-    face_min_approach_speed: float
-    storm: Storm = DEFAULT_STORM  # frozen: shared
-
-    @property
-    def roots(self) -> range:
-        """Indices of the gaps (roots) of this element: one per corner."""
-        return range(self.first_root, self.first_root + len(self.pairs))
-
-    def pair_index(self, root: int) -> int:
-        """The corner (index in this element's states) of gap ``root``."""
-        return root - self.first_root
-
-    def pair_name(self, root: int) -> str:
-        """The name of the corner of gap ``root`` (its events' ``pair``)."""
-        return self.pairs[root - self.first_root]
-
-    def _evaluate(self, y: NDArray) -> tuple[NDArray, NDArray]:
-        q, v = y[:self.n_q], y[self.n_q:2 * self.n_q]
-        gaps, rates = self.rate(q, v)
-        return np.asarray(gaps, dtype=float).ravel(), np.asarray(rates, dtype=float).ravel()
+    face_names: tuple[str, ...] = ()
+    face_terms: tuple[int, ...] = ()
+    face_corners: tuple[tuple[int, int], ...] = ()
+    face_needs_approach: bool = False
+    face_min_approach_speed: float = 0.0
 
     def _faces_on(self, states: PairStates) -> list[bool]:
         return [states[a].contact and states[b].contact for a, b in self.face_corners]
-
-    def start(self, t: float, y: NDArray) -> PairStates:
-        """Each corner's state at the start of a run (mode from its gap, rate latched, no history)."""
-        gaps, rates = self._evaluate(y)
-        return tuple(start(gaps[i] > 0.0, float(rates[i]), self.min_approach_speed) for i in range(len(self.pairs)))
 
     def terms(self, states: PairStates) -> list[TermSwitch]:
         """A face's term while both its corners are in contact (parameter: their mean latched speed,
@@ -189,67 +97,28 @@ class SliderGuideLogic:
             speed = max(0.5 * (states[a].latched + states[b].latched), self.face_min_approach_speed)
             out.append((self.face_terms[f], on, np.array([speed]) if self.face_needs_approach else np.zeros(0)))
             in_face[a] = in_face[b] = on
-        for i, k in enumerate(self.corner_terms):
-            params = np.array([states[i].latched]) if self.needs_approach else np.zeros(0)
-            out.append((k, states[i].term_on and not in_face[i], params))
-        return out
+        return out + [(k, on and not face, p) for (k, on, p), face in zip(super().terms(states), in_face)]
 
     def modes(self, states: PairStates) -> dict[str, str]:
-        modes = {p: ("contact" if st.contact else "free") for p, st in zip(self.pairs, states)}
+        modes = super().modes(states)
         modes.update({f: ("contact" if on else "free") for f, on in zip(self.face_names, self._faces_on(states))})
         return modes
 
-    def root_directions(self, states: PairStates) -> list[tuple[int, int]]:
-        """While a corner is free watch its onsets (+1), in contact separations (-1), held both (0)."""
-        return [(self.first_root + i, st.watch) for i, st in enumerate(states)]
-
     def decide(self, states: PairStates, t: float, y: NDArray, roots_found: NDArray | None
                ) -> tuple[PairStates, list[ContactEvent]]:
-        """Decide the roots of the corners' gaps by the automaton: the new states and the events of
-        corners and of faces that formed or broke."""
-        if roots_found is None:
-            return states, []
-        found = roots_found[self.first_root:self.first_root + len(self.pairs)]
-        if not np.any(found):
-            return states, []
-        gaps, rates = self._evaluate(y)
-        events: list[ContactEvent] = []
-        new = list(states)
-        for i, direction in enumerate(int(d) for d in found):
-            if direction == 0:
-                continue
-            rate = float(rates[i])
-            new[i], decision = step(new[i], t, direction, rate, storm=self.storm,
-                                    min_approach_speed=self.min_approach_speed)
-            events += pair_event(self.pairs[i], t, y, rate, decision)
-        after = tuple(new)
+        """The corners' decisions, then the events of the faces that formed or broke."""
+        after, events = super().decide(states, t, y, roots_found)
         for f, (was, on) in enumerate(zip(self._faces_on(states), self._faces_on(after))):
-            a, b = self.face_corners[f]
-            if on and not was:
-                speed = 0.5 * (after[a].latched + after[b].latched)
-                events.append(ContactEvent(t=t, pair=self.face_names[f], kind="onset", approach_speed=speed,
-                                           y=y.copy()))
-            elif was and not on:
-                events.append(ContactEvent(t=t, pair=self.face_names[f], kind="separation",
-                                           approach_speed=float("nan"), y=y.copy()))
+            if on != was:
+                a, b = self.face_corners[f]
+                speed = 0.5 * (after[a].latched + after[b].latched) if on else float("nan")
+                events.append(ContactEvent.from_solver(t, self.face_names[f], "onset" if on else "separation", speed,
+                                                       np.array(y, dtype=float)))
         return after, events
 
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
-        """Without faces (model ``corners``) every corner term follows its own pair, so the compiled
-        IDA loop may decide its switches itself; with faces the terms depend on two corners."""
-        if self.face_names:
-            return None
-        fn = getattr(self.rate, "function", None)
-        if fn is None:
-            return None
-        q, v, P = (ca.SX.sym(label, fn.numel_in(i)) for i, label in enumerate(("q", "v", "P")))
-        gaps, rates = fn(q, v, P)
-        out = []
-        for i, pair in enumerate(self.pairs):
-            f = ca.Function(f"{pair.replace('.', '_')}_gap_rate", [q, v, P], [ca.vertcat(gaps[i], rates[i])])
-            out.append((self.first_root + i, self.corner_terms[i], f, bool(self.needs_approach),
-                        float(self.min_approach_speed)))
-        return out
+        """None with faces (their terms depend on two corners); else every corner's pair."""
+        return None if self.face_names else super().simple_pairs()
 
 
 def translational_clearance_parameters(ref: Reference,
@@ -285,12 +154,8 @@ def translational_clearance_parameters(ref: Reference,
 
 def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClearance, first_term: int,
                                   first_root: int) -> ContactBuild:
-    """Slider-guide contact (section 4.3): eqs. (4.14)-(4.27) with the joint's laws and model.
-
-    Terms, in order: the corner pairs A_upper, B_upper, C_lower, D_lower, then (model
-    ``section-4.3``) the faces upper_face, lower_face. Gaps: the four corner pairs. Every
-    number comes from the run-time parameters ``<joint>.*``.
-    """
+    """Slider-guide contact, eqs. (4.14)-(4.27): terms A_upper, B_upper, C_lower, D_lower (then
+    upper_face, lower_face in ``section-4.3``), gaps the four corners; numbers from ``<joint>.*``."""
     name, ident = joint.name, _identifier(joint.name)
     law_numeric = joint.resolved_law()
     face_numeric = joint.resolved_face_law() if joint.contact_model == "section-4.3" else None
@@ -317,23 +182,26 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
     def surface_point(s: Any, surface: str) -> Any:
         return O + s * t_vec + side[surface] * 0.5 * H * n_vec  # (4.16) on the surface line
 
-    def sliding_velocity(point: Any) -> Any:
-        return ca.dot(slider.world_point_velocity(point) - guide.world_point_velocity(point), t_vec)
+    terms: list[Term] = []
+    forces: list[tuple[Any, Any, Any, Any]] = []  # per term: (F_N, F_T, v_T, p)
 
-    def contact_force(F_N: Any, point_slider: Any, point_guide: Any, surface: str) -> tuple[Any, Any, Any]:
-        """Generalized force of a normal force F_N (and friction) on the slider at ``point_slider``."""
+    def add_term(label: str, law_: Any, n_p: int, d: Any, d_dot: Any, point_slider: Any, point_guide: Any,
+                 surface: Any) -> None:
+        """The term of ``law_``'s force on the slider at ``point_slider`` (and friction), its opposite
+        on the guide at ``point_guide``, (4.22)-(4.25)."""
+        p = ca.SX.sym("p", n_p)
+        F_N = law_.force(d, d_dot, p[0] if n_p else None)
         n_in = -side[surface] * n_vec  # surface normal pointing into the guide
-        v_T = sliding_velocity(point_guide)
+        v_T = ca.dot(slider.world_point_velocity(point_guide) - guide.world_point_velocity(point_guide), t_vec)
         F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
-        f_slider = F_N * n_in + F_T * t_vec  # (4.22)
-        Q = ctx.generalized_force([(joint.body_j, f_slider, point_slider),  # (4.23)
-                                   (joint.body_i, -f_slider, point_guide)])  # (4.24)-(4.25)
-        return Q, F_T, v_T
+        f_slider = F_N * n_in + F_T * t_vec
+        Q = ctx.generalized_force([(joint.body_j, f_slider, point_slider), (joint.body_i, -f_slider, point_guide)])
+        terms.append(Term(f"{name}.{label}", ca.Function(f"{ident}_{label}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P],
+                                                          [Q], ["t", "q", "v", "p", "P"], ["Q"]), n_p))
+        forces.append((F_N, F_T, v_T, p))
 
     corner_s, corner_d, corner_gap, corner_rate = [], [], [], []
-    terms: list[Term] = []
     pair_names: list[str] = []
-    forces: list[tuple[Any, Any, Any, Any]] = []  # per term: (F_N, F_T, v_T, p)
     energies: list[Any | None] = []  # per term: elastic energy stored while the term is on
     n_params = 1 if law_numeric.needs_approach_speed else 0
     for label, sign_l, sign_w, surface in CORNERS:
@@ -352,14 +220,8 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         corner_d.append(d_k)
         corner_gap.append(gap)
         corner_rate.append(d_dot)
-        pair = f"{label}_{surface}"
-        pair_names.append(f"{name}.{pair}")
-        p = ca.SX.sym("p", n_params)
-        F_N = law.force(d_k, d_dot, p[0] if n_params else None)
-        Q, F_T, v_T = contact_force(F_N, r_k, surface_point(s_k, surface), surface)
-        terms.append(Term(f"{name}.{pair}", ca.Function(f"{ident}_{pair}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P],
-                                                         [Q], ["t", "q", "v", "p", "P"], ["Q"]), n_params))
-        forces.append((F_N, F_T, v_T, p))
+        pair_names.append(f"{name}.{label}_{surface}")
+        add_term(f"{label}_{surface}", law, n_params, d_k, d_dot, r_k, surface_point(s_k, surface), surface)
         energies.append(_elastic_energy(law_numeric, law, d_k))
 
     face_names: list[str] = []
@@ -376,13 +238,7 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
             # centroid of the penetrated trapezoid (sides d_1, d_2), measured along the guide
             s_gc = 0.5 * (s_1 + s_2) + (s_2 - s_1) * (w_2 - w_1) / (6.0 * (w_1 + w_2) + _CENTROID_EPS)
             point = surface_point(s_gc, surface)
-            p = ca.SX.sym("p", face_params)
-            F_N = face_law.force(d_mean, d_mean_dot, p[0] if face_params else None)
-            Q, F_T, v_T = contact_force(F_N, point, point, surface)
-            terms.append(Term(f"{name}.{face}", ca.Function(f"{ident}_{face}_force",
-                                                             [ctx.t, ctx.q, ctx.v, p, ctx.P], [Q],
-                                                             ["t", "q", "v", "p", "P"], ["Q"]), face_params))
-            forces.append((F_N, F_T, v_T, p))
+            add_term(face, face_law, face_params, d_mean, d_mean_dot, point, point, surface)
             # Winkler potential of the linear law at the trapezoid's centroid (see module docstring)
             linear = getattr(face_numeric, "effective_exponent", 1.0) == 1.0 and face_numeric.stiffness is not None
             energies.append(face_law.stiffness * (w_1 * w_1 + w_1 * w_2 + w_2 * w_2) / 6.0 if linear else None)
@@ -398,8 +254,7 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
 
     def logic(P: NDArray[np.float64]) -> list[Any]:
         return [SliderGuideLogic(
-            name=name, pairs=tuple(pair_names), first_root=first_root,
-            corner_terms=tuple(first_term + i for i in range(n_corners)),
+            pairs=tuple(pair_names), first_root=first_root, pair_terms=tuple(first_term + i for i in range(n_corners)),
             face_names=tuple(face_names), face_terms=tuple(first_term + n_corners + f for f in range(len(face_names))),
             face_corners=tuple(face_corners), rate=BufferedFunction(rate, bound=(P,)), n_q=n_q,
             needs_approach=law_numeric.needs_approach_speed, min_approach_speed=floor(P),
@@ -419,6 +274,12 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
             p = forces[k][3]
             return on * (ca.substitute(expr, p, p_sym) if p.numel() else expr)
 
+        def friction_channels(prefix: str, k: int) -> list[Channel]:
+            if friction.frictionless:
+                return []
+            return [Channel(f"{prefix}.friction_force", "N", switched(k, forces[k][1])),
+                    Channel(f"{prefix}.sliding_velocity", "m/s", forces[k][2])]
+
         out = [
             Channel(f"{name}.s", "m", s_centre),
             Channel(f"{name}.y", "m", y_centre),
@@ -434,33 +295,20 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
             on_f = switches[n_corners + f][0]
             in_face[a] = in_face[a] + on_f
             in_face[b] = in_face[b] + on_f
-        for i, pair in enumerate(pair_names):
-            F_N = switched(i, forces[i][0])
-            total = total + F_N
-            in_contact = switches[i][0] + in_face[i]
-            any_contact = ca.fmax(any_contact, in_contact)
-            out += [
-                Channel(f"{pair}.penetration", "m", corner_d[i]),
-                Channel(f"{pair}.penetration_rate", "m/s", corner_rate[i]),
-                Channel(f"{pair}.normal_force", "N", F_N),
-                Channel(f"{pair}.in_contact", "", in_contact),
-            ]
-            if not friction.frictionless:
-                out += [Channel(f"{pair}.friction_force", "N", switched(i, forces[i][1])),
-                        Channel(f"{pair}.sliding_velocity", "m/s", forces[i][2])]
-        for f, face in enumerate(face_names):
-            k = n_corners + f
-            a, b = face_corners[f]
+        for k, label in enumerate(pair_names + face_names):  # the corners, then the faces
             F_N = switched(k, forces[k][0])
             total = total + F_N
-            out += [
-                Channel(f"{face}.penetration", "m", 0.5 * (corner_d[a] + corner_d[b])),
-                Channel(f"{face}.normal_force", "N", F_N),
-                Channel(f"{face}.in_contact", "", switches[k][0]),
-            ]
-            if not friction.frictionless:
-                out += [Channel(f"{face}.friction_force", "N", switched(k, forces[k][1])),
-                        Channel(f"{face}.sliding_velocity", "m/s", forces[k][2])]
+            if k < n_corners:
+                in_contact = switches[k][0] + in_face[k]
+                any_contact = ca.fmax(any_contact, in_contact)
+                out += [Channel(f"{label}.penetration", "m", corner_d[k]),
+                        Channel(f"{label}.penetration_rate", "m/s", corner_rate[k])]
+            else:
+                a, b = face_corners[k - n_corners]
+                in_contact = switches[k][0]
+                out.append(Channel(f"{label}.penetration", "m", 0.5 * (corner_d[a] + corner_d[b])))
+            out += [Channel(f"{label}.normal_force", "N", F_N), Channel(f"{label}.in_contact", "", in_contact),
+                    *friction_channels(label, k)]
         if all(e is not None for e in energies):
             stored = sum(switches[k][0] * e for k, e in enumerate(energies))
             out.append(Channel(f"{name}.elastic_energy", "J", stored))

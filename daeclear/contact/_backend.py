@@ -1,16 +1,8 @@
 """Tiny math shim so each contact law is written once for floats, numpy and CasADi.
 
-Every function here looks at its arguments: if one of them is a CasADi ``SX``, ``MX``
-or ``DM``, the CasADi operation is used (so the expression stays symbolic and
-differentiable, and generated C code stays branch-free); otherwise the numpy
-operation is used. CasADi is imported lazily, only when a CasADi object is seen,
-so ``daeclear.contact`` can be imported without loading CasADi.
-
-Rules for law implementers (they keep both paths NaN-free, value and derivative):
-
-- guard every operand before a fractional power, a logarithm or a division, e.g.
-  ``fmax(delta, 0.0) ** 1.5`` and never ``delta ** 1.5`` with ``delta`` possibly < 0;
-- ``if_else`` evaluates both branches in both backends, so both must be finite.
+Each function uses the CasADi operation when an argument is a CasADi ``SX``, ``MX`` or ``DM``
+(imported lazily), numpy otherwise. Guard every operand of a fractional power, a logarithm or a
+division (``fmax(delta, 0.0) ** 1.5``); ``if_else`` evaluates both branches, so both must be finite.
 """
 
 from __future__ import annotations
@@ -108,12 +100,8 @@ def fabs(x: Any) -> Any:
 
 
 def as_numeric(*args: Any) -> tuple[bool, tuple[Any, ...]]:
-    """Prepare arguments for a law body.
-
-    Returns ``(scalar, converted)``: CasADi objects pass through unchanged; anything
-    else becomes a float numpy array. ``scalar`` is True when every non-None argument
-    is a plain Python/numpy scalar (the caller then returns a ``float``).
-    """
+    """``(scalar, converted)``: CasADi arguments unchanged, others as float arrays; ``scalar`` when
+    every non-None argument is a scalar (the caller then returns a ``float``)."""
     if is_symbolic(*args):
         return False, args
     converted = tuple(None if a is None else np.asarray(a, dtype=float) for a in args)

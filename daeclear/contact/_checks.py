@@ -11,12 +11,8 @@ from ..errors import SceneError
 
 def check_number(owner: str, field: str, value: Any, *, low: float = -math.inf, high: float = math.inf,
                  low_open: bool = True, high_open: bool = True, unit: str = "") -> float:
-    """Return ``value`` as a float, or raise SceneError naming owner, field, value and range.
-
-    The bounds are open unless ``low_open``/``high_open`` say otherwise; infinite
-    bounds are always open, so ``nan`` and ``inf`` are rejected.
-    Example message: ``LankaraniNikravesh: restitution=1.2, must be in (0, 1].``
-    """
+    """``value`` as a float, or a SceneError naming owner, field, value and range
+    (``LankaraniNikravesh: restitution=1.2, must be in (0, 1].``); infinite bounds are open."""
     if type(value) is float:  # the common case first: numbers.Real is an abstract class, slow to test
         x = value
     elif isinstance(value, bool) or not isinstance(value, numbers.Real):

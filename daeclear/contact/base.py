@@ -1,19 +1,10 @@
 """Base class of the normal contact laws and the ``resolve`` protocol.
 
-Contract for implementers of a :class:`NormalLaw` subclass (a frozen, keyword-only
-dataclass whose fields are the law's parameters):
-
-- set the class attributes ``name`` (registry name, lower case with hyphens),
-  ``geometry`` (``"sphere"``, ``"cylinder"`` or ``"face"``: what the law needs from a
-  joint to complete itself) and ``supported_kinds`` (the ``resolve`` kinds for which
-  the missing numbers can be computed);
-- override ``is_resolved`` (all numbers set), ``_resolve`` (return a copy with the
-  numbers computed from the joint's geometry) and ``_force`` (the law, written once
-  with the functions of ``daeclear.contact._backend`` so it runs on numpy arrays and
-  CasADi symbols; zero for penetration <= 0, never negative, never NaN, including
-  its CasADi derivatives);
-- override ``dissipative`` / ``needs_approach_speed`` / ``penetration_limit`` when
-  they differ from the defaults (False / False / inf).
+A subclass (a frozen keyword-only dataclass of the law's parameters) sets ``name``, ``geometry``
+(``"sphere"``, ``"cylinder"`` or ``"face"``: what it needs from a joint) and ``supported_kinds``,
+and overrides ``is_resolved``, ``_resolve`` and ``_force`` (written with ``daeclear.contact._backend``:
+zero for penetration <= 0, never negative, never NaN, derivatives included), and ``dissipative`` /
+``needs_approach_speed`` / ``penetration_limit`` when they are not False / False / inf.
 """
 
 from __future__ import annotations
@@ -29,9 +20,8 @@ import numpy as np
 from ..errors import DaeclearWarning, SceneError
 from . import _backend as B
 from ._checks import check_number
-from .geometry import (
-    MaterialPair, internal_contact_stiffness, material_pair, plane_face_stiffness, sphere_plane_stiffness,
-)
+from .geometry import (MaterialPair, internal_contact_stiffness, material_pair, plane_face_stiffness,
+                       sphere_plane_stiffness)
 
 __all__ = ["KINDS", "Geometry", "Kind", "NormalLaw", "bearing_radii", "computed_stiffness"]
 
@@ -44,20 +34,14 @@ KINDS: tuple[str, ...] = ("internal_cylinder", "sphere_plane", "plane_face")
 
 @dataclass(frozen=True, kw_only=True)
 class NormalLaw(abc.ABC):
-    """A normal contact force law ``F_N(delta, delta_dot, delta_dot_minus)``.
-
-    Sign conventions (chapter 4): penetration ``delta > 0`` in contact; penetration
-    rate ``delta_dot > 0`` while the bodies approach (compression) and < 0 while
-    they separate (restitution); approach speed ``delta_dot_minus > 0`` is the rate
-    latched at contact onset. The returned force is the magnitude along the contact
-    normal, ``>= 0``.
-    """
+    """A normal contact force law ``F_N(delta, delta_dot, delta_dot_minus) >= 0``: penetration
+    ``delta > 0`` in contact, rate ``delta_dot > 0`` approaching, ``delta_dot_minus`` the rate latched
+    at contact onset."""
 
     name: ClassVar[str]
     geometry: ClassVar[Geometry]
     supported_kinds: ClassVar[tuple[str, ...]]
 
-    # ---- metadata -----------------------------------------------------------------
     @property
     def dissipative(self) -> bool:
         """True if the law dissipates energy in an impact (hysteresis or damping)."""
@@ -78,34 +62,21 @@ class NormalLaw(abc.ABC):
         """Largest penetration (m) of the law's valid range; beyond it see the class Notes."""
         return math.inf
 
-    # ---- resolve protocol ---------------------------------------------------------
     def resolve(self, kind: Kind, *, radii: tuple[float, ...] | float | None = None,
                 materials: MaterialPair | None = None,
                 face_half_width: float | None = None) -> Self:
-        """Return a copy with every number the force needs set from the joint's geometry.
-
-        Values the user set (``stiffness=``, ``length=``...) are never overridden;
-        only fields left ``None`` are computed. Calling it on a resolved law is harmless.
+        """A copy with every number left ``None`` computed from the joint's geometry (given ones kept).
 
         Parameters
         ----------
         kind : {"internal_cylinder", "sphere_plane", "plane_face"}
-            ``"internal_cylinder"``: journal (radius R_j) inside a bearing (R_i), the
-            revolute clearance joint; ``"sphere_plane"``: a rounded slider corner of
-            radius R_c on a guide surface; ``"plane_face"``: a square slider face of
-            side ``2 a`` flat on the guide.
+            A journal in a bearing; a rounded slider corner on a guide; a square slider face (side 2a).
         radii : tuple of float or float, optional
-            ``(R_i, R_j)`` = (bearing radius, journal radius) in m for
-            ``"internal_cylinder"``; ``(R_c,)`` or ``R_c`` for ``"sphere_plane"``.
+            ``(R_i, R_j)`` (bearing, journal) in m, or ``(R_c,)`` / ``R_c`` for ``"sphere_plane"``.
         materials : Material or (Material, Material), optional
             Materials of bodies i and j; one Material means both.
         face_half_width : float, optional
             Half side ``a`` (m) of the square contact area, for ``"plane_face"``.
-
-        Returns
-        -------
-        NormalLaw
-            A resolved law of the same class (``is_resolved`` is True).
 
         Raises
         ------
@@ -121,30 +92,22 @@ class NormalLaw(abc.ABC):
     def _resolve(self, kind: str, *, radii: Any, materials: Any, face_half_width: Any) -> Self:
         """Implementation of :meth:`resolve` (kind already validated)."""
 
-    # ---- evaluation ---------------------------------------------------------------
     def force(self, penetration: Any, penetration_rate: Any = None, approach_speed: Any = None) -> Any:
-        """Normal force magnitude ``F_N >= 0`` (N) on floats, numpy arrays or CasADi symbols.
+        """Normal force ``F_N >= 0`` (N) on floats, numpy arrays (broadcast) or CasADi symbols.
 
         Parameters
         ----------
         penetration : float, array_like, casadi.SX or casadi.MX
-            ``delta`` in m, > 0 in contact. For ``delta <= 0`` the force is exactly 0.
+            ``delta`` in m, > 0 in contact (force exactly 0 otherwise).
         penetration_rate : same types, optional
-            ``delta_dot`` in m/s, > 0 approaching. Required by dissipative laws.
+            ``delta_dot`` in m/s, > 0 approaching; required by dissipative laws.
         approach_speed : same types, optional
-            ``delta_dot_minus`` in m/s (> 0), the rate latched at contact onset.
-            Required when ``needs_approach_speed``; floored at the law's
-            ``min_approach_speed``.
-
-        Returns
-        -------
-        float, numpy.ndarray or CasADi expression
-            A float when every argument is a scalar; arrays broadcast.
+            ``delta_dot_minus`` in m/s, latched at onset; required when ``needs_approach_speed``.
 
         Raises
         ------
         SceneError
-            If the law is not resolved (``stiffness=None``...): call :meth:`resolve`.
+            If the law is not resolved: call :meth:`resolve`.
         TypeError
             If a required rate or approach speed is missing.
         """
@@ -166,13 +129,8 @@ class NormalLaw(abc.ABC):
         """The law, written once with ``daeclear.contact._backend`` functions."""
 
     def check_penetration(self, penetration: Any, *, warn: bool = True) -> bool:
-        """Return True if every (numeric) penetration is inside the law's valid range.
-
-        Inside a simulation the law cannot raise; it continues as documented in the
-        class Notes. Call this on results (e.g. a penetration channel) to be told.
-        With ``warn=True`` a :class:`~daeclear.errors.DaeclearWarning` is issued
-        when some value is outside.
-        """
+        """True if every penetration (e.g. of a result's channel) is inside the law's valid range; else
+        a :class:`~daeclear.errors.DaeclearWarning` with ``warn``."""
         values = np.asarray(penetration, dtype=float)
         worst = float(np.max(values)) if values.size else -math.inf
         ok = worst <= self.penetration_limit
@@ -183,7 +141,6 @@ class NormalLaw(abc.ABC):
         return ok
 
 
-# ---- helpers for implementers: turn resolve() inputs into numbers ---------------------
 def bearing_radii(owner: str, radii: Any) -> tuple[float, float]:
     """``(R_i, R_j)`` for kind ``"internal_cylinder"``, checked ``R_i > R_j > 0``."""
     if not (isinstance(radii, (tuple, list)) and len(radii) == 2):

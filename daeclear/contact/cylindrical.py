@@ -10,43 +10,14 @@ length, X a force scale and k = +1 or -1 (docs/contact_laws.md).
 It is implicit in F. ``delta(F)`` rises from 0 to its maximum ``delta_max = s X e^(k-1)``
 at ``F_max = X e^(k-1)`` and falls after it; only ``0 < F < F_max`` is physical.
 
-Solving it (exactly, on floats, numpy and CasADi from one definition)
---------------------------------------------------------------------
-With ``z = ln(X / F) + k`` the law reads ``z - ln z = 1 + r``, ``r = ln(delta_max / delta)``,
-on the branch ``z > 1``, i.e. ``z = -W_{-1}(-exp(-1 - r))`` (Lambert W). We solve
-``eps - log1p(eps) = r`` for ``eps = z - 1 > 0`` (no cancellation near the branch end)
-with a fixed number of safeguarded Newton steps (Newton in ``eps`` is Newton in
-``u = ln F``; the safeguard ``eps_new >= eps / 2`` keeps the iterate on the physical
-branch) from a starting value that is the series ``t + t^2/3 + t^3/36 - t^4/270``,
-``t = sqrt(2 r)``, for r < 2 and ``r + ln(1 + r + ln(1 + r))`` above. Three steps reach
-round-off (relative 2e-16 in ``z``) over the whole valid range; we take
-:data:`NEWTON_STEPS` = 4 (tested). Then ``F = delta / (s (1 + eps))``: the relative
-error of F is that of ``z``. The graph is branch-free (``if_else`` evaluates both
-starting values), so the generated C code has no data-dependent loops, and CasADi's
-derivative through the converged Newton steps is the implicit-function derivative
-``dF/d delta = 1 / (d delta / dF) = 1 / (s eps)`` (Newton's map has zero slope at its
-root, so the derivative converges with the iterate).
-
-Valid range and fallback
-------------------------
-``dF/d delta = 1/(s eps)`` is infinite at ``delta_max``. The law is used up to
-``penetration_limit = delta_max exp(-(eps_min - log1p(eps_min)))`` with
-``eps_min = 1e-3`` (i.e. 0.99999950 delta_max, force ``F_lim``); beyond it the force is
-continued as ``F_lim (delta / penetration_limit)**1.5`` (Hertz-like, continuous,
-increasing). A simulation cannot raise; call :meth:`~NormalLaw.check_penetration` on
-results to get a warning. For the chapter's steel journal (c = 0.5 mm, L = 10 mm)
-``delta_max`` is 526 um (D-F), 271 um (ESDU) and 0.2 m (Goldsmith), far above the
-micrometre penetrations of the benchmark. Very small penetrations,
-``delta < delta_max e^-200`` (~1e-90 m), are evaluated at ``r = 200`` (the force stays
-proportional to delta, and every derivative stays finite).
-
-sigma convention
-----------------
-``sigma_convention="plain"`` uses ``sigma = (1 - nu^2)/E`` (eq. 3.4 as in Flores et al.);
-``"pi"`` uses ``sigma' = (1 - nu^2)/(pi E)`` (Lankarani-Nikravesh 1990). Which one the
-book used in these laws is not known. Defaults: "plain" for Dubowsky-Freudenstein and
-Goldsmith, "pi" for ESDU 78035, whose formula is written in sigma' (so that it equals
-Johnson's conforming-cylinder solution).
+With ``z = ln(X / F) + k = 1 + eps`` the law reads ``eps - log1p(eps) = r``,
+``r = ln(delta_max / delta)`` (``1 + eps = -W_{-1}(-exp(-1 - r))``), solved by :data:`NEWTON_STEPS`
+unrolled safeguarded Newton steps from a series (r < 2) or asymptotic start: round-off accuracy,
+branch-free code, and CasADi's derivative is the implicit-function one ``1 / (s eps)``. Up to
+``penetration_limit`` (``eps = EPS_MIN``, just below ``delta_max``) the law holds; beyond it the
+force is continued as ``F_lim (delta / penetration_limit)**1.5`` (:meth:`~NormalLaw.check_penetration`
+warns). ``sigma_convention``: "plain" ``(1 - nu^2)/E`` (eq. 3.4) or "pi" ``(1 - nu^2)/(pi E)``
+(the default of ESDU 78035, written in it). docs/contact_laws.md has the derivation.
 """
 
 from __future__ import annotations
@@ -90,10 +61,7 @@ class CylinderConstants(NamedTuple):
 
 
 def solve_branch(r: Any) -> Any:
-    """Return ``eps > 0`` with ``eps - log1p(eps) = r`` for ``r >= r_min > 0`` (floats, numpy, CasADi).
-
-    ``1 + eps = -W_{-1}(-exp(-1 - r))``. Fixed, unrolled safeguarded Newton steps.
-    """
+    """``eps > 0`` with ``eps - log1p(eps) = r`` for ``r > 0``, by unrolled safeguarded Newton steps."""
     t = B.sqrt(2.0 * r)
     series = t + t * t / 3.0 + t**3 / 36.0 - t**4 / 270.0
     asymptotic = r + B.log(1.0 + r + B.log(1.0 + r))
@@ -135,7 +103,6 @@ class _CylindricalLaw(NormalLaw):
             raise SceneError(f"{owner}: sigma_convention={self.sigma_convention!r}, must be 'plain' "
                              "((1-nu^2)/E) or 'pi' ((1-nu^2)/(pi E)).")
 
-    # ---- resolve ------------------------------------------------------------------
     @property
     def is_resolved(self) -> bool:
         return None not in (self.bearing_radius, self.journal_radius, self.materials)
@@ -159,7 +126,6 @@ class _CylindricalLaw(NormalLaw):
             changes["materials"] = material_pair(materials, owner)
         return dataclasses.replace(self, **changes) if changes else self
 
-    # ---- numbers ------------------------------------------------------------------
     @property
     def sigma_sum(self) -> float:
         """``sigma_i + sigma_j`` in the law's ``sigma_convention`` (1/Pa)."""
@@ -200,10 +166,7 @@ class _CylindricalLaw(NormalLaw):
         return self.constants().delta_lim
 
     def penetration_from_force(self, force: Any) -> Any:
-        """The explicit law ``delta(F) = s F [ln(X / F) + k]`` (0 for F <= 0), any backend.
-
-        Meaningful on the physical branch ``0 < F <= F_max``.
-        """
+        """The explicit law ``delta(F) = s F [ln(X / F) + k]`` (0 for F <= 0; physical for F <= F_max)."""
         c = self.constants()
         scalar, (f,) = B.as_numeric(force)
         f_safe = B.fmax(f, c.force_max * math.exp(-R_MAX))
@@ -236,12 +199,8 @@ _COMMON = """
 
     Notes
     -----
-    Elastic: ``dissipative`` and ``needs_approach_speed`` are False. Implicit in F:
-    solved as described in :mod:`daeclear.contact.cylindrical` (round-off accuracy,
-    exact derivative). Valid for ``penetration <= penetration_limit`` (just below
-    ``max_penetration``); beyond it the force is continued as
-    ``F_lim (delta / penetration_limit)**1.5`` and :meth:`check_penetration` warns.
-    Force 0 for ``delta <= 0``; never negative.
+    Elastic; implicit in F (:mod:`daeclear.contact.cylindrical`). Beyond ``penetration_limit`` the
+    force is continued as ``F_lim (delta / penetration_limit)**1.5`` and :meth:`check_penetration` warns.
 """
 
 
@@ -250,9 +209,7 @@ class DubowskyFreudenstein(_CylindricalLaw):
     """Dubowsky-Freudenstein (1971) internal cylinder law.
 
     ``delta = F sigma_s / L [ln(L^3 (R_i - R_j) / (F sigma_s R_i R_j)) + 1]``,
-    the ``L^3`` reading (the only dimensionless one) of docs/contact_laws.md
-    Steel, R_i = 10 mm, c = 0.5 mm, L = 10 mm, sigma "plain": 119 N at 1 um,
-    739 N at 5 um, 1650 N at 10 um.
+    the ``L^3`` reading (the only dimensionless one) of docs/contact_laws.md.
     """ + _COMMON
 
     name: ClassVar[str] = "dubowsky-freudenstein"
@@ -268,12 +225,8 @@ class Goldsmith(_CylindricalLaw):
 
     ``delta = F sigma_s / L [ln(L^3 / (F sigma_s (R_i - R_j))) + 1]``.
 
-    Warning: the book's printed form (chapter 3) was not available. The one public
-    implementation found is dimensionally wrong, or identical to Dubowsky-Freudenstein
-    once repaired, yet the chapter plots different curves (Fig. 4.22c-d). This is the
-    plausible reading with the radial clearance in place of ``R_i R_j / (R_i - R_j)``
-    (docs/contact_laws.md). Steel, c = 0.5 mm, L = 10 mm, sigma "plain":
-    71 N at 1 um, 399 N at 5 um, 842 N at 10 um.
+    Warning: the book's printed form was not available; this is a plausible reading with the radial
+    clearance in place of ``R_i R_j / (R_i - R_j)`` (docs/contact_laws.md).
     """ + _COMMON
 
     name: ClassVar[str] = "goldsmith"
@@ -288,12 +241,8 @@ class ESDU78035(_CylindricalLaw):
     """ESDU 78035 internal cylinder law (Johnson-consistent reading).
 
     ``delta = F sigma'_s / L [ln(4 L (R_i - R_j) / (F sigma'_s)) - 1]`` with
-    ``sigma' = (1 - nu^2)/(pi E)`` by default (``sigma_convention="pi"``); this equals
-    Johnson's conforming-cylinder solution
-    ``delta = F/(pi L E*) [ln(4 pi L E* (R_i - R_j)/F) - 1]`` (docs/contact_laws.md 8.5a).
-    The other published reading (``pi`` in front, ``+1``) is not offered.
-    Steel, c = 0.5 mm, L = 10 mm: 407 N at 1 um, 2579 N at 5 um, 5850 N at 10 um
-    (130 / 821 / 1862 N with ``sigma_convention="plain"``).
+    ``sigma' = (1 - nu^2)/(pi E)`` by default: Johnson's conforming-cylinder solution
+    (docs/contact_laws.md 8.5a).
     """ + _COMMON
 
     sigma_convention: SigmaConvention = "pi"

@@ -8,18 +8,11 @@ D its diameter), with the Reynolds cavitation condition:
   and the attitude angle beta (between the force and the line of centres) for eps = 0.1 ... 0.99;
 - pure squeeze: So_d = F psi^2 / (B D mu |eps_dot|) for eps = 0 ... 0.99, closing and opening film.
 
-Here each table is turned into a ratio to the short (Ocvirk) half-film theory, which is 1 as
-B/D -> 0 and smooth in eps, whose logarithm is interpolated bilinearly (branch-free hat functions,
-so the same code runs on numbers and CasADi symbols). The short half film of the combined motion
-is split into its wedge and squeeze parts (the pressure is linear in both over the film); the wedge
-part is scaled and turned to the rotation table, the squeeze part scaled to the squeeze table.
-Beyond eps = 0.99 the ratio is held (the forces keep the short theory's
-growth); below 0.1 (rotation) the ratio of 0.1 is used. Three entries of the transcription used
-(the test data of MBDyn's hydrodynamic plain bearing, mboct-mbdyn-pkg) are out of line with their
-neighbours and are replaced by the finite-difference Reynolds solution of tests/test_contact_hydrodynamic.py
-(which reproduces the other entries to about 0.1 %): So_d closing at eps = 0.8, B/D = 1/2.5 (15.94 ->
-19.94; FD 19.93), closing at eps = 0.1, B/D = 1/2 (0.9814 -> 0.9305, FD), opening at eps = 0.95,
-B/D = 1/8 (0.0085 -> 0.0089, FD 0.00885). docs/lubrication.md has the validation.
+Each table is turned into its ratio to the short (Ocvirk) half film (1 as B/D -> 0), whose
+logarithm is interpolated bilinearly with branch-free hat functions (numbers and CasADi alike),
+held beyond the tables' eps range. The short film's wedge part is scaled and turned to the rotation
+table, its squeeze part scaled to the squeeze table. Three entries of the transcription (MBDyn's
+test data) are replaced by the finite-difference Reynolds solution (docs/lubrication.md).
 """
 
 from __future__ import annotations
@@ -171,10 +164,9 @@ def squeeze_ratio(eps: Any, bd: Any, closing: Any) -> Any:
 
 def finite_film_force(wedge: tuple[Any, Any], squeeze: tuple[Any, Any], eps: Any, w: Any, eps_dot: Any,
                       bd: Any) -> tuple[Any, Any]:
-    """(radial, tangential) of a finite bearing from the short half film's wedge and squeeze parts
-    (each (radial, tangential), over the film of the combined motion): the wedge part scaled to
-    Butenschoen's So_r and turned from Ocvirk's attitude angle to his, the squeeze part scaled to
-    his So_d (closing or opening film). For a pure rotation or squeeze this is his table."""
+    """(radial, tangential) of a finite bearing from the short half film's wedge and squeeze parts:
+    the wedge part scaled to So_r and turned to Butenschoen's attitude angle, the squeeze part scaled
+    to So_d (closing or opening film)."""
     k_rot, beta = rotation_ratio(eps, bd)
     turn = beta - B.atan2(math.pi * B.sqrt(1.0 - eps * eps), 4.0 * eps)  # minus Ocvirk's attitude angle
     sense = B.sign(w)

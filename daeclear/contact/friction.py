@@ -1,15 +1,8 @@
 """Friction laws: none, Coulomb, and the modified Coulomb law of Ambrosio (eq. 3.16).
 
-Sign convention: ``sliding_velocity`` is the tangential velocity of the body the force
-acts on, relative to the other body (material points, spin included). The returned
-signed force OPPOSES it, so the friction power ``force * sliding_velocity <= 0``.
-For the revolute clearance joint with ``v_T = (r_dot_j^Q - r_dot_i^Q) . t`` (journal j
-relative to bearing i): force on the journal ``friction_force(F_N, v_T) * t``, on the
-bearing the opposite.
-
-Every law runs on floats, numpy arrays and CasADi symbols from one definition and
-never divides by ``|v|``, so nothing is NaN at ``v = 0`` (``sign(0) = 0``, and its
-CasADi derivative is 0).
+``sliding_velocity`` is the tangential velocity of the body the force acts on relative to the
+other (material points); the signed force opposes it. No law divides by ``|v|``: nothing is NaN
+at ``v = 0``.
 """
 
 from __future__ import annotations
@@ -27,13 +20,8 @@ __all__ = ["Coulomb", "FrictionLaw", "ModifiedCoulomb", "NoFriction"]
 
 @dataclass(frozen=True, kw_only=True)
 class FrictionLaw(abc.ABC):
-    """A tangential force law ``F_T(F_N, v_T)``.
-
-    Contract for implementers: set ``name`` and ``smooth`` (continuous in the sliding
-    velocity), override ``_force(normal_force, sliding_velocity)`` using
-    ``daeclear.contact._backend`` functions; it must oppose the velocity and be finite
-    (with finite CasADi derivatives) everywhere, including ``v = 0``.
-    """
+    """A tangential force law ``F_T(F_N, v_T)``: subclasses set ``name`` and ``smooth`` (continuous in
+    v_T) and override ``_force`` (``_backend`` functions, finite everywhere)."""
 
     name: ClassVar[str]
     smooth: ClassVar[bool]
@@ -44,20 +32,8 @@ class FrictionLaw(abc.ABC):
         return False
 
     def friction_force(self, normal_force: Any, sliding_velocity: Any) -> Any:
-        """Signed tangential force (N) opposing ``sliding_velocity``.
-
-        Parameters
-        ----------
-        normal_force : float, array_like, casadi.SX or casadi.MX
-            ``F_N >= 0`` in N.
-        sliding_velocity : same types
-            ``v_T`` in m/s, of the body the force acts on relative to the other.
-
-        Returns
-        -------
-        float, numpy.ndarray or CasADi expression
-            ``F_T`` with ``F_T * v_T <= 0``; a float for scalar inputs.
-        """
+        """Signed tangential force ``F_T`` (N), ``F_T * v_T <= 0``, from ``F_N >= 0`` (N) and the sliding
+        velocity ``v_T`` (m/s), on floats, numpy arrays or CasADi symbols."""
         scalar, (f_n, v_t) = B.as_numeric(normal_force, sliding_velocity)
         out = self._force(f_n, v_t)
         return float(out) if scalar else out
@@ -90,15 +66,8 @@ def _coefficient(owner: str, value: Any) -> float:
 class Coulomb(FrictionLaw):
     """Plain Coulomb friction, ``F_T = -c_f F_N sign(v_T)``.
 
-    Parameters
-    ----------
-    coefficient : float
-        Friction coefficient c_f >= 0.
-
-    Notes
-    -----
-    Discontinuous at ``v_T = 0`` (``sign(0) = 0``, so the force is 0 exactly there):
-    an integrator chatters across sliding reversals. Prefer :class:`ModifiedCoulomb`.
+    ``coefficient``: c_f >= 0. Discontinuous at ``v_T = 0``: an integrator chatters across reversals;
+    prefer :class:`ModifiedCoulomb`.
     """
 
     coefficient: float
@@ -131,10 +100,7 @@ class ModifiedCoulomb(FrictionLaw):
 
     Notes
     -----
-    Continuous in ``v_T`` (piecewise linear ramp), which is what makes it kinder to
-    integrators than :class:`Coulomb`; it has no stiction (zero force below v0).
-    The book's v0, v1 are not known; the defaults are the only Flores-attributed
-    values found (docs/contact_laws.md).
+    Continuous in ``v_T``, no stiction; the defaults are the Flores-attributed values (docs/contact_laws.md).
     """
 
     coefficient: float

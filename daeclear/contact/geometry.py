@@ -1,9 +1,7 @@
 """Materials and contact stiffness from materials and geometry (eqs. 3.4, 3.5, 4.27).
 
-Conventions (docs/contact_laws.md, decisions): the material parameter is
-``sigma = (1 - nu**2) / E`` without pi (eq. 3.4 as Flores et al. use it; the 0.475 of
-eq. 4.27 only works with this convention), and the internal journal-bearing pair uses
-the sphere formula (3.5) with ``R_i - R_j``.
+``sigma = (1 - nu**2) / E`` without pi (eq. 3.4; the 0.475 of 4.27 needs it); the journal-bearing
+pair uses the sphere formula (3.5) with ``R_i - R_j`` (docs/contact_laws.md).
 
 Example
 -------
@@ -37,11 +35,6 @@ class Material:
     poisson : float
         Poisson's ratio nu, in (-1, 0.5).
 
-    Raises
-    ------
-    SceneError
-        If a value is out of range.
-
     Example
     -------
     >>> Material(young=207e9, poisson=0.3).sigma
@@ -66,13 +59,7 @@ MaterialPair = Material | tuple[Material, Material]
 
 
 def material_pair(materials: MaterialPair | None, owner: str = "contact") -> tuple[Material, Material]:
-    """Return ``(material_i, material_j)``; a single Material is used for both bodies.
-
-    Raises
-    ------
-    SceneError
-        If ``materials`` is missing or is not a Material or a pair of Materials.
-    """
+    """``(material_i, material_j)``; a single Material for both. SceneError for anything else."""
     if isinstance(materials, Material):
         return materials, materials
     if (isinstance(materials, (tuple, list)) and len(materials) == 2
@@ -92,22 +79,8 @@ def _radius(owner: str, field: str, value: float) -> float:
 
 
 def internal_contact_stiffness(bearing_radius: float, journal_radius: float, materials: MaterialPair) -> float:
-    """Generalized stiffness K of a journal inside a bearing, eq. (3.5) with ``R_i - R_j``.
-
-    ``K = 4 / (3 (sigma_i + sigma_j)) * sqrt(R_i R_j / (R_i - R_j))`` in N/m^1.5.
-
-    Parameters
-    ----------
-    bearing_radius, journal_radius : float
-        ``R_i > R_j > 0`` in m.
-    materials : Material or (Material, Material)
-        Bearing and journal materials.
-
-    Notes
-    -----
-    This is the sphere formula applied to the cylinder pair, the approximation the
-    chapter uses with (3.9). Steel (207 GPa, 0.3), 10 mm / 9.5 mm: 6.610e10 N/m^1.5.
-    """
+    """Generalized stiffness of a journal (R_j) inside a bearing (R_i > R_j > 0, m), eq. (3.5) with
+    ``R_i - R_j`` as the chapter uses it with (3.9): ``K = 4 / (3 sigma_s) sqrt(R_i R_j / (R_i - R_j))``, N/m^1.5."""
     owner = "internal_contact_stiffness"
     r_i = _radius(owner, "bearing_radius", bearing_radius)
     r_j = _radius(owner, "journal_radius", journal_radius)
@@ -125,20 +98,14 @@ def external_contact_stiffness(radius_i: float, radius_j: float, materials: Mate
 
 
 def sphere_plane_stiffness(radius: float, materials: MaterialPair) -> float:
-    """Generalized stiffness K of a sphere (e.g. a rounded slider corner) on a plane, in N/m^1.5.
-
-    Eq. (3.5) with ``R_j -> infinity``: ``K = 4 / (3 (sigma_i + sigma_j)) * sqrt(R)``.
-    Steel, R = 1 mm: 4.80e9 N/m^1.5.
-    """
+    """Generalized stiffness of a sphere (a rounded slider corner) on a plane, eq. (3.5) with
+    ``R_j -> infinity``: ``K = 4 / (3 (sigma_i + sigma_j)) * sqrt(R)``, N/m^1.5."""
     r = _radius("sphere_plane_stiffness", "radius", radius)
     return 4.0 / (3.0 * sigma_sum(materials)) * math.sqrt(r)
 
 
 def plane_face_stiffness(half_width: float, materials: MaterialPair) -> float:
-    """Linear stiffness of two square plane surfaces, eq. (4.27), in N/m.
-
-    ``K = a / (0.475 (sigma_i + sigma_j))`` with ``a`` half the side of the square
-    contact area (Lankarani 1988). Steel, a = 25 mm: 5.99e9 N/m.
-    """
+    """Linear stiffness of two square plane surfaces, eq. (4.27) (Lankarani 1988), in N/m:
+    ``K = a / (0.475 (sigma_i + sigma_j))``, ``a`` half the side of the square contact."""
     a = check_number("plane_face_stiffness", "half_width", half_width, low=0.0, unit="m")
     return a / (0.475 * sigma_sum(materials))

@@ -1,29 +1,12 @@
-"""Hydrodynamic film forces of a lubricated journal bearing (a lubricated revolute clearance joint).
+"""Hydrodynamic film forces of a lubricated journal bearing (docs/lubrication.md: derivation, validation).
 
-Model (docs/lubrication.md has the derivation and the validation). The film thickness is
-``h = c (1 + eps cos theta)``, ``theta`` measured from the line of centres at the widest film, in
-the sense of positive rotation; Reynolds' equation for an incompressible, isoviscous film is ::
-
-    d/dtheta(h^3 dp/dtheta) / R^2 + d/dz(h^3 dp/dz) = -6 mu c eps w sin(theta) + 12 mu c eps_dot cos(theta)
-
-with ``w = omega_journal + omega_bearing - 2 dgamma/dt`` (the wedge rate) and ``eps_dot`` (the
-squeeze rate). Two closed forms, and a finite bearing:
-
-- ``theory="short"`` (Ocvirk, L/D -> 0: the theta derivative dropped, p = 0 at z = +-L/2);
-- ``theory="long"`` (Sommerfeld, L/D -> infinity: the z derivative dropped);
-- ``theory="finite"``: the short forces corrected by Butenschoen's finite-width tables
-  (:mod:`daeclear.contact.finite_bearing`).
-
-Cavitation: ``"full"`` keeps the whole (partly negative) film; ``"half"`` keeps the half of the
-film ``theta1 < theta < theta1 + pi``, ``theta1 = atan2(2 eps_dot, eps w)``, where the combined
-wedge and squeeze action builds pressure, with p = 0 at both ends (Guembel's condition; for the
-short bearing it is exactly "negative pressures set to zero", for the long one it is the usual
-pi-film of Pinkus & Sternlicht and Flores et al. 2009, exact for pure rotation).
-
-Every integral of the forces is a trigonometric polynomial after the substitution
-``1 + eps cos theta = (1 - eps^2) / (1 - eps cos psi)`` (psi continuous and monotone in theta), so
-the forces are closed forms, written once with :mod:`daeclear.contact._backend` for floats, numpy
-arrays and CasADi symbols.
+Film ``h = c (1 + eps cos theta)``, theta from the widest film; Reynolds' equation with the wedge
+rate ``w = omega_journal + omega_bearing - 2 dgamma/dt`` and the squeeze rate ``eps_dot``, solved
+for ``theory="short"`` (Ocvirk), ``"long"`` (Sommerfeld) or ``"finite"`` (the short forces corrected
+by Butenschoen's tables, :mod:`daeclear.contact.finite_bearing`). Cavitation ``"full"`` keeps the
+whole film, ``"half"`` the half ``theta1 < theta < theta1 + pi``, ``theta1 = atan2(2 eps_dot, eps w)``,
+where pressure builds (Guembel). With ``1 + eps cos theta = (1 - eps^2) / (1 - eps cos psi)`` every
+force integral is a trigonometric polynomial: closed forms on floats, numpy and CasADi.
 """
 
 from __future__ import annotations
@@ -47,14 +30,12 @@ __all__ = ["CAVITATION", "HydrodynamicBearing", "THEORIES", "bearing_from_table"
 #: The film theories and the cavitation options (the first of each is the default).
 THEORIES: tuple[str, ...] = ("short", "long", "finite")
 CAVITATION: tuple[str, ...] = ("half", "full")
-#: Largest eccentricity ratio the symbolic film force is evaluated at (the force diverges at 1;
-#: the dry law acts long before, at c (1 - eps) = film_threshold).
+#: Largest eccentricity ratio of the symbolic film force (it diverges at 1; the dry law acts before).
 EPS_CAP = 1.0 - 1e-6
 
 
 def _anomaly(theta: Any, beta: Any) -> Any:
-    """psi(theta) with tan(psi/2) = sqrt((1-eps)/(1+eps)) tan(theta/2), continuous and monotone
-    (beta = eps / (1 + sqrt(1 - eps^2)) < 1, so the atan2 below never wraps)."""
+    """psi(theta), tan(psi/2) = sqrt((1-eps)/(1+eps)) tan(theta/2), continuous (beta < 1: no wrap)."""
     return theta - 2.0 * B.atan2(beta * B.sin(theta), 1.0 + beta * B.cos(theta))
 
 
@@ -67,10 +48,8 @@ def _trig(a0: Any, a1: Any, b1: Any, a2: Any, b2: Any, psi1: Any, psi2: Any) -> 
 
 
 def film_integrals(eps: Any, theta1: Any, theta2: Any) -> dict[str, Any]:
-    """Integrals over (theta1, theta2) of {1, cos, sin, cos^2, sin^2, sin cos} / (1 + eps cos)^3.
-
-    Keys ``"1", "c", "s", "cc", "ss", "sc"``; valid for 0 <= eps < 1 and any theta1 < theta2.
-    """
+    """Integrals over (theta1, theta2) of {1, cos, sin, cos^2, sin^2, sin cos} / (1 + eps cos)^3, keys
+    ``"1", "c", "s", "cc", "ss", "sc"`` (0 <= eps < 1)."""
     q = 1.0 - eps * eps
     sq = B.sqrt(q)
     beta = eps / (1.0 + sq)
@@ -87,8 +66,7 @@ def film_integrals(eps: Any, theta1: Any, theta2: Any) -> dict[str, Any]:
 
 
 def _pressure_start(eps: Any, w: Any, eps_dot: Any) -> Any:
-    """theta1 = atan2(2 eps_dot, eps w): where the half film starts (0 when nothing moves;
-    the guard keeps the value and the CasADi derivative finite there)."""
+    """theta1 = atan2(2 eps_dot, eps w), where the half film starts (0, finite, when nothing moves)."""
     x, y = eps * w, 2.0 * eps_dot
     moving = x * x + y * y > 0.0
     return B.atan2(B.if_else(moving, y, 0.0), B.if_else(moving, x, 1.0))
@@ -107,30 +85,19 @@ class HydrodynamicBearing:
     Parameters
     ----------
     viscosity : float
-        Dynamic viscosity mu of the oil in Pa s, > 0 (an SAE 30 oil at 60 C: about 0.03).
+        Dynamic viscosity mu of the oil in Pa s, > 0 (SAE 30 at 60 C: about 0.03).
     length : float
         Axial length L of the bearing in m, > 0.
     theory : {"short", "long", "finite"}
-        Ocvirk's infinitely short or Sommerfeld's infinitely long bearing, or a finite bearing
-        (B/D = L / (2 R) <= 1) from Butenschoen's tables (:mod:`daeclear.contact.finite_bearing`).
+        Ocvirk's short, Sommerfeld's long, or a finite bearing (L / (2 R) <= 1, Butenschoen's tables).
     cavitation : {"half", "full"}
-        "half": the film keeps only the half where pressure builds (Guembel); "full": the whole film.
+        "half": only the half of the film where pressure builds (Guembel); "full": the whole film.
     dry : NormalLaw
-        The contact law once the film has broken down (default: Lankarani-Nikravesh, c_e = 0.9,
-        stiffness from the joint's materials).
+        The contact law once the film has broken down (stiffness from the joint's materials if None).
     film_threshold : float
-        Minimum film thickness c (1 - eps) in m (> 0) below which the dry law takes over: of the
-        order of the surfaces' combined roughness. Default 1 um.
+        Minimum film thickness c (1 - eps) in m (> 0) below which the dry law takes over.
     hysteresis : float
-        The film forms again (the film force replaces the dry law) only when the minimum film
-        thickness exceeds ``film_threshold * (1 + hysteresis)``; >= 0, default 1. The band keeps
-        the two regimes from chattering at the threshold.
-
-    Notes
-    -----
-    :meth:`film_force` returns (radial, tangential): radial > 0 pushes the journal towards the
-    bearing's centre (against the eccentricity); tangential is along the eccentricity turned by
-    +90 degrees (the sense of positive rotation).
+        The film forms again above ``film_threshold * (1 + hysteresis)``; >= 0.
     """
 
     viscosity: float
@@ -159,7 +126,6 @@ class HydrodynamicBearing:
                   check_number(owner, "film_threshold", self.film_threshold, low=0.0, unit="m"))
         set_field(self, "hysteresis", check_number(owner, "hysteresis", self.hysteresis, low=0.0, low_open=False))
 
-    # ---- what a revolute clearance joint asks of its law -----------------------------------
     @property
     def reform_threshold(self) -> float:
         """Minimum film thickness (m) above which the film forms again after a dry contact."""
@@ -197,28 +163,15 @@ class HydrodynamicBearing:
                        f"{2.0 * journal_radius:g} m (Butenschoen's tables end at B/D = 1).")
         return out
 
-    # ---- the film --------------------------------------------------------------------------
     def film_force(self, eccentricity_ratio: Any, wedge_rate: Any, squeeze_rate: Any, radius: Any,
                    clearance: Any) -> tuple[Any, Any]:
-        """The film's force on the journal, (radial, tangential) in N.
+        """The film's force on the journal, (radial, tangential) in N: radial > 0 towards the bearing's
+        centre, tangential along the eccentricity turned by +90 degrees.
 
-        Parameters
-        ----------
-        eccentricity_ratio : float, array_like or CasADi symbol
-            eps = e / c, in [0, 1) (a symbol is clamped to [0, 1 - 1e-6]).
-        wedge_rate : same types
-            omega_journal + omega_bearing - 2 x the line of centres' rate, rad/s.
-        squeeze_rate : same types
-            d eps / dt, 1/s (> 0 while the film thins).
-        radius : float or symbol
-            Journal radius R in m (> 0).
-        clearance : float or symbol
-            Radial clearance c in m (> 0).
-
-        Returns
-        -------
-        (radial, tangential)
-            Floats for scalar inputs; radial > 0 pushes the journal towards the centre.
+        ``eccentricity_ratio`` eps in [0, 1) (a symbol is clamped to [0, 1 - 1e-6]), ``wedge_rate``
+        (omega_journal + omega_bearing - 2 x the line of centres' rate, rad/s), ``squeeze_rate``
+        (d eps / dt, 1/s, > 0 while the film thins): floats, arrays or CasADi symbols; journal
+        ``radius`` and radial ``clearance`` in m.
 
         Example
         -------
@@ -243,8 +196,7 @@ class HydrodynamicBearing:
 
     def film_force_with(self, viscosity: Any, length: Any, eps: Any, w: Any, eps_dot: Any, R: Any,
                         c: Any) -> tuple[Any, Any]:
-        """:meth:`film_force` with viscosity and length given (CasADi symbols of the run-time
-        parameters in an assembled model), no checks; a symbolic eps is clamped to [0, 1 - 1e-6]."""
+        """:meth:`film_force` with viscosity and length given (run-time symbols), no checks."""
         if B.is_symbolic(eps):
             eps = B.fmin(B.fmax(eps, 0.0), EPS_CAP)
         if self.cavitation == "full":
@@ -275,7 +227,7 @@ class HydrodynamicBearing:
 def bearing_from_table(params: dict[str, Any]) -> HydrodynamicBearing:
     """A HydrodynamicBearing from a scene file's law table (``name = "hydrodynamic"`` already taken
     out); ``dry`` may be a law name or a table ``{ name = ..., parameters }``."""
-    from .registry import normal_law
+    from .registry import build_law, normal_law
 
     params = dict(params)
     dry = params.get("dry")
@@ -284,14 +236,7 @@ def bearing_from_table(params: dict[str, Any]) -> HydrodynamicBearing:
         params["dry"] = normal_law(dry.pop("name", None), **dry)
     elif isinstance(dry, str):
         params["dry"] = normal_law(dry)
-    fields = [f.name for f in dataclasses.fields(HydrodynamicBearing)]
-    unknown = sorted(set(params) - set(fields))
-    if unknown:
-        raise SceneError(f"HydrodynamicBearing: unknown parameter(s) {', '.join(unknown)}; valid: {', '.join(fields)}.")
-    missing = [name for name in ("viscosity", "length") if name not in params]
-    if missing:
-        raise SceneError(f"HydrodynamicBearing: missing required parameter(s) {', '.join(missing)}.")
-    return HydrodynamicBearing(**params)
+    return build_law(HydrodynamicBearing, params)
 
 
 def law_from_table(table: dict[str, Any]) -> Any:

@@ -1,10 +1,6 @@
-"""Single-degree-of-freedom impact on a normal contact law (the Fig. 4.26 experiment).
-
-A mass m reaches the contact at speed v (``delta = 0``, ``delta_dot = v > 0``) and moves
-under ``m delta_ddot = -F_N(delta, delta_dot, v)`` until it leaves (``delta`` back to 0).
-Integrated with scipy's ``solve_ivp`` (DOP853) at tight tolerance, independently of the
-DAE machinery: used by the plot helpers, the tests and to measure a law's effective
-restitution.
+"""Single-degree-of-freedom impact on a normal contact law (the Fig. 4.26 experiment):
+``m delta_ddot = -F_N(delta, delta_dot, v)`` from ``delta = 0``, ``delta_dot = v``, until ``delta``
+is 0 again; scipy's DOP853, independent of the DAE machinery.
 """
 
 from __future__ import annotations
@@ -27,23 +23,10 @@ __all__ = ["ImpactResult", "simulate_impact"]
 
 @dataclass(frozen=True)
 class ImpactResult:
-    """Outcome of :func:`simulate_impact` (SI units; time 0 at first contact).
-
-    Attributes
-    ----------
-    t, penetration, rate, force : ndarray, shape (n_points,)
-        Uniform samples over the contact, from 0 to ``duration``.
-    law : NormalLaw
-        The resolved law used.
-    mass, entry_speed, exit_speed : float
-        Mass (kg), approach speed at onset and separation speed (m/s, both > 0).
-    max_penetration, time_of_max_penetration : float
-        Largest penetration (m) and when it occurs (s): ``rate = 0``, located by an event.
-    peak_force : float
-        Largest force (N), refined between samples.
-    duration : float
-        Contact duration (s), from ``delta = 0`` to ``delta = 0`` again.
-    """
+    """Outcome of :func:`simulate_impact` (SI units; time 0 at first contact): uniform samples ``t``,
+    ``penetration``, ``rate``, ``force`` over the contact; ``entry_speed`` and ``exit_speed`` (> 0);
+    ``max_penetration`` at ``time_of_max_penetration`` (rate 0); ``peak_force`` (refined between
+    samples); ``duration`` of the contact."""
 
     t: NDArray[np.float64]
     penetration: NDArray[np.float64]
@@ -77,7 +60,7 @@ class ImpactResult:
 
 
 def _penetration_scale(law: NormalLaw, mass: float, speed: float) -> float:
-    """Penetration where the elastic part of the force times delta equals m v^2 (a scale only)."""
+    """Penetration where the force times delta equals m v^2 (a scale only)."""
     energy = mass * speed**2
     lo, hi = 1e-15, 1e-15
     while law.force(hi, 0.0, speed) * hi < energy:
@@ -93,37 +76,9 @@ def _penetration_scale(law: NormalLaw, mass: float, speed: float) -> float:
 
 def simulate_impact(law: NormalLaw, *, mass: float, speed: float, rtol: float = 1e-12,
                     n_points: int = 2001) -> ImpactResult:
-    """Simulate one impact of a mass on a contact law.
-
-    Parameters
-    ----------
-    law : NormalLaw
-        A resolved law (``law.is_resolved``); its ``approach_speed`` is ``speed``.
-    mass : float
-        m in kg, > 0.
-    speed : float
-        Approach speed v in m/s, > 0.
-    rtol : float
-        Relative tolerance of DOP853 (absolute tolerances are ``rtol`` times the
-        penetration and speed scales). Default 1e-12.
-    n_points : int
-        Number of uniform samples returned. Default 2001.
-
-    Returns
-    -------
-    ImpactResult
-
-    Raises
-    ------
-    SceneError
-        Invalid mass or speed, unresolved law, or no separation.
-
-    Notes
-    -----
-    Separation is the event ``delta = 0`` crossed downwards (so for
-    :class:`~daeclear.contact.KelvinVoigt`, whose force vanishes before, the duration
-    includes the final force-free part). Maximum penetration is the event
-    ``delta_dot = 0``.
+    """Simulate one impact of a ``mass`` (kg) at ``speed`` (m/s, also the law's approach speed) on a
+    resolved ``law``; ``rtol`` of DOP853 (absolute: ``rtol`` times the penetration and speed scales),
+    ``n_points`` uniform samples. Raises SceneError for a bad argument or no separation.
 
     Example
     -------

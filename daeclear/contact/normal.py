@@ -1,17 +1,9 @@
-"""Point and face contact laws: Hertz, Kelvin-Voigt, the Hertz-type hysteresis laws
-(Hunt-Crossley, Lankarani-Nikravesh (3.9), Flores et al. 2011) and Lankarani's linear
-law for two plane surfaces (4.26-4.27).
+"""Point and face contact laws: Hertz, Kelvin-Voigt, the hysteresis laws (Hunt-Crossley,
+Lankarani-Nikravesh (3.9), Flores et al. 2011) and Lankarani's plane law (4.26-4.27).
 
-Every law is written once (``_force``) with the functions of
-:mod:`daeclear.contact._backend`, so the same definition runs on floats, numpy arrays
-and CasADi ``SX``/``MX`` symbols. Guards common to all of them:
-
-- the force is exactly 0 for ``penetration <= 0`` (value and CasADi derivative are
-  finite there: the power is taken of ``fmax(delta, 0)``);
-- the force never pulls: it is clamped to ``F >= 0`` (the damped laws would otherwise
-  pull at the end of restitution);
-- the approach speed ``delta_dot_minus`` is floored at ``min_approach_speed``
-  (default 1e-4 m/s), so the damping term never divides by ~0.
+Each ``_force`` is written once with :mod:`daeclear.contact._backend`; the force is 0 for
+``penetration <= 0`` (powers of ``fmax(delta, 0)``), clamped at ``F >= 0``, and the approach speed
+is floored at ``min_approach_speed`` (default 1e-4 m/s).
 """
 
 from __future__ import annotations
@@ -83,28 +75,19 @@ class _StiffnessLaw(NormalLaw):
         return dataclasses.replace(self, stiffness=stiffness, exponent=1.0)
 
     def _elastic(self, delta: Any) -> Any:
-        # fmax before the power: no NaN and a zero derivative for delta <= 0.
         return self.stiffness * B.fmax(delta, 0.0) ** self.effective_exponent
 
 
 @dataclass(frozen=True, kw_only=True)
 class Hertz(_StiffnessLaw):
-    """Hertz elastic contact law, ``F_N = K delta**n`` for ``delta > 0``, else 0.
+    """Hertz elastic contact law, ``F_N = K delta**n`` for ``delta > 0``, else 0 (Figs. 4.22a-4.24a).
 
     Parameters
     ----------
     stiffness : float or None
-        Generalized stiffness K in N/m^n, > 0. ``None``: computed by :meth:`resolve`
-        from materials and radii, eq. (3.5) (or (4.27) for ``kind="plane_face"``).
+        K in N/m^n, > 0; None: computed by :meth:`resolve`, eq. (3.5) (or (4.27) for "plane_face").
     exponent : float or None
-        n in [1, 10]; ``None`` means 1.5 (metal surfaces), or 1 when the stiffness is
-        computed for ``kind="plane_face"``.
-
-    Notes
-    -----
-    Purely elastic (no hysteresis): ``dissipative`` is False, the rate and the
-    approach speed are ignored. Chapter 4 uses it in Figs. 4.22a-4.24a. For steel
-    (K = 6.61e10 N/m^1.5): 66.1 N at 1 um, 739 N at 5 um, 2090 N at 10 um.
+        n in [1, 10]; None means 1.5 (1 for a computed "plane_face" stiffness).
 
     Example
     -------
@@ -149,10 +132,7 @@ class _HysteresisLaw(_StiffnessLaw):
         """Dimensionless h(c_e) multiplying ``delta_dot / delta_dot_minus``."""
 
     def damping(self, approach_speed: float) -> float:
-        """Hysteresis damping coefficient ``chi = h K / delta_dot_minus`` (N s/m^(n+1)).
-
-        The approach speed is floored at ``min_approach_speed``.
-        """
+        """Hysteresis damping ``chi = h K / max(delta_dot_minus, min_approach_speed)`` (N s/m^(n+1))."""
         if self.stiffness is None:
             raise SceneError(f"{type(self).__name__}: stiffness=None; call resolve(...) first.")
         return self.hysteresis_factor * self.stiffness / max(approach_speed, self.min_approach_speed)
@@ -164,10 +144,7 @@ class _HysteresisLaw(_StiffnessLaw):
 
 
 _HYSTERESIS_NOTES = """
-    Guards: 0 for ``delta <= 0``; clamped at ``F >= 0`` (the bracket turns negative
-    only for ``delta_dot < -delta_dot_minus / h``); ``delta_dot_minus`` floored at
-    ``min_approach_speed``. ``dissipative`` and ``needs_approach_speed`` are True when
-    ``restitution < 1``; at ``restitution = 1`` the law is exactly :class:`Hertz`.
+    Clamped at ``F >= 0``; at ``restitution = 1`` the law is exactly :class:`Hertz`.
 """
 
 
@@ -182,8 +159,8 @@ class LankaraniNikravesh(_HysteresisLaw):
     restitution : float
         Coefficient of restitution c_e in (0, 1]; 0.9 in the chapter's benchmark.
     stiffness : float or None
-        K in N/m^n (> 0), or None to compute it in :meth:`resolve` (eq. 3.5; eq. 4.27
-        with n = 1 for ``kind="plane_face"``, the "unified" face model of section 4.3).
+        K in N/m^n (> 0); None: computed by :meth:`resolve` (eq. 3.5; 4.27 with n = 1 for
+        "plane_face", the "unified" face model of section 4.3).
     exponent : float or None
         n in [1, 10]; None means 1.5 (1 for a computed plane-face stiffness).
     min_approach_speed : float
@@ -191,11 +168,8 @@ class LankaraniNikravesh(_HysteresisLaw):
 
     Notes
     -----
-    Derived for c_e close to 1. Effective restitution (exit/entry speed of a single
-    impact, :func:`~daeclear.contact.simulate_impact`; it depends on c_e only):
-    0.99 -> 0.9901, 0.95 -> 0.9535, 0.9 -> 0.9132 (+1.5 %), 0.5 -> 0.7252 (+45 %:
-    the energy loss is under-predicted at low c_e). Table in docs/contact_laws.md.
-    """ + _HYSTERESIS_NOTES
+    Derived for c_e close to 1: the loss is under-predicted at low c_e (effective restitution:
+    docs/contact_laws.md).""" + _HYSTERESIS_NOTES
 
     name: ClassVar[str] = "lankarani-nikravesh"
 
@@ -212,10 +186,7 @@ class HuntCrossley(_HysteresisLaw):
 
     Notes
     -----
-    Linearised about c_e = 1 (factor 0.150 at 0.9 against 0.1425 for (3.9)), so also a
-    high-restitution law. Effective restitution: 0.99 -> 0.9901, 0.95 -> 0.9524,
-    0.9 -> 0.9090 (+1.0 %), 0.5 -> 0.6630 (+33 %) (docs/contact_laws.md).
-    """ + _HYSTERESIS_NOTES
+    Linearised about c_e = 1: a high-restitution law (docs/contact_laws.md).""" + _HYSTERESIS_NOTES
 
     name: ClassVar[str] = "hunt-crossley"
 
@@ -235,10 +206,7 @@ class Flores(_HysteresisLaw):
 
     Notes
     -----
-    Designed for the whole range of c_e; it slightly over-predicts the loss.
-    Effective restitution: 0.99 -> 0.9893, 0.95 -> 0.9468, 0.9 -> 0.8939 (-0.7 %),
-    0.5 -> 0.4704 (-5.9 %), 0.3 -> 0.2562 (-15 %) (docs/contact_laws.md).
-    """ + _HYSTERESIS_NOTES
+    It slightly over-predicts the loss (docs/contact_laws.md).""" + _HYSTERESIS_NOTES
 
     name: ClassVar[str] = "flores"
 
@@ -284,21 +252,9 @@ class _FaceLaw(NormalLaw):
 class LankaraniPlane(_FaceLaw):
     """Lankarani (1988) linear law for two square plane surfaces, eqs. (4.26)-(4.27).
 
-    ``F_N = K delta`` with ``K = a / (0.475 (sigma_i + sigma_j))``, ``a`` half the side
-    of the square contact area (steel, a = 25 mm: 5.99e9 N/m).
-
-    Parameters
-    ----------
-    stiffness : float or None
-        K in N/m, > 0, or None to compute it with ``resolve(kind="plane_face",
-        face_half_width=a, materials=...)``.
-
-    Notes
-    -----
-    Elastic. With two adjacent slider corners in contact, the chapter evaluates it with
-    the average penetration of the two corners and applies it at the geometric centre
-    of the penetrated region (Fig. 4.13a, Fig. 4.35b); that is the joint's job.
-    For the damped "unified" face model use
+    ``F_N = K delta``, ``stiffness`` K in N/m (> 0), or None: ``K = a / (0.475 (sigma_i + sigma_j))``
+    from ``resolve(kind="plane_face", face_half_width=a, materials=...)``. Elastic; the translational
+    joint applies it to a face (Fig. 4.13a). The damped "unified" face model is
     ``LankaraniNikravesh(restitution=...).resolve(kind="plane_face", ...)``.
     """
 
@@ -315,19 +271,14 @@ class KelvinVoigt(_FaceLaw):
     Parameters
     ----------
     stiffness : float or None
-        Linear stiffness K in N/m (> 0); None is only computable for
-        ``kind="plane_face"`` (eq. 4.27), otherwise give it.
+        K in N/m (> 0); None is only computable for ``kind="plane_face"`` (eq. 4.27).
     damping : float
         D in N s/m, >= 0. Default 0.
 
     Notes
     -----
-    For comparison only: the chapter notes it "does not represent the overall
-    nonlinear nature of impact". The force jumps to ``D delta_dot_minus`` at first
-    contact; it is clamped at 0 where it would pull near separation, so a mass
-    leaves the law before ``delta`` returns to 0. Without the clamp a half cycle of
-    a mass m gives restitution ``exp(-pi zeta / sqrt(1 - zeta**2))``,
-    ``zeta = D / (2 sqrt(K m))``; with it the exit speed is higher.
+    For comparison only (it "does not represent the overall nonlinear nature of impact"). The
+    force jumps to ``D delta_dot_minus`` at first contact and is clamped at 0 near separation.
     """
 
     damping: float = 0.0

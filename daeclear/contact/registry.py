@@ -56,7 +56,8 @@ def normal_law_class(name: str) -> type:
     return _lookup("law", name, NORMAL_LAWS, _NORMAL_ALIASES)
 
 
-def _build(cls: type, params: dict[str, Any]) -> Any:
+def build_law(cls: type, params: dict[str, Any]) -> Any:
+    """``cls(**params)`` after checking the names: unknown or missing parameters are a SceneError."""
     fields = [f.name for f in dataclasses.fields(cls)]
     unknown = sorted(set(params) - set(fields))
     if unknown:
@@ -70,23 +71,9 @@ def _build(cls: type, params: dict[str, Any]) -> Any:
 
 
 def normal_law(name: str | NormalLaw, **params: Any) -> NormalLaw:
-    """Build a normal contact law from its name.
-
-    Parameters
-    ----------
-    name : str or NormalLaw
-        Case-insensitive; hyphens, underscores and spaces are ignored
-        (``"Lankarani_Nikravesh"`` == ``"lankarani-nikravesh"``). Names:
-        hertz, kelvin-voigt, hunt-crossley, lankarani-nikravesh, flores,
-        dubowsky-freudenstein, goldsmith, esdu-78035, lankarani-plane; aliases ln, esdu,
-        kv, hc, df. A NormalLaw instance is returned as is (no params allowed).
-    **params
-        The law's constructor keywords, e.g. ``restitution=0.9``.
-
-    Raises
-    ------
-    SceneError
-        Unknown name (lists the valid ones), unknown or missing parameter, bad value.
+    """Build a normal contact law from its name (:data:`NORMAL_LAWS` or an alias: ln, esdu, kv, hc, df;
+    case, hyphens, underscores and spaces ignored) and its constructor keywords ``params``; a NormalLaw
+    instance is returned as is. Raises SceneError for an unknown name or parameter, or a bad value.
 
     Example
     -------
@@ -97,24 +84,13 @@ def normal_law(name: str | NormalLaw, **params: Any) -> NormalLaw:
         if params:
             raise SceneError(f"normal_law: parameters {sorted(params)} given with a law instance.")
         return name
-    return _build(_lookup("normal_law", name, NORMAL_LAWS, _NORMAL_ALIASES), params)
+    return build_law(_lookup("normal_law", name, NORMAL_LAWS, _NORMAL_ALIASES), params)
 
 
 def friction_law(name_or_coefficient: str | float | FrictionLaw | None, **params: Any) -> FrictionLaw:
-    """Build a friction law.
-
-    Parameters
-    ----------
-    name_or_coefficient : str, float, FrictionLaw or None
-        ``None`` -> :class:`NoFriction`; a number -> :class:`ModifiedCoulomb` with that
-        coefficient (``params`` may set ``v0``, ``v1``); a name ("none"/"frictionless",
-        "coulomb", "modified-coulomb"/"ambrosio", case-insensitive) with ``params``;
-        a FrictionLaw instance is returned as is.
-
-    Raises
-    ------
-    SceneError
-        Unknown name (lists the valid ones), unknown parameter or bad value.
+    """Build a friction law: ``None``, :class:`NoFriction`; a number, :class:`ModifiedCoulomb` with that
+    coefficient; a name ("none"/"frictionless", "coulomb", "modified-coulomb"/"ambrosio") with
+    ``params``; a FrictionLaw as is. Raises SceneError for an unknown name or parameter, or a bad value.
 
     Example
     -------
@@ -126,7 +102,7 @@ def friction_law(name_or_coefficient: str | float | FrictionLaw | None, **params
             raise SceneError(f"friction_law: parameters {sorted(params)} given with a law instance.")
         return name_or_coefficient
     if name_or_coefficient is None:
-        return _build(NoFriction, params) if params else _NO_FRICTION
+        return build_law(NoFriction, params) if params else _NO_FRICTION
     if isinstance(name_or_coefficient, numbers.Real) and not isinstance(name_or_coefficient, bool):
-        return _build(ModifiedCoulomb, {"coefficient": float(name_or_coefficient), **params})
-    return _build(_lookup("friction_law", name_or_coefficient, FRICTION_LAWS, _FRICTION_ALIASES), params)
+        return build_law(ModifiedCoulomb, {"coefficient": float(name_or_coefficient), **params})
+    return build_law(_lookup("friction_law", name_or_coefficient, FRICTION_LAWS, _FRICTION_ALIASES), params)

@@ -1,29 +1,18 @@
 """Archard wear of a revolute clearance joint: the law, the pressure over the contact arc, the depth.
 
-Archard's law: the worn volume is ``dV = k F_n ds``, with ``k`` the dimensional wear coefficient
-(the wear coefficient over the hardness, m^2/N; published joint studies use about 1e-14 to 1e-13)
-and ``ds`` the sliding distance of the contacting material points. Spread over the contact arc with
-a pressure ``p(phi)`` (phi measured from the contact point), the depth worn at each material point
-is ``dh = k p ds``. Whatever the distribution, the worn volume is ``k`` times the sliding work
-``integral of F_n |v_slip| dt``: :func:`wear_increment` spreads each load onto the profile's nodes
-so that this holds to round-off on the discrete profile (tests/test_wear.py checks it).
-
-Two pressure shapes over the arc ``|phi| < phi0`` (docs/wear.md):
-
-- ``"elastic-foundation"`` (Winkler): ``p ~ cos(phi) - cos(phi0)``, the overlap of journal and
-  bearing along each direction; ``phi0 = arccos(c / (c + delta))`` from the penetration ``delta``;
-- ``"hertz"``: ``p ~ sqrt(1 - (phi / phi0)^2)``, the Hertz line contact of conformal cylinders,
-  ``phi0 = b / R`` with ``b = sqrt(4 F R_eff / (pi L E*))`` and ``R_eff = R_b R_j / (R_b - R_j)``.
-
-The profile is a depth per node over the angle in the worn body's frame (the bearing's, the
-journal's or both); the nodes are equally spaced, node ``k`` at ``2 pi k / nodes``.
+Archard: ``dV = k F_n ds`` (``k`` in m^2/N, ``ds`` the sliding distance), spread over the contact
+arc as ``dh = k p ds``, so the worn volume is ``k`` times the sliding work whatever the pressure
+shape over ``|phi| < phi0`` (docs/wear.md): ``"elastic-foundation"``, ``p ~ cos(phi) - cos(phi0)``,
+``phi0 = arccos(c / (c + delta))``; ``"hertz"``, ``p ~ sqrt(1 - (phi / phi0)^2)``, ``phi0 = b / R``,
+``b = sqrt(4 F R_eff / (pi L E*))``. The profile is a depth per node (node ``k`` at ``2 pi k / nodes``)
+in the worn body's frame.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -37,8 +26,7 @@ __all__ = ["ArchardWear", "DISTRIBUTIONS", "SURFACES", "WearHistoryArrays", "hal
 
 SURFACES: tuple[str, ...] = ("bearing", "journal", "both")
 DISTRIBUTIONS: tuple[str, ...] = ("elastic-foundation", "hertz")
-# samples of the pressure over one contact arc when it is spread onto the nodes (at least this many,
-# and at least 8 per node the arc covers): the spread weights are exact in sum whatever the number
+# samples of the pressure over one contact arc spread onto the nodes (at least)
 ARC_SAMPLES = 64
 # samples spread in one pass (contacts x samples per contact): about 8 MB a sample array
 SPREAD_SAMPLES = 1 << 20
@@ -62,7 +50,7 @@ class ArchardWear:
         Shape of the pressure over the contact arc (module docstring).
     modes : int
         Fourier modes of the worn profile in the joint's gap (:func:`profile_coefficients`), >= 1 and
-        below ``nodes / 2``; 48 by default (worn spots down to about 0.1 rad to 0.1 %).
+        below ``nodes / 2``.
     """
 
     coefficient: float
@@ -98,21 +86,18 @@ class ArchardWear:
         return 2.0 * math.pi * np.arange(self.nodes) / self.nodes
 
 
-def half_angle_overlap(penetration: float, clearance: float) -> float:
-    """Half-angle of the arc where a journal at eccentricity ``c + delta`` overlaps its bearing, rad."""
-    if penetration <= 0.0:
-        return 0.0
-    return math.acos(clearance / (clearance + penetration))
+def half_angle_overlap(penetration: ArrayLike, clearance: float) -> Any:
+    """Half-angle (rad) of the arc where a journal at eccentricity ``c + delta`` overlaps its bearing;
+    0 without penetration."""
+    return np.arccos(clearance / (clearance + np.clip(penetration, 0.0, None)))
 
 
-def half_angle_hertz(force: float, bearing_radius: float, journal_radius: float, length: float,
-                     effective_modulus: float) -> float:
+def half_angle_hertz(force: ArrayLike, bearing_radius: float, journal_radius: float, length: float,
+                     effective_modulus: float) -> Any:
     """Half-angle of the Hertz line contact of a journal in its bearing, rad: ``b / R_b``,
-    ``b = sqrt(4 F R_eff / (pi L E*))``, ``R_eff = R_b R_j / (R_b - R_j)``."""
-    if force <= 0.0:
-        return 0.0
+    ``b = sqrt(4 F R_eff / (pi L E*))``, ``R_eff = R_b R_j / (R_b - R_j)``; 0 without force."""
     r_eff = bearing_radius * journal_radius / (bearing_radius - journal_radius)
-    return math.sqrt(4.0 * force * r_eff / (math.pi * length * effective_modulus)) / bearing_radius
+    return np.sqrt(4.0 * np.clip(force, 0.0, None) * r_eff / (math.pi * length * effective_modulus)) / bearing_radius
 
 
 def _shape(distribution: str, phi: NDArray[np.float64], half_angle: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -124,15 +109,8 @@ def _shape(distribution: str, phi: NDArray[np.float64], half_angle: NDArray[np.f
 
 def spread(centres: ArrayLike, half_angles: ArrayLike, loads: ArrayLike, nodes: int,
            distribution: str = "elastic-foundation") -> NDArray[np.float64]:
-    """Loads spread over the nodes: ``sum_i loads[i] * weights(centres[i], half_angles[i])``.
-
-    Each contact's pressure shape is sampled at the midpoints of equal pieces of its arc
-    ``centre +- half_angle`` (as many for every contact: at least 64, and 16 per node spacing the
-    widest arc covers) and each sample is split between its two neighbouring nodes in proportion to
-    its distance (linear interpolation's weights), so that an arc narrower than a node's spacing
-    still loads the nodes around it smoothly; each contact's weights sum to one. An arc of zero
-    width puts the load on the nodes around its centre.
-    """
+    """Loads spread over the nodes: ``sum_i loads[i] * weights(centres[i], half_angles[i])``; each arc's
+    pressure sampled at equal pieces, each sample split between its two neighbouring nodes linearly."""
     centre = np.asarray(centres, dtype=float).ravel()
     half = np.asarray(half_angles, dtype=float).ravel()
     load = np.asarray(loads, dtype=float).ravel()
@@ -175,9 +153,8 @@ def node_weights(centre: float, half_angle: float, nodes: int, distribution: str
 
 @dataclass(frozen=True)
 class WearHistoryArrays:
-    """What a run gives the wear computation, at each output time: time (s), normal force (N), the
-    contact direction's angle in the bearing's and in the journal's frame (rad), the sliding speed of
-    the contact points (m/s) and the penetration (m)."""
+    """A run's contact history at each output time: time, normal force, the contact direction's angle
+    in the bearing's and the journal's frame, sliding speed and penetration (SI units)."""
 
     t: NDArray[np.float64]
     force: NDArray[np.float64]
@@ -189,13 +166,8 @@ class WearHistoryArrays:
 
 def wear_increment(wear: ArchardWear, history: WearHistoryArrays, *, bearing_radius: float, clearance: float,
                    effective_modulus: float | None = None) -> tuple[dict[str, NDArray[np.float64]], float]:
-    """The depth worn at each node (m) by one stretch of a run, and its sliding work (N m).
-
-    Each interval between output times contributes ``k F ds`` of volume, ``F`` the mean of its end
-    forces and ``ds`` the trapezoid of the sliding speed, spread over the nodes around the
-    interval's mean contact angle by :func:`node_weights`. Returns ({surface: depth per node},
-    sliding work); the worn volume of each surface is ``sum(depth) * R dphi * L = k * work``.
-    """
+    """({surface: depth per node} (m), sliding work (N m)) of one stretch of a run: each interval
+    contributes ``k F ds`` (mean force, trapezoidal distance), spread around its mean contact angle."""
     t = np.asarray(history.t, dtype=float)
     if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) < 0):
         raise SceneError("wear_increment: history.t must hold at least two increasing times.")
@@ -208,11 +180,9 @@ def wear_increment(wear: ArchardWear, history: WearHistoryArrays, *, bearing_rad
     if wear.distribution == "hertz":
         if effective_modulus is None:
             raise SceneError("wear_increment: the 'hertz' distribution needs effective_modulus (Pa).")
-        journal = bearing_radius - clearance
-        r_eff = bearing_radius * journal / (bearing_radius - journal)
-        half = np.sqrt(4.0 * F * r_eff / (math.pi * wear.length * effective_modulus)) / bearing_radius
-    else:  # arccos(c / (c + delta)), 0 without penetration
-        half = np.arccos(clearance / (clearance + np.clip(d, 0.0, None)))
+        half = half_angle_hertz(F, bearing_radius, bearing_radius - clearance, wear.length, effective_modulus)
+    else:
+        half = half_angle_overlap(d, clearance)
     loads = wear.coefficient * F * ds[active] / area
     angles = {"bearing": history.angle_bearing, "journal": history.angle_journal}
     depth = {}
@@ -225,14 +195,8 @@ def wear_increment(wear: ArchardWear, history: WearHistoryArrays, *, bearing_rad
 
 
 def profile_coefficients(depth: ArrayLike, modes: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The smooth profile of a nodal depth for the joint's gap: its Fourier series to ``modes`` (the
-    least-squares fit on the nodes). Returns (cosine coefficients a_0..a_modes, sine coefficients
-    b_1..b_modes) of ``h(theta) = a_0 + sum a_m cos(m theta) + b_m sin(m theta)``.
-
-    The mean depth (a_0), and so the worn volume, is kept exactly. A worn spot narrower than the
-    series resolves rings (negative depth beside it): with 48 modes a Gaussian spot of half-width
-    0.1 rad is reproduced to 0.1 % and rings by 0.04 %, one of 0.05 rad to 8 % and 5 % (worn spots
-    of a joint are the contact arcs, 0.1-0.3 rad, smeared over many impacts)."""
+    """A nodal depth's Fourier series to ``modes`` (least squares on the nodes; the mean, so the worn
+    volume, kept exactly): (a_0..a_modes, b_1..b_modes) of ``a_0 + sum a_m cos(m theta) + b_m sin(m theta)``."""
     h = np.asarray(depth, dtype=float)
     theta = 2.0 * np.pi * np.arange(h.size) / h.size
     m = np.arange(1, modes + 1)
