@@ -1,39 +1,12 @@
-"""Nonlinear-dynamics analysis of runs: phase portraits, Poincaré sections, motion classification.
+"""Nonlinear-dynamics analysis of runs: the public face ``daeclear.analysis``.
 
-The chapter reads periodic, quasi-periodic and chaotic responses from "Poincaré maps",
-which are phase portraits (slider acceleration against slider velocity over many
-revolutions, section 4.4). This module adds the true stroboscopic Poincaré section
-(one point per crank revolution, after a transient) and a documented classification
-of the motion with the evidence behind it:
-
-1. **Periodicity** (:func:`classify_section`): the section points, each channel scaled
-   by the attractor's size (its 1 %-99 % quantile range over the analysed span), are
-   tested for recurrence: the motion is periodic of period k when every point is within
-   ``tol`` (5 % by default) of the point k revolutions later, for the smallest
-   k <= ``max_period``.
-2. **Sensitivity** (:func:`twin_divergence`, :func:`twin_evidence` from arrays): twin
-   trajectories are restarted on the attractor from the same state, one of them perturbed
-   by ``perturbation`` (1e-8 m by default) along the constraint manifold. Their separation
-   gives a largest Lyapunov exponent estimate (a straight-line fit of ln(distance) against
-   time over the growth window, with its R^2, when it grew at least 100-fold), the
-   amplification, and the distance of their late section points (gap, and decorrelation: the
-   gap over the section's spread).
-3. **Agreement** (:func:`classify_section`, the one place both tests meet): a recurring
-   section whose twins show a resolved positive exponent or end apart at the section is
-   "uncertain" with both numbers -- except growth >= 1000-fold with decorrelation from a
-   free-flight restart, documented as chaos small in the section's channels (the
-   translational joint's lateral impacts). A non-recurring section is chaotic when the twins
-   decorrelate with a positive exponent, quasi-periodic when they stay together without one.
-   Missing (nan) twin numbers are reported as missing, never counted as agreement.
-
-This module runs the whole pipeline (:func:`classify_motion`) and is the public face of the
-analysis (``daeclear.analysis``): it re-exports the parts, each in a module of its own job --
-:mod:`~daeclear.studies.poincare` (periods, sampling, phase portraits, sections),
-:mod:`~daeclear.studies.twin_runs` (restarts and twin evidence),
-:mod:`~daeclear.studies.motion_class` (the rules) and :mod:`~daeclear.studies.motion_thresholds`
-(their numbers). Only numpy here (no plotting); figures are in :mod:`daeclear.plot`.
-``docs/nonlinear_dynamics.md`` states the method, thresholds, limits and the measured
-evidence for the chapter's cases.
+:func:`classify_motion` runs the whole pipeline: a run sampled by :func:`sampling_times`, its
+stroboscopic Poincaré section after a transient, twin runs restarted on the attractor (one perturbed),
+and the verdict of :func:`classify_section`. The parts are re-exported from their modules:
+:mod:`~daeclear.studies.poincare` (periods, sampling, sections), :mod:`~daeclear.studies.twin_runs`
+(restarts, twin evidence), :mod:`~daeclear.studies.motion_class` (the rules) and
+:mod:`~daeclear.studies.motion_thresholds` (their numbers). ``docs/nonlinear_dynamics.md`` states the
+method, thresholds, limits and checks.
 
 Examples
 --------
@@ -72,55 +45,18 @@ if TYPE_CHECKING:
     from ..results.result import Result
     from ..model.scene import Scene
 
-__all__ = [
-    "CHANNELS",
-    "MOTION_LABELS",
-    "Divergence",
-    "MotionAnalysis",
-    "MotionClass",
-    "PhasePortrait",
-    "PoincareSection",
-    "RestartState",
-    "TwinReading",
-    "classify_motion",
-    "classify_section",
-    "crank_period",
-    "energy_balance",
-    "work_precision",
-    "phase_portrait",
-    "poincare_section",
-    "restart_state",
-    "section_channels",
-    "read_twins",
-    "sampling_times",
-    "twin_divergence",
-    "twin_evidence",
-]
-
-
-# --------------------------------------------------------------------------- the whole pipeline
+__all__ = ["CHANNELS", "MOTION_LABELS", "Divergence", "MotionAnalysis", "MotionClass", "PhasePortrait",
+           "PoincareSection", "RestartState", "TwinReading", "classify_motion", "classify_section", "crank_period",
+           "energy_balance", "work_precision", "phase_portrait", "poincare_section", "restart_state",
+           "section_channels", "read_twins", "sampling_times", "twin_divergence", "twin_evidence"]
 
 
 @dataclass(frozen=True)
 class MotionAnalysis:
-    """Everything :func:`classify_motion` computed.
-
-    Attributes
-    ----------
-    result : Result
-        The reference run from t = 0, sampled by :func:`sampling_times`.
-    section : PoincareSection
-        Its section over the analysed span (after the transient).
-    motion : MotionClass
-        The classification and its evidence.
-    divergence : Divergence or None
-        Twin evidence (None with ``twin=False``).
-    twins : (Result, Result) or None
-        The unperturbed and perturbed restarted runs (from the restart time on, at their true times).
-    options : dict
-        The options of the analysis (revolutions, transient, ...), with ``rtol`` and, under
-        ``"solver"``, every solver setting of the runs (:meth:`daeclear.SolverOptions.to_dict`).
-    """
+    """Everything :func:`classify_motion` computed: the reference run from t = 0 (``result``), its
+    ``section`` after the transient, the ``motion`` class, the twin evidence and runs (``divergence``,
+    ``twins``: unperturbed and perturbed, from the restart time on; None without twins) and the
+    analysis ``options`` (with ``rtol`` and, under ``"solver"``, :meth:`daeclear.SolverOptions.to_dict`)."""
 
     result: Result
     section: PoincareSection
@@ -154,40 +90,24 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
     scene : Scene or DAEModel
         A driven mechanism (its driver sets the period T).
     channels : sequence of str, optional
-        Section channels; default :func:`section_channels` (slider velocity and acceleration, as
-        the chapter, or the last body's angular velocity and acceleration without a slider).
-    revolutions : int
-        Revolutions analysed after the transient (30): revolutions + 1 section points.
-    transient : int
-        Revolutions simulated and discarded first (10).
+        Section channels; default :func:`section_channels`.
+    revolutions, transient : int
+        Revolutions analysed (30: revolutions + 1 section points), after ``transient`` discarded ones (10).
     per_revolution : int
         Output samples per revolution (32): attractor size, phase portrait, twin separation.
     phase : float
-        Crank angle of the section past the initial crank angle, rad (0: the chapter's
-        initial collinear position).
+        Crank angle of the section past the initial crank angle, rad.
     twin : {True, "auto", False}
-        Run the twin trajectories (two more runs of ``twin_revolutions``): they separate
-        quasi-periodic from chaotic motion and catch chaos that is small in the section's
-        channels. True (default): always; "auto": only when the section does not recur
-        (cheaper; a recurring section is then "periodic" without the sensitivity check);
-        False: never (a non-periodic run is then "non-periodic").
-    twin_revolutions : int
-        Length of the twin runs, revolutions (20).
-    perturbation : float
-        Position perturbation of the twin, m (1e-8).
-    seed : int
-        Seed of the perturbation direction.
+        Run the twin trajectories (two more runs of ``twin_revolutions``, 20) that tell quasi-periodic
+        from chaotic motion: always, only when the section does not recur, or never.
+    perturbation, seed : float, int
+        Position perturbation of the twin, m (1e-8), and the seed of its direction.
     tol, max_period, decorrelation : float, int, float
         Classification thresholds (:func:`classify_section`).
-    rtol : float
-        Relative tolerance (default that of ``options``, 1e-6 without it).
-    options : SolverOptions, optional
-        The solver settings of every run (:class:`daeclear.SolverOptions`); a solver keyword given
-        explicitly (``rtol``, ``atol``, ``method``, ...) overrides the same setting, as in
-        :func:`daeclear.simulate`. ``formulation`` is used when ``scene`` is a Scene.
+    rtol, options : float, SolverOptions
+        The runs' solver settings; explicit solver keywords override ``options``, as in :func:`daeclear.simulate`.
     **simulate_options
-        Passed to :func:`daeclear.simulate`: solver settings (``atol``, ``max_step``, ``backend``,
-        ``formulation``, ...), ``store_steps`` (:class:`daeclear.SaveAt`'s ``steps``) and ``progress``.
+        Passed to :func:`daeclear.simulate`: solver settings, ``store_steps`` (SaveAt's ``steps``), ``progress``.
 
     Returns
     -------

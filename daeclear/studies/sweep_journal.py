@@ -1,12 +1,8 @@
 """Crash-safe writing of a sweep file: per-run journal files, their merge, and the file's lock.
 
-Each finished run goes to its own journal file ``<path>.parts/<key>.h5`` (temporary name, fsync,
-rename: atomic on POSIX, :func:`write_part`); :func:`consolidate` merges the journal into a new
-file renamed over ``<path>``; both write through :func:`daeclear.results.outputs.atomic_file`,
-the package's one atomic write, so a crash at any point leaves the old or the new file plus the
-journal; ``<path>.lock`` (:func:`acquire_lock`) keeps two sweeps from writing one file at once.
-Separate from the layout of a run (:mod:`daeclear.studies.sweep_file`): this module only decides
-how and when bytes reach the disk safely.
+Journal files (:func:`write_part`) and the merged file (:func:`consolidate`) are written through
+:func:`daeclear.results.outputs.atomic_file`, so a crash at any point leaves the old or the new file
+plus the journal; ``<path>.lock`` (:func:`acquire_lock`) keeps two sweeps from writing one file.
 """
 
 from __future__ import annotations
@@ -27,8 +23,7 @@ __all__ = ["acquire_lock", "consolidate", "lock_path", "write_part"]
 
 
 def write_part(parts: Path, outcome: Mapping[str, Any], mechanism: str, options: Mapping[str, Any]) -> Path:
-    """Write one run to ``parts/<key>.h5`` atomically (:func:`~daeclear.results.outputs.atomic_file`:
-    a temporary name beside it, fsync, rename; removed on any exception, Ctrl-C included)."""
+    """Write one run to ``parts/<key>.h5`` atomically (removed on any exception, Ctrl-C included)."""
     import h5py
 
     parts.mkdir(parents=True, exist_ok=True)
@@ -91,8 +86,8 @@ def _pid_alive(pid: int) -> bool:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
-    except PermissionError:
-        return True
+    except PermissionError:  # alive, another user's
+        pass
     return True
 
 

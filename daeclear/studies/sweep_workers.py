@@ -1,11 +1,4 @@
-"""What a sweep's workers run, and the lifecycle of the local process pool.
-
-:func:`run_task` builds the scene of one parameter point, classifies its motion and returns plain
-data (it runs in a worker process, on any ``concurrent.futures.Executor``: a local pool or a Dask
-cluster); :func:`ignore_sigint` is the local pool's initializer and :func:`terminate_pool` stops
-its workers on an interrupt. Separate from the sweep's bookkeeping (:mod:`daeclear.studies.sweep`)
-and its file (:mod:`daeclear.studies.sweep_file`): workers only compute, they never write files.
-"""
+"""What a sweep's workers run (:func:`run_task`: plain data back, no files), and the local pool's lifecycle."""
 
 from __future__ import annotations
 
@@ -29,10 +22,8 @@ __all__ = ["build_scene", "ignore_sigint", "run_task", "terminate_pool"]
 
 
 def build_scene(mechanism: str | Callable[..., Any], parameters: Mapping[str, Any]) -> Any:
-    """The scene of one parameter point: ``mechanism(**options)`` (a callable or a ready mechanism's
-    name) with the point's scene values set: a parameter whose name holds a dot (``"clearance.clearance"``,
-    ``"clearance.law.restitution"``, see :meth:`daeclear.Scene.with_values`) is a value of the built
-    scene, any other an option of the mechanism."""
+    """The scene of one parameter point: ``mechanism(**options)`` with the point's scene values set (a
+    name with a dot, :meth:`daeclear.Scene.with_values`; any other is an option of the mechanism)."""
     options = {k: v for k, v in parameters.items() if "." not in k}
     values = {k: v for k, v in parameters.items() if "." in k}
     if callable(mechanism):
