@@ -171,9 +171,7 @@ def _solver_options(settings: Settings) -> SolverOptions:
 
 def _method_of(settings: Settings) -> str:
     """The method of ``settings``, lower case ("ida" when not given)."""
-    if isinstance(settings, SolverOptions):
-        return settings.method
-    return str(settings.get("method", "ida")).lower()
+    return settings.method if isinstance(settings, SolverOptions) else str(settings.get("method", "ida")).lower()
 
 
 def _describe(settings: Settings) -> str:
@@ -190,9 +188,7 @@ def _with(settings: Settings, name: str, value: float) -> Settings:
     """``settings`` with the tolerance or step ``name`` set to ``value``."""
     if isinstance(settings, SolverOptions):
         return settings.replace(**{name: value})
-    opts = {k: v for k, v in settings.items() if k not in ("rtol", "step")}
-    opts[name] = value
-    return opts
+    return {**{k: v for k, v in settings.items() if k not in ("rtol", "step")}, name: value}
 
 
 def _timed(model: Scene | DAEModel, t_end: float, t_eval: NDArray, settings: Settings, repeats: int
@@ -246,11 +242,9 @@ def work_precision(
         methods run at every ``rtols``, fixed-step ones (rk4, euler) at every ``steps``. Default: IDA,
         DOP853, LSODA and RK4.
     reference, check : mapping, SolverOptions or None
-        The reference run (default DOP853 at rtol 1e-12, independent of the implicit runs it judges) and
-        the second one that finds the converged window (default IDA index-1 at rtol 1e-12).
-    window : (t0, t1) or None
-        Error window; None: from 0 to where ``reference`` and ``check`` stop agreeing to
-        ``converged_tol`` (of each channel's range).
+        The reference run (default DOP853 at rtol 1e-12) and the one that finds the converged window
+        (default IDA index-1 at rtol 1e-12): the error ``window`` (None) ends where they stop agreeing
+        to ``converged_tol`` of each channel's range.
     n_eval, repeats : int
         Output times (uniform over [0, t_end]) where runs are compared; timed repeats per run (best
         kept, after one warm-up run).

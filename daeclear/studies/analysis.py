@@ -1,12 +1,8 @@
-"""Nonlinear-dynamics analysis of runs: the public face ``daeclear.analysis``.
+"""Nonlinear-dynamics analysis of runs, ``daeclear.analysis``: the pipeline and its re-exported parts.
 
-:func:`classify_motion` runs the whole pipeline: a run sampled by :func:`sampling_times`, its
-stroboscopic Poincaré section after a transient, twin runs restarted on the attractor (one perturbed),
-and the verdict of :func:`classify_section`. The parts are re-exported from their modules:
-:mod:`~daeclear.studies.poincare` (periods, sampling, sections), :mod:`~daeclear.studies.twin_runs`
-(restarts, twin evidence), :mod:`~daeclear.studies.motion_class` (the rules) and
-:mod:`~daeclear.studies.motion_thresholds` (their numbers). ``docs/nonlinear_dynamics.md`` states the
-method, thresholds, limits and checks.
+:func:`classify_motion` samples a run (:func:`sampling_times`), takes its Poincaré section after a
+transient, restarts twin runs on the attractor (one perturbed) and classifies the motion
+(:func:`classify_section`). ``docs/nonlinear_dynamics.md`` states the method, thresholds and limits.
 
 Examples
 --------
@@ -26,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .accuracy import energy_balance, work_precision  # re-exported: daeclear.analysis.work_precision
+from .accuracy import energy_balance, work_precision
 # The parts of the analysis, re-exported: daeclear.analysis.<name> keeps working for every name it had.
 from .motion_class import (  # noqa: F401
     MOTION_LABELS, MotionClass, MotionLabel, TwinReading, classify_section, read_twins)
@@ -38,7 +34,7 @@ from .poincare import (CHANNELS, PhasePortrait, PoincareSection, crank_period, m
 from .twin_runs import Divergence, RestartState, all_free, restart_state, twin_divergence, twin_evidence
 from ..assembly.assemble import DAEModel
 from ..errors import DaeclearError, SceneError  # noqa: F401  (DaeclearError: re-exported as before)
-from ..options import default_formulation
+from ..options import default_formulation, integer
 from ..solver_options import UNSET, SolverOptions
 
 if TYPE_CHECKING:
@@ -69,12 +65,6 @@ class MotionAnalysis:
     def t0(self) -> float:
         """First section time (end of the transient plus the section offset), s."""
         return float(self.section.t[0]) if len(self.section) else float("nan")
-
-
-def _check_int(name: str, value: Any, low: int) -> int:
-    if not (isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= low):
-        raise SceneError(f"classify_motion: {name}={value!r}, must be an integer >= {low}.")
-    return int(value)
 
 
 def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None = None, revolutions: int = 30,
@@ -122,10 +112,10 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
     from ..save_at import SaveAt
     from ..solvers.dispatch import simulate
 
-    revolutions = _check_int("revolutions", revolutions, 2)
-    transient = _check_int("transient", transient, 0)
-    per_revolution = _check_int("per_revolution", per_revolution, 4)
-    twin_revolutions = _check_int("twin_revolutions", twin_revolutions, 2)
+    revolutions = integer(revolutions, where="classify_motion", field="revolutions", low=2)
+    transient = integer(transient, where="classify_motion", field="transient", low=0)
+    per_revolution = integer(per_revolution, where="classify_motion", field="per_revolution", low=4)
+    twin_revolutions = integer(twin_revolutions, where="classify_motion", field="twin_revolutions", low=2)
     if twin not in ("auto", True, False):
         raise SceneError(f"classify_motion: twin={twin!r}, must be 'auto', True or False.")
     for key in ("t_eval", "t_eval_step", "on_failure", "t0", "y0"):

@@ -49,10 +49,8 @@ def _scene_parameters(source: Any) -> Mapping[str, Any]:
     if isinstance(source, Scene):
         return source.to_dict()
     params = getattr(source, "parameters", source)
-    if isinstance(params, Mapping) and "scene" in params:
-        return params["scene"]
     if isinstance(params, Mapping):
-        return params
+        return params.get("scene", params)
     raise TypeError(f"crank_period: cannot read a scene from a {type(source).__name__}.")
 
 
@@ -200,15 +198,13 @@ def poincare_section(result: Result, channels: Sequence[str] = CHANNELS, *, t0: 
     Parameters
     ----------
     result : Result
-        A run whose output times contain the section times (``t_eval`` from :func:`sampling_times`);
-        dense output in between gives the attractor size.
+        Its output times contain the section times (:func:`sampling_times`); dense output in between
+        gives the attractor size.
     channels : sequence of str
-        Any channels or states (two for a plot, any number for classification).
-    t0, t1 : float, optional
-        First section time (the end of the transient plus the section's offset) and last time, s;
-        default the first and last output times.
-    period : float, optional
-        T, s; default :func:`crank_period`.
+        Any channels or states.
+    t0, t1, period : float, optional
+        First section time (end of the transient plus the section's offset) and last time, s (default
+        the run's ends); T, s (default :func:`crank_period`).
 
     Raises
     ------

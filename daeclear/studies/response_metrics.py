@@ -133,7 +133,8 @@ def measure(run: Any, ideal: Any, *, joint: str, period: float, t0: float, t1: f
         "velocity_rms_rel": relative_rms(v, vi),
         "velocity_max_rel": float(np.max(np.abs(v - vi)) / np.ptp(vi)),
         # the same RMS over the samples in free flight only: is a smooth velocity evidence of contact?
-        "velocity_rms_rel_free": _rms_where(v - vi, ~contact, np.ptp(vi)),
+        "velocity_rms_rel_free": (float(np.sqrt(np.mean((v - vi)[~contact] ** 2)) / np.ptp(vi))
+                                  if np.any(~contact) else float("nan")),
         "impacts_per_rev": impacts.size / revolutions,
         "moment_peak_median_Nm": float(np.median(peaks)),
         "moment_peak_max_Nm": float(np.max(peaks)),
@@ -142,10 +143,6 @@ def measure(run: Any, ideal: Any, *, joint: str, period: float, t0: float, t1: f
         "max_tilt_mrad": float(np.max(np.abs(np.asarray(run[f"{joint}.tilt"])[w])) * 1e3),
         "max_abs_eta": float(np.max(np.abs(np.asarray(run[f"{joint}.eta"])[w]))),
     }
-
-
-def _rms_where(x: NDArray[np.float64], mask: NDArray[np.bool_], scale: float) -> float:
-    return float(np.sqrt(np.mean(x[mask] ** 2)) / scale) if np.any(mask) else float("nan")
 
 
 @dataclass(frozen=True)

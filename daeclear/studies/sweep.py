@@ -1,12 +1,9 @@
 """Parameter sweeps: many independent classified runs on any ``concurrent.futures.Executor``.
 
-``sweep(path, grid)`` builds one scene per parameter point (``slider_crank(**point)`` by default),
-classifies it (:func:`daeclear.analysis.classify_motion`) in a worker and gathers every run in one
-HDF5 file; only the calling process writes files. Each finished run is journalled atomically, an
-interrupted sweep resumes without losing one, and ``<path>.lock`` keeps two sweeps apart
-(docs/nonlinear_dynamics.md, *Sweeps*). This module plans and drives the runs; the file is
-:mod:`~daeclear.studies.sweep_file`, the journal and lock :mod:`~daeclear.studies.sweep_journal`, the
-workers' task :mod:`~daeclear.studies.sweep_workers`.
+``sweep(path, grid)`` classifies one scene per parameter point (:func:`daeclear.analysis.classify_motion`)
+in workers and gathers every run in one HDF5 file, written by the calling process alone: each finished
+run is journalled atomically, so an interrupted sweep resumes without losing one
+(docs/nonlinear_dynamics.md, *Sweeps*). This module plans and drives the runs.
 
 Examples
 --------
@@ -137,21 +134,18 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     Parameters
     ----------
     path : str or path-like
-        The sweep file (``.h5``) in an existing directory; with ``resume=True`` an existing file
-        (and its journal ``<path>.parts/``) is continued.
-    grid : mapping of str to list, optional
-        Parameter name -> values, every combination run (:func:`grid_points`): an option of ``mechanism``
-        (``"clearance"``) or, with a dot, a value of the built scene (``"clearance.law.restitution"``).
-    runs : iterable of dict, optional
-        Explicit parameter points, after the grid's.
+        The sweep file (``.h5``) in an existing directory.
+    grid, runs : mapping of str to list, iterable of dict, optional
+        Parameter name -> values, every combination run (:func:`grid_points`), and explicit points
+        after them. A name is an option of ``mechanism`` or, with a dot, a value of the built scene
+        (``"clearance.law.restitution"``).
     mechanism : str or callable
         A ready mechanism's name or a picklable top-level function ``f(**parameters) -> Scene``.
     fixed : mapping, optional
         Parameters common to every run (part of each run's parameters and key).
-    channels : sequence of str, optional
-        Poincaré-section channels; default :func:`daeclear.analysis.section_channels` of the first point.
-    store_channels : sequence of str, optional
-        Channels stored over the analysed span with ``keep="channels"``; default ``channels``.
+    channels, store_channels : sequence of str, optional
+        Poincaré-section channels (default :func:`daeclear.analysis.section_channels` of the first
+        point) and those stored over the analysed span (default ``channels``).
     keep : {"section", "channels", "full"}
         What each run stores beyond its classification and section: nothing more, the stored
         channels (default), or also the full reference Result.
@@ -169,11 +163,9 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
         Where runs go; default a local process pool of ``max_workers`` (default the CPU count, at most
         the number of runs); a Dask cluster: ``client.get_executor()``. On macOS and Windows a script
         must call sweep under ``if __name__ == "__main__":``.
-    resume, retry_failed : bool
-        Continue an existing file, skipping its finished runs (False deletes its runs and journal
-        first); on resume, run the failed runs again.
-    progress : bool
-        Progress line on stderr.
+    resume, retry_failed, progress : bool
+        Continue an existing file and its journal, skipping finished runs (False deletes them first); on
+        resume, run the failed runs again; a progress line on stderr.
     on_run : callable, optional
         Called with each new RunRecord as soon as it is saved.
 

@@ -27,7 +27,8 @@ import math
 import os
 import warnings
 from collections import Counter
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -69,9 +70,7 @@ def _current_form(options: dict[str, Any]) -> dict[str, Any]:
         return options
     legacy = {k: options[k] for k in _LEGACY_SOLVER_KEYS if k in options}
     rest = {k: v for k, v in options.items() if k not in _LEGACY_SOLVER_KEYS}
-    from ..solver_options import SolverOptions
-
-    return {**rest, SOLVER_KEY: SolverOptions.from_dict(legacy).to_dict()}
+    return {**rest, SOLVER_KEY: solver_options({SOLVER_KEY: legacy}).to_dict()}
 
 
 @dataclass(frozen=True)
@@ -311,14 +310,15 @@ class SweepResult:
                            "enough parameter values to pick one.")
         return found[0]
 
-    def _open(self, record: RunRecord) -> tuple[Any, str]:
-        """(open h5py.File, group path) holding the run: the journal file if present, else the sweep file."""
+    @contextmanager
+    def _group(self, record: RunRecord) -> Iterator[h5py.Group]:
+        """The run's open group: in its journal file if present, else in the sweep file."""
         import h5py
 
         part = parts_dir(self.path) / f"{record.key}.h5"
-        if part.is_file():
-            return h5py.File(part, "r"), "/"
-        return h5py.File(self.path, "r"), f"/runs/{record.key}"
+        journal = part.is_file()
+        with h5py.File(part if journal else self.path, "r") as f:
+            yield f["/" if journal else f"/runs/{record.key}"]
 
     def _record(self, run: RunRecord | str | int) -> RunRecord:
         return run if isinstance(run, RunRecord) else self.run(run)
@@ -328,9 +328,8 @@ class SweepResult:
         record = self._record(run)
         if not record.ok:
             raise DaeclearError(f"run {record.key} failed ({record.error}); it has no section.")
-        f, where = self._open(record)
-        with f:
-            g = f[where]["section"]
+        with self._group(record) as run_group:
+            g = run_group["section"]
             return PoincareSection(t=g["t"][()], points=g["points"][()],
                                    channels=tuple(_text(c) for c in g.attrs["channels"]),
                                    units=tuple(_text(u) for u in g.attrs["units"]), period=float(g.attrs["period"]),
@@ -340,9 +339,7 @@ class SweepResult:
     def channels(self, run: RunRecord | str | int) -> dict[str, np.ndarray]:
         """The stored channels of a run over its analysed span (``"t"`` included)."""
         record = self._record(run)
-        f, where = self._open(record)
-        with f:
-            g = f[where]
+        with self._group(record) as g:
             if "channels" not in g:
                 raise DaeclearError(f"run {record.key}: no channels stored (sweep keep={self.options.get('keep')!r}; "
                                     "use keep='channels' or 'full').")
@@ -359,9 +356,8 @@ class SweepResult:
             if name not in stored:
                 raise DaeclearError(f"run {record.key}: channel {name!r} not stored; stored: "
                                     f"{', '.join(n for n in stored if n != 't')}.")
-        f, where = self._open(record)
-        with f:
-            units = tuple(_text(f[where]["channels"][n].attrs.get("units", "")) for n in (x, y))
+        with self._group(record) as g:
+            units = tuple(_text(g["channels"][n].attrs.get("units", "")) for n in (x, y))
         return PhasePortrait(t=stored["t"], x=stored[x], y=stored[y], names=(x, y),
                              units=units)  # type: ignore[arg-type]
 
@@ -370,9 +366,7 @@ class SweepResult:
         from ..results.result import read_result_group
 
         record = self._record(run)
-        f, where = self._open(record)
-        with f:
-            g = f[where]
+        with self._group(record) as g:
             if "result" not in g:
                 raise DaeclearError(f"run {record.key}: no full result stored (sweep keep="
                                     f"{self.options.get('keep')!r}; use keep='full').")

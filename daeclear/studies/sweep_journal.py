@@ -7,6 +7,7 @@ plus the journal; ``<path>.lock`` (:func:`acquire_lock`) keeps two sweeps from w
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import socket
@@ -67,13 +68,10 @@ def consolidate(path: Path, *, mechanism: str, options: Mapping[str, Any], order
                     extra += 1
     for part in merged:
         part.unlink(missing_ok=True)
-    if parts_dir(path).is_dir():  # half-written parts of a killed sweep (the lock is ours: no writer runs)
-        for stale in parts_dir(path).glob(".run-*.tmp"):  # atomic_file's temporary names: .<key>.h5.<hex>.tmp
-            stale.unlink(missing_ok=True)
-    try:
+    for stale in parts_dir(path).glob(".run-*.tmp"):  # a killed sweep's half-written parts (the lock is ours)
+        stale.unlink(missing_ok=True)
+    with contextlib.suppress(OSError):  # not empty (an unreadable part) or absent
         parts_dir(path).rmdir()
-    except OSError:
-        pass  # not empty (an unreadable part) or absent
 
 
 def lock_path(path: Path) -> Path:

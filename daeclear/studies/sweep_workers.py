@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import concurrent.futures as cf
+import dataclasses
 import os
 import signal
 import socket
@@ -68,10 +69,7 @@ def run_task(task: Mapping[str, Any]) -> dict[str, Any]:
         analysis = classify_motion(scene, options=options, **task["analysis"])
         section = analysis.section
         data: dict[str, Any] = {
-            "section": {"t": np.asarray(section.t), "points": np.asarray(section.points),
-                        "channels": list(section.channels), "units": list(section.units),
-                        "size": np.asarray(section.size), "center": np.asarray(section.center),
-                        "period": section.period},
+            "section": dataclasses.asdict(section),  # t, points, channels, units, period, size, center
             "motion": {"label": analysis.motion.label, "period": analysis.motion.period,
                        "reason": analysis.motion.reason, "evidence": dict(analysis.motion.evidence)},
         }

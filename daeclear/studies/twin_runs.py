@@ -99,13 +99,10 @@ class Divergence:
         range of the state).
     restart_time, restart_in_contact : float, bool
         Time of the restart state in the original run (s); True when no section time was in free
-        flight, so the twins restarted in contact (a slightly different system: the latched approach
-        speed is replaced by the current penetration rate).
-    perturbation, d0 : float
-        Position perturbation (m, Euclidean norm over q) and the normalised separation it gives.
-    d_start : float
-        Separation at the first sample after the restart (integration noise, about rtol, when it
-        exceeds d0); the growth is measured from it.
+        flight (the restart's latched approach speed is then the current penetration rate).
+    perturbation, d0, d_start : float
+        Position perturbation (m, norm over q), the separation it gives, and the separation at the
+        first sample after the restart (integration noise when larger), which the growth starts from.
     d_saturation, amplification : float
         Median separation over the second half of the twin run, and d_saturation / d_start.
     lyapunov, r_squared, fit_window : float, float, (float, float)
@@ -179,15 +176,9 @@ def twin_evidence(t: ArrayLike, distance: ArrayLike, points_a: ArrayLike, points
         Times since the restart (s, t[0] = 0) and the twins' normalised separation (distance[0]: the
         perturbation).
     points_a, points_b : array_like (n, d)
-        The twins' section points (one row per revolution), in the units of ``section.points``.
-    section : PoincareSection
-        Section of the reference run: attractor size, centre and spread.
+        The twins' section points, one row per revolution, in the units of the reference ``section``.
     restart_time, restart_in_contact, perturbation, max_period : float, bool, float, int
         Recorded as evidence; the longest period of the unperturbed twin's recurrence check.
-
-    Returns
-    -------
-    Divergence
     """
     t = np.asarray(t, dtype=float)
     distance = np.asarray(distance, dtype=float)
@@ -240,19 +231,12 @@ def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *,
     Parameters
     ----------
     twin_a, twin_b : Result
-        Unperturbed and perturbed runs from the same restart state (:func:`restart_state`), on the same
-        output times, which contain the section times ``offset + k T`` from the restart on.
+        Unperturbed and perturbed runs from one restart state (:func:`restart_state`), on the same
+        output times, containing the section times ``offset + k T`` (s) from the restart on.
     section, reference : PoincareSection, Result
-        The reference run's section (channels, attractor size, spread) and the run itself (each
-        state's attractor range over the section's window).
+        The reference run's section and the run (each state's attractor range over the section's window).
     restart_time, restart_in_contact, perturbation : float, bool, float
-        Recorded as evidence; ``restart_time`` defaults to the twins' first output time.
-    offset : float
-        Section time within the revolution, s.
-
-    Returns
-    -------
-    Divergence
+        Recorded as evidence (``restart_time`` defaults to the twins' first output time).
     """
     if twin_a.t.shape != twin_b.t.shape or not np.allclose(twin_a.t, twin_b.t, rtol=0, atol=1e-12):
         raise DaeclearError("twin_divergence: the twin runs have different output times.")

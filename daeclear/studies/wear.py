@@ -145,10 +145,9 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
 
     Parameters
     ----------
-    scene : Scene
-        The mechanism; its joint ``joint`` has ``wear=ArchardWear(...)`` (and maybe a ``wear_depth``).
-    cycles : float
-        Cycles to wear (> 0); the last block may run past it.
+    scene, cycles : Scene, float
+        The mechanism, whose joint ``joint`` has ``wear=ArchardWear(...)``, and the cycles to wear (> 0;
+        the last block may run past it).
     update_every, extrapolate : int
         Cycles simulated per profile update, and the factor each block's wear is extrapolated by (>= 1).
     period : float or None
@@ -156,10 +155,8 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
     path : str, path or None
         An HDF5 file the history is appended to after every block: a call with the same file and
         settings resumes where a stopped one ended.
-    options : SolverOptions or None
-        The runs' solver settings.
-    progress : bool
-        A progress line on stderr.
+    options, progress : SolverOptions or None, bool
+        The runs' solver settings; a progress line on stderr.
 
     A failed block, or a depth beyond :data:`MAX_DEPTH_FRACTION` of the bearing radius, ends the
     history early with a :class:`~daeclear.PhysicsWarning`; ``WearHistory.message`` says why.
@@ -200,14 +197,12 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
                 message = (f"stopped at {done:g} cycles: the worn depth {deepest:.3g} m exceeds "
                            f"{MAX_DEPTH_FRACTION:g} of the bearing radius {radius:g} m, where the gap's small-slope "
                            "model no longer holds; a smaller wear coefficient, or fewer cycles.")
-                warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
                 break
             model = model.with_parameters({f"{name}.wear_depth": _depth_value(depth, wear.surfaces)})
             try:
                 result = simulate(model, t0 + update_every * period, t0=t0, y0=y0, options=options)
             except SolveError as exc:  # the history so far is the result (and, with a path, in the file)
                 message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
-                warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
                 break
             increment, block_work = wear_increment(wear, wear_history(result, model, name), bearing_radius=radius,
                                                    clearance=clearance, effective_modulus=modulus)
@@ -223,6 +218,8 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
             bar.update(min(done, cycles), f"max depth {max(float(d.max()) for d in depth.values()):.3g} m")
     finally:
         bar.close()
+    if message:
+        warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
     return _history(rows, wear, radius, time.perf_counter() - tic, message)
 
 
