@@ -231,10 +231,8 @@ def work_precision(
 
     Parameters
     ----------
-    scene : Scene or DAEModel
-        The mechanism: a Scene is timed as users call it (assembly included), a model without assembly.
-    t_end : float
-        End of the runs, s.
+    scene, t_end : Scene or DAEModel, float
+        The mechanism (a Scene is timed with its assembly, as users call it) and the runs' end, s.
     channels : sequence of str
         Channels whose error is measured (relative to the reference's range).
     methods : mapping label -> simulate options or SolverOptions

@@ -77,14 +77,12 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
 
     Parameters
     ----------
-    scene : Scene or DAEModel
-        A driven mechanism (its driver sets the period T).
-    channels : sequence of str, optional
-        Section channels; default :func:`section_channels`.
-    revolutions, transient : int
-        Revolutions analysed (30: revolutions + 1 section points), after ``transient`` discarded ones (10).
-    per_revolution : int
-        Output samples per revolution (32): attractor size, phase portrait, twin separation.
+    scene, channels : Scene or DAEModel, sequence of str
+        A driven mechanism (its driver sets the period T) and the section channels (default
+        :func:`section_channels`).
+    revolutions, transient, per_revolution : int
+        Revolutions analysed (30: revolutions + 1 section points), after ``transient`` discarded ones
+        (10); output samples per revolution (32).
     phase : float
         Crank angle of the section past the initial crank angle, rad.
     twin : {True, "auto", False}

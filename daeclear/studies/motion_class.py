@@ -45,14 +45,12 @@ class MotionClass:
         "non-periodic": no recurrence, and no (or missing, or contradictory) twin evidence to tell
         quasi-periodic from chaotic; "uncertain": the section recurs but the twin test contradicts it;
         "undetermined": too few section points or no attractor size.
-    period : int
-        k for "periodic" (revolutions), else 0.
+    period, reason : int, str
+        k for "periodic" (revolutions), else 0; one sentence with the deciding numbers.
     evidence : dict
         Plain numbers and strings: ``periodicity_defect`` (attractor units) at ``best_period``,
         ``defect_k1`` ... ``defect_kK``, ``n_clusters`` (at ``tol``), ``spread`` and, with twins,
         :meth:`Divergence.evidence`.
-    reason : str
-        One sentence with the deciding numbers.
     """
 
     label: MotionLabel

@@ -140,14 +140,10 @@ class PoincareSection:
 
     Attributes
     ----------
-    t : ndarray (n,)
-        Section times t0 + k T, s.
-    points : ndarray (n, d)
-        Channel values at those times, one column per channel.
-    channels, units : tuple of str
-        Channel names (d of them) and units.
-    period : float
-        T, s.
+    t, points : ndarray (n,), ndarray (n, d)
+        Section times t0 + k T (s) and the channel values there, one column per channel.
+    channels, units, period : tuple of str, tuple of str, float
+        Channel names (d of them), their units, and T (s).
     size, center : ndarray (d,)
         Attractor size per channel, the 1 %-99 % quantile range over all output samples of the
         analysed window (nan when sampled too sparsely to tell: fewer than 4 per revolution), and

@@ -56,7 +56,7 @@ def restart_state(model: DAEModel, result: Result, index: int, *, perturbation: 
     Returns
     -------
     RestartState
-        ``(t0, y0)``: the output time and a copy of the (perturbed) state.
+        The output time and a copy of the (perturbed) state.
     """
     t_restart = float(result.t[index])
     y = np.array(result.y[index], dtype=float)
@@ -108,15 +108,11 @@ class Divergence:
     lyapunov, r_squared, fit_window : float, float, (float, float)
         Slope of ln(distance) against time over the growth window (1/s), its fit's R^2 and the fitted
         times since restart; nan when the separation grew less than MIN_AMPLIFICATION times.
-    decorrelation : float
-        RMS distance of the twins' late section points (attractor units) over sqrt(2) x the section's
-        RMS spread: about 1 for unrelated points of the attractor, << 1 when the twins stay together.
-    period : float
-        T, s.
-    section_gap : float
-        That RMS distance alone, compared with ``tol`` (a periodic section's spread is only noise).
-    twin_recurrence : float
-        Recurrence defect of the unperturbed twin's late section points (smallest over k).
+    section_gap, decorrelation : float
+        RMS distance of the twins' late section points (attractor units), and that over sqrt(2) x the
+        section's RMS spread: about 1 for unrelated points of the attractor, << 1 for twins together.
+    period, twin_recurrence : float
+        T (s), and the recurrence defect of the unperturbed twin's late section points.
     """
 
     t: NDArray[np.float64]
