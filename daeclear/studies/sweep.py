@@ -232,6 +232,7 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     file_options = {**{k: _plain_value(k, v) for k, v in analysis_options.items()}, "keep": keep,
                     "store_channels": stored, SOLVER_KEY: solver.to_dict()}
     mech_name = _mechanism_name(mechanism)
+    task_analysis = {k: (tuple(v) if k == "channels" else v) for k, v in analysis_options.items()}
     tasks: list[dict[str, Any]] = []
     order: dict[str, int] = {}
     for point in points:
@@ -241,8 +242,8 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
             continue  # the same point twice: one run
         order[key] = len(tasks)
         tasks.append({"key": key, "index": len(tasks), "parameters": params, "mechanism": mechanism,
-                      "analysis": {k: (tuple(v) if k == "channels" else v) for k, v in analysis_options.items()},
-                      SOLVER_KEY: solver.to_dict(), "keep": keep, "store_channels": stored})
+                      "analysis": task_analysis, SOLVER_KEY: file_options[SOLVER_KEY], "keep": keep,
+                      "store_channels": stored})
     varying = varying_names([t["parameters"] for t in tasks])
 
     lock = acquire_lock(path, {"mechanism": mech_name})

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import dataclasses
 import os
 import signal
@@ -91,8 +92,7 @@ def run_task(task: Mapping[str, Any]) -> dict[str, Any]:
             out.update(status="interrupted")
         else:
             out.update(status="failed", error=f"{type(exc).__name__}: {message}", traceback=tb.format_exc())
-    out["wall_time"] = time.perf_counter() - start
-    out["computed_at"] = datetime.now(UTC).isoformat(timespec="seconds")
+    out.update(wall_time=time.perf_counter() - start, computed_at=datetime.now(UTC).isoformat(timespec="seconds"))
     return out
 
 
@@ -100,7 +100,5 @@ def terminate_pool(executor: cf.Executor) -> None:
     """Stop our own process pool's workers now (their running tasks are abandoned, not recorded)."""
     processes = getattr(executor, "_processes", None) or {}
     for process in list(processes.values()):
-        try:
+        with contextlib.suppress(Exception):  # already gone
             process.terminate()
-        except Exception:  # already gone
-            pass

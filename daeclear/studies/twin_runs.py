@@ -210,7 +210,7 @@ def twin_evidence(t: ArrayLike, distance: ArrayLike, points_a: ArrayLike, points
         p = section.normalized()
         spread = float(np.sqrt(np.mean(np.sum((p - p.mean(axis=0)) ** 2, axis=1))))
         decorrelation = gap / (math.sqrt(2.0) * spread) if spread > 0 else float("nan")
-        defects = recurrence_defects(na, max_period) if na.shape[0] >= 2 else {}
+        defects = recurrence_defects(na, max_period)  # {} for one point
         recurrence = min(defects.values()) if defects else float("nan")
     return Divergence(t=t, distance=distance, restart_time=float(restart_time),
                       restart_in_contact=bool(restart_in_contact), perturbation=float(perturbation), d0=d0,
@@ -255,8 +255,7 @@ def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *,
         first = offset + T * math.ceil((start - offset) / T - TIME_MATCH)
         n_sec = int(math.floor((float(twin_a.t[-1]) - first) / T + TIME_MATCH)) + 1
         times = first + T * np.arange(max(n_sec, 0))
-    d = len(section.channels)
-    pa = pb = np.zeros((0, d))
+    pa = pb = np.zeros((0, len(section.channels)))
     if times.size >= 2:
         ia, ib = match_times(twin_a, times, T), match_times(twin_b, times, T)
         pa = np.column_stack([np.asarray(twin_a[c], dtype=float)[ia] for c in section.channels])
