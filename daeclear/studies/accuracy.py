@@ -1,11 +1,8 @@
 """Accuracy studies: error against run time (work-precision) for any set of integrators.
 
-Every run integrates the same assembled model with the same contact events and mode logic
-(``simulate(..., method=...)``). Errors are measured against a reference run at a much tighter
-tolerance from an independent method or formulation, on named channels, over a window where
-the reference itself is converged: impacts make a clearance mechanism's response chaotic, so
-late-time differences say nothing about a method's accuracy. The window is found by comparing
-the reference with a second, independent reference run (or given), and is reported.
+Errors are measured against a tight-tolerance reference from an independent method, on named channels,
+over a window where that reference is converged (found by a second independent run, or given):
+impacts make the late response chaotic, so later differences say nothing about a method's accuracy.
 """
 
 from __future__ import annotations
@@ -135,8 +132,7 @@ def channel_error(result: Result, reference: Result, channels: Sequence[str],
         ref = np.asarray(reference[name])[mask]
         val = np.asarray(result[name])[mask]
         scale = float(np.ptp(ref)) or float(np.max(np.abs(ref))) or 1.0
-        err = np.abs(val - ref)
-        errors[name] = float(np.max(err)) / scale if np.all(np.isfinite(val)) else math.inf
+        errors[name] = float(np.max(np.abs(val - ref))) / scale if np.all(np.isfinite(val)) else math.inf
     return errors
 
 
@@ -162,10 +158,7 @@ def converged_window(reference: Result, check: Result, channels: Sequence[str], 
         ref, other = np.asarray(reference[name]), np.asarray(check[name])
         scale = float(np.ptp(ref)) or 1.0
         bad |= ~(np.abs(ref - other) <= tol * scale)
-    if not bad.any():
-        return float(t[-1])
-    first = int(np.argmax(bad))
-    return float(t[max(first - 1, 0)])
+    return float(t[max(int(np.argmax(bad)) - 1, 0)]) if bad.any() else float(t[-1])
 
 
 Settings = Mapping[str, Any] | SolverOptions  # the options of one run: simulate keywords or a SolverOptions
@@ -178,9 +171,7 @@ def _solver_options(settings: Settings) -> SolverOptions:
 
 def _method_of(settings: Settings) -> str:
     """The method of ``settings``, lower case ("ida" when not given)."""
-    if isinstance(settings, SolverOptions):
-        return settings.method
-    return str(settings.get("method", "ida")).lower()
+    return settings.method if isinstance(settings, SolverOptions) else str(settings.get("method", "ida")).lower()
 
 
 def _describe(settings: Settings) -> str:
@@ -197,9 +188,7 @@ def _with(settings: Settings, name: str, value: float) -> Settings:
     """``settings`` with the tolerance or step ``name`` set to ``value``."""
     if isinstance(settings, SolverOptions):
         return settings.replace(**{name: value})
-    opts = {k: v for k, v in settings.items() if k not in ("rtol", "step")}
-    opts[name] = value
-    return opts
+    return {**{k: v for k, v in settings.items() if k not in ("rtol", "step")}, name: value}
 
 
 def _timed(model: Scene | DAEModel, t_end: float, t_eval: NDArray, settings: Settings, repeats: int
@@ -242,37 +231,27 @@ def work_precision(
 
     Parameters
     ----------
-    scene : Scene or DAEModel
-        The mechanism. A Scene is what every timed run gets (``simulate(scene, ...)``, assembly
-        included, as users call it); a model is timed without assembly.
-    t_end : float
-        End of the runs, s.
+    scene, t_end : Scene or DAEModel, float
+        The mechanism (a Scene is timed with its assembly, as users call it) and the runs' end, s.
     channels : sequence of str
         Channels whose error is measured (relative to the reference's range).
     methods : mapping label -> simulate options or SolverOptions
-        E.g. ``{"IDA": {"method": "ida"}, "DOP853": {"method": "DOP853"}, "RK4": {"method": "rk4"}}``
-        or ``{"IDA sparse": SolverOptions(linear_solver="sparse")}``; adaptive methods run at every
-        ``rtols``, fixed-step ones (rk4, euler) at every ``steps`` (each replacing the rtol or step
-        of the entry). Default: IDA, DOP853, LSODA and RK4.
-    reference : mapping, SolverOptions or None
-        Options of the reference run (default DOP853 at rtol 1e-12: an explicit high-order method,
-        independent of the implicit runs it judges).
-    check : mapping, SolverOptions or None
-        Options of the second reference used to find the converged window (default IDA,
-        rtol 1e-12).
-    window : (t0, t1) or None
-        Error window; None: from 0 to where ``reference`` and ``check`` stop agreeing to
-        ``converged_tol`` (of each channel's range).
-    n_eval : int
-        Output times (uniform over [0, t_end]) at which every run is compared.
-    repeats : int
-        Timed repeats per run (best kept; one warm-up run before).
+        E.g. ``{"IDA": {"method": "ida"}, "IDA sparse": SolverOptions(linear_solver="sparse")}``; adaptive
+        methods run at every ``rtols``, fixed-step ones (rk4, euler) at every ``steps``. Default: IDA,
+        DOP853, LSODA and RK4.
+    reference, check : mapping, SolverOptions or None
+        The reference run (default DOP853 at rtol 1e-12) and the one that finds the converged window
+        (default IDA index-1 at rtol 1e-12): the error ``window`` (None) ends where they stop agreeing
+        to ``converged_tol`` of each channel's range.
+    n_eval, repeats : int
+        Output times (uniform over [0, t_end]) where runs are compared; timed repeats per run (best
+        kept, after one warm-up run).
 
     Returns
     -------
     WorkPrecision
-        ``rows`` (label, method, tolerance, error, event_time_error, solve/wall time, steps,
-        evaluations, status, message), the window and its reason, the reference result.
+        One row per run (error, event time error, solve/wall time, steps, status), the window and its
+        reason, the reference result.
     """
     if methods is None:
         methods = {"IDA": {"method": "ida"}, "DOP853": {"method": "DOP853"}, "LSODA": {"method": "LSODA"},
@@ -322,19 +301,18 @@ def work_precision(
                          "impact sequence); errors beyond are not meaningful.")
     else:
         reason = "given"
-    rows: list[dict[str, Any]] = []
+    out = WorkPrecision(rows=[], channels=list(channels), window=window, window_reason=reason, reference=ref,
+                        reference_options=ref_options, assembly_time=assembly_time, notes=notes,
+                        timed_with_scene=isinstance(scene, Scene))
     try:
-        _measure(rows, scene_for_ref, ref, methods, rtols, steps, t_end, t_eval, channels, window, repeats, progress)
+        _measure(out.rows, scene_for_ref, ref, methods, rtols, steps, t_end, t_eval, channels, window, repeats,
+                 progress)
     except KeyboardInterrupt as exc:  # Ctrl-C: stop, with the finished rows in .result (never a "failed" row)
-        partial = WorkPrecision(rows=rows, channels=list(channels), window=window, window_reason=reason,
-                                reference=ref, reference_options=ref_options, assembly_time=assembly_time,
-                                notes=notes + [f"Interrupted by the user after {len(rows)} runs; the table is "
-                                               "incomplete."], timed_with_scene=isinstance(scene, Scene))
-        raise Interrupted(f"work_precision: interrupted by the user after {len(rows)} runs; the finished rows "
-                          "are in .result.", partial) from exc
-    return WorkPrecision(rows=rows, channels=list(channels), window=window, window_reason=reason, reference=ref,
-                         reference_options=ref_options, assembly_time=assembly_time, notes=notes,
-                         timed_with_scene=isinstance(scene, Scene))
+        n = len(out.rows)
+        out.notes.append(f"Interrupted by the user after {n} runs; the table is incomplete.")
+        raise Interrupted(f"work_precision: interrupted by the user after {n} runs; the finished rows "
+                          "are in .result.", out) from exc
+    return out
 
 
 def _measure(rows: list[dict[str, Any]], scene_for_ref: Scene | DAEModel, ref: Result,
@@ -345,47 +323,36 @@ def _measure(rows: list[dict[str, Any]], scene_for_ref: Scene | DAEModel, ref: R
     total = sum(len(steps if _method_of(m) in FIXED_STEP_METHODS else rtols) for m in methods.values())
     bar = Progress(total, unit="runs", desc="work-precision", enabled=progress)
     try:
-        _measure_all(rows, scene_for_ref, ref, methods, rtols, steps, t_end, t_eval, channels, window, repeats, bar)
+        for label, method_options in methods.items():
+            method = _method_of(method_options)
+            fixed = method in FIXED_STEP_METHODS
+            for value in steps if fixed else rtols:
+                bar.update(len(rows), f"{label} {'step' if fixed else 'rtol'}={value:g} ...")
+                try:
+                    result, wall = _timed(scene_for_ref, t_end, t_eval,
+                                          _with(method_options, "step" if fixed else "rtol", value), repeats)
+                except Exception as exc:  # a run that cannot even start stays in the table
+                    rows.append({"label": label, "method": method, "tolerance": value, "error": math.inf,
+                                 "event_time_error": math.inf, "events": 0, "solve_time": math.nan,
+                                 "wall_time": math.nan, "n_steps": 0, "n_res_evals": 0, "status": -1,
+                                 "message": f"{type(exc).__name__}: {exc}"})
+                    continue
+                if result.success:
+                    errors = channel_error(result, ref, channels, window)
+                    ev_err, n_events = event_time_error(result, ref, window)
+                else:
+                    errors, ev_err, n_events = {c: math.inf for c in channels}, math.inf, 0
+                rows.append({
+                    "label": label, "method": method, "tolerance": value, "error": max(errors.values()),
+                    **{f"error[{c}]": e for c, e in errors.items()}, "event_time_error": ev_err, "events": n_events,
+                    "solve_time": float(result.stats.get("solve_time", math.nan)), "wall_time": wall,
+                    "n_steps": int(result.stats.get("n_steps", 0)),
+                    "n_res_evals": int(result.stats.get("n_res_evals", 0)),
+                    "status": 0 if result.success else -1, "message": result.message,
+                })
         bar.update(total, "")
     finally:
         bar.close()
-
-
-def _measure_all(rows: list[dict[str, Any]], scene_for_ref: Scene | DAEModel, ref: Result,
-                 methods: Mapping[str, Settings], rtols: Sequence[float], steps: Sequence[float],
-                 t_end: float, t_eval: NDArray, channels: Sequence[str], window: tuple[float, float], repeats: int,
-                 bar: Progress) -> None:
-    """The loop of :func:`_measure`, reporting each run to ``bar`` as it starts."""
-    done = 0
-    for label, method_options in methods.items():
-        method = _method_of(method_options)
-        fixed = method in FIXED_STEP_METHODS
-        values = steps if fixed else rtols
-        for value in values:
-            opts = _with(method_options, "step" if fixed else "rtol", value)
-            bar.update(done, f"{label} {'step' if fixed else 'rtol'}={value:g} ...")
-            done += 1
-            try:
-                result, wall = _timed(scene_for_ref, t_end, t_eval, opts, repeats)
-            except Exception as exc:  # a run that cannot even start stays in the table
-                rows.append({"label": label, "method": method, "tolerance": value, "error": math.inf,
-                             "event_time_error": math.inf, "events": 0, "solve_time": math.nan,
-                             "wall_time": math.nan, "n_steps": 0, "n_res_evals": 0, "status": -1,
-                             "message": f"{type(exc).__name__}: {exc}"})
-                continue
-            if result.success:
-                errors = channel_error(result, ref, channels, window)
-                ev_err, n_events = event_time_error(result, ref, window)
-            else:
-                errors, ev_err, n_events = {c: math.inf for c in channels}, math.inf, 0
-            rows.append({
-                "label": label, "method": method, "tolerance": value, "error": max(errors.values()),
-                **{f"error[{c}]": e for c, e in errors.items()},
-                "event_time_error": ev_err, "events": n_events,
-                "solve_time": float(result.stats.get("solve_time", math.nan)), "wall_time": wall,
-                "n_steps": int(result.stats.get("n_steps", 0)), "n_res_evals": int(result.stats.get("n_res_evals", 0)),
-                "status": 0 if result.success else -1, "message": result.message,
-            })
 
 
 def energy_balance(result: Result) -> dict[str, float]:

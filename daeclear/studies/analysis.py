@@ -1,39 +1,8 @@
-"""Nonlinear-dynamics analysis of runs: phase portraits, Poincaré sections, motion classification.
+"""Nonlinear-dynamics analysis of runs, ``daeclear.analysis``: the pipeline and its re-exported parts.
 
-The chapter reads periodic, quasi-periodic and chaotic responses from "Poincaré maps",
-which are phase portraits (slider acceleration against slider velocity over many
-revolutions, section 4.4). This module adds the true stroboscopic Poincaré section
-(one point per crank revolution, after a transient) and a documented classification
-of the motion with the evidence behind it:
-
-1. **Periodicity** (:func:`classify_section`): the section points, each channel scaled
-   by the attractor's size (its 1 %-99 % quantile range over the analysed span), are
-   tested for recurrence: the motion is periodic of period k when every point is within
-   ``tol`` (5 % by default) of the point k revolutions later, for the smallest
-   k <= ``max_period``.
-2. **Sensitivity** (:func:`twin_divergence`, :func:`twin_evidence` from arrays): twin
-   trajectories are restarted on the attractor from the same state, one of them perturbed
-   by ``perturbation`` (1e-8 m by default) along the constraint manifold. Their separation
-   gives a largest Lyapunov exponent estimate (a straight-line fit of ln(distance) against
-   time over the growth window, with its R^2, when it grew at least 100-fold), the
-   amplification, and the distance of their late section points (gap, and decorrelation: the
-   gap over the section's spread).
-3. **Agreement** (:func:`classify_section`, the one place both tests meet): a recurring
-   section whose twins show a resolved positive exponent or end apart at the section is
-   "uncertain" with both numbers -- except growth >= 1000-fold with decorrelation from a
-   free-flight restart, documented as chaos small in the section's channels (the
-   translational joint's lateral impacts). A non-recurring section is chaotic when the twins
-   decorrelate with a positive exponent, quasi-periodic when they stay together without one.
-   Missing (nan) twin numbers are reported as missing, never counted as agreement.
-
-This module runs the whole pipeline (:func:`classify_motion`) and is the public face of the
-analysis (``daeclear.analysis``): it re-exports the parts, each in a module of its own job --
-:mod:`~daeclear.studies.poincare` (periods, sampling, phase portraits, sections),
-:mod:`~daeclear.studies.twin_runs` (restarts and twin evidence),
-:mod:`~daeclear.studies.motion_class` (the rules) and :mod:`~daeclear.studies.motion_thresholds`
-(their numbers). Only numpy here (no plotting); figures are in :mod:`daeclear.plot`.
-``docs/nonlinear_dynamics.md`` states the method, thresholds, limits and the measured
-evidence for the chapter's cases.
+:func:`classify_motion` samples a run (:func:`sampling_times`), takes its Poincaré section after a
+transient, restarts twin runs on the attractor (one perturbed) and classifies the motion
+(:func:`classify_section`). ``docs/nonlinear_dynamics.md`` states the method, thresholds and limits.
 
 Examples
 --------
@@ -53,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .accuracy import energy_balance, work_precision  # re-exported: daeclear.analysis.work_precision
+from .accuracy import energy_balance, work_precision
 # The parts of the analysis, re-exported: daeclear.analysis.<name> keeps working for every name it had.
 from .motion_class import (  # noqa: F401
     MOTION_LABELS, MotionClass, MotionLabel, TwinReading, classify_section, read_twins)
@@ -65,62 +34,25 @@ from .poincare import (CHANNELS, PhasePortrait, PoincareSection, crank_period, m
 from .twin_runs import Divergence, RestartState, all_free, restart_state, twin_divergence, twin_evidence
 from ..assembly.assemble import DAEModel
 from ..errors import DaeclearError, SceneError  # noqa: F401  (DaeclearError: re-exported as before)
-from ..options import default_formulation
+from ..options import default_formulation, integer
 from ..solver_options import UNSET, SolverOptions
 
 if TYPE_CHECKING:
     from ..results.result import Result
     from ..model.scene import Scene
 
-__all__ = [
-    "CHANNELS",
-    "MOTION_LABELS",
-    "Divergence",
-    "MotionAnalysis",
-    "MotionClass",
-    "PhasePortrait",
-    "PoincareSection",
-    "RestartState",
-    "TwinReading",
-    "classify_motion",
-    "classify_section",
-    "crank_period",
-    "energy_balance",
-    "work_precision",
-    "phase_portrait",
-    "poincare_section",
-    "restart_state",
-    "section_channels",
-    "read_twins",
-    "sampling_times",
-    "twin_divergence",
-    "twin_evidence",
-]
-
-
-# --------------------------------------------------------------------------- the whole pipeline
+__all__ = ["CHANNELS", "MOTION_LABELS", "Divergence", "MotionAnalysis", "MotionClass", "PhasePortrait",
+           "PoincareSection", "RestartState", "TwinReading", "classify_motion", "classify_section", "crank_period",
+           "energy_balance", "work_precision", "phase_portrait", "poincare_section", "restart_state",
+           "section_channels", "read_twins", "sampling_times", "twin_divergence", "twin_evidence"]
 
 
 @dataclass(frozen=True)
 class MotionAnalysis:
-    """Everything :func:`classify_motion` computed.
-
-    Attributes
-    ----------
-    result : Result
-        The reference run from t = 0, sampled by :func:`sampling_times`.
-    section : PoincareSection
-        Its section over the analysed span (after the transient).
-    motion : MotionClass
-        The classification and its evidence.
-    divergence : Divergence or None
-        Twin evidence (None with ``twin=False``).
-    twins : (Result, Result) or None
-        The unperturbed and perturbed restarted runs (from the restart time on, at their true times).
-    options : dict
-        The options of the analysis (revolutions, transient, ...), with ``rtol`` and, under
-        ``"solver"``, every solver setting of the runs (:meth:`daeclear.SolverOptions.to_dict`).
-    """
+    """Everything :func:`classify_motion` computed: the reference run from t = 0 (``result``), its
+    ``section`` after the transient, the ``motion`` class, the twin evidence and runs (``divergence``,
+    ``twins``: unperturbed and perturbed, from the restart time on; None without twins) and the
+    analysis ``options`` (with ``rtol`` and, under ``"solver"``, :meth:`daeclear.SolverOptions.to_dict`)."""
 
     result: Result
     section: PoincareSection
@@ -135,12 +67,6 @@ class MotionAnalysis:
         return float(self.section.t[0]) if len(self.section) else float("nan")
 
 
-def _check_int(name: str, value: Any, low: int) -> int:
-    if not (isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= low):
-        raise SceneError(f"classify_motion: {name}={value!r}, must be an integer >= {low}.")
-    return int(value)
-
-
 def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None = None, revolutions: int = 30,
                     transient: int = 10, per_revolution: int = 32, phase: float = 0.0, twin: bool | str = True,
                     twin_revolutions: int = 20, perturbation: float = DEFAULT_PERTURBATION, seed: int = 0,
@@ -151,43 +77,25 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
 
     Parameters
     ----------
-    scene : Scene or DAEModel
-        A driven mechanism (its driver sets the period T).
-    channels : sequence of str, optional
-        Section channels; default :func:`section_channels` (slider velocity and acceleration, as
-        the chapter, or the last body's angular velocity and acceleration without a slider).
-    revolutions : int
-        Revolutions analysed after the transient (30): revolutions + 1 section points.
-    transient : int
-        Revolutions simulated and discarded first (10).
-    per_revolution : int
-        Output samples per revolution (32): attractor size, phase portrait, twin separation.
+    scene, channels : Scene or DAEModel, sequence of str
+        A driven mechanism (its driver sets the period T) and the section channels (default
+        :func:`section_channels`).
+    revolutions, transient, per_revolution : int
+        Revolutions analysed (30: revolutions + 1 section points), after ``transient`` discarded ones
+        (10); output samples per revolution (32).
     phase : float
-        Crank angle of the section past the initial crank angle, rad (0: the chapter's
-        initial collinear position).
+        Crank angle of the section past the initial crank angle, rad.
     twin : {True, "auto", False}
-        Run the twin trajectories (two more runs of ``twin_revolutions``): they separate
-        quasi-periodic from chaotic motion and catch chaos that is small in the section's
-        channels. True (default): always; "auto": only when the section does not recur
-        (cheaper; a recurring section is then "periodic" without the sensitivity check);
-        False: never (a non-periodic run is then "non-periodic").
-    twin_revolutions : int
-        Length of the twin runs, revolutions (20).
-    perturbation : float
-        Position perturbation of the twin, m (1e-8).
-    seed : int
-        Seed of the perturbation direction.
+        Run the twin trajectories (two more runs of ``twin_revolutions``, 20) that tell quasi-periodic
+        from chaotic motion: always, only when the section does not recur, or never.
+    perturbation, seed : float, int
+        Position perturbation of the twin, m (1e-8), and the seed of its direction.
     tol, max_period, decorrelation : float, int, float
         Classification thresholds (:func:`classify_section`).
-    rtol : float
-        Relative tolerance (default that of ``options``, 1e-6 without it).
-    options : SolverOptions, optional
-        The solver settings of every run (:class:`daeclear.SolverOptions`); a solver keyword given
-        explicitly (``rtol``, ``atol``, ``method``, ...) overrides the same setting, as in
-        :func:`daeclear.simulate`. ``formulation`` is used when ``scene`` is a Scene.
+    rtol, options : float, SolverOptions
+        The runs' solver settings; explicit solver keywords override ``options``, as in :func:`daeclear.simulate`.
     **simulate_options
-        Passed to :func:`daeclear.simulate`: solver settings (``atol``, ``max_step``, ``backend``,
-        ``formulation``, ...), ``store_steps`` (:class:`daeclear.SaveAt`'s ``steps``) and ``progress``.
+        Passed to :func:`daeclear.simulate`: solver settings, ``store_steps`` (SaveAt's ``steps``), ``progress``.
 
     Returns
     -------
@@ -202,10 +110,10 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
     from ..save_at import SaveAt
     from ..solvers.dispatch import simulate
 
-    revolutions = _check_int("revolutions", revolutions, 2)
-    transient = _check_int("transient", transient, 0)
-    per_revolution = _check_int("per_revolution", per_revolution, 4)
-    twin_revolutions = _check_int("twin_revolutions", twin_revolutions, 2)
+    revolutions = integer(revolutions, where="classify_motion", field="revolutions", low=2)
+    transient = integer(transient, where="classify_motion", field="transient", low=0)
+    per_revolution = integer(per_revolution, where="classify_motion", field="per_revolution", low=4)
+    twin_revolutions = integer(twin_revolutions, where="classify_motion", field="twin_revolutions", low=2)
     if twin not in ("auto", True, False):
         raise SceneError(f"classify_motion: twin={twin!r}, must be 'auto', True or False.")
     for key in ("t_eval", "t_eval_step", "on_failure", "t0", "y0"):

@@ -1,9 +1,7 @@
 """Motion classes: the rules that read a Poincaré section and the twin evidence as one verdict.
 
-:func:`classify_section` is the one place where the section's recurrence test
-(:mod:`daeclear.studies.poincare`) and the twin test (:mod:`daeclear.studies.twin_runs`, read once
-by :func:`read_twins`) meet: a label never contradicts its own evidence, and missing twin numbers
-are reported as missing. Separate from both tests so that the rules, in order, read in one place
+:func:`classify_section` is the one place where the section's recurrence test and the twin test (read
+once by :func:`read_twins`) meet, so that the rules, in order, read in one place
 (``docs/nonlinear_dynamics.md`` gives them with their checks).
 """
 
@@ -28,9 +26,6 @@ MotionLabel = Literal["periodic", "quasi-periodic", "chaotic", "non-periodic", "
 MOTION_LABELS: tuple[str, ...] = ("periodic", "quasi-periodic", "chaotic", "non-periodic", "uncertain", "undetermined")
 
 
-# --------------------------------------------------------------------------- classification
-
-
 def _clusters(p: NDArray[np.float64], tol: float) -> int:
     """Leader clustering in the max-norm: a point opens a new cluster when farther than tol from every leader."""
     leaders: list[NDArray[np.float64]] = []
@@ -47,22 +42,15 @@ class MotionClass:
     Attributes
     ----------
     label : {"periodic", "quasi-periodic", "chaotic", "non-periodic", "uncertain", "undetermined"}
-        "non-periodic": the section does not recur, and no twin evidence (or missing or
-        contradictory twin evidence) to tell quasi-periodic from chaotic. "uncertain": the
-        section recurs but the twin test contradicts it (a positive exponent, growth beyond
-        1000-fold, or twins ending apart at the section); the reason gives both tests'
-        numbers. "undetermined": too few section points or no attractor size.
-    period : int
-        k for "periodic" (revolutions), else 0.
+        "non-periodic": no recurrence, and no (or missing, or contradictory) twin evidence to tell
+        quasi-periodic from chaotic; "uncertain": the section recurs but the twin test contradicts it;
+        "undetermined": too few section points or no attractor size.
+    period, reason : int, str
+        k for "periodic" (revolutions), else 0; one sentence with the deciding numbers.
     evidence : dict
-        Plain numbers and strings: ``n_points``, ``tol``, ``periodicity_defect`` (the
-        recurrence distance at the period found, else the smallest over k, in units of the
-        attractor size), ``best_period`` (its k),
-        ``defect_k1`` ... ``defect_kK``, ``n_clusters`` (distinct section points at ``tol``),
-        ``spread`` (RMS distance of the section points from their mean, attractor units) and,
-        with twins, the fields of :meth:`Divergence.evidence`.
-    reason : str
-        One sentence with the deciding numbers.
+        Plain numbers and strings: ``periodicity_defect`` (attractor units) at ``best_period``,
+        ``defect_k1`` ... ``defect_kK``, ``n_clusters`` (at ``tol``), ``spread`` and, with twins,
+        :meth:`Divergence.evidence`.
     """
 
     label: MotionLabel
@@ -84,24 +72,11 @@ def _num(x: float, fmt: str = ".3g") -> str:
 class TwinReading:
     """What the twin evidence says, decided once for every rule of :func:`classify_section`.
 
-    Attributes
-    ----------
-    complete : bool
-        Amplification and decorrelation (and, for a recurring section, the section gap) are
-        numbers; otherwise the twin test is *missing* and can neither confirm nor contradict.
-    exponent : bool
-        A positive exponent resolved by a usable fit: amplification >= MIN_AMPLIFICATION (100),
-        Lyapunov estimate > 0 (a finite slope; nan is never positive) and R^2 >= MIN_FIT_R2 (0.2).
-    sensitive : bool
-        Sensitive dependence beyond doubt: amplification >= SENSITIVE_AMPLIFICATION (1000) and a
-        positive exponent.
-    decorrelated : bool
-        Decorrelation >= the threshold (0.3).
-    apart : bool
-        The twins' late section points are farther apart than ``tol`` (attractor units): they do
-        not recur onto each other at the recurrence test's own resolution.
-    numbers : str
-        The twin numbers as one clause (nan written as "missing").
+    ``complete``: amplification and decorrelation are numbers (else the twin test can neither
+    confirm nor contradict); ``exponent``: a positive Lyapunov estimate from a usable fit (growth >=
+    MIN_AMPLIFICATION, R^2 >= MIN_FIT_R2); ``sensitive``: an exponent with growth >=
+    SENSITIVE_AMPLIFICATION; ``decorrelated``: decorrelation >= the threshold; ``apart``: the twins'
+    late section points farther apart than ``tol``; ``numbers``: the twin numbers as one clause.
     """
 
     complete: bool
@@ -138,28 +113,18 @@ def classify_section(section: PoincareSection, divergence: Divergence | None = N
                      min_points: int = MIN_POINTS) -> MotionClass:
     """Classify the motion from a Poincaré section and, optionally, twin-trajectory evidence.
 
-    The one place where the section test and the twin test are combined: a label never
-    contradicts its own evidence, and missing (nan) twin numbers are reported as missing,
-    never counted as agreement. Rules, in order (docs/nonlinear_dynamics.md, with the checks
-    behind each threshold); "exponent" means amplification >= 100 with a positive Lyapunov
-    fit (R^2 >= 0.2), "sensitive" an exponent with amplification >= 1000 (:func:`read_twins`):
+    A label never contradicts its own evidence, and missing (nan) twin numbers are reported as
+    missing. Rules, in order (docs/nonlinear_dynamics.md; "exponent" and "sensitive" as in
+    :class:`TwinReading`):
 
-    1. fewer than ``min_points`` section points, or unknown attractor size: "undetermined";
-    2. the section recurs: smallest k <= ``max_period`` whose defect
-       max_j max_channel |p[j+k] - p[j]| / size <= ``tol``. Then
-       a. no twins, or twin numbers missing: "periodic" (k), the reason saying the
-          sensitivity was not tested or its evidence is missing;
-       b. twins sensitive and decorrelated (>= ``decorrelation``), restarted in free flight:
-          "chaotic" -- chaos small in the section's channels (the translational joint);
-       c. twins sensitive, or with an exponent, or ending apart at the section (gap > ``tol``):
-          "uncertain", with both tests' numbers;
-       d. otherwise (no resolved growth, twins within ``tol``): "periodic" (k);
-    3. without twins: "non-periodic";
-    4. twin numbers missing: "non-periodic" (missing evidence named);
-    5. twins decorrelated with an exponent, or sensitive: "chaotic";
-    6. twins not decorrelated and no exponent: "quasi-periodic";
-    7. otherwise (decorrelated without resolved growth, or together with a positive
-       exponent): "non-periodic", both numbers given.
+    1. fewer than ``min_points`` points, or unknown attractor size: "undetermined";
+    2. the section recurs (smallest k <= ``max_period`` with max_j max_channel |p[j+k] - p[j]| / size
+       <= ``tol``): "periodic" (k) without twins or with missing twin numbers; "chaotic" when the
+       twins are sensitive and decorrelated after a free-flight restart (chaos small in the section's
+       channels); "uncertain" when they are sensitive, have an exponent or end apart; else "periodic";
+    3. no recurrence: "non-periodic" without twins or with missing numbers; "chaotic" when the twins
+       decorrelate with an exponent, or are sensitive; "quasi-periodic" when they stay together
+       without one; otherwise "non-periodic", both numbers given.
 
     Parameters
     ----------
@@ -168,14 +133,9 @@ def classify_section(section: PoincareSection, divergence: Divergence | None = N
     divergence : Divergence, optional
         From :func:`twin_divergence` or :func:`twin_evidence`.
     tol : float
-        Recurrence tolerance, fraction of the attractor size (0.05); also the largest section
-        gap of twins that agree with a recurring section.
-    max_period : int
-        Longest period looked for, revolutions (8).
-    decorrelation : float
-        Decorrelation threshold (0.3).
-    min_points : int
-        Fewest section points to classify (8).
+        Recurrence tolerance, fraction of the attractor size (0.05); also the largest twins' section gap.
+    max_period, decorrelation, min_points : int, float, int
+        Longest period looked for (8 revolutions), decorrelation threshold (0.3), fewest points (8).
 
     Returns
     -------

@@ -1,14 +1,8 @@
-"""The numbers of the motion analysis in one place: classification defaults and thresholds.
-
-Every module of the analysis (sections, twin runs, classification, the pipeline) reads its
-thresholds here, so one number has one definition; ``docs/nonlinear_dynamics.md`` gives the reason
-and the check behind each. A module of its own because the section, twin and classification modules
-all need them and none owns the others.
-"""
+"""The numbers of the motion analysis in one place (its section, twin and classification modules all
+read them); ``docs/nonlinear_dynamics.md`` gives the reason and the check behind each."""
 
 from __future__ import annotations
 
-# Defaults of the classification (docs/nonlinear_dynamics.md gives the reasons and the checks).
 DEFAULT_TOL = 0.05  # recurrence tolerance, fraction of the attractor size per channel
 DEFAULT_MAX_PERIOD = 8  # longest period (revolutions) looked for
 DEFAULT_DECORRELATION = 0.3  # twin decorrelation from which the twins count as unrelated

@@ -1,12 +1,10 @@
 """Crank periods, sampling times, phase portraits and stroboscopic Poincaré sections of a run.
 
-The chapter reads periodic, quasi-periodic and chaotic responses from "Poincaré maps", which are
-phase portraits (slider acceleration against slider velocity, section 4.4). This module gives them
-(:func:`phase_portrait`) and the true stroboscopic section (:func:`poincare_section`: one point per
-crank revolution after a transient, on output times that :func:`sampling_times` makes exact), with
-the attractor size that scales every later test and the recurrence defects the periodicity test
-reads. Separate from the classification (:mod:`daeclear.studies.motion_class`) and the twin runs
-(:mod:`daeclear.studies.twin_runs`): a section is data any of them, or a plot, can use. Only numpy.
+The chapter reads its responses from "Poincaré maps", phase portraits of slider acceleration against
+velocity (section 4.4): :func:`phase_portrait`. :func:`poincare_section` takes the true stroboscopic
+section (one point per crank revolution, on output times that :func:`sampling_times` makes exact),
+with the attractor size that scales every later test, and :func:`recurrence_defects` the numbers
+the periodicity test reads. Only numpy.
 """
 
 from __future__ import annotations
@@ -44,9 +42,6 @@ def section_channels(scene: Scene | DAEModel) -> tuple[str, str]:
     return (f"{bodies[-1]}.omega", f"{bodies[-1]}.alpha")
 
 
-# --------------------------------------------------------------------------- periods and sampling
-
-
 def _scene_parameters(source: Any) -> Mapping[str, Any]:
     """The scene dictionary of a Result, DAEModel, Scene or mapping."""
     from ..model.scene import Scene
@@ -54,31 +49,21 @@ def _scene_parameters(source: Any) -> Mapping[str, Any]:
     if isinstance(source, Scene):
         return source.to_dict()
     params = getattr(source, "parameters", source)
-    if isinstance(params, Mapping) and "scene" in params:
-        return params["scene"]
     if isinstance(params, Mapping):
-        return params
+        return params.get("scene", params)
     raise TypeError(f"crank_period: cannot read a scene from a {type(source).__name__}.")
 
 
 def crank_period(source: Result | DAEModel | Scene | Mapping[str, Any]) -> float:
-    """Duration of one crank revolution, s: 2 pi / |speed| of the scene's driver.
+    """Duration of one crank revolution, s: 2 pi / |speed| of the scene's driver (0.012 s at 5000 rpm).
 
-    Parameters
-    ----------
-    source : Result, DAEModel, Scene or mapping
-        Anything carrying the scene (a Result's or model's ``parameters["scene"]``).
-
-    Returns
-    -------
-    float
-        Period T, s (0.012 s at the chapter's 5000 rpm).
+    ``source`` is anything carrying the scene (a Result's or model's ``parameters["scene"]``).
 
     Raises
     ------
     DaeclearError
-        If the scene has no driver, or drivers of different speeds (no common period):
-        pass ``period=`` explicitly then.
+        If the scene has no driver, drivers of different speeds or one that is not a constant-speed
+        rotation: pass ``period=`` explicitly then.
     """
     scene = _scene_parameters(source)
     elements = scene.get("elements", {}) if isinstance(scene, Mapping) else {}
@@ -104,27 +89,10 @@ def sampling_times(period: float, revolutions: int, *, per_revolution: int = 32,
                    offset: float = 0.0) -> NDArray[np.float64]:
     """Output times for ``simulate(t_eval=...)`` that contain every section time exactly.
 
-    ``per_revolution`` uniform samples per revolution from t = 0 to ``revolutions * period``,
-    plus the section times ``offset + k * period`` (k = 0, 1, ...) when ``offset`` is not
-    on the uniform grid.
-
-    Parameters
-    ----------
-    period : float
-        Crank period T, s.
-    revolutions : int
-        Number of revolutions simulated (transient included).
-    per_revolution : int
-        Uniform samples per revolution (>= 1); they give the phase portrait, the attractor
-        size and the twin separation.
-    offset : float
-        Section time within the revolution, s, in [0, period): the section samples the
-        crank angle ``omega * offset`` past its initial angle.
-
-    Returns
-    -------
-    ndarray
-        Increasing times in [0, revolutions * period].
+    ``per_revolution`` uniform samples per revolution (they give the phase portrait, the attractor
+    size and the twin separation) from t = 0 to ``revolutions * period`` (s), plus the section times
+    ``offset + k * period`` when ``offset`` (s, in [0, period): the section's crank angle past the
+    initial one) is not on that grid.
     """
     if not (isinstance(revolutions, (int, np.integer)) and revolutions >= 1):
         raise SceneError(f"sampling_times: revolutions={revolutions!r}, must be an integer >= 1.")
@@ -142,24 +110,11 @@ def sampling_times(period: float, revolutions: int, *, per_revolution: int = 32,
     keep = np.min(np.abs(t[:, None] - section[None, :]), axis=1) > TIME_MATCH * period
     return np.union1d(t[keep], section)
 
-# --------------------------------------------------------------------------- phase portraits
-
 
 @dataclass(frozen=True)
 class PhasePortrait:
-    """Two channels against each other over a time window (the chapter's "Poincaré maps").
-
-    Attributes
-    ----------
-    t : ndarray (n,)
-        Times of the samples, s.
-    x, y : ndarray (n,)
-        The two channels.
-    names : (str, str)
-        Channel names of x and y.
-    units : (str, str)
-        Their units.
-    """
+    """Two channels against each other over a time window (the chapter's "Poincaré maps"): samples
+    at times ``t`` (s) of channels ``names`` (units ``units``) as ``x`` and ``y``."""
 
     t: NDArray[np.float64]
     x: NDArray[np.float64]
@@ -170,27 +125,13 @@ class PhasePortrait:
 
 def phase_portrait(result: Result, x: str = CHANNELS[0], y: str = CHANNELS[1], *, t0: float | None = None,
                    t1: float | None = None) -> PhasePortrait:
-    """The samples of two channels over [t0, t1], for a phase portrait.
-
-    Parameters
-    ----------
-    result : Result
-        A run; a dense ``t_eval`` (:func:`sampling_times`) gives a smooth curve.
-    x, y : str
-        Channel (or state) names; default slider velocity and acceleration.
-    t0, t1 : float, optional
-        Window, s (e.g. ``t0`` = end of the transient); None: the whole run.
-
-    Returns
-    -------
-    PhasePortrait
-    """
+    """The samples of channels ``x`` and ``y`` (default slider velocity and acceleration) over
+    [t0, t1] (s; None: the run's ends), for a phase portrait; a dense ``t_eval`` (:func:`sampling_times`)
+    gives a smooth curve."""
     mask = result.window_mask(t0, t1)
     return PhasePortrait(t=np.asarray(result.t)[mask], x=np.asarray(result[x], dtype=float)[mask],
                          y=np.asarray(result[y], dtype=float)[mask], names=(x, y),
                          units=(result.units.get(x, ""), result.units.get(y, "")))
-
-# --------------------------------------------------------------------------- Poincaré sections
 
 
 @dataclass(frozen=True)
@@ -199,22 +140,14 @@ class PoincareSection:
 
     Attributes
     ----------
-    t : ndarray (n,)
-        Section times t0 + k T, s.
-    points : ndarray (n, d)
-        Channel values at those times, one column per channel.
-    channels : tuple of str
-        Channel names (d of them).
-    units : tuple of str
-        Their units.
-    period : float
-        T, s.
-    size : ndarray (d,)
-        Attractor size per channel: the 1 %-99 % quantile range of the channel over the
-        analysed window (all output samples, not only the section); nan when the run was
-        sampled too sparsely to tell (fewer than 4 samples per revolution).
-    center : ndarray (d,)
-        Median of each channel over the same window.
+    t, points : ndarray (n,), ndarray (n, d)
+        Section times t0 + k T (s) and the channel values there, one column per channel.
+    channels, units, period : tuple of str, tuple of str, float
+        Channel names (d of them), their units, and T (s).
+    size, center : ndarray (d,)
+        Attractor size per channel, the 1 %-99 % quantile range over all output samples of the
+        analysed window (nan when sampled too sparsely to tell: fewer than 4 per revolution), and
+        each channel's median there.
     """
 
     t: NDArray[np.float64]
@@ -261,21 +194,13 @@ def poincare_section(result: Result, channels: Sequence[str] = CHANNELS, *, t0: 
     Parameters
     ----------
     result : Result
-        A run whose output times contain the section times (use :func:`sampling_times`
-        for ``t_eval``); dense output in between gives the attractor size.
+        Its output times contain the section times (:func:`sampling_times`); dense output in between
+        gives the attractor size.
     channels : sequence of str
-        Any channels or states (two for a plot, any number for classification).
-    t0 : float, optional
-        First section time, s: the end of the transient (plus the section's phase offset).
-        Default: the first output time.
-    t1 : float, optional
-        Last time, s; default the last output time.
-    period : float, optional
-        T, s; default from the scene's driver (:func:`crank_period`).
-
-    Returns
-    -------
-    PoincareSection
+        Any channels or states.
+    t0, t1, period : float, optional
+        First section time (end of the transient plus the section's offset) and last time, s (default
+        the run's ends); T, s (default :func:`crank_period`).
 
     Raises
     ------
@@ -312,7 +237,6 @@ def poincare_section(result: Result, channels: Sequence[str] = CHANNELS, *, t0: 
     return PoincareSection(t=result.t[idx] if times.size else np.zeros(0), points=points, channels=channels,
                            units=tuple(result.units.get(c, "") for c in channels), period=T, size=size,
                            center=center)
-
 
 
 def recurrence_defects(p: NDArray[np.float64], max_period: int) -> dict[int, float]:

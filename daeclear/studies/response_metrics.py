@@ -1,20 +1,9 @@
 """What the chapter reads from a run of the slider-crank, as numbers (section 4.5, Fig. 4.28).
 
-The chapter describes its Fig. 4.28 in words: the slider velocity is "smooth and close to the
-ideal joint simulation", slider and guide "are in permanent contact for long periods", "some
-sudden changes in the velocity are due to the impacts", which give "visible high peaks in the
-crank moment". Measured here on sampled channels (numpy only):
-
-* :func:`contact_periods`: the periods of contact of a 0/1 channel sampled uniformly, their
-  lengths and the fraction of the time they cover;
-* :func:`relative_rms`: the RMS distance of a channel from a reference, over the reference's
-  range (peak to peak);
-* :func:`revolution_peaks`: the largest ``|x|`` in each crank revolution;
-* :func:`onset_times`: the times of the corner impacts of a clearance joint, simultaneous ones
-  (a face landing on two corners) counted once;
-* :func:`measure`: all of them for one run against the ideal joint's run over one window;
-* :data:`FIG_4_28` and :func:`verdict`: the chapter's statements as thresholds, and which of
-  them a set of measured numbers meets.
+The chapter describes Fig. 4.28 in words (a velocity "smooth and close to the ideal joint
+simulation", slider and guide "in permanent contact for long periods", impacts giving "visible high
+peaks in the crank moment"). :func:`measure` measures them on sampled channels (numpy only), and
+:data:`FIG_4_28` with :func:`verdict` states them as thresholds and checks which are met.
 """
 
 from __future__ import annotations
@@ -32,11 +21,8 @@ __all__ = ["ContactPeriods", "contact_periods", "relative_rms", "revolution_peak
 
 @dataclass(frozen=True)
 class ContactPeriods:
-    """Periods of contact ``[starts[k], ends[k])`` within a sampled span of length ``span`` (s).
-
-    Each sample stands for the interval ``dt`` after it; a period cut by the span's start or
-    end is counted with the part inside the span.
-    """
+    """Periods of contact ``[starts[k], ends[k])`` within a sampled span of length ``span`` (s); each
+    sample stands for the interval ``dt`` after it (a period cut by the span counts its part inside)."""
 
     starts: NDArray[np.float64]
     ends: NDArray[np.float64]
@@ -122,12 +108,8 @@ LONG_CONTACT = 0.125
 
 
 def measure(run: Any, ideal: Any, *, joint: str, period: float, t0: float, t1: float) -> dict[str, float]:
-    """The numbers of :data:`FIG_4_28` (and a few more) of ``run`` against ``ideal`` over ``[t0, t1]``.
-
-    ``run``, ``ideal``: results with the same uniform output times (``slider.vx``,
-    ``drive.moment``, ``<joint>.in_contact``, ``<joint>.tilt``, ``<joint>.eta`` and events);
-    ``period``: the crank period, s; the window should hold whole revolutions.
-    """
+    """The numbers of :data:`FIG_4_28` (and a few more) of ``run`` against ``ideal`` (results on the same
+    uniform output times) over ``[t0, t1]``, a window of whole crank periods ``period`` (s)."""
     t, ti = np.asarray(run.t), np.asarray(ideal.t)
     pad = 1e-9 * period
     w, wi = (t >= t0 - pad) & (t <= t1 + pad), (ti >= t0 - pad) & (ti <= t1 + pad)
@@ -151,7 +133,8 @@ def measure(run: Any, ideal: Any, *, joint: str, period: float, t0: float, t1: f
         "velocity_rms_rel": relative_rms(v, vi),
         "velocity_max_rel": float(np.max(np.abs(v - vi)) / np.ptp(vi)),
         # the same RMS over the samples in free flight only: is a smooth velocity evidence of contact?
-        "velocity_rms_rel_free": _rms_where(v - vi, ~contact, np.ptp(vi)),
+        "velocity_rms_rel_free": (float(np.sqrt(np.mean((v - vi)[~contact] ** 2)) / np.ptp(vi))
+                                  if np.any(~contact) else float("nan")),
         "impacts_per_rev": impacts.size / revolutions,
         "moment_peak_median_Nm": float(np.median(peaks)),
         "moment_peak_max_Nm": float(np.max(peaks)),
@@ -160,10 +143,6 @@ def measure(run: Any, ideal: Any, *, joint: str, period: float, t0: float, t1: f
         "max_tilt_mrad": float(np.max(np.abs(np.asarray(run[f"{joint}.tilt"])[w])) * 1e3),
         "max_abs_eta": float(np.max(np.abs(np.asarray(run[f"{joint}.eta"])[w]))),
     }
-
-
-def _rms_where(x: NDArray[np.float64], mask: NDArray[np.bool_], scale: float) -> float:
-    return float(np.sqrt(np.mean(x[mask] ** 2)) / scale) if np.any(mask) else float("nan")
 
 
 @dataclass(frozen=True)
@@ -181,8 +160,6 @@ class Criterion:
 
 
 #: Fig. 4.28 (c = 0.5 mm), section 4.5's description as numbers over the analysed span.
-#: ``long_contact_fraction``: the fraction of the time in contact periods of at least 1/8 of a
-#: revolution (45 degrees of crank, 1.5 ms at 5000 rpm).
 FIG_4_28: tuple[Criterion, ...] = (
     Criterion("velocity_rms_rel", 0.0, 0.02, "The slider velocity diagram is smooth and close to the ideal joint "
               "simulation.", "RMS(v - v_ideal) <= 2 % of the ideal's range"),

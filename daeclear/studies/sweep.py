@@ -1,29 +1,9 @@
 """Parameter sweeps: many independent classified runs on any ``concurrent.futures.Executor``.
 
-``sweep(path, grid)`` builds one scene per parameter point (``slider_crank(**point)`` by
-default), runs :func:`daeclear.analysis.classify_motion` on it in a worker, and gathers
-every run in one HDF5 file. Workers only compute; the calling process is the only one
-that writes files.
-
-Robustness (a run's data is never half-written, an interrupted sweep loses no finished run):
-
-- each finished run is first written to its own journal file ``<path>.parts/<key>.h5``
-  under a temporary name, fsync'ed and renamed (atomic on POSIX; the package's one atomic
-  write, :func:`daeclear.results.outputs.atomic_file`);
-- at the end (and on an interrupt or an error) the journal is merged into ``<path>``: a
-  new file is written beside it and renamed over it, then the merged journal files are
-  deleted; a crash at any point leaves either the old or the new file, plus the journal;
-- a resumed sweep (the default) reads ``<path>`` and the journal, skips every finished run
-  (failed runs too, unless ``retry_failed=True``) and computes only the others;
-- ``<path>.lock`` keeps two sweeps from writing the same file at once.
-
-The file's HDF5 layout and its reader (:func:`load_sweep`, :class:`SweepResult`) are in
-:mod:`daeclear.studies.sweep_file`; the journal, merge and lock in
-:mod:`daeclear.studies.sweep_journal`; what the workers run in
-:mod:`daeclear.studies.sweep_workers`. This module plans the runs and drives them.
-
-``<key>`` is ``run-`` + the first 16 hex digits of the SHA-256 of the run's parameters as
-canonical JSON: the same point always has the same key, whatever grid it came from.
+``sweep(path, grid)`` classifies one scene per parameter point (:func:`daeclear.analysis.classify_motion`)
+in workers and gathers every run in one HDF5 file, written by the calling process alone: each finished
+run is journalled atomically, so an interrupted sweep resumes without losing one
+(docs/nonlinear_dynamics.md, *Sweeps*). This module plans and drives the runs.
 
 Examples
 --------
@@ -31,12 +11,6 @@ Examples
 >>> out = dc.sweep("clearance.h5", {"clearance": [0.01e-3, 0.1e-3, 0.5e-3]},
 ...                fixed={"joint": "revolute"})                      # doctest: +SKIP
 >>> [(r.parameters["clearance"], r.motion) for r in out.runs]         # doctest: +SKIP
-
-On a Dask cluster::
-
-    from dask.distributed import Client
-    client = Client("tcp://scheduler:8786")            # or Client(LocalCluster(...))
-    dc.sweep("big.h5", grid, executor=client.get_executor())
 """
 
 from __future__ import annotations
@@ -56,12 +30,12 @@ from typing import Any
 
 import numpy as np
 
-from .poincare import CHANNELS, PhasePortrait, PoincareSection, section_channels  # noqa: F401  (re-exported)
-from .sweep_file import (FORMAT_NAME, FORMAT_VERSION, SOLVER_KEY, RunRecord, SweepResult,  # noqa: F401
-                         load_sweep, part_files, parts_dir, read_record, solver_options)
+from .poincare import section_channels
+from .sweep_file import (FORMAT_NAME, FORMAT_VERSION, SOLVER_KEY, RunRecord, SweepResult, load_sweep, part_files,
+                         parts_dir, read_record, varying_names)
 from .sweep_journal import acquire_lock, consolidate, lock_path, write_part
 from .sweep_workers import build_scene, ignore_sigint, run_task, terminate_pool
-from ..errors import DaeclearError, DaeclearWarning, OutputError, SceneError  # noqa: F401
+from ..errors import DaeclearError, OutputError, SceneError
 from ..progress import Progress
 from ..results.outputs import check_file, deferred_sigint, sigint_latch
 from ..solver_options import UNSET, SolverOptions
@@ -75,9 +49,6 @@ ANALYSIS_OPTIONS = ("channels", "revolutions", "transient", "per_revolution", "p
                     "formulation", "backend")
 #: The solver settings analysis= may still give (the keyword form); they go into the sweep's SolverOptions.
 SOLVER_ANALYSIS_OPTIONS = ("atol", "max_step", "formulation", "backend")
-
-
-# --------------------------------------------------------------------------- parameters and keys
 
 
 def _plain_value(name: str, value: Any) -> Any:
@@ -96,29 +67,20 @@ def _plain_value(name: str, value: Any) -> Any:
                      "numbers, strings, bools, None or lists of them (give a law by name, e.g. law='hertz').")
 
 
-def _canonical(parameters: Mapping[str, Any]) -> str:
-    return json.dumps({k: parameters[k] for k in sorted(parameters)}, sort_keys=True, separators=(",", ":"))
+def _plain(parameters: Mapping[Any, Any]) -> dict[str, Any]:
+    """Parameters with str names and plain JSON values (:func:`_plain_value`)."""
+    return {str(k): _plain_value(str(k), v) for k, v in parameters.items()}
 
 
 def run_key(parameters: Mapping[str, Any]) -> str:
     """The stable name of a run: ``run-`` + 16 hex digits of the SHA-256 of its parameters (canonical JSON)."""
-    plain = {str(k): _plain_value(str(k), v) for k, v in parameters.items()}
-    return "run-" + hashlib.sha256(_canonical(plain).encode()).hexdigest()[:16]
+    canonical = json.dumps(_plain(parameters), sort_keys=True, separators=(",", ":"))
+    return "run-" + hashlib.sha256(canonical.encode()).hexdigest()[:16]
 
 
 def grid_points(grid: Mapping[str, Iterable[Any]]) -> list[dict[str, Any]]:
-    """Every combination of the grid's values, the last name varying fastest.
-
-    Parameters
-    ----------
-    grid : mapping of str to iterable
-        Parameter name -> values, e.g. ``{"clearance": [0.1e-3, 0.5e-3], "friction": [0.01, 0.1]}``.
-
-    Returns
-    -------
-    list of dict
-        One dict per point, in ``itertools.product`` order.
-    """
+    """Every combination of the grid's values (name -> values, e.g. ``{"clearance": [0.1e-3, 0.5e-3],
+    "friction": [0.01, 0.1]}``), one dict per point in ``itertools.product`` order."""
     names = list(grid)
     values = []
     for name in names:
@@ -130,10 +92,6 @@ def grid_points(grid: Mapping[str, Iterable[Any]]) -> list[dict[str, Any]]:
             raise SceneError(f"sweep: grid[{name!r}] is empty.")
         values.append(v)
     return [dict(zip(names, combo)) for combo in itertools.product(*values)]
-
-
-
-# --------------------------------------------------------------------------- the sweep
 
 
 def _mechanism_name(mechanism: str | Callable[..., Any]) -> str:
@@ -176,59 +134,40 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     Parameters
     ----------
     path : str or path-like
-        The sweep file (``.h5``); its directory must exist. With ``resume=True`` an existing
-        file (and its journal ``<path>.parts/``) is continued.
-    grid : mapping of str to list, optional
-        Parameter name -> values; every combination is run (:func:`grid_points`). A name is an
-        option of ``mechanism`` (``"clearance"``) or, with a dot, a value of the built scene
-        (``"clearance.law.restitution"``, :meth:`daeclear.Scene.with_values`).
-    runs : iterable of dict, optional
-        Explicit parameter points, instead of or after the grid's.
+        The sweep file (``.h5``) in an existing directory.
+    grid, runs : mapping of str to list, iterable of dict, optional
+        Parameter name -> values, every combination run (:func:`grid_points`), and explicit points
+        after them. A name is an option of ``mechanism`` or, with a dot, a value of the built scene
+        (``"clearance.law.restitution"``).
     mechanism : str or callable
-        Name of a ready mechanism (``"slider_crank"``) or a picklable top-level function
-        ``f(**parameters) -> Scene``.
+        A ready mechanism's name or a picklable top-level function ``f(**parameters) -> Scene``.
     fixed : mapping, optional
-        Parameters common to every run (e.g. ``{"joint": "revolute"}``); part of each run's
-        parameters and key.
-    channels : sequence of str, optional
-        Poincaré-section channels; default those of the first point's scene
-        (:func:`daeclear.analysis.section_channels`: slider velocity and acceleration, or the last
-        body's angular velocity and acceleration in a mechanism without a slider).
-    store_channels : sequence of str, optional
-        Channels stored over the analysed span with ``keep="channels"``; default ``channels``.
+        Parameters common to every run (part of each run's parameters and key).
+    channels, store_channels : sequence of str, optional
+        Poincaré-section channels (default :func:`daeclear.analysis.section_channels` of the first
+        point) and those stored over the analysed span (default ``channels``).
     keep : {"section", "channels", "full"}
-        What each run stores beyond its classification and section: nothing, the stored
+        What each run stores beyond its classification and section: nothing more, the stored
         channels (default), or also the full reference Result.
     revolutions, transient, per_revolution, twin
         Passed to :func:`daeclear.analysis.classify_motion`.
-    rtol : float
-        Relative tolerance of every run (default that of ``options``, 1e-6 without it).
-    options : SolverOptions, optional
-        The solver settings of every run (:class:`daeclear.SolverOptions`: method, tolerances,
-        formulation, backend, ...). ``rtol=`` and the solver settings of ``analysis=`` override
-        the same setting, as keywords do in :func:`daeclear.simulate`. Stored in the file
-        (``options_json["solver"]``, :meth:`SolverOptions.to_dict`); ``SweepResult.solver_options``
-        gives it back, and a resume with other settings is refused.
+    rtol, options : float, SolverOptions
+        The solver settings of every run; ``rtol=`` and the solver settings of ``analysis=`` override
+        ``options``, as in :func:`daeclear.simulate`. Stored in the file (``SweepResult.solver_options``);
+        a resume with other settings is refused.
     analysis : mapping, optional
-        Further options of :func:`~daeclear.analysis.classify_motion` (``phase``, ``tol``,
-        ``max_period``, ``decorrelation``, ``perturbation``, ``seed``, ``twin_revolutions``) and,
-        as keywords, the solver settings ``atol``, ``max_step``, ``formulation``, ``backend``.
+        Further :func:`~daeclear.analysis.classify_motion` options (``phase``, ``tol``, ``max_period``,
+        ``decorrelation``, ``perturbation``, ``seed``, ``twin_revolutions``) and the solver settings
+        ``atol``, ``max_step``, ``formulation``, ``backend``.
     executor : concurrent.futures.Executor, optional
-        Where runs go. Default: a local process pool (spawned processes, ``max_workers``
-        of them, the platform's start method: on macOS and Windows a script must call
-        sweep under ``if __name__ == "__main__":``) created and shut down here. A Dask
-        cluster: ``client.get_executor()``.
-    max_workers : int, optional
-        Size of the default pool (default: the CPU count, at most the number of runs).
-    resume : bool
-        Continue an existing file, skipping its finished runs (default). False deletes the
-        file's runs and journal first.
-    retry_failed : bool
-        On resume, run the recorded failed runs again.
-    progress : bool
-        Progress line on stderr.
+        Where runs go; default a local process pool of ``max_workers`` (default the CPU count, at most
+        the number of runs); a Dask cluster: ``client.get_executor()``. On macOS and Windows a script
+        must call sweep under ``if __name__ == "__main__":``.
+    resume, retry_failed, progress : bool
+        Continue an existing file and its journal, skipping finished runs (False deletes them first); on
+        resume, run the failed runs again; a progress line on stderr.
     on_run : callable, optional
-        Called with each new RunRecord as soon as it is saved (e.g. live monitoring).
+        Called with each new RunRecord as soon as it is saved.
 
     Returns
     -------
@@ -240,9 +179,8 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     SceneError
         Bad arguments (unknown option, non-plain parameter value, no points).
     DaeclearError
-        The file belongs to another sweep (different mechanism, analysis or solver options:
-        the message names each difference), is locked by a running sweep, or the process pool broke (finished runs are
-        saved; run again to resume).
+        The file belongs to another sweep (each difference named), is locked by a running sweep, or
+        the process pool broke (finished runs are saved; run again to resume).
     KeyboardInterrupt
         Re-raised after the finished runs are saved.
     """
@@ -278,12 +216,12 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
         where="sweep", rtol=rtol, **{k: extra.pop(k) for k in SOLVER_ANALYSIS_OPTIONS if k in extra})
     if not isinstance(mechanism, str) and not callable(mechanism):
         raise SceneError(f"sweep: mechanism={mechanism!r}, must be a mechanism name or a callable.")
-    base = {str(k): _plain_value(str(k), v) for k, v in (fixed or {}).items()}
+    base = _plain(fixed or {})
     points = grid_points(grid) if grid else []
     points += [dict(p) for p in (runs or [])]
     if not points:
         raise SceneError("sweep: no parameter points; give grid= and/or runs=.")
-    first = {**base, **{str(k): _plain_value(str(k), v) for k, v in points[0].items()}}
+    first = {**base, **_plain(points[0])}
     first_scene = build_scene(mechanism, first)  # a bad fixed parameter fails here, before any run
     if channels is None:  # from what the mechanism holds (every point has its bodies)
         channels = section_channels(first_scene)
@@ -294,19 +232,19 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     file_options = {**{k: _plain_value(k, v) for k, v in analysis_options.items()}, "keep": keep,
                     "store_channels": stored, SOLVER_KEY: solver.to_dict()}
     mech_name = _mechanism_name(mechanism)
+    task_analysis = {k: (tuple(v) if k == "channels" else v) for k, v in analysis_options.items()}
     tasks: list[dict[str, Any]] = []
     order: dict[str, int] = {}
     for point in points:
-        params = {**base, **{str(k): _plain_value(str(k), v) for k, v in point.items()}}
+        params = {**base, **_plain(point)}
         key = run_key(params)
         if key in order:
             continue  # the same point twice: one run
         order[key] = len(tasks)
         tasks.append({"key": key, "index": len(tasks), "parameters": params, "mechanism": mechanism,
-                      "analysis": {k: (tuple(v) if k == "channels" else v) for k, v in analysis_options.items()},
-                      SOLVER_KEY: solver.to_dict(), "keep": keep, "store_channels": stored})
-    varying = [n for n in dict.fromkeys(k for t in tasks for k in t["parameters"])
-               if len({json.dumps(t["parameters"].get(n)) for t in tasks}) > 1]
+                      "analysis": task_analysis, SOLVER_KEY: file_options[SOLVER_KEY], "keep": keep,
+                      "store_channels": stored})
+    varying = varying_names([t["parameters"] for t in tasks])
 
     lock = acquire_lock(path, {"mechanism": mech_name})
     n_computed = n_skipped = 0

@@ -16,10 +16,8 @@ HDF5 layout of ``<path>`` (root attributes ``format="daeclear-sweep"``, ``versio
     /runs/<key>/result          the reference run in the layout of daeclear.results.result
                                 (keep="full"; read it with SweepResult.result)
 
-A run's group is the same in the sweep file and in its journal file ``<path>.parts/<key>.h5``
-(:mod:`daeclear.studies.sweep_journal` writes those atomically and merges them into ``<path>``);
-:func:`load_sweep` reads both. Separate from the sweep's execution (:mod:`daeclear.studies.sweep`):
-a sweep file is read without running anything.
+A run's group is the same in the sweep file and in its journal file ``<path>.parts/<key>.h5``;
+:func:`load_sweep` reads both, without running anything.
 """
 
 from __future__ import annotations
@@ -28,7 +26,9 @@ import json
 import math
 import os
 import warnings
-from collections.abc import Mapping
+from collections import Counter
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -45,7 +45,7 @@ if TYPE_CHECKING:
     from ..solver_options import SolverOptions
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "SOLVER_KEY", "RunRecord", "SweepResult", "json_default", "load_sweep",
-           "part_files", "parts_dir", "read_record", "solver_options", "write_header", "write_run"]
+           "part_files", "parts_dir", "read_record", "solver_options", "varying_names", "write_header", "write_run"]
 
 FORMAT_NAME = "daeclear-sweep"
 FORMAT_VERSION = 1
@@ -70,45 +70,19 @@ def _current_form(options: dict[str, Any]) -> dict[str, Any]:
         return options
     legacy = {k: options[k] for k in _LEGACY_SOLVER_KEYS if k in options}
     rest = {k: v for k, v in options.items() if k not in _LEGACY_SOLVER_KEYS}
-    from ..solver_options import SolverOptions
-
-    return {**rest, SOLVER_KEY: SolverOptions.from_dict(legacy).to_dict()}
-
-
-# --------------------------------------------------------------------------- records
+    return {**rest, SOLVER_KEY: solver_options({SOLVER_KEY: legacy}).to_dict()}
 
 
 @dataclass(frozen=True)
 class RunRecord:
-    """One run of a sweep, as stored.
+    """One run of a sweep, as stored (the layout's fields, see the module docstring).
 
-    Attributes
-    ----------
-    key : str
-        Group name under ``/runs``.
-    index : int
-        Position in the sweep's list of points.
-    parameters : dict
-        The scene parameters of the run (fixed ones included).
-    status : {"done", "failed"}
-    motion : str
-        Motion label (:data:`daeclear.analysis.MOTION_LABELS`); "" for a failed run.
-    period : int
-        Period in revolutions for a periodic run, else 0.
-    evidence : dict
-        The classification evidence (:class:`daeclear.analysis.MotionClass`).
-    reason : str
-        The classification's one-line reason.
-    error : str
-        ``"<Exception>: <message>"`` of a failed run, else "".
-    traceback : str
-        Its traceback text.
-    wall_time : float
-        Seconds the worker spent on the run.
-    computed_at : str
-        UTC time the run finished (ISO 8601).
-    worker : str
-        ``host:pid`` of the worker process.
+    ``key`` is the group name under ``/runs``, ``index`` the position in the sweep's points,
+    ``parameters`` the run's scene parameters (fixed ones included), ``status`` "done" or "failed";
+    a done run has ``motion`` (:data:`daeclear.analysis.MOTION_LABELS`), ``period`` (revolutions, 0
+    unless periodic), ``evidence`` and ``reason`` (:class:`daeclear.analysis.MotionClass`); a failed
+    one ``error`` (``"<Exception>: <message>"``) and ``traceback``. ``wall_time`` (s), ``computed_at``
+    (UTC, ISO 8601) and ``worker`` (``host:pid``) say where and how long it ran.
     """
 
     key: str
@@ -138,9 +112,6 @@ class RunRecord:
             row[name] = self.evidence.get(name, float("nan"))
         row.update(error=self.error, wall_time=self.wall_time)
         return row
-
-
-# --------------------------------------------------------------------------- HDF5 writing
 
 
 def _attr_value(value: Any) -> Any:
@@ -234,7 +205,10 @@ def write_header(f: h5py.File | h5py.Group, mechanism: str, options: Mapping[str
     f.attrs["options_json"] = json.dumps(options, sort_keys=True)
 
 
-# --------------------------------------------------------------------------- reading
+def varying_names(points: Sequence[Mapping[str, Any]]) -> list[str]:
+    """Names of the parameters that differ between points, in first-seen order."""
+    names = dict.fromkeys(k for p in points for k in p)
+    return [n for n in names if len({json.dumps(p.get(n), sort_keys=True) for p in points}) > 1]
 
 
 def _text(value: Any) -> str:
@@ -274,33 +248,21 @@ def _check_format(f: h5py.File, path: Path) -> None:
                             f"daeclear reads versions up to {FORMAT_VERSION}. Upgrade daeclear.")
 
 
+@dataclass(eq=False)
 class SweepResult:
-    """The runs of a sweep file (and its journal of runs not yet merged), with their data.
+    """The runs of a sweep file ``path`` (and of its journal), in index order, with their data.
 
-    Attributes
-    ----------
-    path : pathlib.Path
-        The sweep file.
-    runs : list of RunRecord
-        Every run, in index order.
-    mechanism : str
-        The mechanism (name, or ``module:function`` of a callable).
-    options : dict
-        The analysis options of the sweep (:func:`daeclear.analysis.classify_motion`), ``keep``,
-        the stored channels and, under ``"solver"``, the solver settings as a dict
-        (:attr:`solver_options` rebuilds the SolverOptions).
-    n_computed, n_skipped : int
-        Runs computed and runs found finished by the call that returned this (0 from `load_sweep`).
+    ``mechanism`` is a name or the ``module:function`` of a callable; ``options`` the analysis options,
+    ``keep``, the stored channels and, under ``"solver"``, the solver settings (:attr:`solver_options`);
+    ``n_computed`` and ``n_skipped`` count the runs the call that returned this computed and found done.
     """
 
-    def __init__(self, path: Path, runs: list[RunRecord], mechanism: str, options: dict[str, Any],
-                 n_computed: int = 0, n_skipped: int = 0) -> None:
-        self.path = path
-        self.runs = runs
-        self.mechanism = mechanism
-        self.options = options
-        self.n_computed = n_computed
-        self.n_skipped = n_skipped
+    path: Path
+    runs: list[RunRecord]
+    mechanism: str
+    options: dict[str, Any]
+    n_computed: int = 0
+    n_skipped: int = 0
 
     def __len__(self) -> int:
         return len(self.runs)
@@ -315,10 +277,7 @@ class SweepResult:
 
     def __repr__(self) -> str:
         done = sum(r.ok for r in self.runs)
-        counts: dict[str, int] = {}
-        for r in self.runs:
-            if r.ok:
-                counts[r.motion] = counts.get(r.motion, 0) + 1
+        counts = Counter(r.motion for r in self.runs if r.ok)
         motions = ", ".join(f"{n} {label}" for label, n in sorted(counts.items()))
         return (f"SweepResult('{self.path}': {len(self.runs)} runs, {done} done, {len(self.runs) - done} failed"
                 + (f"; {motions}" if motions else "") + ")")
@@ -330,23 +289,14 @@ class SweepResult:
 
     def parameter_names(self) -> list[str]:
         """Names of the parameters that vary between runs, in first-seen order."""
-        names: dict[str, None] = {}
-        for r in self.runs:
-            names.update(dict.fromkeys(r.parameters))
-        return [n for n in names if len({json.dumps(r.parameters.get(n), sort_keys=True) for r in self.runs}) > 1]
+        return varying_names([r.parameters for r in self.runs])
 
     def table(self) -> list[dict[str, Any]]:
         """One flat dict per run (:meth:`RunRecord.row`), in index order."""
         return [r.row() for r in self.runs]
 
     def run(self, key: str | int | None = None, **parameters: Any) -> RunRecord:
-        """A run by key, by index, or by (some of) its parameter values.
-
-        Raises
-        ------
-        KeyError
-            If no run, or more than one, matches.
-        """
+        """A run by key, by index, or by (some of) its parameter values; KeyError unless exactly one matches."""
         if isinstance(key, str):
             found = [r for r in self.runs if r.key == key]
         elif isinstance(key, int):
@@ -360,14 +310,15 @@ class SweepResult:
                            "enough parameter values to pick one.")
         return found[0]
 
-    def _open(self, record: RunRecord) -> tuple[Any, str]:
-        """(open h5py.File, group path) holding the run: the journal file if present, else the sweep file."""
+    @contextmanager
+    def _group(self, record: RunRecord) -> Iterator[h5py.Group]:
+        """The run's open group: in its journal file if present, else in the sweep file."""
         import h5py
 
         part = parts_dir(self.path) / f"{record.key}.h5"
-        if part.is_file():
-            return h5py.File(part, "r"), "/"
-        return h5py.File(self.path, "r"), f"/runs/{record.key}"
+        journal = part.is_file()
+        with h5py.File(part if journal else self.path, "r") as f:
+            yield f["/" if journal else f"/runs/{record.key}"]
 
     def _record(self, run: RunRecord | str | int) -> RunRecord:
         return run if isinstance(run, RunRecord) else self.run(run)
@@ -377,9 +328,8 @@ class SweepResult:
         record = self._record(run)
         if not record.ok:
             raise DaeclearError(f"run {record.key} failed ({record.error}); it has no section.")
-        f, where = self._open(record)
-        with f:
-            g = f[where]["section"]
+        with self._group(record) as run_group:
+            g = run_group["section"]
             return PoincareSection(t=g["t"][()], points=g["points"][()],
                                    channels=tuple(_text(c) for c in g.attrs["channels"]),
                                    units=tuple(_text(u) for u in g.attrs["units"]), period=float(g.attrs["period"]),
@@ -389,9 +339,7 @@ class SweepResult:
     def channels(self, run: RunRecord | str | int) -> dict[str, np.ndarray]:
         """The stored channels of a run over its analysed span (``"t"`` included)."""
         record = self._record(run)
-        f, where = self._open(record)
-        with f:
-            g = f[where]
+        with self._group(record) as g:
             if "channels" not in g:
                 raise DaeclearError(f"run {record.key}: no channels stored (sweep keep={self.options.get('keep')!r}; "
                                     "use keep='channels' or 'full').")
@@ -408,9 +356,8 @@ class SweepResult:
             if name not in stored:
                 raise DaeclearError(f"run {record.key}: channel {name!r} not stored; stored: "
                                     f"{', '.join(n for n in stored if n != 't')}.")
-        f, where = self._open(record)
-        with f:
-            units = tuple(_text(f[where]["channels"][n].attrs.get("units", "")) for n in (x, y))
+        with self._group(record) as g:
+            units = tuple(_text(g["channels"][n].attrs.get("units", "")) for n in (x, y))
         return PhasePortrait(t=stored["t"], x=stored[x], y=stored[y], names=(x, y),
                              units=units)  # type: ignore[arg-type]
 
@@ -419,26 +366,15 @@ class SweepResult:
         from ..results.result import read_result_group
 
         record = self._record(run)
-        f, where = self._open(record)
-        with f:
-            g = f[where]
+        with self._group(record) as g:
             if "result" not in g:
                 raise DaeclearError(f"run {record.key}: no full result stored (sweep keep="
                                     f"{self.options.get('keep')!r}; use keep='full').")
             return read_result_group(g["result"], self.path)
 
     def bifurcation_data(self, parameter: str, channel: str | int = 0) -> tuple[np.ndarray, np.ndarray, list[str]]:
-        """Section values of one channel against a swept parameter, for a bifurcation diagram.
-
-        Returns
-        -------
-        x : ndarray
-            The parameter value of each section point.
-        y : ndarray
-            The section values of ``channel`` (name or column index).
-        labels : list of str
-            The motion label of the run of each point.
-        """
+        """For a bifurcation diagram: each section point's ``parameter`` value, its value of ``channel``
+        (name or column index) and its run's motion label."""
         xs, ys, labels = [], [], []
         for r in self.runs:
             if not r.ok:

@@ -1,16 +1,13 @@
 """Crash-safe writing of a sweep file: per-run journal files, their merge, and the file's lock.
 
-Each finished run goes to its own journal file ``<path>.parts/<key>.h5`` (temporary name, fsync,
-rename: atomic on POSIX, :func:`write_part`); :func:`consolidate` merges the journal into a new
-file renamed over ``<path>``; both write through :func:`daeclear.results.outputs.atomic_file`,
-the package's one atomic write, so a crash at any point leaves the old or the new file plus the
-journal; ``<path>.lock`` (:func:`acquire_lock`) keeps two sweeps from writing one file at once.
-Separate from the layout of a run (:mod:`daeclear.studies.sweep_file`): this module only decides
-how and when bytes reach the disk safely.
+Journal files (:func:`write_part`) and the merged file (:func:`consolidate`) are written through
+:func:`daeclear.results.outputs.atomic_file`, so a crash at any point leaves the old or the new file
+plus the journal; ``<path>.lock`` (:func:`acquire_lock`) keeps two sweeps from writing one file.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import socket
@@ -27,8 +24,7 @@ __all__ = ["acquire_lock", "consolidate", "lock_path", "write_part"]
 
 
 def write_part(parts: Path, outcome: Mapping[str, Any], mechanism: str, options: Mapping[str, Any]) -> Path:
-    """Write one run to ``parts/<key>.h5`` atomically (:func:`~daeclear.results.outputs.atomic_file`:
-    a temporary name beside it, fsync, rename; removed on any exception, Ctrl-C included)."""
+    """Write one run to ``parts/<key>.h5`` atomically (removed on any exception, Ctrl-C included)."""
     import h5py
 
     parts.mkdir(parents=True, exist_ok=True)
@@ -72,13 +68,10 @@ def consolidate(path: Path, *, mechanism: str, options: Mapping[str, Any], order
                     extra += 1
     for part in merged:
         part.unlink(missing_ok=True)
-    if parts_dir(path).is_dir():  # half-written parts of a killed sweep (the lock is ours: no writer runs)
-        for stale in parts_dir(path).glob(".run-*.tmp"):  # atomic_file's temporary names: .<key>.h5.<hex>.tmp
-            stale.unlink(missing_ok=True)
-    try:
+    for stale in parts_dir(path).glob(".run-*.tmp"):  # a killed sweep's half-written parts (the lock is ours)
+        stale.unlink(missing_ok=True)
+    with contextlib.suppress(OSError):  # not empty (an unreadable part) or absent
         parts_dir(path).rmdir()
-    except OSError:
-        pass  # not empty (an unreadable part) or absent
 
 
 def lock_path(path: Path) -> Path:
@@ -91,8 +84,8 @@ def _pid_alive(pid: int) -> bool:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
-    except PermissionError:
-        return True
+    except PermissionError:  # alive, another user's
+        pass
     return True
 
 

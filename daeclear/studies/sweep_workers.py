@@ -1,15 +1,10 @@
-"""What a sweep's workers run, and the lifecycle of the local process pool.
-
-:func:`run_task` builds the scene of one parameter point, classifies its motion and returns plain
-data (it runs in a worker process, on any ``concurrent.futures.Executor``: a local pool or a Dask
-cluster); :func:`ignore_sigint` is the local pool's initializer and :func:`terminate_pool` stops
-its workers on an interrupt. Separate from the sweep's bookkeeping (:mod:`daeclear.studies.sweep`)
-and its file (:mod:`daeclear.studies.sweep_file`): workers only compute, they never write files.
-"""
+"""What a sweep's workers run (:func:`run_task`: plain data back, no files), and the local pool's lifecycle."""
 
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
+import dataclasses
 import os
 import signal
 import socket
@@ -29,10 +24,8 @@ __all__ = ["build_scene", "ignore_sigint", "run_task", "terminate_pool"]
 
 
 def build_scene(mechanism: str | Callable[..., Any], parameters: Mapping[str, Any]) -> Any:
-    """The scene of one parameter point: ``mechanism(**options)`` (a callable or a ready mechanism's
-    name) with the point's scene values set: a parameter whose name holds a dot (``"clearance.clearance"``,
-    ``"clearance.law.restitution"``, see :meth:`daeclear.Scene.with_values`) is a value of the built
-    scene, any other an option of the mechanism."""
+    """The scene of one parameter point: ``mechanism(**options)`` with the point's scene values set (a
+    name with a dot, :meth:`daeclear.Scene.with_values`; any other is an option of the mechanism)."""
     options = {k: v for k, v in parameters.items() if "." not in k}
     values = {k: v for k, v in parameters.items() if "." in k}
     if callable(mechanism):
@@ -77,10 +70,7 @@ def run_task(task: Mapping[str, Any]) -> dict[str, Any]:
         analysis = classify_motion(scene, options=options, **task["analysis"])
         section = analysis.section
         data: dict[str, Any] = {
-            "section": {"t": np.asarray(section.t), "points": np.asarray(section.points),
-                        "channels": list(section.channels), "units": list(section.units),
-                        "size": np.asarray(section.size), "center": np.asarray(section.center),
-                        "period": section.period},
+            "section": dataclasses.asdict(section),  # t, points, channels, units, period, size, center
             "motion": {"label": analysis.motion.label, "period": analysis.motion.period,
                        "reason": analysis.motion.reason, "evidence": dict(analysis.motion.evidence)},
         }
@@ -102,8 +92,7 @@ def run_task(task: Mapping[str, Any]) -> dict[str, Any]:
             out.update(status="interrupted")
         else:
             out.update(status="failed", error=f"{type(exc).__name__}: {message}", traceback=tb.format_exc())
-    out["wall_time"] = time.perf_counter() - start
-    out["computed_at"] = datetime.now(UTC).isoformat(timespec="seconds")
+    out.update(wall_time=time.perf_counter() - start, computed_at=datetime.now(UTC).isoformat(timespec="seconds"))
     return out
 
 
@@ -111,7 +100,5 @@ def terminate_pool(executor: cf.Executor) -> None:
     """Stop our own process pool's workers now (their running tasks are abandoned, not recorded)."""
     processes = getattr(executor, "_processes", None) or {}
     for process in list(processes.values()):
-        try:
+        with contextlib.suppress(Exception):  # already gone
             process.terminate()
-        except Exception:  # already gone
-            pass

@@ -1,13 +1,8 @@
 """Twin trajectories: restart a run on its attractor, perturb one twin, measure how they separate.
 
-The sensitivity half of the motion analysis: :func:`restart_state` takes a run's state on the
-attractor to restart from (one twin perturbed along the constraint manifold; ``simulate(...,
-t0=, y0=)`` continues the run at its true time), :func:`twin_divergence` measures
-the twins' separation and section points, and :func:`twin_evidence` turns any such pair of
-trajectories into the numbers the classification reads (:class:`Divergence`: Lyapunov fit,
-amplification, decorrelation, section gap). Separate from the section test
-(:mod:`daeclear.studies.poincare`) and from the rules that combine both
-(:mod:`daeclear.studies.motion_class`).
+:func:`restart_state` gives the (perturbed) state to restart from, :func:`twin_divergence` measures the
+twins' separation and section points, and :func:`twin_evidence` turns any such pair of trajectories
+into the numbers the classification (:mod:`daeclear.studies.motion_class`) reads.
 """
 
 from __future__ import annotations
@@ -30,9 +25,6 @@ if TYPE_CHECKING:
 __all__ = ["Divergence", "RestartState", "all_free", "restart_state", "twin_divergence", "twin_evidence"]
 
 
-# --------------------------------------------------------------------------- twin trajectories
-
-
 def _state_selection(result: Result) -> list[int]:
     """Columns of y that are positions or velocities (states with a unit; multipliers have none)."""
     return [i for i, name in enumerate(result.state_names) if result.units.get(name, "")]
@@ -49,30 +41,22 @@ def restart_state(model: DAEModel, result: Result, index: int, *, perturbation: 
                   seed: int = 0) -> RestartState:
     """The time and state of ``result`` at output ``index``, optionally perturbed, to restart from.
 
-    ``simulate(model, t0 + span, t0=t0, y0=y0)`` continues the run from there (drivers at the true
-    time; positions and velocities kept, GGL projected; multipliers recomputed; contact modes from
-    the gaps at ``t0``): see *Restarts from a state* in docs/user_guide.md. Any output time will
-    do; the twin runs of :func:`daeclear.analysis.classify_motion` restart in free flight.
+    ``simulate(model, t0 + span, t0=t0, y0=y0)`` continues the run from there (*Restarts from a state*
+    in docs/user_guide.md).
 
     Parameters
     ----------
-    model : DAEModel
-        The model of ``result``.
-    result : Result
-        A run of ``model``.
-    index : int
-        Output index of the restart state.
-    perturbation : float
-        Size (Euclidean norm over the positions q, m and rad mixed) of a random
-        perturbation of the positions, projected on the null space of the constraint Jacobian
-        at ``t0`` so the joints stay closed to first order; 0 for none.
-    seed : int
-        Seed of the perturbation's random direction.
+    model, result, index : DAEModel, Result, int
+        A run of ``model`` and the output index of the restart state.
+    perturbation, seed : float, int
+        Euclidean norm (over the positions q, m and rad mixed) of a random perturbation of the
+        positions, projected on the null space of the constraint Jacobian so the joints stay
+        closed to first order (0: none), and the seed of its direction.
 
     Returns
     -------
     RestartState
-        ``(t0, y0)``: the output time and a copy of the (perturbed) state.
+        The output time and a copy of the (perturbed) state.
     """
     t_restart = float(result.t[index])
     y = np.array(result.y[index], dtype=float)
@@ -110,49 +94,25 @@ class Divergence:
 
     Attributes
     ----------
-    t : ndarray (m,)
-        Times since the restart, s.
-    distance : ndarray (m,)
-        RMS over positions and velocities of |twin a - twin b| / (attractor range of the state).
-    restart_time : float
-        Time of the restart state in the original run, s.
-    restart_in_contact : bool
-        True when no section time of the analysed span was in free flight, so the restart is
-        in contact (the approach speed latched at the last impact is replaced by the current
-        penetration rate for that contact: the twins are then a slightly different system).
-    perturbation : float
-        Size of the position perturbation, m (Euclidean norm over q).
-    d0 : float
-        Normalised separation at the restart (the perturbation).
-    d_start : float
-        Separation at the first sample after the restart: the integration noise of two runs
-        whose steps differ (about rtol) when it exceeds d0; the growth is measured from it.
-    d_saturation : float
-        Median separation over the second half of the twin run.
-    amplification : float
-        d_saturation / d_start.
-    lyapunov : float
-        Largest Lyapunov exponent estimate, 1/s: slope of ln(distance) against time over the
-        growth window; nan when the separation grew less than MIN_AMPLIFICATION times.
-    r_squared : float
-        Coefficient of determination of that straight-line fit (nan without a fit).
-    fit_window : (float, float)
-        Times since restart (s) of the fitted samples.
-    decorrelation : float
-        RMS distance between the twins' section points over the second half of the twin run,
-        in units of the attractor's size, divided by sqrt(2) x the section's RMS spread: about 1
-        when the twins are as far apart as two unrelated points of the attractor, << 1 when
-        they stay together.
-    period : float
-        T, s.
-    section_gap : float
-        The numerator of the decorrelation alone: RMS distance between the twins' late section
-        points in units of the attractor size, the recurrence test's own yardstick (a periodic
-        section's spread is integration noise, so its decorrelation is a ratio to noise; the gap
-        is compared with ``tol`` instead). nan when not measured.
-    twin_recurrence : float
-        Recurrence defect of the unperturbed twin's late section points (smallest over k, attractor
-        units): a faithful restart of a periodic run recurs as the reference does. nan when not measured.
+    t, distance : ndarray (m,)
+        Times since the restart (s) and the RMS over positions and velocities of |a - b| / (attractor
+        range of the state).
+    restart_time, restart_in_contact : float, bool
+        Time of the restart state in the original run (s); True when no section time was in free
+        flight (the restart's latched approach speed is then the current penetration rate).
+    perturbation, d0, d_start : float
+        Position perturbation (m, norm over q), the separation it gives, and the separation at the
+        first sample after the restart (integration noise when larger), which the growth starts from.
+    d_saturation, amplification : float
+        Median separation over the second half of the twin run, and d_saturation / d_start.
+    lyapunov, r_squared, fit_window : float, float, (float, float)
+        Slope of ln(distance) against time over the growth window (1/s), its fit's R^2 and the fitted
+        times since restart; nan when the separation grew less than MIN_AMPLIFICATION times.
+    section_gap, decorrelation : float
+        RMS distance of the twins' late section points (attractor units), and that over sqrt(2) x the
+        section's RMS spread: about 1 for unrelated points of the attractor, << 1 for twins together.
+    period, twin_recurrence : float
+        T (s), and the recurrence defect of the unperturbed twin's late section points.
     """
 
     t: NDArray[np.float64]
@@ -203,29 +163,18 @@ def twin_evidence(t: ArrayLike, distance: ArrayLike, points_a: ArrayLike, points
                   perturbation: float = float("nan"), max_period: int = DEFAULT_MAX_PERIOD) -> Divergence:
     """Twin evidence from arrays: Lyapunov fit, amplification, decorrelation and section gap.
 
-    The array-level half of :func:`twin_divergence`, public so that any pair of trajectories
-    (a small ODE, a map, measured data) is judged by exactly the numbers a mechanism's twins are.
+    The array half of :func:`twin_divergence`, public so that any pair of trajectories (a small
+    ODE, a map, measured data) is judged by the same numbers as a mechanism's twins.
 
     Parameters
     ----------
-    t : array_like (m,)
-        Times since the restart, s (t[0] = 0: the restart).
-    distance : array_like (m,)
-        Normalised separation of the twins at those times (e.g. RMS over the states of
-        |a - b| / attractor range); distance[0] is the perturbation.
+    t, distance : array_like (m,)
+        Times since the restart (s, t[0] = 0) and the twins' normalised separation (distance[0]: the
+        perturbation).
     points_a, points_b : array_like (n, d)
-        The twins' section points (one row per revolution from the restart), in the units of
-        ``section.points``.
-    section : PoincareSection
-        Section of the reference run: attractor size, centre and spread.
-    restart_time, restart_in_contact, perturbation : float, bool, float
-        Recorded as evidence.
-    max_period : int
-        Longest period of the unperturbed twin's recurrence check.
-
-    Returns
-    -------
-    Divergence
+        The twins' section points, one row per revolution, in the units of the reference ``section``.
+    restart_time, restart_in_contact, perturbation, max_period : float, bool, float, int
+        Recorded as evidence; the longest period of the unperturbed twin's recurrence check.
     """
     t = np.asarray(t, dtype=float)
     distance = np.asarray(distance, dtype=float)
@@ -261,7 +210,7 @@ def twin_evidence(t: ArrayLike, distance: ArrayLike, points_a: ArrayLike, points
         p = section.normalized()
         spread = float(np.sqrt(np.mean(np.sum((p - p.mean(axis=0)) ** 2, axis=1))))
         decorrelation = gap / (math.sqrt(2.0) * spread) if spread > 0 else float("nan")
-        defects = recurrence_defects(na, max_period) if na.shape[0] >= 2 else {}
+        defects = recurrence_defects(na, max_period)  # {} for one point
         recurrence = min(defects.values()) if defects else float("nan")
     return Divergence(t=t, distance=distance, restart_time=float(restart_time),
                       restart_in_contact=bool(restart_in_contact), perturbation=float(perturbation), d0=d0,
@@ -273,33 +222,17 @@ def twin_evidence(t: ArrayLike, distance: ArrayLike, points_a: ArrayLike, points
 def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *, reference: Result,
                     restart_time: float | None = None, restart_in_contact: bool = False,
                     perturbation: float = float("nan"), offset: float = 0.0) -> Divergence:
-    """Separation, Lyapunov estimate and decorrelation of two twin runs.
-
-    Measures the separation of the states and the twins' section points, then hands them to
-    :func:`twin_evidence` (the same numbers for any pair of trajectories).
+    """Separation, Lyapunov estimate and decorrelation of two twin runs (via :func:`twin_evidence`).
 
     Parameters
     ----------
     twin_a, twin_b : Result
-        Unperturbed and perturbed runs from the same restart state (at their true times: a
-        restart at t_r runs from t_r, :func:`restart_state`), on the same output times, which
-        contain the section times ``offset + k T`` from the restart on.
-    section : PoincareSection
-        Section of the reference run: gives the channels, the attractor size and the spread.
-    reference : Result
-        The reference run: the attractor range of each state over the section's window.
-    restart_time : float, optional
-        Recorded as evidence; default the twins' first output time (the restart).
-    restart_in_contact, perturbation : bool, float
-        Recorded as evidence.
-    offset : float
-        Section time within the revolution, s: the section times are the times ``offset + k T``
-        (k an integer) in the twins' span, the reference's own section times when the twins
-        continue the reference run.
-
-    Returns
-    -------
-    Divergence
+        Unperturbed and perturbed runs from one restart state (:func:`restart_state`), on the same
+        output times, containing the section times ``offset + k T`` (s) from the restart on.
+    section, reference : PoincareSection, Result
+        The reference run's section and the run (each state's attractor range over the section's window).
+    restart_time, restart_in_contact, perturbation : float, bool, float
+        Recorded as evidence (``restart_time`` defaults to the twins' first output time).
     """
     if twin_a.t.shape != twin_b.t.shape or not np.allclose(twin_a.t, twin_b.t, rtol=0, atol=1e-12):
         raise DaeclearError("twin_divergence: the twin runs have different output times.")
@@ -309,11 +242,8 @@ def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *,
     y_ref = np.asarray(reference.y)[window][:, cols]
     ranges = np.ptp(y_ref, axis=0) if y_ref.shape[0] else np.zeros(len(cols))
     units = [reference.units[reference.state_names[i]] for i in cols]
-    keep = np.zeros(len(cols), dtype=bool)
-    for unit in set(units):
-        same = np.array([u == unit for u in units])
-        top = float(np.max(ranges[same])) if np.any(same) else 0.0
-        keep |= same & (ranges > 1e-9 * top) & (ranges > 0)
+    top = np.array([np.max(ranges[[v == u for v in units]]) for u in units])  # largest range of the same unit
+    keep = (ranges > 1e-9 * top) & (ranges > 0)
     idx = [c for c, k in zip(cols, keep) if k]
     scale = ranges[keep]
     diff = (np.asarray(twin_a.y)[:, idx] - np.asarray(twin_b.y)[:, idx]) / scale
@@ -325,8 +255,7 @@ def twin_divergence(twin_a: Result, twin_b: Result, section: PoincareSection, *,
         first = offset + T * math.ceil((start - offset) / T - TIME_MATCH)
         n_sec = int(math.floor((float(twin_a.t[-1]) - first) / T + TIME_MATCH)) + 1
         times = first + T * np.arange(max(n_sec, 0))
-    d = len(section.channels)
-    pa = pb = np.zeros((0, d))
+    pa = pb = np.zeros((0, len(section.channels)))
     if times.size >= 2:
         ia, ib = match_times(twin_a, times, T), match_times(twin_b, times, T)
         pa = np.column_stack([np.asarray(twin_a[c], dtype=float)[ia] for c in section.channels])

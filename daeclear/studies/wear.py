@@ -1,12 +1,9 @@
 """Joint wear over many cycles: a run's contact history, and the cycle scheme that grows the profile.
 
-:func:`wear_history` turns a run of a revolute clearance joint into the arrays of
-:class:`daeclear.contact.wear.WearHistoryArrays`: the normal force, the contact direction in the
-bearing's and in the journal's frame, the sliding speed of the contacting material points and the
-penetration, at every output time. :func:`daeclear.contact.wear.wear_increment` spreads them over
-the worn profile. :func:`simulate_wear` runs the mechanism block by block, each block's wear
-(optionally extrapolated over more cycles) put into the joint's profile for the next block
-(the iterative scheme of Mukras et al. 2010), as new run-time numbers of the same model.
+:func:`wear_history` gives the contact history of a revolute clearance joint
+(:class:`daeclear.contact.wear.WearHistoryArrays`), which :func:`daeclear.contact.wear.wear_increment`
+spreads over the worn profile; :func:`simulate_wear` runs the mechanism block by block, each block's
+wear put into the joint's profile for the next block (Mukras et al. 2010) as new run-time numbers.
 """
 
 from __future__ import annotations
@@ -35,8 +32,8 @@ from .poincare import crank_period
 from .wear_file import WearFile
 
 
-#: The deepest wear a history goes on with, as a fraction of the bearing radius: beyond it the profile's
-#: slope tilts the contact normal by more than the gap's model (normal e / |e|) neglects.
+#: The deepest wear a history goes on with, as a fraction of the bearing radius (the gap's model neglects
+#: the profile's slope).
 MAX_DEPTH_FRACTION = 0.05
 
 
@@ -94,11 +91,10 @@ def wear_history(result: Result, model: DAEModel, joint: str) -> WearHistoryArra
 
 @dataclass(frozen=True)
 class WearHistory:
-    """The profile's growth: one row per profile (the first unworn), ``cycles`` the cycles worn into
-    it. ``depth`` is (profiles, nodes) for one worn surface, (profiles, 2, nodes) for both (bearing,
-    journal); ``volume`` the worn volume (m^3, both surfaces), ``sliding_work`` the integral of normal
-    force times sliding speed so far (N m; ``volume = coefficient * sliding_work``), ``peak_force``
-    the largest normal force of the block simulated after each profile (N; NaN for the last)."""
+    """The profile's growth, one row per profile (the first unworn) worn over ``cycles``: ``depth``
+    (profiles, nodes) or, both surfaces worn, (profiles, 2, nodes); ``volume`` (m^3), ``sliding_work``
+    (integral of normal force times sliding speed, N m), ``peak_force`` (N, of the block run after
+    each profile; NaN for the last)."""
 
     angles: NDArray[np.float64]
     cycles: NDArray[np.float64]
@@ -143,33 +139,27 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
                   options: SolverOptions | None = None, progress: bool = False) -> WearHistory:
     """Wear a revolute clearance joint over ``cycles`` cycles of the mechanism.
 
-    The mechanism runs ``update_every`` cycles with the current profile; Archard's law over that
-    block (:func:`wear_history`, :func:`~daeclear.contact.wear.wear_increment`) times ``extrapolate``
-    is added to the profile, which counts as ``update_every * extrapolate`` cycles; the next block
-    continues from the block's last state with the new profile (new run-time numbers of the same
-    model: nothing is compiled). ``extrapolate=1`` simulates every cycle.
+    Each block runs ``update_every`` cycles with the current profile; its Archard wear times
+    ``extrapolate`` is added to the profile (counting ``update_every * extrapolate`` cycles), and the
+    next block continues from its last state with the new profile (nothing is compiled).
 
     Parameters
     ----------
-    scene : Scene
-        The mechanism; its joint ``joint`` has ``wear=ArchardWear(...)`` (and maybe a ``wear_depth`` to start from).
-    cycles : float
-        Cycles to wear (> 0); the last block may run past it (the cycles are counted in blocks).
+    scene, cycles : Scene, float
+        The mechanism, whose joint ``joint`` has ``wear=ArchardWear(...)``, and the cycles to wear (> 0;
+        the last block may run past it).
     update_every, extrapolate : int
         Cycles simulated per profile update, and the factor each block's wear is extrapolated by (>= 1).
     period : float or None
         One cycle, s; None: one turn of the scene's driver.
     path : str, path or None
-        An HDF5 file the history is appended to after every update (with the state to continue
-        from): a stopped run loses at most one block, and a call with the same file and settings
-        resumes where it stopped.
-    options : SolverOptions or None
-        The runs' solver settings (:class:`daeclear.SolverOptions`).
-    progress : bool
-        A progress line on stderr.
+        An HDF5 file the history is appended to after every block: a call with the same file and
+        settings resumes where a stopped one ended.
+    options, progress : SolverOptions or None, bool
+        The runs' solver settings; a progress line on stderr.
 
-    A block whose run fails, or a depth beyond :data:`MAX_DEPTH_FRACTION` of the bearing radius, ends
-    the history early with a :class:`~daeclear.PhysicsWarning`; ``WearHistory.message`` says why.
+    A failed block, or a depth beyond :data:`MAX_DEPTH_FRACTION` of the bearing radius, ends the
+    history early with a :class:`~daeclear.PhysicsWarning`; ``WearHistory.message`` says why.
     """
     for label, value in (("update_every", update_every), ("extrapolate", extrapolate)):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
@@ -207,14 +197,12 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
                 message = (f"stopped at {done:g} cycles: the worn depth {deepest:.3g} m exceeds "
                            f"{MAX_DEPTH_FRACTION:g} of the bearing radius {radius:g} m, where the gap's small-slope "
                            "model no longer holds; a smaller wear coefficient, or fewer cycles.")
-                warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
                 break
             model = model.with_parameters({f"{name}.wear_depth": _depth_value(depth, wear.surfaces)})
             try:
                 result = simulate(model, t0 + update_every * period, t0=t0, y0=y0, options=options)
             except SolveError as exc:  # the history so far is the result (and, with a path, in the file)
                 message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
-                warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
                 break
             increment, block_work = wear_increment(wear, wear_history(result, model, name), bearing_radius=radius,
                                                    clearance=clearance, effective_modulus=modulus)
@@ -230,6 +218,8 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
             bar.update(min(done, cycles), f"max depth {max(float(d.max()) for d in depth.values()):.3g} m")
     finally:
         bar.close()
+    if message:
+        warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
     return _history(rows, wear, radius, time.perf_counter() - tic, message)
 
 
