@@ -1,15 +1,7 @@
 """Panels of one run over time: a channel, the impact force curves, the response figure, and saving.
 
-The building blocks every other figure module draws with (:func:`plot_channel`, the run title,
-x-y curves of two channels) and :func:`save_figure`; separate so the joint, study and overview
-figures share them without importing each other.
-
-Each function takes data and an optional ``ax``, draws on it (a new figure when
-``ax`` is None) and returns the Axes; none calls ``plt.show()``. Units on the axes are
-stated in the labels. Figures of a run are titled with its parameters (clearance, crank speed,
-contact law, restitution, friction; ``title=``); functions that draw a run over time take a time
-``window=(t0, t1)`` and ``max_points`` (min-max decimation, so a long run does not plot as a
-solid band).
+The building blocks (:func:`plot_channel`, the run title, x-y curves of two channels, :func:`save_figure`)
+that the joint, study and overview figures share without importing each other.
 """
 
 from __future__ import annotations
@@ -36,13 +28,8 @@ Window = tuple[float | None, float | None] | None
 """A closed time window ``(t0, t1)`` in s; None (or a None side) leaves it open."""
 
 
-def _axes(ax: Axes | None) -> Axes:
-    return style.new_axes(ax)
-
-
 def set_run_title(target: Any, result: Result, title: str | bool | None, created: bool) -> None:
-    """Title ``target`` (Axes or Figure): the run's caption when ``title`` is True, or None and the
-    function made the figure itself; the text when a str; nothing when False."""
+    """Title ``target`` (Axes or Figure): a str as given; the run's caption when True, or None and ``created``."""
     if isinstance(title, str):
         style.set_title(target, title)
     elif title or (title is None and created):
@@ -82,14 +69,24 @@ def _labelled(impacts: Impacts) -> list[tuple[str, ImpactResult]]:
     return [(_label(i), i) for i in impacts]
 
 
+def _force_against(impacts: Impacts, ax: Axes | None, x: str, x_label: str, line_kw: Any) -> Axes:
+    """Contact force of each impact against ``impact.<x>`` (in millionths), labelled."""
+    ax = style.new_axes(ax)
+    for label, impact in _labelled(impacts):
+        ax.plot(getattr(impact, x) * 1e6, impact.force, label=label, **line_kw)
+    ax.set_xlabel(x_label)
+    ax.set_ylabel("contact force (N)")
+    ax.legend()
+    return ax
+
+
 def plot_force_penetration(impacts: Impacts, *, ax: Axes | None = None, **line_kw: Any) -> Axes:
     """Contact force against penetration for single impacts (hysteresis loops, Fig. 4.26b).
 
     Parameters
     ----------
     impacts : ImpactResult, iterable of ImpactResult, or mapping label -> ImpactResult
-        From :func:`daeclear.contact.simulate_impact`, one per law; unlabelled ones
-        are labelled by law name and restitution.
+        From :func:`daeclear.contact.simulate_impact`; unlabelled ones are labelled by law and restitution.
     ax : matplotlib Axes, optional
         Where to draw; a new figure when None.
     **line_kw
@@ -98,42 +95,17 @@ def plot_force_penetration(impacts: Impacts, *, ax: Axes | None = None, **line_k
     Returns
     -------
     matplotlib.axes.Axes
-        Penetration in um on x, force in N on y. The area enclosed by a loop is the
-        energy lost in the impact.
+        Penetration in µm on x, force in N on y; a loop's area is the energy lost in the impact.
     """
-    ax = _axes(ax)
-    for label, impact in _labelled(impacts):
-        ax.plot(impact.penetration * 1e6, impact.force, label=label, **line_kw)
-    ax.set_xlabel("penetration (µm)")
-    ax.set_ylabel("contact force (N)")
-    ax.legend()
-    return ax
+    return _force_against(impacts, ax, "penetration", "penetration (µm)", line_kw)
 
 
 def plot_force_time(impacts: Impacts, *, ax: Axes | None = None, **line_kw: Any) -> Axes:
-    """Contact force against time for single impacts (Fig. 4.26a).
+    """Contact force against time since first contact, µs, for single impacts (Fig. 4.26a).
 
-    Parameters
-    ----------
-    impacts : ImpactResult, iterable of ImpactResult, or mapping label -> ImpactResult
-        As in :func:`plot_force_penetration`.
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    **line_kw
-        Passed to ``ax.plot`` for every curve.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        Time since first contact in us on x, force in N on y.
+    ``impacts``, ``ax`` and ``line_kw`` as in :func:`plot_force_penetration`; returns the Axes.
     """
-    ax = _axes(ax)
-    for label, impact in _labelled(impacts):
-        ax.plot(impact.t * 1e6, impact.force, label=label, **line_kw)
-    ax.set_xlabel("time since contact onset (µs)")
-    ax.set_ylabel("contact force (N)")
-    ax.legend()
-    return ax
+    return _force_against(impacts, ax, "t", "time since contact onset (µs)", line_kw)
 
 
 def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, reference: Result | None = None,
@@ -154,13 +126,12 @@ def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, refere
     label : str, optional
         Legend label of the run (default its scene name).
     window : (t0, t1), optional
-        Time window in s; only output times inside it are drawn.
+        Time window in s.
     max_points : int, optional
-        Draw at most this many points per line, keeping the lowest and highest value of each
-        stretch (min-max decimation): peaks survive, a long run does not fill the axes.
+        At most this many points per line, min-max decimated (peaks survive).
     title : str or bool, optional
-        Axes title: True for the run's caption (clearance, speed, law, restitution, friction),
-        a str for that text, False for none; None gives the caption only on a new figure.
+        True: the run's caption (clearance, speed, law, restitution, friction); a str: that text;
+        False: none; None: the caption only on a new figure.
     **line_kw
         Passed to ``ax.plot`` for the run's line.
 
@@ -170,7 +141,7 @@ def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, refere
         ``ax.lines[0]`` is the reference when given, then the run.
     """
     created = ax is None
-    ax = _axes(ax)
+    ax = style.new_axes(ax)
     unit = result.units.get(channel, "")
     if reference is not None:
         ax.plot(*_series(reference, channel, window, max_points), "k--", lw=0.8, label="ideal joint")
@@ -198,11 +169,9 @@ def response_panels(result: Result, reference: Result | None, axes: Any, window:
 def save_response_figure(result: Result, path: Any, *, reference: Result | None = None,
                          channels: Iterable[str] = RESPONSE_CHANNELS, window: Window = None,
                          max_points: int | None = None, title: str | bool = True) -> Any:
-    """Write a figure of slider velocity, acceleration and driving moment (Fig. 4.15a-c) to ``path``.
+    """Write a figure of slider velocity, acceleration and driving moment (Fig. 4.15a-c) to ``path``; returns it.
 
-    Channels missing from the result are skipped; ``window`` and ``max_points`` as in
-    :func:`plot_channel`; titled with the run's caption (scene, clearance, speed, law,
-    restitution, friction) unless ``title`` is False or a text. Returns the path written.
+    Missing channels are skipped; ``window``, ``max_points`` and ``title`` as in :func:`plot_channel`.
     """
     import matplotlib.pyplot as plt
 

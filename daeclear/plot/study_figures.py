@@ -1,8 +1,5 @@
-"""Figures of studies: work-precision of the solvers, Poincaré sections, bifurcation diagrams, motion maps.
-
-Each takes the object a study returns (:mod:`daeclear.studies`) rather than one run, so it lives
-apart from the run and joint figures. Sweep figures show the swept parameter with its unit, on a
-log axis when the grid is geometric.
+"""Figures of studies (:mod:`daeclear.studies`): work-precision, Poincaré sections, bifurcation diagrams,
+motion maps; a swept parameter is shown with its unit, on a log axis when the grid is geometric.
 """
 
 from __future__ import annotations
@@ -19,10 +16,8 @@ __all__ = ["MOTION_COLORS", "plot_bifurcation", "plot_motion_map", "plot_poincar
 
 
 def plot_work_precision(study: Any, *, ax: Axes | None = None) -> Axes:
-    """Error against wall time (log-log), one line per method, failed runs marked with x at the top.
-
-    ``study`` is a :class:`daeclear.studies.accuracy.WorkPrecision`.
-    """
+    """Error against wall time (log-log) of a :class:`daeclear.studies.accuracy.WorkPrecision`, one line per
+    method, failed runs marked with x at the top."""
     import math
 
     ax = style.new_axes(ax)
@@ -55,10 +50,6 @@ MOTION_COLORS = {"periodic": "#2ca02c", "quasi-periodic": "#1f77b4", "chaotic": 
 """Colour of each motion class (:data:`daeclear.analysis.MOTION_LABELS`) in the sweep figures."""
 
 
-def _channel_label(name: str, unit: str) -> str:
-    return style.quantity_label(name, unit)
-
-
 def plot_poincare_section(section: Any, *, ax: Axes | None = None, portrait: Any = None, label: str | None = None,
                           **marker_kw: Any) -> Axes:
     """Stroboscopic Poincaré section (one point per crank revolution), over the phase portrait.
@@ -66,14 +57,12 @@ def plot_poincare_section(section: Any, *, ax: Axes | None = None, portrait: Any
     Parameters
     ----------
     section : daeclear.analysis.PoincareSection
-        Its first two channels are drawn (x, y); with one channel, the value against the
-        revolution number.
+        Its first two channels are drawn (x, y); with one channel, the value against the revolution.
     ax : matplotlib Axes, optional
         Where to draw; a new figure when None.
     portrait : PhasePortrait or Result, optional
-        Drawn first as a thin grey curve (the chapter's "Poincaré map"): a
-        :class:`~daeclear.analysis.PhasePortrait`, or a Result whose same two channels are
-        plotted from the section's first time on.
+        Drawn first, thin grey: a :class:`~daeclear.analysis.PhasePortrait`, or a Result (its same two
+        channels from the section's first time on).
     label : str, optional
         Legend label of the points (default "once per revolution (n points)").
     **marker_kw
@@ -102,12 +91,12 @@ def plot_poincare_section(section: Any, *, ax: Axes | None = None, portrait: Any
     text = label or f"once per revolution ({len(points)} points)"
     if points.shape[1] >= 2:
         ax.plot(points[:, 0], points[:, 1], label=text, **kw)
-        ax.set_xlabel(_channel_label(section.channels[0], section.units[0]))
-        ax.set_ylabel(_channel_label(section.channels[1], section.units[1]))
+        ax.set_xlabel(style.quantity_label(section.channels[0], section.units[0]))
+        ax.set_ylabel(style.quantity_label(section.channels[1], section.units[1]))
     else:
         ax.plot(np.arange(len(points)), points[:, 0], label=text, **kw)
         ax.set_xlabel("revolution after the transient")
-        ax.set_ylabel(_channel_label(section.channels[0], section.units[0]))
+        ax.set_ylabel(style.quantity_label(section.channels[0], section.units[0]))
     ax.legend(loc="best", fontsize="x-small")
     return ax
 
@@ -124,23 +113,19 @@ def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: 
     parameter : str
         The swept parameter (x axis), e.g. ``"clearance"``.
     channel : str or int
-        Section channel on the y axis (name or column; default the first, slider velocity).
+        Section channel on the y axis (name or column).
     ax : matplotlib Axes, optional
         Where to draw; a new figure when None.
-    scale : float, optional
-        Factor applied to the parameter values (e.g. 1e3 for a clearance in mm).
-    unit : str, optional
-        Unit of the scaled parameter, shown in the x label. With neither `scale` nor
-        `unit`, both come from :data:`daeclear.plot.style.PARAMETER_AXES` (clearance in mm,
-        rpm, restitution and friction dimensionless).
+    scale, unit : optional
+        Factor applied to the parameter values and their unit; when neither is given, both from
+        :data:`daeclear.plot.style.PARAMETER_AXES` (clearance in mm).
     log : bool, optional
-        Logarithmic x axis; None: when the parameter values form a geometric grid
-        (``numpy.geomspace``, three values or more).
+        Logarithmic x axis; None: when the values form a geometric grid (three or more).
     color_by_motion : bool
         Colour each run's points by its motion class (:data:`MOTION_COLORS`), with a legend.
     title : str or bool, optional
-        Axes title: True for the mechanism and the parameters every run shares, a str for
-        that text, False for none; None gives the caption only on a new figure.
+        True: the mechanism and the parameters every run shares; a str: that text; False: none;
+        None: the caption only on a new figure.
     **marker_kw
         Passed to ``ax.plot``.
 
@@ -160,7 +145,7 @@ def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: 
             col = sec.channels.index(channel) if isinstance(channel, str) else int(channel)
             xs.append(np.full(len(sec), float(value)))
             ys.append(np.asarray(sec.points)[:, col])
-            labels += ["" for _ in range(len(sec))]
+            labels += [""] * len(sec)
         x = np.concatenate(xs) if xs else np.zeros(0)
         y = np.concatenate(ys) if ys else np.zeros(0)
         name = channel if isinstance(channel, str) else next(iter(sweep.values())).channels[int(channel)]
@@ -188,12 +173,18 @@ def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: 
         ax.plot(x, y, **kw)
     values = list(sweep) if isinstance(sweep, Mapping) else [r.parameters.get(parameter) for r in sweep.runs]
     style.parameter_axis(ax, "x", parameter, values, unit, log)
-    ax.set_ylabel(f"{_channel_label(name, y_unit)} once per revolution")
+    ax.set_ylabel(f"{style.quantity_label(name, y_unit)} once per revolution")
+    if not isinstance(sweep, Mapping) or isinstance(title, str):
+        _sweep_title(ax, sweep, title, created, (parameter,))
+    return ax
+
+
+def _sweep_title(ax: Axes, sweep: Any, title: str | bool | None, created: bool, exclude: tuple[str, ...]) -> None:
+    """A str as given; the mechanism and the parameters every run shares when True, or None and ``created``."""
     if isinstance(title, str):
         style.set_title(ax, title)
-    elif (title or (title is None and created)) and not isinstance(sweep, Mapping):
-        style.set_title(ax, style.sweep_caption(sweep, exclude=(parameter,)))
-    return ax
+    elif title or (title is None and created):
+        style.set_title(ax, style.sweep_caption(sweep, exclude=exclude))
 
 
 def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_scale: float | None = None,
@@ -210,25 +201,21 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
         Parameter names of the horizontal and vertical axes.
     ax : matplotlib Axes, optional
         Where to draw; a new figure when None.
-    x_scale, y_scale : float, optional
-        Factors applied to the parameter values (e.g. 1e3 for mm).
-    x_unit, y_unit : str, optional
-        Units of the scaled values, in the axis labels. Without scale and unit, both come
-        from :data:`daeclear.plot.style.PARAMETER_AXES`.
+    x_scale, y_scale, x_unit, y_unit : optional
+        As ``scale`` and ``unit`` of :func:`plot_bifurcation`, per axis.
     x_log, y_log : bool, optional
-        Logarithmic axis (cells centred on the values, edges at geometric midpoints);
-        None: when the values of that axis form a geometric grid (three or more).
+        Logarithmic axis (cell edges at geometric midpoints); None: when the values form a geometric grid.
     annotate : bool
-        Write the period k in periodic cells ("P1", "P2", ...), "C" chaotic, "Q"
-        quasi-periodic, "N" non-periodic, "U" uncertain, "?" undetermined, "x" failed.
+        Write "P<k>" in periodic cells, "C" chaotic, "Q" quasi-periodic, "N" non-periodic, "U"
+        uncertain, "?" undetermined, "x" failed.
     title : str or bool, optional
-        As in :func:`plot_bifurcation` (the parameters every run shares).
+        As in :func:`plot_bifurcation`.
 
     Returns
     -------
     matplotlib.axes.Axes
-        Cells coloured by :data:`MOTION_COLORS`, ticks labelled with the values; on an index
-        grid, or on the values themselves along a log axis; one legend entry per class present.
+        Cells coloured by :data:`MOTION_COLORS` on an index grid (on the values along a log axis),
+        ticks labelled with the values; one legend entry per class present.
 
     Raises
     ------
@@ -293,12 +280,9 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
     ax.set_yticks(y_centres, [fmt(v, y_scale) for v in ys])
     ax.set_xlim(x_edges[0], x_edges[-1])
     ax.set_ylim(y_edges[0], y_edges[-1])
-    ax.set_xlabel(style.parameter_label(x, x_unit))
-    ax.set_ylabel(style.parameter_label(y, y_unit))
-    if isinstance(title, str):
-        style.set_title(ax, title)
-    elif title or (title is None and created):
-        style.set_title(ax, style.sweep_caption(sweep, exclude=(x, y)))
+    ax.set_xlabel(style.quantity_label(x, x_unit))
+    ax.set_ylabel(style.quantity_label(y, y_unit))
+    _sweep_title(ax, sweep, title, created, (x, y))
     present = sorted({int(v) for v in grid[np.isfinite(grid)]})
     ax.legend(handles=[Patch(color=MOTION_COLORS[classes[k]], label=classes[k]) for k in present],
               loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="x-small", title="motion",
@@ -321,5 +305,3 @@ def _cells(values: list[Any], scale: float, log: bool) -> tuple[Any, Any]:
     last = centres[-1] ** 2 / inner[-1]
     return centres, np.concatenate([[first], inner, [last]])
 
-
-__all__ += ["MOTION_COLORS", "plot_bifurcation", "plot_motion_map", "plot_poincare_section"]

@@ -1,10 +1,6 @@
-"""The one style of daeclear's figures: captions that carry the run's parameters, time
-windows and decimation for long runs, parameter axes with units and log scales.
+"""The one style of daeclear's figures: captions with the run's parameters, time windows and
+min-max decimation for long runs, parameter axes with units and log scales.
 
-Every figure function of :mod:`daeclear.plot` draws through these helpers, so a figure says
-which clearance, speed, contact law, restitution and friction produced it, a 200-revolution
-run can be shown over a window or thinned to a number of points that still shows its peaks,
-and a sweep over a geometric grid gets a log axis with the parameter's unit.
 matplotlib is imported only when an Axes is made.
 """
 
@@ -22,25 +18,9 @@ if TYPE_CHECKING:
 
     from ..results.result import Result
 
-__all__ = [
-    "PARAMETER_AXES",
-    "TITLE_SIZE",
-    "caption",
-    "decimate",
-    "format_parameter",
-    "is_geometric",
-    "new_axes",
-    "parameter_axis",
-    "parameter_display",
-    "parameter_label",
-    "quantity_label",
-    "run_parameters",
-    "select_times",
-    "set_title",
-    "stride",
-    "sweep_caption",
-    "window_index",
-]
+__all__ = ["PARAMETER_AXES", "TITLE_SIZE", "caption", "decimate", "format_parameter", "is_geometric", "new_axes",
+           "parameter_axis", "parameter_display", "quantity_label", "run_parameters", "scene_elements",
+           "select_times", "set_title", "stride", "sweep_caption", "window_bounds", "window_index"]
 
 TITLE_SIZE = "medium"
 """Font size of every figure and panel title."""
@@ -59,11 +39,7 @@ PARAMETER_AXES: dict[str, tuple[float, str]] = {
     "friction": (1.0, "-"),
     "rtol": (1.0, "-"),
 }
-"""How a swept parameter is shown: name -> (factor from its SI value, unit of the axis).
-
-The parameters of :func:`daeclear.mechanisms.slider_crank` and :func:`~daeclear.mechanisms.chain`,
-given in SI units (``clearance`` in m, shown in mm; ``rpm`` in rev/min).
-"""
+"""How a swept parameter (of the mechanisms' builders, in SI units) is shown: name -> (factor, unit of the axis)."""
 
 _LAW_NAMES = {"lankarani-nikravesh": "Lankarani-Nikravesh", "hunt-crossley": "Hunt-Crossley", "flores": "Flores",
               "hertz": "Hertz", "esdu-78035": "ESDU-78035", "goldsmith": "Goldsmith",
@@ -118,23 +94,25 @@ def _law_text(law: Any) -> str:
 
 
 def _friction_text(friction: Any) -> str:
-    if friction is None or friction == {} or friction is False:
+    if friction is None or friction == {} or friction is False or friction == "none":
         return "frictionless"
-    coefficient = _number(friction)
-    if coefficient is not None:
-        return "frictionless" if coefficient == 0 else f"friction $c_f$ = {coefficient:g}"
     if isinstance(friction, str):
-        return "frictionless" if friction == "none" else _FRICTION_NAMES.get(friction, friction)
-    if isinstance(friction, Mapping):
-        name = friction.get("name")
-        if name == "none":
-            return "frictionless"
-        coefficient = _number(friction.get("coefficient"))
-        text = _FRICTION_NAMES.get(name, str(name)) if isinstance(name, str) else "friction"
-        if coefficient is not None:
-            return "frictionless" if coefficient == 0 else f"{text} $c_f$ = {coefficient:g}"
-        return text
-    return ""
+        return _FRICTION_NAMES.get(friction, friction)
+    name = friction.get("name") if isinstance(friction, Mapping) else None
+    if name == "none":
+        return "frictionless"
+    coefficient = _number(friction.get("coefficient") if isinstance(friction, Mapping) else friction)
+    text = _FRICTION_NAMES.get(name, str(name)) if isinstance(name, str) else "friction"
+    if coefficient is not None:
+        return "frictionless" if coefficient == 0 else f"{text} $c_f$ = {coefficient:g}"
+    return text if isinstance(friction, Mapping) else ""
+
+
+def scene_elements(result: Result) -> Mapping[str, Any]:
+    """The element descriptions of the run's scene, ``result.parameters["scene"]["elements"]`` (empty if none)."""
+    scene = result.parameters.get("scene") if isinstance(result.parameters, Mapping) else None
+    elements = scene.get("elements", {}) if isinstance(scene, Mapping) else {}
+    return elements if isinstance(elements, Mapping) else {}
 
 
 def run_parameters(result: Result) -> dict[str, Any]:
@@ -147,11 +125,9 @@ def run_parameters(result: Result) -> dict[str, Any]:
         clearance joint, ``{"name", "kind", "clearance" (m), "law" (text), "restitution",
         "friction" (text)}``; entries that the scene does not have are left out.
     """
-    scene = result.parameters.get("scene") if isinstance(result.parameters, Mapping) else None
-    elements = scene.get("elements", {}) if isinstance(scene, Mapping) else {}
     out: dict[str, Any] = {}
     joints: list[dict[str, Any]] = []
-    for name, element in (elements.items() if isinstance(elements, Mapping) else ()):
+    for name, element in scene_elements(result).items():
         if not isinstance(element, Mapping):
             continue
         speed = _number(element.get("speed"))
@@ -183,9 +159,8 @@ def _joint_text(joint: Mapping[str, Any]) -> str:
 def caption(result: Result, *, name: bool = True) -> str:
     """One line naming the run: scene, clearance, crank speed, law and restitution, friction.
 
-    E.g. ``"slider_crank_revolute: c = 0.5 mm, 5000 rpm, Lankarani-Nikravesh $c_e$ = 0.9,
-    frictionless"``; a failed run is marked ``(FAILED: partial result)``. Several clearance
-    joints with different settings are listed by joint name.
+    E.g. ``"slider_crank_revolute: c = 0.5 mm, 5000 rpm, Lankarani-Nikravesh $c_e$ = 0.9, frictionless"``;
+    joints with different settings are listed by name, a failed run ends in ``(FAILED: partial result)``.
     """
     info = run_parameters(result)
     joints = info.get("joints", [])
@@ -248,12 +223,10 @@ def _check_max_points(max_points: int | None) -> None:
 
 
 def decimate(y: ArrayLike, max_points: int | None, index: NDArray[np.intp] | None = None) -> NDArray[np.intp]:
-    """Indices of at most ``max_points`` samples of ``y`` that keep its envelope (min-max decimation).
+    """Indices of at most ``max_points`` samples of ``y`` (or ``y[index]``) that keep its envelope.
 
-    The samples (all of ``y``, or ``y[index]``) are cut into ``max_points // 2`` runs of
-    consecutive points, and the lowest and highest point of each run are kept, in time
-    order: peaks (impacts) survive, which plain striding would miss. ``max_points=None``
-    keeps every point.
+    Min-max decimation: the lowest and highest point of each of ``max_points // 2`` runs of samples, in
+    time order, so peaks (impacts) survive; ``max_points=None`` keeps every point.
     """
     _check_max_points(max_points)
     values = np.asarray(y)
@@ -268,14 +241,11 @@ def decimate(y: ArrayLike, max_points: int | None, index: NDArray[np.intp] | Non
     for a, b in zip(edges[:-1], edges[1:]):
         if b <= a:
             continue
-        chunk = v[a:b]
-        finite = np.isfinite(chunk)
-        if not finite.any():
+        chunk = np.where(np.isfinite(v[a:b]), v[a:b], np.nan)
+        if np.isnan(chunk).all():
             keep.append(a)
-            continue
-        lo = a + int(np.nanargmin(np.where(finite, chunk, np.nan)))
-        hi = a + int(np.nanargmax(np.where(finite, chunk, np.nan)))
-        keep.extend(sorted({lo, hi}))
+        else:
+            keep.extend(sorted({a + int(np.nanargmin(chunk)), a + int(np.nanargmax(chunk))}))
     return idx[np.asarray(keep, dtype=np.intp)]
 
 
@@ -288,11 +258,10 @@ def stride(index: NDArray[np.intp], max_points: int | None) -> NDArray[np.intp]:
     return index[picks]
 
 
-def window_index(t: ArrayLike, window: tuple[float | None, float | None] | None) -> NDArray[np.intp]:
-    """Indices of the times inside the closed ``window = (t0, t1)`` (None: every time, or an open side)."""
-    times = np.asarray(t, dtype=np.float64)
+def window_bounds(window: tuple[float | None, float | None] | None) -> tuple[float, float]:
+    """``window = (t0, t1)`` as floats, a None side (or None) open (+-inf); ValueError if not a pair or t0 > t1."""
     if window is None:
-        return np.arange(times.shape[0])
+        return -math.inf, math.inf
     try:
         t0, t1 = window
     except (TypeError, ValueError):
@@ -301,13 +270,21 @@ def window_index(t: ArrayLike, window: tuple[float | None, float | None] | None)
     hi = math.inf if t1 is None else float(t1)
     if lo > hi:
         raise ValueError(f"window=({t0}, {t1}): t0 must not exceed t1.")
+    return lo, hi
+
+
+def window_index(t: ArrayLike, window: tuple[float | None, float | None] | None) -> NDArray[np.intp]:
+    """Indices of the times inside the closed ``window = (t0, t1)`` (None: every time, or an open side)."""
+    times = np.asarray(t, dtype=np.float64)
+    if window is None:
+        return np.arange(times.shape[0])
+    lo, hi = window_bounds(window)
     return np.flatnonzero((times >= lo) & (times <= hi))
 
 
 def select_times(t: ArrayLike, y: ArrayLike | None = None, *, window: tuple[float | None, float | None] | None = None,
                  max_points: int | None = None) -> NDArray[np.intp]:
-    """Indices to plot of a time series: inside ``window``, then min-max decimated on ``y`` to ``max_points``
-    (evenly strided when no ``y`` is given, e.g. for an x-y curve)."""
+    """Indices to plot: inside ``window``, min-max decimated on ``y`` to ``max_points`` (strided without ``y``)."""
     index = window_index(t, window)
     if y is None:
         return stride(index, max_points)
@@ -331,20 +308,14 @@ def is_geometric(values: Iterable[Any], rtol: float = 1e-6) -> bool:
 
 def parameter_display(name: str, scale: float | None = None, unit: str | None = None) -> tuple[float, str]:
     """Factor and unit of a parameter axis: the given ones, else :data:`PARAMETER_AXES`, else (1, "")."""
+    default_scale, default_unit = PARAMETER_AXES.get(name, (1.0, ""))
     if scale is None and unit is None:
-        return PARAMETER_AXES.get(name, (1.0, ""))
+        return default_scale, default_unit
     if scale is None:
-        default_scale, default_unit = PARAMETER_AXES.get(name, (1.0, ""))
         return (default_scale if unit == default_unit else 1.0), unit or ""
     if unit is None:
-        default_scale, default_unit = PARAMETER_AXES.get(name, (1.0, ""))
         return float(scale), (default_unit if scale == default_scale else "")
     return float(scale), unit
-
-
-def parameter_label(name: str, unit: str) -> str:
-    """Axis label of a parameter, ``"clearance (mm)"``."""
-    return quantity_label(name, unit)
 
 
 def parameter_axis(ax: Axes, which: str, name: str, values: Iterable[Any], unit: str,
@@ -352,12 +323,8 @@ def parameter_axis(ax: Axes, which: str, name: str, values: Iterable[Any], unit:
     """Label the x or y axis with the parameter and its unit; log scale when ``log`` or, if None, when
     ``values`` form a geometric grid. Returns whether the axis is logarithmic."""
     use_log = is_geometric(values) if log is None else bool(log)
-    if which == "x":
-        ax.set_xlabel(parameter_label(name, unit))
-        if use_log:
-            ax.set_xscale("log")
-    else:
-        ax.set_ylabel(parameter_label(name, unit))
-        if use_log:
-            ax.set_yscale("log")
+    axis = "x" if which == "x" else "y"
+    getattr(ax, f"set_{axis}label")(quantity_label(name, unit))
+    if use_log:
+        getattr(ax, f"set_{axis}scale")("log")
     return use_log
