@@ -1,9 +1,8 @@
 """Reading result files: the constructor keywords of a `Result` from an HDF5 file, group or window.
 
 The checks of a file (format, version, every item of the layout, with messages naming the file and
-what is missing) and the windowed reading that `load` (daeclear.results.result) builds a `Result`
-from. It returns keywords rather than a `Result` so that daeclear.results.result can offer `load`
-without an import circle. h5py is imported only when a file is read.
+what is missing) and the windowed reading that `load` builds a `Result` from; keywords rather than a
+`Result`, so that daeclear.results.result offers `load` without an import circle.
 """
 
 from __future__ import annotations
@@ -109,24 +108,25 @@ class _Reader:
     def has(self, name: str) -> bool:
         return name in self.f
 
-    def array(self, name: str, rows: slice | None = None) -> np.ndarray:
+    def _get(self, name: str) -> Any:
         if name not in self.f:
             raise self._missing(f"dataset '/{name}'")
+        return self.f[name]
+
+    def array(self, name: str, rows: slice | None = None) -> np.ndarray:
+        data = self._get(name)
         try:
-            return self.f[name][()] if rows is None else self.f[name][rows]
+            return data[()] if rows is None else data[rows]
         except (OSError, RuntimeError) as exc:  # a failed checksum (Fletcher-32) or a damaged chunk index
             raise DaeclearError(f"'{self.path}' is a damaged daeclear result: dataset '/{name}' cannot be read "
                                 f"({str(exc).splitlines()[0]}).") from None
 
     def strings(self, name: str, rows: slice | None = None) -> list[str]:
-        if name not in self.f:
-            raise self._missing(f"dataset '/{name}'")
-        return [str(s) for s in (self.f[name].asstr()[()] if rows is None else self.f[name].asstr()[rows])]
+        text = self._get(name).asstr()
+        return [str(s) for s in (text[()] if rows is None else text[rows])]
 
     def json(self, name: str) -> Any:
-        if name not in self.f:
-            raise self._missing(f"dataset '/{name}'")
-        return json.loads(self.f[name].asstr()[()])
+        return json.loads(self._get(name).asstr()[()])
 
     def attr(self, name: str, obj: str = "/") -> Any:
         attrs = self.f[obj].attrs
@@ -182,26 +182,13 @@ def _read(r: _Reader) -> dict[str, Any]:
         steps = {"step_t": r.array("steps/t", rows), "step_h": r.array("steps/h", rows),
                  "step_order": r.array("steps/order", rows)}
 
-    return dict(
-        t=t,
-        y=y,
-        yp=yp,
-        state_names=state_names,
-        channels=channels,
-        units=units,
-        events=events,
-        segments=segments,
-        stats=r.json("stats_json"),
-        success=bool(r.attr("success")),
-        status=int(r.attr("status")),
-        message=str(r.attr("message")),
-        parameters=parameters,
-        scene_name=str(r.attr("scene_name")),
-        method=str(r.attr("method")),
-        formulation=str(r.attr("formulation")),
-        warnings=r.json("warnings_json") if r.has("warnings_json") else [],  # older files: no warnings
-        **steps,
-    )
+    return dict(t=t, y=y, yp=yp, state_names=state_names, channels=channels, units=units, events=events,
+                segments=segments, stats=r.json("stats_json"), success=bool(r.attr("success")),
+                status=int(r.attr("status")), message=str(r.attr("message")), parameters=parameters,
+                scene_name=str(r.attr("scene_name")), method=str(r.attr("method")),
+                formulation=str(r.attr("formulation")),
+                warnings=r.json("warnings_json") if r.has("warnings_json") else [],  # older files: no warnings
+                **steps)
 
 
 class _GroupAsFile:

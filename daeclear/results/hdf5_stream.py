@@ -1,9 +1,8 @@
 """The streaming writer `ResultWriter`: a result written to HDF5 while its run goes on.
 
-Separate from daeclear.results.hdf5_write (a finished result, written whole and atomically)
-because a streamed file grows append by append (extendable datasets, each append flushed with
-Ctrl-C held back) so that a long run never holds all its data in memory; it follows the same
-layout, so `load` reads both alike.
+Separate from daeclear.results.hdf5_write (a finished result, written whole and atomically): a
+streamed file grows append by append, so a long run never holds all its data in memory; it follows
+the same layout, so `load` reads both alike.
 """
 
 from __future__ import annotations
@@ -28,9 +27,7 @@ if TYPE_CHECKING:  # h5py is imported lazily, only where a file is written
 __all__ = ["STREAM_RUNNING", "ResultWriter"]
 
 _STREAM_ROWS = 1024  # rows per HDF5 chunk of a streamed 2-D array (1-D arrays: 4 times as many)
-#: Rows per chunk of the events and segments (the steps: _STREAM_ROWS): a run of two revolutions has
-#: tens of them, and a chunk is written whole (4096 rows made the chapter's main-job file 0.6 MB
-#: larger for its 61 events and 62 segments).
+#: Rows per chunk of the events and segments: a run has tens of them, and a chunk is written whole.
 _LIST_ROWS = 64
 #: Root message of a streamed file while its run goes on; a file left so was stopped without a word
 #: (killed): it holds the data of its last complete append.
@@ -40,12 +37,10 @@ STREAM_RUNNING = "incomplete: the run was stopped before it finished (the data a
 class ResultWriter:
     """Writes a result to an HDF5 file while its run goes on, in the layout of `Result.save`.
 
-    The file is created with every item of the layout (empty, extendable datasets; root
-    attributes ``success=False``, ``status=-1`` and the message :data:`STREAM_RUNNING`) and each
-    `append` adds rows to it, flushed to disk, with Ctrl-C held back until the rows are complete:
-    between two appends `load` reads it as the run so far. `close` writes the statistics,
-    warnings and the outcome. Streamed arrays are chunked (gzip only for integer and bool
-    channels); `load` reads them as it reads a saved file.
+    The file is created with every item of the layout (empty, extendable datasets; the outcome
+    ``success=False``, ``status=-1``, :data:`STREAM_RUNNING`); each `append` adds rows, flushed, with
+    Ctrl-C held back until they are complete, so between two appends `load` reads the run so far.
+    `close` writes the statistics, warnings and the outcome.
 
     Parameters
     ----------
@@ -71,9 +66,8 @@ class ResultWriter:
         try:
             f.attrs["format"] = FORMAT_NAME
             f.attrs["version"] = FORMAT_VERSION
-            f.attrs["scene_name"] = str(scene_name)
-            f.attrs["method"] = str(method)
-            f.attrs["formulation"] = str(formulation)
+            for key, value in (("scene_name", scene_name), ("method", method), ("formulation", formulation)):
+                f.attrs[key] = str(value)
             self._outcome(False, -1, STREAM_RUNNING)
             self._grow(f, "t", np.float64).attrs["units"] = "s"
             self._grow(f, "y", np.float64, (self._n,))
@@ -85,20 +79,16 @@ class ResultWriter:
             if channel_names is not None:  # states only: the reader computes the channels
                 string_dataset(f, "channel_names", list(channel_names))
                 string_dataset(f, "channel_units", [self._units.get(str(n), "") for n in channel_names])
-            events = f.create_group("events")
-            self._grow(events, "t", np.float64, rows=_LIST_ROWS)
-            self._grow(events, "pair", h5py.string_dtype(), rows=_LIST_ROWS)
-            self._grow(events, "kind", h5py.string_dtype(), rows=_LIST_ROWS)
-            self._grow(events, "approach_speed", np.float64, rows=_LIST_ROWS)
-            self._grow(events, "y", np.float64, (self._n,), rows=_LIST_ROWS)
-            segments = f.create_group("segments")
-            self._grow(segments, "t_start", np.float64, rows=_LIST_ROWS)
-            self._grow(segments, "t_end", np.float64, rows=_LIST_ROWS)
-            self._grow(segments, "modes", h5py.string_dtype(), rows=_LIST_ROWS)
-            steps = f.create_group("steps")
-            self._grow(steps, "t", np.float64, rows=_STREAM_ROWS)
-            self._grow(steps, "h", np.float64, rows=_STREAM_ROWS)
-            self._grow(steps, "order", np.int64, rows=_STREAM_ROWS)
+            text = h5py.string_dtype()
+            layout = {"events": {"t": np.float64, "pair": text, "kind": text, "approach_speed": np.float64,
+                                 "y": np.float64},
+                      "segments": {"t_start": np.float64, "t_end": np.float64, "modes": text},
+                      "steps": {"t": np.float64, "h": np.float64, "order": np.int64}}
+            for group, columns in layout.items():
+                g = f.create_group(group)
+                for name, dtype in columns.items():
+                    self._grow(g, name, dtype, (self._n,) if (group, name) == ("events", "y") else (),
+                               rows=_STREAM_ROWS if group == "steps" else _LIST_ROWS)
             f.create_group("stats")
             json_dataset(f, "stats_json", {})
             plain = to_plain(dict(parameters), "parameters")
@@ -143,9 +133,7 @@ class ResultWriter:
                step_h: ArrayLike = (), step_order: ArrayLike = ()) -> None:
         """Add output rows (``t``, ``y``, ``yp``, ``switch``, ``channels``: one row per time), events,
         segments and steps; written whole (a Ctrl-C meanwhile is raised afterwards) and flushed."""
-        from .outputs import deferred_sigint
-
-        from .outputs import check_space, disk_full, is_disk_full
+        from .outputs import check_space, deferred_sigint, disk_full, is_disk_full
 
         f = self._f
         t_arr = np.asarray(t, dtype=np.float64)
