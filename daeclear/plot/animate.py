@@ -26,6 +26,7 @@ from . import style
 from ..errors import MissingDependencyError, SceneError
 from ..progress import Progress
 from .animation_panels import layout_frame
+from .run_panels import Window
 from .mechanism_frame import (CONTACT, FREE, IMPACT, Geometry, Joint, Sampler, body_pose, contact_state,
                               scene_geometry)
 
@@ -54,9 +55,6 @@ SIZE_RANGE = (160, 4000)
 
 FORMATS = (".gif", ".mp4")
 _DPI = 100.0
-
-
-Window = tuple[float | None, float | None] | None
 
 
 # --------------------------------------------------------------------------- options

@@ -100,10 +100,7 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
     created = ax is None
     ax = style.new_axes(ax)
     scale = _LENGTH_SCALE[unit]
-    kw: dict[str, Any] = {"lw": 0.6, "color": "C0"}
-    if markers:
-        kw.update(marker=".", ms=2.5)
-    kw.update(line_kw)
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0", **({"marker": ".", "ms": 2.5} if markers else {}), **line_kw}
     ex, ey = xy_curve(result, f"{joint}.ex", f"{joint}.ey", window, max_points)
     ax.plot(ex * scale, ey * scale, **kw)
     own, threshold = _joint_lengths(result, joint)
@@ -154,8 +151,7 @@ def plot_phase_portrait(result: Result, x: str = "slider.vx", y: str = "slider.a
     ax = style.new_axes(ax)
     if reference is not None:
         ax.plot(*xy_curve(reference, x, y, window, max_points), "k--", lw=0.8, label="ideal joint")
-    kw: dict[str, Any] = {"lw": 0.5, "color": "C0"}
-    kw.update(line_kw)
+    kw: dict[str, Any] = {"lw": 0.5, "color": "C0", **line_kw}
     ax.plot(*xy_curve(result, x, y, window, max_points), **kw)
     for axis_label, name in ((ax.set_xlabel, x), (ax.set_ylabel, y)):
         axis_label(style.quantity_label(name, result.units.get(name, "")))
@@ -205,8 +201,7 @@ def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None 
     t = np.asarray(result.step_t)
     inside = style.window_index(t, window)
     index = style.decimate(h, max_points, inside[h[inside] > 0])
-    kw: dict[str, Any] = {"lw": 0.6, "color": "C0", "marker": ".", "ms": 1.5}
-    kw.update(line_kw)
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0", "marker": ".", "ms": 1.5, **line_kw}
     ax.plot(t[index], h[index], **kw)
     ax.set_yscale("log")
     if shade:
@@ -352,8 +347,7 @@ def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | Non
     if reference is not None:
         x_ref, y_ref = xy_curve(reference, along, eta, window, max_points)
         ax.plot(x_ref * scale, y_ref, "k:", lw=0.8, label="ideal joint")
-    kw: dict[str, Any] = {"lw": 0.6, "color": "C0"}
-    kw.update(line_kw)
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0", **line_kw}
     x, y = xy_curve(result, along, eta, window, max_points)
     ax.plot(x * scale, y, **kw)
     if limits:

@@ -1,11 +1,9 @@
 """One frame of a mechanism animation: the scene's geometry, body poses at the frame times, the mechanism drawn.
 
-Turns a result's scene description into body-fixed points (:func:`scene_geometry`), samples its
-channels at the frame times (:class:`Sampler`, :func:`body_pose`, :func:`contact_state`) and
-draws the mechanism to scale (:class:`MechanismPanel`: bodies, ideal joints, clearance rings and
-slider blocks, red while in contact). Separate from :mod:`daeclear.plot.animate`, which checks
-the options and writes the file, and from :mod:`daeclear.plot.animation_panels` (the magnified
-joint panels and the time cursor built on these pieces).
+:func:`scene_geometry` turns a result's scene description into body-fixed points, :class:`Sampler`
+samples its channels at the frame times, :class:`MechanismPanel` draws the mechanism to scale (red
+while in contact). The options and the file are :mod:`daeclear.plot.animate`'s, the magnified joint
+panels :mod:`daeclear.plot.animation_panels`'.
 """
 
 from __future__ import annotations
@@ -51,10 +49,6 @@ def _vec(value: Any) -> NDArray[np.float64] | None:
     return v if v.shape == (2,) and np.all(np.isfinite(v)) else None
 
 
-def _rot(phi: Any) -> tuple[Any, Any]:
-    return np.cos(phi), np.sin(phi)
-
-
 @dataclass
 class Joint:
     """A joint as drawn: kind, its two bodies, body-fixed points and the element's description."""
@@ -78,21 +72,19 @@ class Geometry:
     joints: list[Joint] = field(default_factory=list)
     drivers: list[str] = field(default_factory=list)
 
-    def local_point(self, body: str, world: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Body-fixed coordinates of a world point of the reference configuration."""
-        if body == self.ground:
-            return world.copy()
-        (x0, y0), phi0 = self.bodies[body]
-        c, s = math.cos(phi0), math.sin(phi0)
-        dx, dy = world[0] - x0, world[1] - y0
-        return np.array([c * dx + s * dy, -s * dx + c * dy])
-
-    def local_vector(self, body: str, world: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Body-fixed components of a world direction (unit length) of the reference configuration."""
-        v = world / math.hypot(*world)
+    def _to_body(self, body: str, v: NDArray[np.float64]) -> NDArray[np.float64]:
+        """World components ``v`` in the frame of ``body`` in the reference configuration."""
         phi0 = 0.0 if body == self.ground else self.bodies[body][1]
         c, s = math.cos(phi0), math.sin(phi0)
         return np.array([c * v[0] + s * v[1], -s * v[0] + c * v[1]])
+
+    def local_point(self, body: str, world: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Body-fixed coordinates of a world point of the reference configuration."""
+        return world.copy() if body == self.ground else self._to_body(body, world - self.bodies[body][0])
+
+    def local_vector(self, body: str, world: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Body-fixed components of a world direction (unit length) of the reference configuration."""
+        return self._to_body(body, world / math.hypot(*world))
 
     def points_of(self, body: str) -> list[NDArray[np.float64]]:
         """Distinct body-fixed joint points of ``body``, in the scene's order."""
@@ -195,14 +187,13 @@ def body_pose(sampler: Sampler, body: str, geo: Geometry, where: str) -> NDArray
 
 def _world(pose: NDArray[np.float64], s: NDArray[np.float64]) -> NDArray[np.float64]:
     """(n_frames, 2) world positions of the body-fixed point ``s``."""
-    c, si = _rot(pose[:, 2])
+    c, si = np.cos(pose[:, 2]), np.sin(pose[:, 2])
     return np.column_stack([pose[:, 0] + c * s[0] - si * s[1], pose[:, 1] + si * s[0] + c * s[1]])
 
 
 def _direction(pose: NDArray[np.float64], u: NDArray[np.float64]) -> NDArray[np.float64]:
-    c, si = _rot(pose[:, 2])
-    return np.column_stack([c * u[0] - si * u[1], si * u[0] + c * u[1]])
-
+    """(n_frames, 2) world components of the body-fixed direction ``u``."""
+    return _world(pose * [0.0, 0.0, 1.0], u)
 
 
 def nice_number(value: float) -> float:
@@ -262,11 +253,8 @@ class MechanismPanel:
 
     def __init__(self, ax: Axes, geo: Geometry, sampler: Sampler, contact: dict[str, NDArray[np.float64]],
                  where: str) -> None:
-        self.ax, self.geo = ax, geo
-        n = sampler.times.size
         self.poses = {b: body_pose(sampler, b, geo, where) for b in geo.bodies}
-        ground_pose = np.zeros((n, 3))
-        pose = lambda b: ground_pose if b == geo.ground else self.poses[b]  # noqa: E731
+        pose = {**self.poses, geo.ground: np.zeros((sampler.times.size, 3))}
         self.updates: list[Callable[[int], None]] = []
         extent: list[NDArray[np.float64]] = []
         static: list[NDArray[np.float64]] = []  # points fixed to the ground
@@ -290,7 +278,7 @@ class MechanismPanel:
 
         ideal_pins: list[NDArray[np.float64]] = []
         for joint in geo.joints:
-            pi, pj = pose(joint.body_i), pose(joint.body_j)
+            pi, pj = pose[joint.body_i], pose[joint.body_j]
             on_ground = geo.ground in (joint.body_i, joint.body_j)
             if joint.kind == "Revolute":
                 track = _world(pi, joint.s_i)

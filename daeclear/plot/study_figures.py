@@ -86,8 +86,7 @@ def plot_poincare_section(section: Any, *, ax: Axes | None = None, portrait: Any
             px = np.asarray(portrait[section.channels[0]])[mask]
             py = np.asarray(portrait[section.channels[1]])[mask]
         ax.plot(px, py, color="0.6", lw=0.4, label="phase portrait")
-    kw: dict[str, Any] = {"ls": "none", "marker": "o", "ms": 3.5, "color": "C3"}
-    kw.update(marker_kw)
+    kw: dict[str, Any] = {"ls": "none", "marker": "o", "ms": 3.5, "color": "C3", **marker_kw}
     text = label or f"once per revolution ({len(points)} points)"
     if points.shape[1] >= 2:
         ax.plot(points[:, 0], points[:, 1], label=text, **kw)
@@ -140,17 +139,16 @@ def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: 
     ax = style.new_axes(ax)
     scale, unit = style.parameter_display(parameter, scale, unit)
     if isinstance(sweep, Mapping):
-        xs, ys, labels = [], [], []
+        xs, ys = [], []
         for value, sec in sweep.items():
             col = sec.channels.index(channel) if isinstance(channel, str) else int(channel)
             xs.append(np.full(len(sec), float(value)))
             ys.append(np.asarray(sec.points)[:, col])
-            labels += [""] * len(sec)
         x = np.concatenate(xs) if xs else np.zeros(0)
         y = np.concatenate(ys) if ys else np.zeros(0)
-        name = channel if isinstance(channel, str) else next(iter(sweep.values())).channels[int(channel)]
-        units = next(iter(sweep.values())).units if sweep else ()
-        y_unit = units[next(iter(sweep.values())).channels.index(name)] if units else ""
+        first: Any = next(iter(sweep.values()), None)
+        name = channel if isinstance(channel, str) else first.channels[int(channel)]
+        y_unit = first.units[first.channels.index(name)] if first is not None and first.units else ""
         color_by_motion = False
     else:
         x, y, labels = sweep.bifurcation_data(parameter, channel)
@@ -158,13 +156,12 @@ def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: 
         sec = sweep.section(ok[0]) if ok else None
         name = channel if isinstance(channel, str) else (sec.channels[int(channel)] if sec else str(channel))
         y_unit = sec.units[sec.channels.index(name)] if sec else ""
-    kw: dict[str, Any] = {"ls": "none", "marker": ".", "ms": 3.0}
-    kw.update(marker_kw)
+    kw: dict[str, Any] = {"ls": "none", "marker": ".", "ms": 3.0, **marker_kw}
     x = x * scale
     if color_by_motion:
-        labels_arr = np.array(labels)
+        motions = np.array(labels)
         for motion, color in MOTION_COLORS.items():
-            sel = labels_arr == motion
+            sel = motions == motion
             if np.any(sel):
                 ax.plot(x[sel], y[sel], label=motion, **{**kw, "color": color})
         ax.legend(loc="best", fontsize="x-small", title="motion", title_fontsize="x-small")

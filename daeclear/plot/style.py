@@ -62,12 +62,8 @@ def new_axes(ax: Axes | None = None) -> Axes:
 
 def set_title(target: Any, text: str) -> None:
     """Title of an Axes, or the suptitle of a Figure, in the common size (nothing for empty text)."""
-    if not text:
-        return
-    if hasattr(target, "suptitle"):
-        target.suptitle(text, fontsize=TITLE_SIZE)
-    else:
-        target.set_title(text, fontsize=TITLE_SIZE)
+    if text:
+        (target.suptitle if hasattr(target, "suptitle") else target.set_title)(text, fontsize=TITLE_SIZE)
 
 
 def quantity_label(name: str, unit: str) -> str:
@@ -151,9 +147,7 @@ def run_parameters(result: Result) -> dict[str, Any]:
 
 
 def _joint_text(joint: Mapping[str, Any]) -> str:
-    parts = [f"c = {joint['clearance'] * 1e3:g} mm"]
-    parts += [joint[k] for k in ("law", "friction") if joint.get(k)]
-    return ", ".join(parts)
+    return ", ".join([f"c = {joint['clearance'] * 1e3:g} mm"] + [joint[k] for k in ("law", "friction") if joint.get(k)])
 
 
 def caption(result: Result, *, name: bool = True) -> str:
@@ -165,19 +159,13 @@ def caption(result: Result, *, name: bool = True) -> str:
     info = run_parameters(result)
     joints = info.get("joints", [])
     texts = list(dict.fromkeys(_joint_text(j) for j in joints))
-    parts: list[str] = []
-    if len(texts) == 1:
+    rpm = [f"{info['rpm']:.4g} rpm"] if "rpm" in info else []
+    if len(texts) == 1:  # the clearance first, then the speed, then the law and friction
         first, _, rest = texts[0].partition(", ")
-        parts.append(first)
-        if "rpm" in info:
-            parts.append(f"{info['rpm']:.4g} rpm")
-        if rest:
-            parts.append(rest)
+        parts = [first, *rpm, rest]
     else:
-        if "rpm" in info:
-            parts.append(f"{info['rpm']:.4g} rpm")
-        parts += [f"{j['name']}: {_joint_text(j)}" for j in joints]
-    text = ", ".join(parts)
+        parts = rpm + [f"{j['name']}: {_joint_text(j)}" for j in joints]
+    text = ", ".join(p for p in parts if p)
     if name and result.scene_name:
         text = f"{result.scene_name}: {text}" if text else result.scene_name
     if not result.success:
@@ -189,9 +177,7 @@ def format_parameter(name: str, value: Any) -> str:
     """``"name = value unit"`` in the display unit of :data:`PARAMETER_AXES`."""
     number = _number(value)
     if number is None:
-        if name == "friction":
-            return _friction_text(value)
-        return f"{name} = {value}"
+        return _friction_text(value) if name == "friction" else f"{name} = {value}"
     scale, unit = PARAMETER_AXES.get(name, (1.0, ""))
     if unit == name:  # "5000 rpm", not "rpm = 5000 rpm"
         return f"{number * scale:g} {unit}"
