@@ -79,8 +79,7 @@ class _RevoluteInset(_Inset):
         self.dot = pen_line(ax, FREE_COLOR, ls="none", marker="o", ms=5, zorder=5)
         self.arm = pen_line(ax, "0.4", lw=0.6)
         reach = 1.2 * max(radius, float(np.max(np.hypot(ex[whole], ey[whole]))) if whole.size else radius)
-        ax.set_xlim(-reach, reach)
-        ax.set_ylim(-reach, reach)
+        ax.set(xlim=(-reach, reach), ylim=(-reach, reach))
 
     def update(self, k: int) -> None:
         if not self.ok:
@@ -141,8 +140,7 @@ class _TranslationalInset(_Inset):
         self.block = ax.fill([], [], fc="0.9", ec=FREE_COLOR, lw=1.2, zorder=3)[0]
         self.hits = pen_line(ax, CONTACT_COLOR, ls="none", marker="o", ms=4, zorder=5)
         margin = 0.25 * half
-        ax.set_xlim(lo - 0.02 * (hi - lo), hi + 0.02 * (hi - lo))
-        ax.set_ylim(-half - margin, half + margin)
+        ax.set(xlim=(lo - 0.02 * (hi - lo), hi + 0.02 * (hi - lo)), ylim=(-half - margin, half + margin))
 
     def update(self, k: int) -> None:
         if not self.ok:

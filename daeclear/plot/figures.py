@@ -104,11 +104,9 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
                          "and the scene has no clearance joint.")
     n_cols = max(1, min(len(panels), MAX_PANELS_PER_ROW))
     panel_rows = -(-len(panels) // n_cols)
-    n_rows = len(names) + panel_rows
-    heights = [1.0] * len(names) + [2.0] * panel_rows
     height = 2.2 * len(names) + 3.8 * panel_rows + 0.6
     fig = plt.figure(figsize=(max(7.0, 3.6 * n_cols), height))
-    grid = fig.add_gridspec(n_rows, n_cols, height_ratios=heights)
+    grid = fig.add_gridspec(len(names) + panel_rows, n_cols, height_ratios=[1.0] * len(names) + [2.0] * panel_rows)
     first = None
     for row, name in enumerate(names):
         ax = fig.add_subplot(grid[row, :], sharex=first)

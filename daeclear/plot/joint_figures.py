@@ -20,8 +20,7 @@ __all__ = ["plot_cases", "plot_journal_orbit", "plot_phase_portrait", "plot_revo
 
 # --------------------------------------------------------------------------- revolute clearance joint (section 4.4)
 
-_LENGTH_SCALE = {"m": 1.0, "mm": 1e3, "um": 1e6}
-_LENGTH_LABEL = {"m": "m", "mm": "mm", "um": "µm"}
+_LENGTHS = {"m": (1.0, "m"), "mm": (1e3, "mm"), "um": (1e6, "µm")}  # unit -> factor from m, axis label
 
 
 def _contact_intervals(result: Result, pair: str | None = None) -> list[tuple[float, float]]:
@@ -93,13 +92,13 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
         ``ax.lines[0]`` the orbit, ``[1]`` the circle |e| = c (dashed) when known, and for a lubricated
         joint ``[2]`` the film threshold |e| = c - h_threshold (dotted). Equal aspect ratio.
     """
-    if unit not in _LENGTH_SCALE:
-        raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTH_SCALE)}.")
+    if unit not in _LENGTHS:
+        raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTHS)}.")
     import numpy as np
 
     created = ax is None
     ax = style.new_axes(ax)
-    scale = _LENGTH_SCALE[unit]
+    scale, label = _LENGTHS[unit]
     kw: dict[str, Any] = {"lw": 0.6, "color": "C0", **({"marker": ".", "ms": 2.5} if markers else {}), **line_kw}
     ex, ey = xy_curve(result, f"{joint}.ex", f"{joint}.ey", window, max_points)
     ax.plot(ex * scale, ey * scale, **kw)
@@ -113,9 +112,7 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
             ax.plot(inner * np.cos(angle), inner * np.sin(angle), "r:", lw=0.8, label="film threshold")
             ax.legend(loc="upper right", fontsize="small")
     ax.set_aspect("equal", adjustable="datalim")
-    label = _LENGTH_LABEL[unit]
-    ax.set_xlabel(f"journal x rel. to bearing ({label})")
-    ax.set_ylabel(f"journal y rel. to bearing ({label})")
+    ax.set(xlabel=f"journal x rel. to bearing ({label})", ylabel=f"journal y rel. to bearing ({label})")
     set_run_title(ax, result, title, created)
     return ax
 
@@ -197,8 +194,7 @@ def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None 
                          f"(simulate(..., save=SaveAt(steps=True)) records them).")
     created = ax is None
     ax = style.new_axes(ax)
-    h = np.asarray(result.step_h)
-    t = np.asarray(result.step_t)
+    t, h = np.asarray(result.step_t), np.asarray(result.step_h)
     inside = style.window_index(t, window)
     index = style.decimate(h, max_points, inside[h[inside] > 0])
     kw: dict[str, Any] = {"lw": 0.6, "color": "C0", "marker": ".", "ms": 1.5, **line_kw}
@@ -209,8 +205,7 @@ def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None 
         spans = [(max(a, lo), min(b, hi)) for a, b in _contact_intervals(result, pair) if b >= lo and a <= hi]
         for k, (t0, t1) in enumerate(spans):
             ax.axvspan(t0, t1, color="0.85", lw=0, zorder=0, label="contact" if k == 0 else None)
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel("IDA step size (s)")
+    ax.set(xlabel="time (s)", ylabel="IDA step size (s)")
     set_run_title(ax, result, title, created)
     return ax
 

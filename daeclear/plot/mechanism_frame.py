@@ -344,8 +344,7 @@ class MechanismPanel:
             dx = dy * shape
         else:
             dy = dx / shape
-        ax.set_xlim(centre[0] - 0.5 * dx, centre[0] + 0.5 * dx)
-        ax.set_ylim(centre[1] - 0.5 * dy, centre[1] + 0.5 * dy)
+        ax.set(xlim=(centre[0] - 0.5 * dx, centre[0] + 0.5 * dx), ylim=(centre[1] - 0.5 * dy, centre[1] + 0.5 * dy))
         ax.set_aspect("equal", adjustable="box")
         ax.tick_params(labelsize="small")
         ax.set_title(f"{geo.name or 'mechanism'} (x, y in m)", fontsize=style.TITLE_SIZE)

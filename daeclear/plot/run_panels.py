@@ -74,8 +74,7 @@ def _force_against(impacts: Impacts, ax: Axes | None, x: str, x_label: str, line
     ax = style.new_axes(ax)
     for label, impact in _labelled(impacts):
         ax.plot(getattr(impact, x) * 1e6, impact.force, label=label, **line_kw)
-    ax.set_xlabel(x_label)
-    ax.set_ylabel("contact force (N)")
+    ax.set(xlabel=x_label, ylabel="contact force (N)")
     ax.legend()
     return ax
 
@@ -146,8 +145,7 @@ def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, refere
     if reference is not None:
         ax.plot(*_series(reference, channel, window, max_points), "k--", lw=0.8, label="ideal joint")
     ax.plot(*_series(result, channel, window, max_points), lw=0.9, label=label or result.scene_name, **line_kw)
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel(style.quantity_label(channel, unit))
+    ax.set(xlabel="time (s)", ylabel=style.quantity_label(channel, unit))
     if reference is not None:
         ax.legend(loc="best", fontsize="small")
     set_run_title(ax, result, title, created)

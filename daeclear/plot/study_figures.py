@@ -34,8 +34,7 @@ def plot_work_precision(study: Any, *, ax: Axes | None = None) -> Axes:
         bad = [r for r in rows if r not in good and math.isfinite(r.get("wall_time", math.nan))]
         if bad:
             ax.loglog([r["wall_time"] for r in bad], [top] * len(bad), "x", color=line.get_color())
-    ax.set_xlabel("wall time (s)")
-    ax.set_ylabel(f"max error / range ({', '.join(study.channels)})")
+    ax.set(xlabel="wall time (s)", ylabel=f"max error / range ({', '.join(study.channels)})")
     style.set_title(ax, f"error over t in [{study.window[0]:.3g}, {study.window[1]:.3g}] s")
     ax.legend(fontsize="small")
     ax.grid(True, which="both", lw=0.3)
@@ -90,12 +89,12 @@ def plot_poincare_section(section: Any, *, ax: Axes | None = None, portrait: Any
     text = label or f"once per revolution ({len(points)} points)"
     if points.shape[1] >= 2:
         ax.plot(points[:, 0], points[:, 1], label=text, **kw)
-        ax.set_xlabel(style.quantity_label(section.channels[0], section.units[0]))
-        ax.set_ylabel(style.quantity_label(section.channels[1], section.units[1]))
+        ax.set(xlabel=style.quantity_label(section.channels[0], section.units[0]),
+               ylabel=style.quantity_label(section.channels[1], section.units[1]))
     else:
         ax.plot(np.arange(len(points)), points[:, 0], label=text, **kw)
-        ax.set_xlabel("revolution after the transient")
-        ax.set_ylabel(style.quantity_label(section.channels[0], section.units[0]))
+        ax.set(xlabel="revolution after the transient",
+               ylabel=style.quantity_label(section.channels[0], section.units[0]))
     ax.legend(loc="best", fontsize="x-small")
     return ax
 
@@ -247,7 +246,6 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
         motion = r.motion if r.ok else "failed"
         grid[i, j] = classes.index(motion)
         text[(i, j)] = f"P{r.period}" if motion == "periodic" else short.get(motion, "")
-    cmap = ListedColormap([MOTION_COLORS[c] for c in classes])
 
     def positive(values: list[Any]) -> bool:  # a log axis needs numbers > 0 only
         return bool(values) and all(key(v)[0] == 0 and float(v) > 0 for v in values)
@@ -256,7 +254,7 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
     y_log = style.is_geometric(ys) if y_log is None else bool(y_log) and positive(ys)
     x_centres, x_edges = _cells(xs, x_scale, x_log)
     y_centres, y_edges = _cells(ys, y_scale, y_log)
-    ax.pcolormesh(x_edges, y_edges, np.ma.masked_invalid(grid), cmap=cmap,
+    ax.pcolormesh(x_edges, y_edges, np.ma.masked_invalid(grid), cmap=ListedColormap(list(MOTION_COLORS.values())),
                   vmin=-0.5, vmax=len(classes) - 0.5, edgecolors="w", linewidth=0.5)
     if annotate:
         for (i, j), label in text.items():
@@ -275,10 +273,8 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
         ax.yaxis.set_minor_locator(NullLocator())
     ax.set_xticks(x_centres, [fmt(v, x_scale) for v in xs], rotation=45 if len(xs) > 8 else 0)
     ax.set_yticks(y_centres, [fmt(v, y_scale) for v in ys])
-    ax.set_xlim(x_edges[0], x_edges[-1])
-    ax.set_ylim(y_edges[0], y_edges[-1])
-    ax.set_xlabel(style.quantity_label(x, x_unit))
-    ax.set_ylabel(style.quantity_label(y, y_unit))
+    ax.set(xlim=(x_edges[0], x_edges[-1]), ylim=(y_edges[0], y_edges[-1]))
+    ax.set(xlabel=style.quantity_label(x, x_unit), ylabel=style.quantity_label(y, y_unit))
     _sweep_title(ax, sweep, title, created, (x, y))
     present = sorted({int(v) for v in grid[np.isfinite(grid)]})
     ax.legend(handles=[Patch(color=MOTION_COLORS[classes[k]], label=classes[k]) for k in present],
