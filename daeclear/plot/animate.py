@@ -209,8 +209,7 @@ def animate(result: Result, path: str | os.PathLike[str], *, fps: float = 25.0, 
     Parameters
     ----------
     result : Result
-        A run with its scene description (``result.parameters["scene"]``, as from :func:`daeclear.simulate`
-        or :func:`daeclear.load`) and the x, y, phi channels of every body.
+        A run with its scene description (``result.parameters["scene"]``) and every body's x, y, phi.
     path : str or path-like
         ``*.gif`` (pillow) or ``*.mp4`` (needs the program ffmpeg); written atomically.
     fps : float
@@ -218,34 +217,22 @@ def animate(result: Result, path: str | os.PathLike[str], *, fps: float = 25.0, 
     window : (t0, t1), optional
         Simulated time shown, s, inside the run with t0 < t1 (a None side: the run's start or end).
     slow_motion : float, optional
-        How many times slower than real time the window plays (> 0); None: it plays in
-        :data:`DEFAULT_PLAY_TIME` = 5 s. ``n_frames = max(2, round(D * slow_motion * fps))`` for a
-        window of duration D (:func:`frame_count`), at most :data:`MAX_FRAMES`.
+        How many times slower than real time the window plays (> 0); None: in :data:`DEFAULT_PLAY_TIME`.
+        ``n_frames = max(2, round(D * slow_motion * fps))`` (:func:`frame_count`), at most :data:`MAX_FRAMES`.
     size : (int, int)
         Width and height, pixels, each in [160, 4000].
     channel : str, optional
-        Channel of the time plot with the cursor; None: the first driver's moment, else the first
-        clearance joint's normal force, else the mechanical energy.
+        Channel of the time plot; None: the first driver's moment, else the first clearance joint's
+        normal force, else the mechanical energy.
     magnify : float, optional
         Magnification (> 0) of a translational clearance joint's offsets in its panel; None: the
-        magnified clearance 2 c M spans a quarter of the slider width (a 1-2-5 number).
+        magnified clearance spans a quarter of the slider width (a 1-2-5 number).
     progress : bool
         Show the frames rendered on stderr.
 
-    Returns
-    -------
-    pathlib.Path
-        ``path``.
-
-    Raises
-    ------
-    SceneError
-        A bad option (named, with its value and what is allowed), or a result without a scene
-        description or body channels.
-    MissingDependencyError
-        An MP4 asked for without ffmpeg.
-    OutputError
-        ``path`` cannot be written (checked before rendering).
+    Returns ``path`` (a Path). Raises SceneError for a bad option (named, with its value and what is
+    allowed) or a result without scene description or body channels, MissingDependencyError for an MP4
+    without ffmpeg, OutputError when ``path`` cannot be written (all before rendering).
     """
     return render(result, path, fps=fps, window=window, slow_motion=slow_motion, size=size, channel=channel,
                   magnify=magnify, progress=progress)

@@ -69,26 +69,11 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
              title: str | bool = True) -> Any:
     """A run of any scene: time plots of its channels, then one panel per clearance joint.
 
-    A revolute clearance joint gets its journal orbit, a translational one its slider path,
-    four to a row under the time plots.
-
-    Parameters
-    ----------
-    result : Result
-        The run.
-    reference : Result, optional
-        E.g. the ideal mechanism's run, dashed in the time plots that have its channel.
-    channels : iterable of str, optional
-        Channels against time; :func:`default_channels` when None. Missing ones are skipped.
-    joints : iterable of str, optional
-        Clearance joints given a panel; every one of the scene when None.
-    window, max_points, title
-        As in :func:`plot_revolute_response`.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        Axes in order: the time plots, then the joint panels.
+    A revolute clearance joint gets its journal orbit, a translational one its slider path, four to a row
+    under the time plots. ``reference`` (e.g. the ideal mechanism's run) is dashed in the time plots that
+    have its channel; ``channels`` default to :func:`default_channels` (missing ones skipped), ``joints`` to
+    every clearance joint; ``window``, ``max_points`` and ``title`` as in :func:`plot_revolute_response`.
+    Returns the Figure: the time plots' axes, then the joint panels'.
     """
     import matplotlib.pyplot as plt
 

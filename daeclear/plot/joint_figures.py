@@ -1,5 +1,8 @@
 """Figures of one clearance joint: the chapter's figure families of sections 4.4 (revolute, Figs. 4.15-4.27)
 and 4.5 (translational, Figs. 4.28-4.31), built from the panels of :mod:`daeclear.plot.run_panels`.
+
+Each draws on ``ax`` (a new figure when None), passes ``**line_kw`` to ``ax.plot`` of its main curve and
+returns the Axes (the four-panel figures: the Figure).
 """
 
 from __future__ import annotations
@@ -72,25 +75,17 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
     result : Result
         A run with the channels ``<joint>.ex``, ``<joint>.ey`` (e = r_journal - r_bearing, eq. 4.1).
     joint : str
-        Name of the revolute clearance joint (``"clearance"`` in ``slider_crank``).
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
+        Name of the revolute clearance joint.
     markers : bool
         A marker on every output point: one per IDA step, as in the chapter, for a run without ``t_eval``.
     clearance : float, optional
         Radial clearance c (m) of the dashed circle; from the scene parameters when None.
     unit : {"um", "mm", "m"}
         Length unit of both axes.
-    window, max_points, title
-        As in :func:`plot_channel` (points evenly spaced in the output times).
-    **line_kw
-        Passed to ``ax.plot`` for the orbit.
 
-    Returns
-    -------
-    matplotlib.axes.Axes
-        ``ax.lines[0]`` the orbit, ``[1]`` the circle |e| = c (dashed) when known, and for a lubricated
-        joint ``[2]`` the film threshold |e| = c - h_threshold (dotted). Equal aspect ratio.
+    ``window``, ``max_points`` (evenly spaced) and ``title`` as in :func:`plot_channel`. ``ax.lines``: the
+    orbit, the circle |e| = c (dashed) when known, and for a lubricated joint the film threshold
+    |e| = c - h_threshold (dotted). Equal aspect ratio.
     """
     if unit not in _LENGTHS:
         raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTHS)}.")
@@ -120,29 +115,11 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
 def plot_phase_portrait(result: Result, x: str = "slider.vx", y: str = "slider.ax", *, ax: Axes | None = None,
                         reference: Result | None = None, window: Window = None, max_points: int | None = None,
                         title: str | bool | None = None, **line_kw: Any) -> Axes:
-    """One channel against another (Figs. 4.18, 4.21: slider acceleration against velocity).
+    """Channel ``y`` against channel ``x`` (Figs. 4.18, 4.21: slider acceleration against velocity).
 
-    The chapter's "Poincaré maps": a closed curve traced again and again is a periodic response.
-
-    Parameters
-    ----------
-    result : Result
-        The run; a dense ``t_eval`` gives a smooth curve.
-    x, y : str
-        Channel names.
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    reference : Result, optional
-        Drawn first, black dashed (e.g. the ideal joint).
-    window, max_points, title
-        As in :func:`plot_channel` (points evenly spaced in the output times).
-    **line_kw
-        Passed to ``ax.plot`` for the result's curve.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        ``ax.lines[0]`` is the reference curve when given, then the result's curve.
+    The chapter's "Poincaré maps": a closed curve traced again and again is a periodic response. A dense
+    ``t_eval`` gives a smooth curve; ``reference`` (e.g. the ideal joint) is drawn first, black dashed
+    (``ax.lines[0]``); ``window``, ``max_points`` (evenly spaced) and ``title`` as in :func:`plot_channel`.
     """
     created = ax is None
     ax = style.new_axes(ax)
@@ -161,31 +138,10 @@ def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None 
                     **line_kw: Any) -> Axes:
     """IDA's step size against time, log scale, contact intervals shaded (section 4.4, Figs. 4.15d, 4.24).
 
-    Parameters
-    ----------
-    result : Result
-        A run with recorded steps (``result.step_t``, ``result.step_h``).
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    pair : str, optional
-        Contact pair whose contact intervals are shaded (every pair when None).
-    shade : bool
-        Shade the contact intervals (from ``result.events``) in grey.
-    window, max_points, title
-        As in :func:`plot_channel` (min-max decimation of the step size; intervals clipped to the window).
-    **line_kw
-        Passed to ``ax.plot`` for the step sizes.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        ``ax.lines[0]``: step size h (s) against the time the step reached, without the initial
-        zero-size placeholder; one patch per contact interval.
-
-    Raises
-    ------
-    ValueError
-        If the result has no recorded steps.
+    ``result`` needs recorded steps (``result.step_t``, ``result.step_h``; ValueError otherwise); the
+    intervals of ``pair`` (every pair when None) are shaded grey when ``shade``. ``window``, ``max_points``
+    (min-max decimation) and ``title`` as in :func:`plot_channel`. ``ax.lines[0]``: step size h (s) against
+    the time the step reached, without the initial zero-size placeholder; one patch per contact interval.
     """
     import numpy as np
 
@@ -220,23 +176,14 @@ def plot_cases(results: Mapping[str, Result], draw: Any, *, ncols: int = 2, shar
     results : mapping of str to Result
         Panel title -> result, in panel order; titles get the chapter's "(a)", "(b)", ...
     draw : callable
-        A figure function called as ``draw(result, ax=ax, **kwargs)``, e.g. ``plot_journal_orbit`` or
+        Called as ``draw(result, ax=ax, **kwargs)``, e.g. ``plot_journal_orbit`` or
         ``functools.partial(plot_channel, channel="drive.moment")``.
-    ncols : int
-        Panels per row.
-    sharex, sharey : bool
-        Share axes between panels (as ``plt.subplots``).
+    ncols, sharex, sharey : optional
+        Panels per row; shared axes (as ``plt.subplots``).
     panel_size : (float, float)
         Width and height of one panel, inches.
-    suptitle : str, optional
-        Figure title.
-    **kwargs
-        Passed to every ``draw`` call (e.g. ``reference=ideal``, ``window=(t0, t1)``).
 
-    Returns
-    -------
-    matplotlib.figure.Figure
-        Its first ``len(results)`` axes hold the panels; unused grid cells are hidden.
+    Returns the Figure; its first ``len(results)`` axes hold the panels, unused cells are hidden.
     """
     import matplotlib.pyplot as plt
 
@@ -288,15 +235,10 @@ def plot_revolute_response(result: Result, *, reference: Result | None = None, o
         Run whose output times are IDA's steps (``t_eval=None``) for panel d; ``result`` when None.
     joint : str
         Name of the revolute clearance joint.
-    window, max_points : optional
-        Time window (s) of every panel; at most this many points per line.
-    title : str or bool
-        Figure title: True for the run's caption, a str for that text, False for none.
+    window, max_points, title
+        As in :func:`plot_channel` (the run's caption unless ``title`` is False or a text).
 
-    Returns
-    -------
-    matplotlib.figure.Figure
-        Axes in order (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) orbit.
+    Returns the Figure, axes (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) orbit.
     """
     def orbit_panel(ax: Axes) -> None:
         plot_journal_orbit(orbit if orbit is not None else result, joint, ax=ax, window=window,
@@ -310,29 +252,11 @@ def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | Non
                      title: str | bool | None = None, **line_kw: Any) -> Axes:
     """Dimensionless path of the slider centre inside the guide (Figs. 4.28d, 4.30, 4.33).
 
-    Parameters
-    ----------
-    result : Result
-        A run with a translational clearance joint: channels ``<joint>.xi`` (0 to 1 along the stroke)
-        and ``<joint>.eta`` (offset from the guide's mid-line over 2c, +-0.5 at a surface). A joint
-        without a ``stroke`` has no ``xi``: its path is drawn against ``<joint>.s`` in mm.
-    joint : str
-        Name of the translational clearance joint (``"clearance"`` in ``slider_crank``).
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    limits : bool
-        Draw the contact limits eta = +-0.5 (dashed).
-    reference : Result, optional
-        Drawn first, black dotted (e.g. the ideal joint).
-    window, max_points, title
-        As in :func:`plot_channel` (points evenly spaced in the output times).
-    **line_kw
-        Passed to ``ax.plot`` for the path.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        ``ax.lines``: the reference path when given, the slider path, the two limit lines.
+    ``result`` has the channels ``<joint>.xi`` (0 to 1 along the stroke) and ``<joint>.eta`` (offset from
+    the guide's mid-line over 2c, +-0.5 at a surface); a joint without a ``stroke`` has no ``xi`` and its
+    path is drawn against ``<joint>.s`` in mm. ``limits`` draws eta = +-0.5 (dashed); ``reference`` is
+    drawn first, black dotted; ``window``, ``max_points`` (evenly spaced) and ``title`` as in
+    :func:`plot_channel`. ``ax.lines``: the reference path, the slider path, the two limit lines.
     """
     created = ax is None
     ax = style.new_axes(ax)
@@ -360,21 +284,8 @@ def plot_translational_response(result: Result, *, reference: Result | None = No
                                 title: str | bool = True) -> Any:
     """Fig. 4.28 in four panels: slider velocity, slider acceleration, crank moment, slider path.
 
-    Parameters
-    ----------
-    result : Result
-        The clearance-joint run (a dense ``t_eval``).
-    reference : Result, optional
-        The ideal-joint run over the same times, dashed in panels a-c.
-    joint : str
-        Name of the translational clearance joint.
-    window, max_points, title
-        As in :func:`plot_revolute_response`.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        Axes in order (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) path.
+    As :func:`plot_revolute_response` (``joint``: the translational clearance joint); axes (a) ``slider.vx``,
+    (b) ``slider.ax``, (c) ``drive.moment``, (d) path.
     """
     def path_panel(ax: Axes) -> None:
         plot_slider_path(result, joint, ax=ax, window=window, max_points=max_points,

@@ -82,19 +82,10 @@ def _force_against(impacts: Impacts, ax: Axes | None, x: str, x_label: str, line
 def plot_force_penetration(impacts: Impacts, *, ax: Axes | None = None, **line_kw: Any) -> Axes:
     """Contact force against penetration for single impacts (hysteresis loops, Fig. 4.26b).
 
-    Parameters
-    ----------
-    impacts : ImpactResult, iterable of ImpactResult, or mapping label -> ImpactResult
-        From :func:`daeclear.contact.simulate_impact`; unlabelled ones are labelled by law and restitution.
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    **line_kw
-        Passed to ``ax.plot`` for every curve.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        Penetration in µm on x, force in N on y; a loop's area is the energy lost in the impact.
+    ``impacts``: ImpactResults of :func:`daeclear.contact.simulate_impact` (one, several, or a mapping
+    label -> impact; unlabelled ones are labelled by law and restitution), drawn on ``ax`` (a new figure when
+    None) with ``**line_kw``. Returns the Axes: penetration in µm on x, force in N on y; a loop's area is
+    the energy lost in the impact.
     """
     return _force_against(impacts, ax, "penetration", "penetration (µm)", line_kw)
 
@@ -121,7 +112,7 @@ def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, refere
     ax : matplotlib Axes, optional
         Where to draw; a new figure when None.
     reference : Result, optional
-        Drawn first, black dashed, over the same window.
+        Drawn first (``ax.lines[0]``), black dashed, over the same window.
     label : str, optional
         Legend label of the run (default its scene name).
     window : (t0, t1), optional
@@ -134,10 +125,7 @@ def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, refere
     **line_kw
         Passed to ``ax.plot`` for the run's line.
 
-    Returns
-    -------
-    matplotlib.axes.Axes
-        ``ax.lines[0]`` is the reference when given, then the run.
+    Returns the Axes.
     """
     created = ax is None
     ax = style.new_axes(ax)

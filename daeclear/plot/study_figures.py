@@ -53,24 +53,11 @@ def plot_poincare_section(section: Any, *, ax: Axes | None = None, portrait: Any
                           **marker_kw: Any) -> Axes:
     """Stroboscopic Poincaré section (one point per crank revolution), over the phase portrait.
 
-    Parameters
-    ----------
-    section : daeclear.analysis.PoincareSection
-        Its first two channels are drawn (x, y); with one channel, the value against the revolution.
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    portrait : PhasePortrait or Result, optional
-        Drawn first, thin grey: a :class:`~daeclear.analysis.PhasePortrait`, or a Result (its same two
-        channels from the section's first time on).
-    label : str, optional
-        Legend label of the points (default "once per revolution (n points)").
-    **marker_kw
-        Passed to ``ax.plot`` for the points.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        ``ax.lines[-1]`` holds the section points.
+    ``section`` (:class:`daeclear.analysis.PoincareSection`): its first two channels are drawn (x, y), a
+    single channel against the revolution. ``portrait`` (a :class:`~daeclear.analysis.PhasePortrait`, or a
+    Result whose same channels are drawn from the section's first time on) is drawn first, thin grey.
+    ``label``: of the points (default "once per revolution (n points)"), drawn with ``**marker_kw`` as
+    ``ax.lines[-1]`` on ``ax`` (a new figure when None). Returns the Axes.
     """
     import numpy as np
 
@@ -112,8 +99,6 @@ def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: 
         The swept parameter (x axis), e.g. ``"clearance"``.
     channel : str or int
         Section channel on the y axis (name or column).
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
     scale, unit : optional
         Factor applied to the parameter values and their unit; when neither is given, both from
         :data:`daeclear.plot.style.PARAMETER_AXES` (clearance in mm).
@@ -124,13 +109,8 @@ def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: 
     title : str or bool, optional
         True: the mechanism and the parameters every run shares; a str: that text; False: none;
         None: the caption only on a new figure.
-    **marker_kw
-        Passed to ``ax.plot``.
 
-    Returns
-    -------
-    matplotlib.axes.Axes
-        One line (markers only) per motion class present, or a single one.
+    Drawn on ``ax`` (a new figure when None) with ``**marker_kw``; returns the Axes, one line per motion class.
     """
     import numpy as np
 
@@ -187,36 +167,14 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
                     y_scale: float | None = None, x_unit: str | None = None, y_unit: str | None = None,
                     x_log: bool | None = None, y_log: bool | None = None, annotate: bool = True,
                     title: str | bool | None = None) -> Axes:
-    """Map of the motion class over two swept parameters (one cell per run).
+    """Map of the motion class over two swept parameters ``x`` and ``y`` of ``sweep`` (one cell per run).
 
-    Parameters
-    ----------
-    sweep : daeclear.sweep.SweepResult
-        A sweep over a grid of ``x`` and ``y`` (other parameters fixed).
-    x, y : str
-        Parameter names of the horizontal and vertical axes.
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    x_scale, y_scale, x_unit, y_unit : optional
-        As ``scale`` and ``unit`` of :func:`plot_bifurcation`, per axis.
-    x_log, y_log : bool, optional
-        Logarithmic axis (cell edges at geometric midpoints); None: when the values form a geometric grid.
-    annotate : bool
-        Write "P<k>" in periodic cells, "C" chaotic, "Q" quasi-periodic, "N" non-periodic, "U"
-        uncertain, "?" undetermined, "x" failed.
-    title : str or bool, optional
-        As in :func:`plot_bifurcation`.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        Cells coloured by :data:`MOTION_COLORS` on an index grid (on the values along a log axis),
-        ticks labelled with the values; one legend entry per class present.
-
-    Raises
-    ------
-    ValueError
-        If two runs share the same (x, y) cell.
+    ``x_scale``, ``y_scale``, ``x_unit``, ``y_unit``, ``x_log``, ``y_log`` and ``title`` as ``scale``,
+    ``unit``, ``log`` and ``title`` of :func:`plot_bifurcation`, per axis (log: cell edges at geometric
+    midpoints). ``annotate`` writes "P<k>" in periodic cells, "C" chaotic, "Q" quasi-periodic, "N"
+    non-periodic, "U" uncertain, "?" undetermined, "x" failed. Returns the Axes: cells coloured by
+    :data:`MOTION_COLORS`, ticks labelled with the values, one legend entry per class present.
+    ValueError if two runs share a cell.
     """
     import numpy as np
     from matplotlib.colors import ListedColormap
