@@ -57,9 +57,6 @@ FORMATS = (".gif", ".mp4")
 _DPI = 100.0
 
 
-# --------------------------------------------------------------------------- options
-
-
 @dataclass(frozen=True)
 class _Fields:
     """How the caller names each option, for error messages (Python keywords or CLI flags)."""
@@ -154,9 +151,6 @@ def _check_channel(result: Result, channel: Any, f: _Fields) -> str:
     if np.asarray(result[channel]).ndim != 1:
         options.fail(f.where, f.channel, channel, "a channel with one value per time")
     return channel
-
-
-# --------------------------------------------------------------------------- writing
 
 
 def _writer(path: Path, fps: float, f: _Fields) -> Any:

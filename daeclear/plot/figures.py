@@ -29,8 +29,6 @@ __all__ += ["MOTION_COLORS", "plot_bifurcation", "plot_motion_map", "plot_poinca
 __all__ += ["MAX_PANELS_PER_ROW", "CLEARANCE_PANELS", "RESPONSE_CHANNELS", "Window", "plot_work_precision"]
 
 
-# --------------------------------------------------------------------------- any scene
-
 #: Joint panels per row of :func:`plot_run` (a chain of many links gets several rows).
 MAX_PANELS_PER_ROW = 4
 

@@ -10,6 +10,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from . import style
 from .run_panels import Window, response_panels, set_run_title, xy_curve
 
@@ -20,8 +22,6 @@ if TYPE_CHECKING:  # matplotlib is imported only when a figure is drawn
 
 __all__ = ["plot_cases", "plot_journal_orbit", "plot_phase_portrait", "plot_revolute_response", "plot_slider_path",
            "plot_step_sizes", "plot_translational_response"]
-
-# --------------------------------------------------------------------------- revolute clearance joint (section 4.4)
 
 _LENGTHS = {"m": (1.0, "m"), "mm": (1e3, "mm"), "um": (1e6, "µm")}  # unit -> factor from m, axis label
 
@@ -89,8 +89,6 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
     """
     if unit not in _LENGTHS:
         raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTHS)}.")
-    import numpy as np
-
     created = ax is None
     ax = style.new_axes(ax)
     scale, label = _LENGTHS[unit]
@@ -143,8 +141,6 @@ def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None 
     (min-max decimation) and ``title`` as in :func:`plot_channel`. ``ax.lines[0]``: step size h (s) against
     the time the step reached, without the initial zero-size placeholder; one patch per contact interval.
     """
-    import numpy as np
-
     if result.step_t is None or result.step_h is None:
         raise ValueError(f"plot_step_sizes: result of scene {result.scene_name!r} has no recorded steps "
                          f"(simulate(..., save=SaveAt(steps=True)) records them).")

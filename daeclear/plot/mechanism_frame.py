@@ -36,9 +36,6 @@ FREE_COLOR = "C0"
 _GROUND = "0.45"
 
 
-# --------------------------------------------------------------------------- scene geometry
-
-
 def _vec(value: Any) -> NDArray[np.float64] | None:
     if value is None:
         return None
@@ -133,9 +130,6 @@ def scene_geometry(result: Result, where: str) -> Geometry:
         s_j = p_j if p_j is not None else geo.local_point(b_j, at)  # type: ignore[arg-type]
         geo.joints.append(Joint(str(name), str(spec.get("kind", "")), b_i, b_j, s_i, s_j, spec))
     return geo
-
-
-# --------------------------------------------------------------------------- sampling
 
 
 class Sampler:
@@ -237,9 +231,6 @@ def guide_geometry(joint: Joint, geo: Geometry) -> dict[str, Any] | None:
     limits = [_vec(spec.get(k)) for k in ("upper_limits", "lower_limits")]
     return {"L": L, "W": W, "c": c, "t_guide": t_guide, "e_slider": e_slider,
             "limits": [lim for lim in limits if lim is not None]}
-
-
-# --------------------------------------------------------------------------- the figure
 
 
 def pen_line(ax: Axes, color: str, **kw: Any) -> Any:

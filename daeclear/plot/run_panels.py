@@ -9,6 +9,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from . import style
 
 if TYPE_CHECKING:  # matplotlib is imported only when a figure is drawn
@@ -38,8 +40,6 @@ def set_run_title(target: Any, result: Result, title: str | bool | None, created
 
 def _series(result: Result, name: str, window: Window, max_points: int | None) -> tuple[Any, Any]:
     """Time and values of a channel inside ``window``, min-max decimated to ``max_points``."""
-    import numpy as np
-
     values = np.asarray(result[name])
     index = style.select_times(result.t, values, window=window, max_points=max_points)
     return np.asarray(result.t)[index], values[index]
@@ -47,8 +47,6 @@ def _series(result: Result, name: str, window: Window, max_points: int | None) -
 
 def xy_curve(result: Result, x: str, y: str, window: Window, max_points: int | None) -> tuple[Any, Any]:
     """Two channels of an x-y curve inside ``window``, evenly thinned to ``max_points``."""
-    import numpy as np
-
     index = style.select_times(result.t, window=window, max_points=max_points)
     return np.asarray(result[x])[index], np.asarray(result[y])[index]
 

@@ -4,8 +4,11 @@ motion maps; a swept parameter is shown with its unit, on a log axis when the gr
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from . import style
 
@@ -18,8 +21,6 @@ __all__ = ["MOTION_COLORS", "plot_bifurcation", "plot_motion_map", "plot_poincar
 def plot_work_precision(study: Any, *, ax: Axes | None = None) -> Axes:
     """Error against wall time (log-log) of a :class:`daeclear.studies.accuracy.WorkPrecision`, one line per
     method, failed runs marked with x at the top."""
-    import math
-
     ax = style.new_axes(ax)
     labels = list(dict.fromkeys(r["label"] for r in study.rows))
     ok_errors = [r["error"] for r in study.rows if r["status"] == 0 and math.isfinite(r["error"])]
@@ -41,8 +42,6 @@ def plot_work_precision(study: Any, *, ax: Axes | None = None) -> Axes:
     return ax
 
 
-# --------------------------------------------------------------------------- Poincaré sections and sweeps
-
 MOTION_COLORS = {"periodic": "#2ca02c", "quasi-periodic": "#1f77b4", "chaotic": "#d62728",
                  "non-periodic": "#ff7f0e", "uncertain": "#9467bd", "undetermined": "#7f7f7f",
                  "failed": "#000000"}
@@ -59,8 +58,6 @@ def plot_poincare_section(section: Any, *, ax: Axes | None = None, portrait: Any
     ``label``: of the points (default "once per revolution (n points)"), drawn with ``**marker_kw`` as
     ``ax.lines[-1]`` on ``ax`` (a new figure when None). Returns the Axes.
     """
-    import numpy as np
-
     ax = style.new_axes(ax)
     points = np.asarray(section.points)
     if points.shape[1] >= 2 and portrait is not None:
@@ -112,8 +109,6 @@ def plot_bifurcation(sweep: Any, parameter: str, channel: str | int = 0, *, ax: 
 
     Drawn on ``ax`` (a new figure when None) with ``**marker_kw``; returns the Axes, one line per motion class.
     """
-    import numpy as np
-
     created = ax is None
     ax = style.new_axes(ax)
     scale, unit = style.parameter_display(parameter, scale, unit)
@@ -176,7 +171,6 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
     :data:`MOTION_COLORS`, ticks labelled with the values, one legend entry per class present.
     ValueError if two runs share a cell.
     """
-    import numpy as np
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
@@ -244,8 +238,6 @@ def plot_motion_map(sweep: Any, x: str, y: str, *, ax: Axes | None = None, x_sca
 def _cells(values: list[Any], scale: float, log: bool) -> tuple[Any, Any]:
     """Cell centres and edges of one motion-map axis: an index grid, or the scaled values on a log axis
     (edges at the geometric midpoints, the outer cells as wide as their neighbours in ratio)."""
-    import numpy as np
-
     if not log:
         return np.arange(len(values), dtype=float), np.arange(len(values) + 1) - 0.5
     centres = np.array([float(v) * scale for v in values])

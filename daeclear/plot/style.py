@@ -48,9 +48,6 @@ _LAW_NAMES = {"lankarani-nikravesh": "Lankarani-Nikravesh", "hunt-crossley": "Hu
 _FRICTION_NAMES = {"coulomb": "Coulomb", "modified-coulomb": "modified Coulomb"}
 
 
-# --------------------------------------------------------------------------- axes and titles
-
-
 def new_axes(ax: Axes | None = None) -> Axes:
     """``ax``, or the Axes of a new figure when None."""
     if ax is not None:
@@ -69,9 +66,6 @@ def set_title(target: Any, text: str) -> None:
 def quantity_label(name: str, unit: str) -> str:
     """Axis label ``"name (unit)"``, or the name alone when there is no unit."""
     return f"{name} ({unit})" if unit else name
-
-
-# --------------------------------------------------------------------------- captions
 
 
 def _number(value: Any) -> float | None:
@@ -199,9 +193,6 @@ def sweep_caption(sweep: Any, exclude: Iterable[str] = ()) -> str:
     return f"{mechanism}: {text}" if mechanism and text else mechanism or text
 
 
-# --------------------------------------------------------------------------- time windows and decimation
-
-
 def _check_max_points(max_points: int | None) -> None:
     if max_points is not None and (isinstance(max_points, bool) or int(max_points) != max_points
                                    or max_points < 2):
@@ -274,9 +265,6 @@ def select_times(t: ArrayLike, y: ArrayLike | None = None, *, window: tuple[floa
     if y is None:
         return stride(index, max_points)
     return decimate(y, max_points, index)
-
-
-# --------------------------------------------------------------------------- parameter axes
 
 
 def is_geometric(values: Iterable[Any], rtol: float = 1e-6) -> bool:

@@ -127,9 +127,6 @@ def check_directory(path: str | os.PathLike[str], option: str, *, files: Sequenc
     return p
 
 
-# --------------------------------------------------------------------------- Ctrl-C during a write
-
-
 def _replaceable_handler() -> Any:
     """The SIGINT handler to replace, or None where none can be (not the main thread; SIGINT ignored or not
     Python's)."""
