@@ -26,19 +26,9 @@ TITLE_SIZE = "medium"
 """Font size of every figure and panel title."""
 
 PARAMETER_AXES: dict[str, tuple[float, str]] = {
-    "clearance": (1e3, "mm"),
-    "bearing_radius": (1e3, "mm"),
-    "journal_radius": (1e3, "mm"),
-    "length": (1e3, "mm"),
-    "width": (1e3, "mm"),
-    "corner_radius": (1e3, "mm"),
-    "rpm": (1.0, "rpm"),
-    "gravity": (1.0, "m/s²"),
-    "crank_angle": (1.0, "rad"),
-    "restitution": (1.0, "-"),
-    "friction": (1.0, "-"),
-    "rtol": (1.0, "-"),
-}
+    **dict.fromkeys(("clearance", "bearing_radius", "journal_radius", "length", "width", "corner_radius"), (1e3, "mm")),
+    "rpm": (1.0, "rpm"), "gravity": (1.0, "m/s²"), "crank_angle": (1.0, "rad"),
+    **dict.fromkeys(("restitution", "friction", "rtol"), (1.0, "-"))}
 """How a swept parameter (of the mechanisms' builders, in SI units) is shown: name -> (factor, unit of the axis)."""
 
 _LAW_NAMES = {"lankarani-nikravesh": "Lankarani-Nikravesh", "hunt-crossley": "Hunt-Crossley", "flores": "Flores",
@@ -106,14 +96,9 @@ def scene_elements(result: Result) -> Mapping[str, Any]:
 
 
 def run_parameters(result: Result) -> dict[str, Any]:
-    """The parameters a figure of ``result`` should state, read from ``result.parameters["scene"]``.
-
-    Returns
-    -------
-    dict
-        ``"rpm"``: crank speed of the first driver (rev/min); ``"joints"``: one dict per
-        clearance joint, ``{"name", "kind", "clearance" (m), "law" (text), "restitution",
-        "friction" (text)}``; entries that the scene does not have are left out.
+    """The parameters a figure of ``result`` states, from its scene: ``"rpm"`` (first driver, rev/min) and
+    ``"joints"``, per clearance joint ``{"name", "kind", "clearance" (m), "law" (text), "restitution",
+    "friction" (text)}``; what the scene lacks is left out.
     """
     out: dict[str, Any] = {}
     joints: list[dict[str, Any]] = []

@@ -38,19 +38,11 @@ class ResultWriter:
     """Writes a result to an HDF5 file while its run goes on, in the layout of `Result.save`.
 
     The file is created with every item of the layout (empty, extendable datasets; the outcome
-    ``success=False``, ``status=-1``, :data:`STREAM_RUNNING`); each `append` adds rows, flushed, with
-    Ctrl-C held back until they are complete, so between two appends `load` reads the run so far.
-    `close` writes the statistics, warnings and the outcome.
-
-    Parameters
-    ----------
-    path : path-like
-        The file, created or replaced (check it with :func:`daeclear.results.outputs.check_file` first).
-    state_names, units, parameters, scene_name, method, formulation
-        As in `Result`.
-    channel_names : sequence of str, optional
-        Given: the file keeps the states alone (``/switch``, ``/channel_names``, ``/channel_units``;
-        no ``/yp``: `load` computes the channels and yp from them) and `append` takes no channels.
+    :data:`STREAM_RUNNING`); each `append` adds rows, flushed, with Ctrl-C held back until they are
+    complete, so between two appends `load` reads the run so far; `close` writes the statistics, warnings
+    and the outcome. ``path`` is created or replaced (check it with :func:`~daeclear.results.outputs.check_file`
+    first); the other parameters are as in `Result`, and with ``channel_names`` the file keeps the states
+    alone (`load` computes the channels and yp) and `append` takes no channels.
     """
 
     def __init__(self, path: str | os.PathLike[str], *, state_names: Sequence[str], units: Mapping[str, str],
@@ -172,26 +164,22 @@ class ResultWriter:
                     self._grow(group, name, arr.dtype, arr.shape[1:],
                                compress=arr.dtype.kind in "biu").attrs["units"] = self._units.get(name, "")
                 self._extend(group[name], arr)
-        if len(events):
-            g = f["events"]
-            self._extend(g["t"], np.array([e.t for e in events], dtype=np.float64))
-            self._extend(g["pair"], np.array([e.pair for e in events], dtype=object))
-            self._extend(g["kind"], np.array([e.kind for e in events], dtype=object))
-            self._extend(g["approach_speed"], np.array([e.approach_speed for e in events], dtype=np.float64))
-            self._extend(g["y"], np.array([e.y for e in events], dtype=np.float64).reshape(len(events), self._n))
-        if len(segments):
-            g = f["segments"]
-            self._extend(g["t_start"], np.array([float(s[0]) for s in segments], dtype=np.float64))
-            self._extend(g["t_end"], np.array([float(s[1]) for s in segments], dtype=np.float64))
-            self._extend(g["modes"], np.array(
-                [json.dumps({str(k): str(v) for k, v in s[2].items()}, ensure_ascii=False) for s in segments],
-                dtype=object))
-        st = np.asarray(step_t, dtype=np.float64)
-        if st.size:
-            g = f["steps"]
-            self._extend(g["t"], st)
-            self._extend(g["h"], np.asarray(step_h, dtype=np.float64))
-            self._extend(g["order"], np.asarray(step_order, dtype=np.int64))
+        g = f["events"]  # no rows: each _extend does nothing
+        self._extend(g["t"], np.array([e.t for e in events], dtype=np.float64))
+        self._extend(g["pair"], np.array([e.pair for e in events], dtype=object))
+        self._extend(g["kind"], np.array([e.kind for e in events], dtype=object))
+        self._extend(g["approach_speed"], np.array([e.approach_speed for e in events], dtype=np.float64))
+        self._extend(g["y"], np.array([e.y for e in events], dtype=np.float64).reshape(len(events), self._n))
+        g = f["segments"]
+        self._extend(g["t_start"], np.array([float(s[0]) for s in segments], dtype=np.float64))
+        self._extend(g["t_end"], np.array([float(s[1]) for s in segments], dtype=np.float64))
+        self._extend(g["modes"], np.array(
+            [json.dumps({str(k): str(v) for k, v in s[2].items()}, ensure_ascii=False) for s in segments],
+            dtype=object))
+        g = f["steps"]
+        self._extend(g["t"], np.asarray(step_t, dtype=np.float64))
+        self._extend(g["h"], np.asarray(step_h, dtype=np.float64))
+        self._extend(g["order"], np.asarray(step_order, dtype=np.int64))
 
     def close(self, *, stats: Mapping[str, Any], success: bool, status: int, message: str,
               warnings: Iterable[Mapping[str, Any]] = ()) -> Path:
