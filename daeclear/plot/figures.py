@@ -21,13 +21,11 @@ from .study_figures import (MOTION_COLORS, plot_bifurcation, plot_motion_map, pl
 if TYPE_CHECKING:
     from ..results.result import Result
 
-__all__ = ["plot_channel", "plot_force_penetration", "plot_force_time", "save_response_figure"]
-__all__ += ["plot_cases", "plot_journal_orbit", "plot_phase_portrait", "plot_revolute_response", "plot_step_sizes"]
-__all__ += ["plot_slider_path", "plot_translational_response"]
-__all__ += ["clearance_joints", "default_channels", "plot_run", "save_figure", "save_run_figure"]
-__all__ += ["MOTION_COLORS", "plot_bifurcation", "plot_motion_map", "plot_poincare_section"]
-__all__ += ["MAX_PANELS_PER_ROW", "CLEARANCE_PANELS", "RESPONSE_CHANNELS", "Window", "plot_work_precision"]
-
+__all__ = ["CLEARANCE_PANELS", "MAX_PANELS_PER_ROW", "MOTION_COLORS", "RESPONSE_CHANNELS", "Window", "clearance_joints",
+           "default_channels", "plot_bifurcation", "plot_cases", "plot_channel", "plot_force_penetration",
+           "plot_force_time", "plot_journal_orbit", "plot_motion_map", "plot_phase_portrait", "plot_poincare_section",
+           "plot_revolute_response", "plot_run", "plot_slider_path", "plot_step_sizes", "plot_translational_response",
+           "plot_work_precision", "save_figure", "save_response_figure", "save_run_figure"]
 
 #: Joint panels per row of :func:`plot_run` (a chain of many links gets several rows).
 MAX_PANELS_PER_ROW = 4

@@ -118,9 +118,7 @@ def scene_geometry(result: Result, where: str) -> Geometry:
             geo.drivers.append(str(name))
             continue
         b_i, b_j = spec.get("body_i"), spec.get("body_j")
-        if not isinstance(b_i, str) or not isinstance(b_j, str):
-            continue
-        if any(b != ground and b not in bodies for b in (b_i, b_j)):
+        if not isinstance(b_i, str) or not isinstance(b_j, str) or not {b_i, b_j} <= {ground, *bodies}:
             continue
         at = _vec(spec.get("at"))
         p_i, p_j = _vec(spec.get("point_i")), _vec(spec.get("point_j"))

@@ -43,22 +43,17 @@ def read_file(path: str | os.PathLike[str], t0: float | None = None, t1: float |
     with f:
         fmt = f.attrs.get("format")
         if fmt is None:
-            raise DaeclearError(
-                f"'{path}' is not a daeclear result: the root attribute 'format' is missing "
-                f"(expected {FORMAT_NAME!r}, as written by Result.save)."
-            )
+            raise DaeclearError(f"'{path}' is not a daeclear result: the root attribute 'format' is missing "
+                                f"(expected {FORMAT_NAME!r}, as written by Result.save).")
         if _text(fmt) != FORMAT_NAME:
-            raise DaeclearError(
-                f"'{path}' is not a daeclear result: root attribute format={_text(fmt)!r}, expected {FORMAT_NAME!r}."
-            )
+            raise DaeclearError(f"'{path}' is not a daeclear result: root attribute format={_text(fmt)!r}, "
+                                f"expected {FORMAT_NAME!r}.")
         version = f.attrs.get("version")
         if version is None:
             raise DaeclearError(f"'{path}' is a damaged daeclear result: the root attribute 'version' is missing.")
         if int(version) > FORMAT_VERSION:
-            raise DaeclearError(
-                f"'{path}' is a daeclear result of format version {int(version)}; this daeclear reads "
-                f"versions up to {FORMAT_VERSION}. Upgrade daeclear to read it."
-            )
+            raise DaeclearError(f"'{path}' is a daeclear result of format version {int(version)}; this daeclear "
+                                f"reads versions up to {FORMAT_VERSION}. Upgrade daeclear to read it.")
         window = time_window(t0, t1)
         if within and (t0 is not None or t1 is not None) and "t" in f and f["t"].shape[0]:
             first, last = float(f["t"][0]), float(f["t"][-1])
@@ -162,14 +157,10 @@ def _read(r: _Reader) -> dict[str, Any]:
     columns = (r.array("events/t", rows), r.strings("events/pair", rows), r.strings("events/kind", rows),
                r.array("events/approach_speed", rows), r.array("events/y", rows))
     if len({len(c) for c in columns}) != 1:
-        raise DaeclearError(
-            f"'{r.path}' is a damaged daeclear result: the datasets of '/events' have different lengths "
-            f"{[len(c) for c in columns]}."
-        )
-    events = [
-        ContactEvent(t=t, pair=pair, kind=kind, approach_speed=speed, y=y)  # type: ignore[arg-type]
-        for t, pair, kind, speed, y in zip(*columns)
-    ]
+        raise DaeclearError(f"'{r.path}' is a damaged daeclear result: the datasets of '/events' have different "
+                            f"lengths {[len(c) for c in columns]}.")
+    events = [ContactEvent(t=t, pair=pair, kind=kind, approach_speed=speed, y=y)  # type: ignore[arg-type]
+              for t, pair, kind, speed, y in zip(*columns)]
     lo, hi = r.window
     starts, ends = r.array("segments/t_start"), r.array("segments/t_end")
     keep = np.flatnonzero((starts < hi) & (ends > lo))  # the segments overlapping the window, clipped to it
