@@ -120,11 +120,8 @@ def _size(size: Any, f: _Fields) -> tuple[int, int]:
 
 
 def frame_count(duration: float, slow_motion: float, fps: float) -> int:
-    """Frames of an animation: ``max(2, round(duration * slow_motion * fps))``.
-
-    ``duration`` is the simulated time shown (s), ``slow_motion`` how many times slower than
-    real time it plays, ``fps`` the frame rate; the animation lasts ``n_frames / fps`` s.
-    """
+    """Frames of an animation of ``duration`` s of simulated time played ``slow_motion`` times slower than real
+    time at ``fps``: ``max(2, round(duration * slow_motion * fps))``; it lasts ``n_frames / fps`` s."""
     return max(2, int(round(duration * slow_motion * fps)))
 
 
@@ -273,15 +270,13 @@ def render(result: Result, path: Any, *, fps: Any, window: Window, slow_motion: 
     spacing = (t1 - t0) / (n_frames - 1) * scale
     decimals = min(9, max(0, math.ceil(-math.log10(spacing)))) + 1 if spacing > 0 else 3
 
-    font = float(np.clip(height / 55.0, 5.5, 11.0))
-    with matplotlib.rc_context({"font.size": font, "savefig.bbox": None}):
+    with matplotlib.rc_context({"font.size": float(np.clip(height / 55.0, 5.5, 11.0)), "savefig.bbox": None}):
         fig = plt.figure(figsize=(width / _DPI, height / _DPI), dpi=_DPI)
         try:
             updates = layout_frame(fig, result, geo, sampler, shown, contact, depth, magnify, channel_v, t0, t1,
-                              scale, unit, f.where)
+                                   scale, unit, f.where)
             clock = fig.text(0.99, 0.985, "", ha="right", va="top", fontsize="small", family="monospace")
-            caption = style.caption(result)
-            fig.text(0.01, 0.985, caption, ha="left", va="top", fontsize="small")
+            fig.text(0.01, 0.985, style.caption(result), ha="left", va="top", fontsize="small")
             if len(clearance) > len(shown):
                 fig.text(0.99, 0.01, f"{len(clearance) - len(shown)} more clearance joint(s) not shown",
                          ha="right", va="bottom", fontsize="x-small", color="0.4")

@@ -1,7 +1,5 @@
-"""Panels of one run over time: a channel, the impact force curves, the response figure, and saving.
-
-The building blocks (:func:`plot_channel`, the run title, x-y curves of two channels, :func:`save_figure`)
-that the joint, study and overview figures share without importing each other.
+"""Panels of one run over time (a channel, impact force curves, the response figure) and :func:`save_figure`:
+the building blocks the joint, study and overview figures share.
 """
 
 from __future__ import annotations

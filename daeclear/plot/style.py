@@ -1,7 +1,5 @@
-"""The one style of daeclear's figures: captions with the run's parameters, time windows and
-min-max decimation for long runs, parameter axes with units and log scales.
-
-matplotlib is imported only when an Axes is made.
+"""The one style of daeclear's figures: captions with the run's parameters, time windows and min-max
+decimation for long runs, parameter axes with units and log scales (matplotlib imported only for an Axes).
 """
 
 from __future__ import annotations

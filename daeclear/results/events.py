@@ -1,7 +1,5 @@
-"""Contact events of a run: `ContactEvent` (one transition found by root finding) and `EventList`.
-
-Apart from the `Result` container: the assembly code builds events while a run goes on and the
-HDF5 reader rebuilds them, neither of which needs the rest of a result.
+"""Contact events of a run: `ContactEvent` (one transition found by root finding) and `EventList`, apart from
+the `Result` container (the assembly code builds them during a run, the HDF5 reader rebuilds them).
 """
 
 from __future__ import annotations
@@ -39,12 +37,11 @@ class ContactEvent:
     kind : {"onset", "separation"}
         ``"onset"`` when the gap closes, ``"separation"`` when it opens.
     approach_speed : float
-        Relative normal velocity at the event (m/s), the impact speed of the laws at onset; ``nan``
-        where meaningless.
+        Relative normal velocity at the event (m/s), the laws' impact speed at onset; ``nan`` where meaningless.
     y : ndarray, shape (n_states,)
         Full state at the event, ordered as `Result.state_names` (stored read-only).
 
-    Two events are equal when all fields are equal, ``nan`` equal to ``nan``.
+    Two events are equal when all fields are, ``nan`` equal to ``nan``.
     """
 
     t: float

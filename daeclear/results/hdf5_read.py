@@ -1,8 +1,5 @@
-"""Reading result files: the constructor keywords of a `Result` from an HDF5 file, group or window.
-
-The checks of a file (format, version, every item of the layout, with messages naming the file and
-what is missing) and the windowed reading that `load` builds a `Result` from; keywords rather than a
-`Result`, so that daeclear.results.result offers `load` without an import circle.
+"""Reading result files: the `Result` keywords from an HDF5 file, group or window, the file checked item by
+item (keywords, so that daeclear.results.result offers `load` without an import circle).
 """
 
 from __future__ import annotations
@@ -84,7 +81,7 @@ def _text(value: Any) -> str:
 class _Reader:
     """Reads items of one file; a missing item raises DaeclearError naming file and item."""
 
-    def __init__(self, f: h5py.File, path: Path, window: tuple[float, float] = (-math.inf, math.inf)) -> None:
+    def __init__(self, f: h5py.Group, path: Path, window: tuple[float, float] = (-math.inf, math.inf)) -> None:
         self.f = f
         self.path = path
         self.window = window
@@ -124,7 +121,7 @@ class _Reader:
         return json.loads(self._get(name).asstr()[()])
 
     def attr(self, name: str, obj: str = "/") -> Any:
-        attrs = self.f[obj].attrs
+        attrs = self.f[obj.lstrip("/") or "."].attrs  # relative: a file's root, or a group holding a result
         if name not in attrs:
             raise self._missing(f"attribute '{name}' of '{obj}'")
         value = attrs[name]
@@ -182,27 +179,7 @@ def _read(r: _Reader) -> dict[str, Any]:
                 **steps)
 
 
-class _GroupAsFile:
-    """Lets the reader read a Result stored inside a group (absolute names become relative)."""
-
-    def __init__(self, group: h5py.Group) -> None:
-        self._group = group
-
-    def _name(self, name: str) -> str:
-        return name.lstrip("/") or "."
-
-    def __getitem__(self, name: str) -> Any:
-        return self._group[self._name(name)]
-
-    def __contains__(self, name: str) -> bool:
-        return self._name(name) in self._group
-
-    @property
-    def attrs(self) -> Any:
-        return self._group.attrs
-
-
 def read_group(group: h5py.Group, path: Path) -> dict[str, Any]:
     """The `Result` keywords of what :func:`write_result_group` wrote into ``group``, an open group of
     the file at ``path`` (named in the messages about a damaged result)."""
-    return _read(_Reader(_GroupAsFile(group), path))
+    return _read(_Reader(group, path))

@@ -1,8 +1,5 @@
-"""The streaming writer `ResultWriter`: a result written to HDF5 while its run goes on.
-
-Separate from daeclear.results.hdf5_write (a finished result, written whole and atomically): a
-streamed file grows append by append, so a long run never holds all its data in memory; it follows
-the same layout, so `load` reads both alike.
+"""The streaming writer `ResultWriter`: a result written to HDF5 append by append while its run goes on (a long
+run never holds all its data in memory), in the layout of daeclear.results.hdf5_write, so `load` reads both alike.
 """
 
 from __future__ import annotations
