@@ -42,11 +42,9 @@ def clearance_joints(result: Result) -> dict[str, str]:
 
 
 def default_channels(result: Result) -> tuple[str, ...]:
-    """Time-plot channels chosen from the run's scene, those the result has.
-
-    A body ``slider``: its velocity and acceleration (Figs. 4.15a-b, 4.28a-b); every driver its moment;
-    no driver: the last body's angular velocity and the mechanical energy; the contact force of the
-    first four clearance joints.
+    """Time-plot channels chosen from the run's scene, those the result has: a body ``slider``'s velocity and
+    acceleration (Figs. 4.15a-b, 4.28a-b), every driver's moment (no driver: the last body's angular velocity
+    and the mechanical energy), the contact force of the first four clearance joints.
     """
     elements = style.scene_elements(result)
     kinds = {name: e.get("kind") for name, e in elements.items() if isinstance(e, dict)}

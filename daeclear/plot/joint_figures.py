@@ -27,10 +27,8 @@ _LENGTHS = {"m": (1.0, "m"), "mm": (1e3, "mm"), "um": (1e6, "µm")}  # unit -> f
 
 
 def _contact_intervals(result: Result, pair: str | None = None) -> list[tuple[float, float]]:
-    """Intervals [t_onset, t_separation] in which ``pair`` (every pair when None) is in contact, from the events.
-
-    A run that starts in contact (first event a separation, or no event and its first segment in contact)
-    gets an interval from ``result.t[0]``; one that ends in contact, one up to ``result.t[-1]``.
+    """Intervals [t_onset, t_separation] in which ``pair`` (every pair when None) is in contact, from the events;
+    open at ``result.t[0]`` or ``result.t[-1]`` when the run starts or ends in contact.
     """
     if result.n_times == 0:
         return []
@@ -196,8 +194,7 @@ def plot_cases(results: Mapping[str, Result], draw: Any, *, ncols: int = 2, shar
         style.set_title(flat[k], f"({chr(ord('a') + k)}) {label}")
     for extra in flat[n:]:
         extra.set_visible(False)
-    if suptitle:
-        style.set_title(fig, suptitle)
+    style.set_title(fig, suptitle or "")
     fig.tight_layout()
     return fig
 

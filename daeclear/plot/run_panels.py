@@ -105,8 +105,6 @@ def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, refere
         The run.
     channel : str
         Channel (or state) name.
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
     reference : Result, optional
         Drawn first (``ax.lines[0]``), black dashed, over the same window.
     label : str, optional
@@ -118,10 +116,9 @@ def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, refere
     title : str or bool, optional
         True: the run's caption (clearance, speed, law, restitution, friction); a str: that text;
         False: none; None: the caption only on a new figure.
-    **line_kw
-        Passed to ``ax.plot`` for the run's line.
 
-    Returns the Axes.
+    Drawn on ``ax`` (a new figure when None), ``**line_kw`` passed to ``ax.plot`` for the run's line;
+    returns the Axes.
     """
     created = ax is None
     ax = style.new_axes(ax)

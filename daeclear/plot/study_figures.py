@@ -63,11 +63,9 @@ def plot_poincare_section(section: Any, *, ax: Axes | None = None, portrait: Any
     if points.shape[1] >= 2 and portrait is not None:
         if hasattr(portrait, "x") and hasattr(portrait, "y"):
             px, py = portrait.x, portrait.y
-        else:
-            t0 = section.t[0] if len(section) else None
-            mask = portrait.window_mask(t0, None)
-            px = np.asarray(portrait[section.channels[0]])[mask]
-            py = np.asarray(portrait[section.channels[1]])[mask]
+        else:  # a Result: its channels from the section's first time on
+            mask = portrait.window_mask(section.t[0] if len(section) else None, None)
+            px, py = (np.asarray(portrait[name])[mask] for name in section.channels[:2])
         ax.plot(px, py, color="0.6", lw=0.4, label="phase portrait")
     kw: dict[str, Any] = {"ls": "none", "marker": "o", "ms": 3.5, "color": "C3", **marker_kw}
     text = label or f"once per revolution ({len(points)} points)"

@@ -166,11 +166,8 @@ def sweep_caption(sweep: Any, exclude: Iterable[str] = ()) -> str:
     """The mechanism and the parameters every run of a sweep shares (the ones not on an axis)."""
     runs = list(getattr(sweep, "runs", ()))
     skip = set(exclude)
-    fixed: dict[str, Any] = {}
-    if runs:
-        for key, value in runs[0].parameters.items():
-            if key not in skip and all(r.parameters.get(key, object()) == value for r in runs):
-                fixed[key] = value
+    first = runs[0].parameters if runs else {}
+    fixed = {k: v for k, v in first.items() if k not in skip and all(r.parameters.get(k, object()) == v for r in runs)}
     mechanism = str(getattr(sweep, "mechanism", "") or "")
     text = ", ".join(format_parameter(k, v) for k, v in fixed.items())
     return f"{mechanism}: {text}" if mechanism and text else mechanism or text

@@ -205,9 +205,8 @@ class EventList(Sequence[ContactEvent]):
     def of(self, pair: str | None = None, kind: EventKind | None = None) -> EventList:
         """The events of one contact pair and/or one kind, in order (empty for a pair that never touched).
 
-        ``pair`` matches that pair and those below it in the dotted naming (``"clearance"`` selects
-        ``"clearance.A_upper"``, not ``"clearance2"``); None: every pair. ``kind``: ``"onset"``,
-        ``"separation"`` or None (both); anything else raises ValueError.
+        ``pair`` matches that pair and those below it (``"clearance"``: ``"clearance.A_upper"``, not
+        ``"clearance2"``); ``kind``: ``"onset"``, ``"separation"`` or None (both; anything else: ValueError).
         """
         if kind is not None and kind not in EVENT_KINDS:
             raise ValueError(f"EventList.of: kind={kind!r}, must be 'onset', 'separation' or None.")

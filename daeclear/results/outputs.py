@@ -163,10 +163,8 @@ def deferred_sigint() -> Iterator[None]:
 
 @contextlib.contextmanager
 def sigint_latch() -> Iterator[list[int]]:
-    """Remember every Ctrl-C received during the block (and raise KeyboardInterrupt as usual).
-
-    Python drops a KeyboardInterrupt raised in a weakref callback or a destructor; a loop that checks
-    the latch between its steps stops anyway. Main thread only; elsewhere the latch stays empty.
+    """Remember every Ctrl-C received during the block (and raise KeyboardInterrupt as usual): Python drops one
+    raised in a weakref callback or a destructor, a loop that checks the latch stops anyway (main thread only).
     """
     previous = _replaceable_handler()
     if previous is None:
@@ -189,9 +187,8 @@ def sigint_latch() -> Iterator[list[int]]:
 def atomic_file(path: str | os.PathLike[str], *, keep_suffix: bool = False) -> Iterator[Path]:
     """A temporary path beside ``path`` to write; fsync'ed and renamed over ``path`` once the block completes.
 
-    An existing file at ``path`` is left untouched or replaced whole; on any exception (Ctrl-C too) the
-    temporary file is removed. ``keep_suffix``: the temporary name ends in ``path``'s suffix, for writers
-    that choose the format by it (GIF, MP4).
+    An existing file is left untouched or replaced whole; on any exception (Ctrl-C too) the temporary file is
+    removed. ``keep_suffix``: the temporary name ends in ``path``'s suffix (writers that choose the format by it).
     """
     p = Path(path)
     tail = f".tmp{p.suffix}" if keep_suffix else ".tmp"
