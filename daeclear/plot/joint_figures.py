@@ -68,22 +68,12 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
                        max_points: int | None = None, title: str | bool | None = None, **line_kw: Any) -> Axes:
     """Journal centre relative to the bearing centre, with the clearance circle (Figs. 4.15d, 4.17, 4.20, 4.24).
 
-    Parameters
-    ----------
-    result : Result
-        A run with the channels ``<joint>.ex``, ``<joint>.ey`` (e = r_journal - r_bearing, eq. 4.1).
-    joint : str
-        Name of the revolute clearance joint.
-    markers : bool
-        A marker on every output point: one per IDA step, as in the chapter, for a run without ``t_eval``.
-    clearance : float, optional
-        Radial clearance c (m) of the dashed circle; from the scene parameters when None.
-    unit : {"um", "mm", "m"}
-        Length unit of both axes.
-
-    ``window``, ``max_points`` (evenly spaced) and ``title`` as in :func:`plot_channel`. ``ax.lines``: the
-    orbit, the circle |e| = c (dashed) when known, and for a lubricated joint the film threshold
-    |e| = c - h_threshold (dotted). Equal aspect ratio.
+    ``result`` has the channels ``<joint>.ex``, ``<joint>.ey`` (e = r_journal - r_bearing, eq. 4.1) of the
+    revolute clearance joint ``joint``. ``markers``: one on every output point (one per IDA step, as in the
+    chapter, for a run without ``t_eval``). ``clearance``: radial clearance c (m) of the dashed circle, from
+    the scene parameters when None. ``unit``: "um", "mm" or "m", of both axes. ``window``, ``max_points``
+    (evenly spaced) and ``title`` as in :func:`plot_channel`. ``ax.lines``: the orbit, the circle |e| = c
+    when known, and for a lubricated joint the film threshold |e| = c - h_threshold (dotted). Equal aspect.
     """
     if unit not in _LENGTHS:
         raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTHS)}.")
@@ -165,19 +155,11 @@ def plot_cases(results: Mapping[str, Result], draw: Any, *, ncols: int = 2, shar
                **kwargs: Any) -> Any:
     """One panel per labelled result, each drawn by a figure function (Figs. 4.16-4.25).
 
-    Parameters
-    ----------
-    results : mapping of str to Result
-        Panel title -> result, in panel order; titles get the chapter's "(a)", "(b)", ...
-    draw : callable
-        Called as ``draw(result, ax=ax, **kwargs)``, e.g. ``plot_journal_orbit`` or
-        ``functools.partial(plot_channel, channel="drive.moment")``.
-    ncols, sharex, sharey : optional
-        Panels per row; shared axes (as ``plt.subplots``).
-    panel_size : (float, float)
-        Width and height of one panel, inches.
-
-    Returns the Figure; its first ``len(results)`` axes hold the panels, unused cells are hidden.
+    ``results``: panel title -> result, in panel order (titles get the chapter's "(a)", "(b)", ...);
+    ``draw(result, ax=ax, **kwargs)`` draws each, e.g. ``plot_journal_orbit`` or
+    ``functools.partial(plot_channel, channel="drive.moment")``; ``ncols`` panels per row, ``sharex`` and
+    ``sharey`` as ``plt.subplots``, ``panel_size`` (width, height) of one panel in inches. Returns the
+    Figure: its first ``len(results)`` axes hold the panels, unused cells are hidden.
     """
     import matplotlib.pyplot as plt
 
@@ -218,20 +200,11 @@ def plot_revolute_response(result: Result, *, reference: Result | None = None, o
                            title: str | bool = True) -> Any:
     """Fig. 4.15 in four panels: slider velocity, slider acceleration, crank moment, journal orbit.
 
-    Parameters
-    ----------
-    result : Result
-        The clearance-joint run (a dense ``t_eval`` for panels a-c).
-    reference : Result, optional
-        The ideal-joint run over the same times, dashed in panels a-c.
-    orbit : Result, optional
-        Run whose output times are IDA's steps (``t_eval=None``) for panel d; ``result`` when None.
-    joint : str
-        Name of the revolute clearance joint.
-    window, max_points, title
-        As in :func:`plot_channel` (the run's caption unless ``title`` is False or a text).
-
-    Returns the Figure, axes (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) orbit.
+    ``result``: the clearance-joint run (a dense ``t_eval`` for panels a-c); ``reference``: the ideal-joint
+    run over the same times, dashed in panels a-c; ``orbit``: a run whose output times are IDA's steps
+    (``t_eval=None``) for panel d (``result`` when None); ``joint``: the revolute clearance joint;
+    ``window``, ``max_points`` and ``title`` as in :func:`plot_channel` (title: the caption unless False or
+    a text). Returns the Figure, axes (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) orbit.
     """
     def orbit_panel(ax: Axes) -> None:
         plot_journal_orbit(orbit if orbit is not None else result, joint, ax=ax, window=window,
