@@ -1,41 +1,11 @@
-"""Animations of a run: the mechanism moving, each clearance joint magnified, a time cursor.
+"""Animations of a run: the mechanism moving, each clearance joint magnified, a time cursor (docs/user_guide.md).
 
-:func:`animate` (and its thin method ``Result.animate``, and ``daeclear animate RESULT.h5``)
-writes an animated GIF with pillow through matplotlib's ``PillowWriter`` (no external
-program), or an MP4 through ffmpeg when the path ends in ``.mp4`` and ffmpeg is installed.
-
-Everything is drawn from the result alone, so any scene animates, including one loaded back
-from HDF5: the geometry comes from the scene description ``result.parameters["scene"]``
-(bodies, joints and their points, clearance joints with their radii, lengths and clearance),
-the motion from the body channels ``<body>.x``, ``<body>.y``, ``<body>.phi`` and the clearance
-channels (``<joint>.ex/ey`` of a revolute clearance joint, ``<joint>.s/y/tilt`` of a
-translational one, ``<joint>.in_contact``, ``<joint>.penetration``).
-
-A frame shows
-
-- the mechanism to scale: each body as a line through its joint points (a plate when it has
-  three or more, a marker at its centre of mass when it has one or none), ideal revolute joints
-  as small circles, the ground's joints and guides in grey, revolute clearance joints as rings
-  and translational ones as the slider block between the guide surfaces, red while in contact;
-- one panel per clearance joint (at most :data:`MAX_INSETS`) with the clearance magnified: the
-  journal orbit inside the clearance circle (eccentricity in micrometres, Fig. 4.15d) with the
-  current journal centre, or the slider in its guide with the lateral offset, tilt and
-  penetration multiplied by ``magnify``; red, with the penetration, while in contact;
-- a time plot of one channel (``channel``, e.g. ``drive.moment``) with a moving cursor,
-  contact intervals shaded.
-
-Frames. The window [t0, t1] of duration D plays at ``slow_motion`` times slower than real
-time at ``fps`` frames per second: ``n_frames = max(2, round(D * slow_motion * fps))``,
-evenly spaced from t0 to t1 inclusive, so the animation lasts ``n_frames / fps`` s. A joint
-is red in a frame when it is in contact then or was since the previous frame ("impact since
-last frame", with the deepest penetration), so an impact shorter than the frame spacing still
-lights up.
-
-matplotlib (and pillow, which it requires) is imported only when an animation is made.
-
-This module checks the options, lays out the figure and writes the file with its progress; the
-frame is drawn by :mod:`daeclear.plot.mechanism_frame` (the mechanism) and
-:mod:`daeclear.plot.animation_panels` (the magnified joints and the time cursor).
+:func:`animate` (``Result.animate``, ``daeclear animate RESULT.h5``) checks the options and writes a GIF
+(pillow, no external program) or an MP4 (ffmpeg), drawn from the result alone (its scene description and
+channels), so a run loaded back from HDF5 animates too. A joint is red in a frame when in contact then or
+since the previous frame, so an impact shorter than the frame spacing still shows. The frame is drawn by
+:mod:`daeclear.plot.mechanism_frame` and :mod:`daeclear.plot.animation_panels`; matplotlib is imported
+only when an animation is made.
 """
 
 from __future__ import annotations
@@ -56,6 +26,7 @@ from . import style
 from ..errors import MissingDependencyError, SceneError
 from ..progress import Progress
 from .animation_panels import layout_frame
+from .run_panels import Window
 from .mechanism_frame import (CONTACT, FREE, IMPACT, Geometry, Joint, Sampler, body_pose, contact_state,
                               scene_geometry)
 
@@ -84,12 +55,6 @@ SIZE_RANGE = (160, 4000)
 
 FORMATS = (".gif", ".mp4")
 _DPI = 100.0
-
-
-Window = tuple[float | None, float | None] | None
-
-
-# --------------------------------------------------------------------------- options
 
 
 @dataclass(frozen=True)
@@ -155,18 +120,14 @@ def _size(size: Any, f: _Fields) -> tuple[int, int]:
 
 
 def frame_count(duration: float, slow_motion: float, fps: float) -> int:
-    """Frames of an animation: ``max(2, round(duration * slow_motion * fps))``.
-
-    ``duration`` is the simulated time shown (s), ``slow_motion`` how many times slower than
-    real time it plays, ``fps`` the frame rate; the animation lasts ``n_frames / fps`` s.
-    """
+    """Frames of an animation of ``duration`` s of simulated time played ``slow_motion`` times slower than real
+    time at ``fps``: ``max(2, round(duration * slow_motion * fps))``; it lasts ``n_frames / fps`` s."""
     return max(2, int(round(duration * slow_motion * fps)))
 
 
 def frame_times(t0: float, t1: float, n_frames: int) -> NDArray[np.float64]:
     """Simulated time of each frame: ``n_frames`` times evenly spaced from t0 to t1 inclusive."""
     return np.linspace(t0, t1, n_frames)
-
 
 
 def _default_channel(result: Result, geo: Geometry, clearance: Sequence[Joint]) -> str:
@@ -187,10 +148,6 @@ def _check_channel(result: Result, channel: Any, f: _Fields) -> str:
     if np.asarray(result[channel]).ndim != 1:
         options.fail(f.where, f.channel, channel, "a channel with one value per time")
     return channel
-
-
-
-# --------------------------------------------------------------------------- writing
 
 
 def _writer(path: Path, fps: float, f: _Fields) -> Any:
@@ -243,58 +200,33 @@ def animate(result: Result, path: str | os.PathLike[str], *, fps: float = 25.0, 
     Parameters
     ----------
     result : Result
-        A run with its scene description (``result.parameters["scene"]``, as every result
-        of :func:`daeclear.simulate` or :func:`daeclear.load` has) and the x, y, phi channels
-        of every body.
+        A run with its scene description (``result.parameters["scene"]``) and every body's x, y, phi.
     path : str or path-like
-        ``*.gif`` (pillow through matplotlib's PillowWriter, no external program) or
-        ``*.mp4`` (needs the program ffmpeg). Written atomically: a failure or Ctrl-C leaves
-        no partial file.
+        ``*.gif`` (pillow) or ``*.mp4`` (needs the program ffmpeg); written atomically.
     fps : float
         Frames per second, in (0, 100].
     window : (t0, t1), optional
-        Simulated time shown, s, inside the run with t0 < t1 (None, or a None side: the
-        run's start or end).
+        Simulated time shown, s, inside the run with t0 < t1 (a None side: the run's start or end).
     slow_motion : float, optional
-        How many times slower than real time the window plays (> 0; < 1 plays faster).
-        None: the window plays in :data:`DEFAULT_PLAY_TIME` = 5 s.
+        How many times slower than real time the window plays (> 0); None: in :data:`DEFAULT_PLAY_TIME`.
+        ``n_frames = max(2, round(D * slow_motion * fps))`` (:func:`frame_count`), at most :data:`MAX_FRAMES`.
     size : (int, int)
         Width and height, pixels, each in [160, 4000].
     channel : str, optional
-        Channel of the time plot with the moving cursor (e.g. ``"drive.moment"``,
-        ``"slider.vx"``). None: the first driver's moment, else the first clearance joint's
+        Channel of the time plot; None: the first driver's moment, else the first clearance joint's
         normal force, else the mechanical energy.
     magnify : float, optional
-        Magnification (> 0) of the lateral offset, tilt and penetration of the slider in the
-        panel of a translational clearance joint. None: the magnified clearance 2 c M spans a
-        quarter of the slider width (a 1-2-5 number; 10 for Table 4.3). The panel of a
-        revolute clearance joint plots the eccentricity in micrometres and needs none.
+        Magnification (> 0) of a translational clearance joint's offsets in its panel; None: the
+        magnified clearance spans a quarter of the slider width (a 1-2-5 number).
     progress : bool
-        Show the frames rendered on stderr (a tqdm bar on a terminal, else a few plain lines).
+        Show the frames rendered on stderr.
 
-    Returns
-    -------
-    pathlib.Path
-        ``path``.
-
-    Notes
-    -----
-    ``n_frames = max(2, round(D * slow_motion * fps))`` for a window of duration D,
-    evenly spaced from t0 to t1 inclusive (:func:`frame_count`, :func:`frame_times`);
-    at most :data:`MAX_FRAMES`.
-
-    Raises
-    ------
-    SceneError
-        A bad option (the message names it, its value and what is allowed), or a result
-        without a scene description or body channels.
-    MissingDependencyError
-        An MP4 asked for without ffmpeg.
-    OutputError
-        ``path`` cannot be written (checked before rendering).
+    Returns ``path`` (a Path). Raises SceneError for a bad option (named, with its value and what is
+    allowed) or a result without scene description or body channels, MissingDependencyError for an MP4
+    without ffmpeg, OutputError when ``path`` cannot be written (all before rendering).
     """
     return render(result, path, fps=fps, window=window, slow_motion=slow_motion, size=size, channel=channel,
-                    magnify=magnify, progress=progress)
+                  magnify=magnify, progress=progress)
 
 
 def render(result: Result, path: Any, *, fps: Any, window: Window, slow_motion: Any, size: Any,
@@ -338,15 +270,13 @@ def render(result: Result, path: Any, *, fps: Any, window: Window, slow_motion: 
     spacing = (t1 - t0) / (n_frames - 1) * scale
     decimals = min(9, max(0, math.ceil(-math.log10(spacing)))) + 1 if spacing > 0 else 3
 
-    font = float(np.clip(height / 55.0, 5.5, 11.0))
-    with matplotlib.rc_context({"font.size": font, "savefig.bbox": None}):
+    with matplotlib.rc_context({"font.size": float(np.clip(height / 55.0, 5.5, 11.0)), "savefig.bbox": None}):
         fig = plt.figure(figsize=(width / _DPI, height / _DPI), dpi=_DPI)
         try:
             updates = layout_frame(fig, result, geo, sampler, shown, contact, depth, magnify, channel_v, t0, t1,
-                              scale, unit, f.where)
+                                   scale, unit, f.where)
             clock = fig.text(0.99, 0.985, "", ha="right", va="top", fontsize="small", family="monospace")
-            caption = style.caption(result)
-            fig.text(0.01, 0.985, caption, ha="left", va="top", fontsize="small")
+            fig.text(0.01, 0.985, style.caption(result), ha="left", va="top", fontsize="small")
             if len(clearance) > len(shown):
                 fig.text(0.99, 0.01, f"{len(clearance) - len(shown)} more clearance joint(s) not shown",
                          ha="right", va="bottom", fontsize="x-small", color="0.4")
@@ -354,7 +284,6 @@ def render(result: Result, path: Any, *, fps: Any, window: Window, slow_motion: 
         finally:
             plt.close(fig)
     return target
-
 
 
 def _write(fig: Figure, writer: Any, target: Path, n_frames: int, updates: Sequence[Callable[[int], None]],

@@ -1,9 +1,6 @@
 """The panels of an animation frame beside the mechanism: each clearance joint magnified, and the time cursor.
 
-A revolute clearance joint's journal orbit inside its clearance circle, a translational one's
-slider in its guide (offsets magnified), and a time plot of one channel with a moving cursor;
-:func:`layout_frame` places them with the mechanism (:mod:`daeclear.plot.mechanism_frame`) in one
-figure. Separate from the file writer (:mod:`daeclear.plot.animate`).
+:func:`layout_frame` places them with the mechanism (:mod:`daeclear.plot.mechanism_frame`) in one figure.
 """
 
 from __future__ import annotations
@@ -31,71 +28,81 @@ _CURSOR_POINTS = 2000  # samples of the cursor channel drawn (min-max decimated)
 _ORBIT_POINTS = 20000  # samples of a journal orbit / slider path drawn
 
 
-class _RevoluteInset:
+class _Inset:
+    """A clearance joint's panel: a trail of its path so far and a status text, red while in contact."""
+
+    def __init__(self, ax: Axes, sampler: Sampler, contact: NDArray[np.float64] | None,
+                 depth: NDArray[np.float64] | None) -> None:
+        ax.tick_params(labelsize="x-small")
+        self.status = status_text(ax)
+        self.contact, self.depth = contact, depth
+        self.first, self.last = sampler.first, sampler.last
+
+    def trail_index(self, k: int) -> NDArray[np.intp]:
+        """Samples of the trail up to frame ``k`` (the whole window for k = -1)."""
+        return style.stride(np.arange(self.first, int(self.last[k]) + 1), _ORBIT_POINTS)
+
+    def show_state(self, k: int) -> str:
+        """Write the joint's state in frame ``k``; returns its colour."""
+        colour = CONTACT_COLOR if self.contact is not None and self.contact[k] > 0 else FREE_COLOR
+        state = float(self.contact[k]) if self.contact is not None else FREE
+        self.status.set_text(contact_text(state, float(self.depth[k]) if self.depth is not None else math.nan))
+        self.status.set_color(colour)
+        return colour
+
+
+class _RevoluteInset(_Inset):
     """Journal orbit inside the clearance circle (µm), current journal centre, contact in red."""
 
     def __init__(self, ax: Axes, joint: Joint, sampler: Sampler, contact: NDArray[np.float64] | None,
                  depth: NDArray[np.float64] | None) -> None:
+        super().__init__(ax, sampler, contact, depth)
         r = sampler.result
         name = joint.name
         self.ok = f"{name}.ex" in r and f"{name}.ey" in r
         c = revolute_clearance(joint.spec)
         ax.set_title(f"{name}: journal orbit (µm)", fontsize="small")
         ax.set_aspect("equal", adjustable="box")
-        ax.tick_params(labelsize="x-small")
-        self.status = status_text(ax)
-        self.contact, self.depth = contact, depth
         if not self.ok:
             self.status.set_text(f"no channels {name}.ex/ey")
             return
         scale = 1e6
         ex, ey = np.asarray(r[f"{name}.ex"]) * scale, np.asarray(r[f"{name}.ey"]) * scale
-        self.ex, self.ey, self.first = ex, ey, sampler.first
-        self.last = sampler.last
+        self.ex, self.ey = ex, ey
         self.x, self.y = sampler.at(f"{name}.ex") * scale, sampler.at(f"{name}.ey") * scale
         radius = c * scale if c is not None else float(np.max(np.hypot(ex, ey)))
         angle = np.linspace(0.0, 2.0 * np.pi, 241)
         ax.plot(radius * np.cos(angle), radius * np.sin(angle), "k--", lw=0.8)
-        end = int(sampler.last[-1]) + 1
-        whole = style.stride(np.arange(self.first, end), _ORBIT_POINTS)
+        whole = self.trail_index(-1)
         ax.plot(ex[whole], ey[whole], color="0.8", lw=0.5)
         self.trail = pen_line(ax, FREE_COLOR, lw=0.8)
         self.dot = pen_line(ax, FREE_COLOR, ls="none", marker="o", ms=5, zorder=5)
         self.arm = pen_line(ax, "0.4", lw=0.6)
         reach = 1.2 * max(radius, float(np.max(np.hypot(ex[whole], ey[whole]))) if whole.size else radius)
-        ax.set_xlim(-reach, reach)
-        ax.set_ylim(-reach, reach)
+        ax.set(xlim=(-reach, reach), ylim=(-reach, reach))
 
     def update(self, k: int) -> None:
         if not self.ok:
             return
-        hit = self.contact is not None and self.contact[k] > 0
-        colour = CONTACT_COLOR if hit else FREE_COLOR
-        stop = int(self.last[k]) + 1
-        idx = style.stride(np.arange(self.first, stop), _ORBIT_POINTS)
+        idx = self.trail_index(k)
         self.trail.set_data(np.append(self.ex[idx], self.x[k]), np.append(self.ey[idx], self.y[k]))
         self.dot.set_data([self.x[k]], [self.y[k]])
-        self.dot.set_color(colour)
+        self.dot.set_color(self.show_state(k))
         self.arm.set_data([0.0, self.x[k]], [0.0, self.y[k]])
-        state = float(self.contact[k]) if self.contact is not None else FREE
-        self.status.set_text(contact_text(state, float(self.depth[k]) if self.depth is not None else math.nan))
-        self.status.set_color(colour)
 
 
-class _TranslationalInset:
+class _TranslationalInset(_Inset):
     """The slider in its guide: lateral offset, tilt and penetration magnified, corners in contact in red."""
 
     CORNERS = (("A_upper", 1, 1), ("B_upper", -1, 1), ("C_lower", -1, -1), ("D_lower", 1, -1))
 
     def __init__(self, ax: Axes, joint: Joint, geo: Geometry, sampler: Sampler, magnify: float | None,
                  contact: NDArray[np.float64] | None, depth: NDArray[np.float64] | None) -> None:
+        super().__init__(ax, sampler, contact, depth)
         r = sampler.result
         name = joint.name
         g = guide_geometry(joint, geo)
         self.ok = g is not None and all(f"{name}.{q}" in r for q in ("s", "y", "tilt"))
-        ax.tick_params(labelsize="x-small")
-        self.status = status_text(ax)
-        self.contact, self.depth = contact, depth
         if not self.ok:
             ax.set_title(f"{name}: slider in guide", fontsize="small")
             self.status.set_text(f"no channels {name}.s/y/tilt")
@@ -126,32 +133,24 @@ class _TranslationalInset:
             ax.axhline(side * 0.5 * W * mm, color="0.75", lw=0.6, ls=":")
         ss = np.asarray(r[f"{name}.s"]) * mm
         yy = np.asarray(r[f"{name}.y"]) * self.M * mm
-        end = int(sampler.last[-1]) + 1
-        whole = style.stride(np.arange(sampler.first, end), _ORBIT_POINTS)
+        whole = self.trail_index(-1)
         ax.plot(ss[whole], yy[whole], color="0.8", lw=0.5)
-        self.ss, self.yy, self.first, self.last = ss, yy, sampler.first, sampler.last
+        self.ss, self.yy = ss, yy
         self.trail = pen_line(ax, FREE_COLOR, lw=0.8)
         self.block = ax.fill([], [], fc="0.9", ec=FREE_COLOR, lw=1.2, zorder=3)[0]
         self.hits = pen_line(ax, CONTACT_COLOR, ls="none", marker="o", ms=4, zorder=5)
         margin = 0.25 * half
-        ax.set_xlim(lo - 0.02 * (hi - lo), hi + 0.02 * (hi - lo))
-        ax.set_ylim(-half - margin, half + margin)
+        ax.set(xlim=(lo - 0.02 * (hi - lo), hi + 0.02 * (hi - lo)), ylim=(-half - margin, half + margin))
 
     def update(self, k: int) -> None:
         if not self.ok:
             return
-        hit = self.contact is not None and self.contact[k] > 0
-        colour = CONTACT_COLOR if hit else FREE_COLOR
         self.block.set_xy(self.quad[k])
-        self.block.set_edgecolor(colour)
-        stop = int(self.last[k]) + 1
-        idx = style.stride(np.arange(self.first, stop), _ORBIT_POINTS)
+        self.block.set_edgecolor(self.show_state(k))
+        idx = self.trail_index(k)
         self.trail.set_data(np.append(self.ss[idx], self.centre[k, 0]), np.append(self.yy[idx], self.centre[k, 1]))
         touching = [i for i, on in enumerate(self.corner_contact) if on is not None and on[k] > 0]
         self.hits.set_data(self.quad[k, touching, 0], self.quad[k, touching, 1])
-        state = float(self.contact[k]) if self.contact is not None else FREE
-        self.status.set_text(contact_text(state, float(self.depth[k]) if self.depth is not None else math.nan))
-        self.status.set_color(colour)
 
 
 class _Cursor:
@@ -182,7 +181,6 @@ class _Cursor:
     def update(self, k: int) -> None:
         self.line.set_xdata([self.times[k], self.times[k]])
         self.dot.set_data([self.times[k]], [self.value[k]])
-
 
 
 def layout_frame(fig: Figure, result: Result, geo: Geometry, sampler: Sampler, shown: Sequence[Joint],

@@ -1,18 +1,8 @@
-"""Figure functions of daeclear (matplotlib): the overview figure of any run, and the home of every figure.
+"""The overview figure of any run (:func:`plot_run`), and the home of every figure function.
 
-:func:`plot_run` draws a run of any scene (its channels over time and a panel per clearance joint);
-the other figures live in :mod:`.run_panels` (one run over time), :mod:`.joint_figures` (the
-chapter's revolute and translational figure families) and :mod:`.study_figures` (studies), and
-are re-exported here so ``daeclear.plot.figures.<name>`` keeps working.
-
-Each function takes data and an optional ``ax``, draws on it (a new figure when
-``ax`` is None) and returns the Axes; none calls ``plt.show()``. Units on the axes are
-stated in the labels. Every function draws through :mod:`daeclear.plot.style`: figures of a
-run are titled with its parameters (clearance, crank speed, contact law, restitution,
-friction; ``title=``), the functions that draw a run over time take a time
-``window=(t0, t1)`` and ``max_points`` (min-max decimation, so a long run does not plot
-as a solid band), and sweep figures show the swept parameter with its unit, on a log
-axis when the grid is geometric.
+The others are drawn in :mod:`.run_panels`, :mod:`.joint_figures` and :mod:`.study_figures` and
+re-exported here. Each takes data and an optional ``ax`` (a new figure when None), returns the Axes
+and never calls ``plt.show()``; the style (captions, windows, decimation) is :mod:`daeclear.plot.style`.
 """
 
 from __future__ import annotations
@@ -20,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any
 
+from . import style
 from .joint_figures import (plot_cases, plot_journal_orbit, plot_phase_portrait, plot_revolute_response,
                             plot_slider_path, plot_step_sizes, plot_translational_response)
 from .run_panels import (RESPONSE_CHANNELS, Window, plot_channel, plot_force_penetration, plot_force_time,
@@ -30,15 +21,11 @@ from .study_figures import (MOTION_COLORS, plot_bifurcation, plot_motion_map, pl
 if TYPE_CHECKING:
     from ..results.result import Result
 
-__all__ = ["plot_channel", "plot_force_penetration", "plot_force_time", "save_response_figure"]
-__all__ += ["plot_cases", "plot_journal_orbit", "plot_phase_portrait", "plot_revolute_response", "plot_step_sizes"]
-__all__ += ["plot_slider_path", "plot_translational_response"]
-__all__ += ["clearance_joints", "default_channels", "plot_run", "save_figure", "save_run_figure"]
-__all__ += ["MOTION_COLORS", "plot_bifurcation", "plot_motion_map", "plot_poincare_section"]
-__all__ += ["MAX_PANELS_PER_ROW", "CLEARANCE_PANELS", "RESPONSE_CHANNELS", "Window", "plot_work_precision"]
-
-
-# --------------------------------------------------------------------------- any scene
+__all__ = ["CLEARANCE_PANELS", "MAX_PANELS_PER_ROW", "MOTION_COLORS", "RESPONSE_CHANNELS", "Window", "clearance_joints",
+           "default_channels", "plot_bifurcation", "plot_cases", "plot_channel", "plot_force_penetration",
+           "plot_force_time", "plot_journal_orbit", "plot_motion_map", "plot_phase_portrait", "plot_poincare_section",
+           "plot_revolute_response", "plot_run", "plot_slider_path", "plot_step_sizes", "plot_translational_response",
+           "plot_work_precision", "save_figure", "save_response_figure", "save_run_figure"]
 
 #: Joint panels per row of :func:`plot_run` (a chain of many links gets several rows).
 MAX_PANELS_PER_ROW = 4
@@ -49,20 +36,17 @@ CLEARANCE_PANELS = {"RevoluteClearance": "journal orbit", "TranslationalClearanc
 
 def clearance_joints(result: Result) -> dict[str, str]:
     """The clearance joints of the run's scene, in scene order: name -> kind (``RevoluteClearance``, ...)."""
-    elements = result.parameters.get("scene", {}).get("elements", {})
+    elements = style.scene_elements(result)
     return {name: e["kind"] for name, e in elements.items()
             if isinstance(e, dict) and e.get("kind") in CLEARANCE_PANELS}
 
 
 def default_channels(result: Result) -> tuple[str, ...]:
-    """Time-plot channels chosen from what the run's scene holds.
-
-    A body named ``slider`` gives its velocity and acceleration (Figs. 4.15a-b, 4.28a-b); every
-    driver its moment (Figs. 4.15c, 4.28c); a scene without a driver the angular velocity of
-    its last body and the mechanical energy; every clearance joint its contact force (the first
-    four clearance joints of a larger scene). Only channels the result has are returned.
+    """Time-plot channels chosen from the run's scene, those the result has: a body ``slider``'s velocity and
+    acceleration (Figs. 4.15a-b, 4.28a-b), every driver's moment (no driver: the last body's angular velocity
+    and the mechanical energy), the contact force of the first four clearance joints.
     """
-    elements = result.parameters.get("scene", {}).get("elements", {})
+    elements = style.scene_elements(result)
     kinds = {name: e.get("kind") for name, e in elements.items() if isinstance(e, dict)}
     bodies = [name for name, kind in kinds.items() if kind == "Body"]
     drivers = [name for name, kind in kinds.items() if kind == "Driver"]
@@ -79,34 +63,17 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
              title: str | bool = True) -> Any:
     """A run of any scene: time plots of its channels, then one panel per clearance joint.
 
-    Every revolute clearance joint gets its journal orbit (:func:`plot_journal_orbit`), every
-    translational one its slider path (:func:`plot_slider_path`), side by side under the time
-    plots, four to a row.
-
-    Parameters
-    ----------
-    result : Result
-        The run.
-    reference : Result, optional
-        E.g. the ideal mechanism's run: dashed in the time plots (channels it lacks, such as a
-        clearance joint's contact force, are drawn without it).
-    channels : iterable of str, optional
-        Channels plotted against time; :func:`default_channels` when None. Missing ones are skipped.
-    joints : iterable of str, optional
-        Clearance joints given a panel; every clearance joint of the scene when None.
-    window, max_points, title
-        As in :func:`plot_revolute_response`.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        Axes in order: the time plots, then the joint panels.
+    A revolute clearance joint gets its journal orbit, a translational one its slider path, four to a row
+    under the time plots. ``reference`` (e.g. the ideal mechanism's run) is dashed in the time plots that
+    have its channel; ``channels`` default to :func:`default_channels` (missing ones skipped), ``joints`` to
+    every clearance joint; ``window``, ``max_points`` and ``title`` as in :func:`plot_revolute_response`.
+    Returns the Figure: the time plots' axes, then the joint panels'.
     """
     import matplotlib.pyplot as plt
 
     names = [c for c in (default_channels(result) if channels is None else channels) if c in result]
     kinds = clearance_joints(result)
-    panels = [j for j in (kinds if joints is None else joints)]
+    panels = list(kinds if joints is None else joints)
     unknown = [j for j in panels if j not in kinds]
     if unknown:
         raise ValueError(f"plot_run: joints={unknown!r} are not clearance joints of the run's scene "
@@ -116,11 +83,9 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
                          "and the scene has no clearance joint.")
     n_cols = max(1, min(len(panels), MAX_PANELS_PER_ROW))
     panel_rows = -(-len(panels) // n_cols)
-    n_rows = len(names) + panel_rows
-    heights = [1.0] * len(names) + [2.0] * panel_rows
     height = 2.2 * len(names) + 3.8 * panel_rows + 0.6
     fig = plt.figure(figsize=(max(7.0, 3.6 * n_cols), height))
-    grid = fig.add_gridspec(n_rows, n_cols, height_ratios=heights)
+    grid = fig.add_gridspec(len(names) + panel_rows, n_cols, height_ratios=[1.0] * len(names) + [2.0] * panel_rows)
     first = None
     for row, name in enumerate(names):
         ax = fig.add_subplot(grid[row, :], sharex=first)

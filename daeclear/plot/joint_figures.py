@@ -1,14 +1,16 @@
-"""Figures of one clearance joint: the chapter's figure families of section 4.4 (revolute) and 4.5 (translational).
+"""Figures of one clearance joint: the chapter's figure families of sections 4.4 (revolute, Figs. 4.15-4.27)
+and 4.5 (translational, Figs. 4.28-4.31), built from the panels of :mod:`daeclear.plot.run_panels`.
 
-Journal orbit, phase portrait, step sizes, a grid of cases, the revolute response (Figs. 4.15-4.27),
-the slider path and the translational response (Figs. 4.28-4.31). Separate from the panels of a
-run (:mod:`daeclear.plot.run_panels`), which they are built from, and from the study figures.
+Each draws on ``ax`` (a new figure when None), passes ``**line_kw`` to ``ax.plot`` of its main curve and
+returns the Axes (the four-panel figures: the Figure).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from . import style
 from .run_panels import Window, response_panels, set_run_title, xy_curve
@@ -21,19 +23,12 @@ if TYPE_CHECKING:  # matplotlib is imported only when a figure is drawn
 __all__ = ["plot_cases", "plot_journal_orbit", "plot_phase_portrait", "plot_revolute_response", "plot_slider_path",
            "plot_step_sizes", "plot_translational_response"]
 
-# --------------------------------------------------------------------------- revolute clearance joint (section 4.4)
-
-_LENGTH_SCALE = {"m": 1.0, "mm": 1e3, "um": 1e6}
-_LENGTH_LABEL = {"m": "m", "mm": "mm", "um": "µm"}
+_LENGTHS = {"m": (1.0, "m"), "mm": (1e3, "mm"), "um": (1e6, "µm")}  # unit -> factor from m, axis label
 
 
 def _contact_intervals(result: Result, pair: str | None = None) -> list[tuple[float, float]]:
-    """Time intervals [t_onset, t_separation] in which ``pair`` (every pair when None) is in contact.
-
-    Built from ``result.events``. A result that starts in contact (its first event of the
-    pair is a separation, or, without events, its first segment has the pair in contact)
-    gets an interval from ``result.t[0]``; one that ends in contact, an interval up to
-    ``result.t[-1]``.
+    """Intervals [t_onset, t_separation] in which ``pair`` (every pair when None) is in contact, from the events;
+    open at ``result.t[0]`` or ``result.t[-1]`` when the run starts or ends in contact.
     """
     if result.n_times == 0:
         return []
@@ -58,19 +53,14 @@ def _contact_intervals(result: Result, pair: str | None = None) -> list[tuple[fl
     return intervals
 
 
-def _clearance_of(result: Result, joint: str) -> float | None:
-    """Radial clearance (m) of clearance joint ``joint`` from the result's scene parameters."""
-    element = result.parameters.get("scene", {}).get("elements", {}).get(joint, {})
-    value = element.get("clearance") if isinstance(element, dict) else None
-    return float(value) if isinstance(value, (int, float)) else None
-
-
-def _film_threshold_of(result: Result, joint: str) -> float | None:
-    """The film threshold (m) of a lubricated joint (law "hydrodynamic"), from the scene parameters."""
-    element = result.parameters.get("scene", {}).get("elements", {}).get(joint, {})
-    law = element.get("law") if isinstance(element, dict) else None
-    value = law.get("film_threshold") if isinstance(law, dict) and law.get("name") == "hydrodynamic" else None
-    return float(value) if isinstance(value, (int, float)) else None
+def _joint_lengths(result: Result, joint: str) -> tuple[float | None, float | None]:
+    """Radial clearance (m) of ``joint`` and, for a lubricated one (law "hydrodynamic"), its film threshold (m)."""
+    element = style.scene_elements(result).get(joint, {})
+    element = element if isinstance(element, dict) else {}
+    law = element.get("law")
+    film = law.get("film_threshold") if isinstance(law, dict) and law.get("name") == "hydrodynamic" else None
+    clearance, threshold = (float(v) if isinstance(v, (int, float)) else None for v in (element.get("clearance"), film))
+    return clearance, threshold
 
 
 def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | None = None, markers: bool = True,
@@ -78,68 +68,32 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
                        max_points: int | None = None, title: str | bool | None = None, **line_kw: Any) -> Axes:
     """Journal centre relative to the bearing centre, with the clearance circle (Figs. 4.15d, 4.17, 4.20, 4.24).
 
-    Parameters
-    ----------
-    result : Result
-        A run with the channels ``<joint>.ex`` and ``<joint>.ey`` (eccentricity vector
-        e = r_journal - r_bearing, eq. 4.1).
-    joint : str
-        Name of the revolute clearance joint (``"clearance"`` in ``slider_crank``).
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    markers : bool
-        Put a marker on every output point. For one marker per IDA step, as in the
-        chapter, pass a result simulated without ``t_eval`` (its output times are
-        the steps): the markers crowd where the steps are small (contact) and thin out
-        in free flight. Points outside the circle show the penetration.
-    clearance : float, optional
-        Radial clearance c (m) of the dashed circle; read from the result's scene
-        parameters when None (no circle if it cannot be found).
-    unit : {"um", "mm", "m"}
-        Length unit of both axes.
-    window : (t0, t1), optional
-        Time window in s; only the orbit inside it is drawn.
-    max_points : int, optional
-        Draw at most this many points, evenly spaced in the output times.
-    title : str or bool, optional
-        As in :func:`plot_channel` (the run's caption on a new figure).
-    **line_kw
-        Passed to ``ax.plot`` for the orbit.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        ``ax.lines[0]`` is the orbit (x: e_x, y: e_y in ``unit``), ``ax.lines[1]`` the
-        clearance circle |e| = c (dashed), when drawn: for a lubricated joint the eccentricity
-        ratio 1, and ``ax.lines[2]`` the film threshold |e| = c - h_threshold (dotted), inside
-        which the film carries and outside which the dry law acts. Equal aspect ratio.
+    ``result`` has the channels ``<joint>.ex``, ``<joint>.ey`` (e = r_journal - r_bearing, eq. 4.1) of the
+    revolute clearance joint ``joint``. ``markers``: one on every output point (one per IDA step, as in the
+    chapter, for a run without ``t_eval``). ``clearance``: radial clearance c (m) of the dashed circle, from
+    the scene parameters when None. ``unit``: "um", "mm" or "m", of both axes. ``window``, ``max_points``
+    (evenly spaced) and ``title`` as in :func:`plot_channel`. ``ax.lines``: the orbit, the circle |e| = c
+    when known, and for a lubricated joint the film threshold |e| = c - h_threshold (dotted). Equal aspect.
     """
-    if unit not in _LENGTH_SCALE:
-        raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTH_SCALE)}.")
-    import numpy as np
-
+    if unit not in _LENGTHS:
+        raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTHS)}.")
     created = ax is None
     ax = style.new_axes(ax)
-    scale = _LENGTH_SCALE[unit]
-    kw: dict[str, Any] = {"lw": 0.6, "color": "C0"}
-    if markers:
-        kw.update(marker=".", ms=2.5)
-    kw.update(line_kw)
+    scale, label = _LENGTHS[unit]
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0", **({"marker": ".", "ms": 2.5} if markers else {}), **line_kw}
     ex, ey = xy_curve(result, f"{joint}.ex", f"{joint}.ey", window, max_points)
     ax.plot(ex * scale, ey * scale, **kw)
-    c = clearance if clearance is not None else _clearance_of(result, joint)
+    own, threshold = _joint_lengths(result, joint)
+    c = clearance if clearance is not None else own
     if c is not None:
         angle = np.linspace(0.0, 2.0 * np.pi, 361)
         ax.plot(c * scale * np.cos(angle), c * scale * np.sin(angle), "k--", lw=0.8, label="eccentricity ratio 1")
-        threshold = _film_threshold_of(result, joint)
         if threshold is not None:
             inner = (c - threshold) * scale
             ax.plot(inner * np.cos(angle), inner * np.sin(angle), "r:", lw=0.8, label="film threshold")
             ax.legend(loc="upper right", fontsize="small")
     ax.set_aspect("equal", adjustable="datalim")
-    label = _LENGTH_LABEL[unit]
-    ax.set_xlabel(f"journal x rel. to bearing ({label})")
-    ax.set_ylabel(f"journal y rel. to bearing ({label})")
+    ax.set(xlabel=f"journal x rel. to bearing ({label})", ylabel=f"journal y rel. to bearing ({label})")
     set_run_title(ax, result, title, created)
     return ax
 
@@ -147,41 +101,17 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
 def plot_phase_portrait(result: Result, x: str = "slider.vx", y: str = "slider.ax", *, ax: Axes | None = None,
                         reference: Result | None = None, window: Window = None, max_points: int | None = None,
                         title: str | bool | None = None, **line_kw: Any) -> Axes:
-    """One channel against another over the whole result (Figs. 4.18, 4.21: slider acceleration against velocity).
+    """Channel ``y`` against channel ``x`` (Figs. 4.18, 4.21: slider acceleration against velocity).
 
-    The chapter calls these plots Poincaré maps: a closed curve traced again and again
-    is a periodic response, a band filled by curves that never repeat a chaotic one.
-
-    Parameters
-    ----------
-    result : Result
-        The run; a dense ``t_eval`` gives a smooth curve.
-    x, y : str
-        Channel names (default slider velocity on x, slider acceleration on y).
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    reference : Result, optional
-        Drawn first, black dashed (e.g. the ideal joint, whose portrait is one closed curve).
-    window : (t0, t1), optional
-        Time window in s (e.g. the steady state after the transient).
-    max_points : int, optional
-        Draw at most this many points per curve, evenly spaced in the output times.
-    title : str or bool, optional
-        As in :func:`plot_channel` (the run's caption on a new figure).
-    **line_kw
-        Passed to ``ax.plot`` for the result's curve.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        ``ax.lines[0]`` is the reference curve when given, then the result's curve.
+    The chapter's "Poincaré maps": a closed curve traced again and again is a periodic response. A dense
+    ``t_eval`` gives a smooth curve; ``reference`` (e.g. the ideal joint) is drawn first, black dashed
+    (``ax.lines[0]``); ``window``, ``max_points`` (evenly spaced) and ``title`` as in :func:`plot_channel`.
     """
     created = ax is None
     ax = style.new_axes(ax)
     if reference is not None:
         ax.plot(*xy_curve(reference, x, y, window, max_points), "k--", lw=0.8, label="ideal joint")
-    kw: dict[str, Any] = {"lw": 0.5, "color": "C0"}
-    kw.update(line_kw)
+    kw: dict[str, Any] = {"lw": 0.5, "color": "C0", **line_kw}
     ax.plot(*xy_curve(result, x, y, window, max_points), **kw)
     for axis_label, name in ((ax.set_xlabel, x), (ax.set_ylabel, y)):
         axis_label(style.quantity_label(name, result.units.get(name, "")))
@@ -194,63 +124,28 @@ def plot_step_sizes(result: Result, *, ax: Axes | None = None, pair: str | None 
                     **line_kw: Any) -> Axes:
     """IDA's step size against time, log scale, contact intervals shaded (section 4.4, Figs. 4.15d, 4.24).
 
-    Parameters
-    ----------
-    result : Result
-        A run with recorded steps (``result.step_t``, ``result.step_h``; ``simulate``
-        records them by default, whatever ``t_eval``).
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    pair : str, optional
-        Contact pair whose contact intervals are shaded (every pair when None).
-    shade : bool
-        Shade the contact intervals (from ``result.events``) in grey.
-    window : (t0, t1), optional
-        Time window in s: steps reaching a time inside it are drawn, contact intervals are
-        clipped to it.
-    max_points : int, optional
-        Draw at most this many steps (min-max decimation of the step size).
-    title : str or bool, optional
-        As in :func:`plot_channel` (the run's caption on a new figure).
-    **line_kw
-        Passed to ``ax.plot`` for the step sizes.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        ``ax.lines[0]``: step size h (s) against the time reached by the step (s); the
-        zero-size placeholder of the initial point is left out. One patch per contact
-        interval.
-
-    Raises
-    ------
-    ValueError
-        If the result has no recorded steps.
+    ``result`` needs recorded steps (``result.step_t``, ``result.step_h``; ValueError otherwise); the
+    intervals of ``pair`` (every pair when None) are shaded grey when ``shade``. ``window``, ``max_points``
+    (min-max decimation) and ``title`` as in :func:`plot_channel`. ``ax.lines[0]``: step size h (s) against
+    the time the step reached, without the initial zero-size placeholder; one patch per contact interval.
     """
-    import numpy as np
-
     if result.step_t is None or result.step_h is None:
         raise ValueError(f"plot_step_sizes: result of scene {result.scene_name!r} has no recorded steps "
                          f"(simulate(..., save=SaveAt(steps=True)) records them).")
     created = ax is None
     ax = style.new_axes(ax)
-    h = np.asarray(result.step_h)
-    t = np.asarray(result.step_t)
+    t, h = np.asarray(result.step_t), np.asarray(result.step_h)
     inside = style.window_index(t, window)
     index = style.decimate(h, max_points, inside[h[inside] > 0])
-    kw: dict[str, Any] = {"lw": 0.6, "color": "C0", "marker": ".", "ms": 1.5}
-    kw.update(line_kw)
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0", "marker": ".", "ms": 1.5, **line_kw}
     ax.plot(t[index], h[index], **kw)
     ax.set_yscale("log")
     if shade:
-        lo, hi = (None, None) if window is None else window
-        lo = -np.inf if lo is None else float(lo)
-        hi = np.inf if hi is None else float(hi)
+        lo, hi = style.window_bounds(window)
         spans = [(max(a, lo), min(b, hi)) for a, b in _contact_intervals(result, pair) if b >= lo and a <= hi]
         for k, (t0, t1) in enumerate(spans):
             ax.axvspan(t0, t1, color="0.85", lw=0, zorder=0, label="contact" if k == 0 else None)
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel("IDA step size (s)")
+    ax.set(xlabel="time (s)", ylabel="IDA step size (s)")
     set_run_title(ax, result, title, created)
     return ax
 
@@ -260,30 +155,11 @@ def plot_cases(results: Mapping[str, Result], draw: Any, *, ncols: int = 2, shar
                **kwargs: Any) -> Any:
     """One panel per labelled result, each drawn by a figure function (Figs. 4.16-4.25).
 
-    Parameters
-    ----------
-    results : mapping of str to Result
-        Panel title -> result, in panel order; titles get the chapter's "(a)", "(b)", ...
-    draw : callable
-        A figure function called as ``draw(result, ax=ax, **kwargs)``, e.g.
-        ``plot_journal_orbit``, ``plot_phase_portrait``, ``plot_step_sizes`` or
-        ``functools.partial(plot_channel, channel="drive.moment")``.
-    ncols : int
-        Panels per row.
-    sharex, sharey : bool
-        Share axes between panels (as ``plt.subplots``).
-    panel_size : (float, float)
-        Width and height of one panel, inches.
-    suptitle : str, optional
-        Figure title.
-    **kwargs
-        Passed to every ``draw`` call (e.g. ``reference=ideal``, ``window=(t0, t1)``,
-        ``max_points=4000``).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        Its first ``len(results)`` axes hold the panels; unused grid cells are hidden.
+    ``results``: panel title -> result, in panel order (titles get the chapter's "(a)", "(b)", ...);
+    ``draw(result, ax=ax, **kwargs)`` draws each, e.g. ``plot_journal_orbit`` or
+    ``functools.partial(plot_channel, channel="drive.moment")``; ``ncols`` panels per row, ``sharex`` and
+    ``sharey`` as ``plt.subplots``, ``panel_size`` (width, height) of one panel in inches. Returns the
+    Figure: its first ``len(results)`` axes hold the panels, unused cells are hidden.
     """
     import matplotlib.pyplot as plt
 
@@ -300,8 +176,21 @@ def plot_cases(results: Mapping[str, Result], draw: Any, *, ncols: int = 2, shar
         style.set_title(flat[k], f"({chr(ord('a') + k)}) {label}")
     for extra in flat[n:]:
         extra.set_visible(False)
-    if suptitle:
-        style.set_title(fig, suptitle)
+    style.set_title(fig, suptitle or "")
+    fig.tight_layout()
+    return fig
+
+
+def _response_figure(result: Result, reference: Result | None, window: Window, max_points: int | None,
+                     title: str | bool, draw_d: Any) -> Any:
+    """Four panels: (a)-(c) of :func:`response_panels`, (d) drawn by ``draw_d(ax)``."""
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(10.0, 7.0))
+    (a, b), (c, d) = axes
+    response_panels(result, reference, (a, b, c), window, max_points)
+    draw_d(d)
+    set_run_title(fig, result, title, True)
     fig.tight_layout()
     return fig
 
@@ -311,43 +200,17 @@ def plot_revolute_response(result: Result, *, reference: Result | None = None, o
                            title: str | bool = True) -> Any:
     """Fig. 4.15 in four panels: slider velocity, slider acceleration, crank moment, journal orbit.
 
-    Parameters
-    ----------
-    result : Result
-        The clearance-joint run (a dense ``t_eval`` for panels a-c).
-    reference : Result, optional
-        The ideal-joint run over the same times, dashed in panels a-c.
-    orbit : Result, optional
-        Run whose output times are IDA's steps (``t_eval=None``), for panel d's
-        one-marker-per-step orbit; ``result`` when None.
-    joint : str
-        Name of the revolute clearance joint.
-    window : (t0, t1), optional
-        Time window in s of every panel.
-    max_points : int, optional
-        At most this many points per line (min-max decimation in panels a-c, even spacing
-        in the orbit).
-    title : str or bool
-        Figure title: True for the run's caption (clearance, speed, law, restitution,
-        friction), a str for that text, False for none.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        Axes in order (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) orbit.
+    ``result``: the clearance-joint run (a dense ``t_eval`` for panels a-c); ``reference``: the ideal-joint
+    run over the same times, dashed in panels a-c; ``orbit``: a run whose output times are IDA's steps
+    (``t_eval=None``) for panel d (``result`` when None); ``joint``: the revolute clearance joint;
+    ``window``, ``max_points`` and ``title`` as in :func:`plot_channel` (title: the caption unless False or
+    a text). Returns the Figure, axes (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) orbit.
     """
-    import matplotlib.pyplot as plt
+    def orbit_panel(ax: Axes) -> None:
+        plot_journal_orbit(orbit if orbit is not None else result, joint, ax=ax, window=window,
+                           max_points=max_points, title="(d) journal trajectory relative to the bearing")
 
-    fig, axes = plt.subplots(2, 2, figsize=(10.0, 7.0))
-    (a, b), (c, d) = axes
-    response_panels(result, reference, (a, b, c), window, max_points)
-    plot_journal_orbit(orbit if orbit is not None else result, joint, ax=d, window=window, max_points=max_points,
-                       title="(d) journal trajectory relative to the bearing")
-    set_run_title(fig, result, title, True)
-    fig.tight_layout()
-    return fig
-
-
+    return _response_figure(result, reference, window, max_points, title, orbit_panel)
 
 
 def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | None = None, limits: bool = True,
@@ -355,37 +218,11 @@ def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | Non
                      title: str | bool | None = None, **line_kw: Any) -> Axes:
     """Dimensionless path of the slider centre inside the guide (Figs. 4.28d, 4.30, 4.33).
 
-    Parameters
-    ----------
-    result : Result
-        A run with a translational clearance joint (channels ``<joint>.xi`` and
-        ``<joint>.eta``: xi from 0 to 1 along the stroke, eta the offset of the slider
-        centre from the guide's mid-line over 2c, +-0.5 where a parallel slider touches
-        a surface). A joint without a ``stroke`` has no ``xi``: its path is drawn against
-        ``<joint>.s``, the slider centre's position along the guide, in mm.
-    joint : str
-        Name of the translational clearance joint (``"clearance"`` in ``slider_crank``).
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    limits : bool
-        Draw the geometric contact limits, eta = +-0.5 (dashed): beyond them the slider
-        and the guide are in contact (the chapter's horizontal lines).
-    reference : Result, optional
-        Drawn first, black dotted (e.g. the ideal joint: eta = 0 along the stroke).
-    window : (t0, t1), optional
-        Time window in s; only the path inside it is drawn.
-    max_points : int, optional
-        Draw at most this many points per path, evenly spaced in the output times.
-    title : str or bool, optional
-        As in :func:`plot_channel` (the run's caption on a new figure).
-    **line_kw
-        Passed to ``ax.plot`` for the path.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        ``ax.lines[0]`` is the reference path when given, then the slider path, then the
-        two limit lines.
+    ``result`` has the channels ``<joint>.xi`` (0 to 1 along the stroke) and ``<joint>.eta`` (offset from
+    the guide's mid-line over 2c, +-0.5 at a surface); a joint without a ``stroke`` has no ``xi`` and its
+    path is drawn against ``<joint>.s`` in mm. ``limits`` draws eta = +-0.5 (dashed); ``reference`` is
+    drawn first, black dotted; ``window``, ``max_points`` (evenly spaced) and ``title`` as in
+    :func:`plot_channel`. ``ax.lines``: the reference path, the slider path, the two limit lines.
     """
     created = ax is None
     ax = style.new_axes(ax)
@@ -395,8 +232,7 @@ def plot_slider_path(result: Result, joint: str = "clearance", *, ax: Axes | Non
     if reference is not None:
         x_ref, y_ref = xy_curve(reference, along, eta, window, max_points)
         ax.plot(x_ref * scale, y_ref, "k:", lw=0.8, label="ideal joint")
-    kw: dict[str, Any] = {"lw": 0.6, "color": "C0"}
-    kw.update(line_kw)
+    kw: dict[str, Any] = {"lw": 0.6, "color": "C0", **line_kw}
     x, y = xy_curve(result, along, eta, window, max_points)
     ax.plot(x * scale, y, **kw)
     if limits:
@@ -414,29 +250,11 @@ def plot_translational_response(result: Result, *, reference: Result | None = No
                                 title: str | bool = True) -> Any:
     """Fig. 4.28 in four panels: slider velocity, slider acceleration, crank moment, slider path.
 
-    Parameters
-    ----------
-    result : Result
-        The clearance-joint run (a dense ``t_eval``).
-    reference : Result, optional
-        The ideal-joint run over the same times, dashed in panels a-c.
-    joint : str
-        Name of the translational clearance joint.
-    window, max_points, title
-        As in :func:`plot_revolute_response`.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        Axes in order (a) ``slider.vx``, (b) ``slider.ax``, (c) ``drive.moment``, (d) path.
+    As :func:`plot_revolute_response` (``joint``: the translational clearance joint); axes (a) ``slider.vx``,
+    (b) ``slider.ax``, (c) ``drive.moment``, (d) path.
     """
-    import matplotlib.pyplot as plt
+    def path_panel(ax: Axes) -> None:
+        plot_slider_path(result, joint, ax=ax, window=window, max_points=max_points,
+                         title="(d) dimensionless slider path inside the guide")
 
-    fig, axes = plt.subplots(2, 2, figsize=(10.0, 7.0))
-    (a, b), (c, d) = axes
-    response_panels(result, reference, (a, b, c), window, max_points)
-    plot_slider_path(result, joint, ax=d, window=window, max_points=max_points,
-                     title="(d) dimensionless slider path inside the guide")
-    set_run_title(fig, result, title, True)
-    fig.tight_layout()
-    return fig
+    return _response_figure(result, reference, window, max_points, title, path_panel)

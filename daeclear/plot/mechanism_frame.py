@@ -1,11 +1,9 @@
 """One frame of a mechanism animation: the scene's geometry, body poses at the frame times, the mechanism drawn.
 
-Turns a result's scene description into body-fixed points (:func:`scene_geometry`), samples its
-channels at the frame times (:class:`Sampler`, :func:`body_pose`, :func:`contact_state`) and
-draws the mechanism to scale (:class:`MechanismPanel`: bodies, ideal joints, clearance rings and
-slider blocks, red while in contact). Separate from :mod:`daeclear.plot.animate`, which checks
-the options and writes the file, and from :mod:`daeclear.plot.animation_panels` (the magnified
-joint panels and the time cursor built on these pieces).
+:func:`scene_geometry` turns a result's scene description into body-fixed points, :class:`Sampler`
+samples its channels at the frame times, :class:`MechanismPanel` draws the mechanism to scale (red
+while in contact). The options and the file are :mod:`daeclear.plot.animate`'s, the magnified joint
+panels :mod:`daeclear.plot.animation_panels`'.
 """
 
 from __future__ import annotations
@@ -38,9 +36,6 @@ FREE_COLOR = "C0"
 _GROUND = "0.45"
 
 
-# --------------------------------------------------------------------------- scene geometry
-
-
 def _vec(value: Any) -> NDArray[np.float64] | None:
     if value is None:
         return None
@@ -49,10 +44,6 @@ def _vec(value: Any) -> NDArray[np.float64] | None:
     except (TypeError, ValueError):
         return None
     return v if v.shape == (2,) and np.all(np.isfinite(v)) else None
-
-
-def _rot(phi: Any) -> tuple[Any, Any]:
-    return np.cos(phi), np.sin(phi)
 
 
 @dataclass
@@ -78,21 +69,19 @@ class Geometry:
     joints: list[Joint] = field(default_factory=list)
     drivers: list[str] = field(default_factory=list)
 
-    def local_point(self, body: str, world: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Body-fixed coordinates of a world point of the reference configuration."""
-        if body == self.ground:
-            return world.copy()
-        (x0, y0), phi0 = self.bodies[body]
-        c, s = math.cos(phi0), math.sin(phi0)
-        dx, dy = world[0] - x0, world[1] - y0
-        return np.array([c * dx + s * dy, -s * dx + c * dy])
-
-    def local_vector(self, body: str, world: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Body-fixed components of a world direction (unit length) of the reference configuration."""
-        v = world / math.hypot(*world)
+    def _to_body(self, body: str, v: NDArray[np.float64]) -> NDArray[np.float64]:
+        """World components ``v`` in the frame of ``body`` in the reference configuration."""
         phi0 = 0.0 if body == self.ground else self.bodies[body][1]
         c, s = math.cos(phi0), math.sin(phi0)
         return np.array([c * v[0] + s * v[1], -s * v[0] + c * v[1]])
+
+    def local_point(self, body: str, world: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Body-fixed coordinates of a world point of the reference configuration."""
+        return world.copy() if body == self.ground else self._to_body(body, world - self.bodies[body][0])
+
+    def local_vector(self, body: str, world: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Body-fixed components of a world direction (unit length) of the reference configuration."""
+        return self._to_body(body, world / math.hypot(*world))
 
     def points_of(self, body: str) -> list[NDArray[np.float64]]:
         """Distinct body-fixed joint points of ``body``, in the scene's order."""
@@ -129,9 +118,7 @@ def scene_geometry(result: Result, where: str) -> Geometry:
             geo.drivers.append(str(name))
             continue
         b_i, b_j = spec.get("body_i"), spec.get("body_j")
-        if not isinstance(b_i, str) or not isinstance(b_j, str):
-            continue
-        if any(b != ground and b not in bodies for b in (b_i, b_j)):
+        if not isinstance(b_i, str) or not isinstance(b_j, str) or not {b_i, b_j} <= {ground, *bodies}:
             continue
         at = _vec(spec.get("at"))
         p_i, p_j = _vec(spec.get("point_i")), _vec(spec.get("point_j"))
@@ -141,9 +128,6 @@ def scene_geometry(result: Result, where: str) -> Geometry:
         s_j = p_j if p_j is not None else geo.local_point(b_j, at)  # type: ignore[arg-type]
         geo.joints.append(Joint(str(name), str(spec.get("kind", "")), b_i, b_j, s_i, s_j, spec))
     return geo
-
-
-# --------------------------------------------------------------------------- sampling
 
 
 class Sampler:
@@ -195,14 +179,13 @@ def body_pose(sampler: Sampler, body: str, geo: Geometry, where: str) -> NDArray
 
 def _world(pose: NDArray[np.float64], s: NDArray[np.float64]) -> NDArray[np.float64]:
     """(n_frames, 2) world positions of the body-fixed point ``s``."""
-    c, si = _rot(pose[:, 2])
+    c, si = np.cos(pose[:, 2]), np.sin(pose[:, 2])
     return np.column_stack([pose[:, 0] + c * s[0] - si * s[1], pose[:, 1] + si * s[0] + c * s[1]])
 
 
 def _direction(pose: NDArray[np.float64], u: NDArray[np.float64]) -> NDArray[np.float64]:
-    c, si = _rot(pose[:, 2])
-    return np.column_stack([c * u[0] - si * u[1], si * u[0] + c * u[1]])
-
+    """(n_frames, 2) world components of the body-fixed direction ``u``."""
+    return _world(pose * [0.0, 0.0, 1.0], u)
 
 
 def nice_number(value: float) -> float:
@@ -248,9 +231,6 @@ def guide_geometry(joint: Joint, geo: Geometry) -> dict[str, Any] | None:
             "limits": [lim for lim in limits if lim is not None]}
 
 
-# --------------------------------------------------------------------------- the figure
-
-
 def pen_line(ax: Axes, color: str, **kw: Any) -> Any:
     """An empty line on ``ax`` that a frame update fills with data."""
     (line,) = ax.plot([], [], color=color, **kw)
@@ -262,11 +242,8 @@ class MechanismPanel:
 
     def __init__(self, ax: Axes, geo: Geometry, sampler: Sampler, contact: dict[str, NDArray[np.float64]],
                  where: str) -> None:
-        self.ax, self.geo = ax, geo
-        n = sampler.times.size
         self.poses = {b: body_pose(sampler, b, geo, where) for b in geo.bodies}
-        ground_pose = np.zeros((n, 3))
-        pose = lambda b: ground_pose if b == geo.ground else self.poses[b]  # noqa: E731
+        pose = {**self.poses, geo.ground: np.zeros((sampler.times.size, 3))}
         self.updates: list[Callable[[int], None]] = []
         extent: list[NDArray[np.float64]] = []
         static: list[NDArray[np.float64]] = []  # points fixed to the ground
@@ -290,7 +267,7 @@ class MechanismPanel:
 
         ideal_pins: list[NDArray[np.float64]] = []
         for joint in geo.joints:
-            pi, pj = pose(joint.body_i), pose(joint.body_j)
+            pi, pj = pose[joint.body_i], pose[joint.body_j]
             on_ground = geo.ground in (joint.body_i, joint.body_j)
             if joint.kind == "Revolute":
                 track = _world(pi, joint.s_i)
@@ -356,8 +333,7 @@ class MechanismPanel:
             dx = dy * shape
         else:
             dy = dx / shape
-        ax.set_xlim(centre[0] - 0.5 * dx, centre[0] + 0.5 * dx)
-        ax.set_ylim(centre[1] - 0.5 * dy, centre[1] + 0.5 * dy)
+        ax.set(xlim=(centre[0] - 0.5 * dx, centre[0] + 0.5 * dx), ylim=(centre[1] - 0.5 * dy, centre[1] + 0.5 * dy))
         ax.set_aspect("equal", adjustable="box")
         ax.tick_params(labelsize="small")
         ax.set_title(f"{geo.name or 'mechanism'} (x, y in m)", fontsize=style.TITLE_SIZE)

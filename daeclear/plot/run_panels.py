@@ -1,21 +1,13 @@
-"""Panels of one run over time: a channel, the impact force curves, the response figure, and saving.
-
-The building blocks every other figure module draws with (:func:`plot_channel`, the run title,
-x-y curves of two channels) and :func:`save_figure`; separate so the joint, study and overview
-figures share them without importing each other.
-
-Each function takes data and an optional ``ax``, draws on it (a new figure when
-``ax`` is None) and returns the Axes; none calls ``plt.show()``. Units on the axes are
-stated in the labels. Figures of a run are titled with its parameters (clearance, crank speed,
-contact law, restitution, friction; ``title=``); functions that draw a run over time take a time
-``window=(t0, t1)`` and ``max_points`` (min-max decimation, so a long run does not plot as a
-solid band).
+"""Panels of one run over time (a channel, impact force curves, the response figure) and :func:`save_figure`:
+the building blocks the joint, study and overview figures share.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from . import style
 
@@ -36,13 +28,8 @@ Window = tuple[float | None, float | None] | None
 """A closed time window ``(t0, t1)`` in s; None (or a None side) leaves it open."""
 
 
-def _axes(ax: Axes | None) -> Axes:
-    return style.new_axes(ax)
-
-
 def set_run_title(target: Any, result: Result, title: str | bool | None, created: bool) -> None:
-    """Title ``target`` (Axes or Figure): the run's caption when ``title`` is True, or None and the
-    function made the figure itself; the text when a str; nothing when False."""
+    """Title ``target`` (Axes or Figure): a str as given; the run's caption when True, or None and ``created``."""
     if isinstance(title, str):
         style.set_title(target, title)
     elif title or (title is None and created):
@@ -51,8 +38,6 @@ def set_run_title(target: Any, result: Result, title: str | bool | None, created
 
 def _series(result: Result, name: str, window: Window, max_points: int | None) -> tuple[Any, Any]:
     """Time and values of a channel inside ``window``, min-max decimated to ``max_points``."""
-    import numpy as np
-
     values = np.asarray(result[name])
     index = style.select_times(result.t, values, window=window, max_points=max_points)
     return np.asarray(result.t)[index], values[index]
@@ -60,8 +45,6 @@ def _series(result: Result, name: str, window: Window, max_points: int | None) -
 
 def xy_curve(result: Result, x: str, y: str, window: Window, max_points: int | None) -> tuple[Any, Any]:
     """Two channels of an x-y curve inside ``window``, evenly thinned to ``max_points``."""
-    import numpy as np
-
     index = style.select_times(result.t, window=window, max_points=max_points)
     return np.asarray(result[x])[index], np.asarray(result[y])[index]
 
@@ -82,58 +65,33 @@ def _labelled(impacts: Impacts) -> list[tuple[str, ImpactResult]]:
     return [(_label(i), i) for i in impacts]
 
 
+def _force_against(impacts: Impacts, ax: Axes | None, x: str, x_label: str, line_kw: Any) -> Axes:
+    """Contact force of each impact against ``impact.<x>`` (in millionths), labelled."""
+    ax = style.new_axes(ax)
+    for label, impact in _labelled(impacts):
+        ax.plot(getattr(impact, x) * 1e6, impact.force, label=label, **line_kw)
+    ax.set(xlabel=x_label, ylabel="contact force (N)")
+    ax.legend()
+    return ax
+
+
 def plot_force_penetration(impacts: Impacts, *, ax: Axes | None = None, **line_kw: Any) -> Axes:
     """Contact force against penetration for single impacts (hysteresis loops, Fig. 4.26b).
 
-    Parameters
-    ----------
-    impacts : ImpactResult, iterable of ImpactResult, or mapping label -> ImpactResult
-        From :func:`daeclear.contact.simulate_impact`, one per law; unlabelled ones
-        are labelled by law name and restitution.
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    **line_kw
-        Passed to ``ax.plot`` for every curve.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        Penetration in um on x, force in N on y. The area enclosed by a loop is the
-        energy lost in the impact.
+    ``impacts``: ImpactResults of :func:`daeclear.contact.simulate_impact` (one, several, or a mapping
+    label -> impact; unlabelled ones are labelled by law and restitution), drawn on ``ax`` (a new figure when
+    None) with ``**line_kw``. Returns the Axes: penetration in µm on x, force in N on y; a loop's area is
+    the energy lost in the impact.
     """
-    ax = _axes(ax)
-    for label, impact in _labelled(impacts):
-        ax.plot(impact.penetration * 1e6, impact.force, label=label, **line_kw)
-    ax.set_xlabel("penetration (µm)")
-    ax.set_ylabel("contact force (N)")
-    ax.legend()
-    return ax
+    return _force_against(impacts, ax, "penetration", "penetration (µm)", line_kw)
 
 
 def plot_force_time(impacts: Impacts, *, ax: Axes | None = None, **line_kw: Any) -> Axes:
-    """Contact force against time for single impacts (Fig. 4.26a).
+    """Contact force against time since first contact, µs, for single impacts (Fig. 4.26a).
 
-    Parameters
-    ----------
-    impacts : ImpactResult, iterable of ImpactResult, or mapping label -> ImpactResult
-        As in :func:`plot_force_penetration`.
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
-    **line_kw
-        Passed to ``ax.plot`` for every curve.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        Time since first contact in us on x, force in N on y.
+    ``impacts``, ``ax`` and ``line_kw`` as in :func:`plot_force_penetration`; returns the Axes.
     """
-    ax = _axes(ax)
-    for label, impact in _labelled(impacts):
-        ax.plot(impact.t * 1e6, impact.force, label=label, **line_kw)
-    ax.set_xlabel("time since contact onset (µs)")
-    ax.set_ylabel("contact force (N)")
-    ax.legend()
-    return ax
+    return _force_against(impacts, ax, "t", "time since contact onset (µs)", line_kw)
 
 
 def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, reference: Result | None = None,
@@ -147,36 +105,28 @@ def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, refere
         The run.
     channel : str
         Channel (or state) name.
-    ax : matplotlib Axes, optional
-        Where to draw; a new figure when None.
     reference : Result, optional
-        Drawn first, black dashed, over the same window.
+        Drawn first (``ax.lines[0]``), black dashed, over the same window.
     label : str, optional
         Legend label of the run (default its scene name).
     window : (t0, t1), optional
-        Time window in s; only output times inside it are drawn.
+        Time window in s.
     max_points : int, optional
-        Draw at most this many points per line, keeping the lowest and highest value of each
-        stretch (min-max decimation): peaks survive, a long run does not fill the axes.
+        At most this many points per line, min-max decimated (peaks survive).
     title : str or bool, optional
-        Axes title: True for the run's caption (clearance, speed, law, restitution, friction),
-        a str for that text, False for none; None gives the caption only on a new figure.
-    **line_kw
-        Passed to ``ax.plot`` for the run's line.
+        True: the run's caption (clearance, speed, law, restitution, friction); a str: that text;
+        False: none; None: the caption only on a new figure.
 
-    Returns
-    -------
-    matplotlib.axes.Axes
-        ``ax.lines[0]`` is the reference when given, then the run.
+    Drawn on ``ax`` (a new figure when None), ``**line_kw`` passed to ``ax.plot`` for the run's line;
+    returns the Axes.
     """
     created = ax is None
-    ax = _axes(ax)
+    ax = style.new_axes(ax)
     unit = result.units.get(channel, "")
     if reference is not None:
         ax.plot(*_series(reference, channel, window, max_points), "k--", lw=0.8, label="ideal joint")
     ax.plot(*_series(result, channel, window, max_points), lw=0.9, label=label or result.scene_name, **line_kw)
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel(style.quantity_label(channel, unit))
+    ax.set(xlabel="time (s)", ylabel=style.quantity_label(channel, unit))
     if reference is not None:
         ax.legend(loc="best", fontsize="small")
     set_run_title(ax, result, title, created)
@@ -198,11 +148,9 @@ def response_panels(result: Result, reference: Result | None, axes: Any, window:
 def save_response_figure(result: Result, path: Any, *, reference: Result | None = None,
                          channels: Iterable[str] = RESPONSE_CHANNELS, window: Window = None,
                          max_points: int | None = None, title: str | bool = True) -> Any:
-    """Write a figure of slider velocity, acceleration and driving moment (Fig. 4.15a-c) to ``path``.
+    """Write a figure of slider velocity, acceleration and driving moment (Fig. 4.15a-c) to ``path``; returns it.
 
-    Channels missing from the result are skipped; ``window`` and ``max_points`` as in
-    :func:`plot_channel`; titled with the run's caption (scene, clearance, speed, law,
-    restitution, friction) unless ``title`` is False or a text. Returns the path written.
+    Missing channels are skipped; ``window``, ``max_points`` and ``title`` as in :func:`plot_channel`.
     """
     import matplotlib.pyplot as plt
 

@@ -1,11 +1,5 @@
-"""The one style of daeclear's figures: captions that carry the run's parameters, time
-windows and decimation for long runs, parameter axes with units and log scales.
-
-Every figure function of :mod:`daeclear.plot` draws through these helpers, so a figure says
-which clearance, speed, contact law, restitution and friction produced it, a 200-revolution
-run can be shown over a window or thinned to a number of points that still shows its peaks,
-and a sweep over a geometric grid gets a log axis with the parameter's unit.
-matplotlib is imported only when an Axes is made.
+"""The one style of daeclear's figures: captions with the run's parameters, time windows and min-max
+decimation for long runs, parameter axes with units and log scales (matplotlib imported only for an Axes).
 """
 
 from __future__ import annotations
@@ -22,57 +16,24 @@ if TYPE_CHECKING:
 
     from ..results.result import Result
 
-__all__ = [
-    "PARAMETER_AXES",
-    "TITLE_SIZE",
-    "caption",
-    "decimate",
-    "format_parameter",
-    "is_geometric",
-    "new_axes",
-    "parameter_axis",
-    "parameter_display",
-    "parameter_label",
-    "quantity_label",
-    "run_parameters",
-    "select_times",
-    "set_title",
-    "stride",
-    "sweep_caption",
-    "window_index",
-]
+__all__ = ["PARAMETER_AXES", "TITLE_SIZE", "caption", "decimate", "format_parameter", "is_geometric", "new_axes",
+           "parameter_axis", "parameter_display", "quantity_label", "run_parameters", "scene_elements",
+           "select_times", "set_title", "stride", "sweep_caption", "window_bounds", "window_index"]
 
 TITLE_SIZE = "medium"
 """Font size of every figure and panel title."""
 
 PARAMETER_AXES: dict[str, tuple[float, str]] = {
-    "clearance": (1e3, "mm"),
-    "bearing_radius": (1e3, "mm"),
-    "journal_radius": (1e3, "mm"),
-    "length": (1e3, "mm"),
-    "width": (1e3, "mm"),
-    "corner_radius": (1e3, "mm"),
-    "rpm": (1.0, "rpm"),
-    "gravity": (1.0, "m/s²"),
-    "crank_angle": (1.0, "rad"),
-    "restitution": (1.0, "-"),
-    "friction": (1.0, "-"),
-    "rtol": (1.0, "-"),
-}
-"""How a swept parameter is shown: name -> (factor from its SI value, unit of the axis).
-
-The parameters of :func:`daeclear.mechanisms.slider_crank` and :func:`~daeclear.mechanisms.chain`,
-given in SI units (``clearance`` in m, shown in mm; ``rpm`` in rev/min).
-"""
+    **dict.fromkeys(("clearance", "bearing_radius", "journal_radius", "length", "width", "corner_radius"), (1e3, "mm")),
+    "rpm": (1.0, "rpm"), "gravity": (1.0, "m/s²"), "crank_angle": (1.0, "rad"),
+    **dict.fromkeys(("restitution", "friction", "rtol"), (1.0, "-"))}
+"""How a swept parameter (of the mechanisms' builders, in SI units) is shown: name -> (factor, unit of the axis)."""
 
 _LAW_NAMES = {"lankarani-nikravesh": "Lankarani-Nikravesh", "hunt-crossley": "Hunt-Crossley", "flores": "Flores",
               "hertz": "Hertz", "esdu-78035": "ESDU-78035", "goldsmith": "Goldsmith",
               "dubowsky-freudenstein": "Dubowsky-Freudenstein", "lankarani-plane": "Lankarani plane",
               "kelvin-voigt": "Kelvin-Voigt"}
 _FRICTION_NAMES = {"coulomb": "Coulomb", "modified-coulomb": "modified Coulomb"}
-
-
-# --------------------------------------------------------------------------- axes and titles
 
 
 def new_axes(ax: Axes | None = None) -> Axes:
@@ -86,20 +47,13 @@ def new_axes(ax: Axes | None = None) -> Axes:
 
 def set_title(target: Any, text: str) -> None:
     """Title of an Axes, or the suptitle of a Figure, in the common size (nothing for empty text)."""
-    if not text:
-        return
-    if hasattr(target, "suptitle"):
-        target.suptitle(text, fontsize=TITLE_SIZE)
-    else:
-        target.set_title(text, fontsize=TITLE_SIZE)
+    if text:
+        (target.suptitle if hasattr(target, "suptitle") else target.set_title)(text, fontsize=TITLE_SIZE)
 
 
 def quantity_label(name: str, unit: str) -> str:
     """Axis label ``"name (unit)"``, or the name alone when there is no unit."""
     return f"{name} ({unit})" if unit else name
-
-
-# --------------------------------------------------------------------------- captions
 
 
 def _number(value: Any) -> float | None:
@@ -118,40 +72,35 @@ def _law_text(law: Any) -> str:
 
 
 def _friction_text(friction: Any) -> str:
-    if friction is None or friction == {} or friction is False:
+    if friction is None or friction == {} or friction is False or friction == "none":
         return "frictionless"
-    coefficient = _number(friction)
-    if coefficient is not None:
-        return "frictionless" if coefficient == 0 else f"friction $c_f$ = {coefficient:g}"
     if isinstance(friction, str):
-        return "frictionless" if friction == "none" else _FRICTION_NAMES.get(friction, friction)
-    if isinstance(friction, Mapping):
-        name = friction.get("name")
-        if name == "none":
-            return "frictionless"
-        coefficient = _number(friction.get("coefficient"))
-        text = _FRICTION_NAMES.get(name, str(name)) if isinstance(name, str) else "friction"
-        if coefficient is not None:
-            return "frictionless" if coefficient == 0 else f"{text} $c_f$ = {coefficient:g}"
-        return text
-    return ""
+        return _FRICTION_NAMES.get(friction, friction)
+    name = friction.get("name") if isinstance(friction, Mapping) else None
+    if name == "none":
+        return "frictionless"
+    coefficient = _number(friction.get("coefficient") if isinstance(friction, Mapping) else friction)
+    text = _FRICTION_NAMES.get(name, str(name)) if isinstance(name, str) else "friction"
+    if coefficient is not None:
+        return "frictionless" if coefficient == 0 else f"{text} $c_f$ = {coefficient:g}"
+    return text if isinstance(friction, Mapping) else ""
+
+
+def scene_elements(result: Result) -> Mapping[str, Any]:
+    """The element descriptions of the run's scene, ``result.parameters["scene"]["elements"]`` (empty if none)."""
+    scene = result.parameters.get("scene") if isinstance(result.parameters, Mapping) else None
+    elements = scene.get("elements", {}) if isinstance(scene, Mapping) else {}
+    return elements if isinstance(elements, Mapping) else {}
 
 
 def run_parameters(result: Result) -> dict[str, Any]:
-    """The parameters a figure of ``result`` should state, read from ``result.parameters["scene"]``.
-
-    Returns
-    -------
-    dict
-        ``"rpm"``: crank speed of the first driver (rev/min); ``"joints"``: one dict per
-        clearance joint, ``{"name", "kind", "clearance" (m), "law" (text), "restitution",
-        "friction" (text)}``; entries that the scene does not have are left out.
+    """The parameters a figure of ``result`` states, from its scene: ``"rpm"`` (first driver, rev/min) and
+    ``"joints"``, per clearance joint ``{"name", "kind", "clearance" (m), "law" (text), "restitution",
+    "friction" (text)}``; what the scene lacks is left out.
     """
-    scene = result.parameters.get("scene") if isinstance(result.parameters, Mapping) else None
-    elements = scene.get("elements", {}) if isinstance(scene, Mapping) else {}
     out: dict[str, Any] = {}
     joints: list[dict[str, Any]] = []
-    for name, element in (elements.items() if isinstance(elements, Mapping) else ()):
+    for name, element in scene_elements(result).items():
         if not isinstance(element, Mapping):
             continue
         speed = _number(element.get("speed"))
@@ -175,34 +124,25 @@ def run_parameters(result: Result) -> dict[str, Any]:
 
 
 def _joint_text(joint: Mapping[str, Any]) -> str:
-    parts = [f"c = {joint['clearance'] * 1e3:g} mm"]
-    parts += [joint[k] for k in ("law", "friction") if joint.get(k)]
-    return ", ".join(parts)
+    return ", ".join([f"c = {joint['clearance'] * 1e3:g} mm"] + [joint[k] for k in ("law", "friction") if joint.get(k)])
 
 
 def caption(result: Result, *, name: bool = True) -> str:
     """One line naming the run: scene, clearance, crank speed, law and restitution, friction.
 
-    E.g. ``"slider_crank_revolute: c = 0.5 mm, 5000 rpm, Lankarani-Nikravesh $c_e$ = 0.9,
-    frictionless"``; a failed run is marked ``(FAILED: partial result)``. Several clearance
-    joints with different settings are listed by joint name.
+    E.g. ``"slider_crank_revolute: c = 0.5 mm, 5000 rpm, Lankarani-Nikravesh $c_e$ = 0.9, frictionless"``;
+    joints with different settings are listed by name, a failed run ends in ``(FAILED: partial result)``.
     """
     info = run_parameters(result)
     joints = info.get("joints", [])
     texts = list(dict.fromkeys(_joint_text(j) for j in joints))
-    parts: list[str] = []
-    if len(texts) == 1:
+    rpm = [f"{info['rpm']:.4g} rpm"] if "rpm" in info else []
+    if len(texts) == 1:  # the clearance first, then the speed, then the law and friction
         first, _, rest = texts[0].partition(", ")
-        parts.append(first)
-        if "rpm" in info:
-            parts.append(f"{info['rpm']:.4g} rpm")
-        if rest:
-            parts.append(rest)
+        parts = [first, *rpm, rest]
     else:
-        if "rpm" in info:
-            parts.append(f"{info['rpm']:.4g} rpm")
-        parts += [f"{j['name']}: {_joint_text(j)}" for j in joints]
-    text = ", ".join(parts)
+        parts = rpm + [f"{j['name']}: {_joint_text(j)}" for j in joints]
+    text = ", ".join(p for p in parts if p)
     if name and result.scene_name:
         text = f"{result.scene_name}: {text}" if text else result.scene_name
     if not result.success:
@@ -214,9 +154,7 @@ def format_parameter(name: str, value: Any) -> str:
     """``"name = value unit"`` in the display unit of :data:`PARAMETER_AXES`."""
     number = _number(value)
     if number is None:
-        if name == "friction":
-            return _friction_text(value)
-        return f"{name} = {value}"
+        return _friction_text(value) if name == "friction" else f"{name} = {value}"
     scale, unit = PARAMETER_AXES.get(name, (1.0, ""))
     if unit == name:  # "5000 rpm", not "rpm = 5000 rpm"
         return f"{number * scale:g} {unit}"
@@ -228,17 +166,11 @@ def sweep_caption(sweep: Any, exclude: Iterable[str] = ()) -> str:
     """The mechanism and the parameters every run of a sweep shares (the ones not on an axis)."""
     runs = list(getattr(sweep, "runs", ()))
     skip = set(exclude)
-    fixed: dict[str, Any] = {}
-    if runs:
-        for key, value in runs[0].parameters.items():
-            if key not in skip and all(r.parameters.get(key, object()) == value for r in runs):
-                fixed[key] = value
+    first = runs[0].parameters if runs else {}
+    fixed = {k: v for k, v in first.items() if k not in skip and all(r.parameters.get(k, object()) == v for r in runs)}
     mechanism = str(getattr(sweep, "mechanism", "") or "")
     text = ", ".join(format_parameter(k, v) for k, v in fixed.items())
     return f"{mechanism}: {text}" if mechanism and text else mechanism or text
-
-
-# --------------------------------------------------------------------------- time windows and decimation
 
 
 def _check_max_points(max_points: int | None) -> None:
@@ -248,12 +180,10 @@ def _check_max_points(max_points: int | None) -> None:
 
 
 def decimate(y: ArrayLike, max_points: int | None, index: NDArray[np.intp] | None = None) -> NDArray[np.intp]:
-    """Indices of at most ``max_points`` samples of ``y`` that keep its envelope (min-max decimation).
+    """Indices of at most ``max_points`` samples of ``y`` (or ``y[index]``) that keep its envelope.
 
-    The samples (all of ``y``, or ``y[index]``) are cut into ``max_points // 2`` runs of
-    consecutive points, and the lowest and highest point of each run are kept, in time
-    order: peaks (impacts) survive, which plain striding would miss. ``max_points=None``
-    keeps every point.
+    Min-max decimation: the lowest and highest point of each of ``max_points // 2`` runs of samples, in
+    time order, so peaks (impacts) survive; ``max_points=None`` keeps every point.
     """
     _check_max_points(max_points)
     values = np.asarray(y)
@@ -262,20 +192,16 @@ def decimate(y: ArrayLike, max_points: int | None, index: NDArray[np.intp] | Non
         return idx
     v = values[idx].astype(np.float64)
     v = v.reshape(v.shape[0], -1)[:, 0] if v.ndim > 1 else v
-    n_bins = max_points // 2
-    edges = np.linspace(0, idx.size, n_bins + 1).astype(np.intp)
+    edges = np.linspace(0, idx.size, max_points // 2 + 1).astype(np.intp)  # max_points // 2 runs
     keep: list[int] = []
     for a, b in zip(edges[:-1], edges[1:]):
         if b <= a:
             continue
-        chunk = v[a:b]
-        finite = np.isfinite(chunk)
-        if not finite.any():
+        chunk = np.where(np.isfinite(v[a:b]), v[a:b], np.nan)
+        if np.isnan(chunk).all():
             keep.append(a)
-            continue
-        lo = a + int(np.nanargmin(np.where(finite, chunk, np.nan)))
-        hi = a + int(np.nanargmax(np.where(finite, chunk, np.nan)))
-        keep.extend(sorted({lo, hi}))
+        else:
+            keep.extend(sorted({a + int(np.nanargmin(chunk)), a + int(np.nanargmax(chunk))}))
     return idx[np.asarray(keep, dtype=np.intp)]
 
 
@@ -288,11 +214,10 @@ def stride(index: NDArray[np.intp], max_points: int | None) -> NDArray[np.intp]:
     return index[picks]
 
 
-def window_index(t: ArrayLike, window: tuple[float | None, float | None] | None) -> NDArray[np.intp]:
-    """Indices of the times inside the closed ``window = (t0, t1)`` (None: every time, or an open side)."""
-    times = np.asarray(t, dtype=np.float64)
+def window_bounds(window: tuple[float | None, float | None] | None) -> tuple[float, float]:
+    """``window = (t0, t1)`` as floats, a None side (or None) open (+-inf); ValueError if not a pair or t0 > t1."""
     if window is None:
-        return np.arange(times.shape[0])
+        return -math.inf, math.inf
     try:
         t0, t1 = window
     except (TypeError, ValueError):
@@ -301,20 +226,25 @@ def window_index(t: ArrayLike, window: tuple[float | None, float | None] | None)
     hi = math.inf if t1 is None else float(t1)
     if lo > hi:
         raise ValueError(f"window=({t0}, {t1}): t0 must not exceed t1.")
+    return lo, hi
+
+
+def window_index(t: ArrayLike, window: tuple[float | None, float | None] | None) -> NDArray[np.intp]:
+    """Indices of the times inside the closed ``window = (t0, t1)`` (None: every time, or an open side)."""
+    times = np.asarray(t, dtype=np.float64)
+    if window is None:
+        return np.arange(times.shape[0])
+    lo, hi = window_bounds(window)
     return np.flatnonzero((times >= lo) & (times <= hi))
 
 
 def select_times(t: ArrayLike, y: ArrayLike | None = None, *, window: tuple[float | None, float | None] | None = None,
                  max_points: int | None = None) -> NDArray[np.intp]:
-    """Indices to plot of a time series: inside ``window``, then min-max decimated on ``y`` to ``max_points``
-    (evenly strided when no ``y`` is given, e.g. for an x-y curve)."""
+    """Indices to plot: inside ``window``, min-max decimated on ``y`` to ``max_points`` (strided without ``y``)."""
     index = window_index(t, window)
     if y is None:
         return stride(index, max_points)
     return decimate(y, max_points, index)
-
-
-# --------------------------------------------------------------------------- parameter axes
 
 
 def is_geometric(values: Iterable[Any], rtol: float = 1e-6) -> bool:
@@ -331,20 +261,14 @@ def is_geometric(values: Iterable[Any], rtol: float = 1e-6) -> bool:
 
 def parameter_display(name: str, scale: float | None = None, unit: str | None = None) -> tuple[float, str]:
     """Factor and unit of a parameter axis: the given ones, else :data:`PARAMETER_AXES`, else (1, "")."""
+    default_scale, default_unit = PARAMETER_AXES.get(name, (1.0, ""))
     if scale is None and unit is None:
-        return PARAMETER_AXES.get(name, (1.0, ""))
+        return default_scale, default_unit
     if scale is None:
-        default_scale, default_unit = PARAMETER_AXES.get(name, (1.0, ""))
         return (default_scale if unit == default_unit else 1.0), unit or ""
     if unit is None:
-        default_scale, default_unit = PARAMETER_AXES.get(name, (1.0, ""))
         return float(scale), (default_unit if scale == default_scale else "")
     return float(scale), unit
-
-
-def parameter_label(name: str, unit: str) -> str:
-    """Axis label of a parameter, ``"clearance (mm)"``."""
-    return quantity_label(name, unit)
 
 
 def parameter_axis(ax: Axes, which: str, name: str, values: Iterable[Any], unit: str,
@@ -352,12 +276,8 @@ def parameter_axis(ax: Axes, which: str, name: str, values: Iterable[Any], unit:
     """Label the x or y axis with the parameter and its unit; log scale when ``log`` or, if None, when
     ``values`` form a geometric grid. Returns whether the axis is logarithmic."""
     use_log = is_geometric(values) if log is None else bool(log)
-    if which == "x":
-        ax.set_xlabel(parameter_label(name, unit))
-        if use_log:
-            ax.set_xscale("log")
-    else:
-        ax.set_ylabel(parameter_label(name, unit))
-        if use_log:
-            ax.set_yscale("log")
+    axis = "x" if which == "x" else "y"
+    getattr(ax, f"set_{axis}label")(quantity_label(name, unit))
+    if use_log:
+        getattr(ax, f"set_{axis}scale")("log")
     return use_log

@@ -1,8 +1,5 @@
-"""Contact events of a run: `ContactEvent` (one transition found by root finding) and `EventList`.
-
-Separate from the `Result` container (daeclear.results.result) because the assembly code builds
-events while a run goes on (contact pairs, translational joints) and the HDF5 reader rebuilds them,
-neither of which needs the rest of a result.
+"""Contact events of a run: `ContactEvent` (one transition found by root finding) and `EventList`, apart from
+the `Result` container (the assembly code builds them during a run, the HDF5 reader rebuilds them).
 """
 
 from __future__ import annotations
@@ -38,19 +35,13 @@ class ContactEvent:
     pair : str
         Name of the contact pair, e.g. ``"C"`` or ``"clearance.A_upper"``.
     kind : {"onset", "separation"}
-        ``"onset"`` when the gap closes (free -> contact), ``"separation"`` when
-        it opens (contact -> free).
+        ``"onset"`` when the gap closes, ``"separation"`` when it opens.
     approach_speed : float
-        Relative normal velocity at the event (m/s), the initial impact speed
-        used by Lankarani-Nikravesh and Hunt-Crossley at onset; ``nan`` where
-        meaningless.
+        Relative normal velocity at the event (m/s), the laws' impact speed at onset; ``nan`` where meaningless.
     y : ndarray, shape (n_states,)
-        Full state at the event, ordered as `Result.state_names`. Stored as a
-        read-only float64 array.
+        Full state at the event, ordered as `Result.state_names` (stored read-only).
 
-    Notes
-    -----
-    Two events are equal when all fields are equal, ``nan`` equal to ``nan``.
+    Two events are equal when all fields are, ``nan`` equal to ``nan``.
     """
 
     t: float
@@ -61,16 +52,12 @@ class ContactEvent:
 
     def __post_init__(self) -> None:
         if self.kind not in EVENT_KINDS:
-            raise ValueError(
-                f"ContactEvent for pair {self.pair!r} at t={self.t}: kind={self.kind!r}, "
-                f"must be 'onset' or 'separation'."
-            )
+            raise ValueError(f"ContactEvent for pair {self.pair!r} at t={self.t}: kind={self.kind!r}, "
+                             f"must be 'onset' or 'separation'.")
         y = np.asarray(self.y, dtype=np.float64)
         if y.ndim != 1:
-            raise ValueError(
-                f"ContactEvent for pair {self.pair!r} at t={self.t}: y has shape {y.shape}, "
-                f"must be one state vector (n_states,)."
-            )
+            raise ValueError(f"ContactEvent for pair {self.pair!r} at t={self.t}: y has shape {y.shape}, "
+                             f"must be one state vector (n_states,).")
         object.__setattr__(self, "t", float(self.t))
         object.__setattr__(self, "pair", str(self.pair))
         object.__setattr__(self, "approach_speed", float(self.approach_speed))
@@ -97,21 +84,15 @@ class ContactEvent:
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, ContactEvent):
             return NotImplemented
-        return (
-            _same_float(self.t, other.t)
-            and self.pair == other.pair
-            and self.kind == other.kind
-            and _same_float(self.approach_speed, other.approach_speed)
-            and np.array_equal(self.y, other.y, equal_nan=True)
-        )
+        return (_same_float(self.t, other.t) and self.pair == other.pair and self.kind == other.kind
+                and _same_float(self.approach_speed, other.approach_speed)
+                and np.array_equal(self.y, other.y, equal_nan=True))
 
     __hash__ = None  # type: ignore[assignment]  # holds an array
 
     def __repr__(self) -> str:
-        return (
-            f"ContactEvent(t={self.t:.9g}, pair={self.pair!r}, kind={self.kind!r}, "
-            f"approach_speed={self.approach_speed:.6g})"
-        )
+        return (f"ContactEvent(t={self.t:.9g}, pair={self.pair!r}, kind={self.kind!r}, "
+                f"approach_speed={self.approach_speed:.6g})")
 
 
 class EventRows(Sequence[ContactEvent]):
@@ -152,11 +133,10 @@ def flatten(parts: Iterable[ContactEvent | EventRows]) -> list[ContactEvent]:
 
 
 class EventList(Sequence[ContactEvent]):
-    """An immutable, list-like sequence of `ContactEvent`, in the solver's (time) order.
+    """An immutable, list-like sequence of `ContactEvent`, in time order.
 
-    Indexing with an int gives one event, with a slice an `EventList`.
-    The properties `t`, `approach_speed`, `pair` and `kind` give one field of
-    every event; `of` filters.
+    A slice is an `EventList`; `t`, `approach_speed`, `pair` and `kind` give one field of every event;
+    `of` filters.
 
     Examples
     --------
@@ -223,37 +203,17 @@ class EventList(Sequence[ContactEvent]):
         return f"EventList({len(self)} events: {counts}; pairs {pairs})"
 
     def of(self, pair: str | None = None, kind: EventKind | None = None) -> EventList:
-        """The events of one contact pair and/or one kind.
+        """The events of one contact pair and/or one kind, in order (empty for a pair that never touched).
 
-        Parameters
-        ----------
-        pair : str, optional
-            Pair name. Matches that pair and every pair below it in the dotted
-            naming: ``"clearance"`` selects ``"clearance"`` and
-            ``"clearance.A_upper"``, not ``"clearance2"``. None: every pair.
-        kind : {"onset", "separation"}, optional
-            None: both kinds.
-
-        Returns
-        -------
-        EventList
-            The matching events, in their original order (possibly empty: a
-            pair that never touched has no events).
-
-        Raises
-        ------
-        ValueError
-            If `kind` is not ``"onset"``, ``"separation"`` or None.
+        ``pair`` matches that pair and those below it (``"clearance"``: ``"clearance.A_upper"``, not
+        ``"clearance2"``); ``kind``: ``"onset"``, ``"separation"`` or None (both; anything else: ValueError).
         """
         if kind is not None and kind not in EVENT_KINDS:
             raise ValueError(f"EventList.of: kind={kind!r}, must be 'onset', 'separation' or None.")
         prefix = None if pair is None else pair + "."
-        return EventList(
-            e
-            for e in self._events
-            if (pair is None or e.pair == pair or e.pair.startswith(prefix))  # type: ignore[arg-type]
-            and (kind is None or e.kind == kind)
-        )
+        return EventList(e for e in self._events
+                         if (pair is None or e.pair == pair or e.pair.startswith(prefix))  # type: ignore[arg-type]
+                         and (kind is None or e.kind == kind))
 
     @property
     def t(self) -> NDArray[np.float64]:

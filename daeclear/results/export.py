@@ -1,8 +1,5 @@
-"""The hand-off of a `Result` to pandas and xarray (optional dependencies, the ``data`` extra).
-
-The bodies of `Result.to_pandas`, `Result.events_frame` and `Result.to_xarray`, whose docstrings
-say what the tables hold. Separate from the container so that the column naming and netCDF-safe
-attributes are read in one place; pandas and xarray are imported only when asked for.
+"""The hand-off of a `Result` to pandas and xarray (the ``data`` extra, imported only when asked for): the
+bodies of `Result.to_pandas`, `Result.events_frame` and `Result.to_xarray`, whose docstrings say what they hold.
 """
 
 from __future__ import annotations
@@ -78,10 +75,9 @@ def to_xarray(r: Result, *, states: bool = True) -> xr.Dataset:
     if states:
         y_events = np.array([e.y for e in ev], dtype=np.float64).reshape(len(ev), r.n_states)
         variables["event_y"] = xr.Variable(("event", "state"), y_events)
-    variables["segment_t_start"] = xr.Variable(
-        "segment", np.array([s[0] for s in r.segments], dtype=np.float64), attrs={"units": "s"})
-    variables["segment_t_end"] = xr.Variable(
-        "segment", np.array([s[1] for s in r.segments], dtype=np.float64), attrs={"units": "s"})
+    for k, side in enumerate(("start", "end")):
+        variables[f"segment_t_{side}"] = xr.Variable("segment", np.array([s[k] for s in r.segments], dtype=np.float64),
+                                                     attrs={"units": "s"})
     variables["segment_modes"] = xr.Variable(
         "segment", np.array([json.dumps(s[2], ensure_ascii=False) for s in r.segments], dtype=object))
     attrs: dict[str, Any] = {**_metadata(r), "success": int(r.success)}

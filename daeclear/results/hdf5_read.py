@@ -1,9 +1,5 @@
-"""Reading result files: the constructor keywords of a `Result` from an HDF5 file, group or window.
-
-The checks of a file (format, version, every item of the layout, with messages naming the file and
-what is missing) and the windowed reading that `load` (daeclear.results.result) builds a `Result`
-from. It returns keywords rather than a `Result` so that daeclear.results.result can offer `load`
-without an import circle. h5py is imported only when a file is read.
+"""Reading result files: the `Result` keywords from an HDF5 file, group or window, the file checked item by
+item (keywords, so that daeclear.results.result offers `load` without an import circle).
 """
 
 from __future__ import annotations
@@ -44,22 +40,17 @@ def read_file(path: str | os.PathLike[str], t0: float | None = None, t1: float |
     with f:
         fmt = f.attrs.get("format")
         if fmt is None:
-            raise DaeclearError(
-                f"'{path}' is not a daeclear result: the root attribute 'format' is missing "
-                f"(expected {FORMAT_NAME!r}, as written by Result.save)."
-            )
+            raise DaeclearError(f"'{path}' is not a daeclear result: the root attribute 'format' is missing "
+                                f"(expected {FORMAT_NAME!r}, as written by Result.save).")
         if _text(fmt) != FORMAT_NAME:
-            raise DaeclearError(
-                f"'{path}' is not a daeclear result: root attribute format={_text(fmt)!r}, expected {FORMAT_NAME!r}."
-            )
+            raise DaeclearError(f"'{path}' is not a daeclear result: root attribute format={_text(fmt)!r}, "
+                                f"expected {FORMAT_NAME!r}.")
         version = f.attrs.get("version")
         if version is None:
             raise DaeclearError(f"'{path}' is a damaged daeclear result: the root attribute 'version' is missing.")
         if int(version) > FORMAT_VERSION:
-            raise DaeclearError(
-                f"'{path}' is a daeclear result of format version {int(version)}; this daeclear reads "
-                f"versions up to {FORMAT_VERSION}. Upgrade daeclear to read it."
-            )
+            raise DaeclearError(f"'{path}' is a daeclear result of format version {int(version)}; this daeclear "
+                                f"reads versions up to {FORMAT_VERSION}. Upgrade daeclear to read it.")
         window = time_window(t0, t1)
         if within and (t0 is not None or t1 is not None) and "t" in f and f["t"].shape[0]:
             first, last = float(f["t"][0]), float(f["t"][-1])
@@ -90,7 +81,7 @@ def _text(value: Any) -> str:
 class _Reader:
     """Reads items of one file; a missing item raises DaeclearError naming file and item."""
 
-    def __init__(self, f: h5py.File, path: Path, window: tuple[float, float] = (-math.inf, math.inf)) -> None:
+    def __init__(self, f: h5py.Group, path: Path, window: tuple[float, float] = (-math.inf, math.inf)) -> None:
         self.f = f
         self.path = path
         self.window = window
@@ -109,27 +100,28 @@ class _Reader:
     def has(self, name: str) -> bool:
         return name in self.f
 
-    def array(self, name: str, rows: slice | None = None) -> np.ndarray:
+    def _get(self, name: str) -> Any:
         if name not in self.f:
             raise self._missing(f"dataset '/{name}'")
+        return self.f[name]
+
+    def array(self, name: str, rows: slice | None = None) -> np.ndarray:
+        data = self._get(name)
         try:
-            return self.f[name][()] if rows is None else self.f[name][rows]
+            return data[()] if rows is None else data[rows]
         except (OSError, RuntimeError) as exc:  # a failed checksum (Fletcher-32) or a damaged chunk index
             raise DaeclearError(f"'{self.path}' is a damaged daeclear result: dataset '/{name}' cannot be read "
                                 f"({str(exc).splitlines()[0]}).") from None
 
     def strings(self, name: str, rows: slice | None = None) -> list[str]:
-        if name not in self.f:
-            raise self._missing(f"dataset '/{name}'")
-        return [str(s) for s in (self.f[name].asstr()[()] if rows is None else self.f[name].asstr()[rows])]
+        text = self._get(name).asstr()
+        return [str(s) for s in (text[()] if rows is None else text[rows])]
 
     def json(self, name: str) -> Any:
-        if name not in self.f:
-            raise self._missing(f"dataset '/{name}'")
-        return json.loads(self.f[name].asstr()[()])
+        return json.loads(self._get(name).asstr()[()])
 
     def attr(self, name: str, obj: str = "/") -> Any:
-        attrs = self.f[obj].attrs
+        attrs = self.f[obj.lstrip("/") or "."].attrs  # relative: a file's root, or a group holding a result
         if name not in attrs:
             raise self._missing(f"attribute '{name}' of '{obj}'")
         value = attrs[name]
@@ -162,14 +154,10 @@ def _read(r: _Reader) -> dict[str, Any]:
     columns = (r.array("events/t", rows), r.strings("events/pair", rows), r.strings("events/kind", rows),
                r.array("events/approach_speed", rows), r.array("events/y", rows))
     if len({len(c) for c in columns}) != 1:
-        raise DaeclearError(
-            f"'{r.path}' is a damaged daeclear result: the datasets of '/events' have different lengths "
-            f"{[len(c) for c in columns]}."
-        )
-    events = [
-        ContactEvent(t=t, pair=pair, kind=kind, approach_speed=speed, y=y)  # type: ignore[arg-type]
-        for t, pair, kind, speed, y in zip(*columns)
-    ]
+        raise DaeclearError(f"'{r.path}' is a damaged daeclear result: the datasets of '/events' have different "
+                            f"lengths {[len(c) for c in columns]}.")
+    events = [ContactEvent(t=t, pair=pair, kind=kind, approach_speed=speed, y=y)  # type: ignore[arg-type]
+              for t, pair, kind, speed, y in zip(*columns)]
     lo, hi = r.window
     starts, ends = r.array("segments/t_start"), r.array("segments/t_end")
     keep = np.flatnonzero((starts < hi) & (ends > lo))  # the segments overlapping the window, clipped to it
@@ -182,49 +170,16 @@ def _read(r: _Reader) -> dict[str, Any]:
         steps = {"step_t": r.array("steps/t", rows), "step_h": r.array("steps/h", rows),
                  "step_order": r.array("steps/order", rows)}
 
-    return dict(
-        t=t,
-        y=y,
-        yp=yp,
-        state_names=state_names,
-        channels=channels,
-        units=units,
-        events=events,
-        segments=segments,
-        stats=r.json("stats_json"),
-        success=bool(r.attr("success")),
-        status=int(r.attr("status")),
-        message=str(r.attr("message")),
-        parameters=parameters,
-        scene_name=str(r.attr("scene_name")),
-        method=str(r.attr("method")),
-        formulation=str(r.attr("formulation")),
-        warnings=r.json("warnings_json") if r.has("warnings_json") else [],  # older files: no warnings
-        **steps,
-    )
-
-
-class _GroupAsFile:
-    """Lets the reader read a Result stored inside a group (absolute names become relative)."""
-
-    def __init__(self, group: h5py.Group) -> None:
-        self._group = group
-
-    def _name(self, name: str) -> str:
-        return name.lstrip("/") or "."
-
-    def __getitem__(self, name: str) -> Any:
-        return self._group[self._name(name)]
-
-    def __contains__(self, name: str) -> bool:
-        return self._name(name) in self._group
-
-    @property
-    def attrs(self) -> Any:
-        return self._group.attrs
+    return dict(t=t, y=y, yp=yp, state_names=state_names, channels=channels, units=units, events=events,
+                segments=segments, stats=r.json("stats_json"), success=bool(r.attr("success")),
+                status=int(r.attr("status")), message=str(r.attr("message")), parameters=parameters,
+                scene_name=str(r.attr("scene_name")), method=str(r.attr("method")),
+                formulation=str(r.attr("formulation")),
+                warnings=r.json("warnings_json") if r.has("warnings_json") else [],  # older files: no warnings
+                **steps)
 
 
 def read_group(group: h5py.Group, path: Path) -> dict[str, Any]:
     """The `Result` keywords of what :func:`write_result_group` wrote into ``group``, an open group of
     the file at ``path`` (named in the messages about a damaged result)."""
-    return _read(_Reader(_GroupAsFile(group), path))
+    return _read(_Reader(group, path))

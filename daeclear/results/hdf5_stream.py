@@ -1,9 +1,5 @@
-"""The streaming writer `ResultWriter`: a result written to HDF5 while its run goes on.
-
-Separate from daeclear.results.hdf5_write (a finished result, written whole and atomically)
-because a streamed file grows append by append (extendable datasets, each append flushed with
-Ctrl-C held back) so that a long run never holds all its data in memory; it follows the same
-layout, so `load` reads both alike.
+"""The streaming writer `ResultWriter`: a result written to HDF5 append by append while its run goes on (a long
+run never holds all its data in memory), in the layout of daeclear.results.hdf5_write, so `load` reads both alike.
 """
 
 from __future__ import annotations
@@ -28,9 +24,7 @@ if TYPE_CHECKING:  # h5py is imported lazily, only where a file is written
 __all__ = ["STREAM_RUNNING", "ResultWriter"]
 
 _STREAM_ROWS = 1024  # rows per HDF5 chunk of a streamed 2-D array (1-D arrays: 4 times as many)
-#: Rows per chunk of the events and segments (the steps: _STREAM_ROWS): a run of two revolutions has
-#: tens of them, and a chunk is written whole (4096 rows made the chapter's main-job file 0.6 MB
-#: larger for its 61 events and 62 segments).
+#: Rows per chunk of the events and segments: a run has tens of them, and a chunk is written whole.
 _LIST_ROWS = 64
 #: Root message of a streamed file while its run goes on; a file left so was stopped without a word
 #: (killed): it holds the data of its last complete append.
@@ -40,22 +34,12 @@ STREAM_RUNNING = "incomplete: the run was stopped before it finished (the data a
 class ResultWriter:
     """Writes a result to an HDF5 file while its run goes on, in the layout of `Result.save`.
 
-    The file is created with every item of the layout (empty, extendable datasets; root
-    attributes ``success=False``, ``status=-1`` and the message :data:`STREAM_RUNNING`) and each
-    `append` adds rows to it, flushed to disk, with Ctrl-C held back until the rows are complete:
-    between two appends `load` reads it as the run so far. `close` writes the statistics,
-    warnings and the outcome. Streamed arrays are chunked (gzip only for integer and bool
-    channels); `load` reads them as it reads a saved file.
-
-    Parameters
-    ----------
-    path : path-like
-        The file, created or replaced (check it with :func:`daeclear.results.outputs.check_file` first).
-    state_names, units, parameters, scene_name, method, formulation
-        As in `Result`.
-    channel_names : sequence of str, optional
-        Given: the file keeps the states alone (``/switch``, ``/channel_names``, ``/channel_units``;
-        no ``/yp``: `load` computes the channels and yp from them) and `append` takes no channels.
+    The file is created with every item of the layout (empty, extendable datasets; the outcome
+    :data:`STREAM_RUNNING`); each `append` adds rows, flushed, with Ctrl-C held back until they are
+    complete, so between two appends `load` reads the run so far; `close` writes the statistics, warnings
+    and the outcome. ``path`` is created or replaced (check it with :func:`~daeclear.results.outputs.check_file`
+    first); the other parameters are as in `Result`, and with ``channel_names`` the file keeps the states
+    alone (`load` computes the channels and yp) and `append` takes no channels.
     """
 
     def __init__(self, path: str | os.PathLike[str], *, state_names: Sequence[str], units: Mapping[str, str],
@@ -71,9 +55,8 @@ class ResultWriter:
         try:
             f.attrs["format"] = FORMAT_NAME
             f.attrs["version"] = FORMAT_VERSION
-            f.attrs["scene_name"] = str(scene_name)
-            f.attrs["method"] = str(method)
-            f.attrs["formulation"] = str(formulation)
+            for key, value in (("scene_name", scene_name), ("method", method), ("formulation", formulation)):
+                f.attrs[key] = str(value)
             self._outcome(False, -1, STREAM_RUNNING)
             self._grow(f, "t", np.float64).attrs["units"] = "s"
             self._grow(f, "y", np.float64, (self._n,))
@@ -85,20 +68,16 @@ class ResultWriter:
             if channel_names is not None:  # states only: the reader computes the channels
                 string_dataset(f, "channel_names", list(channel_names))
                 string_dataset(f, "channel_units", [self._units.get(str(n), "") for n in channel_names])
-            events = f.create_group("events")
-            self._grow(events, "t", np.float64, rows=_LIST_ROWS)
-            self._grow(events, "pair", h5py.string_dtype(), rows=_LIST_ROWS)
-            self._grow(events, "kind", h5py.string_dtype(), rows=_LIST_ROWS)
-            self._grow(events, "approach_speed", np.float64, rows=_LIST_ROWS)
-            self._grow(events, "y", np.float64, (self._n,), rows=_LIST_ROWS)
-            segments = f.create_group("segments")
-            self._grow(segments, "t_start", np.float64, rows=_LIST_ROWS)
-            self._grow(segments, "t_end", np.float64, rows=_LIST_ROWS)
-            self._grow(segments, "modes", h5py.string_dtype(), rows=_LIST_ROWS)
-            steps = f.create_group("steps")
-            self._grow(steps, "t", np.float64, rows=_STREAM_ROWS)
-            self._grow(steps, "h", np.float64, rows=_STREAM_ROWS)
-            self._grow(steps, "order", np.int64, rows=_STREAM_ROWS)
+            text = h5py.string_dtype()
+            layout = {"events": {"t": np.float64, "pair": text, "kind": text, "approach_speed": np.float64,
+                                 "y": np.float64},
+                      "segments": {"t_start": np.float64, "t_end": np.float64, "modes": text},
+                      "steps": {"t": np.float64, "h": np.float64, "order": np.int64}}
+            for group, columns in layout.items():
+                g = f.create_group(group)
+                for name, dtype in columns.items():
+                    self._grow(g, name, dtype, (self._n,) if (group, name) == ("events", "y") else (),
+                               rows=_STREAM_ROWS if group == "steps" else _LIST_ROWS)
             f.create_group("stats")
             json_dataset(f, "stats_json", {})
             plain = to_plain(dict(parameters), "parameters")
@@ -143,9 +122,7 @@ class ResultWriter:
                step_h: ArrayLike = (), step_order: ArrayLike = ()) -> None:
         """Add output rows (``t``, ``y``, ``yp``, ``switch``, ``channels``: one row per time), events,
         segments and steps; written whole (a Ctrl-C meanwhile is raised afterwards) and flushed."""
-        from .outputs import deferred_sigint
-
-        from .outputs import check_space, disk_full, is_disk_full
+        from .outputs import check_space, deferred_sigint, disk_full, is_disk_full
 
         f = self._f
         t_arr = np.asarray(t, dtype=np.float64)
@@ -184,26 +161,22 @@ class ResultWriter:
                     self._grow(group, name, arr.dtype, arr.shape[1:],
                                compress=arr.dtype.kind in "biu").attrs["units"] = self._units.get(name, "")
                 self._extend(group[name], arr)
-        if len(events):
-            g = f["events"]
-            self._extend(g["t"], np.array([e.t for e in events], dtype=np.float64))
-            self._extend(g["pair"], np.array([e.pair for e in events], dtype=object))
-            self._extend(g["kind"], np.array([e.kind for e in events], dtype=object))
-            self._extend(g["approach_speed"], np.array([e.approach_speed for e in events], dtype=np.float64))
-            self._extend(g["y"], np.array([e.y for e in events], dtype=np.float64).reshape(len(events), self._n))
-        if len(segments):
-            g = f["segments"]
-            self._extend(g["t_start"], np.array([float(s[0]) for s in segments], dtype=np.float64))
-            self._extend(g["t_end"], np.array([float(s[1]) for s in segments], dtype=np.float64))
-            self._extend(g["modes"], np.array(
-                [json.dumps({str(k): str(v) for k, v in s[2].items()}, ensure_ascii=False) for s in segments],
-                dtype=object))
-        st = np.asarray(step_t, dtype=np.float64)
-        if st.size:
-            g = f["steps"]
-            self._extend(g["t"], st)
-            self._extend(g["h"], np.asarray(step_h, dtype=np.float64))
-            self._extend(g["order"], np.asarray(step_order, dtype=np.int64))
+        g = f["events"]  # no rows: each _extend does nothing
+        self._extend(g["t"], np.array([e.t for e in events], dtype=np.float64))
+        self._extend(g["pair"], np.array([e.pair for e in events], dtype=object))
+        self._extend(g["kind"], np.array([e.kind for e in events], dtype=object))
+        self._extend(g["approach_speed"], np.array([e.approach_speed for e in events], dtype=np.float64))
+        self._extend(g["y"], np.array([e.y for e in events], dtype=np.float64).reshape(len(events), self._n))
+        g = f["segments"]
+        self._extend(g["t_start"], np.array([float(s[0]) for s in segments], dtype=np.float64))
+        self._extend(g["t_end"], np.array([float(s[1]) for s in segments], dtype=np.float64))
+        self._extend(g["modes"], np.array(
+            [json.dumps({str(k): str(v) for k, v in s[2].items()}, ensure_ascii=False) for s in segments],
+            dtype=object))
+        g = f["steps"]
+        self._extend(g["t"], np.asarray(step_t, dtype=np.float64))
+        self._extend(g["h"], np.asarray(step_h, dtype=np.float64))
+        self._extend(g["order"], np.asarray(step_order, dtype=np.int64))
 
     def close(self, *, stats: Mapping[str, Any], success: bool, status: int, message: str,
               warnings: Iterable[Mapping[str, Any]] = ()) -> Path:

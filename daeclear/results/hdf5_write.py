@@ -1,51 +1,9 @@
 """Writing a `Result` to HDF5: the file layout, `save_result` (atomic) and `write_result_group`.
 
 The one place that knows how a finished result is laid out in a file; the streaming writer
-(daeclear.results.hdf5_stream) and the reader (daeclear.results.hdf5_read) follow the same layout
-with the helpers and constants here. h5py is imported only when a file is written.
-
-docs/hdf5_layout.md documents the file item by item for readers without daeclear
-(a test keeps it in step with `_write`).
-
-HDF5 layout (root attributes ``format="daeclear-result"``, ``version=2``)::
-
-    /                     attrs: format, version, scene_name, method, formulation,
-                                 success, status, message
-    /t                    (n_times,)            attr units="s"
-    /y, /yp               (n_times, n_states)   time first (/yp absent when the channels are)
-    /state_names          (n_states,)           strings, e.g. "crank.x", "lambda.A.x"
-    /state_units          (n_states,)           strings ("" when unknown)
-    /switch               (n_times, n_switch)   each point's contact switch vector (a run's result)
-    /channel_names        (n_channels,)         strings: the channels computed when read (then
-    /channel_units        (n_channels,)         strings   /channels is empty)
-    /channels/<name>      (n_times, ...)        attr units; one dataset per channel (when stored)
-    /events/t             (n_events,)
-    /events/pair          (n_events,)           strings
-    /events/kind          (n_events,)           "onset" | "separation"
-    /events/approach_speed (n_events,)          m/s, nan where meaningless
-    /events/y             (n_events, n_states)  full state at each event
-    /segments/t_start, /segments/t_end  (n_segments,)
-    /segments/modes       (n_segments,)         JSON object per segment: {pair: mode}
-    /steps/t, /steps/h, /steps/order            IDA's internal steps (only if recorded)
-    /stats                group, one attribute per statistic
-    /stats_json           scalar string: the statistics as JSON (what `load` reads)
-    /parameters           groups and attributes mirroring the nested parameters
-    /parameters_json      scalar string: the parameters as JSON (what `load` reads)
-    /warnings_json        scalar string: the physics warnings as a JSON list (absent in older files)
-
-Channel names keep their dots (``/channels/slider.vx``): a "." is an ordinary
-character in an HDF5 name. The ``/stats`` and ``/parameters`` groups are a
-readable mirror for other tools (HDFView, h5dump, MATLAB): every number, string,
-bool and homogeneous list becomes an attribute (a dataset when longer than
-1024 items), every nested dict a group. Values that HDF5 cannot hold this way
-(None, mixed lists, lists of dicts) live only in the JSON copies, which are the
-lossless source `load` reads. Arrays of more than 16384 values that compress
-cheaply (integers, bools, mostly-zero floats such as contact forces) are stored
-chunked with shuffle + gzip level 1, which any HDF5 tool reads; other float
-arrays are chunked and uncompressed (gzip would save ~20% at ~8x the time). Every
-non-empty numeric dataset carries HDF5's Fletcher-32 checksum per chunk (strings
-and JSON cannot: HDF5 filters skip variable-length data); `load` refuses a dataset
-whose checksum fails, naming it.
+(daeclear.results.hdf5_stream) and the reader (daeclear.results.hdf5_read) follow it with the helpers
+and constants here. docs/hdf5_layout.md documents the file item by item (a test keeps it in step with
+`_write`). h5py is imported only when a file is written.
 """
 
 from __future__ import annotations
@@ -78,11 +36,7 @@ _MIRROR_ATTR_MAX_LEN = 1024  # longer lists become datasets (HDF5 attributes are
 
 
 def _compress(data: np.ndarray) -> bool:
-    """Whether gzip is cheap and worth it: large integer or bool arrays, large mostly-zero arrays.
-
-    General float64 data (states, velocities) shrinks by only ~20% at ~8x the write time,
-    so it is stored uncompressed; contact forces and penetrations, zero in free flight, shrink a lot.
-    """
+    """Whether gzip is worth it: large integer, bool or mostly-zero arrays (general floats: ~20% at ~8x the time)."""
     if data.size < _COMPRESS_MIN_SIZE:
         return False
     return bool(data.dtype.kind in "biu" or np.count_nonzero(data) <= data.size // 2)
@@ -148,12 +102,8 @@ def _write(f: h5py.File | h5py.Group, r: Result, channels: bool = False) -> None
     channel and yp, even when the reader could compute them)."""
     f.attrs["format"] = FORMAT_NAME
     f.attrs["version"] = FORMAT_VERSION
-    f.attrs["scene_name"] = r.scene_name
-    f.attrs["method"] = r.method
-    f.attrs["formulation"] = r.formulation
-    f.attrs["success"] = r.success
-    f.attrs["status"] = r.status
-    f.attrs["message"] = r.message
+    for key in ("scene_name", "method", "formulation", "success", "status", "message"):
+        f.attrs[key] = getattr(r, key)
 
     _dataset(f, "t", np.asarray(r.t)).attrs["units"] = "s"
     _dataset(f, "y", np.asarray(r.y))
@@ -189,14 +139,12 @@ def _write(f: h5py.File | h5py.Group, r: Result, channels: bool = False) -> None
 
     if r.step_t is not None:
         steps = f.create_group("steps")
-        _dataset(steps, "t", np.asarray(r.step_t))
-        _dataset(steps, "h", np.asarray(r.step_h))
-        _dataset(steps, "order", np.asarray(r.step_order))
+        for name, values in (("t", r.step_t), ("h", r.step_h), ("order", r.step_order)):
+            _dataset(steps, name, np.asarray(values))
 
-    mirror(f.create_group("stats"), r.stats)
-    json_dataset(f, "stats_json", r.stats)
-    mirror(f.create_group("parameters"), r.parameters)
-    json_dataset(f, "parameters_json", r.parameters)
+    for name, tree in (("stats", r.stats), ("parameters", r.parameters)):
+        mirror(f.create_group(name), tree)
+        json_dataset(f, f"{name}_json", tree)
     json_dataset(f, "warnings_json", r.warnings)
 
 

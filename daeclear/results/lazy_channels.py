@@ -1,15 +1,12 @@
 """Channels computed when read: a run's (or a result file's) states, and what computes its channels.
 
-A run stores its states only: the times ``t``, the states ``y`` and, per point, the switch vector
-of its segment (the contact terms' on flags and parameters, the outputs' ``switch`` input). A run
-kept in memory stores IDA's own ``y``, whose multipliers IDA does not converge: the multipliers
-and ``yp`` are made consistent (the run's consistency pass) at the first read of either. Its channels (positions, forces, energies, ...) are one function of these, the
-model's generated output function, so :class:`LazyChannels` evaluates them all at once in one
-vectorised call at the first read and keeps them: the `Result` that holds it is their owner.
-The values are those the run would have computed point by point (the same generated function on
-the same inputs: equal bit for bit, see tests/test_lazy_channels.py).
+A run stores its states only: the times ``t``, the states ``y`` and, per point, the switch vector of its
+segment (the outputs' ``switch`` input). A run kept in memory stores IDA's own ``y``, whose multipliers
+IDA does not converge: they and ``yp`` are made consistent (the run's consistency pass) at the first read
+of either. The channels are one function of these, the model's generated output function, so
+:class:`LazyChannels` evaluates them all in one vectorised call at the first read and keeps them, equal
+bit for bit to what the run would have computed point by point (tests/test_lazy_channels.py).
 """
-
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence

@@ -1,14 +1,8 @@
 """Output places checked before any work, and writes that neither an error nor Ctrl-C can half-do.
 
-:func:`check_file` and :func:`check_directory` are the one rule for every place daeclear writes
-(``Result.save``, ``daeclear.sweep``, ``daeclear run|study|sweep``): called before a run starts,
-so a bad ``--out`` costs nothing instead of a whole computation. The message names the option,
-the path and what is allowed. Writability is tested by creating (and removing) a probe file, the
-only test that also holds for root and read-only file systems.
-
-:func:`deferred_sigint` holds Ctrl-C back while a result is written: a second Ctrl-C during the
-save of a partial result is delivered after the file is complete (and renamed into place).
-:func:`atomic_file` is the one temporary-file-and-rename write (``Result.save``, the tables).
+:func:`check_file` and :func:`check_directory` are the one rule for every place daeclear writes, called
+before a run starts so that a bad ``--out`` costs nothing; :func:`deferred_sigint` holds Ctrl-C back
+while a file is written; :func:`atomic_file` is the one temporary-file-and-rename write.
 """
 
 from __future__ import annotations
@@ -24,12 +18,12 @@ import uuid
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from types import FrameType
+from typing import Any
 
 from ..errors import DiskFull, OutputDirectoryMissing, OutputError
 
-#: Bytes a write leaves free beyond its own data: the HDF5 metadata flushed with each append and when
-#: a file is closed (its outcome, statistics and warnings), so that a file stopped for want of space
-#: can still be completed and read back.
+#: Bytes a write leaves free beyond its own data (HDF5 metadata of each append and of closing the file),
+#: so that a file stopped for want of space can still be completed and read back.
 SPACE_MARGIN = 1 << 20
 _FULL_ERRNOS = (errno.ENOSPC, errno.EDQUOT)
 
@@ -74,29 +68,11 @@ def _probe(directory: Path, option: str, path: Path) -> None:
 
 def check_file(path: str | os.PathLike[str], option: str, *, what: str = "an HDF5 file (.h5)",
                example: str = "result.h5") -> Path:
-    """Check that ``path`` can become (or replace) a file: not a directory, in an existing writable directory.
+    """``path`` as a Path, checked that it can become (or replace) a file in an existing writable directory.
 
-    Parameters
-    ----------
-    path : str or path-like
-        The output file.
-    option : str
-        How the user named it (``--out``, ``Result.save(path)``, ``sweep(path)``), for the message.
-    what : str
-        What is allowed there, for the message.
-    example : str
-        A file name suggested when ``path`` is a directory.
-
-    Returns
-    -------
-    pathlib.Path
-
-    Raises
-    ------
-    OutputError
-        ``path`` is a directory or another non-file, or its directory cannot be written.
-    OutputDirectoryMissing
-        Its directory does not exist (also a FileNotFoundError).
+    ``option`` (how the user named it, e.g. ``--out``) and ``what`` (what is allowed) make the message;
+    ``example`` is a file name suggested when ``path`` is a directory. Raises OutputError (a directory or
+    other non-file, an unwritable directory) or OutputDirectoryMissing (also a FileNotFoundError).
     """
     p = Path(path)
     if str(path) == "":
@@ -117,16 +93,10 @@ def check_file(path: str | os.PathLike[str], option: str, *, what: str = "an HDF
 
 def check_directory(path: str | os.PathLike[str], option: str, *, files: Sequence[str] = (),
                     create: bool = True) -> Path:
-    """Check (and create) an output directory and the files that will be written in it.
+    """Check (and create when ``create``) an output directory, and that none of ``files`` in it is a directory.
 
-    ``path`` must be a directory or not exist yet (then its nearest existing parent must be a
-    writable directory, and it is created when ``create``); each of ``files`` inside it must not
-    be a directory.
-
-    Raises
-    ------
-    OutputError
-        ``path`` is a file, cannot be created or written, or one of ``files`` is a directory.
+    ``path`` must be a directory or not exist yet (then its nearest existing parent must be a writable
+    directory). Raises OutputError naming what is wrong.
     """
     p = Path(path)
     allowed = "a directory (created if missing)"
@@ -157,21 +127,21 @@ def check_directory(path: str | os.PathLike[str], option: str, *, files: Sequenc
     return p
 
 
-# --------------------------------------------------------------------------- Ctrl-C during a write
+def _replaceable_handler() -> Any:
+    """The SIGINT handler to replace, or None where none can be (not the main thread; SIGINT ignored or not
+    Python's)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    previous = signal.getsignal(signal.SIGINT)
+    return None if previous in (signal.SIG_IGN, None) else previous
 
 
 @contextlib.contextmanager
 def deferred_sigint() -> Iterator[None]:
-    """Hold SIGINT back for the duration of the block; a Ctrl-C received meanwhile is raised after it.
-
-    Only the main thread can install signal handlers; elsewhere (and when SIGINT is ignored or
-    not Python's default handler's business) the block runs unshielded.
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.getsignal(signal.SIGINT)
-    if previous in (signal.SIG_IGN, None):
+    """Hold SIGINT back for the duration of the block; a Ctrl-C received meanwhile is raised after it
+    (in the main thread only: elsewhere the block runs unshielded)."""
+    previous = _replaceable_handler()
+    if previous is None:
         yield
         return
     received: list[int] = []
@@ -193,17 +163,11 @@ def deferred_sigint() -> Iterator[None]:
 
 @contextlib.contextmanager
 def sigint_latch() -> Iterator[list[int]]:
-    """Remember every Ctrl-C received during the block (and raise KeyboardInterrupt as usual).
-
-    Python drops a KeyboardInterrupt raised while it runs a weakref callback or a destructor (it
-    prints "Exception ignored in ..."); a loop that checks the latch between its steps stops anyway.
-    Main thread only, like every signal handler; elsewhere the latch stays empty.
+    """Remember every Ctrl-C received during the block (and raise KeyboardInterrupt as usual): Python drops one
+    raised in a weakref callback or a destructor, a loop that checks the latch stops anyway (main thread only).
     """
-    if threading.current_thread() is not threading.main_thread():
-        yield []
-        return
-    previous = signal.getsignal(signal.SIGINT)
-    if previous in (signal.SIG_IGN, None):
+    previous = _replaceable_handler()
+    if previous is None:
         yield []
         return
     received: list[int] = []
@@ -221,15 +185,10 @@ def sigint_latch() -> Iterator[list[int]]:
 
 @contextlib.contextmanager
 def atomic_file(path: str | os.PathLike[str], *, keep_suffix: bool = False) -> Iterator[Path]:
-    """A temporary path beside ``path`` to write; renamed over ``path`` once the block completes.
+    """A temporary path beside ``path`` to write; fsync'ed and renamed over ``path`` once the block completes.
 
-    The one implementation of atomic output files: the file written at the yielded path is
-    fsync'ed (data on disk before the rename makes it visible) and renamed over ``path``
-    (`os.replace`, atomic on POSIX), so an existing file at ``path`` is either left untouched or
-    replaced whole. On any exception (KeyboardInterrupt too) the temporary file is removed and the
-    exception raised. Hold Ctrl-C back around it with :func:`deferred_sigint` where a Ctrl-C
-    should wait for the file. ``keep_suffix``: the temporary name ends in ``path``'s suffix, for
-    writers that choose the format by it (the animations' GIF and MP4 writers).
+    An existing file is left untouched or replaced whole; on any exception (Ctrl-C too) the temporary file is
+    removed. ``keep_suffix``: the temporary name ends in ``path``'s suffix (writers that choose the format by it).
     """
     p = Path(path)
     tail = f".tmp{p.suffix}" if keep_suffix else ".tmp"

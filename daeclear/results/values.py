@@ -1,7 +1,5 @@
-"""How a result holds what it is given: plain JSON values, read-only arrays, checked time windows.
-
-Shared by the `Result` container, its events and the HDF5 writers and reader (parameters and
-statistics are stored as plain values in memory and in files alike), so it lives apart from each.
+"""How a result holds what it is given: plain JSON values, read-only arrays, checked time windows (shared by
+the `Result` container, its events and the HDF5 writers and reader).
 """
 
 from __future__ import annotations
@@ -21,8 +19,7 @@ __all__ = ["field_names", "readonly", "time_window", "to_plain"]
 
 
 def readonly(a: np.ndarray) -> np.ndarray:
-    """A read-only view of ``a`` (the caller's array keeps its own flags); ``a`` itself when it is
-    read-only already."""
+    """A read-only view of ``a`` (the caller's array keeps its flags), or ``a`` when it is read-only already."""
     if not a.flags.writeable:
         return a
     view = a.view()
@@ -44,14 +41,11 @@ _PLAIN_LEAVES = frozenset({type(None), bool, str, int, float})
 
 
 def to_plain(value: Any, where: str) -> Any:
-    """``value`` as plain JSON-able Python.
+    """``value`` as plain JSON-able Python (numpy values, tuples and paths converted).
 
-    numpy scalars and arrays, tuples and paths are converted; a dataclass instance (e.g. a
-    Material) becomes the dict of its fields, headed by ``"name"`` when its class has a name
-    (a contact or friction law: figures and readers of the file need to know which law). Anything
-    else is stored as its ``repr`` with a DaeclearWarning naming ``where``: a finished run is never
-    lost to an odd parameter.
-    Non-string dict keys raise TypeError.
+    A dataclass instance (e.g. a Material) becomes the dict of its fields, headed by ``"name"`` when its
+    class has one (a contact law's); anything else is stored as its ``repr`` with a DaeclearWarning naming
+    ``where``, so a finished run is never lost to an odd parameter. Non-string dict keys raise TypeError.
     """
     return _plain(value, (where,))
 
@@ -62,8 +56,7 @@ def field_names(cls: type) -> tuple[str, ...]:
 
 
 def _location(path: tuple[Any, ...]) -> str:
-    """``where[key][index]...``: where a value sits in what to_plain was given (made only for a
-    message: a path of keys costs less than a text per container)."""
+    """``where[key][index]...``: where a value sits in what to_plain was given (made only for a message)."""
     return str(path[0]) + "".join(f"[{key!r}]" for key in path[1:])
 
 
