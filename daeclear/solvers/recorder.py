@@ -197,14 +197,13 @@ class Recorder:
         self._points.clear()
         evaluator = ModelEvaluator(self.model, self._backend)
         raw = self.consistent_when_read
-        if raw:
-            yp = None  # IDA's: made consistent with y when either is first read
-        lazy = LazyChannels(self.model.channel_names, evaluator.channels, t, y, yp,
+        kept_yp = None if raw else yp  # raw: IDA's, made consistent with y when either is first read
+        lazy = LazyChannels(self.model.channel_names, evaluator.channels, t, y, kept_yp,
                             np.asarray(switch), consistent=evaluator.consistent, raw=raw, values=channels,
                             rebuildable=self.rebuildable)
         steps = [np.concatenate(c) for c in zip(*self._steps)] if self._steps else [
             np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)]
-        return Result.of_run(t=t, y=y, yp=yp, channels=lazy, events=self.events, segments=self.segments,
+        return Result.of_run(t=t, y=y, yp=kept_yp, channels=lazy, events=self.events, segments=self.segments,
                              step_t=steps[0], step_h=steps[1], step_order=steps[2].astype(np.int64, copy=False),
                              **self._header, **outcome)
 
