@@ -67,11 +67,6 @@ def _elastic_energy(numeric: Any, law: Any, d: Any) -> Any | None:
     return law.stiffness * ca.fmax(d, 0.0) ** (n + 1.0) / (n + 1.0)
 
 
-def _unit(v: Sequence[float]) -> NDArray[np.float64]:
-    a = np.asarray(v, dtype=float)
-    return a / math.hypot(*a)
-
-
 @dataclass(frozen=True)
 class SliderGuideLogic(PairLogic):
     """Mode switching of one translational clearance joint: its four corner pairs
@@ -130,7 +125,8 @@ def translational_clearance_parameters(ref: Reference,
     s_i, s_j = ref.joint_points(joint)
     t_guide = ref.local_vector(joint.body_i, joint.axis)  # (4.14): t in guide coordinates
     # slider length direction, slider coordinates
-    e_slider = ref.local_vector(joint.body_j, joint.axis) if joint.slider_axis is None else _unit(joint.slider_axis)
+    e_slider = (ref.local_vector(joint.body_j, joint.axis) if joint.slider_axis is None
+                else np.asarray(joint.slider_axis, dtype=float) / math.hypot(*joint.slider_axis))
     values: dict[str, Any] = {
         "s_i": s_i, "s_j": s_j, "length": float(joint.length), "width": float(joint.width),
         "height": joint.height, "clearance": joint.radial_clearance, "t_guide": t_guide, "e_slider": e_slider,

@@ -221,9 +221,7 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
         friction=friction_law(friction), model=contact_model, reading=reading)
 
 
-# Chain of links (a multi-link pendulum with a clearance joint at every pin): steel links
-# 0.1 m between pins, 25 x 10 mm section (m = 7850 * 0.1 * 0.025 * 0.010 = 0.196 kg, slender-bar
-# inertia m L^2 / 12), pins with the slider-crank's bearing (10 mm radius, steel).
+# Chain links: steel, 0.1 m between pins, 25 x 10 mm section (7850 * 0.1 * 0.025 * 0.010 = 0.196 kg).
 CHAIN_LINK_LENGTH = 0.1
 CHAIN_LINK_MASS = 0.196
 CHAIN_LINK_INERTIA = CHAIN_LINK_MASS * CHAIN_LINK_LENGTH ** 2 / 12.0
@@ -237,7 +235,7 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
           length: float | None = None, name: str | None = None, **options: Any) -> Scene:
     """A planar chain of ``n_links`` rigid links with a revolute clearance joint at every pin.
 
-    The scalable mechanism of the benchmarks. Links ``link1`` ... ``link<N>`` lie end to end from
+    Links ``link1`` ... ``link<N>`` lie end to end from
     the origin along ``angle``; pin ``pin<k>`` joins link k-1 (the bearing; the ground for k = 1) to
     link k, journals centred at the start. ``rpm=None``: a free chain released from rest, every pin a
     clearance joint (6 N states, no constraint). ``rpm`` a number: ``pin1`` is an ideal revolute
@@ -410,9 +408,7 @@ def four_bar(clearance_joints: Any = (), *, rpm: float = 5000.0, crank_angle: fl
     origin, driven by driver ``drive``), ``B``, ``C`` and ``D`` (ground - rocker, at (0.13, 0) m).
     A joint named in ``clearance_joints`` becomes a RevoluteClearance of the same name (bearing on
     the joint's first body), journals centred and velocities from the ideal mechanism at the start.
-    Dimensions (this package's choice, docs/mechanisms.md): crank 0.05, coupler 0.12, rocker 0.10,
-    ground 0.13 m, a Grashof crank-rocker; crank and coupler are the slider-crank's links (Table 4.1),
-    bearings and law its revolute clearance joint's (Table 4.2).
+    Dimensions (this package's choice): docs/mechanisms.md.
 
     Parameters
     ----------
