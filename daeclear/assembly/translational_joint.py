@@ -8,12 +8,9 @@ the rate is ``(d d_k / dq) v`` (4.21); the force acts on the slider at the corne
 at the closest surface point (4.22)-(4.25). Corners A, B touch the upper surface, C, D the lower:
 four pairs, each gap ``min(d_k, s_k - s_P, s_Q - s_k)`` with contact limits (s_P, s_Q).
 
-Models (``contact_model``): ``corners``, one term per corner (its law, approach speed latched at
-onset); ``section-4.3``, also one term per face, on instead of its corners' while both touch:
-``face_law(d_mean, d_mean_dot)``, ``d_mean = (d_1 + d_2)/2``, at the centroid of the penetrated
-trapezoid (Fig. 4.13a), the resultant of a Winkler pressure (potential ``K (d_1^2 + d_1 d_2 +
-d_2^2) / 6``); approach speed the mean of its corners' (docs/contact_laws.md). Friction acts along
-``t``. A face's switches are events of ``<name>.upper_face`` / ``<name>.lower_face``.
+Models (``contact_model``): ``corners``, one term per corner; ``section-4.3``, also one term per
+face, on instead of its corners' while both touch: ``face_law(d_mean, d_mean_dot)`` at the centroid
+of the penetrated trapezoid (docs/validation.md). Friction acts along ``t``.
 
 Channels: ``<name>.s``, ``.y`` (m; along the guide, off the mid-line), ``.tilt`` (rad), ``.eta`` =
 y / (2c), ``.xi`` (0..1 along ``stroke``, Fig. 4.28d); per pair ``<name>.A_upper`` ...
@@ -207,11 +204,8 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         s_k = ca.dot(t_vec, u)
         d_k = side[surface] * ca.dot(n_vec, u) - 0.5 * H  # (4.17)-(4.20): -n^T delta
         d_dot = ca.jtimes(d_k, ctx.q, ctx.v)  # (4.21) along the normal
-        gap = d_k
         limit = limits[surface]
-        if limit is not None:
-            lo, hi = limit[0], limit[1]
-            gap = ca.fmin(d_k, ca.fmin(s_k - lo, hi - s_k))
+        gap = d_k if limit is None else ca.fmin(d_k, ca.fmin(s_k - limit[0], limit[1] - s_k))
         corner_s.append(s_k)
         corner_d.append(d_k)
         corner_gap.append(gap)
@@ -260,7 +254,6 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
 
     y_centre = ca.dot(n_vec, rel_centre)
     s_centre = ca.dot(t_vec, rel_centre)
-    # angle from the guide's direction to the slider's length direction
     tilt = slider.phi - guide.phi + ctx.p(name, "tilt0")
     stroke = ctx.p(name, "stroke") if f"{name}.stroke" in ctx.params else None
 
