@@ -51,10 +51,8 @@ from .joint_coordinates import joint_channels
 from ..model.loads import Load, build_loads, load_parameters
 from .symbolic import AssemblyContext, Channel, Reference, Term, body_frames, rotation
 from ..solvers.physics import checked_channel
-from .dae_model import (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_START_KINEMATICS,  # noqa: F401
-                        EXTRA_TERM0, KIND_MULTIPLIER, KIND_POSITION, KIND_VELOCITY, KIND_WORK, NEWTON_STEPS,
-                        NULL_WEIGHT, POSITION_TOL, RANK_TOL, DAEModel, Formulation, check_independent,
-                        start_parameters)
+from .dae_model import (EXTRA_TERM0, KIND_MULTIPLIER, KIND_POSITION, KIND_VELOCITY, KIND_WORK,  # noqa: F401
+                        DAEModel, start_parameters)
 
 
 # ---- element parameters (numbers) and builders (structure) --------------------------------

@@ -1,25 +1,9 @@
 """The contact-mode automaton of one pair: the one definition of the event rule.
 
-A pair (one gap, positive in penetration) is *free* or in *contact*, and may be *held* by the storm
-guard. At a root of its gap, given the time, the direction (+1 up, -1 down, 0 none) and the
-penetration rate there, :func:`step` decides:
-
-* free, upward: *onset*; the approach speed ``max(rate, min_approach_speed)`` is latched, the term
-  goes on;
-* contact, downward: *separation*; the term goes off, unless this switch completes a storm
-  (``storm.events`` switches within ``storm.window`` s): then the pair is *held*, its term stays on
-  (the force is zero while the gap is open) and both directions are watched;
-* a crossing against the sign of the rate within ``SAME_INSTANT`` (relative to t) of the pair's
-  last switch: nothing. It is the gap's round-off at the restart after that switch (a gap cannot
-  cross against its own rate); the loops restart IDA in the same modes
-  (``solvers.ida_loop.guarded_root``);
-* held: a downward crossing restarts the flight clock (``free_since``); an upward one ends the hold
-  (a genuine onset) only after a flight longer than ``storm.window``;
-* anything else: nothing.
-
-:func:`step` is pure. The compiled IDA loop runs its line-by-line C mirror (``pair_step`` in
-``csrc/ida_driver.c``) for the pairs it switches itself; ``tests/test_automaton.py`` requires
-identical decisions from both (docs/user_guide.md, "Contact events").
+A pair is *free* or in *contact*, and may be *held* by the storm guard; at a root of its gap
+:func:`step` decides onset, separation, a hold or nothing (the rule: docs/user_guide.md, "Contact
+events"). :func:`step` is pure; the compiled IDA loop runs its C mirror (``pair_step`` in
+``csrc/ida_driver.c``) and ``tests/test_automaton.py`` requires identical decisions from both.
 """
 
 from __future__ import annotations

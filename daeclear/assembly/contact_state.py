@@ -1,10 +1,8 @@
 """A run's contact state: one value, passed in and returned, never kept by the model.
 
-The contact elements of a model (``model.contacts``, :class:`~daeclear.assembly.contact_pairs.PairLogic`
-and its subclasses) are rules; a :data:`ContactState` holds each pair's automaton state
-(:class:`~daeclear.assembly.automaton.PairState`), one tuple per element. The terms, modes and root
-directions follow from it; :func:`decide` returns the new state and the events; the compiled loop's
-own decisions are read back by :func:`with_pairs`.
+A :data:`ContactState` holds each pair's automaton state, one tuple per contact element of
+``model.contacts`` (rules, no state); :func:`decide` returns the new state and the events, and
+:func:`with_pairs` reads back the compiled loop's own decisions.
 """
 
 from __future__ import annotations

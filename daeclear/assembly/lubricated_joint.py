@@ -1,10 +1,8 @@
 """The lubricated revolute clearance joint (law :class:`~daeclear.contact.HydrodynamicBearing`).
 
-Two regimes, one pair of the contact automaton: *film* (its free mode; the film term acts) and
-*dry* (contact mode; the dry law and friction act). Two gaps, positive once the film is thinner
-than their level: ``film_break`` (``c - |e| = film_threshold``), whose upward crossing is the
-onset, and ``film_reform`` (``film_threshold (1 + hysteresis)``), whose downward crossing is the
-separation; the band between them keeps the regimes from chattering (docs/lubrication.md).
+One pair of the contact automaton: *film* (free mode) and *dry* (contact mode), switched by the
+gaps ``film_break`` (onset) and ``film_reform`` (separation) with a band against chattering
+(docs/lubrication.md).
 """
 
 from __future__ import annotations

@@ -194,12 +194,6 @@ def _fixed_flag(flag: str) -> property:
     return property(lambda self: self._fixed_flags[flag])
 
 
-def _twin_class(cls: type) -> type:
-    """A subclass whose structural flags are fixed values, not expressions of its fields."""
-    fixed = {flag: _fixed_flag(flag) for flag in _FLAGS if hasattr(cls, flag)}
-    return type(cls.__name__, (cls,), fixed)
-
-
 def _check_parametric(law: Any) -> bool:
     names = _numeric_fields(law)
     if not names:
@@ -228,7 +222,8 @@ def _check_parametric(law: Any) -> bool:
 def _twin(law: Any, symbols: dict[str, Any]) -> Any:
     """A copy of ``law`` with some numeric fields replaced by symbols (not validated again; its
     structural flags kept as values)."""
-    twin: Any = object.__new__(_twin_class(type(law)))
+    cls = type(law)  # a subclass whose structural flags are fixed values, not expressions of its fields
+    twin: Any = object.__new__(type(cls.__name__, (cls,), {f: _fixed_flag(f) for f in _FLAGS if hasattr(cls, f)}))
     object.__setattr__(twin, "_fixed_flags", {flag: getattr(law, flag) for flag in _FLAGS if hasattr(law, flag)})
     for f in dataclasses.fields(law):
         object.__setattr__(twin, f.name, symbols.get(f.name, getattr(law, f.name)))

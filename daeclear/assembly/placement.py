@@ -1,14 +1,8 @@
 """A scene placed at chosen joint coordinates: :meth:`Scene.assembled` (``start=``, ``speeds=``).
 
-``scene.assembled(start={"A": 0.5}, speeds={"A": 2.0})`` solves for the bodies' poses so that the
-named joints' coordinates have these values and every joint closes as at a run's start (ideal
-joints, the clearance joints' ideal joints, drivers at t = 0, a named joint's driver replaced):
-least-norm Newton from the declared poses, then a check that the rows fix every coordinate.
-Velocities likewise from ``speeds`` (without: the declared ones corrected, least norm).
-
-The returned scene is the same mechanism: every number the declared configuration defined (world
-points ``at``, an axis, free lengths and angles left None) is written as the body-fixed value it
-stood for; only the poses (and velocities) differ.
+Least-norm Newton from the declared poses closes every joint as at a run's start with the named
+joints at their values, velocities likewise; every number the declared configuration defined is
+written as the body-fixed value it stood for (docs/user_guide.md).
 """
 
 from __future__ import annotations

@@ -57,6 +57,5 @@ def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, fir
 
 #: Clearance joint type -> (parameter function, builder).
 CONTACT_BUILDERS: dict[type, tuple[Callable[..., tuple[dict[str, Any], list[Any]]], Callable[..., ContactBuild]]] = {
-    RevoluteClearance: (revolute_clearance_parameters, build_revolute_clearance)}
-
-CONTACT_BUILDERS[TranslationalClearance] = (translational_clearance_parameters, build_translational_clearance)
+    RevoluteClearance: (revolute_clearance_parameters, build_revolute_clearance),
+    TranslationalClearance: (translational_clearance_parameters, build_translational_clearance)}

@@ -8,12 +8,9 @@ the rate is ``(d d_k / dq) v`` (4.21); the force acts on the slider at the corne
 at the closest surface point (4.22)-(4.25). Corners A, B touch the upper surface, C, D the lower:
 four pairs, each gap ``min(d_k, s_k - s_P, s_Q - s_k)`` with contact limits (s_P, s_Q).
 
-Models (``contact_model``): ``corners``, one term per corner (its law, approach speed latched at
-onset); ``section-4.3``, also one term per face, on instead of its corners' while both touch:
-``face_law(d_mean, d_mean_dot)``, ``d_mean = (d_1 + d_2)/2``, at the centroid of the penetrated
-trapezoid (Fig. 4.13a), the resultant of a Winkler pressure (potential ``K (d_1^2 + d_1 d_2 +
-d_2^2) / 6``); approach speed the mean of its corners' (docs/contact_laws.md). Friction acts along
-``t``. A face's switches are events of ``<name>.upper_face`` / ``<name>.lower_face``.
+Models (``contact_model``): ``corners``, one term per corner; ``section-4.3``, also one term per
+face, on instead of its corners' while both touch: ``face_law(d_mean, d_mean_dot)`` at the centroid
+of the penetrated trapezoid (docs/validation.md). Friction acts along ``t``.
 
 Channels: ``<name>.s``, ``.y`` (m; along the guide, off the mid-line), ``.tilt`` (rad), ``.eta`` =
 y / (2c), ``.xi`` (0..1 along ``stroke``, Fig. 4.28d); per pair ``<name>.A_upper`` ...
@@ -65,11 +62,6 @@ def _elastic_energy(numeric: Any, law: Any, d: Any) -> Any | None:
         return None
     n = getattr(law, "effective_exponent", n_value)
     return law.stiffness * ca.fmax(d, 0.0) ** (n + 1.0) / (n + 1.0)
-
-
-def _unit(v: Sequence[float]) -> NDArray[np.float64]:
-    a = np.asarray(v, dtype=float)
-    return a / math.hypot(*a)
 
 
 @dataclass(frozen=True)
@@ -130,7 +122,8 @@ def translational_clearance_parameters(ref: Reference,
     s_i, s_j = ref.joint_points(joint)
     t_guide = ref.local_vector(joint.body_i, joint.axis)  # (4.14): t in guide coordinates
     # slider length direction, slider coordinates
-    e_slider = ref.local_vector(joint.body_j, joint.axis) if joint.slider_axis is None else _unit(joint.slider_axis)
+    e_slider = (ref.local_vector(joint.body_j, joint.axis) if joint.slider_axis is None
+                else np.asarray(joint.slider_axis, dtype=float) / math.hypot(*joint.slider_axis))
     values: dict[str, Any] = {
         "s_i": s_i, "s_j": s_j, "length": float(joint.length), "width": float(joint.width),
         "height": joint.height, "clearance": joint.radial_clearance, "t_guide": t_guide, "e_slider": e_slider,
@@ -211,11 +204,8 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         s_k = ca.dot(t_vec, u)
         d_k = side[surface] * ca.dot(n_vec, u) - 0.5 * H  # (4.17)-(4.20): -n^T delta
         d_dot = ca.jtimes(d_k, ctx.q, ctx.v)  # (4.21) along the normal
-        gap = d_k
         limit = limits[surface]
-        if limit is not None:
-            lo, hi = limit[0], limit[1]
-            gap = ca.fmin(d_k, ca.fmin(s_k - lo, hi - s_k))
+        gap = d_k if limit is None else ca.fmin(d_k, ca.fmin(s_k - limit[0], limit[1] - s_k))
         corner_s.append(s_k)
         corner_d.append(d_k)
         corner_gap.append(gap)
@@ -264,7 +254,6 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
 
     y_centre = ca.dot(n_vec, rel_centre)
     s_centre = ca.dot(t_vec, rel_centre)
-    # angle from the guide's direction to the slider's length direction
     tilt = slider.phi - guide.phi + ctx.p(name, "tilt0")
     stroke = ctx.p(name, "stroke") if f"{name}.stroke" in ctx.params else None
 

@@ -1,13 +1,9 @@
 """Contact-impact and friction laws that run on floats, numpy arrays and CasADi symbols.
 
-Normal laws (frozen keyword-only dataclasses, ``law.force(penetration, penetration_rate,
-approach_speed) -> F_N >= 0``): :class:`Hertz`, :class:`KelvinVoigt`, :class:`HuntCrossley`,
-:class:`LankaraniNikravesh` (eq. 3.9, the chapter's), :class:`Flores`, :class:`LankaraniPlane`
-(4.26-4.27) and the implicit cylindrical :class:`DubowskyFreudenstein`, :class:`Goldsmith`,
-:class:`ESDU78035` (Figs. 4.22c-e). Friction laws (``friction_force(F_N, v_T)``, opposing v_T):
-:class:`NoFriction`, :class:`Coulomb`, :class:`ModifiedCoulomb` (eq. 3.16). Lubricated joints:
-:class:`HydrodynamicBearing`. By name: :func:`normal_law`, :func:`friction_law`. Stiffness:
-:class:`Material` and the ``*_stiffness`` functions; a single impact: :func:`simulate_impact`.
+Normal laws (frozen dataclasses, ``law.force(penetration, penetration_rate, approach_speed) -> F_N
+>= 0``), friction laws (``friction_force(F_N, v_T)``, opposing v_T), :class:`HydrodynamicBearing`,
+by name :func:`normal_law` and :func:`friction_law`; stiffness: :class:`Material` and the
+``*_stiffness`` functions; a single impact: :func:`simulate_impact`.
 
 Penetration ``delta > 0`` in contact, rate ``delta_dot > 0`` approaching, approach speed latched at
 onset; the force is 0 for ``delta <= 0`` and never negative. A joint completes a law with

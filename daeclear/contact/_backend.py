@@ -17,13 +17,9 @@ __all__ = [
 ]
 
 
-def _is_casadi(x: Any) -> bool:
-    return type(x).__module__ == "casadi.casadi"
-
-
 def is_symbolic(*args: Any) -> bool:
     """Return True if any argument is a CasADi object (``SX``, ``MX`` or ``DM``)."""
-    return any(_is_casadi(a) for a in args)
+    return any(type(a).__module__ == "casadi.casadi" for a in args)
 
 
 def _ca() -> Any:

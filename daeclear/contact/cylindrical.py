@@ -2,22 +2,10 @@
 Goldsmith and ESDU 78035 (chapter 4, Figs. 4.22c-e).
 
 Each law gives the penetration as an explicit function of the force,
-
-    delta = s F [ln(X / F) + k],        s = sigma_s / L,
-
-with ``sigma_s = sigma_i + sigma_j`` (eq. 3.4, convention below), L the axial contact
-length, X a force scale and k = +1 or -1 (docs/contact_laws.md).
-It is implicit in F. ``delta(F)`` rises from 0 to its maximum ``delta_max = s X e^(k-1)``
-at ``F_max = X e^(k-1)`` and falls after it; only ``0 < F < F_max`` is physical.
-
-With ``z = ln(X / F) + k = 1 + eps`` the law reads ``eps - log1p(eps) = r``,
-``r = ln(delta_max / delta)`` (``1 + eps = -W_{-1}(-exp(-1 - r))``), solved by :data:`NEWTON_STEPS`
-unrolled safeguarded Newton steps from a series (r < 2) or asymptotic start: round-off accuracy,
-branch-free code, and CasADi's derivative is the implicit-function one ``1 / (s eps)``. Up to
-``penetration_limit`` (``eps = EPS_MIN``, just below ``delta_max``) the law holds; beyond it the
-force is continued as ``F_lim (delta / penetration_limit)**1.5`` (:meth:`~NormalLaw.check_penetration`
-warns). ``sigma_convention``: "plain" ``(1 - nu^2)/E`` (eq. 3.4) or "pi" ``(1 - nu^2)/(pi E)``
-(the default of ESDU 78035, written in it). docs/contact_laws.md has the derivation.
+``delta = s F [ln(X / F) + k]``, ``s = sigma_s / L`` (eq. 3.4), implicit in F and physical only
+below its maximum; it is solved by :data:`NEWTON_STEPS` unrolled safeguarded Newton steps and
+continued beyond ``penetration_limit`` as ``F_lim (delta / penetration_limit)**1.5``. The
+derivation and the ``sigma_convention`` ("plain" or "pi"): docs/contact_laws.md.
 """
 
 from __future__ import annotations

@@ -1,18 +1,9 @@
 """Finite-width journal bearing: Butenschoen's (1976) tables as corrections of the short-bearing forces.
 
 H. J. Butenschoen, *Das hydrodynamische, zylindrische Gleitlager endlicher Breite unter
-instationaerer Belastung*, Karlsruhe 1976, tabulates for B/D = 1/8 ... 1 (B the bearing's length,
-D its diameter), with the Reynolds cavitation condition:
-
-- pure rotation: the Sommerfeld number So_r = F psi^2 / (B D mu |w|) (psi = c/R, w the wedge rate)
-  and the attitude angle beta (between the force and the line of centres) for eps = 0.1 ... 0.99;
-- pure squeeze: So_d = F psi^2 / (B D mu |eps_dot|) for eps = 0 ... 0.99, closing and opening film.
-
-Each table is turned into its ratio to the short (Ocvirk) half film (1 as B/D -> 0), whose
-logarithm is interpolated bilinearly with branch-free hat functions (numbers and CasADi alike),
-held beyond the tables' eps range. The short film's wedge part is scaled and turned to the rotation
-table, its squeeze part scaled to the squeeze table. Three entries of the transcription (MBDyn's
-test data) are replaced by the finite-difference Reynolds solution (docs/lubrication.md).
+instationaerer Belastung*, Karlsruhe 1976. Each table (rotation: So_r and beta; squeeze: So_d) is
+turned into its ratio to the short (Ocvirk) half film, whose logarithm is interpolated bilinearly
+with branch-free hat functions (numbers and CasADi alike); docs/lubrication.md has the details.
 """
 
 from __future__ import annotations

@@ -1,12 +1,8 @@
 """Hydrodynamic film forces of a lubricated journal bearing (docs/lubrication.md: derivation, validation).
 
-Film ``h = c (1 + eps cos theta)``, theta from the widest film; Reynolds' equation with the wedge
-rate ``w = omega_journal + omega_bearing - 2 dgamma/dt`` and the squeeze rate ``eps_dot``, solved
-for ``theory="short"`` (Ocvirk), ``"long"`` (Sommerfeld) or ``"finite"`` (the short forces corrected
-by Butenschoen's tables, :mod:`daeclear.contact.finite_bearing`). Cavitation ``"full"`` keeps the
-whole film, ``"half"`` the half ``theta1 < theta < theta1 + pi``, ``theta1 = atan2(2 eps_dot, eps w)``,
-where pressure builds (Guembel). With ``1 + eps cos theta = (1 - eps^2) / (1 - eps cos psi)`` every
-force integral is a trigonometric polynomial: closed forms on floats, numpy and CasADi.
+Film ``h = c (1 + eps cos theta)``; Reynolds' equation for ``theory="short"`` (Ocvirk), ``"long"``
+(Sommerfeld) or ``"finite"`` (:mod:`daeclear.contact.finite_bearing`), cavitation ``"full"`` or
+``"half"`` (Guembel); every force integral in closed form on floats, numpy and CasADi.
 """
 
 from __future__ import annotations

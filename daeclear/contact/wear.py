@@ -1,11 +1,8 @@
 """Archard wear of a revolute clearance joint: the law, the pressure over the contact arc, the depth.
 
-Archard: ``dV = k F_n ds`` (``k`` in m^2/N, ``ds`` the sliding distance), spread over the contact
-arc as ``dh = k p ds``, so the worn volume is ``k`` times the sliding work whatever the pressure
-shape over ``|phi| < phi0`` (docs/wear.md): ``"elastic-foundation"``, ``p ~ cos(phi) - cos(phi0)``,
-``phi0 = arccos(c / (c + delta))``; ``"hertz"``, ``p ~ sqrt(1 - (phi / phi0)^2)``, ``phi0 = b / R``,
-``b = sqrt(4 F R_eff / (pi L E*))``. The profile is a depth per node (node ``k`` at ``2 pi k / nodes``)
-in the worn body's frame.
+Archard: ``dV = k F_n ds``, spread over the contact arc as ``dh = k p ds`` with an
+``"elastic-foundation"`` or ``"hertz"`` pressure shape (docs/wear.md); the profile is a depth per
+node (node ``k`` at ``2 pi k / nodes``) in the worn body's frame.
 """
 
 from __future__ import annotations

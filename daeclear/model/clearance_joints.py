@@ -219,15 +219,12 @@ SLIDER_MODELS: tuple[str, ...] = ("corners", "section-4.3")
 class TranslationalClearance(PointJoint):
     """Translational joint with clearance: a rectangular slider (body j) free inside a guide (body i).
 
-    No constraint: each slider corner that reaches a guide surface is pushed back by a contact-impact
-    force (section 4.3, eqs. 4.14-4.27). The guide is two parallel surfaces ``H`` apart, symmetric
-    about its mid-line; the slider an ``L x W`` rectangle with rounded corners. ``at`` is, in the
-    reference configuration, a point of the mid-line and the slider's centre (or give ``point_i``,
-    guide coordinates, and ``point_j``, slider coordinates). Coordinates ``s`` along the guide run
-    from that point along ``axis``; "upper" is the surface left of ``axis``. Corners A (+L/2, +W/2),
-    B (-L/2, +W/2), C (-L/2, -W/2), D (+L/2, -W/2); pairs ``<name>.A_upper``, ``<name>.B_upper``,
-    ``<name>.C_lower``, ``<name>.D_lower``; faces ``<name>.upper_face`` and ``<name>.lower_face``
-    (docs/validation.md). Unlike the chapter, the guide (outer part) is body i.
+    No constraint: each slider corner that reaches a guide surface (two parallel surfaces ``H``
+    apart) is pushed back by a contact-impact force (section 4.3, eqs. 4.14-4.27). ``at`` is a point
+    of the guide's mid-line and the slider's centre (or give ``point_i`` and ``point_j``); ``s`` runs
+    from it along ``axis``, "upper" is left of ``axis``. Corners A (+L/2, +W/2), B (-L/2, +W/2),
+    C (-L/2, -W/2), D (+L/2, -W/2); pairs ``<name>.A_upper`` ... ``<name>.D_lower``, faces
+    ``<name>.upper_face``/``lower_face`` (docs/validation.md). The guide is body i.
 
     Parameters
     ----------
@@ -271,10 +268,8 @@ class TranslationalClearance(PointJoint):
 
     Notes
     -----
-    The slider must not be able to turn over (``sqrt(L^2 + W^2) > H``): then these four pairs
-    are all the contacts there are. The ``section-4.3`` model is the chapter's for a slider that
-    lands flat (Fig. 4.35b): a face forming under an already deep corner makes the stored elastic
-    energy jump (docs/validation.md, section 4.5); for tilting sliders use ``corners``.
+    The slider must not be able to turn over (``sqrt(L^2 + W^2) > H``). ``section-4.3`` is for a
+    slider that lands flat (Fig. 4.35b); for tilting sliders use ``corners`` (docs/validation.md).
 
     Example
     -------
@@ -460,8 +455,7 @@ def clearance_joint(joint: Joint, *, bearing: str | None = None, name: str | Non
     """The clearance joint that replaces the ideal ``joint``: same bodies, point and axis.
 
     Ideal and clearance joints share their kinematic data (Ambrósio and Pombo, Multibody Syst. Dyn.
-    42, 2018): the joint's point becomes the bearing and journal centres, or the guide's mid-line
-    point and the slider centre (``axis`` the guide direction).
+    42, 2018).
 
     Parameters
     ----------
@@ -531,7 +525,6 @@ def ideal_joint(joint: Joint) -> Joint:
         return Translational(**shared, axis=joint.axis)
     raise SceneError(f"ideal joint of '{getattr(joint, 'name', joint)}': it is a "
                      f"{getattr(joint, 'kind', type(joint).__name__)}, not a clearance joint.")
-
 
 
 def driven_coordinate(joint: Any) -> str | None:

@@ -1,12 +1,8 @@
 """Applied loads: point forces, torques, spring-dampers and motors acting on the bodies of a scene.
 
 A load adds no state and no constraint, only a term of the applied generalized force ``Q(t, q, v)``
-(docs/user_guide.md, section 1.1). A point of application is a world point ``at`` of the reference
-configuration or a body-fixed ``point``, one of the two. A force component or a torque is a number,
-a :class:`Table` in time or an :class:`Expression` (:mod:`daeclear.model.load_values`). Every number
-is a run-time parameter; structure is which elements there are, each value's kind, a table's number
-of points and an expression's function. The springs' elastic energy is part of ``energy.potential``;
-every other power is in ``energy.input_power`` and each element's ``<name>.power`` channel.
+(the loads, their values and channels: docs/user_guide.md, section 1.1). A point of application is a
+world point ``at`` of the reference configuration or a body-fixed ``point``, one of the two.
 """
 
 from __future__ import annotations

@@ -133,10 +133,8 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     Parameters
     ----------
     joint : {"ideal", "revolute", "translational"}
-        Which joint has clearance; "ideal" has none. "revolute": joint ``C`` becomes the
-        revolute clearance joint ``clearance`` (Table 4.2), journal centred at the start.
-        "translational": joint ``D`` becomes the translational clearance joint ``clearance``
-        (Fig. 4.27, Table 4.3; its geometry in docs/validation.md), the slider centred in its guide.
+        Which joint has clearance (named ``clearance``, centred at the start): none, ``C`` (Table 4.2)
+        or ``D`` (Fig. 4.27, Table 4.3; its geometry in docs/validation.md).
     gravity : float
         Magnitude of gravity along -Y, m/s^2 (0 to switch it off).
     rpm : float
@@ -146,11 +144,9 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     name : str or None
         Scene name; defaults to ``"slider_crank"`` (+ the joint kind).
     clearance : float
-        Radial clearance of the clearance joint, m (0.5 mm in Figs. 4.15 and 4.28); for
-        the translational joint c = (H - W)/2.
+        Radial clearance, m (0.5 mm in Figs. 4.15 and 4.28); translational: c = (H - W)/2.
     law : str, NormalLaw, HydrodynamicBearing (lubricated revolute joint) or a law table (dict)
-        Normal contact law (name or object; stiffness computed when not given). Default
-        Lankarani-Nikravesh (3.9).
+        Normal contact law, stiffness computed when not given (default Lankarani-Nikravesh, 3.9).
     restitution : float or None
         Coefficient of restitution c_e for laws that take one (None: 0.9, Table 4.2); an error with
         a law that has none.
@@ -163,8 +159,7 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     length : float or None
         Axial contact length L, m, required by the cylindrical laws.
     contact_model : {"corners", "section-4.3"}
-        Translational joint only: every touching corner a sphere on a plane ("corners"), or a face in
-        contact on ``face_law`` ("section-4.3"); see :class:`~daeclear.model.scene.TranslationalClearance`.
+        Translational joint only: :class:`~daeclear.model.scene.TranslationalClearance`'s ``model``.
     face_law : str or NormalLaw
         Translational joint, "section-4.3" only: the law of a face in contact (default (4.26)).
     reading : str or None
@@ -221,9 +216,7 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
         friction=friction_law(friction), model=contact_model, reading=reading)
 
 
-# Chain of links (a multi-link pendulum with a clearance joint at every pin): steel links
-# 0.1 m between pins, 25 x 10 mm section (m = 7850 * 0.1 * 0.025 * 0.010 = 0.196 kg, slender-bar
-# inertia m L^2 / 12), pins with the slider-crank's bearing (10 mm radius, steel).
+# Chain links: steel, 0.1 m between pins, 25 x 10 mm section (7850 * 0.1 * 0.025 * 0.010 = 0.196 kg).
 CHAIN_LINK_LENGTH = 0.1
 CHAIN_LINK_MASS = 0.196
 CHAIN_LINK_INERTIA = CHAIN_LINK_MASS * CHAIN_LINK_LENGTH ** 2 / 12.0
@@ -237,7 +230,7 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
           length: float | None = None, name: str | None = None, **options: Any) -> Scene:
     """A planar chain of ``n_links`` rigid links with a revolute clearance joint at every pin.
 
-    The scalable mechanism of the benchmarks. Links ``link1`` ... ``link<N>`` lie end to end from
+    Links ``link1`` ... ``link<N>`` lie end to end from
     the origin along ``angle``; pin ``pin<k>`` joins link k-1 (the bearing; the ground for k = 1) to
     link k, journals centred at the start. ``rpm=None``: a free chain released from rest, every pin a
     clearance joint (6 N states, no constraint). ``rpm`` a number: ``pin1`` is an ideal revolute
@@ -410,9 +403,7 @@ def four_bar(clearance_joints: Any = (), *, rpm: float = 5000.0, crank_angle: fl
     origin, driven by driver ``drive``), ``B``, ``C`` and ``D`` (ground - rocker, at (0.13, 0) m).
     A joint named in ``clearance_joints`` becomes a RevoluteClearance of the same name (bearing on
     the joint's first body), journals centred and velocities from the ideal mechanism at the start.
-    Dimensions (this package's choice, docs/mechanisms.md): crank 0.05, coupler 0.12, rocker 0.10,
-    ground 0.13 m, a Grashof crank-rocker; crank and coupler are the slider-crank's links (Table 4.1),
-    bearings and law its revolute clearance joint's (Table 4.2).
+    Dimensions (this package's choice): docs/mechanisms.md.
 
     Parameters
     ----------
@@ -479,17 +470,14 @@ def double_pendulum(clearance_joints: Any = (), *, angles: Any = (0.0, 0.0), gra
 
     Links ``link1`` and ``link2`` (the chain's), pin ``A`` from the ground (bearing) to ``link1`` at
     the origin, pin ``B`` from ``link1`` (bearing) to ``link2``; no driver. A pin named in
-    ``clearance_joints`` becomes a RevoluteClearance of the same name, journal centred. With
-    ``restitution=1`` and no friction, ``energy.mechanical - energy.work`` (``track_work=True``) is
-    conserved.
+    ``clearance_joints`` becomes a RevoluteClearance of the same name, journal centred.
 
     Parameters
     ----------
     clearance_joints : sequence of {"A", "B"}
         Pins with clearance; () is the ideal double pendulum.
     angles : (float, float)
-        Initial angles of the two links from the X axis, rad ((0, 0): both horizontal, so the
-        pendulum swings down; -pi/2: hanging).
+        Initial angles of the two links from the X axis, rad ((0, 0): horizontal; -pi/2: hanging).
     gravity : float
         Magnitude of gravity along -Y, m/s^2.
     clearance : float or dict

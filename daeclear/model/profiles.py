@@ -1,18 +1,10 @@
 """Motion profiles of drivers: how a driven joint coordinate moves in time.
 
 A :class:`~daeclear.model.scene.Driver` prescribes ``x0 + speed * f(t)`` (a :class:`Tabulated`
-profile: the coordinate itself). The profile's kind is structure, its numbers are run-time
-parameters (``<driver>.profile.<field>``). The index reduction differentiates the driver constraint
-twice, so every profile is C2 in time at least:
-
-* :class:`ConstantSpeed` ``x(t) = speed t`` (the default);
-* :class:`Ramp` from rest to ``speed`` over ``time``, ``x'(t) = speed s(u)`` with the quintic blend
-  ``s(u) = 10u^3 - 15u^4 + 6u^5``, ``u = t/time`` (x is C3); after the ramp ``x = speed (t - time/2)``;
-* :class:`Harmonic` ``x'(t) = speed (1 + amplitude sin(2 pi frequency t + phase))``, integrated;
-* :class:`Tabulated` the natural cubic spline through ``(times, values)``, continued after the last
-  time at its end slope.
-
-Plain data (no CasADi at import); :func:`motion` writes a profile as a CasADi expression.
+profile: the coordinate itself); :class:`ConstantSpeed`, :class:`Ramp`, :class:`Harmonic` and
+:class:`Tabulated` are C2 in time at least, as the index reduction differentiates the constraint
+twice (the formulas: docs/user_guide.md). The kind is structure, the numbers run-time parameters
+(``<driver>.profile.<field>``). Plain data; :func:`motion` writes a profile as a CasADi expression.
 """
 
 from __future__ import annotations

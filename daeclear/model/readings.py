@@ -1,13 +1,9 @@
 """Readings of the chapter's translational clearance joint (section 4.3) and of its Fig. 4.28 run.
 
-Each model the chapter's text supports for Fig. 4.28 is a named *reading*, with the sentence it
-comes from (``source``) and what the text leaves open and we chose (``note``); the table is in
-docs/validation.md. Joint readings (:data:`JOINT_READINGS`, ``TranslationalClearance(reading=...)``,
-defined in :mod:`daeclear.model.joint_readings` and re-exported here) set the corner law's stiffness
-(3.5) or (4.27) and exponent and the face law, keeping the restitution of the joint's ``law``; K of
-(4.27) is in N/m, taken in N/m^1.5 with n = 1.5. Mechanism readings (:data:`MECHANISM_READINGS`,
-:func:`slider_crank_scene`) change the rest of the scene: gravity, the slider's mass and inertia,
-where the rod is pinned on the slider, friction.
+Each model the chapter's text supports for Fig. 4.28 is a named *reading* with its ``source`` and
+``note`` (the table: docs/validation.md). Joint readings (:data:`JOINT_READINGS`, from
+:mod:`daeclear.model.joint_readings`) set the contact laws; mechanism readings
+(:data:`MECHANISM_READINGS`, :func:`slider_crank_scene`) change the rest of the scene.
 """
 
 from __future__ import annotations

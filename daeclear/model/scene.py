@@ -25,8 +25,8 @@ from .elements import (GROUND, Body, Driver, Element, Ground, Joint, PointJoint,
 PLACEMENT_MODULE = "daeclear.assembly.placement"
 
 
-def _did_you_mean(name: str, names: Iterable[str]) -> str:
-    close = difflib.get_close_matches(name, list(names), n=3)
+def _did_you_mean(name: str, names: Iterable[str], n: int = 3) -> str:
+    close = difflib.get_close_matches(name, list(names), n=n)
     return f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
 
 
@@ -200,10 +200,8 @@ class Scene:
         for joint, roles in referring:
             for role, body in roles:
                 if body not in known:
-                    close = difflib.get_close_matches(str(body), sorted(known), n=1)
-                    hint = f" Did you mean '{close[0]}'?" if close else ""
                     out.append(f"{joint.kind} '{joint.name}': {role} refers to body '{body}', "
-                               f"not in scene '{self.name}'.{hint}")
+                               f"not in scene '{self.name}'.{_did_you_mean(str(body), sorted(known), n=1)}")
         joints = {j.name: j for j in self.joints}
         driven: set[str] = set()
         for driver in self.drivers:
