@@ -1,29 +1,8 @@
-"""Scene -> DAEModel: the symbolic equations of motion, built once with CasADi.
+"""Scene -> DAEModel: the symbolic equations of motion, built once per structure with CasADi.
 
-Coordinates: each moving body k has ``q_k = (x_k, y_k, phi_k)`` of its centre of
-mass; the state is ``y = [q, v, lam]`` (``index1``) or ``y = [q, v, lam, mu]``
-(``ggl``). Ideal joints and drivers are constraints ``Phi(q, t) = 0``; contact
-elements (clearance joints) add no constraint but *terms*: generalized forces that
-the solver switches on and off between integration segments.
-
-Formulations
-------------
-``index1`` (the chapter's; Tables 4.2 and 4.3)::
-
-    q' - v                                   = 0
-    M v' + Phi_q^T lam - Q(q, v, t)          = 0
-    Phi_q v' - gamma + 2 alpha Phi' + beta^2 Phi = 0     (Baumgarte)
-
-``ggl`` (the default: stabilised index 2, Gear-Gupta-Leimkuhler; drift-free)::
-
-    q' - v + Phi_q^T mu                      = 0
-    M v' + Phi_q^T lam - Q(q, v, t)          = 0
-    Phi_q v + Phi_t                          = 0
-    Phi(q, t)                                = 0
-
-where ``Phi' = Phi_q v + Phi_t`` and ``gamma = -(d Phi'/dq) v - d Phi'/dt``.
-
-The model is built once per structure (:class:`Structure`); :class:`DAEModel` is re-exported.
+State ``y = [q, v, lam]`` (``index1``, the chapter's) or ``[q, v, lam, mu]`` (``ggl``, the default);
+ideal joints and drivers are constraints ``Phi(q, t) = 0``, clearance joints add switched force
+terms. The equations of both formulations: docs/engine.md ("Formulations").
 """
 
 from __future__ import annotations

@@ -1,20 +1,9 @@
-"""The compiled IDA session: SUNDIALS IDA, the model's callbacks and the step loop in C.
-
-The model is generated as C with CasADi, compiled with the hand-written IDA driver
-(``csrc/ida_driver.c``) into a shared library linked against the SUNDIALS libraries of the
-scikit-sundae wheel (:mod:`daeclear.engine.codegen`), loaded by :mod:`daeclear.engine.library` and
-driven here through ctypes a few calls per segment. No Python runs per step or per model
-evaluation. A closed session's C session goes to a small pool, and the next session of the same
-library takes it reset (``dc_reset``) instead of opening another (:mod:`daeclear.engine.c_handle`).
-Separate from the python backend (:mod:`daeclear.engine.python_session`), which has the same
-interface (:class:`daeclear.engine.session_base.Session`) but nothing else in common.
-
-Linear solver (``linear_solver``): IDA's Newton iteration solves with the iteration matrix
-dF/dy + cj dF/dy' by dense LU of the system left after eliminating the position rows
-(``"reduced"``, csrc/dc_reduced_ls.h), by dense LU of the whole matrix (``"dense"``, SUNDIALS'
-own) or by sparse LU (``"sparse"``: SuperLU_MT, one thread, on a SUNSparseMatrix whose pattern is
-the union of the base and all term Jacobians' patterns). ``"auto"`` picks sparse from
-``SPARSE_MIN_STATES`` states on, reduced below (measured, ``benchmarks/bench_linear_solver.py``).
+"""The compiled IDA session: SUNDIALS IDA, the model's callbacks and the step loop in C, driven
+through ctypes a few calls per segment (no Python per step); the same interface as the python
+backend (:class:`daeclear.engine.session_base.Session`). How the library is built and what the
+C driver does: docs/engine.md. Linear solvers (``linear_solver``): ``"reduced"`` (dense LU after
+eliminating the position rows), ``"dense"`` (SUNDIALS'), ``"sparse"`` (SuperLU_MT); ``"auto"``
+picks sparse from ``SPARSE_MIN_STATES`` states on.
 """
 
 from __future__ import annotations
@@ -55,11 +44,8 @@ from .sundials import SPARSE_LIBS
 
 __all__ = ["CSession", "SPARSE_MIN_STATES"]
 
-#: linear_solver="auto" uses the sparse solver for models with at least this many states, the
-#: reduced dense LU below. Measured with benchmarks/bench_linear_solver.py (chains of N links, 6 N
-#: states; docs/performance.md): the reduced LU is faster up to 336 states (SuperLU_MT's fixed cost
-#: per factorization), sparse is faster from 360 on (whole simulate calls 1.04x at 360 states,
-#: 1.07x at 384).
+#: linear_solver="auto" uses the sparse solver from this many states on, the reduced dense LU below
+#: (measured: benchmarks/bench_linear_solver.py, docs/performance.md).
 SPARSE_MIN_STATES = 360
 _LS_NAMES = {code: name for name, code in LINEAR_SOLVER_CODES.items()}
 log = logging.getLogger("daeclear")
