@@ -111,15 +111,11 @@ def tolerance_vector(model: DAEModel, rtol: float, atol: float | Mapping[str, fl
     if atol is None or isinstance(atol, Mapping):  # a mapping: the quantities it does not name keep their defaults
         given = defaults if atol is None else {**defaults, **atol_by_quantity(atol, where="simulate", field="atol")}
         vec[:n] = [given[k] for k in quantities]
-    elif np.ndim(atol) == 0:
-        value = float(atol)  # type: ignore[arg-type]
-        if not math.isfinite(value) or value <= 0:
-            fail("simulate", "atol", atol, "a finite number > 0")
-        vec[:n] = value
+    elif np.ndim(atol) == 0:  # values checked by options.atol (SolverOptions)
+        vec[:n] = float(atol)  # type: ignore[arg-type]
     else:
         given_vec = np.asarray(atol, dtype=float)  # checked by options.atol but for its length
-        if given_vec.shape not in ((n,), (model.n_states,)) or not np.all(np.isfinite(given_vec)) \
-                or np.any(given_vec[:n] <= 0):
+        if given_vec.shape not in ((n,), (model.n_states,)):
             fail("simulate", "atol", atol, f"a finite number > 0, a mapping by quantity, or {n} values > 0 "
                  f"(positions and velocities: {', '.join(model.state_names[:3])}, ...) or {model.n_states} "
                  "(one per state)", shown=f"array of shape {given_vec.shape}")
