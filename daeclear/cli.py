@@ -126,8 +126,7 @@ def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
 
 
 def _add_joint(target: str, joint: str | None, params: dict[str, Any]) -> None:
-    """Put ``--joint`` into the mechanism's parameters: the slider-crank's option; the other mechanisms
-    choose their clearance joints with --set clearance_joints=..., and --set joint= with --joint is given twice."""
+    """Put ``--joint`` (the slider-crank's option only; not with --set joint=) into the mechanism's parameters."""
     if joint is None:
         return
     if target != "slider_crank":
@@ -204,7 +203,6 @@ def _run(args: argparse.Namespace) -> int:
         lo, hi = args.window
         if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 <= lo < hi and lo < t_end):
             options.fail(where, "--window", tuple(args.window), f"T0 < T1 with 0 <= T0 < t_end={t_end:g} s", "s")
-    # the command line and the file's [simulate] table as the call's solver settings and output
     settings: dict[str, Any] = {"backend": args.backend, **sim}
     if args.formulation:
         settings["formulation"] = args.formulation
@@ -278,8 +276,7 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
 
 
 def _read_back(h5: Path) -> tuple[float | None, Any]:
-    """The streamed result, whole, or from the time of its last CLI_SHOWN_EVENTS events on (bounded memory:
-    the points are at most CLI_POINTS + 1, the events and segments of a long run are not)."""
+    """The streamed result, whole, or from the time of its last CLI_SHOWN_EVENTS events on (bounded memory)."""
     from .results.result import load, load_times
 
     events = load_times(h5, "events")
@@ -288,14 +285,12 @@ def _read_back(h5: Path) -> tuple[float | None, Any]:
 
 
 def default_max_steps(t_end: float) -> int:
-    """IDA's step cap of ``daeclear run``: CLI_STEPS_PER_SECOND per simulated second, at least the API's 5e6
-    (the chapter's revolute slider-crank takes ~190 000 steps per simulated second at 5000 rpm)."""
+    """IDA's step cap of ``daeclear run``: CLI_STEPS_PER_SECOND per simulated second, at least the API's 5e6."""
     return max(5_000_000, math.ceil(CLI_STEPS_PER_SECOND * t_end))
 
 
 def default_t_eval_step(t_end: float) -> float:
-    """Spacing of the points ``daeclear run`` reports by default: ``t_end / CLI_POINTS``, no finer than
-    ``CLI_FINEST_STEP`` (at most CLI_POINTS + 1 points, whatever the length of the run)."""
+    """The default spacing of ``daeclear run``'s points: ``t_end / CLI_POINTS``, no finer than CLI_FINEST_STEP."""
     return min(t_end, max(CLI_FINEST_STEP, t_end / CLI_POINTS))
 
 

@@ -52,11 +52,8 @@ class OutputDirectoryMissing(OutputError, FileNotFoundError):
 
 
 class Interrupted(KeyboardInterrupt):
-    """Ctrl-C (KeyboardInterrupt) during a run or a study; ``.result`` holds what was computed.
-
-    A KeyboardInterrupt, so it stops every loop that catches only errors (``except Exception``,
-    ``except SolveError``), and ``except KeyboardInterrupt`` still catches it.
-    """
+    """Ctrl-C during a run or a study; ``.result`` holds what was computed. A KeyboardInterrupt, so that
+    loops catching only errors (``except Exception``) stop too."""
 
     def __init__(self, message: str, result: Any = None) -> None:
         super().__init__(message)

@@ -38,12 +38,8 @@ def is_terminal(stream: Any) -> bool:
 
 
 class Progress:
-    """Progress of ``total`` units of work (seconds simulated, runs, frames) on ``stream`` (stderr).
-
-    ``update(done, note)`` reports the work done so far (absolute) and a short note; ``close(note)``
-    ends the display (again: nothing). Both are cheap when nothing is due (a solver calls ``update``
-    every step).
-    """
+    """Progress of ``total`` units of work (seconds simulated, runs, frames) on ``stream`` (stderr);
+    :meth:`update` is cheap when nothing is due (a solver calls it every step)."""
 
     def __init__(self, total: float, *, unit: str = "", desc: str = "", enabled: bool = True,
                  stream: TextIO | None = None, interval: float = PLAIN_INTERVAL) -> None:

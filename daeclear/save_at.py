@@ -28,25 +28,19 @@ class SaveAt:
     Parameters
     ----------
     times : array_like or None
-        Output times (finite, strictly increasing, inside ``[t0, t_end]``). None: every internal step
-        (or the grid of ``every``).
+        Output times (finite, strictly increasing, inside ``[t0, t_end]``). None: every internal step.
     every : float or None
-        Output times every ``every`` seconds from t0 to t_end, both included (spacing
-        ``(t_end - t0) / floor((t_end - t0) / every)``), made window by window. Not with ``times``.
+        Output times every ``every`` seconds from t0 to t_end, both included. Not with ``times``.
     steps : bool
-        Keep every internal step's time, size and order (``result.step_t``...). Without ``times``
-        and ``every`` the steps are the output points (False: the start point only); with them,
-        False keeps the run's memory from growing with its length.
+        Keep every internal step's time, size and order (``result.step_t``...); without ``times`` and
+        ``every`` False keeps the start point only.
     stream_to : str, path or None
-        Write the result to this HDF5 file chunk by chunk while the run goes on (docs/hdf5_layout.md);
-        the file holds what was computed whatever stops the run.
+        Write the result to this HDF5 file chunk by chunk during the run (docs/hdf5_layout.md).
     keep_data : bool
-        With ``stream_to``: return the result read back from the file (True), or (False) the outcome
-        alone (success, message, statistics, warnings). False needs ``stream_to``.
+        With ``stream_to``: return the result read back (True) or the outcome alone (False).
     max_points : int or None
-        The most output points the run may report (:data:`daeclear.options.MAX_OUTPUT_POINTS`, about
-        1 GB for the chapter's slider-crank); more is refused before the run with the estimated size.
-        None: no cap.
+        The most output points a run may report (:data:`daeclear.options.MAX_OUTPUT_POINTS`), refused
+        before the run with the estimated size. None: no cap.
     """
 
     times: ArrayLike | None = None

@@ -1,9 +1,5 @@
-"""SolverOptions: the settings that decide what a run computes, as one checked, immutable value.
-
-:func:`daeclear.simulate`, the studies and sweeps take the same settings; checked once on
-construction (the rules of :mod:`daeclear.options`), round-tripped through a dict of JSON types.
-What a call reports (``save``, ``progress``) and does on failure are not settings: they never
-change the computed trajectory.
+"""SolverOptions: the settings that decide what a run computes, as one checked, immutable value (what a
+call reports and does on failure are not settings: they never change the computed trajectory).
 """
 
 from __future__ import annotations
@@ -40,9 +36,7 @@ class SolverOptions:
     """The solver settings of a run: ``options=`` of :func:`daeclear.simulate`.
 
     Checked on construction (:class:`daeclear.SceneError` naming the field, the value and what is
-    allowed; ``step`` by the method's solver, :meth:`daeclear.solvers.base.Solver.check`); names
-    normalised (``"RK45"`` stored as ``"rk45"``), ``atol`` as a float, a tuple of floats or of
-    (quantity, value) pairs. Immutable: derive variants with :meth:`replace`.
+    allowed), names normalised (``"RK45"`` as ``"rk45"``); immutable: derive variants with :meth:`replace`.
 
     Parameters
     ----------
@@ -52,36 +46,27 @@ class SolverOptions:
     rtol : float
         Relative tolerance (the chapter's "integration tolerance"), in [1e-14, 1e-2].
     atol : float, mapping, array or None
-        Absolute tolerance of positions and velocities. None: per quantity from the mechanism's
-        scales (:mod:`daeclear.solvers.tolerances`). A number: all of them. A mapping by quantity,
-        e.g. ``{"q": 1e-9, "v": 1e-6}`` or by ``"position"``, ``"angle"``, ``"velocity"``,
-        ``"angular_velocity"`` (the others default). An array: ``2 n_q`` values or one per state.
-        Values below round-off are raised to it, with a warning; multipliers are never tested.
+        Absolute tolerance of positions and velocities: None (from the mechanism's scales, docs/engine.md),
+        a number, a mapping by quantity (``{"q": 1e-9, "v": 1e-6}``, ``"position"``, ``"angle"``,
+        ``"velocity"``, ``"angular_velocity"``) or an array (``2 n_q`` values or one per state).
     formulation : {"ggl", "index1"} or None
-        Used when a Scene is run. None: the solver's own ("ggl" for IDA; "index1", the chapter's
-        Baumgarte alpha = beta = 5, for the other methods, which integrate that one only).
+        Used when a Scene is run. None: the solver's own ("ggl" for IDA, "index1" for the others).
     backend : {"auto", "c", "python"}
-        "c": generated C and an IDA loop in C; "python": scikit-sundae with CasADi callbacks;
-        "auto": C when a compiler works, else python with a warning.
+        "c": generated C and the IDA loop in C; "python": scikit-sundae; "auto": C when a compiler works.
     max_step : float
         Largest step, s (0: unbounded); IDA and the scipy methods.
     max_steps : int
         Cap on the total number of steps; the run fails cleanly beyond it.
     step : float or None
-        Step size, s, of "rk4" and "euler" (required there, e.g. 1e-5); refused by the others.
+        Step size, s, of "rk4" and "euler" (required there); refused by the others.
     linear_solver : {"auto", "reduced", "dense", "sparse"}
-        LU of IDA's Newton iteration in the compiled backend: "reduced" (the system left after
-        eliminating the position rows), "dense", "sparse" (SuperLU_MT) or "auto" (sparse from
-        :data:`daeclear.engine.ida_session.SPARSE_MIN_STATES` states).
+        LU of IDA's Newton iteration in the compiled backend (docs/engine.md).
     start : {"ideal", "declared"}
-        How a run starts without ``y0``: "ideal" (the chapter's, section 4.4: clearance joints
-        centred) or "declared" (the bodies' declared state, corrected for the ideal joints only).
+        The start without ``y0``: "ideal" (the chapter's, clearance joints centred) or "declared".
     allow_penetration : bool
-        Start even deeper in a wall than :data:`daeclear.solvers.physics.START_PENETRATION_FRACTION`
-        of the clearance (a ``y0``: :data:`~daeclear.solvers.physics.GIVEN_PENETRATION_FRACTION`).
+        Start even deeper in a wall than the physics checks allow (:mod:`daeclear.solvers.physics`).
     track_work : bool
-        IDA only: integrate the work of drivers and contact forces as the state ``work.input``
-        (channel ``energy.work``), see :func:`daeclear.assemble`.
+        IDA only: integrate the work of drivers and contact forces (channel ``energy.work``).
     """
 
     method: str = "ida"

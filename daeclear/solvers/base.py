@@ -1,9 +1,5 @@
-"""The one contract every integrator of :func:`daeclear.simulate` implements (as scipy's ``OdeSolver``).
-
-A solver is a class, named (:data:`daeclear.solvers.registry.SOLVERS`) or given (``method=MySolver``);
-on an instance :meth:`Solver.check` is called when the :class:`daeclear.SolverOptions` naming it are
-made, :meth:`Solver.run` once per run after every check of the call.
-"""
+"""The one contract every integrator of :func:`daeclear.simulate` implements (as scipy's ``OdeSolver``):
+a class, named (:data:`daeclear.solvers.registry.SOLVERS`) or given (``method=MySolver``)."""
 
 from __future__ import annotations
 
@@ -24,17 +20,15 @@ if TYPE_CHECKING:
 
 @runtime_checkable
 class Solver(Protocol):
-    """An integrator of an assembled model from t0 to t_end.
-
-    ``name`` is what ``result.method`` reports; ``formulation`` the DAE formulation a Scene is
-    assembled with when the options name none ("ggl" for IDA, "index1" for the ODE methods).
-    """
+    """An integrator of an assembled model from t0 to t_end: ``name`` is what ``result.method`` reports,
+    ``formulation`` what a Scene is assembled with when the options name none."""
 
     name: ClassVar[str]
     formulation: ClassVar[str]
 
     def check(self, settings: SolverOptions) -> None:
-        """Refuse (SceneError) a setting this method does not take or needs and lacks (e.g. ``step``)."""
+        """Refuse (SceneError) a setting this method does not take or needs and lacks (e.g. ``step``);
+        called when the SolverOptions naming the method are made."""
 
     def run(self, model: Scene | DAEModel, t_end: float, t0: float, y0: NDArray | None, save: Output,
             settings: SolverOptions, on_failure: str, progress: bool) -> Result:

@@ -1,11 +1,6 @@
-"""What computes a result's channels from its stored states: the model's output function.
-
-A run stores states only (:class:`daeclear.results.lazy_channels.LazyChannels`); its channels
-are the model's generated output function at the stored rows, evaluated in one vectorised call
-in the compiled library of the run's backend (or CasADi for the python backend), so they equal
-bit for bit what the run would have computed point by point. A result file stores the scene's
-description; :func:`evaluator_from_parameters` rebuilds the model from it when a loaded
-result's channels are first read.
+"""What computes a result's channels from its stored states: the model's output function, in one
+vectorised call in the run's backend (bit for bit what the run would compute); a loaded result's
+model is rebuilt from its file's scene description (:func:`evaluator_from_parameters`).
 """
 
 from __future__ import annotations
@@ -19,15 +14,13 @@ from ..assembly.assemble import DAEModel, assemble
 from ..engine.ida_session import open_session
 from ..errors import SceneError
 from ..model.scenefile import scene_from_description
-from ..results.lazy_channels import Evaluate
 
-__all__ = ["ModelEvaluator", "evaluator_from_parameters", "model_evaluator", "rebuildable"]
+__all__ = ["ModelEvaluator", "evaluator_from_parameters", "rebuildable"]
 
 
 class ModelEvaluator:
-    """A model's channels and derivatives at stored rows, each call in a session of ``backend`` ("c",
-    "python", "auto") opened for it alone (its library is the run's, loaded once per process; opening
-    and closing one costs ~0.5 ms)."""
+    """A model's channels and derivatives at stored rows, each call in a session of ``backend`` opened
+    for it alone (the run's library, loaded once per process)."""
 
     def __init__(self, model: DAEModel, backend: str) -> None:
         self.model, self.backend = model, backend
@@ -55,11 +48,6 @@ class ModelEvaluator:
             return model.consistent_state(t, y, model.term_forces_rows(t, y, switch, session), session)
         finally:
             session.close()
-
-
-def model_evaluator(model: DAEModel, backend: str) -> Evaluate:
-    """The channels in a session of ``backend`` opened for the evaluation alone (:class:`ModelEvaluator`)."""
-    return ModelEvaluator(model, backend).channels
 
 
 def rebuildable(parameters: Mapping[str, Any]) -> bool:

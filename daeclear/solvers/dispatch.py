@@ -37,57 +37,46 @@ def simulate(
 ) -> Result:
     """Integrate a scene (or an assembled model) from ``t0`` to ``t_end``.
 
-    ``method``, ``rtol`` and ``atol`` override the same settings of ``options`` (every other solver
-    setting is a field of :class:`daeclear.SolverOptions`); what the run reports is ``save``.
-
     Parameters
     ----------
     scene : Scene or DAEModel
-        The mechanism; a Scene is assembled with ``options.formulation`` first. No run changes a
-        model: runs of one model (also in threads) are independent.
+        The mechanism; a Scene is assembled with ``options.formulation`` first. No run changes a model.
     t_end : float
         End time, s (> t0).
     t0 : float
         Start time, s (>= 0, < t_end); drivers and loads see the true time.
     y0 : array_like or None
-        The full state at ``t0`` (a row of ``result.y`` of the same model): positions and velocities
-        kept (GGL: projected), multipliers and accelerations recomputed, contact modes set from the
-        gaps. None: the start of ``options.start``. A run's history (storm guard, BDF) starts afresh.
+        The full state at ``t0`` (a row of ``result.y`` of the same model); None: ``options.start``.
     method : str or a solver class
         "ida" (default), "RK45", "DOP853", "Radau", "BDF", "LSODA", "rk4" or "euler" (case-insensitive),
-        or a class implementing :class:`daeclear.solvers.base.Solver`. All but "ida" integrate the
-        index-1 model as an ODE in (q, v) (:mod:`daeclear.solvers.explicit`); "rk4", "euler" need ``step``.
+        or a :class:`daeclear.solvers.base.Solver` class; overrides ``options.method``.
     rtol : float
-        Relative tolerance (1e-6; the chapter's "integration tolerance").
+        Relative tolerance (1e-6; the chapter's "integration tolerance"); overrides ``options.rtol``.
     atol : float, mapping, array or None
-        Absolute tolerance of positions and velocities (:class:`daeclear.SolverOptions`; None: from the
-        mechanism's scales, :mod:`daeclear.solvers.tolerances`).
+        Absolute tolerance of positions and velocities (:class:`daeclear.SolverOptions`).
     options : SolverOptions or None
         The solver settings (None: the defaults).
     save : SaveAt or None
         The output (:class:`daeclear.SaveAt`; None: every internal step, in memory).
     on_failure : {"raise", "return"}
-        On an integrator failure raise :class:`SolveError` (``.result`` holds the partial result) or
+        On an integrator failure raise :class:`SolveError` (``.result``: the partial result) or
         return the partial result with ``success=False``.
     progress : bool
         Show a progress line on stderr.
     parameters : mapping or None
-        New numbers for this run by name, as :meth:`DAEModel.with_parameters` (e.g.
-        ``{"clearance.clearance": 2e-4}``); nothing is compiled, the model is unchanged.
+        New numbers for this run by name (:meth:`DAEModel.with_parameters`); nothing is compiled.
 
     Returns
     -------
     Result
-        ``result.warnings`` lists the physics checks' findings (:mod:`daeclear.solvers.physics`), each
-        also issued as a :class:`daeclear.PhysicsWarning`.
+        ``result.warnings``: the physics checks' findings, each also a :class:`daeclear.PhysicsWarning`.
 
     Raises
     ------
     SceneError
         A bad argument (naming it, its value and what is allowed), before any work.
     AssemblyError
-        The initial positions cannot be assembled, the constraints are redundant, or a declared
-        start is in deep penetration.
+        The start cannot be assembled, the constraints are redundant, or it is in deep penetration.
     """
     if not isinstance(scene, (Scene, DAEModel)):  # e.g. a mechanism's name: say what is wanted
         opts.fail("simulate", "scene", scene, "a daeclear.Scene or an assembled model, e.g. "

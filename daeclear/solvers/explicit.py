@@ -1,37 +1,17 @@
-"""The same assembled model integrated by other schemes than IDA, for accuracy studies.
+"""The assembled model integrated by other schemes than IDA, for accuracy studies.
 
-Solvers (:class:`daeclear.solvers.base.Solver`) of every method but ``"ida"``: explicit adaptive
-``"RK45"``, ``"DOP853"``; implicit ``"Radau"``, ``"BDF"``, ``"LSODA"`` (scipy, with the generated
-Jacobian); fixed step ``"rk4"`` and ``"euler"`` (``step=``, the step loop in C). This module holds the
-solver classes and the two integration loops; the model as an ODE is in
-:mod:`~daeclear.solvers.ode_model`, its evaluation in :mod:`~daeclear.solvers.ode_evaluators`, gap
-crossings in :mod:`~daeclear.solvers.ode_crossings`, the run's bookkeeping in :mod:`~daeclear.solvers.ode_run`.
+Solvers (:class:`daeclear.solvers.base.Solver`) of every method but ``"ida"``: scipy's ``"RK45"``,
+``"DOP853"``, ``"Radau"``, ``"BDF"``, ``"LSODA"`` (the implicit ones with the generated Jacobian) and
+the fixed-step ``"rk4"``, ``"euler"`` (``step=``, the loop in C). The index-1 DAE is an ODE in
+``x = (q, v)`` (:mod:`~daeclear.solvers.ode_model`); GGL is IDA-only.
 
-The index-1 DAE is an ODE in ``x = (q, v)``: ``q' = v``, ``v' = a(t, q, v)``, with ``a`` and the
-multipliers from the chapter's linear system (Baumgarte alpha, beta as assembled)::
-
-    [M  Phi_q^T] [a  ]   [Q + sum of the active contact terms' forces]
-    [Phi_q   0 ] [lam] = [gamma - 2 alpha Phi' - beta^2 Phi          ]
-
-GGL is IDA-only. ``backend="python"`` (or ``"auto"`` without a C compiler) evaluates the same
-functions through ``casadi.FunctionBuffer`` and numpy.
-
-Events follow the contact rules and run state of IDA (:mod:`daeclear.assembly.contact_state`): each
-segment watches every gap in the direction the contact state gives, ``contact_state.decide`` switches
-modes at a crossing, and the integrator restarts from the event with fresh history, the state (q, v)
-kept. A step may hold a crossing of G = direction * g from <= 0 to > 0 when G changed sign over it,
-or when the cubic Hermite interpolant of G has an interior maximum above zero (a quick re-contact
-within one step, confirmed on the scheme's own state; one the cubic does not predict is still missed);
-the crossing is bracketed by Illinois regula falsi down to IDA's root tolerance
-(:mod:`~daeclear.solvers.ode_crossings`). The state at the event comes from the dense output (scipy)
-or a re-step from the step's start (rk4, euler: event times are not quantised to the step).
-
-Output: every accepted step and event point, or (``SaveAt.times``/``every``) dense output / cubic
-Hermite interpolation; multipliers and accelerations are recomputed at the output points. Statistics
-as IDA's (``n_res_evals``: scheme stages and event re-steps; ``n_lu``: Radau, BDF). A run fails
-(``success=False``, a message saying when, which pairs were in contact and why) on the scheme's own
-failure, a non-finite state, a step-size collapse (:mod:`daeclear.engine.stall_guard`), ``max_steps``
-steps, or ``STALL_EVENTS`` events at the same time.
+Events follow IDA's contact rules (:mod:`daeclear.assembly.contact_state`): each segment watches every
+gap in the direction the contact state gives; a step holds a crossing when G = direction * g changed
+sign over it or its cubic Hermite interpolant has an interior maximum above zero, located to IDA's
+root tolerance (:mod:`~daeclear.solvers.ode_crossings`); the integrator restarts from the event with
+(q, v) kept. The event state comes from the dense output (scipy) or a re-step (rk4, euler). A run
+fails (``success=False``) on the scheme's failure, a non-finite state, a step-size collapse,
+``max_steps`` steps or ``STALL_EVENTS`` events at one time.
 """
 
 from __future__ import annotations

@@ -1,9 +1,5 @@
-"""The IDA solver (:class:`IDA`, the method "ida" of :func:`daeclear.simulate`): sets a run up.
-
-IDA integrates a :class:`DAEModel` segment by segment with root finding on the gaps; at a root the
-contact logic switches modes, the state is made consistent again and IDA restarts with fresh BDF
-history. The segment loop itself is :class:`daeclear.solvers.ida_loop.SegmentLoop`.
-"""
+"""The IDA solver (:class:`IDA`, the method "ida" of :func:`daeclear.simulate`): sets a run up for
+its segment loop (:class:`daeclear.solvers.ida_loop.SegmentLoop`)."""
 
 from __future__ import annotations
 
@@ -42,9 +38,8 @@ STALL_COUNT = 2000
 
 
 class IDA:
-    """SUNDIALS IDA on the DAE (any formulation), with root finding and consistent restarts: the
-    compiled loop in C or, with ``backend="python"`` (or "auto" without a working compiler), the same
-    loop on scikit-sundae; the backend is one of the settings (:class:`daeclear.SolverOptions`)."""
+    """SUNDIALS IDA on the DAE (any formulation), with root finding and consistent restarts: the compiled
+    loop in C or (``backend="python"``) the same loop on scikit-sundae."""
 
     name: ClassVar[str] = "ida"
     formulation: ClassVar[str] = opts.DEFAULT_FORMULATION

@@ -1,15 +1,10 @@
 """The IDA segment loop of one run: advance, record contact switches, restart, finish.
 
-:meth:`daeclear.solvers.ida.IDA.run` opens the session and the recorder (the options are checked) and
-hands them to a :class:`SegmentLoop`, which integrates segment by segment. Between two roots of
-the gap functions the set of active contact terms is fixed. The compiled loop may decide the
-switches of simple pairs itself (:meth:`SegmentLoop.record_advance` takes its decisions into
-the run's contact state); any other root returns to Python, where the contact rules decide the
-new state (:func:`daeclear.assembly.contact_state.decide`) and IDA restarts from a consistent state
-(:meth:`SegmentLoop.decide_roots`). The points go to the recorder chunk by chunk
-(:meth:`SegmentLoop.flush`), so a run that streams to a file and keeps no steps runs in bounded
-memory, and whatever stops the run (a failure, Ctrl-C, running out of memory) the result holds
-what was computed (:meth:`SegmentLoop.finish`).
+Between two roots of the gap functions the active contact terms are fixed. The compiled loop may
+decide simple pairs' switches itself (:meth:`SegmentLoop.record_advance`); any other root returns to
+Python, where the contact rules decide (:func:`daeclear.assembly.contact_state.decide`) and IDA
+restarts from a consistent state. Points go to the recorder chunk by chunk (bounded memory when
+streamed), and whatever stops the run the result holds what was computed (:meth:`SegmentLoop.finish`).
 """
 
 from __future__ import annotations
@@ -42,9 +37,8 @@ STICKING_FLAGS = ("DC_STEP_COLLAPSE", "IDA_CONV_FAIL", "IDA_ERR_FAIL")
 
 
 class SegmentLoop:
-    """One run's loop state: its contact state (:mod:`daeclear.assembly.contact_state`) and what
-    follows from it (active terms and their parameters, contact modes, the switch vector), the
-    current segment's start and the reported points not yet made consistent."""
+    """One run's loop state: its contact state and what follows from it (active terms, modes, the switch
+    vector), the current segment's start and the reported points not yet made consistent."""
 
     def __init__(self, model: DAEModel, session: Any, rec: Recorder, t0: float, y0: NDArray, yp0: NDArray,
                  t_end: float, eval_times: opts.OutputTimes | None, store_steps: bool, progress: bool) -> None:
@@ -70,12 +64,9 @@ class SegmentLoop:
         # reported points not made consistent yet (IDA's raw values, with each row's switch vector)
         self.raw: list[tuple[NDArray, NDArray, NDArray, NDArray]] = []
         rec.add_steps(np.array([t0]), np.array([0.0]), np.array([0]))
-        self.i_eval = 0  # index of the next output time
-        if eval_times is None:
+        self.i_eval = int(eval_times is not None and eval_times.window(0, 1)[0] == t0)  # the next output time
+        if eval_times is None or self.i_eval:  # the start point is reported
             self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
-        elif eval_times.window(0, 1)[0] == t0:
-            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
-            self.i_eval = 1
         self.events, self.segments = rec.events, rec.segments
         rec.session = session  # the checked channels in the run's library while it is open
         self.t, self.y, self.yp, self.y0 = t0, y, yp, y0
@@ -122,14 +113,10 @@ class SegmentLoop:
     def prepare(self) -> None:
         """Start IDA; let the compiled loop make states consistent and decide simple pairs' switches."""
         model, session = self.model, self.session
-        # the compiled loop makes states consistent itself (restarts after its own switches, the
-        # reported points); the python backend leaves that to the model's Python methods
         self.c_layout = session.set_layout(model.layout(project=model.formulation == "ggl"))
         session.reinit(self.t, self.y, self.yp, self.active, self.params,
                        contact_state.root_directions(model, self.state))
-        # the compiled loop may decide every contact switch itself (simple pairs): the rule and the
-        # starting state of each pair come from its logic object; Python then only records
-        if model.auto_pairs:
+        if model.auto_pairs:  # simple pairs: each one's rule and start state from its logic object
             owners = {root: logic for logic in model.contacts for root in logic.roots}
             columns = list(itertools.accumulate((1 + term.n_params for term in model.terms), initial=0))
             self.auto_info = [(owners[root], root, owners[root].pair_name(root), columns[term], bool(needs))
@@ -237,9 +224,7 @@ class SegmentLoop:
         return times, rows
 
     def take_pair_states(self) -> None:
-        """The run's contact state of the pairs the compiled loop decides: read from the loop, which
-        holds it (no replay of its decisions). The terms the state implies and those the loop set are
-        the same by construction; tests/test_automaton.py checks it after every advance."""
+        """The run's contact state of the pairs the compiled loop decides, read from the loop (no replay)."""
         pairs = self.session.pair_states()
         self.set_state(contact_state.with_pairs(self.model, self.state,
                                                 {root: st for (_, root, *_), st in zip(self.auto_info, pairs)}))
@@ -280,12 +265,8 @@ class SegmentLoop:
         self.flush()
 
     def flush(self) -> None:
-        """Hand the raw points, the events and the segments to the recorder; points for a file are
-        made consistent first (kept in memory, the Result makes them consistent when first read).
-
-        IDA does not converge the multipliers (out of its error test) and its interpolant of them is
-        not controlled: multipliers, accelerations (and the work rate) are recomputed from every
-        point's q and v with that point's contact modes (point by point: chunks change nothing)."""
+        """Hand the raw points, events and segments to the recorder; points for a file are made consistent
+        first (multipliers and accelerations recomputed from q and v: IDA does not converge them)."""
         model, session, raw = self.model, self.session, self.raw
         if self.rec.consistent_when_read:  # as IDA left them, joined once (by the recorder)
             for chunk in raw:
@@ -391,11 +372,9 @@ def _restart_state(model: DAEModel, session: Any, t: float, y: NDArray, yp: NDAr
 
 
 def guarded_root(watched: NDArray | None, found: NDArray) -> bool:
-    """Whether a root was found in the direction its pair watched (``watched``, the root directions
-    before it) and decided nothing: the automaton's same-instant guard. IDA then restarts though
-    nothing switched: going on from a root whose gap is exactly zero, IDA reports "root found at and
-    very near t" (an error) when the gap is still zero a root tolerance later, while a restart masks
-    such a gap until it moves (the compiled loop restarts alike)."""
+    """Whether a root was found in the direction its pair watched (``watched``) and decided nothing: IDA
+    restarts then (as the compiled loop), since going on from a gap exactly zero is IDA's "root found at
+    and very near t" error."""
     if watched is None:
         return False
     found = np.ravel(found)

@@ -1,10 +1,5 @@
-"""Gap crossings inside one step of the non-IDA methods: which steps may hold one, and where it is.
-
-:func:`candidate` decides from the gaps and rates at a step's ends whether a watched gap may have
-crossed zero inside it (the rule of ``candidate()`` in ``csrc/ode_driver.c``); :func:`locate` confirms
-the crossing on the scheme's own state and brackets it to IDA's root tolerance (the method:
-:mod:`daeclear.solvers.explicit`).
-"""
+"""Gap crossings inside one step of the non-IDA methods: :func:`candidate` (the rule of ``candidate()``
+in ``csrc/ode_driver.c``) says which steps may hold one, :func:`locate` confirms and brackets it."""
 
 from __future__ import annotations
 

@@ -1,11 +1,7 @@
-"""Numeric evaluation of a model's ODE for the non-IDA methods: generated C through ctypes, or Python.
-
-:func:`evaluator` gives an :class:`Evaluator` of :func:`~daeclear.solvers.ode_model.ode_spec`: the
-right-hand side, its Jacobian, the gaps and their rates, single steps and the fixed-step loop of
-rk4/euler, output channels and call counters. The compiled one calls the library
-:func:`daeclear.engine.codegen.build_ode_library` builds from ``csrc/ode_driver.c``; the Python one
-(``backend="python"``, or ``"auto"`` without a C compiler) evaluates the same CasADi functions
-through ``casadi.FunctionBuffer`` and numpy.
+"""Numeric evaluation of a model's ODE (:func:`~daeclear.solvers.ode_model.ode_spec`) for the non-IDA
+methods: the library ``csrc/ode_driver.c`` compiled by :func:`daeclear.engine.codegen.build_ode_library`
+through ctypes, or (``backend="python"``, or ``"auto"`` without a C compiler) the same CasADi
+functions through ``casadi.FunctionBuffer`` and numpy.
 """
 
 from __future__ import annotations
@@ -367,10 +363,7 @@ class _PyEvaluator(_Shared):
         return dict(self.cnt)
 
 
-#: Either evaluation: set_terms (the active force terms and their parameters), rhs and jac (dx/dt and
-#: its Jacobian), gaps (gaps and rates, None on failure), step (one fixed step, None on failure), batch
-#: (dx/dt and multipliers at N points), fixed (the fixed-step loop up to t_stop, a full buffer, a
-#: crossing candidate or an error), channels (N points, one switch vector) and counters.
+#: Either evaluation (the same methods; gaps and step return None on failure).
 Evaluator = _CEvaluator | _PyEvaluator
 
 

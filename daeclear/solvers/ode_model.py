@@ -1,10 +1,5 @@
-"""The assembled DAE model as an ODE in ``x = (q, v)``: the symbolic functions of the non-IDA methods.
-
-:func:`ode_spec` turns an index-1 :class:`~daeclear.assembly.assemble.DAEModel` into the
-:class:`~daeclear.engine.codegen.OdeSpec` that :mod:`daeclear.solvers.ode_evaluators` evaluates: the
-accelerations' linear system and its Jacobian, each contact term's force and Jacobian, and the gaps
-with their rates, every number a run-time parameter (built once per structure).
-"""
+"""The assembled index-1 model as an ODE in ``x = (q, v)``: the symbolic functions (an
+:class:`~daeclear.engine.codegen.OdeSpec`, built once per structure) of the non-IDA methods."""
 
 from __future__ import annotations
 
@@ -21,13 +16,8 @@ __all__ = ["ode_spec"]
 
 
 def ode_spec(model: DAEModel) -> OdeSpec:
-    """The model's index-1 equations as an ODE in x = (q, v): the functions the C driver needs.
-
-    Raises SceneError for a GGL model, or when a gap function depends on anything but (t, q).
-    """
-    if model.formulation != "index1":
-        raise SceneError(f"simulate: formulation={model.formulation!r} is integrated by IDA only; the other "
-                         "methods integrate the chapter's index-1 formulation (formulation='index1').")
+    """The model's index-1 equations (checked by the caller) as an ODE in x = (q, v); SceneError when the
+    model has other states (track_work) or a gap function depends on anything but (t, q)."""
     if getattr(model, "track_work", False) or model.n_states != 2 * model.n_q + model.n_constraints:
         raise SceneError(f"simulate: model '{model.scene_name}' has states besides q, v and the multipliers "
                          "(track_work); only method='ida' integrates it.")

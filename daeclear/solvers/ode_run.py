@@ -1,10 +1,5 @@
-"""The record of one non-IDA run: its segments, contact modes, events and failure, and its Result.
-
-A :class:`Run` opens and closes the segments (:class:`Segment`, between two contact events) that the
-loops of :mod:`daeclear.solvers.explicit` step, hands each closed segment's steps and output points to
-the :class:`~daeclear.solvers.recorder.Recorder`, switches modes at an event, words the failure and
-builds the :class:`~daeclear.results.result.Result`; it also holds the table of the methods.
-"""
+"""The record of one non-IDA run (:class:`Run`): its segments, contact modes, events and failure,
+handed to the :class:`~daeclear.solvers.recorder.Recorder`; and the table of the methods."""
 
 from __future__ import annotations
 

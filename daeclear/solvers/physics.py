@@ -1,20 +1,9 @@
 """Physics checks of a finished run: results no real mechanism could produce are warned of.
 
-A run can end with ``success=True`` and still be meaningless (penetration beyond the clearance,
-constraint drift, a contact crossed in one fixed step, a start inside the wall or flying across the
-play). Each finding is a record (a dict, in ``Result.warnings`` and the HDF5 file) with the keys
-
-``kind``      one of :data:`KINDS`
-``quantity``  what was measured, e.g. ``"penetration"``
-``value``     its worst value in the run, in ``unit``
-``limit``     the limit it passed, in ``unit``
-``unit``      e.g. ``"m"``
-``where``     the joint, contact pair or constraint equation
-``t``         when (s)
-``message``   one sentence that says all of this and what to do
-
-and is also issued as a :class:`daeclear.PhysicsWarning` (a :class:`daeclear.DaeclearWarning`).
-docs/reliability.md gives the limits and the numbers measured.
+A run can succeed and still be meaningless (penetration beyond the clearance, constraint drift, a
+contact crossed in one fixed step, a start inside the wall or flying across the play). Each finding
+is a record (:func:`record`; keys and limits: docs/reliability.md, section 4) in ``Result.warnings``
+and the HDF5 file, also issued as a :class:`daeclear.PhysicsWarning`.
 """
 
 from __future__ import annotations
@@ -74,11 +63,6 @@ def issue(records: Sequence[dict[str, Any]], stacklevel: int = 3) -> None:
 def joint_pairs(model: Any, joint: str) -> list[str]:
     """The contact pairs (gap names) of one clearance joint: the joint itself or ``<joint>.<corner>``."""
     return [g for g in model.gap_names if g == joint or g.startswith(joint + ".")]
-
-
-def smallest_clearance(model: Any) -> float:
-    """The smallest clearance of the model's clearance joints (inf without any)."""
-    return min((c for _, c, _ in model.clearance_joints), default=math.inf)
 
 
 def check_run(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels: dict[str, NDArray[np.float64]],
@@ -167,7 +151,7 @@ def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np
     for joint, clearance, corner in model.clearance_joints:
         fraction = GIVEN_PENETRATION_FRACTION if given else START_PENETRATION_FRACTION
         limit = fraction * (min(clearance, corner) if corner > 0 else clearance)
-        basis = "corner radius" if 0 < corner < clearance else "clearance"
+        basis = "the corner radius" if 0 < corner < clearance else "the clearance"
         for pair in joint_pairs(model, joint):
             depth = float(channels.get(f"{pair}.penetration", np.zeros(1))[0])
             if depth > limit:
@@ -175,14 +159,14 @@ def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np
                     raise AssemblyError(
                         f"simulate: y0 puts clearance joint '{joint}' in deep penetration: '{pair}' is {depth:.3g} m "
                         f"inside the wall, {depth / clearance:.0%} of the clearance {clearance:.3g} m (a given state "
-                        f"may penetrate at most {GIVEN_PENETRATION_FRACTION:g} times the {basis}, {limit:.3g} m, "
+                        f"may penetrate at most {GIVEN_PENETRATION_FRACTION:g} times {basis}, {limit:.3g} m, "
                         "deeper than any run reaches); give a state from a run of this model (a row of result.y), "
                         "or pass allow_penetration=True to start there anyway.")
                 raise AssemblyError(
                     f"scene '{model.scene_name}': clearance joint '{joint}' starts in deep penetration: '{pair}' "
                     f"is {depth:.3g} m inside the wall at t=0, {depth / clearance:.0%} of the clearance "
                     f"{clearance:.3g} m (a declared start may penetrate at most {START_PENETRATION_FRACTION:.0%} "
-                    f"of the {basis}, {limit:.3g} m); its first contact force would be an artefact of the declared "
+                    f"of {basis}, {limit:.3g} m); its first contact force would be an artefact of the declared "
                     "positions. Declare the positions with the journal (slider) inside its play, use start='ideal' "
                     "(clearance joints centred), or pass allow_penetration=True to start there anyway.")
 
@@ -226,7 +210,7 @@ def _drift(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels:
     i = _worst_drift_row(drift) if np.isfinite(drift).any() else 0
     worst = float(drift[i])
     stats["max_constraint_drift"] = worst
-    clearance = smallest_clearance(model)
+    clearance = min((c for _, c, _ in model.clearance_joints), default=math.inf)
     if not worst > DRIFT_FRACTION * clearance:
         return []
     where = "constraints"
@@ -286,8 +270,7 @@ def sign_changes(model: Any, T: NDArray[np.float64], X: NDArray[np.float64]) -> 
     N, n_states = T.size, model.n_states
     Y = np.zeros((N, n_states))
     Y[:, :X.shape[1]] = X
-    f = roots if N == 1 else roots.map(N)
-    G = np.array(f(T.reshape(1, -1), Y.T, np.zeros((n_states, N)), model.parameter_values)).reshape(-1, N).T
+    G = np.array(roots.map(N)(T.reshape(1, -1), Y.T, np.zeros((n_states, N)), model.parameter_values)).reshape(-1, N).T
     sure = np.abs(G) > GAP_ROUNDING
     flips = (np.sign(G[1:]) != np.sign(G[:-1])) & sure[1:] & sure[:-1]
     return [(float(T[k]), float(T[k + 1]), model.gap_names[g]) for k, g in zip(*np.nonzero(flips))]

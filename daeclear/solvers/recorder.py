@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import physics
-from .channel_eval import ModelEvaluator, model_evaluator, rebuildable
+from .channel_eval import ModelEvaluator, rebuildable
 from ..errors import OutputError
 from ..results.events import EventRows, flatten
 from ..results.lazy_channels import LazyChannels
@@ -139,7 +139,7 @@ class Recorder:
     def _evaluated(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> dict[str, NDArray]:
         if self.session is not None:
             return self.model.channels(t, y, yp, switch, self.session)
-        out = model_evaluator(self.model, self._backend)(t, y, yp, switch)
+        out = ModelEvaluator(self.model, self._backend).channels(t, y, yp, switch)
         return {name: np.ascontiguousarray(out[name]) for name in self.model.channel_names}
 
     def _joined(self) -> tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray] | None]:

@@ -1,8 +1,4 @@
-"""The methods of :func:`daeclear.simulate`: each name and the solver class that runs it.
-
-``method=`` is one of these names (case-insensitive) or a class implementing
-:class:`daeclear.solvers.base.Solver` (``name``, ``formulation``, ``check``, ``run``).
-"""
+"""The methods of :func:`daeclear.simulate`: each name and the solver class that runs it."""
 
 from __future__ import annotations
 

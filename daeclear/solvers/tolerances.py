@@ -1,13 +1,6 @@
-"""Absolute tolerances per state, from the mechanism's own scales: the rule every method shares.
-
-Each position and velocity state is one of four quantities (a body's ``x``/``y``, ``phi``,
-``vx``/``vy``, ``omega``); its default absolute tolerance is ``rtol`` times a fraction of its scale,
-with ``L`` the mechanism's size and ``W`` its angular rate (:func:`scales`; docs/engine.md,
-"Tolerances"): ``position`` ``rtol * POSITION_FRACTION * L`` or twice the smallest clearance if
-smaller, ``angle`` ``rtol * ANGLE_FRACTION``, ``velocity`` ``rtol * VELOCITY_FRACTION * L * W``,
-``angular_velocity`` ``rtol * VELOCITY_FRACTION * W``. No absolute tolerance is below the round-off
-of its quantity (``ROUNDOFF_FACTOR * eps`` times its scale: GGL's Newton corrections cannot be
-smaller). Multipliers (and the work state of ``track_work``) are always out of the error test.
+"""Absolute tolerances per state from the mechanism's own scales (:func:`scales`): the rule every
+method shares; the formulas and the round-off floor are in docs/engine.md, "Tolerances".
+Multipliers (and the work state of ``track_work``) are always out of the error test.
 """
 
 from __future__ import annotations
@@ -70,12 +63,7 @@ class Scales:
 
 
 def scales(model: DAEModel) -> Scales:
-    """The scales of an assembled mechanism, from its numbers and its declared start.
-
-    L: the largest of the bodies' centres' and joint points' distances and radii of gyration (1 m if
-    all are 0). W: the largest of the start's angular velocities and linear velocities over L, the
-    drivers' speeds, sqrt(|g| / L) and the loads' sqrt(|Q_phi| / I), sqrt(|Q_xy| / (m L)) (1 rad/s).
-    """
+    """The scales L and W of an assembled mechanism, from its numbers and its declared start (docs/engine.md)."""
     n = model.n_q
     q, v = model.q_guess.tolist(), model.v_guess.tolist()
     values, offset, entries = model.parameter_values.tolist(), 0, {}
@@ -113,13 +101,8 @@ def state_quantities(model: DAEModel) -> list[str]:
 
 def tolerance_vector(model: DAEModel, rtol: float, atol: float | Mapping[str, float] | ArrayLike | None,
                      *, newton: bool = True) -> NDArray[np.float64]:
-    """Absolute tolerances per state from ``atol``; multipliers and work always out of the error test.
-
-    ``atol``: None (the defaults of :class:`Scales`), one number, a mapping by quantity (the others
-    default), or ``2 n_q`` values (positions, then velocities) or ``n_states``. Given values below
-    the round-off of their quantity (``newton``: IDA's) are raised to it with a warning.
-    """
-
+    """Absolute tolerances per state from ``atol`` (None: :class:`Scales`' defaults, a number, a mapping
+    by quantity, ``2 n_q`` or ``n_states`` values); given values below round-off are raised, with a warning."""
     n = 2 * model.n_q
     vec = np.empty(model.n_states)
     quantities = state_quantities(model)
@@ -128,15 +111,11 @@ def tolerance_vector(model: DAEModel, rtol: float, atol: float | Mapping[str, fl
     if atol is None or isinstance(atol, Mapping):  # a mapping: the quantities it does not name keep their defaults
         given = defaults if atol is None else {**defaults, **atol_by_quantity(atol, where="simulate", field="atol")}
         vec[:n] = [given[k] for k in quantities]
-    elif np.ndim(atol) == 0:
-        value = float(atol)  # type: ignore[arg-type]
-        if not math.isfinite(value) or value <= 0:
-            fail("simulate", "atol", atol, "a finite number > 0")
-        vec[:n] = value
+    elif np.ndim(atol) == 0:  # values checked by options.atol (SolverOptions)
+        vec[:n] = float(atol)  # type: ignore[arg-type]
     else:
         given_vec = np.asarray(atol, dtype=float)  # checked by options.atol but for its length
-        if given_vec.shape not in ((n,), (model.n_states,)) or not np.all(np.isfinite(given_vec)) \
-                or np.any(given_vec[:n] <= 0):
+        if given_vec.shape not in ((n,), (model.n_states,)):
             fail("simulate", "atol", atol, f"a finite number > 0, a mapping by quantity, or {n} values > 0 "
                  f"(positions and velocities: {', '.join(model.state_names[:3])}, ...) or {model.n_states} "
                  "(one per state)", shown=f"array of shape {given_vec.shape}")
@@ -154,8 +133,7 @@ def _raise_to_roundoff(vec: NDArray[np.float64], quantities: list[str], floor: d
     raised = {}
     for i, quantity in enumerate(quantities):
         if vec[i] < floor[quantity]:
-            raised[quantity] = floor[quantity]
-            vec[i] = floor[quantity]
+            raised[quantity] = vec[i] = floor[quantity]
     if raised:
         parts = ", ".join(f"{q} to {v:.2g} {UNITS[q]}" for q, v in raised.items())
         warnings.warn(f"simulate: atol below round-off raised ({parts}): Newton's corrections cannot be "
