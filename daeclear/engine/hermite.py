@@ -1,8 +1,5 @@
-"""Cubic Hermite interpolation: the one interpolant between two states with known time derivatives.
-
-Used for output times between steps wherever the integrator gives no dense output of its own: the
-python IDA session (:mod:`daeclear.engine.python_session`) and the fixed-step schemes of
-:mod:`daeclear.solvers.explicit`. A module of its own because both use it and neither owns it.
+"""Cubic Hermite interpolation between two states with known time derivatives: output times between
+steps where the integrator has no dense output (the python IDA session, :mod:`daeclear.solvers.explicit`).
 """
 
 from __future__ import annotations
