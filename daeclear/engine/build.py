@@ -1,10 +1,7 @@
 """Compiling generated C into a cached shared library: the C compiler, the cache directory and key,
-the per-key file lock, and the in-process memos. Knows nothing of CasADi or SUNDIALS.
-
-The key is the SHA-256 of the generated source, the driver sources, the compiler command and version
-and whatever the caller adds; the directory is ``$DAECLEAR_CACHE_DIR`` or ``~/.cache/daeclear``. A
-build compiles in a private temporary directory and moves the result into place with ``os.replace``
-under a per-key file lock: concurrent processes neither corrupt nor duplicate each other's work.
+the per-key file lock, and the in-process memos. The key: the SHA-256 of the generated source, the
+driver sources, the compiler command and version and what the caller adds. A build compiles in a
+temporary directory and moves the result into place under the key's file lock (safe across processes).
 """
 
 from __future__ import annotations
@@ -46,8 +43,7 @@ _LOCAL_INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.MULTILINE)
 
 
 def driver_files(driver: str) -> tuple[Path, ...]:
-    """``csrc/<driver>`` and every file of ``csrc/`` it includes (``#include "..."``, also through
-    another one), sorted: what the cache key of a library built with that driver hashes."""
+    """``csrc/<driver>`` and every ``csrc/`` file it includes, also indirectly, sorted (for the cache key)."""
     seen: dict[str, Path] = {}
     todo = [driver]
     while todo:
@@ -93,6 +89,7 @@ def _compiler_version(exe: str) -> str:
 
 
 def cache_dir() -> Path:
+    """``$DAECLEAR_CACHE_DIR``, else ``~/.cache/daeclear``."""
     d = os.environ.get("DAECLEAR_CACHE_DIR")
     return Path(d).expanduser() if d else Path.home() / ".cache" / "daeclear"
 
@@ -164,9 +161,8 @@ def _intact(library: Path, digest: Path) -> bool:
 
 def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text: str, flags: list[str],
                    link: list[str], extra_key: list[str], t0: float) -> BuildResult:
-    """Compile ``source`` with the driver ``csrc/<driver>`` into a cached shared library (see the module
-    docstring). Its SHA-256 is kept beside it and checked before a cached library is used: a damaged
-    file is built again, never loaded. ``t0``: when code generation started (``codegen_time``).
+    """Compile ``source`` with ``csrc/<driver>`` into a cached shared library, whose SHA-256 is checked
+    before it is used (a damaged one is built again). ``t0``: when code generation started.
     """
     cc = compiler_command()
     version = _compiler_version(cc[0])
@@ -207,10 +203,7 @@ def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text
                 if len(msg) > 4000:
                     msg = msg[:2000] + "\n...\n" + msg[-2000:]
                 raise CompileError(f"compiling {what} failed (exit {proc.returncode}):\n$ {shlex.join(cmd)}\n{msg}")
-            # keep the generated source next to the library, for debugging
-            src_tmp = tmpd / "src.c"
-            src_tmp.write_text(source)
-            os.replace(src_tmp, root / f"{stem}.c")
+            os.replace(tmpd / "model.c", root / f"{stem}.c")  # the source beside the library, for debugging
             digest_tmp = tmpd / "lib.sha256"
             digest_tmp.write_text(_sha256(out))
             os.replace(digest_tmp, digest)  # the digest first: a library is never there without it

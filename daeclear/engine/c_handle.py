@@ -45,8 +45,7 @@ class Handle:
         self.lib, self.h = lib, h
         weakref.finalize(self, lib.dc_free, h)
         self.jac_nnz = int(lib.dc_jac_nnz(h))
-        # rows of the step buffers: buffer_steps with the steps' states, TIMES_ROWS_PER_STATE_ROW
-        # times as many for times alone (20 bytes a row: a long run comes back in few pieces)
+        # rows of the step buffers: buffer_steps with states, TIMES_ROWS_PER_STATE_ROW times as many without
         self.cap = buffer_steps
         cap = self.cap_times = buffer_steps * TIMES_ROWS_PER_STATE_ROW
         self.st = np.empty(cap)

@@ -1,23 +1,17 @@
 """The integrator backend: SUNDIALS IDA on a CasADi model, restartable between events.
 
 ``open_session(funcs, ...)`` returns a :class:`Session` that integrates ``F(t, y, y') = 0`` with IDA in
-one-step mode and stops at roots of the model's root functions, at a hard stop time or at an error. The
-event logic above it switches the model's *terms* (contact forces) between segments with
-:meth:`Session.reinit`; an inactive term is never evaluated.
+one-step mode and stops at roots of the root functions, at a stop time or at an error; the event logic
+above it switches the model's *terms* (contact forces) between segments with :meth:`Session.reinit`.
+Backends: ``"c"`` (:mod:`daeclear.engine.c_session`), ``"python"`` (:mod:`daeclear.engine.python_session`:
+``t_eval`` values by cubic Hermite, statistics it lacks and step orders ``-1``, a non-finite residual
+ends the advance with ``IDA_RES_FAIL`` at once) and ``"auto"`` (``"c"`` when a C compiler works, else
+``"python"`` with one :class:`DaeclearWarning`). A stale compiled library is built again, never run.
 
-Backends: ``"c"`` (:mod:`daeclear.engine.c_session`: generated C, a hand-written IDA driver and the
-wheel's SUNDIALS, driven through ctypes a few calls per segment), ``"python"``
-(:mod:`daeclear.engine.python_session`: scikit-sundae's ``IDA`` with FunctionBuffer callbacks; its
-``t_eval`` values are cubic Hermite interpolants, statistics it lacks and step orders are ``-1``, and a
-non-finite residual ends the advance with ``IDA_RES_FAIL`` at once) and ``"auto"`` (``"c"`` when a C
-compiler works, else ``"python"`` with one :class:`DaeclearWarning`). A stale compiled library (other
-SUNDIALS version or index size, :mod:`daeclear.engine.library`) is deleted and built again, never run.
-
-At a restart (SUNDIALS 7.9, tests/test_ida_session.py): IDA returns a root at the end of the final
-bracket, on the far side of the crossing, so restarting there does not report it again. A root
-function exactly ``0`` at ``t0`` is inactive until it moves away from zero. One tiny but still on the
-*near* side at ``t0`` and heading for zero is reported again within a few ulps: restart from the state
-IDA returned (or mask the direction with ``root_directions``).
+At a restart (SUNDIALS 7.9, tests/test_ida_session.py): IDA returns a root on the far side of the
+crossing, so restarting there does not report it again; a root function exactly ``0`` at ``t0`` is
+inactive until it moves away from zero; one tiny but still on the *near* side and heading for zero is
+reported again within a few ulps (restart from IDA's state, or mask it with ``root_directions``).
 """
 
 from __future__ import annotations
@@ -69,15 +63,14 @@ def _file_id(path: Path) -> tuple[int, int] | None:
 
 
 def _remove_if_unchanged(path: Path, seen: tuple[int, int] | None) -> None:
-    """Delete a rejected cache entry, unless another process has replaced it meanwhile (by a
-    good build: deleting that would only make it build once more)."""
+    """Delete a rejected cache entry, unless another process has replaced it meanwhile."""
     if seen is not None and _file_id(path) == seen:
         path.unlink(missing_ok=True)
 
 
 def _load_library(funcs: DAEFunctions, model: NormalizedModel) -> tuple[ModelLibrary, BuildResult]:
-    """Build (or find in the cache) the model's library and load it. A damaged or stale cache entry
-    is deleted and built once more, never run; SundialsMismatch if even the fresh build is stale."""
+    """Build (or find in the cache) and load the model's library; a damaged or stale one is built again,
+    never run (SundialsMismatch if even the fresh build is stale)."""
     build = build_model_library(funcs, model=model)
     seen = _file_id(build.path)
     try:

@@ -1,11 +1,9 @@
 """Loading compiled libraries: the one place that opens a built shared library with ctypes.
 
-It declares the library's functions from a prototype table, checks that the library was built for
-this daeclear's driver ABI and, for an IDA model library (:class:`ModelLibrary`, ``csrc/ida_driver.c``),
-for the SUNDIALS it runs with: its build tag, read before loading, against
-:func:`daeclear.engine.sundials.sundials_info`, then ``dc_build_info`` and ``SUNDIALSGetVersion``.
-One that must not run is unloaded (:class:`StaleLibrary`). :class:`OdeLibrary` is the ODE evaluator
-(``csrc/ode_driver.c``) of :mod:`daeclear.solvers.explicit`. Each library is opened once per process.
+Declares the functions from a prototype table and checks the driver ABI and, for an IDA model library
+(:class:`ModelLibrary`), the SUNDIALS build (the file's build tag before loading, then ``dc_build_info``
+and ``SUNDIALSGetVersion``); one that must not run is unloaded (:class:`StaleLibrary`).
+:class:`OdeLibrary`: the ODE evaluator of :mod:`daeclear.solvers.explicit`.
 """
 
 from __future__ import annotations
@@ -125,8 +123,7 @@ def _version_prefix(text: str) -> str:
 
 
 def _staleness(built: SundialsInfo, current: SundialsInfo) -> str | None:
-    """Why a library built for the SUNDIALS ``built`` must not run with the wheel's SUNDIALS
-    ``current``; None if it may."""
+    """Why a library built for the SUNDIALS ``built`` must not run with ``current``; None if it may."""
     if (built.version, built.index_size) != (current.version, current.index_size):
         return (f"built for SUNDIALS {built.version} with {built.index_size}-bit indices, but the wheel has "
                 f"SUNDIALS {current.version} with {current.index_size}-bit indices")
@@ -137,9 +134,8 @@ def _staleness(built: SundialsInfo, current: SundialsInfo) -> str | None:
 
 
 def _check_loaded(lib: ctypes.CDLL, tagged: SundialsInfo) -> tuple[SundialsInfo, str, str | None]:
-    """(build info, SUNDIALSGetVersion, problem or None) of a loaded library: dc_build_info must say
-    what the file's tag said, and the SUNDIALS it resolved (LD_LIBRARY_PATH may find another) must
-    be the version it was built for."""
+    """(build info, SUNDIALSGetVersion, problem or None): dc_build_info must be the tag's, and the SUNDIALS
+    it resolved (LD_LIBRARY_PATH may find another) the version it was built for."""
     buf = ctypes.create_string_buffer(64)
     lib.dc_sundials_version(buf, 64)
     loaded = buf.value.decode()

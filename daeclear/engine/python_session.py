@@ -1,6 +1,5 @@
-"""The python IDA session: scikit-sundae's ``IDA`` with callbacks that evaluate the model's CasADi
-functions through ``casadi.FunctionBuffer``; the fallback when no C compiler works (and
-``backend="python"``). Its differences from the compiled session: :mod:`daeclear.engine.ida_session`.
+"""The python IDA session: scikit-sundae's ``IDA`` with ``casadi.FunctionBuffer`` callbacks, the fallback
+when no C compiler works; its differences from the compiled session: :mod:`daeclear.engine.ida_session`.
 """
 
 from __future__ import annotations
@@ -247,8 +246,7 @@ class PythonSession(SessionBase):
             return solver.step(t_stop, method="normal", tstop=None), True
 
     def _take_return(self, r: Any, fl: int, interpolated: bool) -> tuple[int, bool, float]:
-        """Move the session to IDA's returned point: (flag, whether a new internal step was taken,
-        that step's size or nan)."""
+        """Move to IDA's returned point: (flag, whether a new internal step was taken, its size or nan)."""
         t_new = float(r.t)
         new_step, h = False, float("nan")
         if interpolated:  # no step taken; IDA still holds tn for the next call
@@ -329,8 +327,7 @@ class _Outcome:
 
 
 class _Rows:
-    """The points one advance of the python session reports: the output times it reaches (cubic
-    Hermite between two IDA returns) and the returns themselves (its steps)."""
+    """What one advance of the python session reports: output times (cubic Hermite) and IDA's returns."""
 
     def __init__(self, te: np.ndarray, n: int, t_start: float) -> None:
         self.te, self.n = te, n

@@ -1,7 +1,5 @@
 """What both IDA session backends share: the DAE (:class:`DAEFunctions`), what an advance returns
-(:class:`Advance`), the :class:`Session` protocol, the options' validation and :class:`SessionBase`.
-Nothing here depends on a backend.
-"""
+(:class:`Advance`), the :class:`Session` protocol, the options' validation and :class:`SessionBase`."""
 
 from __future__ import annotations
 
@@ -29,7 +27,6 @@ __all__ = ["DAEFunctions", "AutoEvents", "StateLayout", "Advance", "Session", "S
 FLAG_MAX_STEPS = -1001
 #: flag of an Advance that stopped because the step size collapsed (daeclear.engine.stall_guard)
 FLAG_STEP_COLLAPSE = -1002
-
 #: names of the flags that daeclear sets itself (not IDA)
 OWN_FLAG_NAMES = {FLAG_MAX_STEPS: "DC_MAX_STEPS", FLAG_STEP_COLLAPSE: "DC_STEP_COLLAPSE"}
 
@@ -65,9 +62,8 @@ class DAEFunctions:
 
 @dataclass(frozen=True)
 class AutoEvents:
-    """The contact switches the compiled loop decided in one advance, a row each in time order.
-    ``pair``: index in :meth:`CSession.set_auto_events`' order; ``info``: kind, contact, held, watch;
-    ``rate``: penetration rate; ``latched``: latched approach speed after it; ``y``: the state."""
+    """The contact switches the C loop decided in one advance, in time order: ``pair`` (index in
+    set_auto_events), ``info`` (kind, contact, held, watch), ``rate``, ``latched`` speed after it, ``y``."""
 
     t: np.ndarray
     pair: np.ndarray
@@ -115,12 +111,9 @@ class StateLayout:
 
 @dataclass
 class Advance:
-    """What one :meth:`Session.advance` call did.
-
-    ``step_*``: every point where IDA returned in one-step mode (each internal step's end, and a
-    root point), times increasing, the start excluded; ``step_h`` the internal step's size,
-    ``step_order`` its BDF order (-1: python backend). ``eval_*``: the ``t_eval`` points in (t_start, t].
-    """
+    """What one :meth:`Session.advance` call did: ``step_*`` every point where IDA returned in one-step
+    mode (each internal step's end, and a root), times increasing, the start excluded (``step_order``
+    -1: python backend); ``eval_*`` the ``t_eval`` points in (t_start, t]."""
 
     status: str  # "tstop" | "root" | "error" | "interrupted" (Ctrl-C between chunks: the steps so far)
     t: float
@@ -155,9 +148,8 @@ class Session(Protocol):
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
                 store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
                 chunked: bool = False) -> Advance:
-        """Integrate towards ``t_stop``; ``store_steps``: keep each step's time, size and order, with
-        ``store_states`` also y and yp. ``chunked``: return (status ``"chunk"``) when the step buffer
-        or the ``t_eval`` rows are full, for the caller to empty them and call again."""
+        """Integrate towards ``t_stop``, keeping the steps (``store_steps``) and their states (``store_states``);
+        ``chunked``: return (status ``"chunk"``) when the step buffer or the ``t_eval`` rows are full."""
         ...
 
     def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
@@ -191,14 +183,14 @@ class SessionOptions:
     linear_solver: str = "auto"  # one of LINEAR_SOLVERS, as requested
 
 
-def _root_dirs(model: NormalizedModel, rd: Any, what: str = "root_directions") -> np.ndarray:
+def _root_dirs(model: NormalizedModel, rd: Any) -> np.ndarray:
     if rd is None:
         return np.zeros(model.n_roots, dtype=np.int32)
     arr = np.asarray(rd)
     if arr.shape != (model.n_roots,):
-        raise ValueError(f"{what} must have shape ({model.n_roots},), got {arr.shape}")
+        raise ValueError(f"root_directions must have shape ({model.n_roots},), got {arr.shape}")
     if not all(d in (-1, 0, 1) for d in arr.tolist()):
-        raise ValueError(f"{what} values must be -1, 0 or +1, got {arr.tolist()}")
+        raise ValueError(f"root_directions values must be -1, 0 or +1, got {arr.tolist()}")
     return np.ascontiguousarray(arr, dtype=np.int32)
 
 
@@ -236,8 +228,7 @@ def check_options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, m
                           _root_dirs(model, root_directions), int(buffer_steps), P, linear_solver.lower())
 
 
-# dc_advance's store_steps flags (daeclear.engine.abi)
-STORE_TIMES, STORE_STATES = DC_STORE_TIMES, DC_STORE_STATES
+STORE_TIMES, STORE_STATES = DC_STORE_TIMES, DC_STORE_STATES  # dc_advance's store_steps flags
 
 
 class _NoRows(dict):
@@ -319,8 +310,7 @@ class SessionBase:
         return False
 
     def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
-        """``DAEFunctions.extras[k]`` at ``n_points`` points, the parameters appended: each input has
-        shape (n_points, size) or (size,) (every point); returns (n_points, n_out)."""
+        """``DAEFunctions.extras[k]`` at ``n_points`` points, (n_points, n_out); inputs (n_points, size) or (size,)."""
         f = self._model.extras[k]
         inputs = [*inputs, self._opts.parameters]
         cols = [np.zeros((0, n_points)) if f.numel_in(j) == 0 else
@@ -382,8 +372,7 @@ class SessionBase:
 
     @property
     def eval_from(self) -> float:
-        """Output times after this one are still to come: the current time, or the last output row's
-        time when a chunked advance filled its rows inside a step."""
+        """Output times after this are still to come: the current time, or the last filled output row's."""
         after = getattr(self, "_eval_after", None)
         return self._t if after is None else after
 

@@ -61,9 +61,8 @@ def sundials_libraries() -> tuple[Path, dict[str, Path]]:
 
 @dataclass(frozen=True)
 class SundialsInfo:
-    """What the compiled driver depends on in the wheel's SUNDIALS build: ``version``
-    (major.minor.patch), ``index_size`` (bits of ``sunindextype``: 32 or 64), ``has_sparse`` (the
-    sparse matrix and SuperLU_MT libraries are there)."""
+    """What the driver depends on in the wheel's SUNDIALS: ``version`` (major.minor.patch), ``index_size``
+    (bits of ``sunindextype``), ``has_sparse`` (the sparse matrix and SuperLU_MT libraries are there)."""
 
     version: str
     index_size: int
@@ -214,13 +213,9 @@ def read_build_tag(path: Path) -> tuple[int, SundialsInfo] | None:
 
 @functools.lru_cache(maxsize=1)
 def sundials_info() -> SundialsInfo:
-    """Detect the SUNDIALS version and index size of the wheel's libraries (once per process).
-
-    Version: the core library's file name (``.so.7.9.0``) and its ``SUNDIALSGetVersionNumber``,
-    which must agree. Index size: ``sksundae/c_config.pxi``, cross-checked by :func:`_probe_index_size`
-    (alone when the file says nothing). Anything unknown or contradictory raises CompilerUnavailable
-    (SundialsMismatch): the compiled backend is not built on a guess.
-    """
+    """The SUNDIALS version (the core library's file name and ``SUNDIALSGetVersionNumber``) and index
+    size (``sksundae/c_config.pxi`` and :func:`_probe_index_size`) of the wheel, once per process; either
+    unknown or contradictory raises CompilerUnavailable (SundialsMismatch), never a guess."""
     _, libs = sundials_libraries()
     core = libs["sundials_core"]
     named, reported = _version_from_name(core), _version_from_library(core)
