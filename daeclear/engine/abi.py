@@ -1,14 +1,8 @@
 """The numbers the compiled drivers and Python share, in one table: return codes, option codes,
-flags, slots of the arrays a driver fills, decision kinds.
+flags, slots of the arrays a driver fills, decision kinds (those of :mod:`daeclear.assembly.automaton`).
 
-Each constant is defined once here. :func:`header_text` writes them as the C header
-``csrc/dc_abi.h`` that both drivers include; Python imports them by name from this module. The
-header is generated and checked in (``python -m daeclear.engine.abi`` writes it again):
-it is compiled like every other file of ``csrc/`` (in the libraries' cache key, readable beside
-the drivers), and ``tests/test_abi.py`` regenerates it and fails when the file differs.
-
-The decision kinds are those of :mod:`daeclear.assembly.automaton` (the pure automaton the C
-loop mirrors), taken from it, not copied.
+:func:`header_text` writes them as ``csrc/dc_abi.h``, generated and checked in
+(``python -m daeclear.engine.abi`` writes it again; ``tests/test_abi.py`` fails when it differs).
 
 >>> DC_ROOT, FX_CANDIDATE, STAT_KEYS[DC_ST_REINITS]
 (2, 2, 'n_reinits')
@@ -16,7 +10,6 @@ loop mirrors), taken from it, not copied.
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Final
 
 from ..assembly import automaton
@@ -206,11 +199,6 @@ def header_text() -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_header(path: Path = HEADER) -> Path:
-    """Write :func:`header_text` to ``path`` (the checked-in header by default)."""
-    path.write_text(header_text())
-    return path
-
-
 if __name__ == "__main__":  # pragma: no cover - the maintainer's regeneration step
-    print(write_header())
+    HEADER.write_text(header_text())
+    print(HEADER)

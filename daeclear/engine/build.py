@@ -1,17 +1,7 @@
-"""Compiling generated C into a cached shared library: the C compiler, the cache directory, the
-cache key, the per-key file lock, and the in-process memos.
-
-:func:`compile_cached` is used for both kinds of library (the IDA model libraries and the ODE
-evaluator libraries, :mod:`daeclear.engine.codegen`); it knows nothing of CasADi or SUNDIALS, which is why
-it is separate from code generation (:mod:`daeclear.engine.codegen`) and from the SUNDIALS checks
-(:mod:`daeclear.engine.sundials`).
-
-Libraries are cached: the key is the SHA-256 of the generated source, the driver sources, the
-compiler command (with its flags) and version, and whatever else the caller names (SUNDIALS version
-and index size, library paths). The cache directory is ``$DAECLEAR_CACHE_DIR`` or
-``~/.cache/daeclear``. A build compiles into a private temporary directory and moves the result
-into place with ``os.replace`` under a per-key file lock, so concurrent processes building the same
-model neither corrupt nor duplicate each other's work.
+"""Compiling generated C into a cached shared library: the C compiler, the cache directory and key,
+the per-key file lock, and the in-process memos. The key: the SHA-256 of the generated source, the
+driver sources, the compiler command and version and what the caller adds. A build compiles in a
+temporary directory and moves the result into place under the key's file lock (safe across processes).
 """
 
 from __future__ import annotations
@@ -34,19 +24,8 @@ from collections.abc import Iterator
 
 from ..errors import DaeclearError
 
-__all__ = [
-    "CSRC",
-    "CompilerUnavailable",
-    "CompileError",
-    "BuildResult",
-    "compiler_command",
-    "cache_dir",
-    "compile_cached",
-    "driver_files",
-    "MemoTable",
-    "memo_table",
-    "clear_memos",
-]
+__all__ = ["CSRC", "CompilerUnavailable", "CompileError", "BuildResult", "compiler_command", "cache_dir",
+           "compile_cached", "driver_files", "MemoTable", "memo_table", "clear_memos"]
 
 #: The hand-written C drivers and the vendored SUNDIALS headers (on the include path of every build).
 CSRC = Path(__file__).resolve().parent / "csrc"
@@ -64,9 +43,7 @@ _LOCAL_INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.MULTILINE)
 
 
 def driver_files(driver: str) -> tuple[Path, ...]:
-    """``csrc/<driver>`` and every file of ``csrc/`` it includes with ``#include "..."``, directly
-    or through another one, in a fixed order: what the cache key of a library built with that
-    driver hashes (a new part or header is in it once it is included)."""
+    """``csrc/<driver>`` and every ``csrc/`` file it includes, also indirectly, sorted (for the cache key)."""
     seen: dict[str, Path] = {}
     todo = [driver]
     while todo:
@@ -77,9 +54,6 @@ def driver_files(driver: str) -> tuple[Path, ...]:
         seen[name] = path
         todo += [inc for inc in _LOCAL_INCLUDE.findall(path.read_text()) if (CSRC / inc).is_file()]
     return tuple(seen[name] for name in sorted(seen))
-
-
-# --------------------------------------------------------------------------- toolchain
 
 
 def compiler_command() -> list[str]:
@@ -101,9 +75,7 @@ def compiler_command() -> list[str]:
         exe = shutil.which(parts[0])
         if exe is not None:
             return [exe, *parts[1:]]
-        tried.append(f"{parts[0]!r} ({origin})")
-        if origin == "$CC":
-            break  # an explicit $CC is not second-guessed
+        tried.append(f"{parts[0]!r} ({origin})")  # an explicit $CC is the only candidate
     raise CompilerUnavailable(f"no C compiler found: tried {', '.join(tried)}")
 
 
@@ -115,12 +87,11 @@ def _compiler_version(exe: str) -> str:
     except (OSError, subprocess.SubprocessError) as exc:
         raise CompilerUnavailable(f"C compiler {exe!r} does not run: {exc}") from exc
 
+
 def cache_dir() -> Path:
+    """``$DAECLEAR_CACHE_DIR``, else ``~/.cache/daeclear``."""
     d = os.environ.get("DAECLEAR_CACHE_DIR")
     return Path(d).expanduser() if d else Path.home() / ".cache" / "daeclear"
-
-
-# --------------------------------------------------------------------------- build
 
 
 @dataclass(frozen=True)
@@ -147,33 +118,27 @@ def _file_lock(path: Path) -> Iterator[None]:
             fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
 
 
-# --------------------------------------------------------------------------- in-process memos
-
-
 MemoTable = dict[Any, Any]
 _MEMO_TABLES: list[MemoTable] = []
 
 
 def memo_table() -> MemoTable:
-    """A new in-process memo (by any key);
-    :func:`clear_memos` empties them all."""
+    """A new in-process memo (by any key); :func:`clear_memos` empties them all."""
     table: MemoTable = {}
     _MEMO_TABLES.append(table)
     return table
 
 
 def clear_memos() -> None:
-    """Forget every structure of this process, and with it (``DAEFunctions.compiled``) its normalised
-    model, generated specs and loaded libraries, for the models assembled from now on (the disk cache
-    stays): the next run generates and loads again, e.g. after changing ``$CC``."""
+    """Forget every structure of this process (and with ``DAEFunctions.compiled`` what was made of it):
+    the next run generates and loads again, e.g. after changing ``$CC``; the disk cache stays."""
     for table in _MEMO_TABLES:
         table.clear()
 
 
 def memo_put_bounded(table: MemoTable, key: Any, value: Any, limit: int) -> None:
-    """``table[key] = value``, the oldest entries dropped first while the table holds ``limit``
-    (a long sweep of new numbers keeps its memos bounded). Safe when another thread changes the
-    table meanwhile: an eviction that loses that race is skipped."""
+    """``table[key] = value``, the oldest entries dropped while the table holds ``limit``; an eviction
+    that loses a race with another thread is skipped."""
     while len(table) >= limit:
         try:
             table.pop(next(iter(table)), None)
@@ -182,16 +147,12 @@ def memo_put_bounded(table: MemoTable, key: Any, value: Any, limit: int) -> None
     table[key] = value
 
 
-# --------------------------------------------------------------------------- cached build
-
-
 def _sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 def _intact(library: Path, digest: Path) -> bool:
-    """The cached library exists and is byte for byte the one that was built (a truncated or
-    damaged file would crash the interpreter when loaded)."""
+    """The cached library is byte for byte the one built (a damaged one would crash when loaded)."""
     try:
         return library.is_file() and digest.read_text().strip() == _sha256(library)
     except OSError:
@@ -200,14 +161,8 @@ def _intact(library: Path, digest: Path) -> bool:
 
 def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text: str, flags: list[str],
                    link: list[str], extra_key: list[str], t0: float) -> BuildResult:
-    """Compile ``source`` with the driver ``csrc/<driver>`` into a cached shared library.
-
-    The cache key hashes the generated source, the driver sources, the compiler command and
-    version and ``extra_key``; the library is built in a temporary directory under a file lock
-    and moved into place atomically, so concurrent processes never see a half-written file. Its
-    SHA-256 is kept beside it (``<stem>.sha256``) and checked before a cached library is used: a
-    truncated or damaged file is built again, never loaded.
-    ``t0`` is when code generation started (reported as ``codegen_time``).
+    """Compile ``source`` with ``csrc/<driver>`` into a cached shared library, whose SHA-256 is checked
+    before it is used (a damaged one is built again). ``t0``: when code generation started.
     """
     cc = compiler_command()
     version = _compiler_version(cc[0])
@@ -236,10 +191,9 @@ def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text
         t1 = time.perf_counter()
         with tempfile.TemporaryDirectory(prefix=f"{stem}-", dir=root) as tmp:
             tmpd = Path(tmp)
-            model_c = tmpd / "model.c"
-            model_c.write_text(source)
+            (tmpd / "model.c").write_text(source)
             out = tmpd / "lib.so"
-            cmd = [*cc, *flags, str(model_c), str(CSRC / driver), "-o", str(out), *link]
+            cmd = [*cc, *flags, str(tmpd / "model.c"), str(CSRC / driver), "-o", str(out), *link]
             try:
                 proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
             except (OSError, subprocess.SubprocessError) as exc:
@@ -249,10 +203,7 @@ def compile_cached(prefix: str, what: str, source: str, driver: str, driver_text
                 if len(msg) > 4000:
                     msg = msg[:2000] + "\n...\n" + msg[-2000:]
                 raise CompileError(f"compiling {what} failed (exit {proc.returncode}):\n$ {shlex.join(cmd)}\n{msg}")
-            # keep the generated source next to the library, for debugging
-            src_tmp = tmpd / "src.c"
-            src_tmp.write_text(source)
-            os.replace(src_tmp, root / f"{stem}.c")
+            os.replace(tmpd / "model.c", root / f"{stem}.c")  # the source beside the library, for debugging
             digest_tmp = tmpd / "lib.sha256"
             digest_tmp.write_text(_sha256(out))
             os.replace(digest_tmp, digest)  # the digest first: a library is never there without it

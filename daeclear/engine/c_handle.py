@@ -1,9 +1,7 @@
-"""One compiled C session (``dc_open``) with the buffers its loop fills, and the pool that hands it on.
-
-dc_open and dc_free cost more than the Python around a short run, so a closed
-:class:`daeclear.engine.c_session.CSession` leaves its :class:`Handle` in a small pool and the next
-session of the same library and settings takes it, re-armed by ``dc_reset`` (a reset session runs
-step for step as a new one). Also here: the arrays' addresses that the ctypes calls pass.
+"""One compiled C session (``dc_open``) with the buffers its loop fills, and the pool that hands it on:
+a closed :class:`daeclear.engine.c_session.CSession` leaves its :class:`Handle` to the next session of
+the same library and settings, re-armed by ``dc_reset`` (step for step as a new one; dc_open and
+dc_free cost more than the Python around a short run).
 """
 
 from __future__ import annotations
@@ -20,20 +18,12 @@ from .build import memo_put_bounded, memo_table
 from .session_base import SessionOptions
 
 log = logging.getLogger("daeclear")
-
-
-
-def _free_c_session(lib: Any, handle: int) -> None:
-    lib.dc_free(handle)
-
-
 _char_at = ctypes.c_char.from_buffer
 
 
 def address(a: np.ndarray) -> int:
-    """The address of a contiguous array's data. Through a ctypes view of its buffer: a quarter of the
-    cost of ``a.ctypes.data``, which makes a numpy helper object at every call (a run makes tens of
-    these calls); a read-only array takes ``a.ctypes.data``."""
+    """The address of a contiguous array's data (a ctypes view of its buffer costs a quarter of
+    ``a.ctypes.data``, which a read-only array takes)."""
     try:
         return ctypes.addressof(_char_at(a))  # type: ignore[arg-type]  # an ndarray is a buffer
     except (TypeError, ValueError, BufferError):
@@ -49,22 +39,17 @@ TIMES_ROWS_PER_STATE_ROW = 16
 
 
 class Handle:
-    """One C session (dc_open) and the buffers the loop fills: what depends on the library, its
-    linear solver, max_order and buffer_steps alone (see the module docstring). Freed when collected."""
+    """One C session (dc_open) and the buffers its loop fills; freed when collected."""
 
     def __init__(self, lib: Any, h: int, n: int, nr: int, nt: int, n_params: int, buffer_steps: int) -> None:
         self.lib, self.h = lib, h
-        weakref.finalize(self, _free_c_session, lib, h)
+        weakref.finalize(self, lib.dc_free, h)
         self.jac_nnz = int(lib.dc_jac_nnz(h))
-        # rows of the step buffers: buffer_steps with the steps' states, TIMES_ROWS_PER_STATE_ROW
-        # times as many for times alone (20 bytes a row: a run of tens of thousands of steps with
-        # output times comes back in one piece, not in a piece per 4096 steps, each made consistent
-        # and checked apart)
+        # rows of the step buffers: buffer_steps with states, TIMES_ROWS_PER_STATE_ROW times as many without
         self.cap = buffer_steps
         cap = self.cap_times = buffer_steps * TIMES_ROWS_PER_STATE_ROW
-        # persistent buffers (addresses cached: ctypes calls stay cheap)
         self.st = np.empty(cap)
-        # the steps' states (1 MB each at n = 32): made at the first advance that stores them
+        # the steps' states: made at the first advance that stores them
         self.sy: np.ndarray | None = None
         self.syp: np.ndarray | None = None
         self.sh = np.empty(cap)
@@ -83,14 +68,12 @@ class Handle:
         self.actb = np.zeros(max(nt, 1), dtype=np.int32)
         self.rdb = np.zeros(max(nr, 1), dtype=np.int32)
         self.pcat = np.zeros(max(n_params, 1))
-        # the buffers of the switches the C loop decided (set_auto_events) and their addresses
+        # set_auto_events' buffers and addresses; the switch vector's columns of the terms' flags and
+        # parameters (active_switch); the latest pairs' rules ((pairs, storms), arrays, addresses)
         self.auto_buf: tuple[tuple[np.ndarray, ...], tuple[int, ...]] | None = None
-        # the switch vector's columns of the terms' flags and of their parameters (active_switch)
         self.switch_columns: tuple[np.ndarray, np.ndarray] | None = None
-        # the pairs' rules of the latest set_auto_events: (pairs, storms), their arrays and addresses
         self.auto_rules: tuple[Any, list[np.ndarray], list[int]] | None = None
-        # per extra: its input and output sizes (asked of CasADi once per library, not per session) and
-        # the ctypes arrays of its call (eval_extra)
+        # per extra: its input and output sizes and the ctypes arrays of its call (eval_extra)
         self.extra_meta: dict[int, tuple[Any, ...]] = {}
         self.addr = dict(
             st=self.st.ctypes.data, sy=None, syp=None,
@@ -127,8 +110,7 @@ def take_pooled(key: tuple[int, str, int, int], opts: SessionOptions) -> Handle 
 
 def put_pooled(key: tuple[int, str, int, int], hd: Handle) -> None:
     """Keep a closed session's handle for the next session (or drop it: freed when collected),
-    without the steps' state buffers (2 x buffer_steps x n values: the next run that stores
-    states makes its own), so that the pool holds little more than IDA's memory."""
+    without the steps' state buffers (the pool holds little more than IDA's memory)."""
     hd.sy = hd.syp = hd.addr["sy"] = hd.addr["syp"] = None
     handles = _POOL.get(key)
     if handles is None:

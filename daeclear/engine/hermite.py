@@ -1,8 +1,5 @@
-"""Cubic Hermite interpolation: the one interpolant between two states with known time derivatives.
-
-Used for output times between steps wherever the integrator gives no dense output of its own: the
-python IDA session (:mod:`daeclear.engine.python_session`) and the fixed-step schemes of
-:mod:`daeclear.solvers.explicit`. A module of its own because both use it and neither owns it.
+"""Cubic Hermite interpolation between two states with known time derivatives: output times between
+steps where the integrator has no dense output (the python IDA session, :mod:`daeclear.solvers.explicit`).
 """
 
 from __future__ import annotations
@@ -27,13 +24,9 @@ def cubic_hermite(t0: ArrayLike, y0: NDArray, yp0: NDArray, t1: ArrayLike, y1: N
 
 def cubic_hermite(t0: ArrayLike, y0: NDArray, yp0: NDArray, t1: ArrayLike, y1: NDArray, yp1: NDArray,
                   t: NDArray, *, derivative: bool = False) -> NDArray | tuple[NDArray, NDArray]:
-    """The cubic that has the values ``y0``, ``y1`` and the derivatives ``yp0``, ``yp1`` at ``t0``,
-    ``t1``, evaluated at the times ``t`` (1-D, m points): an (m, n) array of values, with
-    ``derivative=True`` also its time derivative (a cubic is reproduced exactly).
-
-    One interval for all points (``t0``, ``t1`` scalars, ``y0`` ... of shape (n,)) or one per point
-    (``t0``, ``t1`` of shape (m,), ``y0`` ... of shape (m, n)). The points need not lie inside
-    their interval (then it extrapolates).
+    """The cubic with values ``y0``, ``y1`` and derivatives ``yp0``, ``yp1`` at ``t0``, ``t1``, at the
+    times ``t`` (m points): an (m, n) array, with ``derivative=True`` also its time derivative. One
+    interval for all points (scalar ``t0``, ``t1``; ``y0`` ... (n,)) or one per point ((m,) and (m, n)).
     """
     dt = np.asarray(t1, dtype=float) - t0
     u = ((t - t0) / dt)[..., None]

@@ -1,55 +1,17 @@
 """The integrator backend: SUNDIALS IDA on a CasADi model, restartable between events.
 
-``open_session(funcs, ...)`` returns a :class:`Session` that integrates ``F(t, y, y') = 0`` with
-IDA in one-step mode and stops at roots of the model's root functions, at a hard stop time, or
-at an error. The event logic above it switches the model's *terms* (contact-force
-contributions) on and off between segments with :meth:`Session.reinit`; an inactive term is
-never evaluated.
+``open_session(funcs, ...)`` returns a :class:`Session` that integrates ``F(t, y, y') = 0`` with IDA in
+one-step mode and stops at roots of the root functions, at a stop time or at an error; the event logic
+above it switches the model's *terms* (contact forces) between segments with :meth:`Session.reinit`.
+Backends: ``"c"`` (:mod:`daeclear.engine.c_session`), ``"python"`` (:mod:`daeclear.engine.python_session`:
+``t_eval`` values by cubic Hermite, statistics it lacks and step orders ``-1``, a non-finite residual
+ends the advance with ``IDA_RES_FAIL`` at once) and ``"auto"`` (``"c"`` when a C compiler works, else
+``"python"`` with one :class:`DaeclearWarning`). A stale compiled library is built again, never run.
 
-Two backends share one interface:
-
-``"c"`` (:mod:`daeclear.engine.c_session`)
-    The model is generated as C with CasADi, compiled with a hand-written IDA driver
-    (``csrc/ida_driver.c``) into a shared library linked against the SUNDIALS libraries of the
-    scikit-sundae wheel (see :mod:`daeclear.engine.codegen`), and driven through ctypes a few calls per
-    segment. No Python runs per step or per model evaluation.
-``"python"`` (:mod:`daeclear.engine.python_session`)
-    scikit-sundae's ``IDA`` with callbacks that evaluate the CasADi functions through
-    ``casadi.FunctionBuffer``. Differences: ``t_eval`` values are cubic Hermite interpolants
-    between stored steps (IDA's own interpolant is not exposed by scikit-sundae; the two
-    differ by far less than the integration error), statistics that scikit-sundae does not
-    expose are ``-1``, step orders are ``-1``, and a non-finite residual ends the advance with
-    ``IDA_RES_FAIL`` at once (the C backend lets IDA retry with smaller steps first).
-``"auto"``
-    ``"c"`` when a C compiler works, else ``"python"`` with one :class:`DaeclearWarning` naming
-    the reason.
-
-Linear solver of the compiled backend (``linear_solver``): IDA's Newton iteration solves with
-the iteration matrix dF/dy + cj dF/dy' by dense LU of the reduced system (``"reduced"``: the
-position rows q' - v (+ Phi_q^T mu) eliminated, csrc/dc_reduced_ls.h), by dense LU of the whole
-matrix (``"dense"``, SUNDIALS' own) or by sparse LU (``"sparse"``: SuperLU_MT, one thread, on a
-SUNSparseMatrix whose pattern is the union of the base and all term Jacobians' patterns).
-``"auto"`` picks sparse from ``SPARSE_MIN_STATES`` states on (measured,
-``benchmarks/bench_linear_solver.py``), reduced below. The python backend is always dense.
-
-A compiled library is used only if it was built for the SUNDIALS version and index size that
-the wheel has now (its build tag, read from the file before loading, against
-:func:`daeclear.engine.sundials.sundials_info`) and that the loaded SUNDIALS reports (``dc_build_info``
-and ``SUNDIALSGetVersion``; :mod:`daeclear.engine.library`); a stale one is deleted and built again,
-never run.
-
-Behaviour at a restart (measured with SUNDIALS 7.9, see tests/test_ida_session.py): IDA
-returns a root at the end of the final bracket, so the state at a root already lies on the
-far side of the crossing (``g`` has changed sign, ``|g|`` tiny). Restarting there does not
-report the same crossing again. A root function exactly ``0`` at the restart point is made
-inactive until it moves away from zero, so no root is reported at ``t0``. A root function
-that is tiny but still on the *near* side at ``t0`` and heading for zero is reported again
-within a few ulps of ``t0``: restart from the state IDA returned (or mask the direction with
-``root_directions``).
-
-This module is the entry point, :func:`open_session`, which picks the backend; the session types
-are in :mod:`daeclear.engine.session_base`, and every public name of those modules that was defined
-here before is still importable from here.
+At a restart (SUNDIALS 7.9, tests/test_ida_session.py): IDA returns a root on the far side of the
+crossing, so restarting there does not report it again; a root function exactly ``0`` at ``t0`` is
+inactive until it moves away from zero; one tiny but still on the *near* side and heading for zero is
+reported again within a few ulps (restart from IDA's state, or mask it with ``root_directions``).
 """
 
 from __future__ import annotations
@@ -67,47 +29,17 @@ from .c_session import SPARSE_MIN_STATES, CSession
 from .codegen import NormalizedModel, build_model_library, normalize_model
 from .library import ModelLibrary, StaleLibrary
 from .python_session import PythonSession
-from .session_base import (
-    FLAG_MAX_STEPS,
-    FLAG_STEP_COLLAPSE,
-    STORE_STATES,
-    STORE_TIMES,
-    TINY_STEP_COUNT,
-    TINY_STEP_GROWTH,
-    TINY_STEP_REL,
-    Advance,
-    AutoEvents,
-    DAEFunctions,
-    Session,
-    StateLayout,
-    check_options,
-)
+from .session_base import (FLAG_MAX_STEPS, FLAG_STEP_COLLAPSE, STORE_STATES, STORE_TIMES, Advance, AutoEvents,
+                           DAEFunctions, Session, StateLayout, check_options)
+from .stall_guard import TINY_STEP_COUNT, TINY_STEP_GROWTH, TINY_STEP_REL
 from .sundials import SundialsMismatch
 
-__all__ = [
-    "DAEFunctions",
-    "Advance",
-    "Session",
-    "open_session",
-    "BACKENDS",
-    "LINEAR_SOLVERS",
-    "SPARSE_MIN_STATES",
-    "StaleLibrary",
-    "FLAG_MAX_STEPS",
-    "FLAG_STEP_COLLAPSE",
-    # defined in session_base, c_session and python_session now, still importable from here
-    "AutoEvents",
-    "StateLayout",
-    "CSession",
-    "PythonSession",
-    "TINY_STEP_REL",
-    "TINY_STEP_COUNT",
-    "TINY_STEP_GROWTH",
-    "STORE_TIMES",
-    "STORE_STATES",
-]
+__all__ = ["DAEFunctions", "Advance", "Session", "open_session", "BACKENDS", "LINEAR_SOLVERS", "SPARSE_MIN_STATES",
+           "StaleLibrary", "FLAG_MAX_STEPS", "FLAG_STEP_COLLAPSE", "AutoEvents", "StateLayout", "CSession",
+           "PythonSession", "TINY_STEP_REL", "TINY_STEP_COUNT", "TINY_STEP_GROWTH", "STORE_TIMES", "STORE_STATES"]
 
 log = logging.getLogger("daeclear")
+
 
 def _warn_fallback(reason: str) -> None:
     """Name the fallback to the python backend, once per reason in a process."""
@@ -131,16 +63,14 @@ def _file_id(path: Path) -> tuple[int, int] | None:
 
 
 def _remove_if_unchanged(path: Path, seen: tuple[int, int] | None) -> None:
-    """Delete a rejected cache entry, unless another process has replaced it meanwhile (by a
-    good build: deleting that would only make it build once more)."""
+    """Delete a rejected cache entry, unless another process has replaced it meanwhile."""
     if seen is not None and _file_id(path) == seen:
         path.unlink(missing_ok=True)
 
 
 def _load_library(funcs: DAEFunctions, model: NormalizedModel) -> tuple[ModelLibrary, BuildResult]:
-    """Build (or find in the cache) the model's library and load it. A damaged cache entry, or
-    a stale one (other driver ABI, SUNDIALS version or index size), is deleted and built once
-    more, never run; SundialsMismatch if even the fresh build does not fit the loaded SUNDIALS."""
+    """Build (or find in the cache) and load the model's library; a damaged or stale one is built again,
+    never run (SundialsMismatch if even the fresh build is stale)."""
     build = build_model_library(funcs, model=model)
     seen = _file_id(build.path)
     try:
@@ -162,19 +92,15 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
                  max_step: float = 0.0, max_order: int = 5, max_steps: int = 5_000_000,
                  root_directions: np.ndarray | None = None, buffer_steps: int = 4096,
                  parameters: np.ndarray | None = None, linear_solver: str = "auto") -> Session:
-    """Open an IDA session on a model; see the module docstring.
+    """Open an IDA session on a model (see the module docstring); call reinit() before the first advance().
 
-    backend: "auto" (compiled if a C compiler works, else python with one DaeclearWarning),
-    "c" (DaeclearError if it cannot be built) or "python"; case-insensitive.
+    backend: "auto", "c" (DaeclearError if it cannot be built) or "python"; case-insensitive.
     atol: per-variable absolute tolerances (a scalar is broadcast). max_step 0: unbounded.
-    max_steps: cap on the IDA steps of the whole session (all segments). root_directions:
-    default directions (-1, 0, +1 per root function; reinit may override them per segment).
-    buffer_steps: rows of the step buffers the C loop fills before returning to Python.
-    parameters: the run-time parameters P of the model (``funcs.n_parameters`` values).
-    linear_solver: "auto" (sparse from SPARSE_MIN_STATES states on, reduced below), "reduced", "dense"
-    or "sparse" (SuperLU_MT on the union of the Jacobians' patterns); case-insensitive. Compiled backend
-    only: the python backend always uses scikit-sundae's dense solver.
-    Call reinit() before the first advance().
+    max_steps: cap on the IDA steps of the whole session. root_directions: default directions
+    (-1, 0, +1 per root function; reinit may override them). buffer_steps: rows of the step buffers
+    the C loop fills before returning. parameters: the model's run-time parameters P.
+    linear_solver: "auto", "reduced", "dense" or "sparse" (:mod:`daeclear.engine.c_session`; the python
+    backend is always dense); case-insensitive.
     """
     if not isinstance(backend, str) or backend.lower() not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}: valid backends are {', '.join(map(repr, BACKENDS))}")
@@ -187,12 +113,12 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
     if b == "python":
         return PythonSession(model, opts)
     try:
-        loaded = funcs.compiled.get("loaded")  # (library, its BuildResult as a cache hit)
+        loaded = funcs.compiled.get("loaded")
         if loaded is None:
             clib, build = _load_library(funcs, model)
             funcs.compiled["loaded"] = (clib, dataclasses.replace(build, cache_hit=True, compile_time=0.0,
                                                                   codegen_time=0.0))
-        else:  # loaded before in this process: no file checks (the loaded library stays valid)
+        else:  # loaded before in this process: no file checks
             clib, build = loaded
         return CSession(model, opts, clib, build)
     except (CompilerUnavailable, CompileError, OSError) as exc:

@@ -1,22 +1,9 @@
 """Loading compiled libraries: the one place that opens a built shared library with ctypes.
 
-It declares the library's functions from a prototype table, checks that the library was built for
-this daeclear's driver interface (ABI version) and, for the IDA model libraries, for the SUNDIALS
-it runs with, and unloads one that must not run (:class:`StaleLibrary`). Every library is opened
-once per process and path (:meth:`LoadedLibrary.load`).
-
-Two kinds of library are loaded, both built by :mod:`daeclear.engine.codegen`:
-
-* :class:`ModelLibrary`: an IDA model (``csrc/ida_driver.c``, symbols ``dc_*``), driven by
-  :class:`daeclear.engine.c_session.CSession`;
-* :class:`OdeLibrary`: the ODE evaluator of the scipy and fixed-step integrators
-  (``csrc/ode_driver.c``, symbols ``dco_*``), driven by :mod:`daeclear.solvers.explicit`.
-
-Separate from generating and compiling the C (codegen, build): loading decides whether a file
-may run in this process at all. A model library is used only if it was built for the SUNDIALS
-version and index size that the wheel has now (its build tag, read from the file before loading,
-against :func:`daeclear.engine.sundials.sundials_info`) and that the loaded SUNDIALS reports
-(``dc_build_info`` and ``SUNDIALSGetVersion``).
+Declares the functions from a prototype table and checks the driver ABI and, for an IDA model library
+(:class:`ModelLibrary`), the SUNDIALS build (the file's build tag before loading, then ``dc_build_info``
+and ``SUNDIALSGetVersion``); one that must not run is unloaded (:class:`StaleLibrary`).
+:class:`OdeLibrary`: the ODE evaluator of :mod:`daeclear.solvers.explicit`.
 """
 
 from __future__ import annotations
@@ -32,21 +19,11 @@ from .abi import DC_BI_INDEX_BITS, DC_BI_INDEX_SIZE, DC_BI_MAJOR, DC_BI_MINOR, D
 from ..errors import DaeclearError
 from .sundials import SundialsInfo
 
-__all__ = [
-    "DRIVER_ABI",
-    "ODE_DRIVER_ABI",
-    "Prototypes",
-    "StaleLibrary",
-    "open_library",
-    "unload",
-    "LoadedLibrary",
-    "ModelLibrary",
-    "OdeLibrary",
-]
+__all__ = ["DRIVER_ABI", "ODE_DRIVER_ABI", "Prototypes", "StaleLibrary", "open_library", "unload", "LoadedLibrary",
+           "ModelLibrary", "OdeLibrary"]
 
 #: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
-#: and checked when a library is loaded: bump it when a dc_* signature or what a dc_* call writes changes
-#: (7: dc_report writes the channels one row per channel).
+#: and checked when a library is loaded: bump it when a dc_* signature or what a dc_* call writes changes.
 DRIVER_ABI = 7
 #: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
 ODE_DRIVER_ABI = 3
@@ -121,8 +98,7 @@ ODE_PROTOTYPES: Prototypes = {
 
 
 class StaleLibrary(DaeclearError):
-    """A cached compiled library was built for another driver ABI, SUNDIALS version or index size
-    than the wheel's now (or than the SUNDIALS it loads): it must not run."""
+    """A cached library was built for another driver ABI or SUNDIALS build than this one: it must not run."""
 
 
 def open_library(path: Path, prototypes: Prototypes) -> ctypes.CDLL:
@@ -135,8 +111,7 @@ def open_library(path: Path, prototypes: Prototypes) -> ctypes.CDLL:
 
 
 def unload(lib: ctypes.CDLL) -> None:
-    """dlclose a library that must not be used, so that one rebuilt at the same path is really
-    loaded (dlopen of a path that is still open returns the old library)."""
+    """dlclose a library that must not be used (dlopen of a path still open returns the old library)."""
     import _ctypes
 
     _ctypes.dlclose(lib._handle)
@@ -148,8 +123,7 @@ def _version_prefix(text: str) -> str:
 
 
 def _staleness(built: SundialsInfo, current: SundialsInfo) -> str | None:
-    """Why a library built for the SUNDIALS ``built`` must not run with the wheel's SUNDIALS
-    ``current``; None if it may."""
+    """Why a library built for the SUNDIALS ``built`` must not run with ``current``; None if it may."""
     if (built.version, built.index_size) != (current.version, current.index_size):
         return (f"built for SUNDIALS {built.version} with {built.index_size}-bit indices, but the wheel has "
                 f"SUNDIALS {current.version} with {current.index_size}-bit indices")
@@ -160,10 +134,8 @@ def _staleness(built: SundialsInfo, current: SundialsInfo) -> str | None:
 
 
 def _check_loaded(lib: ctypes.CDLL, tagged: SundialsInfo) -> tuple[SundialsInfo, str, str | None]:
-    """(build info, SUNDIALSGetVersion, problem or None) of a loaded library: dc_build_info must
-    say what the file's tag said, and the SUNDIALS it resolved must be the version it was built
-    for (another libsundials found first, e.g. through LD_LIBRARY_PATH, would be a silent ABI
-    mismatch)."""
+    """(build info, SUNDIALSGetVersion, problem or None): dc_build_info must be the tag's, and the SUNDIALS
+    it resolved (LD_LIBRARY_PATH may find another) the version it was built for."""
     buf = ctypes.create_string_buffer(64)
     lib.dc_sundials_version(buf, 64)
     loaded = buf.value.decode()
@@ -181,8 +153,7 @@ def _check_loaded(lib: ctypes.CDLL, tagged: SundialsInfo) -> tuple[SundialsInfo,
 
 
 class LoadedLibrary:
-    """ctypes view of one compiled library (``lib``, its functions declared from ``PROTOTYPES``),
-    opened once per process and path by :meth:`load` and shared by everything that uses it."""
+    """ctypes view (``lib``) of one compiled library, opened once per process and path by :meth:`load`."""
 
     PROTOTYPES: ClassVar[Prototypes] = {}
     _cache: ClassVar[dict[str, Any]] = {}
@@ -205,14 +176,9 @@ class LoadedLibrary:
 
 
 class ModelLibrary(LoadedLibrary):
-    """ctypes view of one compiled IDA model library (shared by all its sessions).
-
-    Before loading, the build tag in the file must name this daeclear's driver ABI and the
-    wheel's SUNDIALS version, index size and sparse libraries (:func:`_staleness`); once loaded,
-    ``dc_build_info`` must agree and the SUNDIALS it resolved must report that version
-    (:func:`_check_loaded`), else it is unloaded before any call into SUNDIALS. A mismatch
-    raises StaleLibrary.
-    """
+    """ctypes view of one compiled IDA model library (shared by all its sessions); StaleLibrary when
+    its build tag (:func:`_staleness`) or, once loaded, its build info (:func:`_check_loaded`) does
+    not fit, then unloaded before any call into SUNDIALS."""
 
     PROTOTYPES = MODEL_PROTOTYPES
 
@@ -228,18 +194,16 @@ class ModelLibrary(LoadedLibrary):
             raise StaleLibrary(f"{path}: {why}")
         super().__init__(path)
         lib = self.lib
-        if lib.dc_abi_version() != DRIVER_ABI:
-            abi = lib.dc_abi_version()
+        abi = lib.dc_abi_version()
+        if abi != DRIVER_ABI:
             unload(lib)
             raise StaleLibrary(f"{path}: driver ABI version {abi} != {DRIVER_ABI} (build tag said {DRIVER_ABI})")
         info, loaded, why = _check_loaded(lib, tagged)
         if why is not None:
             unload(lib)
             raise StaleLibrary(f"{path}: {why}")
-        #: what the library was compiled for (the -D flags checked against csrc/sundials' config)
-        self.build_info: SundialsInfo = info
-        #: SUNDIALSGetVersion of the SUNDIALS libraries this library loaded
-        self.sundials_version = loaded
+        self.build_info: SundialsInfo = info  # what it was compiled for
+        self.sundials_version = loaded  # SUNDIALSGetVersion of the SUNDIALS it loaded
 
     def model_info(self, n_terms: int) -> tuple[int, int, int, list[int]]:
         """(n, terms, roots, parameters per term) of the compiled model."""

@@ -1,10 +1,5 @@
-"""The python IDA session: scikit-sundae's ``IDA`` with callbacks that evaluate the model's CasADi
-functions through ``casadi.FunctionBuffer``.
-
-The fallback when no C compiler works (and ``backend="python"``). Same interface as the compiled
-session (:class:`daeclear.engine.session_base.Session`); the differences are listed in
-:mod:`daeclear.engine.ida_session`. Separate from :mod:`daeclear.engine.c_session` because the two
-share the interface only: one drives C through ctypes, this one drives scikit-sundae from Python.
+"""The python IDA session: scikit-sundae's ``IDA`` with ``casadi.FunctionBuffer`` callbacks, the fallback
+when no C compiler works; its differences from the compiled session: :mod:`daeclear.engine.ida_session`.
 """
 
 from __future__ import annotations
@@ -20,16 +15,9 @@ import casadi
 import numpy as np
 
 from ..errors import DaeclearError
-from .codegen import NormalizedModel
+from .codegen import NormalizedModel, densified
 from .hermite import cubic_hermite
-from .session_base import (
-    FLAG_MAX_STEPS,
-    FLAG_STEP_COLLAPSE,
-    OWN_FLAG_NAMES,
-    Advance,
-    SessionBase,
-    SessionOptions,
-)
+from .session_base import FLAG_MAX_STEPS, FLAG_STEP_COLLAPSE, OWN_FLAG_NAMES, Advance, SessionBase, SessionOptions
 
 __all__ = ["PythonSession"]
 
@@ -59,7 +47,6 @@ class PythonSession(SessionBase):
     def __init__(self, model: NormalizedModel, opts: SessionOptions, fallback_reason: str | None = None) -> None:
         super().__init__(model, opts)
         import sksundae  # noqa: F401  (fail early if missing)
-
         n = model.n
         self.fallback_reason = fallback_reason
         # shared input arrays: every function reads t, y, yp, cj from the same memory
@@ -71,9 +58,9 @@ class PythonSession(SessionBase):
         P = opts.parameters
         base = [self._a_t, self._a_y, self._a_yp]
         self._res = _Buffered(model.res, base + [P])
-        self._jac = _Buffered(model.dense(model.jac), base + [self._a_cj, P])
-        self._tres = [_Buffered(model.dense(f), base + [p, P]) for f, p in zip(model.term_res, self._a_p)]
-        self._tjac = [_Buffered(model.dense(f), base + [p, self._a_cj, P]) for f, p in zip(model.term_jac, self._a_p)]
+        self._jac = _Buffered(densified(model.jac), base + [self._a_cj, P])
+        self._tres = [_Buffered(densified(f), base + [p, P]) for f, p in zip(model.term_res, self._a_p)]
+        self._tjac = [_Buffered(densified(f), base + [p, self._a_cj, P]) for f, p in zip(model.term_jac, self._a_p)]
         self._roots_fn = _Buffered(model.roots, base + [P]) if model.roots is not None else None
         self._active_idx: list[int] = []
         self._solver: Any = None
@@ -82,38 +69,34 @@ class PythonSession(SessionBase):
         self._pending_tn = False
         self._t_internal = 0.0
 
-    # ---------------------------------------------------------------- evaluation
-    def _eval_res(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+    def _at(self, t: float, y: np.ndarray, yp: np.ndarray) -> None:
+        """Set the point every function reads."""
         self._a_t[0] = t
         self._a_y[:] = y
         self._a_yp[:] = yp
-        self._res.call()
-        r = self._res.out
+
+    def _with_terms(self, base: _Buffered, terms: list[_Buffered]) -> np.ndarray:
+        """``base``'s output plus the active terms' (a copy only when a term is active)."""
+        base.call()
+        out = base.out
         if self._active_idx:
-            r = r.copy()
+            out = out.copy()
             for k in self._active_idx:
-                self._tres[k].call()
-                r += self._tres[k].out
-        return r
+                terms[k].call()
+                out += terms[k].out
+        return out
+
+    def _eval_res(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        self._at(t, y, yp)
+        return self._with_terms(self._res, self._tres)
 
     def _eval_jac(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray:
-        self._a_t[0] = t
-        self._a_y[:] = y
-        self._a_yp[:] = yp
+        self._at(t, y, yp)
         self._a_cj[0] = cj
-        self._jac.call()
-        J = self._jac.out
-        if self._active_idx:
-            J = J.copy()
-            for k in self._active_idx:
-                self._tjac[k].call()
-                J += self._tjac[k].out
-        return J.reshape(self._n, self._n, order="F")
+        return self._with_terms(self._jac, self._tjac).reshape(self._n, self._n, order="F")
 
     def _eval_roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
-        self._a_t[0] = t
-        self._a_y[:] = y
-        self._a_yp[:] = yp
+        self._at(t, y, yp)
         roots = self._roots_fn
         if roots is None:  # the events callback exists only when the model has root functions
             raise _ModelError("the model has no root functions")
@@ -161,7 +144,6 @@ class PythonSession(SessionBase):
             self._events = events
         return IDA(resfn, **options)
 
-    # ---------------------------------------------------------------- core
     def reinit(self, t0: float, y0: np.ndarray, yp0: np.ndarray, active: Sequence[bool],
                params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None:
         t0, y0, yp0, act, plist, rd = self._check_reinit(t0, y0, yp0, active, params, root_directions)
@@ -173,10 +155,7 @@ class PythonSession(SessionBase):
             self._solver_dirs = rd.copy()
         try:
             self._solver.init_step(t0, y0, yp0)
-        except _ModelError as exc:
-            self._ready = False
-            raise DaeclearError(f"IDA reinit failed: {exc}") from exc
-        except RuntimeError as exc:
+        except (_ModelError, RuntimeError) as exc:
             self._ready = False
             raise DaeclearError(f"IDA reinit failed: {exc}") from exc
         self._count["reinits"] += 1
@@ -187,8 +166,6 @@ class PythonSession(SessionBase):
         self._ready = True
 
     def _apply_terms(self, act: np.ndarray, plist: list[np.ndarray]) -> None:
-        self._active = act
-        self._params = plist
         for k, p in enumerate(plist):
             self._a_p[k][:] = p
         self._active_idx = [k for k in range(self._nt) if act[k]]
@@ -258,9 +235,8 @@ class PythonSession(SessionBase):
         solver = self._solver
         if not self._pending_tn:
             return solver.step(t_stop, method="onestep", tstop=t_stop), False
-        # after a root return IDA's internal time tn is beyond self._t; a t_stop inside
-        # (self._t, tn) makes IDASetStopTime fail (scikit-sundae prints that error): then
-        # IDA_NORMAL mode interpolates, as in C
+        # after a root return IDA's tn is beyond self._t; a t_stop inside (self._t, tn) makes
+        # IDASetStopTime fail (scikit-sundae prints it): then IDA_NORMAL mode interpolates, as in C
         try:
             with contextlib.redirect_stdout(io.StringIO()):
                 return solver.step(t_stop, method="onestep", tstop=t_stop), False
@@ -270,8 +246,7 @@ class PythonSession(SessionBase):
             return solver.step(t_stop, method="normal", tstop=None), True
 
     def _take_return(self, r: Any, fl: int, interpolated: bool) -> tuple[int, bool, float]:
-        """Move the session to IDA's returned point: (flag, whether a new internal step was taken,
-        that step's size or nan)."""
+        """Move to IDA's returned point: (flag, whether a new internal step was taken, its size or nan)."""
         t_new = float(r.t)
         new_step, h = False, float("nan")
         if interpolated:  # no step taken; IDA still holds tn for the next call
@@ -312,23 +287,11 @@ class PythonSession(SessionBase):
 
     def stats(self) -> dict[str, int | float | str]:
         c = self._count
-        return {
-            "n_steps": c["steps"],
-            "n_res_evals": c["res"],
-            "n_jac_evals": c["jac"],
-            "n_lin_setups": -1,
-            "n_nonlin_iters": -1,
-            "n_nonlin_conv_fails": -1,
-            "n_err_test_fails": -1,
-            "n_root_evals": c["roots"],
-            "n_reinits": c["reinits"],
-            "solve_time": self._solve_time,
-            "compile_time": 0.0,
-            "codegen_time": 0.0,
-            "cache_hit": False,
-            "linear_solver": "dense",
-            "jac_nnz": self._n * self._n,
-        }
+        unknown = dict.fromkeys(("n_lin_setups", "n_nonlin_iters", "n_nonlin_conv_fails", "n_err_test_fails"), -1)
+        return {"n_steps": c["steps"], "n_res_evals": c["res"], "n_jac_evals": c["jac"], **unknown,
+                "n_root_evals": c["roots"], "n_reinits": c["reinits"], "solve_time": self._solve_time,
+                "compile_time": 0.0, "codegen_time": 0.0, "cache_hit": False, "linear_solver": "dense",
+                "jac_nnz": self._n * self._n}
 
     @property
     def linear_solver(self) -> str:
@@ -364,8 +327,7 @@ class _Outcome:
 
 
 class _Rows:
-    """The points one advance of the python session reports: the output times it reaches (cubic
-    Hermite between two IDA returns) and the returns themselves (its steps)."""
+    """What one advance of the python session reports: output times (cubic Hermite) and IDA's returns."""
 
     def __init__(self, te: np.ndarray, n: int, t_start: float) -> None:
         self.te, self.n = te, n

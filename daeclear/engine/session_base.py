@@ -1,11 +1,5 @@
-"""What both IDA session backends share: the DAE they integrate (:class:`DAEFunctions`), what an
-advance returns (:class:`Advance`), the :class:`Session` protocol, the validation of the session
-options, and :class:`SessionBase`, the common base class of the compiled and the python session.
-
-Separate from the backends (:mod:`daeclear.engine.c_session`, :mod:`daeclear.engine.python_session`)
-and from :func:`daeclear.engine.ida_session.open_session`, which chooses between them: both backends
-and the callers above them depend on these types, and nothing here depends on a backend.
-"""
+"""What both IDA session backends share: the DAE (:class:`DAEFunctions`), what an advance returns
+(:class:`Advance`), the :class:`Session` protocol, the options' validation and :class:`SessionBase`."""
 
 from __future__ import annotations
 
@@ -23,34 +17,16 @@ from ..errors import DaeclearError
 from ..options import LINEAR_SOLVERS
 from .abi import DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND, DC_EV_WATCH, DC_STORE_STATES, DC_STORE_TIMES
 from .codegen import NormalizedModel
-from .stall_guard import TINY_STEP_COUNT, TINY_STEP_GROWTH, TINY_STEP_REL, StallGuard
+from .stall_guard import StallGuard
 
-__all__ = [
-    "DAEFunctions",
-    "AutoEvents",
-    "StateLayout",
-    "Advance",
-    "Session",
-    "SessionOptions",
-    "check_options",
-    "SessionBase",
-    "FLAG_MAX_STEPS",
-    "FLAG_STEP_COLLAPSE",
-    "OWN_FLAG_NAMES",
-    "TINY_STEP_REL",
-    "TINY_STEP_COUNT",
-    "TINY_STEP_GROWTH",
-    "STORE_TIMES",
-    "STORE_STATES",
-    "NO_ROWS",
-    "empty_advance_arrays",
-]
+__all__ = ["DAEFunctions", "AutoEvents", "StateLayout", "Advance", "Session", "SessionOptions", "check_options",
+           "SessionBase", "FLAG_MAX_STEPS", "FLAG_STEP_COLLAPSE", "OWN_FLAG_NAMES", "STORE_TIMES", "STORE_STATES",
+           "NO_ROWS", "empty_advance_arrays"]
 
 #: flag of an Advance that stopped because the session's step cap (max_steps) was reached
 FLAG_MAX_STEPS = -1001
 #: flag of an Advance that stopped because the step size collapsed (daeclear.engine.stall_guard)
 FLAG_STEP_COLLAPSE = -1002
-
 #: names of the flags that daeclear sets itself (not IDA)
 OWN_FLAG_NAMES = {FLAG_MAX_STEPS: "DC_MAX_STEPS", FLAG_STEP_COLLAPSE: "DC_STEP_COLLAPSE"}
 
@@ -64,12 +40,10 @@ class DAEFunctions:
     term_residuals[k]: (t, y, yp, p_k[n_params_k], P) -> r_k[n], added to r while term k is active.
     term_jacobians[k]: (t, y, yp, p_k, cj, P) -> J_k[n x n], added to J while term k is active.
     roots: (t, y, yp, P) -> g[n_roots], or None when the model has no events.
-    extras[k]: any functions with vector inputs, P last, and one output, compiled into the same
-    library and evaluated over many points at once by :meth:`Session.eval_extra` (post-processing:
-    output channels, consistent restarts); never called by IDA.
-
-    ``P`` holds the ``n_parameters`` run-time parameters (the values are given to
-    :func:`open_session`); with ``n_parameters == 0`` the functions may leave it out.
+    extras[k]: functions with vector inputs, P last, and one output, evaluated over many points by
+    :meth:`Session.eval_extra` (output channels, consistent restarts); never called by IDA.
+    ``P``: the ``n_parameters`` run-time parameters (values given to :func:`open_session`); with
+    ``n_parameters == 0`` the functions may leave it out.
     """
 
     n: int
@@ -81,19 +55,15 @@ class DAEFunctions:
     name: str = "model"
     extras: tuple[casadi.Function, ...] = ()
     n_parameters: int = 0
-    # what this process made of these functions, once, by kind ("normalized", "built", "loaded",
-    # "ode_spec", "ode_library"): owned here, so the models of one structure (which share these
-    # functions) share it, and it goes when the functions go
+    # what this process made of these functions, by kind ("normalized", "built", "loaded", "ode_spec",
+    # "ode_library"): shared by the models of one structure, gone with the functions
     compiled: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
 class AutoEvents:
-    """The contact switches the compiled loop decided itself in one advance, in time order, one
-    row each (columns, not objects: a run records dozens per revolution). ``pair``: index in the
-    order given to :meth:`CSession.set_auto_events`; ``info``: the decision's kind, contact, held
-    and watch; ``rate``: the penetration rate there; ``latched``: the pair's latched approach speed
-    after the decision; ``y``: the state at the switch."""
+    """The contact switches the C loop decided in one advance, in time order: ``pair`` (index in
+    set_auto_events), ``info`` (kind, contact, held, watch), ``rate``, ``latched`` speed after it, ``y``."""
 
     t: np.ndarray
     pair: np.ndarray
@@ -141,15 +111,9 @@ class StateLayout:
 
 @dataclass
 class Advance:
-    """What one :meth:`Session.advance` call did.
-
-    ``step_*`` hold every point where IDA returned in one-step mode during the call: the end of
-    each internal step, and on a root return the root point itself (which lies inside IDA's last
-    internal step). Times strictly increase; the start point of the call is not included.
-    ``step_h`` is the size of the internal step the point belongs to, ``step_order`` the BDF
-    order used for it (-1 when unknown: python backend).
-    ``eval_*`` hold the requested ``t_eval`` points reached in this call, in (t_start, t].
-    """
+    """What one :meth:`Session.advance` call did: ``step_*`` every point where IDA returned in one-step
+    mode (each internal step's end, and a root), times increasing, the start excluded (``step_order``
+    -1: python backend); ``eval_*`` the ``t_eval`` points in (t_start, t]."""
 
     status: str  # "tstop" | "root" | "error" | "interrupted" (Ctrl-C between chunks: the steps so far)
     t: float
@@ -167,7 +131,6 @@ class Advance:
     flag: int = 0
     flag_name: str = ""
     message: str = ""
-    # contact switches the compiled loop decided itself (see CSession.set_auto_events), in time order
     auto_events: AutoEvents | None = None
 
     @property
@@ -185,11 +148,8 @@ class Session(Protocol):
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
                 store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
                 chunked: bool = False) -> Advance:
-        """Integrate towards ``t_stop``; ``store_steps``: keep every step's time, size and order,
-        with ``store_states`` also its y and yp (else ``step_y``/``step_yp`` have no rows).
-        ``chunked``: return (status ``"chunk"``) whenever the step buffer is full or a step filled
-        the last of the ``t_eval`` rows, so that the caller can empty them and call again (a run in
-        bounded memory hands ``t_eval`` over in windows); the integration is not changed."""
+        """Integrate towards ``t_stop``, keeping the steps (``store_steps``) and their states (``store_states``);
+        ``chunked``: return (status ``"chunk"``) when the step buffer or the ``t_eval`` rows are full."""
         ...
 
     def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
@@ -208,9 +168,6 @@ class Session(Protocol):
     def close(self) -> None: ...
 
 
-# =========================================================================== options
-
-
 @dataclass
 class SessionOptions:
     """The validated options of one session (see :func:`check_options`)."""
@@ -226,22 +183,21 @@ class SessionOptions:
     linear_solver: str = "auto"  # one of LINEAR_SOLVERS, as requested
 
 
-def _root_dirs(model: NormalizedModel, rd: Any, what: str = "root_directions") -> np.ndarray:
+def _root_dirs(model: NormalizedModel, rd: Any) -> np.ndarray:
     if rd is None:
         return np.zeros(model.n_roots, dtype=np.int32)
     arr = np.asarray(rd)
     if arr.shape != (model.n_roots,):
-        raise ValueError(f"{what} must have shape ({model.n_roots},), got {arr.shape}")
-    if not all(d in (-1, 0, 1) for d in arr.tolist()):  # (not numpy's min, max and round: at every restart)
-        raise ValueError(f"{what} values must be -1, 0 or +1, got {arr.tolist()}")
+        raise ValueError(f"root_directions must have shape ({model.n_roots},), got {arr.shape}")
+    if not all(d in (-1, 0, 1) for d in arr.tolist()):
+        raise ValueError(f"root_directions values must be -1, 0 or +1, got {arr.tolist()}")
     return np.ascontiguousarray(arr, dtype=np.int32)
 
 
 def check_options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, max_order: Any,
                   max_steps: Any, root_directions: Any, buffer_steps: Any, parameters: Any,
                   linear_solver: Any = "auto") -> SessionOptions:
-    """The options of :func:`daeclear.engine.ida_session.open_session`, checked (ValueError naming the
-    option and the allowed values) and converted."""
+    """The options of :func:`daeclear.engine.ida_session.open_session`, checked (ValueError) and converted."""
     if not isinstance(linear_solver, str) or linear_solver.lower() not in LINEAR_SOLVERS:
         raise ValueError(f"linear_solver={linear_solver!r} is not a linear solver: valid values are "
                          f"{', '.join(map(repr, LINEAR_SOLVERS))}")
@@ -272,11 +228,7 @@ def check_options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, m
                           _root_dirs(model, root_directions), int(buffer_steps), P, linear_solver.lower())
 
 
-# =========================================================================== common base
-
-
-# dc_advance's store_steps flags (daeclear.engine.abi)
-STORE_TIMES, STORE_STATES = DC_STORE_TIMES, DC_STORE_STATES
+STORE_TIMES, STORE_STATES = DC_STORE_TIMES, DC_STORE_STATES  # dc_advance's store_steps flags
 
 
 class _NoRows(dict):
@@ -297,10 +249,8 @@ _EMPTY.flags.writeable = False
 
 def empty_advance_arrays(n: int) -> dict[str, np.ndarray]:
     """The step arrays of an Advance that took no step (n states)."""
-    return dict(
-        step_t=np.empty(0), step_y=np.empty((0, n)), step_yp=np.empty((0, n)),
-        step_h=np.empty(0), step_order=np.empty(0, dtype=np.int32),
-    )
+    return dict(step_t=np.empty(0), step_y=np.empty((0, n)), step_yp=np.empty((0, n)), step_h=np.empty(0),
+                step_order=np.empty(0, dtype=np.int32))
 
 
 class SessionBase:
@@ -320,15 +270,12 @@ class SessionBase:
         self._yp = np.zeros(model.n)
         self._active = np.zeros(self._nt, dtype=np.int32)
         self._params = [np.zeros(p) for p in model.n_params]
-        self._stall = StallGuard()  # the step-size collapse rule (daeclear.engine.stall_guard)
+        self._stall = StallGuard()
         self._solve_time = 0.0
-        self._extra_stats: dict[str, int | float | str] = {}
-        # the compiled library and its session handle: set by CSession only, used here by set_stall
-        # when backend == "c" (declared, not assigned: the python session has neither)
+        # the compiled library and its session handle: CSession's only (set_stall uses them)
         self._lib: Any
         self._h: Any
 
-    # ---------------------------------------------------------------- properties
     @property
     def max_steps(self) -> int:
         """The session's cap on the number of IDA steps of a run."""
@@ -337,10 +284,6 @@ class SessionBase:
     @property
     def n(self) -> int:
         return self._n
-
-    @property
-    def n_terms(self) -> int:
-        return self._nt
 
     @property
     def n_roots(self) -> int:
@@ -355,7 +298,6 @@ class SessionBase:
         """Time of the current state (last reinit or last advance)."""
         return self._t
 
-    # ---------------------------------------------------------------- validation
     def _vec(self, v: Any, what: str) -> np.ndarray:
         a = np.ascontiguousarray(v, dtype=float)
         if a.shape != (self._n,):
@@ -364,15 +306,11 @@ class SessionBase:
 
     def set_hints(self, *, nonlin_conv_coef: float | None = None, jacobian_refresh: float | None = None,
                   first_step: bool | None = None) -> bool:
-        """Solver hints (see CSession.set_hints); scikit-sundae exposes none of them, so the python
-        backend ignores them and returns False."""
+        """Solver hints (see CSession.set_hints): the python backend has none, returns False."""
         return False
 
     def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
-        """Evaluate ``DAEFunctions.extras[k]`` at ``n_points`` points: each input is an array of
-        shape (n_points, size) or (size,) (the same for every point); returns (n_points, n_out).
-        The compiled backend loops in C; the python backend maps the CasADi function. The
-        run-time parameters are appended as the last input."""
+        """``DAEFunctions.extras[k]`` at ``n_points`` points, (n_points, n_out); inputs (n_points, size) or (size,)."""
         f = self._model.extras[k]
         inputs = [*inputs, self._opts.parameters]
         cols = [np.zeros((0, n_points)) if f.numel_in(j) == 0 else
@@ -391,8 +329,7 @@ class SessionBase:
         return False
 
     def set_stall(self, stall_step: float, count: int) -> None:
-        """Stall detection: ``count`` tiny steps (below ``stall_step`` s and not growing, with no
-        step 100x larger in between) end an advance with DC_STEP_COLLAPSE. Both backends."""
+        """``count`` tiny steps (below ``stall_step`` s, see stall_guard) end an advance with DC_STEP_COLLAPSE."""
         if not (stall_step >= 0.0) or count < 1:
             raise ValueError(f"set_stall: stall_step={stall_step!r} must be >= 0 and count={count!r} >= 1")
         self._check_open()
@@ -404,16 +341,10 @@ class SessionBase:
                       root_directions: Any) -> tuple[float, np.ndarray, np.ndarray, np.ndarray,
                                                      list[np.ndarray], np.ndarray]:
         """Validate reinit arguments (kept lean: it runs at every event)."""
-        if self._closed:
-            raise DaeclearError("the session is closed")
+        self._check_open()
         t0 = float(t0)
-        n, nt = self._n, self._nt
-        y0 = np.asarray(y0, dtype=float)
-        yp0 = np.asarray(yp0, dtype=float)
-        if y0.shape != (n,):
-            raise ValueError(f"y0 must have shape ({n},), got {y0.shape}")
-        if yp0.shape != (n,):
-            raise ValueError(f"yp0 must have shape ({n},), got {yp0.shape}")
+        nt = self._nt
+        y0, yp0 = self._vec(y0, "y0"), self._vec(yp0, "yp0")
         if not (math.isfinite(t0) and math.isfinite(y0.sum()) and math.isfinite(yp0.sum())):
             raise ValueError(f"t0, y0 and yp0 must be finite (t0={t0}, y0={y0.tolist()}, yp0={yp0.tolist()})")
         if active is None:
@@ -441,9 +372,7 @@ class SessionBase:
 
     @property
     def eval_from(self) -> float:
-        """Output times after this one are still to come: the current time, or, when the last
-        (chunked) advance filled its last output row inside a step, that row's time (the rest
-        of the step's output times are given at the next call)."""
+        """Output times after this are still to come: the current time, or the last filled output row's."""
         after = getattr(self, "_eval_after", None)
         return self._t if after is None else after
 
@@ -472,9 +401,8 @@ class SessionBase:
             raise ValueError("t_stop must be finite")
         return t_stop
 
-    # ---------------------------------------------------------------- context manager
     def close(self) -> None:
-        """Free the solver; the session cannot be used afterwards (each backend frees its own)."""
+        """Free the solver; the session cannot be used afterwards."""
         raise NotImplementedError
 
     def __enter__(self) -> SessionBase:

@@ -1,16 +1,9 @@
 """The stall guard: when a run's step size has collapsed, one rule for every integrator.
 
 A step of size ``h`` ending at ``t`` is *tiny* when ``|h| < max(TINY_STEP_REL * max(1, |t|),
-stall_step)``. ``count`` tiny steps that did not grow by more than ``TINY_STEP_GROWTH`` over the
-previous step, with no normal step in between, end the run with a clear message instead of
-creeping on (e.g. plain Coulomb friction chattering at zero sliding speed takes ~1e-12 s
-order-1 steps for ever). A step resets the count when it is at least the threshold, or 100 times
-it when an absolute ``stall_step`` is set (the start-up steps after a restart grow through the
-threshold and do not count as normal steps).
-
-The compiled IDA loop (``csrc/ida_driver.c``), the Python session over scikit-sundae and the
-explicit methods all apply it: the C driver gets the numbers below as ``-D`` defines
-(:func:`c_defines`, hashed into the compile-cache key), the Python loops use :class:`StallGuard`.
+stall_step)``. ``count`` tiny steps, each grown by at most ``TINY_STEP_GROWTH``, with no normal step
+(at least the threshold, 100 times it with an absolute ``stall_step``) in between, end the run with a
+clear message instead of creeping on. The C driver gets the numbers as ``-D`` defines (:func:`c_defines`).
 """
 
 from __future__ import annotations

@@ -1,15 +1,8 @@
-"""The SUNDIALS of the scikit-sundae wheel, as the compiled IDA driver depends on it.
-
-Where its shared libraries are (:func:`sundials_libraries`), which version and ``sunindextype``
-width they have (:func:`sundials_info`, detected once per process), the vendored SUNDIALS headers
-that must describe that same build (:func:`vendored_sundials`, :func:`check_vendored`), and the
-build tag a compiled model library carries (:func:`read_build_tag`). Separate from compiling
-(:mod:`daeclear.engine.build`) because it is only about the wheel: a wrong index width would be
-silent memory corruption, so nothing here guesses.
-
-The wheel has no SUNDIALS headers; the driver is compiled against the real SUNDIALS headers of the
-wheel's release, vendored unmodified in ``csrc/sundials/include`` with a ``sundials_config.h``
-describing the wheel's build (see ``csrc/sundials/README.md``).
+"""The SUNDIALS of the scikit-sundae wheel, as the compiled IDA driver depends on it: its libraries
+(:func:`sundials_libraries`), their version and ``sunindextype`` width (:func:`sundials_info`), the
+vendored headers that must describe that same build (:func:`vendored_sundials`, :func:`check_vendored`;
+the wheel has no headers, ``csrc/sundials/README.md``) and a library's build tag (:func:`read_build_tag`).
+A wrong index width would be silent memory corruption, so nothing here guesses.
 """
 
 from __future__ import annotations
@@ -23,36 +16,17 @@ from pathlib import Path
 
 from .build import CSRC, CompilerUnavailable
 
-__all__ = [
-    "SUNDIALS_INCLUDE",
-    "SUNDIALS_LIBS",
-    "SPARSE_LIBS",
-    "SUNDIALS_MAJOR",
-    "SundialsInfo",
-    "SundialsMismatch",
-    "sundials_libraries",
-    "sundials_info",
-    "parse_index_size",
-    "vendored_sundials",
-    "check_vendored",
-    "read_build_tag",
-]
+__all__ = ["SUNDIALS_INCLUDE", "SUNDIALS_LIBS", "SPARSE_LIBS", "SUNDIALS_MAJOR", "SundialsInfo", "SundialsMismatch",
+           "sundials_libraries", "sundials_info", "parse_index_size", "vendored_sundials", "check_vendored",
+           "read_build_tag"]
 
-#: The vendored SUNDIALS headers (csrc/sundials/README.md), the include path of the IDA driver;
-#: every file of its parent folder is in the cache key.
+#: The vendored SUNDIALS headers (csrc/sundials/README.md): the IDA driver's include path, in the cache key.
 SUNDIALS_INCLUDE = CSRC / "sundials" / "include"
-SUNDIALS_LIBS = (
-    "sundials_ida",
-    "sundials_core",
-    "sundials_nvecserial",
-    "sundials_sunmatrixdense",
-    "sundials_sunlinsoldense",
-)
-#: Linked when the wheel has both: the driver's sparse linear solver (SuperLU_MT on a
-#: SUNSparseMatrix). SuperLU_MT's own BLAS and OpenMP libraries sit in the same folder.
+SUNDIALS_LIBS = ("sundials_ida", "sundials_core", "sundials_nvecserial", "sundials_sunmatrixdense",
+                 "sundials_sunlinsoldense")
+#: Linked when the wheel has both: the driver's sparse linear solver (SuperLU_MT on a SUNSparseMatrix).
 SPARSE_LIBS = ("sundials_sunmatrixsparse", "sundials_sunlinsolsuperlumt")
-#: The SUNDIALS major version of the vendored headers (their sundials_config.h #errors on any
-#: other version than theirs; vendored_sundials reads the full one).
+#: The SUNDIALS major version of the vendored headers (vendored_sundials reads the full one).
 SUNDIALS_MAJOR = 7
 
 
@@ -70,8 +44,8 @@ def _sksundae_dir() -> Path:
 
 @functools.lru_cache(maxsize=1)
 def sundials_libraries() -> tuple[Path, dict[str, Path]]:
-    """(directory, {name: path}) of the SUNDIALS shared libraries inside the scikit-sundae wheel:
-    every one of ``SUNDIALS_LIBS``, and those of ``SPARSE_LIBS`` that are present."""
+    """(directory, {name: path}) of the wheel's SUNDIALS libraries: ``SUNDIALS_LIBS`` and those of
+    ``SPARSE_LIBS`` that are present."""
     libdir = _sksundae_dir().parent / "scikit_sundae.libs"
     if not libdir.is_dir():
         raise CompilerUnavailable(f"SUNDIALS libraries not found: {libdir} does not exist")
@@ -87,12 +61,8 @@ def sundials_libraries() -> tuple[Path, dict[str, Path]]:
 
 @dataclass(frozen=True)
 class SundialsInfo:
-    """What the compiled driver depends on in the wheel's SUNDIALS build.
-
-    ``version`` is major.minor.patch; ``index_size`` the width of ``sunindextype`` in bits (32 or
-    64), which sizes every vector, matrix and sparse index the driver hands to SUNDIALS;
-    ``has_sparse`` whether the sparse matrix and SuperLU_MT libraries are there.
-    """
+    """What the driver depends on in the wheel's SUNDIALS: ``version`` (major.minor.patch), ``index_size``
+    (bits of ``sunindextype``), ``has_sparse`` (the sparse matrix and SuperLU_MT libraries are there)."""
 
     version: str
     index_size: int
@@ -104,8 +74,8 @@ class SundialsInfo:
         return major, minor, patch
 
     def compile_flags(self) -> list[str]:
-        """The -D flags that tell the vendored sundials_config.h and csrc/ida_driver.c what they
-        build for (the header #errors when they disagree with it)."""
+        """The -D flags that tell the vendored sundials_config.h (which #errors on a mismatch) and
+        csrc/ida_driver.c what they build for."""
         major, minor, patch = self.version_tuple
         return [f"-DDC_SUNDIALS_MAJOR={major}", f"-DDC_SUNDIALS_MINOR={minor}", f"-DDC_SUNDIALS_PATCH={patch}",
                 f"-DDC_INDEX_SIZE={self.index_size}", f"-DDC_HAVE_SPARSE={int(self.has_sparse)}"]
@@ -117,9 +87,8 @@ _INDEX_TYPES = {"int": 32, "int32_t": 32, "long": 64, "long int": 64, "long long
 
 
 def parse_index_size(text: str, source: str = "c_config.pxi") -> int | None:
-    """Width in bits of ``sunindextype`` declared in scikit-sundae's ``c_config.pxi`` (``ctypedef
-    int sunindextype``); None when the file declares none; CompilerUnavailable for a type that is
-    not a known 32- or 64-bit integer (guessing would corrupt memory)."""
+    """Width in bits of ``sunindextype`` in scikit-sundae's ``c_config.pxi``; None when it declares
+    none; CompilerUnavailable for a type not known as a 32- or 64-bit integer."""
     m = re.search(r"^\s*ctypedef\s+([A-Za-z_][\w ]*?)\s+sunindextype\s*(?:#.*)?$", text, re.MULTILINE)
     if m is None:
         return None
@@ -150,8 +119,7 @@ def vendored_sundials() -> tuple[str, int]:
 
 
 def check_vendored(info: SundialsInfo) -> None:
-    """SundialsMismatch unless the wheel's SUNDIALS (version, index width) is the one the vendored
-    headers describe: compiling the driver against other headers would corrupt memory."""
+    """SundialsMismatch unless the wheel's SUNDIALS (version, index width) is the vendored headers'."""
     version, bits = vendored_sundials()
     if (info.version, info.index_size) != (version, bits):
         raise SundialsMismatch(
@@ -184,12 +152,10 @@ def _version_from_library(core: Path) -> str | None:
 
 
 def _probe_index_size(libs: dict[str, Path]) -> int | None:
-    """Width of sunindextype the libraries were really built with, or None if it cannot be probed.
-
-    Public API only: a dense 2 x 2 matrix converted to CSC has column pointers [0, 2, 4]; read as
-    32-bit integers they are [0, 2, 4] in an int32 build and [0, 0, 2] in an int64 one. The
-    sizes are passed as 64-bit values, which either build reads correctly (x86-64 registers).
-    """
+    """Width of sunindextype the libraries were really built with, or None if it cannot be probed:
+    a dense 2 x 2 matrix converted to CSC has column pointers [0, 2, 4], read as 32-bit integers
+    [0, 2, 4] in an int32 build and [0, 0, 2] in an int64 one (sizes passed as 64-bit values,
+    which either build reads correctly on x86-64)."""
     try:
         core = ctypes.CDLL(str(libs["sundials_core"]))
         dense = ctypes.CDLL(str(libs["sundials_sunmatrixdense"]))
@@ -197,18 +163,16 @@ def _probe_index_size(libs: dict[str, Path]) -> int | None:
     except (OSError, KeyError):
         return None
     V = ctypes.c_void_p
-    core.SUNContext_Create.argtypes = [ctypes.c_int, ctypes.POINTER(V)]
-    core.SUNContext_Free.argtypes = [ctypes.POINTER(V)]
-    core.SUNMatDestroy.argtypes = [V]
-    core.SUNMatDestroy.restype = None
-    dense.SUNDenseMatrix.argtypes = [ctypes.c_int64, ctypes.c_int64, V]
-    dense.SUNDenseMatrix.restype = V
-    dense.SUNDenseMatrix_Data.argtypes = [V]
-    dense.SUNDenseMatrix_Data.restype = ctypes.POINTER(ctypes.c_double)
-    sparse.SUNSparseFromDenseMatrix.argtypes = [V, ctypes.c_double, ctypes.c_int]
-    sparse.SUNSparseFromDenseMatrix.restype = V
-    sparse.SUNSparseMatrix_IndexPointers.argtypes = [V]
-    sparse.SUNSparseMatrix_IndexPointers.restype = ctypes.POINTER(ctypes.c_int32)
+    for lib, name, restype, argtypes in (
+            (core, "SUNContext_Create", ctypes.c_int, [ctypes.c_int, ctypes.POINTER(V)]),
+            (core, "SUNContext_Free", ctypes.c_int, [ctypes.POINTER(V)]),
+            (core, "SUNMatDestroy", None, [V]),
+            (dense, "SUNDenseMatrix", V, [ctypes.c_int64, ctypes.c_int64, V]),
+            (dense, "SUNDenseMatrix_Data", ctypes.POINTER(ctypes.c_double), [V]),
+            (sparse, "SUNSparseFromDenseMatrix", V, [V, ctypes.c_double, ctypes.c_int]),
+            (sparse, "SUNSparseMatrix_IndexPointers", ctypes.POINTER(ctypes.c_int32), [V])):
+        fn = getattr(lib, name)
+        fn.restype, fn.argtypes = restype, argtypes
     ctx = V()
     if core.SUNContext_Create(0, ctypes.byref(ctx)) != 0 or not ctx.value:
         return None
@@ -224,8 +188,7 @@ def _probe_index_size(libs: dict[str, Path]) -> int | None:
         if not B:
             return None
         ptr = sparse.SUNSparseMatrix_IndexPointers(B)
-        words = [ptr[i] for i in range(3)]
-        return {(0, 2, 4): 32, (0, 0, 2): 64}.get(tuple(words))
+        return {(0, 2, 4): 32, (0, 0, 2): 64}.get((ptr[0], ptr[1], ptr[2]))
     finally:
         for M in (B, A):
             if M:
@@ -237,8 +200,8 @@ _BUILD_TAG = re.compile(rb"daeclear-build:abi=(\d+);sundials=(\d+)\.(\d+)\.(\d+)
 
 
 def read_build_tag(path: Path) -> tuple[int, SundialsInfo] | None:
-    """(driver ABI, SUNDIALS build) a compiled model library was made for, read from the file's
-    bytes (the driver's ``dc_build_tag``) without loading it; None when it has no tag."""
+    """(driver ABI, SUNDIALS build) of a compiled model library, read from the file (``dc_build_tag``)
+    without loading it; None when it has no tag."""
     data = path.read_bytes()
     start = data.find(b"daeclear-build:")
     m = _BUILD_TAG.match(data, start) if start >= 0 else None
@@ -250,15 +213,9 @@ def read_build_tag(path: Path) -> tuple[int, SundialsInfo] | None:
 
 @functools.lru_cache(maxsize=1)
 def sundials_info() -> SundialsInfo:
-    """Detect the SUNDIALS version and index size of the wheel's libraries (once per process).
-
-    Version: from the core library's file name (``.so.7.9.0``) and from
-    ``SUNDIALSGetVersionNumber`` of that library; both must agree when both are known.
-    Index size: ``sunindextype`` in ``sksundae/c_config.pxi``, cross-checked on the libraries
-    themselves (:func:`_probe_index_size`); when the file is missing or silent the probe alone
-    decides. Whatever cannot be determined, or contradicts itself, raises CompilerUnavailable
-    (SundialsMismatch): the compiled backend is then not used, never built on a guess.
-    """
+    """The SUNDIALS version (the core library's file name and ``SUNDIALSGetVersionNumber``) and index
+    size (``sksundae/c_config.pxi`` and :func:`_probe_index_size`) of the wheel, once per process; either
+    unknown or contradictory raises CompilerUnavailable (SundialsMismatch), never a guess."""
     _, libs = sundials_libraries()
     core = libs["sundials_core"]
     named, reported = _version_from_name(core), _version_from_library(core)
