@@ -323,6 +323,31 @@ def test_dae_t_eval_matches_steps(pendulum_runs, backend):
     np.testing.assert_allclose(b.eval_yp[:, 0], b.eval_y[:, 2], rtol=0, atol=1e-5)
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_no_yp_when_not_asked(pendulum_runs, backend):
+    """store_yp=False: the same run (steps and output rows bit for bit) without yp at the steps or the
+    output times; output rows that fill their buffer are handed over as it, a partial window as a copy."""
+    a, b, te, s = pendulum_runs[backend]
+    y0, yp0 = np.array([1.0, 0, 0, 0, 0]), np.array([0.0, 0, 0, -G, 0])
+    s.reinit(0.0, y0, yp0, [], [])
+    c = s.advance(3.0, t_eval=te, store_yp=False)
+    assert c.step_yp is None and c.eval_yp is None
+    np.testing.assert_array_equal(c.step_t, b.step_t)
+    np.testing.assert_array_equal(c.step_y, b.step_y)
+    np.testing.assert_array_equal(c.eval_y, b.eval_y)
+    assert c.eval_y.shape == (te.size, 5) and c.eval_y.base is None  # every row filled: the buffer itself
+    partial = []
+    for store_yp in (False, True):  # stops before the last output times: the rows so far
+        s.reinit(0.0, y0, yp0, [], [])
+        partial.append(s.advance(1.5, t_eval=te, store_yp=store_yp))
+    n = int(np.searchsorted(te, 1.5, side="right"))
+    d, e = partial
+    assert 0 < n < te.size and d.eval_y.shape == (n, 5) and d.eval_y.base is None  # a copy of the rows
+    assert d.eval_yp is None and e.eval_yp.shape == (n, 5) and e.eval_yp.base is None
+    np.testing.assert_array_equal(d.eval_y, e.eval_y)
+    np.testing.assert_array_equal(d.step_y, e.step_y)
+
+
 # --------------------------------------------------------------------------- 4. residual / Jacobian
 
 

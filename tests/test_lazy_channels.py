@@ -15,6 +15,7 @@ import pytest
 
 import daeclear as dc
 from daeclear.engine.ida_session import open_session
+from daeclear.assembly.dae_model import EXTRA_CHECKS
 from daeclear.model.scenefile import scene_from_description
 from daeclear.results.values import to_plain
 
@@ -69,10 +70,14 @@ def test_the_checked_channels_are_the_outputs_own(joint):
     whole = model.channels(result.t, result.y, result.yp, switch)
     session = open_session(model.functions, rtol=1e-8, atol=1.0, parameters=model.parameter_values)
     try:
-        compiled = model.checks(result.t, result.y, result.yp, switch, session)
+        compiled = model.checks(result.t, result.y, switch, session)
     finally:
         session.close()
-    for checked in (compiled, model.checks(result.t, result.y, result.yp, switch)):
+    # checks takes no yp (it passes zeros): the generated function reads none of it
+    checks_function = model.functions.extras[EXTRA_CHECKS]
+    assert checks_function.name_in(2) == "yp" and checks_function.sparsity_jac(2, 0).nnz() == 0
+    assert checks_function.sparsity_jac(1, 0).nnz() > 0  # it reads y (q): the check can fail
+    for checked in (compiled, model.checks(result.t, result.y, switch)):
         assert tuple(checked) == model.checked_names
         for name, values in checked.items():
             assert np.array_equal(values, whole[name]), name
@@ -230,3 +235,27 @@ def test_a_runs_states_are_made_consistent_when_first_read(scene, tmp_path):
     multipliers = np.array([name.startswith("lambda.") for name in kept.state_names])
     assert np.array_equal(idas[:, ~multipliers], kept.y[:, ~multipliers])  # q, v (and GGL's mu) are IDA's
     assert not np.array_equal(idas[:, multipliers], kept.y[:, multipliers])  # the multipliers are not
+
+
+def test_a_state_the_pass_keeps_is_read_without_it(scene):
+    """Reading q, v (or GGL's mu) of a run does not run the consistency pass and gives the consistent
+    column; reading a multiplier runs it. The columns the pass recomputes are the multipliers'."""
+    kept = dc.simulate(scene, TWO_REVOLUTIONS / 8)
+    source = kept.channel_source
+    assert source is not None and source.raw
+    multipliers = [j for j, name in enumerate(kept.state_names) if name.startswith("lambda.")]
+    assert list(range(kept.n_states))[source.recomputed] == multipliers
+    others = [name for name in kept.state_names if not name.startswith("lambda.")]
+    assert "crank.x" in others and any(name.startswith("mu.") for name in others)  # GGL's default
+    read = {name: np.array(kept[name]) for name in others}
+    assert source.raw and not kept[others[0]].flags.writeable  # nothing made consistent yet, read-only
+    first_multiplier = kept[kept.state_names[multipliers[0]]]
+    assert not source.raw  # the pass ran
+    assert np.array_equal(first_multiplier, kept.y[:, multipliers[0]])
+    assert not source.computed
+    for name, values in read.items():
+        assert np.array_equal(values, kept.y[:, kept.state_names.index(name)]), name
+        if name in kept.channel_names:  # a body's coordinate or velocity: the channel of that name is the column
+            assert np.array_equal(values, kept.channels[name]), name
+            assert np.array_equal(values, kept[name]), name
+    assert source.computed and sum(name in kept.channel_names for name in read) == 18

@@ -366,10 +366,12 @@ class DAEModel:
         """The channels the physics checks read (:func:`daeclear.solvers.physics.checked_channel`), in order."""
         return tuple(name for name in self.channel_names if checked_channel(name))
 
-    def checks(self, t: NDArray[np.float64], y: NDArray[np.float64], yp: NDArray[np.float64],
-               switch: NDArray[np.float64], session: Any = None) -> dict[str, NDArray[np.float64]]:
-        """The channels the physics checks read (as :meth:`channels`, bit for bit), without the others."""
-        return self._rows(EXTRA_CHECKS, self.checked_names, t, y, yp, switch, session)
+    def checks(self, t: NDArray[np.float64], y: NDArray[np.float64], switch: NDArray[np.float64],
+               session: Any = None) -> dict[str, NDArray[np.float64]]:
+        """The channels the physics checks read (as :meth:`channels`, bit for bit), without the others.
+        Penetrations and the position constraints are functions of q alone: no yp is needed (zeros are
+        passed for the generated function's yp input)."""
+        return self._rows(EXTRA_CHECKS, self.checked_names, t, y, np.zeros(self.n_states), switch, session)
 
     def _rows(self, k: int, names: tuple[str, ...], t: ArrayLike, y: ArrayLike, yp: ArrayLike,
               switch: ArrayLike | None, session: Any) -> dict[str, NDArray[np.float64]]:

@@ -39,6 +39,7 @@ from .session_base import (
     SessionOptions,
     StateLayout,
     empty_advance_arrays,
+    output_rows,
 )
 from .sundials import SPARSE_LIBS
 
@@ -360,17 +361,18 @@ class CSession(SessionBase):
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
                 store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
-                chunked: bool = False) -> Advance:
+                chunked: bool = False, store_yp: bool = True) -> Advance:
         t_stop = self._check_advance(t_stop)
         n = self._n
         te = self._select_eval(t_eval, t_stop)
         m = te.size
         ev_y = np.empty((m, n))
-        ev_yp = np.empty((m, n))
-        te_p, evy_p, evyp_p = (address(te), address(ev_y), address(ev_yp)) if m else (None, None, None)
+        ev_yp = np.empty((m, n)) if store_yp else None  # None: the C loop computes no yp at the output times
+        te_p, evy_p = (address(te), address(ev_y)) if m else (None, None)
+        evyp_p = address(ev_yp) if m and ev_yp is not None else None
         A = self._addr
         self._i_eval.value = 0
-        chunks: list[tuple[np.ndarray, ...]] = []
+        chunks: list[tuple[Any, ...]] = []  # step times, y, yp (None unless store_yp), sizes, orders
         auto_events: list[AutoEvents] = []
         store = (STORE_TIMES | (STORE_STATES if store_states else 0)) if store_steps else 0
         if store & STORE_STATES and self._sy is None:  # kept by the handle for the sessions after this one
@@ -391,8 +393,8 @@ class CSession(SessionBase):
                 k = self._n_stored.value
                 if k:
                     sy, syp = self._sy, self._syp
-                    states = (sy[:k].copy(), syp[:k].copy()) if sy is not None and syp is not None and store_states \
-                        else (NO_ROWS[n],) * 2
+                    states = (sy[:k].copy(), syp[:k].copy() if store_yp else None) \
+                        if sy is not None and syp is not None and store_states else (NO_ROWS[n],) * 2
                     chunks.append((self._st[:k].copy(), *states, self._sh[:k].copy(), self._sord[:k].copy()))
                 taken = self._take_auto_events()  # drained at every chunk: the C buffer never overflows
                 if taken is not None:
@@ -413,7 +415,8 @@ class CSession(SessionBase):
         if len(chunks) == 1:
             st, sy, syp, sh, so = chunks[0]
         elif chunks:
-            st, sy, syp, sh, so = (np.concatenate(c) for c in zip(*chunks))
+            st, sy, sh, so = (np.concatenate([c[i] for c in chunks]) for i in (0, 1, 3, 4))
+            syp = np.concatenate([c[2] for c in chunks]) if store_yp else None
         else:
             e = empty_advance_arrays(n)
             st, sy, syp, sh, so = e["step_t"], e["step_y"], e["step_yp"], e["step_h"], e["step_order"]
@@ -421,8 +424,10 @@ class CSession(SessionBase):
         # the C loop stopped inside a step that has output times after the last row (see dc_advance)
         self._eval_after = float(te[-1]) if rc == DC_CHUNK and m and ne == m and te[-1] < self._t else None
         adv = Advance(status="tstop", t=self._t, y=self._y, yp=self._yp, step_t=st,
-                      step_y=sy, step_yp=syp, step_h=sh, step_order=so, eval_t=te[:ne].copy(),
-                      eval_y=ev_y[:ne], eval_yp=ev_yp[:ne], auto_events=AutoEvents.join(auto_events))
+                      step_y=sy, step_yp=syp if store_yp else None, step_h=sh, step_order=so,
+                      eval_t=te[:ne].copy(), eval_y=output_rows(ev_y, ne),
+                      eval_yp=None if ev_yp is None else output_rows(ev_yp, ne),
+                      auto_events=AutoEvents.join(auto_events))
         if interrupted:
             adv.status = "interrupted"
             return adv

@@ -17,7 +17,8 @@ import numpy as np
 from ..errors import DaeclearError
 from .codegen import NormalizedModel, densified
 from .hermite import cubic_hermite
-from .session_base import FLAG_MAX_STEPS, FLAG_STEP_COLLAPSE, OWN_FLAG_NAMES, Advance, SessionBase, SessionOptions
+from .session_base import (FLAG_MAX_STEPS, FLAG_STEP_COLLAPSE, OWN_FLAG_NAMES, Advance, SessionBase, SessionOptions,
+                           output_rows)
 
 __all__ = ["PythonSession"]
 
@@ -177,7 +178,7 @@ class PythonSession(SessionBase):
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
                 store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
-                chunked: bool = False) -> Advance:
+                chunked: bool = False, store_yp: bool = True) -> Advance:
         t_stop = self._check_advance(t_stop)
         rows = _Rows(self._select_eval(t_eval, t_stop), self._n, self._t)
         outcome = _Outcome()
@@ -187,7 +188,7 @@ class PythonSession(SessionBase):
                 self._step_until(t_stop, rows, outcome, store_steps, chunked)
         finally:
             self._solve_time += time.perf_counter() - tic
-        return rows.advance(outcome, self._t, self._y, self._yp)
+        return rows.advance(outcome, self._t, self._y, self._yp, store_yp)
 
     def _step_until(self, t_stop: float, rows: _Rows, outcome: _Outcome, store_steps: bool, chunked: bool) -> None:
         """IDA in one-step mode until t_stop, a root, a failure, the step cap or (chunked) a full buffer."""
@@ -360,13 +361,14 @@ class _Rows:
             self.sh.append(h)
             self.t_rec = t
 
-    def advance(self, outcome: _Outcome, t: float, y: np.ndarray, yp: np.ndarray) -> Advance:
+    def advance(self, outcome: _Outcome, t: float, y: np.ndarray, yp: np.ndarray, store_yp: bool) -> Advance:
         k, n, ie = len(self.st), self.n, self.ie
         return Advance(
             status=outcome.status, t=t, y=y.copy(), yp=yp.copy(),
             step_t=np.array(self.st, dtype=float), step_y=np.array(self.sy, dtype=float).reshape(k, n),
-            step_yp=np.array(self.syp, dtype=float).reshape(k, n), step_h=np.array(self.sh, dtype=float),
-            step_order=np.full(k, -1, dtype=np.int32), eval_t=self.te[:ie].copy(), eval_y=self.ev_y[:ie],
-            eval_yp=self.ev_yp[:ie], roots_found=outcome.roots, flag=outcome.flag, flag_name=outcome.flag_name,
-            message=outcome.message,
+            step_yp=np.array(self.syp, dtype=float).reshape(k, n) if store_yp else None,
+            step_h=np.array(self.sh, dtype=float), step_order=np.full(k, -1, dtype=np.int32),
+            eval_t=self.te[:ie].copy(), eval_y=output_rows(self.ev_y, ie),
+            eval_yp=output_rows(self.ev_yp, ie) if store_yp else None, roots_found=outcome.roots, flag=outcome.flag,
+            flag_name=outcome.flag_name, message=outcome.message,
         )

@@ -21,7 +21,7 @@ from .stall_guard import StallGuard
 
 __all__ = ["DAEFunctions", "AutoEvents", "StateLayout", "Advance", "Session", "SessionOptions", "check_options",
            "SessionBase", "FLAG_MAX_STEPS", "FLAG_STEP_COLLAPSE", "OWN_FLAG_NAMES", "STORE_TIMES", "STORE_STATES",
-           "NO_ROWS", "empty_advance_arrays"]
+           "NO_ROWS", "empty_advance_arrays", "output_rows"]
 
 #: flag of an Advance that stopped because the session's step cap (max_steps) was reached
 FLAG_MAX_STEPS = -1001
@@ -113,7 +113,8 @@ class StateLayout:
 class Advance:
     """What one :meth:`Session.advance` call did: ``step_*`` every point where IDA returned in one-step
     mode (each internal step's end, and a root), times increasing, the start excluded (``step_order``
-    -1: python backend); ``eval_*`` the ``t_eval`` points in (t_start, t]."""
+    -1: python backend); ``eval_*`` the ``t_eval`` points in (t_start, t]; ``step_yp`` and ``eval_yp``
+    None when the caller asked for no yp (``store_yp=False``)."""
 
     status: str  # "tstop" | "root" | "error" | "interrupted" (Ctrl-C between chunks: the steps so far)
     t: float
@@ -121,12 +122,12 @@ class Advance:
     yp: np.ndarray
     step_t: np.ndarray
     step_y: np.ndarray
-    step_yp: np.ndarray
+    step_yp: np.ndarray | None
     step_h: np.ndarray
     step_order: np.ndarray
     eval_t: np.ndarray
     eval_y: np.ndarray
-    eval_yp: np.ndarray
+    eval_yp: np.ndarray | None
     roots_found: np.ndarray | None = None
     flag: int = 0
     flag_name: str = ""
@@ -147,9 +148,10 @@ class Session(Protocol):
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
                 store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
-                chunked: bool = False) -> Advance:
-        """Integrate towards ``t_stop``, keeping the steps (``store_steps``) and their states (``store_states``);
-        ``chunked``: return (status ``"chunk"``) when the step buffer or the ``t_eval`` rows are full."""
+                chunked: bool = False, store_yp: bool = True) -> Advance:
+        """Integrate towards ``t_stop``, keeping the steps (``store_steps``) and their states (``store_states``;
+        yp too unless not ``store_yp``); ``chunked``: return (status ``"chunk"``) when the step buffer or the
+        ``t_eval`` rows are full."""
         ...
 
     def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
@@ -251,6 +253,12 @@ def empty_advance_arrays(n: int) -> dict[str, np.ndarray]:
     """The step arrays of an Advance that took no step (n states)."""
     return dict(step_t=np.empty(0), step_y=np.empty((0, n)), step_yp=np.empty((0, n)), step_h=np.empty(0),
                 step_order=np.empty(0, dtype=np.int32))
+
+
+def output_rows(buffer: np.ndarray, n_rows: int) -> np.ndarray:
+    """The first ``n_rows`` rows of an output-time buffer: the buffer itself when they fill it, else a copy
+    (a kept view of a partly filled window would hold the whole buffer in memory)."""
+    return buffer if n_rows == buffer.shape[0] else buffer[:n_rows].copy()
 
 
 class SessionBase:

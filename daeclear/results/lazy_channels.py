@@ -44,6 +44,9 @@ class LazyChannels:
     raw : bool
         ``y`` holds IDA's own multipliers (a run kept in memory, ``yp`` None): ``y`` too is read
         from ``consistent``.
+    recomputed : slice
+        The columns of ``y`` the consistency pass recomputes (the multipliers); the others (q, v, ...)
+        it keeps, so that :meth:`state_column` reads them without the pass.
     values : mapping, optional
         The channels when already computed (e.g. for the run's physics checks).
     rebuildable : bool or callable returning bool
@@ -54,7 +57,8 @@ class LazyChannels:
 
     def __init__(self, names: Sequence[str], evaluate: Evaluate, t: NDArray, y: NDArray, yp: NDArray | None,
                  switch: NDArray, *, consistent: Consistent | None = None, raw: bool = False,
-                 values: Mapping[str, NDArray] | None = None, rebuildable: bool | Callable[[], bool] = False) -> None:
+                 recomputed: slice = slice(0, 0), values: Mapping[str, NDArray] | None = None,
+                 rebuildable: bool | Callable[[], bool] = False) -> None:
         if switch.ndim != 2 or switch.shape[0] != t.shape[0]:
             raise ValueError(f"LazyChannels: switch has shape {switch.shape}, must be (n_times={t.shape[0]}, "
                              "n_switch).")
@@ -65,7 +69,7 @@ class LazyChannels:
         if raw and yp is not None:
             raise ValueError("LazyChannels: raw states come without yp (both are made consistent together).")
         self.t, self._y, self._yp, self.switch = t, y, yp, readonly(switch)
-        self.consistent, self.raw = consistent, raw
+        self.consistent, self.raw, self.recomputed = consistent, raw, recomputed
         self._rebuildable = rebuildable
         self._values = None if values is None else {n: readonly(values[n]) for n in self.names}
 
@@ -83,6 +87,12 @@ class LazyChannels:
         if self.raw:
             self._make_consistent()
         return self._y
+
+    def state_column(self, j: int) -> NDArray:
+        """Column ``j`` of the states: a kept column of raw states as stored (the pass leaves it unchanged)."""
+        if self.raw and not self.recomputed.start <= j < self.recomputed.stop:
+            return readonly(self._y[:, j])
+        return self.y[:, j]
 
     @property
     def yp(self) -> NDArray:
@@ -131,7 +141,8 @@ class LazyChannels:
         values = None if self._values is None else {n: v[rows] for n, v in self._values.items()}
         yp = None if self._yp is None else self._yp[rows]
         return LazyChannels(self.names, self.evaluate, self.t[rows], self._y[rows], yp, self.switch[rows],
-                            consistent=self.consistent, raw=self.raw, values=values, rebuildable=self._rebuildable)
+                            consistent=self.consistent, raw=self.raw, recomputed=self.recomputed, values=values,
+                            rebuildable=self._rebuildable)
 
 
 def rebuilt_evaluator(parameters: Mapping[str, Any]) -> tuple[Evaluate, Consistent]:

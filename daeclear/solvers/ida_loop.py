@@ -61,12 +61,13 @@ class SegmentLoop:
             y, yp = model.consistent_state(t0, y0, model.term_forces(t0, y0, self.active, self.params, session),
                                            session)
         self.switch = model.switch_vector(self.active, self.params)
-        # reported points not made consistent yet (IDA's raw values, with each row's switch vector)
-        self.raw: list[tuple[NDArray, NDArray, NDArray, NDArray]] = []
+        # reported points not made consistent yet (t and IDA's raw y, with each row's switch vector; no yp:
+        # the consistency pass computes it)
+        self.raw: list[tuple[NDArray, NDArray, NDArray]] = []
         rec.add_steps(np.array([t0]), np.array([0.0]), np.array([0]))
         self.i_eval = int(eval_times is not None and eval_times.window(0, 1)[0] == t0)  # the next output time
         if eval_times is None or self.i_eval:  # the start point is reported
-            self.raw.append((np.array([t0]), y[None, :], yp[None, :], self.switch[None, :]))
+            self.raw.append((np.array([t0]), y[None, :], self.switch[None, :]))
         self.events, self.segments = rec.events, rec.segments
         rec.session = session  # the checked channels in the run's library while it is open
         self.t, self.y, self.yp, self.y0 = t0, y, yp, y0
@@ -160,7 +161,7 @@ class SegmentLoop:
             self.i_eval, window = _eval_window(self.eval_times, self.i_eval, self.session.eval_from,
                                                EVAL_WINDOW if self.c_layout else self.eval_times.size)
         adv = self.session.advance(self.t_end, window, self.store_steps, store_states=self.eval_times is None,
-                                   chunked=True)
+                                   chunked=True, store_yp=False)
         self.i_eval += adv.eval_t.size
         return adv
 
@@ -174,9 +175,7 @@ class SegmentLoop:
         advance's points, each with the switch vector of the segment it belongs to."""
         if self.store_steps and adv.step_t.size:  # the steps of every segment at once
             self.rec.add_steps(adv.step_t, adv.step_h, adv.step_order)
-        # an output window's rows are copied: they view a buffer of the window's size, which a kept row would hold
-        rows = (adv.step_t, adv.step_y, adv.step_yp) if self.eval_times is None else (
-            adv.eval_t, adv.eval_y.copy(), adv.eval_yp.copy())
+        rows = (adv.step_t, adv.step_y) if self.eval_times is None else (adv.eval_t, adv.eval_y)
         if (self.eval_times is None and not self.store_steps) or not rows[0].size:  # no points to keep
             if adv.auto_events is not None:
                 self.record_switches(adv.auto_events)
@@ -269,17 +268,17 @@ class SegmentLoop:
         first (multipliers and accelerations recomputed from q and v: IDA does not converge them)."""
         model, session, raw = self.model, self.session, self.raw
         if self.rec.consistent_when_read:  # as IDA left them, joined once (by the recorder)
-            for chunk in raw:
-                self.rec.add_points(*chunk)
+            for t, y, switch in raw:
+                self.rec.add_points(t, y, None, switch)
         elif raw:
             joined = len(raw) > 1  # joined arrays are the loop's own: made consistent in place
             if joined:
-                out_t, out_y, out_yp, out_switch = (np.concatenate(column) for column in zip(*raw))
+                out_t, out_y, out_switch = (np.concatenate(column) for column in zip(*raw))
             else:
-                out_t, out_y, out_yp, out_switch = raw[0]
+                out_t, out_y, out_switch = raw[0]
             if self.c_layout:  # one pass in C, states only (the file's reader computes the channels)
-                out_y, out_yp, _ = session.report(out_t, out_y, out_switch,
-                                                  into=(out_y, out_yp) if joined else None, channels=False)
+                out_y, out_yp, _ = session.report(out_t, out_y, out_switch, channels=False,
+                                                  into=(out_y, np.empty(out_y.shape)) if joined else None)
             else:
                 out_y, out_yp = model.consistent_state(
                     out_t, out_y, model.term_forces_rows(out_t, out_y, out_switch, session), session)

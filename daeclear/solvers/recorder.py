@@ -25,8 +25,9 @@ from ..results.events import EventRows, flatten
 from ..results.lazy_channels import LazyChannels
 from ..results.result import ContactEvent, Result, ResultWriter, load
 
-#: a chunk of points: t, y, yp, switch rows and the channels when the solver computed them
-Points = tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray] | None]
+#: a chunk of points: t, y, yp (None: IDA's raw points, made consistent when read), switch rows and the
+#: channels when the solver computed them
+Points = tuple[NDArray, NDArray, NDArray | None, NDArray, dict[str, NDArray] | None]
 
 
 def out_of_memory(t: float) -> str:
@@ -84,16 +85,18 @@ class Recorder:
             self._rebuildable = self._header["method"] == "ida" and rebuildable(self._header["parameters"])
         return self._rebuildable
 
-    def add_points(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray,
+    def add_points(self, t: NDArray, y: NDArray, yp: NDArray | None, switch: NDArray,
                    channels: dict[str, NDArray] | None = None) -> None:
-        """Reported points, consistent (unless :attr:`consistent_when_read`: IDA's own): one row per time of
-        ``t``, with its switch vector (one row per time) and, when the solver computed them, its channels."""
+        """Reported points, consistent (unless :attr:`consistent_when_read`: IDA's own y, and no yp): one row
+        per time of ``t``, with its switch vector (one row per time) and, when the solver computed them, its
+        channels."""
         if not t.size:
             return
         if self.writer is not None:
+            assert yp is not None, "a file stores consistent points, with their yp"
             if channels is None and not self.rebuildable():  # the file stores every channel
                 channels = self._evaluated(t, y, yp, switch)
-            self._keep_key_rows(t, y, self._checked(t, y, yp, switch, channels))
+            self._keep_key_rows(t, y, self._checked(t, y, switch, channels))
             self.writer.append(t=t, y=y, yp=yp, switch=switch, channels=None if self.rebuildable() else channels)
         else:
             self._points.append((t, y, yp, switch, channels))
@@ -117,13 +120,13 @@ class Recorder:
             self._in_blocks = 0
             self.segments.clear()
 
-    def _checked(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray,
+    def _checked(self, t: NDArray, y: NDArray, switch: NDArray,
                  channels: dict[str, NDArray] | None) -> dict[str, NDArray]:
         """The channels the physics checks read at the rows: taken from ``channels`` when given, else
         the model's checks function (in the run's session while it is open)."""
         if channels is not None:
             return {c: channels[c] for c in self.model.checked_names}
-        return self.model.checks(t, y, yp, switch, self.session)
+        return self.model.checks(t, y, switch, self.session)
 
     def _keep_key_rows(self, t: NDArray, y: NDArray, channels: dict[str, NDArray]) -> None:
         names = self.model.checked_names
@@ -142,7 +145,7 @@ class Recorder:
         out = ModelEvaluator(self.model, self._backend).channels(t, y, yp, switch)
         return {name: np.ascontiguousarray(out[name]) for name in self.model.channel_names}
 
-    def _joined(self) -> tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray] | None]:
+    def _joined(self) -> tuple[NDArray, NDArray, NDArray | None, NDArray, dict[str, NDArray] | None]:
         """The points kept in memory as one chunk, with their channels when the solver gave them (else
         None: the Result computes them when they are first read)."""
         n = self.model.n_states
@@ -151,7 +154,8 @@ class Recorder:
         if len(points) == 1:  # one chunk (a short run): nothing to join
             t, y, yp, switch, channels = points[0]
         elif points:
-            t, y, yp, switch = (np.concatenate([p[k] for p in points]) for k in range(4))
+            t, y, switch = (np.concatenate([p[k] for p in points]) for k in (0, 1, 3))
+            yp = None if points[0][2] is None else np.concatenate([p[2] for p in points])
             given = [p[4] for p in points]
             channels = None
             if all(g is not None for g in given):
@@ -169,7 +173,7 @@ class Recorder:
         in memory, the checked channels are computed at every point for them (the others are not)."""
         if self.writer is None:
             t, y, yp, switch, channels = self._joined()
-            checked = self._checked(t, y, yp, switch, channels)
+            checked = self._checked(t, y, switch, channels)
             rows = physics.key_rows(t, checked)
             return t[rows], y[rows], {c: v[rows] for c, v in checked.items()}
         return self._key
@@ -197,9 +201,10 @@ class Recorder:
         self._points.clear()
         evaluator = ModelEvaluator(self.model, self._backend)
         raw = self.consistent_when_read
-        kept_yp = None if raw else yp  # raw: IDA's, made consistent with y when either is first read
+        kept_yp = None if raw else yp  # raw: none kept, made consistent with y when either is first read
         lazy = LazyChannels(self.model.channel_names, evaluator.channels, t, y, kept_yp,
                             np.asarray(switch), consistent=evaluator.consistent, raw=raw, values=channels,
+                            recomputed=slice(2 * self.model.n_q, 2 * self.model.n_q + self.model.n_constraints),
                             rebuildable=self.rebuildable)
         steps = [np.concatenate(c) for c in zip(*self._steps)] if self._steps else [
             np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)]

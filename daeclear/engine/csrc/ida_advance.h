@@ -17,7 +17,7 @@ typedef struct {
   int n_eval;
   int* i_eval;          /* next output row */
   double* eval_y;
-  double* eval_yp;
+  double* eval_yp;       /* NULL: the caller needs no yp at the output times */
   int store_steps;      /* DC_STORE_* flags, 0: no step buffers */
   int cap;              /* rows of the step buffers (else IDA calls) per call */
   double* st;
@@ -112,7 +112,7 @@ static int adv_inside_last_step(dc_session* s, dc_adv* a) {
     if (te > p.t_prev) {
       if (IDAGetDky(s->ida, te, 0, s->dky) == 0)
         memcpy(a->eval_y + (size_t)(*a->i_eval) * n, N_VGetArrayPointer(s->dky), sizeof(double) * (size_t)n);
-      if (IDAGetDky(s->ida, te, 1, s->dky) == 0)
+      if (a->eval_yp && IDAGetDky(s->ida, te, 1, s->dky) == 0)
         memcpy(a->eval_yp + (size_t)(*a->i_eval) * n, N_VGetArrayPointer(s->dky), sizeof(double) * (size_t)n);
     }
     ++(*a->i_eval);
@@ -187,8 +187,8 @@ static int adv_dense_output(dc_session* s, dc_adv* a, const dc_step* p) {
     if (te > p->eval_lo) {
       const int f0 = IDAGetDky(s->ida, te, 0, s->dky);
       if (f0 == 0) memcpy(a->eval_y + (size_t)(*a->i_eval) * n, N_VGetArrayPointer(s->dky), sizeof(double) * (size_t)n);
-      const int f1 = f0 == 0 ? IDAGetDky(s->ida, te, 1, s->dky) : f0;
-      if (f1 == 0) memcpy(a->eval_yp + (size_t)(*a->i_eval) * n, N_VGetArrayPointer(s->dky), sizeof(double) * (size_t)n);
+      const int f1 = f0 != 0 ? f0 : a->eval_yp ? IDAGetDky(s->ida, te, 1, s->dky) : 0;
+      if (f1 == 0 && a->eval_yp) memcpy(a->eval_yp + (size_t)(*a->i_eval) * n, N_VGetArrayPointer(s->dky), sizeof(double) * (size_t)n);
       if (f0 || f1) {
         *a->flag_out = f0 ? f0 : f1;
         set_msg(s->msg, "IDAGetDky failed at t=%.17g (flag %d): %s", te, *a->flag_out, s->ida_msg);
@@ -247,11 +247,11 @@ static int adv_full(const dc_adv* a) {
  * Integrate from the current time towards t_stop (hard stop) in one-step mode.
  *
  * t_eval[*i_eval .. n_eval) are the requested output times, sorted, all > current time; each
- * one reached is written (y via IDAGetDky k=0, yp via k=1) to eval_y/eval_yp row *i_eval and
- * *i_eval advances. If store_steps (DC_STORE_TIMES, with DC_STORE_STATES also y and yp), every
- * return point of IDA (the end of each internal step; on a root return the root point;
- * duplicates skipped) is written to the step buffers, at most cap rows; *n_stored rows were
- * written.
+ * one reached is written (y via IDAGetDky k=0, yp via k=1 unless eval_yp is NULL) to
+ * eval_y/eval_yp row *i_eval and *i_eval advances. If store_steps (DC_STORE_TIMES, with
+ * DC_STORE_STATES also y and yp), every return point of IDA (the end of each internal step; on
+ * a root return the root point; duplicates skipped) is written to the step buffers, at most cap
+ * rows; *n_stored rows were written.
  *
  * Returns DC_CHUNK when cap rows were written (store_steps), cap IDA calls were made
  * (otherwise), or a step filled the last of the n_eval output rows (so that a caller can hand
