@@ -42,7 +42,8 @@ class SolverOptions:
     ----------
     method : str or a solver class
         "ida", "RK45", "DOP853", "Radau", "BDF", "LSODA", "rk4" or "euler" (case-insensitive), or a
-        class implementing :class:`daeclear.solvers.base.Solver`.
+        class implementing :class:`daeclear.solvers.base.Solver`, or such a class's import path
+        ``"module:Class"`` (how :meth:`to_dict` stores a class).
     rtol : float
         Relative tolerance (the chapter's "integration tolerance"), in [1e-14, 1e-2].
     atol : float, mapping, array or None
@@ -100,7 +101,10 @@ class SolverOptions:
     def to_dict(self) -> dict[str, Any]:
         """Every setting as JSON types (``atol`` a float, a list, a mapping or None): :meth:`from_dict`
         inverts it."""
+        from .solvers.registry import method_path
+
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        out["method"] = method_path(self.method)  # a class as its import path "module:Class"
         out["atol"] = self.atol_value()
         if isinstance(out["atol"], np.ndarray):
             out["atol"] = out["atol"].tolist()

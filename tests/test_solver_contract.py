@@ -81,6 +81,28 @@ def test_a_class_that_is_not_a_solver_is_refused() -> None:
         dc.simulate(dc.mechanisms.slider_crank("ideal"), T, method=int)
 
 
+def test_a_solver_class_is_stored_by_its_import_path_and_read_back() -> None:
+    """to_dict gives JSON (a sweep file, a result's parameters): a class as "module:Class", which
+    from_dict, SolverOptions and simulate read back to the class; a path that does not import is refused."""
+    import json
+
+    given = dc.SolverOptions(method=WrappedEuler, step=1e-5)
+    stored = json.loads(json.dumps(given.to_dict()))
+    assert stored["method"] == f"{__name__}:WrappedEuler"
+    assert dc.SolverOptions.from_dict(stored) == given and dc.SolverOptions.from_dict(stored).method is WrappedEuler
+    assert dc.SolverOptions(method="daeclear.solvers.explicit:Euler", step=1e-5).method.name == "euler"
+    assert dc.SolverOptions(method="lsoda").to_dict()["method"] == "lsoda"  # a name stays a name
+    with pytest.raises(SceneError, match=r"SolverOptions: method='no_such_module:Solver', must be a registered "
+                                         r"method name or the import path 'module:Class' of a solver class .*"
+                                         r"ModuleNotFoundError"):
+        dc.SolverOptions(method="no_such_module:Solver")
+    with pytest.raises(SceneError, match=r"method='daeclear:NoSuchClass', .*AttributeError"):
+        dc.SolverOptions(method="daeclear:NoSuchClass")
+    with pytest.raises(SceneError, match=r"method='daeclear:__version__', must be an import path 'module:Class' "
+                                         r"naming a class"):
+        dc.SolverOptions(method="daeclear:__version__")
+
+
 def test_simulate_takes_at_most_fourteen_parameters() -> None:
     import inspect
 

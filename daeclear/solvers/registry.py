@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 from typing import Any
 
 from .. import options
@@ -18,7 +19,20 @@ _MEMBERS = ("name", "formulation", "check", "run")
 
 
 def method(value: Any, *, where: str = "simulate", field: str = "method") -> str | type[Solver]:
-    """``method=``: a registered name (returned in lower case) or a class implementing the protocol."""
+    """``method=``: a registered name (returned in lower case), a class implementing the protocol, or
+    such a class by its import path ``"module:Class"`` (:func:`method_path`: how a file stores it)."""
+    if isinstance(value, str) and ":" in value:
+        module, _, qualname = value.partition(":")
+        try:
+            found: Any = importlib.import_module(module)
+            for part in qualname.split("."):
+                found = getattr(found, part)
+        except (ImportError, AttributeError, ValueError) as exc:
+            options.fail(where, field, value, "a registered method name or the import path 'module:Class' of a "
+                         f"solver class that can be imported here ({type(exc).__name__}: {exc})")
+        if not isinstance(found, type):
+            options.fail(where, field, value, "an import path 'module:Class' naming a class")
+        return method(found, where=where, field=field)
     if isinstance(value, type):
         missing = [m for m in _MEMBERS if not hasattr(value, m)]
         if missing or not all(callable(getattr(value, m)) for m in ("run", "check")):
@@ -27,6 +41,12 @@ def method(value: Any, *, where: str = "simulate", field: str = "method") -> str
                          + (f"; it lacks {', '.join(missing)}" if missing else ""))
         return value
     return options.method(value, where=where, field=field)
+
+
+def method_path(value: str | type[Solver]) -> str:
+    """A checked ``method`` as text (JSON, a file, a sweep's options): its name, or a class's import path
+    ``"module:Class"``, which :func:`method` reads back."""
+    return value if isinstance(value, str) else f"{value.__module__}:{value.__qualname__}"
 
 
 def solver_class(value: str | type[Solver]) -> type[Solver]:
