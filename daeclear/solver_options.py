@@ -102,7 +102,6 @@ class SolverOptions:
         """Every setting as JSON types (``atol`` a float, a list, a mapping or None): :meth:`from_dict`
         inverts it."""
         from .solvers.registry import method_path
-
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         out["method"] = method_path(self.method)  # a class as its import path "module:Class"
         out["atol"] = self.atol_value()

@@ -368,9 +368,8 @@ class DAEModel:
 
     def checks(self, t: NDArray[np.float64], y: NDArray[np.float64], switch: NDArray[np.float64],
                session: Any = None) -> dict[str, NDArray[np.float64]]:
-        """The channels the physics checks read (as :meth:`channels`, bit for bit), without the others.
-        Penetrations and the position constraints are functions of q alone: no yp is needed (zeros are
-        passed for the generated function's yp input)."""
+        """The channels the physics checks read (as :meth:`channels`, bit for bit), without the others:
+        penetrations and position constraints, functions of q alone (zeros go in for the yp input)."""
         return self._rows(EXTRA_CHECKS, self.checked_names, t, y, np.zeros(self.n_states), switch, session)
 
     def _rows(self, k: int, names: tuple[str, ...], t: ArrayLike, y: ArrayLike, yp: ArrayLike,

@@ -29,7 +29,6 @@ from .library import ModelLibrary
 from .session_base import (
     FLAG_MAX_STEPS,
     FLAG_STEP_COLLAPSE,
-    NO_ROWS,
     OWN_FLAG_NAMES,
     STORE_STATES,
     STORE_TIMES,
@@ -38,7 +37,6 @@ from .session_base import (
     SessionBase,
     SessionOptions,
     StateLayout,
-    empty_advance_arrays,
     output_rows,
 )
 from .sundials import SPARSE_LIBS
@@ -394,7 +392,7 @@ class CSession(SessionBase):
                 if k:
                     sy, syp = self._sy, self._syp
                     states = (sy[:k].copy(), syp[:k].copy() if store_yp else None) \
-                        if sy is not None and syp is not None and store_states else (NO_ROWS[n],) * 2
+                        if sy is not None and syp is not None and store_states else (np.empty((0, n)),) * 2
                     chunks.append((self._st[:k].copy(), *states, self._sh[:k].copy(), self._sord[:k].copy()))
                 taken = self._take_auto_events()  # drained at every chunk: the C buffer never overflows
                 if taken is not None:
@@ -418,8 +416,7 @@ class CSession(SessionBase):
             st, sy, sh, so = (np.concatenate([c[i] for c in chunks]) for i in (0, 1, 3, 4))
             syp = np.concatenate([c[2] for c in chunks]) if store_yp else None
         else:
-            e = empty_advance_arrays(n)
-            st, sy, syp, sh, so = e["step_t"], e["step_y"], e["step_yp"], e["step_h"], e["step_order"]
+            st, sy, syp, sh, so = np.empty(0), np.empty((0, n)), np.empty((0, n)), np.empty(0), np.empty(0, np.int32)
         ne = self._i_eval.value
         # the C loop stopped inside a step that has output times after the last row (see dc_advance)
         self._eval_after = float(te[-1]) if rc == DC_CHUNK and m and ne == m and te[-1] < self._t else None

@@ -21,7 +21,7 @@ from .stall_guard import StallGuard
 
 __all__ = ["DAEFunctions", "AutoEvents", "StateLayout", "Advance", "Session", "SessionOptions", "check_options",
            "SessionBase", "FLAG_MAX_STEPS", "FLAG_STEP_COLLAPSE", "OWN_FLAG_NAMES", "STORE_TIMES", "STORE_STATES",
-           "NO_ROWS", "empty_advance_arrays", "output_rows"]
+           "output_rows"]
 
 #: flag of an Advance that stopped because the session's step cap (max_steps) was reached
 FLAG_MAX_STEPS = -1001
@@ -233,26 +233,8 @@ def check_options(model: NormalizedModel, rtol: Any, atol: Any, max_step: Any, m
 STORE_TIMES, STORE_STATES = DC_STORE_TIMES, DC_STORE_STATES  # dc_advance's store_steps flags
 
 
-class _NoRows(dict):
-    """Empty (0, n) arrays by n: the step states of an advance that was not asked to keep them."""
-
-    def __missing__(self, n: int) -> np.ndarray:
-        self[n] = value = np.empty((0, n))
-        value.flags.writeable = False
-        return value
-
-
-#: NO_ROWS[n]: a read-only empty (0, n) array
-NO_ROWS = _NoRows()
-
 _EMPTY = np.empty(0)
 _EMPTY.flags.writeable = False
-
-
-def empty_advance_arrays(n: int) -> dict[str, np.ndarray]:
-    """The step arrays of an Advance that took no step (n states)."""
-    return dict(step_t=np.empty(0), step_y=np.empty((0, n)), step_yp=np.empty((0, n)), step_h=np.empty(0),
-                step_order=np.empty(0, dtype=np.int32))
 
 
 def output_rows(buffer: np.ndarray, n_rows: int) -> np.ndarray:

@@ -45,8 +45,8 @@ class LazyChannels:
         ``y`` holds IDA's own multipliers (a run kept in memory, ``yp`` None): ``y`` too is read
         from ``consistent``.
     recomputed : slice
-        The columns of ``y`` the consistency pass recomputes (the multipliers); the others (q, v, ...)
-        it keeps, so that :meth:`state_column` reads them without the pass.
+        The columns of ``y`` the consistency pass recomputes (the multipliers); :meth:`state_column`
+        reads the others without it.
     values : mapping, optional
         The channels when already computed (e.g. for the run's physics checks).
     rebuildable : bool or callable returning bool

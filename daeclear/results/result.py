@@ -284,8 +284,7 @@ class Result:
                 f"use result.t, result.y for the arrays."
             )
         if self._channels is None and self._lazy is not None and name in self.state_names:
-            # a state before any channel is read: its column (a channel of that name holds the same values),
-            # q and v of a run as stored, without computing the channels or the consistency pass
+            # a state before any channel is read (a channel of that name holds the same values): no pass
             return self._lazy.state_column(self.state_names.index(name))
         if name in self._names:
             return self._channel_values()[name]

@@ -61,8 +61,7 @@ class SegmentLoop:
             y, yp = model.consistent_state(t0, y0, model.term_forces(t0, y0, self.active, self.params, session),
                                            session)
         self.switch = model.switch_vector(self.active, self.params)
-        # reported points not made consistent yet (t and IDA's raw y, with each row's switch vector; no yp:
-        # the consistency pass computes it)
+        # reported points not made consistent yet: t, IDA's raw y (no yp) and each row's switch vector
         self.raw: list[tuple[NDArray, NDArray, NDArray]] = []
         rec.add_steps(np.array([t0]), np.array([0.0]), np.array([0]))
         self.i_eval = int(eval_times is not None and eval_times.window(0, 1)[0] == t0)  # the next output time

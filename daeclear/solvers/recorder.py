@@ -25,8 +25,7 @@ from ..results.events import EventRows, flatten
 from ..results.lazy_channels import LazyChannels
 from ..results.result import ContactEvent, Result, ResultWriter, load
 
-#: a chunk of points: t, y, yp (None: IDA's raw points, made consistent when read), switch rows and the
-#: channels when the solver computed them
+#: a chunk of points: t, y, yp (None: IDA's raw points), switch rows, the channels when the solver computed them
 Points = tuple[NDArray, NDArray, NDArray | None, NDArray, dict[str, NDArray] | None]
 
 
@@ -87,9 +86,8 @@ class Recorder:
 
     def add_points(self, t: NDArray, y: NDArray, yp: NDArray | None, switch: NDArray,
                    channels: dict[str, NDArray] | None = None) -> None:
-        """Reported points, consistent (unless :attr:`consistent_when_read`: IDA's own y, and no yp): one row
-        per time of ``t``, with its switch vector (one row per time) and, when the solver computed them, its
-        channels."""
+        """Reported points, consistent (unless :attr:`consistent_when_read`: IDA's own y, no yp), one row per
+        time of ``t``, with its switch vector and, when the solver computed them, its channels."""
         if not t.size:
             return
         if self.writer is not None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import importlib
 from typing import Any
 
@@ -24,9 +25,7 @@ def method(value: Any, *, where: str = "simulate", field: str = "method") -> str
     if isinstance(value, str) and ":" in value:
         module, _, qualname = value.partition(":")
         try:
-            found: Any = importlib.import_module(module)
-            for part in qualname.split("."):
-                found = getattr(found, part)
+            found = functools.reduce(getattr, qualname.split("."), importlib.import_module(module))
         except (ImportError, AttributeError, ValueError) as exc:
             options.fail(where, field, value, "a registered method name or the import path 'module:Class' of a "
                          f"solver class that can be imported here ({type(exc).__name__}: {exc})")
@@ -44,8 +43,7 @@ def method(value: Any, *, where: str = "simulate", field: str = "method") -> str
 
 
 def method_path(value: str | type[Solver]) -> str:
-    """A checked ``method`` as text (JSON, a file, a sweep's options): its name, or a class's import path
-    ``"module:Class"``, which :func:`method` reads back."""
+    """A checked ``method`` as text (JSON): its name, or a class as ``"module:Class"`` (:func:`method` reads it)."""
     return value if isinstance(value, str) else f"{value.__module__}:{value.__qualname__}"
 
 
