@@ -180,7 +180,7 @@ class PythonSession(SessionBase):
                 store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
                 chunked: bool = False, store_yp: bool = True) -> Advance:
         t_stop = self._check_advance(t_stop)
-        rows = _Rows(self._select_eval(t_eval, t_stop), self._n, self._t)
+        rows = _Rows(self._select_eval(t_eval, t_stop), self._n, self._t, store_yp)
         outcome = _Outcome()
         tic = time.perf_counter()
         try:
@@ -188,7 +188,7 @@ class PythonSession(SessionBase):
                 self._step_until(t_stop, rows, outcome, store_steps, chunked)
         finally:
             self._solve_time += time.perf_counter() - tic
-        return rows.advance(outcome, self._t, self._y, self._yp, store_yp)
+        return rows.advance(outcome, self._t, self._y, self._yp)
 
     def _step_until(self, t_stop: float, rows: _Rows, outcome: _Outcome, store_steps: bool, chunked: bool) -> None:
         """IDA in one-step mode until t_stop, a root, a failure, the step cap or (chunked) a full buffer."""
@@ -330,9 +330,10 @@ class _Outcome:
 class _Rows:
     """What one advance of the python session reports: output times (cubic Hermite) and IDA's returns."""
 
-    def __init__(self, te: np.ndarray, n: int, t_start: float) -> None:
+    def __init__(self, te: np.ndarray, n: int, t_start: float, store_yp: bool) -> None:
         self.te, self.n = te, n
-        self.ev_y, self.ev_yp = np.empty((te.size, n)), np.empty((te.size, n))
+        self.ev_y = np.empty((te.size, n))
+        self.ev_yp = np.empty((te.size, n)) if store_yp else None  # None: no yp computed at the output times
         self.ie = 0  # output times filled so far
         self.st: list[float] = []
         self.sy: list[np.ndarray] = []
@@ -347,8 +348,11 @@ class _Rows:
         if not (ie < te.size and te[ie] <= t_new):
             return False
         j = int(np.searchsorted(te, t_new, side="right"))
-        self.ev_y[ie:j], self.ev_yp[ie:j] = cubic_hermite(t_prev, y_prev, yp_prev, t_new, y_new, yp_new, te[ie:j],
-                                                          derivative=True)
+        if self.ev_yp is None:
+            self.ev_y[ie:j] = cubic_hermite(t_prev, y_prev, yp_prev, t_new, y_new, yp_new, te[ie:j])
+        else:
+            self.ev_y[ie:j], self.ev_yp[ie:j] = cubic_hermite(t_prev, y_prev, yp_prev, t_new, y_new, yp_new,
+                                                              te[ie:j], derivative=True)
         self.ie = j
         return True
 
@@ -361,14 +365,14 @@ class _Rows:
             self.sh.append(h)
             self.t_rec = t
 
-    def advance(self, outcome: _Outcome, t: float, y: np.ndarray, yp: np.ndarray, store_yp: bool) -> Advance:
-        k, n, ie = len(self.st), self.n, self.ie
+    def advance(self, outcome: _Outcome, t: float, y: np.ndarray, yp: np.ndarray) -> Advance:
+        k, n, ie, store_yp = len(self.st), self.n, self.ie, self.ev_yp is not None
         return Advance(
             status=outcome.status, t=t, y=y.copy(), yp=yp.copy(),
             step_t=np.array(self.st, dtype=float), step_y=np.array(self.sy, dtype=float).reshape(k, n),
             step_yp=np.array(self.syp, dtype=float).reshape(k, n) if store_yp else None,
             step_h=np.array(self.sh, dtype=float), step_order=np.full(k, -1, dtype=np.int32),
             eval_t=self.te[:ie].copy(), eval_y=output_rows(self.ev_y, ie),
-            eval_yp=output_rows(self.ev_yp, ie) if store_yp else None, roots_found=outcome.roots, flag=outcome.flag,
-            flag_name=outcome.flag_name, message=outcome.message,
+            eval_yp=None if self.ev_yp is None else output_rows(self.ev_yp, ie), roots_found=outcome.roots,
+            flag=outcome.flag, flag_name=outcome.flag_name, message=outcome.message,
         )
