@@ -18,12 +18,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import statistics
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from bench_trees import tree_env
 
 #: one call a line on stdin ("formulation rtol t_end"), its wall time and steps as JSON on stdout
 WORKER = r"""
@@ -52,8 +53,7 @@ CALLS = [(window, t_end, formulation, rtol)
 
 def start_worker(tree: Path, cache: Path) -> subprocess.Popen[str]:
     """A worker in ``tree``'s package (its own compile cache)."""
-    env = {**os.environ, "PYTHONPATH": str(tree), "DAECLEAR_CACHE_DIR": str(cache), "MPLBACKEND": "Agg"}
-    return subprocess.Popen([sys.executable, "-c", WORKER], cwd=tree, env=env, stdin=subprocess.PIPE,
+    return subprocess.Popen([sys.executable, "-c", WORKER], cwd=tree, env=tree_env(tree, cache), stdin=subprocess.PIPE,
                             stdout=subprocess.PIPE, text=True)
 
 

@@ -66,9 +66,14 @@ def times_by_line(output: str) -> dict[tuple[str, int], list[float]]:
     return out
 
 
+def tree_env(tree: Path, cache: Path) -> dict[str, str]:
+    """The environment of a process that imports ``tree``'s package, with its own compile cache."""
+    return {**os.environ, "PYTHONPATH": str(tree), "DAECLEAR_CACHE_DIR": str(cache), "MPLBACKEND": "Agg"}
+
+
 def run(tree: Path, script: str, args: list[str], cache: Path) -> str:
     """One benchmark script of ``tree`` (or a worker's code) in ``tree``'s package; its standard output."""
-    env = {**os.environ, "PYTHONPATH": str(tree), "DAECLEAR_CACHE_DIR": str(cache), "MPLBACKEND": "Agg"}
+    env = tree_env(tree, cache)
     command = ["-c", script] if "\n" in script else [str(tree / "benchmarks" / script)]
     done = subprocess.run([sys.executable, *command, *args], cwd=tree, env=env, capture_output=True, text=True,
                           check=False)
