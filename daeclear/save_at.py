@@ -121,8 +121,9 @@ class Output(NamedTuple):
         place = ("in the file and in memory" if self.stream_to is not None and self.keep_data
                  else "in the file" if self.stream_to is not None else "in memory")
         field, value, shown = source
+        count = f"{points:,}".replace(",", " ")  # exact: 1 000 001 is not the cap of 1 000 000
         fail(where, field, value,
-             f"coarser: it gives {points:.4g} output points over {end - start:g} s, about {_size(points * per_point)} "
+             f"coarser: it gives {count} output points over {end - start:g} s, about {_size(points * per_point)} "
              f"{place} ({per_point} bytes a point: t, {n_states} states and their derivatives, {n_channels} "
              f"channels), more than save.max_points={limit}; or raise max_points (daeclear run: "
              "--max-points; None: no limit) to run it anyway", shown=shown)

@@ -3,10 +3,11 @@
 Runs every example script's cases in this process (each script's ``run`` and ``figures``, with
 the scripts' default settings: 4 revolutions of transient, 20 analysed for section 4.4 and 10 for
 section 4.5, the last two plotted; nothing but the PNGs is written), and writes one small PNG
-per family into ``--out`` (default
-``docs/figures/gallery/``): 90 dpi, quantized to a 256-colour palette, the figure title also
-in the PNG's ``Title`` text. With the default output directory it also writes
-``docs/gallery.md``, the page that shows them.
+per family into ``--out`` (default ``results/gallery/`` in the current directory, as every example
+script): 90 dpi, quantized to a 256-colour palette, the figure title also in the PNG's ``Title``
+text; ``--doc PAGE`` also writes the page that shows them. The committed gallery is made by
+``python examples/gallery.py --out docs/figures/gallery --doc docs/gallery.md``: only a command that
+names them writes into the checkout.
 
 Every figure is titled with the parameters of its runs (``daeclear.plot.style.caption``): clearance,
 crank speed, contact law and restitution, friction; a figure comparing cases states the shared
@@ -39,8 +40,10 @@ sys.path.insert(0, str(HERE))
 import _common as cm  # noqa: E402
 
 ROOT = HERE.parent
-DEFAULT_OUT = ROOT / "docs" / "figures" / "gallery"
-DEFAULT_DOC = ROOT / "docs" / "gallery.md"
+DEFAULT_OUT = Path("results") / "gallery"  # in the current directory, as every example script writes
+COMMITTED = ROOT / "docs" / "figures" / "gallery"  # the gallery docs/gallery.md shows
+#: The command that makes the committed gallery and its page (the only one that writes into the checkout).
+REGENERATE = "python examples/gallery.py --out docs/figures/gallery --doc docs/gallery.md"
 DPI = 90
 
 
@@ -147,7 +150,7 @@ def markdown(sizes: dict[str, int], seconds: float) -> str:
         "contact law and restitution, friction. A figure comparing cases states the shared parameters in its",
         "title and the varied one in its panel titles or legend.",
         "",
-        f"Made by `python examples/gallery.py` ({len(sizes)} images, {total / 1e3:.0f} kB, {seconds:.0f} s on the",
+        f"Made by `{REGENERATE}` ({len(sizes)} images, {total / 1e3:.0f} kB, {seconds:.0f} s on the",
         "project's 2-core machine with a warm compile cache): each example script's cases with its default "
         "settings (4 revolutions of",
         "transient discarded, 20 analysed for section 4.4 and 10 for section 4.5, the last two plotted),",
@@ -190,15 +193,11 @@ def build(out: Path, *, quick: bool = False, doc: Path | None = None) -> dict[st
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="gallery.py", description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="5 ms runs (smoke test), same file names")
-    parser.add_argument("--out", type=Path, default=DEFAULT_OUT,
-                        help="output directory (default docs/figures/gallery/)")
+    parser.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"output directory (default {DEFAULT_OUT}/)")
     parser.add_argument("--doc", type=Path, default=None,
-                        help="page to write (default docs/gallery.md for a full run into the default directory)")
+                        help=f"also write the page showing the images (default none; the committed: {REGENERATE})")
     args = parser.parse_args(argv)
-    doc = args.doc
-    if doc is None and not args.quick and args.out.resolve() == DEFAULT_OUT:
-        doc = DEFAULT_DOC
-    build(args.out, quick=args.quick, doc=doc)
+    build(args.out, quick=args.quick, doc=args.doc)
     return 0
 
 

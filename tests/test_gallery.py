@@ -96,9 +96,23 @@ def test_committed_gallery_matches_its_page(gallery: ModuleType) -> None:
     assert shown == [f.file for f in gallery.FAMILIES]
     total = 0
     for family in gallery.FAMILIES:
-        path = gallery.DEFAULT_OUT / family.file
+        path = gallery.COMMITTED / family.file
         assert 5_000 < path.stat().st_size < 200_000, family.file
         assert "5000 rpm" in gallery.png_title(path)
         assert f"python examples/{family.script}.py" in page
         total += path.stat().st_size
     assert total < 2_000_000
+
+
+def test_gallery_without_options_writes_into_the_current_directory_only(
+        gallery: ModuleType, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    # `python examples/gallery.py` (a README command) rewrote the 10 tracked files under docs/ (issue 45):
+    # now only a command naming docs/ writes there
+    calls: list[tuple[Path, Path | None]] = []
+    monkeypatch.setattr(gallery, "build", lambda out, *, quick=False, doc=None: calls.append((out, doc)) or {})
+    monkeypatch.chdir(tmp_path)
+    assert gallery.main([]) == 0
+    assert gallery.main(gallery.REGENERATE.split()[2:]) == 0
+    out, doc = calls[0]
+    assert (tmp_path / out).resolve() == tmp_path / "results" / "gallery" and doc is None
+    assert calls[1] == (Path("docs/figures/gallery"), Path("docs/gallery.md"))
