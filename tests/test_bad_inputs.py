@@ -127,7 +127,7 @@ API_SIMULATE: list[tuple[str, dict[str, Any], str, str]] = [
     ("times above the cap", {"times": np.linspace(0.0, TINY, 10), "max_points": 9}, "times",
      "array of 10 times"),
     ("rk4 every step above the cap", {"method": "rk4", "step": 1e-11}, "step", "1e-11"),
-    ("DOP853 every too fine", {"method": "DOP853", "every": 1e-12}, "every", "1e+08 output points"),
+    ("DOP853 every too fine", {"method": "DOP853", "every": 1e-12}, "every", "100 000 001 output points"),
     ("max_points 0", {"max_points": 0}, "max_points", "0"),
     ("max_points bool", {"max_points": True}, "max_points", "True"),
     ("max_points float", {"max_points": 1e6}, "max_points", "1000000.0"),

@@ -94,7 +94,7 @@ def test_sweep_exits_non_zero_when_a_run_fails(tmp_path, capsys, monkeypatch):
 
 
 @pytest.mark.parametrize("args, shown", [
-    (["--t-end", "0.002", "--t-eval-step", "1e-12"], "2e+09 output points"),
+    (["--t-end", "0.002", "--t-eval-step", "1e-12"], "2 000 000 001 output points"),
     (["--t-end", "0.002", "--t-eval-step", "1e-6", "--max-points", "1000"], "save.max_points=1000"),
 ])
 def test_cli_refuses_an_output_too_large_before_the_run(args, shown, tmp_path, capsys):
