@@ -175,3 +175,41 @@ def test_car_axis_built_as_a_mechanism_reaches_the_test_set_reference():
     start = [(*scene[b].position, *scene[b].velocity) for b in ("left_wheel", "axle")]
     np.testing.assert_allclose(start, [(0.0, 0.5, -0.5, 0.0), (1.0, 0.5, -0.5, 0.0)], rtol=0, atol=1e-14)
     assert car_axis.digits(car_axis.daeclear_state(scene, 1e-8)) > 5.0
+
+
+def test_contradictory_speeds_are_refused_with_what_the_mechanism_allows():
+    """Issue 45: two speeds for a one-degree-of-freedom four-bar were fitted by least squares (A started at
+    -2.03 rad/s, B at 3.01, neither value) without a word; now refused, both joints and values named."""
+    free = dc.mechanisms.four_bar().without("drive")
+    with pytest.raises(AssemblyError) as info:
+        free.assembled(start={"A": 0.5}, speeds={"A": 1.0, "B": 5.0})
+    text = str(info.value)
+    assert "speeds={'A': 1.0, 'B': 5.0} contradict the joints" in text and "1 degree(s) of freedom" in text
+    assert "(1 given)" in text and "(5 given)" in text and "A.rate = " in text and "B.rate = " in text
+    # the same two speeds when they agree with the kinematics: accepted, and both held
+    placed = free.assembled(start={"A": 0.5}, speeds={"A": 1.0})
+    b_rate = dc.simulate(placed, 1e-5, options=dc.SolverOptions(start="declared"))["B.rate"][0]
+    again = free.assembled(start={"A": 0.5}, speeds={"A": 1.0, "B": b_rate})
+    run = dc.simulate(again, 1e-5, options=dc.SolverOptions(start="declared"))
+    assert run["A.rate"][0] == pytest.approx(1.0, abs=1e-9) and run["B.rate"][0] == pytest.approx(b_rate, abs=1e-9)
+
+
+@pytest.mark.parametrize("displacement", [0.075, 0.12, 0.16, 0.169])
+def test_a_start_from_a_dead_centre_declaration_finds_the_configuration(displacement):
+    """Issue 45: the ready slider-crank is declared at its outer dead centre (crank along the rod), where the
+    slider's displacement does not move to first order: Newton from there failed for every reachable
+    displacement. Continuation from a first guess finds the closed form (crank above the axis)."""
+    placed = dc.mechanisms.slider_crank().without("drive").assembled(start={"D": displacement})
+    theta = brentq(lambda a: R * math.cos(a) + math.sqrt(L**2 - (R * math.sin(a))**2) - displacement, 0.0, math.pi,
+                   xtol=1e-15, rtol=4 * np.finfo(float).eps)
+    expected = ideal_slider_crank_state(theta, 0.0)
+    for name, pose in _poses(placed).items():
+        np.testing.assert_allclose(pose[:3], expected[name][:3], rtol=0, atol=1e-12)
+
+
+def test_an_unreachable_start_from_a_dead_centre_names_the_singular_joint():
+    with pytest.raises(AssemblyError) as info:
+        dc.mechanisms.slider_crank().without("drive").assembled(start={"D": 0.2})  # beyond R + L = 0.17 m
+    text = str(info.value)
+    assert "cannot all close" in text and "6 first guesses" in text
+    assert "D (displacement) is at a singular configuration" in text

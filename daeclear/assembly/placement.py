@@ -50,57 +50,157 @@ def assembled(scene: Scene, start: Mapping[str, float] | None = None,
                              "leave it out of speeds.")
     model = assemble(scene)
     ref = Reference(tuple(scene.bodies), GROUND)
-    n = model.n_q
     names = list(dict.fromkeys([*start_values, *(speed_values or {})]))
-    coordinates = _coordinate_function(scene, ref, [joints[name] for name in names])
     replaced = {drivers[name].name for name in start_values if name in drivers}
-    owners = _row_owners(model)
-    keep = [i for i, owner in enumerate(owners) if owner not in replaced]
+    place = _Placement(model, _coordinate_function(scene, ref, [joints[name] for name in names]), names,
+                       [i for i, owner in enumerate(_row_owners(model)) if owner not in replaced])
     label = f"scene '{scene.name}': assembled(start={dict(start_values)!r})"
+    q = place.positions(label, start_values, joints)
+    Phi, Phi_q, c, C_q = place.rows(q, list(start_values))
+    _check_fixed(label, "start", np.vstack([Phi_q, C_q]), scene, list(start_values), joints)
+    # no speeds: the declared velocities corrected (least norm) to the joints and drivers, as a run's start does
+    v = model.assemble_velocities(q, model.v_guess, ideal=True)
+    if speed_values is not None:
+        v = place.velocities(scene, q, speed_values, joints)
+    return _placed(scene, ref, q, v)
 
-    def rows(q: NDArray[np.float64], v: NDArray[np.float64], chosen: list[str]
+
+#: First guesses when Newton from the declared pose fails: the pose moved along each of its free motions
+#: (the null space of the joints' Jacobian, unit vectors in the body coordinates) by these steps, both ways.
+GUESS_STEPS = (0.1, 0.3, 1.0)
+#: Continuation from a first guess: the chosen coordinates moved to their values in this many equal steps.
+CONTINUATION_STEPS = 16
+#: Speeds are consistent when the velocity the joints allow meets each to this fraction of the largest speed.
+SPEED_TOL = 1e-9
+
+
+class _Placement:
+    """The start's conditions on the body coordinates: the joints and drivers closed as at a run's start
+    (``keep``: the rows of the drivers of named joints left out) and the named joints' coordinates."""
+
+    def __init__(self, model: DAEModel, coordinates: ca.Function, names: list[str], keep: list[int]) -> None:
+        self.model, self.coordinates, self.names, self.keep = model, coordinates, names, keep
+        self.zero = np.zeros(model.n_q)
+
+    def rows(self, q: NDArray[np.float64], chosen: list[str]
              ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        Phi, Phi_q, Phi_dot = model.constraints(q, v, 0.0, ideal=True)
-        c, C_q = (np.asarray(x, dtype=float) for x in coordinates(q))
-        index = [names.index(name) for name in chosen]
-        return Phi[keep], Phi_q[keep], c.ravel()[index], C_q[index]
+        """(Phi, Phi_q, c, C_q): the kept joint rows and the ``chosen`` coordinates at ``q``."""
+        Phi, Phi_q, _ = self.model.constraints(q, self.zero, 0.0, ideal=True)
+        c, C_q = (np.asarray(x, dtype=float) for x in self.coordinates(q))
+        index = [self.names.index(name) for name in chosen]
+        return Phi[self.keep], Phi_q[self.keep], c.ravel()[index], C_q[index]
 
-    q = np.array(model.q_guess, dtype=float)
-    chosen = list(start_values)
-    target = np.array([start_values[name] for name in chosen])
-    scale = max(1.0, float(np.max(np.abs(q))))
-    for _ in range(NEWTON_STEPS):
-        Phi, Phi_q, c, C_q = rows(q, np.zeros(n), chosen)
-        F, J = np.concatenate([Phi, c - target]), np.vstack([Phi_q, C_q])
-        if F.size == 0 or np.max(np.abs(F)) < POSITION_TOL * scale:
-            # one step more: the coordinates to round-off, however flat the closure is in them
-            q = q + np.linalg.lstsq(J, -F, rcond=None)[0] if F.size else q
-            break
-        q = q + np.linalg.lstsq(J, -F, rcond=None)[0]
-    else:
-        row_names = [model.start_constraint_names[i] for i in keep] + [
+    def newton(self, q: NDArray[np.float64], chosen: list[str], target: NDArray[np.float64], scale: float
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64], bool]:
+        """Least-norm Newton on the joints and the ``chosen`` coordinates at ``target``: (q, residual, closed)."""
+        F = np.zeros(0)
+        for _ in range(NEWTON_STEPS):
+            Phi, Phi_q, c, C_q = self.rows(q, chosen)
+            F, J = np.concatenate([Phi, c - target]), np.vstack([Phi_q, C_q])
+            if F.size == 0 or np.max(np.abs(F)) < POSITION_TOL * scale:
+                # one step more: the coordinates to round-off, however flat the closure is in them
+                return (q + np.linalg.lstsq(J, -F, rcond=None)[0] if F.size else q), F, True
+            if not np.all(np.isfinite(F)):
+                break
+            q = q + np.linalg.lstsq(J, -F, rcond=None)[0]
+        return q, F, False
+
+    def continued(self, q: NDArray[np.float64], chosen: list[str], target: NDArray[np.float64], scale: float
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64], bool]:
+        """From ``q``: close the joints, then move the coordinates to ``target`` step by step (each step's
+        Newton starts at the previous pose, so the branch of ``q`` is kept)."""
+        q, F, closed = self.newton(q, [], np.zeros(0), scale)
+        if not closed:
+            return q, F, False
+        start = self.rows(q, chosen)[2]
+        for k in range(1, CONTINUATION_STEPS + 1):
+            q, F, closed = self.newton(q, chosen, start + k / CONTINUATION_STEPS * (target - start), scale)
+            if not closed:
+                return q, F, False
+        return q, F, True
+
+    def positions(self, label: str, start_values: dict[str, float], joints: dict[str, Any]) -> NDArray[np.float64]:
+        """The body coordinates with the joints closed and the named coordinates at their values: Newton from
+        the declared pose; failing that, continuation from it and from first guesses around it (a declared
+        pose at a dead centre, where the coordinate does not move to first order). AssemblyError if none closes."""
+        chosen = list(start_values)
+        target = np.array([start_values[name] for name in chosen])
+        declared = np.array(self.model.q_guess, dtype=float)
+        scale = max(1.0, float(np.max(np.abs(declared))))
+        q, F, closed = self.newton(declared, chosen, target, scale)
+        guesses = [] if closed else [declared, *first_guesses(declared, self.rows(declared, [])[1])]
+        for guess in guesses:
+            found = self.continued(guess, chosen, target, scale)
+            if found[2]:
+                return found[0]
+        if closed:
+            return q
+        row_names = [self.model.start_constraint_names[i] for i in self.keep] + [
             f"{name}.{JOINT_CHANNELS[driven_coordinate(joints[name])][0][0]}" for name in chosen]  # type: ignore[index]
         worst = np.argsort(-np.abs(F))[:4]
         detail = ", ".join(f"{row_names[i]} = {F[i]:.3g}" for i in worst)
         involved = ", ".join(dict.fromkeys(row_names[i].rsplit(".", 1)[0] for i in worst if abs(F[i]) > 1e-9))
-        raise AssemblyError(f"{label}: the joints cannot all close at the chosen coordinates: after {NEWTON_STEPS} "
-                            f"Newton iterations the largest residuals are {detail} (joints {involved}). Check the "
-                            "chosen values (a loop that cannot reach them), the joint points and the drivers' "
-                            "initial values.")
-    _check_fixed(label, "start", np.vstack([Phi_q, C_q]), scene, chosen, joints)
-    # no speeds: the declared velocities corrected (least norm) to the joints and drivers, as a run's start does
-    v = model.assemble_velocities(q, model.v_guess, ideal=True)
-    if speed_values is not None:
-        _, Phi_q, Phi_t = model.constraints(q, np.zeros(n), 0.0, ideal=True)
-        by_name = [names.index(name) for name in speed_values]
-        C_q = np.asarray(coordinates(q)[1], dtype=float)[by_name]
-        # every row of the start, the drivers' too (their profiles give their joints' speeds)
-        J = np.vstack([Phi_q, C_q])
-        b = np.concatenate([-Phi_t, [speed_values[name] for name in speed_values]])
-        _check_fixed(f"scene '{scene.name}': assembled(speeds={dict(speed_values)!r})", "speeds", J, scene,
-                     list(speed_values), joints)
-        v = np.linalg.lstsq(J, b, rcond=None)[0]
-    return _placed(scene, ref, q, v)
+        _, Phi_q, _, C_q = self.rows(declared, chosen)
+        raise AssemblyError(f"{label}: the joints cannot all close at the chosen coordinates: Newton from the "
+                            f"declared pose and continuation from it and from {len(guesses) - 1} first guesses "
+                            f"around it fail; the largest residuals are {detail} (joints {involved}). "
+                            + stationary(Phi_q, C_q, chosen, joints)
+                            + "Check the chosen values (a loop that cannot reach them), the joint points and the "
+                            "drivers' initial values.")
+
+    def velocities(self, scene: Scene, q: NDArray[np.float64], speed_values: dict[str, float],
+                   joints: dict[str, Any]) -> NDArray[np.float64]:
+        """The velocity with the joints' rates ``speed_values``: every row of the start held (the drivers' too:
+        their profiles give their joints' speeds), the speeds met exactly or refused (AssemblyError)."""
+        _, Phi_q, Phi_t = self.model.constraints(q, self.zero, 0.0, ideal=True)
+        C_q = np.asarray(self.coordinates(q)[1], dtype=float)[[self.names.index(name) for name in speed_values]]
+        given = np.array([speed_values[name] for name in speed_values])
+        _check_fixed(f"scene '{scene.name}': assembled(speeds={dict(speed_values)!r})", "speeds",
+                     np.vstack([Phi_q, C_q]), scene, list(speed_values), joints)
+        # the velocities the joints allow, v_p + N z; the speeds fit in z alone, so a miss is theirs
+        v_p = np.linalg.lstsq(Phi_q, -Phi_t, rcond=None)[0]
+        free = _free_motions(Phi_q)
+        v = v_p + free.T @ np.linalg.lstsq(C_q @ free.T, given - C_q @ v_p, rcond=None)[0]
+        got = C_q @ v
+        if np.max(np.abs(got - given)) > SPEED_TOL * max(1.0, float(np.max(np.abs(given)))):
+            rates = [JOINT_CHANNELS[driven_coordinate(joints[name])][1] for name in speed_values]  # type: ignore[index]
+            detail = ", ".join(f"{name}.{rate} = {closest:.6g} {unit} ({value:.6g} given)" for name, value, closest,
+                               (rate, unit) in zip(speed_values, given, got, rates))
+            raise AssemblyError(
+                f"scene '{scene.name}': assembled: speeds={dict(speed_values)!r} contradict the joints: the mechanism "
+                f"has {free.shape[0]} degree(s) of freedom, {len(speed_values)} speeds given, and no velocity it "
+                f"allows has them all; the closest has {detail}. Give {free.shape[0]} independent speed(s), or values "
+                "the kinematics allow.")
+        return v
+
+
+def _free_motions(Phi_q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """An orthonormal basis of the motions the rows ``Phi_q`` allow (their null space), one per row."""
+    if not Phi_q.size:
+        return np.eye(Phi_q.shape[1])
+    _, sigma, vt = np.linalg.svd(Phi_q)
+    return vt[int(np.sum(sigma > RANK_TOL * float(sigma[0]))):]
+
+
+def first_guesses(q: NDArray[np.float64], Phi_q: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+    """Poses around ``q`` along its free motions, nearest first (the positive direction before the negative)."""
+    free = _free_motions(Phi_q)
+    return [q + sign * step * direction for step in GUESS_STEPS for direction in free for sign in (1.0, -1.0)]
+
+
+def stationary(Phi_q: NDArray[np.float64], C_q: NDArray[np.float64], chosen: list[str],
+               joints: dict[str, Any]) -> str:
+    """The sentence naming the chosen joints whose coordinate no motion the joints allow changes at the
+    declared pose (a singular configuration, e.g. a slider-crank at a dead centre), or ""."""
+    free = _free_motions(Phi_q)
+    stuck = [name for name, row in zip(chosen, C_q)
+             if free.size == 0 or np.linalg.norm(free @ row) <= 1e-8 * max(1.0, float(np.linalg.norm(row)))]
+    if not stuck:
+        return ""
+    words = ", ".join(f"{name} ({JOINT_CHANNELS[driven_coordinate(joints[name])][0][0]})" for name in stuck)
+    return (f"At the declared pose {words} is at a singular configuration: no motion the joints allow changes "
+            "its coordinate to first order (links aligned, e.g. a dead centre); declare the bodies away from it, "
+            "on the branch wanted. ")
 
 
 def _checked(scene: Scene, field_name: str, values: Mapping[str, float] | None, joints: dict[str, Any]
