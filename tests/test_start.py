@@ -87,3 +87,32 @@ def test_a_journal_declared_off_centre_starts_centred():
 def test_start_is_validated():
     with pytest.raises(dc.SceneError, match="start='centred'"):
         dc.simulate(hand_built("revolute"), t_end=1e-3, options=dc.SolverOptions(start="centred"))
+
+
+def _moving_journal() -> dc.Scene:
+    scene = dc.Scene("drop", gravity=(0.0, -9.81))
+    journal = scene.add(dc.Body("journal", mass=0.1, inertia=1e-5, velocity=(1.0, 0.0), angular_velocity=5.0))
+    scene.add(dc.RevoluteClearance("bearing", scene.ground, journal, at=(0, 0), bearing_radius=10e-3,
+                                   clearance=0.5e-3, material=dcc.Material(young=207e9, poisson=0.3),
+                                   law=dcc.LankaraniNikravesh(restitution=0.9)))
+    return scene
+
+
+def test_a_declared_velocity_the_ideal_start_replaces_is_warned_of_and_a_free_one_kept():
+    """Issue 45: a free journal declared at 1 m/s started at rest without a word. The ideal pin of the
+    chapter's start fixes its centre (so the start moves it with the bearing: at rest) and says so,
+    naming the option that keeps it; its spin, which the pin leaves free, is kept as declared."""
+    scene = _moving_journal()
+    with pytest.warns(dc.DaeclearWarning) as record:
+        result = dc.simulate(scene, 1e-5)
+    text = " ".join(str(w.message) for w in record)
+    assert "Body 'journal': velocity=(1, 0) m/s declared, started at (0, 0) m/s" in text
+    assert "start='declared'" in text and "angular_velocity" not in text
+    assert result["journal.vx"][0] == 0.0 and result["journal.omega"][0] == pytest.approx(5.0, rel=1e-12)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", dc.DaeclearWarning)
+        kept = dc.simulate(scene, 1e-5, options=dc.SolverOptions(start="declared"))
+        dc.simulate(dc.mechanisms.slider_crank("revolute"), 1e-5)  # declared on its kinematics: nothing changed
+    assert kept["journal.vx"][0] == pytest.approx(1.0, rel=1e-12)

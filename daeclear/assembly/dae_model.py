@@ -80,7 +80,7 @@ class DAEModel:
     has_loads: bool = False  # loads besides gravity
     # consistent starts by (start, allow_penetration, evaluator, numbers, guesses), shared by the models
     # of one structure: a model run again skips assembling its start
-    start_memo: dict[tuple[Any, ...], tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
+    start_memo: dict[tuple[Any, ...], tuple[NDArray[np.float64], NDArray[np.float64], str]] = field(
         default_factory=dict, compare=False, repr=False)
     # the parameters the chapter's start depends on (None: all), its memo key's numbers (start_parameters())
     start_parameters: NDArray[np.intp] | None = field(default=None, compare=False, repr=False)
@@ -335,17 +335,26 @@ class DAEModel:
         key = (start, bool(allow_penetration), "casadi" if session is None else type(session).__name__,
                numbers.tobytes(), self.q_guess.tobytes(), self.v_guess.tobytes())
         known = self.start_memo.get(key)
-        if known is not None:
-            return known[0].copy(), known[1].copy()
-        q = self.assemble_positions(self.q_guess, session=session, ideal=ideal)
-        check_independent(self, q, session)
-        v = self.assemble_velocities(q, self.v_guess, session=session, ideal=ideal)
-        y, yp = self.consistent_state(0.0, np.concatenate([q, v, np.zeros(self.n_states - 2 * self.n_q)]),
-                                      session=session)
-        if not ideal and not allow_penetration:
-            check_start_penetration(self, y, yp, session)
-        memo_put_bounded(self.start_memo, key, (_read_only(y), _read_only(yp)), START_MEMO_LIMIT)
-        return y, yp
+        if known is None:
+            q = self.assemble_positions(self.q_guess, session=session, ideal=ideal)
+            check_independent(self, q, session)
+            v = self.assemble_velocities(q, self.v_guess, session=session, ideal=ideal)
+            y, yp = self.consistent_state(0.0, np.concatenate([q, v, np.zeros(self.n_states - 2 * self.n_q)]),
+                                          session=session)
+            if not ideal and not allow_penetration:
+                check_start_penetration(self, y, yp, session)
+            # the declared velocities the clearance joints' ideal joints change (start="declared" keeps them)
+            replaced = replaced_velocities(self, v, self.assemble_velocities(q, self.v_guess, session=session)) \
+                if ideal else ""
+            known = (_read_only(y), _read_only(yp), replaced)
+            memo_put_bounded(self.start_memo, key, known, START_MEMO_LIMIT)
+        if known[2]:
+            import warnings
+
+            from ..errors import DaeclearWarning
+
+            warnings.warn(known[2], DaeclearWarning, stacklevel=4)
+        return known[0].copy(), known[1].copy()
 
     def switch_vector(self, active: Sequence[bool], params: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
         """The contact terms' on/off flags and parameters as the outputs' ``switch`` input."""
@@ -404,6 +413,37 @@ def start_parameters(functions: DAEFunctions) -> NDArray[np.intp]:
 RANK_TOL = 1e-9
 # a row takes part in a dependency when its weight in a left null vector of the Jacobian is above this
 NULL_WEIGHT = 1e-6
+
+
+#: A declared body velocity counts as replaced by the ideal start when it moves by more than this fraction of it.
+REPLACED_VELOCITY = 1e-6
+
+
+def replaced_velocities(model: DAEModel, ideal: NDArray[np.float64], declared: NDArray[np.float64]) -> str:
+    """The warning that the chapter's start changed declared velocities, or "": each body whose non-zero declared
+    velocity (as ``start="declared"`` would start it, ``declared``) the start ``ideal`` changed (its clearance
+    joints' ideal joints constrain it: a free journal declared moving starts with its bearing). A velocity they
+    leave free is kept; a body declared at rest takes its kinematics silently (the chapter's start)."""
+    guess = np.asarray(model.v_guess, dtype=float)
+    linear = np.ones(guess.size, dtype=bool)
+    linear[2::3] = False
+    scales = {"m/s": float(np.max(np.abs(declared[linear]), initial=0.0)),
+              "rad/s": float(np.max(np.abs(declared[~linear]), initial=0.0))}  # round-off is relative to these
+    changed = []
+    for k, body in enumerate(model.body_names):
+        for part, name, unit in ((slice(3 * k, 3 * k + 2), "velocity", "m/s"),
+                                 (slice(3 * k + 2, 3 * k + 3), "angular_velocity", "rad/s")):
+            d, s = declared[part], ideal[part]
+            if np.any(guess[part] != 0.0) and np.max(np.abs(s - d)) > REPLACED_VELOCITY * scales[unit]:
+                shown = ", ".join(f"{x:.6g}" for x in d)
+                started = ", ".join(f"{x:.6g}" for x in s)
+                if d.size > 1:
+                    shown, started = f"({shown})", f"({started})"
+                changed.append(f"Body '{body}': {name}={shown} {unit} declared, started at {started} {unit}")
+    if not changed:
+        return ""
+    return ("simulate: the chapter's start (start='ideal': every clearance joint as its ideal joint, centred) "
+            f"changed declared velocities: {'; '.join(changed)}. SolverOptions(start='declared') keeps them.")
 
 
 def check_independent(model: DAEModel, q: NDArray[np.float64], session: Any = None) -> None:
