@@ -12,19 +12,18 @@ from pathlib import Path
 from typing import Any
 from collections.abc import Callable, Sequence
 
+from .defaults import (CLI_FIGURE_POINTS, CLI_FINEST_STEP, CLI_POINTS, CLI_SHOWN_EVENTS, CLI_STEPS_PER_SECOND,
+                       FORMULATION, MAX_OUTPUT_POINTS, MAX_STEPS, RTOL)
 from .errors import DaeclearError, DiskFull, Interrupted, PhysicsWarning, SolveError
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by Ctrl-C
-#: ``daeclear run`` reports at most CLI_POINTS + 1 points by default, spaced no finer than
-#: CLI_FINEST_STEP (s: each impact's peak force within 0.5 % of a grid 8 times finer).
-CLI_POINTS = 100_000
-CLI_FINEST_STEP = 2e-6
-#: ``daeclear run`` shows (summary, figure) at most this many of the last events of a run (the file has all).
-CLI_SHOWN_EVENTS = 20_000
-#: ``daeclear run``'s figure draws at most this many points a curve (min-max per bucket: peaks survive).
-CLI_FIGURE_POINTS = 2000
-#: ``daeclear run``'s default step cap per simulated second (see default_max_steps).
-CLI_STEPS_PER_SECOND = 2_000_000
+__all__ = ["CLI_FIGURE_POINTS", "CLI_FINEST_STEP", "CLI_POINTS", "CLI_SHOWN_EVENTS", "CLI_STEPS_PER_SECOND",
+           "build_parser", "default_max_steps", "default_t_eval_step", "main"]
+
+
+def _count(n: int) -> str:
+    """A count as the docs write it: 1 000 000."""
+    return f"{n:,}".replace(",", " ")
 
 
 def _parse_value(text: str) -> Any:
@@ -59,8 +58,9 @@ def _mechanism_keys(argv: Sequence[str]) -> str | None:
     from .model.mechanism_options import option_table
     from .model.scenefile import MECHANISMS
 
-    if argv[1] not in MECHANISMS:
-        return None
+    if argv[1] not in MECHANISMS:  # not the generic help, as if MECH had no keys: say so
+        raise DaeclearError(f"{argv[0]}: {argv[1]!r} is neither a scene file (.toml) nor a mechanism "
+                            f"({', '.join(MECHANISMS)}); 'daeclear {argv[0]} --help' describes the command.")
     lines = [f"--set keys of {argv[1]} (KEY=VALUE, a Python literal; default in brackets):"]
     lines += [f"  --set {name}=...  [{default}]  {text}" for name, default, text in option_table(MECHANISMS[argv[1]])]
     return "\n".join(lines)
@@ -83,23 +83,27 @@ def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
                           "(repeatable)")
     run.add_argument("--t-end", type=float,
                      help="end time, s (default: two revolutions of the driver; 0.024 s without one)")
-    run.add_argument("--rtol", type=float, help="relative tolerance (default 1e-6)")
+    run.add_argument("--rtol", type=float, help=f"relative tolerance (default {RTOL:g})")
     run.add_argument("--max-steps", type=int, metavar="N",
-                     help="cap on IDA's steps (default: 2 000 000 per simulated second, at least 5 000 000)")
+                     help=f"cap on IDA's steps (default: {_count(CLI_STEPS_PER_SECOND)} per simulated second, at "
+                          f"least {_count(MAX_STEPS)})")
     points = run.add_mutually_exclusive_group()
     points.add_argument("--t-eval-step", type=float, metavar="DT",
-                        help="report the run every DT seconds (default: the scene file's t_eval_step, else "
-                             "t_end / 100000 but no finer than 1e-6 s: at most 100001 points)")
+                        help=f"report the run every DT seconds (default: the scene file's t_eval_step, else "
+                             f"t_end / {CLI_POINTS} but no finer than {CLI_FINEST_STEP:g} s: at most "
+                             f"{_count(CLI_POINTS + 1)} points)")
     points.add_argument("--every-step", action="store_true",
                         help="report every IDA step (memory and file grow with the run, ~1.7 MB per revolution "
                              "of the chapter's slider-crank)")
     run.add_argument("--max-points", type=int, metavar="N",
-                     help="refuse before the run to report more than N points (default 1 000 000, about 1 GB for "
-                          "the chapter's slider-crank; the message gives the estimated size)")
+                     help=f"refuse before the run to report more than N points (default {_count(MAX_OUTPUT_POINTS)}, "
+                          "about 1 GB for the chapter's slider-crank; the message gives the estimated size)")
     run.add_argument("--formulation", choices=["index1", "ggl"],
-                     help="DAE formulation (default ggl; index1: the chapter's)")
-    run.add_argument("--backend", choices=["auto", "c", "python"], default="auto")
-    run.add_argument("--out", type=Path, default=Path("results"), help="output directory (default ./results)")
+                     help=f"DAE formulation (default {FORMULATION}; index1: the chapter's)")
+    run.add_argument("--backend", choices=["auto", "c", "python"], default="auto",
+                     help="model and IDA loop in generated C (c), in scikit-sundae (python), or c when a compiler "
+                          "is found (default %(default)s)")
+    run.add_argument("--out", type=Path, default=Path("results"), help="output directory (default ./%(default)s)")
     run.add_argument("--name", help="base name of the output files (default: the scene name)")
     run.add_argument("--no-figure", action="store_true", help="write the HDF5 result only")
     run.add_argument("--window", type=float, nargs=2, metavar=("T0", "T1"),
@@ -112,14 +116,18 @@ def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
     study.add_argument("target", help="mechanism name (slider_crank)")
     study.add_argument("--joint", help="slider_crank: which joint has clearance (default revolute)")
     study.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="mechanism parameter")
-    study.add_argument("--t-end", type=float, default=0.012, help="end time, s (default one revolution at 5000 rpm)")
+    study.add_argument("--t-end", type=float, default=0.012,
+                       help="end time, s (default %(default)s: one revolution at 5000 rpm)")
     study.add_argument("--methods", default="ida,DOP853,LSODA,rk4",
-                       help="comma-separated methods (ida, RK45, DOP853, Radau, BDF, LSODA, rk4, euler)")
-    study.add_argument("--rtols", default="1e-4,1e-6,1e-8", help="tolerances of the adaptive methods")
-    study.add_argument("--steps", default="1e-5,5e-6", help="steps of the fixed-step methods, s")
-    study.add_argument("--channels", default="slider.vx,drive.moment", help="channels whose error is measured")
-    study.add_argument("--repeats", type=int, default=3, help="timed repeats per run (best kept)")
-    study.add_argument("--out", type=Path, default=Path("results/study"), help="output directory")
+                       help="comma-separated methods (ida, RK45, DOP853, Radau, BDF, LSODA, rk4, euler; "
+                            "default %(default)s)")
+    study.add_argument("--rtols", default="1e-4,1e-6,1e-8",
+                       help="tolerances of the adaptive methods (default %(default)s)")
+    study.add_argument("--steps", default="1e-5,5e-6", help="steps of the fixed-step methods, s (default %(default)s)")
+    study.add_argument("--channels", default="slider.vx,drive.moment",
+                       help="channels whose error is measured (default %(default)s)")
+    study.add_argument("--repeats", type=int, default=3, help="timed repeats per run, best kept (default %(default)s)")
+    study.add_argument("--out", type=Path, default=Path("results/study"), help="output directory (default %(default)s)")
     _add_sweep_parser(sub, epilog)
     _add_animate_parser(sub)
     return parser
@@ -286,7 +294,7 @@ def _read_back(h5: Path) -> tuple[float | None, Any]:
 
 def default_max_steps(t_end: float) -> int:
     """IDA's step cap of ``daeclear run``: CLI_STEPS_PER_SECOND per simulated second, at least the API's 5e6."""
-    return max(5_000_000, math.ceil(CLI_STEPS_PER_SECOND * t_end))
+    return max(MAX_STEPS, math.ceil(CLI_STEPS_PER_SECOND * t_end))
 
 
 def default_t_eval_step(t_end: float) -> float:
@@ -394,17 +402,18 @@ def _add_sweep_parser(sub: Any, epilog: str) -> None:
     sweep.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="fixed mechanism parameter, e.g. --set rpm=3000 (repeatable)")
     sweep.add_argument("--points", type=Path, help="JSON file with a list of parameter points (dicts) to run")
-    sweep.add_argument("--revolutions", type=int, default=30, help="revolutions analysed (default 30)")
-    sweep.add_argument("--transient", type=int, default=10, help="revolutions discarded first (default 10)")
-    sweep.add_argument("--per-revolution", type=int, default=32, help="output samples per revolution (default 32)")
+    sweep.add_argument("--revolutions", type=int, default=30, help="revolutions analysed (default %(default)s)")
+    sweep.add_argument("--transient", type=int, default=10, help="revolutions discarded first (default %(default)s)")
+    sweep.add_argument("--per-revolution", type=int, default=32,
+                       help="output samples per revolution (default %(default)s)")
     sweep.add_argument("--channels", help="Poincaré-section channels (default: slider.vx,slider.ax with a body "
                                           "named slider, else the last body's omega,alpha)")
     sweep.add_argument("--twin", choices=["always", "auto", "never"], default="always",
                        help="twin runs for the chaos test: always (default), only when the section does not "
                             "recur (auto), or never")
-    sweep.add_argument("--rtol", type=float, default=1e-6, help="IDA relative tolerance (default 1e-6)")
+    sweep.add_argument("--rtol", type=float, default=RTOL, help="IDA relative tolerance (default %(default)g)")
     sweep.add_argument("--keep", choices=["section", "channels", "full"], default="channels",
-                       help="what each run stores besides its class and section (default channels)")
+                       help="what each run stores besides its class and section (default %(default)s)")
     sweep.add_argument("--workers", type=int, help="worker processes (default: the CPU count)")
     sweep.add_argument("--dask", metavar="ADDRESS",
                        help="run on a Dask cluster: a scheduler address (tcp://host:8786) or 'local'")
@@ -551,13 +560,14 @@ def _add_animate_parser(sub: Any) -> None:
                     "a time plot with a moving cursor. Frames: round(duration x slow motion x fps), at least 2.")
     animate.add_argument("result", type=Path, help="result file (.h5) written by daeclear run or Result.save")
     animate.add_argument("--out", type=Path, help="animation file, .gif or .mp4 (default: RESULT with .gif)")
-    animate.add_argument("--fps", type=float, default=25.0, help="frames per second (default 25)")
+    animate.add_argument("--fps", type=float, default=25.0, help="frames per second (default %(default)g)")
     animate.add_argument("--window", type=float, nargs=2, metavar=("T0", "T1"),
                          help="simulated time shown, s (default: the whole run)")
     animate.add_argument("--slow-motion", type=float,
                          help="times slower than real time (default: the window plays in 5 s)")
-    animate.add_argument("--size", type=int, nargs=2, default=(720, 450), metavar=("WIDTH", "HEIGHT"),
-                         help="pixels (default 720 450)")
+    size = (720, 450)
+    animate.add_argument("--size", type=int, nargs=2, default=size, metavar=("WIDTH", "HEIGHT"),
+                         help=f"pixels (default {size[0]} {size[1]})")
     animate.add_argument("--channel", help="channel of the time plot (default: the driver's moment)")
     animate.add_argument("--magnify", type=float,
                          help="magnification of a slider's offset and tilt in its guide (default: automatic)")
@@ -583,7 +593,12 @@ def _animate(args: argparse.Namespace) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="daeclear: %(message)s")
     argv = list(sys.argv[1:] if argv is None else argv)
-    args = build_parser(argv).parse_args(argv)
+    try:
+        parser = build_parser(argv)
+    except DaeclearError as exc:  # daeclear run UNKNOWN --help
+        print(f"daeclear: error: {exc}", file=sys.stderr)
+        return 2
+    args = parser.parse_args(argv)
     try:
         if args.command == "run":
             return _run(args)

@@ -15,13 +15,12 @@ from collections.abc import Iterable, Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import defaults
 from .errors import SceneError
 
 METHODS: tuple[str, ...] = ("ida", "rk45", "dop853", "radau", "bdf", "lsoda", "rk4", "euler")
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
-#: GGL (stabilised index 2) holds the joints closed to Newton's tolerance, so contact times converge
-#: with rtol at any clearance; index-1 Baumgarte drifts (docs/engine.md).
-DEFAULT_FORMULATION = "ggl"
+DEFAULT_FORMULATION = defaults.FORMULATION
 #: The chapter's (Tables 4.2, 4.3: index-1, Baumgarte alpha = beta = 5), the only one of the non-IDA methods.
 CHAPTER_FORMULATION = "index1"
 BACKENDS: tuple[str, ...] = ("auto", "c", "python")
@@ -158,7 +157,10 @@ def atol(value: Any, *, where: str = "simulate", field: str = "atol"
         values = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         fail(where, field, value, rule)
-    if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)) or np.any(values <= 0):
+    if values.ndim != 1:  # a table is not flattened: which order was meant?
+        fail(where, field, value, "one-dimensional (2 n_q values or one per state): " + rule,
+             shown=f"array of shape {values.shape}")
+    if values.size == 0 or not np.all(np.isfinite(values)) or np.any(values <= 0):
         fail(where, field, value, rule)
     return values.copy()
 
@@ -241,9 +243,7 @@ def t_eval_step(value: Any, end: float, *, where: str, field: str = "t_eval_step
     return number(value, where=where, field=field, unit="s", low=0.0, high=end)
 
 
-#: The most output points a run reports unless told otherwise (``SaveAt.max_points``): about 1 GB for
-#: the chapter's slider-crank, so a mistyped spacing is refused instead of filling a disk.
-MAX_OUTPUT_POINTS = 1_000_000
+MAX_OUTPUT_POINTS = defaults.MAX_OUTPUT_POINTS
 
 
 def max_output_points(value: Any, *, where: str = "simulate", field: str = "max_output_points") -> int | None:

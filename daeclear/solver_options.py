@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from . import options
+from . import defaults, options
 from .options import fail
 
 WHERE = "SolverOptions"
@@ -71,12 +71,12 @@ class SolverOptions:
     """
 
     method: str = "ida"
-    rtol: float = 1e-6
+    rtol: float = defaults.RTOL
     atol: float | tuple[float, ...] | tuple[tuple[str, float], ...] | None = None
     formulation: str | None = None
     backend: str = "auto"
     max_step: float = 0.0
-    max_steps: int = 5_000_000
+    max_steps: int = defaults.MAX_STEPS
     step: float | None = None
     linear_solver: str = "auto"
     start: str = "ideal"

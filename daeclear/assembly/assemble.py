@@ -153,12 +153,15 @@ class Structure:
     def rebind(self, model: DAEModel, values: Mapping[str, Any]) -> DAEModel:
         """``model`` with some of its scene's numbers replaced (:meth:`DAEModel.with_parameters`)."""
         values = dict(values)
-        alpha = float(values.pop("baumgarte.alpha", model.alpha))
-        beta = float(values.pop("baumgarte.beta", model.beta))
-        if (alpha, beta) != (model.alpha, model.beta) and model.formulation != "index1":
-            raise SceneError(f"with_parameters: baumgarte.alpha/beta are numbers of the index1 formulation; "
-                             f"this model is {model.formulation}.")
+        for name in ("baumgarte.alpha", "baumgarte.beta"):
+            if name in values and model.formulation != "index1":  # even its own value: it would mean nothing
+                raise SceneError(f"with_parameters: {name}={values[name]!r}, must be left out: Baumgarte's constants "
+                                 f"are numbers of the index1 formulation and this model is {model.formulation} "
+                                 "(assemble(scene, formulation='index1') to set them).")
+        alpha = values.pop("baumgarte.alpha", model.alpha)
+        beta = values.pop("baumgarte.beta", model.beta)
         _check_baumgarte(alpha, beta)
+        alpha, beta = float(alpha), float(beta)
         scene = model.scene.with_values(values)
         table, key, described = scene_parameters(scene, model.formulation, alpha, beta, model.track_work)
         if key != self.key:
@@ -176,8 +179,8 @@ _STRUCTURE_LIMIT = 64
 _ENGINE_VERSION = "engine-3"
 
 
-def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: float = 5.0, beta: float = 5.0,
-             track_work: bool = False) -> DAEModel:
+def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: float | None = None,
+             beta: float | None = None, track_work: bool = False) -> DAEModel:
     """Assemble a validated scene into a :class:`DAEModel`.
 
     Only the scene's structure is built symbolically, once per process; every number is run-time
@@ -190,8 +193,8 @@ def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: flo
     formulation : {"ggl", "index1"}
         ``ggl`` (default): stabilised index 2, drift-free; ``index1``: acceleration-level constraints
         with Baumgarte stabilisation (Tables 4.2-4.3; the only one the non-IDA methods integrate).
-    alpha, beta : float
-        Baumgarte parameters of ``index1`` (1/s), 5 and 5 by default (Table 4.2).
+    alpha, beta : float or None
+        Baumgarte parameters of ``index1`` (1/s), None: 5 and 5 (Table 4.2); refused with ``ggl``, which has none.
     track_work : bool
         Add the state ``work.input`` (channel ``energy.work``): the work of drivers, contact forces and
         loads, integrated out of the error test; ``energy.mechanical - work`` is then conserved.
@@ -210,6 +213,12 @@ def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: flo
     formulation = str(formulation).lower()
     if formulation not in FORMULATIONS:
         raise SceneError(f"formulation={formulation!r}, must be one of {', '.join(FORMULATIONS)}.")
+    for label, value in (("alpha", alpha), ("beta", beta)):
+        if value is not None and formulation != "index1":
+            raise SceneError(f"assemble: {label}={value!r}, must be left out with formulation={formulation!r}: "
+                             "Baumgarte's constants are numbers of the index1 formulation.")
+    alpha = BAUMGARTE if alpha is None else alpha
+    beta = BAUMGARTE if beta is None else beta
     _check_baumgarte(alpha, beta)
     scene.validate()
     table, key, described = scene_parameters(scene, formulation, alpha, beta, bool(track_work))
@@ -218,6 +227,10 @@ def assemble(scene: Scene, formulation: str = DEFAULT_FORMULATION, *, alpha: flo
         structure = _build_template(scene, formulation, bool(track_work), table, key)
         memo_put_bounded(_STRUCTURES, key, structure, _STRUCTURE_LIMIT)
     return structure.bind(scene, table, described, alpha, beta)
+
+
+#: Baumgarte's alpha and beta of the index1 formulation unless given (1/s, Table 4.2).
+BAUMGARTE = 5.0
 
 
 def _check_baumgarte(alpha: Any, beta: Any) -> None:

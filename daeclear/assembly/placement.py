@@ -43,9 +43,9 @@ def assembled(scene: Scene, start: Mapping[str, float] | None = None,
             raise SceneError(f"scene '{scene.name}': assembled: start[{name!r}]={start_values[name]!r}, but Driver "
                              f"'{driver.name}' fixes the coordinate of joint '{name}' at t = 0 (its initial value or "
                              "tabulated profile); leave one of the two out.")
-    for name in speed_values or {}:
+    for name, value in (speed_values or {}).items():
         if name in drivers:
-            raise SceneError(f"scene '{scene.name}': assembled: speeds[{name!r}]={speed_values[name]!r}, but joint "  # type: ignore[index]
+            raise SceneError(f"scene '{scene.name}': assembled: speeds[{name!r}]={value!r}, but joint "
                              f"'{name}' is driven by Driver '{drivers[name].name}', whose profile gives its speed; "
                              "leave it out of speeds.")
     model = assemble(scene)
@@ -136,7 +136,7 @@ class _Placement:
         if closed:
             return q
         row_names = [self.model.start_constraint_names[i] for i in self.keep] + [
-            f"{name}.{JOINT_CHANNELS[driven_coordinate(joints[name])][0][0]}" for name in chosen]  # type: ignore[index]
+            f"{name}.{_channels(joints[name])[0][0]}" for name in chosen]
         worst = np.argsort(-np.abs(F))[:4]
         detail = ", ".join(f"{row_names[i]} = {F[i]:.3g}" for i in worst)
         involved = ", ".join(dict.fromkeys(row_names[i].rsplit(".", 1)[0] for i in worst if abs(F[i]) > 1e-9))
@@ -163,7 +163,7 @@ class _Placement:
         v = v_p + free.T @ np.linalg.lstsq(C_q @ free.T, given - C_q @ v_p, rcond=None)[0]
         got = C_q @ v
         if np.max(np.abs(got - given)) > SPEED_TOL * max(1.0, float(np.max(np.abs(given)))):
-            rates = [JOINT_CHANNELS[driven_coordinate(joints[name])][1] for name in speed_values]  # type: ignore[index]
+            rates = [_channels(joints[name])[1] for name in speed_values]
             detail = ", ".join(f"{name}.{rate} = {closest:.6g} {unit} ({value:.6g} given)" for name, value, closest,
                                (rate, unit) in zip(speed_values, given, got, rates))
             raise AssemblyError(
@@ -172,6 +172,13 @@ class _Placement:
                 f"allows has them all; the closest has {detail}. Give {free.shape[0]} independent speed(s), or values "
                 "the kinematics allow.")
         return v
+
+
+def _channels(joint: Any) -> tuple[tuple[str, str], tuple[str, str]]:
+    """The (coordinate, unit) and (rate, unit) channel names of a revolute or translational joint."""
+    kind = driven_coordinate(joint)
+    assert kind is not None  # the joints named in start and speeds are checked to have one
+    return JOINT_CHANNELS[kind]
 
 
 def _free_motions(Phi_q: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -197,7 +204,7 @@ def stationary(Phi_q: NDArray[np.float64], C_q: NDArray[np.float64], chosen: lis
              if free.size == 0 or np.linalg.norm(free @ row) <= 1e-8 * max(1.0, float(np.linalg.norm(row)))]
     if not stuck:
         return ""
-    words = ", ".join(f"{name} ({JOINT_CHANNELS[driven_coordinate(joints[name])][0][0]})" for name in stuck)
+    words = ", ".join(f"{name} ({_channels(joints[name])[0][0]})" for name in stuck)
     return (f"At the declared pose {words} is at a singular configuration: no motion the joints allow changes "
             "its coordinate to first order (links aligned, e.g. a dead centre); declare the bodies away from it, "
             "on the branch wanted. ")

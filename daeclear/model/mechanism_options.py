@@ -67,6 +67,14 @@ def ideal_parameters(mechanism: str, params: dict[str, Any]) -> dict[str, Any] |
     return {**{k: v for k, v in params.items() if k not in dropped}, key: none}
 
 
+def plain(text: str) -> str:
+    """Docstring text without its reStructuredText markup, as a terminal shows it: ``x`` and `x` as x,
+    :class:`~a.b.C` as C, :mod:`a.b` (any role) as a.b."""
+    text = re.sub(r":[a-z]+:`~[\w.]*?(\w+)`", r"\1", text)
+    text = re.sub(r":[a-z]+:`([^`]+)`", r"\1", text)
+    return re.sub(r"``([^`]+)``|`([^`]+)`", lambda m: m[1] or m[2], text)
+
+
 def option_table(function: Callable[..., Any]) -> list[tuple[str, str, str]]:
     """(name, default, first sentence of its description) for each keyword option of a ready mechanism,
     read from its signature and its numpy-style docstring (units are in the description)."""
@@ -82,7 +90,7 @@ def option_table(function: Callable[..., Any]) -> list[tuple[str, str, str]]:
             if not follow.startswith("    "):
                 break
             text.append(follow.strip())
-        sentence = re.split(r"\.\s+(?=[A-Z])", " ".join(text))[0].rstrip(".")  # not at "Figs. 4.15"
+        sentence = re.split(r"\.\s+(?=[A-Z])", plain(" ".join(text)))[0].rstrip(".")  # not at "Figs. 4.15"
         for name in match.group(1).split(","):
             described.setdefault(name.strip(), sentence)
     rows = []

@@ -133,8 +133,9 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     Parameters
     ----------
     joint : {"ideal", "revolute", "translational"}
-        Which joint has clearance (named ``clearance``, centred at the start): none, ``C`` (Table 4.2)
-        or ``D`` (Fig. 4.27, Table 4.3; its geometry in docs/validation.md).
+        Which joint has clearance, named ``clearance`` and centred at the start: "ideal" none,
+        "revolute" the rod-slider pin ``C`` (Table 4.2), "translational" the slider's guide ``D``
+        (Fig. 4.27, Table 4.3; its geometry in docs/validation.md).
     gravity : float
         Magnitude of gravity along -Y, m/s^2 (0 to switch it off).
     rpm : float

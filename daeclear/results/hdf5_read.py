@@ -31,6 +31,10 @@ def read_file(path: str | os.PathLike[str], t0: float | None = None, t1: float |
     import h5py
 
     path = Path(path)
+    window = time_window(t0, t1, "load")  # checked before the file is opened
+    if path.is_dir():
+        raise IsADirectoryError(f"load: '{path}' is a directory; give a result file (.h5) in it, e.g. "
+                                f"'{path / 'run.h5'}'.")
     if not path.is_file():
         raise FileNotFoundError(f"no result file '{path}'.")
     try:
@@ -51,7 +55,6 @@ def read_file(path: str | os.PathLike[str], t0: float | None = None, t1: float |
         if int(version) > FORMAT_VERSION:
             raise DaeclearError(f"'{path}' is a daeclear result of format version {int(version)}; this daeclear "
                                 f"reads versions up to {FORMAT_VERSION}. Upgrade daeclear to read it.")
-        window = time_window(t0, t1)
         if within and (t0 is not None or t1 is not None) and "t" in f and f["t"].shape[0]:
             first, last = float(f["t"][0]), float(f["t"][-1])
             if window[0] > last or window[1] < first:

@@ -345,7 +345,7 @@ class Result:
     def window_mask(self, t0: float | None = None, t1: float | None = None) -> NDArray[np.bool_]:
         """Boolean mask of the output times in the closed window [t0, t1] (s; None: that side open).
         ValueError if ``t0 > t1``."""
-        lo, hi = time_window(t0, t1)
+        lo, hi = time_window(t0, t1, "Result.window_mask")
         return (self.t >= lo) & (self.t <= hi)
 
     def slice(self, t0: float | None = None, t1: float | None = None) -> Result:
@@ -361,7 +361,7 @@ class Result:
         >>> period = 2 * np.pi / 523.6
         >>> steady = result.slice(result.t[-1] - 2 * period, None)   # doctest: +SKIP
         """
-        lo, hi = time_window(t0, t1)
+        lo, hi = time_window(t0, t1, "Result.slice")
         mask = self.window_mask(t0, t1)
         kw = self.to_dict(channels=False)
         kw.update(
@@ -522,7 +522,9 @@ def load(path: str | os.PathLike[str], t0: float | None = None, t1: float | None
     Raises
     ------
     FileNotFoundError
-        If `path` does not exist.
+        If `path` does not exist (IsADirectoryError: it is a directory).
+    SceneError
+        If `t0` or `t1` is not None or a number (NaN), or ``t0 > t1``; checked before the file is read.
     DaeclearError
         If the file is not HDF5, not a daeclear result, written by a newer daeclear, or lacks an
         item of the layout (the message names the file and what is missing); SceneError if the

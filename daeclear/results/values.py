@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import DaeclearWarning
+from ..options import fail, is_real
 
 __all__ = ["field_names", "readonly", "time_window", "to_plain"]
 
@@ -27,12 +28,16 @@ def readonly(a: np.ndarray) -> np.ndarray:
     return view
 
 
-def time_window(t0: float | None, t1: float | None) -> tuple[float, float]:
-    """The closed window [t0, t1] as floats (None: that side open, +-inf); ValueError if ``t0 > t1``."""
+def time_window(t0: float | None, t1: float | None, where: str = "slice") -> tuple[float, float]:
+    """The closed window [t0, t1] as floats (None: that side open, +-inf); SceneError (a ValueError) naming
+    ``where`` for a bound that is not a number (NaN included: it would select nothing, silently) or ``t0 > t1``."""
+    for name, value in (("t0", t0), ("t1", t1)):
+        if value is not None and not (is_real(value) and not math.isnan(float(value))):
+            fail(where, name, value, "None (that side open) or a number, s")
     lo = -math.inf if t0 is None else float(t0)
     hi = math.inf if t1 is None else float(t1)
     if lo > hi:
-        raise ValueError(f"time window t0={t0} > t1={t1}; t0 must not exceed t1.")
+        fail(where, "t0", t0, f"<= t1={t1!r} s (the window [t0, t1])", "s")
     return lo, hi
 
 

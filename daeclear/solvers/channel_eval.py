@@ -64,6 +64,8 @@ def evaluator_from_parameters(parameters: Mapping[str, Any]) -> ModelEvaluator:
     """The channels of a result file's states: its model rebuilt from the file's parameters (scene
     description, formulation, the GGL/Baumgarte numbers, track_work) in the run's backend."""
     scene = scene_from_description(parameters["scene"])
-    model = assemble(scene, str(parameters["formulation"]), alpha=float(parameters["alpha"]),
-                     beta=float(parameters["beta"]), track_work=bool(parameters["track_work"]))
+    formulation = str(parameters["formulation"])
+    baumgarte = ({"alpha": float(parameters["alpha"]), "beta": float(parameters["beta"])}
+                 if formulation == "index1" else {})
+    model = assemble(scene, formulation, track_work=bool(parameters["track_work"]), **baumgarte)
     return ModelEvaluator(model, str(parameters.get("simulate", {}).get("backend", "auto")))

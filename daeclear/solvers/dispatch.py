@@ -92,6 +92,10 @@ def simulate(
     out = save_value(save).plan(t0, t_end)
     if y0 is not None:  # checked before any work (a Scene's length: once it is assembled)
         y0 = opts.state(y0, scene.n_states if isinstance(scene, DAEModel) else None)
+    if isinstance(scene, DAEModel) and settings.formulation not in (None, scene.formulation):
+        opts.fail("simulate", "options.formulation", settings.formulation,
+                  f"None or the model's own, {scene.formulation!r}: the formulation is chosen when a Scene is "
+                  "assembled (pass the Scene, or assemble(scene, formulation=...))")
     solver = solver_class(settings.method)()
     if parameters is not None:  # new numbers: bound to the structure (checked before any run)
         if not isinstance(parameters, Mapping):
@@ -100,4 +104,8 @@ def simulate(
         if isinstance(scene, Scene):
             scene = assemble(scene, settings.formulation or solver.formulation, track_work=settings.track_work)
         scene = scene.with_parameters(parameters)
-    return solver.run(scene, t_end, t0, y0, out, settings, on_failure, progress)
+    result = solver.run(scene, t_end, t0, y0, out, settings, on_failure, progress)
+    if not isinstance(result, Result):  # a solver class of the user's: its contract checked where it is used
+        opts.fail("simulate", "method", settings.method, "a solver whose run() returns a daeclear.Result "
+                  f"(the contract of daeclear.solvers.base.Solver); it returned {type(result).__name__}")
+    return result

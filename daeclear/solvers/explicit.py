@@ -277,8 +277,13 @@ class ODESolver:
     fixed_step: ClassVar[bool] = False  # rk4, euler: the step is the option ``step``
 
     def check(self, settings: SolverOptions) -> None:
-        """``step`` is required by the fixed-step schemes and refused by the others."""
+        """``step`` is required by the fixed-step schemes and refused by the others; IDA's ``linear_solver``
+        is refused (these methods would ignore it)."""
         step_rule(self.name, settings.step, fixed=self.fixed_step)
+        if settings.linear_solver != "auto":
+            raise SceneError(f"simulate: linear_solver={settings.linear_solver!r}, must be 'auto' with "
+                             f"method={self.name!r}: it chooses the LU of IDA's Newton iteration, which "
+                             f"{self.name} does not run.")
 
     def run(self, model: Scene | DAEModel, t_end: float, t0: float, y0: NDArray | None, save: Output,
             settings: SolverOptions, on_failure: str, progress: bool) -> Result:

@@ -26,7 +26,7 @@ def method(value: Any, *, where: str = "simulate", field: str = "method") -> str
         module, _, qualname = value.partition(":")
         try:
             found = functools.reduce(getattr, qualname.split("."), importlib.import_module(module))
-        except (ImportError, AttributeError, ValueError) as exc:
+        except Exception as exc:  # whatever the module raises on import (a bug in it), said with the path
             options.fail(where, field, value, "a registered method name or the import path 'module:Class' of a "
                          f"solver class that can be imported here ({type(exc).__name__}: {exc})")
         if not isinstance(found, type):
@@ -38,6 +38,12 @@ def method(value: Any, *, where: str = "simulate", field: str = "method") -> str
             options.fail(where, field, value, "a registered method name or a class implementing "
                          "daeclear.solvers.base.Solver (name, formulation, check, run)"
                          + (f"; it lacks {', '.join(missing)}" if missing else ""))
+        name, formulation = value.name, value.formulation  # type: ignore[attr-defined]
+        if not isinstance(name, str) or not name:
+            options.fail(where, field, value, f"a solver class whose name is a non-empty string, not {name!r}")
+        if formulation not in options.FORMULATIONS:
+            options.fail(where, field, value, f"a solver class whose formulation is one of "
+                         f"{', '.join(options.FORMULATIONS)}, not {formulation!r}")
         return value
     return options.method(value, where=where, field=field)
 
