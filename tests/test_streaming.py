@@ -61,7 +61,7 @@ def test_a_streamed_run_equals_the_run_in_memory(revolute, tmp_path, output):
     _same(dc.load(tmp_path / "saved.h5"), dc.load(path))
     if output:  # the grid: exactly the points asked for
         assert np.array_equal(memory.t, options.uniform_times(1e-5, t_end))
-        assert memory.step_t.size == 1  # only the start: the steps were not kept
+        assert memory.step_t.size == 0  # no steps kept (issue 45: not a phantom step at the start)
 
 
 def test_keep_data_false_returns_the_outcome_and_the_file_holds_the_data(revolute, tmp_path):
@@ -71,6 +71,23 @@ def test_keep_data_false_returns_the_outcome_and_the_file_holds_the_data(revolut
     assert outcome.success and outcome.n_times == 0 and not outcome.channels and not outcome.events
     assert outcome.stats["n_events"] == len(full.events) > 10 and full.n_times == 1201
     assert outcome.warnings == full.warnings and outcome.message == full.message
+    # issue 45: its summary said "0 events, 0 segments" while the file held them: now it says the file's counts
+    onsets, separations = len(full.events.of(kind="onset")), len(full.events.of(kind="separation"))
+    summary = repr(outcome)
+    assert f"{full.n_times} points in '{path}'" in summary
+    assert f"{len(full.events)} events ({onsets} onset, {separations} separation), {len(full.segments)} segments" \
+        in summary
+    assert not full.step_t.size and outcome.step_t is None  # steps=False: none kept, not a phantom one at t0
+
+
+@pytest.mark.parametrize("method, step", [("ida", None), ("RK45", None), ("rk4", 1e-5)])
+def test_no_step_is_kept_without_steps(revolute, method, step):
+    """Issue 45: ``SaveAt(steps=False)`` kept one step, at t0 (``step_t == [0.]``)."""
+    save = dc.SaveAt(every=1e-4, steps=False)
+    r = dc.simulate(revolute, REV / 4, save=save, options=dc.SolverOptions(method=method, step=step))
+    assert r.step_t.size == r.step_h.size == r.step_order.size == 0 and r.n_times == int(REV / 4 / 1e-4) + 1
+    kept = dc.simulate(revolute, REV / 4, options=dc.SolverOptions(method=method, step=step))
+    assert kept.step_t[0] == 0.0 and kept.step_t.size == kept.stats["n_steps"] + 1  # the start, then each step
 
 
 def test_output_windows_inside_steps_lose_no_point():
@@ -283,7 +300,7 @@ def test_cli_run_streams_a_grid_and_keeps_no_steps(tmp_path, capsys):
     assert main(["run", "slider_crank", "--joint", "revolute", "--t-end", str(REV), "--out", str(tmp_path),
                  "--no-figure", "--quiet"]) == 0
     r = dc.load(tmp_path / "slider_crank_revolute.h5")
-    assert r.success and np.array_equal(r.t, options.uniform_times(CLI_FINEST_STEP, REV)) and r.step_t.size == 1
+    assert r.success and np.array_equal(r.t, options.uniform_times(CLI_FINEST_STEP, REV)) and r.step_t.size == 0
     assert main(["run", "slider_crank", "--joint", "revolute", "--t-end", str(REV), "--out", str(tmp_path),
                  "--no-figure", "--quiet", "--t-eval-step", "1e-4"]) == 0
     assert dc.load(tmp_path / "slider_crank_revolute.h5").n_times == 121

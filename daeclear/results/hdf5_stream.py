@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -180,12 +181,17 @@ class ResultWriter:
 
     def close(self, *, stats: Mapping[str, Any], success: bool, status: int, message: str,
               warnings: Iterable[Mapping[str, Any]] = ()) -> Path:
-        """Write the statistics, the warnings and the outcome, and close the file."""
+        """Write the statistics, the warnings and the outcome, and close the file (``counts``: what it holds)."""
         from .outputs import deferred_sigint
 
         f = self._f
         with deferred_sigint():
             try:
+                kinds = Counter(str(k) for k in f["events/kind"].asstr()[()])
+                #: what the file holds, read from it: a summary of a run kept only in its file says these
+                self.counts: dict[str, Any] = {
+                    "path": str(self.path), "n_points": int(f["t"].shape[0]), "n_events": sum(kinds.values()),
+                    "events_by_kind": dict(kinds), "n_segments": int(f["segments/t_start"].shape[0])}
                 plain = to_plain(dict(stats), "stats")
                 del f["stats"], f["stats_json"], f["warnings_json"]
                 mirror(f.create_group("stats"), plain)

@@ -312,17 +312,25 @@ class Result:
             f"daeclear Result: scene {self.scene_name!r}, method {self.method!r}, formulation {self.formulation!r}",
             f"  success: {self.success} (status {self.status}): {self.message!r}",
         ]
+        file = self.stats.get("file") if not self.n_times else None  # a streamed run's outcome: data in its file
         if self.n_times:
             lines.append(
                 f"  time: {self.t[0]:.6g} to {self.t[-1]:.6g} s, {self.n_times} output times, {self.n_states} states"
             )
+        elif isinstance(file, Mapping) and "n_points" in file:
+            lines.append(f"  time: no output times in memory (keep_data=False): {file['n_points']} points in "
+                         f"{file['path']!r}, {self.n_states} states")
         else:
             lines.append(f"  time: no output times, {self.n_states} states")
         n_steps = self.stats.get("n_steps", None if self._steps is None else len(self._steps[0]))
-        counts = ", ".join(f"{self._events.kind.count(k)} {k}" for k in EVENT_KINDS)
+        if isinstance(file, Mapping) and "n_events" in file:
+            kinds, n_events, n_segments = file["events_by_kind"], file["n_events"], file["n_segments"]
+        else:
+            kinds = {k: self._events.kind.count(k) for k in EVENT_KINDS}
+            n_events, n_segments = len(self._events), len(self.segments)
+        counts = ", ".join(f"{kinds.get(k, 0)} {k}" for k in EVENT_KINDS)
         lines.append(
-            f"  steps: {n_steps if n_steps is not None else '?'}, {len(self._events)} events ({counts}), "
-            f"{len(self.segments)} segments"
+            f"  steps: {n_steps if n_steps is not None else '?'}, {n_events} events ({counts}), {n_segments} segments"
         )
         setup, solve = self.stats.get("setup_time"), self.stats.get("solve_time")
         wall = self.stats.get("wall_time")

@@ -63,7 +63,8 @@ class SegmentLoop:
         self.switch = model.switch_vector(self.active, self.params)
         # reported points not made consistent yet: t, IDA's raw y (no yp) and each row's switch vector
         self.raw: list[tuple[NDArray, NDArray, NDArray]] = []
-        rec.add_steps(np.array([t0]), np.array([0.0]), np.array([0]))
+        if store_steps:  # the start is the first step kept (h = 0); without steps none, not a phantom one
+            rec.add_steps(np.array([t0]), np.array([0.0]), np.array([0]))
         self.i_eval = int(eval_times is not None and eval_times.window(0, 1)[0] == t0)  # the next output time
         if eval_times is None or self.i_eval:  # the start point is reported
             self.raw.append((np.array([t0]), y[None, :], self.switch[None, :]))

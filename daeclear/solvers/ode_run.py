@@ -152,7 +152,8 @@ class Run:
                 Xd = ev.batch(T, X)[0]
                 seg.et.append(te)
                 seg.ex.append(_hermite(T, X, Xd, te))
-        # recorded steps: every step (the first segment's start too, h = 0); store_steps=False: the start only
+        # recorded steps: every step (the first segment's start too, h = 0); store_steps=False: none (the start
+        # alone stays an output point when there are no output times)
         if seg.include_start:
             kt, kx, kh = T, X, np.concatenate([[0.0], np.diff(T)])
         else:
@@ -160,7 +161,8 @@ class Run:
         if not self.store_steps:
             k = 1 if seg.include_start else 0
             kt, kx, kh = kt[:k], kx[:k], kh[:k]
-        self.rec.add_steps(kt, kh, np.full(kt.size, _ORDER[self.method], dtype=np.int64))
+        else:
+            self.rec.add_steps(kt, kh, np.full(kt.size, _ORDER[self.method], dtype=np.int64))
         if self.eval_times is None:
             ot, ox = kt, kx
         else:

@@ -194,6 +194,8 @@ class Recorder:
             n = self.model.n_states
             header = {**self._header, "units": {s: u for s, u in self._header["units"].items()
                                                 if s in self._header["state_names"]}}
+            # the outcome's summary tells what the file holds, read from it (the outcome holds no data)
+            outcome["stats"] = {**outcome["stats"], "file": getattr(self.writer, "counts", {"path": str(path)})}
             return Result(t=np.zeros(0), y=np.zeros((0, n)), yp=np.zeros((0, n)), channels={}, **header, **outcome)
         t, y, yp, switch, channels = self._joined()
         self._points.clear()
