@@ -208,3 +208,76 @@ def test_figure_functions_on_a_simulated_clearance_joint():
     assert ax.get_lines()[0].get_xdata().size == np.count_nonzero(result.step_h > 0)
     n_onsets = len(result.events.of("clearance", "onset"))
     assert n_onsets >= 1 and len(ax.patches) == n_onsets
+
+
+# --------------------------------------------------------------------------- the run figure (issue 45)
+
+
+@pytest.fixture(scope="module")
+def two_revolutions() -> dc.Result:
+    """The main job's run (`daeclear run slider_crank --joint revolute`) on a 10 us grid."""
+    return dc.simulate(dc.mechanisms.slider_crank("revolute"), 0.024, save=dc.SaveAt(every=1e-5, steps=False))
+
+
+def test_run_figure_marks_the_penetration_on_square_axes_that_fit_the_orbit(two_revolutions):
+    """The orbit drew the journal up to 80 um outside the clearance circle unexplained, on an axis twice
+    too wide: now square, centred, fitting the orbit; the circle and the deepest penetration labelled."""
+    from daeclear.plot import plot_run
+
+    r = two_revolutions
+    fig = plot_run(r)
+    orbit = next(ax for ax in fig.axes if ax.get_title() == "clearance: journal orbit")
+    e = np.hypot(r["clearance.ex"], r["clearance.ey"])
+    reach = 1e6 * max(C, float(e.max()))
+    assert orbit.get_aspect() == 1.0
+    assert orbit.get_xlim() == pytest.approx((-1.12 * reach, 1.12 * reach))
+    assert orbit.get_ylim() == pytest.approx((-1.12 * reach, 1.12 * reach))
+    k = int(np.argmax(e))  # the deepest penetration, |e| - c, found here from the orbit alone
+    np.testing.assert_allclose(orbit.collections[0].get_offsets()[0],
+                               1e6 * np.array([r["clearance.ex"][k], r["clearance.ey"][k]]))
+    texts = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert texts[0].startswith("|e| = c = 500 µm") and "penetration δ = |e| − c" in texts[0]
+    assert f"δ = {(e[k] - C) * 1e6:.3g} µm" in texts[1] and f"t = {r.t[k] * 1e3:.3g} ms" in texts[1]
+    assert 60 < (e[k] - C) * 1e6 < 100  # the chapter's hardest impacts: ~80 um (docs/user_guide.md, 1.3)
+    plt.close(fig)
+
+
+def test_run_figure_fits_the_acceleration_panel_to_the_steady_range(two_revolutions):
+    """The first impact of the journal started centred (-3.3e5 m/s^2) flattened the acceleration panel:
+    now it fits the values after the first 5 % of the run, the spike annotated with its value and time."""
+    from daeclear.plot import plot_run
+
+    r = two_revolutions
+    fig = plot_run(r)
+    panel = next(ax for ax in fig.axes if ax.get_ylabel().startswith("slider.ax"))
+    a, t = r["slider.ax"], r.t
+    late = t >= 0.05 * t[-1]
+    low, high = panel.get_ylim()
+    assert low <= a[late].min() and high >= a[late].max()  # every steady value is on the scale
+    assert a.min() < low  # the start spike is not
+    k = int(np.argmin(a))
+    assert t[k] < 0.05 * t[-1]
+    (note,) = panel.texts
+    assert f"start: {a[k]:.3g} m/s^2 at t = {t[k] * 1e3:.3g} ms, off scale" == note.get_text()
+    # the other panels keep their whole range (the first impact's force stays on the scale)
+    force = next(ax for ax in fig.axes if ax.get_ylabel().startswith("clearance.normal_force"))
+    assert force.get_ylim()[1] >= r["clearance.normal_force"].max() and not force.texts
+    plt.close(fig)
+
+
+def test_plot_channel_steady_range_leaves_a_steady_signal_alone():
+    t = np.linspace(0.0, 1.0, 1001)
+    r = make_result()
+    values = np.sin(2 * np.pi * 5 * t)
+    r2 = Result(t=t, y=np.zeros((t.size, 1)), yp=np.zeros((t.size, 1)), state_names=["q"],
+                channels={"x.ax": values}, units={"x.ax": "m/s^2"}, scene_name="synthetic")
+    ax = plot_channel(r2, "x.ax", steady_from=0.05)
+    assert not ax.texts and ax.get_ylim()[0] <= -1.0 and ax.get_ylim()[1] >= 1.0
+    spiked = values.copy()
+    spiked[10] = -9.0
+    r3 = Result(t=t, y=np.zeros((t.size, 1)), yp=np.zeros((t.size, 1)), state_names=["q"],
+                channels={"x.ax": spiked}, units={"x.ax": "m/s^2"}, scene_name="synthetic")
+    ax = plot_channel(r3, "x.ax", steady_from=0.05)
+    assert ax.get_ylim() == pytest.approx((-1.16, 1.16), abs=1e-3) and "-9 m/s^2 at t = 10 ms" in ax.texts[0].get_text()
+    with pytest.raises(ValueError, match="legend='below'"):
+        plot_journal_orbit(r, legend="below")

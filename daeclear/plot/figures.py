@@ -87,15 +87,26 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
     fig = plt.figure(figsize=(max(7.0, 3.6 * n_cols), height))
     grid = fig.add_gridspec(len(names) + panel_rows, n_cols, height_ratios=[1.0] * len(names) + [2.0] * panel_rows)
     first = None
+    steady_from = start_transient(result, window)
     for row, name in enumerate(names):
         ax = fig.add_subplot(grid[row, :], sharex=first)
         first = first or ax
         ref = reference if reference is not None and name in reference else None
-        plot_channel(result, name, ax=ax, reference=ref, window=window, max_points=max_points, title=False)
+        accelerating = name.rsplit(".", 1)[-1] in ACCELERATIONS  # their start spike would flatten the panel
+        plot_channel(result, name, ax=ax, reference=ref, window=window, max_points=max_points, title=False,
+                     steady_from=steady_from if accelerating else None)
         if row < len(names) - 1:
             ax.set_xlabel("")
+    beside: tuple[Any, Any] | None = None  # a single orbit's legend goes into the room beside it
     for k, joint in enumerate(panels):
-        ax = fig.add_subplot(grid[len(names) + k // n_cols, k % n_cols])
+        cell = grid[len(names) + k // n_cols, k % n_cols]
+        if kinds[joint] == "RevoluteClearance" and n_cols == 1:
+            left, right = cell.subgridspec(1, 2, width_ratios=(1.15, 1.0))
+            beside = (fig.add_subplot(left), right)
+            plot_journal_orbit(result, joint, ax=beside[0], window=window, max_points=max_points, markers=False,
+                               title=f"{joint}: journal orbit", legend="none")
+            continue
+        ax = fig.add_subplot(cell)
         if kinds[joint] == "RevoluteClearance":
             plot_journal_orbit(result, joint, ax=ax, window=window, max_points=max_points, markers=False,
                                title=f"{joint}: journal orbit")
@@ -104,7 +115,28 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
                              title=f"{joint}: slider path")
     set_run_title(fig, result, title, True)
     fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.4 / height))  # 0.4 in at the top for the title
+    if beside is not None and beside[0].get_legend_handles_labels()[0]:
+        box = beside[1].get_position(fig)
+        fig.legend(*beside[0].get_legend_handles_labels(), loc="center left", fontsize="small", frameon=False,
+                   bbox_to_anchor=(box.x0, 0.5 * (box.y0 + box.y1)))
     return fig
+
+
+#: The channels whose time plot :func:`plot_run` fits to the steady range (accelerations: the first impact of a
+#: journal started centred is several times any later one).
+ACCELERATIONS = ("ax", "ay", "alpha")
+#: The start transient of :func:`plot_run`'s time plots: this fraction of the run (their y axes fit what follows).
+START_TRANSIENT = 0.05
+
+
+def start_transient(result: Result, window: Window) -> float | None:
+    """The end of the start transient when the window shows the run's start (None otherwise)."""
+    if result.n_times < 2:
+        return None
+    t0, t1 = float(result.t[0]), float(result.t[-1])
+    if window is not None and window[0] is not None and window[0] > t0:
+        return None
+    return t0 + START_TRANSIENT * (t1 - t0)
 
 
 def save_run_figure(result: Result, path: Any, **options: Any) -> Any:

@@ -65,7 +65,8 @@ def _joint_lengths(result: Result, joint: str) -> tuple[float | None, float | No
 
 def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | None = None, markers: bool = True,
                        clearance: float | None = None, unit: str = "um", window: Window = None,
-                       max_points: int | None = None, title: str | bool | None = None, **line_kw: Any) -> Axes:
+                       max_points: int | None = None, title: str | bool | None = None, penetration: bool = True,
+                       legend: str = "inside", **line_kw: Any) -> Axes:
     """Journal centre relative to the bearing centre, with the clearance circle (Figs. 4.15d, 4.17, 4.20, 4.24).
 
     ``result`` has the channels ``<joint>.ex``, ``<joint>.ey`` (e = r_journal - r_bearing, eq. 4.1) of the
@@ -73,8 +74,15 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
     chapter, for a run without ``t_eval``). ``clearance``: radial clearance c (m) of the dashed circle, from
     the scene parameters when None. ``unit``: "um", "mm" or "m", of both axes. ``window``, ``max_points``
     (evenly spaced) and ``title`` as in :func:`plot_channel`. ``ax.lines``: the orbit, the circle |e| = c
-    when known, and for a lubricated joint the film threshold |e| = c - h_threshold (dotted). Equal aspect.
+    when known, and for a lubricated joint the film threshold |e| = c - h_threshold (dotted). Equal axes,
+    square, centred on the bearing and fitting the orbit and the circle. ``penetration`` (with the circle
+    known): the points outside the circle are the contact law's penetration delta = |e| - c, said in the
+    legend, and the deepest one of the window is marked (``ax.collections[0]``) and labelled with delta and t.
+    ``legend``: "inside" (above the orbit, in room left for it) or "none" (the caller draws the Axes'
+    labelled handles elsewhere, as :func:`daeclear.plot.plot_run` does beside a single orbit).
     """
+    if legend not in ("inside", "none"):
+        raise ValueError(f"plot_journal_orbit: legend={legend!r}, must be 'inside' or 'none'.")
     if unit not in _LENGTHS:
         raise ValueError(f"plot_journal_orbit: unit={unit!r}, must be one of {', '.join(_LENGTHS)}.")
     created = ax is None
@@ -85,17 +93,43 @@ def plot_journal_orbit(result: Result, joint: str = "clearance", *, ax: Axes | N
     ax.plot(ex * scale, ey * scale, **kw)
     own, threshold = _joint_lengths(result, joint)
     c = clearance if clearance is not None else own
+    reach = float(np.max(np.hypot(ex, ey), initial=0.0))
     if c is not None:
         angle = np.linspace(0.0, 2.0 * np.pi, 361)
-        ax.plot(c * scale * np.cos(angle), c * scale * np.sin(angle), "k--", lw=0.8, label="eccentricity ratio 1")
+        circle = f"|e| = c = {c * scale:.4g} {label}" + ("; outside it:\nthe penetration δ = |e| − c" if penetration
+                                                          else "")
+        ax.plot(c * scale * np.cos(angle), c * scale * np.sin(angle), "k--", lw=0.8, label=circle)
         if threshold is not None:
             inner = (c - threshold) * scale
             ax.plot(inner * np.cos(angle), inner * np.sin(angle), "r:", lw=0.8, label="film threshold")
-            ax.legend(loc="upper right", fontsize="small")
-    ax.set_aspect("equal", adjustable="datalim")
+        if penetration:
+            _mark_deepest(ax, result, joint, c, scale, label, window)
+        if (threshold is not None or penetration) and legend == "inside":
+            ax.legend(loc="upper left", fontsize="x-small", framealpha=0.85)
+        reach = max(reach, c)
+    if reach > 0:  # square, centred on the bearing: the orbit and the circle with a margin (and the legend)
+        top = 1.4 if legend == "inside" and ax.get_legend() is not None else 1.12
+        ax.set_xlim(-1.12 * reach * scale, 1.12 * reach * scale)
+        ax.set_ylim(-1.12 * reach * scale, top * reach * scale)
+    ax.set_aspect("equal", adjustable="box")
     ax.set(xlabel=f"journal x rel. to bearing ({label})", ylabel=f"journal y rel. to bearing ({label})")
     set_run_title(ax, result, title, created)
     return ax
+
+
+def _mark_deepest(ax: Axes, result: Result, joint: str, c: float, scale: float, label: str, window: Window) -> None:
+    """Mark the deepest penetration of the window: its point on the orbit, delta and the time."""
+    index = style.window_index(result.t, window)
+    if not index.size:
+        return
+    ex, ey = (np.asarray(result[f"{joint}.{axis}"])[index] for axis in ("ex", "ey"))
+    delta = np.hypot(ex, ey) - c
+    k = int(np.argmax(delta))
+    if delta[k] <= 0:
+        return
+    t = float(np.asarray(result.t)[index][k])
+    ax.scatter([ex[k] * scale], [ey[k] * scale], s=22, color="C3", zorder=3,
+               label=f"deepest penetration δ = {delta[k] * scale:.3g} {label}\nat t = {t * 1e3:.3g} ms")
 
 
 def plot_phase_portrait(result: Result, x: str = "slider.vx", y: str = "slider.ax", *, ax: Axes | None = None,

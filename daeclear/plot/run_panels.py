@@ -94,9 +94,14 @@ def plot_force_time(impacts: Impacts, *, ax: Axes | None = None, **line_kw: Any)
     return _force_against(impacts, ax, "t", "time since contact onset (µs)", line_kw)
 
 
+#: An extreme of the start transient counts as off the steady scale when it lies further than this many
+#: steady spans beyond the steady range (:func:`plot_channel`'s ``steady_from``).
+OFF_SCALE = 0.5
+
+
 def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, reference: Result | None = None,
                  label: str | None = None, window: Window = None, max_points: int | None = None,
-                 title: str | bool | None = None, **line_kw: Any) -> Axes:
+                 title: str | bool | None = None, steady_from: float | None = None, **line_kw: Any) -> Axes:
     """A channel against time, with the same channel of a reference run (e.g. the ideal joint) dashed.
 
     Parameters
@@ -116,6 +121,10 @@ def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, refere
     title : str or bool, optional
         True: the run's caption (clearance, speed, law, restitution, friction); a str: that text;
         False: none; None: the caption only on a new figure.
+    steady_from : float, optional
+        The end of the start transient, s: the y axis fits the values from then on, and an extreme of the
+        transient further than ``OFF_SCALE`` steady spans beyond them is left off the scale and annotated
+        with its value and time at the panel's edge (e.g. the first impact of a journal started centred).
 
     Drawn on ``ax`` (a new figure when None), ``**line_kw`` passed to ``ax.plot`` for the run's line;
     returns the Axes.
@@ -125,12 +134,42 @@ def plot_channel(result: Result, channel: str, *, ax: Axes | None = None, refere
     unit = result.units.get(channel, "")
     if reference is not None:
         ax.plot(*_series(reference, channel, window, max_points), "k--", lw=0.8, label="ideal joint")
-    ax.plot(*_series(result, channel, window, max_points), lw=0.9, label=label or result.scene_name, **line_kw)
+    t, values = _series(result, channel, window, max_points)
+    ax.plot(t, values, lw=0.9, label=label or result.scene_name, **line_kw)
     ax.set(xlabel="time (s)", ylabel=style.quantity_label(channel, unit))
+    if steady_from is not None:
+        _fit_steady(ax, np.asarray(t), np.asarray(values), steady_from, unit)
     if reference is not None:
         ax.legend(loc="best", fontsize="small")
     set_run_title(ax, result, title, created)
     return ax
+
+
+def _fit_steady(ax: Axes, t: Any, values: Any, steady_from: float, unit: str) -> None:
+    """Fit the y axis to the values from ``steady_from`` on, an extreme of the start off that scale annotated."""
+    late = t >= steady_from
+    if values.ndim != 1 or late.sum() < 2 or late.all():
+        return
+    lo, hi = float(np.min(values[late])), float(np.max(values[late]))
+    span = hi - lo
+    early = values[~late]
+    below = span > 0 and float(np.min(early)) < lo - OFF_SCALE * span
+    above = span > 0 and float(np.max(early)) > hi + OFF_SCALE * span
+    if not (below or above):
+        return
+    bottom = lo if below else min(lo, float(np.min(early)))
+    top = hi if above else max(hi, float(np.max(early)))
+    margin = 0.08 * (top - bottom)
+    ax.set_ylim(bottom - margin, top + margin)
+    for off, pick, edge in ((below, np.argmin, bottom - margin), (above, np.argmax, top + margin)):
+        if off:
+            k = int(pick(early))
+            at = float(t[~late][k])
+            text = f"start: {float(early[k]):.3g} {unit} at t = {at * 1e3:.3g} ms, off scale".replace("  ", " ")
+            ax.annotate(text, xy=(at, edge), xytext=(0.08, 0.1 if edge < lo else 0.9), textcoords="axes fraction",
+                        va="center", fontsize="x-small", color="C3", zorder=5,
+                        bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "C3", "lw": 0.5, "alpha": 0.9},
+                        arrowprops={"arrowstyle": "->", "color": "C3", "lw": 0.8})
 
 
 RESPONSE_CHANNELS = ("slider.vx", "slider.ax", "drive.moment")
