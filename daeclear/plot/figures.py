@@ -101,8 +101,8 @@ def plot_run(result: Result, *, reference: Result | None = None, channels: Itera
     for k, joint in enumerate(panels):
         cell = grid[len(names) + k // n_cols, k % n_cols]
         if kinds[joint] == "RevoluteClearance" and n_cols == 1:
-            left, right = cell.subgridspec(1, 2, width_ratios=(1.15, 1.0))
-            beside = (fig.add_subplot(left), right)
+            halves = cell.subgridspec(1, 2, width_ratios=(1.15, 1.0))
+            beside = (fig.add_subplot(halves[0, 0]), halves[0, 1])
             plot_journal_orbit(result, joint, ax=beside[0], window=window, max_points=max_points, markers=False,
                                title=f"{joint}: journal orbit", legend="none")
             continue
