@@ -74,7 +74,8 @@ class Page:
 
 
 @pytest.fixture(scope="module")
-def pages(tmp_path_factory: pytest.TempPathFactory) -> dict[Path, Page]:
+def pages() -> dict[Path, Page]:
+    """Each document's run, shared by its blocks' tests (pytest runs them in the module's order)."""
     return {}
 
 
