@@ -17,15 +17,15 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and readers
     from .studies import analysis
     from .model import loads, mechanisms, profiles
     from .assembly.assemble import DAEModel, assemble
-    from .errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted, OutputError,
+    from .core.errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted, OutputError,
                          PhysicsWarning, SceneError, SolveError)
     from .results.result import ContactEvent, Result, load
     from .contact import Material
     from .model.loads import Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
     from .model.scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational,
                               TranslationalClearance)
-    from .save_at import SaveAt
-    from .solver_options import SolverOptions
+    from .solvers.save_at import SaveAt
+    from .solvers.solver_options import SolverOptions
     from .solvers.dispatch import simulate
     from .studies.sweep import load_sweep, sweep
 
@@ -49,7 +49,7 @@ def _load_all() -> dict[str, Any]:
     from .studies import analysis  # noqa: F401
     from .model import loads, mechanisms, profiles  # noqa: F401
     from .assembly.assemble import DAEModel, assemble  # noqa: F401
-    from .errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted,  # noqa: F401
+    from .core.errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted,  # noqa: F401
                          OutputError, PhysicsWarning, SceneError, SolveError)
     from .results.result import ContactEvent, Result, load  # noqa: F401
     from .contact import Material  # noqa: F401
@@ -57,8 +57,8 @@ def _load_all() -> dict[str, Any]:
                               Torque)
     from .model.scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational,  # noqa: F401
                               TranslationalClearance)
-    from .save_at import SaveAt  # noqa: F401
-    from .solver_options import SolverOptions  # noqa: F401
+    from .solvers.save_at import SaveAt  # noqa: F401
+    from .solvers.solver_options import SolverOptions  # noqa: F401
     from .solvers.dispatch import simulate  # noqa: F401
     from .studies.sweep import load_sweep, sweep  # noqa: F401
     names = locals()

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from daeclear.assembly import automaton
+from daeclear.core import automaton
 from daeclear.engine import abi, c_handle, codegen
 from daeclear.engine.build import CSRC, CompilerUnavailable, compiler_command, driver_files
 

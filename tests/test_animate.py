@@ -11,7 +11,7 @@ from PIL import Image
 import daeclear as dc
 from daeclear.plot.animate import MAX_FRAMES, frame_count, frame_times
 from daeclear.cli import main
-from daeclear.errors import MissingDependencyError, OutputError
+from daeclear.core.errors import MissingDependencyError, OutputError
 from daeclear.model.mechanisms import chain, slider_crank
 from daeclear.model.scenefile import read_scene_file
 from scene_texts import PENDULUM
@@ -80,7 +80,7 @@ def test_translational_slider_crank(translational, tmp_path, capsys):
                                  channel="slider.vx", magnify=20, progress=True)
     assert path.stat().st_size > 5_000
     assert _frames(path) == (8, 50)  # round(0.004 s x 100 x 20)
-    assert "animating translational.gif: 8/8 frames  100.0 %" in capsys.readouterr().err  # daeclear/progress.py
+    assert "animating translational.gif: 8/8 frames  100.0 %" in capsys.readouterr().err  # daeclear/core/progress.py
 
 
 def test_chain_and_scene_file(tmp_path):
@@ -169,7 +169,7 @@ def test_cli_animates_a_saved_result(translational, tmp_path, capsys):
     # default output: the result's name with .gif
     assert main(["animate", str(h5), "--fps", "5", "--slow-motion", "100", "--size", "320", "200"]) == 0
     assert _frames(tmp_path / "run.gif")[0] == 2
-    assert "animating run.gif: 2/2 frames  100.0 %" in capsys.readouterr().err  # daeclear/progress.py
+    assert "animating run.gif: 2/2 frames  100.0 %" in capsys.readouterr().err  # daeclear/core/progress.py
 
 
 @pytest.mark.parametrize(

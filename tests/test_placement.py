@@ -14,7 +14,7 @@ import pytest
 from scipy.optimize import brentq
 
 import daeclear as dc
-from daeclear.errors import AssemblyError, SceneError
+from daeclear.core.errors import AssemblyError, SceneError
 from daeclear.model.mechanisms import CRANK_LENGTH as R, ROD_LENGTH as L, ideal_slider_crank_state, rpm_to_rad_s
 
 OMEGA = rpm_to_rad_s(5000.0)

@@ -16,7 +16,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import AssemblyError, SceneError
+from ..core.errors import AssemblyError, SceneError
 from ..model.loads import Force, RotationalSpringDamper, SpringDamper, attachment
 from ..model.scene import (GROUND, Body, PointJoint, Scene, Translational,
                            TranslationalClearance, driven_coordinate, is_finite_number)

@@ -8,7 +8,7 @@ import numbers
 import re
 from typing import Any
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 from .base import NormalLaw
 from .cylindrical import DubowskyFreudenstein, ESDU78035, Goldsmith
 from .friction import Coulomb, FrictionLaw, ModifiedCoulomb, NoFriction

@@ -7,11 +7,11 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from .. import options as rules
+from ..core import options as rules
 from ..contact import HydrodynamicBearing, Material, friction_law, normal_law
 from ..contact.hydrodynamic import law_from_table
 from ..contact.base import NormalLaw
-from ..errors import SceneError
+from ..core.errors import SceneError
 from .mechanism_options import joint_names, refuse_clearance_options
 from .scene import (GROUND, Body, Driver, Element, Revolute, RevoluteClearance, Scene, Translational,
                     is_finite_number)

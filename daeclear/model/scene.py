@@ -1,6 +1,6 @@
 """Scene: the container of a planar mechanism's bodies, joints, drivers and loads, with its gravity.
 
-Plain data, no CasADi. ``Scene.validate()`` raises one :class:`~daeclear.errors.SceneError` listing
+Plain data, no CasADi. ``Scene.validate()`` raises one :class:`~daeclear.core.errors.SceneError` listing
 every problem (each element's own and those between elements). The elements
 (:mod:`daeclear.model.elements`, :mod:`daeclear.model.clearance_joints`) are re-exported here.
 """
@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import Any
 from collections.abc import Iterable, Iterator, Mapping
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 # the elements, re-exported: ``from daeclear.model.scene import Body`` keeps working
 from .clearance_joints import (RevoluteClearance, TranslationalClearance, clearance_joint,  # noqa: F401
                                driven_coordinate, ideal_joint)

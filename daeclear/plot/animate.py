@@ -21,10 +21,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import options
+from ..core import options
 from . import style
-from ..errors import MissingDependencyError, SceneError
-from ..progress import Progress
+from ..core.errors import MissingDependencyError, SceneError
+from ..core.progress import Progress
 from .animation_panels import layout_frame
 from .run_panels import Window
 from .mechanism_frame import (CONTACT, FREE, IMPACT, Geometry, Joint, Sampler, body_pose, contact_state,

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .values import readonly
+from ..core.values import readonly
 
 __all__ = ["Consistent", "Evaluate", "LazyChannels", "rebuilt_evaluator"]
 
@@ -154,7 +154,7 @@ def rebuilt_evaluator(parameters: Mapping[str, Any]) -> tuple[Evaluate, Consiste
     def rebuilt() -> Any:
         import importlib
 
-        return importlib.import_module("daeclear.solvers.channel_eval").evaluator_from_parameters(parameters)
+        return importlib.import_module("daeclear.results.channel_eval").evaluator_from_parameters(parameters)
 
     def evaluate(t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> Mapping[str, NDArray]:
         return rebuilt().channels(t, y, yp, switch)

@@ -382,8 +382,8 @@ def restitution(value: Any, law: Any, *, where: str, field: str = "restitution")
     """A restitution given explicitly must reach a law that has one (it is never dropped silently)."""
     if value is None:
         return
-    from .contact.base import NormalLaw
-    from .contact.registry import NORMAL_LAWS, normal_law_class
+    from ..contact.base import NormalLaw
+    from ..contact.registry import NORMAL_LAWS, normal_law_class
 
     if isinstance(law, NormalLaw):
         fail(where, field, value, f"left out when law is a law object ({type(law).__name__}); set it on the "
