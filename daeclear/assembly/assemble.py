@@ -27,7 +27,8 @@ from ..model.scene import (GROUND, Body, Driver, Revolute, RevoluteClearance, Sc
 from .revolute_joint import CONTACT_BUILDERS
 from .drivers import driver_constraint, driver_load, driver_parameters
 from .joint_coordinates import joint_channels
-from ..model.loads import Load, build_loads, load_parameters
+from ..model.loads import Load, load_parameters
+from .load_terms import build_loads
 from .symbolic import AssemblyContext, Channel, Reference, Term, body_frames, rotation
 from .physics import checked_channel
 from .dae_model import (EXTRA_TERM0, KIND_MULTIPLIER, KIND_POSITION, KIND_VELOCITY, KIND_WORK,  # noqa: F401

@@ -1,6 +1,6 @@
 """Animations of a run: the mechanism moving, each clearance joint magnified, a time cursor (docs/user_guide.md).
 
-:func:`animate` (``Result.animate``, ``daeclear animate RESULT.h5``) checks the options and writes a GIF
+:func:`animate` (``daeclear.animate``, ``daeclear animate RESULT.h5``) checks the options and writes a GIF
 (pillow, no external program) or an MP4 (ffmpeg), drawn from the result alone (its scene description and
 channels), so a run loaded back from HDF5 animates too. A joint is red in a frame when in contact then or
 since the previous frame, so an impact shorter than the frame spacing still shows. The frame is drawn by
@@ -61,7 +61,7 @@ _DPI = 100.0
 class _Fields:
     """How the caller names each option, for error messages (Python keywords or CLI flags)."""
 
-    where: str = "Result.animate"
+    where: str = "animate"
     path: str = "path"
     fps: str = "fps"
     window: str = "window"

@@ -439,26 +439,6 @@ class Result:
         """
         return export.to_xarray(self, states=states)
 
-    # ------------------------------------------------------------------ animation
-
-    def animate(self, path: str | os.PathLike[str], *, fps: float = 25.0,
-                window: tuple[float | None, float | None] | None = None, slow_motion: float | None = None,
-                size: tuple[int, int] = (720, 450), channel: str | None = None, magnify: float | None = None,
-                progress: bool = False) -> Path:
-        """Write an animated GIF (or MP4 with ffmpeg) of the mechanism moving; see
-        :func:`daeclear.plot.animate.animate`.
-
-        Frames: ``max(2, round(duration * slow_motion * fps))`` evenly spaced over the window.
-
-        Examples
-        --------
-        >>> result.animate("run.gif", window=(0.010, 0.014), slow_motion=500, size=(560, 360))  # doctest: +SKIP
-        """
-        from ..plot.animate import animate
-
-        return animate(self, path, fps=fps, window=window, slow_motion=slow_motion, size=size, channel=channel,
-                       magnify=magnify, progress=progress)
-
     # ------------------------------------------------------------------ HDF5
 
     def save(self, path: str | os.PathLike[str], *, channels: bool = False) -> Path:
