@@ -77,7 +77,7 @@ def _load_all() -> dict[str, Any]:
 
 def __getattr__(name: str) -> Any:
     """A public name: the first use imports them all. Another name is a sub-package or module
-    (``daeclear.plot``), imported alone (the package's own ``from .. import options`` comes here too)."""
+    (``daeclear.plot``), imported alone (the package's own ``from .. import contact`` comes here too)."""
     if name in __all__ and not _loading:
         _loading.append(name)
         try:
