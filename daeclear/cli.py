@@ -12,9 +12,9 @@ from pathlib import Path
 from typing import Any
 from collections.abc import Callable, Sequence
 
-from .defaults import (CLI_FIGURE_POINTS, CLI_FINEST_STEP, CLI_POINTS, CLI_SHOWN_EVENTS, CLI_STEPS_PER_SECOND,
-                       FORMULATION, MAX_OUTPUT_POINTS, MAX_STEPS, RTOL)
-from .errors import DaeclearError, DiskFull, Interrupted, PhysicsWarning, SolveError
+from .core.defaults import (CLI_FIGURE_POINTS, CLI_FINEST_STEP, CLI_POINTS, CLI_SHOWN_EVENTS, CLI_STEPS_PER_SECOND,
+                            FORMULATION, MAX_OUTPUT_POINTS, MAX_STEPS, RTOL)
+from .core.errors import DaeclearError, DiskFull, Interrupted, PhysicsWarning, SolveError
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by Ctrl-C
 __all__ = ["CLI_FIGURE_POINTS", "CLI_FINEST_STEP", "CLI_POINTS", "CLI_SHOWN_EVENTS", "CLI_STEPS_PER_SECOND",
@@ -155,13 +155,13 @@ def _mechanism(mechanisms: dict[str, Any], name: str, params: dict[str, Any]) ->
 
 
 def _run(args: argparse.Namespace) -> int:
-    from . import options
+    from .core import options
     from .model.mechanism_options import ideal_parameters
     from .results.outputs import check_directory
     from .model.scene import RevoluteClearance, TranslationalClearance
     from .model.scenefile import MECHANISMS, read_scene_file
-    from .save_at import SaveAt
-    from .solver_options import SolverOptions
+    from .solvers.save_at import SaveAt
+    from .solvers.solver_options import SolverOptions
     from .solvers.dispatch import simulate
 
     where = "daeclear run"
@@ -263,8 +263,8 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
     """The response figure of ``daeclear run`` (against the ideal joint when there is one)."""
     if args.no_figure:
         return
-    from .save_at import SaveAt
-    from .solver_options import SolverOptions
+    from .solvers.save_at import SaveAt
+    from .solvers.solver_options import SolverOptions
     from .solvers.dispatch import simulate
     import matplotlib
     matplotlib.use("Agg")
@@ -310,7 +310,7 @@ def _floats(text: str, what: str) -> list[float]:
 
 
 def _study(args: argparse.Namespace) -> int:
-    from . import options
+    from .core import options
     from .studies.accuracy import WorkPrecision, work_precision
     from .results.outputs import check_directory
     from .model.scenefile import MECHANISMS
@@ -453,7 +453,7 @@ def _grid_values(item: str) -> tuple[str, list[Any]]:
 def _sweep(args: argparse.Namespace) -> int:
     import json
 
-    from . import options
+    from .core import options
     from .results.outputs import check_directory, check_file
     from .studies.sweep import sweep
 

@@ -1,7 +1,7 @@
 """The defaults a run uses, the command line's help texts and the docs say the same (issue 45).
 
 `--t-eval-step`'s help and docs/reliability.md said the default grid was 1 us while the run used 2 us.
-The defaults now live in ``daeclear.defaults`` (and the dataclasses' fields); the help texts are made
+The defaults now live in ``daeclear.core.defaults`` (and the dataclasses' fields); the help texts are made
 from them, and these tests read the docs' tables and sentences back against them.
 """
 
@@ -18,7 +18,7 @@ from typing import Any
 import pytest
 
 import daeclear as dc
-from daeclear import defaults
+from daeclear.core import defaults
 from daeclear.cli import build_parser, default_max_steps, default_t_eval_step
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -55,7 +55,7 @@ SHORTENED: dict[tuple[str, str], tuple[tuple[str, str], ...]] = {
     ("docs/user_guide.md", "six runs with their figures, a study and an animation of 48 frames (about 30 s)"): (
         ("--slow-motion 400", "--slow-motion 40"), ("--t-end 0.06", "--t-end 0.02"), ("--t-end 0.2", "--t-end 0.02")),
     ("docs/user_guide.md", "renders 173 frames (about 15 s)"): (
-        ('result.animate("run.gif")', 'result.animate("run.gif", fps=2)'), ("fps=20,", "fps=2,")),
+        ('dc.animate(result, "run.gif")', 'dc.animate(result, "run.gif", fps=2)'), ("fps=20,", "fps=2,")),
 }
 
 BLOCKS = doc_blocks.all_blocks()

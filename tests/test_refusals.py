@@ -19,7 +19,7 @@ import pytest
 
 import daeclear as dc
 from daeclear.cli import main
-from daeclear.errors import AssemblyError, SceneError
+from daeclear.core.errors import AssemblyError, SceneError
 
 IDEAL = dc.mechanisms.slider_crank()
 REVOLUTE = dc.mechanisms.slider_crank("revolute")
@@ -80,15 +80,15 @@ CASES: list[tuple[str, Callable[[Path], Any], type[BaseException], tuple[str, ..
     # (id, call(tmp_path), error, texts the message holds)
     # assembled(start=, speeds=): over-determined speeds no motion has, a dead-centre start that cannot reach
     ("four-bar two contradictory speeds",
-     lambda p: FREE_FOUR_BAR.assembled(start={"A": 0.5}, speeds={"A": 1.0, "B": 5.0}), AssemblyError,
+     lambda p: dc.place(FREE_FOUR_BAR, start={"A": 0.5}, speeds={"A": 1.0, "B": 5.0}), AssemblyError,
      ("speeds={'A': 1.0, 'B': 5.0} contradict the joints", "B.rate = ", "(5 given)", "1 degree(s) of freedom")),
     ("slider-crank crank and slider speeds disagree",
-     lambda p: FREE_SLIDER_CRANK.assembled(start={"A": 1.0}, speeds={"A": 100.0, "D": 5.0}), AssemblyError,
+     lambda p: dc.place(FREE_SLIDER_CRANK, start={"A": 1.0}, speeds={"A": 100.0, "D": 5.0}), AssemblyError,
      ("speeds={'A': 100.0, 'D': 5.0}", "D.speed = ", "(5 given)")),
-    ("speed not finite", lambda p: FREE_SLIDER_CRANK.assembled(start={"A": 1.0}, speeds={"A": math.inf}),
+    ("speed not finite", lambda p: dc.place(FREE_SLIDER_CRANK, start={"A": 1.0}, speeds={"A": math.inf}),
      SceneError, ("speeds['A']=inf", "finite")),
     ("start beyond the stroke from a dead centre",
-     lambda p: FREE_SLIDER_CRANK.assembled(start={"D": 0.2}), AssemblyError,
+     lambda p: dc.place(FREE_SLIDER_CRANK, start={"D": 0.2}), AssemblyError,
      ("start={'D': 0.2}", "D (displacement) is at a singular configuration", "D.displacement = ")),
     # options that do not apply to the formulation
     ("baumgarte.alpha on GGL at its default", lambda p: dc.assemble(REVOLUTE).with_parameters({"baumgarte.alpha": 5}),

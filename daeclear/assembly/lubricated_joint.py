@@ -16,8 +16,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.clearance_joints import RevoluteClearance
-from ..results.result import ContactEvent
-from .automaton import start, step
+from ..core.events import ContactEvent
+from ..core.automaton import start, step
 from .contact_pairs import (ContactBuild, PairLogic, PairStates, TermSwitch, journal_contact, journal_logic,
                             journal_parameters, pair_event)
 from .parameters import law_structure

@@ -1,4 +1,4 @@
-"""A scene placed at chosen joint coordinates: :meth:`Scene.assembled` (``start=``, ``speeds=``).
+"""A scene placed at chosen joint coordinates: :func:`daeclear.place` (``start=``, ``speeds=``).
 
 Least-norm Newton from the declared poses closes every joint as at a run's start with the named
 joints at their values, velocities likewise; every number the declared configuration defined is
@@ -16,7 +16,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import AssemblyError, SceneError
+from ..core.errors import AssemblyError, SceneError
 from ..model.loads import Force, RotationalSpringDamper, SpringDamper, attachment
 from ..model.scene import (GROUND, Body, PointJoint, Scene, Translational,
                            TranslationalClearance, driven_coordinate, is_finite_number)
@@ -26,7 +26,7 @@ from .joint_coordinates import JOINT_CHANNELS, joint_coordinate
 from .symbolic import Reference, body_frames
 
 
-def assembled(scene: Scene, start: Mapping[str, float] | None = None,
+def place(scene: Scene, start: Mapping[str, float] | None = None,
               speeds: Mapping[str, float] | None = None) -> Scene:
     """The scene with its bodies at the joint coordinates ``start`` (name -> rad or m) and moving at the
     joint rates ``speeds`` (rad/s, m/s). Raises SceneError for a bad argument, AssemblyError when the
@@ -40,28 +40,28 @@ def assembled(scene: Scene, start: Mapping[str, float] | None = None,
         driver = drivers.get(name)
         if driver is not None and (driver.initial_angle is not None or driver.initial_position is not None
                                    or not driver.motion_profile.uses_speed):
-            raise SceneError(f"scene '{scene.name}': assembled: start[{name!r}]={start_values[name]!r}, but Driver "
+            raise SceneError(f"scene '{scene.name}': place: start[{name!r}]={start_values[name]!r}, but Driver "
                              f"'{driver.name}' fixes the coordinate of joint '{name}' at t = 0 (its initial value or "
                              "tabulated profile); leave one of the two out.")
     for name, value in (speed_values or {}).items():
         if name in drivers:
-            raise SceneError(f"scene '{scene.name}': assembled: speeds[{name!r}]={value!r}, but joint "
+            raise SceneError(f"scene '{scene.name}': place: speeds[{name!r}]={value!r}, but joint "
                              f"'{name}' is driven by Driver '{drivers[name].name}', whose profile gives its speed; "
                              "leave it out of speeds.")
     model = assemble(scene)
     ref = Reference(tuple(scene.bodies), GROUND)
     names = list(dict.fromkeys([*start_values, *(speed_values or {})]))
     replaced = {drivers[name].name for name in start_values if name in drivers}
-    place = _Placement(model, _coordinate_function(scene, ref, [joints[name] for name in names]), names,
+    placement = _Placement(model, _coordinate_function(scene, ref, [joints[name] for name in names]), names,
                        [i for i, owner in enumerate(_row_owners(model)) if owner not in replaced])
-    label = f"scene '{scene.name}': assembled(start={dict(start_values)!r})"
-    q = place.positions(label, start_values, joints)
-    Phi, Phi_q, c, C_q = place.rows(q, list(start_values))
+    label = f"scene '{scene.name}': place(start={dict(start_values)!r})"
+    q = placement.positions(label, start_values, joints)
+    Phi, Phi_q, c, C_q = placement.rows(q, list(start_values))
     _check_fixed(label, "start", np.vstack([Phi_q, C_q]), scene, list(start_values), joints)
     # no speeds: the declared velocities corrected (least norm) to the joints and drivers, as a run's start does
     v = model.assemble_velocities(q, model.v_guess, ideal=True)
     if speed_values is not None:
-        v = place.velocities(scene, q, speed_values, joints)
+        v = placement.velocities(scene, q, speed_values, joints)
     return _placed(scene, ref, q, v)
 
 
@@ -155,7 +155,7 @@ class _Placement:
         _, Phi_q, Phi_t = self.model.constraints(q, self.zero, 0.0, ideal=True)
         C_q = np.asarray(self.coordinates(q)[1], dtype=float)[[self.names.index(name) for name in speed_values]]
         given = np.array([speed_values[name] for name in speed_values])
-        _check_fixed(f"scene '{scene.name}': assembled(speeds={dict(speed_values)!r})", "speeds",
+        _check_fixed(f"scene '{scene.name}': place(speeds={dict(speed_values)!r})", "speeds",
                      np.vstack([Phi_q, C_q]), scene, list(speed_values), joints)
         # the velocities the joints allow, v_p + N z; the speeds fit in z alone, so a miss is theirs
         v_p = np.linalg.lstsq(Phi_q, -Phi_t, rcond=None)[0]
@@ -213,7 +213,7 @@ def stationary(Phi_q: NDArray[np.float64], C_q: NDArray[np.float64], chosen: lis
 def _checked(scene: Scene, field_name: str, values: Mapping[str, float] | None, joints: dict[str, Any]
              ) -> dict[str, float]:
     """``values`` as a dict joint name -> float; a clear error for anything else."""
-    where = f"scene '{scene.name}': assembled"
+    where = f"scene '{scene.name}': place"
     if values is None:
         return {}
     if not isinstance(values, Mapping):

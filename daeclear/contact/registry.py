@@ -8,7 +8,8 @@ import numbers
 import re
 from typing import Any
 
-from ..errors import SceneError
+from ..core.errors import SceneError
+from ..core.options import fail
 from .base import NormalLaw
 from .cylindrical import DubowskyFreudenstein, ESDU78035, Goldsmith
 from .friction import Coulomb, FrictionLaw, ModifiedCoulomb, NoFriction
@@ -106,3 +107,17 @@ def friction_law(name_or_coefficient: str | float | FrictionLaw | None, **params
     if isinstance(name_or_coefficient, numbers.Real) and not isinstance(name_or_coefficient, bool):
         return build_law(ModifiedCoulomb, {"coefficient": float(name_or_coefficient), **params})
     return build_law(_lookup("friction_law", name_or_coefficient, FRICTION_LAWS, _FRICTION_ALIASES), params)
+
+
+def check_restitution(value: Any, law: Any, *, where: str, field: str = "restitution") -> None:
+    """A restitution given explicitly must reach a law that has one (it is never dropped silently)."""
+    if value is None:
+        return
+    if isinstance(law, NormalLaw):
+        fail(where, field, value, f"left out when law is a law object ({type(law).__name__}); set it on the "
+             "law object instead")
+    cls = normal_law_class(str(law))
+    if "restitution" not in getattr(cls, "__dataclass_fields__", {}):
+        takes = [n for n, c in NORMAL_LAWS.items() if "restitution" in getattr(c, "__dataclass_fields__", {})]
+        fail(where, field, value, f"left out with law={law!r}, which has no coefficient of restitution "
+             f"(laws with one: {', '.join(takes)})")

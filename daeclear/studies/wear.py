@@ -22,11 +22,11 @@ from ..assembly.assemble import assemble
 from ..assembly.dae_model import DAEModel
 from ..contact.geometry import sigma_sum
 from ..contact.wear import ArchardWear, WearHistoryArrays, wear_increment, worn_volume
-from ..errors import PhysicsWarning, SceneError, SolveError
+from ..core.errors import PhysicsWarning, SceneError, SolveError
 from ..model.scene import RevoluteClearance, Scene
-from ..progress import Progress
+from ..core.progress import Progress
 from ..results.result import Result
-from ..solver_options import SolverOptions
+from ..solvers.solver_options import SolverOptions
 from ..solvers.dispatch import simulate
 from .poincare import crank_period
 from .wear_file import WearFile

@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import DaeclearWarning
-from ..options import fail, is_real
+from .errors import DaeclearWarning
+from .options import fail, is_real
 
 __all__ = ["field_names", "readonly", "time_window", "to_plain"]
 
