@@ -173,7 +173,7 @@ DC_API int dc_set_layout(void* sp, int nq, int m, int ggl, int track_work, int a
     if (!s->xarg || !s->xres || !s->xiw || !s->xw || !s->xnz) return -1;
   }
   s->lay_n_channels = nc;
-  if (s->lin_kind == DC_LS_REDUCED && rls_set_kinematic_rows(s->LS, nq) != 0) return -1;
+  if (s->lin_kind == DC_LS_REDUCED && rls_set_kinematic_rows(s->lin, nq) != 0) return -1;
   s->lay_ready = 1;
   return 0;
 }
