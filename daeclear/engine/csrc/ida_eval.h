@@ -287,4 +287,16 @@ static int eval_extra1(dc_session* s, int k, int n_in, const double* const* in, 
   return extra_dense(&dc_extra_tab[k], s->xarg, s->xres, s->xiw, s->xw, 0, out, s->xnz);
 }
 
+/* eval_extra1 added into out (the output's length) instead of written: a sparse output's nonzeros
+ * only (a contact term's generalized force touches two bodies of a long chain). */
+static int add_extra1(dc_session* s, int k, int n_in, const double* const* in, double* out) {
+  const dc_fun_t* f = &dc_extra_tab[k];
+  const dc_int* sp = f->sparsity_out(0);
+  for (int j = 0; j < n_in; ++j) s->xarg[j] = in[j];
+  s->xres[0] = s->xnz;
+  if (f->eval(s->xarg, s->xres, s->xiw, s->xw, 0) != 0) return -1;
+  dc_sp_scatter(sp, s->xnz, out, sp[0], 1);
+  return 0;
+}
+
 #endif

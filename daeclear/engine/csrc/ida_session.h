@@ -170,7 +170,7 @@ typedef struct {
   int proj_on;        /* restarts after a switch decided in C: project q and v on the manifold */
   int proj_iter;
   double proj_tol;    /* |Phi| < proj_tol * max(1, |q|) ends the position Newton */
-  double* lay_buf;    /* Qc, Fk (nq each), sol (nq + m + 1), K (2m + m nq), G (m m), x (m), par, channels */
+  double* lay_buf;    /* Qc, a spare (nq each), sol (nq + m + 1), K (2m + m nq), G (m m), x (m), par, channels */
   const double** xarg; /* CasADi work memory for the extras, sized for the largest (dc_set_layout) */
   double** xres;
   dc_int* xiw;
