@@ -21,7 +21,9 @@
  * counted in n_fallback; the next Jacobian tries the plan again.
  *
  * solve: x <- P^T U^-1 L^-1 P x, the two substitutions column by column over the factors' nonzeros
- * (U's diagonal as reciprocals: products, not divisions).
+ * (U's diagonal as reciprocals: products, not divisions). solve_many: the same for several
+ * right-hand sides in one pass over the factors (each factor entry read once for all of them, the
+ * right-hand sides interleaved row by row), every one's arithmetic that of solve.
  */
 #ifndef DAECLEAR_DC_SPARSE_LU_H
 #define DAECLEAR_DC_SPARSE_LU_H
@@ -38,6 +40,8 @@ typedef struct {
   double* y;            /* [n] the permuted right-hand side */
   int* prow;            /* [nnz] the pivot-order row of each union nonzero */
   double* rs;           /* [n] reciprocal row maxima of J, in pivot order */
+  double* ym;           /* [n * ym_cols] solve_many's right-hand sides, row by row */
+  int ym_cols;
   int dense;            /* the current factorisation is the dense fallback's */
   double* dA;           /* the fallback's n x n matrix, its columns and pivots (allocated at first use) */
   double** dcols;
@@ -135,6 +139,45 @@ static void dcls_sparse_solve(dc_linsol* ls, double* b) {
   for (int i = 0; i < n; ++i) b[perm[i]] = y[i];
 }
 
+static void dcls_sparse_solve_many(dc_linsol* ls, double* X, int nrhs, int ld) {
+  dcls_sparse* c = (dcls_sparse*)ls->content;
+  const dc_lu_plan* p = c->p;
+  const int n = p->n;
+  if (!c->dense && nrhs > c->ym_cols && nrhs > 1) {
+    double* grown = (double*)realloc(c->ym, sizeof(double) * (size_t)n * (size_t)nrhs);
+    if (grown) {
+      c->ym = grown;
+      c->ym_cols = nrhs;
+    }
+  }
+  if (c->dense || nrhs < 2 || nrhs > c->ym_cols) { /* the dense fallback's, or no memory: one at a time */
+    dcls_solve_each(ls, X, nrhs, ld);
+    return;
+  }
+  const int *fcol = p->fcolptr, *frow = p->frow, *fdiag = p->fdiag, *perm = p->perm;
+  const double* f = c->f;
+  double* Y = c->ym;
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < nrhs; ++k) Y[(size_t)i * nrhs + k] = X[(size_t)k * ld + perm[i]];
+  for (int j = 0; j < n; ++j) { /* L Y = P B */
+    const double* yj = Y + (size_t)j * nrhs;
+    for (int l = fdiag[j] + 1; l < fcol[j + 1]; ++l) {
+      double* yr = Y + (size_t)frow[l] * nrhs;
+      for (int k = 0; k < nrhs; ++k) yr[k] -= f[l] * yj[k];
+    }
+  }
+  for (int j = n - 1; j >= 0; --j) { /* U X = Y */
+    double* yj = Y + (size_t)j * nrhs;
+    for (int k = 0; k < nrhs; ++k) yj[k] *= c->rdiag[j];
+    for (int q = fcol[j]; q < fdiag[j]; ++q) {
+      double* yr = Y + (size_t)frow[q] * nrhs;
+      for (int k = 0; k < nrhs; ++k) yr[k] -= f[q] * yj[k];
+    }
+  }
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < nrhs; ++k) X[(size_t)k * ld + perm[i]] = Y[(size_t)i * nrhs + k];
+}
+
 static void dcls_sparse_destroy(dc_linsol* ls) {
   dcls_sparse* c = (dcls_sparse*)ls->content;
   if (c) {
@@ -144,6 +187,7 @@ static void dcls_sparse_destroy(dc_linsol* ls) {
     free(c->y);
     free(c->prow);
     free(c->rs);
+    free(c->ym);
     free(c->dA);
     free(c->dcols);
     free(c->dpiv);
@@ -176,6 +220,7 @@ static dc_linsol* dcls_sparse_create(int kind, const dc_lu_plan* plan) {
     dcls_free(ls);
     return NULL;
   }
+  ls->solve_many = dcls_sparse_solve_many;
   for (int k = 0; k < n; ++k) pinv[plan->perm[k]] = k;
   for (int q = 0; q < plan->nnz; ++q) c->prow[q] = pinv[plan->rowind[q]];
   free(pinv);
