@@ -46,7 +46,7 @@ __all__ = ["CSession", "SPARSE_MIN_STATES"]
 
 #: linear_solver="auto" uses the sparse LU from this many states on, the reduced dense LU below
 #: (measured: benchmarks/bench_linear_solver.py, docs/performance.md).
-SPARSE_MIN_STATES = 48
+SPARSE_MIN_STATES = 60
 _LS_NAMES = {code: name for name, code in LINEAR_SOLVER_CODES.items()}
 log = logging.getLogger("daeclear")
 
