@@ -194,6 +194,25 @@ def test_reduced_solve_equals_a_plain_lu(formulation):
                                    atol=1e-12 * np.abs(exact).max())
 
 
+@pytest.mark.parametrize("formulation", ["ggl", "index1"])
+def test_every_solver_solves_several_right_hand_sides_with_one_factorisation(formulation):
+    """The one interface of the loop's solvers (csrc/dc_linsol.h): factor once, then solve_many with four
+    right-hand sides at once, for the dense, reduced and sparse LU alike: each column is numpy's solution of
+    the iteration matrix (the forward sensitivities will solve their right-hand sides this way)."""
+    model = dc.assemble(slider_crank("revolute"), formulation)
+    y, yp = model.initial_state()
+    s = open_session(model.functions, backend="c", rtol=1e-8, atol=1e-10, parameters=model.parameter_values)
+    s.set_terms([False] * len(model.terms), [np.zeros(term.n_params) for term in model.terms])
+    nq = model.layout(project=False).n_q
+    B = np.random.default_rng(13).normal(size=(model.n_states, 4))
+    J = s.jacobian(0.0, y, yp, 2e4)
+    exact = np.linalg.solve(J, B)
+    for solver, nk in (("dense", 0), ("reduced", nq), ("sparse", 0)):
+        X, fallbacks = s.solve_linear(0.0, y, yp, 2e4, B, solver=solver, n_kinematic=nk)
+        assert X.shape == B.shape and fallbacks == 0
+        np.testing.assert_allclose(X, exact, rtol=0, atol=1e-10 * np.abs(exact).max(), err_msg=solver)
+
+
 def test_reduced_solve_of_general_matrices():
     """The reduced solver on random matrices whose first nk rows have a diagonal block: exact
     (to round-off) for every nk, so for every size of the factored part and every remainder of
