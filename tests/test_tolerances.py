@@ -79,11 +79,32 @@ def test_scales_follow_the_mechanism():
 def test_defaults_are_never_below_round_off():
     s = tol.scales(dc.assemble(dc.mechanisms.slider_crank("revolute")))
     floor = s.roundoff()
-    assert floor["velocity"] == pytest.approx(tol.ROUNDOFF_FACTOR * np.finfo(float).eps * 0.17 * 523.6, rel=1e-4)
+    assert floor["velocity"] == pytest.approx(tol.ROUNDOFF_FACTOR * np.finfo(float).eps * 0.17 * 523.6, rel=1e-4,
+                                             abs=0.0)
     atol = s.default_atol(1e-14)
     assert all(atol[q] == floor[q] for q in tol.QUANTITIES)
     loose = s.default_atol(1e-3)
     assert all(loose[q] > floor[q] for q in tol.QUANTITIES)
+
+
+def test_round_off_floors_scale_with_the_mechanism():
+    """docs/engine.md, Tolerances: each floor is 300 eps (IDA's Newton) or 10 eps (the ODE methods)
+    times its quantity's scale: L for positions (m), 1 for angles, L W for velocities, W for angular
+    velocities. The chapter's slider-crank: L = 0.17 m, W = 5000 rpm; the five-link pendulum: L =
+    0.45 m, W = sqrt(g / L). A given atol below them is raised to them, position states included."""
+    eps = np.finfo(float).eps
+    crank, swing = dc.assemble(dc.mechanisms.slider_crank("revolute")), dc.assemble(pendulum())
+    for model, L, W in ((crank, 0.17, 5000 * 2 * math.pi / 60), (swing, 0.45, math.sqrt(9.81 / 0.45))):
+        for newton, factor in ((True, 300.0), (False, 10.0)):
+            floor = tol.scales(model).roundoff(newton)
+            expected = {"position": factor * eps * L, "angle": factor * eps, "velocity": factor * eps * L * W,
+                        "angular_velocity": factor * eps * W}
+            assert floor == pytest.approx(expected, rel=1e-9, abs=0.0)  # (approx's default abs 1e-12 is above them)
+        with pytest.warns(DaeclearWarning, match=f"position to {300 * eps * L:.2g} m"):
+            vec = tol.tolerance_vector(model, 1e-6, 1e-30)
+        names = model.state_names
+        assert vec[names.index("rod.x" if model is crank else "link5.y")] == pytest.approx(300 * eps * L, rel=1e-9,
+                                                                                       abs=0.0)
 
 
 def test_the_tolerance_vector_per_state():
