@@ -344,7 +344,8 @@ def test_runs_with_output_times_come_back_in_long_pieces(monkeypatch):
 # ---------------------------------------------------------------- where the contact force acts (issue 47)
 
 G, R_B, C_B, MASS, INERTIA, MU, SPIN = 9.81, 10e-3, 0.5e-3, 0.1, 1e-5, 0.1, 200.0
-STEEL_K = 6.6102e10  # (3.5) for steel, R = 10 / 9.5 mm: 4 / (3 (s_i + s_j)) sqrt(R_i R_j / (R_i - R_j))
+SIGMA = (1 - 0.3**2) / 207e9  # steel, eq. (3.4)
+STEEL_K = 4 / (3 * 2 * SIGMA) * np.sqrt(R_B * (R_B - C_B) / C_B)  # (3.5), journal in bearing: 6.61e10 N/m^1.5
 
 
 def braked_journal(bearing_free: bool = False) -> dc.Scene:

@@ -51,9 +51,10 @@ def test_scales_of_the_chapter_slider_crank():
     assert s.resolution == pytest.approx(1e-3)
     atol = s.default_atol(1e-6)
     # the 1e-3 * rtol of earlier releases in m, rad and m/s; 5000 rpm * 1e-5 in rad/s
-    assert atol["position"] == pytest.approx(1e-9) and atol["angle"] == pytest.approx(1e-9)
-    assert atol["velocity"] == pytest.approx(1e-6 * 1e-5 * 0.17 * 523.5987755982989)
-    assert atol["angular_velocity"] == pytest.approx(1e-6 * 1e-5 * 523.5987755982989)
+    assert atol["position"] == pytest.approx(1e-9, rel=1e-6, abs=0.0)
+    assert atol["angle"] == pytest.approx(1e-9, rel=1e-6, abs=0.0)
+    assert atol["velocity"] == pytest.approx(1e-6 * 1e-5 * 0.17 * 523.5987755982989, rel=1e-6, abs=0.0)
+    assert atol["angular_velocity"] == pytest.approx(1e-6 * 1e-5 * 523.5987755982989, rel=1e-6, abs=0.0)
 
 
 def test_scales_follow_the_mechanism():
@@ -250,3 +251,13 @@ def test_the_sticking_advice_makes_the_run_finish():
                          on_failure="return")
     assert not failed.success and "modified Coulomb law (friction=<coefficient>" in failed.message
     assert dc.simulate(dc.mechanisms.slider_crank("revolute", friction=0.5), 0.024).success
+
+
+def test_a_comparison_the_default_abs_would_widen_is_refused():
+    """tests/conftest.py: pytest.approx(5.9e-12, rel=1e-4) would pass anything within 1e-12 (17 %): refused;
+    with abs= given, or values the default abs does not widen, it compares as pytest's."""
+    with pytest.raises(ValueError, match="default abs=1e-12 makes this comparison up to 0.17 relative"):
+        pytest.approx(5.9e-12, rel=1e-4)
+    assert 5.9e-12 == pytest.approx(5.9e-12, rel=1e-4, abs=0.0) and 6.5e-12 != pytest.approx(5.9e-12, rel=1e-4, abs=0)
+    assert 1.0 == pytest.approx(1.0) and 1e-3 == pytest.approx(1e-3, rel=1e-6) and 0.0 == pytest.approx(0.0)
+    assert {"a": 1e-9} == pytest.approx({"a": 1e-9}, rel=1e-3)  # 1e-12 / 1e-9 = 1e-3: not widened
