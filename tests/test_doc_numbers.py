@@ -13,6 +13,7 @@ from __future__ import annotations
 import importlib.util
 import re
 import sys
+import warnings
 from pathlib import Path
 from types import ModuleType
 
@@ -292,3 +293,25 @@ def test_the_sparse_threshold_the_docs_state_is_the_codes():
                          ("docs/user_guide.md", r"sparse from (\d+) states on")):
         m = re.search(pattern, (ROOT / doc).read_text())
         assert m and int(m.group(1)) == SPARSE_MIN_STATES, doc
+
+
+def test_the_work_precision_pages_chapter_runs():
+    """docs/work_precision.md (bench_figures.py --write): each chapter run's steps, evaluations and
+    events (index-1, five revolutions) within 5 %."""
+    module = bench("benchmarks/bench_figures.py")
+    text = (ROOT / "docs" / "work_precision.md").read_text()
+    for label, make in module.SCENES.items():
+        section = text[text.index(f"## {label}"):]
+        table = blocks.table_rows(section[section.index("Chapter run"):])
+        assert [float(row["rtol"]) for row in table] == [1e-6, 1e-8]
+        for row in table:
+            model = dc.assemble(make(), "index1")
+            with warnings.catch_warnings():  # index-1's drift warning at rtol 1e-6: the chapter's settings
+                warnings.simplefilter("ignore", dc.DaeclearWarning)
+                result = dc.simulate(model, 5 * module.REV, rtol=float(row["rtol"]))
+            s = result.stats
+            shown = sum(1 for e in result.events if e.t >= 3 * module.REV)
+            events, in_shown = row["events (in the 2 shown)"].replace(")", "").split(" (")
+            for got, cell in ((s["n_steps"], row["steps"]), (s["n_res_evals"], row["residuals"]),
+                              (s["n_jac_evals"], row["Jacobians"]), (s["n_events"], events), (shown, in_shown)):
+                same_count(got, cell, CHAOTIC, f"{label} rtol {row['rtol']}")
