@@ -221,3 +221,95 @@ def test_command_line_with_a_lubricant(tmp_path) -> None:
     result = dc.load(tmp_path / "slider_crank_revolute.h5")
     assert result.success and result["clearance.regime"].max() == 0.0
     assert result["clearance.film_radial"].max() > 0.0
+
+
+# ---------------------------------------------------------------- the bearing's rotation in the wedge (issue 47)
+#
+# Reynolds' equation in the frame of the line of centres (turning at dgamma/dt): the surfaces slide at
+# R (w_journal - dgamma/dt) and R (w_bearing - dgamma/dt), and the pressure's wedge term is their sum,
+# so the film force is the journal's alone at the wedge rate w = w_journal + w_bearing - 2 dgamma/dt.
+# Hence: a bearing spinning under a still journal carries it as a journal spinning at the same rate in a
+# still bearing; both spinning with the centres still, twice the rate; spinning against each other, no
+# wedge; the whole joint turning rigidly (centres included), no film force at all; and the mirror image
+# of a spin (-w) mirrors the attitude.
+
+
+def ring(mu: float, w_bearing: float, w_journal: float, mass: float, gravity: float = G) -> dc.Scene:
+    """A bearing ring pinned to the ground at its centre and spinning at w_bearing; a journal (centre of
+    mass at its centre) spinning at w_journal inside it, under gravity."""
+    scene = dc.Scene("ring", gravity=(0.0, -gravity))
+    bearing = scene.add(dc.Body("ring", mass=1.0, inertia=1e-4, angular_velocity=w_bearing))
+    scene.add(dc.Revolute("pivot", scene.ground, bearing, at=(0.0, 0.0)))
+    body = scene.add(dc.Body("journal", mass=mass, inertia=1e-4, angular_velocity=w_journal))
+    scene.add(dc.RevoluteClearance("bearing", bearing, body, at=(0.0, 0.0), bearing_radius=R, clearance=C,
+                                   material=STEEL, law=HydrodynamicBearing(viscosity=mu, length=L)))
+    return scene
+
+
+def ocvirk_force(eps: float, mu: float, omega: float) -> tuple[float, float]:
+    """Short bearing, half film, rotation part: (F_r, F_t), the force on the journal -F_r n + F_t t
+    (n along the eccentricity, t turned +90 deg from it)."""
+    q = 1 - eps**2
+    return (mu * omega * R_J * L**3 * eps**2 / (C**2 * q**2),
+            math.pi * mu * omega * R_J * L**3 * eps / (4 * C**2 * q**1.5))
+
+
+@pytest.mark.parametrize("angle", [-math.pi / 2, 0.7])
+def test_film_force_of_the_two_surfaces_rotations(angle: float) -> None:
+    """One state each, the journal's film force against the closed form at the wedge rate the two
+    rotations make (centres still unless said)."""
+    mu, omega, eps = 0.01, 200.0, 0.6
+    model = dc.assemble(ring(mu, 0.0, 0.0, 1.0, gravity=0.0))
+    names = model.state_names
+    n = np.array([math.cos(angle), math.sin(angle)])
+    t = np.array([-n[1], n[0]])
+    journal = [names.index(f"journal.{k}") for k in ("x", "y", "phi")]
+    film = [i for i, term in enumerate(model.terms) if term.name == "bearing.film"]
+    assert len(film) == 1
+
+    def force(w_bearing: float, w_journal: float, centre_velocity=(0.0, 0.0)) -> np.ndarray:
+        y = np.zeros(model.n_states)
+        y[names.index("journal.x")], y[names.index("journal.y")] = eps * C * n
+        y[names.index("journal.vx")], y[names.index("journal.vy")] = centre_velocity
+        y[names.index("ring.omega")], y[names.index("journal.omega")] = w_bearing, w_journal
+        active = [i == film[0] for i in range(len(model.terms))]
+        params = [np.zeros(term.n_params) if i == film[0] else np.ones(term.n_params)
+                  for i, term in enumerate(model.terms)]
+        return model.term_forces(0.0, y, active, params)[journal]
+
+    def closed_form(wedge: float) -> np.ndarray:
+        F_r, F_t = ocvirk_force(eps, mu, abs(wedge))
+        return np.array([*(-F_r * n + math.copysign(F_t, wedge) * t), 0.0])  # through the centre: no moment
+
+    scale = math.hypot(*ocvirk_force(eps, mu, omega))
+    check = lambda got, wedge: np.testing.assert_allclose(got, closed_form(wedge), rtol=0, atol=1e-6 * scale)  # noqa: E731
+    check(force(0.0, omega), omega)  # the journal spins
+    check(force(omega, 0.0), omega)  # the bearing spins: the same force
+    check(force(-omega, 0.0), -omega)  # the mirror image: the tangential part reversed
+    check(force(omega, omega), 2 * omega)  # both, centres still: twice the wedge
+    check(force(omega, -omega), 0.0)  # against each other: no wedge
+    np.testing.assert_allclose(force(omega, -omega), 0.0, atol=1e-9 * scale)
+    # the whole joint turning rigidly at omega (the journal's centre too): no relative motion, no film
+    rigid = force(omega, omega, omega * eps * C * t)
+    assert np.max(np.abs(rigid)) < 1e-6 * scale  # (the film's regularisation leaves 1e-8 eps^-2)
+
+
+@pytest.mark.parametrize("w_bearing, w_journal, wedge", [(200.0, 0.0, 200.0), (-200.0, 0.0, -200.0),
+                                                         (200.0, 200.0, 400.0)])
+def test_a_spinning_bearing_carries_the_journal_like_a_spinning_journal(w_bearing: float, w_journal: float,
+                                                                          wedge: float) -> None:
+    """The ring spins (a journal that does not turn inside it): the journal settles at Ocvirk's static
+    eccentricity and attitude angle of the wedge rate w_bearing + w_journal, measured from the load line
+    in the sense of that rate (mirrored for -200 rad/s); the spins are kept (the film's forces pass
+    through the centres)."""
+    mu, mass = 0.01, 4.675
+    W = mass * G
+    eps = brentq(lambda x: ocvirk_load(x, mu, abs(wedge)) - W, 1e-6, 1 - 1e-9)
+    attitude = math.copysign(math.atan(math.pi * math.sqrt(1 - eps**2) / (4 * eps)), wedge)
+    run = dc.simulate(ring(mu, w_bearing, w_journal, mass), 0.4, rtol=1e-8)
+    assert run.success and not run.events
+    assert run["bearing.eccentricity_ratio"][-1] == pytest.approx(eps, rel=1e-6)
+    angle = math.atan2(run["bearing.ey"][-1], run["bearing.ex"][-1]) + math.pi / 2  # from the load line (-y)
+    assert angle == pytest.approx(attitude, rel=1e-6)
+    assert run["ring.omega"][-1] == pytest.approx(w_bearing, abs=1e-9)
+    assert run["journal.omega"][-1] == pytest.approx(w_journal, abs=1e-9)

@@ -43,7 +43,7 @@ def test_worn_volume_is_k_times_the_sliding_work(distribution, surface):
     ds = 0.5 * (np.abs(h.slip_speed[1:]) + np.abs(h.slip_speed[:-1])) * np.diff(h.t)
     assert work == pytest.approx(float(np.sum(force * ds)), rel=1e-12) and work > 0
     for profile in depth.values():
-        assert worn_volume(profile, R, L) == pytest.approx(K * work, rel=1e-9)
+        assert worn_volume(profile, R, L) == pytest.approx(K * work, rel=1e-9, abs=0.0)
         assert np.all(profile >= 0)
     assert set(depth) == ({"bearing", "journal"} if surface == "both" else {surface})
 
@@ -59,6 +59,19 @@ def test_a_load_turning_round_the_bearing_wears_it_uniformly():
     assert np.max(np.abs(depth["bearing"] / expected - 1)) < 2e-3
 
 
+def test_angles_wrapped_as_a_run_gives_them_wear_the_short_way_round():
+    """A run's contact angles come wrapped to (-pi, pi] (atan2): an interval from pi - 0.01 to -pi + 0.01
+    crosses the wrap and wears around pi, not around 0; the turning load of the test above wears the
+    bearing uniformly whether its angles are wrapped or not."""
+    h = history(2, 500.0, np.array([math.pi - 0.01, -math.pi + 0.01]), slip=0.3, penetration=0.0)
+    depth = wear_increment(ArchardWear(coefficient=K, length=L), h, bearing_radius=R, clearance=C)[0]["bearing"]
+    assert np.argmax(depth) in (179, 180) and depth[170:191].sum() == pytest.approx(depth.sum(), rel=1e-12, abs=0.0)
+    force, turns, slip = 500.0, 10, 0.3
+    wrapped = history(20001, force, lambda t: np.angle(np.exp(2j * math.pi * turns * t)), slip=slip)
+    depth = wear_increment(ArchardWear(coefficient=K, length=L), wrapped, bearing_radius=R, clearance=C)[0]["bearing"]
+    assert np.max(np.abs(depth / (K * force * slip / (2 * math.pi * R * L)) - 1)) < 2e-3
+
+
 @pytest.mark.parametrize("penetration", [2e-6, 2e-5])
 def test_a_fixed_load_wears_one_spot_with_the_pressure_shape(penetration):
     """The load fixed at 1 rad in the bearing's frame, the journal sliding under it: the elastic-foundation
@@ -67,13 +80,58 @@ def test_a_fixed_load_wears_one_spot_with_the_pressure_shape(penetration):
     wear = ArchardWear(coefficient=K, length=L, nodes=3600)
     h = history(101, force, 1.0, angle_journal=lambda t: 50 * t, slip=slip, penetration=penetration)
     depth = wear_increment(wear, h, bearing_radius=R, clearance=C)[0]["bearing"]
-    phi0 = half_angle_overlap(penetration, C)
+    phi0 = math.acos(C / (C + penetration))  # the arc where the journal's surface overlaps the bearing's
     peak = K * force * slip / (R * L) * (1 - math.cos(phi0)) / (2 * (math.sin(phi0) - phi0 * math.cos(phi0)))
     spot = int(round(1.0 / (2 * math.pi / wear.nodes)))
     assert depth.max() == pytest.approx(peak, rel=2e-3)
     assert abs(int(np.argmax(depth)) - spot) <= 1
     off_arc = np.abs(np.remainder(wear.angles - 1.0 + math.pi, 2 * math.pi) - math.pi) > phi0 + 2 * math.pi / wear.nodes
     assert np.all(depth[off_arc] == 0.0)
+
+
+def test_a_fixed_load_wears_one_spot_with_the_hertz_shape():
+    """The Hertz distribution: p = p0 sqrt(1 - (phi/phi0)^2) over the half-width phi0 = b / R of the line
+    contact, the load F = p0 R L phi0 pi / 2, so the depth under a fixed load is k s p0 sqrt(...) with
+    p0 = 2 F / (pi R L phi0), b = sqrt(4 F R_eff / (pi L E*)), R_eff = R (R - c) / c."""
+    force, slip, e_star = 800.0, 0.5, 113.7e9
+    wear = ArchardWear(coefficient=K, length=L, nodes=3600, distribution="hertz")
+    h = history(101, force, 1.0, angle_journal=lambda t: 50 * t, slip=slip)
+    depth = wear_increment(wear, h, bearing_radius=R, clearance=C, effective_modulus=e_star)[0]["bearing"]
+    phi0 = math.sqrt(4 * force * (R * (R - C) / C) / (math.pi * L * e_star)) / R
+    p0 = 2 * force / (math.pi * R * L * phi0)
+    phi = np.remainder(wear.angles - 1.0 + math.pi, 2 * math.pi) - math.pi  # from the load's direction
+    expected = K * slip * p0 * np.sqrt(np.clip(1 - (phi / phi0) ** 2, 0, None))
+    assert phi0 > 10 * 2 * math.pi / wear.nodes  # the arc spans many nodes
+    assert depth.max() == pytest.approx(expected.max(), rel=2e-3)
+    inner = np.abs(phi) < 0.8 * phi0  # the sampled edges blur the shape's vertical ends
+    np.testing.assert_allclose(depth[inner], expected[inner], rtol=5e-3)
+    assert np.all(depth[np.abs(phi) > phi0 + 2 * math.pi / wear.nodes] == 0.0)
+
+
+def circles_overlap_half_angle(penetration: float, clearance: float, radius: float) -> float:
+    """Half-angle, seen from the bearing's centre, of the bearing's circle (radius R) inside the journal's
+    (radius R - c, centre at c + delta): the law of cosines, R^2 + e^2 - 2 R e cos(phi) = (R - c)^2."""
+    e = clearance + penetration
+    return math.acos((radius**2 + e**2 - (radius - clearance) ** 2) / (2 * radius * e))
+
+
+@pytest.mark.parametrize("penetration", [2e-6, 2e-5, 1e-4])
+def test_the_contact_arc_is_the_circles_overlap(penetration):
+    """The elastic foundation's arc is where the radial gap c - (c + delta) cos(phi) of the conformal
+    pair is negative: the overlap of the two circles in the limit R >> c, cos(phi0) = c / (c + delta).
+    The exact intersection's cosine is larger by (e^2 - c^2) / (2 R e) (e = c + delta), which makes its
+    arc narrower by that over sin(phi0), about c / (2 R) relative: 5e-5 at R = 1e4 c, 2.5 % at the
+    joint's R = 20 c."""
+    phi0 = half_angle_overlap(penetration, C)
+    e = C + penetration
+    for radius in (1e4 * C, 1e5 * C, R):
+        exact = circles_overlap_half_angle(penetration, C, radius)
+        first_order = (e**2 - C**2) / (2 * radius * e) / math.sin(phi0)
+        assert phi0 - exact == pytest.approx(first_order, rel=0.1, abs=0.0)
+        assert 0 < 1 - exact / phi0 < C / radius
+    # the arc's two ends, and only they, close the radial gap
+    gap = lambda phi: C - e * math.cos(phi)  # noqa: E731
+    assert gap(phi0) == pytest.approx(0.0, abs=1e-12 * C) and gap(0.99 * phi0) < 0 < gap(1.01 * phi0)
 
 
 def test_node_weights_sum_to_one_and_follow_narrow_arcs():

@@ -51,13 +51,13 @@ def test_profile_series_of_a_smooth_profile():
     reproduced to 1e-3 of its depth with 48 modes, its mean (the worn volume) exactly."""
     depth = 5e-6 + 2e-6 * np.cos(2 * THETA) - 1e-6 * np.sin(3 * THETA)
     a, b = profile_coefficients(depth, MODES)
-    assert a[0] == pytest.approx(5e-6, rel=1e-12) and a[2] == pytest.approx(2e-6, rel=1e-9)
-    assert b[2] == pytest.approx(-1e-6, rel=1e-9)
+    assert a[0] == pytest.approx(5e-6, rel=1e-12, abs=0.0) and a[2] == pytest.approx(2e-6, rel=1e-9, abs=0.0)
+    assert b[2] == pytest.approx(-1e-6, rel=1e-9, abs=0.0)
     assert np.max(np.abs(np.delete(a, [0, 2]))) < 1e-19 and np.max(np.abs(np.delete(b, 2))) < 1e-19  # round-off
     np.testing.assert_allclose(profile_depth(a, b, THETA), depth, rtol=0, atol=1e-18)
     spot = _bump(1.0, depth=1e-5, width=0.1)
     smooth = profile_depth(*profile_coefficients(spot, MODES), THETA)
-    assert smooth.mean() == pytest.approx(spot.mean(), rel=1e-12)
+    assert smooth.mean() == pytest.approx(spot.mean(), rel=1e-12, abs=0.0)
     assert np.max(np.abs(smooth - spot)) < 1e-3 * spot.max()
     coarse = profile_depth(*profile_coefficients(spot, 16), THETA)  # too few modes: a visible error
     assert np.max(np.abs(coarse - spot)) > 0.1 * spot.max()
@@ -184,7 +184,7 @@ def test_example_joint_wear_quick(tmp_path, capsys):
         assert (tmp_path / name).stat().st_size > 5_000
     metrics = json.loads((tmp_path / "metrics.json").read_text())
     assert metrics["cycles"] == 40 and metrics["volume_m3"] == pytest.approx(
-        metrics["coefficient"] * metrics["sliding_work_Nm"], rel=1e-12)
+        metrics["coefficient"] * metrics["sliding_work_Nm"], rel=1e-12, abs=0.0)
     assert "wrote" in capsys.readouterr().out
 
 
@@ -216,4 +216,4 @@ def test_spread_in_passes_equals_one_pass(monkeypatch):
     whole = wear.spread(centres, halves, loads, NODES)
     monkeypatch.setattr(wear, "SPREAD_SAMPLES", 1000)  # passes of a handful of contacts
     np.testing.assert_allclose(wear.spread(centres, halves, loads, NODES), whole, rtol=1e-12, atol=1e-24)
-    assert whole.sum() == pytest.approx(loads.sum(), rel=1e-12)
+    assert whole.sum() == pytest.approx(loads.sum(), rel=1e-12, abs=0.0)
