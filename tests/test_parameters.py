@@ -57,7 +57,7 @@ VARIANTS = {
     # the lubricated joint: viscosity, bearing length, film thresholds and the dry law's numbers
     "lubricated": (dict(joint="revolute", friction=0.1, law=HydrodynamicBearing(viscosity=0.04, length=0.02)),
                    dict(joint="revolute", friction=0.05, clearance=0.3e-3, rpm=3000.0,
-                        law=HydrodynamicBearing(viscosity=0.01, length=0.015, film_threshold=2e-6, hysteresis=0.5,
+                        law=HydrodynamicBearing(viscosity=0.01, length=0.015, roughness=2e-6, hysteresis=0.5,
                                                 dry=normal_law("lankarani-nikravesh", restitution=0.7)))),
     # readings of the translational joint (daeclear.model.readings): their K, n, c_e, the slider's mass and
     # inertia and the pin's place on it are numbers
@@ -146,12 +146,13 @@ def test_lubricated_joint_numbers_are_parameters_and_its_theory_is_structure():
                                                                                  **law}))
 
     reference = dc.assemble(scene())
-    assert reference.parameter("clearance.film.viscosity")[0] == 0.04
-    assert reference.parameter("clearance.film.length")[0] == 0.02
-    assert reference.parameter("clearance.film.threshold")[0] == 1e-6
-    assert reference.parameter("clearance.film.reform_threshold")[0] == 2e-6
-    assert reference.parameter("clearance.law.restitution")[0] == 0.9
-    for law in (dict(viscosity=0.002), dict(length=0.05), dict(film_threshold=3e-6, hysteresis=0.2)):
+    assert reference.parameter("clearance.law.viscosity")[0] == 0.04
+    assert reference.parameter("clearance.law.length")[0] == 0.02
+    assert reference.parameter("clearance.law.roughness")[0] == 1e-6
+    assert reference.parameter("clearance.law.film_parameter")[0] == 1.0
+    assert reference.parameter("clearance.law.hysteresis")[0] == 1.0
+    assert reference.parameter("clearance.law.dry.restitution")[0] == 0.9
+    for law in (dict(viscosity=0.002), dict(length=0.05), dict(roughness=3e-6, film_parameter=2.0, hysteresis=0.2)):
         assert dc.assemble(scene(**law)).functions is reference.functions, law
     for law in (dict(theory="long"), dict(cavitation="full"), dict(dry=normal_law("hertz"))):
         assert dc.assemble(scene(**law)).functions is not reference.functions, law

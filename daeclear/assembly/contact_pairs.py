@@ -190,13 +190,14 @@ class JournalContact:
 
 
 def journal_logic(ctx: AssemblyContext, jc: JournalContact, cls: type[PairLogic], name: str, first_root: int,
-                  first_term: int, gaps: list[Any], law: Any, friction: Any
+                  first_term: int, gaps: list[Any], law: Any, friction: Any, law_prefix: str = "law"
                   ) -> Callable[[NDArray[np.float64]], list[Any]]:
     """A journal's logic maker: one pair ``name`` of class ``cls``, its rate function (q, v, P) ->
-    (``gaps``..., penetration rate) bound to each parameter vector."""
+    (``gaps``..., penetration rate) bound to each parameter vector; the law's numbers under
+    ``<name>.<law_prefix>``."""
     penetration_rate = ca.dot(jc.e_dot, jc.e) / ca.fmax(jc.e_norm, 1e-300)
     rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P], [*gaps, penetration_rate])
-    floor = approach_floor(ctx, law, f"{name}.law")
+    floor = approach_floor(ctx, law, f"{name}.{law_prefix}")
     discontinuous = not friction.frictionless and not friction.smooth
     n_q = ctx.n_q  # read once: a CasADi call costs more inside a sweep's loop than the logic it makes
 
@@ -206,14 +207,15 @@ def journal_logic(ctx: AssemblyContext, jc: JournalContact, cls: type[PairLogic]
     return logic
 
 
-def journal_parameters(ref: Reference, joint: Any, law: Any, friction: Any, film: dict[str, Any] | None = None
-                       ) -> dict[str, Any]:
-    """A revolute clearance joint's points, clearance and radii, ``film``'s entries, and its laws' numbers."""
+def journal_parameters(ref: Reference, joint: Any, law: Any, friction: Any, film: dict[str, Any] | None = None,
+                       law_prefix: str = "law") -> dict[str, Any]:
+    """A revolute clearance joint's points, clearance and radii, ``film``'s entries, and its laws' numbers
+    (the normal law's under ``law_prefix``)."""
     s_i, s_j = ref.joint_points(joint)
     values: dict[str, Any] = {"s_i": s_i, "s_j": s_j, "clearance": joint.radial_clearance,
                               "bearing_radius": float(joint.bearing_radius), "journal_radius": joint.journal,
                               **(film or {})}
-    values.update({f"law.{k}": v for k, v in law_values(law).items()})
+    values.update({f"{law_prefix}.{k}": v for k, v in law_values(law).items()})
     values.update({f"friction.{k}": v for k, v in law_values(friction).items()})
     return values
 
@@ -238,10 +240,12 @@ def worn_depths(ctx: AssemblyContext, joint: Any, direction: Any, bi: Any, bj: A
     return out[0], out[1]
 
 
-def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction_numeric: Any) -> JournalContact:
-    """Journal-bearing contact (section 4.2) of ``joint``: body i the bearing (R_i), j the journal (R_j)."""
+def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction_numeric: Any,
+                    law_prefix: str = "law") -> JournalContact:
+    """Journal-bearing contact (section 4.2) of ``joint``: body i the bearing (R_i), j the journal (R_j);
+    the normal law's numbers under ``<joint>.<law_prefix>``."""
     name = joint.name
-    law = symbolic_law(law_numeric, ctx.params, f"{name}.law")
+    law = symbolic_law(law_numeric, ctx.params, f"{name}.{law_prefix}")
     friction = symbolic_law(friction_numeric, ctx.params, f"{name}.friction")
     R_i, R_j = ctx.p(name, "bearing_radius"), ctx.p(name, "journal_radius")
     s_i, s_j = ctx.p(name, "s_i"), ctx.p(name, "s_j")
