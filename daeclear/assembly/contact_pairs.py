@@ -168,6 +168,14 @@ class JournalContact:
     p: Any
     n_params: int
     force: ca.Function
+    # d/dt of the worn surfaces' depth along e (0 unworn): the gap's rate is d|e|/dt minus it
+    worn_rate: Any = 0.0
+
+    @property
+    def penetration_rate(self) -> Any:
+        """d(delta)/dt along the motion, the worn profile's change under the moving contact included
+        (regular at e = 0, where it is 0 unworn)."""
+        return ca.dot(self.e_dot, self.e) / ca.fmax(self.e_norm, 1e-300) - self.worn_rate
 
     def channels(self, name: str, on: Any, p_sym: Any, frictionless: bool) -> list[Channel]:
         """The contact's channels: eccentricity, penetration, the force while ``on``."""
@@ -178,7 +186,7 @@ class JournalContact:
             Channel(f"{name}.ey", "m", e[1]),
             Channel(f"{name}.eccentricity", "m", e_norm),
             Channel(f"{name}.penetration", "m", e_norm - self.c),
-            Channel(f"{name}.penetration_rate", "m/s", ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)),
+            Channel(f"{name}.penetration_rate", "m/s", self.penetration_rate),
             Channel(f"{name}.normal_force", "N", F_N_out),
             Channel(f"{name}.in_contact", "", on),
         ]
@@ -195,8 +203,7 @@ def journal_logic(ctx: AssemblyContext, jc: JournalContact, cls: type[PairLogic]
     """A journal's logic maker: one pair ``name`` of class ``cls``, its rate function (q, v, P) ->
     (``gaps``..., penetration rate) bound to each parameter vector; the law's numbers under
     ``<name>.<law_prefix>``."""
-    penetration_rate = ca.dot(jc.e_dot, jc.e) / ca.fmax(jc.e_norm, 1e-300)
-    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P], [*gaps, penetration_rate])
+    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P], [*gaps, jc.penetration_rate])
     floor = approach_floor(ctx, law, f"{name}.{law_prefix}")
     discontinuous = not friction.frictionless and not friction.smooth
     n_q = ctx.n_q  # read once: a CasADi call costs more inside a sweep's loop than the logic it makes
@@ -257,10 +264,17 @@ def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction
     # in contact |e| >= c > 0: the normal and everything below are regular there
     e_norm = ca.sqrt(ee)
     n = e / e_norm  # (4.4)
-    worn = worn_depths(ctx, joint, e / ca.fmax(e_norm, 1e-300), bi, bj)  # 0 without wear
-    c = ctx.p(name, "clearance") + worn[0] + worn[1]  # the clearance along n, worn surfaces included
+    # the direction of e, regular at e = 0 (where the gap is far from closing): exactly n in contact
+    clearance = ctx.p(name, "clearance")
+    worn = worn_depths(ctx, joint, e / ca.fmax(e_norm, 0.5 * clearance), bi, bj)  # 0 without wear
+    c_worn = worn[0] + worn[1]
+    c = clearance + c_worn  # the clearance along n, worn surfaces included
     delta = e_norm - c  # (4.5)
-    delta_dot = ca.dot(e_dot, n)  # (4.8): v_N = d|e|/dt (the profile's slope neglected: h' / R ~ 1e-4)
+    worn_jacobian = ca.jacobian(c_worn, ctx.q) if isinstance(c_worn, ca.SX) else None
+    worn_rate = ca.mtimes(worn_jacobian, ctx.v) if worn_jacobian is not None else 0.0
+    # (4.8): v_N = d|e|/dt, less the worn depth's change as the contact moves along the profile and the
+    # worn bodies turn (the gap's own rate: a contact is left only when its gap closes)
+    delta_dot = ca.dot(e_dot, n) - worn_rate
     t_vec = perpendicular(n)
     Q_i = P_i + (R_i + worn[0]) * n  # (4.6) contact points, on the worn surfaces
     Q_j = P_j + (R_j - worn[1]) * n
@@ -272,5 +286,7 @@ def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction
     F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
     f_journal = -F_N * n + F_T * t_vec  # force on the journal (body j); the bearing gets the opposite
     Q = ctx.generalized_force([(joint.body_j, f_journal, Q_j), (joint.body_i, -f_journal, Q_i)])
+    if worn_jacobian is not None:  # the normal force along the gap's gradient: -F_N d(delta)/dq, delta's worn part
+        Q = Q + F_N * worn_jacobian.T
     force = ca.Function(f"{name}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P], [Q], ["t", "q", "v", "p", "P"], ["Q"])
-    return JournalContact(e, e_dot, ee, e_norm, c, bi, bj, P_i, P_j, F_N, F_T, v_T, p, n_params, force)
+    return JournalContact(e, e_dot, ee, e_norm, c, bi, bj, P_i, P_j, F_N, F_T, v_T, p, n_params, force, worn_rate)

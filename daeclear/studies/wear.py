@@ -22,7 +22,7 @@ from ..assembly.assemble import assemble
 from ..assembly.dae_model import DAEModel
 from ..contact.geometry import sigma_sum
 from ..contact.wear import ArchardWear, WearHistoryArrays, wear_increment, worn_volume
-from ..errors import PhysicsWarning, SceneError, SolveError
+from ..errors import AssemblyError, PhysicsWarning, SceneError, SolveError
 from ..model.scene import RevoluteClearance, Scene
 from ..progress import Progress
 from ..results.result import Result
@@ -200,9 +200,17 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
                 break
             model = model.with_parameters({f"{name}.wear_depth": _depth_value(depth, wear.surfaces)})
             try:
-                result = simulate(model, t0 + update_every * period, t0=t0, y0=y0, options=options)
-            except SolveError as exc:  # the history so far is the result (and, with a path, in the file)
+                with warnings.catch_warnings():  # a block beyond its contact law is judged below, once
+                    warnings.simplefilter("ignore", PhysicsWarning)
+                    result = simulate(model, t0 + update_every * period, t0=t0, y0=y0, options=options)
+            except (SolveError, AssemblyError) as exc:  # the history so far is the result (and in the file)
                 message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
+                break
+            deepest_run = float(np.max(result[f"{name}.penetration"]))
+            if deepest_run > clearance:
+                message = (f"stopped at {done:g} cycles: the next block's run left joint '{name}' {deepest_run:.3g} m "
+                           f"inside its wall, more than its clearance {clearance:g} m (beyond what its contact law "
+                           "describes); its wear is not taken. A tighter rtol, or a smaller wear coefficient.")
                 break
             increment, block_work = wear_increment(wear, wear_history(result, model, name), bearing_radius=radius,
                                                    clearance=clearance, effective_modulus=modulus)
