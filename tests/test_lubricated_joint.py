@@ -291,3 +291,23 @@ def test_command_line_with_a_lubricant(tmp_path) -> None:
     result = dc.load(tmp_path / "slider_crank_revolute.h5")
     assert result.success and result["clearance.regime"].max() == 0.0
     assert result["clearance.film_radial"].max() > 0.0
+
+
+def test_example_viscosity_study_quick(tmp_path) -> None:
+    """The viscosity study's script: its table and figure; a thick oil carries the joint below the dry
+    joint's peak force, a thin one breaks down."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "lubricated_viscosity_study.py"
+    spec = importlib.util.spec_from_file_location("example_viscosity_study", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    lines = module.main(["--quick", "--out", str(tmp_path)])
+    assert (tmp_path / "viscosity_study.png").stat().st_size > 5_000
+    rows = [[cell.strip() for cell in line.strip("|").split("|")] for line in lines[2:]]
+    for c in ("0.1", "0.5"):
+        dry = next(float(r[2]) for r in rows if r[0] == c and r[1] == "dry")
+        thick = next(r for r in rows if r[0] == c and r[1] == "0.1")
+        assert float(thick[2]) < dry and thick[4] == "0"
+        assert int(next(r for r in rows if r[0] == c and r[1] == "0.001")[4]) >= 1
