@@ -67,6 +67,11 @@ def _contact_fields(entry: dict[str, Any]) -> dict[str, Any]:
         if isinstance(out.get("friction"), dict):
             params = dict(out["friction"])
             out["friction"] = friction_law(params.pop("name", None), **params)
+        key = "wear"  # a table { coefficient = 1e-13, length = 0.02, ... }: Archard wear
+        if isinstance(out.get("wear"), dict):
+            from ..contact.wear import ArchardWear
+
+            out["wear"] = ArchardWear(**out["wear"])
     except (TypeError, ValueError, SceneError) as exc:
         raise SceneError(f"key {key}: {exc}") from None
     return out
