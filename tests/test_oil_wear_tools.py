@@ -38,3 +38,49 @@ def test_saved_and_streamed_runs_read_back_whole(make, tmp_path):
         assert [(e.t, e.pair, e.kind) for e in back.events] == [(e.t, e.pair, e.kind) for e in run.events]
         joint = back.parameters["scene"]["elements"]["clearance"]
         assert joint["law"] == run.parameters["scene"]["elements"]["clearance"]["law"]
+
+
+SWEPT = [  # (scene maker, swept name, two values): the numbers item 5 of issue 44 names
+    (lubricated_scene, "clearance.law.viscosity", (0.01, 0.1)),
+    (lubricated_scene, "clearance.law.length", (0.008, 0.012)),
+    (lubricated_scene, "clearance.law.roughness", (0.5e-6, 2e-6)),
+    (lubricated_scene, "clearance.law.film_parameter", (1.0, 2.0)),
+    (lubricated_scene, "clearance.law.hysteresis", (0.5, 1.5)),
+    (lubricated_scene, "clearance.law.dry.restitution", (0.5, 0.8)),
+    (worn_scene, "clearance.wear.coefficient", (1e-14, 1e-12)),
+    (worn_scene, "clearance.wear_depth", (tuple([0.0] * 360), tuple([1e-6] * 360))),
+]
+
+
+@pytest.mark.parametrize("make, name, values", SWEPT, ids=[s[1] for s in SWEPT])
+def test_sweep_points_over_oil_and_wear_numbers_share_one_compiled_model(make, name, values):
+    """A sweep's points (built as its workers build them) differ only in numbers: one model, new numbers."""
+    from daeclear.studies.sweep_workers import build_scene
+
+    law = {"name": "hydrodynamic", "viscosity": 1e-3, "length": 0.01}
+    fixed = ({"joint": "revolute", "law": law} if make is lubricated_scene else  # tables, as --set gives them
+             {"joint": "revolute", "friction": 0.1, "clearance.wear": {"coefficient": 1e-13, "length": 0.02}})
+    models = [dc.assemble(build_scene("slider_crank", {**fixed, name: value})) for value in values]
+    assert models[1].scene[name.split(".")[0]] != models[0].scene[name.split(".")[0]]
+    assert models[0].functions is models[1].functions
+    base = dc.assemble(make())
+    reused = base.with_parameters({name: values[1]})  # the same name in the one name space
+    assert reused.functions is base.functions
+
+
+def test_a_viscosity_sweep_from_the_command_line_compiles_nothing(tmp_path):
+    from daeclear.cli import main
+    from daeclear.engine.build import cache_dir
+    from daeclear.studies.sweep import load_sweep
+
+    law = "law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01}"
+    dc.assemble(dc.mechanisms.slider_crank("revolute", law=HydrodynamicBearing(viscosity=0.1, length=0.01)))
+    libraries = sorted(cache_dir().glob("*.so"))  # the structure is built (or was): the sweep adds none
+    out = tmp_path / "viscosity.h5"
+    assert main(["sweep", "slider_crank", str(out), "--joint", "revolute", "--set", law, "--grid",
+                 "clearance.law.viscosity=0.01,0.03,0.1", "--revolutions", "2", "--transient", "1", "--workers", "1",
+                 "--no-figure", "--quiet"]) == 0
+    assert sorted(cache_dir().glob("*.so")) == libraries
+    records = load_sweep(out).runs
+    assert [r.parameters["clearance.law.viscosity"] for r in records] == [0.01, 0.03, 0.1]
+    assert all(r.ok for r in records)

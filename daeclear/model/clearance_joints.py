@@ -54,6 +54,33 @@ def _law_problems(element: RevoluteClearance | TranslationalClearance) -> list[s
     return out
 
 
+#: Fields of the clearance joints whose value a table (a dict, as scene files and results write it) may give.
+TABLE_FIELDS: tuple[str, ...] = ("material", "law", "face_law", "friction", "wear")
+
+
+def table_value(field_name: str, value: Any) -> Any:
+    """A clearance joint's field given as a table (dict) as the object it stands for: ``material``
+    ({young, poisson}, or a list of two), ``law``/``face_law`` ({name = ..., parameters}; "hydrodynamic"
+    a HydrodynamicBearing), ``friction`` ({name = ..., parameters}), ``wear`` (ArchardWear's fields).
+    Anything else is returned as given."""
+    from ..contact import Material, friction_law
+    from ..contact.hydrodynamic import law_from_table
+    from ..contact.wear import ArchardWear
+
+    if field_name == "material" and isinstance(value, list):
+        return tuple(Material(**m) if isinstance(m, dict) else m for m in value)
+    if not isinstance(value, dict) or field_name not in TABLE_FIELDS:
+        return value
+    if field_name == "material":
+        return Material(**value)
+    if field_name in ("law", "face_law"):
+        return law_from_table(value)
+    if field_name == "friction":
+        params = dict(value)
+        return friction_law(params.pop("name", None), **params)
+    return ArchardWear(**value)
+
+
 def _law_object(law: Any) -> Any:
     """A law given by name as the law object (anything else as given)."""
     from ..contact import normal_law
