@@ -385,6 +385,16 @@ def restitution(value: Any, law: Any, *, where: str, field: str = "restitution")
     from .contact.base import NormalLaw
     from .contact.registry import NORMAL_LAWS, normal_law_class
 
+    from .contact.hydrodynamic import HydrodynamicBearing
+
+    lubricated = isinstance(law, HydrodynamicBearing) or (isinstance(law, dict) and law.get("name") == "hydrodynamic")
+    if lubricated:
+        fail(where, field, value, "left out with a lubricated law (hydrodynamic), whose dry law has the restitution; "
+             "give it there, e.g. law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01, 'dry': "
+             "{'name': 'lankarani-nikravesh', 'restitution': 0.5}}")
+    if isinstance(law, dict):
+        fail(where, field, value, "left out when law is a table; give it in the table, e.g. "
+             "law={'name': 'hunt-crossley', 'restitution': 0.5}")
     if isinstance(law, NormalLaw):
         fail(where, field, value, f"left out when law is a law object ({type(law).__name__}); set it on the "
              "law object instead")

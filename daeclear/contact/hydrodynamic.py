@@ -274,11 +274,14 @@ def bearing_from_table(params: dict[str, Any]) -> HydrodynamicBearing:
 
     params = dict(params)
     dry = params.get("dry")
-    if isinstance(dry, dict):
-        dry = dict(dry)
-        params["dry"] = normal_law(dry.pop("name", None), **dry)
-    elif isinstance(dry, str):
-        params["dry"] = normal_law(dry)
+    try:
+        if isinstance(dry, dict):
+            dry = dict(dry)
+            params["dry"] = normal_law(dry.pop("name", None), **dry)
+        elif isinstance(dry, str):
+            params["dry"] = normal_law(dry)
+    except (SceneError, TypeError) as exc:
+        raise SceneError(f"HydrodynamicBearing: dry={dry!r}: {exc}") from None
     return build_law(HydrodynamicBearing, params)
 
 
@@ -289,6 +292,9 @@ def law_from_table(table: dict[str, Any]) -> Any:
 
     params = dict(table)
     name = params.pop("name", None)
+    if not isinstance(name, str):
+        raise SceneError(f"law table {table!r}: name={name!r}, must be a law's name (e.g. 'lankarani-nikravesh' "
+                         "or 'hydrodynamic').")
     if name == HydrodynamicBearing.name:
         return bearing_from_table(params)
     return normal_law(name, **params)

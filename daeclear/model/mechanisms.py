@@ -90,6 +90,10 @@ def _contact_law(law: Any, restitution: float | None, length: float | None) -> N
         raise SceneError(f"contact law: length={length!r}, must be None or a finite number > 0 m.")
     if isinstance(law, (NormalLaw, HydrodynamicBearing, dict)):  # a dict: a law table (--set "law={...}")
         return law_from_table(law) if isinstance(law, dict) else law
+    if str(law).strip().lower() == HydrodynamicBearing.name:
+        raise SceneError("contact law: law='hydrodynamic' (a lubricated joint) needs its oil's numbers: give a "
+                         "table, e.g. law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01} "
+                         "(viscosity in Pa s, length in m; docs/lubrication.md).")
     fields = {"restitution": DEFAULT_RESTITUTION if restitution is None else restitution, "length": length}
     accepted = set(getattr(normal_law_class(str(law)), "__dataclass_fields__", {}))
     return normal_law(str(law), **{k: v for k, v in fields.items() if k in accepted and v is not None})
