@@ -24,7 +24,9 @@ __all__ = ["ArchardWear", "DISTRIBUTIONS", "SURFACES", "WearHistoryArrays", "hal
 SURFACES: tuple[str, ...] = ("bearing", "journal", "both")
 DISTRIBUTIONS: tuple[str, ...] = ("elastic-foundation", "hertz")
 # the grid the arcs' pressure is spread on, per node spacing
-SUBDIVISIONS = 8
+SUBDIVISIONS = 4
+# arcs wider than 2^WIDTH_BITS grid steps share a shape within 2^-(WIDTH_BITS + 1) of their half-width
+WIDTH_BITS = 8
 # contacts binned in one pass: SPREAD_SAMPLES // ARC_SAMPLES (index arrays of a few MB)
 ARC_SAMPLES = 64
 SPREAD_SAMPLES = 1 << 20
@@ -124,6 +126,8 @@ def spread(centres: ArrayLike, half_angles: ArrayLike, loads: ArrayLike, nodes: 
     size = nodes * SUBDIVISIONS
     step = 2.0 * math.pi / size
     widths = np.rint(half / step).astype(np.int64)  # the arc's half-width in grid steps
+    coarse = np.maximum(np.floor(np.log2(np.maximum(widths, 1))).astype(np.int64) - WIDTH_BITS, 0)
+    widths = ((widths + (1 << coarse >> 1)) >> coarse) << coarse  # wide arcs: 2^WIDTH_BITS widths an octave
     kinds, kind = np.unique(widths, return_inverse=True)
     histogram = np.zeros(kinds.size * size)
     rows = max(1, SPREAD_SAMPLES // ARC_SAMPLES)  # contacts per pass: the index arrays stay a few MB
