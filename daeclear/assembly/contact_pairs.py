@@ -170,6 +170,8 @@ class JournalContact:
     force: ca.Function
     # d/dt of the worn surfaces' depth along e (0 unworn): the gap's rate is d|e|/dt minus it
     worn_rate: Any = 0.0
+    # a worn joint's contact direction in the bearing's and the journal's frame (rad), for the wear study
+    worn_angles: tuple[Any, Any] | None = None
 
     @property
     def penetration_rate(self) -> Any:
@@ -192,8 +194,12 @@ class JournalContact:
         ]
         if not frictionless:
             F_T_out = on * (ca.substitute(self.F_T, p, p_sym) if self.n_params else self.F_T)
-            out += [Channel(f"{name}.friction_force", "N", F_T_out),
-                    Channel(f"{name}.sliding_velocity", "m/s", self.v_T)]
+            out.append(Channel(f"{name}.friction_force", "N", F_T_out))
+        if not frictionless or self.worn_angles is not None:  # what the wear study reads (studies.wear)
+            out.append(Channel(f"{name}.sliding_velocity", "m/s", self.v_T))
+        if self.worn_angles is not None:
+            out += [Channel(f"{name}.bearing_angle", "rad", self.worn_angles[0]),
+                    Channel(f"{name}.journal_angle", "rad", self.worn_angles[1])]
         return out
 
 
@@ -284,9 +290,14 @@ def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction
     p = ca.SX.sym("p", n_params)
     F_N = law.force(delta, delta_dot, p[0] if n_params else None)
     F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
+    worn_angles = None
+    if worn_jacobian is not None:  # the contact direction's angle in each body's frame: atan2 of A(phi)^T n
+        worn_angles = tuple(ca.atan2(-ca.sin(f.phi) * e[0] + ca.cos(f.phi) * e[1],
+                                     ca.cos(f.phi) * e[0] + ca.sin(f.phi) * e[1]) for f in (bi, bj))
     f_journal = -F_N * n + F_T * t_vec  # force on the journal (body j); the bearing gets the opposite
     Q = ctx.generalized_force([(joint.body_j, f_journal, Q_j), (joint.body_i, -f_journal, Q_i)])
     if worn_jacobian is not None:  # the normal force along the gap's gradient: -F_N d(delta)/dq, delta's worn part
         Q = Q + F_N * worn_jacobian.T
     force = ca.Function(f"{name}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P], [Q], ["t", "q", "v", "p", "P"], ["Q"])
-    return JournalContact(e, e_dot, ee, e_norm, c, bi, bj, P_i, P_j, F_N, F_T, v_T, p, n_params, force, worn_rate)
+    return JournalContact(e, e_dot, ee, e_norm, c, bi, bj, P_i, P_j, F_N, F_T, v_T, p, n_params, force, worn_rate,
+                          worn_angles)
