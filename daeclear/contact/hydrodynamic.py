@@ -210,6 +210,16 @@ class HydrodynamicBearing:
         if not B.is_symbolic(eccentricity_ratio, wedge_rate, squeeze_rate, radius, clearance):
             check_number(owner, "radius", radius, low=0.0, unit="m")
             check_number(owner, "clearance", clearance, low=0.0, unit="m")
+            if not clearance < radius:
+                raise SceneError(f"{owner}: clearance={clearance:g} m, must be < radius={radius:g} m (a radial "
+                                 "clearance, far smaller than the journal).")
+            for field, value, unit in (("wedge_rate", wedge_rate, "rad/s"), ("squeeze_rate", squeeze_rate, "1/s")):
+                raw = np.asarray(value)
+                if raw.dtype.kind not in "iuf":
+                    raise SceneError(f"{owner}: {field}={value!r} is not a real number ({unit}).")
+                bad = ~np.isfinite(raw)
+                if np.any(bad):
+                    raise SceneError(f"{owner}: {field}={raw[bad].flat[0]}, must be a finite number ({unit}).")
             eps_values = np.asarray(eccentricity_ratio, dtype=float)
             bad = ~((eps_values >= 0.0) & (eps_values < 1.0))
             if np.any(bad):

@@ -17,11 +17,14 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import SceneError
 from ._checks import check_number
 
-__all__ = ["ArchardWear", "DISTRIBUTIONS", "SURFACES", "WearHistoryArrays", "half_angle_hertz",
+__all__ = ["ArchardWear", "DISTRIBUTIONS", "MAX_DEPTH_FRACTION", "SURFACES", "WearHistoryArrays", "half_angle_hertz",
            "half_angle_overlap", "node_weights", "profile_coefficients", "spread", "profile_depth", "wear_increment",
            "worn_volume"]
 
 SURFACES: tuple[str, ...] = ("bearing", "journal", "both")
+#: The deepest wear the gap's model takes, as a fraction of the bearing radius (it neglects the profile's
+#: slope in the contact points; docs/wear.md); simulate_wear stops there.
+MAX_DEPTH_FRACTION = 0.05
 DISTRIBUTIONS: tuple[str, ...] = ("elastic-foundation", "hertz")
 # the grid the arcs' pressure is spread on, per node spacing
 SUBDIVISIONS = 4

@@ -225,10 +225,20 @@ def _wear_problems(joint: RevoluteClearance) -> list[str]:
         depth = np.asarray(joint.wear_depth, dtype=float)
     except (TypeError, ValueError):
         depth = np.zeros(0)
-    if depth.shape != shape or not np.all(np.isfinite(depth)) or np.any(depth < 0):
+    if depth.shape != shape:
         shown = f"an array of shape {depth.shape}" if depth.size else repr(joint.wear_depth)[:60]
         return [f"{where}: wear_depth={shown}, must be {shape[-1]} finite depths >= 0 (m)"
                 + (" for each of bearing and journal" if rows == 2 else "") + f", shape {shape}."]
+    from ..contact.wear import MAX_DEPTH_FRACTION
+
+    deepest = MAX_DEPTH_FRACTION * float(joint.bearing_radius)
+    bad = ~(np.isfinite(depth) & (depth >= 0) & (depth < deepest))
+    if np.any(bad):
+        index = tuple(int(i) for i in np.argwhere(bad)[0])
+        value = float(depth[index])
+        rule = (f"must be below {deepest:g} m ({MAX_DEPTH_FRACTION:g} of the bearing radius: the gap's worn-profile "
+                "model ends there)" if np.isfinite(value) and value >= 0 else "must be a finite depth >= 0 (m)")
+        return [f"{where}: wear_depth{list(index)}={value!r}, {rule}."]
     return []
 
 
