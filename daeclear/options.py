@@ -385,10 +385,10 @@ def restitution(value: Any, law: Any, *, where: str, field: str = "restitution")
     from .contact.base import NormalLaw
     from .contact.registry import NORMAL_LAWS, normal_law_class
 
-    from .contact.hydrodynamic import HydrodynamicBearing
+    from .contact.registry import JOINT_LAWS
 
-    lubricated = isinstance(law, HydrodynamicBearing) or (isinstance(law, dict) and law.get("name") == "hydrodynamic")
-    if lubricated:
+    name = law.get("name") if isinstance(law, dict) else law if isinstance(law, str) else getattr(law, "name", None)
+    if name in JOINT_LAWS:
         fail(where, field, value, "left out with a lubricated law (hydrodynamic), whose dry law has the restitution; "
              "give it there, e.g. law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01, 'dry': "
              "{'name': 'lankarani-nikravesh', 'restitution': 0.5}}")

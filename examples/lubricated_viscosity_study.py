@@ -53,7 +53,8 @@ def study(viscosities: Sequence[float], revolutions: int = 2) -> list[dict[str, 
     rows = []
     for c in CLEARANCES:
         dry = dc.simulate(dc.mechanisms.slider_crank("revolute", clearance=c, rpm=RPM), t_end)
-        rows.append({"clearance": c, "viscosity": float("nan"), "peak_force": float(dry["clearance.normal_force"].max()),
+        rows.append({"clearance": c, "viscosity": float("nan"),
+                     "peak_force": float(dry["clearance.normal_force"].max()),
                      "peak_moment": float(np.abs(dry["drive.moment"]).max()),
                      "breakdowns": float("nan"), "min_film": float("nan")})
         law = HydrodynamicBearing(viscosity=viscosities[0], length=LENGTH)

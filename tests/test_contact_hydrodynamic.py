@@ -442,11 +442,12 @@ def test_film_power_is_never_negative(theory: str, cavitation: str) -> None:
     rng = np.random.default_rng(7)
     bearing = law(0.01, theory, cavitation)
     for _ in range(200):
-        eps, w_j, w_b, eps_dot, gamma_dot = rng.uniform(0.0, 0.95), *rng.normal(0.0, 300.0, 2), *rng.normal(0.0, 20.0, 2)
+        eps, (w_j, w_b) = rng.uniform(0.0, 0.95), rng.normal(0.0, 300.0, 2)
+        eps_dot, gamma_dot = rng.normal(0.0, 20.0, 2)
         w = w_j + w_b - 2.0 * gamma_dot
         radial, tangential = bearing.film_force(eps, w, eps_dot, R, C)
         t_j, t_b = shear_torques(MU, 0.01, eps, w_j - w_b, tangential, R, C)
-        # the film's force on the journal -radial n + tangential t; the journal moves e_dot = c eps_dot n + e gamma_dot t
+        # the film's force on the journal: -radial n + tangential t; e_dot = c eps_dot n + e gamma_dot t
         taken = -(-radial * C * eps_dot + tangential * eps * C * gamma_dot + t_j * w_j + t_b * w_b)
         assert taken >= -1e-9 * (abs(radial) + abs(tangential)) * C * (abs(w) + abs(eps_dot) + 1.0)
 

@@ -66,7 +66,8 @@ def test_journal_settles_at_the_static_eccentricity_and_attitude_angle() -> None
     assert np.all(run["bearing.regime"] == 0.0)
     # the journal's friction torque (Hamrock, Fundamentals of Fluid Film Lubrication, short bearing):
     # Petroff's 2 pi mu R^3 L omega / (c sqrt(1 - eps^2)) plus e W sin(attitude) / 2; the driver supplies it
-    friction = 2 * math.pi * mu * R_J**3 * L * omega / (C * math.sqrt(1 - eps**2)) + C * eps * W * math.sin(attitude) / 2
+    friction = (2 * math.pi * mu * R_J**3 * L * omega / (C * math.sqrt(1 - eps**2))
+                + C * eps * W * math.sin(attitude) / 2)
     assert run["spin.moment"][-1] == pytest.approx(friction, rel=1e-6)
     assert run["bearing.film_torque"][-1] == pytest.approx(-friction, rel=1e-6)
     # the film's net power is its dissipation, here the driver's power: moment x omega

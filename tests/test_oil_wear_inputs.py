@@ -151,7 +151,7 @@ def test_ctrl_c_keeps_and_returns_the_history(worn, tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("value, words", [
-    ("hydrodynamic", ["law='hydrodynamic'", "needs its oil's numbers", "viscosity"]),
+    ("hydrodynamic", ["law='hydrodynamic' needs its numbers", "give a table", "'viscosity': 0.1"]),
     ("{'name': 'hydrodynamic', 'viscosity': 0.1", ["--set law={'name'", "not a Python literal", "never closed"]),
     ("{'name': 'hydrodynamic', 'viscosity': x}", ["not a Python literal", "a bare name"]),
     ("{'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01, 'dry': 'hertzz'}",

@@ -167,5 +167,6 @@ def test_the_history_of_a_run_matches_the_joint_s_own_channels():
         np.testing.assert_allclose(np.sin(angle[off_centre]), np.sin(reference[off_centre]), atol=1e-12)
         assert np.max(np.abs(np.diff(angle[off_centre]))) < np.pi  # unwrapped
     assert np.array_equal(h.force, result["clearance.normal_force"])
-    with pytest.raises(SceneError, match="joint=.B., must be a revolute clearance joint with wear of the run .clearance."):
+    with pytest.raises(SceneError, match="joint=.B., must be a revolute clearance joint with wear of the run "
+                                         ".clearance."):
         wear_history(result, model, "B")

@@ -181,7 +181,7 @@ class JournalContact:
 
     def channels(self, name: str, on: Any, p_sym: Any, frictionless: bool) -> list[Channel]:
         """The contact's channels: eccentricity, penetration, the force while ``on``."""
-        e, e_dot, e_norm, p = self.e, self.e_dot, self.e_norm, self.p
+        e, e_norm, p = self.e, self.e_norm, self.p
         F_N_out = on * ca.substitute(self.F_N, p, p_sym) if self.n_params else on * self.F_N
         out = [
             Channel(f"{name}.ex", "m", e[0]),

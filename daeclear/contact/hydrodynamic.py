@@ -23,8 +23,7 @@ from .finite_bearing import finite_film_force
 from .geometry import sigma_sum
 from .normal import LankaraniNikravesh
 
-__all__ = ["CAVITATION", "HydrodynamicBearing", "THEORIES", "bearing_from_table", "film_integrals", "law_from_table",
-           "shear_torques"]
+__all__ = ["CAVITATION", "HydrodynamicBearing", "THEORIES", "film_integrals", "shear_torques"]
 
 #: The film theories and the cavitation options (the first of each is the default).
 THEORIES: tuple[str, ...] = ("short", "long", "finite")
@@ -117,6 +116,12 @@ class HydrodynamicBearing:
     asperity_modulus: float | None = None
 
     name: ClassVar[str] = "hydrodynamic"
+    #: A revolute clearance joint's law only, assembled as a lubricated journal; wear is not modelled with it.
+    joint_kinds: ClassVar[tuple[str, ...]] = ("RevoluteClearance",)
+    journal_model: ClassVar[str] = "lubricated"
+    wears: ClassVar[bool] = False
+    #: A table with the numbers the law needs (error messages).
+    example: ClassVar[str] = "{'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01}"
 
     def __post_init__(self) -> None:
         owner = type(self).__name__
@@ -173,7 +178,25 @@ class HydrodynamicBearing:
             modulus = 1.0 / (math.pi * sigma_sum(materials))  # sigma = (1 - nu^2) / (pi E), eq. (3.4)
         return dataclasses.replace(self, dry=dry, asperity_modulus=modulus)
 
-    def problems(self, clearance: float, journal_radius: float) -> list[str]:
+    @classmethod
+    def from_table(cls, params: dict[str, Any]) -> HydrodynamicBearing:
+        """The bearing from a scene file's law table (its ``name`` taken out); ``dry`` may be a law name
+        or a table ``{ name = ..., parameters }``."""
+        from .registry import build_law, normal_law
+
+        params = dict(params)
+        dry = params.get("dry")
+        try:
+            if isinstance(dry, dict):
+                dry = dict(dry)
+                params["dry"] = normal_law(dry.pop("name", None), **dry)
+            elif isinstance(dry, str):
+                params["dry"] = normal_law(dry)
+        except (SceneError, TypeError) as exc:
+            raise SceneError(f"HydrodynamicBearing: dry={dry!r}: {exc}") from None
+        return build_law(cls, params)
+
+    def joint_problems(self, clearance: float, journal_radius: float) -> list[str]:
         """What is wrong with this law in a joint of radial clearance ``clearance`` (m)."""
         owner = type(self).__name__
         out = []
@@ -275,36 +298,3 @@ def shear_torques(viscosity: Any, length: Any, eps: Any, relative_speed: Any, ta
     couette = 2.0 * math.pi * viscosity * radius**3 * length * relative_speed / (clearance * B.sqrt(1.0 - eps * eps))
     poiseuille = -0.5 * eps * clearance * tangential
     return -couette + poiseuille, couette + poiseuille
-
-
-def bearing_from_table(params: dict[str, Any]) -> HydrodynamicBearing:
-    """A HydrodynamicBearing from a scene file's law table (``name = "hydrodynamic"`` already taken
-    out); ``dry`` may be a law name or a table ``{ name = ..., parameters }``."""
-    from .registry import build_law, normal_law
-
-    params = dict(params)
-    dry = params.get("dry")
-    try:
-        if isinstance(dry, dict):
-            dry = dict(dry)
-            params["dry"] = normal_law(dry.pop("name", None), **dry)
-        elif isinstance(dry, str):
-            params["dry"] = normal_law(dry)
-    except (SceneError, TypeError) as exc:
-        raise SceneError(f"HydrodynamicBearing: dry={dry!r}: {exc}") from None
-    return build_law(HydrodynamicBearing, params)
-
-
-def law_from_table(table: dict[str, Any]) -> Any:
-    """A normal law or a HydrodynamicBearing from a table ``{name = ..., parameters}`` (scene files,
-    ``daeclear run --set law={...}``): ``name = "hydrodynamic"`` makes the bearing."""
-    from .registry import normal_law
-
-    params = dict(table)
-    name = params.pop("name", None)
-    if not isinstance(name, str):
-        raise SceneError(f"law table {table!r}: name={name!r}, must be a law's name (e.g. 'lankarani-nikravesh' "
-                         "or 'hydrodynamic').")
-    if name == HydrodynamicBearing.name:
-        return bearing_from_table(params)
-    return normal_law(name, **params)

@@ -12,9 +12,10 @@ from ..errors import SceneError
 from .base import NormalLaw
 from .cylindrical import DubowskyFreudenstein, ESDU78035, Goldsmith
 from .friction import Coulomb, FrictionLaw, ModifiedCoulomb, NoFriction
+from .hydrodynamic import HydrodynamicBearing
 from .normal import Flores, Hertz, HuntCrossley, KelvinVoigt, LankaraniNikravesh, LankaraniPlane
 
-__all__ = ["FRICTION_LAWS", "NORMAL_LAWS", "friction_law", "normal_law"]
+__all__ = ["FRICTION_LAWS", "JOINT_LAWS", "LAW_TYPES", "NORMAL_LAWS", "contact_law", "friction_law", "normal_law"]
 
 #: Normal laws by registry name.
 NORMAL_LAWS: dict[str, type[NormalLaw]] = {cls.name: cls for cls in (
@@ -22,6 +23,12 @@ NORMAL_LAWS: dict[str, type[NormalLaw]] = {cls.name: cls for cls in (
     ESDU78035, LankaraniPlane)}
 _NORMAL_ALIASES = {"ln": "lankarani-nikravesh", "esdu": "esdu-78035", "kv": "kelvin-voigt",
                    "hc": "hunt-crossley", "df": "dubowsky-freudenstein", "flores-2011": "flores"}
+
+#: A clearance joint's laws besides the normal laws, by registry name: each has ``from_table(params)``
+#: and ``example`` (a table with the numbers it needs).
+JOINT_LAWS: dict[str, Any] = {HydrodynamicBearing.name: HydrodynamicBearing}
+#: What a clearance joint's ``law`` may be an instance of.
+LAW_TYPES: tuple[type, ...] = (NormalLaw, HydrodynamicBearing)
 
 #: Friction laws by registry name.
 FRICTION_LAWS: dict[str, type[FrictionLaw]] = {cls.name: cls for cls in (NoFriction, Coulomb, ModifiedCoulomb)}
@@ -106,3 +113,26 @@ def friction_law(name_or_coefficient: str | float | FrictionLaw | None, **params
     if isinstance(name_or_coefficient, numbers.Real) and not isinstance(name_or_coefficient, bool):
         return build_law(ModifiedCoulomb, {"coefficient": float(name_or_coefficient), **params})
     return build_law(_lookup("friction_law", name_or_coefficient, FRICTION_LAWS, _FRICTION_ALIASES), params)
+
+
+def contact_law(value: Any) -> Any:
+    """A clearance joint's law from a law object (as is), a name, or a table ``{name = ..., parameters}``
+    (scene files, ``--set law={...}``, sweeps): the normal laws (:data:`NORMAL_LAWS`) and the joint laws
+    (:data:`JOINT_LAWS`: ``"hydrodynamic"``, whose table may give its ``dry`` law as a name or a table)."""
+    if isinstance(value, LAW_TYPES):
+        return value
+    if isinstance(value, dict):
+        params = dict(value)
+        name = params.pop("name", None)
+        if not isinstance(name, str):
+            raise SceneError(f"law table {value!r}: name={name!r}, must be a law's name (one of "
+                             f"{', '.join([*NORMAL_LAWS, *JOINT_LAWS])}).")
+        joint_law = _keys(tuple(JOINT_LAWS), ()).get(_key(name))
+        if joint_law is not None:
+            return JOINT_LAWS[joint_law].from_table(params)
+        return normal_law(name, **params)
+    joint_law = _keys(tuple(JOINT_LAWS), ()).get(_key(value)) if isinstance(value, str) else None
+    if joint_law is not None:
+        raise SceneError(f"contact law: law={value!r} needs its numbers: give a table, e.g. "
+                         f"law={JOINT_LAWS[joint_law].example} ({JOINT_LAWS[joint_law].__doc__.splitlines()[0]})")
+    return normal_law(value)

@@ -27,23 +27,20 @@ def _default_law() -> Any:
 def _law_problems(element: RevoluteClearance | TranslationalClearance) -> list[str]:
     """Resolve the joint's contact and friction laws once, reporting what is wrong."""
     from ..contact import friction_law
-    from ..contact.base import NormalLaw
-    from ..contact.hydrodynamic import HydrodynamicBearing
+    from ..contact.registry import LAW_TYPES
 
     out: list[str] = []
     try:
-        law = _law_object(element.law)
-        if isinstance(law, HydrodynamicBearing):
-            if not isinstance(element, RevoluteClearance):
-                out.append(f"{element.kind} '{element.name}': law=HydrodynamicBearing(...), must be a normal "
-                           "contact law (a lubricated film is a revolute clearance joint's law).")
-            else:
-                problems = law.problems(element.radial_clearance, element.journal)
-                out.extend(f"{element.kind} '{element.name}': {p}" for p in problems)
-                element.resolved_law()
-        elif not isinstance(law, NormalLaw):
+        law: Any = _law_object(element.law)  # a NormalLaw or a joint law (contact.registry.LAW_TYPES)
+        if not isinstance(law, LAW_TYPES):
             out.append(f"{element.kind} '{element.name}': law={law!r}, must be a daeclear.contact law or a law name.")
+        elif element.kind not in law.joint_kinds:
+            out.append(f"{element.kind} '{element.name}': law={type(law).__name__}(...), must be a normal contact "
+                       f"law (a {law.name} law is a {' or '.join(law.joint_kinds)}'s law).")
         else:
+            if isinstance(element, RevoluteClearance):
+                problems = law.joint_problems(element.radial_clearance, element.journal)
+                out.extend(f"{element.kind} '{element.name}': {p}" for p in problems)
             element.resolved_law()
     except (SceneError, TypeError) as exc:
         out.append(f"{element.kind} '{element.name}': {exc}")
@@ -64,7 +61,7 @@ def table_value(field_name: str, value: Any) -> Any:
     a HydrodynamicBearing), ``friction`` ({name = ..., parameters}), ``wear`` (ArchardWear's fields).
     Anything else is returned as given."""
     from ..contact import Material, friction_law
-    from ..contact.hydrodynamic import law_from_table
+    from ..contact.registry import contact_law
     from ..contact.wear import ArchardWear
 
     if field_name == "material" and isinstance(value, list):
@@ -74,7 +71,7 @@ def table_value(field_name: str, value: Any) -> Any:
     if field_name == "material":
         return Material(**value)
     if field_name in ("law", "face_law"):
-        return law_from_table(value)
+        return contact_law(value)
     if field_name == "friction":
         params = dict(value)
         return friction_law(params.pop("name", None), **params)
@@ -83,9 +80,9 @@ def table_value(field_name: str, value: Any) -> Any:
 
 def _law_object(law: Any) -> Any:
     """A law given by name as the law object (anything else as given)."""
-    from ..contact import normal_law
+    from ..contact.registry import contact_law
 
-    return normal_law(law) if isinstance(law, str) else law
+    return contact_law(law) if isinstance(law, str) else law
 
 
 def _friction(joint: RevoluteClearance | TranslationalClearance) -> Any:
@@ -205,7 +202,6 @@ def _wear_problems(joint: RevoluteClearance) -> list[str]:
     """What is wrong with a joint's wear and worn profile."""
     import numpy as np
 
-    from ..contact.hydrodynamic import HydrodynamicBearing
     from ..contact.wear import ArchardWear
 
     where = f"{joint.kind} '{joint.name}'"
@@ -214,9 +210,9 @@ def _wear_problems(joint: RevoluteClearance) -> list[str]:
             f"{where}: wear_depth is given without wear; give wear=ArchardWear(...) too."]
     if not isinstance(joint.wear, ArchardWear):
         return [f"{where}: wear={joint.wear!r}, must be None or a daeclear.contact.wear.ArchardWear."]
-    if isinstance(joint.law, HydrodynamicBearing):
-        return [f"{where}: wear with a lubricated joint (law=HydrodynamicBearing) is not modelled; "
-                "give a dry contact law."]
+    if not getattr(joint.law, "wears", True):
+        return [f"{where}: wear with a {joint.law.name} law ({type(joint.law).__name__}, a lubricated joint) is not "
+                "modelled; give a dry contact law."]
     if joint.wear_depth is None:
         return []
     rows = len(joint.wear.surfaces)

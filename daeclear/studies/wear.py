@@ -160,7 +160,8 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
     blocks = math.ceil(cycles / (update_every * extrapolate))
     if blocks > MAX_BLOCKS:
         size = blocks * (len(wear.surfaces) * wear.nodes * 8 + 32)
-        raise SceneError(f"simulate_wear: cycles={cycles:g} with update_every={update_every}, extrapolate={extrapolate} "
+        raise SceneError(f"simulate_wear: cycles={cycles:g} with update_every={update_every}, "
+                         f"extrapolate={extrapolate} "
                          f"is {blocks:.3g} blocks, must be at most {MAX_BLOCKS:.0e} (at about 10 ms a simulated cycle "
                          f"that is {blocks * update_every * 0.01 / 3.15e7:.3g} years, and a history of "
                          f"{size / 1e9:.3g} GB); raise extrapolate or ask fewer cycles.")
