@@ -31,8 +31,9 @@ def _law_problems(element: RevoluteClearance | TranslationalClearance) -> list[s
 
     out: list[str] = []
     try:
-        law: Any = _law_object(element.law)  # a NormalLaw or a joint law (contact.registry.LAW_TYPES)
-        if not isinstance(law, LAW_TYPES):
+        given = _law_object(element.law)
+        law: Any = given  # a NormalLaw or a joint law (contact.registry.LAW_TYPES)
+        if not isinstance(given, LAW_TYPES):
             out.append(f"{element.kind} '{element.name}': law={law!r}, must be a daeclear.contact law or a law name.")
         elif element.kind not in law.joint_kinds:
             out.append(f"{element.kind} '{element.name}': law={type(law).__name__}(...), must be a normal contact "
