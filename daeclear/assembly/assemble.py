@@ -22,6 +22,7 @@ from ..model.elements import kept_with
 from ..engine.session_base import DAEFunctions
 from ..options import DEFAULT_FORMULATION, FORMULATIONS
 from .parameters import ParameterTable, entries, structure_key
+from .parameter_names import BAUMGARTE, is_numbers
 from ..model.scene import (GROUND, Body, Driver, Revolute, RevoluteClearance, Scene, Translational,
                            TranslationalClearance)
 from .revolute_joint import CONTACT_BUILDERS
@@ -153,11 +154,24 @@ class Structure:
     def rebind(self, model: DAEModel, values: Mapping[str, Any]) -> DAEModel:
         """``model`` with some of its scene's numbers replaced (:meth:`DAEModel.with_parameters`)."""
         values = dict(values)
+        settable, structural = model.parameter_names, model.structural_names
+        for name in values:
+            if name in settable:
+                continue
+            nested = any(n.startswith(f"{name}.") for n in (*settable, *structural))
+            if name in structural or nested or not is_numbers(values[name]):
+                raise SceneError(f"with_parameters: {name!r} is structure of the model (read-only: a new value would "
+                                 "change the structure of the model); set its numbers by their names (model."
+                                 "parameter_names), or assemble the changed scene: assemble(model.scene.with_values(...)).")
+            if name in BAUMGARTE:
+                raise SceneError(f"with_parameters: baumgarte.alpha/beta are numbers of the index1 formulation; "
+                                 f"this model is {model.formulation}.")
+            model.scene.with_values({name: values[name]})  # an unknown name: its error names the element or field
+            raise SceneError(f"with_parameters: {name!r} is not one of the model's numbers: this scene leaves it to be "
+                             "derived (None); give it in the scene and assemble it (nothing compiles): "
+                             "assemble(model.scene.with_values(...)).")
         alpha = float(values.pop("baumgarte.alpha", model.alpha))
         beta = float(values.pop("baumgarte.beta", model.beta))
-        if (alpha, beta) != (model.alpha, model.beta) and model.formulation != "index1":
-            raise SceneError(f"with_parameters: baumgarte.alpha/beta are numbers of the index1 formulation; "
-                             f"this model is {model.formulation}.")
         _check_baumgarte(alpha, beta)
         scene = model.scene.with_values(values)
         table, key, described = scene_parameters(scene, model.formulation, alpha, beta, model.track_work)
