@@ -162,7 +162,8 @@ class Structure:
             if name in structural or nested or not is_numbers(values[name]):
                 raise SceneError(f"with_parameters: {name!r} is structure of the model (read-only: a new value would "
                                  "change the structure of the model); set its numbers by their names (model."
-                                 "parameter_names), or assemble the changed scene: assemble(model.scene.with_values(...)).")
+                                 "parameter_names), or assemble the changed scene: "
+                                 "assemble(model.scene.with_values(...)).")
             if name in BAUMGARTE:
                 raise SceneError(f"with_parameters: baumgarte.alpha/beta are numbers of the index1 formulation; "
                                  f"this model is {model.formulation}.")
