@@ -33,7 +33,7 @@ def scene_names(scene: Any, formulation: str, table: frozenset[str]) -> tuple[tu
     settable: list[str] = ["gravity"]
     structural: list[str] = []
     for element in scene.elements:
-        free = getattr(element, "NOT_STRUCTURE", frozenset())
+        free: frozenset[str] = getattr(element, "NOT_STRUCTURE", frozenset())
         for f in dataclasses.fields(element):
             if f.name == "name":
                 continue
