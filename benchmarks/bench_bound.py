@@ -224,7 +224,7 @@ def build_program(folder: Path) -> Program:
                            f"version {BOUND_ABI}: update its calls (see csrc and daeclear.engine.library)")
     cc = compiler_command()
     exe, so = folder / "bound", folder / "libbound.so"
-    inc = f"-I{CSRC}"  # dc_abi.h: the return codes and stats slots of the driver
+    inc = f"-I{CSRC}"  # dc_abi.h (return codes, stats slots) and dc_api.h (the dc_* declarations)
     for cmd in ([*cc, "-O2", inc, str(SOURCE), "-o", str(exe), "-ldl"],
                 [*cc, "-O2", "-fPIC", "-shared", "-DBOUND_NO_MAIN", inc, str(SOURCE), "-o", str(so), "-ldl"]):
         subprocess.run(cmd, check=True, capture_output=True, text=True)

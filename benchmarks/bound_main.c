@@ -28,40 +28,26 @@
 #include <time.h>
 
 #include "dc_abi.h" /* DC_CHUNK, DC_TSTOP, DC_ST_N: generated from daeclear/engine/abi.py (csrc on -I) */
+#include "dc_api.h" /* the dc_* declarations: generated from daeclear/engine/c_api.py */
 
 #define BOUND_ABI 7
 
-typedef int (*abi_fn)(void);
-typedef void* (*open_fn)(double, const double*, double, int, long long, const int*, const double*, int, char*,
-                         int);
-typedef int (*set_d_fn)(void*, double);
-typedef int (*set_i_fn)(void*, int);
-typedef int (*stall_fn)(void*, double, int);
-typedef int (*layout_fn)(void*, int, int, int, int, int, int, int, int, int, double, int);
-typedef int (*reinit_fn)(void*, double, const double*, const double*, const int*, const double*, const int*);
-typedef int (*auto_fn)(void*, int, const int*, const int*, const int*, const int*, const double*, const int*,
-                       const double*, const int*, const int*, const double*, int);
-typedef int (*advance_fn)(void*, double, const double*, int, int*, double*, double*, int, int, double*, double*,
-                          double*, double*, int*, int*, double*, double*, double*, int*, int*);
-typedef int (*take_fn)(void*, int, double*, int*, int*, double*, double*, double*);
-typedef void (*stats_fn)(void*, long long*);
-typedef const char* (*message_fn)(void*);
-typedef void (*free_fn)(void*);
-
+/* the driver's entry points, as dlsym returns them: pointers of the types dc_api.h declares */
 typedef struct {
-  abi_fn abi_version;
-  open_fn open;
-  set_d_fn nonlin_conv_coef, jacobian_refresh;
-  set_i_fn first_step;
-  stall_fn stall;
-  layout_fn layout;
-  reinit_fn reinit;
-  auto_fn set_auto;
-  advance_fn advance;
-  take_fn take_events;
-  stats_fn stats;
-  message_fn message;
-  free_fn free_;
+  __typeof__(&dc_abi_version) abi_version;
+  __typeof__(&dc_open) open;
+  __typeof__(&dc_set_nonlin_conv_coef) nonlin_conv_coef;
+  __typeof__(&dc_set_jacobian_refresh) jacobian_refresh;
+  __typeof__(&dc_set_first_step) first_step;
+  __typeof__(&dc_set_stall) stall;
+  __typeof__(&dc_set_layout) layout;
+  __typeof__(&dc_reinit) reinit;
+  __typeof__(&dc_set_auto) set_auto;
+  __typeof__(&dc_advance) advance;
+  __typeof__(&dc_take_events) take_events;
+  __typeof__(&dc_stats) stats;
+  __typeof__(&dc_message) message;
+  __typeof__(&dc_free) free_;
 } driver_t;
 
 /* One recorded call of the set-up, or the advance loop ("advance"). */

@@ -3,11 +3,15 @@ opened once per path, with its interface version checked and a library of the ot
 
 from __future__ import annotations
 
+import shutil
+import subprocess
+from pathlib import Path
+
 import casadi as ca
 import pytest
 
 from daeclear.assembly.assemble import assemble
-from daeclear.engine import codegen, library
+from daeclear.engine import c_api, codegen, library
 from daeclear.engine.library import MODEL_PROTOTYPES, ODE_PROTOTYPES, ModelLibrary, OdeLibrary, StaleLibrary
 from daeclear.engine.session_base import DAEFunctions
 from daeclear.errors import DaeclearError
@@ -42,6 +46,28 @@ def test_each_kind_is_loaded_once_per_path_with_its_prototypes(paths):
             fn = getattr(lib, name)
             assert fn.restype is restype and fn.argtypes == list(argtypes), name
     assert m.model_info(0) == (1, 0, 0, [])
+
+
+def exported(path: Path) -> dict[str, str]:
+    """The symbols a shared library defines for others (``nm -D --defined-only``) and their kinds."""
+    nm = shutil.which("nm")
+    if nm is None:
+        pytest.skip("no nm (binutils) to list a library's symbols")
+    out = subprocess.run([nm, "-D", "--defined-only", str(path)], check=True, capture_output=True, text=True).stdout
+    rows = [line.split()[-2:] for line in out.splitlines() if line.strip()]
+    return {name: kind for kind, name in rows if not name.startswith("_")}  # not the linker's _edata, _end, ...
+
+
+def test_each_library_exports_exactly_its_table(paths):
+    """Every symbol a built library exports has an entry in c_api's table, and every entry is exported:
+    the functions as code, the build tag as read-only data; the other driver's names not at all."""
+    model_path, ode_path = paths
+    for path, entries, data in ((model_path, c_api.IDA_ENTRY_POINTS, c_api.IDA_DATA),
+                                (ode_path, c_api.ODE_ENTRY_POINTS, ())):
+        symbols = exported(path)
+        assert {name for name, kind in symbols.items() if kind == "T"} == {e.name for e in entries}, path.name
+        assert {name: kind for name, kind in symbols.items() if kind != "T"} == {name: "R" for _, name in data}
+    assert len(exported(model_path)) == 38 + 1 and len(exported(ode_path)) == 16
 
 
 def test_other_interface_versions_are_refused(paths, monkeypatch):

@@ -2,7 +2,8 @@
 flags, slots of the arrays a driver fills, decision kinds (those of :mod:`daeclear.assembly.automaton`).
 
 :func:`header_text` writes them as ``csrc/dc_abi.h``, generated and checked in
-(``python -m daeclear.engine.abi`` writes it again; ``tests/test_abi.py`` fails when it differs).
+(``python -m daeclear.engine.abi`` writes it again, and ``csrc/dc_api.h``, the entry points of
+:mod:`daeclear.engine.c_api`; ``tests/test_abi.py`` fails when one differs).
 
 >>> DC_ROOT, FX_CANDIDATE, STAT_KEYS[DC_ST_REINITS]
 (2, 2, 'n_reinits')
@@ -10,9 +11,11 @@ flags, slots of the arrays a driver fills, decision kinds (those of :mod:`daecle
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Final
 
 from ..assembly import automaton
+from . import c_api
 from .build import CSRC
 
 __all__ = [
@@ -28,7 +31,7 @@ __all__ = [
     "FX_CHUNK", "FX_TSTOP", "FX_CANDIDATE", "FX_ERR", "FX_MAXSTEPS",
     "DCO_EULER", "DCO_RK4", "DCO_CNT_RHS", "DCO_CNT_JAC", "DCO_CNT_GAPS", "DCO_CNT_STEPS", "DCO_CNT_N",
     "ODE_COUNTER_KEYS",
-    "GROUPS", "table", "header_text", "HEADER",
+    "GROUPS", "table", "header_text", "HEADER", "generated_headers",
 ]
 
 #: Where the generated header lives (beside the drivers that include it).
@@ -199,6 +202,12 @@ def header_text() -> str:
     return "\n".join(lines) + "\n"
 
 
+def generated_headers() -> dict[Path, str]:
+    """Every generated header and its text: this table's ``dc_abi.h`` and the entry points' ``dc_api.h``."""
+    return {HEADER: header_text(), c_api.HEADER: c_api.header_text()}
+
+
 if __name__ == "__main__":  # pragma: no cover - the maintainer's regeneration step
-    HEADER.write_text(header_text())
-    print(HEADER)
+    for path, text in generated_headers().items():
+        path.write_text(text)
+        print(path)

@@ -1,8 +1,9 @@
 """Loading compiled libraries: the one place that opens a built shared library with ctypes.
 
-Declares the functions from a prototype table and checks the driver ABI and, for an IDA model library
-(:class:`ModelLibrary`), the SUNDIALS build (the file's build tag before loading, then ``dc_build_info``
-and ``SUNDIALSGetVersion``); one that must not run is unloaded (:class:`StaleLibrary`).
+Declares the functions from the table that also declares them to C (:mod:`daeclear.engine.c_api`) and
+checks the driver ABI and, for an IDA model library (:class:`ModelLibrary`), the SUNDIALS build (the
+file's build tag before loading, then ``dc_build_info`` and ``SUNDIALSGetVersion``); one that must not
+run is unloaded (:class:`StaleLibrary`).
 :class:`OdeLibrary`: the ODE evaluator of :mod:`daeclear.solvers.explicit`.
 """
 
@@ -14,7 +15,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 from collections.abc import Mapping, Sequence
 
-from . import sundials
+from . import c_api, sundials
 from .abi import DC_BI_INDEX_BITS, DC_BI_INDEX_SIZE, DC_BI_MAJOR, DC_BI_MINOR, DC_BI_N, DC_BI_PATCH, DC_BI_SPARSE
 from ..errors import DaeclearError
 from .sundials import SundialsInfo
@@ -23,7 +24,8 @@ __all__ = ["DRIVER_ABI", "ODE_DRIVER_ABI", "Prototypes", "StaleLibrary", "open_l
            "ModelLibrary", "OdeLibrary"]
 
 #: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
-#: and checked when a library is loaded: bump it when a dc_* signature or what a dc_* call writes changes.
+#: and checked when a library is loaded: bump it when a dc_* signature (c_api.py) or what a dc_* call writes
+#: changes.
 DRIVER_ABI = 7
 #: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
 ODE_DRIVER_ABI = 3
@@ -31,70 +33,10 @@ ODE_DRIVER_ABI = 3
 #: A prototype table: C function name -> (restype, argtypes), as ctypes declares them.
 Prototypes = Mapping[str, tuple[Any, Sequence[Any]]]
 
-P, I, D = ctypes.c_void_p, ctypes.c_int, ctypes.c_double
-S, LL, LONG = ctypes.c_char_p, ctypes.c_longlong, ctypes.c_long
-
-#: The dc_* functions of csrc/ida_driver.c.
-MODEL_PROTOTYPES: Prototypes = {
-    "dc_abi_version": (I, []),
-    "dc_build_info": (I, [P, I]),
-    "dc_sundials_version": (I, [S, I]),
-    "dc_model_info": (I, [P, P, P, P]),
-    "dc_model_name": (S, []),
-    "dc_message": (S, [P]),
-    "dc_open": (P, [D, P, D, I, LL, P, P, I, S, I]),
-    "dc_jac_nnz": (LL, [P]),
-    "dc_linear_solver": (I, [P]),
-    "dc_jac_pattern": (None, [P, P, P]),
-    "dc_eval_jacobian_sparse": (I, [P, D, P, P, D, P]),
-    "dc_n_parameters": (I, []),
-    "dc_set_nonlin_conv_coef": (I, [P, D]),
-    "dc_set_jacobian_refresh": (I, [P, D]),
-    "dc_n_extra": (I, []),
-    "dc_eval_extra": (I, [I, I, I, P, P, P, I]),
-    "dc_set_auto": (I, [P, I, P, P, P, P, P, P, P, P, P, P, I]),
-    "dc_take_events": (I, [P, I, P, P, P, P, P, P]),
-    "dc_automaton_run": (I, [I, P, P, P, I, D, D, I, I, D, P, P, P, P, P]),
-    "dc_pending_events": (I, [P]),
-    "dc_get_active": (None, [P, P, P]),
-    "dc_get_pairs": (None, [P, P, P, P, P, P, P]),
-    "dc_set_layout": (I, [P, I, I, I, I, I, I, I, I, I, D, I]),
-    "dc_report": (I, [P, I, P, P, P, P, P, P]),
-    "dc_set_stall": (I, [P, D, I]),
-    "dc_set_first_step": (I, [P, I]),
-    "dc_first_step": (D, [P]),
-    "dc_solve_reduced": (I, [P, I, D, P, P, D, P, P]),
-    "dc_free": (None, [P]),
-    "dc_reset": (I, [P, D, P, D, LL, P, P]),
-    "dc_reinit": (I, [P, D, P, P, P, P, P]),
-    "dc_advance": (I, [P, D, P, I, P, P, P, I, I, P, P, P, P, P, P, P, P, P, P, P]),
-    "dc_stats": (None, [P, P]),
-    "dc_eval_residual": (I, [P, D, P, P, P]),
-    "dc_eval_jacobian": (I, [P, D, P, P, D, P]),
-    "dc_eval_roots": (I, [P, D, P, P, P]),
-    "dc_set_terms": (None, [P, P, P]),
-    "dc_flag_name": (None, [LONG, S, I]),
-}
-
+#: The dc_* functions of csrc/ida_driver.c, from the table that also declares them to C (c_api.py).
+MODEL_PROTOTYPES: Prototypes = c_api.prototypes(c_api.IDA_ENTRY_POINTS)
 #: The dco_* functions of csrc/ode_driver.c.
-ODE_PROTOTYPES: Prototypes = {
-    "dco_abi_version": (I, []),
-    "dco_info": (I, [P, P, P, P, P]),
-    "dco_message": (S, [P]),
-    "dco_open": (P, [P, P, S, I]),
-    "dco_free": (None, [P]),
-    "dco_set_terms": (None, [P, P, P]),
-    "dco_rhs": (I, [P, D, P, P]),
-    "dco_jac": (I, [P, D, P, P]),
-    "dco_gaps": (I, [P, D, P, P, P]),
-    "dco_step": (I, [P, I, D, P, D, P]),
-    "dco_batch": (I, [P, I, P, P, P, P]),
-    "dco_fixed": (I, [P, I, D, P, D, D, LL, P, I, P, P, P, P, P, P, P, P]),
-    "dco_counters": (None, [P, P]),
-    "dco_set_hermite": (None, [P, I]),
-    "dco_outputs": (I, [P, I, P, P, P, P, P]),
-    "dco_output_sizes": (None, [P, P, P]),
-}
+ODE_PROTOTYPES: Prototypes = c_api.prototypes(c_api.ODE_ENTRY_POINTS)
 
 
 class StaleLibrary(DaeclearError):

@@ -25,14 +25,16 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunmatrix/sunmatrix_sparse.h>
+#include "dc_api.h" /* the dc_* entry points, generated from daeclear/engine/c_api.py */
+/* every exported function is declared there: one defined without a declaration is an error, one that
+ * differs from its declaration too (conflicting types) */
+#pragma GCC diagnostic error "-Wmissing-prototypes"
 #include "dc_abi.h"
 #include "dc_common.h"
 #include "dc_model.h"
 #include "dc_linalg.h"
 #include "dc_reduced_ls.h"
 #include "ida_automaton.h"
-
-#define DC_API __attribute__((visibility("default")))
 
 #ifndef DC_ABI_VERSION /* given by daeclear.engine.codegen (daeclear.engine.library.DRIVER_ABI) */
 #error "compile with -DDC_ABI_VERSION=<daeclear.engine.library.DRIVER_ABI>"

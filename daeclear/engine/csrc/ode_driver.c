@@ -29,12 +29,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dc_api.h" /* the dco_* entry points, generated from daeclear/engine/c_api.py */
+/* every exported function is declared there: one defined without a declaration is an error, one that
+ * differs from its declaration too (conflicting types) */
+#pragma GCC diagnostic error "-Wmissing-prototypes"
 #include "dc_abi.h"
 #include "dc_common.h"
 #include "dco_model.h"
 #include "dc_linalg.h"
 
-#define DCO_API __attribute__((visibility("default")))
 #ifndef DCO_ABI_VERSION /* given by daeclear.engine.codegen (daeclear.engine.library.ODE_DRIVER_ABI) */
 #error "compile with -DDCO_ABI_VERSION=<daeclear.engine.library.ODE_DRIVER_ABI>"
 #endif
@@ -297,9 +300,9 @@ static double candidate(double G0, double Gd0, double G1, double Gd1, double h, 
 
 /* ------------------------------------------------------------------ API ---- */
 
-DCO_API int dco_abi_version(void) { return DCO_ABI_VERSION; }
+DC_API int dco_abi_version(void) { return DCO_ABI_VERSION; }
 
-DCO_API int dco_info(int* n, int* m, int* n_terms, int* n_gaps, int* n_params) {
+DC_API int dco_info(int* n, int* m, int* n_terms, int* n_gaps, int* n_params) {
   *n = dco_model.n;
   *m = dco_model.m;
   *n_terms = dco_model.n_terms;
@@ -309,9 +312,9 @@ DCO_API int dco_info(int* n, int* m, int* n_terms, int* n_gaps, int* n_params) {
   return 0;
 }
 
-DCO_API const char* dco_message(void* sp) { return sp ? ((dco_session*)sp)->msg : ""; }
+DC_API const char* dco_message(void* sp) { return sp ? ((dco_session*)sp)->msg : ""; }
 
-DCO_API void dco_free(void* sp) {
+DC_API void dco_free(void* sp) {
   dco_session* s = (dco_session*)sp;
   const dco_model_t* M = &dco_model;
   if (!s) return;
@@ -348,7 +351,7 @@ DCO_API void dco_free(void* sp) {
   free(s);
 }
 
-DCO_API void* dco_open(const double* mass, const double* P, char* err, int errlen) {
+DC_API void* dco_open(const double* mass, const double* P, char* err, int errlen) {
   const dco_model_t* M = &dco_model;
   dco_session* s = (dco_session*)calloc(1, sizeof(dco_session));
   if (!s) {
@@ -456,7 +459,7 @@ DCO_API void* dco_open(const double* mass, const double* P, char* err, int errle
 }
 
 /* active[n_terms] flags and the terms' parameters concatenated in term order. */
-DCO_API void dco_set_terms(void* sp, const int* active, const double* params) {
+DC_API void dco_set_terms(void* sp, const int* active, const double* params) {
   dco_session* s = (dco_session*)sp;
   for (int k = 0; k < s->nt; ++k) s->active[k] = active[k] ? 1 : 0;
   int np = s->nt ? s->poff[s->nt] : 0;
@@ -465,10 +468,10 @@ DCO_API void dco_set_terms(void* sp, const int* active, const double* params) {
 
 /* 1 (default): a step may hold a crossing when the cubic Hermite interpolant of a gap has an
  * interior maximum above zero; 0: sign changes at the step ends only (for measurements). */
-DCO_API void dco_set_hermite(void* sp, int on) { ((dco_session*)sp)->hermite = on ? 1 : 0; }
+DC_API void dco_set_hermite(void* sp, int on) { ((dco_session*)sp)->hermite = on ? 1 : 0; }
 
 /* x' at (t, x): 0 on success, else a DCO_* code (message in dco_message; xdot may hold NaN). */
-DCO_API int dco_rhs(void* sp, double t, const double* x, double* xdot) {
+DC_API int dco_rhs(void* sp, double t, const double* x, double* xdot) {
   dco_session* s = (dco_session*)sp;
   s->cnt[DCO_CNT_RHS]++;
   int rc = accel(s, t, x, xdot);
@@ -477,7 +480,7 @@ DCO_API int dco_rhs(void* sp, double t, const double* x, double* xdot) {
   return rc;
 }
 
-DCO_API int dco_jac(void* sp, double t, const double* x, double* J) {
+DC_API int dco_jac(void* sp, double t, const double* x, double* J) {
   dco_session* s = (dco_session*)sp;
   s->cnt[DCO_CNT_JAC]++;
   int rc = eval_jac(s, t, x, J);
@@ -486,19 +489,19 @@ DCO_API int dco_jac(void* sp, double t, const double* x, double* J) {
   return rc;
 }
 
-DCO_API int dco_gaps(void* sp, double t, const double* x, double* g, double* gd) {
+DC_API int dco_gaps(void* sp, double t, const double* x, double* g, double* gd) {
   dco_session* s = (dco_session*)sp;
   if (s->ng == 0) return 0;
   return eval_gaps(s, t, x, g, gd);
 }
 
-DCO_API int dco_step(void* sp, int scheme, double t, const double* x, double h, double* xn) {
+DC_API int dco_step(void* sp, int scheme, double t, const double* x, double h, double* xn) {
   return scheme_step((dco_session*)sp, scheme, t, x, h, xn);
 }
 
 /* x' and lam at N points (row-major N x nx and N x m), uncounted. Returns the index of the first
  * point that failed (its row holds NaN), or -1. */
-DCO_API int dco_batch(void* sp, int N, const double* t, const double* X, double* Xdot, double* Lam) {
+DC_API int dco_batch(void* sp, int N, const double* t, const double* X, double* Xdot, double* Lam) {
   dco_session* s = (dco_session*)sp;
   int bad = -1;
   for (int p = 0; p < N; ++p) {
@@ -520,10 +523,10 @@ DCO_API int dco_batch(void* sp, int N, const double* t, const double* X, double*
  * FX_CANDIDATE (ta, xa) is the start and (tb, xb) the end of the step that may hold a crossing,
  * sstar[2i] (increasing) and sstar[2i+1] (decreasing) the far-side points (step-relative) of
  * gap i, or -1. */
-DCO_API int dco_fixed(void* sp, int scheme, double t0, const double* x0, double hstep,
-                      double t_stop, long long max_steps, const int* rootdir, int cap, double* st,
-                      double* sx, int* n_stored, double* ta, double* xa, double* tb, double* xb,
-                      double* sstar) {
+DC_API int dco_fixed(void* sp, int scheme, double t0, const double* x0, double hstep,
+                     double t_stop, long long max_steps, const int* rootdir, int cap, double* st,
+                     double* sx, int* n_stored, double* ta, double* xa, double* tb, double* xb,
+                     double* sstar) {
   dco_session* s = (dco_session*)sp;
   const int nx = s->nx, ng = s->ng;
   const int watch = ng > 0;
@@ -579,8 +582,8 @@ DCO_API int dco_fixed(void* sp, int scheme, double t0, const double* x0, double 
 /* Output channels at N points: Y, YP row-major (N x n_y), one switch vector for all points,
  * out row-major (N x n_channels). Returns 0, -1 without an outputs function, or 1 + the index of
  * the first point that failed. */
-DCO_API int dco_outputs(void* sp, int N, const double* t, const double* Y, const double* YP,
-                        const double* sw, double* out) {
+DC_API int dco_outputs(void* sp, int N, const double* t, const double* Y, const double* YP,
+                       const double* sw, double* out) {
   dco_session* s = (dco_session*)sp;
   const dco_model_t* M = &dco_model;
   if (M->n_channels <= 0) return -1;
@@ -592,14 +595,14 @@ DCO_API int dco_outputs(void* sp, int N, const double* t, const double* Y, const
   return 0;
 }
 
-DCO_API void dco_output_sizes(int* n_y, int* n_switch, int* n_channels) {
+DC_API void dco_output_sizes(int* n_y, int* n_switch, int* n_channels) {
   *n_y = dco_model.n_y;
   *n_switch = dco_model.n_switch;
   *n_channels = dco_model.n_channels;
 }
 
 /* counters: rhs evaluations, Jacobians, gap evaluations, fixed steps */
-DCO_API void dco_counters(void* sp, long long* out) {
+DC_API void dco_counters(void* sp, long long* out) {
   dco_session* s = (dco_session*)sp;
   for (int i = 0; i < DCO_CNT_N; ++i) out[i] = s->cnt[i];
 }
