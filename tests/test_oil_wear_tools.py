@@ -84,3 +84,22 @@ def test_a_viscosity_sweep_from_the_command_line_compiles_nothing(tmp_path):
     records = load_sweep(out).runs
     assert [r.parameters["clearance.law.viscosity"] for r in records] == [0.01, 0.03, 0.1]
     assert all(r.ok for r in records)
+
+
+def test_the_command_line_figure_of_a_lubricated_joint(tmp_path):
+    """daeclear run's figure of a lubricated joint: the film force and the eccentricity ratio beside the dry
+    force, and a title naming the oil's viscosity, the bearing's length and the theory."""
+    from daeclear.cli import main
+    from daeclear.plot.figures import default_channels
+    from daeclear.plot.style import caption
+
+    law = "law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01, 'theory': 'long'}"
+    assert main(["run", "slider_crank", "--joint", "revolute", "--set", law, "--t-end", "0.003", "--out",
+                 str(tmp_path), "--quiet"]) == 0
+    assert (tmp_path / "slider_crank_revolute.png").stat().st_size > 20_000
+    result = dc.load(tmp_path / "slider_crank_revolute.h5")
+    channels = default_channels(result)
+    assert {"clearance.film_radial", "clearance.normal_force", "clearance.eccentricity_ratio"} <= set(channels)
+    assert "oil $\\mu$ = 0.1 Pa s, L = 10 mm, long bearing" in caption(result)
+    dry = dc.simulate(dc.mechanisms.slider_crank("revolute"), 0.001)
+    assert "clearance.film_radial" not in default_channels(dry) and "Lankarani" in caption(dry)
