@@ -178,24 +178,6 @@ class HydrodynamicBearing:
             modulus = 1.0 / (math.pi * sigma_sum(materials))  # sigma = (1 - nu^2) / (pi E), eq. (3.4)
         return dataclasses.replace(self, dry=dry, asperity_modulus=modulus)
 
-    @classmethod
-    def from_table(cls, params: dict[str, Any]) -> HydrodynamicBearing:
-        """The bearing from a scene file's law table (its ``name`` taken out); ``dry`` may be a law name
-        or a table ``{ name = ..., parameters }``."""
-        from .registry import build_law, normal_law
-
-        params = dict(params)
-        dry = params.get("dry")
-        try:
-            if isinstance(dry, dict):
-                dry = dict(dry)
-                params["dry"] = normal_law(dry.pop("name", None), **dry)
-            elif isinstance(dry, str):
-                params["dry"] = normal_law(dry)
-        except (SceneError, TypeError) as exc:
-            raise SceneError(f"HydrodynamicBearing: dry={dry!r}: {exc}") from None
-        return build_law(cls, params)
-
     def joint_problems(self, clearance: float, journal_radius: float) -> list[str]:
         """What is wrong with this law in a joint of radial clearance ``clearance`` (m)."""
         owner = type(self).__name__

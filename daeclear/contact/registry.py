@@ -24,8 +24,8 @@ NORMAL_LAWS: dict[str, type[NormalLaw]] = {cls.name: cls for cls in (
 _NORMAL_ALIASES = {"ln": "lankarani-nikravesh", "esdu": "esdu-78035", "kv": "kelvin-voigt",
                    "hc": "hunt-crossley", "df": "dubowsky-freudenstein", "flores-2011": "flores"}
 
-#: A clearance joint's laws besides the normal laws, by registry name: each has ``from_table(params)``
-#: and ``example`` (a table with the numbers it needs).
+#: A clearance joint's laws besides the normal laws, by registry name: each has ``example`` (a table with
+#: the numbers it needs); its table is read by :func:`contact_law`.
 JOINT_LAWS: dict[str, Any] = {HydrodynamicBearing.name: HydrodynamicBearing}
 #: What a clearance joint's ``law`` may be an instance of.
 LAW_TYPES: tuple[type, ...] = (NormalLaw, HydrodynamicBearing)
@@ -129,10 +129,25 @@ def contact_law(value: Any) -> Any:
                              f"{', '.join([*NORMAL_LAWS, *JOINT_LAWS])}).")
         joint_law = _keys(tuple(JOINT_LAWS), ()).get(_key(name))
         if joint_law is not None:
-            return JOINT_LAWS[joint_law].from_table(params)
+            return _joint_law_from_table(JOINT_LAWS[joint_law], params)
         return normal_law(name, **params)
     joint_law = _keys(tuple(JOINT_LAWS), ()).get(_key(value)) if isinstance(value, str) else None
     if joint_law is not None:
         raise SceneError(f"contact law: law={value!r} needs its numbers: give a table, e.g. "
                          f"law={JOINT_LAWS[joint_law].example} ({JOINT_LAWS[joint_law].__doc__.splitlines()[0]})")
     return normal_law(value)
+
+
+def _joint_law_from_table(cls: type, params: dict[str, Any]) -> Any:
+    """A joint law from its table (``name`` taken out); a ``dry`` law in it may be a name or a table."""
+    params = dict(params)
+    dry = params.get("dry")
+    try:
+        if isinstance(dry, dict):
+            dry = dict(dry)
+            params["dry"] = normal_law(dry.pop("name", None), **dry)
+        elif isinstance(dry, str):
+            params["dry"] = normal_law(dry)
+    except (SceneError, TypeError) as exc:
+        raise SceneError(f"{cls.__name__}: dry={dry!r}: {exc}") from None
+    return build_law(cls, params)
