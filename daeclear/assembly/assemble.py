@@ -22,7 +22,7 @@ from ..model.elements import kept_with
 from ..engine.session_base import DAEFunctions
 from ..options import DEFAULT_FORMULATION, FORMULATIONS
 from .parameters import ParameterTable, entries, structure_key
-from .parameter_names import BAUMGARTE, is_numbers
+from .parameter_names import BAUMGARTE, is_numbers, scene_names
 from ..model.scene import (GROUND, Body, Driver, Revolute, RevoluteClearance, Scene, Translational,
                            TranslationalClearance)
 from .revolute_joint import CONTACT_BUILDERS
@@ -154,7 +154,9 @@ class Structure:
     def rebind(self, model: DAEModel, values: Mapping[str, Any]) -> DAEModel:
         """``model`` with some of its scene's numbers replaced (:meth:`DAEModel.with_parameters`)."""
         values = dict(values)
-        settable, structural = model.parameter_names, model.structural_names
+        table = frozenset(name for name, _ in model.parameter_layout)
+        settable, structural = scene_names(model.scene, model.formulation, table,  # the named elements only
+                                           frozenset(str(name).split(".")[0] for name in values))
         for name in values:
             if name in settable:
                 continue

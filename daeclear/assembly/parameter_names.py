@@ -26,13 +26,16 @@ __all__ = ["BAUMGARTE", "is_numbers", "scene_names"]
 BAUMGARTE = ("baumgarte.alpha", "baumgarte.beta")
 
 
-def scene_names(scene: Any, formulation: str, table: frozenset[str]) -> tuple[tuple[str, ...], tuple[str, ...]]:
+def scene_names(scene: Any, formulation: str, table: frozenset[str], elements: frozenset[str] | None = None
+                ) -> tuple[tuple[str, ...], tuple[str, ...]]:
     """(settable, structural) value names of ``scene`` assembled with ``formulation`` into a model whose
     parameter table has the entries ``table`` (a law's numbers are settable when the table has them:
-    its formula runs on symbols), in scene order."""
+    its formula runs on symbols), in scene order; ``elements``: those of these elements only."""
     settable: list[str] = ["gravity"]
     structural: list[str] = []
     for element in scene.elements:
+        if elements is not None and element.name not in elements:
+            continue
         free: frozenset[str] = getattr(element, "NOT_STRUCTURE", frozenset())
         for f in dataclasses.fields(element):
             if f.name == "name":
