@@ -154,8 +154,8 @@ class Structure:
     def rebind(self, model: DAEModel, values: Mapping[str, Any]) -> DAEModel:
         """``model`` with some of its scene's numbers replaced (:meth:`DAEModel.with_parameters`)."""
         values = dict(values)
-        table = frozenset(name for name, _ in model.parameter_layout)
-        settable, structural = scene_names(model.scene, model.formulation, table,  # the named elements only
+        table_names = frozenset(name for name, _ in model.parameter_layout)
+        settable, structural = scene_names(model.scene, model.formulation, table_names,  # the named elements only
                                            frozenset(str(name).split(".")[0] for name in values))
         for name in values:
             if name in settable:
