@@ -27,8 +27,10 @@ import warnings
 import numpy as np
 
 import daeclear as dc
-from daeclear.assembly import automaton, contact_state
-from daeclear.solvers import physics, ida as solve
+from daeclear.assembly import contact_state
+from daeclear.core import automaton
+from daeclear.assembly import physics
+from daeclear.solvers import ida as solve
 from daeclear.engine.ida_session import open_session
 
 REV = 60.0 / 5000.0

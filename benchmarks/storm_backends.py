@@ -20,7 +20,7 @@ except ImportError:  # running from a checkout without installing
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import daeclear as dc  # noqa: E402
-from daeclear.assembly.automaton import Storm  # noqa: E402
+from daeclear.core.automaton import Storm  # noqa: E402
 
 
 def main() -> None:

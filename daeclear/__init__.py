@@ -2,6 +2,8 @@
 
 Scene --assemble--> DAEModel --simulate--> Result --> analysis | plot | io
 
+This module is the face above every stage (docs/architecture.md): it only gathers their public names.
+
 The public names are imported when first used (PEP 562): ``import daeclear`` and ``daeclear --help``
 load no numerical library (CasADi, scipy, h5py, matplotlib); ``daeclear.simulate`` loads what a run
 needs. ``python -X importtime -c "import daeclear"`` measures it.
@@ -17,15 +19,18 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and readers
     from .studies import analysis
     from .model import loads, mechanisms, profiles
     from .assembly.assemble import DAEModel, assemble
-    from .errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted, OutputError,
-                         PhysicsWarning, SceneError, SolveError)
-    from .results.result import ContactEvent, Result, load
+    from .assembly.placement import place
+    from .core.errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted, OutputError,
+                              PhysicsWarning, SceneError, SolveError)
+    from .core.events import ContactEvent
+    from .results.result import Result, load
     from .contact import Material
     from .model.loads import Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
     from .model.scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational,
                               TranslationalClearance)
-    from .save_at import SaveAt
-    from .solver_options import SolverOptions
+    from .plot.animate import animate
+    from .solvers.save_at import SaveAt
+    from .solvers.solver_options import SolverOptions
     from .solvers.dispatch import simulate
     from .studies.sweep import load_sweep, sweep
 
@@ -35,7 +40,7 @@ __all__ = [
     "AssemblyError", "Body", "ContactEvent", "DAEModel", "DaeclearError", "DaeclearWarning", "DiskFull", "Driver",
     "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "SaveAt",
     "Scene", "SceneError", "SolveError", "SolverOptions", "Translational", "TranslationalClearance", "analysis",
-    "assemble", "load", "load_sweep", "mechanisms", "profiles", "simulate", "sweep",
+    "animate", "assemble", "load", "load_sweep", "mechanisms", "place", "profiles", "simulate", "sweep",
     # applied loads (daeclear.loads)
     "Expression", "Force", "Motor", "RotationalSpringDamper", "SpringDamper", "Table", "Torque", "loads",
 ]
@@ -49,16 +54,19 @@ def _load_all() -> dict[str, Any]:
     from .studies import analysis  # noqa: F401
     from .model import loads, mechanisms, profiles  # noqa: F401
     from .assembly.assemble import DAEModel, assemble  # noqa: F401
-    from .errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted,  # noqa: F401
-                         OutputError, PhysicsWarning, SceneError, SolveError)
-    from .results.result import ContactEvent, Result, load  # noqa: F401
+    from .assembly.placement import place  # noqa: F401
+    from .core.errors import (AssemblyError, DaeclearError, DaeclearWarning, DiskFull, Interrupted,  # noqa: F401
+                              OutputError, PhysicsWarning, SceneError, SolveError)
+    from .core.events import ContactEvent  # noqa: F401
+    from .results.result import Result, load  # noqa: F401
     from .contact import Material  # noqa: F401
     from .model.loads import (Expression, Force, Motor, RotationalSpringDamper, SpringDamper, Table,  # noqa: F401
                               Torque)
     from .model.scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational,  # noqa: F401
                               TranslationalClearance)
-    from .save_at import SaveAt  # noqa: F401
-    from .solver_options import SolverOptions  # noqa: F401
+    from .plot.animate import animate  # noqa: F401
+    from .solvers.save_at import SaveAt  # noqa: F401
+    from .solvers.solver_options import SolverOptions  # noqa: F401
     from .solvers.dispatch import simulate  # noqa: F401
     from .studies.sweep import load_sweep, sweep  # noqa: F401
     names = locals()
@@ -69,7 +77,7 @@ def _load_all() -> dict[str, Any]:
 
 def __getattr__(name: str) -> Any:
     """A public name: the first use imports them all. Another name is a sub-package or module
-    (``daeclear.plot``), imported alone (the package's own ``from .. import options`` comes here too)."""
+    (``daeclear.plot``), imported alone (the package's own ``from .. import contact`` comes here too)."""
     if name in __all__ and not _loading:
         _loading.append(name)
         try:

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 from collections.abc import Callable, Sequence
 
-from .errors import DaeclearError, DiskFull, Interrupted, PhysicsWarning, SolveError
+from .core.errors import DaeclearError, DiskFull, Interrupted, PhysicsWarning, SolveError
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by Ctrl-C
 #: ``daeclear run`` reports at most CLI_POINTS + 1 points by default, spaced no finer than
@@ -156,13 +156,13 @@ def _mechanism(mechanisms: dict[str, Any], name: str, params: dict[str, Any]) ->
 
 
 def _run(args: argparse.Namespace) -> int:
-    from . import options
+    from .core import options
     from .model.mechanism_options import ideal_parameters
     from .results.outputs import check_directory
     from .model.scene import RevoluteClearance, TranslationalClearance
     from .model.scenefile import MECHANISMS, read_scene_file
-    from .save_at import SaveAt
-    from .solver_options import SolverOptions
+    from .solvers.save_at import SaveAt
+    from .solvers.solver_options import SolverOptions
     from .solvers.dispatch import simulate
 
     where = "daeclear run"
@@ -264,8 +264,8 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
     """The response figure of ``daeclear run`` (against the ideal joint when there is one)."""
     if args.no_figure:
         return
-    from .save_at import SaveAt
-    from .solver_options import SolverOptions
+    from .solvers.save_at import SaveAt
+    from .solvers.solver_options import SolverOptions
     from .solvers.dispatch import simulate
     import matplotlib
     matplotlib.use("Agg")
@@ -311,7 +311,7 @@ def _floats(text: str, what: str) -> list[float]:
 
 
 def _study(args: argparse.Namespace) -> int:
-    from . import options
+    from .core import options
     from .studies.accuracy import WorkPrecision, work_precision
     from .results.outputs import check_directory
     from .model.scenefile import MECHANISMS
@@ -453,7 +453,7 @@ def _grid_values(item: str) -> tuple[str, list[Any]]:
 def _sweep(args: argparse.Namespace) -> int:
     import json
 
-    from . import options
+    from .core import options
     from .results.outputs import check_directory, check_file
     from .studies.sweep import sweep
 

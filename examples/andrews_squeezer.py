@@ -8,7 +8,7 @@ bodies 3 (pivot B), 4-5 (pivot A) and 6-7 (pivot A) close three loops at the poi
 spring of stiffness ``c0`` and free length ``l0`` pulls body 3's point D towards the fixed point
 C. No gravity. Every length and point is the drawing's, in each body's frame: joint points and the
 spring's end are body-fixed (``point_i``/``point_j``), and the start is the drawing's relative
-angles (``scene.assembled(start=...)``: beta of joint O alone fixes the 1-degree-of-freedom
+angles (``dc.place(scene, start=...)``: beta of joint O alone fixes the 1-degree-of-freedom
 mechanism; the bodies are declared only roughly, every centre at the origin).
 
 The published coordinates are joint angles (beta, Theta, gamma, Phi, delta, Omega, epsilon):
@@ -81,7 +81,7 @@ def andrews_squeezer() -> dc.Scene:
     s.add(dc.SpringDamper("spring", s.ground, b[3], point_i=(xc, yc), point_j=(sd - c3[0], -sc - c3[1]),
                           stiffness=c0, free_length=l0))
     s.add(dc.Torque("drive", b[1], mom))
-    return s.assembled(start={"O": BETA0})
+    return dc.place(s, start={"O": BETA0})
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -8,7 +8,7 @@ first two revolutions (the start-up transient), placed on the busiest stretch of
 ``--slow-motion`` times slower than real time: the journal rattling inside the bearing next to
 the moving mechanism, with the crank moment under a time cursor.
 
-Frames: round(span x slow motion x fps) (Result.animate's rule); the defaults give
+Frames: round(span x slow motion x fps) (daeclear.animate's rule); the defaults give
 6 ms x 400 x 20 fps = 48 frames, a 2.4 s GIF of about 0.5 MB.
 
 Writes ``docs/figures/fig4_15_animation.gif`` by default (``--out`` to change it).
@@ -66,7 +66,7 @@ def main(argv: Sequence[str] | None = None) -> int:
           f"{len(result.events.of('clearance', kind='onset'))} impacts")
     window = busiest_window(result, min(2 * PERIOD, t_end - args.span * 1e-3), t_end, args.span * 1e-3)
     started = time.perf_counter()
-    path = result.animate(args.out, window=window, slow_motion=args.slow_motion, fps=args.fps,
+    path = dc.animate(result, args.out, window=window, slow_motion=args.slow_motion, fps=args.fps,
                           size=tuple(args.size), channel="drive.moment", progress=True)
     print(f"wrote {path} ({path.stat().st_size / 1e6:.2f} MB, window {window[0] * 1e3:.2f}-{window[1] * 1e3:.2f} ms, "
           f"{time.perf_counter() - started:.1f} s)")

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from daeclear.assembly import automaton
+from daeclear.core import automaton
 from daeclear.engine import abi, c_api, c_handle, codegen, library, sundials
 from daeclear.engine.build import CSRC, CompilerUnavailable, compiler_command, driver_files
 from daeclear.engine.stall_guard import c_defines

@@ -7,7 +7,7 @@ import pytest
 
 import daeclear as dc
 from daeclear.studies.accuracy import channel_error, converged_window, event_time_error, work_precision
-from daeclear.errors import SceneError
+from daeclear.core.errors import SceneError
 
 REV = 60.0 / 5000.0
 

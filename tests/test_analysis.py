@@ -27,7 +27,7 @@ from daeclear.studies.analysis import (
     twin_divergence,
     twin_evidence,
 )
-from daeclear.errors import DaeclearError, SceneError
+from daeclear.core.errors import DaeclearError, SceneError
 from daeclear.model.mechanisms import slider_crank
 
 T = 0.012  # s, one crank revolution at the chapter's 5000 rpm

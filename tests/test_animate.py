@@ -11,7 +11,7 @@ from PIL import Image
 import daeclear as dc
 from daeclear.plot.animate import MAX_FRAMES, frame_count, frame_times
 from daeclear.cli import main
-from daeclear.errors import MissingDependencyError, OutputError
+from daeclear.core.errors import MissingDependencyError, OutputError
 from daeclear.model.mechanisms import chain, slider_crank
 from daeclear.model.scenefile import read_scene_file
 from scene_texts import PENDULUM
@@ -57,7 +57,7 @@ def test_frame_rule():
 
 
 def test_revolute_slider_crank(revolute, tmp_path):
-    path = revolute.animate(tmp_path / "revolute.gif", fps=10, window=(0.001, 0.003), slow_motion=300, size=SMALL)
+    path = dc.animate(revolute, tmp_path / "revolute.gif", fps=10, window=(0.001, 0.003), slow_motion=300, size=SMALL)
     assert path == tmp_path / "revolute.gif"
     assert path.stat().st_size > 5_000
     assert _frames(path) == (frame_count(0.002, 300, 10), 100)  # 6 frames of 100 ms
@@ -69,34 +69,34 @@ def test_revolute_slider_crank(revolute, tmp_path):
 def test_contact_is_highlighted(revolute, tmp_path):
     # the journal hits the bearing several times in the first 4 ms (cursor plot shaded, ring and dot red)
     assert revolute["clearance.in_contact"].max() > 0
-    path = revolute.animate(tmp_path / "hits.gif", fps=10, slow_motion=200, size=SMALL)
+    path = dc.animate(revolute, tmp_path / "hits.gif", fps=10, slow_motion=200, size=SMALL)
     n, _ = _frames(path)
     assert n == 8
     assert 0 < _red_frames(path) <= n
 
 
 def test_translational_slider_crank(translational, tmp_path, capsys):
-    path = translational.animate(tmp_path / "translational.gif", fps=20, slow_motion=100, size=SMALL,
+    path = dc.animate(translational, tmp_path / "translational.gif", fps=20, slow_motion=100, size=SMALL,
                                  channel="slider.vx", magnify=20, progress=True)
     assert path.stat().st_size > 5_000
     assert _frames(path) == (8, 50)  # round(0.004 s x 100 x 20)
-    assert "animating translational.gif: 8/8 frames  100.0 %" in capsys.readouterr().err  # daeclear/progress.py
+    assert "animating translational.gif: 8/8 frames  100.0 %" in capsys.readouterr().err  # daeclear/core/progress.py
 
 
 def test_chain_and_scene_file(tmp_path):
     links = dc.simulate(chain(2), 0.02)
-    path = links.animate(tmp_path / "chain.gif", fps=10, slow_motion=20, size=SMALL)
+    path = dc.animate(links, tmp_path / "chain.gif", fps=10, slow_motion=20, size=SMALL)
     assert _frames(path)[0] == 4
     scene_file = tmp_path / "pendulum.toml"
     scene_file.write_text(PENDULUM_TOML)
     pendulum = dc.simulate(read_scene_file(scene_file).scene, 0.2)
-    path = pendulum.animate(tmp_path / "pendulum.gif", fps=10, slow_motion=3, size=SMALL)  # no clearance joint
+    path = dc.animate(pendulum, tmp_path / "pendulum.gif", fps=10, slow_motion=3, size=SMALL)  # no clearance joint
     assert _frames(path)[0] == 6
     assert path.stat().st_size > 2_000
 
 
 def test_default_slow_motion_plays_in_five_seconds(revolute, tmp_path):
-    path = revolute.animate(tmp_path / "default.gif", fps=2, window=(0.0, 0.002), size=SMALL)
+    path = dc.animate(revolute, tmp_path / "default.gif", fps=2, window=(0.0, 0.002), size=SMALL)
     assert _frames(path)[0] == 10  # 5 s at 2 frames per second
 
 
@@ -128,19 +128,19 @@ def test_default_slow_motion_plays_in_five_seconds(revolute, tmp_path):
 )
 def test_bad_options_raise(revolute, tmp_path, options, text):
     with pytest.raises(dc.SceneError) as info:
-        revolute.animate(tmp_path / "bad.gif", **{"size": SMALL, **options})
+        dc.animate(revolute, tmp_path / "bad.gif", **{"size": SMALL, **options})
     assert text in str(info.value)
-    assert str(info.value).startswith("Result.animate: ")
+    assert str(info.value).startswith("animate: ")
     assert list(tmp_path.iterdir()) == []  # nothing rendered
 
 
 def test_bad_path_fails_before_rendering(revolute, tmp_path):
     with pytest.raises(dc.SceneError, match=r"path='.*run\.avi', must be an animation file ending in \.gif"):
-        revolute.animate(tmp_path / "run.avi", size=SMALL)
+        dc.animate(revolute, tmp_path / "run.avi", size=SMALL)
     with pytest.raises(OutputError, match="does not exist"):
-        revolute.animate(tmp_path / "missing" / "run.gif", size=SMALL)
+        dc.animate(revolute, tmp_path / "missing" / "run.gif", size=SMALL)
     with pytest.raises(OutputError, match="is a directory"):
-        revolute.animate(tmp_path, size=SMALL)
+        dc.animate(revolute, tmp_path, size=SMALL)
 
 
 def test_mp4_without_ffmpeg_names_the_program(revolute, tmp_path, monkeypatch):
@@ -148,14 +148,14 @@ def test_mp4_without_ffmpeg_names_the_program(revolute, tmp_path, monkeypatch):
 
     monkeypatch.setitem(matplotlib.rcParams, "animation.ffmpeg_path", "no-such-ffmpeg-program")
     with pytest.raises(MissingDependencyError, match="needs the program ffmpeg.*no-such-ffmpeg-program.*\\.gif"):
-        revolute.animate(tmp_path / "run.mp4", size=SMALL)
+        dc.animate(revolute, tmp_path / "run.mp4", size=SMALL)
     assert list(tmp_path.iterdir()) == []
 
 
 def test_result_without_scene_description(revolute, tmp_path):
     bare = dc.Result(**{**revolute.to_dict(), "parameters": {}})
     with pytest.raises(dc.SceneError, match="no scene description"):
-        bare.animate(tmp_path / "bare.gif", size=SMALL)
+        dc.animate(bare, tmp_path / "bare.gif", size=SMALL)
 
 
 def test_cli_animates_a_saved_result(translational, tmp_path, capsys):
@@ -169,7 +169,7 @@ def test_cli_animates_a_saved_result(translational, tmp_path, capsys):
     # default output: the result's name with .gif
     assert main(["animate", str(h5), "--fps", "5", "--slow-motion", "100", "--size", "320", "200"]) == 0
     assert _frames(tmp_path / "run.gif")[0] == 2
-    assert "animating run.gif: 2/2 frames  100.0 %" in capsys.readouterr().err  # daeclear/progress.py
+    assert "animating run.gif: 2/2 frames  100.0 %" in capsys.readouterr().err  # daeclear/core/progress.py
 
 
 @pytest.mark.parametrize(
@@ -248,9 +248,9 @@ def test_a_failed_animation_leaves_the_old_file_and_no_temporary(revolute, tmp_p
 
     monkeypatch.setattr(matplotlib.animation.PillowWriter, "grab_frame", broken_grab)
     with pytest.raises(OSError, match="disk full"):
-        revolute.animate(target, fps=10, window=(0.001, 0.002), slow_motion=100, size=SMALL)
+        dc.animate(revolute, target, fps=10, window=(0.001, 0.002), slow_motion=100, size=SMALL)
     assert seen and str(seen[0]).endswith(".gif") and seen[0] != str(target)
     assert target.read_bytes() == b"old" and list(tmp_path.iterdir()) == [target]
     monkeypatch.undo()
-    revolute.animate(target, fps=10, window=(0.001, 0.002), slow_motion=100, size=SMALL)
+    dc.animate(revolute, target, fps=10, window=(0.001, 0.002), slow_motion=100, size=SMALL)
     assert target.read_bytes()[:3] == b"GIF" and list(tmp_path.iterdir()) == [target]

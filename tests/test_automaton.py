@@ -1,4 +1,4 @@
-"""The contact-mode automaton (daeclear.assembly.automaton) and its C mirror in the compiled IDA loop.
+"""The contact-mode automaton (daeclear.core.automaton) and its C mirror in the compiled IDA loop.
 
 The randomized tests feed the same root sequences (bursts inside the storm window, random
 directions and rates, varied storm constants) to the Python automaton and to the compiled one
@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.assembly import automaton
-from daeclear.assembly.automaton import NONE, ONSET, SEPARATION, Decision, PairState, Storm, step
+from daeclear.core import automaton
+from daeclear.core.automaton import NONE, ONSET, SEPARATION, Decision, PairState, Storm, step
 from daeclear.engine.ida_session import CSession, open_session
 
 

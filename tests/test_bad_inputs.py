@@ -19,7 +19,7 @@ import pytest
 import daeclear as dc
 from daeclear.studies.accuracy import work_precision
 from daeclear.cli import main
-from daeclear.errors import OutputDirectoryMissing, OutputError, SceneError
+from daeclear.core.errors import OutputDirectoryMissing, OutputError, SceneError
 from daeclear.model.scenefile import read_scene_file
 from scene_texts import PENDULUM as PENDULUM_FILE
 

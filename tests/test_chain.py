@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.errors import SceneError
+from daeclear.core.errors import SceneError
 from daeclear.model.mechanisms import CHAIN_LINK_INERTIA, CHAIN_LINK_LENGTH, CHAIN_LINK_MASS, chain
 from daeclear.model.scenefile import MECHANISMS, read_scene_file
 

@@ -27,7 +27,7 @@ from scipy.special import lambertw
 
 from daeclear.contact import DubowskyFreudenstein, ESDU78035, Goldsmith, Material, normal_law
 from daeclear.contact import cylindrical
-from daeclear.errors import DaeclearWarning, SceneError
+from daeclear.core.errors import DaeclearWarning, SceneError
 
 STEEL = Material(young=207e9, poisson=0.3)
 R_I, R_J = 10.0e-3, 9.5e-3

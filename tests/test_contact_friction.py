@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from daeclear.contact import Coulomb, ModifiedCoulomb, NoFriction, friction_law
-from daeclear.errors import SceneError
+from daeclear.core.errors import SceneError
 
 
 def reference_modified_coulomb(c_f: float, f_n: float, v: float, v0: float, v1: float) -> float:

@@ -33,7 +33,7 @@ import scipy.sparse.linalg as spla
 from daeclear.contact import Hertz, LankaraniNikravesh
 from daeclear.contact.asperity import asperity_load, asperity_pressure
 from daeclear.contact.hydrodynamic import HydrodynamicBearing, shear_torques
-from daeclear.errors import SceneError
+from daeclear.core.errors import SceneError
 
 MU, R, C = 0.04, 0.01, 5.0e-5  # Pa s, m, m
 

@@ -31,7 +31,7 @@ from daeclear.contact import (
     simulate_impact, sphere_plane_stiffness,
 )
 from daeclear.contact.cylindrical import DubowskyFreudenstein, ESDU78035, Goldsmith
-from daeclear.errors import SceneError
+from daeclear.core.errors import SceneError
 
 # ---- closed forms ------------------------------------------------------------------
 HERTZ_DURATION_CONSTANT = 2.0 * math.sqrt(math.pi) * gamma(1.4) / gamma(0.9)

@@ -19,7 +19,7 @@ import pytest
 from scipy.interpolate import CubicSpline
 
 import daeclear as dc
-from daeclear.errors import AssemblyError, SceneError
+from daeclear.core.errors import AssemblyError, SceneError
 from daeclear.model.profiles import ConstantSpeed, Harmonic, Ramp, Tabulated
 from daeclear.model.scene import GROUND
 from daeclear.model.scenefile import read_scene_file
@@ -446,7 +446,7 @@ def test_slider_declared_in_its_guide_wall_is_refused():
 
 def test_crank_period_needs_a_constant_speed_rotation():
     from daeclear.studies.analysis import crank_period
-    from daeclear.errors import DaeclearError
+    from daeclear.core.errors import DaeclearError
 
     assert crank_period(disc_scene(None)) == pytest.approx(2 * math.pi / SPEED)
     assert crank_period(crank_bearing_clearance(0.1e-3)) == pytest.approx(REVOLUTION)

@@ -191,8 +191,8 @@ def test_tight_run_keeps_every_corner_out_of_its_wall_while_free(rtol):
     crossing of one corner is logged twice at one instant. (The runs part from each other after about
     20 ms, so the root sequence of that impact is tests/test_automaton.py's, not this run's.)"""
     import daeclear as dc
-    from daeclear.assembly.automaton import SAME_INSTANT
-    from daeclear.solvers.physics import GAP_ROUNDING
+    from daeclear.core.automaton import SAME_INSTANT
+    from daeclear.assembly.physics import GAP_ROUNDING
 
     script = _script()
     result = dc.simulate(script.siconos_scene(1e11, script.calibrated_restitution()), 0.2, rtol=rtol)

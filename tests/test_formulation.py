@@ -15,8 +15,8 @@ import warnings
 import pytest
 
 import daeclear as dc
-from daeclear import options
-from daeclear.solvers.physics import DRIFT_FRACTION
+from daeclear.core import options
+from daeclear.assembly.physics import DRIFT_FRACTION
 
 CLEARANCE = 0.01e-3
 REV = 60.0 / 5000.0

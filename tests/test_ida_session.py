@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from daeclear.engine import codegen
-from daeclear.errors import DaeclearError, DaeclearWarning
+from daeclear.core.errors import DaeclearError, DaeclearWarning
 from daeclear.engine.ida_session import (
     FLAG_MAX_STEPS,
     FLAG_STEP_COLLAPSE,

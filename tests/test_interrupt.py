@@ -21,7 +21,7 @@ import pytest
 import daeclear as dc
 from daeclear.studies.accuracy import WorkPrecision, work_precision
 from daeclear.cli import main
-from daeclear.errors import Interrupted
+from daeclear.core.errors import Interrupted
 from daeclear.studies.sweep import load_sweep
 
 T_END = 0.006
@@ -45,7 +45,7 @@ def ctrl_c_after(monkeypatch):
     import daeclear.solvers.ida as solve
 
     monkeypatch.setattr(solve, "open_session", functools.partial(solve.open_session, buffer_steps=64))
-    from daeclear.progress import Progress
+    from daeclear.core.progress import Progress
 
     original = Progress.update
 

@@ -17,7 +17,7 @@ import daeclear as dc
 from daeclear.engine.ida_session import open_session
 from daeclear.assembly.dae_model import EXTRA_CHECKS
 from daeclear.model.scenefile import scene_from_description
-from daeclear.results.values import to_plain
+from daeclear.core.values import to_plain
 
 RPM = 5000.0
 TWO_REVOLUTIONS = 2 * 60.0 / RPM  # s

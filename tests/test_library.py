@@ -14,7 +14,7 @@ from daeclear.assembly.assemble import assemble
 from daeclear.engine import c_api, codegen, library
 from daeclear.engine.library import MODEL_PROTOTYPES, ODE_PROTOTYPES, ModelLibrary, OdeLibrary, StaleLibrary
 from daeclear.engine.session_base import DAEFunctions
-from daeclear.errors import DaeclearError
+from daeclear.core.errors import DaeclearError
 from daeclear.model.mechanisms import slider_crank
 from daeclear.solvers.explicit import ode_spec
 

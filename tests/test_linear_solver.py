@@ -16,7 +16,7 @@ import pytest
 
 import daeclear as dc
 from daeclear.engine import c_session, ida_session
-from daeclear.errors import DaeclearError, SceneError
+from daeclear.core.errors import DaeclearError, SceneError
 from daeclear.engine.ida_session import DAEFunctions, open_session
 from daeclear.model.mechanisms import chain, slider_crank
 

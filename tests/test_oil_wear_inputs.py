@@ -12,7 +12,7 @@ import daeclear as dc
 from daeclear.cli import main
 from daeclear.contact import HydrodynamicBearing
 from daeclear.contact.wear import ArchardWear
-from daeclear.errors import DaeclearError, Interrupted, OutputError, SceneError
+from daeclear.core.errors import DaeclearError, Interrupted, OutputError, SceneError
 from daeclear.studies.wear import simulate_wear
 
 BEARING = HydrodynamicBearing(viscosity=0.04, length=0.02)

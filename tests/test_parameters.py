@@ -19,7 +19,7 @@ import daeclear as dc
 from daeclear.engine.codegen import clear_memos
 from daeclear.contact import FRICTION_LAWS, NORMAL_LAWS, HydrodynamicBearing, Material, friction_law, normal_law
 from daeclear.assembly.parameters import is_parametric, law_values, symbolic_law
-from daeclear.errors import SceneError
+from daeclear.core.errors import SceneError
 
 STEEL = Material(young=207e9, poisson=0.3)
 

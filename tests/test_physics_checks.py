@@ -20,9 +20,9 @@ import pytest
 import daeclear as dc
 import daeclear.solvers.explicit as integrators
 import daeclear.solvers.ida as solve
-from daeclear.solvers import physics
+from daeclear.assembly import physics
 from daeclear.cli import main
-from daeclear.errors import AssemblyError, DaeclearError, PhysicsWarning, SceneError
+from daeclear.core.errors import AssemblyError, DaeclearError, PhysicsWarning, SceneError
 from daeclear.model.scene import GROUND
 from daeclear.model.scenefile import read_scene_file
 from daeclear.assembly.symbolic import Reference
@@ -227,7 +227,8 @@ def test_failure_message_calls_a_pair_deep_in_its_wall_while_free_a_solver_defec
     same-instant guard once did for one corner of the Siconos slider-crank): a corner goes 9 cm into
     its wall with no force and IDA fails at its step cap. The message says the solver lost the onset,
     not that the joint carries too much load."""
-    from daeclear.assembly import automaton, contact_pairs
+    from daeclear.assembly import contact_pairs
+    from daeclear.core import automaton
 
     seen: list[int] = []
 

@@ -1,4 +1,4 @@
-"""Scene.assembled: a scene placed at chosen joint coordinates (issue 34, item 2).
+"""daeclear.place: a scene placed at chosen joint coordinates (issue 34, item 2).
 
 Checked against closed-form kinematics (the slider-crank's crank and rod angles, a double
 pendulum given in relative angles), against the scene the mechanism library builds at the same
@@ -14,7 +14,7 @@ import pytest
 from scipy.optimize import brentq
 
 import daeclear as dc
-from daeclear.errors import AssemblyError, SceneError
+from daeclear.core.errors import AssemblyError, SceneError
 from daeclear.model.mechanisms import CRANK_LENGTH as R, ROD_LENGTH as L, ideal_slider_crank_state, rpm_to_rad_s
 
 OMEGA = rpm_to_rad_s(5000.0)
@@ -25,7 +25,7 @@ def _poses(scene: dc.Scene) -> dict[str, tuple[float, ...]]:
 
 
 def test_slider_crank_placed_at_a_crank_angle_is_the_closed_form():
-    placed = dc.mechanisms.slider_crank().assembled(start={"A": 0.7})
+    placed = dc.place(dc.mechanisms.slider_crank(), start={"A": 0.7})
     expected = ideal_slider_crank_state(0.7, OMEGA)
     for name, pose in _poses(placed).items():
         np.testing.assert_allclose(pose[:3], expected[name][:3], rtol=0, atol=1e-13)
@@ -41,7 +41,7 @@ def test_slider_crank_placed_at_a_crank_angle_is_the_closed_form():
 
 def test_speeds_give_the_closed_form_velocities():
     free = dc.mechanisms.slider_crank().without("drive")
-    placed = free.assembled(start={"A": 0.7}, speeds={"A": OMEGA})
+    placed = dc.place(free, start={"A": 0.7}, speeds={"A": OMEGA})
     expected = ideal_slider_crank_state(0.7, OMEGA)
     for name, pose in _poses(placed).items():
         np.testing.assert_allclose(pose, expected[name], rtol=0, atol=1e-10 * OMEGA)
@@ -50,7 +50,7 @@ def test_speeds_give_the_closed_form_velocities():
 def test_a_translational_coordinate_places_the_crank():
     """The slider's displacement along D chosen: the crank angle solves x(theta) = 0.16 m on the
     declared branch (crank above the axis)."""
-    placed = dc.mechanisms.slider_crank(crank_angle=0.5).without("drive").assembled(start={"D": 0.16})
+    placed = dc.place(dc.mechanisms.slider_crank(crank_angle=0.5).without("drive"), start={"D": 0.16})
     theta = brentq(lambda a: R * math.cos(a) + math.sqrt(L**2 - (R * math.sin(a))**2) - 0.16, 0.0, math.pi,
                    xtol=1e-15, rtol=4 * np.finfo(float).eps)
     expected = ideal_slider_crank_state(theta, 0.0)
@@ -61,7 +61,7 @@ def test_a_translational_coordinate_places_the_crank():
 def test_double_pendulum_in_relative_angles():
     """Pin A: link1 from the ground, pin B: link2 relative to link1 (the drawing's angles)."""
     a, b, wa, wb = -1.2, 0.5, 1.0, -2.0
-    placed = dc.mechanisms.double_pendulum().assembled(start={"A": a, "B": b}, speeds={"A": wa, "B": wb})
+    placed = dc.place(dc.mechanisms.double_pendulum(), start={"A": a, "B": b}, speeds={"A": wa, "B": wb})
     length = 0.1
     u1, u2 = np.array([math.cos(a), math.sin(a)]), np.array([math.cos(a + b), math.sin(a + b)])
     p1, p2 = 0.5 * length * u1, length * u1 + 0.5 * length * u2
@@ -83,7 +83,7 @@ def test_clearance_joints_close_as_ideal_and_the_equations_are_kept():
     scene.add(dc.Force("push", "rod", fx=2.0, at=(0.1, 0.01)))
     scene.add(dc.SpringDamper("spring", "ground", "slider", at_i=(0.3, 0.0), at_j=(0.17, 0.0), stiffness=100.0))
     scene.add(dc.RotationalSpringDamper("torsion", "crank", "rod", stiffness=0.5))
-    placed = scene.assembled(start={"A": 0.7})
+    placed = dc.place(scene, start={"A": 0.7})
     expected = ideal_slider_crank_state(0.7, OMEGA)
     for name, pose in _poses(placed).items():
         np.testing.assert_allclose(pose[:3], expected[name][:3], rtol=0, atol=1e-13)
@@ -100,16 +100,16 @@ def test_clearance_joints_close_as_ideal_and_the_equations_are_kept():
 
 def test_coordinates_that_do_not_fix_the_configuration_are_refused():
     with pytest.raises(AssemblyError, match=r"do not fix the configuration.*1 degree\(s\) of freedom.*A, B, C, D"):
-        dc.mechanisms.slider_crank().without("drive").assembled()
+        dc.place(dc.mechanisms.slider_crank().without("drive"), )
     with pytest.raises(AssemblyError, match=r"speeds.*do not fix.*1 degree"):
-        dc.mechanisms.double_pendulum().assembled(start={"A": 0.1, "B": 0.2}, speeds={"A": 1.0})
+        dc.place(dc.mechanisms.double_pendulum(), start={"A": 0.1, "B": 0.2}, speeds={"A": 1.0})
 
 
 def test_a_loop_that_cannot_close_reports_the_residual_and_the_joints():
     """The driver holds A at 0 (the slider at its outer dead centre): the rod cannot also turn by
     1 rad relative to the crank."""
     with pytest.raises(AssemblyError, match=r"cannot all close.*largest residuals are .* = .*\(joints "):
-        dc.mechanisms.slider_crank().assembled(start={"B": 1.0})
+        dc.place(dc.mechanisms.slider_crank(), start={"B": 1.0})
 
 
 @pytest.mark.parametrize("start, speeds, shown", [
@@ -120,7 +120,7 @@ def test_a_loop_that_cannot_close_reports_the_residual_and_the_joints():
 ])
 def test_bad_arguments_name_the_field(start, speeds, shown):
     with pytest.raises(SceneError) as info:
-        dc.mechanisms.slider_crank().assembled(start=start, speeds=speeds)
+        dc.place(dc.mechanisms.slider_crank(), start=start, speeds=speeds)
     assert shown in str(info.value)
 
 
@@ -128,7 +128,7 @@ def test_a_driver_with_an_initial_angle_and_a_start_value_conflict():
     scene = dc.mechanisms.slider_crank().without("drive")
     scene.add(dc.Driver("drive", joint="A", speed=OMEGA, initial_angle=0.2))
     with pytest.raises(SceneError, match=r"start\['A'\]=0.5, but Driver 'drive' fixes"):
-        scene.assembled(start={"A": 0.5})
+        dc.place(scene, start={"A": 0.5})
 
 
 def _andrews():

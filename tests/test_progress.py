@@ -1,4 +1,4 @@
-"""The progress display (daeclear/progress.py): plain rate-limited lines off a terminal, tqdm on one, nothing
+"""The progress display (daeclear/core/progress.py): plain rate-limited lines off a terminal, tqdm on one, nothing
 when off."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ import re
 import pytest
 
 import daeclear as dc
-import daeclear.progress as progress_module
+import daeclear.core.progress as progress_module
 from daeclear.cli import main
-from daeclear.progress import PLAIN_STEPS, Progress
+from daeclear.core.progress import PLAIN_STEPS, Progress
 
 T_END = 0.006
 

@@ -13,9 +13,9 @@ import h5py
 import numpy as np
 import pytest
 
-from daeclear.errors import DaeclearError, DaeclearWarning, MissingDependencyError
+from daeclear.core.errors import DaeclearError, DaeclearWarning, MissingDependencyError
 from daeclear.results.result import FORMAT_NAME, FORMAT_VERSION, ContactEvent, EventList, Result, load
-from daeclear.results.values import to_plain
+from daeclear.core.values import to_plain
 
 STATE_NAMES = ["crank.x", "crank.vx", "slider.x", "slider.vx", "lambda.A.x"]
 
@@ -362,7 +362,7 @@ def test_event_blocks_read_as_the_events_they_hold() -> None:
     """A solver's events given as ContactEvents and column blocks (the compiled loop's EventRows) read
     as one EventList in their order; a block makes its events only when read, with read-only states;
     the recorder counts every event of a block."""
-    from daeclear.results.events import EventRows, flatten
+    from daeclear.core.events import EventRows, flatten
     from daeclear.solvers.recorder import Recorder
 
     ys = np.arange(6.0).reshape(3, 2)

@@ -14,8 +14,8 @@ from scipy.integrate import simpson
 
 import daeclear as dc
 from daeclear.assembly.assemble import EXTRA_TERM0
-from daeclear.assembly.automaton import PairState
-from daeclear.errors import SceneError
+from daeclear.core.automaton import PairState
+from daeclear.core.errors import SceneError
 from daeclear.model.scene import Driver, RevoluteClearance
 
 PERIOD = 60.0 / 5000.0  # one crank revolution at 5000 rpm

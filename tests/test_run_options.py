@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.errors import SceneError
+from daeclear.core.errors import SceneError
 from daeclear.model.mechanisms import chain, slider_crank
 
 T = 0.024  # the chapter's slider-crank: two crank turns at 5000 rpm

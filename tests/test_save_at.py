@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.errors import SceneError
+from daeclear.core import options
+from daeclear.core.errors import SceneError
 
 NAN, INF = math.nan, math.inf
 
@@ -87,7 +88,7 @@ def test_a_save_at_is_an_immutable_value_that_keeps_its_own_times() -> None:
     default = dc.SaveAt()
     assert (default.times, default.every, default.steps, default.stream_to, default.keep_data) == (
         None, None, True, None, True)
-    assert default.max_points == dc.options.MAX_OUTPUT_POINTS
+    assert default.max_points == options.MAX_OUTPUT_POINTS
     with pytest.raises(SceneError, match=r"simulate: save=\{'every': 1e-05\}, must be None or a daeclear.SaveAt"):
         dc.simulate(dc.mechanisms.slider_crank("ideal"), 1e-3, save={"every": 1e-5})  # type: ignore[arg-type]
 
@@ -98,7 +99,7 @@ def test_the_grid_of_every_equals_the_given_times_value_for_value() -> None:
     t0, t_end, spacing = 1e-3, 4e-3, 1e-4
     grid = dc.simulate(model, t_end, t0=t0, y0=dc.simulate(model, t0).y[-1], save=dc.SaveAt(every=spacing))
     given = dc.simulate(model, t_end, t0=t0, y0=dc.simulate(model, t0).y[-1],
-                        save=dc.SaveAt(times=dc.options.uniform_times(spacing, t_end, t0)))
+                        save=dc.SaveAt(times=options.uniform_times(spacing, t_end, t0)))
     assert grid.t.size == 31 and grid.t[0] == t0 and grid.t[-1] == t_end
     np.testing.assert_array_equal(grid.t, given.t)
     np.testing.assert_array_equal(grid.y, given.y)

@@ -5,7 +5,7 @@ import math
 import pytest
 
 import daeclear as dc
-from daeclear.errors import AssemblyError, SceneError
+from daeclear.core.errors import AssemblyError, SceneError
 
 
 def pendulum_scene(**body_kw):

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear import options
-from daeclear.errors import SceneError
+from daeclear.core import options
+from daeclear.core.errors import SceneError
 from daeclear.solvers.base import Solver, step_rule
 from daeclear.solvers.registry import SOLVERS
 

@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear import options
+from daeclear.core import options
 from daeclear.cli import CLI_FINEST_STEP, CLI_POINTS, default_t_eval_step, main
-from daeclear.errors import Interrupted, OutputError, SceneError
+from daeclear.core.errors import Interrupted, OutputError, SceneError
 
 REV = 60.0 / 5000.0  # s, one crank revolution of the chapter's slider-crank
 
@@ -142,7 +142,7 @@ def fail_after(monkeypatch):
     import daeclear.solvers.ida as solve
 
     monkeypatch.setattr(solve, "open_session", functools.partial(solve.open_session, buffer_steps=64))
-    from daeclear.progress import Progress
+    from daeclear.core.progress import Progress
 
     original = Progress.update
 

@@ -24,7 +24,7 @@ import pytest
 
 from daeclear.engine import codegen, sundials
 from daeclear.engine.build import driver_files
-from daeclear.errors import DaeclearWarning
+from daeclear.core.errors import DaeclearWarning
 from daeclear.engine.ida_session import DAEFunctions, open_session
 from daeclear.engine.library import ModelLibrary
 

@@ -21,7 +21,7 @@ import pytest
 
 import daeclear as dc
 from daeclear.cli import main
-from daeclear.errors import DaeclearError, SceneError
+from daeclear.core.errors import DaeclearError, SceneError
 from daeclear.studies.sweep import grid_points, load_sweep, run_key, sweep
 
 FAST = dict(revolutions=8, transient=2, per_revolution=16, twin=False, progress=False)

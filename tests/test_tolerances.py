@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.errors import DaeclearWarning, SceneError
+from daeclear.core.errors import DaeclearWarning, SceneError
 from daeclear.solvers import tolerances as tol
 from daeclear.solvers.ida_loop import steps_needed
 

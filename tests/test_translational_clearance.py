@@ -27,7 +27,7 @@ import pytest
 
 import daeclear as dc
 import daeclear.contact as dcc
-from daeclear.errors import SceneError
+from daeclear.core.errors import SceneError
 from daeclear.model.scene import Driver, TranslationalClearance
 
 STEEL = dcc.Material(young=207e9, poisson=0.3)

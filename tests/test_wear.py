@@ -14,7 +14,7 @@ import pytest
 
 from daeclear.contact.wear import (ArchardWear, WearHistoryArrays, half_angle_hertz, half_angle_overlap,
                                    node_weights, wear_increment, worn_volume)
-from daeclear.errors import SceneError
+from daeclear.core.errors import SceneError
 
 R, C, L = 10e-3, 0.5e-3, 20e-3  # bearing radius, clearance, length (m)
 K = 1e-13  # m^2/N

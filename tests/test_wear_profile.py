@@ -14,7 +14,7 @@ import pytest
 import daeclear as dc
 import daeclear.contact as dcc
 from daeclear.contact.wear import ArchardWear, profile_coefficients, profile_depth
-from daeclear.errors import SceneError
+from daeclear.core.errors import SceneError
 from daeclear.model.scene import RevoluteClearance
 from daeclear.studies.wear import simulate_wear
 

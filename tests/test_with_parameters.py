@@ -11,7 +11,7 @@ import pytest
 
 import daeclear as dc
 from daeclear.contact import ModifiedCoulomb
-from daeclear.errors import SceneError
+from daeclear.core.errors import SceneError
 
 T_END = 0.004  # two impacts' worth of the Fig. 4.15 scene at c = 0.5 mm
 

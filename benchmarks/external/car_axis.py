@@ -20,7 +20,7 @@ As a user builds it with daeclear (a planar multibody scene; no equation written
   joint on the crank), the axle is a body pinned to it at distance L, its centre of mass the
   right wheel (a point mass: its own moment of inertia 1e-16 kg m^2, 2e-13 of k L^2);
 * the springs are ``SpringDamper`` loads between body-fixed points; the start is given as the
-  test set gives it, in the joints' coordinates: ``scene.assembled(start={"slide": 0.5, "hinge":
+  test set gives it, in the joints' coordinates: ``dc.place(scene, start={"slide": 0.5, "hinge":
   0}, speeds={"slide": 0, "hinge": -1})`` (the left wheel 0.5 from the origin, the axle
   horizontal, both wheels moving at -1/2 along X).
 
@@ -79,7 +79,7 @@ def car_axis_scene() -> dc.Scene:
                           free_length=L0))
     s.add(dc.SpringDamper("right_spring", crank, axle, point_i=(L, 0.0), point_j=(0.0, 0.0), stiffness=1.0,
                           free_length=L0))
-    return s.assembled(start={"slide": L0, "hinge": 0.0}, speeds={"slide": 0.0, "hinge": -R * W})
+    return dc.place(s, start={"slide": L0, "hinge": 0.0}, speeds={"slide": 0.0, "hinge": -R * W})
 
 
 def daeclear_state(scene: dc.Scene, rtol: float) -> np.ndarray:

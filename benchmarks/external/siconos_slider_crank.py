@@ -22,7 +22,7 @@ used here).
 
 daeclear builds it as a user would: three ``Body``s, ``Revolute`` joints A (ground-crank), B, C
 (rod-slider at the slider's centre), a ``TranslationalClearance`` "guide" (ground, slider; ``corners``
-model: each corner a contact on its wall), the start ``scene.assembled(start={"A": 0}, speeds={"A":
+model: each corner a contact on its wall), the start ``dc.place(scene, start={"A": 0}, speeds={"A":
 150})``. Its contact is compliant: the ``Flores`` law F_N = K d^1.5 [1 + 8 (1 - c_e)/(5 c_e) d'/d'(-)]
 with c_e chosen so that one impact of a mass on the law leaves at 0.4 of its entry speed (the law's
 restitution depends on c_e alone), K = 1e11 N/m^1.5 (``--stiffness``), modified Coulomb friction
@@ -156,7 +156,7 @@ def siconos_scene(stiffness: float = STIFFNESS, restitution: float | None = None
         "guide", s.ground, slider, point_i=(L1 + L2, 0.0), point_j=(0.0, 0.0), axis=(1.0, 0.0),
         length=2 * A, width=2 * B, clearance=C, corner_radius=1e-3, model="corners",
         law=dcc.Flores(restitution=ce, stiffness=stiffness), friction=friction or None))
-    return s.assembled(start={"A": 0.0}, speeds={"A": CRANK_RATE})
+    return dc.place(s, start={"A": 0.0}, speeds={"A": CRANK_RATE})
 
 
 def daeclear_run(scene: dc.Scene, t_end: float, rtol: float) -> tuple[Channels, float, int]:

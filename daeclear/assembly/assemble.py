@@ -17,10 +17,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..engine.build import memo_put_bounded, memo_table
-from ..errors import AssemblyError, SceneError
+from ..core.errors import AssemblyError, SceneError
 from ..model.elements import kept_with
 from ..engine.session_base import DAEFunctions
-from ..options import DEFAULT_FORMULATION, FORMULATIONS
+from ..core.options import DEFAULT_FORMULATION, FORMULATIONS
 from .parameters import ParameterTable, entries, structure_key
 from .parameter_names import BAUMGARTE, is_numbers, scene_names
 from ..model.scene import (GROUND, Body, Driver, Revolute, RevoluteClearance, Scene, Translational,
@@ -28,9 +28,10 @@ from ..model.scene import (GROUND, Body, Driver, Revolute, RevoluteClearance, Sc
 from .revolute_joint import CONTACT_BUILDERS
 from .drivers import driver_constraint, driver_load, driver_parameters
 from .joint_coordinates import joint_channels
-from ..model.loads import Load, build_loads, load_parameters
+from ..model.loads import Load, load_parameters
+from .load_terms import build_loads
 from .symbolic import AssemblyContext, Channel, Reference, Term, body_frames, rotation
-from ..solvers.physics import checked_channel
+from .physics import checked_channel
 from .dae_model import (EXTRA_TERM0, KIND_MULTIPLIER, KIND_POSITION, KIND_VELOCITY, KIND_WORK,  # noqa: F401
                         DAEModel, start_parameters)
 

@@ -3,7 +3,7 @@
 A clearance joint adds no constraint but *terms* (generalized contact forces, on only while a pair
 is in contact), *gaps* (root functions watched by IDA, positive in penetration), *channels* and
 *logic* (what a root decides: mode switch, approach speed latched at onset). The event rule, storm
-guard included, is :mod:`daeclear.assembly.automaton`'s (docs/user_guide.md, "Contact events").
+guard included, is :mod:`daeclear.core.automaton`'s (docs/user_guide.md, "Contact events").
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from .automaton import DEFAULT_STORM, EVENT_KINDS, NONE, Decision, PairState, Storm, start, step
-from ..results.result import ContactEvent
+from ..core.automaton import DEFAULT_STORM, EVENT_KINDS, NONE, Decision, PairState, Storm, start, step
+from ..core.events import ContactEvent
 from .parameters import law_values, symbolic_law
 from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular
 
@@ -32,12 +32,12 @@ TermSwitch = tuple[int, bool, NDArray[np.float64]]
 class PairLogic:
     """Mode switching of contact pairs, each with one gap (root ``first_root + i``) and one term
     (``pair_terms[i]``). A rule, not a state: the run's pair states
-    (:class:`~daeclear.assembly.automaton.PairState`) are passed in and returned
+    (:class:`~daeclear.core.automaton.PairState`) are passed in and returned
     (:mod:`daeclear.assembly.contact_state`).
 
     ``rate`` maps ``(q, v)`` to the gaps and the penetration rates; ``needs_approach``: a term's
     parameter is the approach speed latched at onset. Each root is decided by
-    :func:`daeclear.assembly.automaton.step`; a term is on while its pair is in contact or held.
+    :func:`daeclear.core.automaton.step`; a term is on while its pair is in contact or held.
     """
 
     pairs: tuple[str, ...]

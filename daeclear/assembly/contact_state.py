@@ -13,8 +13,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..results.result import ContactEvent
-from .automaton import PairState
+from ..core.events import ContactEvent
+from ..core.automaton import PairState
 
 #: One tuple of pair states per contact element of the model, in ``model.contacts`` order.
 ContactState = tuple[tuple[PairState, ...], ...]

@@ -17,8 +17,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..engine.build import memo_put_bounded
 from ..engine.session_base import DAEFunctions, StateLayout
-from ..errors import AssemblyError, SceneError
-from ..solvers.physics import check_start_penetration, checked_channel
+from ..core.errors import AssemblyError, SceneError
+from .physics import check_start_penetration, checked_channel
 from .parameter_names import scene_names
 from .symbolic import Term
 
@@ -377,7 +377,7 @@ class DAEModel:
 
     @property
     def checked_names(self) -> tuple[str, ...]:
-        """The channels the physics checks read (:func:`daeclear.solvers.physics.checked_channel`), in order."""
+        """The channels the physics checks read (:func:`daeclear.assembly.physics.checked_channel`), in order."""
         return tuple(name for name in self.channel_names if checked_channel(name))
 
     def checks(self, t: NDArray[np.float64], y: NDArray[np.float64], switch: NDArray[np.float64],

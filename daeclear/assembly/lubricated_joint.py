@@ -20,8 +20,8 @@ from numpy.typing import NDArray
 from ..contact.asperity import asperity_load
 from ..contact.hydrodynamic import shear_torques
 from ..model.clearance_joints import RevoluteClearance
-from ..results.result import ContactEvent
-from .automaton import PairState, start, step
+from ..core.events import ContactEvent
+from ..core.automaton import PairState, start, step
 from .contact_pairs import (ContactBuild, PairLogic, PairStates, TermSwitch, journal_contact, journal_logic,
                             journal_parameters, pair_event)
 from .parameters import law_structure

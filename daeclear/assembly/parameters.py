@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.elements import kept
-from ..results.values import field_names
+from ..core.values import field_names
 
 __all__ = ["ParameterTable", "entries", "floats", "structure_key", "element_structure", "law_values", "symbolic_law",
            "law_structure", "is_parametric"]

@@ -1,4 +1,4 @@
-"""A scene placed at chosen joint coordinates: :meth:`Scene.assembled` (``start=``, ``speeds=``).
+"""A scene placed at chosen joint coordinates: :func:`daeclear.place` (``start=``, ``speeds=``).
 
 Least-norm Newton from the declared poses closes every joint as at a run's start with the named
 joints at their values, velocities likewise; every number the declared configuration defined is
@@ -16,7 +16,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import AssemblyError, SceneError
+from ..core.errors import AssemblyError, SceneError
 from ..model.loads import Force, RotationalSpringDamper, SpringDamper, attachment
 from ..model.scene import (GROUND, Body, PointJoint, Scene, Translational,
                            TranslationalClearance, driven_coordinate, is_finite_number)
@@ -26,7 +26,7 @@ from .joint_coordinates import JOINT_CHANNELS, joint_coordinate
 from .symbolic import Reference, body_frames
 
 
-def assembled(scene: Scene, start: Mapping[str, float] | None = None,
+def place(scene: Scene, start: Mapping[str, float] | None = None,
               speeds: Mapping[str, float] | None = None) -> Scene:
     """The scene with its bodies at the joint coordinates ``start`` (name -> rad or m) and moving at the
     joint rates ``speeds`` (rad/s, m/s). Raises SceneError for a bad argument, AssemblyError when the
@@ -40,12 +40,12 @@ def assembled(scene: Scene, start: Mapping[str, float] | None = None,
         driver = drivers.get(name)
         if driver is not None and (driver.initial_angle is not None or driver.initial_position is not None
                                    or not driver.motion_profile.uses_speed):
-            raise SceneError(f"scene '{scene.name}': assembled: start[{name!r}]={start_values[name]!r}, but Driver "
+            raise SceneError(f"scene '{scene.name}': place: start[{name!r}]={start_values[name]!r}, but Driver "
                              f"'{driver.name}' fixes the coordinate of joint '{name}' at t = 0 (its initial value or "
                              "tabulated profile); leave one of the two out.")
     for name in speed_values or {}:
         if name in drivers:
-            raise SceneError(f"scene '{scene.name}': assembled: speeds[{name!r}]={speed_values[name]!r}, but joint "  # type: ignore[index]
+            raise SceneError(f"scene '{scene.name}': place: speeds[{name!r}]={speed_values[name]!r}, but joint "  # type: ignore[index]
                              f"'{name}' is driven by Driver '{drivers[name].name}', whose profile gives its speed; "
                              "leave it out of speeds.")
     model = assemble(scene)
@@ -56,7 +56,7 @@ def assembled(scene: Scene, start: Mapping[str, float] | None = None,
     replaced = {drivers[name].name for name in start_values if name in drivers}
     owners = _row_owners(model)
     keep = [i for i, owner in enumerate(owners) if owner not in replaced]
-    label = f"scene '{scene.name}': assembled(start={dict(start_values)!r})"
+    label = f"scene '{scene.name}': place(start={dict(start_values)!r})"
 
     def rows(q: NDArray[np.float64], v: NDArray[np.float64], chosen: list[str]
              ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
@@ -97,7 +97,7 @@ def assembled(scene: Scene, start: Mapping[str, float] | None = None,
         # every row of the start, the drivers' too (their profiles give their joints' speeds)
         J = np.vstack([Phi_q, C_q])
         b = np.concatenate([-Phi_t, [speed_values[name] for name in speed_values]])
-        _check_fixed(f"scene '{scene.name}': assembled(speeds={dict(speed_values)!r})", "speeds", J, scene,
+        _check_fixed(f"scene '{scene.name}': place(speeds={dict(speed_values)!r})", "speeds", J, scene,
                      list(speed_values), joints)
         v = np.linalg.lstsq(J, b, rcond=None)[0]
     return _placed(scene, ref, q, v)
@@ -106,7 +106,7 @@ def assembled(scene: Scene, start: Mapping[str, float] | None = None,
 def _checked(scene: Scene, field_name: str, values: Mapping[str, float] | None, joints: dict[str, Any]
              ) -> dict[str, float]:
     """``values`` as a dict joint name -> float; a clear error for anything else."""
-    where = f"scene '{scene.name}': assembled"
+    where = f"scene '{scene.name}': place"
     if values is None:
         return {}
     if not isinstance(values, Mapping):

@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Any
 from collections.abc import Callable, Sequence
 
-from .automaton import STORM_EVENTS, STORM_WINDOW  # noqa: F401  (re-exported: the storm guard's defaults)
+from ..core.automaton import STORM_EVENTS, STORM_WINDOW  # noqa: F401  (re-exported: the storm guard's defaults)
 from .parameters import law_structure
 from ..model.scene import RevoluteClearance
 from .symbolic import AssemblyContext, Channel, Reference, Term

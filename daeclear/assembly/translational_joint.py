@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 
 from .contact_pairs import ContactBuild, PairLogic, PairStates, TermSwitch, approach_floor
 from .parameters import law_structure, law_values, symbolic_law
-from ..results.result import ContactEvent
+from ..core.events import ContactEvent
 from ..model.scene import TranslationalClearance
 from .symbolic import AssemblyContext, BufferedFunction, Channel, Reference, Term, perpendicular, rotation
 

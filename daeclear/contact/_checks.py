@@ -6,7 +6,7 @@ import math
 import numbers
 from typing import Any
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 
 
 def check_number(owner: str, field: str, value: Any, *, low: float = -math.inf, high: float = math.inf,

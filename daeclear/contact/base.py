@@ -17,7 +17,7 @@ from typing import Any, ClassVar, Literal, Self
 
 import numpy as np
 
-from ..errors import DaeclearWarning, SceneError
+from ..core.errors import DaeclearWarning, SceneError
 from . import _backend as B
 from ._checks import check_number
 from .geometry import (MaterialPair, internal_contact_stiffness, material_pair, plane_face_stiffness,
@@ -139,7 +139,7 @@ class NormalLaw(abc.ABC):
 
     def check_penetration(self, penetration: Any, *, warn: bool = True) -> bool:
         """True if every penetration (e.g. of a result's channel) is inside the law's valid range; else
-        a :class:`~daeclear.errors.DaeclearWarning` with ``warn``."""
+        a :class:`~daeclear.core.errors.DaeclearWarning` with ``warn``."""
         values = np.asarray(penetration, dtype=float)
         worst = float(np.max(values)) if values.size else -math.inf
         ok = worst <= self.penetration_limit

@@ -16,7 +16,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, Literal, NamedTuple, Self
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 from . import _backend as B
 from ._checks import check_number, set_field
 from .base import Geometry, NormalLaw, bearing_radii

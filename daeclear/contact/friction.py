@@ -11,7 +11,7 @@ import abc
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 from . import _backend as B
 from ._checks import check_number, set_field
 

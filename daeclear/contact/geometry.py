@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 from ._checks import check_number
 
 __all__ = [

@@ -14,7 +14,7 @@ from typing import Any, ClassVar, Self
 
 import numpy as np
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 from . import _backend as B
 from ._checks import check_number, set_field
 from .base import NormalLaw

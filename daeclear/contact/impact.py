@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 from ._checks import check_number
 from .base import NormalLaw
 

@@ -13,7 +13,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any, ClassVar, Self
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 from . import _backend as B
 from ._checks import check_number, set_field
 from .base import KINDS, Geometry, NormalLaw, computed_stiffness

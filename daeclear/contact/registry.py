@@ -8,7 +8,8 @@ import numbers
 import re
 from typing import Any
 
-from ..errors import SceneError
+from ..core.errors import SceneError
+from ..core.options import fail
 from .base import NormalLaw
 from .cylindrical import DubowskyFreudenstein, ESDU78035, Goldsmith
 from .friction import Coulomb, FrictionLaw, ModifiedCoulomb, NoFriction
@@ -151,3 +152,25 @@ def _joint_law_from_table(cls: type, params: dict[str, Any]) -> Any:
     except (SceneError, TypeError) as exc:
         raise SceneError(f"{cls.__name__}: dry={dry!r}: {exc}") from None
     return build_law(cls, params)
+
+
+def check_restitution(value: Any, law: Any, *, where: str, field: str = "restitution") -> None:
+    """A restitution given explicitly must reach a law that has one (it is never dropped silently)."""
+    if value is None:
+        return
+    name = law.get("name") if isinstance(law, dict) else law if isinstance(law, str) else getattr(law, "name", None)
+    if name in JOINT_LAWS:
+        fail(where, field, value, "left out with a lubricated law (hydrodynamic), whose dry law has the restitution; "
+             "give it there, e.g. law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01, 'dry': "
+             "{'name': 'lankarani-nikravesh', 'restitution': 0.5}}")
+    if isinstance(law, dict):
+        fail(where, field, value, "left out when law is a table; give it in the table, e.g. "
+             "law={'name': 'hunt-crossley', 'restitution': 0.5}")
+    if isinstance(law, NormalLaw):
+        fail(where, field, value, f"left out when law is a law object ({type(law).__name__}); set it on the "
+             "law object instead")
+    cls = normal_law_class(str(law))
+    if "restitution" not in getattr(cls, "__dataclass_fields__", {}):
+        takes = [n for n, c in NORMAL_LAWS.items() if "restitution" in getattr(c, "__dataclass_fields__", {})]
+        fail(where, field, value, f"left out with law={law!r}, which has no coefficient of restitution "
+             f"(laws with one: {', '.join(takes)})")

@@ -14,7 +14,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 from ._checks import check_number
 
 __all__ = ["ArchardWear", "DISTRIBUTIONS", "MAX_DEPTH_FRACTION", "SURFACES", "WearHistoryArrays", "half_angle_hertz",

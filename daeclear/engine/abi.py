@@ -1,5 +1,5 @@
 """The numbers the compiled drivers and Python share, in one table: return codes, option codes,
-flags, slots of the arrays a driver fills, decision kinds (those of :mod:`daeclear.assembly.automaton`).
+flags, slots of the arrays a driver fills, decision kinds (those of :mod:`daeclear.core.automaton`).
 
 :func:`header_text` writes them as ``csrc/dc_abi.h``, generated and checked in
 (``python -m daeclear.engine.abi`` writes it again, and ``csrc/dc_api.h``, the entry points of
@@ -14,7 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Final
 
-from ..assembly import automaton
+from ..core import automaton
 from . import c_api
 from .build import CSRC
 
@@ -49,7 +49,7 @@ DC_ERR_USAGE: Final = -4
 DC_LS_DENSE: Final = 0
 DC_LS_SPARSE: Final = 1
 DC_LS_REDUCED: Final = 2
-#: dc_open's linear_solver argument by the option's name (daeclear.options.LINEAR_SOLVERS but "auto")
+#: dc_open's linear_solver argument by the option's name (daeclear.core.options.LINEAR_SOLVERS but "auto")
 LINEAR_SOLVER_CODES: Final = {"dense": DC_LS_DENSE, "sparse": DC_LS_SPARSE, "reduced": DC_LS_REDUCED}
 
 DC_STORE_TIMES: Final = 1
@@ -144,7 +144,7 @@ GROUPS: Final[tuple[tuple[str, tuple[tuple[str, int | float, str], ...]], ...]] 
     ("dc_advance's store_steps flags", (
         ("DC_STORE_TIMES", DC_STORE_TIMES, "step times, sizes and orders"),
         ("DC_STORE_STATES", DC_STORE_STATES, "also the states y and yp"))),
-    ("decision kinds of the contact automaton (daeclear.assembly.automaton)", (
+    ("decision kinds of the contact automaton (daeclear.core.automaton)", (
         ("DC_NONE", DC_NONE, "nothing changes"),
         ("DC_ONSET", DC_ONSET, "contact starts"),
         ("DC_SEPARATION", DC_SEPARATION, "contact ends"),

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 from collections.abc import Iterator
 
-from ..errors import DaeclearError
+from ..core.errors import DaeclearError
 
 __all__ = ["CSRC", "CompilerUnavailable", "CompileError", "BuildResult", "compiler_command", "cache_dir",
            "compile_cached", "driver_files", "MemoTable", "memo_table", "clear_memos"]

@@ -18,8 +18,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..assembly.automaton import Decision, PairState, Storm
-from ..errors import DaeclearError
+from ..core.automaton import Decision, PairState, Storm
+from ..core.errors import DaeclearError
 from .abi import (DC_CHUNK, DC_ERR_COLLAPSE, DC_ERR_MAXSTEPS, DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND, DC_EV_N,
                   DC_EV_WATCH, DC_ROOT, DC_TSTOP, LINEAR_SOLVER_CODES, STAT_KEYS)
 from .build import BuildResult
@@ -138,7 +138,7 @@ class CSession(SessionBase):
 
         ``pairs``: (root index, term index, gap-rate extra, needs approach speed, min speed), one
         per root function; ``storms``: each pair's storm-guard constants; ``states``: each pair's
-        :class:`daeclear.assembly.automaton.PairState` to start from (its history is not carried over).
+        :class:`daeclear.core.automaton.PairState` to start from (its history is not carried over).
         Each advance then returns the switches it made in ``Advance.auto_events``.
         """
         self._check_open()
@@ -249,7 +249,7 @@ class CSession(SessionBase):
                       storm: Storm, min_approach_speed: float, contact: bool = False, held: bool = False,
                       latched: float = 0.0) -> list[Decision]:
         """Run the compiled loop's pair automaton over a root sequence from the given state with no
-        history (a test hook: the decisions must be those of :func:`daeclear.assembly.automaton.step`)."""
+        history (a test hook: the decisions must be those of :func:`daeclear.core.automaton.step`)."""
         t = np.ascontiguousarray(times, dtype=np.float64)
         d = np.ascontiguousarray(directions, dtype=np.int32)
         r = np.ascontiguousarray(rates, dtype=np.float64)

@@ -20,7 +20,7 @@ from typing import Any
 import casadi
 
 from . import sundials
-from ..errors import AssemblyError
+from ..core.errors import AssemblyError
 from .build import (CSRC, BuildResult, CompileError, CompilerUnavailable, MemoTable, cache_dir, clear_memos,
                     compile_cached, compiler_command, driver_files, memo_table)
 from .library import DRIVER_ABI, ODE_DRIVER_ABI

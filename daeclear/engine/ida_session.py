@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DaeclearError, warn_once
-from ..options import BACKENDS, LINEAR_SOLVERS
+from ..core.errors import DaeclearError, warn_once
+from ..core.options import BACKENDS, LINEAR_SOLVERS
 from .build import BuildResult, CompileError, CompilerUnavailable
 from .c_session import SPARSE_MIN_STATES, CSession
 from .codegen import NormalizedModel, build_model_library, normalize_model

@@ -17,7 +17,7 @@ from collections.abc import Mapping, Sequence
 
 from . import c_api, sundials
 from .abi import DC_BI_INDEX_BITS, DC_BI_INDEX_SIZE, DC_BI_MAJOR, DC_BI_MINOR, DC_BI_N, DC_BI_PATCH, DC_BI_SPARSE
-from ..errors import DaeclearError
+from ..core.errors import DaeclearError
 from .sundials import SundialsInfo
 
 __all__ = ["DRIVER_ABI", "ODE_DRIVER_ABI", "Prototypes", "StaleLibrary", "open_library", "unload", "LoadedLibrary",

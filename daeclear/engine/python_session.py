@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import casadi
 import numpy as np
 
-from ..errors import DaeclearError
+from ..core.errors import DaeclearError
 from .codegen import NormalizedModel, densified
 from .hermite import cubic_hermite
 from .session_base import (FLAG_MAX_STEPS, FLAG_STEP_COLLAPSE, OWN_FLAG_NAMES, Advance, SessionBase, SessionOptions,

@@ -12,9 +12,9 @@ from collections.abc import Sequence
 import casadi
 import numpy as np
 
-from ..assembly.automaton import Decision, PairState, Storm
-from ..errors import DaeclearError
-from ..options import LINEAR_SOLVERS
+from ..core.automaton import Decision, PairState, Storm
+from ..core.errors import DaeclearError
+from ..core.options import LINEAR_SOLVERS
 from .abi import DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND, DC_EV_WATCH, DC_STORE_STATES, DC_STORE_TIMES
 from .codegen import NormalizedModel
 from .stall_guard import StallGuard

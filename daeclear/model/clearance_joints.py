@@ -9,11 +9,11 @@ import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 
 if TYPE_CHECKING:
     from numpy.typing import NDArray
-from ..results.values import field_names
+from ..core.values import field_names
 from .elements import (Joint, PointJoint, Revolute, Translational, Vector2, as_vector2, computed_once,
                        own_problems, store_vectors)
 

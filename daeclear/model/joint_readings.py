@@ -10,7 +10,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 
 __all__ = ["JointReading", "JOINT_READINGS", "joint_reading", "corner_law", "face_law", "find_reading"]
 

@@ -10,7 +10,7 @@ import re
 from typing import Any
 from collections.abc import Callable
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 
 #: Options that only a clearance joint uses, per ready mechanism (chain: every pin is one, none listed).
 CLEARANCE_ONLY: dict[str, tuple[str, ...]] = {

@@ -7,11 +7,11 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from .. import options as rules
 from ..contact import HydrodynamicBearing, Material, friction_law, normal_law
 from ..contact.registry import LAW_TYPES, contact_law
 from ..contact.base import NormalLaw
-from ..errors import SceneError
+from ..contact.registry import check_restitution
+from ..core.errors import SceneError
 from .mechanism_options import joint_names, refuse_clearance_options
 from .scene import (GROUND, Body, Driver, Element, Revolute, RevoluteClearance, Scene, Translational,
                     is_finite_number)
@@ -201,7 +201,7 @@ def slider_crank(joint: str = "ideal", *, gravity: float = 9.81, rpm: float = 50
     if joint == "ideal":  # an option of a clearance joint would be ignored: refused
         refuse_clearance_options("slider_crank", slider_crank, locals(), "joint='ideal'")
         return scene
-    rules.restitution(restitution, law, where="slider_crank")  # given for a law without one, it would be dropped
+    check_restitution(restitution, law, where="slider_crank")  # given for a law without one, it would be dropped
     if joint == "revolute":
         _check(where, ("clearance", clearance, "must be a number in (0, bearing_radius) m",
                        is_finite_number(clearance) and 0 < clearance < bearing_radius))
@@ -290,7 +290,7 @@ def chain(n_links: int, *, clearance: float = 0.1e-3, gravity: float = 9.81, rpm
     omega = 0.0 if rpm is None else rpm_to_rad_s(rpm)
     scene = Scene(name or f"chain{n_links}", gravity=(0.0, -gravity))
     ux, uy = math.cos(angle), math.sin(angle)
-    rules.restitution(restitution, law, where="chain")
+    check_restitution(restitution, law, where="chain")
     contact_law = _contact_law(law, restitution, length)
     bearing: Any = scene.ground
     for k in range(1, n_links + 1):
@@ -342,7 +342,7 @@ def _with_revolute_clearances(scene: Scene, joints: Any, allowed: tuple[str, ...
             "clearance": clearance, "law": law, "restitution": restitution, "friction": friction,
             "bearing_radius": bearing_radius, "material": material, "length": length}, "clearance_joints=()")
         return scene
-    rules.restitution(restitution, law, where=where)
+    check_restitution(restitution, law, where=where)
     contact_law = _contact_law(law, restitution, length)
     for joint in chosen:
         scene = scene.with_clearance(joint, clearance=_clearance_of_joint(clearance, joint, where),

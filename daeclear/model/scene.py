@@ -1,6 +1,6 @@
 """Scene: the container of a planar mechanism's bodies, joints, drivers and loads, with its gravity.
 
-Plain data, no CasADi. ``Scene.validate()`` raises one :class:`~daeclear.errors.SceneError` listing
+Plain data, no CasADi. ``Scene.validate()`` raises one :class:`~daeclear.core.errors.SceneError` listing
 every problem (each element's own and those between elements). The elements
 (:mod:`daeclear.model.elements`, :mod:`daeclear.model.clearance_joints`) are re-exported here.
 """
@@ -9,21 +9,16 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
-import importlib
 from dataclasses import dataclass, field
 from typing import Any
 from collections.abc import Iterable, Iterator, Mapping
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 # the elements, re-exported: ``from daeclear.model.scene import Body`` keeps working
 from .clearance_joints import (RevoluteClearance, TranslationalClearance, clearance_joint,  # noqa: F401
                                driven_coordinate, ideal_joint, table_value)
 from .elements import (GROUND, Body, Driver, Element, Ground, Joint, PointJoint, Revolute,  # noqa: F401
                        Translational, Vector2, as_vector2, is_finite_number, is_frozen, own_problems)
-
-#: The module of :meth:`Scene.assembled`, loaded by name: the assembly layer imports this module.
-PLACEMENT_MODULE = "daeclear.assembly.placement"
-
 
 def _did_you_mean(name: str, names: Iterable[str], n: int = 3) -> str:
     close = difflib.get_close_matches(name, list(names), n=n)
@@ -102,18 +97,6 @@ class Scene:
         elements[index] = clearance_joint(elements[index], bearing=bearing, name=name,  # type: ignore[arg-type]
                                           **fields_)
         return Scene(self.name, gravity=self.gravity, elements=elements, ground=self.ground)
-
-    def assembled(self, start: Mapping[str, float] | None = None,
-                  speeds: Mapping[str, float] | None = None) -> Scene:
-        """A new scene, its bodies placed so that the joints named in ``start`` have the given
-        coordinates (rad, or m along a translational axis) and every joint (clearance joints as
-        ideal) and driver closes; ``speeds``: the joints' rates, else the declared velocities
-        corrected (least norm). The declared poses are the Newton guess. This scene is left unchanged.
-        Raises SceneError for an unknown joint or a bad value, AssemblyError when the joints cannot
-        close (:mod:`daeclear.assembly.placement`).
-        """
-        placement: Any = importlib.import_module(PLACEMENT_MODULE)
-        return placement.assembled(self, start, speeds)
 
     def ideal(self) -> Scene:
         """A new scene, the same mechanism with every clearance joint ideal (see :func:`ideal_joint`):

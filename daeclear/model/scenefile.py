@@ -15,9 +15,9 @@ from typing import Any
 from collections.abc import Callable, Mapping
 
 from . import mechanisms
-from .. import options
-from ..errors import SceneError
-from ..results.values import to_plain
+from ..core import options
+from ..core.errors import SceneError
+from ..core.values import to_plain
 from .clearance_joints import TABLE_FIELDS, table_value
 from .profiles import profile_from_dict
 from .loads import Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
@@ -167,7 +167,7 @@ def _with_key(problem: str, entry: dict[str, Any]) -> str:
 
 
 def check_simulate(simulate: dict[str, Any], *, where: str) -> dict[str, Any]:
-    """The [simulate] table checked by the rules simulate() applies (daeclear.options), none ignored:
+    """The [simulate] table checked by the rules simulate() applies (daeclear.core.options), none ignored:
     ``t_end = 0`` or ``t_eval_step = 0`` are errors, not "use the default"."""
     out = dict(simulate)
     for key, rule in (("t_end", options.t_end), ("rtol", options.rtol), ("atol", options.atol),

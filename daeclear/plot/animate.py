@@ -1,6 +1,6 @@
 """Animations of a run: the mechanism moving, each clearance joint magnified, a time cursor (docs/user_guide.md).
 
-:func:`animate` (``Result.animate``, ``daeclear animate RESULT.h5``) checks the options and writes a GIF
+:func:`animate` (``daeclear.animate``, ``daeclear animate RESULT.h5``) checks the options and writes a GIF
 (pillow, no external program) or an MP4 (ffmpeg), drawn from the result alone (its scene description and
 channels), so a run loaded back from HDF5 animates too. A joint is red in a frame when in contact then or
 since the previous frame, so an impact shorter than the frame spacing still shows. The frame is drawn by
@@ -21,10 +21,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import options
+from ..core import options
 from . import style
-from ..errors import MissingDependencyError, SceneError
-from ..progress import Progress
+from ..core.errors import MissingDependencyError, SceneError
+from ..core.progress import Progress
 from .animation_panels import layout_frame
 from .run_panels import Window
 from .mechanism_frame import (CONTACT, FREE, IMPACT, Geometry, Joint, Sampler, body_pose, contact_state,
@@ -61,7 +61,7 @@ _DPI = 100.0
 class _Fields:
     """How the caller names each option, for error messages (Python keywords or CLI flags)."""
 
-    where: str = "Result.animate"
+    where: str = "animate"
     path: str = "path"
     fps: str = "fps"
     window: str = "window"

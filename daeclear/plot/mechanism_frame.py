@@ -16,9 +16,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import options
+from ..core import options
 from . import style
-from ..errors import SceneError
+from ..core.errors import SceneError
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

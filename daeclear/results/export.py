@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import MissingDependencyError
+from ..core.errors import MissingDependencyError
 
 if TYPE_CHECKING:  # pandas and xarray are imported lazily, only where they are used
     import pandas as pd

@@ -12,11 +12,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import DaeclearError, SceneError
-from .events import ContactEvent
+from ..core.errors import DaeclearError, SceneError
+from ..core.events import ContactEvent
 from .hdf5_write import FORMAT_NAME, FORMAT_VERSION
 from .lazy_channels import LazyChannels, rebuilt_evaluator
-from .values import time_window
+from ..core.values import time_window
 
 if TYPE_CHECKING:  # h5py is imported lazily, only where a file is read
     import h5py

@@ -14,12 +14,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, json_dataset, mirror, string_dataset
-from .values import to_plain
+from ..core.values import to_plain
 
 if TYPE_CHECKING:  # h5py is imported lazily, only where a file is written
     import h5py
 
-    from .events import ContactEvent
+    from ..core.events import ContactEvent
 
 __all__ = ["STREAM_RUNNING", "ResultWriter"]
 

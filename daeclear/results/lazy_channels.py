@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .values import readonly
+from ..core.values import readonly
 
 __all__ = ["Consistent", "Evaluate", "LazyChannels", "rebuilt_evaluator"]
 
@@ -147,14 +147,12 @@ class LazyChannels:
 
 def rebuilt_evaluator(parameters: Mapping[str, Any]) -> tuple[Evaluate, Consistent]:
     """:data:`Evaluate` and :data:`Consistent` for a result file's states: the model rebuilt from the
-    file's parameters (scene description, formulation, run options) when they are first used.
-
-    The solvers own the model and its compiled functions, and import this package: they are
-    imported here at the first evaluation, by name, so that daeclear.results stays below them."""
+    file's parameters (scene description, formulation, run options) when they are first used
+    (:mod:`daeclear.results.channel_eval`, imported then: reading a file loads no CasADi)."""
     def rebuilt() -> Any:
-        import importlib
+        from .channel_eval import evaluator_from_parameters
 
-        return importlib.import_module("daeclear.solvers.channel_eval").evaluator_from_parameters(parameters)
+        return evaluator_from_parameters(parameters)
 
     def evaluate(t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> Mapping[str, NDArray]:
         return rebuilt().channels(t, y, yp, switch)

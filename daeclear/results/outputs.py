@@ -20,7 +20,7 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
-from ..errors import DiskFull, OutputDirectoryMissing, OutputError
+from ..core.errors import DiskFull, OutputDirectoryMissing, OutputError
 
 #: Bytes a write leaves free beyond its own data (HDF5 metadata of each append and of closing the file),
 #: so that a file stopped for want of space can still be completed and read back.

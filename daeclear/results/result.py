@@ -18,16 +18,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import DaeclearError
-from ..options import close_matches
+from ..core.errors import DaeclearError
+from ..core.options import close_matches
 from . import export
-from .events import EVENT_KINDS, ContactEvent, EventKind, EventList, EventRows
+from ..core.events import EVENT_KINDS, ContactEvent, EventKind, EventList, EventRows
 from .hdf5_read import read_dataset, read_file, read_group
 from .hdf5_stream import STREAM_RUNNING, ResultWriter
 from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, save_result, write_result_group
 from .lazy_channels import LazyChannels
 from .result_checks import checked_fields
-from .values import readonly, time_window, to_plain
+from ..core.values import readonly, time_window, to_plain
 
 if TYPE_CHECKING:  # h5py, pandas and xarray are imported lazily, only where they are used
     import h5py
@@ -93,7 +93,7 @@ class Result:
     scene_name, method, formulation : str, default ""
         The scene's name, the integrator (``"ida"``, ``"DOP853"``, ...) and the formulation.
     warnings : sequence of dict, optional
-        What the run's physics checks found (see :mod:`daeclear.solvers.physics`): each a dict with
+        What the run's physics checks found (see :mod:`daeclear.assembly.physics`): each a dict with
         ``kind``, ``quantity``, ``value``, ``limit``, ``unit``, ``where``, ``t``, ``message``.
 
     Raises
@@ -438,26 +438,6 @@ class Result:
         xarray: ``pip install "daeclear[data]"``.
         """
         return export.to_xarray(self, states=states)
-
-    # ------------------------------------------------------------------ animation
-
-    def animate(self, path: str | os.PathLike[str], *, fps: float = 25.0,
-                window: tuple[float | None, float | None] | None = None, slow_motion: float | None = None,
-                size: tuple[int, int] = (720, 450), channel: str | None = None, magnify: float | None = None,
-                progress: bool = False) -> Path:
-        """Write an animated GIF (or MP4 with ffmpeg) of the mechanism moving; see
-        :func:`daeclear.plot.animate.animate`.
-
-        Frames: ``max(2, round(duration * slow_motion * fps))`` evenly spaced over the window.
-
-        Examples
-        --------
-        >>> result.animate("run.gif", window=(0.010, 0.014), slow_motion=500, size=(560, 360))  # doctest: +SKIP
-        """
-        from ..plot.animate import animate
-
-        return animate(self, path, fps=fps, window=window, slow_motion=slow_motion, size=size, channel=channel,
-                       magnify=magnify, progress=progress)
 
     # ------------------------------------------------------------------ HDF5
 

@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..options import close_matches
-from .events import ContactEvent, EventList
+from ..core.options import close_matches
+from ..core.events import ContactEvent, EventList
 from .lazy_channels import LazyChannels
 
 __all__ = ["checked_fields"]

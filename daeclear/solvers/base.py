@@ -7,15 +7,15 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol, runtime_checkable
 
 from numpy.typing import NDArray
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 from .ode_run import FIXED_STEP_METHODS
 
 if TYPE_CHECKING:
     from ..assembly.assemble import DAEModel
     from ..model.scene import Scene
     from ..results.result import Result
-    from ..save_at import Output
-    from ..solver_options import SolverOptions
+    from .save_at import Output
+    from .solver_options import SolverOptions
 
 
 @runtime_checkable

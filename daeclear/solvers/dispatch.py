@@ -8,12 +8,12 @@ from typing import Any
 
 from numpy.typing import ArrayLike
 
-from .. import options as opts
+from ..core import options as opts
 from ..assembly.assemble import DAEModel, assemble
 from ..model.scene import Scene
 from ..results.result import Result
-from ..save_at import SaveAt, save_value
-from ..solver_options import UNSET, SolverOptions
+from .save_at import SaveAt, save_value
+from .solver_options import UNSET, SolverOptions
 from .base import Solver
 from .registry import solver_class
 

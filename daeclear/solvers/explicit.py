@@ -25,8 +25,8 @@ from numpy.typing import NDArray
 
 from ..assembly import contact_state
 from ..assembly.assemble import DAEModel, assemble
-from .. import options
-from ..errors import Interrupted, SceneError, SolveError
+from ..core import options
+from ..core.errors import Interrupted, SceneError, SolveError
 from .recorder import Recorder, out_of_memory
 from .tolerances import atol_record, tolerance_vector
 from ..results.result import Result
@@ -34,13 +34,13 @@ from ..model.scene import Scene
 from .ode_crossings import candidate, locate
 from .ode_evaluators import FX_CHUNK, FX_ERR, FX_MAXSTEPS, FX_TSTOP, evaluator
 from .ode_model import ode_spec
-from . import physics
+from ..assembly import physics
 from .base import step_rule
 from .ode_run import FIXED_STEP_METHODS, IMPLICIT_METHODS, METHOD_NAMES, SCIPY_METHODS, Run
 
 if TYPE_CHECKING:
-    from ..save_at import Output
-    from ..solver_options import SolverOptions
+    from .save_at import Output
+    from .solver_options import SolverOptions
 
 __all__ = ["METHOD_NAMES", "SCIPY_METHODS", "FIXED_STEP_METHODS", "ODESolver", "RK45", "DOP853", "Radau", "BDF",
            "LSODA", "RK4", "Euler", "ode_spec"]

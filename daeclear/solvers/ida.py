@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 from numpy.typing import NDArray
 
-from .. import options as opts
-from . import physics
+from ..core import options as opts
+from ..assembly import physics
 from ..assembly.assemble import DAEModel, assemble
 from ..engine.ida_session import open_session
 from .base import step_rule
@@ -20,8 +20,8 @@ from ..results.result import Result
 from ..model.scene import Scene
 
 if TYPE_CHECKING:
-    from ..save_at import Output
-    from ..solver_options import SolverOptions
+    from .save_at import Output
+    from .solver_options import SolverOptions
 
 DRIFT_FRACTION = physics.DRIFT_FRACTION  # physics' limit, named here too
 # IDA's settings (docs/engine.md): GGL's Newton test coefficient (IDA's default 0.33; the python backend

@@ -17,17 +17,17 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import options as opts
-from . import physics
+from ..core import options as opts
+from ..assembly import physics
 from ..assembly.assemble import DAEModel
 from ..assembly import contact_state
-from ..assembly.automaton import EVENT_KINDS, ONSET
+from ..core.automaton import EVENT_KINDS, ONSET
 from ..engine.abi import DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND
 from ..engine.session_base import AutoEvents
-from ..errors import Interrupted, SolveError
+from ..core.errors import Interrupted, SolveError
 from .recorder import Recorder, out_of_memory
-from ..progress import Progress
-from ..results.events import EventRows
+from ..core.progress import Progress
+from ..core.events import EventRows
 from ..results.result import Result
 
 #: Output times handed to the compiled loop at a time: their rows are emptied between windows.

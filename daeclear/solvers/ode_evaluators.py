@@ -26,7 +26,7 @@ from ..engine.codegen import (
 )
 from ..engine.abi import DCO_CNT_N, DCO_EULER, FX_CANDIDATE, FX_CHUNK, FX_ERR, FX_MAXSTEPS, FX_TSTOP, ODE_COUNTER_KEYS
 from ..engine.library import OdeLibrary
-from ..errors import DaeclearError, warn_once
+from ..core.errors import DaeclearError, warn_once
 from .ode_crossings import candidate
 from .ode_model import ode_spec
 

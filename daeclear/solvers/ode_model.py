@@ -10,7 +10,7 @@ import numpy as np
 
 from ..assembly.assemble import DAEModel
 from ..engine.codegen import OdeSpec
-from ..errors import SceneError
+from ..core.errors import SceneError
 
 __all__ = ["ode_spec"]
 

@@ -16,9 +16,10 @@ from ..assembly.assemble import DAEModel
 from ..engine.hermite import cubic_hermite
 from ..engine.abi import DCO_EULER, DCO_RK4
 from ..engine.stall_guard import StallGuard
-from ..progress import Progress
-from ..results.result import ContactEvent, Result
-from . import physics
+from ..core.progress import Progress
+from ..core.events import ContactEvent
+from ..results.result import Result
+from ..assembly import physics
 from .ode_evaluators import Evaluator
 from .recorder import Recorder
 

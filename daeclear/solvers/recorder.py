@@ -6,7 +6,7 @@ and, kept in memory, as IDA left them: the run's `Result` makes their multiplier
 and computes the channels at the first read (:class:`~daeclear.results.lazy_channels.LazyChannels`).
 Streamed (``stream_to``), each chunk is appended to the file and dropped, so the run's memory does
 not grow with its length and the file holds what was computed whatever stops the run. Either way
-the physics checks read the few rows of :func:`daeclear.solvers.physics.key_rows`.
+the physics checks read the few rows of :func:`daeclear.assembly.physics.key_rows`.
 """
 
 from __future__ import annotations
@@ -18,12 +18,13 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import NDArray
 
-from . import physics
-from .channel_eval import ModelEvaluator, rebuildable
-from ..errors import OutputError
-from ..results.events import EventRows, flatten
+from ..assembly import physics
+from ..results.channel_eval import ModelEvaluator, rebuildable
+from ..core.errors import OutputError
+from ..core.events import EventRows, flatten
 from ..results.lazy_channels import LazyChannels
-from ..results.result import ContactEvent, Result, ResultWriter, load
+from ..core.events import ContactEvent
+from ..results.result import Result, ResultWriter, load
 
 #: a chunk of points: t, y, yp (None: IDA's raw points), switch rows, the channels when the solver computed them
 Points = tuple[NDArray, NDArray, NDArray | None, NDArray, dict[str, NDArray] | None]
@@ -167,7 +168,7 @@ class Recorder:
         return t, y, yp, switch, channels
 
     def key_rows(self) -> tuple[NDArray, NDArray, dict[str, NDArray]]:
-        """(t, y, channels) of the rows the physics checks read (:func:`daeclear.solvers.physics.key_rows`);
+        """(t, y, channels) of the rows the physics checks read (:func:`daeclear.assembly.physics.key_rows`);
         in memory, the checked channels are computed at every point for them (the others are not)."""
         if self.writer is None:
             t, y, yp, switch, channels = self._joined()

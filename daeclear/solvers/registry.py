@@ -6,12 +6,12 @@ import functools
 import importlib
 from typing import Any
 
-from .. import options
+from ..core import options
 from .base import Solver
 from .explicit import BDF, DOP853, LSODA, RK4, RK45, Euler, Radau
 from .ida import IDA
 
-#: lower-case method name -> its solver class (the names of :data:`daeclear.options.METHODS`)
+#: lower-case method name -> its solver class (the names of :data:`daeclear.core.options.METHODS`)
 SOLVERS: dict[str, type[Solver]] = {
     "ida": IDA, "rk45": RK45, "dop853": DOP853, "radau": Radau, "bdf": BDF, "lsoda": LSODA, "rk4": RK4,
     "euler": Euler,

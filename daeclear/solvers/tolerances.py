@@ -15,8 +15,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..assembly.assemble import KIND_MULTIPLIER, KIND_WORK, DAEModel
-from ..errors import DaeclearWarning
-from ..options import ATOL_QUANTITIES as QUANTITIES, atol_by_quantity, fail
+from ..core.errors import DaeclearWarning
+from ..core.options import ATOL_QUANTITIES as QUANTITIES, atol_by_quantity, fail
 
 # Multipliers are kept out of IDA's error test (scikit-sundae has no IDASetSuppressAlg) by
 # atol = max(MULTIPLIER_ATOL_FACTOR * rtol, MULTIPLIER_ATOL_FLOOR N): below the floor impact

@@ -20,14 +20,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..assembly.assemble import DAEModel, assemble
-from .. import options
-from ..errors import DaeclearError, Interrupted, SceneError
-from ..progress import Progress
+from ..core import options
+from ..core.errors import DaeclearError, Interrupted, SceneError
+from ..core.progress import Progress
 from ..results.outputs import atomic_write_text, check_file
 from ..results.result import Result
 from ..model.scene import Scene
-from ..save_at import SaveAt
-from ..solver_options import SolverOptions
+from ..solvers.save_at import SaveAt
+from ..solvers.solver_options import SolverOptions
 from ..solvers.dispatch import simulate
 
 FIXED_STEP_METHODS = ("rk4", "euler")

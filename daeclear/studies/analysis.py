@@ -33,9 +33,9 @@ from .poincare import (CHANNELS, PhasePortrait, PoincareSection, crank_period, m
                        poincare_section, sampling_times, section_channels)
 from .twin_runs import Divergence, RestartState, all_free, restart_state, twin_divergence, twin_evidence
 from ..assembly.assemble import DAEModel
-from ..errors import DaeclearError, SceneError  # noqa: F401  (DaeclearError: re-exported as before)
-from ..options import default_formulation, integer
-from ..solver_options import UNSET, SolverOptions
+from ..core.errors import DaeclearError, SceneError  # noqa: F401  (DaeclearError: re-exported as before)
+from ..core.options import default_formulation, integer
+from ..solvers.solver_options import UNSET, SolverOptions
 
 if TYPE_CHECKING:
     from ..results.result import Result
@@ -107,7 +107,7 @@ def classify_motion(scene: Scene | DAEModel, *, channels: Sequence[str] | None =
         If a run fails (partial result in ``.result``).
     """
     from ..assembly.assemble import assemble
-    from ..save_at import SaveAt
+    from ..solvers.save_at import SaveAt
     from ..solvers.dispatch import simulate
 
     revolutions = integer(revolutions, where="classify_motion", field="revolutions", low=2)

@@ -18,7 +18,7 @@ from .motion_thresholds import (DEFAULT_DECORRELATION, DEFAULT_MAX_PERIOD, DEFAU
                                 MIN_POINTS, SENSITIVE_AMPLIFICATION)
 from .poincare import PoincareSection, recurrence_defects
 from .twin_runs import Divergence
-from ..errors import SceneError
+from ..core.errors import SceneError
 
 __all__ = ["MOTION_LABELS", "MotionClass", "MotionLabel", "TwinReading", "classify_section", "read_twins"]
 

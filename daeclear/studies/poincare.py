@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from .motion_thresholds import SIZE_QUANTILES, TIME_MATCH
 from ..assembly.assemble import DAEModel
-from ..errors import DaeclearError, SceneError
+from ..core.errors import DaeclearError, SceneError
 
 if TYPE_CHECKING:
     from ..results.result import Result

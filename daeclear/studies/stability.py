@@ -17,12 +17,12 @@ import numpy as np
 
 from .. import contact
 from .accuracy import energy_balance
-from ..errors import DaeclearError
-from ..progress import Progress
+from ..core.errors import DaeclearError
+from ..core.progress import Progress
 from ..model.mechanisms import STEEL, slider_crank
 from ..model.scene import Body, RevoluteClearance, Scene
-from ..save_at import SaveAt
-from ..solver_options import SolverOptions
+from ..solvers.save_at import SaveAt
+from ..solvers.solver_options import SolverOptions
 from ..solvers.dispatch import simulate
 
 REV = 60.0 / 5000.0

@@ -35,10 +35,10 @@ from .sweep_file import (FORMAT_NAME, FORMAT_VERSION, SOLVER_KEY, RunRecord, Swe
                          parts_dir, read_record, varying_names)
 from .sweep_journal import acquire_lock, consolidate, lock_path, write_part
 from .sweep_workers import build_scene, ignore_sigint, run_task, terminate_pool
-from ..errors import DaeclearError, OutputError, SceneError
-from ..progress import Progress
+from ..core.errors import DaeclearError, OutputError, SceneError
+from ..core.progress import Progress
 from ..results.outputs import check_file, deferred_sigint, sigint_latch
-from ..solver_options import UNSET, SolverOptions
+from ..solvers.solver_options import UNSET, SolverOptions
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "KEEP", "RunRecord", "SweepResult", "grid_points", "load_sweep",
            "run_key", "sweep"]
@@ -188,7 +188,7 @@ def sweep(path: str | os.PathLike[str], grid: Mapping[str, Iterable[Any]] | None
     KeyboardInterrupt
         Re-raised after the finished runs are saved.
     """
-    from .. import options as check
+    from ..core import options as check
 
     path = check_file(path, "sweep(path)", what="a sweep file (.h5)", example="sweep.h5")  # before any work
     if parts_dir(path).exists() and not parts_dir(path).is_dir():
@@ -290,7 +290,7 @@ def _preflight(scene: Any, first: Mapping[str, Any], channels: Mapping[str, Sequ
     Without it, every run would fail the same way after the whole sweep's work."""
     from .poincare import crank_period
     from ..assembly.assemble import assemble
-    from ..options import close_matches, default_formulation, fail
+    from ..core.options import close_matches, default_formulation, fail
 
     try:
         crank_period(scene)

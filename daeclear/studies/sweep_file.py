@@ -36,13 +36,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .poincare import CHANNELS, PhasePortrait, PoincareSection
-from ..errors import DaeclearError, DaeclearWarning
+from ..core.errors import DaeclearError, DaeclearWarning
 
 if TYPE_CHECKING:
     import h5py
 
     from ..results.result import Result
-    from ..solver_options import SolverOptions
+    from ..solvers.solver_options import SolverOptions
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "SOLVER_KEY", "RunRecord", "SweepResult", "json_default", "load_sweep",
            "part_files", "parts_dir", "read_record", "solver_options", "varying_names", "write_header", "write_run"]
@@ -57,7 +57,7 @@ _LEGACY_SOLVER_KEYS = ("rtol", "atol", "max_step", "formulation", "backend")
 
 def solver_options(options: Mapping[str, Any]) -> SolverOptions:
     """The SolverOptions of a sweep's options (``options[SOLVER_KEY]``, rebuilt by ``from_dict``)."""
-    from ..solver_options import SolverOptions
+    from ..solvers.solver_options import SolverOptions
 
     return SolverOptions.from_dict(options.get(SOLVER_KEY, {}))
 

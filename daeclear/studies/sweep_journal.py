@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from .sweep_file import json_default, part_files, parts_dir, write_header, write_run
-from ..errors import DaeclearError, DaeclearWarning
+from ..core.errors import DaeclearError, DaeclearWarning
 from ..results.outputs import atomic_file
 
 __all__ = ["acquire_lock", "consolidate", "lock_path", "write_part"]

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from .sweep_file import SOLVER_KEY
-from ..errors import SceneError
+from ..core.errors import SceneError
 
 __all__ = ["build_scene", "ignore_sigint", "run_task", "terminate_pool"]
 
@@ -59,7 +59,7 @@ def ignore_sigint(parent: int | None = None) -> None:
 def run_task(task: Mapping[str, Any]) -> dict[str, Any]:
     """Build the scene of one point, classify its motion and return plain data (runs in a worker)."""
     from .analysis import classify_motion
-    from ..solver_options import SolverOptions
+    from ..solvers.solver_options import SolverOptions
 
     start = time.perf_counter()
     out: dict[str, Any] = {"key": task["key"], "index": task["index"], "parameters": dict(task["parameters"]),

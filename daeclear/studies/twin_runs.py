@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from .motion_thresholds import DEFAULT_MAX_PERIOD, MIN_AMPLIFICATION, SATURATION_FRACTION, TIME_MATCH
 from .poincare import PoincareSection, match_times, recurrence_defects
 from ..assembly.assemble import DAEModel
-from ..errors import DaeclearError
+from ..core.errors import DaeclearError
 
 if TYPE_CHECKING:
     from ..results.result import Result

@@ -22,13 +22,13 @@ from ..assembly.assemble import assemble
 from ..assembly.dae_model import DAEModel
 from ..contact.geometry import sigma_sum
 from ..contact.wear import MAX_DEPTH_FRACTION, ArchardWear, WearHistoryArrays, wear_increment, worn_volume
-from ..errors import AssemblyError, DaeclearError, Interrupted, PhysicsWarning, SceneError, SolveError
+from ..core.errors import AssemblyError, DaeclearError, Interrupted, PhysicsWarning, SceneError, SolveError
 from ..model.scene import RevoluteClearance, Scene
-from ..progress import Progress
+from ..core.progress import Progress
 from ..results.outputs import check_file
-from ..results.values import to_plain
+from ..core.values import to_plain
 from ..results.result import Result
-from ..solver_options import SolverOptions
+from ..solvers.solver_options import SolverOptions
 from ..solvers.dispatch import simulate
 from .poincare import crank_period
 from .wear_file import WearFile

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import SceneError
+from ..core.errors import SceneError
 
 FORMAT = "daeclear-wear"
 Row = tuple[float, dict[str, NDArray[np.float64]], float, float]  # cycles, depth by surface, work, peak force

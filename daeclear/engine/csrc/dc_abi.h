@@ -23,7 +23,7 @@
 #define DC_STORE_TIMES 1 /* step times, sizes and orders */
 #define DC_STORE_STATES 2 /* also the states y and yp */
 
-/* decision kinds of the contact automaton (daeclear.assembly.automaton) */
+/* decision kinds of the contact automaton (daeclear.core.automaton) */
 #define DC_NONE 0 /* nothing changes */
 #define DC_ONSET 1 /* contact starts */
 #define DC_SEPARATION (-1) /* contact ends */

@@ -13,7 +13,7 @@
 #include "dc_abi.h"
 
 /* ------------------------------------------------------------------ contact-mode automaton
- * The C mirror of daeclear/assembly/automaton.py (step): the decision of one contact pair at a root of
+ * The C mirror of daeclear/core/automaton.py (step): the decision of one contact pair at a root of
  * its gap. Keep the two identical, branch for branch; tests/test_automaton.py drives both
  * with the same random root sequences through dc_automaton_run. */
 /* The decision kinds DC_NONE, DC_ONSET, DC_SEPARATION and DC_SAME_INSTANT (a crossing against the

@@ -15,8 +15,8 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import options
-from .options import MAX_OUTPUT_POINTS, OutputTimes, fail
+from ..core import options
+from ..core.options import MAX_OUTPUT_POINTS, OutputTimes, fail
 
 WHERE = "SaveAt"
 
@@ -39,7 +39,7 @@ class SaveAt:
     keep_data : bool
         With ``stream_to``: return the result read back (True) or the outcome alone (False).
     max_points : int or None
-        The most output points a run may report (:data:`daeclear.options.MAX_OUTPUT_POINTS`), refused
+        The most output points a run may report (:data:`daeclear.core.options.MAX_OUTPUT_POINTS`), refused
         before the run with the estimated size. None: no cap.
     """
 
@@ -81,7 +81,7 @@ class SaveAt:
             times = OutputTimes(spacing=spacing, end=t_end, start=t0)
         path = None
         if self.stream_to is not None:
-            from .results.outputs import check_file
+            from ..results.outputs import check_file
 
             path = check_file(self.stream_to, f"{where}: save.stream_to")
         return Output(times=times, stream_to=path, keep_data=bool(self.keep_data), steps=bool(self.steps),

@@ -11,8 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from . import options
-from .options import fail
+from ..core import options
+from ..core.options import fail
 
 WHERE = "SolverOptions"
 
@@ -65,7 +65,7 @@ class SolverOptions:
     start : {"ideal", "declared"}
         The start without ``y0``: "ideal" (the chapter's, clearance joints centred) or "declared".
     allow_penetration : bool
-        Start even deeper in a wall than the physics checks allow (:mod:`daeclear.solvers.physics`).
+        Start even deeper in a wall than the physics checks allow (:mod:`daeclear.assembly.physics`).
     track_work : bool
         IDA only: integrate the work of drivers and contact forces (channel ``energy.work``).
     """
@@ -89,7 +89,7 @@ class SolverOptions:
         values = checked({f.name: getattr(self, f.name) for f in dataclasses.fields(self)}, where=where)
         for name, value in values.items():
             object.__setattr__(self, name, value)
-        from .solvers.registry import solver_class
+        from .registry import solver_class
 
         solver_class(self.method)().check(self)  # what the method takes: its solver's rule
 
@@ -101,7 +101,7 @@ class SolverOptions:
     def to_dict(self) -> dict[str, Any]:
         """Every setting as JSON types (``atol`` a float, a list, a mapping or None): :meth:`from_dict`
         inverts it."""
-        from .solvers.registry import method_path
+        from .registry import method_path
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         out["method"] = method_path(self.method)  # a class as its import path "module:Class"
         out["atol"] = self.atol_value()
@@ -137,9 +137,9 @@ class SolverOptions:
 
 
 def checked(values: Mapping[str, Any], *, where: str) -> dict[str, Any]:
-    """Every field of SolverOptions in ``values`` checked and normalised (:mod:`daeclear.options`);
+    """Every field of SolverOptions in ``values`` checked and normalised (:mod:`daeclear.core.options`);
     errors name ``where``."""
-    from .solvers.registry import method as method_rule
+    from .registry import method as method_rule
 
     method = method_rule(values["method"], where=where)
     raw = values["atol"]

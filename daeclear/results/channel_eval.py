@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 
 from ..assembly.assemble import DAEModel, assemble
 from ..engine.ida_session import open_session
-from ..errors import SceneError
+from ..core.errors import SceneError
 from ..model.scenefile import scene_from_description
 
 __all__ = ["ModelEvaluator", "evaluator_from_parameters", "rebuildable"]

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import AssemblyError, PhysicsWarning
+from ..core.errors import AssemblyError, PhysicsWarning
 
 KINDS: tuple[str, ...] = ("penetration", "initial_penetration", "initial_velocity", "constraint_drift",
                           "contact_within_one_step", "missed_contact")

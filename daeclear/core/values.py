@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import DaeclearWarning
+from .errors import DaeclearWarning
 
 __all__ = ["field_names", "readonly", "time_window", "to_plain"]
 

@@ -376,31 +376,3 @@ def per_revolution(value: Any, *, where: str = "sweep", field: str = "per_revolu
 def workers(value: Any, *, where: str = "sweep", field: str = "max_workers") -> int | None:
     """Worker processes: None (the CPU count) or an integer >= 1."""
     return None if value is None else integer(value, where=where, field=field, low=1)
-
-
-def restitution(value: Any, law: Any, *, where: str, field: str = "restitution") -> None:
-    """A restitution given explicitly must reach a law that has one (it is never dropped silently)."""
-    if value is None:
-        return
-    from .contact.base import NormalLaw
-    from .contact.registry import NORMAL_LAWS, normal_law_class
-
-    from .contact.registry import JOINT_LAWS
-
-    name = law.get("name") if isinstance(law, dict) else law if isinstance(law, str) else getattr(law, "name", None)
-    if name in JOINT_LAWS:
-        fail(where, field, value, "left out with a lubricated law (hydrodynamic), whose dry law has the restitution; "
-             "give it there, e.g. law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01, 'dry': "
-             "{'name': 'lankarani-nikravesh', 'restitution': 0.5}}")
-    if isinstance(law, dict):
-        fail(where, field, value, "left out when law is a table; give it in the table, e.g. "
-             "law={'name': 'hunt-crossley', 'restitution': 0.5}")
-    if isinstance(law, NormalLaw):
-        fail(where, field, value, f"left out when law is a law object ({type(law).__name__}); set it on the "
-             "law object instead")
-    cls = normal_law_class(str(law))
-    if "restitution" not in getattr(cls, "__dataclass_fields__", {}):
-        takes = [n for n, c in NORMAL_LAWS.items() if "restitution" in getattr(c, "__dataclass_fields__", {})]
-        fail(where, field, value, f"left out with law={law!r}, which has no coefficient of restitution "
-             f"(laws with one: {', '.join(takes)})")
-
