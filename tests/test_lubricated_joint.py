@@ -34,12 +34,15 @@ R, C, L, G = 0.01, 5.0e-5, 0.01, 9.81
 R_J = R - C  # the film forces take the journal's radius
 
 
-def journal(mu: float, omega: float, mass: float, **law: float | str) -> dc.Scene:
-    """A journal (centre of mass at its centre) in a bearing on the ground, under gravity, spinning at omega."""
+def journal(mu: float, omega: float, mass: float, driven: bool = False, **law: float | str) -> dc.Scene:
+    """A journal (centre of mass at its centre) in a bearing on the ground, under gravity, spinning at omega
+    (``driven``: kept at omega by a driver ``spin``, against the film's shear)."""
     scene = dc.Scene("journal", gravity=(0.0, -G))
     body = scene.add(dc.Body("journal", mass=mass, inertia=1e-4, position=(0.0, 0.0), angular_velocity=omega))
     scene.add(dc.RevoluteClearance("bearing", scene.ground, body, at=(0.0, 0.0), bearing_radius=R, clearance=C,
                                    material=STEEL, law=HydrodynamicBearing(viscosity=mu, length=L, **law)))
+    if driven:
+        scene.add(dc.Driver("spin", joint="bearing", speed=omega))
     return scene
 
 
@@ -53,15 +56,22 @@ def test_journal_settles_at_the_static_eccentricity_and_attitude_angle() -> None
     W = mass * G
     eps = brentq(lambda x: ocvirk_load(x, mu, omega) - W, 1e-6, 1 - 1e-9)
     attitude = math.atan(math.pi * math.sqrt(1 - eps**2) / (4 * eps))
-    run = dc.simulate(journal(mu, omega, mass), 0.4, rtol=1e-8)
+    run = dc.simulate(journal(mu, omega, mass, driven=True), 0.4, rtol=1e-8)
     assert run.success and not run.events  # the film carries throughout
     assert run["bearing.eccentricity_ratio"][-1] == pytest.approx(eps, rel=1e-6)
     angle = math.atan2(run["bearing.ey"][-1], run["bearing.ex"][-1]) + math.pi / 2  # from the load line (-y)
     assert angle == pytest.approx(attitude, rel=1e-6)
-    # the film's resultant is the load; pressure forces pass through the centre: the spin is kept
+    # the film's resultant is the load
     assert math.hypot(run["bearing.film_radial"][-1], run["bearing.film_tangential"][-1]) == pytest.approx(W, rel=1e-6)
-    assert run["journal.omega"][-1] == pytest.approx(omega, rel=1e-12)
     assert np.all(run["bearing.regime"] == 0.0)
+    # the journal's friction torque (Hamrock, Fundamentals of Fluid Film Lubrication, short bearing):
+    # Petroff's 2 pi mu R^3 L omega / (c sqrt(1 - eps^2)) plus e W sin(attitude) / 2; the driver supplies it
+    friction = (2 * math.pi * mu * R_J**3 * L * omega / (C * math.sqrt(1 - eps**2))
+                + C * eps * W * math.sin(attitude) / 2)
+    assert run["spin.moment"][-1] == pytest.approx(friction, rel=1e-6)
+    assert run["bearing.film_torque"][-1] == pytest.approx(-friction, rel=1e-6)
+    # the film's net power is its dissipation, here the driver's power: moment x omega
+    assert run["bearing.film_dissipation"][-1] == pytest.approx(friction * omega, rel=1e-6)
 
 
 def test_finite_bearing_settles_at_butenschoens_eccentricity_and_angle() -> None:
@@ -73,6 +83,7 @@ def test_finite_bearing_settles_at_butenschoens_eccentricity_and_angle() -> None
     body = scene.add(dc.Body("journal", mass=W / G, inertia=1e-4, position=(0.0, 0.0), angular_velocity=omega))
     scene.add(dc.RevoluteClearance("bearing", scene.ground, body, at=(0.0, 0.0), bearing_radius=R, clearance=C,
                                    material=STEEL, law=HydrodynamicBearing(viscosity=mu, length=R_J, theory="finite")))
+    scene.add(dc.Driver("spin", joint="bearing", speed=omega))  # against the film's shear
     run = dc.simulate(scene, 0.4, rtol=1e-8)
     assert run.success and not run.events
     assert run["bearing.eccentricity_ratio"][-1] == pytest.approx(0.8, rel=1e-5)
@@ -111,16 +122,17 @@ def test_pure_squeeze_fall_against_the_one_degree_of_freedom_solution() -> None:
 def breaking_run() -> dc.Result:
     """A film as thin as air's (1.8e-5 Pa s): it breaks, the journal hits the bearing dry, bounces, and
     the film forms again, a few times."""
-    return dc.simulate(journal(1.8e-5, 0.0, 2.0, film_threshold=2e-6, hysteresis=1.0), 0.03, rtol=1e-10,
+    return dc.simulate(journal(1.8e-5, 0.0, 2.0, roughness=2e-6, hysteresis=1.0), 0.03, rtol=1e-10,
                        options=dc.SolverOptions(track_work=True))
 
 
 def test_transitions_are_located_roots_with_hysteresis(breaking_run: dc.Result) -> None:
     run = breaking_run
-    kinds = [event.kind for event in run.events]
+    regime = run.events.of("bearing.regime")
+    kinds = [event.kind for event in regime]
     assert run.success and kinds[:2] == ["onset", "separation"] and len(kinds) >= 4
     assert all(a != b for a, b in zip(kinds, kinds[1:]))  # film and dry alternate
-    for event in run.events:
+    for event in regime:
         x, y = event.y[0], event.y[1]  # the journal body is (x, y, phi), its centre the joint point
         vx, vy = event.y[3], event.y[4]
         e = math.hypot(x, y)
@@ -134,6 +146,63 @@ def test_transitions_are_located_roots_with_hysteresis(breaking_run: dc.Result) 
     assert np.all(run["bearing.film_radial"][regime == 1.0] == 0.0)
     assert np.all(run["bearing.normal_force"][regime == 0.0] == 0.0)
     assert run["bearing.normal_force"].max() > 0.0  # a dry impact happened
+
+
+def lankarani_exit_speed(speed: float, mass: float, stiffness: float, restitution: float) -> float:
+    """The separation speed of a journal of ``mass`` hitting its bearing straight down at ``speed``
+    under gravity, by a 1-DOF integration of m delta'' = m g - K delta^1.5 (1 + 3 (1 - c_e^2) / 4
+    delta' / speed) (scipy): the Lankarani-Nikravesh law with the impact's own approach speed."""
+    h = 0.75 * (1 - restitution**2)
+
+    def rhs(t: float, x: np.ndarray) -> list[float]:
+        d, v = x
+        force = stiffness * max(d, 0.0) ** 1.5 * (1 + h * v / speed)
+        return [v, G - max(force, 0.0) / mass]
+
+    def out(t: float, x: np.ndarray) -> float:
+        return x[0] if t > 0 else 1.0
+    out.terminal, out.direction = True, -1  # type: ignore[attr-defined]
+    sol = solve_ivp(rhs, (0.0, 1.0), [0.0, speed], events=out, rtol=1e-12, atol=1e-16, method="LSODA")
+    return float(-sol.y_events[0][0][1])
+
+
+def test_every_dry_bounce_latches_its_own_approach_speed(breaking_run: dc.Result) -> None:
+    """After the film breaks the journal bounces on the bearing several times; each impact is an onset
+    whose approach speed is the journal's speed then (not the breakdown's), and each bounce leaves at
+    the speed the dry law gives for that impact alone."""
+    run = breaking_run
+    dry = [e for e in run.events if e.pair == "bearing"]
+    onsets = [e for e in dry if e.kind == "onset"]
+    assert len(onsets) >= 4 and [e.kind for e in dry[:2]] == ["onset", "separation"]
+    stiffness = journal(1.8e-5, 0.0, 2.0)["bearing"].resolved_law().dry.stiffness
+    checked = 0
+    for onset, separation in zip(dry[::2], dry[1::2]):
+        assert (onset.kind, separation.kind) == ("onset", "separation")
+        x, y, vx, vy = onset.y[0], onset.y[1], onset.y[3], onset.y[4]
+        assert onset.approach_speed == pytest.approx((x * vx + y * vy) / math.hypot(x, y), rel=1e-9)
+        assert abs(x) < 1e-9 * C  # straight down: the 1-DOF reference holds
+        expected = lankarani_exit_speed(onset.approach_speed, 2.0, stiffness, 0.9)
+        assert -separation.approach_speed == pytest.approx(expected, rel=1e-5)
+        checked += 1
+    assert checked >= 4
+    # between bounces in the dry regime the journal flies freely: it comes back at the speed it left with
+    in_dry = [(a, b) for a, b in zip(dry[1::2], dry[2::2]) if not any(a.t < e.t < b.t for e in run.events.of(
+        "bearing.regime"))]
+    assert in_dry
+    for left, back in in_dry:
+        assert back.approach_speed == pytest.approx(-left.approach_speed, rel=1e-6)
+
+
+def test_the_film_breaks_and_forms_again(breaking_run: dc.Result) -> None:
+    """The film re-forms when the gap opens past the band (a located root) and carries again after it."""
+    run = breaking_run
+    reformed = run.events.of("bearing.regime", kind="separation")
+    assert len(reformed) >= 2
+    regime = run["bearing.regime"]
+    for event in reformed:
+        after = np.searchsorted(run.t, event.t, side="right")
+        assert regime[after] == 0.0 and run["bearing.film_radial"][after] != 0.0
+        assert run["bearing.in_contact"][after] == 0.0
 
 
 def test_energy_balance_with_film_dissipation(breaking_run: dc.Result) -> None:
@@ -156,9 +225,11 @@ def test_slider_crank_with_a_lubricated_joint_runs() -> None:
 
 
 def test_bad_lubricated_joints() -> None:
-    with pytest.raises(dc.SceneError, match=r"film_threshold \* \(1 \+ hysteresis\)=0.0001 m, must be < the radial "
-                                            r"clearance 5e-05 m"):
-        dc.assemble(journal(0.01, 10.0, 1.0, film_threshold=5e-5))
+    with pytest.raises(dc.SceneError, match=r"film_parameter \* roughness \* \(1 \+ hysteresis\)=5.4e-05 m, must be "
+                                            r"< the radial clearance 5e-05 m"):
+        dc.assemble(journal(0.01, 10.0, 1.0, film_parameter=3.0, roughness=6e-6, hysteresis=2.0))
+    with pytest.raises(dc.SceneError, match=r"roughness=1e-05 m, must be < the radial clearance / 8"):
+        dc.assemble(journal(0.01, 10.0, 1.0, roughness=1e-5, film_parameter=0.5, hysteresis=0.5))
     with pytest.raises(dc.SceneError, match="must be a normal contact law"):
         dc.assemble(slider_crank("translational", law=HydrodynamicBearing(viscosity=0.01, length=0.01)))
 
@@ -215,7 +286,7 @@ def test_example_lubricated_joint_quick(tmp_path) -> None:
 def test_command_line_with_a_lubricant(tmp_path) -> None:
     from daeclear.cli import main
 
-    law = "law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01, 'film_threshold': 2e-6}"
+    law = "law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01, 'roughness': 2e-6}"
     assert main(["run", "slider_crank", "--joint", "revolute", "--set", law, "--t-end", "0.003", "--out",
                  str(tmp_path), "--no-figure", "--quiet"]) == 0
     result = dc.load(tmp_path / "slider_crank_revolute.h5")
@@ -313,3 +384,23 @@ def test_a_spinning_bearing_carries_the_journal_like_a_spinning_journal(w_bearin
     assert angle == pytest.approx(attitude, rel=1e-6)
     assert run["ring.omega"][-1] == pytest.approx(w_bearing, abs=1e-9)
     assert run["journal.omega"][-1] == pytest.approx(w_journal, abs=1e-9)
+
+
+def test_example_viscosity_study_quick(tmp_path) -> None:
+    """The viscosity study's script: its table and figure; a thick oil carries the joint below the dry
+    joint's peak force, a thin one breaks down."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "lubricated_viscosity_study.py"
+    spec = importlib.util.spec_from_file_location("example_viscosity_study", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    lines = module.main(["--quick", "--out", str(tmp_path)])
+    assert (tmp_path / "viscosity_study.png").stat().st_size > 5_000
+    rows = [[cell.strip() for cell in line.strip("|").split("|")] for line in lines[2:]]
+    for c in ("0.1", "0.5"):
+        dry = next(float(r[2]) for r in rows if r[0] == c and r[1] == "dry")
+        thick = next(r for r in rows if r[0] == c and r[1] == "0.1")
+        assert float(thick[2]) < dry and thick[4] == "0"
+        assert int(next(r for r in rows if r[0] == c and r[1] == "0.001")[4]) >= 1

@@ -174,27 +174,57 @@ def test_hertz_needs_the_modulus():
         wear_increment(ArchardWear(coefficient=K, length=L, distribution="hertz"), h, bearing_radius=R, clearance=C)
 
 
+def _kinematics(result, s_i, s_j, r_i, r_j, bearing, journal):
+    """The contact kinematics of a journal in its bearing computed in numpy from the bodies' states,
+    apart from the generated model: n = e / |e| (4.4), contact points P + R n (4.6), the tangential
+    component of v_Qj - v_Qi with each body's spin (4.9), n's angle in each body's frame."""
+    def body(name):
+        return (np.stack([result[f"{name}.x"], result[f"{name}.y"]], axis=1), np.asarray(result[f"{name}.phi"]),
+                np.stack([result[f"{name}.vx"], result[f"{name}.vy"]], axis=1), np.asarray(result[f"{name}.omega"]))
+
+    def rotate(angle, point):
+        c, s_ = np.cos(angle), np.sin(angle)
+        return np.stack([c * point[0] - s_ * point[1], s_ * point[0] + c * point[1]], axis=1)
+
+    def cross(omega, r):
+        return np.stack([-omega * r[:, 1], omega * r[:, 0]], axis=1)
+
+    (x_i, phi_i, v_i, w_i), (x_j, phi_j, v_j, w_j) = body(bearing), body(journal)
+    arm_i, arm_j = rotate(phi_i, s_i), rotate(phi_j, s_j)
+    e = (x_j + arm_j) - (x_i + arm_i)
+    n = e / np.maximum(np.hypot(e[:, 0], e[:, 1]), 1e-300)[:, None]
+    tangent = np.stack([-n[:, 1], n[:, 0]], axis=1)
+    slip = np.sum((v_j + cross(w_j, arm_j + r_j * n) - v_i - cross(w_i, arm_i + r_i * n)) * tangent, axis=1)
+    direction = np.arctan2(n[:, 1], n[:, 0])
+    return slip, direction - phi_i, direction - phi_j
+
+
 def test_the_history_of_a_run_matches_the_joint_s_own_channels():
-    """wear_history recomputes the sliding speed and the penetration in numpy from the bodies' states:
-    they equal the generated model's channels (with friction, sliding_velocity is one)."""
+    """wear_history reads the worn joint's generated channels: the sliding speed and the contact
+    directions equal an independent numpy computation from the bodies' states, the penetration and the
+    force the joint's channels."""
     import daeclear as dc
     from daeclear.studies.wear import wear_history
 
-    model = dc.assemble(dc.mechanisms.slider_crank("revolute", friction=0.05))
+    scene = dc.mechanisms.slider_crank("revolute", friction=0.05).with_values(
+        {"clearance.wear": ArchardWear(coefficient=K, length=L)})
+    model = dc.assemble(scene)
     result = dc.simulate(model, 0.006, save=dc.SaveAt(times=np.linspace(0, 0.006, 601)))
     h = wear_history(result, model, "clearance")
     contact = result["clearance.in_contact"] > 0
     assert contact.sum() > 20
     off_centre = result["clearance.eccentricity"] > 0  # the start is centred: no direction there
     assert off_centre[1:].all()
-    np.testing.assert_allclose(h.slip_speed[off_centre], result["clearance.sliding_velocity"][off_centre], rtol=1e-9,
-                               atol=1e-12)
+    joint = scene["clearance"]
+    slip, bearing, journal = _kinematics(result, model.parameter("clearance.s_i"), model.parameter("clearance.s_j"),
+                                         joint.bearing_radius, joint.journal, "slider", "rod")
+    np.testing.assert_allclose(h.slip_speed[off_centre], slip[off_centre], rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(h.penetration[contact], result["clearance.penetration"][contact], rtol=1e-9, atol=1e-15)
-    direction = np.arctan2(result["clearance.ey"], result["clearance.ex"])
-    for angle, body in ((h.angle_bearing, "slider"), (h.angle_journal, "rod")):
-        world = angle + result[f"{body}.phi"]
-        np.testing.assert_allclose(np.cos(world[off_centre]), np.cos(direction[off_centre]), atol=1e-12)
-        np.testing.assert_allclose(np.sin(world[off_centre]), np.sin(direction[off_centre]), atol=1e-12)
+    for angle, reference in ((h.angle_bearing, bearing), (h.angle_journal, journal)):
+        np.testing.assert_allclose(np.cos(angle[off_centre]), np.cos(reference[off_centre]), atol=1e-12)
+        np.testing.assert_allclose(np.sin(angle[off_centre]), np.sin(reference[off_centre]), atol=1e-12)
+        assert np.max(np.abs(np.diff(angle[off_centre]))) < np.pi  # unwrapped
     assert np.array_equal(h.force, result["clearance.normal_force"])
-    with pytest.raises(SceneError, match="joint='B', must be a revolute clearance joint of the run \\(clearance\\)"):
+    with pytest.raises(SceneError, match="joint=.B., must be a revolute clearance joint with wear of the run "
+                                         ".clearance."):
         wear_history(result, model, "B")

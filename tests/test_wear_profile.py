@@ -217,3 +217,52 @@ def test_spread_in_passes_equals_one_pass(monkeypatch):
     monkeypatch.setattr(wear, "SPREAD_SAMPLES", 1000)  # passes of a handful of contacts
     np.testing.assert_allclose(wear.spread(centres, halves, loads, NODES), whole, rtol=1e-12, atol=1e-24)
     assert whole.sum() == pytest.approx(loads.sum(), rel=1e-12, abs=0.0)
+
+
+def _planted_block() -> tuple[dc.DAEModel, float, np.ndarray, float]:
+    """The block that let the journal through its wall (issue 44): examples/joint_wear.py's scene at
+    k = 1e-12, every cycle simulated, its profile and state after 911 cycles (tests/data)."""
+    from pathlib import Path
+
+    from daeclear.studies.poincare import crank_period
+
+    data = np.load(Path(__file__).resolve().parent / "data" / "worn_block_912.npz")
+    scene = dc.mechanisms.slider_crank("revolute", friction=0.1).with_values(
+        {"clearance.wear": ArchardWear(coefficient=1e-12, length=0.02)})
+    model = dc.assemble(scene).with_parameters({"clearance.wear_depth": tuple(data["depth"].tolist())})
+    return model, float(data["t0"]), data["y0"], crank_period(scene)
+
+
+def test_a_worn_contact_is_never_left_while_it_penetrates():
+    """The planted block: its journal slides along a steep worn flank where |e| falls while the gap
+    (|e| - c - h) grows. Every onset has a positive approach speed, which is the gap's own rate (a
+    central difference of the penetration channel along the motion), no separation follows an onset at
+    the same instant, and the penetration stays a contact's (it went 75 mm through the wall before)."""
+    model, t0, y0, period = _planted_block()
+    run = dc.simulate(model, t0 + period, t0=t0, y0=y0)
+    assert run.success
+    penetration = run["clearance.penetration"]
+    assert 0.0 < penetration.max() < 0.1 * CLEARANCE
+    events = list(run.events)
+    assert len(events) > 4
+    for before, after in zip(events, events[1:]):
+        assert after.t - before.t > 1e-9 or before.kind == after.kind
+    n_q, h = model.n_q, 1e-9
+    for event in events:
+        assert (event.approach_speed > 0) == (event.kind == "onset")
+        moved = np.array([event.y, event.y])  # the state moved along its velocity: q -+ h v
+        moved[0, :n_q] -= h * event.y[n_q:2 * n_q]
+        moved[1, :n_q] += h * event.y[n_q:2 * n_q]
+        pen = model.channels(np.full(2, event.t), moved, np.zeros_like(moved))["clearance.penetration"]
+        assert event.approach_speed == pytest.approx((pen[1] - pen[0]) / (2 * h), rel=1e-4, abs=1e-6)
+
+
+def test_an_unphysical_block_ends_the_wear_history():
+    """A block whose run leaves the journal deeper in the wall than the clearance, or whose next start
+    cannot be assembled, ends simulate_wear early with a warning, as documented (a stand-in: a block
+    run with a law 1e6 times softer)."""
+    scene = dc.mechanisms.slider_crank("revolute", friction=0.1).with_values(
+        {"clearance.wear": ArchardWear(coefficient=1e-13, length=0.02), "clearance.law.stiffness": 1e4})
+    with pytest.warns(dc.PhysicsWarning, match="stopped at 0 cycles"):
+        history = simulate_wear(scene, 3)
+    assert history.cycles.tolist() == [0.0] and "clearance" in history.message
