@@ -298,22 +298,34 @@ def test_command_line_with_a_lubricant(tmp_path) -> None:
 #
 # Reynolds' equation in the frame of the line of centres (turning at dgamma/dt): the surfaces slide at
 # R (w_journal - dgamma/dt) and R (w_bearing - dgamma/dt), and the pressure's wedge term is their sum,
-# so the film force is the journal's alone at the wedge rate w = w_journal + w_bearing - 2 dgamma/dt.
+# so the film's pressure force is the journal's alone at the wedge rate w = w_journal + w_bearing - 2 dgamma/dt.
 # Hence: a bearing spinning under a still journal carries it as a journal spinning at the same rate in a
 # still bearing; both spinning with the centres still, twice the rate; spinning against each other, no
 # wedge; the whole joint turning rigidly (centres included), no film force at all; and the mirror image
 # of a spin (-w) mirrors the attitude.
+#
+# The film's shear (issue 44) acts apart from the pressure: the wall shear mu (U_b - U_j) / h - (h / 2)
+# dp/(R dtheta) gives the journal, about its centre, Petroff's Couette torque -2 pi mu R^3 L (w_journal -
+# w_bearing) / (c sqrt(1 - eps^2)), which follows the surfaces' *difference*, plus the Poiseuille torque
+# -(e / 2) F_t of the pressure (Hamrock, Fundamentals of Fluid Film Lubrication, short bearing); the
+# bearing gets +Couette - (e / 2) F_t, so that the film's moments about the bearing's centre balance.
 
 
-def ring(mu: float, w_bearing: float, w_journal: float, mass: float, gravity: float = G) -> dc.Scene:
+def ring(mu: float, w_bearing: float, w_journal: float, mass: float, gravity: float = G,
+         driven: bool = False) -> dc.Scene:
     """A bearing ring pinned to the ground at its centre and spinning at w_bearing; a journal (centre of
-    mass at its centre) spinning at w_journal inside it, under gravity."""
+    mass at its centre) spinning at w_journal inside it, under gravity (``driven``: the ring kept at
+    w_bearing by the driver ``ring_spin`` on the pivot, the journal at w_journal by ``journal_spin`` on
+    the clearance joint, at the relative speed w_journal - w_bearing, against the film's shear)."""
     scene = dc.Scene("ring", gravity=(0.0, -gravity))
     bearing = scene.add(dc.Body("ring", mass=1.0, inertia=1e-4, angular_velocity=w_bearing))
     scene.add(dc.Revolute("pivot", scene.ground, bearing, at=(0.0, 0.0)))
     body = scene.add(dc.Body("journal", mass=mass, inertia=1e-4, angular_velocity=w_journal))
     scene.add(dc.RevoluteClearance("bearing", bearing, body, at=(0.0, 0.0), bearing_radius=R, clearance=C,
                                    material=STEEL, law=HydrodynamicBearing(viscosity=mu, length=L)))
+    if driven:
+        scene.add(dc.Driver("ring_spin", joint="pivot", speed=w_bearing))
+        scene.add(dc.Driver("journal_spin", joint="bearing", speed=w_journal - w_bearing))
     return scene
 
 
@@ -325,20 +337,28 @@ def ocvirk_force(eps: float, mu: float, omega: float) -> tuple[float, float]:
             math.pi * mu * omega * R_J * L**3 * eps / (4 * C**2 * q**1.5))
 
 
+def petroff_torque(eps: float, mu: float, relative_speed: float) -> float:
+    """Petroff's Couette torque of the whole film, 2 pi mu R^3 L (w_journal - w_bearing) / (c sqrt(1 - eps^2))."""
+    return 2 * math.pi * mu * R_J**3 * L * relative_speed / (C * math.sqrt(1 - eps**2))
+
+
 @pytest.mark.parametrize("angle", [-math.pi / 2, 0.7])
 def test_film_force_of_the_two_surfaces_rotations(angle: float) -> None:
-    """One state each, the journal's film force against the closed form at the wedge rate the two
-    rotations make (centres still unless said)."""
+    """One state each, the film's pressure force on the journal against the closed form at the wedge rate
+    the two rotations make (centres still unless said), and its shear torques on the journal and the
+    bearing against Petroff's torque of the surfaces' difference plus the pressure's -(e/2) F_t."""
     mu, omega, eps = 0.01, 200.0, 0.6
     model = dc.assemble(ring(mu, 0.0, 0.0, 1.0, gravity=0.0))
     names = model.state_names
     n = np.array([math.cos(angle), math.sin(angle)])
     t = np.array([-n[1], n[0]])
     journal = [names.index(f"journal.{k}") for k in ("x", "y", "phi")]
+    bearing = [names.index(f"ring.{k}") for k in ("x", "y", "phi")]
     film = [i for i, term in enumerate(model.terms) if term.name == "bearing.film"]
     assert len(film) == 1
 
-    def force(w_bearing: float, w_journal: float, centre_velocity=(0.0, 0.0)) -> np.ndarray:
+    def forces(w_bearing: float, w_journal: float, centre_velocity=(0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+        """The film's generalized forces (x, y, phi) on the journal and on the ring."""
         y = np.zeros(model.n_states)
         y[names.index("journal.x")], y[names.index("journal.y")] = eps * C * n
         y[names.index("journal.vx")], y[names.index("journal.vy")] = centre_velocity
@@ -346,44 +366,72 @@ def test_film_force_of_the_two_surfaces_rotations(angle: float) -> None:
         active = [i == film[0] for i in range(len(model.terms))]
         params = [np.zeros(term.n_params) if i == film[0] else np.ones(term.n_params)
                   for i, term in enumerate(model.terms)]
-        return model.term_forces(0.0, y, active, params)[journal]
+        total = model.term_forces(0.0, y, active, params)
+        return total[journal], total[bearing]
 
-    def closed_form(wedge: float) -> np.ndarray:
+    def closed_form(w_bearing: float, w_journal: float) -> tuple[np.ndarray, float, float]:
+        """The pressure force on the journal and the shear torques (journal, bearing) about each centre."""
+        wedge = w_bearing + w_journal
         F_r, F_t = ocvirk_force(eps, mu, abs(wedge))
-        return np.array([*(-F_r * n + math.copysign(F_t, wedge) * t), 0.0])  # through the centre: no moment
+        F_t = math.copysign(F_t, wedge)
+        couette = petroff_torque(eps, mu, w_journal - w_bearing)
+        poiseuille = -0.5 * eps * C * F_t
+        return -F_r * n + F_t * t, -couette + poiseuille, couette + poiseuille
 
     scale = math.hypot(*ocvirk_force(eps, mu, omega))
-    check = lambda got, wedge: np.testing.assert_allclose(got, closed_form(wedge), rtol=0, atol=1e-6 * scale)  # noqa: E731
-    check(force(0.0, omega), omega)  # the journal spins
-    check(force(omega, 0.0), omega)  # the bearing spins: the same force
-    check(force(-omega, 0.0), -omega)  # the mirror image: the tangential part reversed
-    check(force(omega, omega), 2 * omega)  # both, centres still: twice the wedge
-    check(force(omega, -omega), 0.0)  # against each other: no wedge
-    np.testing.assert_allclose(force(omega, -omega), 0.0, atol=1e-9 * scale)
+    torque_scale = petroff_torque(eps, mu, omega)
+
+    def check(w_bearing: float, w_journal: float) -> None:
+        (*f_j, m_j), (*f_b, m_b) = forces(w_bearing, w_journal)
+        force, torque_j, torque_b = closed_form(w_bearing, w_journal)
+        # the pressure's resultant passes through the two centres, equal and opposite on the two bodies
+        np.testing.assert_allclose(f_j, force, rtol=0, atol=1e-6 * scale)
+        np.testing.assert_allclose(f_b, -force, rtol=0, atol=1e-6 * scale)
+        np.testing.assert_allclose([m_j, m_b], [torque_j, torque_b], rtol=0, atol=1e-6 * torque_scale)
+        # the film is internal: its moments about the bearing's centre (the journal's centre at e = eps c n) balance
+        moment = m_j + m_b + eps * C * (n[0] * f_j[1] - n[1] * f_j[0])
+        assert abs(moment) < 1e-9 * torque_scale
+
+    check(0.0, omega)  # the journal spins
+    check(omega, 0.0)  # the bearing spins: the same pressure force (the shear's Couette part reversed)
+    check(-omega, 0.0)  # the mirror image: the tangential part reversed
+    check(omega, omega)  # both, centres still: twice the wedge, no Couette shear
+    check(omega, -omega)  # against each other: no wedge, twice the Couette shear
+    f_j, f_b = forces(omega, -omega)
+    np.testing.assert_allclose(f_j[:2], 0.0, atol=1e-9 * scale)
+    np.testing.assert_allclose(f_b[:2], 0.0, atol=1e-9 * scale)
     # the whole joint turning rigidly at omega (the journal's centre too): no relative motion, no film
-    rigid = force(omega, omega, omega * eps * C * t)
-    assert np.max(np.abs(rigid)) < 1e-6 * scale  # (the film's regularisation leaves 1e-8 eps^-2)
+    rigid_j, rigid_b = forces(omega, omega, omega * eps * C * t)
+    assert max(np.max(np.abs(rigid_j[:2])), np.max(np.abs(rigid_b[:2]))) < 1e-6 * scale  # (the film's
+    assert max(abs(rigid_j[2]), abs(rigid_b[2])) < 1e-6 * torque_scale  # regularisation leaves 1e-8 eps^-2)
 
 
 @pytest.mark.parametrize("w_bearing, w_journal, wedge", [(200.0, 0.0, 200.0), (-200.0, 0.0, -200.0),
                                                          (200.0, 200.0, 400.0)])
 def test_a_spinning_bearing_carries_the_journal_like_a_spinning_journal(w_bearing: float, w_journal: float,
                                                                           wedge: float) -> None:
-    """The ring spins (a journal that does not turn inside it): the journal settles at Ocvirk's static
-    eccentricity and attitude angle of the wedge rate w_bearing + w_journal, measured from the load line
-    in the sense of that rate (mirrored for -200 rad/s); the spins are kept (the film's forces pass
-    through the centres)."""
+    """The ring spins (a journal that does not turn inside it, or turns with it), both kept at their
+    speeds by drivers against the film's shear: the journal settles at Ocvirk's static eccentricity and
+    attitude angle of the wedge rate w_bearing + w_journal, measured from the load line in the sense of
+    that rate (mirrored for -200 rad/s). The drivers' moments: the journal's balances the film's shear
+    torque on it, Petroff's of the relative speed plus (e/2) F_t = W e_x / 2 (the film carries the weight:
+    F_t = W sin(attitude)); the ring's balances gravity's moment about the pivot, W e_x (statics of the
+    whole: the film is internal)."""
     mu, mass = 0.01, 4.675
     W = mass * G
     eps = brentq(lambda x: ocvirk_load(x, mu, abs(wedge)) - W, 1e-6, 1 - 1e-9)
     attitude = math.copysign(math.atan(math.pi * math.sqrt(1 - eps**2) / (4 * eps)), wedge)
-    run = dc.simulate(ring(mu, w_bearing, w_journal, mass), 0.4, rtol=1e-8)
+    run = dc.simulate(ring(mu, w_bearing, w_journal, mass, driven=True), 0.4, rtol=1e-8)
     assert run.success and not run.events
     assert run["bearing.eccentricity_ratio"][-1] == pytest.approx(eps, rel=1e-6)
     angle = math.atan2(run["bearing.ey"][-1], run["bearing.ex"][-1]) + math.pi / 2  # from the load line (-y)
     assert angle == pytest.approx(attitude, rel=1e-6)
     assert run["ring.omega"][-1] == pytest.approx(w_bearing, abs=1e-9)
     assert run["journal.omega"][-1] == pytest.approx(w_journal, abs=1e-9)
+    e_x = eps * C * math.sin(attitude)  # the journal's centre, right of the load line for a positive rate
+    journal_moment = petroff_torque(eps, mu, w_journal - w_bearing) + W * e_x / 2
+    assert run["journal_spin.moment"][-1] == pytest.approx(journal_moment, rel=1e-6)
+    assert run["ring_spin.moment"][-1] == pytest.approx(W * e_x, rel=1e-6)
 
 
 def test_example_viscosity_study_quick(tmp_path) -> None:
