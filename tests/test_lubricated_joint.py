@@ -118,11 +118,17 @@ def test_pure_squeeze_fall_against_the_one_degree_of_freedom_solution() -> None:
     np.testing.assert_allclose(run["bearing.film_tangential"], 0.0, atol=1e-9)
 
 
+#: The breaking run's journal (kg). The asperities carry 68 N at the breakdown (Lambda = 1, roughness
+#: 2 um): a 2 kg journal (19.6 N) comes to rest on them after three bounces; a 5 kg one (49 N) goes on
+#: breaking through, bouncing dry several times in one dry regime and the film forming again between.
+BREAKING_MASS = 5.0
+
+
 @pytest.fixture(scope="module")
 def breaking_run() -> dc.Result:
     """A film as thin as air's (1.8e-5 Pa s): it breaks, the journal hits the bearing dry, bounces, and
     the film forms again, a few times."""
-    return dc.simulate(journal(1.8e-5, 0.0, 2.0, roughness=2e-6, hysteresis=1.0), 0.03, rtol=1e-10,
+    return dc.simulate(journal(1.8e-5, 0.0, BREAKING_MASS, roughness=2e-6, hysteresis=1.0), 0.03, rtol=1e-10,
                        options=dc.SolverOptions(track_work=True))
 
 
@@ -174,14 +180,14 @@ def test_every_dry_bounce_latches_its_own_approach_speed(breaking_run: dc.Result
     dry = [e for e in run.events if e.pair == "bearing"]
     onsets = [e for e in dry if e.kind == "onset"]
     assert len(onsets) >= 4 and [e.kind for e in dry[:2]] == ["onset", "separation"]
-    stiffness = journal(1.8e-5, 0.0, 2.0)["bearing"].resolved_law().dry.stiffness
+    stiffness = journal(1.8e-5, 0.0, BREAKING_MASS)["bearing"].resolved_law().dry.stiffness
     checked = 0
     for onset, separation in zip(dry[::2], dry[1::2]):
         assert (onset.kind, separation.kind) == ("onset", "separation")
         x, y, vx, vy = onset.y[0], onset.y[1], onset.y[3], onset.y[4]
         assert onset.approach_speed == pytest.approx((x * vx + y * vy) / math.hypot(x, y), rel=1e-9)
         assert abs(x) < 1e-9 * C  # straight down: the 1-DOF reference holds
-        expected = lankarani_exit_speed(onset.approach_speed, 2.0, stiffness, 0.9)
+        expected = lankarani_exit_speed(onset.approach_speed, BREAKING_MASS, stiffness, 0.9)
         assert -separation.approach_speed == pytest.approx(expected, rel=1e-5)
         checked += 1
     assert checked >= 4
@@ -432,6 +438,100 @@ def test_a_spinning_bearing_carries_the_journal_like_a_spinning_journal(w_bearin
     journal_moment = petroff_torque(eps, mu, w_journal - w_bearing) + W * e_x / 2
     assert run["journal_spin.moment"][-1] == pytest.approx(journal_moment, rel=1e-6)
     assert run["ring_spin.moment"][-1] == pytest.approx(W * e_x, rel=1e-6)
+
+
+# ---------------------------------------------------------------- the mixed regime (issue 44)
+#
+# Below a film parameter h_min / sigma of 4 the asperities touch and carry a share of the load with the film
+# (Greenwood and Tripp 1970): mean pressure K E' F_5/2(h / sigma), K = 16 pi sqrt(2) / 15 (eta sigma beta)^2
+# sqrt(sigma / beta) with eta sigma beta = 0.04, sigma / beta = 1e-3, and Hu et al.'s (1994) fit F_5/2(x) =
+# 4.4086e-5 (4 - x)^6.804; E' the composite modulus, 1 / E' = 2 (1 - nu^2) / E for two steel surfaces. The
+# load is that pressure over the journal's length and arc, along the line of centres.
+
+SIGMA = 1e-6  # the default composite roughness, m
+E_COMPOSITE = 1.0 / (2 * (1 - 0.3**2) / 207e9)
+
+
+def greenwood_tripp(film_parameter: float) -> float:
+    """The mean asperity pressure (Pa) at h / sigma (written here from the sources)."""
+    k = 16 * math.pi * math.sqrt(2) / 15 * 0.04**2 * math.sqrt(1e-3)
+    return k * E_COMPOSITE * 4.4086e-5 * max(4.0 - film_parameter, 0.0) ** 6.804
+
+
+def asperity_reference(eps: float, parabolic: bool) -> float:
+    """The asperities' load (N) by quadrature over the arc where h < 4 sigma: the exact film h = c (1 -
+    eps cos phi) projected on the line of centres, or (``parabolic``) the film near its minimum, h = c (1 -
+    eps) + c eps phi^2 / 2, unprojected (the model's closed form takes that one)."""
+    from scipy.integrate import quad
+
+    if parabolic:
+        edge = math.sqrt(2 * (4 * SIGMA - C * (1 - eps)) / (C * eps))
+        pressure = lambda phi: greenwood_tripp((C * (1 - eps) + C * eps * phi**2 / 2) / SIGMA)  # noqa: E731
+    else:
+        edge = math.acos((1 - 4 * SIGMA / C) / eps)
+        pressure = lambda phi: greenwood_tripp(C * (1 - eps * math.cos(phi)) / SIGMA) * math.cos(phi)  # noqa: E731
+    return L * R_J * quad(pressure, -edge, edge, epsabs=0.0, epsrel=1e-12, limit=200)[0]
+
+
+def test_asperities_carry_their_share_in_the_mixed_regime() -> None:
+    """One state each at h_min = 2 sigma (the mixed regime: the film still on, Lambda = 1 breaks it): a
+    journal at rest feels the asperities' load alone, towards the bearing's centre; a spinning one
+    Ocvirk's film force plus that load, and the film's shear torque (the asperities' friction is not
+    modelled)."""
+    mu, omega, eps = 0.01, 200.0, 1 - 2 * SIGMA / C
+    load = asperity_reference(eps, parabolic=True)
+    # the closed form's parabolic film against the exact one: the arc's half-width ~0.2 rad
+    assert load == pytest.approx(asperity_reference(eps, parabolic=False), rel=2e-3)
+    assert load > 1.0  # a real share (N)
+    model = dc.assemble(journal(mu, 0.0, 1.0))
+    names = model.state_names
+    film = [i for i, term in enumerate(model.terms) if term.name == "bearing.film"]
+    coordinates = [names.index(f"journal.{k}") for k in ("x", "y", "phi")]
+    angle = 0.7
+    n = np.array([math.cos(angle), math.sin(angle)])
+    t = np.array([-n[1], n[0]])
+
+    def force(w_journal: float) -> np.ndarray:
+        y = np.zeros(model.n_states)
+        y[names.index("journal.x")], y[names.index("journal.y")] = eps * C * n
+        y[names.index("journal.omega")] = w_journal
+        active = [i == film[0] for i in range(len(model.terms))]
+        params = [np.zeros(term.n_params) if i == film[0] else np.ones(term.n_params)
+                  for i, term in enumerate(model.terms)]
+        return model.term_forces(0.0, y, active, params)[coordinates]
+
+    # (the film's regularisation moves h_min by c (1e-4)^2 / (2 eps) ~ 3e-13 m: 1e-6 of the load)
+    np.testing.assert_allclose(force(0.0), [*(-load * n), 0.0], rtol=0, atol=1e-5 * load)
+    F_r, F_t = ocvirk_force(eps, mu, omega)
+    torque = -petroff_torque(eps, mu, omega) - 0.5 * eps * C * F_t
+    got = force(omega)
+    np.testing.assert_allclose(got[:2], -(F_r + load) * n + F_t * t, rtol=0, atol=1e-6 * math.hypot(F_r, F_t))
+    assert got[2] == pytest.approx(torque, rel=1e-6)
+
+
+def test_a_driven_journal_settles_where_film_and_asperities_carry_its_weight() -> None:
+    """A heavy journal kept at 20 rad/s settles in the mixed regime: Ocvirk's film force plus the
+    asperities' load along the line of centres balance its weight, |(F_r + W_a) n - F_t t| = W, at the
+    attitude tan(phi) = F_t / (F_r + W_a); the driver supplies the film's shear torque, Petroff's plus
+    (e/2) F_t = W e_x / 2."""
+    mu, omega, mass = 0.01, 20.0, 12.7
+    W = mass * G
+
+    def carried(eps: float) -> tuple[float, float]:
+        F_r, F_t = ocvirk_force(eps, mu, omega)
+        return F_r + (asperity_reference(eps, parabolic=True) if C * (1 - eps) < 4 * SIGMA else 0.0), F_t
+
+    eps = brentq(lambda x: math.hypot(*carried(x)) - W, 0.5, 1 - 1.01 * SIGMA / C, xtol=1e-15, rtol=1e-15)
+    radial, tangential = carried(eps)
+    assert 1.0 < C * (1 - eps) / SIGMA < 4.0 and radial - ocvirk_force(eps, mu, omega)[0] > 0.01 * W  # mixed
+    run = dc.simulate(journal(mu, omega, mass, driven=True), 0.4, rtol=1e-8)
+    assert run.success and not run.events
+    assert run["bearing.eccentricity_ratio"][-1] == pytest.approx(eps, rel=1e-6)
+    angle = math.atan2(run["bearing.ey"][-1], run["bearing.ex"][-1]) + math.pi / 2  # from the load line (-y)
+    assert angle == pytest.approx(math.atan2(tangential, radial), rel=1e-6)
+    assert run["bearing.asperity_force"][-1] == pytest.approx(radial - ocvirk_force(eps, mu, omega)[0], rel=1e-5)
+    e_x = eps * C * tangential / W
+    assert run["spin.moment"][-1] == pytest.approx(petroff_torque(eps, mu, omega) + W * e_x / 2, rel=1e-6)
 
 
 def test_example_viscosity_study_quick(tmp_path) -> None:

@@ -175,7 +175,7 @@ class HydrodynamicBearing:
             if materials is None:
                 raise SceneError(f"{type(self).__name__}: asperity_modulus=None and the joint has no material; "
                                  "give the joint's material or asperity_modulus (Pa).")
-            modulus = 1.0 / (math.pi * sigma_sum(materials))  # sigma = (1 - nu^2) / (pi E), eq. (3.4)
+            modulus = 1.0 / sigma_sum(materials)  # 1/E' = sum (1 - nu^2) / E (Material.sigma, no pi)
         return dataclasses.replace(self, dry=dry, asperity_modulus=modulus)
 
     def joint_problems(self, clearance: float, journal_radius: float) -> list[str]:
