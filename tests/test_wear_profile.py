@@ -82,6 +82,43 @@ def test_impact_at_a_worn_spot_comes_when_kinematics_says(surface):
         == pytest.approx(CLEARANCE / SPEED, rel=1e-6)  # the unworn side: the nominal clearance
 
 
+@pytest.mark.parametrize("surface", ["bearing", "journal", "both"])
+def test_a_worn_contacts_force_is_its_law_at_the_gaps_own_rate_along_the_gaps_gradient(surface):
+    """One state on a worn flank, the journal sliding along it and turning: the contact's generalized
+    force is -F_N grad_q(delta) (frictionless: the virtual work of F_N on the gap), F_N the
+    Lankarani-Nikravesh force K delta^1.5 (1 + 3 (1 - c_e^2) / 4 delta' / v-) at the gap's own rate
+    delta' = grad_q(delta) . v, the gap and its gradient by central differences of the penetration
+    channel (so d|e|/dt alone, or a force along e alone, would be off by the profile's slope)."""
+    direction, turned, approach = 0.3, 0.5, 0.1
+    bearing, journal = _bump(direction + 0.15), _bump(direction - turned + 0.15, depth=25e-6)
+    depth = {"bearing": bearing, "journal": journal, "both": np.array([bearing, journal])}[surface]
+    model = dc.assemble(flight(direction, surface=surface, depth=depth, journal_angle=turned))
+    n_q = model.n_q
+    y = np.zeros(model.n_states)
+    reach = CLEARANCE + bearing.max() + journal.max() + 2e-6  # past the worn wall: in contact
+    y[:n_q] = reach * math.cos(direction), reach * math.sin(direction), turned
+    y[n_q:2 * n_q] = -0.2 * math.sin(direction) + 0.05 * math.cos(direction), \
+        0.2 * math.cos(direction) + 0.05 * math.sin(direction), 30.0  # along the flank, outwards, turning
+
+    def gap(states: np.ndarray) -> np.ndarray:
+        return model.channels(np.zeros(len(states)), states, np.zeros_like(states))["bearing.penetration"]
+
+    h = 1e-9  # (1e-7 leaves 1e-6 of truncation in the flank's slope)
+    moved = np.repeat(y[None, :], 2 * n_q, axis=0)
+    for k in range(n_q):
+        moved[2 * k, k] -= h
+        moved[2 * k + 1, k] += h
+    delta = gap(y[None, :])[0]
+    grad = (gap(moved)[1::2] - gap(moved)[0::2]) / (2 * h)
+    rate = grad @ y[n_q:2 * n_q]
+    slope = grad[:2] @ np.array([-math.sin(direction), math.cos(direction)])
+    assert delta > 1e-6 and abs(slope) > 0.05  # a real flank: d|e|/dt is not the gap's rate
+    law = model.scene["bearing"].resolved_law()
+    force = law.stiffness * delta**1.5 * (1 + 0.75 * (1 - 0.9**2) * rate / approach)
+    got = model.term_forces(0.0, y, [True], [np.array([approach])])[:n_q]
+    np.testing.assert_allclose(got, -force * grad, rtol=1e-6, atol=1e-9 * force)
+
+
 def test_an_unworn_profile_is_the_joint_without_wear():
     plain = dc.simulate(flight(0.3, wear=False), 0.01, rtol=1e-10, options=dc.SolverOptions(start="declared"))
     worn = dc.simulate(flight(0.3), 0.01, rtol=1e-10, options=dc.SolverOptions(start="declared"))
