@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -25,7 +26,7 @@ from ..engine.sensitivity_functions import SensitivityFunctions, jacobian_blocks
 from .dae_model import EXTRA_ACCEL, EXTRA_TERM0, DAEModel
 
 __all__ = ["parameter_value", "parameter_directions", "initial_sensitivities", "model_sensitivity_functions",
-           "ModelSensitivity", "STEP_BITS"]
+           "ModelSensitivity", "RootTerms", "STEP_BITS"]
 
 #: Central differences of the scene-to-P map and of the start use the step 2**-STEP_BITS |p| (a power of
 #: two: p +- h is exact) and h/2, combined by Richardson's extrapolation (error O(h^4) + eps/h, ~1e-12).
@@ -166,6 +167,20 @@ def model_sensitivity_functions(model: DAEModel, width: int) -> SensitivityFunct
     return known
 
 
+@dataclass(frozen=True)
+class RootTerms:
+    """The pieces of the jump at the model's roots (each (n_roots,) but ``g_p``): the root's sensitivity
+    ``g_p`` = g_y S + g_y' S' + g_P dP (n_roots, Ns); its ``rate`` g_t + g_y y'; the magnitude of that rate's
+    terms ``scale`` = |g_t| + |g_y| |y'|; its ``curvature`` d^2 g/dt^2; and its uncertainty ``error`` =
+    |g_y| (atol + rtol |y|) (the grazing tests of :func:`daeclear.solvers.sensitivity_jumps.is_grazing`)."""
+
+    g_p: NDArray[np.float64]
+    rate: NDArray[np.float64]
+    scale: NDArray[np.float64]
+    curvature: NDArray[np.float64]
+    error: NDArray[np.float64]
+
+
 class ModelSensitivity:
     """What a run with sensitivities to ``names`` asks of ``model``, evaluated in CasADi (the python
     path; the compiled loop calls the same functions generated in C)."""
@@ -223,22 +238,26 @@ class ModelSensitivity:
             Sp[-1] = d[n + m]
         return S_out, Sp
 
-    def roots(self, t: float, y: NDArray, yp: NDArray, S: NDArray, Sp: NDArray
-              ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """Each root's sensitivity g_y S + g_y' S' + g_P dP (n_roots, Ns), its rate g_t + g_y y' (n_roots,) and
-        the magnitude of that rate's terms, |g_t| + |g_y| |y'| (the grazing test's scale)."""
+    def roots(self, t: float, y: NDArray, yp: NDArray, S: NDArray, Sp: NDArray, rtol: float = 0.0,
+              atol: NDArray | None = None) -> RootTerms:
+        """What the jump at each root needs of it (:class:`RootTerms`), at a point of the mode before the
+        switch; ``rtol``/``atol`` the run's tolerances (the gap's uncertainty)."""
         model, n = self.model, self.model.n_states
         f = self.functions.root_jacobian
-        if f is None:
+        if f is None or self.functions.root_curvature is None:
             raise ValueError("ModelSensitivity.roots: the model has no roots")
-        J = np.array(f(t, y, yp, model.parameter_values))
+        P = model.parameter_values
+        J = np.array(f(t, y, yp, P))
         g_t, g_y, g_yp, g_P = J[:, :1], J[:, 1:1 + n], J[:, 1 + n:1 + 2 * n], J[:, 1 + 2 * n:]
         if np.any(g_yp != 0.0):
             raise ValueError("ModelSensitivity.roots: a root reads y' (its rate would need y''): not supported")
-        g_p = g_y @ S + g_yp @ Sp + g_P @ self.dP
-        rate = g_t[:, 0] + g_y @ yp
-        scale = np.abs(g_t[:, 0]) + np.abs(g_y) @ np.abs(yp)
-        return g_p, rate, scale
+        ypp = np.zeros(n)
+        ypp[:model.n_q] = yp[model.n_q:2 * model.n_q]  # q'' = v' (GGL: mu is 0 on the solution)
+        tolerance = (np.zeros(n) if atol is None else np.asarray(atol, dtype=float)) + rtol * np.abs(y)
+        return RootTerms(g_p=g_y @ S + g_yp @ Sp + g_P @ self.dP, rate=g_t[:, 0] + g_y @ yp,
+                         scale=np.abs(g_t[:, 0]) + np.abs(g_y) @ np.abs(yp),
+                         curvature=np.array(self.functions.root_curvature(t, y, yp, ypp, P)).ravel(),
+                         error=np.abs(g_y) @ tolerance)
 
     def approach_rate(self, root: int, y: NDArray, yp: NDArray, S: NDArray
                       ) -> tuple[float, NDArray[np.float64], float]:
@@ -250,7 +269,7 @@ class ModelSensitivity:
                 j = logic.pair_index(root)
                 P = model.parameter_values
                 q, v = y[:n], y[n:2 * n]
-                rate = float(np.ravel(logic.rate.function(q, v, P)[1])[j])
+                rate = float(np.array(logic.rate.function(q, v, P)[1]).ravel()[j])
                 J = np.array(self._rate_jacobians[i](q, v, P))[j]
                 r_q, r_v, r_P = J[:n], J[n:2 * n], J[2 * n:]
                 return rate, r_q @ S[:n] + r_v @ S[n:2 * n] + r_P @ self.dP, float(r_q @ yp[:n] + r_v @ yp[n:2 * n])

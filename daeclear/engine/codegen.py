@@ -230,6 +230,7 @@ def _sensitivity_functions(sens: Any) -> dict[str, casadi.Function]:
     funs = {"dcs_res": sens.res, **{f"dcs_term{k}_res": f for k, f in enumerate(sens.term_res)}}
     if sens.root_jacobian is not None:
         funs["dcs_root_jac"] = sens.root_jacobian
+        funs["dcs_root_curv"] = sens.root_curvature
     funs.update({f"dcs_extra{k}": f for k, f in zip(sens.extra_index, sens.extras)})
     return funs
 
@@ -242,9 +243,11 @@ def _sensitivity_table(sens: Any) -> list[str]:
              f"static const dc_fun_t dcs_extra_tab[{max(ne, 1)}] = {{",
              *([f"  {_fun_entry(f'dcs_extra{k}')}," for k in sens.extra_index] or [f"  {_NO_FUN},"]), "};",
              f"static const int dcs_extra_index[{max(ne, 1)}] = {{{', '.join(map(str, sens.extra_index)) or '0'}}};"]
-    root_jac = _fun_entry("dcs_root_jac") if sens.root_jacobian is not None else _NO_FUN
+    roots = sens.root_jacobian is not None
+    root_jac, root_curv = (_fun_entry("dcs_root_jac"), _fun_entry("dcs_root_curv")) if roots else (_NO_FUN, _NO_FUN)
     lines += ["const dc_sens_t dc_sens = {", f"  {sens.width}, {nt}, {ne},", f"  {_fun_entry('dcs_res')},",
-              f"  {'dcs_term_res_tab' if nt else '0'},", f"  {root_jac},", "  dcs_extra_tab, dcs_extra_index", "};", ""]
+              f"  {'dcs_term_res_tab' if nt else '0'},", f"  {root_jac},", f"  {root_curv},",
+              "  dcs_extra_tab, dcs_extra_index", "};", ""]
     return lines
 
 

@@ -20,7 +20,7 @@ import casadi
 from .session_base import DAEFunctions
 
 __all__ = ["SensitivityFunctions", "directional", "sensitivity_functions", "augmented_functions",
-           "jacobian_blocks"]
+           "jacobian_blocks", "curvature_along"]
 
 
 def _symbols(f: casadi.Function, sizes: Sequence[Any], names: Sequence[str]) -> list[Any]:
@@ -37,6 +37,17 @@ def jacobian_blocks(f: casadi.Function, name: str, out: int = 0) -> casadi.Funct
     value = casadi.vec(f.call([casadi.reshape(x, f.size_in(k)) for k, x in enumerate(xs)])[out])
     blocks = casadi.horzcat(*(casadi.jacobian(value, x) for x in xs))
     return casadi.Function(name, xs, [casadi.densify(blocks)], names, [f"J_{f.name_out(out)}"])
+
+
+def curvature_along(f: casadi.Function, name: str) -> casadi.Function:
+    """(t, y, yp, ypp, P) -> d^2/ds^2 of ``f(t + s, y + s yp + s^2/2 ypp, yp + s ypp, P)`` at s = 0 (f takes
+    (t, y, yp, P)): the second time derivative of a root along a solution with derivatives yp and ypp."""
+    t, y, yp, ypp, P, s = _symbols(f, [1, f.numel_in(1), f.numel_in(1), f.numel_in(1), f.numel_in(3), 1],
+                                   ["t", "y", "yp", "ypp", "P", "s"])
+    value = casadi.vec(f.call([t + s, y + s * yp + 0.5 * s * s * ypp, yp + s * ypp, P])[0])
+    second = casadi.substitute(casadi.jacobian(casadi.jacobian(value, s), s), s, casadi.DM.zeros(1, 1))
+    return casadi.Function(name, [t, y, yp, ypp, P], [casadi.densify(second)], ["t", "y", "yp", "ypp", "P"],
+                           [f"d2{f.name_out(0)}"])
 
 
 def directional(f: casadi.Function, width: int, wrt: Sequence[int] | None = None, name: str | None = None,
@@ -72,6 +83,8 @@ class SensitivityFunctions:
     * ``root_jacobian``: (t, y, yp, P) -> [g_t | g_y | g_y' | g_P] (n_roots x (1 + 2 n + n_P)): at an
       event the root's sensitivity g_y S + g_y' S' + g_P dP, its rate g_t + g_y y' (+ g_y' y'') and the
       magnitude of the terms of that rate (the grazing test);
+    * ``root_curvature``: (t, y, yp, ypp, P) -> d^2 g/dt^2 along (y', y'') (:func:`curvature_along`, the
+      grazing test near an apex);
     * ``extras[i]``: the directional derivative of ``DAEFunctions.extras[extra_index[i]]`` in all its
       inputs (:func:`directional`): consistent restarts, latched values, channels."""
 
@@ -83,6 +96,7 @@ class SensitivityFunctions:
     res: casadi.Function
     term_res: tuple[casadi.Function, ...]
     root_jacobian: casadi.Function | None
+    root_curvature: casadi.Function | None
     extras: tuple[casadi.Function, ...] = ()
     extra_index: tuple[int, ...] = ()
 
@@ -108,18 +122,18 @@ def sensitivity_functions(funcs: DAEFunctions, width: int, extras: Sequence[int]
         fk = _with_parameters(fk, 4, n_P)
         term_res.append(directional(fk, width, (1, 2, 3, 4), f"sens_term{k}_res"))
         n_params.append(int(fk.numel_in(3)))
-    roots, n_roots = None, 0
+    roots, curvature, n_roots = None, None, 0
     if funcs.roots is not None and funcs.roots.numel_out(0) > 0:
         g = _with_parameters(funcs.roots, 3, n_P)
         n_roots = int(g.numel_out(0))
-        roots = jacobian_blocks(g, "sens_root_jacobian")
+        roots, curvature = jacobian_blocks(g, "sens_root_jacobian"), curvature_along(g, "sens_root_curvature")
     bad = [k for k in extras if not 0 <= k < len(funcs.extras)]
     if bad:
         raise ValueError(f"sensitivity_functions: extras={list(extras)!r}, must be indices below "
                          f"{len(funcs.extras)} (the model's extras).")
     fwd = tuple(directional(funcs.extras[k], width, None, f"sens_extra{k}") for k in extras)
     return SensitivityFunctions(int(funcs.n), n_P, int(width), tuple(n_params), n_roots, r, tuple(term_res), roots,
-                                fwd, tuple(int(k) for k in extras))
+                                curvature, fwd, tuple(int(k) for k in extras))
 
 
 def augmented_functions(funcs: DAEFunctions, width: int) -> DAEFunctions:

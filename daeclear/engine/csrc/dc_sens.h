@@ -18,6 +18,7 @@ typedef struct {
   const dc_fun_t* term_res;  /* [n_terms] (t, y, yp, p, P, S, Sp, Sp_k, dP) -> term k's part (n x width) */
   dc_fun_t root_jac;         /* (t, y, yp, P) -> [g_t | g_y | g_yp | g_P] (n_roots x (1 + 2n + n_P)); eval == 0
                                 without roots */
+  dc_fun_t root_curv;        /* (t, y, yp, ypp, P) -> d2g/dt2 along (yp, ypp) (n_roots): the grazing test */
   const dc_fun_t* extras;    /* [n_extras] (inputs of extra k, their seeds (numel x width)) -> d out (numel x width) */
   const int* extra_index;    /* [n_extras] k of each: dc_extra_tab[k] */
 } dc_sens_t;
