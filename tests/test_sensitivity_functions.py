@@ -180,3 +180,24 @@ def test_generated_c_agrees_with_casadi(crank, tmp_path: Path) -> None:
     assert np.allclose(_evaluate_c(lib, "dcs_root_jac", args[:4], jac.size), jac, rtol=1e-13, atol=1e-300)
     width = ctypes.c_int.in_dll(lib, "dc_sens")  # the table's first field
     assert width.value == W
+
+
+def test_the_exponents_sensitivity_is_zero_out_of_contact(crank) -> None:
+    """d/dn of K max(delta, 0)^n is log(delta) delta^n: 0 at delta <= 0, where CasADi's pow gave 0 * log(0) =
+    NaN (a slider-crank run with sensitivities stopped at its first onset, its residual NaN); the law keeps
+    its power behind a branch."""
+    y, yp = crank.initial_state()
+    sens = sensitivity_functions(crank.functions, 1)
+    dP = np.zeros((crank.parameter_values.size, 1))
+    dP[entries_of(crank).index("clearance.law.exponent")] = 1.0
+    n = crank.n_states
+    for shift, free in ((0.4e-3, True), (0.5e-3 - 1e-12, True), (0.50001e-3, False)):  # delta -1e-4, -1e-12, 1e-8 m
+        y1 = y.copy()
+        y1[3] += shift  # the rod's end towards the bearing's wall
+        out = np.array(sens.term_res[0](0.0, y1, yp, [0.5], crank.parameter_values, np.zeros((n, 1)),
+                                        np.zeros((n, 1)), np.zeros((1, 1)), dP))
+        assert np.all(out == 0.0) if free else (np.all(np.isfinite(out)) and np.any(out != 0.0)), shift
+
+
+def entries_of(model: dc.DAEModel) -> list[str]:
+    return [name for name, size in model.parameter_layout for _ in range(size)]
