@@ -176,3 +176,29 @@ def test_approach_rate_and_its_derivatives_closed_form() -> None:
     assert at.curvature[0] == pytest.approx((yp[0] ** 2 + yp[1] ** 2 + y[0] * yp[3] + y[1] * yp[4]) / 0.1, rel=1e-13)
     assert at.error[0] == pytest.approx((abs(y[0]) * (1e-9 + 1e-8 * abs(y[0])) + abs(y[1]) * (1e-9 + 1e-8 * abs(y[1])))
                                         / 0.1, rel=1e-13)
+
+
+def test_projection_puts_sensitivities_on_the_linearised_constraints(ggl) -> None:
+    """GGL restarts: after ModelSensitivity.projected, Phi(q + e S_q, P + e dP) and Phi'(q + e S_q, v + e S_v,
+    P + e dP) have zero derivative in e (central differences of the constraints), and the correction is the
+    least-norm one (in the row space of Phi_q)."""
+    ms = ModelSensitivity(ggl, ["clearance.clearance", "rod.mass"])
+    x = mode_point(ggl, 2)
+    S = ms.projected(x["t"], x["y"], x["S"])
+    n, m, P = ggl.n_q, ggl.n_constraints, ggl.parameter_values
+
+    def kinematics(e: float, j: int) -> np.ndarray:
+        flat = np.array(ggl.functions.extras[2](x["y"][:n] + e * S[:n, j], x["y"][n:2 * n] + e * S[n:2 * n, j],
+                                                x["t"], P + e * ms.dP[:, j])).ravel()
+        return np.concatenate([flat[:m], flat[m + m * n:]])
+
+    flat = np.array(ggl.functions.extras[2](x["y"][:n], x["y"][n:2 * n], x["t"], P)).ravel()
+    Phi_q = flat[m:m + m * n].reshape(n, m).T
+    for j in range(2):
+        h = 1e-7
+        d = (kinematics(h, j) - kinematics(-h, j)) / (2 * h)
+        assert np.abs(d).max() < 1e-6 * np.abs(x["S"][:, j]).max()
+        for rows in (slice(0, n), slice(n, 2 * n)):
+            change = S[rows, j] - x["S"][rows, j]
+            assert np.abs(change).max() > 0
+            assert np.allclose(change, Phi_q.T @ np.linalg.lstsq(Phi_q.T, change, rcond=None)[0], atol=1e-12)

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from ..core.errors import SceneError
 from ..core.options import close_matches
 from ..engine.sensitivity_functions import SensitivityFunctions, jacobian_blocks, sensitivity_functions
-from .dae_model import EXTRA_ACCEL, EXTRA_TERM0, DAEModel
+from .dae_model import EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_TERM0, DAEModel
 
 __all__ = ["parameter_value", "parameter_directions", "initial_sensitivities", "model_sensitivity_functions",
            "ModelSensitivity", "RootTerms", "STEP_BITS"]
@@ -155,13 +155,13 @@ def initial_sensitivities(model: DAEModel, names: Sequence[str], start: str = "i
 
 def model_sensitivity_functions(model: DAEModel, width: int) -> SensitivityFunctions:
     """The model's sensitivity functions for ``width`` parameters, with the directional derivatives of
-    the accelerations, of each term's force and of the simple pairs' gap rates (built once per structure
-    and width, kept with the model's compiled functions)."""
+    the accelerations, the constraints, each term's force and the simple pairs' gap rates (built once per
+    structure and width, kept with the model's compiled functions)."""
     funcs = model.functions
     key = f"sensitivity{width}"
     known = funcs.compiled.get(key)
     if known is None:
-        extras = (EXTRA_ACCEL, *(EXTRA_TERM0 + k for k in range(len(model.terms))),
+        extras = (EXTRA_ACCEL, EXTRA_KINEMATICS, *(EXTRA_TERM0 + k for k in range(len(model.terms))),
                   *(extra for _, _, extra, _, _ in model.auto_pairs))
         known = funcs.compiled[key] = sensitivity_functions(funcs, width, extras)
     return known
@@ -237,6 +237,24 @@ class ModelSensitivity:
         if model.track_work:
             Sp[-1] = d[n + m]
         return S_out, Sp
+
+    def projected(self, t: float, y: NDArray, S: NDArray) -> NDArray[np.float64]:
+        """S with S_q and S_v moved (least norm) onto the linearised constraints, d Phi = Phi_q S_q + Phi_P dP
+        = 0 and d(Phi_q v + Phi_t) = 0: what :meth:`DAEModel.consistent_state` with ``project`` does to q and v
+        at a GGL restart (IDA's S holds them only to its tolerance; GGL's index-2 rows need them exact)."""
+        model, P, W = self.model, self.model.parameter_values, self.width
+        n, m = model.n_q, model.n_constraints
+        if not m:
+            return np.array(S, dtype=float)
+        S = np.array(S, dtype=float)
+        q, v = y[:n], y[n:2 * n]
+        kinematics = self._extra[EXTRA_KINEMATICS]
+        Phi_q = np.array(model.functions.extras[EXTRA_KINEMATICS](q, v, t, P)).ravel()[m:m + m * n].reshape(n, m).T
+        zero_t = np.zeros((1, W))
+        for rows, level in ((slice(0, n), slice(0, m)), (slice(n, 2 * n), slice(m + m * n, 2 * m + m * n))):
+            d = np.array(kinematics(q, v, t, P, S[:n], S[n:2 * n], zero_t, self.dP))[level]
+            S[rows] -= np.linalg.lstsq(Phi_q, d, rcond=None)[0]
+        return S
 
     def roots(self, t: float, y: NDArray, yp: NDArray, S: NDArray, Sp: NDArray, rtol: float = 0.0,
               atol: NDArray | None = None) -> RootTerms:

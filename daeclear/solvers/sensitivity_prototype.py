@@ -167,7 +167,15 @@ def _event(ms: ModelSensitivity, state: contact_state.ContactState, active: list
     # y' and S' before the switch, exact for the old mode at (t, y)
     y_m, yp_m = model.consistent_state(t, y, model.term_forces(t, y, active, params))
     S_m, Sp_m = ms.consistent(t, y_m, S, active, params, S_params)
-    y_p, yp_p = model.consistent_state(t, y_m, model.term_forces(t, y_m, new_active, new_params))
+    project = model.formulation == "ggl"  # as the run's restarts: on the constraint manifold, mu = 0
+    y_p, yp_p = model.consistent_state(t, y_m, model.term_forces(t, y_m, new_active, new_params), project=project)
+    if project and model.gap_names:  # unless that moves a root that did not fire across zero (a lost event)
+        g0 = np.array(model.functions.roots(t, y_m, yp_m, model.parameter_values)).ravel()
+        g1 = np.array(model.functions.roots(t, y_p, yp_p, model.parameter_values)).ravel()
+        quiet = np.zeros(g0.shape, bool) if found is None else np.ravel(found) == 0
+        if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
+            project = False
+            y_p, yp_p = model.consistent_state(t, y_m, model.term_forces(t, y_m, new_active, new_params))
     new_S_params = [p.copy() for p in S_params]
     roots = {name: root for root, name in enumerate(model.gap_names)}
     dt_dps = []
@@ -197,5 +205,7 @@ def _event(ms: ModelSensitivity, state: contact_state.ContactState, active: list
     if dt_dps:
         dt_dp = dt_dps[0] if same_event_times(dt_dps, rtol) else np.full(W, np.nan)
     S_p = state_jump(S_m, yp_m, yp_p, dt_dp, differential) if jumps else S_m
+    if project:
+        S_p = ms.projected(t, y_p, S_p)
     S_p, Sp_p = ms.consistent(t, y_p, S_p, new_active, new_params, new_S_params)
     return new_state, new_active, new_params, new_S_params, y_p, yp_p, S_p, Sp_p
