@@ -169,9 +169,10 @@ def _event(ms: ModelSensitivity, state: contact_state.ContactState, active: list
     S_m, Sp_m = ms.consistent(t, y_m, S, active, params, S_params)
     project = model.formulation == "ggl"  # as the run's restarts: on the constraint manifold, mu = 0
     y_p, yp_p = model.consistent_state(t, y_m, model.term_forces(t, y_m, new_active, new_params), project=project)
-    if project and model.gap_names:  # unless that moves a root that did not fire across zero (a lost event)
-        g0 = np.array(model.functions.roots(t, y_m, yp_m, model.parameter_values)).ravel()
-        g1 = np.array(model.functions.roots(t, y_p, yp_p, model.parameter_values)).ravel()
+    roots_of = model.functions.roots
+    if project and roots_of is not None:  # unless that moves a root that did not fire across zero (a lost event)
+        g0 = np.array(roots_of(t, y_m, yp_m, model.parameter_values)).ravel()
+        g1 = np.array(roots_of(t, y_p, yp_p, model.parameter_values)).ravel()
         quiet = np.zeros(g0.shape, bool) if found is None else np.ravel(found) == 0
         if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
             project = False
