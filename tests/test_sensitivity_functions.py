@@ -116,12 +116,14 @@ def test_directional_of_an_extra_in_every_input() -> None:
         directional(f, 0)
 
 
-def test_augmented_system_stacks_the_sensitivities(crank) -> None:
-    """[y; S] as one DAE: its residual is (F, F_y S + F_y' S' + F_P dP) and its Jacobian block lower
-    triangular with the state's iteration matrix on every diagonal block."""
+@pytest.mark.parametrize("coupled", [False, True])
+def test_augmented_system_stacks_the_sensitivities(crank, coupled: bool) -> None:
+    """[y; S] as one DAE: its residual is (F, F_y S + F_y' S' + F_P dP); its Jacobian has the state's iteration
+    matrix on every diagonal block, nothing else (IDAS' simultaneous corrector), or (``coupled``) the exact
+    one, block lower triangular, its blocks below the diagonal by differences of the residual."""
     x = a_point(crank, seed=3)
     f, n = crank.functions, crank.n_states
-    aug = augmented_functions(f, W)
+    aug = augmented_functions(f, W, coupled=coupled)
     Y, Yp = np.concatenate([x["y"], x["S"].ravel(order="F")]), np.concatenate([x["yp"], x["Sp"].ravel(order="F")])
     PA = np.concatenate([x["P"], x["dP"].ravel(order="F")])
     r = np.array(aug.residual(x["t"], Y, Yp, PA)).ravel()
@@ -135,6 +137,17 @@ def test_augmented_system_stacks_the_sensitivities(crank) -> None:
     for i in range(1 + W):
         assert np.allclose(J[i * n:(i + 1) * n, i * n:(i + 1) * n], J0, rtol=1e-14, atol=1e-9)
         assert not np.any(J[i * n:(i + 1) * n, (i + 1) * n:])
+    below = J[n:, :n]
+    if not coupled:
+        assert not below.any()
+        return
+    seed = np.zeros(n)
+    seed[3] = 1e-3  # the rod's x: d(F_y S + ...)/d y along it, by differences
+
+    def moved(e: float) -> np.ndarray:
+        return np.array(aug.residual(x["t"], Y + e * np.concatenate([seed, np.zeros(n * W)]), Yp, PA)).ravel()[n:]
+    want = richardson(moved, 1e-3)
+    assert np.allclose(below @ seed, want, rtol=1e-6, atol=1e-6 * np.abs(want).max()) and np.abs(want).max() > 0
 
 
 def _evaluate_c(lib: ctypes.CDLL, name: str, inputs: list[np.ndarray], n_out: int) -> np.ndarray:

@@ -136,11 +136,15 @@ def sensitivity_functions(funcs: DAEFunctions, width: int, extras: Sequence[int]
                                 curvature, fwd, tuple(int(k) for k in extras))
 
 
-def augmented_functions(funcs: DAEFunctions, width: int) -> DAEFunctions:
+def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False) -> DAEFunctions:
     """The DAE of [y; S_1; ...; S_width] as one :class:`DAEFunctions` (a reference for tests and the
     prototype run, never the fast path): parameters [P; vec(dP)], term k's parameters [p_k; vec(Sk)],
-    the roots those of y, no extras. Its Jacobian is the symbolic one of the stacked residual (block
-    lower triangular with the state's Jacobian on the diagonal)."""
+    the roots those of y, no extras.
+
+    Its Jacobian: the state's iteration matrix on every diagonal block, nothing else (IDAS' simultaneous
+    corrector: a modified Newton that converges since S's equations are linear in S); ``coupled``: the
+    exact Jacobian of the stacked residual, block lower triangular, whose blocks (F_yy S) blow up where a
+    force has no second derivative (Hertz's delta^1.5 at onset: Newton then fails at the restart)."""
     n, n_P = int(funcs.n), int(funcs.n_parameters)
     res = _with_parameters(funcs.residual, 3, n_P)
     sym: Any = casadi.SX if res.is_a("SXFunction") else casadi.MX  # one kind at run time
@@ -156,7 +160,10 @@ def augmented_functions(funcs: DAEFunctions, width: int) -> DAEFunctions:
         return casadi.vertcat(value, casadi.vec(derivative))
 
     def jacobian(r: Any) -> Any:
-        return casadi.jacobian(r, Y) + cj * casadi.jacobian(r, Yp)
+        if coupled:
+            return casadi.jacobian(r, Y) + cj * casadi.jacobian(r, Yp)
+        block = casadi.jacobian(r[:n], y) + cj * casadi.jacobian(r[:n], yp)
+        return casadi.diagcat(*([block] * (1 + width)))
 
     r = stacked(res(t, y, yp, P), sens.res(t, y, yp, P, S, Sp, dP))
     residual = casadi.Function("residual", [t, Y, Yp, PA], [r], ["t", "y", "yp", "P"], ["r"])
@@ -175,5 +182,5 @@ def augmented_functions(funcs: DAEFunctions, width: int) -> DAEFunctions:
         g = _with_parameters(funcs.roots, 3, n_P)
         roots = casadi.Function("roots", [t, Y, Yp, PA], [g(t, y, yp, P)], ["t", "y", "yp", "P"], ["g"])
     return DAEFunctions(n=n * (1 + width), residual=residual, jacobian=jac, term_residuals=tuple(term_res),
-                        term_jacobians=tuple(term_jac), roots=roots, name=f"{funcs.name}_sens{width}",
+                        term_jacobians=tuple(term_jac), roots=roots, name=f"{funcs.name}_sens{width}{'c' if coupled else ''}",
                         n_parameters=n_P * (1 + width))

@@ -29,6 +29,7 @@ from ..assembly.sensitivity import ModelSensitivity, initial_sensitivities, para
 from ..core.errors import DaeclearError, PhysicsWarning
 from ..engine.ida_session import open_session
 from ..engine.sensitivity_functions import augmented_functions
+from . import ida
 from .sensitivity_jumps import event_time_sensitivity, latched_sensitivity, same_event_times, state_jump
 from .tolerances import tolerance_vector
 
@@ -115,6 +116,10 @@ def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[st
     session = open_session(augmented_functions(model.functions, W), backend=backend, rtol=rtol,
                            atol=np.concatenate([atol_y, *(atol_y / p for p in pbar)]), max_step=max_step,
                            parameters=np.concatenate([model.parameter_values, ms.dP.ravel(order="F")]))
+    # the run's IDA settings (daeclear.solvers.ida; the python backend has none)
+    session.set_hints(jacobian_refresh=ida.JACOBIAN_REFRESH, first_step=ida.FIRST_STEP_ESTIMATE and model.formulation == "ggl")
+    if model.formulation == "ggl" and model.n_constraints:
+        session.set_hints(nonlin_conv_coef=min(0.33, max(ida.GGL_NEWTON_COEF, 1e-13 / rtol)))
     poisoned = np.zeros(W, dtype=bool)  # parameters whose sensitivities are NaN from a grazing event on
     rows_t: list[NDArray] = [eval_times[:1]] if eval_times[0] == 0.0 else []
     rows_y: list[NDArray] = [y[None, :]] if rows_t else []
