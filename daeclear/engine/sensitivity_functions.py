@@ -182,5 +182,5 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False) 
         g = _with_parameters(funcs.roots, 3, n_P)
         roots = casadi.Function("roots", [t, Y, Yp, PA], [g(t, y, yp, P)], ["t", "y", "yp", "P"], ["g"])
     return DAEFunctions(n=n * (1 + width), residual=residual, jacobian=jac, term_residuals=tuple(term_res),
-                        term_jacobians=tuple(term_jac), roots=roots, name=f"{funcs.name}_sens{width}{'c' if coupled else ''}",
-                        n_parameters=n_P * (1 + width))
+                        term_jacobians=tuple(term_jac), roots=roots, n_parameters=n_P * (1 + width),
+                        name=f"{funcs.name}_sens{width}{'c' if coupled else ''}")

@@ -117,7 +117,8 @@ def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[st
                            atol=np.concatenate([atol_y, *(atol_y / p for p in pbar)]), max_step=max_step,
                            parameters=np.concatenate([model.parameter_values, ms.dP.ravel(order="F")]))
     # the run's IDA settings (daeclear.solvers.ida; the python backend has none)
-    session.set_hints(jacobian_refresh=ida.JACOBIAN_REFRESH, first_step=ida.FIRST_STEP_ESTIMATE and model.formulation == "ggl")
+    session.set_hints(jacobian_refresh=ida.JACOBIAN_REFRESH,
+                      first_step=ida.FIRST_STEP_ESTIMATE and model.formulation == "ggl")
     if model.formulation == "ggl" and model.n_constraints:
         session.set_hints(nonlin_conv_coef=min(0.33, max(ida.GGL_NEWTON_COEF, 1e-13 / rtol)))
     poisoned = np.zeros(W, dtype=bool)  # parameters whose sensitivities are NaN from a grazing event on
