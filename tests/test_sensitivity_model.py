@@ -202,3 +202,11 @@ def test_projection_puts_sensitivities_on_the_linearised_constraints(ggl) -> Non
             change = S[rows, j] - x["S"][rows, j]
             assert np.abs(change).max() > 0
             assert np.allclose(change, Phi_q.T @ np.linalg.lstsq(Phi_q.T, change, rcond=None)[0], atol=1e-12)
+
+
+def test_contact_elements_without_jumps_yet_are_refused() -> None:
+    """Translational faces (section 4.3: a face term follows two corner pairs) have no jump rule yet: refused,
+    naming the pairs and the logic, before any work."""
+    scene = dc.mechanisms.slider_crank("translational").with_values({"clearance.model": "section-4.3"})
+    with pytest.raises(dc.DaeclearError, match=r"the events of 'clearance.A_upper'.*SliderGuideLogic: faces"):
+        ModelSensitivity(dc.assemble(scene), ["clearance.clearance"])

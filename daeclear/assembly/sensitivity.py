@@ -20,13 +20,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.errors import SceneError
+from ..core.errors import DaeclearError, SceneError
 from ..core.options import close_matches
 from ..engine.sensitivity_functions import SensitivityFunctions, jacobian_blocks, sensitivity_functions
 from .dae_model import EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_TERM0, DAEModel
 
 __all__ = ["parameter_value", "parameter_directions", "initial_sensitivities", "model_sensitivity_functions",
-           "ModelSensitivity", "RootTerms", "STEP_BITS"]
+           "check_supported", "ModelSensitivity", "RootTerms", "STEP_BITS"]
 
 #: Central differences of the scene-to-P map and of the start use the step 2**-STEP_BITS |p| (a power of
 #: two: p +- h is exact) and h/2, combined by Richardson's extrapolation (error O(h^4) + eps/h, ~1e-12).
@@ -181,11 +181,25 @@ class RootTerms:
     error: NDArray[np.float64]
 
 
+def check_supported(model: DAEModel) -> None:
+    """Refuse (DaeclearError) a model with contact elements whose events have no sensitivity jump yet:
+    those whose pairs the compiled loop cannot decide itself (translational faces, the lubricated
+    joint's film regimes: their terms follow two pairs or two roots)."""
+    for logic in model.contacts:
+        if logic.simple_pairs() is None:
+            raise DaeclearError(
+                f"sensitivities: the events of {', '.join(map(repr, logic.pairs))} ({type(logic).__name__}: faces "
+                "or a film regime) have no sensitivity jump yet; revolute clearance joints and translational ones "
+                "without faces have (issue 43).")
+
+
 class ModelSensitivity:
     """What a run with sensitivities to ``names`` asks of ``model``, evaluated in CasADi (the python
-    path; the compiled loop calls the same functions generated in C)."""
+    path; the compiled loop calls the same functions generated in C). Refuses the contact elements
+    :func:`check_supported` refuses."""
 
     def __init__(self, model: DAEModel, names: Sequence[str]) -> None:
+        check_supported(model)
         self.model = model
         self.names = _checked_names(names)
         self.dP = parameter_directions(model, self.names)

@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 from ..assembly import contact_state
 from ..assembly.dae_model import KIND_MULTIPLIER, DAEModel
 from ..assembly.sensitivity import ModelSensitivity, initial_sensitivities, parameter_value
-from ..core.errors import DaeclearError, PhysicsWarning
+from ..core.errors import PhysicsWarning
 from ..engine.ida_session import open_session
 from ..engine.sensitivity_functions import augmented_functions
 from . import ida
@@ -72,15 +72,6 @@ class SensitivityRun:
         return column[:, self.names.index(parameter)]
 
 
-def _supported(model: DAEModel) -> None:
-    for logic in model.contacts:
-        if logic.simple_pairs() is None:
-            raise DaeclearError(
-                f"forward_sensitivities: the events of {', '.join(map(repr, logic.pairs))} "
-                f"({type(logic).__name__}: faces or a film regime) have no sensitivity jump yet; the prototype "
-                "handles revolute clearance joints and translational ones without faces (issue 43).")
-
-
 def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[str], *,
                           t_eval: NDArray[np.float64] | None = None, rtol: float = 1e-8,
                           atol: float | None = None, start: str = "ideal", allow_penetration: bool = False,
@@ -92,8 +83,7 @@ def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[st
     model's scales); ``backend``: the session's ("python", "c", "auto"); ``jumps=False`` leaves the jumps
     out (S carried through each event as it is, the latched values' dt*/dp term dropped): a wrong answer,
     kept to show that the tests see the jump."""
-    _supported(model)
-    ms = ModelSensitivity(model, parameters)
+    ms = ModelSensitivity(model, parameters)  # refuses contact elements without jumps yet
     W, n = ms.width, model.n_states
     eval_times = np.array([0.0, float(t_end)] if t_eval is None else t_eval, dtype=float)
     y, yp = model.initial_state(start=start, allow_penetration=allow_penetration)
