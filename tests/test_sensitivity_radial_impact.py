@@ -50,6 +50,18 @@ def complex_step(f, p: np.ndarray) -> np.ndarray:
 
 
 P0 = np.array([K, D, Z0])
+T_CONTACT = 0.11  # 10 ms into the contact, before the force reaches zero
+
+
+def kelvin_voigt_force(p: np.ndarray) -> np.ndarray:
+    """The normal force K d + D d' at T_CONTACT (in contact), for p = (K, D, z0)."""
+    k, d, z0 = p
+    a = d / (2 * M)
+    wd = np.sqrt(k / M - a * a)
+    s = T_CONTACT - z0 / U
+    depth = (U / wd) * np.exp(-a * s) * np.sin(wd * s)
+    rate = (U / wd) * np.exp(-a * s) * (wd * np.cos(wd * s) - a * np.sin(wd * s))
+    return np.array([k * depth + d * rate])
 
 
 def test_closed_form_gives_the_issues_values() -> None:
@@ -95,7 +107,8 @@ def test_prototype_run_reproduces_the_closed_form(kv_model, backend: str) -> Non
     """S(T) of x and vx, and each event time's sensitivity, from the stacked DAE with the jumps."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", dc.DaeclearWarning)  # atol at round-off, raised
-        run = forward_sensitivities(kv_model, T, NAMES, rtol=1e-10, start="declared", backend=backend)
+        run = forward_sensitivities(kv_model, T, NAMES, rtol=1e-10, start="declared", backend=backend,
+                                    t_eval=np.array([0.0, T_CONTACT, T]))
     assert run.success
     want = complex_step(kelvin_voigt_radial, P0)
     x, vx, t_sep = kelvin_voigt_radial(P0)
@@ -108,6 +121,11 @@ def test_prototype_run_reproduces_the_closed_form(kv_model, backend: str) -> Non
     assert onset.dt_dp == pytest.approx([0.0, 0.0, 1 / U], abs=1e-12)  # dt1/dz0 = 1/u
     assert separation.t == pytest.approx(t_sep, rel=1e-9)
     assert separation.dt_dp == pytest.approx(want[2], rel=1e-6)
+    # a channel's sensitivity, the chain rule through its function: the normal force in contact
+    assert run.sensitivity("clearance.normal_force")[1] == pytest.approx(complex_step(kelvin_voigt_force, P0)[0],
+                                                                         rel=1e-6)
+    channel = run.channel_S[:, run.channel_names.index("journal.vx"), :]  # the channel of a state is the state
+    assert np.array_equal(channel, run.S[:, run.state_names.index("journal.vx"), :])
 
 
 def test_the_run_without_the_jump_fails_the_test(kv_model) -> None:

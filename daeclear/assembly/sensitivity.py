@@ -22,8 +22,8 @@ from numpy.typing import NDArray
 
 from ..core.errors import DaeclearError, SceneError
 from ..core.options import close_matches
-from ..engine.sensitivity_functions import SensitivityFunctions, jacobian_blocks, sensitivity_functions
-from .dae_model import EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_TERM0, DAEModel
+from ..engine.sensitivity_functions import SensitivityFunctions, directional, jacobian_blocks, sensitivity_functions
+from .dae_model import EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_TERM0, DAEModel
 
 __all__ = ["parameter_value", "parameter_directions", "initial_sensitivities", "model_sensitivity_functions",
            "check_supported", "ModelSensitivity", "RootTerms", "STEP_BITS"]
@@ -208,6 +208,7 @@ class ModelSensitivity:
         # each contact element's gap rates' Jacobian [r_q | r_v | r_P]: the latched approach speed's derivative
         self._rate_jacobians = [jacobian_blocks(logic.rate.function, f"rate_jacobian{i}", out=1)
                                 for i, logic in enumerate(model.contacts)]
+        self._outputs: Any = None  # the channels' directional derivative, made when first asked for
 
     @property
     def width(self) -> int:
@@ -251,6 +252,25 @@ class ModelSensitivity:
         if model.track_work:
             Sp[-1] = d[n + m]
         return S_out, Sp
+
+    def switch_sensitivity(self, S_params: Sequence[NDArray]) -> NDArray[np.float64]:
+        """The sensitivity of :meth:`DAEModel.switch_vector` (n_switch, Ns): 0 for each term's on/off flag,
+        its parameters' sensitivities (the latched values') after it."""
+        rows = [np.zeros((1, self.width))]
+        out = []
+        for S_k in S_params:
+            out += [rows[0], np.asarray(S_k, dtype=float).reshape(-1, self.width)]
+        return np.vstack(out) if out else np.zeros((0, self.width))
+
+    def channels(self, t: float, y: NDArray, yp: NDArray, S: NDArray, Sp: NDArray, switch: NDArray,
+                 S_switch: NDArray) -> NDArray[np.float64]:
+        """Every output channel's sensitivity at one point, (n_channels, Ns): d ch/dy S + d ch/dy' S'
+        + d ch/d switch S_switch + d ch/dP dP (the chain rule through the channels' functions)."""
+        if self._outputs is None:
+            self._outputs = directional(self.model.functions.extras[EXTRA_OUTPUTS], self.width, (1, 2, 3, 4),
+                                        "sens_outputs")
+        P = self.model.parameter_values
+        return np.array(self._outputs(t, y, yp, switch, P, S, Sp, S_switch, self.dP))
 
     def projected(self, t: float, y: NDArray, S: NDArray) -> NDArray[np.float64]:
         """S with S_q and S_v moved (least norm) onto the linearised constraints, d Phi = Phi_q S_q + Phi_P dP

@@ -48,23 +48,30 @@ class EventSensitivity:
 
 @dataclass
 class SensitivityRun:
-    """What :func:`forward_sensitivities` computed: states ``y`` (n_times, n_states) and their
-    sensitivities ``S`` (n_times, n_states, Ns) at the times ``t``; NaN columns after a grazing event."""
+    """What :func:`forward_sensitivities` computed at the times ``t``: states ``y`` (n_times, n_states,
+    consistent), their sensitivities ``S`` (n_times, n_states, Ns) and the channels' ``channel_S``
+    (n_times, n_channels, Ns); NaN columns after a grazing event."""
 
     names: tuple[str, ...]
     state_names: tuple[str, ...]
+    channel_names: tuple[str, ...]
     t: NDArray[np.float64]
     y: NDArray[np.float64]
     S: NDArray[np.float64]
+    channel_S: NDArray[np.float64]
     events: list[EventSensitivity] = field(default_factory=list)
     success: bool = True
     message: str = "end of the time span reached"
 
-    def sensitivity(self, state: str, parameter: str | None = None) -> NDArray[np.float64]:
-        """d(state)/d(parameter) at every time, (n_times,); every parameter (n_times, Ns) without one."""
-        if state not in self.state_names:
-            raise KeyError(f"no state {state!r}; the states are {', '.join(self.state_names)}")
-        column = self.S[:, self.state_names.index(state), :]
+    def sensitivity(self, name: str, parameter: str | None = None) -> NDArray[np.float64]:
+        """d(name)/d(parameter) of a state or a channel at every time, (n_times,); every parameter
+        (n_times, Ns) without one."""
+        if name in self.state_names:
+            column = self.S[:, self.state_names.index(name), :]
+        elif name in self.channel_names:
+            column = self.channel_S[:, self.channel_names.index(name), :]
+        else:
+            raise KeyError(f"no state or channel {name!r}; the states are {', '.join(self.state_names)}")
         if parameter is None:
             return column
         if parameter not in self.names:
@@ -112,10 +119,12 @@ def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[st
     if model.formulation == "ggl" and model.n_constraints:
         session.set_hints(nonlin_conv_coef=min(0.33, max(ida.GGL_NEWTON_COEF, 1e-13 / rtol)))
     poisoned = np.zeros(W, dtype=bool)  # parameters whose sensitivities are NaN from a grazing event on
-    rows_t: list[NDArray] = [eval_times[:1]] if eval_times[0] == 0.0 else []
-    rows_y: list[NDArray] = [y[None, :]] if rows_t else []
-    rows_S: list[NDArray] = [S[None, :, :]] if rows_t else []
-    run = SensitivityRun(ms.names, model.state_names, np.zeros(0), np.zeros((0, n)), np.zeros((0, n, W)))
+    rows: list[tuple[float, NDArray, NDArray, NDArray]] = []  # (t, y, S, channels' S) at the output times
+    if eval_times[0] == 0.0:
+        rows.append(_row(ms, 0.0, y, S, active, params, S_params, poisoned))
+    n_ch = len(model.channel_names)
+    run = SensitivityRun(ms.names, model.state_names, model.channel_names, np.zeros(0), np.zeros((0, n)),
+                         np.zeros((0, n, W)), np.zeros((0, n_ch, W)))
     t = 0.0
     try:
         while True:
@@ -123,13 +132,8 @@ def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[st
                            active, [np.concatenate([p, s.ravel(order="F")]) for p, s in zip(params, S_params)],
                            contact_state.root_directions(model, state))
             adv = session.advance(float(t_end), eval_times, store_steps=False, store_states=False)
-            for te, Ye in zip(adv.eval_t, adv.eval_y):
-                Se = Ye[n:].reshape(n, W, order="F")
-                Se = ms.consistent(float(te), Ye[:n], Se, active, params, S_params)[0]
-                Se[:, poisoned] = np.nan
-                rows_t.append(np.array([te]))
-                rows_y.append(Ye[None, :n])
-                rows_S.append(Se[None])
+            for te, Ye in zip(adv.eval_t.tolist(), adv.eval_y):
+                rows.append(_row(ms, te, Ye[:n], Ye[n:].reshape(n, W, order="F"), active, params, S_params, poisoned))
             t = adv.t
             if adv.status != "root":
                 if adv.status == "error":
@@ -146,10 +150,22 @@ def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[st
                 S_params[k][:, poisoned] = 0.0
     finally:
         session.close()
-    run.t = np.concatenate(rows_t) if rows_t else np.zeros(0)
-    run.y = np.concatenate(rows_y) if rows_y else np.zeros((0, n))
-    run.S = np.concatenate(rows_S) if rows_S else np.zeros((0, n, W))
+    if rows:
+        run.t = np.array([r[0] for r in rows])
+        run.y, run.S, run.channel_S = (np.stack([r[k] for r in rows]) for k in (1, 2, 3))
     return run
+
+
+def _row(ms: ModelSensitivity, t: float, y: NDArray, S: NDArray, active: list[bool], params: list[NDArray],
+         S_params: list[NDArray], poisoned: NDArray) -> tuple[float, NDArray, NDArray, NDArray]:
+    """An output row, made consistent in its mode: (t, y, S, the channels' sensitivities), NaN where poisoned."""
+    model = ms.model
+    y, yp = model.consistent_state(t, y, model.term_forces(t, y, active, params))
+    S, Sp = ms.consistent(t, y, S, active, params, S_params)
+    channels = ms.channels(t, y, yp, S, Sp, model.switch_vector(active, params), ms.switch_sensitivity(S_params))
+    S[:, poisoned] = np.nan
+    channels[:, poisoned] = np.nan
+    return t, y, S, channels
 
 
 def _event(ms: ModelSensitivity, state: contact_state.ContactState, active: list[bool], params: list[NDArray],
