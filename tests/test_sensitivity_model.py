@@ -44,7 +44,8 @@ def test_parameter_directions_exact_and_derived(index1) -> None:
                                                   "clearance.clearance"))
     assert c_col[rows.index("clearance.clearance")] == 1.0
     assert c_col[rows.index("clearance.journal_radius")] == pytest.approx(-1.0, rel=1e-12, abs=0.0)
-    assert c_col[rows.index("clearance.law.stiffness")] == pytest.approx(K * 0.5 * (-1 / (R - c) - 1 / c), rel=1e-10, abs=0.0)
+    assert c_col[rows.index("clearance.law.stiffness")] == pytest.approx(K * 0.5 * (-1 / (R - c) - 1 / c), rel=1e-10,
+                                                                     abs=0.0)
     assert np.count_nonzero(c_col) == 3
 
 
@@ -169,11 +170,13 @@ def test_approach_rate_and_its_derivatives_closed_form() -> None:
     def gap(z: np.ndarray, c: complex = 0.1) -> complex:
         return (z[0] ** 2 + z[1] ** 2 - c * c) / (2 * c)
 
-    assert at.g_p[0] == pytest.approx([float(np.imag(gap(y + 1e-30j * S[:, 0], 0.1 + 1e-30j)) / 1e-30)], rel=1e-13, abs=0.0)
+    assert at.g_p[0] == pytest.approx([float(np.imag(gap(y + 1e-30j * S[:, 0], 0.1 + 1e-30j)) / 1e-30)], rel=1e-13,
+                                      abs=0.0)
     assert at.rate[0] == pytest.approx((y[0] * yp[0] + y[1] * yp[1]) / 0.1, rel=1e-13, abs=0.0)
     assert at.scale[0] == pytest.approx((abs(y[0] * yp[0]) + abs(y[1] * yp[1])) / 0.1, rel=1e-13, abs=0.0)
     # d2/dt2 along q' = v, q'' = v': (|v|^2 + e.a) / c
-    assert at.curvature[0] == pytest.approx((yp[0] ** 2 + yp[1] ** 2 + y[0] * yp[3] + y[1] * yp[4]) / 0.1, rel=1e-13, abs=0.0)
+    assert at.curvature[0] == pytest.approx((yp[0] ** 2 + yp[1] ** 2 + y[0] * yp[3] + y[1] * yp[4]) / 0.1, rel=1e-13,
+                                            abs=0.0)
     assert at.error[0] == pytest.approx((abs(y[0]) * (1e-9 + 1e-8 * abs(y[0])) + abs(y[1]) * (1e-9 + 1e-8 * abs(y[1])))
                                         / 0.1, rel=1e-13, abs=0.0)
 
