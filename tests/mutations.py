@@ -50,6 +50,8 @@ def left_out_of_copy(directory: str, names: list[str]) -> set[str]:
     if "results" in names and not (Path(directory) / "results" / "__init__.py").exists():
         left_out.add("results")
     return left_out
+
+
 #: pytest's exit statuses: 0 all passed, 1 some failed; anything else (interrupted, internal error,
 #: usage error, nothing collected) is no verdict.
 PASSED, FAILED = 0, 1
