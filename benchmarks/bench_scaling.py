@@ -3,6 +3,7 @@
     python benchmarks/bench_scaling.py [--sizes 8,16,32,64,128] [--t-end 0.2] [--repeats 3]
     python benchmarks/bench_scaling.py --trees OLD NEW [...]      two trees side by side
     python benchmarks/bench_scaling.py --accuracy [--repeats 3]   against scipy at equal accuracy
+    python benchmarks/bench_scaling.py [--trees OLD NEW] [...] --write-doc
 
 The mechanism is ``daeclear.mechanisms.chain(N)``: N steel links released from the horizontal, every
 pin (the ground pin too) a 0.1 mm revolute clearance joint with Lankarani-Nikravesh contact, so the
@@ -29,6 +30,10 @@ against a DOP853 rtol 1e-12 reference over the window where an independent IDA r
 every run a whole ``simulate(scene, ...)`` call) of the 16-link chain and of the chapter's
 slider-crank, IDA (GGL and index-1) against every scipy method; for each IDA tolerance, the fastest
 scipy method whose error is at most IDA's, and the ratio of wall times.
+
+``--write-doc`` writes the table into docs/performance.md (block "scaling"): states, steps and events of
+this tree's (the NEW tree's) calls, which are deterministic (tests/test_doc_numbers.py runs them again
+at the block's ``--t-end``), and the measured times (with ``--trees`` both trees' and their ratios).
 """
 
 from __future__ import annotations
@@ -175,6 +180,31 @@ def print_table(results: dict[int, dict[str, dict[str, Any]]], labels: list[str]
                   f"per step per state (loop) {per_step_state(o, 'loop') / per_step_state(w, 'loop'):.2f}x{note}")
 
 
+def doc_table(results: dict[int, dict[str, dict[str, Any]]], labels: list[str]) -> list[str]:
+    """The Markdown table of --write-doc: the last tree's counts, each tree's times, the old / new ratios."""
+    new = labels[-1]
+    head = "| N | states | steps | events | build | "
+    head += " | ".join(f"{what} ({label})" for what in ("call", "loop", "ns/step/state") for label in labels)
+    if len(labels) == 2:
+        head += f" | {labels[0]} / {new}, loop | {labels[0]} / {new}, ns per step per state"
+    lines = [head + " |", "|" + "---:|" * (head.count("|"))]
+    base = {label: per_step_state(results[16][label], "loop") if 16 in results else None for label in labels}
+    for n, per_tree in results.items():
+        r = per_tree[new]
+        cells = [str(n), str(r["states"]), str(r["steps"]), str(r["events"]), f"{r['build']:.1f} s"]
+        cells += [f"{per_tree[label]['wall']:.3f} s" for label in labels]
+        cells += [f"{per_tree[label]['loop']:.3f} s" for label in labels]
+        for label in labels:
+            ns = per_step_state(per_tree[label], "loop")
+            flat = f" ({ns / base[label]:.2f}x N = 16's)" if base[label] else ""
+            cells.append(f"{ns:.0f}{flat}")
+        if len(labels) == 2:
+            o = per_tree[labels[0]]
+            cells += [f"{o['loop'] / r['loop']:.2f}", f"{per_step_state(o, 'loop') / per_step_state(r, 'loop'):.2f}"]
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
 # --------------------------------------------------------------------------- equal accuracy
 
 def accuracy(repeats: int) -> None:
@@ -228,6 +258,7 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3, help="warm calls per size and tree, best kept (3)")
     parser.add_argument("--trees", nargs=2, type=Path, metavar=("OLD", "NEW"), help="two checkouts side by side")
     parser.add_argument("--accuracy", action="store_true", help="the equal-accuracy study instead")
+    parser.add_argument("--write-doc", action="store_true", help="write the table into docs/performance.md")
     args = parser.parse_args()
     if args.t_end <= 0 or args.repeats < 1:
         parser.error("--t-end must be > 0 and --repeats >= 1")
@@ -244,6 +275,14 @@ def main() -> None:
         print(f"  N={n}: " + "; ".join(f"{label} call {r['wall']:.2f} s, {r['steps']} steps"
                                       for label, r in results[n].items()), file=sys.stderr, flush=True)
     print_table(results, list(trees), args.t_end)
+    if args.write_doc:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from doc_tables import write_block
+
+        command = (f"python benchmarks/bench_scaling.py --sizes {','.join(map(str, args.sizes))} "
+                   f"--t-end {args.t_end:g} --repeats {args.repeats}"
+                   + (" --trees OLD NEW" if args.trees else "") + " --write-doc")
+        print(f"wrote {write_block('docs/performance.md', 'scaling', command, doc_table(results, list(trees)))}")
 
 
 if __name__ == "__main__":

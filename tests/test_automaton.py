@@ -136,6 +136,23 @@ def test_storm_holds_ignores_quick_recontacts_and_releases_after_a_flight():
     assert d == Decision(ONSET, True, False, 3.0, -1)  # a genuine impact: hold ends, speed latched
 
 
+@pytest.mark.parametrize("events", [2, 3, 4, 20])
+def test_the_storm_holds_at_exactly_its_count_of_switches(events):
+    """Storm(n, window): a separation holds the term on when it makes n switches or more within the
+    window, itself included. Onsets and separations alternate a nanosecond apart, so the first held
+    separation is switch number n (n even) or n + 1 (n odd: the n-th switch is an onset)."""
+    rule = dict(storm=Storm(events, 1e-6), min_approach_speed=1e-4)
+    state, t, switches = PairState(), 0.0, 0
+    while True:
+        state, d = step(state, t := t + 1e-9, +1, 1.0, **rule)
+        state, d = step(state, t := t + 1e-9, -1, -1.0, **rule)
+        switches += 2
+        assert d.kind == SEPARATION
+        if d.held:
+            break
+    assert switches == events + events % 2
+
+
 def test_storm_constants_are_checked():
     assert (Storm().events, Storm().window) == (automaton.STORM_EVENTS, automaton.STORM_WINDOW)
     for bad in (dict(events=0), dict(events=2.0), dict(window=-1e-6), dict(window=math.inf)):
@@ -187,7 +204,8 @@ def _slider_crank(kind: str, storm: Storm | None) -> dc.DAEModel:
     scene = dc.mechanisms.slider_crank(kind, gravity=0.0) if kind == "revolute" else dc.mechanisms.slider_crank(kind)
     model = dc.assemble(scene, "index1")  # step for step on both backends (GGL's Newton coefficient: C only)
     if storm is not None:  # the rules are frozen: a model with other rules is a new value
-        model = model.copy_with(contacts=tuple(dataclasses.replace(logic, storm=storm) for logic in model.contacts))
+        contacts = tuple(dataclasses.replace(logic, storm=storm) for logic in model.contacts)
+        model = dataclasses.replace(model, contacts=contacts)
     return model
 
 
