@@ -1,7 +1,7 @@
 """How the cost of a run grows with the mechanism's size: chains of N links, a clearance at every pin.
 
     python benchmarks/bench_scaling.py [--sizes 8,16,32,64,128] [--t-end 0.2] [--repeats 3]
-    python benchmarks/bench_scaling.py --trees OLD NEW [...]      two trees side by side
+    python benchmarks/bench_scaling.py --trees OLD NEW [--old-max 64] [...]   two trees side by side
     python benchmarks/bench_scaling.py --accuracy [--repeats 3]   against scipy at equal accuracy
     python benchmarks/bench_scaling.py [--trees OLD NEW] [...] --write-doc
 
@@ -23,7 +23,8 @@ With ``--trees`` the two trees' warm calls of a size alternate (the order swappe
 workers that stay up, so both see the same machine (the machine is shared: wall times of one
 process minutes apart differ by 1.5x; ratios within one interleaved pair hold to about 5 %). Only
 public API is used (``daeclear.simulate``, ``daeclear.mechanisms.chain``, ``daeclear.assemble``), so
-an older tree runs it too.
+an older tree runs it too. ``--old-max N`` runs the old tree only up to N (its loop grows like N^2.4:
+at N = 128 one call takes minutes).
 
 ``--accuracy``: the work-precision study (:func:`daeclear.studies.accuracy.work_precision`, errors
 against a DOP853 rtol 1e-12 reference over the window where an independent IDA run agrees with it,
@@ -150,14 +151,14 @@ def print_table(results: dict[int, dict[str, dict[str, Any]]], labels: list[str]
           "| ns/step/state call |")
     print("|---:|---:|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|")
     for n, per_tree in results.items():
-        for label in labels:
+        for label in (label for label in labels if label in per_tree):
             r = per_tree[label]
             print(f"| {n} | {r['states']} | {label} | {r['build']:.1f} s | {r['cc'] or 0:.1f} s | "
                   f"{r['code'] / 1e3:.0f} kB | {r['steps']} | {r['events']} | {r['solver']} | {r['wall']:.3f} s | "
                   f"{r['loop']:.3f} s | {per_step_state(r, 'loop'):.0f} | {per_step_state(r, 'wall'):.0f} |"
                   + ("" if r["success"] else f" FAILED: {r['message'][:60]}"))
     for label in labels:
-        rows = {n: per_tree[label] for n, per_tree in results.items()}
+        rows = {n: per_tree[label] for n, per_tree in results.items() if label in per_tree}
         if 16 in rows:
             base = per_step_state(rows[16], "loop")
             flat = {n: per_step_state(r, "loop") / base for n, r in rows.items() if n >= 16}
@@ -174,6 +175,8 @@ def print_table(results: dict[int, dict[str, dict[str, Any]]], labels: list[str]
     if len(labels) == 2:
         old, new = labels
         for n, per_tree in results.items():
+            if old not in per_tree:
+                continue
             o, w = per_tree[old], per_tree[new]
             note = f" (target at N = 64: >= {SPEEDUP_TARGET}x)" if n == 64 else ""
             print(f"N={n}: {old} / {new}: whole call {o['wall'] / w['wall']:.2f}x, loop {o['loop'] / w['loop']:.2f}x, "
@@ -188,19 +191,24 @@ def doc_table(results: dict[int, dict[str, dict[str, Any]]], labels: list[str]) 
     if len(labels) == 2:
         head += f" | {labels[0]} / {new}, loop | {labels[0]} / {new}, ns per step per state"
     lines = [head + " |", "|" + "---:|" * (head.count("|"))]
-    base = {label: per_step_state(results[16][label], "loop") if 16 in results else None for label in labels}
+    base = {label: per_step_state(results[16][label], "loop") if label in results.get(16, {}) else None
+            for label in labels}
     for n, per_tree in results.items():
         r = per_tree[new]
         cells = [str(n), str(r["states"]), str(r["steps"]), str(r["events"]), f"{r['build']:.1f} s"]
-        cells += [f"{per_tree[label]['wall']:.3f} s" for label in labels]
-        cells += [f"{per_tree[label]['loop']:.3f} s" for label in labels]
+        cells += [f"{per_tree[label]['wall']:.3f} s" if label in per_tree else "-" for label in labels]
+        cells += [f"{per_tree[label]['loop']:.3f} s" if label in per_tree else "-" for label in labels]
         for label in labels:
+            if label not in per_tree:
+                cells.append("-")
+                continue
             ns = per_step_state(per_tree[label], "loop")
             flat = f" ({ns / base[label]:.2f}x N = 16's)" if base[label] else ""
             cells.append(f"{ns:.0f}{flat}")
         if len(labels) == 2:
-            o = per_tree[labels[0]]
-            cells += [f"{o['loop'] / r['loop']:.2f}", f"{per_step_state(o, 'loop') / per_step_state(r, 'loop'):.2f}"]
+            o = per_tree.get(labels[0])
+            cells += ([f"{o['loop'] / r['loop']:.2f}", f"{per_step_state(o, 'loop') / per_step_state(r, 'loop'):.2f}"]
+                      if o is not None else ["-", "-"])
         lines.append("| " + " | ".join(cells) + " |")
     return lines
 
@@ -217,7 +225,7 @@ def accuracy(repeats: int) -> None:
     rivals = {name: {"method": name} for name in ("RK45", "DOP853", "Radau", "BDF", "LSODA")}
     ida = {"IDA GGL": {"method": "ida"}, "IDA index1": {"method": "ida", "formulation": "index1"}}
     rev = 60.0 / 5000.0
-    studies = [("16-link chain, 30 ms", dc.mechanisms.chain(16), 0.03, ["link16.vx", "link8.vy"]),
+    studies = [("16-link chain, 30 ms", dc.mechanisms.chain(16), 0.03, ["link1.omega", "link2.vx", "link3.vy"]),
                ("slider-crank (gravity), two revolutions", dc.mechanisms.slider_crank("revolute"), 2 * rev,
                 ["slider.vx"])]
     for title, scene, t_end, channels in studies:
@@ -257,6 +265,7 @@ def main() -> None:
     parser.add_argument("--t-end", type=float, default=0.2, help="simulated time of the warm calls, s (0.2)")
     parser.add_argument("--repeats", type=int, default=3, help="warm calls per size and tree, best kept (3)")
     parser.add_argument("--trees", nargs=2, type=Path, metavar=("OLD", "NEW"), help="two checkouts side by side")
+    parser.add_argument("--old-max", type=int, default=0, help="with --trees: run OLD only up to this N (0: all)")
     parser.add_argument("--accuracy", action="store_true", help="the equal-accuracy study instead")
     parser.add_argument("--write-doc", action="store_true", help="write the table into docs/performance.md")
     args = parser.parse_args()
@@ -271,7 +280,9 @@ def main() -> None:
                                      if args.trees else {"this": None})
     results: dict[int, dict[str, dict[str, Any]]] = {}
     for n in args.sizes:
-        results[n] = measure(trees, n, args.t_end, args.repeats)
+        at_n = {label: tree for label, tree in trees.items()
+                if not (label == "old" and args.old_max and n > args.old_max)}
+        results[n] = measure(at_n, n, args.t_end, args.repeats)
         print(f"  N={n}: " + "; ".join(f"{label} call {r['wall']:.2f} s, {r['steps']} steps"
                                       for label, r in results[n].items()), file=sys.stderr, flush=True)
     print_table(results, list(trees), args.t_end)
@@ -281,7 +292,8 @@ def main() -> None:
 
         command = (f"python benchmarks/bench_scaling.py --sizes {','.join(map(str, args.sizes))} "
                    f"--t-end {args.t_end:g} --repeats {args.repeats}"
-                   + (" --trees OLD NEW" if args.trees else "") + " --write-doc")
+                   + (" --trees OLD NEW" if args.trees else "")
+                   + (f" --old-max {args.old_max}" if args.trees and args.old_max else "") + " --write-doc")
         print(f"wrote {write_block('docs/performance.md', 'scaling', command, doc_table(results, list(trees)))}")
 
 
