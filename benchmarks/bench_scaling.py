@@ -4,6 +4,7 @@
     python benchmarks/bench_scaling.py --trees OLD NEW [--old-max 64] [...]   two trees side by side
     python benchmarks/bench_scaling.py --accuracy [--repeats 3]   against scipy at equal accuracy
     python benchmarks/bench_scaling.py [--trees OLD NEW] [...] --write-doc
+    python benchmarks/bench_scaling.py --flat 16,64,128 [--repeats 3]   this tree's sizes interleaved
 
 The mechanism is ``daeclear.mechanisms.chain(N)``: N steel links released from the horizontal, every
 pin (the ground pin too) a 0.1 mm revolute clearance joint with Lankarani-Nikravesh contact, so the
@@ -31,6 +32,9 @@ against a DOP853 rtol 1e-12 reference over the window where an independent IDA r
 every run a whole ``simulate(scene, ...)`` call) of the 16-link chain and of the chapter's
 slider-crank, IDA (GGL and index-1) against every scipy method; for each IDA tolerance, the fastest
 scipy method whose error is at most IDA's, and the ratio of wall times.
+
+``--flat``: one worker per size of this tree, their calls interleaved round-robin, so the sizes' ns per
+step per state see the same machine (sizes measured one after another do not: the load moves).
 
 ``--write-doc`` writes the table into docs/performance.md (block "scaling"): states, steps and events of
 this tree's (the NEW tree's) calls, which are deterministic (tests/test_doc_numbers.py runs them again
@@ -213,6 +217,31 @@ def doc_table(results: dict[int, dict[str, dict[str, Any]]], labels: list[str]) 
     return lines
 
 
+def flat(sizes: list[int], t_end: float, repeats: int) -> None:
+    """This tree's sizes interleaved call by call: ns per step per state of the loop, against the first size's."""
+    workers = {n: Worker(None, n) for n in sizes}
+    try:
+        states = {n: w.ask("build")["states"] for n, w in workers.items()}
+        best: dict[int, float] = {}
+        for k in range(repeats):
+            for n in (sizes if k % 2 == 0 else sizes[::-1]):
+                r = workers[n].ask(f"call {t_end!r}")
+                ns = r["loop"] / max(r["steps"], 1) / states[n] * 1e9
+                best[n] = min(best.get(n, ns), ns)
+                print(f"  N={n}: loop {r['loop']:.3f} s, {r['steps']} steps, {ns:.0f} ns/step/state", file=sys.stderr,
+                      flush=True)
+    finally:
+        for w in workers.values():
+            w.close()
+    first = sizes[0]
+    print(f"\nchain(N), {t_end:g} s, sizes interleaved, best of {repeats}: ns per step per state of the IDA loop\n")
+    print("| N | states | ns/step/state | against N = " + str(first) + "'s |\n|---:|---:|---:|---:|")
+    for n in sizes:
+        print(f"| {n} | {states[n]} | {best[n]:.0f} | {best[n] / best[first]:.2f} |")
+    worst = max(best[n] / best[first] for n in sizes)
+    print(f"\nlargest ratio {worst:.2f} (target within {FLAT_TARGET}: {'ok' if worst <= FLAT_TARGET else 'MISSED'})")
+
+
 # --------------------------------------------------------------------------- equal accuracy
 
 def accuracy(repeats: int) -> None:
@@ -266,6 +295,7 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3, help="warm calls per size and tree, best kept (3)")
     parser.add_argument("--trees", nargs=2, type=Path, metavar=("OLD", "NEW"), help="two checkouts side by side")
     parser.add_argument("--old-max", type=int, default=0, help="with --trees: run OLD only up to this N (0: all)")
+    parser.add_argument("--flat", type=_sizes, help="this tree's sizes interleaved (e.g. 16,64,128)")
     parser.add_argument("--accuracy", action="store_true", help="the equal-accuracy study instead")
     parser.add_argument("--write-doc", action="store_true", help="write the table into docs/performance.md")
     args = parser.parse_args()
@@ -275,6 +305,9 @@ def main() -> None:
           "are noisy; compare ratios of interleaved calls)")
     if args.accuracy:
         accuracy(args.repeats)
+        return
+    if args.flat:
+        flat(args.flat, args.t_end, args.repeats)
         return
     trees: dict[str, Path | None] = ({"old": args.trees[0].resolve(), "new": args.trees[1].resolve()}
                                      if args.trees else {"this": None})
