@@ -27,6 +27,7 @@ from ..model.scene import RevoluteClearance, Scene
 from ..core.progress import Progress
 from ..results.outputs import check_file
 from ..core.values import to_plain
+from ..results.channel_eval import RunChannels
 from ..results.result import Result
 from ..solvers.solver_options import SolverOptions
 from ..solvers.dispatch import simulate
@@ -36,22 +37,37 @@ from .wear_file import WearFile
 
 
 
+#: The worn joint's generated channels the wear update reads (``<joint>.<name>``): functions of the
+#: positions and velocities alone, read from a run's stored rows (:class:`RunChannels`).
+HISTORY_CHANNELS = ("normal_force", "bearing_angle", "journal_angle", "sliding_velocity", "penetration")
+
+
+def joint_channels(model: DAEModel, joint: str) -> RunChannels:
+    """The reader of revolute clearance joint ``joint``'s contact history in runs of ``model``'s structure."""
+    names = [f"{joint}.{q}" for q in HISTORY_CHANNELS]
+    if any(name not in model.channel_names for name in names):
+        worn = [e.name for e in getattr(model.scene, "elements", ()) if getattr(e, "wear", None) is not None]
+        raise SceneError(f"wear_history: joint={joint!r}, must be a revolute clearance joint with wear of the run "
+                         f"({', '.join(worn) or 'none has wear=ArchardWear(...)'}).")
+    return RunChannels(model, names)
+
+
+def history_arrays(t: NDArray[np.float64], values: dict[str, NDArray[np.float64]], joint: str) -> WearHistoryArrays:
+    """The contact history from the joint's channels (:data:`HISTORY_CHANNELS`) at the times ``t``."""
+    force, bearing, journal, slip, penetration = (values[f"{joint}.{q}"] for q in HISTORY_CHANNELS)
+    slip = np.where(np.isfinite(slip), slip, 0.0)  # no direction at the centred journal (e = 0), far from contact
+    return WearHistoryArrays(t=np.asarray(t, dtype=float), force=force, angle_bearing=np.unwrap(bearing),
+                             angle_journal=np.unwrap(journal), slip_speed=slip,
+                             penetration=np.clip(penetration, 0.0, None))
+
+
 def wear_history(result: Result, model: DAEModel, joint: str) -> WearHistoryArrays:
     """The contact history of revolute clearance joint ``joint`` (with wear) in a run of ``model``, read from
     the joint's generated channels: normal force, the contact direction's angle in the bearing's and the
     journal's frame (``<joint>.bearing_angle``, ``.journal_angle``, unwrapped), the sliding velocity of the
     contact points (4.9) and the penetration."""
-    names = [f"{joint}.{q}" for q in ("normal_force", "bearing_angle", "journal_angle", "sliding_velocity",
-                                       "penetration")]
-    if any(name not in model.channel_names for name in names):
-        worn = [e.name for e in getattr(model.scene, "elements", ()) if getattr(e, "wear", None) is not None]
-        raise SceneError(f"wear_history: joint={joint!r}, must be a revolute clearance joint with wear of the run "
-                         f"({', '.join(worn) or 'none has wear=ArchardWear(...)'}).")
-    force, bearing, journal, slip, penetration = (np.asarray(result[name], dtype=float) for name in names)
-    slip = np.where(np.isfinite(slip), slip, 0.0)  # no direction at the centred journal (e = 0), far from contact
-    return WearHistoryArrays(t=np.asarray(result.t, dtype=float), force=force, angle_bearing=np.unwrap(bearing),
-                             angle_journal=np.unwrap(journal), slip_speed=slip,
-                             penetration=np.clip(penetration, 0.0, None))
+    backend = str(result.parameters.get("simulate", {}).get("backend", "auto"))
+    return history_arrays(result.t, joint_channels(model, joint)(result, model, backend), joint)
 
 
 @dataclass(frozen=True)
@@ -187,6 +203,8 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
     done, work = rows[-1][0], rows[-1][2]
     bar = Progress(float(cycles), unit="cycles", desc="wear", enabled=progress)
     name, radius, clearance = element.name, float(element.bearing_radius), element.radial_clearance
+    history_of = joint_channels(model, name)
+    backend = (options or SolverOptions()).backend  # the runs' (resolved alike by every session)
     message = ""
     try:
         while done < cycles:
@@ -204,21 +222,23 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
             except (SolveError, AssemblyError) as exc:  # the history so far is the result (and in the file)
                 message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
                 break
-            deepest_run = float(np.max(result[f"{name}.penetration"]))
+            channels = history_of(result, model, backend)
+            deepest_run = float(np.max(channels[f"{name}.penetration"]))
             if deepest_run > clearance:
                 message = (f"stopped at {done:g} cycles: the next block's run left joint '{name}' {deepest_run:.3g} m "
                            f"inside its wall, more than its clearance {clearance:g} m (beyond what its contact law "
                            "describes); its wear is not taken. A tighter rtol, or a smaller wear coefficient.")
                 break
-            increment, block_work = wear_increment(wear, wear_history(result, model, name), bearing_radius=radius,
-                                                   clearance=clearance, effective_modulus=modulus)
+            increment, block_work = wear_increment(wear, history_arrays(result.t, channels, name),
+                                                   bearing_radius=radius, clearance=clearance,
+                                                   effective_modulus=modulus)
             depth = {s: depth[s] + extrapolate * increment[s] for s in depth}
             done += update_every * extrapolate
             work += extrapolate * block_work
-            peak = float(np.max(result[f"{name}.normal_force"]))
+            peak = float(np.max(channels[f"{name}.normal_force"]))
             rows[-1] = (*rows[-1][:3], peak)
             rows.append((done, depth, work, math.nan))
-            t0, y0 = float(result.t[-1]), result.y[-1]
+            t0, y0 = float(result.t[-1]), result.state(-1)
             if store is not None:
                 store.append(done, depth, work, math.nan, t0=t0, y0=y0, peak_before=peak)
             bar.update(min(done, cycles), f"max depth {max(float(d.max()) for d in depth.values()):.3g} m")
