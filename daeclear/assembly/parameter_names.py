@@ -52,7 +52,7 @@ def scene_names(scene: Any, formulation: str, table: frozenset[str], elements: f
 
 
 def _is_number(value: Any) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+    return type(value) is float or isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 def is_numbers(value: Any) -> bool:
