@@ -103,7 +103,7 @@ def half_angle_hertz(force: ArrayLike, bearing_radius: float, journal_radius: fl
     return np.sqrt(4.0 * np.clip(force, 0.0, None) * r_eff / (math.pi * length * effective_modulus)) / bearing_radius
 
 
-def _shape(distribution: str, phi: NDArray[np.float64], half_angle: NDArray[np.float64]) -> NDArray[np.float64]:
+def _shape(distribution: str, phi: NDArray[Any], half_angle: NDArray[Any]) -> NDArray[np.float64]:
     """The pressure's shape over the arc (not normalised), 0 outside it; ``half_angle`` > 0."""
     if distribution == "hertz":
         return np.sqrt(np.clip(1.0 - (phi / half_angle) ** 2, 0.0, None))

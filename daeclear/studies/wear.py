@@ -8,11 +8,12 @@ wear put into the joint's profile for the next block (Mukras et al. 2010) as new
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -32,7 +33,7 @@ from ..results.result import Result
 from ..solvers.solver_options import SolverOptions
 from ..solvers.dispatch import simulate
 from .poincare import crank_period
-from .wear_file import WearFile
+from .wear_file import WearFile, WearRow
 
 
 
@@ -183,24 +184,44 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
                          f"{size / 1e9:.3g} GB); raise extrapolate or ask fewer cycles.")
     if path is not None:
         path = check_file(path, "simulate_wear(path)", what="a wear history file (.h5)", example="wear.h5")
-    modulus = effective_modulus(element) if wear.distribution == "hertz" else None
+    if wear.distribution == "hertz":
+        effective_modulus(element)  # the materials it needs, checked before any work
     settings = {"joint": element.name, "update_every": update_every, "extrapolate": extrapolate, "period": period,
                 "formulation": model.formulation if model is not None else "default",
                 "options": None if options is None else options.to_dict(),
                 "scene": to_plain(scene.to_dict(), "simulate_wear(scene)")}
     store = WearFile(path, settings) if path is not None else None
     tic = time.perf_counter()
-    rows = store.read() if store is not None else None
-    model = assemble(scene) if model is None else model
-    if rows is None:
-        depth = element.worn_profiles()
-        rows = [(0.0, depth, 0.0, math.nan)]
-        t0, y0 = 0.0, None
-        if store is not None:
-            store.append(*rows[0], t0=t0, y0=None)
-    else:
-        depth, t0, y0 = rows[-1][1], store.t0, store.y0  # type: ignore[union-attr]
-    done, work = rows[-1][0], rows[-1][2]
+    with store if store is not None else contextlib.nullcontext():
+        rows = store.open() if store is not None else None  # checked against the settings before any work
+        model = assemble(scene) if model is None else model
+        if rows is None:
+            rows = [WearRow(cycles=0.0, depth=element.worn_profiles(), work=0.0, block_peak=math.nan, t=0.0, y=None)]
+            if store is not None:
+                store.append(rows[0], model.n_states)
+        history, interrupted = _blocks(model, rows, store, element, cycles, (update_every, extrapolate, period),
+                                       options, progress)
+    if interrupted:  # Ctrl-C: the history so far is kept (and in the file), then the caller stops
+        raise Interrupted(f"simulate_wear: interrupted by the user at {history.cycles[-1]:g} cycles; the history so "
+                          "far is in .result" + (f" and in {path}" if path is not None else ""),
+                          result=replace(history, wall_time=time.perf_counter() - tic)) from None
+    if history.message:
+        warnings.warn(f"simulate_wear: {history.message}", PhysicsWarning, stacklevel=2)
+    return replace(history, wall_time=time.perf_counter() - tic)
+
+
+def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, element: RevoluteClearance,
+            cycles: float, scheme: tuple[int, int, float], options: SolverOptions | None,
+            progress: bool) -> tuple[WearHistory, bool]:
+    """simulate_wear's blocks from the last of ``rows`` on, each appended to ``rows`` and ``store``
+    (``scheme``: update interval, extrapolation, period): the history (its message says why it stopped
+    early) and whether Ctrl-C stopped it."""
+    update_every, extrapolate, period = scheme
+    wear = element.wear
+    assert wear is not None
+    modulus = effective_modulus(element) if wear.distribution == "hertz" else None
+    last = rows[-1]
+    depth, done, work, t0, y0 = last.depth, last.cycles, last.work, last.t, last.y
     bar = Progress(float(cycles), unit="cycles", desc="wear", enabled=progress)
     name, radius, clearance = element.name, float(element.bearing_radius), element.radial_clearance
     history_of = joint_channels(model, name)
@@ -235,22 +256,17 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
             depth = {s: depth[s] + extrapolate * increment[s] for s in depth}
             done += update_every * extrapolate
             work += extrapolate * block_work
-            peak = float(np.max(channels[f"{name}.normal_force"]))
-            rows[-1] = (*rows[-1][:3], peak)
-            rows.append((done, depth, work, math.nan))
             t0, y0 = float(result.t[-1]), result.state(-1)
-            if store is not None:
-                store.append(done, depth, work, math.nan, t0=t0, y0=y0, peak_before=peak)
+            peak = float(np.max(channels[f"{name}.normal_force"]))
+            rows.append(WearRow(cycles=done, depth=depth, work=work, block_peak=peak, t=t0, y=y0))
+            if store is not None:  # a Ctrl-C meanwhile arrives once the row is written whole
+                store.append(rows[-1], model.n_states)
             bar.update(min(done, cycles), f"max depth {max(float(d.max()) for d in depth.values()):.3g} m")
-    except KeyboardInterrupt:  # Ctrl-C: the history so far is kept (and in the file), then the caller stops
-        history = _history(rows, wear, radius, time.perf_counter() - tic, f"interrupted at {done:g} cycles")
-        raise Interrupted(f"simulate_wear: interrupted by the user at {done:g} cycles; the history so far is in "
-                          ".result" + (f" and in {path}" if path is not None else ""), result=history) from None
+    except KeyboardInterrupt:  # Ctrl-C: the history so far is kept (and in the file)
+        return _history(rows, wear, radius, f"interrupted at {done:g} cycles"), True
     finally:
         bar.close()
-    if message:
-        warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
-    return _history(rows, wear, radius, time.perf_counter() - tic, message)
+    return _history(rows, wear, radius, message), False
 
 
 def _checked_period(scene: Scene, period: float | None) -> float:
@@ -275,12 +291,13 @@ def _depth_value(depth: dict[str, NDArray[np.float64]], surfaces: tuple[str, ...
         tuple(depth[s].tolist()) for s in surfaces)
 
 
-def _history(rows: list[tuple[float, dict[str, NDArray[np.float64]], float, float]], wear: ArchardWear,
-             radius: float, wall_time: float, message: str) -> WearHistory:
+def _history(rows: list[WearRow], wear: ArchardWear, radius: float, message: str) -> WearHistory:
+    """The history of ``rows``; a profile's peak force is that of the block run with it (the next row's)."""
     surfaces = wear.surfaces
-    depth = np.array([[row[1][s] for s in surfaces] for row in rows])
-    volume = np.array([sum(worn_volume(row[1][s], radius, wear.length) for s in surfaces) for row in rows])
-    return WearHistory(angles=wear.angles, cycles=np.array([row[0] for row in rows]),
+    depth = np.array([[row.depth[s] for s in surfaces] for row in rows])
+    volume = np.array([sum(worn_volume(row.depth[s], radius, wear.length) for s in surfaces) for row in rows])
+    return WearHistory(angles=wear.angles, cycles=np.array([row.cycles for row in rows]),
                        depth=depth[:, 0] if len(surfaces) == 1 else depth, volume=volume,
-                       sliding_work=np.array([row[2] for row in rows]), peak_force=np.array([row[3] for row in rows]),
-                       surfaces=surfaces, wall_time=wall_time, message=message)
+                       sliding_work=np.array([row.work for row in rows]),
+                       peak_force=np.array([row.block_peak for row in rows[1:]] + [math.nan]),
+                       surfaces=surfaces, message=message)
