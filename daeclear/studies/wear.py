@@ -176,7 +176,7 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
     period = _checked_period(scene, period)
     blocks = math.ceil(cycles / (update_every * extrapolate))
     if blocks > MAX_BLOCKS:
-        size = blocks * (len(wear.surfaces) * wear.nodes * 8 + 32)
+        size = blocks * 8 * (len(wear.surfaces) * wear.nodes + 4 + 6 * len(scene.bodies))  # a row: profile, state
         raise SceneError(f"simulate_wear: cycles={cycles:g} with update_every={update_every}, "
                          f"extrapolate={extrapolate} "
                          f"is {blocks:.3g} blocks, must be at most {MAX_BLOCKS:.0e} (at about 10 ms a simulated cycle "
