@@ -102,7 +102,8 @@ def differences(stored: Any, now: Any, where: str = "") -> list[str]:
 
 class RunFile:
     """A study's run file (module docstring): :meth:`open` reads the rows of an existing one (its kind,
-    version and header checked) or creates it, :meth:`append` adds a row to every column.
+    version and header checked, the file kept open), :meth:`append` adds a row to every column (the
+    first makes the file).
 
     Parameters
     ----------
@@ -145,8 +146,8 @@ class RunFile:
         return SceneError(f"{self.where}: {self.path} {why}; give a new path.")
 
     def open(self) -> dict[str, NDArray[Any]] | None:
-        """The rows of an existing file, every column's, as many as every column has (None: a new file,
-        created now, or one without rows yet); the file stays open for :meth:`append`."""
+        """The rows of an existing file, every column's, as many as every column has (None: no file yet,
+        or one without rows); an existing file stays open for :meth:`append`."""
         import h5py
 
         if not self.path.exists():  # made with the first append
