@@ -80,3 +80,16 @@ def test_run_channels_refuse_unknown_names_and_other_structures(scene):
     run = dc.simulate(renumbered, 0.002)
     assert np.array_equal(reader(run, renumbered)["clearance.penetration"],
                           dc.simulate(renumbered, 0.002)["clearance.penetration"])
+
+
+def test_the_python_backend_reads_them_alike(scene):
+    """A run of the python backend (scikit-sundae, CasADi's evaluation): its channels read in that backend."""
+    model = dc.assemble(scene)
+    options = dc.SolverOptions(backend="python")
+    first, second = (dc.simulate(model, 0.002, options=options) for _ in range(2))
+    assert first.parameters["simulate"]["backend"] == "python" and len(first.events) > 3
+    names = ["clearance.normal_force", "clearance.penetration", "clearance.sliding_velocity"]
+    read = RunChannels(model, names)(first, model, "python")
+    assert first.channel_source.raw
+    for name in names:
+        assert np.array_equal(read[name], second[name], equal_nan=True), name
