@@ -79,7 +79,7 @@ def _start_session(model: DAEModel, t0: float, y0: NDArray | None,
                    settings: SolverOptions) -> tuple[Any, NDArray, NDArray]:
     """Open one run's IDA session and find its consistent start (the session is closed if that fails)."""
     rtol, allow_penetration = settings.rtol, settings.allow_penetration
-    session = open_session(model.functions, backend=settings.backend, rtol=rtol,
+    session = open_session(model.compiled, backend=settings.backend, rtol=rtol,
                            atol=tolerance_vector(model, rtol, settings.atol_value()), max_step=settings.max_step,
                            parameters=model.parameter_values, max_steps=settings.max_steps,
                            linear_solver=settings.linear_solver)
