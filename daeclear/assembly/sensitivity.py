@@ -26,7 +26,8 @@ from ..core.options import close_matches
 from ..engine.sensitivity_functions import SensitivityFunctions, directional, jacobian_blocks
 from .dae_model import EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_TERM0, DAEModel
 
-__all__ = ["parameter_value", "parameter_directions", "initial_sensitivities", "model_sensitivity_functions",
+__all__ = ["parameter_value", "moved_parameter", "parameter_directions", "initial_sensitivities",
+           "model_sensitivity_functions",
            "ModelSensitivity", "RootTerms", "STEP_BITS"]
 
 #: Central differences of the scene-to-P map and of the start use the step 2**-STEP_BITS |p| (a power of
@@ -78,7 +79,7 @@ def _step(p: float) -> float:
     return math.ldexp(1.0, exponent - STEP_BITS)
 
 
-def _at(model: DAEModel, name: str, value: float) -> DAEModel:
+def moved_parameter(model: DAEModel, name: str, value: float) -> DAEModel:
     """``model`` with the parameter ``name`` at ``value`` (the scene's number, or the table entry itself)."""
     if _scene_value(model, name) is not None:
         try:
@@ -121,7 +122,7 @@ def parameter_directions(model: DAEModel, names: Sequence[str]) -> NDArray[np.fl
     columns = []
     for name in names:
         p = parameter_value(model, name)
-        columns.append(_richardson(lambda x, name=name: _at(model, name, x).parameter_values, p, _step(p)))
+        columns.append(_richardson(lambda x, name=name: moved_parameter(model, name, x).parameter_values, p, _step(p)))
     return np.stack(columns, axis=1) if columns else np.zeros((model.parameter_values.size, 0))
 
 
@@ -149,7 +150,8 @@ def initial_sensitivities(model: DAEModel, names: Sequence[str], start: str = "i
         def start_at(x: float, name: str = name) -> NDArray[np.float64]:
             with warnings.catch_warnings():  # the start's notes were given for the run itself
                 warnings.simplefilter("ignore")
-                return _at(model, name, x).initial_state(start=start, allow_penetration=allow_penetration)[0]
+                moved = moved_parameter(model, name, x)
+                return moved.initial_state(start=start, allow_penetration=allow_penetration)[0]
         columns.append(_richardson(start_at, p, _step(p)))
     return np.stack(columns, axis=1)
 

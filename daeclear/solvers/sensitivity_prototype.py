@@ -50,8 +50,10 @@ class EventSensitivity:
 @dataclass
 class SensitivityRun:
     """What :func:`forward_sensitivities` computed at the times ``t``: states ``y`` (n_times, n_states,
-    consistent), their sensitivities ``S`` (n_times, n_states, Ns) and the channels' ``channel_S``
-    (n_times, n_channels, Ns); NaN columns after a grazing event."""
+    consistent), their sensitivities ``S`` (n_times, n_states, Ns), the channels' values ``channels``
+    (n_times, n_channels) and sensitivities ``channel_S`` (n_times, n_channels, Ns); NaN columns after a
+    grazing event. With ``event_rows`` an event at t* adds two rows at t*, before and after the switch
+    (what :mod:`daeclear.results.objectives` needs of a trajectory)."""
 
     names: tuple[str, ...]
     state_names: tuple[str, ...]
@@ -60,9 +62,18 @@ class SensitivityRun:
     y: NDArray[np.float64]
     S: NDArray[np.float64]
     channel_S: NDArray[np.float64]
+    channels: NDArray[np.float64]
     events: list[EventSensitivity] = field(default_factory=list)
     success: bool = True
     message: str = "end of the time span reached"
+
+    def values(self, name: str) -> NDArray[np.float64]:
+        """A state's or a channel's value at every time, (n_times,)."""
+        if name in self.state_names:
+            return self.y[:, self.state_names.index(name)]
+        if name in self.channel_names:
+            return self.channels[:, self.channel_names.index(name)]
+        raise KeyError(f"no state or channel {name!r}; the states are {', '.join(self.state_names)}")
 
     def sensitivity(self, name: str, parameter: str | None = None) -> NDArray[np.float64]:
         """d(name)/d(parameter) of a state or a channel at every time, (n_times,); every parameter
@@ -83,14 +94,16 @@ class SensitivityRun:
 def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[str], *,
                           t_eval: NDArray[np.float64] | None = None, rtol: float = 1e-8,
                           atol: float | None = None, start: str = "ideal", allow_penetration: bool = False,
-                          backend: str = "python", max_step: float = 0.0, jumps: bool = True) -> SensitivityRun:
+                          backend: str = "python", max_step: float = 0.0, jumps: bool = True,
+                          event_rows: bool = False) -> SensitivityRun:
     """Integrate y and S = dy/dp of ``model`` from 0 to ``t_end`` for the named ``parameters``
     (``model.parameter_names``), with the sensitivity jumps at every contact switch.
 
     ``t_eval``: output times (default: the start and the end); ``atol`` as ``simulate``'s (None: the
     model's scales); ``backend``: the session's ("python", "c", "auto"); ``jumps=False`` leaves the jumps
     out (S carried through each event as it is, the latched values' dt*/dp term dropped): a wrong answer,
-    kept to show that the tests see the jump."""
+    kept to show that the tests see the jump; ``event_rows``: two output rows at each event, before and after
+    its switch."""
     ms = ModelSensitivity(model, parameters)
     W, n = ms.width, model.n_states
     eval_times = np.array([0.0, float(t_end)] if t_eval is None else t_eval, dtype=float)
@@ -121,12 +134,12 @@ def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[st
     session.set_hints(jacobian_refresh=ida.JACOBIAN_REFRESH,
                       first_step=ida.FIRST_STEP_ESTIMATE and model.formulation == "ggl")
     poisoned = np.zeros(W, dtype=bool)  # parameters whose sensitivities are NaN from a grazing event on
-    rows: list[tuple[float, NDArray, NDArray, NDArray]] = []  # (t, y, S, channels' S) at the output times
+    rows: list[tuple[float, NDArray, NDArray, NDArray, NDArray]] = []  # (t, y, S, channels' S, channels)
     if eval_times[0] == 0.0:
         rows.append(_row(ms, 0.0, y, S, active, params, S_params, poisoned))
     n_ch = len(model.channel_names)
     run = SensitivityRun(ms.names, model.state_names, model.channel_names, np.zeros(0), np.zeros((0, n)),
-                         np.zeros((0, n, W)), np.zeros((0, n_ch, W)))
+                         np.zeros((0, n, W)), np.zeros((0, n_ch, W)), np.zeros((0, n_ch)))
     t = 0.0
     try:
         while True:
@@ -142,6 +155,8 @@ def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[st
                     run.success, run.message = False, adv.message
                 break
             y, S = adv.y[:n], adv.y[n:].reshape(n, W, order="F")
+            if event_rows:
+                rows.append(_row(ms, t, y, S, active, params, S_params, poisoned))
             state, active, params, latched, y, yp, S, Sp = _event(
                 ms, state, active, params, latched, t, y, S, adv.roots_found, rtol, atol_y, jumps, differential, run)
             bad = ~np.all(np.isfinite(S), axis=0)
@@ -152,11 +167,13 @@ def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[st
                 for value in per_pair:
                     value[poisoned] = 0.0
             S_params = _term_sensitivities(model, state, latched, W)
+            if event_rows:
+                rows.append(_row(ms, t, y, S, active, params, S_params, poisoned))
     finally:
         session.close()
     if rows:
         run.t = np.array([r[0] for r in rows])
-        run.y, run.S, run.channel_S = (np.stack([r[k] for r in rows]) for k in (1, 2, 3))
+        run.y, run.S, run.channel_S, run.channels = (np.stack([r[k] for r in rows]) for k in (1, 2, 3, 4))
     return run
 
 
@@ -171,15 +188,18 @@ def _term_sensitivities(model: DAEModel, state: contact_state.ContactState, latc
 
 
 def _row(ms: ModelSensitivity, t: float, y: NDArray, S: NDArray, active: list[bool], params: list[NDArray],
-         S_params: list[NDArray], poisoned: NDArray) -> tuple[float, NDArray, NDArray, NDArray]:
-    """An output row, made consistent in its mode: (t, y, S, the channels' sensitivities), NaN where poisoned."""
+         S_params: list[NDArray], poisoned: NDArray) -> tuple[float, NDArray, NDArray, NDArray, NDArray]:
+    """An output row, made consistent in its mode: (t, y, S, the channels' sensitivities, the channels), NaN
+    where poisoned."""
     model = ms.model
     y, yp = model.consistent_state(t, y, model.term_forces(t, y, active, params))
     S, Sp = ms.consistent(t, y, S, active, params, S_params)
-    channels = ms.channels(t, y, yp, S, Sp, model.switch_vector(active, params), ms.switch_sensitivity(S_params))
+    switch = model.switch_vector(active, params)
+    channel_S = ms.channels(t, y, yp, S, Sp, switch, ms.switch_sensitivity(S_params))
+    values = np.array(model.outputs(t, y, yp, switch, model.parameter_values), dtype=float).ravel()
     S[:, poisoned] = np.nan
-    channels[:, poisoned] = np.nan
-    return t, y, S, channels
+    channel_S[:, poisoned] = np.nan
+    return t, y, S, channel_S, values
 
 
 def _event(ms: ModelSensitivity, state: contact_state.ContactState, active: list[bool], params: list[NDArray],
