@@ -41,9 +41,9 @@ def plot_sensitivity_horizon(t: ArrayLike, growth: ArrayLike, rtol: float, *, ax
     ax.axhline(1.0 / tol, color="0.4", lw=0.8, ls=":", label=f"1/rtol = {1.0 / tol:.3g}")
     if math.isfinite(horizon):
         ax.axvline(horizon, color="#d62728", lw=1.0, label=f"horizon {horizon:.4g} s")
-        title = f"sensitivity growth: lambda = {lam:.3g} 1/s, horizon {horizon:.4g} s at rtol {tol:g}"
+        title = f"sensitivity growth: lambda = {lam:.3g} 1/s\nhorizon {horizon:.4g} s at rtol {tol:g}"
     else:
-        title = f"sensitivity growth: no exponential growth, no horizon at rtol {tol:g}"
+        title = f"sensitivity growth: not exponential\nno horizon at rtol {tol:g}"
     ax.set(xlabel="t (s)", ylabel="max |S| |p| / scale")
     style.set_title(ax, title)
     ax.legend(fontsize="small")
