@@ -205,6 +205,10 @@ def test_bad_gradient_calls(scene: dc.Scene) -> None:
         dc.gradient(scene, T, of=dc.Final("journal.x"), parameters=NAMES, method="adjoint")
     with pytest.raises(dc.SceneError, match=r"gradient: of='journal.x', must be an objective"):
         dc.gradient(scene, T, of="journal.x", parameters=NAMES)  # type: ignore[arg-type]
+    with pytest.raises(dc.SceneError, match=r"gradient: parameters='clearance.clearance', must be a non-empty list"):
+        dc.gradient(scene, T, of=dc.Final("journal.x"), parameters="clearance.clearance")
+    with pytest.raises(dc.SceneError, match=r"gradient: formulation='index1', must be None or the model's own"):
+        dc.gradient(dc.assemble(scene, "ggl"), T, of=dc.Final("journal.x"), parameters=NAMES, formulation="index1")
     with pytest.raises(dc.SceneError, match=r"parameter='clearance.stiffness', must be one of model.parameter_names"):
         dc.gradient(scene, T, of=dc.Final("journal.x"), parameters=["clearance.stiffness"])
     with pytest.raises(dc.SceneError, match=r"Peak: window=\(0.1, 0.5\), must be inside the run"):

@@ -52,9 +52,15 @@ def gradient(scene_or_model: Scene | DAEModel, t_end: float, *, of: Objective, p
         model = assemble(scene_or_model) if formulation is None else assemble(scene_or_model, formulation)
     elif isinstance(scene_or_model, DAEModel):
         model = scene_or_model
+        if formulation is not None and formulation != model.formulation:
+            options.fail(where, "formulation", formulation, f"None or the model's own ({model.formulation!r}); "
+                         "assemble the model with the formulation you want")
     else:
         options.fail(where, "scene_or_model", scene_or_model, "a Scene or an assembled DAEModel")
-    names = list(parameters) if not isinstance(parameters, str) else parameters
+    if isinstance(parameters, str) or not isinstance(parameters, Sequence) or not parameters:
+        options.fail(where, "parameters", parameters, "a non-empty list of names from model.parameter_names, "
+                     "e.g. ['clearance.clearance']")
+    names = list(parameters)
     values = {name: parameter_value(model, name) for name in names}  # checks each name before any run
     times = _output_times(of, end, count)
 
