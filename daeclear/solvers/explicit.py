@@ -57,6 +57,13 @@ class ODESolver(DrivenSolver):
                              f"method={self.name!r}.")
         if settings.formulation not in (None, CHAPTER_FORMULATION):
             raise _formulation_refused(settings.formulation, self.name)
+        if not self.fixed_step and not isinstance(self.scheme, (str, type(None))):  # a scheme of the user's
+            import scipy.integrate
+
+            if not (isinstance(self.scheme, type) and issubclass(self.scheme, scipy.integrate.OdeSolver)):
+                raise SceneError(f"simulate: method={self.name!r}: scheme={self.scheme!r}, must be a subclass of "
+                                 "scipy.integrate.OdeSolver (its name in scipy.integrate), or fixed_step = True "
+                                 "with the order of a scheme of the C loop.")
 
     def integrator(self, model: DAEModel, t_end: float, output: Output, settings: SolverOptions) -> ODEIntegrator:
         """The run's integrator of the model's ODE (SceneError for a model of another formulation)."""

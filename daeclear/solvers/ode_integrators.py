@@ -66,7 +66,6 @@ class ODEIntegrator:
         self.n, self.m = model.n_q, model.n_constraints
         self.times = output.times
         self.pending: NDArray | None = None if output.times is None else output.times.values()
-        self.store_steps = output.steps
         self.max_steps = settings.max_steps
         self.n_steps = 0
         self.solve_time = 0.0
@@ -93,7 +92,22 @@ class ODEIntegrator:
         """What the scheme sets up at a segment's start."""
 
     def advance(self) -> Advance:
-        """The scheme's steps to the next stop (see :meth:`daeclear.solvers.integrator.Integrator.advance`)."""
+        """The scheme's steps to the next stop (:meth:`daeclear.solvers.integrator.Integrator.advance`), or
+        the failure found when it restarted."""
+        if self.error is not None:
+            why, hint = self.error
+            self.error = None
+            none, rows = np.zeros(0), np.zeros((0, 2 * self.n))
+            return self.advanced("error", none, rows, none, rows, t_prev=self.t, why=why, hint=hint)
+        tic = time.perf_counter()
+        try:
+            with np.errstate(all="ignore"):
+                return self.steps()
+        finally:
+            self.solve_time += time.perf_counter() - tic
+
+    def steps(self) -> Advance:
+        """The scheme's own steps from ``(self.t, self.x)`` to the next stop."""
         raise NotImplementedError
 
     def pair_states(self) -> dict[int, PairState]:
@@ -103,8 +117,9 @@ class ODEIntegrator:
                  ) -> tuple[NDArray, NDArray, dict[str, NDArray] | None]:
         """Multipliers, accelerations and channels of rows of the current segment (their (q, v))."""
         model = self.model
-        y2, yp2 = self.dae_rows(t, y[:, :2 * self.n])
-        ch = self.ev.channels(model, t, y2, yp2, switch[0])
+        with np.errstate(all="ignore"):
+            y2, yp2 = self.dae_rows(t, y[:, :2 * self.n])
+            ch = self.ev.channels(model, t, y2, yp2, switch[0])
         return y2, yp2, {k: np.ascontiguousarray(ch[:, i]) for i, k in enumerate(model.channel_names)}
 
     def advice(self, adv: Advance, in_contact: list[str]) -> str:
@@ -180,16 +195,6 @@ class ODEIntegrator:
 
         return re.sub(r"(right-hand side component|state component) (\d+)", name, why).replace("-nan", "nan")
 
-    def started_failure(self) -> Advance | None:
-        """The failure found at the last (re)start, as the advance that reports it."""
-        if self.error is None:
-            return None
-        why, hint = self.error
-        self.error = None
-        none = np.zeros(0)
-        return self.advanced("error", none, np.zeros((0, 2 * self.n)), none, np.zeros((0, 2 * self.n)),
-                             t_prev=self.t, why=why, hint=hint)
-
 
 class _Watch:
     """The gap functions a segment watches (each in the direction of its next switch, 0: both, as
@@ -244,19 +249,8 @@ class ScipyIntegrator(ODEIntegrator):
             self.n_lu += getattr(self.solver, "nlu", 0) - self.lu0
             self.solver = None
 
-    def advance(self) -> Advance:
-        """Step until an event, the end, a failure or SCIPY_CHUNK steps."""
-        failed = self.started_failure()
-        if failed is not None:
-            return failed
-        tic = time.perf_counter()
-        try:
-            with np.errstate(all="ignore"):
-                return self.steps()
-        finally:
-            self.solve_time += time.perf_counter() - tic
-
     def steps(self) -> Advance:
+        """Step until an event, the end, a failure or SCIPY_CHUNK steps."""
         solver, watch = self.solver, self.watch
         step_t: list[float] = []
         step_x: list[NDArray] = []
@@ -374,20 +368,9 @@ class FixedStepIntegrator(ODEIntegrator):
         self.fixed_step = self.step = settings.step
         self.scheme = order
 
-    def advance(self) -> Advance:
+    def steps(self) -> Advance:
         """One call of the step loop: to the end, a full buffer, a failure or a step that may hold a
         crossing (confirmed and located on re-steps from its start: an event, or the loop goes on)."""
-        failed = self.started_failure()
-        if failed is not None:
-            return failed
-        tic = time.perf_counter()
-        try:
-            with np.errstate(all="ignore"):
-                return self.steps()
-        finally:
-            self.solve_time += time.perf_counter() - tic
-
-    def steps(self) -> Advance:
         ev, t0, x0 = self.ev, self.t, self.x
         parts_t: list[NDArray] = []
         parts_x: list[NDArray] = []
