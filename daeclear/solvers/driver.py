@@ -149,7 +149,7 @@ class Driver:
         self.last_terms: dict[str, tuple[float, bool]] = {}
         self.auto = auto_pairs(model)  # the pairs an integrator may decide itself, in Advance.auto_events' order
         self.checked_rows: tuple[NDArray, NDArray] = (np.zeros(0), np.zeros((0, 0)))  # (t, y) the checks read
-        self.t = self.t_start = self.seg_start = 0.0  # seg_start: nan once the last segment is closed
+        self.t = self.seg_start = 0.0  # seg_start: nan once the last segment is closed
         self.y = self.yp = np.zeros(0)
         self.y0: NDArray | None = None  # a declared start, for the physics checks
         self.from_state = False
@@ -165,7 +165,7 @@ class Driver:
         """Integrate from the consistent start ``(y0, yp0)`` to the end, a failure or Ctrl-C; always
         return (or attach) what was computed."""
         self.y0, self.from_state = declared, from_state
-        self.t = self.t_start = self.seg_start = t0
+        self.t = self.seg_start = t0
         try:
             self.begin(t0, y0, yp0)
             self.advance_to_end()
@@ -250,7 +250,8 @@ class Driver:
         terms = self.terms()
         switched = not _same_terms(before, terms)
         if not switched and integrator.resumes_at_roots and not guarded_root(before.directions, found):
-            self.jump(Jump(t, self.y, self.yp, self.y, self.yp, found, tuple(new_events), state, restarted=False))
+            if self.observers:
+                self.jump(Jump(t, self.y, self.yp, self.y, self.yp, found, tuple(new_events), state, restarted=False))
             return True  # nothing switched: the integrator goes on from the root, in the same segment
         new_segment = switched or not integrator.resumes_at_roots
         if new_segment:
@@ -268,13 +269,15 @@ class Driver:
         self.flush()  # the rows of the segment that ends, completed in its mode
         y, yp = consistent_restart(model, integrator.session, t, self.y, self.yp, terms, found)
         self.switch = model.switch_vector(terms.active, terms.params)
-        self.jump(Jump(t, self.y, self.yp, y, yp, found, tuple(new_events), state, restarted=True))
+        if self.observers:
+            self.jump(Jump(t, self.y, self.yp, y, yp, found, tuple(new_events), state, restarted=True))
         integrator.restart(t, y, yp, terms)
         self.y, self.yp = y, yp
         return True
 
     def jump(self, jump: Jump) -> None:
-        """The one place every event of the run passes (see :class:`Jump`): the observers see it."""
+        """The one place every event of the run passes (see :class:`Jump`; made only when observed): the
+        observers see it. A quantity integrated beside the states (issue 43's sensitivities) jumps here."""
         for observer in self.observers:
             observer(jump)
 

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple, Protocol
 
 from numpy.typing import NDArray
 
+from ..assembly.contact_pairs import PairLogic
 from ..assembly.contact_state import ContactState
 from ..core.automaton import PairState
 from ..core.events import ContactEvent
@@ -70,7 +71,7 @@ class AutoPair(NamedTuple):
     its contact element, root, name, switch-vector column of its term and whether the term's
     parameter is the latched approach speed."""
 
-    logic: Any  # the model's contact element (assembly.contact_pairs.PairLogic), as model.contacts holds it
+    logic: PairLogic
     root: int
     name: str
     column: int
@@ -151,8 +152,8 @@ class Integrator(Protocol):
         """Integrate towards the run's end: stop there (``"tstop"``), at a root (``"root"``: its time,
         the state there in the mode before, the roots found), on a failure (``"error"``: flag and
         message), with a full buffer (``"chunk"``) or on Ctrl-C (``"interrupted"``: what it computed).
-        Reports its steps after the last advance (when the output keeps steps, or is the steps) and
-        its dense output at the run's output times it passed."""
+        Reports its steps since the last advance (their states when the run's output is its steps; none
+        needed when the output keeps no steps) and its dense output at the run's output times it passed."""
         ...
 
     def pair_states(self) -> dict[int, PairState]:
