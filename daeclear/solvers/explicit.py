@@ -46,7 +46,8 @@ class ODESolver(DrivenSolver):
 
     def check(self, settings: SolverOptions) -> None:
         """``step`` is required by the fixed-step schemes and refused by the others; what IDA alone does
-        is refused: its ``linear_solver``, ``track_work``, the GGL formulation."""
+        is refused: its ``linear_solver``, ``track_work``, the GGL formulation; and a ``scheme`` that is no
+        ``scipy.integrate.OdeSolver``."""
         step_rule(self.name, settings.step, fixed=self.fixed_step)
         if settings.linear_solver != "auto":
             raise SceneError(f"simulate: linear_solver={settings.linear_solver!r}, must be 'auto' with "
@@ -61,8 +62,8 @@ class ODESolver(DrivenSolver):
             import scipy.integrate
 
             if not (isinstance(self.scheme, type) and issubclass(self.scheme, scipy.integrate.OdeSolver)):
-                raise SceneError(f"simulate: method={self.name!r}: scheme={self.scheme!r}, must be a subclass of "
-                                 "scipy.integrate.OdeSolver (its name in scipy.integrate), or fixed_step = True "
+                raise SceneError(f"simulate: {type(self).__name__}.scheme={self.scheme!r}, must be a subclass of "
+                                 "scipy.integrate.OdeSolver (or its name in scipy.integrate), or fixed_step = True "
                                  "with the order of a scheme of the C loop.")
 
     def integrator(self, model: DAEModel, t_end: float, output: Output, settings: SolverOptions) -> ODEIntegrator:

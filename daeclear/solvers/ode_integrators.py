@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import re
 import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -250,21 +251,30 @@ class ScipyIntegrator(ODEIntegrator):
             self.solver = None
 
     def steps(self) -> Advance:
-        """Step until an event, the end, a failure or SCIPY_CHUNK steps."""
-        solver, watch = self.solver, self.watch
+        """Step until an event, the end, a failure, SCIPY_CHUNK steps or Ctrl-C."""
         step_t: list[float] = []
         step_x: list[NDArray] = []
         eval_t: list[NDArray] = []
         eval_x: list[NDArray] = []
-        start = t_prev = self.t
+        start = self.t
 
         def ended(status: str, roots: NDArray | None = None, why: str = "", hint: str = "") -> Advance:
-            n2 = 2 * self.n
-            return self.advanced(status, np.array(step_t, dtype=float), np.array(step_x).reshape(len(step_x), n2),
-                                 np.concatenate(eval_t) if eval_t else np.zeros(0),
-                                 np.concatenate(eval_x) if eval_x else np.zeros((0, n2)),
+            n2, k, e = 2 * self.n, min(len(step_t), len(step_x)), min(len(eval_t), len(eval_x))  # (Ctrl-C: pairs)
+            return self.advanced(status, np.array(step_t[:k], dtype=float), np.array(step_x[:k]).reshape(k, n2),
+                                 np.concatenate(eval_t[:e]) if e else np.zeros(0),
+                                 np.concatenate(eval_x[:e]) if e else np.zeros((0, n2)),
                                  t_prev=start, roots=roots, why=why, hint=hint)
 
+        try:
+            return self.stepped(step_t, step_x, eval_t, eval_x, ended)
+        except KeyboardInterrupt:  # Ctrl-C inside a step: the steps before it are kept (the driver stops)
+            return ended("interrupted")
+
+    def stepped(self, step_t: list[float], step_x: list[NDArray], eval_t: list[NDArray], eval_x: list[NDArray],
+                ended: Callable[..., Advance]) -> Advance:
+        """The step loop of :meth:`steps`, filling its lists; ``ended`` makes the advance."""
+        solver, watch = self.solver, self.watch
+        t_prev = self.t
         next_eval = self.pending[0] if self.pending is not None and self.pending.size else math.inf
         while True:
             if self.n_steps >= self.max_steps:
