@@ -98,15 +98,19 @@ def consistent_start(model: DAEModel, t0: float, y0: NDArray | None, settings: S
     return y, yp
 
 
-def consistent_restart(model: DAEModel, session: Session | None, t: float, y: NDArray, yp: NDArray, terms: Terms,
+def consistent_restart(model: DAEModel, integrator: Integrator, t: float, y: NDArray, yp: NDArray, terms: Terms,
                        found: NDArray | None) -> tuple[NDArray, NDArray]:
-    """The consistent state to restart from at ``t`` in the mode of ``terms`` (GGL: projected onto the
-    constraint manifold), unprojected when the projection moves a root function that did not fire
-    across zero (it would never be found again: a missed contact). The compiled loop's rule
-    (project_kept_roots) for the switches it decides itself."""
+    """The consistent state to restart from at ``t`` in the mode of ``terms``: index-1 keeps q and v (the
+    integrator's :meth:`~daeclear.solvers.integrator.Integrator.consistent`); GGL projects them onto the
+    constraint manifold, unprojected when the projection moves a root function that did not fire across
+    zero (it would never be found again: a missed contact). The compiled loop's rule (project_kept_roots)
+    for the switches it decides itself."""
+    if model.formulation != "ggl":
+        return integrator.consistent(t, y, terms)
+    session = integrator.session
     forces = model.term_forces(t, y, terms.active, terms.params, session)
     projected = model.consistent_state(t, y, forces, session, project=True)
-    if model.formulation != "ggl" or not model.gap_names:
+    if not model.gap_names:
         return projected
     g0, g1 = _roots(model, session, t, y, yp), _roots(model, session, t, projected[0], yp)
     quiet = np.zeros(g0.shape, bool) if found is None else np.asarray(found).ravel() == 0
@@ -193,9 +197,8 @@ class Driver:
         self.last_terms = {name: (t0, contact_state.pair_state(model, self.state, root).term_on)
                            for root, name in enumerate(model.gap_names)}
         y, yp = y0, yp0
-        if any(self.active):
-            y, yp = model.consistent_state(t0, y0, model.term_forces(t0, y0, self.active, self.params, session),
-                                           session)
+        if any(self.active):  # in contact at the start: the multipliers and derivatives of that mode
+            y, yp = self.integrator.consistent(t0, y0, self.terms())
         self.switch = model.switch_vector(self.active, self.params)
         if self.store_steps:  # the start is the first step kept (h = 0); without steps none, not a phantom one
             self.rec.add_steps(np.array([t0]), np.array([0.0]), np.array([self.integrator.order]))
@@ -267,7 +270,7 @@ class Driver:
             self.fail(t, "", f"{self.stall} events at the same time: the event loop does not advance", "")
             return False
         self.flush()  # the rows of the segment that ends, completed in its mode
-        y, yp = consistent_restart(model, integrator.session, t, self.y, self.yp, terms, found)
+        y, yp = consistent_restart(model, integrator, t, self.y, self.yp, terms, found)
         self.switch = model.switch_vector(terms.active, terms.params)
         if self.observers:
             self.jump(Jump(t, self.y, self.yp, y, yp, found, tuple(new_events), state, restarted=True))

@@ -115,6 +115,11 @@ class IDAIntegrator:
                 model.auto_pairs, storms=[pair.logic.storm for pair in self.auto],
                 states=[contact_state.pair_state(model, state, pair.root) for pair in self.auto])
 
+    def consistent(self, t: float, y: NDArray, terms: Terms) -> tuple[NDArray, NDArray]:
+        """q and v of ``y`` kept, multipliers and derivatives in the mode of ``terms`` (in the session's library)."""
+        model, session = self.model, self.session
+        return model.consistent_state(t, y, model.term_forces(t, y, terms.active, terms.params, session), session)
+
     def restart(self, t: float, y: NDArray, yp: NDArray, terms: Terms) -> None:
         """IDA re-initialised at a consistent state, with new terms and root directions."""
         self.session.reinit(t, y, yp, terms.active, terms.params, terms.directions)

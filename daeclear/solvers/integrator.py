@@ -48,7 +48,9 @@ class Jump:
 
     ``y_minus``, ``yp_minus``: the state and its derivative at the root ``t`` in the mode before;
     ``y_plus``, ``yp_plus``: the consistent state the integrator restarts from in the new mode (the
-    same arrays when nothing switched and it goes on). ``found``: the roots found (+1 up, -1 down, 0
+    same arrays when nothing switched and it goes on). IDA's root state has the gap closed to round-off,
+    where a law whose force jumps at contact (Kelvin-Voigt) still gives zero: ``yp_plus`` is then not the
+    right limit (the ODE methods restart past the root, where it is). ``found``: the roots found (+1 up, -1 down, 0
     none); ``events``: the contact events decided at ``t``; ``state``: the run's contact state after
     them (each pair's mode, hold and latched approach speed). Switches the integrator decided itself
     (``by_integrator``, the compiled loop's simple pairs) carry the state at the event only:
@@ -146,6 +148,11 @@ class Integrator(Protocol):
 
     def restart(self, t: float, y: NDArray, yp: NDArray, terms: Terms) -> None:
         """Re-initialise at a consistent state after a root (the driver has completed the rows before)."""
+        ...
+
+    def consistent(self, t: float, y: NDArray, terms: Terms) -> tuple[NDArray, NDArray]:
+        """The DAE state with the positions and velocities of ``y`` and its derivative, consistent in the
+        mode of ``terms`` (multipliers and accelerations recomputed), as this integrator evaluates the model."""
         ...
 
     def advance(self) -> Advance:

@@ -89,6 +89,12 @@ class ODEIntegrator:
         self.directions = terms.directions
         self.open()
 
+    def consistent(self, t: float, y: NDArray, terms: Terms) -> tuple[NDArray, NDArray]:
+        """The DAE state at (q, v) of ``y`` in the mode of ``terms`` (the evaluator's; it restarts in it)."""
+        self.ev.set_terms(terms.active, terms.params)
+        rows = self.dae_rows(np.array([float(t)]), np.asarray(y, dtype=float)[None, :2 * self.n])
+        return rows[0][0], rows[1][0]
+
     def open(self) -> None:
         """What the scheme sets up at a segment's start."""
 
