@@ -1,6 +1,6 @@
 """The all-C bound of a ``simulate`` call (issue 35, item 6), side by side with the call itself.
 
-    python benchmarks/bench_bound.py [--t-end 0.024] [--repeats 5] [--formulations index1 ggl]
+    python benchmarks/bench_bound.py [--t-end 0.024] [--repeats 5] [--formulations index1 ggl] [--write-doc]
 
 Scene: the chapter's slider-crank with the 0.5 mm revolute clearance joint and no gravity
 (Fig. 4.15), two crank revolutions (0.024 s) at rtol 1e-8, every internal step reported (the
@@ -30,7 +30,8 @@ default output). For each formulation:
    (whole call within 1.3x of it with index-1, within 1.6x with the default GGL).
 
 The C run does not compute the consistent start (Python does, once, for the setup file), which
-is part of the simulate call.
+is part of the simulate call. ``--write-doc`` writes the ratios, steps and events (deterministic,
+checked by tests/test_doc_numbers.py) into docs/performance.md (block "bound").
 """
 
 from __future__ import annotations
@@ -411,11 +412,27 @@ def table(results: list[Comparison], t_end: float, repeats: int) -> list[str]:
     return lines
 
 
+def doc_table(results: list[Comparison]) -> list[str]:
+    """The ratios of --write-doc: the best call of each over the best all-C run."""
+    base = {r.formulation: min(r.c_walls) for r in results}.get("index1")
+    lines = ["| formulation | steps | events | `simulate(scene)` / all-C run | its IDA loop / all-C run | "
+             "its set-up and the rest, share of the call | `simulate` / index-1 all-C run |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for r in results:
+        c = min(r.c_walls)
+        best = int(np.argmin(r.walls))
+        w, loop = r.walls[best], r.solves[best]
+        lines.append(f"| {r.formulation} | {r.bound.steps} | {r.bound.events} | {w / c:.2f} | {loop / c:.2f} | "
+                     f"{(w - loop) / w:.0%} | " + (f"{w / base:.2f} |" if base else "- |"))
+    return lines
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--t-end", type=float, default=2 * REV, help="end time, s (two revolutions: 0.024)")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--formulations", nargs="+", default=["index1", "ggl"], choices=["index1", "ggl"])
+    parser.add_argument("--write-doc", action="store_true", help="write the ratios into docs/performance.md")
     args = parser.parse_args(argv)
     if not args.repeats >= 1:
         parser.error(f"--repeats={args.repeats}, must be >= 1")
@@ -430,6 +447,13 @@ def main(argv: list[str] | None = None) -> int:
               + f" (IDA's counters {'all equal' if r.counters_equal else 'differ'})")
         ok = ok and not r.agree
     print("\n".join(table(results, args.t_end, args.repeats)))
+    if args.write_doc and ok:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from doc_tables import write_block
+
+        command = "python benchmarks/bench_bound.py" + (f" --repeats {args.repeats}" if args.repeats != 5 else "") + (
+            f" --t-end {args.t_end:g}" if args.t_end != 2 * REV else "")
+        print(f"wrote {write_block('docs/performance.md', 'bound', command, doc_table(results))}")
     return 0 if ok else 1
 
 

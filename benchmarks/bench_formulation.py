@@ -1,6 +1,6 @@
 """Index-1 Baumgarte against GGL (and candidates) at small clearances: accuracy and cost.
 
-    python benchmarks/bench_formulation.py [--revolutions 10] [--repeats 2] [--quick]
+    python benchmarks/bench_formulation.py [--revolutions 10] [--repeats 2] [--quick] [--write-doc]
 
 For the chapter's slider-crank (``mechanisms.slider_crank``, gravity on, 5000 rpm) with a
 revolute clearance joint of c = 0.5, 0.1, 0.02, 0.01 mm, the ideal mechanism and the
@@ -25,14 +25,19 @@ Candidates besides ``index1`` (the chapter's, alpha = beta = 5) and ``ggl``:
 ``index1 a=b=500`` (Baumgarte scaled to the crank speed, 524 rad/s) and ``index1+proj``
 (index-1 with every restart after a contact switch projected onto the constraint manifold, as
 GGL restarts are; measured by switching the projection on for index-1 here, not an option).
+
+``--write-doc`` writes the index1 and ggl rows into docs/engine.md (block "formulation"), each run's
+CPU time as a ratio to index1's on the same scene and rtol.
 """
 
 from __future__ import annotations
 
 import argparse
 import copy
+import sys
 import time
 import warnings
+from pathlib import Path
 from typing import Any
 from collections.abc import Callable
 
@@ -102,11 +107,15 @@ def free_translational() -> dc.Scene:
     return scene
 
 
-def energy_table(repeats: int) -> None:
+def energy_table(repeats: int) -> list[str]:
+    """The free slider-crank's energy table (printed), and its rows with CPU time as a ratio to index1's."""
     print("\nfree elastic translational slider-crank, 0.05 s: energy conservation")
     print("| formulation | rtol | energy change / E0 | steps | cpu (s) |")
     print("|---|---|---|---|---|")
     scene = free_translational()
+    doc = ["| free elastic translational slider-crank, 0.05 s | rtol | energy change / E0 | steps | CPU / index1's |",
+           "|---|---|---|---|---|"]
+    index1_cpu: dict[float, float] = {}
     for name in ("index1", "ggl"):
         for rtol in (1e-8, 1e-9):
             result, cpu, _ = run(CANDIDATES[name], scene, 0.05, repeats, rtol=rtol,
@@ -114,6 +123,10 @@ def energy_table(repeats: int) -> None:
             total = result["energy.mechanical"] + result["clearance.elastic_energy"]
             print(f"| {name} | {rtol:.0e} | {np.ptp(total) / total[0]:.1e} | {result.stats['n_steps']} | {cpu:.3f} |",
                   flush=True)
+            index1_cpu.setdefault(rtol, cpu)
+            doc.append(f"| {name} | {rtol:.0e} | {np.ptp(total) / total[0]:.1e} | {result.stats['n_steps']} | "
+                       f"{cpu / index1_cpu[rtol]:.2f} |")
+    return doc
 
 
 def main() -> None:
@@ -121,6 +134,7 @@ def main() -> None:
     parser.add_argument("--revolutions", type=int, default=10)
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--quick", action="store_true", help="only c = 0.5 and 0.01 mm, index1 and ggl")
+    parser.add_argument("--write-doc", action="store_true", help="write the index1 and ggl rows into docs/engine.md")
     args = parser.parse_args()
     warnings.simplefilter("ignore", dc.DaeclearWarning)
     t_long = args.revolutions * REV
@@ -131,6 +145,8 @@ def main() -> None:
     print("| scene | formulation | rtol | onset rel. err | moment err | accel err | drift (m) | drift / c | steps "
           "| cpu (s) | wall (s) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
+    doc = ["| scene | formulation | rtol | onset err | moment err | drift (m) | drift / c | steps | CPU / index1's |",
+           "|---|---|---|---|---|---|---|---|---|"]
     for label, (scene, clearance) in scenes().items():
         if args.quick and label not in ("revolute c=0.5 mm", "revolute c=0.01 mm"):
             continue
@@ -142,6 +158,7 @@ def main() -> None:
             dop = dc.simulate(scene, WINDOW, rtol=1e-12, method="DOP853")
             note = f" (DOP853 rtol 1e-12 onset differs by {abs(first_onset(dop) - ref_onset) / ref_onset:.1e})"
         scale = {ch: float(np.max(np.abs(ref[ch]))) for ch in ("drive.moment", "slider.ax")}
+        index1_cpu: dict[float, float] = {}
         for name, make in candidates.items():
             for rtol in RTOLS:
                 short = dc.simulate(make(scene), WINDOW, rtol=rtol, save=dc.SaveAt(times=grid))
@@ -153,10 +170,26 @@ def main() -> None:
                 print(f"| {label} | {name} | {rtol:.0e} | {onset:.1e} | {err['drive.moment']:.1e} | "
                       f"{err['slider.ax']:.1e} | {drift:.1e} | {frac} | {long.stats['n_steps']} | "
                       f"{cpu:.3f} | {wall:.3f} |", flush=True)
+                if name == "index1":
+                    index1_cpu[rtol] = cpu
+                if name in ("index1", "ggl"):
+                    first = name == "index1" and rtol == RTOLS[0]
+                    doc.append(f"| {label if first else ''} | {name} | {rtol:.0e} | "
+                               f"{'' if not clearance else f'{onset:.1e}'} | {err['drive.moment']:.1e} | {drift:.1e} | "
+                               f"{frac} | {long.stats['n_steps']} | {cpu / index1_cpu[rtol]:.2f} |")
         if note:
             print(f"|  | reference: GGL rtol {REFERENCE_RTOL:.0e}{note} | | | | | | | | | |", flush=True)
-    if not args.quick:
-        energy_table(args.repeats)
+    energy = energy_table(args.repeats) if not args.quick else []
+    if args.write_doc:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from doc_tables import write_block
+
+        doc += ["", f"{args.revolutions} revolutions for drift, steps and CPU time (best of {args.repeats}); onset "
+                f"and moment errors over the first {WINDOW * 1e3:g} ms against GGL at rtol {REFERENCE_RTOL:g}."]
+        if energy:
+            doc += ["", *energy]
+        command = "python benchmarks/bench_formulation.py" + (" --quick" if args.quick else "")
+        print(f"wrote {write_block('docs/engine.md', 'formulation', command, doc)}")
 
 
 if __name__ == "__main__":

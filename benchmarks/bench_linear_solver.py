@@ -11,9 +11,12 @@ evaluations and the nonzeros of the union Jacobian pattern the sparse solver fac
 ``red/sp`` is reduced wall / sparse wall: above 1 the sparse solver is faster. ``linear_solver="auto"``
 chooses between those two: the threshold ``daeclear.engine.c_session.SPARSE_MIN_STATES`` is set
 from this table. ``den/red`` shows what the reduced LU gains over SUNDIALS' dense LU.
-Only public API is used (``daeclear.simulate``, ``daeclear.mechanisms.chain``).
+Only public API is used (``daeclear.simulate``, ``daeclear.mechanisms.chain``). ``--write-doc`` writes
+the ratios, the union pattern's nonzeros and the steps and events (deterministic, checked by
+tests/test_doc_numbers.py) into docs/performance.md (block "linear-solver").
 
     python benchmarks/bench_linear_solver.py [--sizes 1,2,4,8,16,32] [--t-end 0.01] [--repeats 5] [--rtol 1e-6]
+        [--write-doc]
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from pathlib import Path
 from typing import Any
 
 import daeclear as dc
@@ -63,6 +67,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--t-end", type=float, default=0.01, help="simulated time per call, s")
     ap.add_argument("--repeats", type=int, default=5, help="timed calls per solver (best is kept)")
     ap.add_argument("--rtol", type=float, default=1e-6)
+    ap.add_argument("--write-doc", action="store_true", help="write the table into docs/performance.md")
     args = ap.parse_args(argv)
     sizes = [int(x) for x in args.sizes.split(",") if x.strip()]
     print(f"chain(N), t_end={args.t_end} s, rtol={args.rtol}, best of {args.repeats}; wall = whole simulate call, "
@@ -71,13 +76,25 @@ def main(argv: list[str] | None = None) -> int:
             f"{'red/sp':>6} {'den/red':>7} {'loop red':>10} {'loop sp':>10} {'red/sp':>6} {'steps r/d/s':>17} "
             f"{'events':>9}")
     print(head)
+    doc = ["| N | states | union nnz | density | reduced / sparse, whole call | dense / reduced | reduced / sparse, "
+           "IDA loop | steps (reduced / dense / sparse) | events |", "|---|---:|---:|---:|---:|---:|---:|---|---|"]
     for n_links in sizes:
         r = measure(n_links, args.t_end, args.rtol, args.repeats)
         w, lp = r["wall"], r["loop"]
+        doc.append(f"| {r['N']} | {r['states']} | {r['nnz']} | {r['density']:.3f} | {w['reduced'] / w['sparse']:.2f} | "
+                   f"{w['dense'] / w['reduced']:.2f} | {lp['reduced'] / lp['sparse']:.2f} | {r['steps']} | "
+                   f"{r['events']} |")
         print(f"{r['N']:>3} {r['states']:>6} {r['nnz']:>6} {r['density']:>6.3f} {w['reduced'] * 1e3:>7.1f} ms "
               f"{w['dense'] * 1e3:>7.1f} ms {w['sparse'] * 1e3:>7.1f} ms {w['reduced'] / w['sparse']:>6.2f} "
               f"{w['dense'] / w['reduced']:>7.2f} {lp['reduced'] * 1e3:>7.1f} ms {lp['sparse'] * 1e3:>7.1f} ms "
               f"{lp['reduced'] / lp['sparse']:>6.2f} {r['steps']:>17} {r['events']:>9}", flush=True)
+    if args.write_doc:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from doc_tables import write_block
+
+        command = (f"python benchmarks/bench_linear_solver.py --sizes {args.sizes} --t-end {args.t_end:g} "
+                   f"--repeats {args.repeats}")
+        print(f"wrote {write_block('docs/performance.md', 'linear-solver', command, doc)}")
     return 0
 
 

@@ -1,6 +1,6 @@
 """IDA against the other integrators on the chapter's clearance slider-crank (Fig. 4.15 scene).
 
-    python benchmarks/bench_methods.py [--repeat 3] [--quick]
+    python benchmarks/bench_methods.py [--repeat 3] [--quick] [--write-doc]
 
 Scene: ``slider_crank("revolute", gravity=0.0)`` (c = 0.5 mm, Lankarani-Nikravesh, c_e = 0.9),
 two crank revolutions (t_end = 0.024 s). For every method and tolerance (or step) it prints the
@@ -11,6 +11,9 @@ slider.vx against an IDA reference at rtol 1e-10 over the first 5 ms only: the m
 and later errors say nothing about the integrator (the reference itself is checked there against
 DOP853 at rtol 1e-12). Then the speed ratio: for each IDA run, the fastest other method whose
 error is at most IDA's (IDA at equal or worse accuracy), and how much slower it is.
+
+``--write-doc`` writes the table (times as ratios to the IDA run at rtol 1e-6) and the speed ratios
+into docs/performance.md (block "methods").
 
 Last, the gap check of daeclear.solvers.explicit with and without its cubic Hermite test for crossings
 inside a step (docs/performance.md): event counts over the first 5 ms and the two revolutions.
@@ -32,6 +35,11 @@ except ImportError:  # running from a checkout without installing
 
 import daeclear as dc  # noqa: E402
 import daeclear.solvers.explicit as integrators  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from doc_tables import write_block  # noqa: E402
+
+DOC, BLOCK = "docs/performance.md", "methods"
 
 T_END = 0.024
 WINDOW = 0.005
@@ -74,6 +82,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3, help="runs per case (best wall time is kept)")
     parser.add_argument("--quick", action="store_true", help="fewer cases")
+    parser.add_argument("--write-doc", action="store_true", help=f"write the table into {DOC}")
     args = parser.parse_args()
 
     model = dc.assemble(dc.mechanisms.slider_crank("revolute", gravity=0.0), "index1")  # every method: index-1
@@ -115,10 +124,19 @@ def main() -> None:
                 err = np.nan
             elif err < ref_err:
                 note = (note + "; " if note else "") + "below the reference's own uncertainty"
-            rows.append(dict(method=method, value=value, wall=wall, err=err, ok=r.success))
+            rows.append(dict(method=method, value=value, wall=wall, err=err, ok=r.success, kind=kind,
+                             steps=st["n_steps"], events=len(r.events), note=note))
             print(f"{method:<7} {value:>8.0e} {wall:>8.3f} {st['n_steps']:>8d} {st['n_res_evals']:>8d} "
                   f"{st.get('n_jac_evals', 0):>7d} {len(r.events):>6d} {err:>9.1e}  {note}")
 
+    base = next(r["wall"] for r in rows if r["method"] == "ida" and r["value"] == 1e-6)
+    doc = ["| method | rtol or step | steps | events | error (m/s) | wall time / IDA's at rtol 1e-6 |",
+           "|---|---|---:|---:|---:|---:|"]
+    for r in rows:
+        setting = f"{'step ' if r['kind'] == 'step' else ''}{r['value']:.0e}"
+        error = "(reference)" if np.isnan(r["err"]) else f"{r['err']:.1e}" if np.isfinite(r["err"]) else "failed"
+        doc.append(f"| {r['method']} | {setting} | {r['steps']} | {r['events']} | {error} | {r['wall'] / base:.1f} |")
+    doc += ["", "IDA against the fastest other method whose error is at most IDA's:", ""]
     print()
     print("IDA against the fastest other method whose error is at most IDA's (IDA at equal or worse accuracy):")
     for row in rows:
@@ -127,11 +145,18 @@ def main() -> None:
         rivals = [r for r in rows if r["method"] != "ida" and r["ok"] and r["err"] <= row["err"]]
         if not rivals:
             print(f"  ida rtol {row['value']:.0e}: error {row['err']:.1e}, no other method reaches it")
+            doc.append(f"- IDA at rtol {row['value']:.0e} (error {row['err']:.1e}): no other method reaches it.")
             continue
         fast = min(rivals, key=lambda r: r["wall"])
         print(f"  ida rtol {row['value']:.0e}: {row['wall']:.3f} s, error {row['err']:.1e}; fastest other: "
               f"{fast['method']} {fast['value']:.0e} {fast['wall']:.3f} s, error {fast['err']:.1e} "
               f"-> IDA {fast['wall'] / row['wall']:.1f}x faster")
+        doc.append(f"- IDA at rtol {row['value']:.0e} (error {row['err']:.1e}): {fast['wall'] / row['wall']:.1f}x "
+                   f"faster than {fast['method']} at {fast['value']:.0e} (error {fast['err']:.1e}).")
+    if args.write_doc:
+        command = "python benchmarks/bench_methods.py" + (f" --repeat {args.repeat}" if args.repeat != 3 else "") + (
+            " --quick" if args.quick else "")
+        print(f"wrote {write_block(DOC, BLOCK, command, doc)}")
 
     print()
     print("gap check inside a step (cubic Hermite test) against sign changes at step ends only:")

@@ -14,7 +14,10 @@ Target: about 1 ms above the IDA loop for a scene seen before or differing only 
 each call repeated 50 times): inside a run the same calls take longer (the run's other pieces
 evict their code and data from the caches), so the pieces add up to less than the column "above it".
 
-    python benchmarks/bench_overhead.py [--repeats 20] [--parts]
+``--write-doc`` writes the time above the IDA loop as a fraction of the loop into docs/engine.md
+(block "overhead").
+
+    python benchmarks/bench_overhead.py [--repeats 20] [--parts] [--write-doc]
 """
 
 from __future__ import annotations
@@ -36,7 +39,7 @@ from daeclear.engine.ida_session import open_session
 REV = 60.0 / 5000.0
 
 
-def measure(label: str, make, t_end: float, repeats: int) -> None:
+def measure(label: str, make, t_end: float, repeats: int) -> tuple[float, float, float]:
     t_eval = np.linspace(0.0, t_end, 400)
     dc.simulate(make(0), t_end=t_end, rtol=1e-7, save=dc.SaveAt(times=t_eval))  # builds or loads the structure
     rows = []
@@ -50,6 +53,7 @@ def measure(label: str, make, t_end: float, repeats: int) -> None:
     print(f"  {label:<12} wall {wall * 1e3:7.2f} ms  IDA loop {solve * 1e3:7.2f} ms  "
           f"above it {(wall - solve) * 1e3:6.2f} ms "
           f"(set-up {setup * 1e3:5.2f} ms, rest {(wall - solve - setup) * 1e3:5.2f} ms)")
+    return wall, solve, setup
 
 
 def parts(repeats: int) -> None:
@@ -98,17 +102,29 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=20)
     parser.add_argument("--parts", action="store_true", help="also time the pieces of the overhead one by one")
+    parser.add_argument("--write-doc", action="store_true", help="write the ratios into docs/engine.md")
     args = parser.parse_args()
     warnings.simplefilter("ignore", dc.DaeclearWarning)
     scene = dc.mechanisms.slider_crank("revolute", gravity=0.0)
     model = dc.assemble(scene)
+    doc = ["| window | same Scene again | new numbers (a sweep) | pre-assembled model |", "|---|---:|---:|---:|"]
     for window, t_end in (("first 2 ms", 0.002), ("two revolutions", 2 * REV)):
         print(f"Fig. 4.15 scene, {window}, rtol 1e-7, 400 output points")
-        measure("same scene", lambda i: scene, t_end, args.repeats)
-        measure("new numbers", lambda i: dc.mechanisms.slider_crank("revolute", gravity=0.0,
-                                                                      clearance=0.5e-3 * (1 + 1e-3 * i)),
-                t_end, args.repeats)
-        measure("model", lambda i: model, t_end, args.repeats)
+        cells = [measure("same scene", lambda i: scene, t_end, args.repeats),
+                 measure("new numbers", lambda i: dc.mechanisms.slider_crank("revolute", gravity=0.0,
+                                                                               clearance=0.5e-3 * (1 + 1e-3 * i)),
+                         t_end, args.repeats),
+                 measure("model", lambda i: model, t_end, args.repeats)]
+        doc.append(f"| {window} | " + " | ".join(f"{(w - s) / s:.2f} (set-up {u / s:.2f})" for w, s, u in cells) + " |")
+    if args.write_doc:
+        import sys
+        from pathlib import Path
+
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from doc_tables import write_block
+
+        command = "python benchmarks/bench_overhead.py" + (f" --repeats {args.repeats}" if args.repeats != 20 else "")
+        print(f"wrote {write_block('docs/engine.md', 'overhead', command, doc)}")
     if args.parts:
         parts(args.repeats)
 

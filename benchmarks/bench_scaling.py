@@ -28,7 +28,11 @@ Only public API is used (``daeclear.simulate``, ``daeclear.assemble``,
 ``daeclear.mechanisms.chain``, ``daeclear.engine.codegen.cache_dir``), so the benchmark keeps working
 when the compiled engine changes.
 
+``--write-doc`` writes the table into docs/performance.md (block "scaling"): times as ratios to
+N = 1's and growth exponents; steps and events are deterministic (tests/test_doc_numbers.py checks them).
+
     python benchmarks/bench_scaling.py [--sizes 1,2,4,8,16,32] [--t-end 0.05] [--repeats 3] [--timeout 300]
+        [--write-doc]
 """
 
 from __future__ import annotations
@@ -286,6 +290,43 @@ def print_table(rows: list[Row], t_end: float, timeout: float) -> None:
         print(f"timed-out sizes (> {timeout:g} s) are left out of the fits: the true growth is steeper.")
 
 
+def doc_table(rows: list[Row], t_end: float) -> list[str]:
+    """The Markdown table of --write-doc: counts, sizes, and times relative to the smallest size's."""
+    first = rows[0]
+
+    def ratio(r: Row, key: str) -> str:
+        return "-" if r.get(key) is None or not first.get(key) else f"{r.get(key) / first.get(key):.1f}"
+
+    lines = [f"| N | states | C code | build / N = {first.n}'s | solve / N = {first.n}'s | steps | events | RSS | "
+             "cc MB |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        code = "-" if r.code_bytes is None else f"{r.code_bytes / 1e3:.0f} kB"
+        lines.append(f"| {r.n} | {_fmt(r.get('states'), 'd')} | {code} | {ratio(r, 'build')} | {ratio(r, 'solve')} | "
+                     f"{_fmt(r.get('steps'), 'd')} | {_fmt(r.get('events'), 'd')} | "
+                     f"{_fmt(r.get('rss_self'), '.0f')} MB | {_fmt(r.get('cc_peak'), '.0f')} |")
+    lines.append("")
+    growth = []
+    for label, value in (("build time", lambda r: r.get("build")), ("C code", lambda r: r.code_bytes),
+                         ("solve time", lambda r: r.get("solve"))):
+        slope, count = growth_exponent(rows, value)
+        local, _ = growth_exponent(rows, value, last=2)
+        if slope is not None:
+            growth.append(f"{label} N^{slope:.2f}" + (f" (N^{local:.2f} between the two largest)"
+                                                       if local is not None and count > 2 else ""))
+    lines.append(f"Growth over N = {rows[0].n}-{rows[-1].n}: " + ", ".join(growth) + f"; solve: warm "
+                 f"`simulate(scene, {t_end:g} s)`, best of the repeats; build: first call minus a warm one.")
+    slope, _ = growth_exponent(rows, lambda r: r.get("build"))
+    verdicts = [f"N = {r.n} built within {BUILD_TARGETS[r.n]:g} s: {build_target(r.n, r.get('build')).split()[-1]}"
+                for r in rows if r.n in BUILD_TARGETS]
+    if slope is not None:
+        verdicts.append(f"build time growing no faster than about N^{BUILD_EXPONENT_TARGET:g}: "
+                        + ("ok" if slope <= BUILD_EXPONENT_TARGET + 0.05 else "MISSED"))
+    if verdicts:
+        lines.append("Targets (the compiled engine's issue): " + "; ".join(verdicts) + ".")
+    return lines
+
+
 def _sizes(text: str) -> list[int]:
     try:
         sizes = [int(s) for s in text.split(",") if s.strip()]
@@ -303,6 +344,7 @@ def main() -> None:
     parser.add_argument("--t-end", type=float, default=0.05, help="simulated time of the solve measurement, s (0.05)")
     parser.add_argument("--repeats", type=int, default=3, help="warm solve repeats, best kept (3)")
     parser.add_argument("--timeout", type=float, default=300.0, help="wall-time limit per size, s (300)")
+    parser.add_argument("--write-doc", action="store_true", help="write the table into docs/performance.md")
     parser.add_argument("--child", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.t_end <= 0 or args.repeats < 1 or args.timeout <= 0:
@@ -322,6 +364,13 @@ def main() -> None:
         print(f"  N={n}: {row.status} in {row.elapsed:.1f} s", flush=True)
     print()
     print_table(rows, args.t_end, args.timeout)
+    if args.write_doc:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from doc_tables import write_block
+
+        command = "python benchmarks/bench_scaling.py" + ("" if args.sizes == [1, 2, 4, 8, 16, 32] else
+                                                          f" --sizes {','.join(map(str, args.sizes))}")
+        print(f"wrote {write_block('docs/performance.md', 'scaling', command, doc_table(rows, args.t_end))}")
 
 
 if __name__ == "__main__":

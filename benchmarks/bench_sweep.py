@@ -14,7 +14,9 @@ the pass least disturbed by the machine's other load), then the same sweep throu
 process (its file, classification and Poincaré section included).
 
     python benchmarks/bench_sweep.py [--points 50] [--revolutions 2] [--rtol 1e-6] [--per-revolution 64]
-                                     [--passes 10] [--no-sweep]
+                                     [--passes 10] [--no-sweep] [--write-doc]
+
+``--write-doc`` writes the ratios into docs/performance.md (block "sweep").
 
 Output: ``--per-revolution`` points per crank revolution (``t_eval``, as sweeps sample their
 Poincare sections and stored channels); 0 reports every IDA step, whose channels cost about
@@ -45,6 +47,7 @@ def main() -> None:
     parser.add_argument("--per-revolution", type=int, default=64, help="output points per revolution (0: every step)")
     parser.add_argument("--no-sweep", action="store_true", help="skip the daeclear.sweep part")
     parser.add_argument("--passes", type=int, default=10, help="passes over the clearances (the first builds)")
+    parser.add_argument("--write-doc", action="store_true", help="write the ratios into docs/performance.md")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="bench_sweep-") as tmp:
         os.environ["DAECLEAR_CACHE_DIR"] = str(Path(tmp) / "cache")  # before daeclear builds anything
@@ -59,13 +62,14 @@ def main() -> None:
         print(f"Fig. 4.15 scene, {args.points} clearances 0.01-0.5 mm, {args.revolutions:g} revolutions, "
               f"rtol {args.rtol:g}, output {output}, simulate(scene) in a loop, {args.passes} passes "
               "(new Scenes every pass; the first builds the structure)")
-        ratios = []
+        ratios, compiled = [], []
         for k in range(args.passes):
             compiles, build, solve, wall, setup_times, walls, solves = _one_pass(dc, clearances, t_end, args.rtol,
                                                                                  t_eval)
             structure = walls[0] - solves[0] if k == 0 else 0.0  # template, C generation, compiler
             ratio = (wall - structure) / solve
             ratios.append(ratio)
+            compiled.append(compiles)
             print(f" pass {k + 1}")
             print(f"  compiles             {compiles}   (libraries in the cache: "
                   f"{len(list(cache_dir().glob('*.so')))}; target 1)")
@@ -84,6 +88,21 @@ def main() -> None:
         print(f"wall / solve, the structure build excluded: best of {args.passes} passes {min(ratios):.3f}, median "
               f"{np.median(ratios):.3f} (passes {', '.join(f'{r:.3f}' for r in ratios)}; target <= {TARGET} "
               f"on the best pass, as the other benchmarks time the best of their repeats: {verdict})")
+        if args.write_doc:
+            import sys
+
+            sys.path.insert(0, str(Path(__file__).resolve().parent))
+            from doc_tables import write_block
+
+            lines = ["| output | compiles (first pass / later passes) | wall / IDA solves, best pass | median pass |",
+                     "|---|---|---:|---:|",
+                     f"| {output} | {compiled[0]} / {max(compiled[1:], default=0)} | {min(ratios):.3f} | "
+                     f"{np.median(ratios):.3f} |", "",
+                     f"{args.points} clearances, {args.revolutions:g} revolutions, rtol {args.rtol:g}, {args.passes} "
+                     "passes; the one build of the structure is left out of the first pass's wall time."]
+            command = "python benchmarks/bench_sweep.py --no-sweep" + (
+                f" --passes {args.passes}" if args.passes != 10 else "")
+            print(f"wrote {write_block('docs/performance.md', 'sweep', command, lines)}")
         if args.no_sweep:
             return
         start = time.perf_counter()

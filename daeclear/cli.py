@@ -46,7 +46,16 @@ def _parse_sets(items: Sequence[str]) -> dict[str, Any]:
         if key in out:
             raise DaeclearError(f"--set {key}={value.strip()}: {key} is given twice (--set {key}={out[key]!r} "
                                 "before); give it once.")
-        out[key] = _parse_value(value.strip())
+        text = value.strip()
+        out[key] = _parse_value(text)
+        if isinstance(out[key], str) and text[:1] in "{[(":  # meant as a table or a list: say why it is not one
+            try:
+                ast.literal_eval(text)
+            except (ValueError, SyntaxError) as exc:
+                why = exc.msg if isinstance(exc, SyntaxError) else "a bare name or an expression where a value must be"
+                raise DaeclearError(f"--set {key}={text}: not a Python literal ({why}); "
+                                    "a table is written with quoted names and numbers only, e.g. --set \"law={'name': "
+                                    "'hydrodynamic', 'viscosity': 0.1, 'length': 0.01}\".") from None
     return out
 
 

@@ -2,9 +2,33 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from daeclear.solvers import ida
+
+_approx = pytest.approx
+#: pytest.approx's default absolute tolerance: below about 1e-9 it, not ``rel``, decides the comparison.
+APPROX_DEFAULT_ABS = 1e-12
+
+
+def _approx_with_an_honest_tolerance(expected, rel=None, abs=None, nan_ok=False):
+    """pytest.approx, refusing a comparison that its default abs=1e-12 would make 10 times wider than the
+    rel asked for (a floor of 5.9e-12 compared at rel=1e-4 passed anything within 17 %): pass abs=."""
+    if abs is None:
+        try:
+            values = expected.values() if isinstance(expected, dict) else expected
+            flat = np.abs(np.asarray(values, dtype=float)).ravel()
+        except (TypeError, ValueError):
+            flat = np.zeros(0)
+        widened = APPROX_DEFAULT_ABS / flat[flat > 0] if flat.size else np.zeros(0)
+        if np.any((widened > 10 * (1e-6 if rel is None else rel)) & (widened > 1e-9)):
+            raise ValueError(f"pytest.approx({expected!r}, rel={rel}): the default abs={APPROX_DEFAULT_ABS:g} makes "
+                             f"this comparison up to {widened.max():.2g} relative; give abs= (abs=0.0 for rel alone).")
+    return _approx(expected, rel=rel, abs=abs, nan_ok=nan_ok)
+
+
+pytest.approx = _approx_with_an_honest_tolerance  # type: ignore[assignment]
 
 
 @pytest.fixture

@@ -136,6 +136,23 @@ def test_storm_holds_ignores_quick_recontacts_and_releases_after_a_flight():
     assert d == Decision(ONSET, True, False, 3.0, -1)  # a genuine impact: hold ends, speed latched
 
 
+@pytest.mark.parametrize("events", [2, 3, 4, 20])
+def test_the_storm_holds_at_exactly_its_count_of_switches(events):
+    """Storm(n, window): a separation holds the term on when it makes n switches or more within the
+    window, itself included. Onsets and separations alternate a nanosecond apart, so the first held
+    separation is switch number n (n even) or n + 1 (n odd: the n-th switch is an onset)."""
+    rule = dict(storm=Storm(events, 1e-6), min_approach_speed=1e-4)
+    state, t, switches = PairState(), 0.0, 0
+    while True:
+        state, d = step(state, t := t + 1e-9, +1, 1.0, **rule)
+        state, d = step(state, t := t + 1e-9, -1, -1.0, **rule)
+        switches += 2
+        assert d.kind == SEPARATION
+        if d.held:
+            break
+    assert switches == events + events % 2
+
+
 def test_storm_constants_are_checked():
     assert (Storm().events, Storm().window) == (automaton.STORM_EVENTS, automaton.STORM_WINDOW)
     for bad in (dict(events=0), dict(events=2.0), dict(window=-1e-6), dict(window=math.inf)):

@@ -31,7 +31,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from daeclear.contact import Hertz, LankaraniNikravesh
-from daeclear.contact.hydrodynamic import HydrodynamicBearing
+from daeclear.contact.asperity import asperity_load, asperity_pressure
+from daeclear.contact.hydrodynamic import HydrodynamicBearing, shear_torques
 from daeclear.core.errors import SceneError
 
 MU, R, C = 0.04, 0.01, 5.0e-5  # Pa s, m, m
@@ -380,7 +381,10 @@ def test_casadi_agrees_and_derivatives_are_finite(theory: str, cavitation: str) 
      "theory='medium', must be one of 'short', 'long', 'finite'"),
     ({"viscosity": 0.01, "length": 0.01, "cavitation": "none"}, "cavitation='none', must be one of 'half', 'full'"),
     ({"viscosity": 0.01, "length": 0.01, "dry": "hertz"}, "dry='hertz', must be a normal contact law"),
-    ({"viscosity": 0.01, "length": 0.01, "film_threshold": 0.0}, "film_threshold=0 m, must be > 0."),
+    ({"viscosity": 0.01, "length": 0.01, "roughness": 0.0}, "roughness=0 m, must be > 0."),
+    ({"viscosity": 0.01, "length": 0.01, "film_parameter": 5.0}, "film_parameter=5, must be in (0, 4)."),
+    ({"viscosity": 0.01, "length": 0.01, "hysteresis": -1.0}, "hysteresis=-1, must be >= 0."),
+    ({"viscosity": 0.01, "length": 0.01, "asperity_modulus": -1.0}, "asperity_modulus=-1 Pa, must be > 0."),
 ])
 def test_bad_parameters(kwargs: dict, message: str) -> None:
     with pytest.raises(SceneError, match=message.replace("(", r"\(").replace(")", r"\)")):
@@ -402,5 +406,80 @@ def test_bad_film_force_inputs() -> None:
 def test_defaults_and_dry_law() -> None:
     bearing = HydrodynamicBearing(viscosity=0.03, length=0.02)
     assert (bearing.theory, bearing.cavitation, bearing.film_threshold) == ("short", "half", 1e-6)
+    assert (bearing.roughness, bearing.film_parameter, bearing.reform_threshold) == (1e-6, 1.0, 2e-6)
     assert isinstance(bearing.dry, LankaraniNikravesh) and bearing.dry.restitution == 0.9
     assert HydrodynamicBearing(viscosity=0.03, length=0.02, dry=Hertz(stiffness=1e10)).dry.stiffness == 1e10
+
+
+# ---- the film's power and shear (docs/lubrication.md, "The film's shear and its power") --------------
+def fd_pressure_dissipation(eps: float, w: float, eps_dot: float, length: float) -> float:
+    """int int h^3 |grad p|^2 / (12 mu) dA of the FD full-film pressure: the pressure flow's dissipation."""
+    p, theta, z = fd_pressure(eps, w, eps_dot, length, n_theta=720, n_z=32)
+    dth, dz = theta[1] - theta[0], z[1] - z[0]
+    h3 = (C * (1.0 + eps * np.cos(theta + 0.5 * dth))) ** 3
+    grad_t = (np.roll(p, -1, axis=0) - p) / (R * dth)  # at theta + dth/2
+    h3z = (C * (1.0 + eps * np.cos(theta))) ** 3
+    grad_z = np.diff(p, axis=1) / dz  # at z + dz/2
+    return float(R * dth * dz * (np.sum(h3[:, None] * grad_t**2) + np.sum(h3z[:, None] * grad_z**2)) / (12.0 * MU))
+
+
+@pytest.mark.parametrize("eps, w, eps_dot", [(0.3, 100.0, 0.0), (0.6, 0.0, 5.0), (0.5, 80.0, -6.0), (0.7, -50.0, 9.0)])
+def test_pressure_power_is_the_reynolds_dissipation(eps: float, w: float, eps_dot: float) -> None:
+    """Energy balance: the pressure's power on the journal's motion relative to the film, F_r c eps_dot +
+    (e / 2) F_t w (what the film takes once its shear torque is counted), equals the viscous dissipation
+    of the Reynolds pressure flow, computed from the finite-difference pressure (short limit, L/D = 1/16)."""
+    length = R / 8.0
+    radial, tangential = law(length, cavitation="full").film_force(eps, w, eps_dot, R, C)
+    power = radial * C * eps_dot + 0.5 * eps * C * tangential * w
+    assert power == pytest.approx(fd_pressure_dissipation(eps, w, eps_dot, length), rel=2e-2)
+
+
+@pytest.mark.parametrize("theory, cavitation", [("short", "half"), ("short", "full"), ("long", "half"),
+                                                ("long", "full")])
+def test_film_power_is_never_negative(theory: str, cavitation: str) -> None:
+    """The film's net power (pressure on the relative motion and shear torques on the spins) is >= 0
+    at random states: a dissipation, as the short and long films' perfect-square integrands say."""
+    rng = np.random.default_rng(7)
+    bearing = law(0.01, theory, cavitation)
+    for _ in range(200):
+        eps, (w_j, w_b) = rng.uniform(0.0, 0.95), rng.normal(0.0, 300.0, 2)
+        eps_dot, gamma_dot = rng.normal(0.0, 20.0, 2)
+        w = w_j + w_b - 2.0 * gamma_dot
+        radial, tangential = bearing.film_force(eps, w, eps_dot, R, C)
+        t_j, t_b = shear_torques(MU, 0.01, eps, w_j - w_b, tangential, R, C)
+        # the film's force on the journal: -radial n + tangential t; e_dot = c eps_dot n + e gamma_dot t
+        taken = -(-radial * C * eps_dot + tangential * eps * C * gamma_dot + t_j * w_j + t_b * w_b)
+        assert taken >= -1e-9 * (abs(radial) + abs(tangential)) * C * (abs(w) + abs(eps_dot) + 1.0)
+
+
+def test_shear_torques_petroff_and_balance() -> None:
+    """Petroff at the centre, T = 2 pi mu R^3 L dw / c; the torques balance the pressure couple."""
+    t_j, t_b = shear_torques(MU, 0.01, 0.0, 100.0, 0.0, R, C)
+    petroff = 2.0 * math.pi * MU * R**3 * 0.01 * 100.0 / C
+    assert (t_j, t_b) == (pytest.approx(-petroff, rel=1e-14), pytest.approx(petroff, rel=1e-14))
+    t_j, t_b = shear_torques(MU, 0.01, 0.6, 100.0, 37.0, R, C)
+    assert t_j + t_b + 0.6 * C * 37.0 == pytest.approx(0.0, abs=1e-15)
+    assert t_j == pytest.approx(-petroff / 0.8 - 0.5 * 0.6 * C * 37.0, rel=1e-14)
+
+
+@pytest.mark.parametrize("film", [0.2, 1.0, 2.5, 3.9])
+def test_asperity_load_closed_form_against_quadrature(film: float) -> None:
+    """The closed form (parabolic film near its minimum) against a quadrature of Greenwood and Tripp's
+    pressure over the exact film h = c (1 - eps cos phi), projected on the line of centres."""
+    from scipy.integrate import quad
+
+    sigma, c, modulus, length = 1e-6, 5e-4, 1.1e11, 0.01
+    eps = 1.0 - film * sigma / c
+    closed = asperity_load(eps, c, sigma, R, length, modulus)
+
+    def pressure(phi: float) -> float:
+        x = c * (1.0 - eps * math.cos(phi)) / sigma
+        return asperity_pressure(x, modulus) * math.cos(phi)
+
+    edge = math.acos(min(1.0, (1.0 - 4.0 * sigma / c) / eps))
+    numeric = length * R * quad(pressure, -edge, edge, epsabs=0.0, epsrel=1e-10, limit=200)[0]
+    assert closed == pytest.approx(numeric, rel=2e-3)
+    # Greenwood and Tripp's fit: F_5/2(1) = 4.4086e-5 3^6.804, K = 16 pi sqrt(2) / 15 0.04^2 sqrt(1e-3)
+    k = 16 * math.pi * math.sqrt(2) / 15 * 0.04**2 * math.sqrt(1e-3)
+    assert asperity_pressure(1.0, modulus) == pytest.approx(k * modulus * 4.4086e-5 * 3**6.804, rel=1e-14)
+    assert asperity_load(1.0 - 4.0 * sigma / c, c, sigma, R, length, modulus) == 0.0

@@ -253,7 +253,7 @@ def test_internal_journal_bearing_stiffness(clearance: float, k_expected: float)
 
 
 def test_other_stiffness_anchors() -> None:
-    assert STEEL.sigma == pytest.approx(4.396e-12, rel=1e-4)
+    assert STEEL.sigma == pytest.approx(4.396e-12, rel=1e-4, abs=0.0)
     assert sphere_plane_stiffness(1e-3, STEEL) == pytest.approx(4.80e9, rel=1e-3)
     assert plane_face_stiffness(0.025, (STEEL, STEEL)) == pytest.approx(5.99e9, rel=1e-3)
     # external: equal spheres of 2R behave like R on a plane

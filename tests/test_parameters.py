@@ -19,6 +19,7 @@ import daeclear as dc
 from daeclear.engine.codegen import clear_memos
 from daeclear.contact import FRICTION_LAWS, NORMAL_LAWS, HydrodynamicBearing, Material, friction_law, normal_law
 from daeclear.assembly.parameters import is_parametric, law_values, symbolic_law
+from daeclear.core.errors import SceneError
 
 STEEL = Material(young=207e9, poisson=0.3)
 
@@ -57,7 +58,7 @@ VARIANTS = {
     # the lubricated joint: viscosity, bearing length, film thresholds and the dry law's numbers
     "lubricated": (dict(joint="revolute", friction=0.1, law=HydrodynamicBearing(viscosity=0.04, length=0.02)),
                    dict(joint="revolute", friction=0.05, clearance=0.3e-3, rpm=3000.0,
-                        law=HydrodynamicBearing(viscosity=0.01, length=0.015, film_threshold=2e-6, hysteresis=0.5,
+                        law=HydrodynamicBearing(viscosity=0.01, length=0.015, roughness=2e-6, hysteresis=0.5,
                                                 dry=normal_law("lankarani-nikravesh", restitution=0.7)))),
     # readings of the translational joint (daeclear.model.readings): their K, n, c_e, the slider's mass and
     # inertia and the pin's place on it are numbers
@@ -146,12 +147,13 @@ def test_lubricated_joint_numbers_are_parameters_and_its_theory_is_structure():
                                                                                  **law}))
 
     reference = dc.assemble(scene())
-    assert reference.parameter("clearance.film.viscosity")[0] == 0.04
-    assert reference.parameter("clearance.film.length")[0] == 0.02
-    assert reference.parameter("clearance.film.threshold")[0] == 1e-6
-    assert reference.parameter("clearance.film.reform_threshold")[0] == 2e-6
-    assert reference.parameter("clearance.law.restitution")[0] == 0.9
-    for law in (dict(viscosity=0.002), dict(length=0.05), dict(film_threshold=3e-6, hysteresis=0.2)):
+    assert reference.parameter("clearance.law.viscosity")[0] == 0.04
+    assert reference.parameter("clearance.law.length")[0] == 0.02
+    assert reference.parameter("clearance.law.roughness")[0] == 1e-6
+    assert reference.parameter("clearance.law.film_parameter")[0] == 1.0
+    assert reference.parameter("clearance.law.hysteresis")[0] == 1.0
+    assert reference.parameter("clearance.law.dry.restitution")[0] == 0.9
+    for law in (dict(viscosity=0.002), dict(length=0.05), dict(roughness=3e-6, film_parameter=2.0, hysteresis=0.2)):
         assert dc.assemble(scene(**law)).functions is reference.functions, law
     for law in (dict(theory="long"), dict(cavitation="full"), dict(dry=normal_law("hertz"))):
         assert dc.assemble(scene(**law)).functions is not reference.functions, law
@@ -643,3 +645,123 @@ def test_a_clearance_joints_checks_run_once(monkeypatch):
     scene.elements[scene.elements.index(scene["clearance"])] = fresh
     scene.validate()
     assert calls == ["clearance"]
+
+
+# ---- the one name space (issue 42 item 3, issue 44 item 5) ------------------------------------------
+def _loads_and_profiles() -> dc.Scene:
+    """Every load kind, a table in time, and a driver with a motion profile."""
+    from daeclear.model.profiles import Ramp
+
+    scene = dc.Scene("loaded", gravity=(0.0, -9.81))
+    link = scene.add(dc.Body("link", mass=1.0, inertia=0.01, position=(0.5, 0.0)))
+    arm = scene.add(dc.Body("arm", mass=0.5, inertia=0.005, position=(1.5, 0.0)))
+    scene.add(dc.Revolute("A", scene.ground, link, at=(0.0, 0.0)))
+    scene.add(dc.Revolute("B", link, arm, at=(1.0, 0.0)))
+    scene.add(dc.Driver("drive", "A", speed=2.0, profile=Ramp(time=0.05)))
+    scene.add(dc.Force("push", "arm", fx=1.0, fy=dc.Table((0.0, 0.1, 0.2), (0.0, 2.0, 0.0)), at=(2.0, 0.0)))
+    scene.add(dc.Torque("twist", "arm", dc.Table((0.0, 0.5), (0.0, 0.3)), reaction="link"))
+    scene.add(dc.SpringDamper("spring", "ground", "arm", at_i=(2.0, 0.5), at_j=(2.0, 0.0), stiffness=40.0,
+                              damping=0.2))
+    scene.add(dc.RotationalSpringDamper("torsion", "link", "arm", stiffness=3.0, damping=0.01, free_angle=0.1))
+    return scene
+
+
+def _motor() -> dc.Scene:
+    scene = dc.Scene("motor", gravity=(0.0, 0.0))
+    crank = scene.add(dc.Body("crank", mass=1.0, inertia=0.01, position=(0.0, 0.0)))
+    scene.add(dc.Revolute("A", scene.ground, crank, at=(0.0, 0.0)))
+    scene.add(dc.Motor("motor", "ground", "crank", stall_torque=0.5, no_load_speed=10.0))
+    return scene
+
+
+NAME_SPACE_SCENES = {
+    "revolute-ln-friction": lambda: dc.mechanisms.slider_crank("revolute", friction=0.1),
+    "revolute-hunt-crossley-coulomb": lambda: dc.mechanisms.slider_crank("revolute", law="hunt-crossley",
+                                                                          friction=dc.contact.Coulomb(coefficient=0.1)),
+    **{f"revolute-{name}": (lambda name=name: dc.mechanisms.slider_crank("revolute", law=name))
+       for name in ("hertz", "flores")},
+    **{f"revolute-{name}": (lambda name=name: dc.mechanisms.slider_crank("revolute", law=name, length=0.02))
+       for name in ("dubowsky-freudenstein", "goldsmith", "esdu-78035")},
+    "revolute-kelvin-voigt": lambda: dc.mechanisms.slider_crank(
+        "revolute", law=normal_law("kelvin-voigt", stiffness=5e8, damping=1e3)),
+    "lubricated-short": lambda: dc.mechanisms.slider_crank(
+        "revolute", friction=0.1, law=HydrodynamicBearing(viscosity=0.04, length=0.02, dry=normal_law("hertz"))),
+    "lubricated-finite": lambda: dc.mechanisms.slider_crank(
+        "revolute", law=HydrodynamicBearing(viscosity=0.04, length=0.015, theory="finite", asperity_modulus=1e11)),
+    "worn-both": lambda: dc.mechanisms.slider_crank("revolute", friction=0.1).with_values(
+        {"clearance.wear": dc.contact.wear.ArchardWear(coefficient=1e-13, length=0.02, surface="both")}),
+    "translational-corners": lambda: dc.mechanisms.slider_crank("translational", friction=0.1),
+    "translational-section-4.3": lambda: dc.mechanisms.slider_crank("translational", contact_model="section-4.3"),
+    "translational-reading": lambda: dc.mechanisms.slider_crank("translational", reading="unified"),
+    "four-bar": lambda: dc.mechanisms.four_bar(clearance_joints=("B", "C")),
+    "double-pendulum": lambda: dc.mechanisms.double_pendulum(clearance_joints=("A",)),
+    "loads-and-profile": _loads_and_profiles,
+    "motor": _motor,
+}
+
+
+def _scene_value(scene: dc.Scene, name: str):
+    if name == "gravity":
+        return scene.gravity
+    element, *path = name.split(".")
+    value = scene[element]
+    for field in path:
+        value = getattr(value, field)
+    return value
+
+
+def _nudged(value):
+    """A slightly different value of the same kind (every number x (1 - 1e-3); an ordered table stays ordered)."""
+    if isinstance(value, (tuple, list)):
+        return type(value)(_nudged(v) for v in value)
+    return value * (1.0 - 1e-3) if isinstance(value, float) else value
+
+
+@pytest.mark.parametrize("label", sorted(NAME_SPACE_SCENES))
+@pytest.mark.parametrize("formulation", ["ggl", "index1"])
+def test_every_listed_name_round_trips(label, formulation):
+    """Every name model.parameter_names lists is accepted by with_parameters, compiles nothing, and gives
+    the model assembled from the scene with that value (an independent build); its value read back from
+    the new model's scene is the one given. The structural names are refused, read-only."""
+    scene = NAME_SPACE_SCENES[label]()
+    model = dc.assemble(scene, formulation)
+    names = model.parameter_names
+    assert names and not set(names) & set(model.structural_names)
+    assert ("baumgarte.alpha" in names) == (formulation == "index1")
+    for name in names:
+        if name.startswith("baumgarte."):
+            value = getattr(model, name.split(".")[1]) * (1.0 - 1e-3)
+            new = model.with_parameters({name: value})
+            assert new.functions is model.functions and new.parameter(name)[0] == value
+            continue
+        same = model.with_parameters({name: _scene_value(scene, name)})
+        assert same.functions is model.functions, name
+        np.testing.assert_array_equal(same.parameter_values, model.parameter_values, err_msg=name)
+        value = _nudged(_scene_value(scene, name))
+        new = model.with_parameters({name: value})
+        assert new.functions is model.functions, name
+        assert _scene_value(new.scene, name) == value, name
+        built = dc.assemble(scene.with_values({name: value}), formulation)
+        np.testing.assert_array_equal(new.parameter_values, built.parameter_values, err_msg=name)
+    for name in model.structural_names:
+        with pytest.raises(SceneError, match=f"{name!r} is structure of the model .read-only"):
+            model.with_parameters({name: _scene_value(scene, name)})
+
+
+def test_the_names_the_issue_named():
+    """clearance.s_i (derived) and clearance.film.viscosity are not names; clearance.law.viscosity and, for the
+    dry law inside a bearing, clearance.law.dry.restitution are; a restitution of the bearing itself is none."""
+    plain = dc.assemble(dc.mechanisms.slider_crank("revolute"))
+    assert "clearance.s_i" not in plain.parameter_names and plain.parameter("clearance.s_i").size == 2
+    assert "clearance.law.restitution" in plain.parameter_names
+    lubricated = dc.assemble(dc.mechanisms.slider_crank("revolute", law=HydrodynamicBearing(viscosity=0.04,
+                                                                                             length=0.02)))
+    names = lubricated.parameter_names
+    assert {"clearance.law.viscosity", "clearance.law.dry.restitution"} <= set(names)
+    assert not {"clearance.film.viscosity", "clearance.law.restitution", "clearance.s_i"} & set(names)
+    with pytest.raises(SceneError, match="HydrodynamicBearing has no field 'restitution'"):
+        lubricated.with_parameters({"clearance.law.restitution": 0.5})
+    with pytest.raises(SceneError, match="'clearance.law.dry' is structure of the model"):
+        lubricated.with_parameters({"clearance.law.dry": normal_law("hertz")})
+    with pytest.raises(SceneError, match="'clearance.law.stiffness' is not one of the model's numbers"):
+        plain.with_parameters({"clearance.law.stiffness": 1e10})  # derived here: give it in the scene

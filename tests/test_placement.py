@@ -89,7 +89,7 @@ def test_clearance_joints_close_as_ideal_and_the_equations_are_kept():
         np.testing.assert_allclose(pose[:3], expected[name][:3], rtol=0, atol=1e-13)
     before, after = dc.assemble(scene), dc.assemble(placed)
     assert before.parameter_layout == after.parameter_layout
-    for name in before.parameter_names:
+    for name, _ in before.parameter_layout:  # the compiled table's entries, derived ones included
         if name != "drive.angle0":
             np.testing.assert_allclose(after.parameter(name), before.parameter(name), rtol=1e-13, atol=1e-15,
                                        err_msg=name)
@@ -154,9 +154,11 @@ def test_andrews_squeezer_starts_at_and_reaches_the_published_values(tmp_path, c
                0.487364979543842550225598953530, -0.222668390165885884674473185609, 1.23054744454982119249735015568)
     result = dc.simulate(scene, andrews.T_END, rtol=1e-10,
                          options=dc.SolverOptions(formulation=formulation, start="declared"))
+    # docs/validation.md's table at rtol 1e-10: 1.2e-8 rad (GGL), 9.3e-8 rad (index1), within a factor of 2
+    largest = {"ggl": 2 * 1.2e-8, "index1": 2 * 9.3e-8}[formulation]
     for joint, start, end in zip(andrews.COORDINATES, initial, andrews.REFERENCE):
         assert result[f"{joint}.angle"][0] == pytest.approx(start, abs=1e-12), joint
-        assert result[f"{joint}.angle"][-1] == pytest.approx(end, abs=1e-7), joint
+        assert result[f"{joint}.angle"][-1] == pytest.approx(end, rel=0, abs=largest), joint
     assert andrews.main([str(tmp_path / "a.png"), "--quick"]) == 0 and (tmp_path / "a.png").exists()
 
 

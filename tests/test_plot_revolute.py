@@ -88,7 +88,8 @@ def test_journal_orbit_of_a_lubricated_joint_draws_the_film_threshold():
     """A lubricated joint (law "hydrodynamic"): the eccentricity-ratio-1 circle |e| = c and the film
     threshold's |e| = c - h_threshold, inside which the film carries."""
     r = make_result()
-    r.parameters["scene"]["elements"]["clearance"]["law"] = {"name": "hydrodynamic", "film_threshold": 2e-6}
+    r.parameters["scene"]["elements"]["clearance"]["law"] = {"name": "hydrodynamic", "roughness": 1e-6,
+                                                          "film_parameter": 2.0}
     ax = plot_journal_orbit(r)
     orbit, circle, threshold = ax.get_lines()
     np.testing.assert_allclose(np.hypot(circle.get_xdata(), circle.get_ydata()), C * 1e6)

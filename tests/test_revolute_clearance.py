@@ -124,6 +124,23 @@ def test_first_impact_matches_kinematic_estimate():
     assert onset.approach_speed == pytest.approx(a0 * onset.t, rel=2e-2)
 
 
+def test_events_are_located_where_the_journal_meets_the_wall():
+    """Every onset and separation is a root of the gap: the penetration |e| - c at the event's state is
+    zero to the root's time tolerance (rate x 1e-14 s), and the latched approach speed is the rate there."""
+    model = dc.assemble(dc.mechanisms.slider_crank("revolute", gravity=0.0))
+    result = dc.simulate(model, 0.012, rtol=1e-8)
+    events = result.events
+    assert len(events) > 20
+    y = np.array([event.y for event in events])
+    at_events = model.channels(events.t, y, np.zeros_like(y))
+    penetration, rate = at_events["clearance.penetration"], at_events["clearance.penetration_rate"]
+    np.testing.assert_allclose(penetration, 0.0, atol=1e-11)
+    onset = np.array([event.kind == "onset" for event in events])
+    assert 10 < onset.sum() < len(events) and np.all(rate[onset] > 0) and np.all(rate[~onset] < 0)
+    np.testing.assert_allclose([event.approach_speed for event in events if event.kind == "onset"], rate[onset],
+                               rtol=1e-9)
+
+
 @pytest.mark.parametrize(
     "kwargs, match",
     [
@@ -322,3 +339,85 @@ def test_runs_with_output_times_come_back_in_long_pieces(monkeypatch):
     np.testing.assert_array_equal(pieces.y, whole.y)
     for name in ("clearance.normal_force", "drive.moment"):
         np.testing.assert_array_equal(pieces.channels[name], whole.channels[name])
+
+
+# ---------------------------------------------------------------- where the contact force acts (issue 47)
+
+G, R_B, C_B, MASS, INERTIA, MU, SPIN = 9.81, 10e-3, 0.5e-3, 0.1, 1e-5, 0.1, 200.0
+SIGMA = (1 - 0.3**2) / 207e9  # steel, eq. (3.4)
+STEEL_K = 4 / (3 * 2 * SIGMA) * np.sqrt(R_B * (R_B - C_B) / C_B)  # (3.5), journal in bearing: 6.61e10 N/m^1.5
+
+
+def braked_journal(bearing_free: bool = False) -> dc.Scene:
+    """A journal spinning at 200 rad/s dropped into its bearing (on the ground, or a free ring) with
+    modified Coulomb friction 0.1: the friction at the contact point brakes the spin."""
+    from daeclear.contact import LankaraniNikravesh, Material, ModifiedCoulomb
+
+    scene = dc.Scene("brake", gravity=(0.0, 0.0 if bearing_free else -G))
+    bearing = scene.add(dc.Body("ring", mass=1.0, inertia=1e-4)) if bearing_free else scene.ground
+    journal = scene.add(dc.Body("journal", mass=MASS, inertia=INERTIA, angular_velocity=SPIN))
+    scene.add(RevoluteClearance("bearing", bearing, journal, at=(0, 0), bearing_radius=R_B, clearance=C_B,
+                                material=Material(young=207e9, poisson=0.3),
+                                law=LankaraniNikravesh(restitution=0.5), friction=ModifiedCoulomb(coefficient=MU)))
+    return scene
+
+
+@pytest.mark.parametrize("angle", [-np.pi / 2, 0.4, 2.5])
+def test_friction_acts_at_the_contact_points_moment_by_hand(angle):
+    """One state in contact, by hand: eccentricity c + delta along n = (cos a, sin a), journal spinning
+    at w_j, bearing ring at w_b, centres still. F_N = K delta^1.5 (no penetration rate), the sliding
+    velocity of the contact points v_T = w_j R_j - w_b R_b along t (n turned +90 deg), F_T = -mu F_N
+    sign(v_T); the journal gets -F_N n + F_T t and the moment R_j F_T about its centre, the ring the
+    opposite force and the moment -R_b F_T (the force at the contact points Q, not at the centres)."""
+    model = dc.assemble(braked_journal(bearing_free=True))
+    names = model.state_names
+    delta, w_j, w_b = 3e-6, SPIN, 50.0
+    n, t = np.array([np.cos(angle), np.sin(angle)]), np.array([-np.sin(angle), np.cos(angle)])
+    y = np.zeros(model.n_states)
+    y[names.index("journal.x")], y[names.index("journal.y")] = (C_B + delta) * n
+    y[names.index("journal.omega")], y[names.index("ring.omega")] = w_j, w_b
+    Q = model.term_forces(0.0, y, [True], [np.array([1.0])])  # the latched approach speed: no rate, no damping
+    R_j = R_B - C_B
+    v_T = w_j * R_j - w_b * R_B
+    F_N = STEEL_K * delta**1.5
+    F_T = -MU * F_N * np.sign(v_T)
+    f = -F_N * n + F_T * t
+    journal = [names.index(f"journal.{k}") for k in ("x", "y", "phi")]
+    ring = [names.index(f"ring.{k}") for k in ("x", "y", "phi")]
+    np.testing.assert_allclose(Q[journal], [*f, R_j * F_T], rtol=1e-4)
+    np.testing.assert_allclose(Q[ring], [*-f, -R_B * F_T], rtol=1e-4)
+    assert abs(R_j * F_T) == pytest.approx(MU * F_N * R_j, rel=1e-4) and F_N > 0.5  # the moment mu F_N R
+
+
+@pytest.fixture(scope="module")
+def braked_run():
+    return dc.simulate(braked_journal(), 0.2, rtol=1e-8, save=dc.SaveAt(times=np.linspace(0.0, 0.2, 20001)))
+
+
+def test_friction_brakes_a_spinning_journal_angular_momentum_and_energy(braked_run):
+    """After the last impact the journal slides on the wall (it swings about the friction angle).
+    Angular momentum about its centre: I (w(t) - w(t_a)) = integral of R_j F_T dt; energy: the
+    mechanical energy changes by the work of the contact forces at the contact points, integral of
+    (-F_N d delta/dt + F_T v_T) dt, friction work included (channels: normal and friction force,
+    penetration rate, sliding velocity). Force at the centres instead: the spin stays 200 rad/s."""
+    from scipy.integrate import cumulative_trapezoid
+
+    run = braked_run
+    assert run.success
+    t_a = run.events[-1].t
+    assert run.events[-1].kind == "onset" and t_a < 0.1
+    k = run.t > t_a
+    assert np.all(run["bearing.in_contact"][k] > 0)  # sliding contact from t_a on
+    t, w = run.t[k], run["journal.omega"][k]
+    F_N, F_T = run["bearing.normal_force"][k], run["bearing.friction_force"][k]
+    v_T, rate = run["bearing.sliding_velocity"][k], run["bearing.penetration_rate"][k]
+    R_j = R_B - C_B
+    assert np.all(v_T > 1.5) and np.all(F_T == pytest.approx(-MU * F_N, rel=1e-12))
+    moment = cumulative_trapezoid(R_j * F_T, t, initial=0.0)
+    assert w[-1] < w[0] - 10.0  # measured: 200 -> 180.9 rad/s in 0.2 s
+    np.testing.assert_allclose(INERTIA * (w - w[0]), moment, rtol=0, atol=1e-5 * abs(moment[-1]))
+    energy = run["energy.mechanical"][k]
+    work = cumulative_trapezoid(-F_N * rate + F_T * v_T, t, initial=0.0)
+    friction_work = cumulative_trapezoid(F_T * v_T, t, initial=0.0)[-1]
+    assert friction_work < -0.02  # J, most of the change
+    np.testing.assert_allclose(energy - energy[0], work, rtol=0, atol=1e-5 * abs(friction_work))

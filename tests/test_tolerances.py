@@ -51,9 +51,10 @@ def test_scales_of_the_chapter_slider_crank():
     assert s.resolution == pytest.approx(1e-3)
     atol = s.default_atol(1e-6)
     # the 1e-3 * rtol of earlier releases in m, rad and m/s; 5000 rpm * 1e-5 in rad/s
-    assert atol["position"] == pytest.approx(1e-9) and atol["angle"] == pytest.approx(1e-9)
-    assert atol["velocity"] == pytest.approx(1e-6 * 1e-5 * 0.17 * 523.5987755982989)
-    assert atol["angular_velocity"] == pytest.approx(1e-6 * 1e-5 * 523.5987755982989)
+    assert atol["position"] == pytest.approx(1e-9, rel=1e-6, abs=0.0)
+    assert atol["angle"] == pytest.approx(1e-9, rel=1e-6, abs=0.0)
+    assert atol["velocity"] == pytest.approx(1e-6 * 1e-5 * 0.17 * 523.5987755982989, rel=1e-6, abs=0.0)
+    assert atol["angular_velocity"] == pytest.approx(1e-6 * 1e-5 * 523.5987755982989, rel=1e-6, abs=0.0)
 
 
 def test_scales_follow_the_mechanism():
@@ -79,11 +80,32 @@ def test_scales_follow_the_mechanism():
 def test_defaults_are_never_below_round_off():
     s = tol.scales(dc.assemble(dc.mechanisms.slider_crank("revolute")))
     floor = s.roundoff()
-    assert floor["velocity"] == pytest.approx(tol.ROUNDOFF_FACTOR * np.finfo(float).eps * 0.17 * 523.6, rel=1e-4)
+    assert floor["velocity"] == pytest.approx(tol.ROUNDOFF_FACTOR * np.finfo(float).eps * 0.17 * 523.6, rel=1e-4,
+                                             abs=0.0)
     atol = s.default_atol(1e-14)
     assert all(atol[q] == floor[q] for q in tol.QUANTITIES)
     loose = s.default_atol(1e-3)
     assert all(loose[q] > floor[q] for q in tol.QUANTITIES)
+
+
+def test_round_off_floors_scale_with_the_mechanism():
+    """docs/engine.md, Tolerances: each floor is 300 eps (IDA's Newton) or 10 eps (the ODE methods)
+    times its quantity's scale: L for positions (m), 1 for angles, L W for velocities, W for angular
+    velocities. The chapter's slider-crank: L = 0.17 m, W = 5000 rpm; the five-link pendulum: L =
+    0.45 m, W = sqrt(g / L). A given atol below them is raised to them, position states included."""
+    eps = np.finfo(float).eps
+    crank, swing = dc.assemble(dc.mechanisms.slider_crank("revolute")), dc.assemble(pendulum())
+    for model, L, W in ((crank, 0.17, 5000 * 2 * math.pi / 60), (swing, 0.45, math.sqrt(9.81 / 0.45))):
+        for newton, factor in ((True, 300.0), (False, 10.0)):
+            floor = tol.scales(model).roundoff(newton)
+            expected = {"position": factor * eps * L, "angle": factor * eps, "velocity": factor * eps * L * W,
+                        "angular_velocity": factor * eps * W}
+            assert floor == pytest.approx(expected, rel=1e-9, abs=0.0)  # (approx's default abs 1e-12 is above them)
+        with pytest.warns(DaeclearWarning, match=f"position to {300 * eps * L:.2g} m"):
+            vec = tol.tolerance_vector(model, 1e-6, 1e-30)
+        names = model.state_names
+        assert vec[names.index("rod.x" if model is crank else "link5.y")] == pytest.approx(300 * eps * L, rel=1e-9,
+                                                                                       abs=0.0)
 
 
 def test_the_tolerance_vector_per_state():
@@ -229,3 +251,13 @@ def test_the_sticking_advice_makes_the_run_finish():
                          on_failure="return")
     assert not failed.success and "modified Coulomb law (friction=<coefficient>" in failed.message
     assert dc.simulate(dc.mechanisms.slider_crank("revolute", friction=0.5), 0.024).success
+
+
+def test_a_comparison_the_default_abs_would_widen_is_refused():
+    """tests/conftest.py: pytest.approx(5.9e-12, rel=1e-4) would pass anything within 1e-12 (17 %): refused;
+    with abs= given, or values the default abs does not widen, it compares as pytest's."""
+    with pytest.raises(ValueError, match="default abs=1e-12 makes this comparison up to 0.17 relative"):
+        pytest.approx(5.9e-12, rel=1e-4)
+    assert 5.9e-12 == pytest.approx(5.9e-12, rel=1e-4, abs=0.0) and 6.5e-12 != pytest.approx(5.9e-12, rel=1e-4, abs=0)
+    assert 1.0 == pytest.approx(1.0) and 1e-3 == pytest.approx(1e-3, rel=1e-6) and 0.0 == pytest.approx(0.0)
+    assert {"a": 1e-9} == pytest.approx({"a": 1e-9}, rel=1e-3)  # 1e-12 / 1e-9 = 1e-3: not widened

@@ -22,6 +22,7 @@ from ..model.elements import kept_with
 from ..engine.session_base import DAEFunctions
 from ..core.options import DEFAULT_FORMULATION, FORMULATIONS
 from .parameters import ParameterTable, entries, structure_key
+from .parameter_names import BAUMGARTE_NAMES, is_numbers, scene_names
 from ..model.scene import (GROUND, Body, Driver, Revolute, RevoluteClearance, Scene, Translational,
                            TranslationalClearance)
 from .revolute_joint import CONTACT_BUILDERS
@@ -154,13 +155,28 @@ class Structure:
     def rebind(self, model: DAEModel, values: Mapping[str, Any]) -> DAEModel:
         """``model`` with some of its scene's numbers replaced (:meth:`DAEModel.with_parameters`)."""
         values = dict(values)
-        for name in ("baumgarte.alpha", "baumgarte.beta"):
-            if name in values and model.formulation != "index1":  # even its own value: it would mean nothing
+        table_names = frozenset(name for name, _ in model.parameter_layout)
+        settable, structural = scene_names(model.scene, model.formulation, table_names,  # the named elements only
+                                           frozenset(str(name).split(".")[0] for name in values))
+        for name in values:
+            if name in settable:
+                continue
+            nested = any(n.startswith(f"{name}.") for n in (*settable, *structural))
+            if name in structural or nested or not is_numbers(values[name]):
+                raise SceneError(f"with_parameters: {name!r} is structure of the model (read-only: a new value would "
+                                 "change the structure of the model); set its numbers by their names (model."
+                                 "parameter_names), or assemble the changed scene: "
+                                 "assemble(model.scene.with_values(...)).")
+            if name in BAUMGARTE_NAMES:  # even its own value: it would mean nothing
                 raise SceneError(f"with_parameters: {name}={values[name]!r}, must be left out: Baumgarte's constants "
                                  f"are numbers of the index1 formulation and this model is {model.formulation} "
                                  "(assemble(scene, formulation='index1') to set them).")
-        alpha = values.pop("baumgarte.alpha", model.alpha)
-        beta = values.pop("baumgarte.beta", model.beta)
+            model.scene.with_values({name: values[name]})  # an unknown name: its error names the element or field
+            raise SceneError(f"with_parameters: {name!r} is not one of the model's numbers: this scene leaves it to be "
+                             "derived (None); give it in the scene and assemble it (nothing compiles): "
+                             "assemble(model.scene.with_values(...)).")
+        alpha = float(values.pop("baumgarte.alpha", model.alpha))
+        beta = float(values.pop("baumgarte.beta", model.beta))
         _check_baumgarte(alpha, beta)
         alpha, beta = float(alpha), float(beta)
         scene = model.scene.with_values(values)

@@ -168,35 +168,49 @@ class JournalContact:
     p: Any
     n_params: int
     force: ca.Function
+    # d/dt of the worn surfaces' depth along e (0 unworn): the gap's rate is d|e|/dt minus it
+    worn_rate: Any = 0.0
+    # a worn joint's contact direction in the bearing's and the journal's frame (rad), for the wear study
+    worn_angles: tuple[Any, Any] | None = None
+
+    @property
+    def penetration_rate(self) -> Any:
+        """d(delta)/dt along the motion, the worn profile's change under the moving contact included
+        (regular at e = 0, where it is 0 unworn)."""
+        return ca.dot(self.e_dot, self.e) / ca.fmax(self.e_norm, 1e-300) - self.worn_rate
 
     def channels(self, name: str, on: Any, p_sym: Any, frictionless: bool) -> list[Channel]:
         """The contact's channels: eccentricity, penetration, the force while ``on``."""
-        e, e_dot, e_norm, p = self.e, self.e_dot, self.e_norm, self.p
+        e, e_norm, p = self.e, self.e_norm, self.p
         F_N_out = on * ca.substitute(self.F_N, p, p_sym) if self.n_params else on * self.F_N
         out = [
             Channel(f"{name}.ex", "m", e[0]),
             Channel(f"{name}.ey", "m", e[1]),
             Channel(f"{name}.eccentricity", "m", e_norm),
             Channel(f"{name}.penetration", "m", e_norm - self.c),
-            Channel(f"{name}.penetration_rate", "m/s", ca.dot(e_dot, e) / ca.fmax(e_norm, 1e-300)),
+            Channel(f"{name}.penetration_rate", "m/s", self.penetration_rate),
             Channel(f"{name}.normal_force", "N", F_N_out),
             Channel(f"{name}.in_contact", "", on),
         ]
         if not frictionless:
             F_T_out = on * (ca.substitute(self.F_T, p, p_sym) if self.n_params else self.F_T)
-            out += [Channel(f"{name}.friction_force", "N", F_T_out),
-                    Channel(f"{name}.sliding_velocity", "m/s", self.v_T)]
+            out.append(Channel(f"{name}.friction_force", "N", F_T_out))
+        if not frictionless or self.worn_angles is not None:  # what the wear study reads (studies.wear)
+            out.append(Channel(f"{name}.sliding_velocity", "m/s", self.v_T))
+        if self.worn_angles is not None:
+            out += [Channel(f"{name}.bearing_angle", "rad", self.worn_angles[0]),
+                    Channel(f"{name}.journal_angle", "rad", self.worn_angles[1])]
         return out
 
 
 def journal_logic(ctx: AssemblyContext, jc: JournalContact, cls: type[PairLogic], name: str, first_root: int,
-                  first_term: int, gaps: list[Any], law: Any, friction: Any
+                  first_term: int, gaps: list[Any], law: Any, friction: Any, law_prefix: str = "law"
                   ) -> Callable[[NDArray[np.float64]], list[Any]]:
     """A journal's logic maker: one pair ``name`` of class ``cls``, its rate function (q, v, P) ->
-    (``gaps``..., penetration rate) bound to each parameter vector."""
-    penetration_rate = ca.dot(jc.e_dot, jc.e) / ca.fmax(jc.e_norm, 1e-300)
-    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P], [*gaps, penetration_rate])
-    floor = approach_floor(ctx, law, f"{name}.law")
+    (``gaps``..., penetration rate) bound to each parameter vector; the law's numbers under
+    ``<name>.<law_prefix>``."""
+    rate = ca.Function(f"{name}_rate", [ctx.q, ctx.v, ctx.P], [*gaps, jc.penetration_rate])
+    floor = approach_floor(ctx, law, f"{name}.{law_prefix}")
     discontinuous = not friction.frictionless and not friction.smooth
     n_q = ctx.n_q  # read once: a CasADi call costs more inside a sweep's loop than the logic it makes
 
@@ -206,14 +220,15 @@ def journal_logic(ctx: AssemblyContext, jc: JournalContact, cls: type[PairLogic]
     return logic
 
 
-def journal_parameters(ref: Reference, joint: Any, law: Any, friction: Any, film: dict[str, Any] | None = None
-                       ) -> dict[str, Any]:
-    """A revolute clearance joint's points, clearance and radii, ``film``'s entries, and its laws' numbers."""
+def journal_parameters(ref: Reference, joint: Any, law: Any, friction: Any, film: dict[str, Any] | None = None,
+                       law_prefix: str = "law") -> dict[str, Any]:
+    """A revolute clearance joint's points, clearance and radii, ``film``'s entries, and its laws' numbers
+    (the normal law's under ``law_prefix``)."""
     s_i, s_j = ref.joint_points(joint)
     values: dict[str, Any] = {"s_i": s_i, "s_j": s_j, "clearance": joint.radial_clearance,
                               "bearing_radius": float(joint.bearing_radius), "journal_radius": joint.journal,
                               **(film or {})}
-    values.update({f"law.{k}": v for k, v in law_values(law).items()})
+    values.update({f"{law_prefix}.{k}": v for k, v in law_values(law).items()})
     values.update({f"friction.{k}": v for k, v in law_values(friction).items()})
     return values
 
@@ -238,10 +253,12 @@ def worn_depths(ctx: AssemblyContext, joint: Any, direction: Any, bi: Any, bj: A
     return out[0], out[1]
 
 
-def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction_numeric: Any) -> JournalContact:
-    """Journal-bearing contact (section 4.2) of ``joint``: body i the bearing (R_i), j the journal (R_j)."""
+def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction_numeric: Any,
+                    law_prefix: str = "law") -> JournalContact:
+    """Journal-bearing contact (section 4.2) of ``joint``: body i the bearing (R_i), j the journal (R_j);
+    the normal law's numbers under ``<joint>.<law_prefix>``."""
     name = joint.name
-    law = symbolic_law(law_numeric, ctx.params, f"{name}.law")
+    law = symbolic_law(law_numeric, ctx.params, f"{name}.{law_prefix}")
     friction = symbolic_law(friction_numeric, ctx.params, f"{name}.friction")
     R_i, R_j = ctx.p(name, "bearing_radius"), ctx.p(name, "journal_radius")
     s_i, s_j = ctx.p(name, "s_i"), ctx.p(name, "s_j")
@@ -253,10 +270,17 @@ def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction
     # in contact |e| >= c > 0: the normal and everything below are regular there
     e_norm = ca.sqrt(ee)
     n = e / e_norm  # (4.4)
-    worn = worn_depths(ctx, joint, e / ca.fmax(e_norm, 1e-300), bi, bj)  # 0 without wear
-    c = ctx.p(name, "clearance") + worn[0] + worn[1]  # the clearance along n, worn surfaces included
+    # the direction of e, regular at e = 0 (where the gap is far from closing): exactly n in contact
+    clearance = ctx.p(name, "clearance")
+    worn = worn_depths(ctx, joint, e / ca.fmax(e_norm, 0.5 * clearance), bi, bj)  # 0 without wear
+    c_worn = worn[0] + worn[1]
+    c = clearance + c_worn  # the clearance along n, worn surfaces included
     delta = e_norm - c  # (4.5)
-    delta_dot = ca.dot(e_dot, n)  # (4.8): v_N = d|e|/dt (the profile's slope neglected: h' / R ~ 1e-4)
+    worn_jacobian = ca.jacobian(c_worn, ctx.q) if isinstance(c_worn, ca.SX) else None
+    worn_rate = ca.mtimes(worn_jacobian, ctx.v) if worn_jacobian is not None else 0.0
+    # (4.8): v_N = d|e|/dt, less the worn depth's change as the contact moves along the profile and the
+    # worn bodies turn (the gap's own rate: a contact is left only when its gap closes)
+    delta_dot = ca.dot(e_dot, n) - worn_rate
     t_vec = perpendicular(n)
     Q_i = P_i + (R_i + worn[0]) * n  # (4.6) contact points, on the worn surfaces
     Q_j = P_j + (R_j - worn[1]) * n
@@ -266,7 +290,14 @@ def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction
     p = ca.SX.sym("p", n_params)
     F_N = law.force(delta, delta_dot, p[0] if n_params else None)
     F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
+    worn_angles = None
+    if worn_jacobian is not None:  # the contact direction's angle in each body's frame: atan2 of A(phi)^T n
+        worn_angles = tuple(ca.atan2(-ca.sin(f.phi) * e[0] + ca.cos(f.phi) * e[1],
+                                     ca.cos(f.phi) * e[0] + ca.sin(f.phi) * e[1]) for f in (bi, bj))
     f_journal = -F_N * n + F_T * t_vec  # force on the journal (body j); the bearing gets the opposite
     Q = ctx.generalized_force([(joint.body_j, f_journal, Q_j), (joint.body_i, -f_journal, Q_i)])
+    if worn_jacobian is not None:  # the normal force along the gap's gradient: -F_N d(delta)/dq, delta's worn part
+        Q = Q + F_N * worn_jacobian.T
     force = ca.Function(f"{name}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P], [Q], ["t", "q", "v", "p", "P"], ["Q"])
-    return JournalContact(e, e_dot, ee, e_norm, c, bi, bj, P_i, P_j, F_N, F_T, v_T, p, n_params, force)
+    return JournalContact(e, e_dot, ee, e_norm, c, bi, bj, P_i, P_j, F_N, F_T, v_T, p, n_params, force, worn_rate,
+                          worn_angles)

@@ -19,6 +19,7 @@ from ..engine.build import memo_put_bounded
 from ..engine.session_base import DAEFunctions, StateLayout
 from ..core.errors import AssemblyError, SceneError
 from .physics import check_start_penetration, checked_channel
+from .parameter_names import scene_names
 from .symbolic import Term
 
 Formulation = Literal["index1", "ggl"]
@@ -119,16 +120,29 @@ class DAEModel:
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
-        return tuple(name for name, _ in self.parameter_layout)
+        """The model's numbers by their scene names: exactly what :meth:`with_parameters`,
+        ``simulate(parameters=)`` and sweeps accept (:mod:`daeclear.assembly.parameter_names`)."""
+        return self._names()[0]
+
+    @property
+    def structural_names(self) -> tuple[str, ...]:
+        """The scene's values that are structure (text, flags, counts, a baked law's numbers): read-only."""
+        return self._names()[1]
+
+    def _names(self) -> tuple[tuple[str, ...], tuple[str, ...]]:
+        if self.scene is None:  # a model not made by assemble(): its table is all it has
+            return tuple(name for name, _ in self.parameter_layout), ()
+        return scene_names(self.scene, self.formulation, frozenset(name for name, _ in self.parameter_layout))
 
     def parameter(self, name: str) -> NDArray[np.float64]:
-        """The value of one run-time parameter, e.g. ``model.parameter("clearance.clearance")``."""
+        """The value of one entry of the compiled parameter table, e.g. ``model.parameter("clearance.clearance")``
+        (a scene's number, or one derived from them such as ``"clearance.s_i"``)."""
         offset = 0
         for key, size in self.parameter_layout:
             if key == name:
                 return self.parameter_values[offset:offset + size].copy()
             offset += size
-        raise KeyError(f"no parameter {name!r}; the model has {', '.join(self.parameter_names)}")
+        raise KeyError(f"no parameter {name!r}; the model's table has {', '.join(k for k, _ in self.parameter_layout)}")
 
     @property
     def n_q(self) -> int:

@@ -13,16 +13,19 @@ from ..model.scene import RevoluteClearance
 from .symbolic import AssemblyContext, Channel, Reference, Term
 from .contact_pairs import PairLogic, ContactBuild, journal_contact, journal_logic, journal_parameters
 from .lubricated_joint import build_lubricated_revolute, lubricated_parameters
-from ..contact.hydrodynamic import HydrodynamicBearing
 from ..contact.wear import profile_coefficients
 from .translational_joint import (
     TranslationalClearance, build_translational_clearance, translational_clearance_parameters)
 
 
-def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> tuple[dict[str, Any], list[str]]:
-    """The joint's numbers (run-time parameters) and what of it is structure."""
-    if isinstance(joint.law, HydrodynamicBearing):
-        return lubricated_parameters(ref, joint)
+def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> tuple[dict[str, Any], list[Any]]:
+    """The joint's numbers (run-time parameters) and what of it is structure, by its law's journal model
+    (:data:`JOURNAL_MODELS`)."""
+    return JOURNAL_MODELS[joint.resolved_law().journal_model][0](ref, joint)
+
+
+def dry_journal_parameters(ref: Reference, joint: RevoluteClearance) -> tuple[dict[str, Any], list[Any]]:
+    """A dry journal's numbers (run-time parameters) and what of it is structure."""
     law, friction = joint.resolved_law(), joint.resolved_friction()
     values = journal_parameters(ref, joint, law, friction)
     structure = [law_structure(law), law_structure(friction)]
@@ -36,10 +39,13 @@ def revolute_clearance_parameters(ref: Reference, joint: RevoluteClearance) -> t
 
 def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, first_term: int,
                              first_root: int) -> ContactBuild:
-    """Journal-bearing contact (section 4.2), eqs. (4.1)-(4.13); a lubricated joint is
-    :func:`build_lubricated_revolute`'s."""
-    if isinstance(joint.law, HydrodynamicBearing):
-        return build_lubricated_revolute(ctx, joint, first_term, first_root)
+    """A revolute clearance joint by its law's journal model (:data:`JOURNAL_MODELS`)."""
+    return JOURNAL_MODELS[joint.resolved_law().journal_model][1](ctx, joint, first_term, first_root)
+
+
+def build_dry_journal(ctx: AssemblyContext, joint: RevoluteClearance, first_term: int,
+                      first_root: int) -> ContactBuild:
+    """Journal-bearing contact (section 4.2), eqs. (4.1)-(4.13)."""
     name = joint.name
     law_numeric, friction_numeric = joint.resolved_law(), joint.resolved_friction()
     jc = journal_contact(ctx, joint, law_numeric, friction_numeric)
@@ -54,6 +60,13 @@ def build_revolute_clearance(ctx: AssemblyContext, joint: RevoluteClearance, fir
     return ContactBuild(terms=[Term(name, jc.force, jc.n_params)], gaps=[gap], gap_names=[name],
                         channels=channels, logic=logic, ideal=[e[0], e[1]], ideal_names=[f"{name}.x", f"{name}.y"])
 
+
+#: A revolute clearance joint's law's ``journal_model`` -> (parameter function, builder): a normal law makes
+#: a dry journal, a HydrodynamicBearing a lubricated one (daeclear.assembly.lubricated_joint).
+JOURNAL_MODELS: dict[str, tuple[Callable[..., tuple[dict[str, Any], list[Any]]], Callable[..., ContactBuild]]] = {
+    "dry": (dry_journal_parameters, build_dry_journal),
+    "lubricated": (lubricated_parameters, build_lubricated_revolute),
+}
 
 #: Clearance joint type -> (parameter function, builder).
 CONTACT_BUILDERS: dict[type, tuple[Callable[..., tuple[dict[str, Any], list[Any]]], Callable[..., ContactBuild]]] = {

@@ -143,9 +143,11 @@ class AssemblyContext:
         value = self.params[f"{owner}.{key}"]
         return value[0] if value.numel() == 1 else value
 
-    def generalized_force(self, loads: Sequence[tuple[str, Any, Any]]) -> Any:
+    def generalized_force(self, loads: Sequence[tuple[str, Any, Any]],
+                          couples: Sequence[tuple[str, Any]] = ()) -> Any:
         """Generalized force (length n_q) of point loads ``(body, force, world point)``, moved to the
-        centres of mass with m = (x_P - x) f_y - (y_P - y) f_x (eqs. 4.10-4.13, 4.22-4.25); none on the ground."""
+        centres of mass with m = (x_P - x) f_y - (y_P - y) f_x (eqs. 4.10-4.13, 4.22-4.25), and of pure
+        ``couples`` ``(body, torque)``; none on the ground."""
         Q = ca.SX(self.n_q, 1)  # structural zeros: only the loaded bodies' entries are nonzeros
         for body, force, point in loads:
             frame = self.frames[body]
@@ -156,6 +158,10 @@ class AssemblyContext:
             Q[k] += force[0]
             Q[k + 1] += force[1]
             Q[k + 2] += arm[0] * force[1] - arm[1] * force[0]
+        for body, torque in couples:
+            frame = self.frames[body]
+            if frame.index is not None:
+                Q[3 * frame.index + 2] += torque
         return Q
 
 

@@ -61,7 +61,8 @@ def _elastic_energy(numeric: Any, law: Any, d: Any) -> Any | None:
     if not math.isfinite(n_value):
         return None
     n = getattr(law, "effective_exponent", n_value)
-    return law.stiffness * ca.fmax(d, 0.0) ** (n + 1.0) / (n + 1.0)
+    # behind a branch: the derivative in n is 0 out of contact, not 0 * log(0) = NaN (see normal.py's _elastic)
+    return law.stiffness * ca.if_else(d > 0.0, ca.fmax(d, 0.0) ** (n + 1.0), 0.0) / (n + 1.0)
 
 
 @dataclass(frozen=True)

@@ -41,6 +41,15 @@ class NormalLaw(abc.ABC):
     name: ClassVar[str]
     geometry: ClassVar[Geometry]
     supported_kinds: ClassVar[tuple[str, ...]]
+    #: The clearance joints (their ``kind``) that take the law, how a revolute joint builds its pair
+    #: (the assembly's registry of journal models), and whether a joint with it can wear.
+    joint_kinds: ClassVar[tuple[str, ...]] = ("RevoluteClearance", "TranslationalClearance")
+    journal_model: ClassVar[str] = "dry"
+    wears: ClassVar[bool] = True
+
+    def joint_problems(self, clearance: float, journal_radius: float) -> list[str]:
+        """What is wrong with this law in a revolute joint of ``clearance`` (m): nothing for a normal law."""
+        return []
 
     @property
     def dissipative(self) -> bool:

@@ -18,10 +18,12 @@ from ..core.errors import SceneError
 from . import _backend as B
 from ._checks import check_number, set_field
 from .base import NormalLaw
+from .asperity import ASPERITY_CUTOFF
 from .finite_bearing import finite_film_force
+from .geometry import sigma_sum
 from .normal import LankaraniNikravesh
 
-__all__ = ["CAVITATION", "HydrodynamicBearing", "THEORIES", "bearing_from_table", "film_integrals", "law_from_table"]
+__all__ = ["CAVITATION", "HydrodynamicBearing", "THEORIES", "film_integrals", "shear_torques"]
 
 #: The film theories and the cavitation options (the first of each is the default).
 THEORIES: tuple[str, ...] = ("short", "long", "finite")
@@ -90,10 +92,17 @@ class HydrodynamicBearing:
         "half": only the half of the film where pressure builds (Guembel); "full": the whole film.
     dry : NormalLaw
         The contact law once the film has broken down (stiffness from the joint's materials if None).
-    film_threshold : float
-        Minimum film thickness c (1 - eps) in m (> 0) below which the dry law takes over.
+    roughness : float
+        Composite RMS roughness sigma = sqrt(sigma_bearing^2 + sigma_journal^2) of the two surfaces, m (> 0).
+    film_parameter : float
+        The film parameter Lambda = h_min / sigma at which the film breaks down and the dry law takes
+        over (> 0; 1 by default, the start of boundary lubrication); below Lambda = 4 the asperities
+        carry a share of the load with the film (Greenwood and Tripp: the mixed regime).
     hysteresis : float
-        The film forms again above ``film_threshold * (1 + hysteresis)``; >= 0.
+        The film forms again above ``film_parameter * (1 + hysteresis)``; >= 0.
+    asperity_modulus : float or None
+        Composite modulus E' of the asperity contact (1/E' = sum (1 - nu^2)/E), Pa; None: from the
+        joint's materials.
     """
 
     viscosity: float
@@ -101,10 +110,18 @@ class HydrodynamicBearing:
     theory: str = "short"
     cavitation: str = "half"
     dry: NormalLaw = LankaraniNikravesh(restitution=0.9)
-    film_threshold: float = 1.0e-6
+    roughness: float = 1.0e-6
+    film_parameter: float = 1.0
     hysteresis: float = 1.0
+    asperity_modulus: float | None = None
 
     name: ClassVar[str] = "hydrodynamic"
+    #: A revolute clearance joint's law only, assembled as a lubricated journal; wear is not modelled with it.
+    joint_kinds: ClassVar[tuple[str, ...]] = ("RevoluteClearance",)
+    journal_model: ClassVar[str] = "lubricated"
+    wears: ClassVar[bool] = False
+    #: A table with the numbers the law needs (error messages).
+    example: ClassVar[str] = "{'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01}"
 
     def __post_init__(self) -> None:
         owner = type(self).__name__
@@ -118,9 +135,18 @@ class HydrodynamicBearing:
         if not isinstance(self.dry, NormalLaw):
             raise SceneError(f"{owner}: dry={self.dry!r}, must be a normal contact law (a NormalLaw, e.g. "
                              "LankaraniNikravesh(restitution=0.9)).")
-        set_field(self, "film_threshold",
-                  check_number(owner, "film_threshold", self.film_threshold, low=0.0, unit="m"))
+        set_field(self, "roughness", check_number(owner, "roughness", self.roughness, low=0.0, unit="m"))
+        set_field(self, "film_parameter", check_number(owner, "film_parameter", self.film_parameter, low=0.0,
+                                                       high=ASPERITY_CUTOFF))
         set_field(self, "hysteresis", check_number(owner, "hysteresis", self.hysteresis, low=0.0, low_open=False))
+        if self.asperity_modulus is not None:
+            set_field(self, "asperity_modulus",
+                      check_number(owner, "asperity_modulus", self.asperity_modulus, low=0.0, unit="Pa"))
+
+    @property
+    def film_threshold(self) -> float:
+        """Minimum film thickness (m) below which the film has broken down: film_parameter x roughness."""
+        return self.film_parameter * self.roughness
 
     @property
     def reform_threshold(self) -> float:
@@ -129,8 +155,8 @@ class HydrodynamicBearing:
 
     @property
     def is_resolved(self) -> bool:
-        """True when the dry law has every number (see :meth:`resolve`)."""
-        return self.dry.is_resolved
+        """True when the dry law and the asperity modulus have every number (see :meth:`resolve`)."""
+        return self.dry.is_resolved and self.asperity_modulus is not None
 
     @property
     def needs_approach_speed(self) -> bool:
@@ -142,18 +168,27 @@ class HydrodynamicBearing:
         if kind != "internal_cylinder":
             raise SceneError(f"{type(self).__name__}.resolve: kind={kind!r}, must be 'internal_cylinder' "
                              "(a lubricated journal bearing is a revolute clearance joint).")
-        dry = self.dry
+        dry, modulus = self.dry, self.asperity_modulus
         if not dry.is_resolved:
             dry = dry.resolve("internal_cylinder", radii=radii, materials=materials)
-        return dataclasses.replace(self, dry=dry)
+        if modulus is None:
+            if materials is None:
+                raise SceneError(f"{type(self).__name__}: asperity_modulus=None and the joint has no material; "
+                                 "give the joint's material or asperity_modulus (Pa).")
+            modulus = 1.0 / sigma_sum(materials)  # 1/E' = sum (1 - nu^2) / E (Material.sigma, no pi)
+        return dataclasses.replace(self, dry=dry, asperity_modulus=modulus)
 
-    def problems(self, clearance: float, journal_radius: float) -> list[str]:
+    def joint_problems(self, clearance: float, journal_radius: float) -> list[str]:
         """What is wrong with this law in a joint of radial clearance ``clearance`` (m)."""
         owner = type(self).__name__
         out = []
         if not self.reform_threshold < clearance:
-            out.append(f"{owner}: film_threshold * (1 + hysteresis)={self.reform_threshold:g} m, must be < the "
-                       f"radial clearance {clearance:g} m (the film must be able to form).")
+            out.append(f"{owner}: film_parameter * roughness * (1 + hysteresis)={self.reform_threshold:g} m, must be "
+                       f"< the radial clearance {clearance:g} m (the film must be able to form).")
+        if not ASPERITY_CUTOFF * self.roughness < 0.5 * clearance:
+            out.append(f"{owner}: roughness={self.roughness:g} m, must be < the radial clearance / 8 = "
+                       f"{clearance / 8:g} m (asperities touch below a film of 4 x roughness, which must stay "
+                       "thin against the clearance).")
         if self.theory == "finite" and self.length > 2.0 * journal_radius:
             out.append(f"{owner}: length={self.length:g} m with theory='finite', must be <= the journal's diameter "
                        f"{2.0 * journal_radius:g} m (Butenschoen's tables end at B/D = 1).")
@@ -180,6 +215,16 @@ class HydrodynamicBearing:
         if not B.is_symbolic(eccentricity_ratio, wedge_rate, squeeze_rate, radius, clearance):
             check_number(owner, "radius", radius, low=0.0, unit="m")
             check_number(owner, "clearance", clearance, low=0.0, unit="m")
+            if not clearance < radius:
+                raise SceneError(f"{owner}: clearance={clearance:g} m, must be < radius={radius:g} m (a radial "
+                                 "clearance, far smaller than the journal).")
+            for field, value, unit in (("wedge_rate", wedge_rate, "rad/s"), ("squeeze_rate", squeeze_rate, "1/s")):
+                raw = np.asarray(value)
+                if raw.dtype.kind not in "iuf":
+                    raise SceneError(f"{owner}: {field}={value!r} is not a real number ({unit}).")
+                bad = ~np.isfinite(raw)
+                if np.any(bad):
+                    raise SceneError(f"{owner}: {field}={raw[bad].flat[0]}, must be a finite number ({unit}).")
             eps_values = np.asarray(eccentricity_ratio, dtype=float)
             bad = ~((eps_values >= 0.0) & (eps_values < 1.0))
             if np.any(bad):
@@ -220,28 +265,18 @@ class HydrodynamicBearing:
         return -f_x, f_y
 
 
-def bearing_from_table(params: dict[str, Any]) -> HydrodynamicBearing:
-    """A HydrodynamicBearing from a scene file's law table (``name = "hydrodynamic"`` already taken
-    out); ``dry`` may be a law name or a table ``{ name = ..., parameters }``."""
-    from .registry import build_law, normal_law
+def shear_torques(viscosity: Any, length: Any, eps: Any, relative_speed: Any, tangential: Any, radius: Any,
+                  clearance: Any) -> tuple[Any, Any]:
+    """The film's shear torques (journal, bearing), N m, about each one's centre (floats or symbols).
 
-    params = dict(params)
-    dry = params.get("dry")
-    if isinstance(dry, dict):
-        dry = dict(dry)
-        params["dry"] = normal_law(dry.pop("name", None), **dry)
-    elif isinstance(dry, str):
-        params["dry"] = normal_law(dry)
-    return build_law(HydrodynamicBearing, params)
-
-
-def law_from_table(table: dict[str, Any]) -> Any:
-    """A normal law or a HydrodynamicBearing from a table ``{name = ..., parameters}`` (scene files,
-    ``daeclear run --set law={...}``): ``name = "hydrodynamic"`` makes the bearing."""
-    from .registry import normal_law
-
-    params = dict(table)
-    name = params.pop("name", None)
-    if name == HydrodynamicBearing.name:
-        return bearing_from_table(params)
-    return normal_law(name, **params)
+    The wall shear ``mu (U_b - U_j) / h - (h / 2) dp/(R dtheta)`` integrated over the journal: Couette
+    (Petroff's term, over the whole circumference: ``2 pi mu R^3 L (w_j - w_b) / (c sqrt(1 - eps^2))``)
+    and Poiseuille, ``-(e / 2) F_t`` by parts for any pressure field; the bearing's makes the film's
+    torques balance, ``T_j + T_b + e F_t = 0``. ``relative_speed`` = omega_journal - omega_bearing,
+    ``tangential`` the film's tangential force (:meth:`HydrodynamicBearing.film_force`).
+    """
+    if B.is_symbolic(eps):
+        eps = B.fmin(B.fmax(eps, 0.0), EPS_CAP)
+    couette = 2.0 * math.pi * viscosity * radius**3 * length * relative_speed / (clearance * B.sqrt(1.0 - eps * eps))
+    poiseuille = -0.5 * eps * clearance * tangential
+    return -couette + poiseuille, couette + poiseuille

@@ -75,7 +75,12 @@ class _StiffnessLaw(NormalLaw):
         return dataclasses.replace(self, stiffness=stiffness, exponent=1.0)
 
     def _elastic(self, delta: Any) -> Any:
-        return self.stiffness * B.fmax(delta, 0.0) ** self.effective_exponent
+        power = B.fmax(delta, 0.0) ** self.effective_exponent
+        if B.is_symbolic(delta, self.effective_exponent):
+            # behind a branch: its derivative in the exponent, log(delta) delta**n, is 0 out of contact
+            # (a sensitivity to n), not 0 * log(0) = NaN
+            power = B.if_else(delta > 0.0, power, 0.0)
+        return self.stiffness * power
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -13,9 +13,10 @@ from ..core.options import fail
 from .base import NormalLaw
 from .cylindrical import DubowskyFreudenstein, ESDU78035, Goldsmith
 from .friction import Coulomb, FrictionLaw, ModifiedCoulomb, NoFriction
+from .hydrodynamic import HydrodynamicBearing
 from .normal import Flores, Hertz, HuntCrossley, KelvinVoigt, LankaraniNikravesh, LankaraniPlane
 
-__all__ = ["FRICTION_LAWS", "NORMAL_LAWS", "friction_law", "normal_law"]
+__all__ = ["FRICTION_LAWS", "JOINT_LAWS", "LAW_TYPES", "NORMAL_LAWS", "contact_law", "friction_law", "normal_law"]
 
 #: Normal laws by registry name.
 NORMAL_LAWS: dict[str, type[NormalLaw]] = {cls.name: cls for cls in (
@@ -23,6 +24,12 @@ NORMAL_LAWS: dict[str, type[NormalLaw]] = {cls.name: cls for cls in (
     ESDU78035, LankaraniPlane)}
 _NORMAL_ALIASES = {"ln": "lankarani-nikravesh", "esdu": "esdu-78035", "kv": "kelvin-voigt",
                    "hc": "hunt-crossley", "df": "dubowsky-freudenstein", "flores-2011": "flores"}
+
+#: A clearance joint's laws besides the normal laws, by registry name: each has ``example`` (a table with
+#: the numbers it needs); its table is read by :func:`contact_law`.
+JOINT_LAWS: dict[str, Any] = {HydrodynamicBearing.name: HydrodynamicBearing}
+#: What a clearance joint's ``law`` may be an instance of.
+LAW_TYPES: tuple[type, ...] = (NormalLaw, HydrodynamicBearing)
 
 #: Friction laws by registry name.
 FRICTION_LAWS: dict[str, type[FrictionLaw]] = {cls.name: cls for cls in (NoFriction, Coulomb, ModifiedCoulomb)}
@@ -109,10 +116,56 @@ def friction_law(name_or_coefficient: str | float | FrictionLaw | None, **params
     return build_law(_lookup("friction_law", name_or_coefficient, FRICTION_LAWS, _FRICTION_ALIASES), params)
 
 
+def contact_law(value: Any) -> Any:
+    """A clearance joint's law from a law object (as is), a name, or a table ``{name = ..., parameters}``
+    (scene files, ``--set law={...}``, sweeps): the normal laws (:data:`NORMAL_LAWS`) and the joint laws
+    (:data:`JOINT_LAWS`: ``"hydrodynamic"``, whose table may give its ``dry`` law as a name or a table)."""
+    if isinstance(value, LAW_TYPES):
+        return value
+    if isinstance(value, dict):
+        params = dict(value)
+        name = params.pop("name", None)
+        if not isinstance(name, str):
+            raise SceneError(f"law table {value!r}: name={name!r}, must be a law's name (one of "
+                             f"{', '.join([*NORMAL_LAWS, *JOINT_LAWS])}).")
+        joint_law = _keys(tuple(JOINT_LAWS), ()).get(_key(name))
+        if joint_law is not None:
+            return _joint_law_from_table(JOINT_LAWS[joint_law], params)
+        return normal_law(name, **params)
+    joint_law = _keys(tuple(JOINT_LAWS), ()).get(_key(value)) if isinstance(value, str) else None
+    if joint_law is not None:
+        raise SceneError(f"contact law: law={value!r} needs its numbers: give a table, e.g. "
+                         f"law={JOINT_LAWS[joint_law].example} ({JOINT_LAWS[joint_law].__doc__.splitlines()[0]})")
+    return normal_law(value)
+
+
+def _joint_law_from_table(cls: type, params: dict[str, Any]) -> Any:
+    """A joint law from its table (``name`` taken out); a ``dry`` law in it may be a name or a table."""
+    params = dict(params)
+    dry = params.get("dry")
+    try:
+        if isinstance(dry, dict):
+            dry = dict(dry)
+            params["dry"] = normal_law(dry.pop("name", None), **dry)
+        elif isinstance(dry, str):
+            params["dry"] = normal_law(dry)
+    except (SceneError, TypeError) as exc:
+        raise SceneError(f"{cls.__name__}: dry={dry!r}: {exc}") from None
+    return build_law(cls, params)
+
+
 def check_restitution(value: Any, law: Any, *, where: str, field: str = "restitution") -> None:
     """A restitution given explicitly must reach a law that has one (it is never dropped silently)."""
     if value is None:
         return
+    name = law.get("name") if isinstance(law, dict) else law if isinstance(law, str) else getattr(law, "name", None)
+    if name in JOINT_LAWS:
+        fail(where, field, value, "left out with a lubricated law (hydrodynamic), whose dry law has the restitution; "
+             "give it there, e.g. law={'name': 'hydrodynamic', 'viscosity': 0.1, 'length': 0.01, 'dry': "
+             "{'name': 'lankarani-nikravesh', 'restitution': 0.5}}")
+    if isinstance(law, dict):
+        fail(where, field, value, "left out when law is a table; give it in the table, e.g. "
+             "law={'name': 'hunt-crossley', 'restitution': 0.5}")
     if isinstance(law, NormalLaw):
         fail(where, field, value, f"left out when law is a law object ({type(law).__name__}); set it on the "
              "law object instead")

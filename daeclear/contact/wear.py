@@ -17,15 +17,21 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.errors import SceneError
 from ._checks import check_number
 
-__all__ = ["ArchardWear", "DISTRIBUTIONS", "SURFACES", "WearHistoryArrays", "half_angle_hertz",
+__all__ = ["ArchardWear", "DISTRIBUTIONS", "MAX_DEPTH_FRACTION", "SURFACES", "WearHistoryArrays", "half_angle_hertz",
            "half_angle_overlap", "node_weights", "profile_coefficients", "spread", "profile_depth", "wear_increment",
            "worn_volume"]
 
 SURFACES: tuple[str, ...] = ("bearing", "journal", "both")
+#: The deepest wear the gap's model takes, as a fraction of the bearing radius (it neglects the profile's
+#: slope in the contact points; docs/wear.md); simulate_wear stops there.
+MAX_DEPTH_FRACTION = 0.05
 DISTRIBUTIONS: tuple[str, ...] = ("elastic-foundation", "hertz")
-# samples of the pressure over one contact arc spread onto the nodes (at least)
+# the grid the arcs' pressure is spread on, per node spacing
+SUBDIVISIONS = 4
+# arcs wider than 2^WIDTH_BITS grid steps share a shape within 2^-(WIDTH_BITS + 1) of their half-width
+WIDTH_BITS = 8
+# contacts binned in one pass: SPREAD_SAMPLES // ARC_SAMPLES (index arrays of a few MB)
 ARC_SAMPLES = 64
-# samples spread in one pass (contacts x samples per contact): about 8 MB a sample array
 SPREAD_SAMPLES = 1 << 20
 
 
@@ -106,40 +112,51 @@ def _shape(distribution: str, phi: NDArray[np.float64], half_angle: NDArray[np.f
 
 def spread(centres: ArrayLike, half_angles: ArrayLike, loads: ArrayLike, nodes: int,
            distribution: str = "elastic-foundation") -> NDArray[np.float64]:
-    """Loads spread over the nodes: ``sum_i loads[i] * weights(centres[i], half_angles[i])``; each arc's
-    pressure sampled at equal pieces, each sample split between its two neighbouring nodes linearly."""
+    """Loads spread over the nodes: ``sum_i loads[i] * weights(centres[i], half_angles[i])``.
+
+    On a grid SUBDIVISIONS times finer than the nodes, each arc's pressure shape is sampled at the grid's
+    points (its half-angle rounded to the grid) and normalised; each load is split between the two grid
+    points around its centre, the loads of arcs of one width summed into one histogram, and every
+    histogram convolved with its arc's shape (FFT, circular); each grid point's share is then split
+    between its two neighbouring nodes linearly. Work grows with the contacts only through two
+    ``bincount`` passes: no per-contact samples. The FFT's round-off (1e-16 of the largest depth) is
+    set to zero, so nodes off every arc stay exactly 0."""
     centre = np.asarray(centres, dtype=float).ravel()
     half = np.asarray(half_angles, dtype=float).ravel()
     load = np.asarray(loads, dtype=float).ravel()
     if not centre.size:
         return np.zeros(nodes)
-    spacing = 2.0 * math.pi / nodes
-    count = max(ARC_SAMPLES, int(math.ceil(16.0 * float(half.max()) / spacing)))
-    rows = max(1, SPREAD_SAMPLES // count)  # contacts per pass: the samples' arrays stay a few MB
-    total = np.zeros(nodes)
+    size = nodes * SUBDIVISIONS
+    step = 2.0 * math.pi / size
+    widths = np.rint(half / step).astype(np.int64)  # the arc's half-width in grid steps
+    coarse = np.maximum(np.floor(np.log2(np.maximum(widths, 1))).astype(np.int64) - WIDTH_BITS, 0)
+    widths = ((widths + (1 << coarse >> 1)) >> coarse) << coarse  # wide arcs: 2^WIDTH_BITS widths an octave
+    kinds, kind = np.unique(widths, return_inverse=True)
+    histogram = np.zeros(kinds.size * size)
+    rows = max(1, SPREAD_SAMPLES // ARC_SAMPLES)  # contacts per pass: the index arrays stay a few MB
     for first in range(0, centre.size, rows):
         part = slice(first, first + rows)
-        total += _spread_rows(centre[part], half[part], load[part], nodes, distribution, count)
-    return total
-
-
-def _spread_rows(centre: NDArray[np.float64], half: NDArray[np.float64], load: NDArray[np.float64], nodes: int,
-                 distribution: str, count: int) -> NDArray[np.float64]:
-    """:func:`spread` of some contacts, ``count`` samples each."""
-    spacing = 2.0 * math.pi / nodes
-    phi = np.outer(half, (np.arange(count) + 0.5) / count * 2.0 - 1.0)
-    wide = half > 0.0
-    shape = np.ones_like(phi)
-    shape[wide] = _shape(distribution, phi[wide], half[wide, None])
-    share = shape * (load / shape.sum(axis=1))[:, None]
-    position = ((centre[:, None] + phi) % (2.0 * math.pi)) / spacing
-    lower = np.floor(position)
-    upper_share = (position - lower).ravel()
-    lower_node = lower.astype(int).ravel() % nodes
-    share = share.ravel()
-    total = (np.bincount(lower_node, share * (1.0 - upper_share), minlength=nodes)
-             + np.bincount((lower_node + 1) % nodes, share * upper_share, minlength=nodes))
-    return np.asarray(total, dtype=float)
+        position = np.remainder(centre[part], 2.0 * math.pi) / step
+        lower = np.floor(position)
+        share = position - lower
+        cell = kind[part] * size + lower.astype(np.int64) % size
+        histogram += np.bincount(cell, load[part] * (1.0 - share), minlength=histogram.size)
+        histogram += np.bincount(kind[part] * size + (lower.astype(np.int64) + 1) % size, load[part] * share,
+                                 minlength=histogram.size)
+    shapes = np.zeros((kinds.size, size))
+    for row, width in enumerate(kinds):
+        offsets = np.arange(-width, width + 1)
+        shape = _shape(distribution, offsets * step, np.full(offsets.size, max(width, 1) * step)) if width else \
+            np.ones(1)
+        shapes[row, offsets % size] = shape / shape.sum()
+    fine = np.fft.irfft(np.sum(np.fft.rfft(histogram.reshape(kinds.size, size), axis=1)
+                               * np.fft.rfft(shapes, axis=1), axis=0), n=size)
+    fine[np.abs(fine) <= 1e-13 * np.max(np.abs(fine))] = 0.0
+    node = np.arange(size) // SUBDIVISIONS
+    part_up = (np.arange(size) % SUBDIVISIONS) / SUBDIVISIONS
+    total = (np.bincount(node, fine * (1.0 - part_up), minlength=nodes)
+             + np.bincount((node + 1) % nodes, fine * part_up, minlength=nodes))
+    return np.maximum(total, 0.0)
 
 
 def node_weights(centre: float, half_angle: float, nodes: int, distribution: str = "elastic-foundation"

@@ -199,12 +199,15 @@ def _term_tables(prefix: str, n_params: tuple[int, ...], kinds: dict[str, str]) 
     return lines
 
 
-def generate_source(model: NormalizedModel) -> str:
-    """CasADi-generated C for every function of the model, plus the dc_model table."""
+def generate_source(model: NormalizedModel, sensitivity: Any = None) -> str:
+    """CasADi-generated C for every function of the model, plus the dc_model table; with ``sensitivity``
+    (a :class:`daeclear.engine.sensitivity_functions.SensitivityFunctions` of the same model) its
+    functions too, named ``dcs_*``, and their ``dc_sens`` table (csrc/dc_sens.h)."""
     funs = [model.res, model.jac, *model.term_res, *model.term_jac, *model.extras]
     if model.roots is not None:
         funs.append(model.roots)
-    src = _code_generator("dc_model_gen.c", funs)
+    sens = _sensitivity_functions(sensitivity) if sensitivity is not None else {}
+    src = _code_generator("dc_model_gen.c", funs + [_column_inputs(f, name) for name, f in sens.items()])
     nt = len(model.term_res)
     lines = ["", "/* ---------------------------------------------------------------- daeclear table */",
              '#include "dc_model.h"',
@@ -217,7 +220,35 @@ def generate_source(model: NormalizedModel) -> str:
               f"  {'dc_n_params_tab' if nt else '0'},", f"  {_fun_entry('dc_res')},", f"  {_fun_entry('dc_jac')},",
               f"  {roots_entry},", f"  {'dc_term_res_tab' if nt else '0'},", f"  {'dc_term_jac_tab' if nt else '0'},",
               f"  {_c_string(model.name)}", "};", ""]
+    if sensitivity is not None:
+        lines += _sensitivity_table(sensitivity)
     return src + "\n".join(lines)
+
+
+def _sensitivity_functions(sens: Any) -> dict[str, casadi.Function]:
+    """The C names of a SensitivityFunctions' functions (one CodeGenerator with the model's: no clash)."""
+    funs = {"dcs_res": sens.res, **{f"dcs_term{k}_res": f for k, f in enumerate(sens.term_res)}}
+    if sens.root_jacobian is not None:
+        funs["dcs_root_jac"] = sens.root_jacobian
+        funs["dcs_root_curv"] = sens.root_curvature
+    funs.update({f"dcs_extra{k}": f for k, f in zip(sens.extra_index, sens.extras)})
+    return funs
+
+
+def _sensitivity_table(sens: Any) -> list[str]:
+    """The ``dc_sens`` table (csrc/dc_sens.h) of a SensitivityFunctions."""
+    nt, ne = len(sens.term_res), len(sens.extras)
+    lines = ['#include "dc_sens.h"',
+             *_term_tables("dcs_", sens.n_params, {"term_res_tab": "dcs_term{}_res"}),
+             f"static const dc_fun_t dcs_extra_tab[{max(ne, 1)}] = {{",
+             *([f"  {_fun_entry(f'dcs_extra{k}')}," for k in sens.extra_index] or [f"  {_NO_FUN},"]), "};",
+             f"static const int dcs_extra_index[{max(ne, 1)}] = {{{', '.join(map(str, sens.extra_index)) or '0'}}};"]
+    roots = sens.root_jacobian is not None
+    root_jac, root_curv = (_fun_entry("dcs_root_jac"), _fun_entry("dcs_root_curv")) if roots else (_NO_FUN, _NO_FUN)
+    lines += ["const dc_sens_t dc_sens = {", f"  {sens.width}, {nt}, {ne},", f"  {_fun_entry('dcs_res')},",
+              f"  {'dcs_term_res_tab' if nt else '0'},", f"  {root_jac},", f"  {root_curv},",
+              "  dcs_extra_tab, dcs_extra_index", "};", ""]
+    return lines
 
 
 def _driver_text() -> str:

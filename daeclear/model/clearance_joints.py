@@ -27,23 +27,21 @@ def _default_law() -> Any:
 def _law_problems(element: RevoluteClearance | TranslationalClearance) -> list[str]:
     """Resolve the joint's contact and friction laws once, reporting what is wrong."""
     from ..contact import friction_law
-    from ..contact.base import NormalLaw
-    from ..contact.hydrodynamic import HydrodynamicBearing
+    from ..contact.registry import LAW_TYPES
 
     out: list[str] = []
     try:
-        law = _law_object(element.law)
-        if isinstance(law, HydrodynamicBearing):
-            if not isinstance(element, RevoluteClearance):
-                out.append(f"{element.kind} '{element.name}': law=HydrodynamicBearing(...), must be a normal "
-                           "contact law (a lubricated film is a revolute clearance joint's law).")
-            else:
-                problems = law.problems(element.radial_clearance, element.journal)
-                out.extend(f"{element.kind} '{element.name}': {p}" for p in problems)
-                element.resolved_law()
-        elif not isinstance(law, NormalLaw):
+        given = _law_object(element.law)
+        law: Any = given  # a NormalLaw or a joint law (contact.registry.LAW_TYPES)
+        if not isinstance(given, LAW_TYPES):
             out.append(f"{element.kind} '{element.name}': law={law!r}, must be a daeclear.contact law or a law name.")
+        elif element.kind not in law.joint_kinds:
+            out.append(f"{element.kind} '{element.name}': law={type(law).__name__}(...), must be a normal contact "
+                       f"law (a {law.name} law is a {' or '.join(law.joint_kinds)}'s law).")
         else:
+            if isinstance(element, RevoluteClearance):
+                problems = law.joint_problems(element.radial_clearance, element.journal)
+                out.extend(f"{element.kind} '{element.name}': {p}" for p in problems)
             element.resolved_law()
     except (SceneError, TypeError) as exc:
         out.append(f"{element.kind} '{element.name}': {exc}")
@@ -54,11 +52,38 @@ def _law_problems(element: RevoluteClearance | TranslationalClearance) -> list[s
     return out
 
 
+#: Fields of the clearance joints whose value a table (a dict, as scene files and results write it) may give.
+TABLE_FIELDS: tuple[str, ...] = ("material", "law", "face_law", "friction", "wear")
+
+
+def table_value(field_name: str, value: Any) -> Any:
+    """A clearance joint's field given as a table (dict) as the object it stands for: ``material``
+    ({young, poisson}, or a list of two), ``law``/``face_law`` ({name = ..., parameters}; "hydrodynamic"
+    a HydrodynamicBearing), ``friction`` ({name = ..., parameters}), ``wear`` (ArchardWear's fields).
+    Anything else is returned as given."""
+    from ..contact import Material, friction_law
+    from ..contact.registry import contact_law
+    from ..contact.wear import ArchardWear
+
+    if field_name == "material" and isinstance(value, list):
+        return tuple(Material(**m) if isinstance(m, dict) else m for m in value)
+    if not isinstance(value, dict) or field_name not in TABLE_FIELDS:
+        return value
+    if field_name == "material":
+        return Material(**value)
+    if field_name in ("law", "face_law"):
+        return contact_law(value)
+    if field_name == "friction":
+        params = dict(value)
+        return friction_law(params.pop("name", None), **params)
+    return ArchardWear(**value)
+
+
 def _law_object(law: Any) -> Any:
     """A law given by name as the law object (anything else as given)."""
-    from ..contact import normal_law
+    from ..contact.registry import contact_law
 
-    return normal_law(law) if isinstance(law, str) else law
+    return contact_law(law) if isinstance(law, str) else law
 
 
 def _friction(joint: RevoluteClearance | TranslationalClearance) -> Any:
@@ -178,7 +203,6 @@ def _wear_problems(joint: RevoluteClearance) -> list[str]:
     """What is wrong with a joint's wear and worn profile."""
     import numpy as np
 
-    from ..contact.hydrodynamic import HydrodynamicBearing
     from ..contact.wear import ArchardWear
 
     where = f"{joint.kind} '{joint.name}'"
@@ -187,9 +211,9 @@ def _wear_problems(joint: RevoluteClearance) -> list[str]:
             f"{where}: wear_depth is given without wear; give wear=ArchardWear(...) too."]
     if not isinstance(joint.wear, ArchardWear):
         return [f"{where}: wear={joint.wear!r}, must be None or a daeclear.contact.wear.ArchardWear."]
-    if isinstance(joint.law, HydrodynamicBearing):
-        return [f"{where}: wear with a lubricated joint (law=HydrodynamicBearing) is not modelled; "
-                "give a dry contact law."]
+    if not getattr(joint.law, "wears", True):
+        return [f"{where}: wear with a {joint.law.name} law ({type(joint.law).__name__}, a lubricated joint) is not "
+                "modelled; give a dry contact law."]
     if joint.wear_depth is None:
         return []
     rows = len(joint.wear.surfaces)
@@ -198,10 +222,20 @@ def _wear_problems(joint: RevoluteClearance) -> list[str]:
         depth = np.asarray(joint.wear_depth, dtype=float)
     except (TypeError, ValueError):
         depth = np.zeros(0)
-    if depth.shape != shape or not np.all(np.isfinite(depth)) or np.any(depth < 0):
+    if depth.shape != shape:
         shown = f"an array of shape {depth.shape}" if depth.size else repr(joint.wear_depth)[:60]
         return [f"{where}: wear_depth={shown}, must be {shape[-1]} finite depths >= 0 (m)"
                 + (" for each of bearing and journal" if rows == 2 else "") + f", shape {shape}."]
+    from ..contact.wear import MAX_DEPTH_FRACTION
+
+    deepest = MAX_DEPTH_FRACTION * float(joint.bearing_radius)
+    bad = ~(np.isfinite(depth) & (depth >= 0) & (depth < deepest))
+    if np.any(bad):
+        index = tuple(int(i) for i in np.argwhere(bad)[0])
+        value = float(depth[index])
+        rule = (f"must be below {deepest:g} m ({MAX_DEPTH_FRACTION:g} of the bearing radius: the gap's worn-profile "
+                "model ends there)" if np.isfinite(value) and value >= 0 else "must be a finite depth >= 0 (m)")
+        return [f"{where}: wear_depth{list(index)}={value!r}, {rule}."]
     return []
 
 

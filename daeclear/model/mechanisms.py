@@ -8,7 +8,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ..contact import HydrodynamicBearing, Material, friction_law, normal_law
-from ..contact.hydrodynamic import law_from_table
+from ..contact.registry import LAW_TYPES, contact_law
 from ..contact.base import NormalLaw
 from ..contact.registry import check_restitution
 from ..core.errors import SceneError
@@ -88,10 +88,14 @@ def _contact_law(law: Any, restitution: float | None, length: float | None) -> N
 
     if length is not None and not (is_finite_number(length) and length > 0):
         raise SceneError(f"contact law: length={length!r}, must be None or a finite number > 0 m.")
-    if isinstance(law, (NormalLaw, HydrodynamicBearing, dict)):  # a dict: a law table (--set "law={...}")
-        return law_from_table(law) if isinstance(law, dict) else law
+    if isinstance(law, (*LAW_TYPES, dict)):  # a law object, or a law table (--set "law={...}")
+        return contact_law(law)
+    try:
+        cls = normal_law_class(str(law))
+    except SceneError:
+        return contact_law(law)  # a joint law's name (it needs a table) or an unknown name: its message
     fields = {"restitution": DEFAULT_RESTITUTION if restitution is None else restitution, "length": length}
-    accepted = set(getattr(normal_law_class(str(law)), "__dataclass_fields__", {}))
+    accepted = set(getattr(cls, "__dataclass_fields__", {}))
     return normal_law(str(law), **{k: v for k, v in fields.items() if k in accepted and v is not None})
 
 

@@ -16,7 +16,7 @@ from collections.abc import Iterable, Iterator, Mapping
 from ..core.errors import SceneError
 # the elements, re-exported: ``from daeclear.model.scene import Body`` keeps working
 from .clearance_joints import (RevoluteClearance, TranslationalClearance, clearance_joint,  # noqa: F401
-                               driven_coordinate, ideal_joint)
+                               driven_coordinate, ideal_joint, table_value)
 from .elements import (GROUND, Body, Driver, Element, Ground, Joint, PointJoint, Revolute,  # noqa: F401
                        Translational, Vector2, as_vector2, is_finite_number, is_frozen, own_problems)
 
@@ -234,6 +234,11 @@ def _replaced(obj: Any, path: list[str], value: Any, key: str) -> Any:
                          f"(its fields: {allowed}).")
     if len(path) > 1:
         value = _replaced(getattr(obj, field_name), path[1:], value, key)
+    elif isinstance(value, (dict, list)) and isinstance(obj, (RevoluteClearance, TranslationalClearance)):
+        try:  # a law, friction, material or wear given as a table, as scene files write them
+            value = table_value(field_name, value)
+        except (TypeError, ValueError) as exc:
+            raise SceneError(f"scene value {key!r}={value!r}: {exc}") from None
     try:
         return dataclasses.replace(obj, **{field_name: value})
     except (TypeError, ValueError) as exc:

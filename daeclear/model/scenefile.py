@@ -18,8 +18,7 @@ from . import mechanisms
 from ..core import options
 from ..core.errors import SceneError
 from ..core.values import to_plain
-from ..contact import Material, friction_law
-from ..contact.hydrodynamic import law_from_table
+from .clearance_joints import TABLE_FIELDS, table_value
 from .profiles import profile_from_dict
 from .loads import Force, Motor, RotationalSpringDamper, SpringDamper, Table, Torque
 from .scene import (Body, Driver, Revolute, RevoluteClearance, Scene, Translational, TranslationalClearance,
@@ -53,20 +52,11 @@ class SceneFile:
 def _contact_fields(entry: dict[str, Any]) -> dict[str, Any]:
     """Clearance joints: material tables -> Material, law tables -> law objects; an error names its key."""
     out = dict(entry)
-    key = "material"
+    key = ""
     try:
-        material = out.get("material")
-        if isinstance(material, dict):
-            out["material"] = Material(**material)
-        elif isinstance(material, list):
-            out["material"] = tuple(Material(**m) if isinstance(m, dict) else m for m in material)
-        for key in ("law", "face_law"):  # a table {name = ..., parameters}; "hydrodynamic": a HydrodynamicBearing
-            if isinstance(out.get(key), dict):
-                out[key] = law_from_table(out[key])
-        key = "friction"
-        if isinstance(out.get("friction"), dict):
-            params = dict(out["friction"])
-            out["friction"] = friction_law(params.pop("name", None), **params)
+        for key in TABLE_FIELDS:  # tables: {young, poisson}, {name = ..., parameters}, ArchardWear's fields
+            if key in out:
+                out[key] = table_value(key, out[key])
     except (TypeError, ValueError, SceneError) as exc:
         raise SceneError(f"key {key}: {exc}") from None
     return out

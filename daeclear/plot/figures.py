@@ -44,7 +44,8 @@ def clearance_joints(result: Result) -> dict[str, str]:
 def default_channels(result: Result) -> tuple[str, ...]:
     """Time-plot channels chosen from the run's scene, those the result has: a body ``slider``'s velocity and
     acceleration (Figs. 4.15a-b, 4.28a-b), every driver's moment (no driver: the last body's angular velocity
-    and the mechanical energy), the contact force of the first four clearance joints.
+    and the mechanical energy), the contact force of the first four clearance joints (a lubricated one: its
+    film force, its dry contact force and its eccentricity ratio).
     """
     elements = style.scene_elements(result)
     kinds = {name: e.get("kind") for name, e in elements.items() if isinstance(e, dict)}
@@ -54,7 +55,8 @@ def default_channels(result: Result) -> tuple[str, ...]:
     names += [f"{d}.moment" for d in drivers]
     if not drivers and bodies:
         names += [f"{bodies[-1]}.omega", "energy.mechanical"]
-    names += [f"{joint}.normal_force" for joint in list(clearance_joints(result))[:MAX_PANELS_PER_ROW]]
+    for joint in list(clearance_joints(result))[:MAX_PANELS_PER_ROW]:  # a lubricated one: its film too
+        names += [f"{joint}.film_radial", f"{joint}.normal_force", f"{joint}.eccentricity_ratio"]
     return tuple(dict.fromkeys(n for n in names if n in result))
 
 

@@ -58,7 +58,10 @@ def _joint_lengths(result: Result, joint: str) -> tuple[float | None, float | No
     element = style.scene_elements(result).get(joint, {})
     element = element if isinstance(element, dict) else {}
     law = element.get("law")
-    film = law.get("film_threshold") if isinstance(law, dict) and law.get("name") == "hydrodynamic" else None
+    film = None
+    if isinstance(law, dict) and law.get("name") == "hydrodynamic":  # h_min at breakdown: film_parameter x roughness
+        parts = (law.get("film_parameter", 1.0), law.get("roughness", 1e-6))
+        film = float(parts[0]) * float(parts[1]) if all(isinstance(v, (int, float)) for v in parts) else None
     clearance, threshold = (float(v) if isinstance(v, (int, float)) else None for v in (element.get("clearance"), film))
     return clearance, threshold
 

@@ -66,6 +66,11 @@ def _law_text(law: Any) -> str:
     if not isinstance(law, Mapping):
         return ""
     name = law.get("name")
+    if name == "hydrodynamic":  # a lubricated joint: the oil, the bearing's length and the film theory
+        mu, length = _number(law.get("viscosity")), _number(law.get("length"))
+        oil = [f"oil $\\mu$ = {mu:g} Pa s" if mu is not None else "oil",
+               f"L = {length * 1e3:g} mm" if length is not None else "", f"{law.get('theory', 'short')} bearing"]
+        return ", ".join(part for part in oil if part)
     text = _LAW_NAMES.get(name, str(name)) if isinstance(name, str) else "contact law"
     restitution = _number(law.get("restitution"))
     return f"{text} $c_e$ = {restitution:g}" if restitution is not None else text

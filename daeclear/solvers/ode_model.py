@@ -37,7 +37,8 @@ def _symbolic_spec(model: DAEModel) -> OdeSpec:
     P = ca.SX.sym("P", model.parameter_values.size)
     x = ca.vertcat(q, v)
     Phi, Phi_q, Phi_dot, gamma = model.kinematics(q, v, t, P)
-    offsets = dict(zip(model.parameter_names, np.cumsum([0] + [size for _, size in model.parameter_layout])))
+    layout = model.parameter_layout
+    offsets = dict(zip([name for name, _ in layout], np.cumsum([0] + [size for _, size in layout])))
     alpha, beta = P[int(offsets["baumgarte.alpha"])], P[int(offsets["baumgarte.beta"])]
     c = gamma - 2.0 * alpha * Phi_dot - beta ** 2 * Phi
     Q = model.base_force(t, q, v, P)

@@ -63,8 +63,12 @@ def _plain_value(name: str, value: Any) -> Any:
         return value
     if isinstance(value, (list, tuple, np.ndarray)):
         return [_plain_value(name, v) for v in value]
+    if isinstance(value, dict) and all(isinstance(k, str) for k in value):  # a law table {name = ..., ...}
+        return {k: _plain_value(f"{name}.{k}", v) for k, v in value.items()}
     raise SceneError(f"sweep: parameter {name!r} = {value!r} is a {type(value).__name__}; sweep parameters must be "
-                     "numbers, strings, bools, None or lists of them (give a law by name, e.g. law='hertz').")
+                     "numbers, strings, bools, None, lists of them or tables (dicts) of them (give a law by name, "
+                     "e.g. law='hertz', or by a table, law={'name': 'hydrodynamic', 'viscosity': 0.1, "
+                     "'length': 0.01}).")
 
 
 def _plain(parameters: Mapping[Any, Any]) -> dict[str, Any]:

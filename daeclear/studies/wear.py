@@ -21,10 +21,12 @@ from numpy.typing import NDArray
 from ..assembly.assemble import assemble
 from ..assembly.dae_model import DAEModel
 from ..contact.geometry import sigma_sum
-from ..contact.wear import ArchardWear, WearHistoryArrays, wear_increment, worn_volume
-from ..core.errors import PhysicsWarning, SceneError, SolveError
+from ..contact.wear import MAX_DEPTH_FRACTION, ArchardWear, WearHistoryArrays, wear_increment, worn_volume
+from ..core.errors import AssemblyError, DaeclearError, Interrupted, PhysicsWarning, SceneError, SolveError
 from ..model.scene import RevoluteClearance, Scene
 from ..core.progress import Progress
+from ..results.outputs import check_file
+from ..core.values import to_plain
 from ..results.result import Result
 from ..solvers.solver_options import SolverOptions
 from ..solvers.dispatch import simulate
@@ -32,61 +34,24 @@ from .poincare import crank_period
 from .wear_file import WearFile
 
 
-#: The deepest wear a history goes on with, as a fraction of the bearing radius (the gap's model neglects
-#: the profile's slope).
-MAX_DEPTH_FRACTION = 0.05
-
-
-def _rotate(angle: NDArray[np.float64], point: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``A(angle) point`` for each angle: (n, 2)."""
-    c, s = np.cos(angle), np.sin(angle)
-    return np.stack([c * point[0] - s * point[1], s * point[0] + c * point[1]], axis=1)
-
-
-def _cross(omega: NDArray[np.float64], r: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``omega x r`` in the plane: (n, 2)."""
-    return np.stack([-omega * r[:, 1], omega * r[:, 0]], axis=1)
 
 
 def wear_history(result: Result, model: DAEModel, joint: str) -> WearHistoryArrays:
-    """The contact history of revolute clearance joint ``joint`` in a run of ``model``.
-
-    Contact direction ``n = e / |e|`` (4.4), contact points ``Q_i = P_i + R_i n`` and ``Q_j = P_j + R_j n``
-    (4.6), sliding speed the tangential component of ``v_Qj - v_Qi`` with each body's spin (4.9):
-    computed here in numpy from the bodies' states, apart from the generated model.
-    """
-    elements = result.parameters.get("scene", {}).get("elements", {})
-    element = elements.get(joint)
-    if element is None or element.get("kind") != "RevoluteClearance":
-        names = [name for name, e in elements.items() if e.get("kind") == "RevoluteClearance"]
-        raise SceneError(f"wear_history: joint={joint!r}, must be a revolute clearance joint of the run "
-                         f"({', '.join(names) or 'none'}).")
-    bearing, journal = element["body_i"], element["body_j"]
-    s_i, s_j = model.parameter(f"{joint}.s_i"), model.parameter(f"{joint}.s_j")
-    r_i = float(model.parameter(f"{joint}.bearing_radius")[0])
-    r_j = float(model.parameter(f"{joint}.journal_radius")[0])
-
-    def body(name: str) -> tuple[NDArray, NDArray, NDArray, NDArray]:
-        if name == "ground":
-            zero = np.zeros(result.t.size)
-            return np.zeros((result.t.size, 2)), zero, np.zeros((result.t.size, 2)), zero
-        return (np.stack([result[f"{name}.x"], result[f"{name}.y"]], axis=1), np.asarray(result[f"{name}.phi"]),
-                np.stack([result[f"{name}.vx"], result[f"{name}.vy"]], axis=1), np.asarray(result[f"{name}.omega"]))
-
-    (x_i, phi_i, v_i, w_i), (x_j, phi_j, v_j, w_j) = body(bearing), body(journal)
-    arm_i, arm_j = _rotate(phi_i, s_i), _rotate(phi_j, s_j)
-    e = (x_j + arm_j) - (x_i + arm_i)
-    distance = np.hypot(e[:, 0], e[:, 1])
-    n = e / np.maximum(distance, 1e-300)[:, None]
-    tangent = np.stack([-n[:, 1], n[:, 0]], axis=1)
-    v_qi = v_i + _cross(w_i, arm_i + r_i * n)
-    v_qj = v_j + _cross(w_j, arm_j + r_j * n)
-    slip = np.sum((v_qj - v_qi) * tangent, axis=1)
-    direction = np.arctan2(n[:, 1], n[:, 0])
-    return WearHistoryArrays(
-        t=np.asarray(result.t, dtype=float), force=np.asarray(result[f"{joint}.normal_force"], dtype=float),
-        angle_bearing=np.unwrap(direction - phi_i), angle_journal=np.unwrap(direction - phi_j),
-        slip_speed=slip, penetration=np.clip(np.asarray(result[f"{joint}.penetration"], dtype=float), 0.0, None))
+    """The contact history of revolute clearance joint ``joint`` (with wear) in a run of ``model``, read from
+    the joint's generated channels: normal force, the contact direction's angle in the bearing's and the
+    journal's frame (``<joint>.bearing_angle``, ``.journal_angle``, unwrapped), the sliding velocity of the
+    contact points (4.9) and the penetration."""
+    names = [f"{joint}.{q}" for q in ("normal_force", "bearing_angle", "journal_angle", "sliding_velocity",
+                                       "penetration")]
+    if any(name not in model.channel_names for name in names):
+        worn = [e.name for e in getattr(model.scene, "elements", ()) if getattr(e, "wear", None) is not None]
+        raise SceneError(f"wear_history: joint={joint!r}, must be a revolute clearance joint with wear of the run "
+                         f"({', '.join(worn) or 'none has wear=ArchardWear(...)'}).")
+    force, bearing, journal, slip, penetration = (np.asarray(result[name], dtype=float) for name in names)
+    slip = np.where(np.isfinite(slip), slip, 0.0)  # no direction at the centred journal (e = 0), far from contact
+    return WearHistoryArrays(t=np.asarray(result.t, dtype=float), force=force, angle_bearing=np.unwrap(bearing),
+                             angle_journal=np.unwrap(journal), slip_speed=slip,
+                             penetration=np.clip(penetration, 0.0, None))
 
 
 @dataclass(frozen=True)
@@ -134,7 +99,14 @@ def effective_modulus(joint: RevoluteClearance) -> float:
     return 1.0 / sigma_sum(joint.material)
 
 
-def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, update_every: int = 1,
+#: The most blocks a history may ask for (update_every x extrapolate cycles each): more has no estimate
+#: of its time or file size that a user would accept.
+MAX_BLOCKS = 10**7
+#: The shortest cycle, as a fraction of one turn of the scene's driver.
+MIN_PERIOD_FRACTION = 1e-3
+
+
+def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None = None, update_every: int = 1,
                   extrapolate: int = 1, period: float | None = None, path: str | os.PathLike[str] | None = None,
                   options: SolverOptions | None = None, progress: bool = False) -> WearHistory:
     """Wear a revolute clearance joint over ``cycles`` cycles of the mechanism.
@@ -145,39 +117,65 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
 
     Parameters
     ----------
-    scene, cycles : Scene, float
-        The mechanism, whose joint ``joint`` has ``wear=ArchardWear(...)``, and the cycles to wear (> 0;
-        the last block may run past it).
+    scene, cycles : Scene or DAEModel, float
+        The mechanism (a scene, or an assembled model: its formulation is kept), whose joint ``joint``
+        has ``wear=ArchardWear(...)``, and the cycles to wear (> 0; the last block may run past it).
     update_every, extrapolate : int
         Cycles simulated per profile update, and the factor each block's wear is extrapolated by (>= 1).
     period : float or None
-        One cycle, s; None: one turn of the scene's driver.
+        One cycle, s; None: one turn of the scene's driver (at least a thousandth of it when given).
     path : str, path or None
-        An HDF5 file the history is appended to after every block: a call with the same file and
-        settings resumes where a stopped one ended.
+        An HDF5 file the history is appended to after every block (checked before any work): a call with
+        the same file, scene and settings resumes where a stopped one ended; any difference is an error
+        naming it.
     options, progress : SolverOptions or None, bool
         The runs' solver settings; a progress line on stderr.
 
-    A failed block, or a depth beyond :data:`MAX_DEPTH_FRACTION` of the bearing radius, ends the
-    history early with a :class:`~daeclear.PhysicsWarning`; ``WearHistory.message`` says why.
+    A failed block (its run fails, its start cannot be assembled, or it leaves the journal deeper in
+    the wall than the clearance), or a depth beyond :data:`MAX_DEPTH_FRACTION` of the bearing radius,
+    ends the history early with a :class:`~daeclear.PhysicsWarning`; ``WearHistory.message`` says why.
+    Ctrl-C raises :class:`~daeclear.errors.Interrupted` whose ``.result`` is the history so far (and the
+    file has it). With ``surface="both"`` each surface wears by Archard's law with the coefficient, so
+    the worn volume is twice k times the sliding work (docs/wear.md).
     """
+    model = scene if isinstance(scene, DAEModel) else None
+    if model is not None:
+        if model.scene is None:
+            raise SceneError("simulate_wear: scene is a model that was not made by assemble(); give its scene.")
+        scene = model.scene
+    if not isinstance(scene, Scene):
+        raise SceneError(f"simulate_wear: scene={scene!r}, must be a daeclear.Scene or a model made by assemble().")
     for label, value in (("update_every", update_every), ("extrapolate", extrapolate)):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise SceneError(f"simulate_wear: {label}={value!r}, must be an integer >= 1.")
-    if not (isinstance(cycles, (int, float)) and math.isfinite(cycles) and cycles > 0):
+    if isinstance(cycles, bool) or not (isinstance(cycles, (int, float)) and math.isfinite(cycles) and cycles > 0):
         raise SceneError(f"simulate_wear: cycles={cycles!r}, must be a finite number > 0.")
+    if not isinstance(progress, bool):
+        raise SceneError(f"simulate_wear: progress={progress!r}, must be True or False.")
+    if options is not None and not isinstance(options, SolverOptions):
+        raise SceneError(f"simulate_wear: options={options!r}, must be None or a daeclear.SolverOptions.")
     element = wear_joint(scene, joint)
     wear = element.wear
-    period = crank_period(scene) if period is None else period
-    if not (isinstance(period, (int, float)) and math.isfinite(period) and period > 0):
-        raise SceneError(f"simulate_wear: period={period!r} s, must be a finite number > 0.")
+    period = _checked_period(scene, period)
+    blocks = math.ceil(cycles / (update_every * extrapolate))
+    if blocks > MAX_BLOCKS:
+        size = blocks * (len(wear.surfaces) * wear.nodes * 8 + 32)
+        raise SceneError(f"simulate_wear: cycles={cycles:g} with update_every={update_every}, "
+                         f"extrapolate={extrapolate} "
+                         f"is {blocks:.3g} blocks, must be at most {MAX_BLOCKS:.0e} (at about 10 ms a simulated cycle "
+                         f"that is {blocks * update_every * 0.01 / 3.15e7:.3g} years, and a history of "
+                         f"{size / 1e9:.3g} GB); raise extrapolate or ask fewer cycles.")
+    if path is not None:
+        path = check_file(path, "simulate_wear(path)", what="a wear history file (.h5)", example="wear.h5")
     modulus = effective_modulus(element) if wear.distribution == "hertz" else None
     settings = {"joint": element.name, "update_every": update_every, "extrapolate": extrapolate, "period": period,
-                "coefficient": wear.coefficient, "nodes": wear.nodes, "surface": wear.surface}
+                "formulation": model.formulation if model is not None else "default",
+                "options": None if options is None else options.to_dict(),
+                "scene": to_plain(scene.to_dict(), "simulate_wear(scene)")}
     store = WearFile(path, settings) if path is not None else None
     tic = time.perf_counter()
-    model = assemble(scene)
     rows = store.read() if store is not None else None
+    model = assemble(scene) if model is None else model
     if rows is None:
         depth = element.worn_profiles()
         rows = [(0.0, depth, 0.0, math.nan)]
@@ -200,9 +198,17 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
                 break
             model = model.with_parameters({f"{name}.wear_depth": _depth_value(depth, wear.surfaces)})
             try:
-                result = simulate(model, t0 + update_every * period, t0=t0, y0=y0, options=options)
-            except SolveError as exc:  # the history so far is the result (and, with a path, in the file)
+                with warnings.catch_warnings():  # a block beyond its contact law is judged below, once
+                    warnings.simplefilter("ignore", PhysicsWarning)
+                    result = simulate(model, t0 + update_every * period, t0=t0, y0=y0, options=options)
+            except (SolveError, AssemblyError) as exc:  # the history so far is the result (and in the file)
                 message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
+                break
+            deepest_run = float(np.max(result[f"{name}.penetration"]))
+            if deepest_run > clearance:
+                message = (f"stopped at {done:g} cycles: the next block's run left joint '{name}' {deepest_run:.3g} m "
+                           f"inside its wall, more than its clearance {clearance:g} m (beyond what its contact law "
+                           "describes); its wear is not taken. A tighter rtol, or a smaller wear coefficient.")
                 break
             increment, block_work = wear_increment(wear, wear_history(result, model, name), bearing_radius=radius,
                                                    clearance=clearance, effective_modulus=modulus)
@@ -216,11 +222,31 @@ def simulate_wear(scene: Scene, cycles: float, *, joint: str | None = None, upda
             if store is not None:
                 store.append(done, depth, work, math.nan, t0=t0, y0=y0, peak_before=peak)
             bar.update(min(done, cycles), f"max depth {max(float(d.max()) for d in depth.values()):.3g} m")
+    except KeyboardInterrupt:  # Ctrl-C: the history so far is kept (and in the file), then the caller stops
+        history = _history(rows, wear, radius, time.perf_counter() - tic, f"interrupted at {done:g} cycles")
+        raise Interrupted(f"simulate_wear: interrupted by the user at {done:g} cycles; the history so far is in "
+                          ".result" + (f" and in {path}" if path is not None else ""), result=history) from None
     finally:
         bar.close()
     if message:
         warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
     return _history(rows, wear, radius, time.perf_counter() - tic, message)
+
+
+def _checked_period(scene: Scene, period: float | None) -> float:
+    """One cycle (s): the driver's turn, or ``period`` checked against it."""
+    if period is None:
+        return crank_period(scene)
+    if isinstance(period, bool) or not (isinstance(period, (int, float)) and math.isfinite(period) and period > 0):
+        raise SceneError(f"simulate_wear: period={period!r} s, must be a finite number > 0.")
+    try:
+        turn = crank_period(scene)
+    except DaeclearError:  # no driver: nothing to compare with
+        return float(period)
+    if period < MIN_PERIOD_FRACTION * turn:
+        raise SceneError(f"simulate_wear: period={period!r} s, must be at least {MIN_PERIOD_FRACTION:g} of one turn of "
+                         f"the driver ({turn:.6g} s): a cycle is a turn of the mechanism (leave period=None).")
+    return float(period)
 
 
 def _depth_value(depth: dict[str, NDArray[np.float64]], surfaces: tuple[str, ...]) -> Any:

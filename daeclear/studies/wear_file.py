@@ -24,6 +24,20 @@ FORMAT = "daeclear-wear"
 Row = tuple[float, dict[str, NDArray[np.float64]], float, float]  # cycles, depth by surface, work, peak force
 
 
+def differences(stored: Any, now: Any, where: str = "") -> list[str]:
+    """Where two plain values (JSON) differ: ``"<path>=<stored>, now <now>"`` for each differing leaf
+    (at most 5; a scene's differences are named by element and field)."""
+    if isinstance(stored, dict) and isinstance(now, dict):
+        out: list[str] = []
+        for key in sorted(set(stored) | set(now)):
+            out += differences(stored.get(key), now.get(key), f"{where}.{key}" if where else str(key))
+        return out[:5]
+    if stored == now:
+        return []
+    shown = [repr(v) if len(repr(v)) <= 60 else repr(v)[:57] + "..." for v in (stored, now)]
+    return [f"{where}={shown[0]}, now {shown[1]}"]
+
+
 class WearFile:
     """One wear history file (see the module docstring); ``settings`` must match the file's to resume."""
 
@@ -31,8 +45,9 @@ class WearFile:
         self.path = Path(path)
         if not self.path.parent.is_dir():
             raise SceneError(f"simulate_wear: path={str(path)!r}, its directory does not exist.")
-        self.settings = settings
-        self.surfaces = ("bearing", "journal") if settings["surface"] == "both" else (settings["surface"],)
+        self.settings = json.loads(json.dumps(settings))  # as the file gives them back (lists, not tuples)
+        wear = self.settings["scene"]["elements"][settings["joint"]]["wear"]
+        self.surfaces = ("bearing", "journal") if wear["surface"] == "both" else (wear["surface"],)
         self.t0 = 0.0
         self.y0: NDArray[np.float64] | None = None
 
@@ -47,12 +62,11 @@ class WearFile:
                 if f.attrs.get("format") != FORMAT:
                     raise SceneError(f"simulate_wear: {self.path} is not a wear history file (format "
                                      f"{f.attrs.get('format')!r}); give a new path.")
-                stored = json.loads(f.attrs["settings_json"])
-                changed = sorted(k for k in self.settings if stored.get(k) != self.settings[k])
+                changed = differences(json.loads(f.attrs["settings_json"]), self.settings)
                 if changed:
-                    raise SceneError(f"simulate_wear: {self.path} was written with other settings ("
-                                     + ", ".join(f"{k}={stored.get(k)!r}, now {self.settings[k]!r}" for k in changed)
-                                     + "); give a new path or the same settings to resume.")
+                    raise SceneError(f"simulate_wear: {self.path} was written with another scene or settings ("
+                                     + "; ".join(changed) + "); give a new path, or the same scene and settings "
+                                     "to resume.")
                 n = min(f[name].shape[0] for name in ("cycles", "depth", "sliding_work", "peak_force"))
                 if n == 0:
                     return None

@@ -99,4 +99,7 @@ static inline dc_int dc_sp_first_nonfinite(const dc_int* sp, const double* out, 
 extern const int dc_n_extras;
 extern const dc_fun_t dc_extra_tab[];
 
+/* the forward sensitivity functions' table, defined when the model is built with sensitivities */
+#include "dc_sens.h"
+
 #endif

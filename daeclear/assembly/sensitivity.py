@@ -1,0 +1,328 @@
+"""Forward sensitivities of an assembled model: parameters by name, consistent sensitivities, the
+derivatives of its roots and latched values at an event (docs/sensitivities.md).
+
+S = dy/dp for parameters p named as ``model.parameter_names`` lists them. A name moves the run-time
+vector P by dP/dp (:func:`parameter_directions`: a unit column for a number that is an entry of P,
+the derivative of the scene-to-P map for a number P is derived from). :class:`ModelSensitivity`
+holds what a run with sensitivities asks of the model: the generated sensitivity functions
+(:mod:`daeclear.engine.sensitivity_functions`), the algebraic sensitivities made consistent (the
+derivative of :meth:`DAEModel.consistent_state`), and the pieces of the jump at an event.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..core.errors import DaeclearError, SceneError
+from ..core.options import close_matches
+from ..engine.sensitivity_functions import SensitivityFunctions, directional, jacobian_blocks, sensitivity_functions
+from .dae_model import EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_TERM0, DAEModel
+
+__all__ = ["parameter_value", "parameter_directions", "initial_sensitivities", "model_sensitivity_functions",
+           "check_supported", "ModelSensitivity", "RootTerms", "STEP_BITS"]
+
+#: Central differences of the scene-to-P map and of the start use the step 2**-STEP_BITS |p| (a power of
+#: two: p +- h is exact) and h/2, combined by Richardson's extrapolation (error O(h^4) + eps/h, ~1e-12).
+STEP_BITS = 10
+
+
+def parameter_value(model: DAEModel, name: str) -> float:
+    """The number a sensitivity parameter ``name`` stands for: a scene value (``"<element>.<field>..."``),
+    ``"baumgarte.alpha"``/``"beta"``, or an entry of the parameter table; SceneError unless one scalar."""
+    where = "sensitivities"
+    if not isinstance(name, str) or name not in model.parameter_names:
+        close = close_matches(str(name), model.parameter_names)
+        hint = f" Close matches: {', '.join(map(repr, close))}." if close else ""
+        raise SceneError(f"{where}: parameter={name!r}, must be one of model.parameter_names "
+                         f"({len(model.parameter_names)} names).{hint}")
+    value: Any = _scene_value(model, name)
+    if value is None:
+        value = model.parameter(name)
+    array = np.asarray(value, dtype=float)
+    if array.size != 1 or not math.isfinite(float(array.ravel()[0])):
+        raise SceneError(f"{where}: parameter={name!r} is {array.tolist()!r}, must be one finite number "
+                         "(a vector value such as a point has no single derivative; name a scalar value).")
+    return float(array.ravel()[0])
+
+
+def _scene_value(model: DAEModel, name: str) -> Any:
+    """The scene's value at ``name`` (``None`` when it is no scene value, e.g. a derived table entry)."""
+    if name in ("baumgarte.alpha", "baumgarte.beta"):
+        return model.alpha if name.endswith("alpha") else model.beta
+    scene = model.scene
+    if scene is None:
+        return None
+    if name == "gravity":
+        return scene.gravity
+    head, _, path = name.partition(".")
+    try:
+        value: Any = scene[head]
+        for part in path.split("."):
+            value = getattr(value, part)
+    except (KeyError, AttributeError):
+        return None
+    return value
+
+
+def _step(p: float) -> float:
+    """The difference step of a parameter of value ``p``: a power of two near 2**-STEP_BITS |p|."""
+    exponent = math.frexp(abs(p))[1] - 1 if p != 0.0 else -10
+    return math.ldexp(1.0, exponent - STEP_BITS)
+
+
+def _at(model: DAEModel, name: str, value: float) -> DAEModel:
+    """``model`` with the parameter ``name`` at ``value`` (the scene's number, or the table entry itself)."""
+    if _scene_value(model, name) is not None:
+        try:
+            return model.with_parameters({name: value})
+        except SceneError as exc:
+            raise SceneError(f"sensitivities: parameter={name!r} cannot be moved to {value!r} to differentiate "
+                             f"the numbers derived from it ({exc}); it is at a bound of its range.") from None
+    P = model.parameter_values.copy()
+    offset = dict(_offsets(model))[name]
+    P[offset] = value
+    return model.copy_with(parameter_values=P)
+
+
+def _offsets(model: DAEModel) -> list[tuple[str, int]]:
+    out, offset = [], 0
+    for key, size in model.parameter_layout:
+        out.append((key, offset))
+        offset += size
+    return out
+
+
+def _richardson(f: Any, p: float, h: float) -> NDArray[np.float64]:
+    """(4 D(h/2) - D(h)) / 3 of central differences D of ``f`` at ``p``, with the exact 0 and 1 of values
+    that do not move or move as ``p`` itself (an entry of P that is the parameter)."""
+    plus, minus, plus2, minus2 = (np.asarray(f(p + s), dtype=float) for s in (h, -h, h / 2, -h / 2))
+    d1, d2 = (plus - minus) / (2 * h), (plus2 - minus2) / h
+    out = (4.0 * d2 - d1) / 3.0
+    still = (plus == minus) & (plus2 == minus2)
+    same = (plus == p + h) & (minus == p - h) & (plus2 == p + h / 2) & (minus2 == p - h / 2)
+    out[still] = 0.0
+    out[same] = 1.0
+    return out
+
+
+def parameter_directions(model: DAEModel, names: Sequence[str]) -> NDArray[np.float64]:
+    """dP/dp, (n_P, Ns): how the run-time vector P moves with each named parameter (column j for
+    ``names[j]``); exact 1 and 0 where P holds the number itself or not at all, else the derivative of
+    the numbers derived from it (central differences with Richardson's extrapolation, ``STEP_BITS``)."""
+    names = _checked_names(names)
+    columns = []
+    for name in names:
+        p = parameter_value(model, name)
+        columns.append(_richardson(lambda x, name=name: _at(model, name, x).parameter_values, p, _step(p)))
+    return np.stack(columns, axis=1) if columns else np.zeros((model.parameter_values.size, 0))
+
+
+def _checked_names(names: Any) -> tuple[str, ...]:
+    if isinstance(names, str) or not isinstance(names, Sequence) or not names:
+        raise SceneError(f"sensitivities: parameters={names!r}, must be a non-empty list of names from "
+                         "model.parameter_names, e.g. ['clearance.clearance'].")
+    twice = sorted({n for n in names if list(names).count(n) > 1})
+    if twice:
+        raise SceneError(f"sensitivities: parameters={list(names)!r}, must name each parameter once "
+                         f"({', '.join(map(repr, twice))} repeated).")
+    return tuple(names)
+
+
+def initial_sensitivities(model: DAEModel, names: Sequence[str], start: str = "ideal",
+                          allow_penetration: bool = False) -> NDArray[np.float64]:
+    """dy0/dp of the start ``model.initial_state(start=...)``, (n_states, Ns): central differences with
+    Richardson's extrapolation over models with the parameter moved (the start is a Newton solution
+    from the declared state, not a formula); the algebraic rows are made consistent afterwards."""
+    names = _checked_names(names)
+    columns = []
+    for name in names:
+        p = parameter_value(model, name)
+
+        def start_at(x: float, name: str = name) -> NDArray[np.float64]:
+            with warnings.catch_warnings():  # the start's notes were given for the run itself
+                warnings.simplefilter("ignore")
+                return _at(model, name, x).initial_state(start=start, allow_penetration=allow_penetration)[0]
+        columns.append(_richardson(start_at, p, _step(p)))
+    return np.stack(columns, axis=1)
+
+
+def model_sensitivity_functions(model: DAEModel, width: int) -> SensitivityFunctions:
+    """The model's sensitivity functions for ``width`` parameters, with the directional derivatives of
+    the accelerations, the constraints, each term's force and the simple pairs' gap rates (built once per
+    structure and width, kept with the model's compiled functions)."""
+    funcs = model.functions
+    key = f"sensitivity{width}"
+    known = funcs.compiled.get(key)
+    if known is None:
+        extras = (EXTRA_ACCEL, EXTRA_KINEMATICS, *(EXTRA_TERM0 + k for k in range(len(model.terms))),
+                  *(extra for _, _, extra, _, _ in model.auto_pairs))
+        known = funcs.compiled[key] = sensitivity_functions(funcs, width, extras)
+    return known
+
+
+@dataclass(frozen=True)
+class RootTerms:
+    """The pieces of the jump at the model's roots (each (n_roots,) but ``g_p``): the root's sensitivity
+    ``g_p`` = g_y S + g_y' S' + g_P dP (n_roots, Ns); its ``rate`` g_t + g_y y'; the magnitude of that rate's
+    terms ``scale`` = |g_t| + |g_y| |y'|; its ``curvature`` d^2 g/dt^2; and its uncertainty ``error`` =
+    |g_y| (atol + rtol |y|) (the grazing tests of :func:`daeclear.solvers.sensitivity_jumps.is_grazing`)."""
+
+    g_p: NDArray[np.float64]
+    rate: NDArray[np.float64]
+    scale: NDArray[np.float64]
+    curvature: NDArray[np.float64]
+    error: NDArray[np.float64]
+
+
+def check_supported(model: DAEModel) -> None:
+    """Refuse (DaeclearError) a model with contact elements whose events have no sensitivity jump yet:
+    those whose pairs the compiled loop cannot decide itself (translational faces, the lubricated
+    joint's film regimes: their terms follow two pairs or two roots)."""
+    for logic in model.contacts:
+        if logic.simple_pairs() is None:
+            raise DaeclearError(
+                f"sensitivities: the events of {', '.join(map(repr, logic.pairs))} ({type(logic).__name__}: faces "
+                "or a film regime) have no sensitivity jump yet; revolute clearance joints and translational ones "
+                "without faces have (issue 43).")
+
+
+class ModelSensitivity:
+    """What a run with sensitivities to ``names`` asks of ``model``, evaluated in CasADi (the python
+    path; the compiled loop calls the same functions generated in C). Refuses the contact elements
+    :func:`check_supported` refuses."""
+
+    def __init__(self, model: DAEModel, names: Sequence[str]) -> None:
+        check_supported(model)
+        self.model = model
+        self.names = _checked_names(names)
+        self.dP = parameter_directions(model, self.names)
+        self.functions = model_sensitivity_functions(model, len(self.names))
+        self._extra = {k: f for k, f in zip(self.functions.extra_index, self.functions.extras)}
+        # each contact element's gap rates' Jacobian [r_q | r_v | r_P]: the latched approach speed's derivative
+        self._rate_jacobians = [jacobian_blocks(logic.rate.function, f"rate_jacobian{i}", out=1)
+                                for i, logic in enumerate(model.contacts)]
+        self._outputs: Any = None  # the channels' directional derivative, made when first asked for
+
+    @property
+    def width(self) -> int:
+        return len(self.names)
+
+    def residual(self, t: float, y: NDArray, yp: NDArray, S: NDArray, Sp: NDArray, active: Sequence[bool],
+                 params: Sequence[NDArray], S_params: Sequence[NDArray]) -> NDArray[np.float64]:
+        """F_y S + F_y' S' + F_P dP of the model with its ``active`` terms, (n_states, Ns)."""
+        f, P, dP = self.functions, self.model.parameter_values, self.dP
+        out = np.array(f.res(t, y, yp, P, S, Sp, dP))
+        for k, on in enumerate(active):
+            if on:
+                out += np.array(f.term_res[k](t, y, yp, params[k], P, S, Sp, S_params[k].reshape(-1, self.width), dP))
+        return out
+
+    def consistent(self, t: float, y: NDArray, S: NDArray, active: Sequence[bool], params: Sequence[NDArray],
+                   S_params: Sequence[NDArray]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(S, S') consistent with the mode (``active`` terms, their ``params`` and their sensitivities
+        ``S_params``): S_q and S_v kept, the multipliers' and the derivatives' sensitivities the derivative
+        of :meth:`DAEModel.consistent_state` (its accelerations' solve) in the direction (S_q, S_v, dP);
+        GGL's mu has sensitivity 0 (mu is 0 on the solution for every p)."""
+        model, P, dP, W = self.model, self.model.parameter_values, self.dP, self.width
+        n, m = model.n_q, model.n_constraints
+        q, v = y[:n], y[n:2 * n]
+        Sq, Sv = S[:n], S[n:2 * n]
+        zero_t = np.zeros((1, W))
+        forces = model.term_forces(t, y, active, params)
+        Qc = np.zeros(n) if forces is None else forces
+        dQc = np.zeros((n, W))
+        for k, on in enumerate(active):
+            if on:
+                dQc += np.array(self._extra[EXTRA_TERM0 + k](t, q, v, params[k], P, zero_t, Sq, Sv,
+                                                             S_params[k].reshape(-1, W), dP))
+        d = np.array(self._extra[EXTRA_ACCEL](t, q, v, Qc, P, zero_t, Sq, Sv, dQc, dP))
+        S_out, Sp = np.array(S, dtype=float), np.zeros((model.n_states, W))
+        S_out[2 * n:2 * n + m] = d[n:n + m]
+        if model.formulation == "ggl":
+            S_out[2 * n + m:2 * n + 2 * m] = 0.0
+        Sp[:n] = Sv
+        Sp[n:2 * n] = d[:n]
+        if model.track_work:
+            Sp[-1] = d[n + m]
+        return S_out, Sp
+
+    def switch_sensitivity(self, S_params: Sequence[NDArray]) -> NDArray[np.float64]:
+        """The sensitivity of :meth:`DAEModel.switch_vector` (n_switch, Ns): 0 for each term's on/off flag,
+        its parameters' sensitivities (the latched values') after it."""
+        rows = [np.zeros((1, self.width))]
+        out = []
+        for S_k in S_params:
+            out += [rows[0], np.asarray(S_k, dtype=float).reshape(-1, self.width)]
+        return np.vstack(out) if out else np.zeros((0, self.width))
+
+    def channels(self, t: float, y: NDArray, yp: NDArray, S: NDArray, Sp: NDArray, switch: NDArray,
+                 S_switch: NDArray) -> NDArray[np.float64]:
+        """Every output channel's sensitivity at one point, (n_channels, Ns): d ch/dy S + d ch/dy' S'
+        + d ch/d switch S_switch + d ch/dP dP (the chain rule through the channels' functions)."""
+        if self._outputs is None:
+            self._outputs = directional(self.model.functions.extras[EXTRA_OUTPUTS], self.width, (1, 2, 3, 4),
+                                        "sens_outputs")
+        P = self.model.parameter_values
+        return np.array(self._outputs(t, y, yp, switch, P, S, Sp, S_switch, self.dP))
+
+    def projected(self, t: float, y: NDArray, S: NDArray) -> NDArray[np.float64]:
+        """S with S_q and S_v moved (least norm) onto the linearised constraints, d Phi = Phi_q S_q + Phi_P dP
+        = 0 and d(Phi_q v + Phi_t) = 0: what :meth:`DAEModel.consistent_state` with ``project`` does to q and v
+        at a GGL restart (IDA's S holds them only to its tolerance; GGL's index-2 rows need them exact)."""
+        model, P, W = self.model, self.model.parameter_values, self.width
+        n, m = model.n_q, model.n_constraints
+        if not m:
+            return np.array(S, dtype=float)
+        S = np.array(S, dtype=float)
+        q, v = y[:n], y[n:2 * n]
+        kinematics = self._extra[EXTRA_KINEMATICS]
+        Phi_q = np.array(model.functions.extras[EXTRA_KINEMATICS](q, v, t, P)).ravel()[m:m + m * n].reshape(n, m).T
+        zero_t = np.zeros((1, W))
+        for rows, level in ((slice(0, n), slice(0, m)), (slice(n, 2 * n), slice(m + m * n, 2 * m + m * n))):
+            d = np.array(kinematics(q, v, t, P, S[:n], S[n:2 * n], zero_t, self.dP))[level]
+            S[rows] -= np.linalg.lstsq(Phi_q, d, rcond=None)[0]
+        return S
+
+    def roots(self, t: float, y: NDArray, yp: NDArray, S: NDArray, Sp: NDArray, rtol: float = 0.0,
+              atol: NDArray | None = None) -> RootTerms:
+        """What the jump at each root needs of it (:class:`RootTerms`), at a point of the mode before the
+        switch; ``rtol``/``atol`` the run's tolerances (the gap's uncertainty)."""
+        model, n = self.model, self.model.n_states
+        f = self.functions.root_jacobian
+        if f is None or self.functions.root_curvature is None:
+            raise ValueError("ModelSensitivity.roots: the model has no roots")
+        P = model.parameter_values
+        J = np.array(f(t, y, yp, P))
+        g_t, g_y, g_yp, g_P = J[:, :1], J[:, 1:1 + n], J[:, 1 + n:1 + 2 * n], J[:, 1 + 2 * n:]
+        if np.any(g_yp != 0.0):
+            raise ValueError("ModelSensitivity.roots: a root reads y' (its rate would need y''): not supported")
+        ypp = np.zeros(n)
+        ypp[:model.n_q] = yp[model.n_q:2 * model.n_q]  # q'' = v' (GGL: mu is 0 on the solution)
+        tolerance = (np.zeros(n) if atol is None else np.asarray(atol, dtype=float)) + rtol * np.abs(y)
+        return RootTerms(g_p=g_y @ S + g_yp @ Sp + g_P @ self.dP, rate=g_t[:, 0] + g_y @ yp,
+                         scale=np.abs(g_t[:, 0]) + np.abs(g_y) @ np.abs(yp),
+                         curvature=np.array(self.functions.root_curvature(t, y, yp, ypp, P)).ravel(),
+                         error=np.abs(g_y) @ tolerance)
+
+    def approach_rate(self, root: int, y: NDArray, yp: NDArray, S: NDArray
+                      ) -> tuple[float, NDArray[np.float64], float]:
+        """The penetration rate of the pair of gap ``root`` (the approach speed an onset latches), its
+        sensitivity r_q S_q + r_v S_v + r_P dP (Ns,) and its rate along y' (before the switch)."""
+        model, n = self.model, self.model.n_q
+        for i, logic in enumerate(model.contacts):
+            if root in logic.roots:
+                j = logic.pair_index(root)
+                P = model.parameter_values
+                q, v = y[:n], y[n:2 * n]
+                rate = float(np.array(logic.rate.function(q, v, P)[1]).ravel()[j])
+                J = np.array(self._rate_jacobians[i](q, v, P))[j]
+                r_q, r_v, r_P = J[:n], J[n:2 * n], J[2 * n:]
+                return rate, r_q @ S[:n] + r_v @ S[n:2 * n] + r_P @ self.dP, float(r_q @ yp[:n] + r_v @ yp[n:2 * n])
+        raise IndexError(f"no contact pair watches root {root}")

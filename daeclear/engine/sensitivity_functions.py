@@ -1,0 +1,186 @@
+"""The forward sensitivity system of a DAE as CasADi functions, ``W`` directions (columns) at once.
+
+For F(t, y, y', P) = 0 and parameters p with dP/dp (``dP``, n_P x W), S = dy/dp satisfies between events
+``F_y S + F_y' S' + F_P dP = 0`` (docs/sensitivities.md). Every function here is a forward-mode
+directional derivative (CasADi ``jtimes``) of a function of :class:`DAEFunctions`: the residual, each
+switchable term (its own parameters p_k, e.g. the latched approach speed, get their sensitivities
+``Sk``) and any extra; the roots' Jacobian blocks give the event time's sensitivity.
+:func:`augmented_functions` stacks [y; S] into one DAE (a slow reference: IDA then factors the (1 + W) n
+system, where the compiled loop will reuse the state's factorisation).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+from collections.abc import Sequence
+
+import casadi
+
+from .session_base import DAEFunctions
+
+__all__ = ["SensitivityFunctions", "directional", "sensitivity_functions", "augmented_functions",
+           "jacobian_blocks", "curvature_along"]
+
+
+def _symbols(f: casadi.Function, sizes: Sequence[Any], names: Sequence[str]) -> list[Any]:
+    """Fresh symbols of ``f``'s kind (SX or MX), one per size (an int or a (rows, cols) pair)."""
+    sym = casadi.SX if f.is_a("SXFunction") else casadi.MX
+    return [sym.sym(name, *(size if isinstance(size, tuple) else (size, 1))) for name, size in zip(names, sizes)]
+
+
+def jacobian_blocks(f: casadi.Function, name: str, out: int = 0) -> casadi.Function:
+    """(x_0, ..., x_m-1) -> [d out/d x_0 | ... | d out/d x_m-1] of output ``out`` of ``f`` (column-vector
+    inputs), dense: (numel_out, sum of the inputs' numel)."""
+    names = [f.name_in(k) for k in range(f.n_in())]
+    xs = _symbols(f, [f.numel_in(k) for k in range(f.n_in())], names)
+    value = casadi.vec(f.call([casadi.reshape(x, f.size_in(k)) for k, x in enumerate(xs)])[out])
+    blocks = casadi.horzcat(*(casadi.jacobian(value, x) for x in xs))
+    return casadi.Function(name, xs, [casadi.densify(blocks)], names, [f"J_{f.name_out(out)}"])
+
+
+def curvature_along(f: casadi.Function, name: str) -> casadi.Function:
+    """(t, y, yp, ypp, P) -> d^2/ds^2 of ``f(t + s, y + s yp + s^2/2 ypp, yp + s ypp, P)`` at s = 0 (f takes
+    (t, y, yp, P)): the second time derivative of a root along a solution with derivatives yp and ypp."""
+    t, y, yp, ypp, P, s = _symbols(f, [1, f.numel_in(1), f.numel_in(1), f.numel_in(1), f.numel_in(3), 1],
+                                   ["t", "y", "yp", "ypp", "P", "s"])
+    value = casadi.vec(f.call([t + s, y + s * yp + 0.5 * s * s * ypp, yp + s * ypp, P])[0])
+    second = casadi.substitute(casadi.jacobian(casadi.jacobian(value, s), s), s, casadi.DM.zeros(1, 1))
+    return casadi.Function(name, [t, y, yp, ypp, P], [casadi.densify(second)], ["t", "y", "yp", "ypp", "P"],
+                           [f"d2{f.name_out(0)}"])
+
+
+def directional(f: casadi.Function, width: int, wrt: Sequence[int] | None = None, name: str | None = None,
+                out: int = 0) -> casadi.Function:
+    """The forward derivative of output ``out`` of ``f`` in ``width`` directions at once.
+
+    Returns ``(x_0, ..., x_m-1, dx_i for i in wrt) -> d`` with column-vector inputs ``x_k`` (numel of f's
+    input k), seeds ``dx_i`` of shape (numel_i, width) and ``d`` (numel_out, width), dense: column j is
+    the sum over ``wrt`` of d f/d x_i times column j of dx_i. ``wrt``: all inputs by default."""
+    if width < 1:
+        raise ValueError(f"directional: width={width!r}, must be an integer >= 1.")
+    wrt = tuple(range(f.n_in())) if wrt is None else tuple(wrt)
+    names = [f.name_in(k) for k in range(f.n_in())]
+    xs = _symbols(f, [f.numel_in(k) for k in range(f.n_in())], names)
+    seeds = _symbols(f, [(f.numel_in(k), width) for k in wrt], [f"d{names[k]}" for k in wrt])
+    value = casadi.vec(f.call([casadi.reshape(x, f.size_in(k)) for k, x in enumerate(xs)])[out])
+    if wrt:
+        d = casadi.jtimes(value, casadi.vertcat(*(xs[k] for k in wrt)), casadi.vertcat(*seeds))
+    else:
+        d = casadi.DM.zeros(value.numel(), width)
+    return casadi.Function(name or f"{f.name()}_fwd{width}", [*xs, *seeds], [casadi.densify(d)],
+                           [*names, *(f"d{names[k]}" for k in wrt)], [f"d{f.name_out(out)}"])
+
+
+@dataclass(frozen=True)
+class SensitivityFunctions:
+    """The sensitivity functions of a :class:`DAEFunctions`, ``width`` directions at once (every matrix
+    input and output n x width, column-major in C):
+
+    * ``res``: (t, y, yp, P, S, Sp, dP) -> F_y S + F_y' S' + F_P dP, the always-active part;
+    * ``term_res[k]``: (t, y, yp, p_k, P, S, Sp, Sk, dP) -> the same of term k, added while it is active
+      (``Sk`` = dp_k/dp, n_params_k x width: the latched values' sensitivities);
+    * ``root_jacobian``: (t, y, yp, P) -> [g_t | g_y | g_y' | g_P] (n_roots x (1 + 2 n + n_P)): at an
+      event the root's sensitivity g_y S + g_y' S' + g_P dP, its rate g_t + g_y y' (+ g_y' y'') and the
+      magnitude of the terms of that rate (the grazing test);
+    * ``root_curvature``: (t, y, yp, ypp, P) -> d^2 g/dt^2 along (y', y'') (:func:`curvature_along`, the
+      grazing test near an apex);
+    * ``extras[i]``: the directional derivative of ``DAEFunctions.extras[extra_index[i]]`` in all its
+      inputs (:func:`directional`): consistent restarts, latched values, channels."""
+
+    n: int
+    n_parameters: int
+    width: int
+    n_params: tuple[int, ...]
+    n_roots: int
+    res: casadi.Function
+    term_res: tuple[casadi.Function, ...]
+    root_jacobian: casadi.Function | None
+    root_curvature: casadi.Function | None
+    extras: tuple[casadi.Function, ...] = ()
+    extra_index: tuple[int, ...] = ()
+
+
+def _with_parameters(f: casadi.Function, n_base: int, n_parameters: int) -> casadi.Function:
+    """``f`` with the run-time parameters as its last input (an unused one added when it has none)."""
+    if f.n_in() != n_base:
+        return f
+    xs = _symbols(f, [f.sparsity_in(k).shape for k in range(n_base)], [f.name_in(k) for k in range(n_base)])
+    P = _symbols(f, [n_parameters], ["P"])[0]
+    return casadi.Function(f.name(), [*xs, P], f.call(xs), [*(f.name_in(k) for k in range(n_base)), "P"],
+                           [f.name_out(k) for k in range(f.n_out())])
+
+
+def sensitivity_functions(funcs: DAEFunctions, width: int, extras: Sequence[int] = ()) -> SensitivityFunctions:
+    """The sensitivity functions of ``funcs`` for ``width`` directions at once, with the directional
+    derivatives of ``funcs.extras[k]`` for k in ``extras``."""
+    n_P = int(funcs.n_parameters)
+    res = _with_parameters(funcs.residual, 3, n_P)
+    r = directional(res, width, (1, 2, 3), "sens_res")
+    term_res, n_params = [], []
+    for k, fk in enumerate(funcs.term_residuals):
+        fk = _with_parameters(fk, 4, n_P)
+        term_res.append(directional(fk, width, (1, 2, 3, 4), f"sens_term{k}_res"))
+        n_params.append(int(fk.numel_in(3)))
+    roots, curvature, n_roots = None, None, 0
+    if funcs.roots is not None and funcs.roots.numel_out(0) > 0:
+        g = _with_parameters(funcs.roots, 3, n_P)
+        n_roots = int(g.numel_out(0))
+        roots, curvature = jacobian_blocks(g, "sens_root_jacobian"), curvature_along(g, "sens_root_curvature")
+    bad = [k for k in extras if not 0 <= k < len(funcs.extras)]
+    if bad:
+        raise ValueError(f"sensitivity_functions: extras={list(extras)!r}, must be indices below "
+                         f"{len(funcs.extras)} (the model's extras).")
+    fwd = tuple(directional(funcs.extras[k], width, None, f"sens_extra{k}") for k in extras)
+    return SensitivityFunctions(int(funcs.n), n_P, int(width), tuple(n_params), n_roots, r, tuple(term_res), roots,
+                                curvature, fwd, tuple(int(k) for k in extras))
+
+
+def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False) -> DAEFunctions:
+    """The DAE of [y; S_1; ...; S_width] as one :class:`DAEFunctions` (a reference for tests and the
+    prototype run, never the fast path): parameters [P; vec(dP)], term k's parameters [p_k; vec(Sk)],
+    the roots those of y, no extras.
+
+    Its Jacobian: the state's iteration matrix on every diagonal block, nothing else (IDAS' simultaneous
+    corrector: a modified Newton that converges since S's equations are linear in S); ``coupled``: the
+    exact Jacobian of the stacked residual, block lower triangular, whose blocks (F_yy S) blow up where a
+    force has no second derivative (Hertz's delta^1.5 at onset: Newton then fails at the restart)."""
+    n, n_P = int(funcs.n), int(funcs.n_parameters)
+    res = _with_parameters(funcs.residual, 3, n_P)
+    sym: Any = casadi.SX if res.is_a("SXFunction") else casadi.MX  # one kind at run time
+    t, cj = sym.sym("t"), sym.sym("cj")
+    Y, Yp = sym.sym("y", n * (1 + width)), sym.sym("yp", n * (1 + width))
+    PA = sym.sym("P", n_P * (1 + width))
+    y, yp, P = Y[:n], Yp[:n], PA[:n_P]
+    S, Sp = casadi.reshape(Y[n:], n, width), casadi.reshape(Yp[n:], n, width)
+    dP = casadi.reshape(PA[n_P:], n_P, width)
+    sens = sensitivity_functions(funcs, width)
+
+    def stacked(value: Any, derivative: Any) -> Any:
+        return casadi.vertcat(value, casadi.vec(derivative))
+
+    def jacobian(r: Any) -> Any:
+        if coupled:
+            return casadi.jacobian(r, Y) + cj * casadi.jacobian(r, Yp)
+        block = casadi.jacobian(r[:n], y) + cj * casadi.jacobian(r[:n], yp)
+        return casadi.diagcat(*([block] * (1 + width)))
+
+    r = stacked(res(t, y, yp, P), sens.res(t, y, yp, P, S, Sp, dP))
+    residual = casadi.Function("residual", [t, Y, Yp, PA], [r], ["t", "y", "yp", "P"], ["r"])
+    jac = casadi.Function("jacobian", [t, Y, Yp, cj, PA], [jacobian(r)], ["t", "y", "yp", "cj", "P"], ["J"])
+    term_res, term_jac = [], []
+    for k, (fk, npk) in enumerate(zip(funcs.term_residuals, sens.n_params)):
+        fk = _with_parameters(fk, 4, n_P)
+        pa = sym.sym("p", npk * (1 + width))
+        Sk = casadi.reshape(pa[npk:], npk, width)
+        rk = stacked(fk(t, y, yp, pa[:npk], P), sens.term_res[k](t, y, yp, pa[:npk], P, S, Sp, Sk, dP))
+        term_res.append(casadi.Function(f"term{k}_res", [t, Y, Yp, pa, PA], [rk], ["t", "y", "yp", "p", "P"], ["r"]))
+        term_jac.append(casadi.Function(f"term{k}_jac", [t, Y, Yp, pa, cj, PA], [jacobian(rk)],
+                                        ["t", "y", "yp", "p", "cj", "P"], ["J"]))
+    roots = None
+    if funcs.roots is not None:
+        g = _with_parameters(funcs.roots, 3, n_P)
+        roots = casadi.Function("roots", [t, Y, Yp, PA], [g(t, y, yp, P)], ["t", "y", "yp", "P"], ["g"])
+    return DAEFunctions(n=n * (1 + width), residual=residual, jacobian=jac, term_residuals=tuple(term_res),
+                        term_jacobians=tuple(term_jac), roots=roots, n_parameters=n_P * (1 + width),
+                        name=f"{funcs.name}_sens{width}{'c' if coupled else ''}")
