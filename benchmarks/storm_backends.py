@@ -33,8 +33,9 @@ def main() -> None:
     scene = (dc.mechanisms.slider_crank("revolute", gravity=0.0) if args.joint == "revolute"
              else dc.mechanisms.slider_crank("translational"))
     model = dc.assemble(scene)  # its contact rules are frozen: a model with other storm constants is a new value
-    model = model.copy_with(contacts=tuple(dataclasses.replace(logic, storm=Storm(args.events, args.window))
-                                           for logic in model.contacts))
+    storm = Storm(args.events, args.window)
+    contacts = tuple(dataclasses.replace(logic, storm=storm) for logic in model.contacts)
+    model = dataclasses.replace(model, contacts=contacts)
     for backend in ("c", "python"):
         tic = time.perf_counter()
         r = dc.simulate(model, args.t_end, rtol=1e-8, on_failure="return", options=dc.SolverOptions(backend=backend))

@@ -40,7 +40,18 @@ ROOT = Path(__file__).resolve().parent.parent
 LIST = ROOT / "tests" / "mutations.toml"
 #: What a copy holds: the package and everything its tests read (examples, benchmarks, docs).
 COPIED = ("daeclear", "tests", "benchmarks", "examples", "docs", "pyproject.toml", "README.md", "CONTRIBUTING.md")
-IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", "*.so", "*.egg-info", ".pytest_cache", "results")
+_BUILD_OUTPUT = shutil.ignore_patterns("__pycache__", "*.pyc", "*.so", "*.egg-info", ".pytest_cache")
+
+
+def left_out_of_copy(directory: str, names: list[str]) -> set[str]:
+    """What a copy leaves out: build output, and a run's ``results`` folder (not the package's
+    ``results`` stage, which is a package: it has an ``__init__.py``)."""
+    left_out = set(_BUILD_OUTPUT(directory, names))
+    if "results" in names and not (Path(directory) / "results" / "__init__.py").exists():
+        left_out.add("results")
+    return left_out
+
+
 #: pytest's exit statuses: 0 all passed, 1 some failed; anything else (interrupted, internal error,
 #: usage error, nothing collected) is no verdict.
 PASSED, FAILED = 0, 1
@@ -142,7 +153,7 @@ def make_tree(where: Path) -> Path:
     for name in COPIED:
         src = ROOT / name
         if src.is_dir():
-            shutil.copytree(src, where / name, ignore=IGNORED)
+            shutil.copytree(src, where / name, ignore=left_out_of_copy)
         elif src.is_file():
             shutil.copy2(src, where / name)
     return where

@@ -204,7 +204,8 @@ def _slider_crank(kind: str, storm: Storm | None) -> dc.DAEModel:
     scene = dc.mechanisms.slider_crank(kind, gravity=0.0) if kind == "revolute" else dc.mechanisms.slider_crank(kind)
     model = dc.assemble(scene, "index1")  # step for step on both backends (GGL's Newton coefficient: C only)
     if storm is not None:  # the rules are frozen: a model with other rules is a new value
-        model = model.copy_with(contacts=tuple(dataclasses.replace(logic, storm=storm) for logic in model.contacts))
+        contacts = tuple(dataclasses.replace(logic, storm=storm) for logic in model.contacts)
+        model = dataclasses.replace(model, contacts=contacts)
     return model
 
 

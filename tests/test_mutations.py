@@ -55,6 +55,18 @@ def test_a_mutation_whose_text_moved_fails_loudly(tmp_path):
         mutations.load(listed)
 
 
+def test_a_copy_holds_the_whole_package(tmp_path):
+    """Every module of the package is in a copy, the ``results`` stage too (a run's output folder of
+    that name is what a copy leaves out)."""
+    tree = mutations.make_tree(tmp_path / "copy")
+    package = mutations.ROOT / "daeclear"
+    here = {p.relative_to(package) for p in package.rglob("*.py") if "__pycache__" not in p.parts}
+    there = {p.relative_to(tree / "daeclear") for p in (tree / "daeclear").rglob("*.py")}
+    assert Path("results/__init__.py") in here
+    assert there == here
+    assert mutations.left_out_of_copy(str(tmp_path), ["results", "a.pyc", "x.py"]) == {"results", "a.pyc"}
+
+
 @pytest.mark.slow
 def test_the_ci_mutations_are_caught():
     """Each ci mutation in a copy of the repository: its caught_by test fails there (and passes here,

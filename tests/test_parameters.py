@@ -282,14 +282,15 @@ def test_a_scene_seen_before_reuses_its_model_and_start():
     rebuilt = dc.assemble(scene)
     assert rebuilt.structure is model.structure and rebuilt.functions is model.functions
     np.testing.assert_array_equal(rebuilt.parameter_values, model.parameter_values)
-    assert rebuilt.start_memo is model.start_memo and dc.assemble(scene, "index1").structure is not model.structure
-    model.start_memo.clear()  # shared by every model of this structure (other tests filled it)
+    memo = model.structure.starts  # the structure's: the models keep none
+    assert rebuilt.structure.starts is memo and dc.assemble(scene, "index1").structure is not model.structure
+    memo.clear()  # shared by every model of this structure (other tests filled it)
     first = dc.simulate(model, 1e-4, rtol=1e-7)
-    assert len(model.start_memo) == 1  # the run copy filled its model's memo
+    assert len(memo) == 1  # the run filled its structure's memo
     y0, yp0 = model.initial_state()  # python evaluation: its own entry
     y0[:] = np.nan  # the caller's copy: the memo stays as it was
     again = model.initial_state()
-    fresh = dataclasses.replace(model, start_memo={}).initial_state()
+    fresh = _fresh_start(model)
     np.testing.assert_array_equal(again[0], fresh[0])
     np.testing.assert_array_equal(again[1], fresh[1])
     second = dc.simulate(model, 1e-4, rtol=1e-7)
@@ -297,20 +298,32 @@ def test_a_scene_seen_before_reuses_its_model_and_start():
     # one structure, one memo: another clearance reads the same start (the start does not depend
     # on it), which equals one computed anew for that clearance
     other = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.3e-3, gravity=0.0))
-    assert other.start_memo is model.start_memo
-    entries = len(model.start_memo)
+    assert other.structure.starts is memo
+    entries = len(memo)
     shared = other.initial_state()
-    assert len(model.start_memo) == entries  # read, not computed
-    fresh_other = dataclasses.replace(other, start_memo={}).initial_state()
+    assert len(memo) == entries  # read, not computed
+    fresh_other = _fresh_start(other)
     np.testing.assert_array_equal(shared[0], fresh_other[0])
     np.testing.assert_array_equal(shared[1], fresh_other[1])
     # a copy with other numbers shares the filled memo but never reads a start of the old numbers
     slower = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.4e-3, gravity=0.0, rpm=4000.0))
     copied = dataclasses.replace(model, parameter_values=slower.parameter_values)
-    assert copied.start_memo is model.start_memo and model.start_memo
+    assert copied.structure.starts is memo and memo
     y_copied = copied.initial_state()[0]
     np.testing.assert_allclose(y_copied, slower.initial_state()[0], rtol=1e-9, atol=1e-12)
     assert not np.allclose(y_copied, again[0])  # the crank turns slower: other velocities
+
+
+def _fresh_start(model):
+    """``model.initial_state()`` computed anew: its structure's memo of starts emptied for the call, then restored."""
+    memo = model.structure.starts
+    kept = dict(memo)
+    memo.clear()
+    try:
+        return model.initial_state()
+    finally:
+        memo.clear()
+        memo.update(kept)
 
 
 def test_the_start_depends_on_the_numbers_its_functions_read():
@@ -328,17 +341,18 @@ def test_the_start_depends_on_the_numbers_its_functions_read():
     assert all(name.startswith("clearance.") for name in unread)  # only the clearance joint's numbers
     assert {"crank.mass", "rod.inertia", "slider.mass", "gravity", "drive.speed"} <= read
     np.testing.assert_array_equal(model.start_parameters, start_parameters(model.functions))
-    model.start_memo.clear()
+    memo = model.structure.starts
+    memo.clear()
     model.initial_state()
     heavier = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.4e-3, friction=0.1, slider_mass=1.5))
-    assert heavier.start_memo is model.start_memo
+    assert heavier.structure.starts is memo
     y_heavy, yp_heavy = heavier.initial_state()
-    assert len(model.start_memo) == 2  # a new mass: a new start
+    assert len(memo) == 2  # a new mass: a new start
     assert not np.allclose(y_heavy, model.initial_state()[0])  # other multipliers (the motion is driven)
     wider = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=0.5e-3, friction=0.1))
     wider.initial_state(start="declared")
     model.initial_state(start="declared")
-    assert len(model.start_memo) == 4  # declared: the clearance is part of the key
+    assert len(memo) == 4  # declared: the clearance is part of the key
 
 
 def test_the_start_memo_keeps_the_latest_starts(monkeypatch):
@@ -348,7 +362,7 @@ def test_the_start_memo_keeps_the_latest_starts(monkeypatch):
 
     monkeypatch.setattr(dae_model, "START_MEMO_LIMIT", 2)
     models = [dc.assemble(dc.mechanisms.slider_crank("revolute", slider_mass=mass)) for mass in (1.0, 1.5, 2.0)]
-    memo = models[0].start_memo
+    memo = models[0].structure.starts
     memo.clear()
     first = models[0].initial_state()
     models[1].initial_state()

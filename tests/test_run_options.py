@@ -322,8 +322,8 @@ def _same(a: dict, b: dict) -> bool:
 
 
 def test_model_arrays_are_read_only(ideal_model) -> None:
-    # a model bound to other numbers of a known structure, and one with new parameters, are copies without
-    # the constructor (DAEModel.copy_with): their arrays are read-only too, and the bound numbers are theirs
+    # a model bound to other numbers of a known structure, and one with new parameters, are made by the
+    # constructor like any: their arrays are read-only too, and the bound numbers are theirs
     bound = dc.assemble(dc.mechanisms.slider_crank(rpm=4000.0, slider_mass=0.2))
     assert bound.functions is dc.assemble(dc.mechanisms.slider_crank()).functions  # one template
     for model in (ideal_model, bound, bound.with_parameters({"crank.mass": 0.4})):

@@ -5,6 +5,8 @@ model's own consistent states)."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import casadi
 import numpy as np
 import pytest
@@ -127,7 +129,7 @@ def test_consistent_sensitivities_differentiate_the_consistent_state(ggl) -> Non
     P = ggl.parameter_values
     for j in range(2):
         def state(e: float, j: int = j) -> tuple[np.ndarray, np.ndarray]:
-            moved = ggl.copy_with(parameter_values=P + e * ms.dP[:, j])
+            moved = dataclasses.replace(ggl, parameter_values=P + e * ms.dP[:, j])
             ye = x["y"] + e * x["S"][:, j]
             pe = [x["params"][0] + e * x["Sk"][0][:, j]]
             return moved.consistent_state(x["t"], ye, moved.term_forces(x["t"], ye, x["active"], pe))

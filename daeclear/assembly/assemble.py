@@ -8,7 +8,8 @@ terms. The equations of both formulations: docs/engine.md ("Formulations").
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from types import MappingProxyType
+from dataclasses import dataclass, field
 from typing import Any
 from collections.abc import Callable, Mapping
 
@@ -17,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..engine.build import memo_put_bounded, memo_table
+from ..engine.compiled import CompiledDAE
 from ..core.errors import AssemblyError, SceneError
 from ..model.elements import kept_with
 from ..engine.session_base import DAEFunctions
@@ -30,10 +32,11 @@ from .drivers import driver_constraint, driver_load, driver_parameters
 from .joint_coordinates import joint_channels
 from ..model.loads import Load, load_parameters
 from .load_terms import build_loads
+from .contact_pairs import PairLogic
 from .symbolic import AssemblyContext, Channel, Reference, Term, body_frames, rotation
 from .physics import checked_channel
 from .dae_model import (EXTRA_TERM0, KIND_MULTIPLIER, KIND_POSITION, KIND_VELOCITY, KIND_WORK,  # noqa: F401
-                        DAEModel, start_parameters)
+                        DAEModel, StartMemo, start_parameters)
 
 
 # ---- element parameters (numbers) and builders (structure) --------------------------------
@@ -114,38 +117,73 @@ def _element_parameters(ref: Reference, element: Any, joints: dict[str, Any]
     return named, "\x02".join([element.name, repr(flags), sizes])
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False, repr=False)
 class Structure:
-    """What of an assembled model depends on the structure only, built once per structure key: the
-    model built for its first scene, and how a scene's numbers are bound to it."""
+    """What of an assembled model depends on its structure only, built once per structure key and shared by
+    every model it binds (:meth:`bind`): the CasADi functions (every number a symbol of ``P``), the names,
+    and how a scene's numbers bind to them.
+
+    The one owner of what a process keeps of a structure: what its functions were compiled and loaded into
+    (``compiled``) and the consistent starts already found (``starts``, see :meth:`DAEModel.initial_state`).
+    Not a value (compared by identity): the process's table of structures and its models hold it.
+    """
 
     key: str  # the structure key (:func:`daeclear.assembly.parameters.structure_key`)
-    model: DAEModel  # the structure, with the numbers of the scene it was built from
-    layout: tuple[tuple[str, int], ...]
-    logic: tuple[Callable[[NDArray[np.float64]], list[Any]], ...]
+    formulation: str
+    track_work: bool
+    functions: DAEFunctions
+    body_names: tuple[str, ...]
+    constraint_names: tuple[str, ...]
+    # constraints of the chapter's start: the ideal joints, then each clearance joint's ideal joint
+    start_constraint_names: tuple[str, ...]
+    constraint_elements: tuple[str, ...]  # the scene element of each constraint row
+    driver_names: tuple[str, ...]
+    has_loads: bool  # loads besides gravity
+    state_names: tuple[str, ...]
+    state_kinds: tuple[str, ...]
+    terms: tuple[Term, ...]
+    gap_names: tuple[str, ...]
+    channel_names: tuple[str, ...]
+    channel_units: Mapping[str, str]
+    outputs: ca.Function  # (t, y, yp, switch, P) -> channel values
+    kinematics: ca.Function  # (q, v, t, P) -> (Phi, Phi_q, Phi_dot, gamma)
+    base_force: ca.Function  # (t, q, v, P) -> Q (gravity and applied loads)
+    layout: tuple[tuple[str, int], ...]  # (name, size) of each entry of P
+    # the parameters the chapter's start reads (its memo key's numbers, :func:`start_parameters`)
+    start_parameters: NDArray[np.intp]
+    logic: tuple[Callable[[NDArray[np.float64]], list[PairLogic]], ...]
     # (root, term, gap-rate extra, needs approach speed, index of the contact logic) of simple pairs
     auto_pairs: tuple[tuple[int, int, int, bool, int], ...]
+    compiled: CompiledDAE = field(init=False, repr=False)  # made empty here, filled by the engine when used
+    starts: StartMemo = field(default_factory=dict, repr=False)  # bounded: START_MEMO_LIMIT
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "compiled", CompiledDAE(self.functions))
+
+    def __repr__(self) -> str:
+        return (f"<Structure {self.key[:16]} ({self.formulation}): {len(self.state_names)} states, "
+                f"{len(self.terms)} terms, {len(self.starts)} starts kept, {self.compiled!r}>")
 
     def bind(self, scene: Scene, table: ParameterTable, described: Mapping[str, Any], alpha: float,
              beta: float) -> DAEModel:
+        """The model of ``scene`` (whose numbers are ``table``, its description ``described``) on this structure."""
         if not table.has_layout(*zip(*self.layout)):  # a structure key collision would land here
             raise AssemblyError(f"scene '{scene.name}': its parameters do not match the cached structure.")
-        P = table.vector
+        P = _fixed(table.vector)
         bodies = scene.bodies
         contacts = tuple(logic for make in self.logic for logic in make(P))
         auto_pairs = tuple((root, term, extra, needs, float(contacts[i].min_approach_speed))
                            for root, term, extra, needs, i in self.auto_pairs)
-        formulation, track_work = self.model.formulation, self.model.track_work
-        return self.model.copy_with(
-            structure=self, scene_name=scene.name, alpha=float(alpha), beta=float(beta),
+        return DAEModel(
+            structure=self, alpha=float(alpha), beta=float(beta),
             # its own copy of the (mutable) scene
             scene=Scene(scene.name, gravity=scene.gravity, elements=list(scene.elements), ground=scene.ground),
-            q_guess=[x for b in bodies for x in (*b.position, b.angle)],
-            v_guess=[x for b in bodies for x in (*b.velocity, b.angular_velocity)],
-            mass_diagonal=[x for b in bodies for x in (b.mass, b.mass, b.inertia)],
-            parameters={"scene": described, "formulation": formulation, "alpha": alpha, "beta": beta,
-                        "track_work": track_work},
-            contacts=contacts, auto_pairs=auto_pairs, parameter_layout=self.layout, parameter_values=P,
+            q_guess=_fixed([x for b in bodies for x in (*b.position, b.angle)]),
+            v_guess=_fixed([x for b in bodies for x in (*b.velocity, b.angular_velocity)]),
+            mass_diagonal=_fixed([x for b in bodies for x in (b.mass, b.mass, b.inertia)]),
+            parameters={"scene": described, "formulation": self.formulation, "alpha": alpha, "beta": beta,
+                        "track_work": self.track_work},
+            contacts=contacts, auto_pairs=auto_pairs, parameter_values=P,
             clearance_joints=tuple((e.name, float(e.radial_clearance), float(getattr(e, "corner_radius", 0.0)))
                                    for e in scene.elements
                                    if isinstance(e, (RevoluteClearance, TranslationalClearance))
@@ -187,6 +225,14 @@ class Structure:
                              "frictionless joint, or a number of a law that is compiled in); assemble the "
                              "changed scene instead: assemble(model.scene.with_values(...)).")
         return self.bind(scene, table, described, alpha, beta)
+
+
+def _fixed(values: list[float] | NDArray[np.float64]) -> NDArray[np.float64]:
+    """``values`` (a list, or a float array made for this model) as a read-only float array: the model
+    keeps it as it is."""
+    array = np.asarray(values, dtype=float)
+    array.setflags(write=False)
+    return array
 
 
 # Structures built in this process, by structure key.
@@ -475,9 +521,9 @@ class _TemplateBuilder:
         self.channels = channels + self.contact_channels + list(self.loads.channels) + joint_readings
 
     def template(self) -> Structure:
-        """The generated functions and the structure's model (numbers bound per scene by :meth:`Structure.bind`)."""
+        """The generated functions and names of the structure (numbers bound per scene by :meth:`Structure.bind`)."""
         library_name = f"mechanism_{self.key[:16]}"
-        t, q, v, P, n, y, yp, channels = self.t, self.q, self.v, self.P, self.n, self.y, self.yp, self.channels
+        t, q, v, P, y, yp, channels = self.t, self.q, self.v, self.P, self.y, self.yp, self.channels
         switch = ca.vertcat(*self.switch_syms) if self.switch_syms else ca.SX(0, 1)
         outputs = ca.Function("outputs", [t, y, yp, switch, P], [ca.vertcat(*[c.expr for c in channels])],
                               ["t", "y", "yp", "switch", "P"], ["channels"])
@@ -518,20 +564,17 @@ class _TemplateBuilder:
             term_jacobians=tuple(self.term_jac), roots=self.roots, name=library_name, extras=tuple(extras),
             n_parameters=int(P.numel()),
         )
-        model = DAEModel(
-            scene_name=self.scene.name, formulation=self.formulation, alpha=0.0, beta=0.0,
+        return Structure(
+            key=self.key, formulation=self.formulation, track_work=self.track_work, functions=functions,
             body_names=tuple(b.name for b in self.bodies), constraint_names=tuple(self.names),
-            state_names=tuple(self.state_names), state_kinds=tuple(self.kinds), functions=functions,
-            terms=tuple(self.terms), gap_names=tuple(self.gap_names),
-            channel_names=tuple(c.name for c in channels), channel_units={c.name: c.unit for c in channels},
-            outputs=outputs, q_guess=np.zeros(n), v_guess=np.zeros(n), mass_diagonal=np.ones(n),
-            kinematics=self.kinematics, base_force=self.base_force, track_work=self.track_work,
             start_constraint_names=start_names, constraint_elements=tuple(self.owners),
-            driver_names=tuple(self.driver_rows), start_parameters=start_parameters(functions),
-            has_loads=bool(self.scene.of_type(Load)),
-        )  # numbers are bound per scene (Structure.bind)
-        return Structure(key=self.key, model=model, layout=self.table.layout, logic=logic_makers,
-                         auto_pairs=tuple(auto_pairs))
+            driver_names=tuple(self.driver_rows), has_loads=bool(self.scene.of_type(Load)),
+            state_names=tuple(self.state_names), state_kinds=tuple(self.kinds), terms=tuple(self.terms),
+            gap_names=tuple(self.gap_names), channel_names=tuple(c.name for c in channels),
+            channel_units=MappingProxyType({c.name: c.unit for c in channels}), outputs=outputs,
+            kinematics=self.kinematics, base_force=self.base_force, layout=self.table.layout,
+            start_parameters=start_parameters(functions), logic=logic_makers,
+            auto_pairs=tuple(auto_pairs))  # numbers are bound per scene (Structure.bind)
 
 
 def _c_identifier(name: str) -> str:

@@ -8,7 +8,7 @@ A :data:`ContactState` holds each pair's automaton state, one tuple per contact 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -16,16 +16,19 @@ from numpy.typing import NDArray
 from ..core.events import ContactEvent
 from ..core.automaton import PairState
 
+if TYPE_CHECKING:
+    from .dae_model import DAEModel
+
 #: One tuple of pair states per contact element of the model, in ``model.contacts`` order.
 ContactState = tuple[tuple[PairState, ...], ...]
 
 
-def start_state(model: Any, t: float, y: NDArray) -> ContactState:
+def start_state(model: DAEModel, t: float, y: NDArray) -> ContactState:
     """Every pair's state at a run's start ``(t, y)``: its mode from its gap, its rate latched, no history."""
     return tuple(logic.start(t, y) for logic in model.contacts)
 
 
-def switches(model: Any, state: ContactState) -> tuple[list[bool], list[NDArray]]:
+def switches(model: DAEModel, state: ContactState) -> tuple[list[bool], list[NDArray]]:
     """Which of the model's terms are on, and each term's parameters, in this state."""
     active = [False] * len(model.terms)
     params = [np.zeros(term.n_params) for term in model.terms]
@@ -35,7 +38,7 @@ def switches(model: Any, state: ContactState) -> tuple[list[bool], list[NDArray]
     return active, params
 
 
-def modes(model: Any, state: ContactState) -> dict[str, str]:
+def modes(model: DAEModel, state: ContactState) -> dict[str, str]:
     """``"contact"`` or ``"free"`` of every pair (and face) by name."""
     out: dict[str, str] = {}
     for logic, states in zip(model.contacts, state):
@@ -43,7 +46,7 @@ def modes(model: Any, state: ContactState) -> dict[str, str]:
     return out
 
 
-def root_directions(model: Any, state: ContactState) -> NDArray | None:
+def root_directions(model: DAEModel, state: ContactState) -> NDArray | None:
     """The direction to watch of every root (+1 up, -1 down, 0 both); None without roots."""
     if not model.gap_names:
         return None
@@ -54,7 +57,7 @@ def root_directions(model: Any, state: ContactState) -> NDArray | None:
     return d
 
 
-def decide(model: Any, state: ContactState, t: float, y: NDArray, roots_found: NDArray | None
+def decide(model: DAEModel, state: ContactState, t: float, y: NDArray, roots_found: NDArray | None
            ) -> tuple[ContactState, list[ContactEvent]]:
     """Decide the roots found at ``t`` (each element those of its gaps): the new state and the events."""
     new: list[tuple[PairState, ...]] = []
@@ -66,7 +69,7 @@ def decide(model: Any, state: ContactState, t: float, y: NDArray, roots_found: N
     return tuple(new), events
 
 
-def pair_state(model: Any, state: ContactState, root: int) -> PairState:
+def pair_state(model: DAEModel, state: ContactState, root: int) -> PairState:
     """The state of the pair of gap ``root``."""
     for logic, states in zip(model.contacts, state):
         if root in logic.roots:
@@ -74,7 +77,7 @@ def pair_state(model: Any, state: ContactState, root: int) -> PairState:
     raise IndexError(f"no contact pair watches root {root}")
 
 
-def with_pairs(model: Any, state: ContactState, pairs: Mapping[int, PairState]) -> ContactState:
+def with_pairs(model: DAEModel, state: ContactState, pairs: Mapping[int, PairState]) -> ContactState:
     """The state with the pairs of the given roots replaced (the compiled loop's, which it decides)."""
     new = [list(states) for states in state]
     for k, logic in enumerate(model.contacts):

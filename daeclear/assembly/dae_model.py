@@ -8,7 +8,7 @@ output channels at many points.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, Protocol
 from collections.abc import Mapping, Sequence
 
 import casadi as ca
@@ -16,11 +16,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..engine.build import memo_put_bounded
+from ..engine.compiled import CompiledDAE
 from ..engine.session_base import DAEFunctions, StateLayout
 from ..core.errors import AssemblyError, SceneError
+from ..model.scene import Scene
+from .contact_pairs import PairLogic
 from .physics import check_start_penetration, checked_channel
 from .parameter_names import scene_names
 from .symbolic import Term
+
+if TYPE_CHECKING:
+    from .assemble import Structure
 
 Formulation = Literal["index1", "ggl"]
 
@@ -38,70 +44,48 @@ NEWTON_STEPS = 50
 KIND_POSITION, KIND_VELOCITY, KIND_MULTIPLIER, KIND_WORK = "q", "v", "lambda", "work"
 
 
+class ExtrasEvaluator(Protocol):
+    """What a model asks of an open session (the ``session`` arguments of its methods): the compiled
+    library's evaluation of ``functions.extras[k]`` at many points (``Session.eval_extra``)."""
+
+    def eval_extra(self, k: int, inputs: Sequence[NDArray[np.float64]], n_points: int) -> NDArray[np.float64]: ...
+
+
+#: A structure's consistent starts already found (:meth:`DAEModel.initial_state`): (y0, yp0, the warning
+#: of replaced velocities or "") by (start, allow_penetration, evaluator, numbers, guesses).
+StartMemo = dict[tuple[str, bool, str, bytes, bytes, bytes], tuple[NDArray[np.float64], NDArray[np.float64], str]]
+
+
 @dataclass(frozen=True)
 class DAEModel:
-    """An assembled mechanism: CasADi functions for the solver and what interprets them.
+    """An assembled mechanism, a value: its :class:`~daeclear.assembly.assemble.Structure` (the CasADi
+    functions and names, shared by every scene of that structure) and the numbers of one scene bound to it
+    (the run-time parameters ``parameter_values`` and what follows from them).
 
-    Made by :func:`~daeclear.assembly.assemble.assemble`; frozen. ``print(model)`` summarises its sizes.
+    Made by :func:`~daeclear.assembly.assemble.assemble` (and :meth:`with_parameters`); frozen, its arrays
+    read-only; it keeps nothing: what a process keeps of a structure (compiled libraries, consistent
+    starts) is its structure's. ``print(model)`` summarises its sizes.
     """
 
-    scene_name: str
-    formulation: str
-    alpha: float
+    structure: Structure
+    scene: Scene = field(compare=False, repr=False)  # the model's own copy of the scene whose numbers are bound
+    alpha: float  # Baumgarte's constants (numbers of index1 only)
     beta: float
-    body_names: tuple[str, ...]
-    constraint_names: tuple[str, ...]
-    state_names: tuple[str, ...]
-    state_kinds: tuple[str, ...]
-    functions: DAEFunctions
-    terms: tuple[Term, ...]
-    gap_names: tuple[str, ...]
-    channel_names: tuple[str, ...]
-    channel_units: dict[str, str]
-    outputs: ca.Function  # (t, y, yp, switch) -> channel values; switch: see switch_vector
-    q_guess: NDArray[np.float64]
+    # run-time parameters, the last input of every function: one entry per parameter_layout row
+    parameter_values: NDArray[np.float64]
+    q_guess: NDArray[np.float64]  # the bodies' declared positions and velocities
     v_guess: NDArray[np.float64]
     mass_diagonal: NDArray[np.float64]
-    kinematics: ca.Function  # (q, v, t) -> (Phi, Phi_q, Phi_dot, gamma)
-    base_force: ca.Function  # (t, q, v) -> Q (gravity and applied loads)
-    parameters: dict[str, Any] = field(default_factory=dict)  # the scene's description and the options
-    contacts: tuple[Any, ...] = ()  # contact elements' event rules (clearance joints; no run state)
-    track_work: bool = False
+    parameters: dict[str, Any]  # the scene's description and the options
+    contacts: tuple[PairLogic, ...]  # contact elements' event rules (clearance joints; no run state)
     # (root, term, gap-rate extra, needs approach speed, min approach speed) of simple pairs
-    auto_pairs: tuple[tuple[int, int, int, bool, float], ...] = ()
-    # constraints of the chapter's start: the ideal joints, then each clearance joint's ideal joint
-    start_constraint_names: tuple[str, ...] = ()
-    # run-time parameters, the last input of every function: (name, size) of each entry, values
-    parameter_layout: tuple[tuple[str, int], ...] = ()
-    parameter_values: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
-    constraint_elements: tuple[str, ...] = ()  # the scene element of each constraint row
+    auto_pairs: tuple[tuple[int, int, int, bool, float], ...]
     # (name, clearance m, corner radius m or 0) of each clearance joint: the limits of the physics checks
-    clearance_joints: tuple[tuple[str, float, float], ...] = ()
-    driver_names: tuple[str, ...] = ()
-    has_loads: bool = False  # loads besides gravity
-    # consistent starts by (start, allow_penetration, evaluator, numbers, guesses), shared by the models
-    # of one structure: a model run again skips assembling its start
-    start_memo: dict[tuple[Any, ...], tuple[NDArray[np.float64], NDArray[np.float64], str]] = field(
-        default_factory=dict, compare=False, repr=False)
-    # the parameters the chapter's start depends on (None: all), its memo key's numbers (start_parameters())
-    start_parameters: NDArray[np.intp] | None = field(default=None, compare=False, repr=False)
-    # the structure (assembly.assemble.Structure) and the scene whose numbers are bound: with_parameters
-    structure: Any = field(default=None, compare=False, repr=False)
-    scene: Any = field(default=None, compare=False, repr=False)
+    clearance_joints: tuple[tuple[str, float, float], ...]
 
     def __post_init__(self) -> None:
         for name in _ARRAY_FIELDS:
             object.__setattr__(self, name, _read_only(getattr(self, name)))
-
-    def copy_with(self, **changes: Any) -> DAEModel:
-        """``dataclasses.replace(self, **changes)`` without the constructor's round of every field."""
-        model = object.__new__(type(self))
-        model.__dict__.update(self.__dict__)
-        model.__dict__.update(changes)
-        for name in _ARRAY_FIELDS:
-            if name in changes:
-                model.__dict__[name] = _read_only(changes[name])
-        return model
 
     def with_parameters(self, values: Mapping[str, Any]) -> DAEModel:
         """A new model with new numbers, compiling nothing:
@@ -111,8 +95,6 @@ class DAEModel:
         ``"baumgarte.alpha"`` and ``"baumgarte.beta"``; the changed elements are made again from their
         fields and validated. Raises SceneError for an unknown name, a bad value, or a change of the
         structure (e.g. friction on a frictionless joint): assemble that scene instead."""
-        if self.structure is None or self.scene is None:
-            raise AssemblyError("with_parameters: this model was not made by assemble(); assemble the scene.")
         if not isinstance(values, Mapping):
             raise SceneError(f"with_parameters: values={values!r}, must be a mapping of names to numbers, "
                              "e.g. {'clearance.clearance': 2e-4}.")
@@ -156,6 +138,106 @@ class DAEModel:
     def n_states(self) -> int:
         return len(self.state_names)
 
+    # ---- the structure's, read through the model
+
+    @property
+    def scene_name(self) -> str:
+        return self.scene.name
+
+    @property
+    def formulation(self) -> str:
+        return self.structure.formulation
+
+    @property
+    def track_work(self) -> bool:
+        return self.structure.track_work
+
+    @property
+    def functions(self) -> DAEFunctions:
+        """The CasADi functions of the structure (P their last input)."""
+        return self.structure.functions
+
+    @property
+    def compiled(self) -> CompiledDAE:
+        """What this process compiled and loaded of the functions: the structure's, shared by its models."""
+        return self.structure.compiled
+
+    @property
+    def body_names(self) -> tuple[str, ...]:
+        return self.structure.body_names
+
+    @property
+    def constraint_names(self) -> tuple[str, ...]:
+        return self.structure.constraint_names
+
+    @property
+    def start_constraint_names(self) -> tuple[str, ...]:
+        """The constraints of the chapter's start: the ideal joints, then each clearance joint's ideal joint."""
+        return self.structure.start_constraint_names
+
+    @property
+    def constraint_elements(self) -> tuple[str, ...]:
+        """The scene element of each constraint row."""
+        return self.structure.constraint_elements
+
+    @property
+    def driver_names(self) -> tuple[str, ...]:
+        return self.structure.driver_names
+
+    @property
+    def has_loads(self) -> bool:
+        """Loads besides gravity."""
+        return self.structure.has_loads
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        return self.structure.state_names
+
+    @property
+    def state_kinds(self) -> tuple[str, ...]:
+        return self.structure.state_kinds
+
+    @property
+    def terms(self) -> tuple[Term, ...]:
+        return self.structure.terms
+
+    @property
+    def gap_names(self) -> tuple[str, ...]:
+        return self.structure.gap_names
+
+    @property
+    def channel_names(self) -> tuple[str, ...]:
+        return self.structure.channel_names
+
+    @property
+    def channel_units(self) -> Mapping[str, str]:
+        return self.structure.channel_units
+
+    @property
+    def outputs(self) -> ca.Function:
+        """(t, y, yp, switch, P) -> channel values; switch: see :meth:`switch_vector`."""
+        return self.structure.outputs
+
+    @property
+    def kinematics(self) -> ca.Function:
+        """(q, v, t, P) -> (Phi, Phi_q, Phi_dot, gamma)."""
+        return self.structure.kinematics
+
+    @property
+    def base_force(self) -> ca.Function:
+        """(t, q, v, P) -> Q (gravity and applied loads)."""
+        return self.structure.base_force
+
+    @property
+    def parameter_layout(self) -> tuple[tuple[str, int], ...]:
+        """(name, size) of each entry of ``parameter_values``."""
+        return self.structure.layout
+
+    @property
+    def start_parameters(self) -> NDArray[np.intp]:
+        """The parameters the chapter's start depends on: its memo key's numbers (:func:`start_parameters`)."""
+        return self.structure.start_parameters
+
     def layout(self, project: bool) -> StateLayout:
         """The state layout and the extras of consistent states, for the compiled loop; ``project``:
         restarts on the constraint manifold."""
@@ -193,8 +275,9 @@ class DAEModel:
             "channels": len(self.channel_names),
         }
 
-    def constraints(self, q: NDArray[np.float64], v: NDArray[np.float64], t: float, session: Any = None,
-                     ideal: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    def constraints(self, q: NDArray[np.float64], v: NDArray[np.float64], t: float,
+                    session: ExtrasEvaluator | None = None, ideal: bool = False
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """(Phi, Phi_q, Phi_dot) at one state, through the compiled library when a session is open;
         ``ideal``: with the ideal joints of the clearance joints added (the chapter's start)."""
         m, n = (len(self.start_constraint_names), self.n_q) if ideal else (self.n_constraints, self.n_q)
@@ -203,7 +286,7 @@ class DAEModel:
         return flat[:m], flat[m:m + m * n].reshape(n, m).T, flat[m + m * n:]
 
     def assemble_positions(self, q_guess: NDArray[np.float64], t: float = 0.0, tol: float = POSITION_TOL,
-                           max_iter: int = NEWTON_STEPS, session: Any = None, ideal: bool = False
+                           max_iter: int = NEWTON_STEPS, session: ExtrasEvaluator | None = None, ideal: bool = False
                            ) -> NDArray[np.float64]:
         """Newton (least-norm) on Phi(q, t) = 0 from ``q_guess`` (``ideal``: the clearance joints'
         ideal joints too); raises AssemblyError if it cannot close."""
@@ -229,7 +312,8 @@ class DAEModel:
         )
 
     def assemble_velocities(self, q: NDArray[np.float64], v_guess: NDArray[np.float64],
-                            t: float = 0.0, session: Any = None, ideal: bool = False) -> NDArray[np.float64]:
+                            t: float = 0.0, session: ExtrasEvaluator | None = None, ideal: bool = False
+                            ) -> NDArray[np.float64]:
         """Least-norm correction of ``v_guess`` so that Phi_q v + Phi_t = 0 (``ideal``: as above)."""
         v = np.array(v_guess, dtype=float)
         if not (self.start_constraint_names if ideal else self.constraint_names):
@@ -238,7 +322,8 @@ class DAEModel:
         dv, *_ = np.linalg.lstsq(Phi_q, -Phi_dot, rcond=None)
         return v + dv
 
-    def evaluate(self, k: int, inputs: Sequence[Any], n_points: int, session: Any = None) -> NDArray[np.float64]:
+    def evaluate(self, k: int, inputs: Sequence[NDArray[np.float64]], n_points: int,
+                 session: ExtrasEvaluator | None = None) -> NDArray[np.float64]:
         """Evaluate ``functions.extras[k]`` at ``n_points`` points (inputs (n_points, size) or (size,)),
         in C with an open compiled ``session``, else CasADi; the parameters are appended as last input."""
         if session is not None:
@@ -252,7 +337,8 @@ class DAEModel:
         return np.array((f if n_points == 1 else f.map(n_points))(*cols)).reshape(-1, n_points).T
 
     def term_forces(self, t: ArrayLike, y: NDArray[np.float64], active: Sequence[bool],
-                    params: Sequence[NDArray[np.float64]], session: Any = None) -> NDArray[np.float64] | None:
+                    params: Sequence[NDArray[np.float64]], session: ExtrasEvaluator | None = None
+                    ) -> NDArray[np.float64] | None:
         """Sum of the generalized forces of the active terms at one state (n_states,) or many (N, n_states)."""
         if not any(active):
             return None
@@ -268,7 +354,7 @@ class DAEModel:
         return total[0] if np.ndim(y) == 1 else total
 
     def term_forces_rows(self, t: NDArray[np.float64], y: NDArray[np.float64], switch: NDArray[np.float64],
-                         session: Any = None) -> NDArray[np.float64] | None:
+                         session: ExtrasEvaluator | None = None) -> NDArray[np.float64] | None:
         """Generalized contact forces at many rows, each with its own modes: ``switch`` holds one
         :meth:`switch_vector` per row (on/off flag and parameters of every term)."""
         if not self.terms:
@@ -286,7 +372,7 @@ class DAEModel:
         return total
 
     def accelerations(self, t: ArrayLike, q: NDArray[np.float64], v: NDArray[np.float64],
-                      generalized_force: NDArray[np.float64] | None = None, session: Any = None
+                      generalized_force: NDArray[np.float64] | None = None, session: ExtrasEvaluator | None = None
                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Solve [M Phi_q^T; Phi_q 0] [v'; lam] = [Q + generalized_force; c] for v' and lam, at one state
         or many ((N, n), ``t`` of shape (N,)); ``c = gamma - 2 alpha Phi' - beta^2 Phi`` (index1) or
@@ -298,13 +384,13 @@ class DAEModel:
         return (a[0], lam[0]) if single else (a, lam)
 
     def _accel_solution(self, t: ArrayLike, q: NDArray, v: NDArray, generalized_force: NDArray | None,
-                        session: Any) -> NDArray[np.float64]:
+                        session: ExtrasEvaluator | None) -> NDArray[np.float64]:
         """[a, lam(, work rate)] per row, from the generated Schur-complement solve."""
         Qc = np.zeros(self.n_q) if generalized_force is None else generalized_force
         return self.evaluate(EXTRA_ACCEL, [_time_column(t, q.shape[0]), q, v, Qc], q.shape[0], session)
 
     def consistent_state(self, t: ArrayLike, y: NDArray[np.float64],
-                         generalized_force: NDArray[np.float64] | None = None, session: Any = None,
+                         generalized_force: NDArray[np.float64] | None = None, session: ExtrasEvaluator | None = None,
                          project: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Keep q and v of ``y`` (one state or (N, n_states)); recompute multipliers and derivatives so
         that F(t, y, y') = 0. ``project`` (GGL restarts): first put q and v on the constraint manifold,
@@ -335,8 +421,8 @@ class DAEModel:
             yp[:, :n] = v - np.einsum("kmn,km->kn", Phi_q, mu)
         return (y2[0], yp[0]) if single else (y2, yp)
 
-    def initial_state(self, session: Any = None, start: str = "ideal", allow_penetration: bool = False
-                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def initial_state(self, session: ExtrasEvaluator | None = None, start: str = "ideal",
+                      allow_penetration: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Consistent (y0, yp0) at t = 0: assembled positions and velocities, then v' and lam.
 
         ``start="ideal"`` (section 4.4): assembled with the clearance joints ideal (journals centred,
@@ -344,11 +430,11 @@ class DAEModel:
         joints only; with a pair in deep penetration it raises AssemblyError unless ``allow_penetration``."""
         ideal = start == "ideal"
         # a declared start is checked against the gaps (penetration): every number is in its key
-        numbers = self.parameter_values if not ideal or self.start_parameters is None else \
-            self.parameter_values[self.start_parameters]
+        numbers = self.parameter_values[self.start_parameters] if ideal else self.parameter_values
         key = (start, bool(allow_penetration), "casadi" if session is None else type(session).__name__,
                numbers.tobytes(), self.q_guess.tobytes(), self.v_guess.tobytes())
-        known = self.start_memo.get(key)
+        starts = self.structure.starts
+        known = starts.get(key)
         if known is None:
             q = self.assemble_positions(self.q_guess, session=session, ideal=ideal)
             check_independent(self, q, session)
@@ -361,7 +447,7 @@ class DAEModel:
             replaced = replaced_velocities(self, v, self.assemble_velocities(q, self.v_guess, session=session)) \
                 if ideal else ""
             known = (_read_only(y), _read_only(yp), replaced)
-            memo_put_bounded(self.start_memo, key, known, START_MEMO_LIMIT)
+            memo_put_bounded(starts, key, known, START_MEMO_LIMIT)
         if known[2]:
             import warnings
 
@@ -379,7 +465,8 @@ class DAEModel:
         return np.array(values, dtype=float)
 
     def channels(self, t: NDArray[np.float64], y: NDArray[np.float64], yp: NDArray[np.float64],
-                 switch: NDArray[np.float64] | None = None, session: Any = None) -> dict[str, NDArray[np.float64]]:
+                 switch: NDArray[np.float64] | None = None, session: ExtrasEvaluator | None = None
+                 ) -> dict[str, NDArray[np.float64]]:
         """Every output channel at the rows of ``y`` and ``yp``; ``switch`` holds one
         :meth:`switch_vector` per row (contact terms' modes; None: all off)."""
         return self._rows(EXTRA_OUTPUTS, self.channel_names, t, y, yp, switch, session)
@@ -390,13 +477,13 @@ class DAEModel:
         return tuple(name for name in self.channel_names if checked_channel(name))
 
     def checks(self, t: NDArray[np.float64], y: NDArray[np.float64], switch: NDArray[np.float64],
-               session: Any = None) -> dict[str, NDArray[np.float64]]:
+               session: ExtrasEvaluator | None = None) -> dict[str, NDArray[np.float64]]:
         """The channels the physics checks read (as :meth:`channels`, bit for bit), without the others:
         penetrations and position constraints, functions of q alone (zeros go in for the yp input)."""
         return self._rows(EXTRA_CHECKS, self.checked_names, t, y, np.zeros(self.n_states), switch, session)
 
     def _rows(self, k: int, names: tuple[str, ...], t: ArrayLike, y: ArrayLike, yp: ArrayLike,
-              switch: ArrayLike | None, session: Any) -> dict[str, NDArray[np.float64]]:
+              switch: ArrayLike | None, session: ExtrasEvaluator | None) -> dict[str, NDArray[np.float64]]:
         """The channels ``names`` of the outputs' extra ``k`` at the rows of ``y`` and ``yp``."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         if t.size == 0 or not names:
@@ -407,7 +494,7 @@ class DAEModel:
         return {name: np.ascontiguousarray(values[:, i]) for i, name in enumerate(names)}
 
 
-# Starts kept per structure (see DAEModel.start_memo); a start is ~0.3 ms to compute again.
+# Starts kept per structure (Structure.starts, see DAEModel.initial_state); a start is ~0.3 ms to compute again.
 START_MEMO_LIMIT = 256
 
 
@@ -460,7 +547,7 @@ def replaced_velocities(model: DAEModel, ideal: NDArray[np.float64], declared: N
             f"changed declared velocities: {'; '.join(changed)}. SolverOptions(start='declared') keeps them.")
 
 
-def check_independent(model: DAEModel, q: NDArray[np.float64], session: Any = None) -> None:
+def check_independent(model: DAEModel, q: NDArray[np.float64], session: ExtrasEvaluator | None = None) -> None:
     """Raise AssemblyError, naming the joints and drivers involved, when the constraint Jacobian is rank
     deficient at the initial positions ``q`` (redundant constraints: undetermined multipliers)."""
     m, n = model.n_constraints, model.n_q

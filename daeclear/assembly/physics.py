@@ -10,13 +10,16 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any
+from typing import TYPE_CHECKING, Any
 from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..core.errors import AssemblyError, PhysicsWarning
+
+if TYPE_CHECKING:
+    from .dae_model import DAEModel, ExtrasEvaluator
 
 KINDS: tuple[str, ...] = ("penetration", "initial_penetration", "initial_velocity", "constraint_drift",
                           "contact_within_one_step", "missed_contact")
@@ -60,13 +63,13 @@ def issue(records: Sequence[dict[str, Any]], stacklevel: int = 3) -> None:
         warnings.warn(rec["message"], PhysicsWarning, stacklevel=stacklevel)
 
 
-def joint_pairs(model: Any, joint: str) -> list[str]:
+def joint_pairs(model: DAEModel, joint: str) -> list[str]:
     """The contact pairs (gap names) of one clearance joint: the joint itself or ``<joint>.<corner>``."""
     return [g for g in model.gap_names if g == joint or g.startswith(joint + ".")]
 
 
-def check_run(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels: dict[str, NDArray[np.float64]],
-              y0: NDArray[np.float64] | None, stats: dict[str, Any], session: Any = None, *,
+def check_run(model: DAEModel, t: NDArray[np.float64], y: NDArray[np.float64], channels: dict[str, NDArray[np.float64]],
+              y0: NDArray[np.float64] | None, stats: dict[str, Any], session: ExtrasEvaluator | None = None, *,
               from_state: bool = False) -> list[dict[str, Any]]:
     """Every check on a run's output (times ``t``, states ``y``, channels): penetrations, the start
     (``y0``: the declared state at t = 0, None after the chapter's start) and drift; ``session``
@@ -103,7 +106,7 @@ def key_rows(t: NDArray[np.float64], channels: dict[str, NDArray[np.float64]]) -
     return np.array(sorted(rows), dtype=np.intp)
 
 
-def _penetration(model: Any, joint: str, clearance: float, corner: float, t: NDArray[np.float64],
+def _penetration(model: DAEModel, joint: str, clearance: float, corner: float, t: NDArray[np.float64],
                  channels: dict[str, NDArray[np.float64]], declared: bool) -> list[dict[str, Any]]:
     """Worst penetration of the joint over the run, and at t = 0 (``declared``: the start is the scene's)."""
     limit = PENETRATION_FRACTION * (min(clearance, corner) if corner > 0 else clearance)
@@ -139,8 +142,8 @@ def _penetration(model: Any, joint: str, clearance: float, corner: float, t: NDA
     return out
 
 
-def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np.float64], session: Any = None,
-                            *, given: bool = False) -> None:
+def check_start_penetration(model: DAEModel, y0: NDArray[np.float64], yp0: NDArray[np.float64],
+                            session: ExtrasEvaluator | None = None, *, given: bool = False) -> None:
     """Refuse (AssemblyError naming the pair, the depth and the clearance) a start with a contact pair
     deeper in its wall than START_PENETRATION_FRACTION of the clearance: a declaration error whose first contact
     force would be an artificial impact. ``given``: the state is simulate()'s ``y0``
@@ -171,7 +174,8 @@ def check_start_penetration(model: Any, y0: NDArray[np.float64], yp0: NDArray[np
                     "(clearance joints centred), or pass allow_penetration=True to start there anyway.")
 
 
-def _initial_velocity(model: Any, y0: NDArray[np.float64], session: Any = None) -> list[dict[str, Any]]:
+def _initial_velocity(model: DAEModel, y0: NDArray[np.float64], session: ExtrasEvaluator | None = None
+                      ) -> list[dict[str, Any]]:
     """Speed at which each clearance joint's two sides move apart at t = 0, for driven mechanisms only
     (without a driver a relative velocity is the experiment's initial condition)."""
     if not model.clearance_joints:
@@ -201,8 +205,8 @@ def _initial_velocity(model: Any, y0: NDArray[np.float64], session: Any = None) 
     return out
 
 
-def _drift(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels: dict[str, NDArray[np.float64]],
-           stats: dict[str, Any], session: Any = None) -> list[dict[str, Any]]:
+def _drift(model: DAEModel, t: NDArray[np.float64], y: NDArray[np.float64], channels: dict[str, NDArray[np.float64]],
+           stats: dict[str, Any], session: ExtrasEvaluator | None = None) -> list[dict[str, Any]]:
     """Largest constraint violation of the run, against DRIFT_FRACTION of the smallest clearance."""
     drift = channels.get("constraints.position")
     if drift is None or drift.size == 0:
@@ -227,7 +231,7 @@ def _drift(model: Any, t: NDArray[np.float64], y: NDArray[np.float64], channels:
            else "Use a smaller rtol."))]
 
 
-def check_fixed_steps(model: Any, events: Sequence[Any], step: float,
+def check_fixed_steps(model: DAEModel, events: Sequence[Any], step: float,
                       missed: Sequence[tuple[float, float, str]]) -> list[dict[str, Any]]:
     """Fixed-step runs: whole contacts shorter than one step, and ``missed`` (t_start, t_end, pair) steps
     over which a gap changed sign without an event."""
@@ -261,7 +265,7 @@ def check_fixed_steps(model: Any, events: Sequence[Any], step: float,
     return out
 
 
-def sign_changes(model: Any, T: NDArray[np.float64], X: NDArray[np.float64]) -> list[tuple[float, float, str]]:
+def sign_changes(model: DAEModel, T: NDArray[np.float64], X: NDArray[np.float64]) -> list[tuple[float, float, str]]:
     """(t_start, t_end, pair) of consecutive points of one segment (no event between them) over which
     a gap changed sign, both ends clear of round-off; ``X`` holds (q, v) rows."""
     roots = model.functions.roots

@@ -11,6 +11,7 @@ derivative of :meth:`DAEModel.consistent_state`), and the pieces of the jump at 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from collections.abc import Sequence
@@ -22,7 +23,7 @@ from numpy.typing import NDArray
 
 from ..core.errors import DaeclearError, SceneError
 from ..core.options import close_matches
-from ..engine.sensitivity_functions import SensitivityFunctions, directional, jacobian_blocks, sensitivity_functions
+from ..engine.sensitivity_functions import SensitivityFunctions, directional, jacobian_blocks
 from .dae_model import EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_TERM0, DAEModel
 
 __all__ = ["parameter_value", "parameter_directions", "initial_sensitivities", "model_sensitivity_functions",
@@ -88,7 +89,7 @@ def _at(model: DAEModel, name: str, value: float) -> DAEModel:
     P = model.parameter_values.copy()
     offset = dict(_offsets(model))[name]
     P[offset] = value
-    return model.copy_with(parameter_values=P)
+    return dataclasses.replace(model, parameter_values=P)
 
 
 def _offsets(model: DAEModel) -> list[tuple[str, int]]:
@@ -156,15 +157,10 @@ def initial_sensitivities(model: DAEModel, names: Sequence[str], start: str = "i
 def model_sensitivity_functions(model: DAEModel, width: int) -> SensitivityFunctions:
     """The model's sensitivity functions for ``width`` parameters, with the directional derivatives of
     the accelerations, the constraints, each term's force and the simple pairs' gap rates (built once per
-    structure and width, kept with the model's compiled functions)."""
-    funcs = model.functions
-    key = f"sensitivity{width}"
-    known = funcs.compiled.get(key)
-    if known is None:
-        extras = (EXTRA_ACCEL, EXTRA_KINEMATICS, *(EXTRA_TERM0 + k for k in range(len(model.terms))),
-                  *(extra for _, _, extra, _, _ in model.auto_pairs))
-        known = funcs.compiled[key] = sensitivity_functions(funcs, width, extras)
-    return known
+    structure and width, kept by the structure's compiled object)."""
+    extras = (EXTRA_ACCEL, EXTRA_KINEMATICS, *(EXTRA_TERM0 + k for k in range(len(model.terms))),
+              *(extra for _, _, extra, _, _ in model.auto_pairs))
+    return model.compiled.sensitivity(width, extras)
 
 
 @dataclass(frozen=True)

@@ -130,7 +130,7 @@ def memo_table() -> MemoTable:
 
 
 def clear_memos() -> None:
-    """Forget every structure of this process (and with ``DAEFunctions.compiled`` what was made of it):
+    """Forget every structure of this process (and with each its ``CompiledDAE``, what was made of it):
     the next run generates and loads again, e.g. after changing ``$CC``; the disk cache stays."""
     for table in _MEMO_TABLES:
         table.clear()

@@ -9,7 +9,6 @@ table (``csrc/dc_model.h``) and ``csrc/ida_driver.c``, against the vendored SUND
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import hashlib
 import time
@@ -268,10 +267,8 @@ def _files_digest(stamps: tuple[tuple[str, int, int], ...]) -> str:
 
 
 def build_model_library(funcs: Any, *, model: NormalizedModel | None = None) -> BuildResult:
-    """Generate, compile (or find in the cache) the shared library of a DAEFunctions (kept in ``funcs.compiled``)."""
-    known = funcs.compiled.get("built")
-    if known is not None and known.path.exists():
-        return dataclasses.replace(known, cache_hit=True, compile_time=0.0, codegen_time=0.0)
+    """Generate, compile (or find in the disk cache) the shared library of a DAEFunctions (loaded and kept
+    for a process by :class:`~daeclear.engine.compiled.CompiledDAE`)."""
     t0 = time.perf_counter()
     if model is None:
         model = normalize_model(funcs)
@@ -292,7 +289,6 @@ def build_model_library(funcs: Any, *, model: NormalizedModel | None = None) -> 
            "\n".join(str(libs[name]) for name in names)]
     result = compile_cached("dc", f"the model {model.name!r}", source, "ida_driver.c", _driver_text(), flags, link,
                             key, t0)
-    funcs.compiled["built"] = result
     return result
 
 

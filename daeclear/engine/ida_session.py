@@ -16,27 +16,25 @@ reported again within a few ulps (restart from IDA's state, or mask it with ``ro
 
 from __future__ import annotations
 
-import dataclasses
 import logging
-from pathlib import Path
 
 import numpy as np
 
 from ..core.errors import DaeclearError, warn_once
 from ..core.options import BACKENDS, LINEAR_SOLVERS
-from .build import BuildResult, CompileError, CompilerUnavailable
+from .build import CompileError, CompilerUnavailable
 from .c_session import SPARSE_MIN_STATES, CSession
-from .codegen import NormalizedModel, build_model_library, normalize_model
-from .library import ModelLibrary, StaleLibrary
+from .compiled import CompiledDAE
+from .library import StaleLibrary
 from .python_session import PythonSession
 from .session_base import (FLAG_MAX_STEPS, FLAG_STEP_COLLAPSE, STORE_STATES, STORE_TIMES, Advance, AutoEvents,
                            DAEFunctions, Session, StateLayout, check_options)
 from .stall_guard import TINY_STEP_COUNT, TINY_STEP_GROWTH, TINY_STEP_REL
-from .sundials import SundialsMismatch
 
-__all__ = ["DAEFunctions", "Advance", "Session", "open_session", "BACKENDS", "LINEAR_SOLVERS", "SPARSE_MIN_STATES",
-           "StaleLibrary", "FLAG_MAX_STEPS", "FLAG_STEP_COLLAPSE", "AutoEvents", "StateLayout", "CSession",
-           "PythonSession", "TINY_STEP_REL", "TINY_STEP_COUNT", "TINY_STEP_GROWTH", "STORE_TIMES", "STORE_STATES"]
+__all__ = ["DAEFunctions", "CompiledDAE", "Advance", "Session", "open_session", "BACKENDS", "LINEAR_SOLVERS",
+           "SPARSE_MIN_STATES", "StaleLibrary", "FLAG_MAX_STEPS", "FLAG_STEP_COLLAPSE", "AutoEvents", "StateLayout",
+           "CSession", "PythonSession", "TINY_STEP_REL", "TINY_STEP_COUNT", "TINY_STEP_GROWTH", "STORE_TIMES",
+           "STORE_STATES"]
 
 log = logging.getLogger("daeclear")
 
@@ -54,45 +52,14 @@ def _warn_fallback(reason: str) -> None:
     )
 
 
-def _file_id(path: Path) -> tuple[int, int] | None:
-    try:
-        st = path.stat()
-    except OSError:
-        return None
-    return st.st_ino, st.st_mtime_ns
-
-
-def _remove_if_unchanged(path: Path, seen: tuple[int, int] | None) -> None:
-    """Delete a rejected cache entry, unless another process has replaced it meanwhile."""
-    if seen is not None and _file_id(path) == seen:
-        path.unlink(missing_ok=True)
-
-
-def _load_library(funcs: DAEFunctions, model: NormalizedModel) -> tuple[ModelLibrary, BuildResult]:
-    """Build (or find in the cache) and load the model's library; a damaged or stale one is built again,
-    never run (SundialsMismatch if even the fresh build is stale)."""
-    build = build_model_library(funcs, model=model)
-    seen = _file_id(build.path)
-    try:
-        return ModelLibrary.load(build.path), build
-    except (OSError, StaleLibrary) as exc:
-        log.info("daeclear: rebuilding the compiled model %r: %s", model.name, exc)
-        _remove_if_unchanged(build.path, seen)
-    build = build_model_library(funcs, model=model)
-    seen = _file_id(build.path)
-    try:
-        return ModelLibrary.load(build.path), build
-    except StaleLibrary as exc:
-        _remove_if_unchanged(build.path, seen)
-        raise SundialsMismatch(f"{exc} (even freshly built: the SUNDIALS libraries the library loads are not "
-                               "those of the scikit-sundae wheel)") from exc
-
-
-def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, atol: np.ndarray | float,
+def open_session(funcs: DAEFunctions | CompiledDAE, *, backend: str = "auto", rtol: float, atol: np.ndarray | float,
                  max_step: float = 0.0, max_order: int = 5, max_steps: int = 5_000_000,
                  root_directions: np.ndarray | None = None, buffer_steps: int = 4096,
                  parameters: np.ndarray | None = None, linear_solver: str = "auto") -> Session:
     """Open an IDA session on a model (see the module docstring); call reinit() before the first advance().
+
+    funcs: the model's functions, or their :class:`~daeclear.engine.compiled.CompiledDAE`, which keeps
+    what this call normalises, builds and loads for the next session (bare functions: made anew).
 
     backend: "auto", "c" (DaeclearError if it cannot be built) or "python"; case-insensitive.
     atol: per-variable absolute tolerances (a scalar is broadcast). max_step 0: unbounded.
@@ -105,21 +72,14 @@ def open_session(funcs: DAEFunctions, *, backend: str = "auto", rtol: float, ato
     if not isinstance(backend, str) or backend.lower() not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}: valid backends are {', '.join(map(repr, BACKENDS))}")
     b = backend.lower()
-    model = funcs.compiled.get("normalized")
-    if model is None:
-        model = funcs.compiled["normalized"] = normalize_model(funcs)
+    compiled = funcs if isinstance(funcs, CompiledDAE) else CompiledDAE(funcs)
+    model = compiled.normalized()
     opts = check_options(model, rtol, atol, max_step, max_order, max_steps, root_directions, buffer_steps,
                          parameters, linear_solver)
     if b == "python":
         return PythonSession(model, opts)
     try:
-        loaded = funcs.compiled.get("loaded")
-        if loaded is None:
-            clib, build = _load_library(funcs, model)
-            funcs.compiled["loaded"] = (clib, dataclasses.replace(build, cache_hit=True, compile_time=0.0,
-                                                                  codegen_time=0.0))
-        else:  # loaded before in this process: no file checks
-            clib, build = loaded
+        clib, build = compiled.library()
         return CSession(model, opts, clib, build)
     except (CompilerUnavailable, CompileError, OSError) as exc:
         if b == "c":

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 from collections.abc import Callable, Sequence
 
@@ -43,7 +43,8 @@ class DAEFunctions:
     extras[k]: functions with vector inputs, P last, and one output, evaluated over many points by
     :meth:`Session.eval_extra` (output channels, consistent restarts); never called by IDA.
     ``P``: the ``n_parameters`` run-time parameters (values given to :func:`open_session`); with
-    ``n_parameters == 0`` the functions may leave it out.
+    ``n_parameters == 0`` the functions may leave it out. A value: what a process compiles of it is
+    kept by a :class:`~daeclear.engine.compiled.CompiledDAE`.
     """
 
     n: int
@@ -55,9 +56,6 @@ class DAEFunctions:
     name: str = "model"
     extras: tuple[casadi.Function, ...] = ()
     n_parameters: int = 0
-    # what this process made of these functions, by kind ("normalized", "built", "loaded", "ode_spec",
-    # "ode_library"): shared by the models of one structure, gone with the functions
-    compiled: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
 
 @dataclass(frozen=True)

@@ -26,7 +26,7 @@ class ModelEvaluator:
         self.model, self.backend = model, backend
 
     def _session(self) -> Any:
-        return open_session(self.model.functions, backend=self.backend, rtol=1e-6, atol=1.0,
+        return open_session(self.model.compiled, backend=self.backend, rtol=1e-6, atol=1.0,
                             parameters=self.model.parameter_values)
 
     def channels(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> Mapping[str, NDArray]:

@@ -80,7 +80,7 @@ class IDAIntegrator:
         rtol = settings.rtol
         self.model, self.t_end, self.times, self.store_steps = model, t_end, output.times, output.steps
         self.session: Session = open_session(
-            model.functions, backend=settings.backend, rtol=rtol,
+            model.compiled, backend=settings.backend, rtol=rtol,
             atol=tolerance_vector(model, rtol, settings.atol_value()), max_step=settings.max_step,
             parameters=model.parameter_values, max_steps=settings.max_steps, linear_solver=settings.linear_solver)
         session = self.session

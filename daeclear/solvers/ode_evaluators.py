@@ -382,7 +382,7 @@ def _model_channels(model: DAEModel, t: NDArray, y: NDArray, yp: NDArray, switch
 def evaluator(model: DAEModel, backend: str) -> Evaluator:
     """The model's ODE evaluator: compiled (cached per model object and on disk) or python."""
     spec = ode_spec(model)
-    compiled = model.functions.compiled.get("ode_library")  # one library per structure
+    compiled = model.compiled.ode_library  # one library per structure
     if backend == "python":
         return _PyEvaluator(spec)
     try:
@@ -395,7 +395,7 @@ def evaluator(model: DAEModel, backend: str) -> Evaluator:
                 build = build_ode_library(spec)
                 clib = OdeLibrary.load(build.path)
             compiled = (clib, build)
-            model.functions.compiled["ode_library"] = compiled
+            model.compiled.ode_library = compiled
         else:
             clib, build = compiled
             compiled = (clib, BuildResult(build.path, build.key, True, 0.0, 0.0))

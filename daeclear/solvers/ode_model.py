@@ -21,9 +21,10 @@ def ode_spec(model: DAEModel) -> OdeSpec:
     if getattr(model, "track_work", False) or model.n_states != 2 * model.n_q + model.n_constraints:
         raise SceneError(f"simulate: model '{model.scene_name}' has states besides q, v and the multipliers "
                          "(track_work); only method='ida' integrates it.")
-    spec = model.functions.compiled.get("ode_spec")
-    if spec is None:  # once per structure: models of the same structure share their functions
-        spec = model.functions.compiled["ode_spec"] = _symbolic_spec(model)
+    compiled = model.compiled  # once per structure: the models of a structure share what it compiled
+    spec = compiled.ode_spec
+    if spec is None:
+        spec = compiled.ode_spec = _symbolic_spec(model)
     return dataclasses.replace(spec, mass=tuple(float(mk) for mk in model.mass_diagonal),
                                parameters=tuple(float(x) for x in model.parameter_values))
 
