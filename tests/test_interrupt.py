@@ -13,6 +13,7 @@ import signal
 import subprocess
 import sys
 import time
+import types
 from pathlib import Path
 
 import numpy as np
@@ -318,11 +319,22 @@ def test_a_ctrl_c_python_drops_is_still_latched(monkeypatch):
     class Target:
         pass
 
+    def fail() -> None:
+        raise ValueError("another error a callback drops")
+
     with sigint_latch() as received:
         target = Target()
         weakref.finalize(target, signal.raise_signal, signal.SIGINT)
-        del target  # the callback runs now; its KeyboardInterrupt is printed and dropped
+        del target  # the callback runs now; Python drops its KeyboardInterrupt
         gc.collect()
         assert received == [signal.SIGINT]
-    assert dropped == [KeyboardInterrupt]  # Python dropped it: only the latch remembers
+        other = Target()
+        weakref.finalize(other, fail)
+        del other
+        gc.collect()
+    # Only the latch remembers the Ctrl-C (not printed as "Exception ignored ... Traceback"); any other
+    # dropped error still reaches the hook that was there before.
+    assert dropped == [ValueError]
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored
+    sys.unraisablehook(types.SimpleNamespace(exc_type=RuntimeError))  # the previous hook is back
+    assert dropped == [ValueError, RuntimeError]

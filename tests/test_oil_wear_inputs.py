@@ -117,6 +117,12 @@ def test_a_resume_must_match_the_scene_and_the_settings(worn, tmp_path):
         assert words in str(info.value)
     with pytest.raises(SceneError, match=r"options=None, now \{"):
         simulate_wear(worn, 2, path=path, options=dc.SolverOptions(rtol=1e-7))
+    for settings, words in ((dict(extrapolate=10), "extrapolate=1, now 10"),
+                            (dict(update_every=2), "update_every=1, now 2"),
+                            (dict(joint="clearance", period=0.02), "period=0.012, now 0.02")):
+        with pytest.raises(SceneError, match="another scene or settings") as info:
+            simulate_wear(worn, 20, path=path, **settings)
+        assert words in str(info.value)
     resumed = simulate_wear(worn, 2, path=path)  # the same call resumes
     assert resumed.cycles.tolist() == [0.0, 1.0, 2.0]
 

@@ -779,3 +779,17 @@ def test_the_names_the_issue_named():
         lubricated.with_parameters({"clearance.law.dry": normal_law("hertz")})
     with pytest.raises(SceneError, match="'clearance.law.stiffness' is not one of the model's numbers"):
         plain.with_parameters({"clearance.law.stiffness": 1e10})  # derived here: give it in the scene
+
+
+def test_a_run_of_floats_is_numbers_as_its_entries_are():
+    """is_numbers reads a flat run of floats (a worn profile) at once: the same answer as entry by entry."""
+    from daeclear.assembly.parameter_names import is_numbers
+
+    assert is_numbers((1e-6,) * 360) and is_numbers([0.5, 2]) and is_numbers(((0.1, 0.2), (0.3, 0.4)))
+    assert not is_numbers((0.5, True)) and not is_numbers((0.5, "a")) and not is_numbers(()) and not is_numbers(
+        (0.5, None))
+    scene = dc.mechanisms.slider_crank("revolute").with_values(
+        {"clearance.wear": dc.contact.wear.ArchardWear(coefficient=1e-13, length=0.02)})
+    floats = dc.assemble(scene.with_values({"clearance.wear_depth": (1e-6,) * 360}))
+    mixed = dc.assemble(scene.with_values({"clearance.wear_depth": (1e-6,) * 359 + (0,)}))
+    assert floats.structure is mixed.structure  # a worn profile's numbers are masked alike in the structure key

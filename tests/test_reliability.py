@@ -146,21 +146,22 @@ def _disk_fills_after(monkeypatch, calls: int) -> None:
 
 
 def _enospc_after(monkeypatch, calls: int) -> None:
-    """The streamed writer's dataset writes fail with ENOSPC after ``calls`` of them (space the
-    check before the write saw, taken meanwhile by another process)."""
+    """The streamed writer's datasets fail to grow with ENOSPC after ``calls`` appended writes (space the
+    check before the write saw, taken meanwhile by another process); shrinking (the append's undo) works."""
     import errno
 
-    from daeclear.results.hdf5_stream import ResultWriter
+    import h5py
 
-    real, count = ResultWriter._extend, [0]
+    real, count = h5py.Dataset.resize, [0]
 
-    def extend(self, dataset, rows):
-        count[0] += 1
-        if count[0] > calls:
-            raise OSError(errno.ENOSPC, "No space left on device", str(self.path))
-        return real(self, dataset, rows)
+    def resize(self, size, axis=None):
+        if axis is not None and size > self.shape[axis]:
+            count[0] += 1
+            if count[0] > calls:
+                raise OSError(errno.ENOSPC, "No space left on device", self.file.filename)
+        return real(self, size, axis)
 
-    monkeypatch.setattr(ResultWriter, "_extend", extend)
+    monkeypatch.setattr(h5py.Dataset, "resize", resize)
 
 
 @pytest.mark.parametrize("inject", [_disk_fills_after, _enospc_after])
@@ -181,7 +182,7 @@ def test_a_full_disk_during_a_streamed_run_keeps_a_readable_prefix(inject, tmp_p
 
 @pytest.mark.parametrize("inject", [_disk_fills_after, _enospc_after])
 def test_cli_run_on_a_full_disk_says_one_line_and_exits_1(inject, tmp_path, monkeypatch, capsys):
-    inject(monkeypatch, 3 if inject is _disk_fills_after else 20)  # the whole run writes 36 times
+    inject(monkeypatch, 3 if inject is _disk_fills_after else 20)  # the whole run grows a dataset 33 times
     code = main(["run", "slider_crank", "--joint", "revolute", "--out", str(tmp_path), "--quiet"])
     err = capsys.readouterr().err
     assert code == 1 and err.count("\n") == 1 and "Traceback" not in err, err

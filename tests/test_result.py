@@ -592,9 +592,11 @@ STATES_ONLY = {"/switch", "/channel_names", "/channel_units"}
 
 
 def _documented_items() -> list[tuple[str, bool]]:
-    """(item, optional) for every table row of docs/hdf5_layout.md whose first cell is `/...`."""
+    """(item, optional) for every table row of docs/hdf5_layout.md's result file (before the wear history
+    file's section, tests/test_wear_file.py) whose first cell is `/...`."""
     items = []
-    for line in LAYOUT_DOC.read_text(encoding="utf-8").splitlines():
+    text = LAYOUT_DOC.read_text(encoding="utf-8").split("\n## The wear history file")[0]
+    for line in text.splitlines():
         m = re.match(r"\|\s*`(/[^`]*)`\s*\|([^|]*)\|", line)
         if m:
             items.append((m.group(1), "optional" in m.group(2)))

@@ -13,7 +13,7 @@ import pytest
 
 import daeclear as dc
 import daeclear.contact as dcc
-from daeclear.contact.wear import ArchardWear, profile_coefficients, profile_depth
+from daeclear.contact.wear import MAX_DEPTH_FRACTION, ArchardWear, profile_coefficients, profile_depth
 from daeclear.core.errors import SceneError
 from daeclear.model.scene import RevoluteClearance
 from daeclear.studies.wear import simulate_wear
@@ -303,3 +303,24 @@ def test_an_unphysical_block_ends_the_wear_history():
     with pytest.warns(dc.PhysicsWarning, match="stopped at 0 cycles"):
         history = simulate_wear(scene, 3)
     assert history.cycles.tolist() == [0.0] and "clearance" in history.message
+
+
+@pytest.mark.slow
+def test_a_thousand_cycles_at_k_1e_12_every_one_simulated_finish():
+    """Issue 44's case (it stopped at cycle 912, the journal through its wall): examples/joint_wear.py's
+    scene at k = 1e-12, 1000 cycles, every one simulated. Every block runs, without a warning; the worn
+    volume is k times the sliding work at every profile; the depth grows every cycle and stays within
+    the gap model's range."""
+    import warnings
+
+    scene = dc.mechanisms.slider_crank("revolute", friction=0.1).with_values(
+        {"clearance.wear": ArchardWear(coefficient=1e-12, length=0.02)})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", dc.PhysicsWarning)
+        history = simulate_wear(scene, 1000)
+    assert history.message == "" and history.cycles.tolist() == list(range(1001))
+    np.testing.assert_allclose(history.volume, 1e-12 * history.sliding_work, rtol=1e-12, atol=0.0)
+    assert np.all(np.diff(history.max_depth) > 0)
+    joint = next(e for e in scene.elements if e.name == "clearance")
+    mean_depth = history.volume[-1] / (2 * math.pi * joint.bearing_radius * 0.02)  # the volume spread evenly
+    assert 2 * mean_depth < history.max_depth[-1] < MAX_DEPTH_FRACTION * joint.bearing_radius  # a worn spot

@@ -52,7 +52,7 @@ def scene_names(scene: Any, formulation: str, table: frozenset[str], elements: f
 
 
 def _is_number(value: Any) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+    return type(value) is float or isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 def is_numbers(value: Any) -> bool:
@@ -61,7 +61,10 @@ def is_numbers(value: Any) -> bool:
         return True
     if isinstance(value, np.ndarray):
         return value.size > 0 and value.dtype.kind in "iuf"
-    return isinstance(value, (tuple, list)) and len(value) > 0 and all(is_numbers(v) for v in value)
+    if not isinstance(value, (tuple, list)) or not value:
+        return False
+    # a flat run of floats (a worn profile's hundreds of nodes) without a call an entry
+    return set(map(type, value)) == {float} or all(is_numbers(v) for v in value)
 
 
 def _walk(value: Any, path: str, annotation: str, parametric: bool, table: frozenset[str], settable: list[str],

@@ -142,6 +142,8 @@ def _masked_text(value: Any) -> str:
     if kind is str or kind is bool or value is None:
         return repr(value)
     if kind is tuple or kind is list:
+        if value and set(map(type, value)) == {float}:  # a flat run of floats (a worn profile): one mask an entry
+            return "[" + ",".join("#" * len(value)) + "]"
         return "[" + ",".join(map(_masked_text, value)) + "]"
     if hasattr(value, "to_dict") or (dataclasses.is_dataclass(value) and not isinstance(value, type)):
         return kept(value, "_masked_text", _described_text)

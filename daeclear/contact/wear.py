@@ -103,7 +103,7 @@ def half_angle_hertz(force: ArrayLike, bearing_radius: float, journal_radius: fl
     return np.sqrt(4.0 * np.clip(force, 0.0, None) * r_eff / (math.pi * length * effective_modulus)) / bearing_radius
 
 
-def _shape(distribution: str, phi: NDArray[np.float64], half_angle: NDArray[np.float64]) -> NDArray[np.float64]:
+def _shape(distribution: str, phi: NDArray[Any], half_angle: NDArray[Any]) -> NDArray[np.float64]:
     """The pressure's shape over the arc (not normalised), 0 outside it; ``half_angle`` > 0."""
     if distribution == "hertz":
         return np.sqrt(np.clip(1.0 - (phi / half_angle) ** 2, 0.0, None))
@@ -139,16 +139,20 @@ def spread(centres: ArrayLike, half_angles: ArrayLike, loads: ArrayLike, nodes: 
         position = np.remainder(centre[part], 2.0 * math.pi) / step
         lower = np.floor(position)
         share = position - lower
-        cell = kind[part] * size + lower.astype(np.int64) % size
-        histogram += np.bincount(cell, load[part] * (1.0 - share), minlength=histogram.size)
-        histogram += np.bincount(kind[part] * size + (lower.astype(np.int64) + 1) % size, load[part] * share,
+        row = kind[part] * size
+        below = lower.astype(np.int64)
+        cells = np.concatenate((row + below % size, row + (below + 1) % size))  # the grid points either side
+        histogram += np.bincount(cells, np.concatenate((load[part] * (1.0 - share), load[part] * share)),
                                  minlength=histogram.size)
+    # every width's shape at once: row k over the offsets -widest..widest, zero beyond its own arc (a
+    # width 0 is a point: its shape is nonzero at the offset 0 alone)
+    offsets = np.arange(-int(kinds[-1]), int(kinds[-1]) + 1)
+    values = _shape(distribution, offsets * step, np.maximum(kinds, 1)[:, None] * step)
+    values[np.abs(offsets) > kinds[:, None]] = 0.0
+    values /= values.sum(axis=1, keepdims=True)
     shapes = np.zeros((kinds.size, size))
-    for row, width in enumerate(kinds):
-        offsets = np.arange(-width, width + 1)
-        shape = _shape(distribution, offsets * step, np.full(offsets.size, max(width, 1) * step)) if width else \
-            np.ones(1)
-        shapes[row, offsets % size] = shape / shape.sum()
+    for first in range(0, offsets.size, size):  # an arc wider than the circle wraps onto itself
+        shapes[:, offsets[first:first + size] % size] += values[:, first:first + size]
     fine = np.fft.irfft(np.sum(np.fft.rfft(histogram.reshape(kinds.size, size), axis=1)
                                * np.fft.rfft(shapes, axis=1), axis=0), n=size)
     fine[np.abs(fine) <= 1e-13 * np.max(np.abs(fine))] = 0.0
@@ -212,11 +216,8 @@ def profile_coefficients(depth: ArrayLike, modes: int) -> tuple[NDArray[np.float
     """A nodal depth's Fourier series to ``modes`` (least squares on the nodes; the mean, so the worn
     volume, kept exactly): (a_0..a_modes, b_1..b_modes) of ``a_0 + sum a_m cos(m theta) + b_m sin(m theta)``."""
     h = np.asarray(depth, dtype=float)
-    theta = 2.0 * np.pi * np.arange(h.size) / h.size
-    m = np.arange(1, modes + 1)
-    a = np.concatenate([[h.mean()], (2.0 / h.size) * (np.cos(np.outer(m, theta)) @ h)])
-    b = (2.0 / h.size) * (np.sin(np.outer(m, theta)) @ h)
-    return a, b
+    series = np.fft.rfft(h)[1:modes + 1] * (2.0 / h.size)  # sum h_k exp(-i m theta_k): a_m - i b_m, scaled
+    return np.concatenate([[h.mean()], series.real]), -series.imag
 
 
 def profile_depth(a: ArrayLike, b: ArrayLike, angles: ArrayLike) -> NDArray[np.float64]:

@@ -5,17 +5,23 @@ model is rebuilt from its file's scene description (:func:`evaluator_from_parame
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
+import numpy as np
 from numpy.typing import NDArray
 
 from ..assembly.assemble import DAEModel, assemble
+from ..assembly.dae_model import EXTRA_OUTPUTS
 from ..engine.ida_session import open_session
 from ..core.errors import SceneError
+from ..core.values import readonly
 from ..model.scenefile import scene_from_description
 
-__all__ = ["ModelEvaluator", "evaluator_from_parameters", "rebuildable"]
+if TYPE_CHECKING:
+    from .result import Result
+
+__all__ = ["ModelEvaluator", "RunChannels", "evaluator_from_parameters", "rebuildable"]
 
 
 class ModelEvaluator:
@@ -29,11 +35,17 @@ class ModelEvaluator:
         return open_session(self.model.compiled, backend=self.backend, rtol=1e-6, atol=1.0,
                             parameters=self.model.parameter_values)
 
-    def channels(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> Mapping[str, NDArray]:
-        """Every channel at the rows (the model's output function, as the run evaluates it)."""
+    def channels(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray,
+                 names: Sequence[str] | None = None) -> Mapping[str, NDArray]:
+        """Every channel at the rows (the model's output function, as the run evaluates it); ``names``:
+        those alone kept (one call all the same; ``yp`` may be one row, the same for every row)."""
         session = self._session()
         try:
-            return self.model.channels(t, y, yp, switch, session)
+            if names is None:
+                return self.model.channels(t, y, yp, switch, session)
+            values = self.model.evaluate(EXTRA_OUTPUTS, [t.reshape(-1, 1), y, yp, switch], t.size, session)
+            column = self.model.channel_names.index
+            return {name: np.ascontiguousarray(values[:, column(name)]) for name in names}
         finally:
             session.close()
 
@@ -48,6 +60,44 @@ class ModelEvaluator:
             return model.consistent_state(t, y, model.term_forces_rows(t, y, switch, session), session)
         finally:
             session.close()
+
+
+class RunChannels:
+    """Some channels (``names``) of runs of the models of one structure, read from each run's stored
+    rows in one call of the output function (a study reading a few channels of many runs).
+
+    A run kept in memory stores IDA's own states; reading any channel first makes every row consistent
+    (multipliers and yp: the run's consistency pass, about twice the output function's cost) and then
+    computes every channel. Channels that read neither yp nor the multipliers the pass recomputes (by
+    the sparsity of the output function: kinematics, gaps, contact forces) are the same numbers from
+    the stored rows: here they are computed from them, bit for bit ``result[name]``; others go through
+    the pass as before.
+    """
+
+    def __init__(self, model: DAEModel, names: Sequence[str]) -> None:
+        missing = [name for name in names if name not in model.channel_names]
+        if missing:
+            raise SceneError(f"RunChannels: names={missing!r}, must be channels of the model "
+                             f"({len(model.channel_names)}: model.channel_names).")
+        self.names = tuple(names)
+        self.outputs = model.outputs  # the structure's output function (every model of it shares it)
+        rows = [model.channel_names.index(name) for name in names]
+        self._y = np.array(self.outputs.jac_sparsity(0, 1), dtype=bool)[rows]  # which states each one reads
+        self._reads_yp = bool(np.array(self.outputs.jac_sparsity(0, 2), dtype=bool)[rows].any())
+
+    def __call__(self, result: Result, model: DAEModel, backend: str = "auto") -> dict[str, NDArray]:
+        """The channels of ``result``, a run of ``model`` in ``backend`` (the run's: its parameters'
+        ``simulate.backend``)."""
+        if model.outputs is not self.outputs:
+            raise SceneError(f"RunChannels: model '{model.scene_name}' is of another structure than the one the "
+                             "channels were chosen for; make a RunChannels for it.")
+        source = result.channel_source
+        if source is None or source.computed or not source.t.size:  # computed already, or given as arrays
+            return {name: np.asarray(result[name]) for name in self.names}
+        y = source.y if self._y[:, source.recomputed].any() else source.stored_y
+        yp = source.yp if self._reads_yp else np.zeros(model.n_states)
+        values = ModelEvaluator(model, backend).channels(source.t, y, yp, source.switch, self.names)
+        return {name: readonly(values[name]) for name in self.names}
 
 
 def rebuildable(parameters: Mapping[str, Any]) -> bool:

@@ -88,6 +88,22 @@ class LazyChannels:
             self._make_consistent()
         return self._y
 
+    @property
+    def stored_y(self) -> NDArray:
+        """The states as stored, without the consistency pass: while :attr:`raw`, IDA's own rows (their
+        :attr:`recomputed` columns, the multipliers, not converged)."""
+        return readonly(self._y)
+
+    def row(self, i: int) -> NDArray:
+        """Row ``i`` of :attr:`y`: while raw, that row alone made consistent (the pass treats every row on
+        its own, so it is bit for bit the row of the whole pass)."""
+        if not self.raw:
+            return self._y[i]
+        assert self.consistent is not None
+        k = range(self.t.size)[i]  # an IndexError beyond the rows, as y[i]
+        rows = slice(k, k + 1)
+        return readonly(self.consistent(self.t[rows], self._y[rows], self.switch[rows])[0][0])
+
     def state_column(self, j: int) -> NDArray:
         """Column ``j`` of the states: a kept column of raw states as stored (the pass leaves it unchanged)."""
         if self.raw and not self.recomputed.start <= j < self.recomputed.stop:

@@ -12,6 +12,7 @@ import errno
 import os
 import shutil
 import signal
+import sys
 import tempfile
 import threading
 import uuid
@@ -165,22 +166,30 @@ def deferred_sigint() -> Iterator[None]:
 def sigint_latch() -> Iterator[list[int]]:
     """Remember every Ctrl-C received during the block (and raise KeyboardInterrupt as usual): Python drops one
     raised in a weakref callback or a destructor, a loop that checks the latch stops anyway (main thread only).
+    Such a dropped KeyboardInterrupt is not printed ("Exception ignored ... Traceback"): the latch has it.
     """
     previous = _replaceable_handler()
     if previous is None:
         yield []
         return
     received: list[int] = []
+    previous_hook = sys.unraisablehook
 
     def latch(signum: int, frame: FrameType | None) -> None:
         received.append(signum)
         raise KeyboardInterrupt
 
+    def report_unless_latched(unraisable: Any) -> None:
+        if not (received and issubclass(unraisable.exc_type, KeyboardInterrupt)):
+            previous_hook(unraisable)
+
     signal.signal(signal.SIGINT, latch)
+    sys.unraisablehook = report_unless_latched
     try:
         yield received
     finally:
         signal.signal(signal.SIGINT, previous)
+        sys.unraisablehook = previous_hook
 
 
 @contextlib.contextmanager

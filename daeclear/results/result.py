@@ -216,6 +216,13 @@ class Result:
             self._yp = self._lazy.yp
         return self._yp
 
+    def state(self, i: int) -> NDArray[np.float64]:
+        """Row ``i`` of :attr:`y` (e.g. -1: the state to continue a run from), without making every row
+        consistent when only this one is wanted (a run kept in memory: that row alone; bit for bit ``y[i]``)."""
+        if self._y is None and self._lazy is not None:
+            return self._lazy.row(i)
+        return self.y[i]
+
     def _channel_values(self) -> dict[str, np.ndarray]:
         """The channels: a run's computed from its states at the first read, in one call, and kept."""
         if self._channels is None:

@@ -8,11 +8,12 @@ wear put into the joint's profile for the next block (Mukras et al. 2010) as new
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -27,13 +28,38 @@ from ..model.scene import RevoluteClearance, Scene
 from ..core.progress import Progress
 from ..results.outputs import check_file
 from ..core.values import to_plain
+from ..results.channel_eval import RunChannels
 from ..results.result import Result
 from ..solvers.solver_options import SolverOptions
 from ..solvers.dispatch import simulate
 from .poincare import crank_period
-from .wear_file import WearFile
+from .wear_file import WearFile, WearRow
 
 
+
+
+#: The worn joint's generated channels the wear update reads (``<joint>.<name>``): functions of the
+#: positions and velocities alone, read from a run's stored rows (:class:`RunChannels`).
+HISTORY_CHANNELS = ("normal_force", "bearing_angle", "journal_angle", "sliding_velocity", "penetration")
+
+
+def joint_channels(model: DAEModel, joint: str) -> RunChannels:
+    """The reader of revolute clearance joint ``joint``'s contact history in runs of ``model``'s structure."""
+    names = [f"{joint}.{q}" for q in HISTORY_CHANNELS]
+    if any(name not in model.channel_names for name in names):
+        worn = [e.name for e in getattr(model.scene, "elements", ()) if getattr(e, "wear", None) is not None]
+        raise SceneError(f"wear_history: joint={joint!r}, must be a revolute clearance joint with wear of the run "
+                         f"({', '.join(worn) or 'none has wear=ArchardWear(...)'}).")
+    return RunChannels(model, names)
+
+
+def history_arrays(t: NDArray[np.float64], values: dict[str, NDArray[np.float64]], joint: str) -> WearHistoryArrays:
+    """The contact history from the joint's channels (:data:`HISTORY_CHANNELS`) at the times ``t``."""
+    force, bearing, journal, slip, penetration = (values[f"{joint}.{q}"] for q in HISTORY_CHANNELS)
+    slip = np.where(np.isfinite(slip), slip, 0.0)  # no direction at the centred journal (e = 0), far from contact
+    return WearHistoryArrays(t=np.asarray(t, dtype=float), force=force, angle_bearing=np.unwrap(bearing),
+                             angle_journal=np.unwrap(journal), slip_speed=slip,
+                             penetration=np.clip(penetration, 0.0, None))
 
 
 def wear_history(result: Result, model: DAEModel, joint: str) -> WearHistoryArrays:
@@ -41,17 +67,8 @@ def wear_history(result: Result, model: DAEModel, joint: str) -> WearHistoryArra
     the joint's generated channels: normal force, the contact direction's angle in the bearing's and the
     journal's frame (``<joint>.bearing_angle``, ``.journal_angle``, unwrapped), the sliding velocity of the
     contact points (4.9) and the penetration."""
-    names = [f"{joint}.{q}" for q in ("normal_force", "bearing_angle", "journal_angle", "sliding_velocity",
-                                       "penetration")]
-    if any(name not in model.channel_names for name in names):
-        worn = [e.name for e in getattr(model.scene, "elements", ()) if getattr(e, "wear", None) is not None]
-        raise SceneError(f"wear_history: joint={joint!r}, must be a revolute clearance joint with wear of the run "
-                         f"({', '.join(worn) or 'none has wear=ArchardWear(...)'}).")
-    force, bearing, journal, slip, penetration = (np.asarray(result[name], dtype=float) for name in names)
-    slip = np.where(np.isfinite(slip), slip, 0.0)  # no direction at the centred journal (e = 0), far from contact
-    return WearHistoryArrays(t=np.asarray(result.t, dtype=float), force=force, angle_bearing=np.unwrap(bearing),
-                             angle_journal=np.unwrap(journal), slip_speed=slip,
-                             penetration=np.clip(penetration, 0.0, None))
+    backend = str(result.parameters.get("simulate", {}).get("backend", "auto"))
+    return history_arrays(result.t, joint_channels(model, joint)(result, model, backend), joint)
 
 
 @dataclass(frozen=True)
@@ -159,7 +176,7 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
     period = _checked_period(scene, period)
     blocks = math.ceil(cycles / (update_every * extrapolate))
     if blocks > MAX_BLOCKS:
-        size = blocks * (len(wear.surfaces) * wear.nodes * 8 + 32)
+        size = blocks * 8 * (len(wear.surfaces) * wear.nodes + 4 + 6 * len(scene.bodies))  # a row: profile, state
         raise SceneError(f"simulate_wear: cycles={cycles:g} with update_every={update_every}, "
                          f"extrapolate={extrapolate} "
                          f"is {blocks:.3g} blocks, must be at most {MAX_BLOCKS:.0e} (at about 10 ms a simulated cycle "
@@ -167,26 +184,48 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
                          f"{size / 1e9:.3g} GB); raise extrapolate or ask fewer cycles.")
     if path is not None:
         path = check_file(path, "simulate_wear(path)", what="a wear history file (.h5)", example="wear.h5")
-    modulus = effective_modulus(element) if wear.distribution == "hertz" else None
+    if wear.distribution == "hertz":
+        effective_modulus(element)  # the materials it needs, checked before any work
     settings = {"joint": element.name, "update_every": update_every, "extrapolate": extrapolate, "period": period,
                 "formulation": model.formulation if model is not None else "default",
                 "options": None if options is None else options.to_dict(),
                 "scene": to_plain(scene.to_dict(), "simulate_wear(scene)")}
     store = WearFile(path, settings) if path is not None else None
     tic = time.perf_counter()
-    rows = store.read() if store is not None else None
-    model = assemble(scene) if model is None else model
-    if rows is None:
-        depth = element.worn_profiles()
-        rows = [(0.0, depth, 0.0, math.nan)]
-        t0, y0 = 0.0, None
-        if store is not None:
-            store.append(*rows[0], t0=t0, y0=None)
-    else:
-        depth, t0, y0 = rows[-1][1], store.t0, store.y0  # type: ignore[union-attr]
-    done, work = rows[-1][0], rows[-1][2]
+    with store if store is not None else contextlib.nullcontext():
+        rows = store.open() if store is not None else None  # checked against the settings before any work
+        model = assemble(scene) if model is None else model
+        if rows is None:
+            rows = [WearRow(cycles=0.0, depth=element.worn_profiles(), work=0.0, block_peak=math.nan, t=0.0, y=None)]
+            if store is not None:
+                store.append(rows[0], model.n_states)
+        history, interrupted = _blocks(model, rows, store, element, cycles, (update_every, extrapolate, period),
+                                       options, progress)
+    if interrupted:  # Ctrl-C: the history so far is kept (and in the file), then the caller stops
+        raise Interrupted(f"simulate_wear: interrupted by the user at {history.cycles[-1]:g} cycles; the history so "
+                          "far is in .result" + (f" and in {path}" if path is not None else ""),
+                          result=replace(history, wall_time=time.perf_counter() - tic)) from None
+    if history.message:
+        warnings.warn(f"simulate_wear: {history.message}", PhysicsWarning, stacklevel=2)
+    return replace(history, wall_time=time.perf_counter() - tic)
+
+
+def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, element: RevoluteClearance,
+            cycles: float, scheme: tuple[int, int, float], options: SolverOptions | None,
+            progress: bool) -> tuple[WearHistory, bool]:
+    """simulate_wear's blocks from the last of ``rows`` on, each appended to ``rows`` and ``store``
+    (``scheme``: update interval, extrapolation, period): the history (its message says why it stopped
+    early) and whether Ctrl-C stopped it."""
+    update_every, extrapolate, period = scheme
+    wear = element.wear
+    assert wear is not None
+    modulus = effective_modulus(element) if wear.distribution == "hertz" else None
+    last = rows[-1]
+    depth, done, work, t0, y0 = last.depth, last.cycles, last.work, last.t, last.y
     bar = Progress(float(cycles), unit="cycles", desc="wear", enabled=progress)
     name, radius, clearance = element.name, float(element.bearing_radius), element.radial_clearance
+    history_of = joint_channels(model, name)
+    backend = (options or SolverOptions()).backend  # the runs' (resolved alike by every session)
     message = ""
     try:
         while done < cycles:
@@ -204,33 +243,30 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
             except (SolveError, AssemblyError) as exc:  # the history so far is the result (and in the file)
                 message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
                 break
-            deepest_run = float(np.max(result[f"{name}.penetration"]))
+            channels = history_of(result, model, backend)
+            deepest_run = float(np.max(channels[f"{name}.penetration"]))
             if deepest_run > clearance:
                 message = (f"stopped at {done:g} cycles: the next block's run left joint '{name}' {deepest_run:.3g} m "
                            f"inside its wall, more than its clearance {clearance:g} m (beyond what its contact law "
                            "describes); its wear is not taken. A tighter rtol, or a smaller wear coefficient.")
                 break
-            increment, block_work = wear_increment(wear, wear_history(result, model, name), bearing_radius=radius,
-                                                   clearance=clearance, effective_modulus=modulus)
+            increment, block_work = wear_increment(wear, history_arrays(result.t, channels, name),
+                                                   bearing_radius=radius, clearance=clearance,
+                                                   effective_modulus=modulus)
             depth = {s: depth[s] + extrapolate * increment[s] for s in depth}
             done += update_every * extrapolate
             work += extrapolate * block_work
-            peak = float(np.max(result[f"{name}.normal_force"]))
-            rows[-1] = (*rows[-1][:3], peak)
-            rows.append((done, depth, work, math.nan))
-            t0, y0 = float(result.t[-1]), result.y[-1]
-            if store is not None:
-                store.append(done, depth, work, math.nan, t0=t0, y0=y0, peak_before=peak)
+            t0, y0 = float(result.t[-1]), result.state(-1)
+            peak = float(np.max(channels[f"{name}.normal_force"]))
+            rows.append(WearRow(cycles=done, depth=depth, work=work, block_peak=peak, t=t0, y=y0))
+            if store is not None:  # a Ctrl-C meanwhile arrives once the row is written whole
+                store.append(rows[-1], model.n_states)
             bar.update(min(done, cycles), f"max depth {max(float(d.max()) for d in depth.values()):.3g} m")
-    except KeyboardInterrupt:  # Ctrl-C: the history so far is kept (and in the file), then the caller stops
-        history = _history(rows, wear, radius, time.perf_counter() - tic, f"interrupted at {done:g} cycles")
-        raise Interrupted(f"simulate_wear: interrupted by the user at {done:g} cycles; the history so far is in "
-                          ".result" + (f" and in {path}" if path is not None else ""), result=history) from None
+    except KeyboardInterrupt:  # Ctrl-C: the history so far is kept (and in the file)
+        return _history(rows, wear, radius, f"interrupted at {done:g} cycles"), True
     finally:
         bar.close()
-    if message:
-        warnings.warn(f"simulate_wear: {message}", PhysicsWarning, stacklevel=2)
-    return _history(rows, wear, radius, time.perf_counter() - tic, message)
+    return _history(rows, wear, radius, message), False
 
 
 def _checked_period(scene: Scene, period: float | None) -> float:
@@ -255,12 +291,13 @@ def _depth_value(depth: dict[str, NDArray[np.float64]], surfaces: tuple[str, ...
         tuple(depth[s].tolist()) for s in surfaces)
 
 
-def _history(rows: list[tuple[float, dict[str, NDArray[np.float64]], float, float]], wear: ArchardWear,
-             radius: float, wall_time: float, message: str) -> WearHistory:
+def _history(rows: list[WearRow], wear: ArchardWear, radius: float, message: str) -> WearHistory:
+    """The history of ``rows``; a profile's peak force is that of the block run with it (the next row's)."""
     surfaces = wear.surfaces
-    depth = np.array([[row[1][s] for s in surfaces] for row in rows])
-    volume = np.array([sum(worn_volume(row[1][s], radius, wear.length) for s in surfaces) for row in rows])
-    return WearHistory(angles=wear.angles, cycles=np.array([row[0] for row in rows]),
+    depth = np.array([[row.depth[s] for s in surfaces] for row in rows])
+    volume = np.array([sum(worn_volume(row.depth[s], radius, wear.length) for s in surfaces) for row in rows])
+    return WearHistory(angles=wear.angles, cycles=np.array([row.cycles for row in rows]),
                        depth=depth[:, 0] if len(surfaces) == 1 else depth, volume=volume,
-                       sliding_work=np.array([row[2] for row in rows]), peak_force=np.array([row[3] for row in rows]),
-                       surfaces=surfaces, wall_time=wall_time, message=message)
+                       sliding_work=np.array([row.work for row in rows]),
+                       peak_force=np.array([row.block_peak for row in rows[1:]] + [math.nan]),
+                       surfaces=surfaces, message=message)

@@ -1,110 +1,85 @@
-"""The history of :func:`daeclear.studies.wear.simulate_wear` in an HDF5 file: appended, and read to resume.
+"""The wear history file of :func:`daeclear.studies.wear.simulate_wear`: its layout and rows.
 
-Layout: root attributes ``format = "daeclear-wear"`` and the settings (joint, update interval,
-extrapolation, period, wear coefficient, nodes, surface) as JSON; datasets ``cycles`` (n),
-``depth`` (n, surfaces, nodes, m), ``sliding_work`` (n, N m), ``peak_force`` (n, N; the block run
-after each profile), and the state to continue from, ``t0`` (attribute) and ``y0`` (dataset). Every
-update appends one row and flushes, the state last: a run stopped anywhere resumes from the last
-complete row (rows beyond the shortest dataset are ignored).
+A run file of results' writer (:class:`daeclear.results.run_file.RunFile`; docs/hdf5_layout.md, "The
+wear history file"): root attributes ``format = "daeclear-wear"`` and ``version = 2``; the header (what a
+resume must match) is the study's settings: the worn joint, update interval, extrapolation, period,
+formulation, solver options and the scene (every element, the wear law's numbers included). One row per
+profile, the unworn first:
+
+    cycles            the cycles worn
+    depth             m, (surfaces, nodes): each worn surface's nodal depth
+    sliding_work      N m, the (extrapolated) sliding work so far
+    block_peak_force  N, the largest normal force of the block run that made this profile (NaN for the first)
+    t, y              s, and the mechanism's state (columns as model.state_names) the next block starts
+                      from; the first row's y is NaN: the scene's own start
+
+A file of the layout before version 2 (main before this one: no version, the state kept apart) is refused
+with a message saying so.
 """
 
 from __future__ import annotations
 
-import json
-import os
+import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.errors import SceneError
+from ..results.run_file import RunFile
 
 FORMAT = "daeclear-wear"
-Row = tuple[float, dict[str, NDArray[np.float64]], float, float]  # cycles, depth by surface, work, peak force
+VERSION = 2
+#: The columns, in order, and their units.
+COLUMNS = {"cycles": "", "depth": "m", "sliding_work": "N m", "block_peak_force": "N", "t": "s", "y": ""}
 
 
-def differences(stored: Any, now: Any, where: str = "") -> list[str]:
-    """Where two plain values (JSON) differ: ``"<path>=<stored>, now <now>"`` for each differing leaf
-    (at most 5; a scene's differences are named by element and field)."""
-    if isinstance(stored, dict) and isinstance(now, dict):
-        out: list[str] = []
-        for key in sorted(set(stored) | set(now)):
-            out += differences(stored.get(key), now.get(key), f"{where}.{key}" if where else str(key))
-        return out[:5]
-    if stored == now:
-        return []
-    shown = [repr(v) if len(repr(v)) <= 60 else repr(v)[:57] + "..." for v in (stored, now)]
-    return [f"{where}={shown[0]}, now {shown[1]}"]
+@dataclass(frozen=True)
+class WearRow:
+    """One profile of a wear history: cycles worn, depth by surface, sliding work, the peak normal force of
+    the block run that made it (NaN for the unworn profile), and the state (time, y; None: the scene's
+    start) the next block starts from."""
+
+    cycles: float
+    depth: dict[str, NDArray[np.float64]]
+    work: float
+    block_peak: float
+    t: float
+    y: NDArray[np.float64] | None
 
 
 class WearFile:
-    """One wear history file (see the module docstring); ``settings`` must match the file's to resume."""
+    """A wear history file (module docstring): :meth:`open` reads its rows (checked against ``settings``)
+    or creates it, :meth:`append` adds one profile."""
 
-    def __init__(self, path: str | os.PathLike[str], settings: dict[str, Any]) -> None:
-        self.path = Path(path)
-        if not self.path.parent.is_dir():
-            raise SceneError(f"simulate_wear: path={str(path)!r}, its directory does not exist.")
-        self.settings = json.loads(json.dumps(settings))  # as the file gives them back (lists, not tuples)
-        wear = self.settings["scene"]["elements"][settings["joint"]]["wear"]
+    def __init__(self, path: Path, settings: dict[str, Any]) -> None:
+        wear = settings["scene"]["elements"][settings["joint"]]["wear"]
         self.surfaces = ("bearing", "journal") if wear["surface"] == "both" else (wear["surface"],)
-        self.t0 = 0.0
-        self.y0: NDArray[np.float64] | None = None
+        self.file = RunFile(path, kind=FORMAT, version=VERSION, header=settings, units=COLUMNS,
+                            where="simulate_wear", subject="scene or settings")
 
-    def read(self) -> list[Row] | None:
-        """The rows of an existing file (and its state to continue from), None without a file."""
-        import h5py
-
-        if not self.path.exists():
+    def open(self) -> list[WearRow] | None:
+        """The file's rows (None: a new file, or one stopped before its first row)."""
+        columns = self.file.open()
+        if columns is None:
             return None
-        try:
-            with h5py.File(self.path, "r") as f:
-                if f.attrs.get("format") != FORMAT:
-                    raise SceneError(f"simulate_wear: {self.path} is not a wear history file (format "
-                                     f"{f.attrs.get('format')!r}); give a new path.")
-                changed = differences(json.loads(f.attrs["settings_json"]), self.settings)
-                if changed:
-                    raise SceneError(f"simulate_wear: {self.path} was written with another scene or settings ("
-                                     + "; ".join(changed) + "); give a new path, or the same scene and settings "
-                                     "to resume.")
-                n = min(f[name].shape[0] for name in ("cycles", "depth", "sliding_work", "peak_force"))
-                if n == 0:
-                    return None
-                cycles, depth = f["cycles"][:n], f["depth"][:n]
-                work, peak = f["sliding_work"][:n], f["peak_force"][:n]
-                self.t0 = float(f.attrs["t0"])
-                y0 = f["y0"][()]
-                self.y0 = y0 if y0.size else None
-        except OSError as exc:
-            raise SceneError(f"simulate_wear: {self.path} cannot be read ({exc}); give a new path.") from None
-        return [(float(cycles[i]), dict(zip(self.surfaces, depth[i])), float(work[i]), float(peak[i]))
-                for i in range(n)]
+        cycles, depth, work, peak, t, y = (columns[name] for name in COLUMNS)
+        return [WearRow(cycles=float(cycles[i]), depth=dict(zip(self.surfaces, depth[i])), work=float(work[i]),
+                        block_peak=float(peak[i]), t=float(t[i]), y=None if np.all(np.isnan(y[i])) else y[i])
+                for i in range(cycles.shape[0])]
 
-    def append(self, cycles: float, depth: dict[str, NDArray[np.float64]], work: float, peak: float, *, t0: float,
-               y0: NDArray[np.float64] | None, peak_before: float | None = None) -> None:
-        """Add one profile's row; ``peak_before``: the peak force of the block run with the previous one."""
-        import h5py
+    def append(self, row: WearRow, n_states: int) -> None:
+        """Add one profile's row (whole or not at all; ``n_states``: the width of a state)."""
+        y = np.full(n_states, math.nan) if row.y is None else row.y
+        self.file.append({"cycles": row.cycles, "depth": np.array([row.depth[s] for s in self.surfaces]),
+                          "sliding_work": row.work, "block_peak_force": row.block_peak, "t": row.t, "y": y})
 
-        nodes = len(next(iter(depth.values())))
-        with h5py.File(self.path, "a") as f:
-            if "cycles" not in f:
-                f.attrs["format"] = FORMAT
-                f.attrs["settings_json"] = json.dumps(self.settings)
-                for name in ("cycles", "sliding_work", "peak_force"):
-                    f.create_dataset(name, shape=(0,), maxshape=(None,), dtype="f8", chunks=(256,))
-                rows = len(self.surfaces)
-                f.create_dataset("depth", shape=(0, rows, nodes), maxshape=(None, rows, nodes), dtype="f8",
-                                 chunks=(16, rows, nodes))
-            n = f["cycles"].shape[0]
-            if peak_before is not None and n:
-                f["peak_force"][n - 1] = peak_before
-            for name, value in (("depth", np.array([depth[s] for s in self.surfaces])), ("sliding_work", work),
-                                ("peak_force", peak), ("cycles", cycles)):
-                f[name].resize(n + 1, axis=0)
-                f[name][n] = value
-            f.attrs["t0"] = t0
-            if "y0" in f:
-                del f["y0"]
-            f.create_dataset("y0", data=np.zeros(0) if y0 is None else np.asarray(y0, dtype=float))
-            f.flush()
-        self.t0, self.y0 = t0, y0
+    def close(self) -> None:
+        self.file.close()
+
+    def __enter__(self) -> WearFile:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
