@@ -4,7 +4,8 @@
 
 OLD and NEW are two checkouts (e.g. ``git worktree add /tmp/base <rev>`` and this one). Every example
 script of NEW's ``examples/`` (or those named) runs with ``--quick`` in each tree's own package and its
-own copy of the script, each in a fresh working folder (``--out`` into it where the script takes one).
+own copy of the script, each in a fresh working folder (``--out`` into it where the script takes one) with
+its own fresh compile cache.
 Then every ``.h5`` file both wrote is read back by each tree's own ``daeclear.load`` (in its own
 interpreter: a result's t, y, yp, every channel, events, segments and steps, whether the file stored
 the channels or the reader computes them) or, for other files (sweeps), dataset by dataset, and the
@@ -93,12 +94,14 @@ def equal(a: np.ndarray, b: np.ndarray, rtol: float = 0.0) -> bool:
     return a.shape == b.shape and bool(np.array_equal(a, b))
 
 
-def run_example(tree: Path, script: Path, folder: Path) -> bool:
-    """``script`` of ``tree`` with --quick in ``folder`` (its --out there); whether it exited 0."""
+def run_example(tree: Path, script: Path, folder: Path, cache: Path) -> bool:
+    """``script`` of ``tree`` with --quick in ``folder`` (its --out there), libraries built into ``cache``;
+    whether it exited 0."""
     args = [sys.executable, str(tree / "examples" / script.name), "--quick"]
     if '"--out"' in script.read_text():
         args += ["--out", str(folder / "out")]
-    env = {**os.environ, "PYTHONPATH": f"{tree}{os.pathsep}{tree / 'examples'}", "MPLBACKEND": "Agg"}
+    env = {**os.environ, "PYTHONPATH": f"{tree}{os.pathsep}{tree / 'examples'}", "MPLBACKEND": "Agg",
+           "DAECLEAR_CACHE_DIR": str(cache)}
     done = subprocess.run(args, cwd=folder, env=env, capture_output=True, text=True, check=False)
     if done.returncode != 0:
         print(f"  {tree.name}: {script.name} exited {done.returncode}: {done.stderr.strip()[-300:]}")
@@ -155,7 +158,7 @@ def main() -> int:
                                     if not p.stem.startswith("_") and not p.stem.endswith("_common"))
     failed = False
     with tempfile.TemporaryDirectory() as tmp, tempfile.TemporaryDirectory() as cache:
-        os.environ["DAECLEAR_CACHE_DIR"] = cache
+        caches = {old: Path(cache) / "old", new: Path(cache) / "new"}  # each tree builds its own libraries
         for name in names:
             script = new / "examples" / f"{name}.py"
             if not (old / "examples" / script.name).is_file():
@@ -165,7 +168,7 @@ def main() -> int:
             ran = True
             for tree, folder in folders.items():
                 folder.mkdir()
-                ran = run_example(tree, script, folder) and ran
+                ran = run_example(tree, script, folder, caches[tree]) and ran
             n, values, meta, worst = compare(folders[old], folders[new], args.rtol)
             verdict = "equal" if not values else f"{len(values)} DIFFER"
             print(f"{name}: {n} datasets in {len(list(folders[new].rglob('*.h5')))} files: values {verdict}"

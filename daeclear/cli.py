@@ -14,6 +14,7 @@ from collections.abc import Callable, Sequence
 
 from .core.defaults import (CLI_FIGURE_POINTS, CLI_FINEST_STEP, CLI_POINTS, CLI_SHOWN_EVENTS, CLI_STEPS_PER_SECOND,
                             FORMULATION, MAX_OUTPUT_POINTS, MAX_STEPS, RTOL)
+from .core.methods import TABLE as METHOD_TABLE
 from .core.errors import DaeclearError, DiskFull, Interrupted, PhysicsWarning, SolveError
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program stopped by Ctrl-C
@@ -128,7 +129,7 @@ def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
     study.add_argument("--t-end", type=float, default=0.012,
                        help="end time, s (default %(default)s: one revolution at 5000 rpm)")
     study.add_argument("--methods", default="ida,DOP853,LSODA,rk4",
-                       help="comma-separated methods (ida, RK45, DOP853, Radau, BDF, LSODA, rk4, euler; "
+                       help=f"comma-separated methods ({', '.join(m.name for m in METHOD_TABLE)}; "
                             "default %(default)s)")
     study.add_argument("--rtols", default="1e-4,1e-6,1e-8",
                        help="tolerances of the adaptive methods (default %(default)s)")

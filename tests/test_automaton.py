@@ -249,20 +249,20 @@ def test_the_run_state_read_from_the_compiled_loop_gives_its_terms(kind, storm, 
     replay): after every advance the terms and latched speeds that state implies are the loop's
     own (dc_get_active), and the recorded switch vector is the same."""
     from daeclear.assembly import contact_state
-    from daeclear.solvers.ida_loop import SegmentLoop
+    from daeclear.solvers.driver import Driver
 
     model = _slider_crank(kind, storm)
     checked: list[int] = []
-    take = SegmentLoop.take_pair_states
+    take = Driver.take_pair_states
 
     def take_and_check(loop):
         take(loop)
         active, params = contact_state.switches(model, loop.state)
         implied = model.switch_vector(active, params)
-        assert loop.session.active_switch().tolist() == implied.tolist() == loop.switch.tolist()
+        assert loop.integrator.session.active_switch().tolist() == implied.tolist() == loop.switch.tolist()
         checked.append(sum(st.contact or st.held for states in loop.state for st in states))
 
-    monkeypatch.setattr(SegmentLoop, "take_pair_states", take_and_check)
+    monkeypatch.setattr(Driver, "take_pair_states", take_and_check)
     monkeypatch.setattr(CSession, "set_auto_events",  # the loop returns after every switch: many checks
                         functools.partialmethod(CSession.set_auto_events, capacity=1))
     result = dc.simulate(model, 0.012, rtol=1e-8, options=dc.SolverOptions(backend="c"))

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-import daeclear.solvers.explicit as integrators
+import daeclear.solvers.ode_integrators as integrators
 import daeclear.solvers.ida as solve
 from daeclear.assembly import physics
 from daeclear.cli import main
@@ -436,7 +436,7 @@ def test_term_on_at_knows_a_pair_from_its_last_switch_on():
     """The failure message's record of the terms keeps one switch a pair (bounded memory): from the
     switch on its state is known; before it, or for a name that is no pair, the term counts as on, so
     that no lost onset is claimed."""
-    from daeclear.solvers.ida_loop import term_on_at
+    from daeclear.solvers.driver import term_on_at
 
     last = {"A": (0.5, False), "B": (0.2, True)}
     assert term_on_at(last, "A", 0.7) is False and term_on_at(last, "A", 0.5) is False

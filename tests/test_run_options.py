@@ -173,12 +173,12 @@ def test_bad_start_time_and_state_are_refused_before_any_work(ideal_model) -> No
 
 
 def test_a_bad_state_for_a_scene_is_refused_before_assembly(monkeypatch) -> None:
-    from daeclear.solvers import ida
+    from daeclear.solvers import driver  # every method's run is the driver's
 
     def no_assembly(*args, **kwargs):
         raise AssertionError("assembled before the state was checked")
 
-    monkeypatch.setattr(ida, "assemble", no_assembly)
+    monkeypatch.setattr(driver, "assemble", no_assembly)
     with pytest.raises(SceneError, match=r"simulate: y0=\[0.0, inf\], must be finite numbers .*\(inf at index 1\)"):
         dc.simulate(slider_crank(), T, t0=T / 8, y0=[0.0, np.inf])
     with pytest.raises(SceneError, match=r"simulate: y0=\[\], must be finite numbers .*not shape \(0,\)"):

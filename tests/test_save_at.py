@@ -64,11 +64,12 @@ BAD_FOR_THE_RUN: list[tuple[str, dict, float, float, str, str]] = [
                          ids=[c[0] for c in BAD_FOR_THE_RUN])
 def test_what_needs_the_run_is_refused_by_simulate_before_any_work(case, fields, t0, t_end, start, part,
                                                                     monkeypatch) -> None:
+    import daeclear.solvers.driver as driver
     import daeclear.solvers.ida as ida
 
     save = dc.SaveAt(**fields)  # fine on its own
     if case != "points beyond max_points":  # the size needs the model: checked after assembly, before the session
-        monkeypatch.setattr(ida, "assemble", lambda *a, **k: pytest.fail("assembled despite a bad output"))
+        monkeypatch.setattr(driver, "assemble", lambda *a, **k: pytest.fail("assembled despite a bad output"))
     monkeypatch.setattr(ida, "open_session", lambda *a, **k: pytest.fail("a session opened despite a bad output"))
     with pytest.raises(dc.DaeclearError) as info:  # a SceneError; an OutputError for the file's place
         dc.simulate(dc.mechanisms.slider_crank("ideal"), t_end, t0=t0, save=save)

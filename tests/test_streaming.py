@@ -95,7 +95,7 @@ def test_output_windows_inside_steps_lose_no_point():
     so windows of EVAL_WINDOW times end inside steps. Every point is IDA's interpolant at its own
     time: the driven crank angle is exactly linear in t, and the constraints hold (a lost, shifted or
     unfilled row would show)."""
-    from daeclear.solvers.ida_loop import EVAL_WINDOW
+    from daeclear.solvers.ida import EVAL_WINDOW
 
     t_end = 0.004
     r = dc.simulate(dc.mechanisms.slider_crank("ideal"), t_end, save=dc.SaveAt(every=1e-7, steps=False))
@@ -248,12 +248,10 @@ def test_the_scipy_methods_stream_the_same_data(revolute, tmp_path):
 ])
 @pytest.mark.parametrize("method", ["ida", "rk4"])
 def test_output_options_are_checked_before_any_work(fields, field, shown, method, monkeypatch, tmp_path):
-    import daeclear.solvers.explicit as explicit
-    import daeclear.solvers.ida as solve
+    import daeclear.solvers.driver as driver  # every method's run is the driver's
 
     monkeypatch.chdir(tmp_path)
-    for module in (solve, explicit):
-        monkeypatch.setattr(module, "assemble", lambda *a, **k: pytest.fail("assembled despite a bad option"))
+    monkeypatch.setattr(driver, "assemble", lambda *a, **k: pytest.fail("assembled despite a bad option"))
     settings = dc.SolverOptions(method="rk4", step=1e-5) if method == "rk4" else None
     with pytest.raises(SceneError) as info:
         dc.simulate(dc.mechanisms.slider_crank("ideal"), 0.01, options=settings, save=dc.SaveAt(**fields))
@@ -477,20 +475,20 @@ def test_memory_error_without_stream_to_returns_the_partial_result(revolute, fai
 @pytest.mark.parametrize("stop", [MemoryError(), KeyboardInterrupt()], ids=["MemoryError", "Ctrl-C"])
 def test_the_scipy_methods_save_the_closed_segments_when_stopped(revolute, tmp_path, monkeypatch, stop):
     """rk4, streamed: stopped in the middle, the file holds every segment closed before (a prefix of the run)."""
-    import daeclear.solvers.ode_run as integrators
+    from daeclear.core.progress import Progress
 
     settings, output = dc.SolverOptions(method="rk4", step=1e-5), {"every": 1e-5, "steps": False}
     full = dc.simulate(revolute, REV, options=settings, save=dc.SaveAt(**output))
     calls = [0]
-    original = integrators.Run._progress
+    original = Progress.update
 
-    def progress(self, t):
+    def progress(self, t, note=""):  # an update after each advance of the integrator, between two of them
         calls[0] += 1
         if calls[0] == 40:
             raise stop
-        return original(self, t)
+        return original(self, t, note)
 
-    monkeypatch.setattr(integrators.Run, "_progress", progress)
+    monkeypatch.setattr(Progress, "update", progress)
     path = tmp_path / "rk4.h5"
     if isinstance(stop, MemoryError):
         result = dc.simulate(revolute, REV, on_failure="return", progress=True, options=settings,

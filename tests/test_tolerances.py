@@ -18,7 +18,7 @@ import pytest
 import daeclear as dc
 from daeclear.core.errors import DaeclearWarning, SceneError
 from daeclear.solvers import tolerances as tol
-from daeclear.solvers.ida_loop import steps_needed
+from daeclear.solvers.ida import steps_needed
 
 REV = 60.0 / 5000.0
 

@@ -15,14 +15,13 @@ from collections.abc import Iterable, Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import defaults
+from . import defaults, methods
 from .errors import SceneError
 
-METHODS: tuple[str, ...] = ("ida", "rk45", "dop853", "radau", "bdf", "lsoda", "rk4", "euler")
+METHODS: tuple[str, ...] = methods.METHODS
 FORMULATIONS: tuple[str, ...] = ("index1", "ggl")
 DEFAULT_FORMULATION = defaults.FORMULATION
-#: The chapter's (Tables 4.2, 4.3: index-1, Baumgarte alpha = beta = 5), the only one of the non-IDA methods.
-CHAPTER_FORMULATION = "index1"
+CHAPTER_FORMULATION = methods.CHAPTER_FORMULATION
 BACKENDS: tuple[str, ...] = ("auto", "c", "python")
 ON_FAILURE: tuple[str, ...] = ("raise", "return")
 LINEAR_SOLVERS: tuple[str, ...] = ("auto", "reduced", "dense", "sparse", "superlu")
@@ -298,7 +297,7 @@ def default_formulation(method_name: Any) -> str:
     the other methods, a solver class's own ``formulation``."""
     if isinstance(method_name, type):
         return str(getattr(method_name, "formulation", DEFAULT_FORMULATION))
-    return DEFAULT_FORMULATION if str(method_name).lower() == "ida" else CHAPTER_FORMULATION
+    return methods.by_key(str(method_name)).formulation
 
 
 def backend(value: Any, *, where: str = "simulate", field: str = "backend") -> str:

@@ -35,6 +35,7 @@ from .session_base import (
     STORE_TIMES,
     Advance,
     AutoEvents,
+    ChunkCallback,
     SessionBase,
     SessionOptions,
     StateLayout,
@@ -364,7 +365,7 @@ class CSession(SessionBase):
         self._ready = True
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
+                store_steps: bool = True, on_chunk: ChunkCallback | None = None, store_states: bool = True,
                 chunked: bool = False, store_yp: bool = True) -> Advance:
         t_stop = self._check_advance(t_stop)
         n = self._n

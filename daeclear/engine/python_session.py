@@ -17,8 +17,8 @@ import numpy as np
 from ..core.errors import DaeclearError
 from .codegen import NormalizedModel, densified
 from .hermite import cubic_hermite
-from .session_base import (FLAG_MAX_STEPS, FLAG_STEP_COLLAPSE, OWN_FLAG_NAMES, Advance, SessionBase, SessionOptions,
-                           output_rows)
+from .session_base import (FLAG_MAX_STEPS, FLAG_STEP_COLLAPSE, OWN_FLAG_NAMES, Advance, ChunkCallback, SessionBase,
+                           SessionOptions, output_rows)
 
 __all__ = ["PythonSession"]
 
@@ -177,7 +177,7 @@ class PythonSession(SessionBase):
         self._apply_terms(act, plist)
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
+                store_steps: bool = True, on_chunk: ChunkCallback | None = None, store_states: bool = True,
                 chunked: bool = False, store_yp: bool = True) -> Advance:
         t_stop = self._check_advance(t_stop)
         rows = _Rows(self._select_eval(t_eval, t_stop), self._n, self._t, store_yp)

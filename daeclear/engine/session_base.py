@@ -7,7 +7,7 @@ import math
 import dataclasses
 from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import casadi
 import numpy as np
@@ -20,8 +20,8 @@ from .codegen import NormalizedModel
 from .stall_guard import StallGuard
 
 __all__ = ["DAEFunctions", "AutoEvents", "StateLayout", "Advance", "Session", "SessionOptions", "check_options",
-           "SessionBase", "FLAG_MAX_STEPS", "FLAG_STEP_COLLAPSE", "OWN_FLAG_NAMES", "STORE_TIMES", "STORE_STATES",
-           "output_rows"]
+           "SessionBase", "ChunkCallback", "FLAG_MAX_STEPS", "FLAG_STEP_COLLAPSE", "OWN_FLAG_NAMES", "STORE_TIMES",
+           "STORE_STATES", "output_rows"]
 
 #: flag of an Advance that stopped because the session's step cap (max_steps) was reached
 FLAG_MAX_STEPS = -1001
@@ -137,37 +137,83 @@ class Advance:
         return self.status != "error"
 
 
+#: ``on_chunk(t, n_switches)`` of :meth:`Session.advance`: called between two full buffers of the compiled loop.
+ChunkCallback = Callable[[float, int], None]
+
+
 @runtime_checkable
 class Session(Protocol):
+    """An open IDA session on one DAE (:func:`daeclear.engine.ida_session.open_session`), as the run's IDA
+    integrator (:mod:`daeclear.solvers.ida`) and a model's evaluations use it: exactly these members."""
+
     backend: str
 
+    @property
+    def max_steps(self) -> int:
+        """The session's cap on the IDA steps of a run."""
+        ...
+
+    @property
+    def eval_from(self) -> float:
+        """Output times after this one are still to come (the current time, or the last filled row's)."""
+        ...
+
     def reinit(self, t0: float, y0: np.ndarray, yp0: np.ndarray, active: Sequence[bool],
-               params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None: ...
+               params: Sequence[np.ndarray], root_directions: np.ndarray | None = None) -> None:
+        """Restart IDA at a consistent state with these terms on and roots watched in these directions."""
+        ...
 
     def advance(self, t_stop: float, t_eval: np.ndarray | None = None,
-                store_steps: bool = True, on_chunk: Any = None, store_states: bool = True,
+                store_steps: bool = True, on_chunk: ChunkCallback | None = None, store_states: bool = True,
                 chunked: bool = False, store_yp: bool = True) -> Advance:
         """Integrate towards ``t_stop``, keeping the steps (``store_steps``) and their states (``store_states``;
         yp too unless not ``store_yp``); ``chunked``: return (status ``"chunk"``) when the step buffer or the
         ``t_eval`` rows are full."""
         ...
 
-    def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
+    def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
+        """The root functions at one point."""
+        ...
 
-    def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray: ...
+    def eval_extra(self, k: int, inputs: Sequence[np.ndarray], n_points: int) -> np.ndarray:
+        """``DAEFunctions.extras[k]`` at ``n_points`` points, (n_points, n_out)."""
+        ...
 
-    def jacobian(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray: ...
-
-    def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray: ...
-
-    def stats(self) -> dict[str, int | float | str]: ...
+    def stats(self) -> dict[str, int | float | str]:
+        """The session's counters and timings."""
+        ...
 
     def set_hints(self, *, nonlin_conv_coef: float | None = None, jacobian_refresh: float | None = None,
-                  first_step: bool | None = None) -> bool: ...
+                  first_step: bool | None = None) -> bool:
+        """Solver hints; whether the backend applies them."""
+        ...
 
-    def set_stall(self, stall_step: float, count: int) -> None: ...
+    def set_stall(self, stall_step: float, count: int) -> None:
+        """The step-size collapse rule's numbers (stall_guard)."""
+        ...
 
-    def close(self) -> None: ...
+    def set_layout(self, layout: StateLayout) -> bool:
+        """Let the loop make states consistent itself; whether it does (compiled backend)."""
+        ...
+
+    def set_auto_events(self, pairs: Sequence[tuple[int, int, int, bool, float]], *, storms: Sequence[Storm],
+                        states: Sequence[PairState], capacity: int = 256) -> bool:
+        """Let the loop decide these pairs' switches itself; whether it does (compiled backend)."""
+        ...
+
+    def pair_states(self) -> list[PairState]:
+        """The automaton states of the pairs the loop decides (:meth:`set_auto_events`' order)."""
+        ...
+
+    def report(self, t: np.ndarray, y: np.ndarray, switch: np.ndarray, *,
+               into: tuple[np.ndarray, np.ndarray] | None = None,
+               channels: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Reported points made consistent by the loop (after :meth:`set_layout` returned True)."""
+        ...
+
+    def close(self) -> None:
+        """Free the session."""
+        ...
 
 
 @dataclass
@@ -317,6 +363,16 @@ class SessionBase:
     def set_layout(self, layout: StateLayout) -> bool:
         """Only the compiled backend makes states consistent in C; returns False here."""
         return False
+
+    def pair_states(self) -> list[PairState]:
+        """No pair is decided by the loop here (:meth:`set_auto_events` returned False)."""
+        return []
+
+    def report(self, t: np.ndarray, y: np.ndarray, switch: np.ndarray, *,
+               into: tuple[np.ndarray, np.ndarray] | None = None,
+               channels: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Only the compiled backend makes reported points consistent itself (after set_layout)."""
+        raise DaeclearError("report() needs the compiled backend's state layout (set_layout returned False)")
 
     def set_stall(self, stall_step: float, count: int) -> None:
         """``count`` tiny steps (below ``stall_step`` s, see stall_guard) end an advance with DC_STEP_COLLAPSE."""

@@ -1,6 +1,7 @@
 """DAEModel -> Result: :func:`simulate` (dispatch) hands a run to its method's solver (the contract:
-base; the methods: registry), IDA (ida, ida_loop) or the explicit and scipy methods (explicit), and
-checks every finished run (physics).
+base; the methods: registry, from core.methods), whose run is the one run driver's (driver) over the
+method's integrator (integrator: the interface; ida: IDA; explicit and ode_integrators: the scipy and
+fixed-step methods); the driver checks every finished run (assembly.physics).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Where a run's output goes while it runs: kept in memory, or streamed to an HDF5 file.
 
-The solvers hand a :class:`Recorder` their reported points chunk by chunk, each with the switch
+The run driver hands a :class:`Recorder` the reported points chunk by chunk, each with the switch
 vector of its segment, and their steps, events and segments. IDA's points come without channels
 and, kept in memory, as IDA left them: the run's `Result` makes their multipliers and yp consistent
 and computes the channels at the first read (:class:`~daeclear.results.lazy_channels.LazyChannels`).
@@ -19,6 +19,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..assembly import physics
+from ..assembly.dae_model import DAEModel
+from ..engine.session_base import Session
 from ..results.channel_eval import ModelEvaluator, rebuildable
 from ..core.errors import OutputError
 from ..core.events import EventRows, flatten
@@ -41,8 +43,8 @@ class Recorder:
     (:meth:`flush` writes and, streamed, empties them); :attr:`session` is the run's open session,
     in whose library the checked channels are evaluated while it is open."""
 
-    def __init__(self, model: Any, *, parameters: Mapping[str, Any], method: str,
-                 stream_to: Path | None = None, keep_data: bool = True) -> None:
+    def __init__(self, model: DAEModel, *, parameters: Mapping[str, Any], method: str,
+                 stream_to: Path | None = None, keep_data: bool = True, lazy_rows: bool = False) -> None:
         self.model = model
         self.keep_data = keep_data
         self.events: list[ContactEvent | EventRows] = []  # events, and blocks of the compiled loop's
@@ -50,13 +52,15 @@ class Recorder:
         self.segments: list[tuple[float, float, dict[str, str]]] = []
         self._written_events = 0
         self.interrupted = False  # a Ctrl-C arrived while finish() completed the file
-        self._header = dict(state_names=list(model.state_names), units=dict(model.channel_units),
+        self._header: dict[str, Any] = dict(state_names=list(model.state_names), units=dict(model.channel_units),
                             parameters=parameters, scene_name=model.scene_name, method=method,
                             formulation=model.formulation)
-        self.session: Any = None
-        #: IDA's points kept in memory are stored as IDA left them (its multipliers are not converged):
-        #: the Result makes them consistent when first read; a file stores consistent points
-        self.consistent_when_read = method == "ida" and stream_to is None
+        self.session: Session | None = None
+        #: ``lazy_rows``: the integrator's points are the DAE's own states (IDA's, its multipliers not
+        #: converged), their channels made again from them alone (the model's output function): kept in
+        #: memory as they are, the Result makes them consistent when first read; a file stores consistent points
+        self._lazy_rows = lazy_rows
+        self.consistent_when_read = lazy_rows and stream_to is None
         self._backend = str(parameters.get("simulate", {}).get("backend", "auto"))
         # the states alone make the channels again (IDA's output function; the scene rebuilt from its
         # description): decided at the first need (a streamed file, a saved result)
@@ -82,7 +86,7 @@ class Recorder:
         """Whether the result's channels can be made again from its states and parameters alone: an
         IDA run (its output function) of a scene that its description rebuilds."""
         if self._rebuildable is None:
-            self._rebuildable = self._header["method"] == "ida" and rebuildable(self._header["parameters"])
+            self._rebuildable = self._lazy_rows and rebuildable(self._header["parameters"])
         return self._rebuildable
 
     def add_points(self, t: NDArray, y: NDArray, yp: NDArray | None, switch: NDArray,

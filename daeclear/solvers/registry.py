@@ -6,16 +6,16 @@ import functools
 import importlib
 from typing import Any
 
-from ..core import options
+from types import MappingProxyType
+
+from ..core import methods, options
+from . import explicit
 from .base import Solver
-from .explicit import BDF, DOP853, LSODA, RK4, RK45, Euler, Radau
 from .ida import IDA
 
-#: lower-case method name -> its solver class (the names of :data:`daeclear.core.options.METHODS`)
-SOLVERS: dict[str, type[Solver]] = {
-    "ida": IDA, "rk45": RK45, "dop853": DOP853, "radau": Radau, "bdf": BDF, "lsoda": LSODA, "rk4": RK4,
-    "euler": Euler,
-}
+#: lower-case method name -> its solver class: a row of :data:`daeclear.core.methods.TABLE` each
+SOLVERS: MappingProxyType[str, type[Solver]] = MappingProxyType(
+    {m.key: IDA if m.family == "ida" else getattr(explicit, m.class_name) for m in methods.TABLE})
 _MEMBERS = ("name", "formulation", "check", "run")
 
 

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 
 from ..assembly.assemble import DAEModel, assemble
 from ..core import options
+from ..core.methods import FIXED_STEP
 from ..core.errors import DaeclearError, Interrupted, SceneError
 from ..core.progress import Progress
 from ..results.outputs import atomic_write_text, check_file
@@ -30,7 +31,7 @@ from ..solvers.save_at import SaveAt
 from ..solvers.solver_options import SolverOptions
 from ..solvers.dispatch import simulate
 
-FIXED_STEP_METHODS = ("rk4", "euler")
+FIXED_STEP_METHODS = FIXED_STEP  # run at each step of a list, not at each tolerance
 COLUMNS = ("label", "method", "tolerance", "error", "event_time_error", "events", "solve_time", "wall_time",
            "n_steps", "n_res_evals", "status", "message")
 

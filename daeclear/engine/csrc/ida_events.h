@@ -208,7 +208,7 @@ static int auto_handle_root(dc_session* s, double t, double t_stop) {
   }
   /* A root of the same-instant guard restarts IDA though nothing switched: going on from a root
    * whose gap is exactly zero, IDA fails ("root found at and very near t") when the gap is still
-   * zero a root tolerance later; a restart masks such a gap until it moves (ida_loop.guarded_root). */
+   * zero a root tolerance later; a restart masks such a gap until it moves (solvers/driver.py, guarded_root). */
   if (!switched && !guarded) return 2;
   /* consistent restart: GGL on the constraint manifold with mu = 0; then multipliers and
    * derivatives from the generated solve with the new set of contact forces */
