@@ -1,16 +1,17 @@
-"""Reduced, dense and sparse LU in the compiled IDA loop: chains of N links, whole ``simulate`` calls.
+"""Reduced, dense, sparse and SuperLU_MT LU in the compiled IDA loop: chains of N links, whole ``simulate`` calls.
 
 The mechanism is ``daeclear.mechanisms.chain(N)``: N links hanging from the ground, every pin a
 revolute clearance joint, so the model has 6 N states and N contact terms. For every N the
 model is compiled once (a warm-up call per solver, not timed), then ``simulate(scene, t_end,
-linear_solver=...)`` is timed ``--repeats`` times per solver, the three interleaved (the machine
+linear_solver=...)`` is timed ``--repeats`` times per solver, the four interleaved (the machine
 is shared: interleaving spreads any disturbance over all of them), and the best wall time of
 each is reported with the IDA loop's own time (``stats["solve_time"]``), the steps, the Jacobian
-evaluations and the nonzeros of the union Jacobian pattern the sparse solver factors.
+evaluations and the nonzeros of the union Jacobian pattern the sparse solvers factor.
 
-``red/sp`` is reduced wall / sparse wall: above 1 the sparse solver is faster. ``linear_solver="auto"``
+``red/sp`` is reduced / sparse (the plan's LU): above 1 the sparse LU is faster. ``linear_solver="auto"``
 chooses between those two: the threshold ``daeclear.engine.c_session.SPARSE_MIN_STATES`` is set
-from this table. ``den/red`` shows what the reduced LU gains over SUNDIALS' dense LU.
+from this table. ``den/red`` shows what the reduced LU gains over SUNDIALS' dense LU, ``slu/sp`` what
+the plan's LU gains over SUNDIALS' SuperLU_MT (``"superlu"``).
 Only public API is used (``daeclear.simulate``, ``daeclear.mechanisms.chain``). ``--write-doc`` writes
 the ratios, the union pattern's nonzeros and the steps and events (deterministic, checked by
 tests/test_doc_numbers.py) into docs/performance.md (block "linear-solver").
@@ -30,7 +31,7 @@ from typing import Any
 import daeclear as dc
 from daeclear.model.mechanisms import chain
 
-SOLVERS = ("reduced", "dense", "sparse")
+SOLVERS = ("reduced", "dense", "sparse", "superlu")
 
 
 def timed(scene: Any, t_end: float, rtol: float, solver: str) -> tuple[float, dict[str, Any]]:
@@ -71,23 +72,27 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     sizes = [int(x) for x in args.sizes.split(",") if x.strip()]
     print(f"chain(N), t_end={args.t_end} s, rtol={args.rtol}, best of {args.repeats}; wall = whole simulate call, "
-          "loop = IDA loop in C; red/sp = reduced / sparse (above 1 sparse is faster), den/red = dense / reduced")
+          "loop = IDA loop in C; red/sp = reduced / sparse (above 1 sparse is faster), den/red = dense / reduced, "
+          "slu/sp = superlu / sparse")
     head = (f"{'N':>3} {'states':>6} {'nnz':>6} {'dens.':>6} {'reduced':>10} {'dense':>10} {'sparse':>10} "
-            f"{'red/sp':>6} {'den/red':>7} {'loop red':>10} {'loop sp':>10} {'red/sp':>6} {'steps r/d/s':>17} "
-            f"{'events':>9}")
+            f"{'superlu':>10} {'red/sp':>6} {'den/red':>7} {'slu/sp':>6} {'loop red':>10} {'loop sp':>10} "
+            f"{'red/sp':>6} {'steps r/d/s/slu':>23} {'events':>15}")
     print(head)
-    doc = ["| N | states | union nnz | density | reduced / sparse, whole call | dense / reduced | reduced / sparse, "
-           "IDA loop | steps (reduced / dense / sparse) | events |", "|---|---:|---:|---:|---:|---:|---:|---|---|"]
+    doc = ["| N | states | union nnz | density | reduced / sparse, whole call | dense / reduced | superlu / sparse | "
+           "reduced / sparse, IDA loop | steps (reduced / dense / sparse / superlu) | events |",
+           "|---|---:|---:|---:|---:|---:|---:|---:|---|---|"]
     for n_links in sizes:
         r = measure(n_links, args.t_end, args.rtol, args.repeats)
         w, lp = r["wall"], r["loop"]
         doc.append(f"| {r['N']} | {r['states']} | {r['nnz']} | {r['density']:.3f} | {w['reduced'] / w['sparse']:.2f} | "
-                   f"{w['dense'] / w['reduced']:.2f} | {lp['reduced'] / lp['sparse']:.2f} | {r['steps']} | "
-                   f"{r['events']} |")
+                   f"{w['dense'] / w['reduced']:.2f} | {w['superlu'] / w['sparse']:.2f} | "
+                   f"{lp['reduced'] / lp['sparse']:.2f} | {r['steps']} | {r['events']} |")
         print(f"{r['N']:>3} {r['states']:>6} {r['nnz']:>6} {r['density']:>6.3f} {w['reduced'] * 1e3:>7.1f} ms "
-              f"{w['dense'] * 1e3:>7.1f} ms {w['sparse'] * 1e3:>7.1f} ms {w['reduced'] / w['sparse']:>6.2f} "
-              f"{w['dense'] / w['reduced']:>7.2f} {lp['reduced'] * 1e3:>7.1f} ms {lp['sparse'] * 1e3:>7.1f} ms "
-              f"{lp['reduced'] / lp['sparse']:>6.2f} {r['steps']:>17} {r['events']:>9}", flush=True)
+              f"{w['dense'] * 1e3:>7.1f} ms {w['sparse'] * 1e3:>7.1f} ms {w['superlu'] * 1e3:>7.1f} ms "
+              f"{w['reduced'] / w['sparse']:>6.2f} {w['dense'] / w['reduced']:>7.2f} "
+              f"{w['superlu'] / w['sparse']:>6.2f} "
+              f"{lp['reduced'] * 1e3:>7.1f} ms {lp['sparse'] * 1e3:>7.1f} ms {lp['reduced'] / lp['sparse']:>6.2f} "
+              f"{r['steps']:>23} {r['events']:>15}", flush=True)
     if args.write_doc:
         sys.path.insert(0, str(Path(__file__).resolve().parent))
         from doc_tables import write_block

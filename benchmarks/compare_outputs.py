@@ -1,6 +1,6 @@
 """Two trees of the package, the same example scripts: are the HDF5 files they write equal, value for value?
 
-    python benchmarks/compare_outputs.py OLD NEW [--examples revolute_fig4_15 ...]
+    python benchmarks/compare_outputs.py OLD NEW [--examples revolute_fig4_15 ...] [--rtol 1e-10]
 
 OLD and NEW are two checkouts (e.g. ``git worktree add /tmp/base <rev>`` and this one). Every example
 script of NEW's ``examples/`` (or those named) runs with ``--quick`` in each tree's own package and its
@@ -72,10 +72,25 @@ def json_differences(a: str, b: str, at: str = "") -> list[str]:
     return [] if x == y else [f"{at or '.'}: {x!r} -> {y!r}"[:160]]
 
 
-def equal(a: np.ndarray, b: np.ndarray) -> bool:
+def relative_difference(a: np.ndarray, b: np.ndarray) -> float:
+    """max |b - a| / max |a| of two float arrays of one shape (NaN where both are NaN counts as equal; 0 for
+    equal arrays, inf when only one is NaN or the scale is 0 and they differ)."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    both_nan = np.isnan(a) & np.isnan(b)
+    if np.any(np.isnan(a) != np.isnan(b)):
+        return float("inf")
+    diff = np.where(both_nan, 0.0, np.abs(b - a))
+    worst = float(diff.max()) if diff.size else 0.0
+    scale = float(np.nanmax(np.abs(a))) if a.size and not np.all(np.isnan(a)) else 0.0
+    return 0.0 if worst == 0.0 else (worst / scale if scale > 0 else float("inf"))
+
+
+def equal(a: np.ndarray, b: np.ndarray, rtol: float = 0.0) -> bool:
     a, b = np.asarray(a), np.asarray(b)
     if a.dtype.kind in "fc" and b.dtype.kind in "fc":
-        return a.shape == b.shape and bool(np.array_equal(a, b, equal_nan=True))
+        if a.shape != b.shape:
+            return False
+        return bool(np.array_equal(a, b, equal_nan=True)) or relative_difference(a, b) <= rtol
     return a.shape == b.shape and bool(np.array_equal(a, b))
 
 
@@ -97,9 +112,12 @@ def run_example(tree: Path, script: Path, folder: Path, cache: Path) -> bool:
     return done.returncode == 0 and read.returncode == 0
 
 
-def compare(old: Path, new: Path) -> tuple[int, list[str], list[str]]:
-    """(datasets compared, values that differ, metadata that differ) of the .h5 files both folders hold."""
+def compare(old: Path, new: Path, rtol: float = 0.0) -> tuple[int, list[str], list[str], tuple[float, str]]:
+    """(datasets compared, values that differ, metadata that differ, the largest relative difference of a
+    numeric value and where) of the .h5 files both folders hold; ``rtol`` > 0: the tolerance mode (module
+    docstring)."""
     n, values, meta = 0, [], []
+    worst = (0.0, "")
     files = sorted({p.relative_to(old) for p in old.rglob("*.h5")} | {p.relative_to(new) for p in new.rglob("*.h5")})
     for rel in files:
         if not (old / rel).is_file() or not (new / rel).is_file():
@@ -109,12 +127,20 @@ def compare(old: Path, new: Path) -> tuple[int, list[str], list[str]]:
         for name in sorted(set(a) | set(b)):
             n += 1
             is_meta = name.split("/")[-1] in METADATA or any(part in METADATA for part in name.split("/"))
-            if name not in a or name not in b or not equal(a[name], b[name]):
+            if rtol > 0 and name.startswith("steps/") and name in a and name in b and a[name].shape != b[name].shape:
+                meta.append(f"{rel}:{name} ({a[name].shape[0]} -> {b[name].shape[0]} integrator steps)")
+                continue
+            if (rtol > 0 and not is_meta and name in a and name in b and a[name].shape == b[name].shape
+                    and a[name].dtype.kind in "fc" and b[name].dtype.kind in "fc"):
+                d = relative_difference(a[name], b[name])
+                if d > worst[0]:
+                    worst = (d, f"{rel}:{name}")
+            if name not in a or name not in b or not equal(a[name], b[name], rtol):
                 what = f"{rel}:{name}"
                 if is_meta and name == "parameters" and name in a and name in b:
                     what += " (" + "; ".join(json_differences(str(a[name]), str(b[name]))[:4]) + ")"
                 (meta if is_meta else values).append(what)
-    return n, values, meta
+    return n, values, meta, worst
 
 
 def main() -> int:
@@ -122,7 +148,11 @@ def main() -> int:
     parser.add_argument("old", type=Path)
     parser.add_argument("new", type=Path)
     parser.add_argument("--examples", nargs="+", help="script names without .py (default: every example)")
+    parser.add_argument("--rtol", type=float, default=0.0,
+                        help="tolerance mode: numeric values agree within rtol of their largest magnitude (0: equal)")
     args = parser.parse_args()
+    if not args.rtol >= 0:
+        parser.error(f"--rtol={args.rtol!r}, must be a number >= 0")
     old, new = args.old.resolve(), args.new.resolve()
     names = args.examples or sorted(p.stem for p in (new / "examples").glob("*.py")
                                     if not p.stem.startswith("_") and not p.stem.endswith("_common"))
@@ -139,7 +169,7 @@ def main() -> int:
             for tree, folder in folders.items():
                 folder.mkdir()
                 ran = run_example(tree, script, folder, caches[tree]) and ran
-            n, values, meta = compare(folders[old], folders[new])
+            n, values, meta, worst = compare(folders[old], folders[new], args.rtol)
             verdict = "equal" if not values else f"{len(values)} DIFFER"
             print(f"{name}: {n} datasets in {len(list(folders[new].rglob('*.h5')))} files: values {verdict}"
                   + (f"; metadata differs: {len(meta)}" if meta else "") + ("" if ran else " (a run failed)"))
@@ -147,6 +177,8 @@ def main() -> int:
                 print(f"    value: {item}")
             for item in meta[:5]:
                 print(f"    metadata: {item}")
+            if args.rtol > 0:
+                print(f"    largest relative difference: {worst[0]:.2e}" + (f" ({worst[1]})" if worst[1] else ""))
             failed = failed or bool(values) or not ran
     return 1 if failed else 0
 

@@ -75,7 +75,8 @@ def test_slots_and_kinds_are_those_python_uses() -> None:
     assert not hasattr(c_handle, "STAT_KEYS")  # the handle's buffer is sized by the table (DC_ST_N), no copy
     assert len(abi.STAT_KEYS) == abi.DC_ST_N and abi.STAT_KEYS[abi.DC_ST_REINITS] == "n_reinits"
     assert len(abi.ODE_COUNTER_KEYS) == abi.DCO_CNT_N
-    assert sorted(abi.LINEAR_SOLVER_CODES.values()) == sorted({abi.DC_LS_DENSE, abi.DC_LS_SPARSE, abi.DC_LS_REDUCED})
+    assert sorted(abi.LINEAR_SOLVER_CODES.values()) == sorted({abi.DC_LS_DENSE, abi.DC_LS_SPARSE, abi.DC_LS_REDUCED,
+                                                               abi.DC_LS_SUPERLU})
     for group, rows in abi.GROUPS:
         values = [value for name, value, _ in rows if not name.endswith("_N")]
         assert len(set(values)) == len(values), f"{group}: two constants share a value"
@@ -213,7 +214,7 @@ def test_every_definition_is_its_table_entry(driver: str) -> None:
 def test_each_driver_has_its_own_prefix() -> None:
     assert all(e.name.startswith("dc_") for e in c_api.IDA_ENTRY_POINTS)
     assert all(e.name.startswith("dco_") for e in c_api.ODE_ENTRY_POINTS)
-    assert len(c_api.IDA_ENTRY_POINTS) == len(library.MODEL_PROTOTYPES) == 38
+    assert len(c_api.IDA_ENTRY_POINTS) == len(library.MODEL_PROTOTYPES) == 39
     assert len(c_api.ODE_ENTRY_POINTS) == len(library.ODE_PROTOTYPES) == 16
 
 
@@ -265,7 +266,7 @@ def test_the_ctypes_sizes_are_the_c_compilers(tmp_path: Path) -> None:
 
 #: The signatures (types, no parameter names) each driver ABI version has: a signature changed with the
 #: same version would let a library of the old one pass the version check. sha256 of signature_text.
-SIGNATURES = {("ida_driver.c", 7): "1b8a8d725d2dbd93", ("ode_driver.c", 3): "84648e05a08e107f"}
+SIGNATURES = {("ida_driver.c", 8): "2cd22fe799aa6faa", ("ode_driver.c", 3): "84648e05a08e107f"}
 
 
 def signature_text(entries: tuple[c_api.EntryPoint, ...]) -> str:

@@ -166,12 +166,13 @@ def test_the_other_integrators_steps_events_and_errors():
 
 @pytest.mark.slow
 def test_the_chains_steps_and_events():
-    """bench_scaling.py: states exactly, steps and events of the warm 0.05 s run within 5 %."""
+    """bench_scaling.py: states exactly, steps and events of the warm run (the block's --t-end) within 5 %."""
+    t_end = float(re.search(r"--t-end (\S+)", blocks.block_command("docs/performance.md", "scaling")).group(1))
     for row in rows("docs/performance.md", "scaling"):
         n = int(row["N"])
         scene = dc.mechanisms.chain(n)
         assert int(row["states"]) == dc.assemble(scene).n_states == 6 * n
-        result = dc.simulate(scene, 0.05, on_failure="return")
+        result = dc.simulate(scene, t_end, on_failure="return")
         same_count(result.stats["n_steps"], row["steps"], CHAOTIC, f"chain({n}) steps")
         same_count(len(result.events), row["events"], CHAOTIC, f"chain({n}) events")
 
@@ -183,14 +184,16 @@ def test_the_linear_solvers_patterns_steps_and_events():
     for row in rows("docs/performance.md", "linear-solver"):
         n = int(row["N"])
         stats = {}
-        for solver in ("reduced", "dense", "sparse"):
+        solvers = ("reduced", "dense", "sparse", "superlu")
+        for solver in solvers:
             result = dc.simulate(dc.mechanisms.chain(n), 0.02, rtol=1e-6,
                                  options=dc.SolverOptions(backend="c", linear_solver=solver))
             stats[solver] = (result.stats, len(result.events))
         nnz = stats["sparse"][0]["jac_nnz"]
         assert int(row["union nnz"]) == nnz and float(row["density"]) == pytest.approx(nnz / (6 * n) ** 2, abs=5e-4)
-        written = zip(("reduced", "dense", "sparse"), row["steps (reduced / dense / sparse)"].split("/"),
-                      row["events"].split("/"))
+        steps, events = row["steps (reduced / dense / sparse / superlu)"].split("/"), row["events"].split("/")
+        assert len(steps) == len(events) == len(solvers)
+        written = zip(solvers, steps, events)
         for solver, steps, events in written:
             same_count(stats[solver][0]["n_steps"], steps, CHAOTIC, f"chain({n}) {solver} steps")
             same_count(stats[solver][1], events, CHAOTIC, f"chain({n}) {solver} events")

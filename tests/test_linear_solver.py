@@ -1,5 +1,6 @@
-"""Dense and sparse (SuperLU_MT) LU in the compiled IDA loop: the option, the union Jacobian
-pattern the sparse solver factors, and identical results of both on real mechanisms.
+"""Dense, reduced, sparse and SuperLU_MT LU in the compiled IDA loop: the option, the union Jacobian
+pattern the sparse solvers factor, and identical results of all on real mechanisms (the sparse LU's
+plan and its factorisation: tests/test_sparse_lu.py).
 
 Measured for the agreement tests (rtol 1e-8): slider-crank with a revolute clearance joint,
 5 ms: the same 30 events within 2.5e-11 s, final state within 1.3e-8 relative; chain of 3
@@ -50,12 +51,14 @@ def dense_of(data, rows, colptr, n):
 
 def test_option_is_validated_with_a_clear_message():
     with pytest.raises(ValueError, match=r"linear_solver='banded' is not a linear solver: valid values are "
-                                         r"'auto', 'reduced', 'dense', 'sparse'"):
+                                         r"'auto', 'reduced', 'dense', 'sparse', 'superlu'"):
         open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="banded")
-    with pytest.raises(SceneError, match=r"linear_solver='lu', must be one of auto, reduced, dense, sparse"):
+    with pytest.raises(SceneError, match=r"linear_solver='lu', must be one of auto, reduced, dense, sparse, superlu"):
         dc.simulate(chain(1), 1e-3, options=dc.SolverOptions(linear_solver="lu"))
     s = open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="SPARSE")
     assert s.linear_solver == "sparse" and s.stats()["linear_solver"] == "sparse"
+    s = open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="SuperLU")
+    assert s.linear_solver == "superlu" and s.stats()["linear_solver"] == "superlu"
 
 
 def test_auto_uses_the_measured_threshold(monkeypatch):
@@ -72,9 +75,12 @@ def test_python_backend_stays_dense():
 
 
 def test_sparse_unavailable_is_a_clear_error():
-    with pytest.raises(DaeclearError, match="linear_solver='sparse' is not available"):
-        c_session._resolve_linear_solver("sparse", 100, has_sparse=False)
-    assert c_session._resolve_linear_solver("auto", 10_000, has_sparse=False) == "reduced"
+    with pytest.raises(DaeclearError, match="linear_solver='superlu' is not available"):
+        c_session._resolve_linear_solver("superlu", 100, has_superlu=False)
+    with pytest.raises(DaeclearError, match="linear_solver='sparse' is not available for this model"):
+        c_session._resolve_linear_solver("sparse", 100, has_superlu=True, has_plan=False)
+    assert c_session._resolve_linear_solver("auto", 10_000, has_superlu=False) == "sparse"
+    assert c_session._resolve_linear_solver("auto", 10_000, has_superlu=True, has_plan=False) == "reduced"
 
 
 # --------------------------------------------------------------------------- union pattern
@@ -93,7 +99,7 @@ def test_union_pattern_holds_every_term_and_fills_like_the_dense_matrix():
         s.set_terms(active, params)
         data, rows, colptr = s.sparse_jacobian(0.01, y, yp, 1234.5)
         assert colptr[0] == 0 and colptr[-1] == len(data) == s.stats()["jac_nnz"] < n * n
-        for c in range(n):  # rows strictly increasing in each column (CSC as SuperLU_MT wants)
+        for c in range(n):  # rows strictly increasing in each column (CSC as the plan and SuperLU_MT want)
             assert np.all(np.diff(rows[colptr[c]:colptr[c + 1]]) > 0)
         J = s.jacobian(0.01, y, yp, 1234.5)
         np.testing.assert_array_equal(dense_of(data, rows, colptr, n), J)
@@ -131,8 +137,9 @@ def assert_same_run(a: dc.Result, b: dc.Result, t_tol: float, y_rtol: float) -> 
 SLIDER_CRANK_WINDOW = 0.004
 
 
-def test_sparse_and_dense_agree_on_the_slider_crank():
-    a, b = both(slider_crank("revolute"), SLIDER_CRANK_WINDOW)
+@pytest.mark.parametrize("solver", ["sparse", "superlu"])
+def test_sparse_and_dense_agree_on_the_slider_crank(solver):
+    a, b = both(slider_crank("revolute"), SLIDER_CRANK_WINDOW, solvers=("dense", solver))
     assert len(a.events) >= 20
     assert_same_run(a, b, t_tol=3e-9, y_rtol=1e-6)
 
@@ -187,6 +194,25 @@ def test_reduced_solve_equals_a_plain_lu(formulation):
                                    atol=1e-12 * np.abs(exact).max())
 
 
+@pytest.mark.parametrize("formulation", ["ggl", "index1"])
+def test_every_solver_solves_several_right_hand_sides_with_one_factorisation(formulation):
+    """The one interface of the loop's solvers (csrc/dc_linsol.h): factor once, then solve_many with four
+    right-hand sides at once, for the dense, reduced and sparse LU alike: each column is numpy's solution of
+    the iteration matrix (the forward sensitivities will solve their right-hand sides this way)."""
+    model = dc.assemble(slider_crank("revolute"), formulation)
+    y, yp = model.initial_state()
+    s = open_session(model.functions, backend="c", rtol=1e-8, atol=1e-10, parameters=model.parameter_values)
+    s.set_terms([False] * len(model.terms), [np.zeros(term.n_params) for term in model.terms])
+    nq = model.layout(project=False).n_q
+    B = np.random.default_rng(13).normal(size=(model.n_states, 4))
+    J = s.jacobian(0.0, y, yp, 2e4)
+    exact = np.linalg.solve(J, B)
+    for solver, nk in (("dense", 0), ("reduced", nq), ("sparse", 0)):
+        X, fallbacks = s.solve_linear(0.0, y, yp, 2e4, B, solver=solver, n_kinematic=nk)
+        assert X.shape == B.shape and fallbacks == 0
+        np.testing.assert_allclose(X, exact, rtol=0, atol=1e-10 * np.abs(exact).max(), err_msg=solver)
+
+
 def test_reduced_solve_of_general_matrices():
     """The reduced solver on random matrices whose first nk rows have a diagonal block: exact
     (to round-off) for every nk, so for every size of the factored part and every remainder of
@@ -212,8 +238,9 @@ def test_reduced_solve_of_general_matrices():
                                        atol=1e-12 * np.abs(exact).max(), err_msg=f"nk={nk} sparse={sparse}")
 
 
-def test_sparse_and_dense_agree_on_a_chain_of_three():
-    a, b = both(chain(3), 0.02)
+@pytest.mark.parametrize("solver", ["sparse", "superlu"])
+def test_sparse_and_dense_agree_on_a_chain_of_three(solver):
+    a, b = both(chain(3), 0.02, solvers=("dense", solver))
     assert {e.pair for e in a.events} == {"pin1", "pin2", "pin3"}
     assert_same_run(a, b, t_tol=1e-8, y_rtol=1e-6)
 
@@ -238,7 +265,7 @@ def test_a_jacobian_entry_that_is_not_finite_is_named_by_every_solver():
     each found and named by row and column, and the run stops with that message."""
     for part, entry, value, after in (("base", "(1, 1)", "inf", 0.5), ("term", "(0, 1)", "nan", 0.2)):
         funcs = jacobian_not_finite_model(part)
-        for ls in ("reduced", "dense", "sparse"):
+        for ls in ("reduced", "dense", "sparse", "superlu"):
             s = open_session(funcs, backend="c", rtol=1e-6, atol=1e-8, linear_solver=ls)
             s.reinit(0.0, [1.0, 1.0], [-1.0, -1.0], [True], [np.full(1, 0.1)])
             a = s.advance(1.0)
@@ -249,7 +276,7 @@ def test_a_jacobian_entry_that_is_not_finite_is_named_by_every_solver():
 def test_ball_bounces_alike():
     """A term whose Jacobian entry lies outside the base pattern: the sparse matrix has its slot."""
     out = {}
-    for ls in ("dense", "sparse"):
+    for ls in ("dense", "sparse", "superlu"):
         s = open_session(ball_model(), backend="c", rtol=1e-9, atol=np.array([1e-12, 1e-10]), linear_solver=ls)
         s.reinit(0.0, [1.0, 0.0], [0.0, -G], [False], [np.zeros(1)])
         a = s.advance(1.0)
@@ -257,10 +284,11 @@ def test_ball_bounces_alike():
         s.reinit(a.t, a.y, a.yp, [True], [np.zeros(1)], root_directions=[1])
         b = s.advance(1.0)
         out[ls] = (a.t, b.t, b.y, s.stats())
-    assert out["sparse"][3]["jac_nnz"] == 4 and out["sparse"][3]["n_jac_evals"] > 0
-    np.testing.assert_allclose(out["dense"][0], out["sparse"][0], rtol=1e-12)
-    np.testing.assert_allclose(out["dense"][1], out["sparse"][1], rtol=1e-7)
-    np.testing.assert_allclose(out["dense"][2], out["sparse"][2], rtol=1e-5, atol=1e-9)
+    for ls in ("sparse", "superlu"):
+        assert out[ls][3]["jac_nnz"] == 4 and out[ls][3]["n_jac_evals"] > 0
+        np.testing.assert_allclose(out["dense"][0], out[ls][0], rtol=1e-12)
+        np.testing.assert_allclose(out["dense"][1], out[ls][1], rtol=1e-7)
+        np.testing.assert_allclose(out["dense"][2], out[ls][2], rtol=1e-5, atol=1e-9)
 
 
 # --------------------------------------------------------------------------- SuperLU_MT lifetime
@@ -275,24 +303,26 @@ def _rss_mb() -> float:
 def test_restarts_reuse_the_factorization_storage():
     """SUNDIALS' SuperLU_MT solver, reinitialized by IDA at every restart, would recompute its
     ordering and allocate new L/U storage each time without freeing the old: 100 kB per event
-    here (60 MB over this run). The driver keeps the first factorization's storage."""
+    here (60 MB over this run). The driver keeps the first factorization's storage (and the sparse
+    LU's plan and storage are fixed from dc_open on)."""
     scene = chain(8)
-    run = dict(rtol=1e-6, options=dc.SolverOptions(backend="c", linear_solver="sparse"),
-               save=dc.SaveAt(steps=False, times=[0.1]))
-    dc.simulate(scene, 0.1, **run)  # warm: compiled, first allocations done
-    before = _rss_mb()
-    result = dc.simulate(scene, 0.1, **run)
-    assert result.stats["n_reinits"] > 500 and result.stats["linear_solver"] == "sparse"
-    assert _rss_mb() - before < 10.0
+    for solver in ("superlu", "sparse"):
+        run = dict(rtol=1e-6, options=dc.SolverOptions(backend="c", linear_solver=solver),
+                   save=dc.SaveAt(steps=False, times=[0.1]))
+        dc.simulate(scene, 0.1, **run)  # warm: compiled, first allocations done
+        before = _rss_mb()
+        result = dc.simulate(scene, 0.1, **run)
+        assert result.stats["n_reinits"] > 500 and result.stats["linear_solver"] == solver
+        assert _rss_mb() - before < 10.0
 
 
 def test_sessions_closed_before_any_step_free_cleanly():
     """A SuperLU_MT solver that never factorized cannot be freed as is (SUNDIALS reads its
     uninitialized options): the driver factors an identity first. Must not crash."""
     for _ in range(3):
-        s = open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="sparse")
+        s = open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="superlu")
         s.close()
-    s = open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="sparse")
+    s = open_session(ball_model(), backend="c", rtol=1e-6, atol=1e-8, linear_solver="superlu")
     del s
 
 

@@ -615,6 +615,29 @@ def test_kept_parameter_entries_follow_the_bodies_they_were_read_from():
     np.testing.assert_array_equal(again.vector, table.vector)
 
 
+def test_each_element_reads_its_own_bodies_only():
+    """An element's kept parameter entries are checked against the bodies it joins (a driver: its joint and
+    that joint's bodies), not against every body: a scene's set-up grows like N, not N^2. A chain that
+    shares every element but one moved link gets new entries for the two pins on that link and its
+    driver, the very same ones for everything else, and the parameter vector of a scene of new objects."""
+    from daeclear.assembly.assemble import scene_parameters
+
+    first = dc.mechanisms.chain(4, rpm=120.0)
+    table, key, _ = scene_parameters(first, "ggl", 5.0, 5.0, False)
+    link1 = dataclasses.replace(first["link1"], position=(0.06, 0.01))
+    moved = dc.Scene(first.name, gravity=first.gravity, ground=first.ground,
+                     elements=[link1 if e.name == "link1" else e for e in first.elements])
+    before = {e.name: e.__dict__["_parameter_entries"][1] for e in first.elements}
+    table2, key2, _ = scene_parameters(moved, "ggl", 5.0, 5.0, False)
+    after = {e.name: e.__dict__["_parameter_entries"][1] for e in moved.elements}
+    renewed = {name for name in after if after[name] is not before[name]}
+    assert renewed == {"link1", "pin1", "pin2", "drive"} and key2 == key
+    fresh = dc.Scene(first.name, gravity=first.gravity, ground=first.ground,
+                     elements=[dataclasses.replace(e) for e in moved.elements])
+    np.testing.assert_array_equal(scene_parameters(fresh, "ggl", 5.0, 5.0, False)[0].vector, table2.vector)
+    assert not np.array_equal(table2.vector, table.vector)
+
+
 def test_a_models_scene_description_is_the_scene_as_it_was_assembled():
     """model.parameters["scene"] equals Scene.to_dict() at assembly, whatever happens to the scene
     later (it is made at its first read from the elements the scene had); with a mutable element it

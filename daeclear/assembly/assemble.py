@@ -84,13 +84,31 @@ def scene_parameters(scene: Scene, formulation: str, alpha: float, beta: float,
     table.add("gravity", scene.gravity)
     structure: list[Any] = [formulation, bool(track_work), _ENGINE_VERSION, table.layout]
     joints = {j.name: j for j in scene.joints}
+    by_name = {b.name: b for b in bodies}
     for element in scene.elements:
-        inputs = (*bodies, joints[element.joint]) if isinstance(element, Driver) else bodies
-        named, shape = kept_with(element, "_parameter_entries", inputs,
+        named, shape = kept_with(element, "_parameter_entries", _read_objects(element, by_name, joints),
                                  lambda e: _element_parameters(ref, e, joints))
         table.extend(named)
         structure.append(shape)
     return table, structure_key(scene.elements, structure), scene.description()
+
+
+def _read_objects(element: Any, bodies: Mapping[str, Body], joints: Mapping[str, Any]) -> tuple[Any, ...]:
+    """The frozen objects an element's parameters are read from besides itself: the bodies it joins or
+    loads (their reference poses), a driver's joint and that joint's bodies; a body reads none. So each
+    element compares a few objects to reuse its kept entries, and a scene's set-up grows like N, not N^2."""
+    if isinstance(element, Body):
+        return ()
+    if isinstance(element, Driver):
+        joint = joints[element.joint]
+        return (joint, *_read_objects(joint, bodies, joints))
+    if hasattr(element, "body_roles"):
+        names = [name for _, name in element.body_roles()]
+    elif hasattr(element, "body_i") and hasattr(element, "body_j"):
+        names = [element.body_i, element.body_j]
+    else:
+        return tuple(bodies.values())
+    return tuple(bodies[name] for name in names if name in bodies)  # the ground's pose is fixed
 
 
 def _element_parameters(ref: Reference, element: Any, joints: dict[str, Any]

@@ -24,7 +24,7 @@ DEFAULT_FORMULATION = defaults.FORMULATION
 CHAPTER_FORMULATION = methods.CHAPTER_FORMULATION
 BACKENDS: tuple[str, ...] = ("auto", "c", "python")
 ON_FAILURE: tuple[str, ...] = ("raise", "return")
-LINEAR_SOLVERS: tuple[str, ...] = ("auto", "reduced", "dense", "sparse")
+LINEAR_SOLVERS: tuple[str, ...] = ("auto", "reduced", "dense", "sparse", "superlu")
 #: How a run starts: "ideal" (the chapter's: clearance joints centred) or "declared" (the bodies' own
 #: state, corrected only for the ideal joints).
 STARTS: tuple[str, ...] = ("ideal", "declared")

@@ -20,12 +20,12 @@ from .build import CSRC
 
 __all__ = [
     "DC_CHUNK", "DC_TSTOP", "DC_ROOT", "DC_ERR_IDA", "DC_ERR_MAXSTEPS", "DC_ERR_COLLAPSE", "DC_ERR_USAGE",
-    "DC_LS_DENSE", "DC_LS_SPARSE", "DC_LS_REDUCED", "LINEAR_SOLVER_CODES",
+    "DC_LS_DENSE", "DC_LS_SPARSE", "DC_LS_REDUCED", "DC_LS_SUPERLU", "LINEAR_SOLVER_CODES", "DC_LU_PIVOT_TOL",
     "DC_STORE_TIMES", "DC_STORE_STATES",
     "DC_NONE", "DC_ONSET", "DC_SEPARATION", "DC_SAME_INSTANT",
     "DC_EV_KIND", "DC_EV_CONTACT", "DC_EV_HELD", "DC_EV_WATCH", "DC_EV_N",
     "DC_ST_STEPS", "DC_ST_RES", "DC_ST_JAC", "DC_ST_LSETUP", "DC_ST_NNI", "DC_ST_NCF", "DC_ST_NETF",
-    "DC_ST_GEVALS", "DC_ST_REINITS", "DC_ST_N", "STAT_KEYS",
+    "DC_ST_GEVALS", "DC_ST_REINITS", "DC_ST_LU_FALLBACKS", "DC_ST_N", "STAT_KEYS",
     "DC_BI_MAJOR", "DC_BI_MINOR", "DC_BI_PATCH", "DC_BI_INDEX_SIZE", "DC_BI_INDEX_BITS", "DC_BI_SPARSE", "DC_BI_N",
     "DCO_OK", "DCO_NONFINITE", "DCO_SINGULAR", "DCO_EVAL_ERR",
     "FX_CHUNK", "FX_TSTOP", "FX_CANDIDATE", "FX_ERR", "FX_MAXSTEPS",
@@ -49,8 +49,15 @@ DC_ERR_USAGE: Final = -4
 DC_LS_DENSE: Final = 0
 DC_LS_SPARSE: Final = 1
 DC_LS_REDUCED: Final = 2
+DC_LS_SUPERLU: Final = 3
 #: dc_open's linear_solver argument by the option's name (daeclear.core.options.LINEAR_SOLVERS but "auto")
-LINEAR_SOLVER_CODES: Final = {"dense": DC_LS_DENSE, "sparse": DC_LS_SPARSE, "reduced": DC_LS_REDUCED}
+LINEAR_SOLVER_CODES: Final = {"dense": DC_LS_DENSE, "sparse": DC_LS_SPARSE, "reduced": DC_LS_REDUCED,
+                              "superlu": DC_LS_SUPERLU}
+#: the sparse LU's pivot test (csrc/dc_sparse_lu.h): a pivot must keep more than this fraction of the
+#: magnitude it was formed from (|u_jj| > tol (|a_jj| + sum |l_jk u_kj|)), else that Jacobian is
+#: factored by dense LU with partial pivoting. Mechanisms' pivots keep 1e-5 and more of it (a KKT
+#: pivot is a sum of terms of one sign); 1e-8 is half the double precision digits lost.
+DC_LU_PIVOT_TOL: Final = 1e-8
 
 DC_STORE_TIMES: Final = 1
 DC_STORE_STATES: Final = 2
@@ -76,12 +83,14 @@ DC_ST_NCF: Final = 5
 DC_ST_NETF: Final = 6
 DC_ST_GEVALS: Final = 7
 DC_ST_REINITS: Final = 8
-DC_ST_N: Final = 9
+DC_ST_LU_FALLBACKS: Final = 9
+DC_ST_N: Final = 10
 #: (C slot name, Python key) of dc_stats, in slot order
 _STATS: Final = (("DC_ST_STEPS", "n_steps"), ("DC_ST_RES", "n_res_evals"), ("DC_ST_JAC", "n_jac_evals"),
                  ("DC_ST_LSETUP", "n_lin_setups"), ("DC_ST_NNI", "n_nonlin_iters"),
                  ("DC_ST_NCF", "n_nonlin_conv_fails"), ("DC_ST_NETF", "n_err_test_fails"),
-                 ("DC_ST_GEVALS", "n_root_evals"), ("DC_ST_REINITS", "n_reinits"))
+                 ("DC_ST_GEVALS", "n_root_evals"), ("DC_ST_REINITS", "n_reinits"),
+                 ("DC_ST_LU_FALLBACKS", "n_lu_fallbacks"))
 #: the keys of dc_stats' slots, in slot order
 STAT_KEYS: Final = tuple(key for _, key in _STATS)
 
@@ -139,8 +148,11 @@ GROUPS: Final[tuple[tuple[str, tuple[tuple[str, int | float, str], ...]], ...]] 
         ("DC_ERR_USAGE", DC_ERR_USAGE, "called in a wrong state or with bad arguments"))),
     ("linear solvers of dc_open", (
         ("DC_LS_DENSE", DC_LS_DENSE, "SUNDIALS' dense LU of the whole iteration matrix"),
-        ("DC_LS_SPARSE", DC_LS_SPARSE, "SuperLU_MT"),
-        ("DC_LS_REDUCED", DC_LS_REDUCED, "dense LU of the reduced system, dc_reduced_ls.h"))),
+        ("DC_LS_SPARSE", DC_LS_SPARSE, "sparse LU on the model's plan, dc_sparse_lu.h"),
+        ("DC_LS_REDUCED", DC_LS_REDUCED, "dense LU of the reduced system, dc_reduced_ls.h"),
+        ("DC_LS_SUPERLU", DC_LS_SUPERLU, "SUNDIALS' SuperLU_MT"))),
+    ("the sparse LU's pivot test (dc_sparse_lu.h)", (
+        ("DC_LU_PIVOT_TOL", DC_LU_PIVOT_TOL, "|u_jj| > tol (|a_jj| + sum |l_jk u_kj|), else dense LU"),)),
     ("dc_advance's store_steps flags", (
         ("DC_STORE_TIMES", DC_STORE_TIMES, "step times, sizes and orders"),
         ("DC_STORE_STATES", DC_STORE_STATES, "also the states y and yp"))),

@@ -122,6 +122,7 @@ IDA_GROUPS: Final = _table(
         "const char* dc_model_name(void)",
         "int dc_n_parameters(void)",
         "int dc_n_extra(void)",
+        "int dc_sparse_plan(long long* out, int len)",
         "void dc_flag_name(long flag, char* buf, int len)",
         "int dc_eval_extra(int k, int n_points, int n_in, const double* const* inputs, const int* in_strides, "
         "double* out, int out_stride)",
@@ -170,8 +171,8 @@ IDA_GROUPS: Final = _table(
         "int dc_eval_jacobian_sparse(void* sp, double t, const double* y, const double* yp, double cj, "
         "double* data)",
         "int dc_eval_roots(void* sp, double t, const double* y, const double* yp, double* g)",
-        "int dc_solve_reduced(void* sp, int nk, double t, const double* y, const double* yp, double cj, "
-        "const double* A, double* b)")),
+        "int dc_solve_linear(void* sp, int kind, int nk, double t, const double* y, const double* yp, double cj, "
+        "const double* A, double* B, int nrhs, long long* info)")),
 )
 
 #: The data csrc/ida_driver.c exports: its build tag, read from the file before it is loaded.

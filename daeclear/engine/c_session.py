@@ -2,7 +2,8 @@
 through ctypes a few calls per segment (no Python per step); the same interface as the python
 backend (:class:`daeclear.engine.session_base.Session`). How the library is built and what the
 C driver does: docs/engine.md. Linear solvers (``linear_solver``): ``"reduced"`` (dense LU after
-eliminating the position rows), ``"dense"`` (SUNDIALS'), ``"sparse"`` (SuperLU_MT); ``"auto"``
+eliminating the position rows), ``"dense"`` (SUNDIALS'), ``"sparse"`` (sparse LU on the plan made at
+code generation, :mod:`daeclear.engine.sparse_plan`), ``"superlu"`` (SUNDIALS' SuperLU_MT); ``"auto"``
 picks sparse from ``SPARSE_MIN_STATES`` states on.
 """
 
@@ -44,21 +45,25 @@ from .sundials import SPARSE_LIBS
 
 __all__ = ["CSession", "SPARSE_MIN_STATES"]
 
-#: linear_solver="auto" uses the sparse solver from this many states on, the reduced dense LU below
+#: linear_solver="auto" uses the sparse LU from this many states on, the reduced dense LU below
 #: (measured: benchmarks/bench_linear_solver.py, docs/performance.md).
-SPARSE_MIN_STATES = 360
+SPARSE_MIN_STATES = 60
 _LS_NAMES = {code: name for name, code in LINEAR_SOLVER_CODES.items()}
 log = logging.getLogger("daeclear")
 
 
-def _resolve_linear_solver(requested: str, n: int, has_sparse: bool) -> str:
-    """The linear solver a compiled session uses: "auto" is sparse from SPARSE_MIN_STATES states on
-    (when the library has the sparse solver), the reduced dense LU below."""
+def _resolve_linear_solver(requested: str, n: int, has_superlu: bool, has_plan: bool = True) -> str:
+    """The linear solver a compiled session uses: "auto" is the sparse LU from SPARSE_MIN_STATES states
+    on (when the model has a sparse plan), the reduced dense LU below."""
     if requested == "auto":
-        return "sparse" if has_sparse and n >= SPARSE_MIN_STATES else "reduced"
-    if requested == "sparse" and not has_sparse:
-        raise DaeclearError("linear_solver='sparse' is not available: the scikit-sundae wheel lacks "
-                            f"lib{SPARSE_LIBS[0]} or lib{SPARSE_LIBS[1]}; use 'dense' or 'auto'")
+        return "sparse" if has_plan and n >= SPARSE_MIN_STATES else "reduced"
+    if requested == "superlu" and not has_superlu:
+        raise DaeclearError("linear_solver='superlu' is not available: the scikit-sundae wheel lacks "
+                            f"lib{SPARSE_LIBS[0]} or lib{SPARSE_LIBS[1]}; use 'sparse', 'dense' or 'auto'")
+    if requested == "sparse" and not has_plan:
+        raise DaeclearError("linear_solver='sparse' is not available for this model: its Newton matrix has a "
+                            "multiplier whose pivot no elimination fills (structurally singular static pivots); "
+                            "use 'dense', 'reduced' or 'auto'")
     return requested
 
 
@@ -79,7 +84,8 @@ class CSession(SessionBase):
         self._clib = clib
         self._lib = clib.lib
         self._build = build
-        self._linear_solver = _resolve_linear_solver(opts.linear_solver, n, clib.build_info.has_sparse)
+        self._linear_solver = _resolve_linear_solver(opts.linear_solver, n, clib.build_info.has_sparse,
+                                                     clib.sparse_plan[0])
         hd = take_pooled(self._pool_key(), opts)
         if hd is None:
             hd = self._open(opts, n, nr)  # "auto" may fall back from the sparse LU to the reduced one
@@ -487,22 +493,39 @@ class CSession(SessionBase):
             raise DaeclearError(f"the generated Jacobian failed at t={t}")
         return np.ascontiguousarray(out)
 
-    def solve_reduced(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float, b: np.ndarray,
-                      n_kinematic: int, matrix: np.ndarray | None = None) -> np.ndarray:
-        """x with J x = b, J the iteration matrix at (t, y, yp, cj) or the given n x n ``matrix``,
-        by the "reduced" linear solver with the first ``n_kinematic`` rows eliminated (its check
-        against a plain LU)."""
+    def solve_linear(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float, b: np.ndarray, *, solver: str,
+                     n_kinematic: int = 0, matrix: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+        """X with J X = B (b: n values, or n x k for k right-hand sides), J the iteration matrix at
+        (t, y, yp, cj) or the given n x n ``matrix``, by a new linear solver of the kind IDA uses:
+        ``solver`` "dense", "reduced" (the first ``n_kinematic`` rows eliminated) or "sparse" (the
+        model's plan; ``matrix`` zero outside the union pattern); and how many times the sparse LU
+        fell back to dense LU. A check of the solvers against a plain LU."""
         self._check_open()
-        y, yp, x = self._vec(y, "y"), self._vec(yp, "yp"), self._vec(b, "b").copy()
+        y, yp = self._vec(y, "y"), self._vec(yp, "yp")
+        B = np.array(b, dtype=float, order="F")
+        if B.shape[0] != self._n or B.ndim > 2:
+            raise ValueError(f"solve_linear: b has shape {B.shape}, must be ({self._n},) or ({self._n}, k)")
         A = None if matrix is None else np.asfortranarray(matrix, dtype=float)
         if A is not None and A.shape != (self._n, self._n):
-            raise ValueError(f"solve_reduced: matrix has shape {A.shape}, must be ({self._n}, {self._n})")
+            raise ValueError(f"solve_linear: matrix has shape {A.shape}, must be ({self._n}, {self._n})")
+        if solver not in ("dense", "reduced", "sparse"):
+            raise ValueError(f"solve_linear: solver={solver!r}, must be 'dense', 'reduced' or 'sparse'")
         self._sync_terms()
-        rc = self._lib.dc_solve_reduced(self._h, int(n_kinematic), float(t), y.ctypes.data, yp.ctypes.data,
-                                        float(cj), None if A is None else A.ctypes.data, x.ctypes.data)
+        info = np.zeros(1, dtype=np.int64)
+        rc = self._lib.dc_solve_linear(self._h, LINEAR_SOLVER_CODES[solver], int(n_kinematic), float(t),
+                                       y.ctypes.data, yp.ctypes.data, float(cj), None if A is None else A.ctypes.data,
+                                       B.ctypes.data, 1 if B.ndim == 1 else B.shape[1], info.ctypes.data)
         if rc:
-            raise DaeclearError(f"the reduced linear solve failed at t={t} ({'singular' if rc > 0 else 'error'})")
-        return x
+            why = {1: "singular", -2: "the matrix has a nonzero outside the union pattern",
+                   -3: "the model has no sparse plan"}.get(rc, "error")
+            raise DaeclearError(f"the {solver} linear solve failed at t={t} ({why})")
+        return B, int(info[0])
+
+    def solve_reduced(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float, b: np.ndarray,
+                      n_kinematic: int, matrix: np.ndarray | None = None) -> np.ndarray:
+        """x with J x = b by the "reduced" linear solver with the first ``n_kinematic`` rows eliminated
+        (:meth:`solve_linear`)."""
+        return self.solve_linear(t, y, yp, cj, b, solver="reduced", n_kinematic=n_kinematic, matrix=matrix)[0]
 
     def roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
         self._check_open()
@@ -542,7 +565,7 @@ class CSession(SessionBase):
 
     @property
     def linear_solver(self) -> str:
-        """"reduced", "dense" or "sparse": the LU IDA's Newton iteration uses in this session."""
+        """"reduced", "dense", "sparse" or "superlu": the LU IDA's Newton iteration uses in this session."""
         return self._linear_solver
 
     @property

@@ -23,6 +23,7 @@ from ..core.errors import AssemblyError
 from .build import (CSRC, BuildResult, CompileError, CompilerUnavailable, MemoTable, cache_dir, clear_memos,
                     compile_cached, compiler_command, driver_files, memo_table)
 from .library import DRIVER_ABI, ODE_DRIVER_ABI
+from .sparse_plan import c_source as plan_source, plan_of_model
 from .stall_guard import c_defines
 from .sundials import (SPARSE_LIBS, SUNDIALS_INCLUDE, SUNDIALS_LIBS, SUNDIALS_MAJOR, SundialsInfo, SundialsMismatch,
                        check_vendored, parse_index_size, read_build_tag, sundials_info, sundials_libraries,
@@ -199,9 +200,9 @@ def _term_tables(prefix: str, n_params: tuple[int, ...], kinds: dict[str, str]) 
 
 
 def generate_source(model: NormalizedModel, sensitivity: Any = None) -> str:
-    """CasADi-generated C for every function of the model, plus the dc_model table; with ``sensitivity``
-    (a :class:`daeclear.engine.sensitivity_functions.SensitivityFunctions` of the same model) its
-    functions too, named ``dcs_*``, and their ``dc_sens`` table (csrc/dc_sens.h)."""
+    """CasADi-generated C for every function of the model, plus the sparse LU's plan and the dc_model table;
+    with ``sensitivity`` (a :class:`daeclear.engine.sensitivity_functions.SensitivityFunctions` of the same
+    model) its functions too, named ``dcs_*``, and their ``dc_sens`` table (csrc/dc_sens.h)."""
     funs = [model.res, model.jac, *model.term_res, *model.term_jac, *model.extras]
     if model.roots is not None:
         funs.append(model.roots)
@@ -211,6 +212,8 @@ def generate_source(model: NormalizedModel, sensitivity: Any = None) -> str:
     lines = ["", "/* ---------------------------------------------------------------- daeclear table */",
              '#include "dc_model.h"',
              *_term_tables("dc_", model.n_params, {"term_res_tab": "dc_term{}_res", "term_jac_tab": "dc_term{}_jac"})]
+    plan_lines, plan_ref = plan_source(plan_of_model(model))
+    lines += plan_lines
     roots_entry = _fun_entry("dc_roots") if model.roots is not None else _NO_FUN
     ne = len(model.extras)
     lines += [f"const int dc_n_extras = {ne};", f"const dc_fun_t dc_extra_tab[{max(ne, 1)}] = {{",
@@ -218,7 +221,7 @@ def generate_source(model: NormalizedModel, sensitivity: Any = None) -> str:
               "const dc_model_t dc_model = {", f"  {model.n}, {nt}, {model.n_roots}, {model.n_parameters},",
               f"  {'dc_n_params_tab' if nt else '0'},", f"  {_fun_entry('dc_res')},", f"  {_fun_entry('dc_jac')},",
               f"  {roots_entry},", f"  {'dc_term_res_tab' if nt else '0'},", f"  {'dc_term_jac_tab' if nt else '0'},",
-              f"  {_c_string(model.name)}", "};", ""]
+              f"  {plan_ref},", f"  {_c_string(model.name)}", "};", ""]
     if sensitivity is not None:
         lines += _sensitivity_table(sensitivity)
     return src + "\n".join(lines)

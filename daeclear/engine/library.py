@@ -26,7 +26,7 @@ __all__ = ["DRIVER_ABI", "ODE_DRIVER_ABI", "Prototypes", "StaleLibrary", "open_l
 #: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
 #: and checked when a library is loaded: bump it when a dc_* signature (c_api.py) or what a dc_* call writes
 #: changes.
-DRIVER_ABI = 7
+DRIVER_ABI = 8
 #: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
 ODE_DRIVER_ABI = 3
 
@@ -146,6 +146,10 @@ class ModelLibrary(LoadedLibrary):
             raise StaleLibrary(f"{path}: {why}")
         self.build_info: SundialsInfo = info  # what it was compiled for
         self.sundials_version = loaded  # SUNDIALSGetVersion of the SUNDIALS it loaded
+        plan = (ctypes.c_longlong * 3)()
+        lib.dc_sparse_plan(ctypes.addressof(plan), 3)
+        #: whether the model has a sparse LU plan, and its union and L + U nonzeros (dc_sparse_plan)
+        self.sparse_plan: tuple[bool, int, int] = (bool(plan[0]), int(plan[1]), int(plan[2]))
 
     def model_info(self, n_terms: int) -> tuple[int, int, int, list[int]]:
         """(n, terms, roots, parameters per term) of the compiled model."""

@@ -290,7 +290,8 @@ class PythonSession(SessionBase):
         c = self._count
         unknown = dict.fromkeys(("n_lin_setups", "n_nonlin_iters", "n_nonlin_conv_fails", "n_err_test_fails"), -1)
         return {"n_steps": c["steps"], "n_res_evals": c["res"], "n_jac_evals": c["jac"], **unknown,
-                "n_root_evals": c["roots"], "n_reinits": c["reinits"], "solve_time": self._solve_time,
+                "n_root_evals": c["roots"], "n_reinits": c["reinits"], "n_lu_fallbacks": 0,
+                "solve_time": self._solve_time,
                 "compile_time": 0.0, "codegen_time": 0.0, "cache_hit": False, "linear_solver": "dense",
                 "jac_nnz": self._n * self._n}
 

@@ -60,8 +60,10 @@ class SolverOptions:
         Cap on the total number of steps; the run fails cleanly beyond it.
     step : float or None
         Step size, s, of "rk4" and "euler" (required there); refused by the others.
-    linear_solver : {"auto", "reduced", "dense", "sparse"}
-        LU of IDA's Newton iteration in the compiled backend (docs/engine.md).
+    linear_solver : {"auto", "reduced", "dense", "sparse", "superlu"}
+        LU of IDA's Newton iteration in the compiled backend (docs/engine.md): "sparse" is the sparse LU
+        planned when the model's C is generated, "superlu" SUNDIALS' SuperLU_MT; "auto": sparse from
+        ``daeclear.engine.c_session.SPARSE_MIN_STATES`` states on, "reduced" below.
     start : {"ideal", "declared"}
         The start without ``y0``: "ideal" (the chapter's, clearance joints centred) or "declared".
     allow_penetration : bool

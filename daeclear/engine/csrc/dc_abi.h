@@ -16,8 +16,12 @@
 
 /* linear solvers of dc_open */
 #define DC_LS_DENSE 0 /* SUNDIALS' dense LU of the whole iteration matrix */
-#define DC_LS_SPARSE 1 /* SuperLU_MT */
+#define DC_LS_SPARSE 1 /* sparse LU on the model's plan, dc_sparse_lu.h */
 #define DC_LS_REDUCED 2 /* dense LU of the reduced system, dc_reduced_ls.h */
+#define DC_LS_SUPERLU 3 /* SUNDIALS' SuperLU_MT */
+
+/* the sparse LU's pivot test (dc_sparse_lu.h) */
+#define DC_LU_PIVOT_TOL 1e-08 /* |u_jj| > tol (|a_jj| + sum |l_jk u_kj|), else dense LU */
 
 /* dc_advance's store_steps flags */
 #define DC_STORE_TIMES 1 /* step times, sizes and orders */
@@ -46,7 +50,8 @@
 #define DC_ST_NETF 6 /* n_err_test_fails */
 #define DC_ST_GEVALS 7 /* n_root_evals */
 #define DC_ST_REINITS 8 /* n_reinits */
-#define DC_ST_N 9 /* slots */
+#define DC_ST_LU_FALLBACKS 9 /* n_lu_fallbacks */
+#define DC_ST_N 10 /* slots */
 
 /* dc_build_info's slots */
 #define DC_BI_MAJOR 0 /* SUNDIALS major version */

@@ -20,6 +20,7 @@ DC_API int dc_model_info(int* n, int* n_terms, int* n_roots, int* n_params);
 DC_API const char* dc_model_name(void);
 DC_API int dc_n_parameters(void);
 DC_API int dc_n_extra(void);
+DC_API int dc_sparse_plan(long long* out, int len);
 DC_API void dc_flag_name(long flag, char* buf, int len);
 DC_API int dc_eval_extra(int k, int n_points, int n_in, const double* const* inputs, const int* in_strides,
                          double* out, int out_stride);
@@ -73,8 +74,8 @@ DC_API int dc_eval_jacobian(void* sp, double t, const double* y, const double* y
 DC_API int dc_eval_jacobian_sparse(void* sp, double t, const double* y, const double* yp, double cj,
                                    double* data);
 DC_API int dc_eval_roots(void* sp, double t, const double* y, const double* yp, double* g);
-DC_API int dc_solve_reduced(void* sp, int nk, double t, const double* y, const double* yp, double cj,
-                            const double* A, double* b);
+DC_API int dc_solve_linear(void* sp, int kind, int nk, double t, const double* y, const double* yp, double cj,
+                           const double* A, double* B, int nrhs, long long* info);
 
 /* ---------------------------------------------------------------- ode_driver.c */
 

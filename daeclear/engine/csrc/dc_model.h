@@ -30,6 +30,24 @@ typedef struct {
   const char* name;
 } dc_fun_t;
 
+/* The sparse LU's plan of the Newton matrix, made by daeclear/engine/sparse_plan.py when the model's C
+ * is generated (csrc/dc_sparse_lu.h factors numerically on it). Pivot k is unknown perm[k]; the
+ * factors L + U of the permuted matrix are stored by columns in pivot order (rows ascending: U above
+ * the diagonal at fdiag[j], unit L's multipliers below it); row j of L is the pairs (lrowcol,
+ * lrowpos) from lrowptr[j]: the column k < j and the position of L(j, k). */
+typedef struct {
+  int n, nnz, fnnz;           /* size, nonzeros of the union pattern and of L + U */
+  const int* colptr;          /* [n + 1] the union pattern (CSC, rows ascending), checked at dc_open */
+  const int* rowind;          /* [nnz] */
+  const int* perm;            /* [n] */
+  const int* fcolptr;         /* [n + 1] */
+  const int* frow;            /* [fnnz] */
+  const int* fdiag;           /* [n] */
+  const int* lrowptr;         /* [n + 1] */
+  const int* lrowcol;         /* [nnz of L] */
+  const int* lrowpos;         /* [nnz of L] */
+} dc_lu_plan;
+
 typedef struct {
   int n;                      /* state size */
   int n_terms;                /* number of switchable terms */
@@ -41,6 +59,7 @@ typedef struct {
   dc_fun_t roots;             /* (t, y, yp, P) -> g[n_roots]; eval == 0 when n_roots == 0 */
   const dc_fun_t* term_res;   /* [n_terms] (t, y, yp, p, P) -> r_k[n] */
   const dc_fun_t* term_jac;   /* [n_terms] (t, y, yp, p, cj, P) -> J_k (sparse, n x n) */
+  const dc_lu_plan* lu;       /* the sparse LU's plan, NULL when its static pivots are structurally singular */
   const char* name;
 } dc_model_t;
 

@@ -16,8 +16,8 @@
  * drivers, guides on the ground). Otherwise (a guide on a moving body, mu off the manifold) the
  * dropped off-diagonal part only changes IDA's iteration matrix (a modified Newton method, as
  * IDA's own stale Jacobians are), never the residual it converges to. J itself is left as the
- * Jacobian callback wrote it (the plain dense solver factors it in place): the solve reads its
- * J_rq and J_qr blocks.
+ * Jacobian callback wrote it (the plain dense solver factors it in place): the factorisation copies
+ * the J_rq and J_qr blocks the solve needs. A dc_linsol (dc_linsol.h): rls_create.
  */
 #ifndef DAECLEAR_DC_REDUCED_LS_H
 #define DAECLEAR_DC_REDUCED_LS_H
@@ -25,11 +25,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sundials/sundials_dense.h>
-#include <sundials/sundials_linearsolver.h>
-#include <sunmatrix/sunmatrix_dense.h>
+#include "dc_linsol.h"
 
 typedef struct {
   sunindextype n, nk;  /* system size; leading kinematic rows eliminated (0: a plain dense LU) */
+  double** a;          /* [n] the columns of the matrix factored last */
   sunindextype* piv;   /* [n] pivots of the Schur complement's LU */
   double* schur;       /* [(n - nk)^2], column-major */
   double** cols;       /* [n] column pointers into schur */
@@ -42,35 +42,20 @@ typedef struct {
   int* rq_start;       /* [nk + 1] nonzeros of J_rq by column (few: a coordinate enters few */
   int* rq_row;         /* equations): rows within r, values */
   double* rq_v;
-  sunindextype last_flag;
 } dc_reduced_ls;
 
-#define RLS(S) ((dc_reduced_ls*)(S)->content)
+#define RLS(ls) ((dc_reduced_ls*)(ls)->content)
 
-static SUNLinearSolver_Type rls_gettype(SUNLinearSolver S) {
-  (void)S;
-  return SUNLINEARSOLVER_DIRECT;
-}
-
-static SUNLinearSolver_ID rls_getid(SUNLinearSolver S) {
-  (void)S;
-  return SUNLINEARSOLVER_CUSTOM;
-}
-
-static SUNErrCode rls_initialize(SUNLinearSolver S) {
-  RLS(S)->last_flag = 0;
-  return SUN_SUCCESS;
-}
-
-/* Factor the Schur complement of J's kinematic block; a positive flag (singular) lets IDA
- * retry with a smaller step, as the plain dense solver's does. */
-static int rls_setup(SUNLinearSolver S, SUNMatrix A) {
-  dc_reduced_ls* c = RLS(S);
+/* Factor the Schur complement of J's kinematic block (J column-major in values, left as it is);
+ * 1 (singular) lets IDA retry with a smaller step, as the plain dense solver's does. */
+static int rls_factor(dc_linsol* ls, double* values) {
+  dc_reduced_ls* c = RLS(ls);
   const sunindextype n = c->n, nk = c->nk, nr = n - nk;
-  double** a = SUNDenseMatrix_Cols(A); /* a[j][i] = J(i, j) */
+  for (sunindextype j = 0; j < n; ++j) c->a[j] = values + (size_t)j * (size_t)n; /* a[j][i] = J(i, j) */
+  double* const* a = c->a;
   long nrq = 0;
   for (sunindextype k = 0; k < nk; ++k) {
-    if (a[k][k] == 0.0) return (int)(c->last_flag = SUNLS_LUFACT_FAIL);
+    if (a[k][k] == 0.0) return 1;
     c->dinv[k] = 1.0 / a[k][k];
     c->rq_start[k] = (int)nrq;
     const double* rq = a[k] + nk; /* column k of J_rq */
@@ -95,10 +80,9 @@ static int rls_setup(SUNLinearSolver S, SUNMatrix A) {
       for (int e = c->rq_start[k]; e < c->rq_start[k + 1]; ++e) col[c->rq_row[e]] -= c->rq_v[e] * f;
     }
   }
-  c->last_flag = nr ? SUNDlsMat_denseGETRF(c->cols, nr, nr, c->piv) : 0;
-  if (c->last_flag > 0) return SUNLS_LUFACT_FAIL;
+  if (nr && SUNDlsMat_denseGETRF(c->cols, nr, nr, c->piv) > 0) return 1;
   for (sunindextype k = 0; k < nr; ++k) c->rdiag[k] = 1.0 / c->cols[k][k];
-  return SUN_SUCCESS;
+  return 0;
 }
 
 /* x[i] -= c0[i] x0 + c1[i] x1 + c2[i] x2 + c3[i] x3 for i in [lo, hi): two rows at a time in
@@ -172,13 +156,10 @@ static void rls_lu_solve(const dc_reduced_ls* c, sunindextype n, double* x) {
   }
 }
 
-static int rls_solve(SUNLinearSolver S, SUNMatrix A, N_Vector x, N_Vector b, sunrealtype tol) {
-  dc_reduced_ls* c = RLS(S);
-  const sunindextype n = c->n, nk = c->nk, nr = n - nk;
-  double* xx = N_VGetArrayPointer(x);
-  (void)A; /* rls_setup copied what the solve needs */
-  (void)tol;
-  if (x != b) memcpy(xx, N_VGetArrayPointer(b), sizeof(double) * (size_t)n);
+/* xx <- J^-1 xx with the factorisation of rls_factor (which copied what the solve needs). */
+static void rls_solve(dc_linsol* ls, double* xx) {
+  dc_reduced_ls* c = RLS(ls);
+  const sunindextype nk = c->nk, nr = c->n - nk;
   double* xr = xx + nk;
   for (sunindextype k = 0; k < nk; ++k) { /* b_r - J_rq D^-1 b_q */
     const double f = xx[k] * c->dinv[k];
@@ -188,14 +169,13 @@ static int rls_solve(SUNLinearSolver S, SUNMatrix A, N_Vector x, N_Vector b, sun
   rls_lu_solve(c, nr, xr);
   for (long e = 0; e < c->qr_nnz; ++e) xx[c->qr_k[e]] -= c->qr_v[e] * xr[c->qr_j[e]];
   for (sunindextype k = 0; k < nk; ++k) xx[k] *= c->dinv[k];
-  c->last_flag = 0;
-  return SUN_SUCCESS;
 }
 
-static sunindextype rls_lastflag(SUNLinearSolver S) { return RLS(S)->last_flag; }
-
-static void rls_free_content(dc_reduced_ls* c) {
+static void rls_destroy(dc_linsol* ls) {
+  dc_reduced_ls* c = RLS(ls);
+  free(ls);
   if (!c) return;
+  free(c->a);
   free(c->piv);
   free(c->schur);
   free(c->cols);
@@ -210,17 +190,9 @@ static void rls_free_content(dc_reduced_ls* c) {
   free(c);
 }
 
-static SUNErrCode rls_free(SUNLinearSolver S) {
-  if (!S) return SUN_SUCCESS;
-  rls_free_content(RLS(S));
-  S->content = NULL;
-  SUNLinSolFreeEmpty(S);
-  return SUN_SUCCESS;
-}
-
 /* (Re)size the solver for nk eliminated kinematic rows (0 <= nk < n); -1 when out of memory. */
-static int rls_set_kinematic_rows(SUNLinearSolver S, sunindextype nk) {
-  dc_reduced_ls* c = RLS(S);
+static int rls_set_kinematic_rows(dc_linsol* ls, sunindextype nk) {
+  dc_reduced_ls* c = RLS(ls);
   const sunindextype n = c->n, nr = n - nk;
   if (nk < 0 || nk >= n) return -1;
   free(c->schur);
@@ -246,31 +218,25 @@ static int rls_set_kinematic_rows(SUNLinearSolver S, sunindextype nk) {
   return 0;
 }
 
-/* A reduced dense solver for n x n systems, starting with nk = 0 (a plain dense LU) until
- * rls_set_kinematic_rows is told the state layout. NULL when out of memory. */
-static SUNLinearSolver rls_create(sunindextype n, SUNContext ctx) {
-  SUNLinearSolver S = SUNLinSolNewEmpty(ctx);
-  if (!S) return NULL;
+/* A reduced dense solver for n x n systems (kind: its DC_LS_* code), starting with nk = 0 (a plain
+ * dense LU) until rls_set_kinematic_rows is told the state layout. NULL when out of memory. */
+static dc_linsol* rls_create(int kind, sunindextype n) {
   dc_reduced_ls* c = (dc_reduced_ls*)calloc(1, sizeof(dc_reduced_ls));
-  S->content = c;
-  S->ops->gettype = rls_gettype;
-  S->ops->getid = rls_getid;
-  S->ops->initialize = rls_initialize;
-  S->ops->setup = rls_setup;
-  S->ops->solve = rls_solve;
-  S->ops->lastflag = rls_lastflag;
-  S->ops->free = rls_free;
-  if (c) {
-    c->n = n;
-    c->piv = (sunindextype*)calloc((size_t)n, sizeof(sunindextype));
-    c->cols = (double**)calloc((size_t)n, sizeof(double*));
-    c->rdiag = (double*)calloc((size_t)n, sizeof(double));
-  }
-  if (!c || !c->piv || !c->cols || !c->rdiag || rls_set_kinematic_rows(S, 0) != 0) {
-    rls_free(S);
+  dc_linsol* ls = c ? dcls_new(kind, (int)n, c, rls_factor, rls_solve, rls_destroy) : NULL;
+  if (!ls) {
+    free(c);
     return NULL;
   }
-  return S;
+  c->n = n;
+  c->a = (double**)calloc((size_t)n, sizeof(double*));
+  c->piv = (sunindextype*)calloc((size_t)n, sizeof(sunindextype));
+  c->cols = (double**)calloc((size_t)n, sizeof(double*));
+  c->rdiag = (double*)calloc((size_t)n, sizeof(double));
+  if (!c->a || !c->piv || !c->cols || !c->rdiag || rls_set_kinematic_rows(ls, 0) != 0) {
+    rls_destroy(ls);
+    return NULL;
+  }
+  return ls;
 }
 
 #undef RLS

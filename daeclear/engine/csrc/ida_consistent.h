@@ -90,8 +90,7 @@ static int project_kept_roots(dc_session* s, double t, double* y, const double* 
 static int make_consistent(dc_session* s, double t, double* y, double* yp, const int* on, const double* par) {
   const int n = s->n, nq = s->lay_nq, m = s->lay_m;
   double* Qc = s->lay_buf;
-  double* Fk = Qc + nq;
-  double* sol = Fk + nq;
+  double* sol = Qc + 2 * nq;
   double* K = sol + nq + m + 1;
   const double* q = y;
   const double* v = y + nq;
@@ -100,8 +99,7 @@ static int make_consistent(dc_session* s, double t, double* y, double* yp, const
   for (int k = 0; k < s->n_terms; ++k) {
     if (!on[k]) continue;
     const double* in_f[5] = {&tt, q, v, par + s->param_off[k], s->P};
-    if (eval_extra1(s, s->lay_force0 + k, 5, in_f, Fk) != 0) return -1;
-    for (int j = 0; j < nq; ++j) Qc[j] += Fk[j];
+    if (add_extra1(s, s->lay_force0 + k, 5, in_f, Qc) != 0) return -1; /* its nonzeros: two bodies' */
   }
   const double* in_a[5] = {&tt, q, v, Qc, s->P};
   if (eval_extra1(s, s->lay_accel, 5, in_a, sol) != 0) return -1;
@@ -173,7 +171,7 @@ DC_API int dc_set_layout(void* sp, int nq, int m, int ggl, int track_work, int a
     if (!s->xarg || !s->xres || !s->xiw || !s->xw || !s->xnz) return -1;
   }
   s->lay_n_channels = nc;
-  if (s->lin_kind == DC_LS_REDUCED && rls_set_kinematic_rows(s->LS, nq) != 0) return -1;
+  if (s->lin_kind == DC_LS_REDUCED && rls_set_kinematic_rows(s->lin, nq) != 0) return -1;
   s->lay_ready = 1;
   return 0;
 }

@@ -103,6 +103,17 @@ DC_API void dc_stats(void* sp, long long* out) {
   if (!s->ready)
     for (int i = 0; i < DC_ST_N; ++i) cur[i] = 0;
   for (int i = 0; i < DC_ST_N; ++i) out[i] = s->base[i] + (i == DC_ST_REINITS ? 0 : cur[i]);
+  out[DC_ST_LU_FALLBACKS] = s->lin ? s->lin->n_fallback : 0;
+}
+
+/* The model's sparse LU plan: out[0] 1 if it has one, out[1] the union's nonzeros, out[2] those of
+ * L + U (0 without a plan); returns how many values were written. */
+DC_API int dc_sparse_plan(long long* out, int len) {
+  const dc_lu_plan* p = dc_model.lu;
+  const long long info[3] = {p != NULL, p ? p->nnz : 0, p ? p->fnnz : 0};
+  int k = len < 3 ? len : 3;
+  for (int i = 0; i < k; ++i) out[i] = info[i];
+  return k;
 }
 
 /* Model evaluation with the current active terms and parameters (tests, consistency). */
@@ -122,26 +133,50 @@ DC_API int dc_eval_jacobian_sparse(void* sp, double t, const double* y, const do
   return eval_jac((dc_session*)sp, t, y, yp, cj, data, 1, 0);
 }
 
-/* Solve J x = b with the reduced dense solver (nk position rows eliminated), J the iteration
- * matrix at (t, y, yp, cj) of the active terms, or the given column-major n x n matrix A (not
- * NULL); b is overwritten by x. The solver IDA uses, on its own copy: a check against a plain
- * LU. 0 ok, 1 singular, -1 evaluation failed or no memory. */
-DC_API int dc_solve_reduced(void* sp, int nk, double t, const double* y, const double* yp, double cj,
-                            const double* A, double* b) {
+/* Solve J X = B (nrhs right-hand sides, column k at B + k n, overwritten by the solutions) with a new
+ * solver of the given kind (DC_LS_DENSE, DC_LS_REDUCED with nk position rows eliminated, DC_LS_SPARSE
+ * on the model's plan), J the iteration matrix at (t, y, yp, cj) of the active terms, or the given
+ * column-major n x n matrix A (not NULL; sparse: zero outside the union pattern). The solvers IDA
+ * uses, on their own copies: a check against a plain LU. info[0]: the sparse LU's dense fallbacks.
+ * 0 ok, 1 singular, -1 evaluation failed, no memory or a kind without this check, -2 A has a nonzero
+ * outside the union pattern, -3 the model has no sparse plan. */
+DC_API int dc_solve_linear(void* sp, int kind, int nk, double t, const double* y, const double* yp, double cj,
+                           const double* A, double* B, int nrhs, long long* info) {
   dc_session* s = (dc_session*)sp;
-  SUNMatrix J = SUNDenseMatrix(s->n, s->n, s->ctx);
-  SUNLinearSolver LS = J ? rls_create(s->n, s->ctx) : NULL;
-  N_Vector x = N_VMake_Serial(s->n, b, s->ctx);
+  const int n = s->n;
+  const int dense = kind != DC_LS_SPARSE;
+  const size_t len = dense ? (size_t)n * (size_t)n : (size_t)(s->jp_nnz ? s->jp_nnz : 1);
+  dc_linsol* ls = NULL;
   int rc = -1;
-  if (J && A) memcpy(SUNDenseMatrix_Data(J), A, sizeof(double) * (size_t)s->n * (size_t)s->n);
-  if (J && LS && x && rls_set_kinematic_rows(LS, nk) == 0 &&
-      (A || eval_jac(s, t, y, yp, cj, SUNDenseMatrix_Data(J), 0, 0) == 0)) {
-    rc = SUNLinSolSetup(LS, J) != SUN_SUCCESS;
-    if (rc == 0) rc = SUNLinSolSolve(LS, J, x, x, 0.0) != SUN_SUCCESS ? -1 : 0;
+  if (info) info[0] = 0;
+  if (kind == DC_LS_SPARSE && !dc_model.lu) return -3;
+  if (kind == DC_LS_DENSE) ls = dcls_dense_create(kind, n);
+  else if (kind == DC_LS_REDUCED) ls = rls_create(kind, n);
+  else if (kind == DC_LS_SPARSE) ls = dcls_sparse_create(kind, dc_model.lu);
+  double* values = ls ? (double*)calloc(len, sizeof(double)) : NULL;
+  if (ls && values && (kind != DC_LS_REDUCED || rls_set_kinematic_rows(ls, nk) == 0)) {
+    if (!A) {
+      rc = eval_jac(s, t, y, yp, cj, values, !dense, 0) == 0 ? 0 : -1;
+    } else if (dense) {
+      memcpy(values, A, sizeof(double) * len);
+      rc = 0;
+    } else { /* A onto the union pattern, every nonzero of A on it */
+      dc_int count = 0;
+      rc = 0;
+      for (int c = 0; c < n; ++c)
+        for (sunindextype k = s->jp_colptr[c]; k < s->jp_colptr[c + 1]; ++k)
+          values[k] = A[(size_t)c * (size_t)n + (size_t)s->jp_rowind[k]];
+      for (size_t i = 0; i < (size_t)n * (size_t)n; ++i) count += A[i] != 0.0;
+      for (dc_int k = 0; k < s->jp_nnz; ++k) count -= values[k] != 0.0;
+      if (count != 0) rc = -2;
+    }
+    if (rc == 0) rc = ls->factor(ls, values);
+    if (rc == 0) ls->solve_many(ls, B, nrhs, n);
+    if (rc < 0 && rc != -2) rc = -1;
+    if (info) info[0] = ls->n_fallback;
   }
-  if (x) N_VDestroy(x);
-  if (LS) SUNLinSolFree(LS);
-  if (J) SUNMatDestroy(J);
+  free(values);
+  dcls_free(ls);
   return rc;
 }
 
@@ -154,7 +189,7 @@ DC_API double dc_first_step(void* sp) {
   return IDAGetActualInitStep(((dc_session*)sp)->ida, &h) < 0 ? 0.0 : h;
 }
 
-/* The session's linear solver: DC_LS_DENSE, DC_LS_SPARSE or DC_LS_REDUCED. */
+/* The session's linear solver: DC_LS_DENSE, DC_LS_SPARSE, DC_LS_REDUCED or DC_LS_SUPERLU. */
 DC_API int dc_linear_solver(void* sp) { return ((dc_session*)sp)->lin_kind; }
 
 /* The union pattern as 64-bit CSC arrays: colptr[n + 1], rowind[dc_jac_nnz]. */

@@ -149,12 +149,13 @@ static void entry_position(const dc_session* s, dc_int i, int sparse, int* row, 
   *col = c;
 }
 
-/* The matrix's storage for eval_jac. A sparse matrix gets its pattern back first: IDA zeroes the
- * matrix before every call (SUNMatZero), and for a SUNSparseMatrix that clears the index arrays
- * too. */
+/* The matrix's storage for eval_jac: the union values (sparse), the SUNSparseMatrix's data with its
+ * pattern put back first (superlu: IDA zeroes the matrix before every call, SUNMatZero, and for a
+ * SUNSparseMatrix that clears the index arrays too), or the dense matrix's data. */
 static double* jac_storage(dc_session* s, SUNMatrix J) {
+  if (s->lin_kind == DC_LS_SPARSE) return dcls_values_data(J);
 #if DC_HAVE_SPARSE
-  if (LIN_SPARSE(s)) {
+  if (s->lin_kind == DC_LS_SUPERLU) {
     memcpy(SUNSparseMatrix_IndexPointers(J), s->jp_colptr, sizeof(sunindextype) * ((size_t)s->n + 1));
     memcpy(SUNSparseMatrix_IndexValues(J), s->jp_rowind, sizeof(sunindextype) * (size_t)s->jp_nnz);
     return SUNSparseMatrix_Data(J);
@@ -166,7 +167,7 @@ static double* jac_storage(dc_session* s, SUNMatrix J) {
 /* An entry of the assembled Jacobian that is not finite (its index in the storage), or -1: in
  * the dense matrix only the positions of the base and active terms' patterns can be. */
 static dc_int jac_first_nonfinite(const dc_session* s, const double* Jd) {
-  if (LIN_SPARSE(s)) return dc_first_nonfinite(Jd, (int)s->jp_nnz);
+  if (LIN_UNION(s)) return dc_first_nonfinite(Jd, (int)s->jp_nnz);
   for (int p = 0; p <= s->n_terms; ++p) {
     if (p > 0 && !s->active[p - 1]) continue;
     const dc_int i = dc_sp_first_nonfinite(jac_part(p)->sparsity_out(0), Jd, s->n);
@@ -183,7 +184,7 @@ static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vec
   (void)t1;
   (void)t2;
   (void)t3;
-  int rc = eval_jac(s, t, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), cj, Jd, LIN_SPARSE(s), 1);
+  int rc = eval_jac(s, t, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), cj, Jd, LIN_UNION(s), 1);
   if (rc) {
     if (rc == -1)
       set_msg(s->cb_msg, "the generated base Jacobian returned an error at t=%.17g", t);
@@ -195,16 +196,11 @@ static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vec
   const dc_int i = jac_first_nonfinite(s, Jd);
   if (i >= 0) {
     int row, col;
-    entry_position(s, i, LIN_SPARSE(s), &row, &col);
+    entry_position(s, i, LIN_UNION(s), &row, &col);
     set_msg(s->cb_msg, "Jacobian entry (%d, %d) is %g at t=%.17g", row, col, Jd[i], t);
     return 1;
   }
-#if DC_HAVE_SPARSE
-  if (LIN_SPARSE(s)) {
-    ONE_OMP_THREAD(); /* IDA factors the matrix next, on this thread */
-    s->lu_factored = 1; /* see free_superlumt */
-  }
-#endif
+  s->lin->cj = cj; /* IDA factors this matrix next */
   return 0;
 }
 
@@ -289,6 +285,18 @@ static int build_jac_pattern(dc_session* s) {
 static int eval_extra1(dc_session* s, int k, int n_in, const double* const* in, double* out) {
   for (int j = 0; j < n_in; ++j) s->xarg[j] = in[j];
   return extra_dense(&dc_extra_tab[k], s->xarg, s->xres, s->xiw, s->xw, 0, out, s->xnz);
+}
+
+/* eval_extra1 added into out (the output's length) instead of written: a sparse output's nonzeros
+ * only (a contact term's generalized force touches two bodies of a long chain). */
+static int add_extra1(dc_session* s, int k, int n_in, const double* const* in, double* out) {
+  const dc_fun_t* f = &dc_extra_tab[k];
+  const dc_int* sp = f->sparsity_out(0);
+  for (int j = 0; j < n_in; ++j) s->xarg[j] = in[j];
+  s->xres[0] = s->xnz;
+  if (f->eval(s->xarg, s->xres, s->xiw, s->xw, 0) != 0) return -1;
+  dc_sp_scatter(sp, s->xnz, out, sp[0], 1);
+  return 0;
 }
 
 #endif

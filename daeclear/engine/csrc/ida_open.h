@@ -33,68 +33,88 @@ static double first_step(const dc_session* s, const double* y, const double* yp)
   return s->max_step > 0.0 ? fmin(h, s->max_step) : h;
 }
 
-/* ------------------------------------------------------------------ sparse LU (SuperLU_MT)
- * SUNDIALS' SuperLU_MT solver starts over whenever it is initialized, which IDA does at the
- * first step after every IDAReInit, i.e. at every contact event: the next factorization then
+/* ------------------------------------------------------------------ SuperLU_MT (linear_solver="superlu")
+ * SUNDIALS' SuperLU_MT solver starts over whenever it is initialized: its next factorization
  * recomputes the column ordering and allocates new L and U storage without freeing the old
- * (measured on a chain of 8 links: resident memory grew by 60 MB over 600 events, and each
- * event paid a full symbolic factorization). The session's pattern never changes (the union of
- * all parts), so the ordering and storage of the first factorization stay valid for all later
- * ones: dc_open initializes the solver once and replaces its initialize operation by a no-op,
- * so every later factorization takes SuperLU_MT's refactorization path (as within a segment). */
+ * (measured on a chain of 8 links when IDA initialized it at every restart: resident memory grew by
+ * 60 MB over 600 events, and each event paid a full symbolic factorization). Here it sits behind
+ * the dc_linsol interface like every solver: IDA initializes only the wrapper (dc_linsol.h), this
+ * solver is initialized once, and every factorization after the first takes SuperLU_MT's
+ * refactorization path on the session's one pattern (the union of all parts). */
 #if DC_HAVE_SPARSE
-static SUNErrCode keep_factorization(SUNLinearSolver S) {
-  (void)S;
-  return 0;
+typedef struct {
+  dc_session* s;
+  SUNLinearSolver sl; /* SuperLU_MT, one thread */
+  N_Vector v;         /* a vector without data of its own: the solve's x */
+  int factored;       /* a Jacobian was handed to it */
+} dcls_superlu;
+
+static int superlu_factor(dc_linsol* ls, double* values) {
+  dcls_superlu* c = (dcls_superlu*)ls->content;
+  (void)values; /* the data of s->A, which SuperLU_MT reads itself */
+  ONE_OMP_THREAD(); /* it factors on this thread */
+  c->factored = 1;
+  const int rc = SUNLinSolSetup(c->sl, c->s->A);
+  return rc > 0 ? 1 : rc < 0 ? -1 : 0;
 }
 
-/* Initialize the solver once (its first factorization sets the ordering and storage), then
- * replace the initialize operation in this solver's own operations table (every
- * SUNLinearSolver has its own, so no other solver is affected) by keep_factorization. The
- * original operation is kept in the session for free_superlumt. Returns the initialize result. */
-static int keep_first_factorization(dc_session* s) {
-  SUNErrCode (*init)(SUNLinearSolver) = s->LS->ops->initialize;
-  if (!init) return -1;
-  s->lu_initialize = init;
-  if (init(s->LS) != 0) return -1;
-  s->LS->ops->initialize = keep_factorization;
-  return 0;
+static void superlu_solve(dc_linsol* ls, double* x) {
+  dcls_superlu* c = (dcls_superlu*)ls->content;
+  N_VSetArrayPointer(x, c->v);
+  SUNLinSolSolve(c->sl, c->s->A, c->v, c->v, 0.0);
 }
 
 /* SUNLinSolFree_SuperLUMT reads uninitialized options when the solver never factorized (a
  * session opened and closed without a step): factor an n x n identity first, so it has. */
-static void free_superlumt(dc_session* s) {
-  if (!s->lu_factored) {
-    SUNMatrix I = SUNSparseMatrix(s->n, s->n, s->n, CSC_MAT, s->ctx);
-    if (!I) return; /* leave the solver allocated rather than crash */
-    if (s->lu_initialize) s->lu_initialize(s->LS); /* the real one: a first factorization */
-    sunindextype* cp = SUNSparseMatrix_IndexPointers(I);
-    sunindextype* ri = SUNSparseMatrix_IndexValues(I);
-    double* d = SUNSparseMatrix_Data(I);
-    for (int i = 0; i < s->n; ++i) {
-      cp[i] = i;
-      ri[i] = i;
-      d[i] = 1.0;
+static void superlu_destroy(dc_linsol* ls) {
+  dcls_superlu* c = (dcls_superlu*)ls->content;
+  if (c && c->sl && !c->factored) {
+    const int n = ls->n;
+    SUNMatrix I = SUNSparseMatrix(n, n, n, CSC_MAT, c->s->ctx);
+    if (I) {
+      sunindextype* cp = SUNSparseMatrix_IndexPointers(I);
+      sunindextype* ri = SUNSparseMatrix_IndexValues(I);
+      double* d = SUNSparseMatrix_Data(I);
+      for (int i = 0; i < n; ++i) {
+        cp[i] = i;
+        ri[i] = i;
+        d[i] = 1.0;
+      }
+      cp[n] = n;
+      ONE_OMP_THREAD();
+      SUNLinSolSetup(c->sl, I);
+      SUNMatDestroy(I);
+    } else {
+      c->sl = NULL; /* without the identity, leave the solver allocated rather than crash */
     }
-    cp[s->n] = s->n;
-    ONE_OMP_THREAD();
-    SUNLinSolSetup(s->LS, I);
-    SUNMatDestroy(I);
   }
-  SUNLinSolFree(s->LS);
+  if (c) {
+    if (c->sl) SUNLinSolFree(c->sl);
+    if (c->v) N_VDestroy(c->v);
+    free(c);
+  }
+  free(ls);
 }
-#endif
 
-static void free_linear_solver(dc_session* s) {
-  if (!s->LS) return;
-#if DC_HAVE_SPARSE
-  if (LIN_SPARSE(s)) {
-    free_superlumt(s);
-    return;
+/* SuperLU_MT on s->A (a SUNSparseMatrix of the union pattern), initialized once; NULL on failure. */
+static dc_linsol* superlu_create(dc_session* s) {
+  dcls_superlu* c = (dcls_superlu*)calloc(1, sizeof(dcls_superlu));
+  dc_linsol* ls = c ? dcls_new(DC_LS_SUPERLU, s->n, c, superlu_factor, superlu_solve, superlu_destroy) : NULL;
+  if (!ls) {
+    free(c);
+    return NULL;
   }
-#endif
-  SUNLinSolFree(s->LS);
+  c->s = s;
+  c->v = N_VMake_Serial(s->n, N_VGetArrayPointer(s->yy), s->ctx);
+  c->sl = c->v ? SUNLinSol_SuperLUMT(s->yy, s->A, 1, s->ctx) : NULL;
+  if (!c->sl || SUNLinSolInitialize(c->sl) != 0) {
+    if (c->sl) c->factored = 1; /* never factor the identity into a solver that did not initialize */
+    superlu_destroy(ls);
+    return NULL;
+  }
+  return ls;
 }
+#endif
 
 static void release_funs(dc_session* s) {
   const dc_model_t* M = &dc_model;
@@ -118,7 +138,8 @@ DC_API void dc_free(void* sp) {
   dc_session* s = (dc_session*)sp;
   if (!s) return;
   if (s->ida) IDAFree(&s->ida);
-  free_linear_solver(s);
+  if (s->LS) SUNLinSolFree(s->LS);
+  dcls_free(s->lin);
   if (s->A) SUNMatDestroy(s->A);
   if (s->yy) N_VDestroy(s->yy);
   if (s->yp) N_VDestroy(s->yp);
@@ -185,6 +206,7 @@ static void clear_run_state(dc_session* s) {
   if (np > 0) memset(s->params, 0, sizeof(double) * (size_t)np);
   for (int i = 0; i < s->n_roots; ++i) s->rootdir[i] = s->rootsfound[i] = 0;
   memset(s->base, 0, sizeof s->base);
+  if (s->lin) s->lin->n_fallback = 0;
   s->t_now = s->t_rec = 0.0;
   s->carry = s->carry_flag = s->carry_order = 0;
   s->carry_lo = s->carry_t_prev = s->carry_h = 0.0;
@@ -287,12 +309,21 @@ static int open_vectors(dc_session* s, const double* atol, int linear_solver, ch
   if (rc == -1) OPEN_FAIL("out of memory");
   if (rc == -2) OPEN_FAIL("a generated Jacobian is not %d x %d", n, n);
   if (rc == -3) OPEN_FAIL("the Jacobian has too many nonzeros for the wheel's 32-bit sunindextype");
-  if (linear_solver != DC_LS_DENSE && linear_solver != DC_LS_SPARSE && linear_solver != DC_LS_REDUCED)
-    OPEN_FAIL("unknown linear solver %d (%d: dense, %d: sparse, %d: reduced)", linear_solver, DC_LS_DENSE,
-              DC_LS_SPARSE, DC_LS_REDUCED);
-  if (linear_solver == DC_LS_SPARSE && !DC_HAVE_SPARSE)
-    OPEN_FAIL("this library was built without the sparse solver (the wheel lacks "
+  if (linear_solver != DC_LS_DENSE && linear_solver != DC_LS_SPARSE && linear_solver != DC_LS_REDUCED &&
+      linear_solver != DC_LS_SUPERLU)
+    OPEN_FAIL("unknown linear solver %d (%d: dense, %d: sparse, %d: reduced, %d: superlu)", linear_solver,
+              DC_LS_DENSE, DC_LS_SPARSE, DC_LS_REDUCED, DC_LS_SUPERLU);
+  if (linear_solver == DC_LS_SUPERLU && !DC_HAVE_SPARSE)
+    OPEN_FAIL("this library was built without SuperLU_MT (the wheel lacks "
               "libsundials_sunmatrixsparse or libsundials_sunlinsolsuperlumt)");
+  if (linear_solver == DC_LS_SPARSE) {
+    const dc_lu_plan* plan = dc_model.lu;
+    if (!plan) OPEN_FAIL("the model has no sparse LU plan (a multiplier's pivot stays structurally zero)");
+    int same = plan->n == n && plan->nnz == (int)s->jp_nnz;
+    for (int c = 0; same && c <= n; ++c) same = plan->colptr[c] == (int)s->jp_colptr[c];
+    for (dc_int k = 0; same && k < s->jp_nnz; ++k) same = plan->rowind[k] == (int)s->jp_rowind[k];
+    if (!same) OPEN_FAIL("the sparse LU plan was made for another Jacobian pattern than the library's");
+  }
   s->lin_kind = linear_solver;
 
   if (SUNContext_Create(SUN_COMM_NULL, &s->ctx) != 0 || !s->ctx)
@@ -313,29 +344,35 @@ static int open_vectors(dc_session* s, const double* atol, int linear_solver, ch
   return 0;
 }
 
-/* IDA's matrix and linear solver: SuperLU_MT on the union pattern (one thread), else a dense
+/* IDA's matrix and the linear solver behind the dc_linsol interface (dc_linsol.h): the sparse LU on
+ * the union values, SuperLU_MT on a SUNSparseMatrix of the union pattern (one thread), else a dense
  * matrix with the reduced or the plain dense LU. */
 static int open_linear_solver(dc_session* s, char* err, int errlen) {
   const int n = s->n;
-  if (LIN_SPARSE(s)) {
+  if (s->lin_kind == DC_LS_SPARSE) {
+    s->A = dcls_values_create((size_t)s->jp_nnz, s->ctx);
+    if (!s->A) OPEN_FAIL("the sparse LU's matrix could not be allocated (nnz=%lld)", (long long)s->jp_nnz);
+    s->lin = dcls_sparse_create(DC_LS_SPARSE, dc_model.lu);
+  } else if (s->lin_kind == DC_LS_SUPERLU) {
 #if DC_HAVE_SPARSE
     /* one thread: the factorizations are small and the machine is shared; more threads cost
      * more in OpenMP start-up than they save */
     s->A = SUNSparseMatrix(n, n, s->jp_nnz > 0 ? (sunindextype)s->jp_nnz : 1, CSC_MAT, s->ctx);
     if (!s->A) OPEN_FAIL("SUNSparseMatrix(%d, %d, nnz=%lld) failed", n, n, (long long)s->jp_nnz);
     (void)jac_storage(s, s->A); /* a valid pattern from the start */
-    s->LS = SUNLinSol_SuperLUMT(s->yy, s->A, 1, s->ctx);
-    if (!s->LS) OPEN_FAIL("SUNLinSol_SuperLUMT failed");
-    if (keep_first_factorization(s) != 0)
-      OPEN_FAIL("the SuperLU_MT solver of this SUNDIALS build could not be initialized; "
-                "use linear_solver='dense'");
+    s->lin = superlu_create(s);
+    if (!s->lin)
+      OPEN_FAIL("the SuperLU_MT solver of this SUNDIALS build could not be created or initialized; "
+                "use linear_solver='sparse'");
 #endif
   } else {
     s->A = SUNDenseMatrix(n, n, s->ctx);
     if (!s->A) OPEN_FAIL("SUNDenseMatrix failed");
-    s->LS = s->lin_kind == DC_LS_REDUCED ? rls_create(n, s->ctx) : SUNLinSol_Dense(s->yy, s->A, s->ctx);
-    if (!s->LS) OPEN_FAIL("the dense linear solver could not be created (out of memory)");
+    s->lin = s->lin_kind == DC_LS_REDUCED ? rls_create(DC_LS_REDUCED, n) : dcls_dense_create(DC_LS_DENSE, n);
   }
+  if (!s->lin) OPEN_FAIL("the linear solver could not be created (out of memory)");
+  s->LS = dcls_sun_create(s->lin, jac_storage(s, s->A), s->ctx);
+  if (!s->LS) OPEN_FAIL("the linear solver could not be created (out of memory)");
   return 0;
 }
 
@@ -369,9 +406,9 @@ static int open_ida(dc_session* s, double rtol, double max_step, int max_order, 
 }
 #undef OPEN_FAIL
 
-/* Open a session: IDA memory, linear solver (DC_LS_DENSE: dense LU; DC_LS_SPARSE: SuperLU_MT on
- * the union pattern, one thread; DC_LS_REDUCED: dense LU of the reduced system), tolerances,
- * options and root functions. IDAInit is called here with a zero state; dc_reinit then
+/* Open a session: IDA memory, linear solver (DC_LS_DENSE: dense LU; DC_LS_SPARSE: the sparse LU on
+ * the model's plan; DC_LS_REDUCED: dense LU of the reduced system; DC_LS_SUPERLU: SuperLU_MT on the
+ * union pattern, one thread), tolerances, options and root functions. IDAInit is called here with a zero state; dc_reinit then
  * (re)starts with IDAReInit. Returns NULL on failure with a message in err. */
 DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_order,
                      long long max_steps, const int* rootdir, const double* P, int linear_solver,

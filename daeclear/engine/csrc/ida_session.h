@@ -33,7 +33,9 @@
 #include "dc_common.h"
 #include "dc_model.h"
 #include "dc_linalg.h"
+#include "dc_linsol.h"
 #include "dc_reduced_ls.h"
+#include "dc_sparse_lu.h"
 #include "ida_automaton.h"
 
 #ifndef DC_ABI_VERSION /* given by daeclear.engine.codegen (daeclear.engine.library.DRIVER_ABI) */
@@ -61,7 +63,9 @@ SUNDIALS_EXPORT SUNLinearSolver SUNLinSol_SuperLUMT(N_Vector y, SUNMatrix A, int
 
 /* the linear solvers of dc_open (DC_LS_*), the return codes, flags and slots of the dc_* calls
  * are in dc_abi.h, generated from daeclear/engine/abi.py */
-#define LIN_SPARSE(s) ((s)->lin_kind == DC_LS_SPARSE) /* IDA's matrix is sparse (CSC), else dense */
+/* IDA's matrix holds the nonzeros of the union pattern (the sparse LU's values, or SuperLU_MT's
+ * SUNSparseMatrix), else it is the dense n x n matrix */
+#define LIN_UNION(s) ((s)->lin_kind == DC_LS_SPARSE || (s)->lin_kind == DC_LS_SUPERLU)
 
 #if DC_HAVE_SPARSE && defined(DC_SUPERLUMT_OMP)
 /* SuperLU_MT factors inside an OpenMP parallel loop over its num_threads (1 here) without a
@@ -87,8 +91,9 @@ typedef struct {
   SUNContext ctx;
   void* ida;
   N_Vector yy, yp, atol, dky;
-  SUNMatrix A;
-  SUNLinearSolver LS;
+  SUNMatrix A;        /* IDA's matrix: dense (dense, reduced), the union values (sparse), SUNSparseMatrix (superlu) */
+  SUNLinearSolver LS; /* IDA's solver: dcls_sun_create's wrapper of lin */
+  dc_linsol* lin;     /* the factorisation IDA's setup makes and every solve uses (dc_linsol.h) */
   int n, n_terms, n_roots;
   /* CasADi work memory, sized for the largest function */
   const double** arg;
@@ -110,10 +115,7 @@ typedef struct {
   /* Jacobian pattern shared by all parts (0: base Jacobian, 1 + k: term k's): the union of
    * their CSC patterns, built once by build_jac_pattern. Nonzero i of part p lands at
    * jp_rowind/data position jmap[jmap_off[p] + i]. */
-  int lin_kind;            /* DC_LS_DENSE, DC_LS_REDUCED (s->A dense) or DC_LS_SPARSE (s->A a
-                            * SUNSparseMatrix, s->LS SuperLU_MT): see LIN_SPARSE */
-  int lu_factored;         /* a Jacobian was handed to the sparse LS (it has factorized) */
-  SUNErrCode (*lu_initialize)(SUNLinearSolver); /* SuperLU_MT's own, see keep_first_factorization */
+  int lin_kind;            /* DC_LS_*: see LIN_UNION */
   dc_int jp_nnz;
   sunindextype* jp_colptr; /* [n + 1] */
   sunindextype* jp_rowind; /* [jp_nnz], rows sorted within each column */
@@ -168,7 +170,7 @@ typedef struct {
   int proj_on;        /* restarts after a switch decided in C: project q and v on the manifold */
   int proj_iter;
   double proj_tol;    /* |Phi| < proj_tol * max(1, |q|) ends the position Newton */
-  double* lay_buf;    /* Qc, Fk (nq each), sol (nq + m + 1), K (2m + m nq), G (m m), x (m), par, channels */
+  double* lay_buf;    /* Qc, a spare (nq each), sol (nq + m + 1), K (2m + m nq), G (m m), x (m), par, channels */
   const double** xarg; /* CasADi work memory for the extras, sized for the largest (dc_set_layout) */
   double** xres;
   dc_int* xiw;
