@@ -137,7 +137,7 @@ def test_ctrl_c_keeps_and_returns_the_history(worn, tmp_path, monkeypatch):
     """Ctrl-C in the third block: Interrupted with the two profiles made before it, and the file has them."""
     import daeclear.studies.wear as study
 
-    real, calls = study.simulate, []
+    real, calls = study.block_run, []
 
     def interrupted(*args, **kwargs):
         calls.append(1)
@@ -145,13 +145,13 @@ def test_ctrl_c_keeps_and_returns_the_history(worn, tmp_path, monkeypatch):
             raise KeyboardInterrupt
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(study, "simulate", interrupted)
+    monkeypatch.setattr(study, "block_run", interrupted)
     path = tmp_path / "wear.h5"
     with pytest.raises(Interrupted, match="interrupted by the user at 2 cycles") as info:
         simulate_wear(worn, 5, path=path)
     assert info.value.result.cycles.tolist() == [0.0, 1.0, 2.0]
     assert isinstance(info.value, KeyboardInterrupt)
-    monkeypatch.setattr(study, "simulate", real)
+    monkeypatch.setattr(study, "block_run", real)
     again = simulate_wear(worn, 2, path=path)  # the file has the two cycles: nothing to run
     np.testing.assert_array_equal(again.depth, info.value.result.depth)
 

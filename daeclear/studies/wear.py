@@ -25,11 +25,16 @@ from ..contact.geometry import sigma_sum
 from ..contact.wear import MAX_DEPTH_FRACTION, ArchardWear, WearHistoryArrays, wear_increment, worn_volume
 from ..core.errors import AssemblyError, DaeclearError, Interrupted, PhysicsWarning, SceneError, SolveError
 from ..model.scene import RevoluteClearance, Scene
+from ..core import options as opts
 from ..core.progress import Progress
 from ..results.outputs import check_file
 from ..core.values import to_plain
 from ..results.channel_eval import RunChannels
 from ..results.result import Result
+from ..solvers import driver
+from ..solvers.base import DrivenSolver
+from ..solvers.registry import solver_class
+from ..solvers.save_at import save_value
 from ..solvers.solver_options import SolverOptions
 from ..solvers.dispatch import simulate
 from .poincare import crank_period
@@ -239,7 +244,7 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
             try:
                 with warnings.catch_warnings():  # a block beyond its contact law is judged below, once
                     warnings.simplefilter("ignore", PhysicsWarning)
-                    result = simulate(model, t0 + update_every * period, t0=t0, y0=y0, options=options)
+                    result = block_run(model, t0, t0 + update_every * period, y0, options)
             except (SolveError, AssemblyError) as exc:  # the history so far is the result (and in the file)
                 message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
                 break
@@ -267,6 +272,20 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
     finally:
         bar.close()
     return _history(rows, wear, radius, message), False
+
+
+def block_run(model: DAEModel, t0: float, t_end: float, y0: NDArray[np.float64] | None,
+               options: SolverOptions | None) -> Result:
+    """One block's run: ``simulate(model, t_end, t0=t0, y0=y0, options=options)`` without the physics
+    checks of a run that reaches its end (the block judges its penetration itself; their warnings were
+    ignored), 5-10 % of a block."""
+    settings = options or SolverOptions()
+    opts.step_within(settings.step, t0, t_end)  # as simulate checks it
+    solver = solver_class(settings.method)()
+    if not isinstance(solver, DrivenSolver):  # a solver class of the user's: its own run, checked
+        return simulate(model, t_end, t0=t0, y0=y0, options=options)
+    return driver.run(solver, model, t_end, t0, y0, save_value(None).plan(t0, t_end), settings, "raise", False,
+                      checks=False)
 
 
 def _checked_period(scene: Scene, period: float | None) -> float:
