@@ -41,6 +41,8 @@ __all__ = [
     "Interrupted", "Material", "OutputError", "PhysicsWarning", "Result", "Revolute", "RevoluteClearance", "SaveAt",
     "Scene", "SceneError", "SolveError", "SolverOptions", "Translational", "TranslationalClearance", "analysis",
     "animate", "assemble", "load", "load_sweep", "mechanisms", "place", "profiles", "simulate", "sweep",
+    # gradients of a response (daeclear.studies.gradient; docs/sensitivities.md)
+    "EventTime", "Final", "Integral", "Peak", "gradient",
     # applied loads (daeclear.loads)
     "Expression", "Force", "Motor", "RotationalSpringDamper", "SpringDamper", "Table", "Torque", "loads",
 ]
@@ -69,6 +71,8 @@ def _load_all() -> dict[str, Any]:
     from .solvers.solver_options import SolverOptions  # noqa: F401
     from .solvers.dispatch import simulate  # noqa: F401
     from .studies.sweep import load_sweep, sweep  # noqa: F401
+    from .studies.gradient import gradient  # noqa: F401
+    from .results.objectives import EventTime, Final, Integral, Peak  # noqa: F401
     names = locals()
     public = {name: names[name] for name in __all__}
     globals().update(public)  # bound once: later uses do not come here

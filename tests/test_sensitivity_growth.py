@@ -42,3 +42,32 @@ def test_nothing_grows_nothing_is_lost() -> None:
     assert predictability_horizon(-1.0, 1e-8) == math.inf
     assert predictability_horizon(math.nan, 1e-8) == math.inf
     assert math.isnan(finite_time_lyapunov([0.0, 1.0], [0.0, 0.0]))
+
+
+def test_horizon_figure_draws_the_growth_its_fit_and_the_horizon() -> None:
+    """Agg: G = 3 exp(50 t) is drawn as given, its fit passes through it (lambda = 50), the level 1/rtol and the
+    horizon ln(1/rtol)/50 from t0 = 0.1 s; an algebraic growth (S ~ t, periodic run) has no horizon line."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from daeclear.plot import plot_sensitivity_horizon
+
+    t = np.linspace(0.1, 0.6, 41)
+    growth = 3.0 * np.exp(50.0 * t)
+    ax = plot_sensitivity_horizon(t, growth, 1e-8)
+    measured, fit = ax.lines[0], ax.lines[1]
+    assert np.array_equal(measured.get_ydata(), growth)
+    assert np.asarray(fit.get_ydata()) == pytest.approx(growth, rel=1e-9)
+    horizon = [line for line in ax.lines if line.get_color() == "#d62728"]
+    assert len(horizon) == 1 and horizon[0].get_xdata()[0] == pytest.approx(0.1 + math.log(1e8) / 50.0, rel=1e-12)
+    assert any(np.all(np.asarray(line.get_ydata()) == 1e8) for line in ax.lines)
+    assert "lambda = 50 1/s" in ax.get_title()
+    ax = plot_sensitivity_horizon(t, 1.0 + t - t[0], 1e-8)  # grows, but slowly: a horizon far past the run
+    assert [line for line in ax.lines if line.get_color() == "#d62728"][0].get_xdata()[0] > 10 * t[-1]
+    ax = plot_sensitivity_horizon(t, np.ones_like(t), 1e-8)
+    assert "no horizon" in ax.get_title() and not [line for line in ax.lines if line.get_color() == "#d62728"]
+    with pytest.raises(Exception, match=r"plot_sensitivity_horizon: rtol=2.0, must be a finite number > 0"):
+        plot_sensitivity_horizon(t, growth, 2.0)
+    plt.close("all")

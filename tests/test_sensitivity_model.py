@@ -209,9 +209,43 @@ def test_projection_puts_sensitivities_on_the_linearised_constraints(ggl) -> Non
             assert np.allclose(change, Phi_q.T @ np.linalg.lstsq(Phi_q.T, change, rcond=None)[0], atol=1e-12)
 
 
-def test_contact_elements_without_jumps_yet_are_refused() -> None:
-    """Translational faces (section 4.3: a face term follows two corner pairs) have no jump rule yet: refused,
-    naming the pairs and the logic, before any work."""
+def test_face_and_film_rules_of_the_latched_sensitivities() -> None:
+    """A section-4.3 face's parameter is the mean of its corners' latched speeds (floored by the face law's
+    minimum, if the face law reads one):
+    its sensitivity is the mean of theirs, 0 where the floor holds; its events are made by its corners' roots.
+    The lubricated joint's dry term reads the dry contact's latched speed (its second pair), the film term
+    nothing; its regime's events are made by the roots film_break and film_reform."""
+    from daeclear.core.automaton import PairState
     scene = dc.mechanisms.slider_crank("translational").with_values({"clearance.model": "section-4.3"})
-    with pytest.raises(dc.DaeclearError, match=r"the events of 'clearance.A_upper'.*SliderGuideLogic: faces"):
-        ModelSensitivity(dc.assemble(scene), ["clearance.clearance"])
+    built = dc.assemble(scene).contacts[0]
+    assert dict(built.term_sensitivities(tuple(PairState() for _ in range(4)), [np.zeros(2)] * 4))[
+        built.face_terms[0]].shape == (0, 2)  # Lankarani's plane law reads no approach speed
+    # the rule of a face law that would (none built in does): the mean, floored at 0.2 m/s
+    logic = dataclasses.replace(built, face_needs_approach=True, face_min_approach_speed=0.2)
+    S = [np.array([1.0, 2.0]), np.array([3.0, 5.0]), np.array([7.0, 11.0]), np.array([13.0, 17.0])]
+    fast = tuple(PairState(contact=True, latched=0.2 * (i + 1)) for i in range(4))
+    rules = dict(logic.term_sensitivities(fast, S))
+    (a, b), (c, d) = logic.face_corners
+    assert rules[logic.face_terms[0]] == pytest.approx(0.5 * (S[a] + S[b])[None, :], rel=0, abs=0)
+    assert rules[logic.face_terms[1]] == pytest.approx(0.5 * (S[c] + S[d])[None, :], rel=0, abs=0)
+    for i, k in enumerate(logic.pair_terms):
+        assert np.array_equal(rules[k], S[i][None, :])
+    slow = tuple(PairState(contact=True, latched=0.5 * logic.face_min_approach_speed) for _ in range(4))
+    assert np.array_equal(dict(logic.term_sensitivities(slow, S))[logic.face_terms[0]], np.zeros((1, 2)))
+    found = np.zeros(len(logic.pairs))
+    found[b] = 1
+    first = logic.first_root
+    assert logic.event_roots(logic.face_names[0], found) == [first + b]
+    assert logic.event_roots(logic.pairs[b], found) == [first + b] and logic.event_roots(logic.pairs[a], found) == []
+    journal = dc.Scene("journal")
+    body = journal.add(dc.Body("journal", mass=1.0, inertia=1e-4))
+    journal.add(dc.RevoluteClearance("bearing", journal.ground, body, at=(0.0, 0.0), bearing_radius=0.01,
+                                     clearance=5e-5, material=dcc.Material(young=207e9, poisson=0.3),
+                                     law=dcc.HydrodynamicBearing(viscosity=0.01, length=0.01)))
+    lub = dc.assemble(journal).contacts[0]
+    rules = dict(lub.term_sensitivities((PairState(), PairState()), [S[0], S[1]]))
+    assert np.array_equal(rules[lub.pair_terms[0]], S[1][None, :]) and rules[lub.pair_terms[0] + 1].shape == (0, 2)
+    found = np.array([0, -1, 0])
+    assert lub.event_roots("bearing.regime", found) == [lub.first_root + 1]
+    assert lub.event_roots("bearing", found) == []
+    assert (lub.rate_output, lub.rate_index(lub.first_root + 2)) == (3, 0)

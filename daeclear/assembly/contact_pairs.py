@@ -104,6 +104,27 @@ class PairLogic:
                 events += pair_event(self.pairs[i], t, y, float(rates[i]), decision)
         return tuple(new), events
 
+    # ---- what forward sensitivities ask of the rule (docs/sensitivities.md, "Jumps at events")
+
+    @property
+    def rate_output(self) -> int:
+        """The output of ``rate`` that holds the pairs' penetration rates (the approach speeds latched)."""
+        return 1
+
+    def rate_index(self, root: int) -> int:
+        """The entry of output :attr:`rate_output` that is the penetration rate of the pair of gap ``root``."""
+        return self.pair_index(root)
+
+    def event_roots(self, pair: str, roots_found: NDArray) -> list[int]:
+        """The roots found (``roots_found`` != 0) whose crossing made an event of ``pair``: its own gap's."""
+        return [root for root in self.roots if roots_found[root] != 0 and self.pair_name(root) == pair]
+
+    def term_sensitivities(self, states: PairStates, latched: Sequence[NDArray]) -> list[tuple[int, NDArray]]:
+        """(term, dp_k/dp (n_params_k, Ns)) of each term, as :meth:`terms` makes its parameters from the
+        pairs' latched speeds, whose sensitivities are ``latched[i]`` (Ns,) (zeros where floored)."""
+        return [(k, np.asarray(S, dtype=float)[None, :] if self.needs_approach else np.zeros((0, np.size(S))))
+                for k, S in zip(self.pair_terms, latched)]
+
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
         """(root, term, (q, v, P) -> [gap; rate], needs approach speed, floor): the pairs whose
         switches the compiled IDA loop decides itself, by the C mirror of the automaton."""

@@ -179,6 +179,20 @@ class LubricatedLogic(PairLogic):
             contact = PairState(latched=contact.latched, recent=contact.recent)
         return (regime, contact), events
 
+    @property
+    def rate_output(self) -> int:
+        """``rate`` gives (film_break, film_reform, the dry gap, the penetration rate)."""
+        return 3
+
+    def rate_index(self, root: int) -> int:
+        return 0
+
+    def term_sensitivities(self, states: PairStates, latched: Sequence[NDArray]) -> list[tuple[int, NDArray]]:
+        """The dry term's parameter is the dry contact's latched speed (``latched[1]``); the film term has none."""
+        k, width = self.pair_terms[0], np.size(latched[1])
+        dry = np.asarray(latched[1], dtype=float)[None, :] if self.needs_approach else np.zeros((0, width))
+        return [(k, dry), (k + 1, np.zeros((0, width)))]
+
     def simple_pairs(self) -> None:
         """None: two terms follow one pair, which the compiled loop's mirror does not do."""
         return None

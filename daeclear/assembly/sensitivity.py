@@ -21,13 +21,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.errors import DaeclearError, SceneError
+from ..core.errors import SceneError
 from ..core.options import close_matches
 from ..engine.sensitivity_functions import SensitivityFunctions, directional, jacobian_blocks
 from .dae_model import EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_TERM0, DAEModel
 
-__all__ = ["parameter_value", "parameter_directions", "initial_sensitivities", "model_sensitivity_functions",
-           "check_supported", "ModelSensitivity", "RootTerms", "STEP_BITS"]
+__all__ = ["parameter_value", "moved_parameter", "parameter_directions", "initial_sensitivities",
+           "model_sensitivity_functions",
+           "ModelSensitivity", "RootTerms", "STEP_BITS"]
 
 #: Central differences of the scene-to-P map and of the start use the step 2**-STEP_BITS |p| (a power of
 #: two: p +- h is exact) and h/2, combined by Richardson's extrapolation (error O(h^4) + eps/h, ~1e-12).
@@ -78,7 +79,7 @@ def _step(p: float) -> float:
     return math.ldexp(1.0, exponent - STEP_BITS)
 
 
-def _at(model: DAEModel, name: str, value: float) -> DAEModel:
+def moved_parameter(model: DAEModel, name: str, value: float) -> DAEModel:
     """``model`` with the parameter ``name`` at ``value`` (the scene's number, or the table entry itself)."""
     if _scene_value(model, name) is not None:
         try:
@@ -121,7 +122,7 @@ def parameter_directions(model: DAEModel, names: Sequence[str]) -> NDArray[np.fl
     columns = []
     for name in names:
         p = parameter_value(model, name)
-        columns.append(_richardson(lambda x, name=name: _at(model, name, x).parameter_values, p, _step(p)))
+        columns.append(_richardson(lambda x, name=name: moved_parameter(model, name, x).parameter_values, p, _step(p)))
     return np.stack(columns, axis=1) if columns else np.zeros((model.parameter_values.size, 0))
 
 
@@ -149,7 +150,8 @@ def initial_sensitivities(model: DAEModel, names: Sequence[str], start: str = "i
         def start_at(x: float, name: str = name) -> NDArray[np.float64]:
             with warnings.catch_warnings():  # the start's notes were given for the run itself
                 warnings.simplefilter("ignore")
-                return _at(model, name, x).initial_state(start=start, allow_penetration=allow_penetration)[0]
+                moved = moved_parameter(model, name, x)
+                return moved.initial_state(start=start, allow_penetration=allow_penetration)[0]
         columns.append(_richardson(start_at, p, _step(p)))
     return np.stack(columns, axis=1)
 
@@ -177,32 +179,20 @@ class RootTerms:
     error: NDArray[np.float64]
 
 
-def check_supported(model: DAEModel) -> None:
-    """Refuse (DaeclearError) a model with contact elements whose events have no sensitivity jump yet:
-    those whose pairs the compiled loop cannot decide itself (translational faces, the lubricated
-    joint's film regimes: their terms follow two pairs or two roots)."""
-    for logic in model.contacts:
-        if logic.simple_pairs() is None:
-            raise DaeclearError(
-                f"sensitivities: the events of {', '.join(map(repr, logic.pairs))} ({type(logic).__name__}: faces "
-                "or a film regime) have no sensitivity jump yet; revolute clearance joints and translational ones "
-                "without faces have (issue 43).")
-
-
 class ModelSensitivity:
     """What a run with sensitivities to ``names`` asks of ``model``, evaluated in CasADi (the python
-    path; the compiled loop calls the same functions generated in C). Refuses the contact elements
-    :func:`check_supported` refuses."""
+    path; the compiled loop calls the same functions generated in C): every contact element, whose rule
+    says which roots make its events and how its terms' parameters follow its pairs' latched speeds
+    (``event_roots``, ``term_sensitivities`` of :class:`~daeclear.assembly.contact_pairs.PairLogic`)."""
 
     def __init__(self, model: DAEModel, names: Sequence[str]) -> None:
-        check_supported(model)
         self.model = model
         self.names = _checked_names(names)
         self.dP = parameter_directions(model, self.names)
         self.functions = model_sensitivity_functions(model, len(self.names))
         self._extra = {k: f for k, f in zip(self.functions.extra_index, self.functions.extras)}
         # each contact element's gap rates' Jacobian [r_q | r_v | r_P]: the latched approach speed's derivative
-        self._rate_jacobians = [jacobian_blocks(logic.rate.function, f"rate_jacobian{i}", out=1)
+        self._rate_jacobians = [jacobian_blocks(logic.rate.function, f"rate_jacobian{i}", out=logic.rate_output)
                                 for i, logic in enumerate(model.contacts)]
         self._outputs: Any = None  # the channels' directional derivative, made when first asked for
 
@@ -314,10 +304,10 @@ class ModelSensitivity:
         model, n = self.model, self.model.n_q
         for i, logic in enumerate(model.contacts):
             if root in logic.roots:
-                j = logic.pair_index(root)
+                j = logic.rate_index(root)
                 P = model.parameter_values
                 q, v = y[:n], y[n:2 * n]
-                rate = float(np.array(logic.rate.function(q, v, P)[1]).ravel()[j])
+                rate = float(np.array(logic.rate.function(q, v, P)[logic.rate_output]).ravel()[j])
                 J = np.array(self._rate_jacobians[i](q, v, P))[j]
                 r_q, r_v, r_P = J[:n], J[n:2 * n], J[2 * n:]
                 return rate, r_q @ S[:n] + r_v @ S[n:2 * n] + r_P @ self.dP, float(r_q @ yp[:n] + r_v @ yp[n:2 * n])

@@ -109,6 +109,29 @@ class SliderGuideLogic(PairLogic):
                                                        np.array(y, dtype=float)))
         return after, events
 
+    def event_roots(self, pair: str, roots_found: NDArray) -> list[int]:
+        """A corner's own gap; a face formed or broken by the corners whose roots were found then."""
+        if pair not in self.face_names:
+            return super().event_roots(pair, roots_found)
+        a, b = self.face_corners[self.face_names.index(pair)]
+        return [self.first_root + i for i in (a, b) if roots_found[self.first_root + i] != 0]
+
+    def term_sensitivities(self, states: PairStates, latched: Sequence[NDArray]) -> list[tuple[int, NDArray]]:
+        """A face's parameter, the mean of its corners' latched speeds, moves by the mean of their
+        sensitivities (0 where the face's floor holds it); the corners' as :class:`PairLogic`'s."""
+        out = []
+        width = np.size(latched[0]) if len(latched) else 0
+        for f, (a, b) in enumerate(self.face_corners):
+            mean = 0.5 * (states[a].latched + states[b].latched)
+            if not self.face_needs_approach:
+                S = np.zeros((0, width))
+            elif mean <= self.face_min_approach_speed:
+                S = np.zeros((1, width))
+            else:
+                S = 0.5 * (np.asarray(latched[a], dtype=float) + np.asarray(latched[b], dtype=float))[None, :]
+            out.append((self.face_terms[f], S))
+        return out + super().term_sensitivities(states, latched)
+
     def simple_pairs(self) -> list[tuple[int, int, ca.Function, bool, float]] | None:
         """None with faces (their terms depend on two corners); else every corner's pair."""
         return None if self.face_names else super().simple_pairs()

@@ -1,0 +1,51 @@
+"""The sensitivity horizon figure: how fast a run's sensitivities grow and past when they mean nothing
+(docs/sensitivities.md, "Chaos and the predictability horizon")."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..core.options import fail, number
+from ..results.sensitivity_growth import finite_time_lyapunov, predictability_horizon
+from . import style
+
+if TYPE_CHECKING:  # matplotlib is imported only when a figure is drawn
+    from matplotlib.axes import Axes
+
+__all__ = ["plot_sensitivity_horizon"]
+
+
+def plot_sensitivity_horizon(t: ArrayLike, growth: ArrayLike, rtol: float, *, ax: Axes | None = None,
+                             label: str = "largest relative sensitivity") -> Axes:
+    """The growth G(t) of a run's sensitivities (log scale; ``relative_growth`` of
+    :mod:`daeclear.results.sensitivity_growth`) with its least-squares exponential (the finite-time Lyapunov
+    estimate lambda, dashed), the level 1/rtol (errors of the run's ``rtol`` grown to 1) and the predictability
+    horizon t0 + ln(1/rtol)/lambda (a vertical line, when it is finite). Returns the Axes (a new figure when
+    ``ax`` is None)."""
+    times, values = np.asarray(t, dtype=float), np.asarray(growth, dtype=float)
+    if times.ndim != 1 or values.shape != times.shape or times.size < 2:
+        fail("plot_sensitivity_horizon", "growth", f"shape {values.shape}", f"one value per time ({times.size} times)")
+    tol = number(rtol, where="plot_sensitivity_horizon", field="rtol", low=0.0, high=1.0)
+    ax = style.new_axes(ax)
+    keep = np.isfinite(values) & (values > 0)
+    ax.semilogy(times[keep], values[keep], lw=1.0, label=label)
+    lam = finite_time_lyapunov(times, values)
+    horizon = predictability_horizon(lam, tol, float(times[0]))
+    if math.isfinite(lam):
+        intercept = float(np.mean(np.log(values[keep]) - lam * times[keep]))  # the same least-squares line
+        ax.semilogy(times, np.exp(intercept + lam * times), "--", lw=0.8, label=f"fit: lambda = {lam:.3g} 1/s")
+    ax.axhline(1.0 / tol, color="0.4", lw=0.8, ls=":", label=f"1/rtol = {1.0 / tol:.3g}")
+    if math.isfinite(horizon):
+        ax.axvline(horizon, color="#d62728", lw=1.0, label=f"horizon {horizon:.4g} s")
+        title = f"sensitivity growth: lambda = {lam:.3g} 1/s\nhorizon {horizon:.4g} s at rtol {tol:g}"
+    else:
+        title = f"sensitivity growth: not exponential\nno horizon at rtol {tol:g}"
+    ax.set(xlabel="t (s)", ylabel="max |S| |p| / scale")
+    style.set_title(ax, title)
+    ax.legend(fontsize="small")
+    ax.grid(True, which="both", lw=0.3)
+    return ax

@@ -1,0 +1,219 @@
+"""dc.gradient and its objectives (daeclear/results/objectives.py, daeclear/studies/gradient.py) on issue 43's
+radial impact, against the closed form (derivatives by the complex step) and against central differences.
+
+A free journal (m = 1 kg) leaves the bearing's centre at u = 1 m/s; clearance z0 = 0.1 m, Kelvin-Voigt
+K = 1e4 N/m, D = 20 N s/m, T = 0.25 s. In contact (s = t - z0/u) the penetration is d(s) = (u/w_d) e^(-a s)
+sin(w_d s), the force F = K d + D d' (it jumps from 0 to D u at onset). References:
+
+* Final x(T), EventTime of the separation: the closed form of the acceptance test;
+* Integral of the normal force: the impulse m (u + v_z) (momentum); its z0-derivative is 0, which needs the
+  onset's jump term (0 - D u) dt1/dz0 = -20 against the integral of S (+20);
+* Peak of the normal force: the root s* of F'(s) = 0 by Newton (in complex arithmetic for the complex step);
+  the peak does not move with z0 (it only shifts in time).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+import pytest
+
+import daeclear as dc
+import daeclear.contact as dcc
+from daeclear.results.objectives import Gradient, evaluate
+
+M, U, T = 1.0, 1.0, 0.25
+P0 = np.array([1e4, 20.0, 0.1])  # K, D, z0
+NAMES = ["clearance.law.stiffness", "clearance.law.damping", "clearance.clearance"]
+
+
+def motion(p: np.ndarray) -> tuple:
+    k, d, _ = p
+    a = d / (2 * M)
+    return k, d, a, np.sqrt(k / M - a * a)
+
+
+def force(p: np.ndarray, s: complex) -> tuple[complex, complex, complex]:
+    """F, F', F'' at s into the contact: F = K d + D d', d'' = -(K d + D d')/m."""
+    k, d, a, wd = motion(p)
+    e = np.exp(-a * s)
+    depth = (U / wd) * e * np.sin(wd * s)
+    rate = (U / wd) * e * (wd * np.cos(wd * s) - a * np.sin(wd * s))
+    accel = -(k * depth + d * rate) / M
+    jerk = -(k * rate + d * accel) / M
+    snap = -(k * accel + d * jerk) / M
+    return k * depth + d * rate, k * rate + d * accel, k * accel + d * jerk + 0 * snap
+
+
+def peak_force(p: np.ndarray) -> np.ndarray:
+    s = 0.005 + 0j  # the force's maximum lies a few ms into the contact: Newton on F'(s) = 0
+    for _ in range(60):
+        _, f1, f2 = force(p, s)
+        s = s - f1 / f2
+    return np.array([force(p, s)[0]])
+
+
+def separation(p: np.ndarray) -> np.ndarray:
+    """(x(T), t_separation, v_z)."""
+    k, d, a, wd = motion(p)
+    z0 = p[2]
+    s_z = (np.pi - np.arctan(d * wd / (k - d * a))) / wd
+    depth = (U / wd) * np.exp(-a * s_z) * np.sin(wd * s_z)
+    v_z = -(U / wd) * np.exp(-a * s_z) * (wd * np.cos(wd * s_z) - a * np.sin(wd * s_z))
+    t_sep = z0 / U + s_z + depth / v_z
+    return np.array([z0 - v_z * (T - t_sep), t_sep, v_z])
+
+
+def complex_step(f, p: np.ndarray) -> np.ndarray:
+    steps = 1e-30 * np.abs(p)
+    return np.stack([np.imag(f(p + 1j * steps[j] * np.eye(p.size)[j])) / steps[j] for j in range(p.size)], axis=1)
+
+
+@pytest.fixture(scope="module")
+def scene() -> dc.Scene:
+    scene = dc.Scene("radial", gravity=(0.0, 0.0))
+    journal = scene.add(dc.Body("journal", mass=M, inertia=1.0, velocity=(U, 0.0)))
+    scene.add(dc.RevoluteClearance("clearance", scene.ground, journal, at=(0, 0), bearing_radius=1.0,
+                                   clearance=P0[2], law=dcc.KelvinVoigt(stiffness=P0[0], damping=P0[1])))
+    return scene
+
+
+def grad(scene: dc.Scene, of: object, **kw: object) -> Gradient:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", dc.DaeclearWarning)  # atol at round-off, raised
+        return dc.gradient(scene, T, of=of, parameters=NAMES, rtol=1e-10, start="declared", **kw)
+
+
+def vector(g: Gradient) -> np.ndarray:
+    return np.array([g.gradient[name] for name in NAMES])
+
+
+def test_final_and_event_times_against_the_closed_form(scene: dc.Scene) -> None:
+    want = complex_step(separation, P0)
+    x, t_sep, _ = np.real(separation(P0))
+    g = grad(scene, dc.Final("journal.x"))
+    assert g.value == pytest.approx(x, abs=1e-9) and vector(g) == pytest.approx(want[0], rel=1e-6)
+    g = grad(scene, dc.EventTime("clearance", "separation"))
+    assert g.value == pytest.approx(t_sep, rel=1e-9) and vector(g) == pytest.approx(want[1], rel=1e-6)
+    g = grad(scene, dc.EventTime("clearance", "onset", index=-1))
+    assert g.value == pytest.approx(P0[2] / U, rel=1e-12)
+    assert vector(g) == pytest.approx([0.0, 0.0, 1.0 / U], abs=1e-12)
+
+
+def x_integral(p: np.ndarray) -> np.ndarray:
+    """int_0^T x dt: u t1^2/2 before the contact, z0 s_z + int_0^s_z d(s) ds in it (force on), then the flight
+    back at v_z from z0 + d(s_z)."""
+    k, d, a, wd = motion(p)
+    z0 = p[2]
+    t1 = z0 / U
+    s_z = (np.pi - np.arctan(d * wd / (k - d * a))) / wd
+
+    def antiderivative(s: complex) -> complex:  # of (u/wd) e^(-a s) sin(wd s)
+        return (U / wd) * np.exp(-a * s) * (-a * np.sin(wd * s) - wd * np.cos(wd * s)) / (a * a + wd * wd)
+
+    depth = (U / wd) * np.exp(-a * s_z) * np.sin(wd * s_z)
+    v_z = -(U / wd) * np.exp(-a * s_z) * (wd * np.cos(wd * s_z) - a * np.sin(wd * s_z))
+    rest = T - t1 - s_z
+    return np.array([U * t1 ** 2 / 2 + z0 * s_z + antiderivative(s_z) - antiderivative(0.0)
+                     + (z0 + depth) * rest - v_z * rest ** 2 / 2])
+
+
+def test_integral_of_a_smooth_channel_against_the_closed_form(scene: dc.Scene) -> None:
+    """int x dt and its derivatives; the cubic quadrature over 2000 intervals (error O(dt^4))."""
+    g = grad(scene, dc.Integral("journal.x"))
+    assert g.value == pytest.approx(np.real(x_integral(P0))[0], rel=1e-9)
+    assert vector(g) == pytest.approx(complex_step(x_integral, P0)[0], rel=1e-6)
+
+
+def test_integral_of_the_force_is_the_impulse_with_the_onset_jump(scene: dc.Scene) -> None:
+    """Value m (u + v_z), gradient m dv_z/dp. The clamped force's S jumps where the force reaches zero (its
+    kink, no event row), which leaves the quadrature first order there: 2 % on the gradient. The z0-derivative
+    is 0 only with the onset's jump term (0 - D u) dt1/dz0 = -20 against the integral of S (+20)."""
+    g = grad(scene, dc.Integral("clearance.normal_force"))
+    v_z = np.real(separation(P0)[2])
+    want = M * complex_step(separation, P0)[2]
+    assert g.value == pytest.approx(M * (U + v_z), rel=1e-5)
+    assert vector(g)[:2] == pytest.approx(want[:2], rel=2e-2)
+    assert abs(vector(g)[2]) < 2e-2 * P0[1] * U  # without the jump term: 20
+
+
+def test_integral_window_and_peak_against_the_closed_form(scene: dc.Scene) -> None:
+    """The force's peak (a few ms into the contact) and its derivatives; a window around it gives the same
+    peak, a window before the contact a zero integral."""
+    want = complex_step(peak_force, P0)[0]
+    g = grad(scene, dc.Peak("clearance.normal_force"))
+    assert g.value == pytest.approx(np.real(peak_force(P0))[0], rel=1e-8)
+    assert vector(g)[:2] == pytest.approx(want[:2], rel=1e-6)
+    assert abs(vector(g)[2]) < 1e-5 * P0[0] * U  # F' dt1/dz0 would be ~ K u were the peak's time fixed
+    windowed = grad(scene, dc.Peak("clearance.normal_force", window=(0.1, 0.12), absolute=True))
+    assert windowed.value == pytest.approx(g.value, rel=1e-8)
+    before = grad(scene, dc.Integral("clearance.normal_force", window=(0.0, 0.05)))
+    assert before.value == 0.0 and all(v == 0.0 for v in before.gradient.values())
+
+
+def test_central_differences_cross_check(scene: dc.Scene) -> None:
+    """method="fd" (separate runs) agrees with the sensitivities and the closed form on the peak's K and D."""
+    fd = grad(scene, dc.Peak("clearance.normal_force"), method="fd")
+    assert fd.method == "fd"
+    assert vector(fd)[:2] == pytest.approx(complex_step(peak_force, P0)[0, :2], rel=1e-5)
+    assert vector(fd)[:2] == pytest.approx(vector(grad(scene, dc.Peak("clearance.normal_force")))[:2], rel=1e-5)
+
+
+@dataclass
+class Line:
+    """A synthetic trajectory: f(t) = p t, an event at 0.5 s where f jumps by +1 and whose time moves with p."""
+
+    names: tuple[str, ...] = ("p",)
+    t: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.25, 0.5, 0.5, 0.75, 1.0]))
+    events: list = field(default_factory=lambda: [type("E", (), dict(t=0.5, pair="a", kind="onset",
+                                                                      dt_dp=np.array([0.5])))()])
+
+    def values(self, name: str) -> np.ndarray:
+        return 2.0 * self.t + np.array([0, 0, 0, 1, 1, 1])
+
+    def sensitivity(self, name: str, parameter: str | None = None) -> np.ndarray:
+        return self.t[:, None]
+
+
+def test_evaluate_on_a_synthetic_trajectory() -> None:
+    """I(p) = int_0^1 p t dt + (1 - t*(p)) with t* moving at 0.5 per unit p: dI/dp = 1/2 - 0.5; the peak at the
+    end moves as t; the event time is the event's."""
+    line = Line()
+    g = evaluate(dc.Integral("f"), line)
+    assert g.value == pytest.approx(1.0 + 0.5) and g.gradient["p"] == pytest.approx(0.5 - 0.5, abs=1e-15)
+    assert evaluate(dc.Peak("f"), line).gradient["p"] == pytest.approx(1.0)
+    assert evaluate(dc.EventTime("a"), line).gradient == {"p": 0.5}
+
+
+@pytest.mark.parametrize(("make", "match"), [
+    (lambda: dc.Final(""), r"Final: channel='', must be a state's or channel's name"),
+    (lambda: dc.Integral("x", window=(1.0, 0.5)), r"Integral: window=\(1.0, 0.5\), must be None or two finite"),
+    (lambda: dc.Peak("x", window=3.0), r"Peak: window=3.0, must be None or two times"),
+    (lambda: dc.Peak("x", absolute="yes"), r"Peak: absolute='yes', must be True or False"),
+    (lambda: dc.EventTime("c", kind="impact"), r"EventTime: kind='impact', must be one of 'onset', 'separation'"),
+    (lambda: dc.EventTime("c", index=1.0), r"EventTime: index=1.0, must be an integer"),
+])
+def test_bad_objectives(make, match: str) -> None:
+    with pytest.raises(dc.SceneError, match=match):
+        make()
+
+
+def test_bad_gradient_calls(scene: dc.Scene) -> None:
+    with pytest.raises(dc.SceneError, match=r"gradient: method='adjoint', must be one of sensitivities, fd"):
+        dc.gradient(scene, T, of=dc.Final("journal.x"), parameters=NAMES, method="adjoint")
+    with pytest.raises(dc.SceneError, match=r"gradient: of='journal.x', must be an objective"):
+        dc.gradient(scene, T, of="journal.x", parameters=NAMES)  # type: ignore[arg-type]
+    with pytest.raises(dc.SceneError, match=r"gradient: parameters='clearance.clearance', must be a non-empty list"):
+        dc.gradient(scene, T, of=dc.Final("journal.x"), parameters="clearance.clearance")
+    with pytest.raises(dc.SceneError, match=r"gradient: formulation='index1', must be None or the model's own"):
+        dc.gradient(dc.assemble(scene, "ggl"), T, of=dc.Final("journal.x"), parameters=NAMES, formulation="index1")
+    with pytest.raises(dc.SceneError, match=r"parameter='clearance.stiffness', must be one of model.parameter_names"):
+        dc.gradient(scene, T, of=dc.Final("journal.x"), parameters=["clearance.stiffness"])
+    with pytest.raises(dc.SceneError, match=r"Peak: window=\(0.1, 0.5\), must be inside the run"):
+        dc.gradient(scene, T, of=dc.Peak("journal.x", window=(0.1, 0.5)), parameters=NAMES)
+    with pytest.raises(dc.SceneError, match=r"objective: channel='journal.z', must be a state or channel of the run"):
+        grad(scene, dc.Final("journal.z"))
+    with pytest.raises(dc.SceneError, match=r"EventTime: index=3, must be within the run's 1 onset event"):
+        grad(scene, dc.EventTime("clearance", index=3))
