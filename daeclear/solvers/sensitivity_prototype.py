@@ -17,7 +17,6 @@ how its terms' parameters follow the latched speeds); a pair held by the storm g
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 from collections.abc import Sequence
 
@@ -25,26 +24,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..assembly import contact_state
-from ..assembly.dae_model import KIND_MULTIPLIER, DAEModel
-from ..assembly.sensitivity import ModelSensitivity, initial_sensitivities, parameter_value
-from ..core.errors import PhysicsWarning
+from ..assembly.dae_model import DAEModel
+from ..assembly.sensitivity import initial_sensitivities
 from ..engine.ida_session import open_session
 from ..engine.sensitivity_functions import augmented_functions
 from . import ida
-from .sensitivity_jumps import event_time_sensitivity, latched_sensitivity, same_event_times, state_jump
+from ..results.sensitivities import SensitivityEvent as EventSensitivity
+from .sensitivity_carrier import SensitivityCarrier, parameter_scales
 from .tolerances import tolerance_vector
 
 __all__ = ["EventSensitivity", "SensitivityRun", "forward_sensitivities"]
-
-
-@dataclass(frozen=True)
-class EventSensitivity:
-    """One contact switch: time, pair, kind and the event time's sensitivity to each parameter."""
-
-    t: float
-    pair: str
-    kind: str
-    dt_dp: NDArray[np.float64]
 
 
 @dataclass
@@ -104,51 +93,38 @@ def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[st
     out (S carried through each event as it is, the latched values' dt*/dp term dropped): a wrong answer,
     kept to show that the tests see the jump; ``event_rows``: two output rows at each event, before and after
     its switch."""
-    ms = ModelSensitivity(model, parameters)
-    W, n = ms.width, model.n_states
+    names = list(parameters)
     eval_times = np.array([0.0, float(t_end)] if t_eval is None else t_eval, dtype=float)
-    y, yp = model.initial_state(start=start, allow_penetration=allow_penetration)
-    S = initial_sensitivities(model, ms.names, start, allow_penetration)
-    state = contact_state.start_state(model, 0.0, y)
-    active, params = contact_state.switches(model, state)
-    latched = [[np.zeros(W) for _ in states] for states in state]  # each pair's latched speed's sensitivity
-    for i, logic in enumerate(model.contacts):  # a pair in contact at the start latched its rate there (t0 fixed)
-        for root in logic.roots:
-            if logic.needs_approach and contact_state.pair_state(model, state, root).contact:
-                speed, rate_p, _ = ms.approach_rate(root, y, yp, S)
-                latched[i][logic.pair_index(root)] = latched_sensitivity(
-                    rate_p, 0.0, np.zeros(W), floored=speed <= logic.min_approach_speed)
-    S_params = _term_sensitivities(model, state, latched, W)
-    if any(active):
-        y, yp = model.consistent_state(0.0, y, model.term_forces(0.0, y, active, params))
-    S, Sp = ms.consistent(0.0, y, S, active, params, S_params)
-    differential = np.array([kind != KIND_MULTIPLIER for kind in model.state_kinds])
-    pbar = np.array([abs(parameter_value(model, name)) or 1.0 for name in ms.names])
     atol_y = tolerance_vector(model, rtol, atol)
+    carrier = SensitivityCarrier(model, names, rtol, atol_y, jumps=jumps)
+    W, n = carrier.width, model.n_states
+    y, yp = model.initial_state(start=start, allow_penetration=allow_penetration)
+    S0 = initial_sensitivities(model, carrier.names, start, allow_penetration)
+    y, yp = carrier.start(0.0, y, yp, contact_state.start_state(model, 0.0, y), S0)
+    pbar = parameter_scales(model, carrier.names)
     session = open_session(augmented_functions(model.functions, W), backend=backend, rtol=rtol,
                            atol=np.concatenate([atol_y, *(atol_y / p for p in pbar)]), max_step=max_step,
-                           parameters=np.concatenate([model.parameter_values, ms.dP.ravel(order="F")]))
+                           parameters=np.concatenate([model.parameter_values, carrier.ms.dP.ravel(order="F")]))
     # the run's IDA settings (daeclear.solvers.ida; the python backend has none), but GGL's tight Newton
     # coefficient: S's corrections converge linearly under the block-diagonal matrix, and 1e-3 in IDA's 4
     # iterations failed a chaotic run (S ~ 1e8) after 10 ms at rtol 1e-8 where IDA's 0.33 carries it to 24 ms
     session.set_hints(jacobian_refresh=ida.JACOBIAN_REFRESH,
                       first_step=ida.FIRST_STEP_ESTIMATE and model.formulation == "ggl")
-    poisoned = np.zeros(W, dtype=bool)  # parameters whose sensitivities are NaN from a grazing event on
-    rows: list[tuple[float, NDArray, NDArray, NDArray, NDArray]] = []  # (t, y, S, channels' S, channels)
     if eval_times[0] == 0.0:
-        rows.append(_row(ms, 0.0, y, S, active, params, S_params, poisoned))
+        carrier.row(0.0, y, carrier.S)
     n_ch = len(model.channel_names)
-    run = SensitivityRun(ms.names, model.state_names, model.channel_names, np.zeros(0), np.zeros((0, n)),
-                         np.zeros((0, n, W)), np.zeros((0, n_ch, W)), np.zeros((0, n_ch)))
+    run = SensitivityRun(carrier.names, model.state_names, model.channel_names, np.zeros(0), np.zeros((0, n)),
+                         np.zeros((0, n, W)), np.zeros((0, n_ch, W)), np.zeros((0, n_ch)), events=carrier.events)
+    ys: list[NDArray] = [y] if eval_times[0] == 0.0 else []
     t = 0.0
     try:
         while True:
-            session.reinit(t, np.concatenate([y, S.ravel(order="F")]), np.concatenate([yp, Sp.ravel(order="F")]),
-                           active, [np.concatenate([p, s.ravel(order="F")]) for p, s in zip(params, S_params)],
-                           contact_state.root_directions(model, state))
+            session.reinit(t, np.concatenate([y, carrier.S.ravel(order="F")]),
+                           np.concatenate([yp, carrier.Sp.ravel(order="F")]), carrier.active,
+                           carrier.terms_stacked(), contact_state.root_directions(model, carrier.state))
             adv = session.advance(float(t_end), eval_times, store_steps=False, store_states=False)
             for te, Ye in zip(adv.eval_t.tolist(), adv.eval_y):
-                rows.append(_row(ms, te, Ye[:n], Ye[n:].reshape(n, W, order="F"), active, params, S_params, poisoned))
+                ys.append(carrier.row(te, Ye[:n], Ye[n:].reshape(n, W, order="F")))
             t = adv.t
             if adv.status != "root":
                 if adv.status == "error":
@@ -156,64 +132,28 @@ def forward_sensitivities(model: DAEModel, t_end: float, parameters: Sequence[st
                 break
             y, S = adv.y[:n], adv.y[n:].reshape(n, W, order="F")
             if event_rows:
-                rows.append(_row(ms, t, y, S, active, params, S_params, poisoned))
-            state, active, params, latched, y, yp, S, Sp = _event(
-                ms, state, active, params, latched, t, y, S, adv.roots_found, rtol, atol_y, jumps, differential, run)
-            bad = ~np.all(np.isfinite(S), axis=0)
-            poisoned |= bad
-            S[:, bad] = 0.0  # integrated as zeros, reported as NaN
-            Sp[:, bad] = 0.0
-            for per_pair in latched:
-                for value in per_pair:
-                    value[poisoned] = 0.0
-            S_params = _term_sensitivities(model, state, latched, W)
+                ys.append(carrier.row(t, y, S))
+            y, yp, S = _event(carrier, t, y, S, adv.roots_found)
             if event_rows:
-                rows.append(_row(ms, t, y, S, active, params, S_params, poisoned))
+                ys.append(carrier.row(t, y, S))
     finally:
         session.close()
-    if rows:
-        run.t = np.array([r[0] for r in rows])
-        run.y, run.S, run.channel_S, run.channels = (np.stack([r[k] for r in rows]) for k in (1, 2, 3, 4))
+    if carrier.rows_t:
+        run.t = np.array(carrier.rows_t)
+        run.y, run.S, run.channel_S = np.stack(ys), np.stack(carrier.rows_S), np.stack(carrier.rows_channel_S)
+        run.channels = np.stack(carrier.rows_channels)
     return run
 
 
-def _term_sensitivities(model: DAEModel, state: contact_state.ContactState, latched: list[list[NDArray]],
-                        width: int) -> list[NDArray]:
-    """Each term's parameters' sensitivity (n_params_k, Ns) in ``state``, from the pairs' ``latched``."""
-    out = [np.zeros((term.n_params, width)) for term in model.terms]
-    for logic, states, per_pair in zip(model.contacts, state, latched):
-        for k, S_k in logic.term_sensitivities(states, per_pair):
-            out[k] = np.array(S_k, dtype=float).reshape(-1, width)
-    return out
-
-
-def _row(ms: ModelSensitivity, t: float, y: NDArray, S: NDArray, active: list[bool], params: list[NDArray],
-         S_params: list[NDArray], poisoned: NDArray) -> tuple[float, NDArray, NDArray, NDArray, NDArray]:
-    """An output row, made consistent in its mode: (t, y, S, the channels' sensitivities, the channels), NaN
-    where poisoned."""
-    model = ms.model
-    y, yp = model.consistent_state(t, y, model.term_forces(t, y, active, params))
-    S, Sp = ms.consistent(t, y, S, active, params, S_params)
-    switch = model.switch_vector(active, params)
-    channel_S = ms.channels(t, y, yp, S, Sp, switch, ms.switch_sensitivity(S_params))
-    values = np.array(model.outputs(t, y, yp, switch, model.parameter_values), dtype=float).ravel()
-    S[:, poisoned] = np.nan
-    channel_S[:, poisoned] = np.nan
-    return t, y, S, channel_S, values
-
-
-def _event(ms: ModelSensitivity, state: contact_state.ContactState, active: list[bool], params: list[NDArray],
-           latched: list[list[NDArray]], t: float, y: NDArray, S: NDArray, found: NDArray | None, rtol: float,
-           atol: NDArray, jumps: bool, differential: NDArray, run: SensitivityRun) -> tuple:
-    """Decide the roots at ``t``, jump the sensitivities (docs/sensitivities.md) and return the new mode
-    with the pairs' latched sensitivities and its consistent (y, y', S, S')."""
-    model, W = ms.model, ms.width
-    S_params = _term_sensitivities(model, state, latched, W)
-    new_state, events = contact_state.decide(model, state, t, y, found)
+def _event(carrier: SensitivityCarrier, t: float, y: NDArray, S: NDArray, found: NDArray | None
+           ) -> tuple[NDArray, NDArray, NDArray]:
+    """Decide the roots at ``t`` and jump the sensitivities (the carrier's jump, as the run driver's);
+    return the consistent (y, y', S) to restart from in the new mode."""
+    model = carrier.model
+    active, params = carrier.active, carrier.params
+    new_state, events = contact_state.decide(model, carrier.state, t, y, found)
     new_active, new_params = contact_state.switches(model, new_state)
-    # y' and S' before the switch, exact for the old mode at (t, y)
     y_m, yp_m = model.consistent_state(t, y, model.term_forces(t, y, active, params))
-    S_m, Sp_m = ms.consistent(t, y_m, S, active, params, S_params)
     project = model.formulation == "ggl"  # as the run's restarts: on the constraint manifold, mu = 0
     y_p, yp_p = model.consistent_state(t, y_m, model.term_forces(t, y_m, new_active, new_params), project=project)
     roots_of = model.functions.roots
@@ -224,40 +164,5 @@ def _event(ms: ModelSensitivity, state: contact_state.ContactState, active: list
         if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
             project = False
             y_p, yp_p = model.consistent_state(t, y_m, model.term_forces(t, y_m, new_active, new_params))
-    new_latched = [[value.copy() for value in per_pair] for per_pair in latched]
-    dt_dps = []
-    if events and found is not None:
-        at = ms.roots(t, y_m, yp_m, S_m, Sp_m, rtol, atol)
-        for e in events:
-            label = f"'{e.pair}' {e.kind} at t={t:.9g} s"
-            owners = [(i, logic, root) for i, logic in enumerate(model.contacts)
-                      for root in logic.event_roots(e.pair, np.ravel(found))]
-            if not owners:  # no root of this instant made it: no derivative to give
-                warnings.warn(f"sensitivities: {label} was made by no root found then; its sensitivities are NaN "
-                              "from here on.", PhysicsWarning, stacklevel=3)
-                dt_dps.append(np.full(W, np.nan))
-                run.events.append(EventSensitivity(t, e.pair, e.kind, dt_dps[-1]))
-                continue
-            for i, logic, root in owners:
-                dt = event_time_sensitivity(at.g_p[root], at.rate[root], at.scale[root], rtol=rtol, event=label,
-                                            curvature=at.curvature[root], gap_error=at.error[root])
-                if contact_state.pair_state(model, new_state, root).held:
-                    warnings.warn(f"sensitivities: {label} is held by the storm guard (a storm of tiny re-contacts "
-                                  "has no derivative); its sensitivities are NaN from here on.", PhysicsWarning,
-                                  stacklevel=3)
-                    dt = np.full(W, np.nan)
-                dt_dps.append(dt)
-                if e.kind == "onset" and logic.needs_approach and logic.pair_name(root) == e.pair:
-                    speed, rate_p, rate_rate = ms.approach_rate(root, y_m, yp_m, S_m)
-                    new_latched[i][logic.pair_index(root)] = latched_sensitivity(
-                        rate_p, rate_rate, dt if jumps else np.zeros(W), floored=speed <= logic.min_approach_speed)
-            run.events.append(EventSensitivity(t, e.pair, e.kind, dt_dps[-len(owners)]))
-    new_S_params = _term_sensitivities(model, new_state, new_latched, W)
-    dt_dp = np.zeros(W)
-    if dt_dps:
-        dt_dp = dt_dps[0] if same_event_times(dt_dps, rtol) else np.full(W, np.nan)
-    S_p = state_jump(S_m, yp_m, yp_p, dt_dp, differential) if jumps else S_m
-    if project:
-        S_p = ms.projected(t, y_p, S_p)
-    S_p, Sp_p = ms.consistent(t, y_p, S_p, new_active, new_params, new_S_params)
-    return new_state, new_active, new_params, new_latched, y_p, yp_p, S_p, Sp_p
+    carrier.jump(t, y, S, found, new_state, events, y_p, project)
+    return y_p, yp_p, carrier.S
