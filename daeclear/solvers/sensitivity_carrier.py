@@ -57,6 +57,8 @@ class SensitivityCarrier:
         self.rows_S: list[NDArray] = []
         self.rows_channel_S: list[NDArray] = []
         self.rows_channels: list[NDArray] = []
+        self.event_t: list[float] = []
+        self.event_rows: list[tuple[NDArray, NDArray, NDArray, NDArray]] = []  # (y, S, channels' S, channels)
 
     def set_state(self, state: contact_state.ContactState) -> None:
         """The contact state S is integrated in, and its terms' parameters' sensitivities."""
@@ -98,6 +100,15 @@ class SensitivityCarrier:
     def row(self, t: float, y: NDArray, S: NDArray) -> NDArray:
         """Keep an output row at ``t`` (S of the state ``y`` in the current mode, made consistent there,
         and the channels' sensitivities); NaN where poisoned. Return the consistent y."""
+        y, S, channel_S, values = self.evaluate(t, y, S)
+        self.rows_t.append(t)
+        self.rows_S.append(S)
+        self.rows_channel_S.append(channel_S)
+        self.rows_channels.append(values)
+        return y
+
+    def evaluate(self, t: float, y: NDArray, S: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+        """A row at ``t`` made consistent in the current mode: (y, S, the channels' S, the channels' values)."""
         model, ms = self.model, self.ms
         y, yp = model.consistent_state(t, y, model.term_forces(t, y, self.active, self.params))
         S, Sp = ms.consistent(t, y, S, self.active, self.params, self.S_params)
@@ -106,11 +117,13 @@ class SensitivityCarrier:
         values = np.array(model.outputs(t, y, yp, switch, model.parameter_values), dtype=float).ravel()
         S[:, self.poisoned] = np.nan
         channel_S[:, self.poisoned] = np.nan
-        self.rows_t.append(t)
-        self.rows_S.append(S)
-        self.rows_channel_S.append(channel_S)
-        self.rows_channels.append(values)
-        return y
+        return y, S, channel_S, values
+
+    def event_row(self, t: float, y: NDArray, S: NDArray) -> None:
+        """Keep a row at an event's time (before its switch, then after): what an objective integrating or
+        peaking across the event reads (:mod:`daeclear.results.objectives`)."""
+        self.event_rows.append(self.evaluate(t, y, S))
+        self.event_t.append(t)
 
     def jump(self, t: float, y: NDArray, S: NDArray, found: NDArray | None, new_state: contact_state.ContactState,
              events: Sequence[ContactEvent], y_p: NDArray, projected: bool) -> None:
@@ -118,6 +131,7 @@ class SensitivityCarrier:
         contact ``events`` decided there into ``new_state``; ``y_p`` the consistent state the run restarts
         from (``projected``: onto GGL's constraint manifold). Leaves S and S' consistent in the new mode."""
         model, ms, W, rtol = self.model, self.ms, self.width, self.rtol
+        self.event_row(t, y, S.copy())
         new_active, new_params = contact_state.switches(model, new_state)
         y_m, yp_m = model.consistent_state(t, y, model.term_forces(t, y, self.active, self.params))
         S_m, Sp_m = ms.consistent(t, y_m, S, self.active, self.params, self.S_params)
@@ -168,3 +182,4 @@ class SensitivityCarrier:
                 value[self.poisoned] = 0.0
         self.S_params = self.term_sensitivities(self.state, self.latched)
         self.S, self.Sp = S_p, Sp_p
+        self.event_row(t, y_p, S_p.copy())

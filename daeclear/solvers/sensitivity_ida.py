@@ -27,7 +27,7 @@ from ..engine.session_base import Advance, Session
 from . import ida
 from .integrator import Jump, Terms
 from ..results.result import Result
-from ..results.sensitivities import Sensitivities
+from ..results.sensitivities import EventSides, Sensitivities
 from .save_at import Output
 from .sensitivity_carrier import SensitivityCarrier, parameter_scales
 from .tolerances import tolerance_vector
@@ -165,6 +165,11 @@ class SensitivityIntegrator:
         shape = (0, model.n_states, c.width), (0, len(model.channel_names), c.width)
         states = np.stack(c.rows_S[:n]) if n else np.zeros(shape[0])
         channels = np.stack(c.rows_channel_S[:n]) if n else np.zeros(shape[1])
+        k = len(c.event_t)
+        n_ch = len(model.channel_names)
+        sides = EventSides(np.array(c.event_t), *(
+            np.stack([row[i] for row in c.event_rows]) if k else np.zeros(empty)
+            for i, empty in ((0, (0, model.n_states)), (3, (0, n_ch)), (1, shape[0]), (2, shape[1]))))
         result.sensitivities = Sensitivities(c.names, tuple(model.state_names), tuple(model.channel_names),
-                                             states, channels, tuple(c.events))
+                                             states, channels, tuple(c.events), sides)
 
