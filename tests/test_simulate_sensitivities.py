@@ -143,7 +143,8 @@ def test_bad_names_are_refused_before_any_run(kv_model, monkeypatch: pytest.Monk
 
 def test_a_scene_is_assembled_to_check_the_names(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(driver, "run", _no_run)
-    with pytest.raises(dc.SceneError, match="sensitivities='clearance.stiffness', must be one of model.parameter_names"):
+    with pytest.raises(dc.SceneError,
+                       match="sensitivities='clearance.stiffness', must be one of model.parameter_names"):
         dc.simulate(radial_scene(dcc.KelvinVoigt(stiffness=K, damping=D)), T, sensitivities=["clearance.stiffness"])
 
 

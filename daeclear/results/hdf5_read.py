@@ -176,15 +176,16 @@ def _read(r: _Reader) -> dict[str, Any]:
 
     sensitivities = None
     if r.has("sensitivities"):  # a run with sensitivities: its rows of the window, its events in it
-        names = tuple(r.strings("sensitivities/names"))
+        parameters_s = tuple(r.strings("sensitivities/names"))
         ev_t = r.array("sensitivities/events/t")
-        inside = (ev_t >= lo) & (ev_t <= hi)
+        inside = [i for i, at in enumerate(ev_t.tolist()) if lo <= at <= hi]
+        pairs, kinds = r.strings("sensitivities/events/pair"), r.strings("sensitivities/events/kind")
+        dt_dp = r.array("sensitivities/events/dt_dp").reshape(-1, len(parameters_s))
         sensitivities = Sensitivities(
-            names, tuple(state_names), tuple(r.strings("sensitivities/channel_names")),
+            parameters_s, tuple(state_names), tuple(r.strings("sensitivities/channel_names")),
             r.array("sensitivities/states", points), r.array("sensitivities/channels", points),
-            sensitivity_events(ev_t[inside], np.array(r.strings("sensitivities/events/pair"), dtype=object)[inside],
-                               np.array(r.strings("sensitivities/events/kind"), dtype=object)[inside],
-                               r.array("sensitivities/events/dt_dp").reshape(-1, len(names))[inside]))
+            sensitivity_events([float(ev_t[i]) for i in inside], [pairs[i] for i in inside],
+                               [kinds[i] for i in inside], dt_dp[inside]))
     return dict(t=t, y=y, yp=yp, state_names=state_names, channels=channels, units=units, events=events,
                 sensitivities=sensitivities,
                 segments=segments, stats=r.json("stats_json"), success=bool(r.attr("success")),

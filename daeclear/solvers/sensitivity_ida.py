@@ -55,7 +55,7 @@ class SensitivityIntegrator:
     """One run's IDA session on [y; S] as the driver's :class:`~daeclear.solvers.integrator.Integrator`."""
 
     name = "IDA"
-    lazy_rows = False  # rows completed by the driver (complete): S's rows are made consistent as they come
+    lazy_rows = True  # the rows are the DAE's states, made consistent when read (as IDA's: a file keeps states only)
     resumes_at_roots = False
     decides = False
     order = 0
