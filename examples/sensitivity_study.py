@@ -29,7 +29,6 @@ import daeclear as dc  # noqa: E402
 from daeclear.assembly.sensitivity import parameter_value  # noqa: E402
 from daeclear.plot import plot_sensitivity_horizon  # noqa: E402
 from daeclear.results.sensitivity_growth import relative_growth  # noqa: E402
-from daeclear.solvers.sensitivity_prototype import forward_sensitivities  # noqa: E402
 
 PARAMETERS = ["clearance.clearance", "clearance.law.restitution"]
 RTOL = 1e-10
@@ -58,12 +57,13 @@ def gradients(span: float) -> dict[str, dict[str, float]]:
 def growth(clearance: float, span: float) -> tuple[np.ndarray, np.ndarray]:
     """G(t), the largest relative sensitivity to the clearance and the restitution, over ``span``."""
     model = dc.assemble(dc.mechanisms.slider_crank("revolute", clearance=clearance))
-    run = forward_sensitivities(model, span, PARAMETERS, t_eval=np.linspace(0.0, span, 201), rtol=1e-8,
-                                backend="auto")
+    run = dc.simulate(model, span, rtol=1e-8, save=dc.SaveAt(times=np.linspace(0.0, span, 201), steps=False),
+                      sensitivities=PARAMETERS, on_failure="return")
     n = 2 * model.n_q  # positions and velocities, each against its largest magnitude over the run
     scale = np.maximum(np.abs(run.y[:, :n]).max(axis=0), 1e-12)
     p = [parameter_value(model, name) for name in PARAMETERS]
-    return run.t, relative_growth(run.S[:, :n, :], scale, p)
+    S = np.stack([run.sensitivity(name) for name in run.state_names[:n]], axis=1)  # (n_times, n, Ns)
+    return run.t, relative_growth(S, scale, p)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -589,6 +589,10 @@ def test_missing_optional_dependency_names_the_extra(monkeypatch: pytest.MonkeyP
 LAYOUT_DOC = Path(__file__).resolve().parents[1] / "docs" / "hdf5_layout.md"
 #: items of a run's file only: each point's switch vector and the names of the channels computed when read
 STATES_ONLY = {"/switch", "/channel_names", "/channel_units"}
+#: items of a run with sensitivities only (simulate(..., sensitivities=...))
+SENSITIVITIES = {"/sensitivities", "/sensitivities/names", "/sensitivities/states", "/sensitivities/channel_names",
+                 "/sensitivities/channels", "/sensitivities/events", "/sensitivities/events/t",
+                 "/sensitivities/events/pair", "/sensitivities/events/kind", "/sensitivities/events/dt_dp"}
 
 
 def _documented_items() -> list[tuple[str, bool]]:
@@ -630,15 +634,17 @@ def test_hdf5_layout_document_lists_every_item_and_only_those(tmp_path: Path) ->
     undocumented = [i for i in in_file if not any(p.match(i) for p, _, _ in patterns)]
     assert not undocumented, f"items written by Result.save but missing from {LAYOUT_DOC.name}: {undocumented}"
     # a result built from arrays stores yp and its channels, not a run's switch rows (STATES_ONLY)
-    absent = [item for p, item, _ in patterns if not any(p.match(i) for i in in_file) and item not in STATES_ONLY]
+    absent = [item for p, item, _ in patterns
+              if not any(p.match(i) for i in in_file) and item not in STATES_ONLY | SENSITIVITIES]
     assert not absent, f"items in {LAYOUT_DOC.name} that Result.save does not write: {absent}"
     # the optional items are the steps, which a result without recorded steps lacks
     path = make_result(step_t=None, step_h=None, step_order=None).save(tmp_path / "no_steps.h5")
     with h5py.File(path, "r") as f:
         in_file = _file_items(f)
-    absent = {item for p, item, _ in patterns if not any(p.match(i) for i in in_file)} - STATES_ONLY
+    absent = {item for p, item, _ in patterns if not any(p.match(i) for i in in_file)} - STATES_ONLY - SENSITIVITIES
     assert absent == {"/steps", "/steps/t", "/steps/h", "/steps/order"}
-    assert {item for item, optional in documented if optional} - STATES_ONLY - {"/yp"} == {"/steps"}
+    assert {item for item, optional in documented if optional} - STATES_ONLY - SENSITIVITIES - {"/yp"} == {"/steps"}
+    assert SENSITIVITIES <= {item for item, optional in documented if optional}
     # a run's file: its states and switch rows, its channels and yp computed when read
     import daeclear as dc
 
@@ -648,8 +654,16 @@ def test_hdf5_layout_document_lists_every_item_and_only_those(tmp_path: Path) ->
     undocumented = [i for i in in_file if not any(p.match(i) for p, _, _ in patterns)]
     assert not undocumented, f"items of a run's file missing from {LAYOUT_DOC.name}: {undocumented}"
     absent = {item for p, item, _ in patterns if not any(p.match(i) for i in in_file)}
-    assert absent == {"/yp", "/channels/<name>", "/channels/<name>@units"}
+    assert absent == {"/yp", "/channels/<name>", "/channels/<name>@units"} | SENSITIVITIES
     assert STATES_ONLY <= {item for item, optional in documented if optional}
+    # a run with sensitivities: every item of its file documented, and the sensitivities' items all present
+    run = dc.simulate(dc.mechanisms.slider_crank("revolute"), t_end=0.4e-3, sensitivities=["clearance.clearance"])
+    with h5py.File(run.save(tmp_path / "run_sensitivities.h5"), "r") as f:
+        in_file = _file_items(f)
+    undocumented = [i for i in in_file if not any(p.match(i) for p, _, _ in patterns)]
+    assert not undocumented, f"items of a run's file missing from {LAYOUT_DOC.name}: {undocumented}"
+    absent = {item for p, item, _ in patterns if not any(p.match(i) for i in in_file)}
+    assert absent == {"/yp", "/channels/<name>", "/channels/<name>@units"}
 
 
 def test_hdf5_layout_document_snippet_reads_a_file_with_plain_h5py(tmp_path: Path,

@@ -1,5 +1,5 @@
-"""Issue 43's acceptance case, a radial impact, against its closed form; and the prototype forward-sensitivity
-run (daeclear/solvers/sensitivity_prototype.py) through it, with and without the jumps.
+"""Issue 43's acceptance case, a radial impact, against its closed form; and a run with forward
+sensitivities (``simulate(..., sensitivities=...)``, tests/sensitivity_runs.py) through it, with and without the jumps.
 
 A free journal (m = 1 kg) starts at the bearing's centre at u = 1 m/s along x; clearance z0 = 0.1 m,
 Kelvin-Voigt K = 1e4 N/m, D = 20 N s/m, no gravity, start="declared", T = 0.25 s. Closed form: a = D/2m,
@@ -23,7 +23,7 @@ import pytest
 
 import daeclear as dc
 import daeclear.contact as dcc
-from daeclear.solvers.sensitivity_prototype import forward_sensitivities
+from sensitivity_runs import forward_sensitivities
 
 M, U, T = 1.0, 1.0, 0.25
 K, D, Z0 = 1e4, 20.0, 0.1
@@ -103,7 +103,7 @@ def kv_model() -> dc.DAEModel:
 
 
 @pytest.mark.parametrize("backend", ["python", "c"])
-def test_prototype_run_reproduces_the_closed_form(kv_model, backend: str) -> None:
+def test_stacked_run_reproduces_the_closed_form(kv_model, backend: str) -> None:
     """S(T) of x and vx, and each event time's sensitivity, from the stacked DAE with the jumps."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", dc.DaeclearWarning)  # atol at round-off, raised

@@ -1,8 +1,8 @@
-"""The prototype forward-sensitivity run on the chapter's slider-crank with its revolute clearance joint
-(Fig. 4.15's scene, c = 0.5 mm, 5000 rpm) over its first 2 ms (13 impacts), and with its translational
-clearance joint (corner pairs) over 5 ms (16): constraints and multipliers, the latched approach speed;
-every position's and velocity's sensitivity to the clearance and the restitution against central
-differences of ordinary runs (issue 43's validation), both formulations.
+"""A run with forward sensitivities (``simulate(..., sensitivities=...)``) on the chapter's slider-crank with
+its revolute clearance joint (Fig. 4.15's scene, c = 0.5 mm, 5000 rpm) over its first 2 ms (13 impacts), and
+with its translational clearance joint (corner pairs) over 5 ms (16): constraints and multipliers, the latched
+approach speed; every position's and velocity's sensitivity to the clearance and the restitution against
+central differences of ordinary runs (issue 43's validation), both formulations.
 
 Differences need a step that keeps the impacts' sequence: at 1e-3 of the clearance the runs have 15
 impacts, not 13 (the derivative of a run whose events change is no derivative); at 1e-4 they keep it.
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.solvers.sensitivity_prototype import forward_sensitivities
+from sensitivity_runs import forward_sensitivities
 
 NAMES = ["clearance.clearance", "clearance.law.restitution"]
 STEP = 1e-4  # relative: keeps the 13 impacts

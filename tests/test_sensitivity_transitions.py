@@ -1,5 +1,5 @@
 """Sensitivity jumps at every kind of event (issue 43 item 3), by the Taylor remainder of the reference run
-(daeclear/solvers/sensitivity_prototype.py) against ordinary runs.
+(``simulate(..., sensitivities=...)``, tests/sensitivity_runs.py) against ordinary runs.
 
 If S = dy/dp at T is right, the first-order prediction y(p + h) ~ y(p) + S h misses by O(h^2): its remainder
 falls 16-fold when h falls 4-fold. A missing or wrong term (a jump left out, a latched speed's dt*/dp) leaves
@@ -29,7 +29,7 @@ import daeclear as dc
 import daeclear.contact as dcc
 from daeclear.assembly.sensitivity import parameter_value
 from daeclear.model.scene import TranslationalClearance
-from daeclear.solvers.sensitivity_prototype import SensitivityRun, forward_sensitivities
+from sensitivity_runs import StackedRun as SensitivityRun, forward_sensitivities
 
 STEEL = dcc.Material(young=207e9, poisson=0.3)
 STEPS = (4e-2, 1e-2, 2.5e-3)  # relative to each parameter

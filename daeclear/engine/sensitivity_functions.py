@@ -137,9 +137,9 @@ def sensitivity_functions(funcs: DAEFunctions, width: int, extras: Sequence[int]
 
 
 def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False) -> DAEFunctions:
-    """The DAE of [y; S_1; ...; S_width] as one :class:`DAEFunctions` (a reference for tests and the
-    prototype run, never the fast path): parameters [P; vec(dP)], term k's parameters [p_k; vec(Sk)],
-    the roots those of y, no extras.
+    """The DAE of [y; S_1; ...; S_width] as one :class:`DAEFunctions` (what IDA integrates for
+    ``simulate(..., sensitivities=...)``, never the fast path): parameters [P; vec(dP)], term k's
+    parameters [p_k; vec(Sk)], the roots those of y, no extras.
 
     Its Jacobian: the state's iteration matrix on every diagonal block, nothing else (IDAS' simultaneous
     corrector: a modified Newton that converges since S's equations are linear in S); ``coupled``: the

@@ -16,6 +16,7 @@ from ..core.errors import DaeclearError, SceneError
 from ..core.events import ContactEvent
 from .hdf5_write import FORMAT_NAME, FORMAT_VERSION
 from .lazy_channels import LazyChannels, rebuilt_evaluator
+from .sensitivities import Sensitivities, sensitivity_events
 from ..core.values import time_window
 
 if TYPE_CHECKING:  # h5py is imported lazily, only where a file is read
@@ -173,7 +174,20 @@ def _read(r: _Reader) -> dict[str, Any]:
         steps = {"step_t": r.array("steps/t", rows), "step_h": r.array("steps/h", rows),
                  "step_order": r.array("steps/order", rows)}
 
+    sensitivities = None
+    if r.has("sensitivities"):  # a run with sensitivities: its rows of the window, its events in it
+        parameters_s = tuple(r.strings("sensitivities/names"))
+        ev_t = r.array("sensitivities/events/t")
+        inside = [i for i, at in enumerate(ev_t.tolist()) if lo <= at <= hi]
+        pairs, kinds = r.strings("sensitivities/events/pair"), r.strings("sensitivities/events/kind")
+        dt_dp = r.array("sensitivities/events/dt_dp").reshape(-1, len(parameters_s))
+        sensitivities = Sensitivities(
+            parameters_s, tuple(state_names), tuple(r.strings("sensitivities/channel_names")),
+            r.array("sensitivities/states", points), r.array("sensitivities/channels", points),
+            sensitivity_events([float(ev_t[i]) for i in inside], [pairs[i] for i in inside],
+                               [kinds[i] for i in inside], dt_dp[inside]))
     return dict(t=t, y=y, yp=yp, state_names=state_names, channels=channels, units=units, events=events,
+                sensitivities=sensitivities,
                 segments=segments, stats=r.json("stats_json"), success=bool(r.attr("success")),
                 status=int(r.attr("status")), message=str(r.attr("message")), parameters=parameters,
                 scene_name=str(r.attr("scene_name")), method=str(r.attr("method")),

@@ -20,6 +20,7 @@ if TYPE_CHECKING:  # h5py is imported lazily, only where a file is written
     import h5py
 
     from .result import Result
+    from .sensitivities import Sensitivities
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "json_dataset", "mirror", "save_result", "stores_states_only",
            "string_dataset", "write_result_group"]
@@ -142,10 +143,27 @@ def _write(f: h5py.File | h5py.Group, r: Result, channels: bool = False) -> None
         for name, values in (("t", r.step_t), ("h", r.step_h), ("order", r.step_order)):
             _dataset(steps, name, np.asarray(values))
 
+    if r.sensitivities is not None:
+        _write_sensitivities(f.create_group("sensitivities"), r.sensitivities)
+
     for name, tree in (("stats", r.stats), ("parameters", r.parameters)):
         mirror(f.create_group(name), tree)
         json_dataset(f, f"{name}_json", tree)
     json_dataset(f, "warnings_json", r.warnings)
+
+
+def _write_sensitivities(group: h5py.Group, s: Sensitivities) -> None:
+    """A run's forward sensitivities (``simulate(..., sensitivities=[...])``): names, S of the states and
+    the channels at every output time, each event time's sensitivity."""
+    string_dataset(group, "names", s.names)
+    _dataset(group, "states", np.asarray(s.states, dtype=np.float64))
+    string_dataset(group, "channel_names", s.channel_names)
+    _dataset(group, "channels", np.asarray(s.channels, dtype=np.float64))
+    events = group.create_group("events")
+    _dataset(events, "t", np.array([e.t for e in s.events], dtype=np.float64))
+    string_dataset(events, "pair", [e.pair for e in s.events])
+    string_dataset(events, "kind", [e.kind for e in s.events])
+    _dataset(events, "dt_dp", np.array([e.dt_dp for e in s.events], dtype=np.float64).reshape(-1, len(s.names)))
 
 
 def stores_states_only(r: Result) -> bool:

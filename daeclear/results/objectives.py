@@ -4,8 +4,8 @@ An objective names what a designer looks at: :class:`Final` (a channel at the en
 window), :class:`Peak` (its largest value in a window) and :class:`EventTime` (when the k-th onset or
 separation of a pair happens). :func:`evaluate` computes its value and its gradient with respect to the run's
 parameters from a :class:`Trajectory`: output rows with the states' and channels' values and sensitivities,
-and the events with their times' sensitivities. Any run that gives these can be evaluated: today the reference
-run (``daeclear.solvers.sensitivity_prototype``), later the run driver's results.
+and the events with their times' sensitivities. Any run that gives these can be evaluated: a result of
+``simulate(..., sensitivities=...)`` through :class:`daeclear.results.sensitivities.RunTrajectory`.
 
 A trajectory holds an event at t* as two rows at t*, before and after its switch: a channel that jumps there
 (a Kelvin-Voigt force at onset) moves an integral by (before - after) dt*/dp, and a peak at the jump moves

@@ -27,6 +27,7 @@ from .hdf5_stream import STREAM_RUNNING, ResultWriter
 from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, save_result, write_result_group
 from .lazy_channels import LazyChannels
 from .result_checks import checked_fields
+from .sensitivities import Sensitivities
 from ..core.values import readonly, time_window, to_plain
 
 if TYPE_CHECKING:  # h5py, pandas and xarray are imported lazily, only where they are used
@@ -139,12 +140,17 @@ class Result:
         method: str = "",
         formulation: str = "",
         warnings: Iterable[Mapping[str, Any]] = (),
+        sensitivities: Sensitivities | None = None,
     ) -> None:
         t_arr, y_arr, yp_arr, names, chans, event_list, segs, steps = checked_fields(
             t, y, yp, state_names, channels, units, events, segments, step_t, step_h, step_order, success, status)
         self._assign(t_arr, y_arr, yp_arr, names, chans, units, event_list, segs, steps, dict(
             stats=stats, success=success, status=status, message=message, scene_name=scene_name, method=method,
             formulation=formulation, warnings=warnings, parameters=to_plain(dict(parameters or {}), "parameters")))
+        if sensitivities is not None and sensitivities.states.shape[:2] != (t_arr.size, len(names)):
+            raise ValueError(f"Result: sensitivities of shape {sensitivities.states.shape} do not match "
+                             f"{t_arr.size} times and {len(names)} states")
+        self.sensitivities = sensitivities
 
     @classmethod
     def of_run(cls, *, t: NDArray, y: NDArray, yp: NDArray | None, state_names: Sequence[str],
@@ -159,6 +165,7 @@ class Result:
         result = cls.__new__(cls)
         result._assign(t, y, yp, list(state_names), channels, units, EventList.of_parts(list(events)), segments,
                        (step_t, step_h, step_order), {**outcome, "parameters": (outcome["parameters"],)})
+        result.sensitivities = None
         return result
 
     def _assign(self, t: NDArray, y: NDArray, yp: NDArray | None, names: list[str],
@@ -215,6 +222,20 @@ class Result:
             assert self._lazy is not None
             self._yp = self._lazy.yp
         return self._yp
+
+    @property
+    def sensitivity_names(self) -> tuple[str, ...]:
+        """The parameters of the run's sensitivities (``simulate(..., sensitivities=[...])``); () without."""
+        return () if self.sensitivities is None else self.sensitivities.names
+
+    def sensitivity(self, name: str, parameter: str | None = None) -> NDArray[np.float64]:
+        """d(name)/dp of a state or channel ``name`` at every output time: (n_times, Ns) in the order of
+        :attr:`sensitivity_names`, or (n_times,) for one ``parameter``; NaN after a grazing event
+        (docs/sensitivities.md). KeyError for a run without sensitivities or a name it does not hold."""
+        if self.sensitivities is None:
+            raise KeyError("Result.sensitivity: this run has no sensitivities; run "
+                           "simulate(..., sensitivities=[names from model.parameter_names]).")
+        return self.sensitivities.of(name, parameter)
 
     def state(self, i: int) -> NDArray[np.float64]:
         """Row ``i`` of :attr:`y` (e.g. -1: the state to continue a run from), without making every row
@@ -387,6 +408,7 @@ class Result:
                 name: arr[mask] for name, arr in self._channel_values().items()},
             events=[e for e in self._events if lo <= e.t <= hi],
             segments=[(max(a, lo), min(b, hi), m) for a, b, m in self.segments if a < hi and b > lo],
+            sensitivities=None if self.sensitivities is None else self.sensitivities.take(mask, lo, hi),
         )
         if self._steps is not None:
             inside = (self._steps[0] >= lo) & (self._steps[0] <= hi)
@@ -419,6 +441,7 @@ class Result:
             "method": self.method,
             "formulation": self.formulation,
             "warnings": json.loads(json.dumps(self.warnings)),
+            "sensitivities": self.sensitivities,
         }
 
     # ------------------------------------------------------------------ hand-off to pandas and xarray

@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from numpy.typing import ArrayLike
@@ -16,6 +16,10 @@ from .save_at import SaveAt, save_value
 from .solver_options import UNSET, SolverOptions
 from .base import Solver
 from .registry import solver_class
+from .ida import IDA
+from .sensitivity_ida import SensitivityIDA
+from .save_at import Output
+from ..assembly.sensitivity import parameter_value
 
 DEFAULTS = SolverOptions()
 
@@ -34,6 +38,7 @@ def simulate(
     on_failure: str = "raise",
     progress: bool = False,
     parameters: Mapping[str, Any] | None = None,
+    sensitivities: Sequence[str] | None = None,
 ) -> Result:
     """Integrate a scene (or an assembled model) from ``t0`` to ``t_end``.
 
@@ -65,6 +70,10 @@ def simulate(
         Show a progress line on stderr.
     parameters : mapping or None
         New numbers for this run by name (:meth:`DAEModel.with_parameters`); nothing is compiled.
+    sensitivities : list of str or None
+        Names from ``model.parameter_names``: IDA integrates S = dy/dp with the states, with the jumps at
+        every event (:meth:`Result.sensitivity`, docs/sensitivities.md). IDA only; not with ``y0`` or a
+        streamed output. None (the default): no cost.
 
     Returns
     -------
@@ -104,8 +113,51 @@ def simulate(
         if isinstance(scene, Scene):
             scene = assemble(scene, settings.formulation or solver.formulation, track_work=settings.track_work)
         scene = scene.with_parameters(parameters)
+    if sensitivities is not None:
+        names = checked_sensitivities(sensitivities, solver, y0, out)
+        if isinstance(scene, Scene):  # the names are the model's: assembled first
+            scene = assemble(scene, settings.formulation or solver.formulation, track_work=settings.track_work)
+        parameter_names(scene, names)
+        solver = SensitivityIDA(names)
     result = solver.run(scene, t_end, t0, y0, out, settings, on_failure, progress)
     if not isinstance(result, Result):  # a solver class of the user's: its contract checked where it is used
         opts.fail("simulate", "method", settings.method, "a solver whose run() returns a daeclear.Result "
                   f"(the contract of daeclear.solvers.base.Solver); it returned {type(result).__name__}")
     return result
+
+
+def checked_sensitivities(value: object, solver: Solver, y0: object, out: Output) -> list[str]:
+    """``simulate``'s ``sensitivities``: a non-empty list of distinct names, for a run that can carry them
+    (IDA, from its own start, kept in memory); checked before any work."""
+    if isinstance(value, str) or not isinstance(value, Sequence) or not value:
+        opts.fail("simulate", "sensitivities", value, "None or a non-empty list of names from "
+                  "model.parameter_names, e.g. ['clearance.clearance']")
+    names = list(value)
+    for name in names:
+        if not isinstance(name, str):
+            opts.fail("simulate", "sensitivities", value, "a list of names (strings) from model.parameter_names")
+    if len(set(names)) != len(names):
+        opts.fail("simulate", "sensitivities", value, "a list naming each parameter once")
+    if not isinstance(solver, IDA):
+        opts.fail("simulate", "sensitivities", value, f"None with method={solver.name!r}: only method='ida' "
+                  "carries sensitivities (the stacked [y; S] with the jumps at every event)")
+    if y0 is not None:
+        opts.fail("simulate", "sensitivities", value, "None when y0 is given: S starts as dy0/dp of the run's "
+                  "own start (options.start), and a given state has none")
+    if out.stream_to is not None:
+        opts.fail("simulate", "sensitivities", value, "None with SaveAt(stream_to=...): a streamed file does not "
+                  "hold sensitivities yet; run in memory and save the result (result.save)")
+    return names
+
+
+def parameter_names(model: DAEModel, names: list[str]) -> None:
+    """Each name one of ``model.parameter_names`` and one finite number (SceneError naming it otherwise)."""
+    known = model.parameter_names
+    for name in names:
+        if name not in known:
+            close = opts.close_matches(name, known)
+            hint = f"close matches: {', '.join(map(repr, close))}" if close else (
+                f"e.g. {', '.join(map(repr, list(known)[:4]))}")
+            opts.fail("simulate", "sensitivities", name, f"one of model.parameter_names ({len(known)} names; "
+                      f"{hint})")
+        parameter_value(model, name)  # one finite number

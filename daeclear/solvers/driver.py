@@ -32,7 +32,7 @@ from ..core.events import ContactEvent, EventRows
 from ..core.progress import Progress
 from ..engine.abi import DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND
 from ..engine.session_base import Advance, AutoEvents, Session
-from .integrator import Driven, Integrator, Jump, Terms, auto_pairs
+from .integrator import Carried, Driven, Integrator, Jump, Terms, auto_pairs
 from .recorder import Recorder, out_of_memory
 from .tolerances import atol_record
 from ..results.result import Result
@@ -56,9 +56,11 @@ def run(solver: Driven, scene: Scene | DAEModel, t_end: float, t0: float, y0: ND
         checks: bool = True) -> Result:
     """Integrate ``scene`` (a Scene is assembled with ``settings.formulation`` or the solver's own) from
     ``t0`` to ``t_end`` with the solver's integrator (the :class:`daeclear.solvers.base.Solver` contract's
-    ``run``); ``observers`` see every :class:`Jump`. ``checks=False``: a run that reaches its end is not
-    checked (no warnings, no ``max_constraint_drift``; a caller judging each run itself, as the wear
-    study's blocks); a failed or interrupted one is, for its message."""
+    ``run``); ``observers`` see every :class:`Jump`. An integrator that carries a quantity beside the
+    states (:class:`~daeclear.solvers.integrator.Carried`: the sensitivities) has it jump at every event.
+    ``checks=False``: a run that reaches its end is not checked (no warnings, no ``max_constraint_drift``;
+    a caller judging each run itself, as the wear study's blocks); a failed or interrupted one is, for its
+    message."""
     setup_start = time.perf_counter()
     if isinstance(scene, DAEModel):
         model = scene
@@ -68,6 +70,7 @@ def run(solver: Driven, scene: Scene | DAEModel, t_end: float, t0: float, y0: ND
     save.check_size(step=settings.step, n_states=model.n_states,
                     n_channels=len(model.channel_names))  # before the integrator: nothing compiled or run
     integrator = solver.integrator(model, t_end, save, settings)
+    carried = integrator if isinstance(integrator, Carried) else None
     from_state = y0 is not None
     try:
         start, start_yp = consistent_start(model, t0, y0, settings, integrator.session)
@@ -77,6 +80,8 @@ def run(solver: Driven, scene: Scene | DAEModel, t_end: float, t0: float, y0: ND
             "backend": integrator.backend}
         if settings.step is not None:
             record["step"] = settings.step
+        if carried is not None:
+            record["sensitivities"] = list(carried.names)
         if t0 != 0.0:
             record["t0"] = t0
         rec = Recorder(model, parameters={**model.parameters, "simulate": record}, method=solver.name,
@@ -85,7 +90,7 @@ def run(solver: Driven, scene: Scene | DAEModel, t_end: float, t0: float, y0: ND
         integrator.close()
         raise
     declared = start if record["start"] == "declared" else None  # the start checks concern a declared state
-    driver = Driver(model, integrator, rec, save, t_end, progress, observers)
+    driver = Driver(model, integrator, rec, save, t_end, progress, observers, carried)
     driver.checks = checks
     return driver.run(t0, start, start_yp, declared, from_state, on_failure, time.perf_counter() - setup_start)
 
@@ -103,24 +108,24 @@ def consistent_start(model: DAEModel, t0: float, y0: NDArray | None, settings: S
 
 
 def consistent_restart(model: DAEModel, integrator: Integrator, t: float, y: NDArray, yp: NDArray, terms: Terms,
-                       found: NDArray | None) -> tuple[NDArray, NDArray]:
+                       found: NDArray | None) -> tuple[NDArray, NDArray, bool]:
     """The consistent state to restart from at ``t`` in the mode of ``terms``: index-1 keeps q and v (the
     integrator's :meth:`~daeclear.solvers.integrator.Integrator.consistent`); GGL projects them onto the
     constraint manifold, unprojected when the projection moves a root function that did not fire across
     zero (it would never be found again: a missed contact). The compiled loop's rule (project_kept_roots)
-    for the switches it decides itself."""
+    for the switches it decides itself. The flag: whether the state was projected (sensitivities follow it)."""
     if model.formulation != "ggl":
-        return integrator.consistent(t, y, terms)
+        return (*integrator.consistent(t, y, terms), False)
     session = integrator.session
     forces = model.term_forces(t, y, terms.active, terms.params, session)
     projected = model.consistent_state(t, y, forces, session, project=True)
     if not model.gap_names:
-        return projected
+        return (*projected, True)
     g0, g1 = _roots(model, session, t, y, yp), _roots(model, session, t, projected[0], yp)
     quiet = np.zeros(g0.shape, bool) if found is None else np.asarray(found).ravel() == 0
     if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
-        return model.consistent_state(t, y, forces, session, project=False)
-    return projected
+        return (*model.consistent_state(t, y, forces, session, project=False), False)
+    return (*projected, True)
 
 
 def _roots(model: DAEModel, session: Session | None, t: float, y: NDArray, yp: NDArray) -> NDArray:
@@ -137,12 +142,13 @@ class Driver:
     current segment's start, the reported points not yet completed, the outcome."""
 
     def __init__(self, model: DAEModel, integrator: Integrator, rec: Recorder, save: Output, t_end: float,
-                 progress: bool, observers: Sequence[Observer] = ()) -> None:
+                 progress: bool, observers: Sequence[Observer] = (), carried: Carried | None = None) -> None:
         self.run_start = time.perf_counter()
         self.progress_line = Progress(t_end, unit="s", desc="simulate", enabled=progress)
         self.model, self.integrator, self.rec = model, integrator, rec
         self.t_end, self.times, self.store_steps = t_end, save.times, save.steps
         self.observers = list(observers)
+        self.carried = carried  # what jumps with the states at every event (sensitivities), or None
         self.state: contact_state.ContactState = ()
         self.active: list[bool] = []
         self.params: list[NDArray] = []
@@ -258,7 +264,7 @@ class Driver:
         terms = self.terms()
         switched = not _same_terms(before, terms)
         if not switched and integrator.resumes_at_roots and not guarded_root(before.directions, found):
-            if self.observers:
+            if self.observers or self.carried is not None:
                 self.jump(Jump(t, self.y, self.yp, self.y, self.yp, found, tuple(new_events), state, restarted=False))
             return True  # nothing switched: the integrator goes on from the root, in the same segment
         new_segment = switched or not integrator.resumes_at_roots
@@ -275,17 +281,21 @@ class Driver:
             self.fail(t, "", f"{self.stall} events at the same time: the event loop does not advance", "")
             return False
         self.flush()  # the rows of the segment that ends, completed in its mode
-        y, yp = consistent_restart(model, integrator, t, self.y, self.yp, terms, found)
+        y, yp, projected = consistent_restart(model, integrator, t, self.y, self.yp, terms, found)
         self.switch = model.switch_vector(terms.active, terms.params)
-        if self.observers:
-            self.jump(Jump(t, self.y, self.yp, y, yp, found, tuple(new_events), state, restarted=True))
+        if self.observers or self.carried is not None:
+            self.jump(Jump(t, self.y, self.yp, y, yp, found, tuple(new_events), state, restarted=True,
+                           projected=projected))
         integrator.restart(t, y, yp, terms)
         self.y, self.yp = y, yp
         return True
 
     def jump(self, jump: Jump) -> None:
-        """The one place every event of the run passes (see :class:`Jump`; made only when observed): the
-        observers see it. A quantity integrated beside the states (issue 43's sensitivities) jumps here."""
+        """The one place every event of the run passes (see :class:`Jump`; made only when observed or
+        carried): a quantity integrated beside the states jumps here (``carried``: the sensitivities of
+        :class:`~daeclear.solvers.sensitivity_carrier.SensitivityCarrier`), then the observers see it."""
+        if self.carried is not None:
+            self.carried.jump(jump)
         for observer in self.observers:
             observer(jump)
 
@@ -418,6 +428,8 @@ class Driver:
             message = self.failure + penetration_advice(w, self.lost_onset(w["where"], w["t"]))
         result = self.rec.finish(stats=stats, success=self.success, status=self.status, message=message,
                                  warnings=found)
+        if self.carried is not None:
+            self.carried.attach(result)
         if self.interrupted or self.rec.interrupted:
             raise Interrupted(f"simulate: {message}; partial result in .result.", result)
         if not self.success and on_failure == "raise":

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple, Protocol
+from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple, Protocol, runtime_checkable
 
 from numpy.typing import NDArray
 
@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from .save_at import Output
     from .solver_options import SolverOptions
 
-__all__ = ["AutoPair", "Driven", "Integrator", "Jump", "Terms", "auto_pairs"]
+__all__ = ["AutoPair", "Carried", "Driven", "Integrator", "Jump", "Terms", "auto_pairs"]
 
 
 class Terms(NamedTuple):
@@ -66,6 +66,25 @@ class Jump:
     state: ContactState | None
     restarted: bool
     by_integrator: bool = False
+    projected: bool = False  # y_plus was projected onto GGL's constraint manifold
+
+
+@runtime_checkable
+class Carried(Protocol):
+    """An integrator that carries a quantity beside a run's states, which jumps at its events (the
+    sensitivities of :mod:`daeclear.solvers.sensitivity_ida`, its parameters ``names``): the driver
+    calls :meth:`jump` at every event, before the integrator restarts, and :meth:`attach` with the
+    finished Result."""
+
+    names: tuple[str, ...]
+
+    def jump(self, jump: Jump) -> None:
+        """Jump at the event ``jump`` (the driver decided its switches)."""
+        ...
+
+    def attach(self, result: Any) -> None:
+        """Put what was carried on the run's Result."""
+        ...
 
 
 class AutoPair(NamedTuple):

@@ -1,9 +1,9 @@
 """``dc.gradient``: the gradient of a scalar of the response w.r.t. named parameters (docs/sensitivities.md).
 
 The objective (:mod:`daeclear.results.objectives`: Final, Integral, Peak, EventTime) is evaluated on a run with
-forward sensitivities, the jumps at every event included. Until ``simulate(..., sensitivities=...)`` is wired
-into the run driver this runs the reference run :func:`daeclear.solvers.sensitivity_prototype.forward_sensitivities`
-(IDA on the stacked [y; S], slow: for small models and short spans). ``method="fd"`` is the cross-check: central
+forward sensitivities, the jumps at every event included: ``simulate(..., sensitivities=...)``'s result, with
+each event's rows before and after its switch (:class:`daeclear.results.sensitivities.RunTrajectory`); IDA
+on the stacked [y; S], for small models and short spans. ``method="fd"`` is the cross-check: central
 differences of the objective over separate runs, one step per parameter.
 """
 
@@ -21,7 +21,10 @@ from ..core import options
 from ..core.errors import SolveError
 from ..model.scene import Scene
 from ..results.objectives import EventTime, Final, Gradient, Integral, Objective, Peak, evaluate
-from ..solvers.sensitivity_prototype import SensitivityRun, forward_sensitivities
+from ..results.sensitivities import RunTrajectory
+from ..solvers.dispatch import simulate
+from ..solvers.save_at import SaveAt
+from ..solvers.solver_options import SolverOptions
 
 __all__ = ["gradient", "METHODS", "DEFAULT_SAMPLES"]
 
@@ -64,13 +67,16 @@ def gradient(scene_or_model: Scene | DAEModel, t_end: float, *, of: Objective, p
     values = {name: parameter_value(model, name) for name in names}  # checks each name before any run
     times = _output_times(of, end, count)
 
-    def run(m: DAEModel, wanted: Sequence[str]) -> SensitivityRun:
-        out = forward_sensitivities(m, end, wanted, t_eval=times, rtol=tol, atol=atol, start=start,
-                                    backend=backend, event_rows=True)
+    settings = SolverOptions(rtol=tol, atol=atol, start=start, backend=backend)
+    save = SaveAt(times=times, steps=False)
+
+    def run(m: DAEModel, wanted: Sequence[str]) -> RunTrajectory:
+        out = simulate(m, end, options=settings, save=save, sensitivities=wanted, on_failure="return")
         if not out.success:
             raise SolveError(f"gradient: the run failed at t={out.t[-1] if out.t.size else 0.0:.6g} s "
                              f"({out.message}).", out)
-        return out
+        assert out.sensitivities is not None
+        return RunTrajectory(out.t, out.__getitem__, out.sensitivities)
 
     if chosen == "sensitivities":
         return evaluate(of, run(model, names))

@@ -1,0 +1,185 @@
+"""Forward sensitivities S = dy/dp carried beside a run's states (issue 43, docs/sensitivities.md).
+
+:class:`SensitivityCarrier` holds what S needs between two events (the contact state it was made consistent
+in, each pair's latched approach speed's sensitivity, the parameters poisoned by a grazing event) and does
+the three things a run asks of it: the start's S (:meth:`~SensitivityCarrier.start`), an output row made
+consistent in its mode with the channels' sensitivities (:meth:`~SensitivityCarrier.row`), and the jump at
+an event (:meth:`~SensitivityCarrier.jump`: event time, differential states, latched values, grazing, a
+storm hold; the formulas of :mod:`daeclear.solvers.sensitivity_jumps`). The run driver calls the jump at
+every event (:meth:`daeclear.solvers.driver.Driver.jump`); the integrator of the stacked [y; S]
+(:mod:`daeclear.solvers.sensitivity_ida`) restarts from what it leaves.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..assembly import contact_state
+from ..assembly.dae_model import KIND_MULTIPLIER, DAEModel
+from ..assembly.sensitivity import ModelSensitivity, parameter_value
+from ..core.errors import PhysicsWarning
+from ..core.events import ContactEvent
+from ..results.sensitivities import SensitivityEvent
+from .sensitivity_jumps import event_time_sensitivity, latched_sensitivity, same_event_times, state_jump
+
+__all__ = ["SensitivityCarrier", "parameter_scales"]
+
+
+def parameter_scales(model: DAEModel, names: Sequence[str]) -> NDArray[np.float64]:
+    """|p| of each parameter (1 at 0): S's absolute tolerance is atol / |p| (IDAS' ``pbar``)."""
+    return np.array([abs(parameter_value(model, name)) or 1.0 for name in names])
+
+
+class SensitivityCarrier:
+    """S of one run between events: its contact mode, the latched values' sensitivities, the poisoned
+    parameters; the rows and events it gave (``rows_t``, ``rows_S``, ``rows_channel_S``, ``events``).
+    ``jumps=False`` leaves the jumps out (a wrong answer, kept to show that tests see the jump)."""
+
+    def __init__(self, model: DAEModel, names: Sequence[str], rtol: float, atol: NDArray, *,
+                 jumps: bool = True) -> None:
+        self.ms = ModelSensitivity(model, names)
+        self.model, self.names, self.width = model, self.ms.names, self.ms.width
+        self.rtol, self.atol, self.jumps = rtol, atol, jumps
+        self.differential = np.array([kind != KIND_MULTIPLIER for kind in model.state_kinds])
+        self.state: contact_state.ContactState = ()
+        self.active: list[bool] = []
+        self.params: list[NDArray] = []
+        self.latched: list[list[NDArray]] = []
+        self.S_params: list[NDArray] = []
+        self.S = self.Sp = np.zeros((model.n_states, self.width))
+        self.poisoned = np.zeros(self.width, dtype=bool)  # NaN from a grazing event on
+        self.events: list[SensitivityEvent] = []
+        self.rows_t: list[float] = []
+        self.rows_S: list[NDArray] = []
+        self.rows_channel_S: list[NDArray] = []
+        self.rows_channels: list[NDArray] = []
+        self.event_t: list[float] = []
+        self.event_rows: list[tuple[NDArray, NDArray, NDArray, NDArray]] = []  # (y, S, channels' S, channels)
+
+    def set_state(self, state: contact_state.ContactState) -> None:
+        """The contact state S is integrated in, and its terms' parameters' sensitivities."""
+        self.state = state
+        self.active, self.params = contact_state.switches(self.model, state)
+        self.S_params = self.term_sensitivities(state, self.latched)
+
+    def start(self, t: float, y: NDArray, yp: NDArray, state: contact_state.ContactState, S0: NDArray
+              ) -> tuple[NDArray, NDArray]:
+        """Begin at the start ``(y, yp)`` (as ``model.initial_state`` gives it) in contact ``state`` with
+        ``S0`` = dy0/dp: a pair in contact latches its rate's sensitivity (t0 fixed); return the start
+        made consistent in its mode, with S and S' consistent there."""
+        model, ms, W = self.model, self.ms, self.width
+        self.latched = [[np.zeros(W) for _ in states] for states in state]
+        for i, logic in enumerate(model.contacts):
+            for root in logic.roots:
+                if logic.needs_approach and contact_state.pair_state(model, state, root).contact:
+                    speed, rate_p, _ = ms.approach_rate(root, y, yp, S0)
+                    self.latched[i][logic.pair_index(root)] = latched_sensitivity(
+                        rate_p, 0.0, np.zeros(W), floored=speed <= logic.min_approach_speed)
+        self.set_state(state)
+        if any(self.active):
+            y, yp = model.consistent_state(t, y, model.term_forces(t, y, self.active, self.params))
+        self.S, self.Sp = ms.consistent(t, y, S0, self.active, self.params, self.S_params)
+        return y, yp
+
+    def term_sensitivities(self, state: contact_state.ContactState, latched: list[list[NDArray]]) -> list[NDArray]:
+        """Each term's parameters' sensitivity (n_params_k, Ns) in ``state``, from the pairs' ``latched``."""
+        out = [np.zeros((term.n_params, self.width)) for term in self.model.terms]
+        for logic, states, per_pair in zip(self.model.contacts, state, latched):
+            for k, S_k in logic.term_sensitivities(states, per_pair):
+                out[k] = np.array(S_k, dtype=float).reshape(-1, self.width)
+        return out
+
+    def terms_stacked(self) -> list[NDArray]:
+        """Each term's parameters followed by their sensitivities: the stacked system's term parameters."""
+        return [np.concatenate([p, s.ravel(order="F")]) for p, s in zip(self.params, self.S_params)]
+
+    def row(self, t: float, y: NDArray, S: NDArray) -> NDArray:
+        """Keep an output row at ``t`` (S of the state ``y`` in the current mode, made consistent there,
+        and the channels' sensitivities); NaN where poisoned. Return the consistent y."""
+        y, S, channel_S, values = self.evaluate(t, y, S)
+        self.rows_t.append(t)
+        self.rows_S.append(S)
+        self.rows_channel_S.append(channel_S)
+        self.rows_channels.append(values)
+        return y
+
+    def evaluate(self, t: float, y: NDArray, S: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+        """A row at ``t`` made consistent in the current mode: (y, S, the channels' S, the channels' values)."""
+        model, ms = self.model, self.ms
+        y, yp = model.consistent_state(t, y, model.term_forces(t, y, self.active, self.params))
+        S, Sp = ms.consistent(t, y, S, self.active, self.params, self.S_params)
+        switch = model.switch_vector(self.active, self.params)
+        channel_S = ms.channels(t, y, yp, S, Sp, switch, ms.switch_sensitivity(self.S_params))
+        values = np.array(model.outputs(t, y, yp, switch, model.parameter_values), dtype=float).ravel()
+        S[:, self.poisoned] = np.nan
+        channel_S[:, self.poisoned] = np.nan
+        return y, S, channel_S, values
+
+    def event_row(self, t: float, y: NDArray, S: NDArray) -> None:
+        """Keep a row at an event's time (before its switch, then after): what an objective integrating or
+        peaking across the event reads (:mod:`daeclear.results.objectives`)."""
+        self.event_rows.append(self.evaluate(t, y, S))
+        self.event_t.append(t)
+
+    def jump(self, t: float, y: NDArray, S: NDArray, found: NDArray | None, new_state: contact_state.ContactState,
+             events: Sequence[ContactEvent], y_p: NDArray, projected: bool) -> None:
+        """The jump at an event at ``t``: the root state ``y`` and its ``S`` in the mode before; the
+        contact ``events`` decided there into ``new_state``; ``y_p`` the consistent state the run restarts
+        from (``projected``: onto GGL's constraint manifold). Leaves S and S' consistent in the new mode."""
+        model, ms, W, rtol = self.model, self.ms, self.width, self.rtol
+        self.event_row(t, y, S.copy())
+        new_active, new_params = contact_state.switches(model, new_state)
+        y_m, yp_m = model.consistent_state(t, y, model.term_forces(t, y, self.active, self.params))
+        S_m, Sp_m = ms.consistent(t, y_m, S, self.active, self.params, self.S_params)
+        yp_p = model.consistent_state(t, y_p, model.term_forces(t, y_p, new_active, new_params))[1]
+        new_latched = [[value.copy() for value in per_pair] for per_pair in self.latched]
+        dt_dps: list[NDArray] = []
+        if events and found is not None:
+            at = ms.roots(t, y_m, yp_m, S_m, Sp_m, rtol, self.atol)
+            for e in events:
+                label = f"'{e.pair}' {e.kind} at t={t:.9g} s"
+                owners = [(i, logic, root) for i, logic in enumerate(model.contacts)
+                          for root in logic.event_roots(e.pair, np.ravel(found))]
+                if not owners:  # no root of this instant made it: no derivative to give
+                    warnings.warn(f"sensitivities: {label} was made by no root found then; its sensitivities are "
+                                  "NaN from here on.", PhysicsWarning, stacklevel=3)
+                    dt_dps.append(np.full(W, np.nan))
+                    self.events.append(SensitivityEvent(t, e.pair, e.kind, dt_dps[-1]))
+                    continue
+                for i, logic, root in owners:
+                    dt = event_time_sensitivity(at.g_p[root], at.rate[root], at.scale[root], rtol=rtol, event=label,
+                                                curvature=at.curvature[root], gap_error=at.error[root])
+                    if contact_state.pair_state(model, new_state, root).held:
+                        warnings.warn(f"sensitivities: {label} is held by the storm guard (a storm of tiny "
+                                      "re-contacts has no derivative); its sensitivities are NaN from here on.",
+                                      PhysicsWarning, stacklevel=3)
+                        dt = np.full(W, np.nan)
+                    dt_dps.append(dt)
+                    if e.kind == "onset" and logic.needs_approach and logic.pair_name(root) == e.pair:
+                        speed, rate_p, rate_rate = ms.approach_rate(root, y_m, yp_m, S_m)
+                        new_latched[i][logic.pair_index(root)] = latched_sensitivity(
+                            rate_p, rate_rate, dt if self.jumps else np.zeros(W),
+                            floored=speed <= logic.min_approach_speed)
+                self.events.append(SensitivityEvent(t, e.pair, e.kind, dt_dps[-len(owners)]))
+        dt_dp = np.zeros(W)
+        if dt_dps:
+            dt_dp = dt_dps[0] if same_event_times(dt_dps, rtol) else np.full(W, np.nan)
+        S_p = state_jump(S_m, yp_m, yp_p, dt_dp, self.differential) if self.jumps else S_m
+        if projected:
+            S_p = ms.projected(t, y_p, S_p)
+        self.latched = new_latched
+        self.set_state(new_state)
+        S_p, Sp_p = ms.consistent(t, y_p, S_p, self.active, self.params, self.S_params)
+        self.poisoned |= ~np.all(np.isfinite(S_p), axis=0)
+        S_p[:, self.poisoned] = 0.0  # integrated as zeros, reported as NaN
+        Sp_p[:, self.poisoned] = 0.0
+        for per_pair in self.latched:
+            for value in per_pair:
+                value[self.poisoned] = 0.0
+        self.S_params = self.term_sensitivities(self.state, self.latched)
+        self.S, self.Sp = S_p, Sp_p
+        self.event_row(t, y_p, S_p.copy())

@@ -1,0 +1,175 @@
+"""IDA on the stacked DAE [y; S] as the run driver's integrator (``simulate(..., sensitivities=[...])``).
+
+:class:`SensitivityIntegrator` integrates the states and S = dy/dp together (the sensitivity residual of
+:func:`daeclear.engine.sensitivity_functions.augmented_functions`: IDA factors the (1 + Ns) n system, a
+reference path, not the fast one) and reports the states' rows to the driver; S's rows, made consistent
+in their mode with the channels' sensitivities, go to its :class:`SensitivityCarrier`. The driver decides
+every root and calls the carrier's jump at every event (:meth:`daeclear.solvers.driver.Driver.jump`); a
+restart then begins from the carrier's S. It restarts at every root (as the reference run did) and
+decides no switch itself. Error control: S in the test, scaled by each parameter's magnitude (IDAS'
+``pbar``: atol_S = atol / |p|); multipliers out.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..assembly.contact_state import ContactState
+from ..assembly.dae_model import DAEModel
+from ..assembly.sensitivity import initial_sensitivities
+from ..core.automaton import PairState
+from ..engine.ida_session import open_session
+from ..engine.sensitivity_functions import augmented_functions
+from ..engine.session_base import Advance, Session
+from . import ida
+from .integrator import Jump, Terms
+from ..results.result import Result
+from ..results.sensitivities import EventSides, Sensitivities
+from .save_at import Output
+from .sensitivity_carrier import SensitivityCarrier, parameter_scales
+from .tolerances import tolerance_vector
+
+if TYPE_CHECKING:
+    from .solver_options import SolverOptions
+
+__all__ = ["SensitivityIDA", "SensitivityIntegrator"]
+
+
+class SensitivityIDA(ida.IDA):
+    """The "ida" method of a run with sensitivities (``simulate(..., sensitivities=names)``): its
+    integrator is IDA on [y; S]."""
+
+    def __init__(self, names: list[str]) -> None:
+        self.names = list(names)
+
+    def integrator(self, model: DAEModel, t_end: float, output: Output,  # type: ignore[override]
+                   settings: SolverOptions) -> SensitivityIntegrator:
+        """The run's IDA session on [y; S], open with the run's settings."""
+        return SensitivityIntegrator(model, t_end, output, settings, self.names)
+
+
+class SensitivityIntegrator:
+    """One run's IDA session on [y; S] as the driver's :class:`~daeclear.solvers.integrator.Integrator`."""
+
+    name = "IDA"
+    lazy_rows = True  # the rows are the DAE's states, made consistent when read (as IDA's: a file keeps states only)
+    resumes_at_roots = False
+    decides = False
+    order = 0
+    fixed_step: float | None = None
+    session: Session | None = None  # the model's own functions serve the driver (the stacked session is S's)
+
+    def __init__(self, model: DAEModel, t_end: float, output: Output, settings: SolverOptions,
+                 names: list[str]) -> None:
+        rtol = settings.rtol
+        self.model, self.t_end, self.times, self.store_steps = model, t_end, output.times, output.steps
+        self.settings = settings
+        atol = tolerance_vector(model, rtol, settings.atol_value())
+        self.sens = SensitivityCarrier(model, names, rtol, atol)
+        self.names = self.sens.names
+        W = self.sens.width
+        pbar = parameter_scales(model, self.sens.names)
+        self.stacked = open_session(
+            augmented_functions(model.functions, W), backend=settings.backend, rtol=rtol,
+            atol=np.concatenate([atol, *(atol / p for p in pbar)]), max_step=settings.max_step,
+            max_steps=settings.max_steps,
+            parameters=np.concatenate([model.parameter_values, self.sens.ms.dP.ravel(order="F")]))
+        try:
+            # GGL's tight Newton coefficient left out: S's corrections converge linearly (the reference run's rule)
+            self.stacked.set_hints(jacobian_refresh=ida.JACOBIAN_REFRESH,
+                                   first_step=ida.FIRST_STEP_ESTIMATE and model.formulation == "ggl")
+            self.stacked.set_stall(ida.STALL_STEP, ida.STALL_COUNT)
+        except BaseException:
+            self.stacked.close()
+            raise
+        self.backend = self.stacked.backend
+        self.missed: list[tuple[float, float, str]] = []
+        self.i_eval = 0
+        self.t_start = 0.0
+
+    def start(self, t: float, y: NDArray, yp: NDArray, terms: Terms, state: ContactState) -> None:
+        """S at the start (dy0/dp of the run's start), consistent in the start's mode; IDA started."""
+        settings, model = self.settings, self.model
+        S0 = initial_sensitivities(model, self.sens.names, settings.start, settings.allow_penetration)
+        self.sens.start(t, y, yp, state, S0)
+        self.t_start = t
+        if self.times is None or self.times.window(0, 1)[0] == t:  # the driver reports the start point
+            self.sens.row(t, y, self.sens.S)
+            self.i_eval = int(self.times is not None)
+        self.restart(t, y, yp, terms)
+
+    def jump(self, jump: Jump) -> None:
+        """The sensitivities' jump at an event the driver decided (before it restarts this integrator)."""
+        n, W = self.model.n_states, self.sens.width
+        assert jump.y_plus is not None and jump.state is not None  # the driver decides every switch here
+        S = self.root_S.reshape(n, W, order="F")
+        self.sens.jump(jump.t, jump.y_minus, S, jump.found, jump.state, jump.events, jump.y_plus, jump.projected)
+
+    def consistent(self, t: float, y: NDArray, terms: Terms) -> tuple[NDArray, NDArray]:
+        """q and v of ``y`` kept, multipliers and derivatives in the mode of ``terms``."""
+        model = self.model
+        return model.consistent_state(t, y, model.term_forces(t, y, terms.active, terms.params))
+
+    def restart(self, t: float, y: NDArray, yp: NDArray, terms: Terms) -> None:
+        """IDA re-initialised at ``(y, yp)`` and the carrier's S, S' (after its jump)."""
+        c = self.sens
+        self.stacked.reinit(t, np.concatenate([y, c.S.ravel(order="F")]), np.concatenate([yp, c.Sp.ravel(order="F")]),
+                            terms.active, c.terms_stacked(), terms.directions)
+
+    def advance(self) -> Advance:
+        """Integrate [y; S] to the end or a root; the states' rows to the driver, S's rows to the carrier."""
+        n, W, times = self.model.n_states, self.sens.width, self.times
+        window = None if times is None else times.window(self.i_eval, times.size)
+        adv = self.stacked.advance(self.t_end, window, self.store_steps, store_states=times is None,
+                                   store_yp=False)
+        rows_t, rows_y = (adv.step_t, adv.step_y) if times is None else (adv.eval_t, adv.eval_y)
+        if times is not None:
+            self.i_eval += adv.eval_t.size
+        for k, t in enumerate(rows_t.tolist()):
+            self.sens.row(t, rows_y[k, :n], rows_y[k, n:].reshape(n, W, order="F"))
+        self.root_S = adv.y[n:]
+        adv.y, adv.yp = adv.y[:n], adv.yp[:n]
+        adv.step_y = adv.step_y[:, :n] if adv.step_y.ndim == 2 else adv.step_y
+        adv.eval_y = adv.eval_y[:, :n] if adv.eval_y.ndim == 2 else adv.eval_y
+        return adv
+
+    def pair_states(self) -> dict[int, PairState]:
+        return {}
+
+    def complete(self, t: NDArray, y: NDArray, switch: NDArray, *, in_place: bool
+                 ) -> tuple[NDArray, NDArray, dict[str, NDArray] | None]:
+        """Multipliers and accelerations recomputed from q and v in each row's mode."""
+        model = self.model
+        return (*model.consistent_state(t, y, model.term_forces_rows(t, y, switch, None)), None)
+
+    def advice(self, adv: Advance, in_contact: list[str]) -> str:
+        """What to try after IDA on [y; S] failed."""
+        if adv.flag_name == "DC_MAX_STEPS":
+            needed = ida.steps_needed(self.stacked.max_steps, self.t_start, adv.t, self.t_end)
+            return f"The run needs more steps than max_steps allows: raise max_steps to about {needed}."
+        return "Try a smaller rtol, or fewer sensitivities."
+
+    def stats(self) -> dict[str, Any]:
+        return dict(self.stacked.stats())
+
+    def close(self) -> None:
+        self.stacked.close()
+
+    def attach(self, result: Result) -> None:
+        """The rows' and events' sensitivities onto the run's Result (the rows it kept: after a MemoryError
+        the driver drops its last unrecorded rows)."""
+        c, model, n = self.sens, self.model, result.n_times
+        shape = (0, model.n_states, c.width), (0, len(model.channel_names), c.width)
+        states = np.stack(c.rows_S[:n]) if n else np.zeros(shape[0])
+        channels = np.stack(c.rows_channel_S[:n]) if n else np.zeros(shape[1])
+        k = len(c.event_t)
+        n_ch = len(model.channel_names)
+        sides = EventSides(np.array(c.event_t), *(
+            np.stack([row[i] for row in c.event_rows]) if k else np.zeros(empty)
+            for i, empty in ((0, (0, model.n_states)), (3, (0, n_ch)), (1, shape[0]), (2, shape[1]))))
+        result.sensitivities = Sensitivities(c.names, tuple(model.state_names), tuple(model.channel_names),
+                                             states, channels, tuple(c.events), sides)
+

@@ -1,0 +1,56 @@
+"""A run with forward sensitivities through ``dc.simulate(..., sensitivities=...)`` as the sensitivity tests read
+it (what the reference run of the stacked [y; S] gave them before the run driver carried sensitivities): the
+times, states, S of states and channels, the events with their dt*/dp, and a run without the jumps (the
+driver's carrier with ``jumps=False``: S carried through each event as it is, the latched values' dt*/dp
+term dropped), a wrong answer that shows the tests see the jumps.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+
+import numpy as np
+import pytest
+
+import daeclear as dc
+from daeclear.solvers.sensitivity_ida import SensitivityIntegrator
+
+
+class StackedRun:
+    """A Result with sensitivities, read as arrays: ``y`` (n_times, n_states), ``S`` (n_times, n_states, Ns),
+    ``channel_S`` (n_times, n_channels, Ns), ``events`` with ``dt_dp``."""
+
+    def __init__(self, result: dc.Result) -> None:
+        sens = result.sensitivities
+        assert sens is not None
+        self.result = result
+        self.names, self.state_names, self.channel_names = sens.names, sens.state_names, sens.channel_names
+        self.t, self.y, self.S, self.channel_S = result.t, result.y, sens.states, sens.channels
+        self.events = list(sens.events)
+        self.success, self.message = result.success, result.message
+
+    def sensitivity(self, name: str, parameter: str | None = None) -> np.ndarray:
+        return self.result.sensitivity(name, parameter)
+
+
+def forward_sensitivities(model: dc.DAEModel, t_end: float, names: Sequence[str], *, rtol: float,
+                          start: str = "ideal", backend: str = "python", jumps: bool = True,
+                          t_eval: Sequence[float] | np.ndarray | None = None) -> StackedRun:
+    """``simulate(model, t_end, sensitivities=names)`` at ``rtol`` with output at ``t_eval`` (default: the
+    start and the end); a failed run is returned (``success`` False); ``jumps=False``: without the jumps."""
+    times = [0.0, float(t_end)] if t_eval is None else t_eval
+    with pytest.MonkeyPatch.context() as patch, warnings.catch_warnings():
+        warnings.simplefilter("ignore", dc.DaeclearWarning)  # the runs' physics notes, atol at round-off
+        if not jumps:
+            original = SensitivityIntegrator.__init__
+
+            def without_jumps(self: SensitivityIntegrator, *args: object, **keywords: object) -> None:
+                original(self, *args, **keywords)  # type: ignore[arg-type]
+                self.sens.jumps = False
+
+            patch.setattr(SensitivityIntegrator, "__init__", without_jumps)
+        result = dc.simulate(model, t_end, rtol=rtol, options=dc.SolverOptions(start=start, backend=backend),
+                             save=dc.SaveAt(times=times, steps=False), sensitivities=list(names),
+                             on_failure="return")
+    return StackedRun(result)
