@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import signal
+
 import numpy as np
 import pytest
 
@@ -40,3 +42,15 @@ def plain_ida(monkeypatch: pytest.MonkeyPatch) -> str:
     monkeypatch.setattr(ida, "JACOBIAN_REFRESH", ida.IDA_JACOBIAN_REFRESH)
     monkeypatch.setattr(ida, "FIRST_STEP_ESTIMATE", False)
     return "dense"
+
+
+@pytest.fixture
+def sigint_as_a_terminal_sends_it():
+    """Ctrl-C handled as Python does at a terminal, also when the suite was started in the background
+    (``cmd &`` in a script: SIGINT ignored, which the child processes of these tests would inherit)."""
+    ignored = signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    if ignored:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    if ignored:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)

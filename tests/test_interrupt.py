@@ -29,16 +29,7 @@ T_END = 0.006
 
 
 
-@pytest.fixture(autouse=True)
-def sigint_as_a_terminal_sends_it():
-    """Ctrl-C handled as Python does at a terminal, also when the suite was started in the background
-    (``cmd &`` in a script: SIGINT ignored, which the child processes of these tests would inherit)."""
-    ignored = signal.getsignal(signal.SIGINT) is signal.SIG_IGN
-    if ignored:
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-    yield
-    if ignored:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
+pytestmark = pytest.mark.usefixtures("sigint_as_a_terminal_sends_it")  # tests/conftest.py
 
 @pytest.fixture
 def ctrl_c_after(monkeypatch):

@@ -115,6 +115,7 @@ def test_a_failing_append_leaves_every_column_as_it_was(tmp_path, monkeypatch):
         assert {name: h5[name].shape[0] for name in UNITS} == {name: 2 for name in UNITS}
 
 
+@pytest.mark.usefixtures("sigint_as_a_terminal_sends_it")  # tests/conftest.py: also when started with &
 def test_ctrl_c_during_an_append_arrives_once_the_row_is_whole(tmp_path, monkeypatch):
     path = tmp_path / "run.h5"
     _written(path, 1)
