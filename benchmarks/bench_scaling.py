@@ -3,6 +3,7 @@
     python benchmarks/bench_scaling.py [--sizes 8,16,32,64,128] [--t-end 0.2] [--repeats 3]
     python benchmarks/bench_scaling.py --trees OLD NEW [--old-max 64] [...]   two trees side by side
     python benchmarks/bench_scaling.py --accuracy [--repeats 3]   against scipy at equal accuracy
+    python benchmarks/bench_scaling.py --chain-accuracy [--t-end 0.2] [--window 0.03]   the whole chain run
     python benchmarks/bench_scaling.py [--trees OLD NEW] [...] --write-doc
     python benchmarks/bench_scaling.py --flat 16,64,128 [--repeats 3]   this tree's sizes interleaved
 
@@ -16,7 +17,8 @@ Each size of each tree runs in its own worker process with an EMPTY compile cach
 * build: the first ``simulate(scene, 1e-4)`` (assembly, code generation, compilation) less the best of
   two warm ones; cc: the compiler alone (``stats["compile_time"]``); C code: the generated source;
 * call: a warm whole ``simulate(chain(N), t_end)`` on a new Scene each time (set-up included), best of
-  ``--repeats``; loop: the IDA loop's own time (``stats["solve_time"]``) of that call; steps, events;
+  ``--repeats`` (its wall time, and the process's CPU time, which the load of a shared machine moves
+  less); loop: the IDA loop's own time (``stats["solve_time"]``) of that call; steps, events;
 * ns per step per state: loop / steps / (6 N), the cost of one IDA step per state, which is flat when
   the loop grows like steps x N; and the same of the whole call.
 
@@ -70,10 +72,10 @@ warnings.simplefilter("ignore")
 n = int(sys.argv[1])
 def call(t_end):
     scene = dc.mechanisms.chain(n)
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     r = dc.simulate(scene, t_end, on_failure="return")
-    wall = time.perf_counter() - start
-    return {"wall": wall, "loop": float(r.stats["solve_time"]), "steps": int(r.stats["n_steps"]),
+    wall, cpu = time.perf_counter() - start, time.process_time() - cpu
+    return {"wall": wall, "cpu": cpu, "loop": float(r.stats["solve_time"]), "steps": int(r.stats["n_steps"]),
             "events": len(r.events), "success": bool(r.success), "message": r.message,
             "solver": str(r.stats.get("linear_solver", "?"))}
 for line in sys.stdin:
@@ -136,7 +138,7 @@ def measure(trees: dict[str, Path | None], n: int, t_end: float, repeats: int) -
         for label, runs in calls.items():
             best = min(runs, key=lambda r: r["wall"])
             out[label].update(best, median_wall=statistics.median(r["wall"] for r in runs),
-                              loop=min(r["loop"] for r in runs))
+                              loop=min(r["loop"] for r in runs), cpu=min(r.get("cpu", math.nan) for r in runs))
     finally:
         for worker in workers.values():
             worker.close()
@@ -183,7 +185,8 @@ def print_table(results: dict[int, dict[str, dict[str, Any]]], labels: list[str]
                 continue
             o, w = per_tree[old], per_tree[new]
             note = f" (target at N = 64: >= {SPEEDUP_TARGET}x)" if n == 64 else ""
-            print(f"N={n}: {old} / {new}: whole call {o['wall'] / w['wall']:.2f}x, loop {o['loop'] / w['loop']:.2f}x, "
+            print(f"N={n}: {old} / {new}: whole call {o['wall'] / w['wall']:.2f}x "
+                  f"(CPU time {o['cpu'] / w['cpu']:.2f}x), loop {o['loop'] / w['loop']:.2f}x, "
                   f"per step per state (loop) {per_step_state(o, 'loop') / per_step_state(w, 'loop'):.2f}x{note}")
 
 
@@ -278,6 +281,88 @@ def accuracy(repeats: int) -> None:
             print(note)
 
 
+def chain_run_accuracy(t_end: float, window: float, rtols: list[float], repeats: int, budget: float) -> None:
+    """The 16-link chain's whole ``t_end`` run (every pin impacts) at equal accuracy: IDA (GGL, index-1)
+    against every scipy method. The reference is IDA GGL at rtol 1e-12 over the whole run; the error
+    (max over [0, ``window``] of |x - x_ref| / range(x_ref), the largest over three channels) is measured
+    only where independent references agree (printed first: IDA index-1 1e-12, GGL 1e-13, DOP853 1e-12,
+    Radau 1e-10 over [0, ``window``]); beyond about 45 ms the impact sequence depends on round-off (the
+    references part), so no error there means anything. Times are the CPU time of whole calls (the
+    process's, all threads: on a shared machine a call's wall time moves by 3x with the load, its CPU
+    time much less): IDA best of ``repeats``, a scipy method one call (they take seconds to minutes); a
+    method whose call took more than ``budget`` s is not run at tighter tolerances."""
+    import time
+
+    import numpy as np
+
+    import daeclear as dc
+
+    scene, channels = dc.mechanisms.chain(16), ["link1.omega", "link2.vx", "link3.vy"]
+    t_eval = np.linspace(0.0, t_end, 2001)
+
+    def run(method: str, rtol: float, until: float = t_end, **extra: Any) -> tuple[Any, float]:
+        times = t_eval[t_eval <= until * (1 - 1e-12)] if until < t_end else t_eval
+        start = time.process_time()
+        r = dc.simulate(scene, until, options=dc.SolverOptions(method=method, rtol=rtol, **extra),
+                        save=dc.SaveAt(times=times), on_failure="return")
+        return r, time.process_time() - start
+
+    ref, ref_cpu = run("ida", 1e-12)
+    print(f"\nreference: IDA GGL rtol 1e-12 over {t_end:g} s ({ref_cpu:.1f} s CPU, {ref.stats['n_steps']} steps, "
+          f"{len(ref.events)} events)")
+    head = ref.t <= window
+
+    def error(r: Any) -> float:
+        if not r.success:
+            return math.inf
+        cut = r.t <= window
+        if not np.array_equal(r.t[cut], ref.t[head]):
+            raise SystemExit("bench_scaling: a run's output times differ from the reference's")
+        # as daeclear.studies.accuracy.channel_error: relative to the reference's range over the window
+        return max(float(np.max(np.abs(np.asarray(r[c])[cut] - np.asarray(ref[c])[head]))
+                         / np.ptp(np.asarray(ref[c])[head])) for c in channels)
+
+    print(f"\nindependent references against it over [0, {window:g}] s (error as below):")
+    checks = [("ida", 1e-12, t_end, {"formulation": "index1"}), ("ida", 1e-13, t_end, {}),
+              ("DOP853", 1e-12, window, {}), ("Radau", 1e-10, window, {})]
+    for method, rtol, until, extra in checks:
+        r, cpu = run(method, rtol, until, **extra)
+        print(f"  {method} {extra.get('formulation', '')} rtol {rtol:g} to {until:g} s: {error(r):.2e} ({cpu:.1f} s)",
+              flush=True)
+    ida = {"GGL": {}, "index1": {"formulation": "index1"}}
+    rows: list[dict[str, Any]] = []
+    for label, extra in ida.items():
+        run("ida", 1e-6, 1e-3, **extra)  # compiled before timing
+        for rtol in rtols:
+            results = [run("ida", rtol, **extra) for _ in range(repeats)]
+            r, cpu = results[0][0], min(w for _, w in results)
+            rows.append({"label": f"IDA {label}", "rtol": rtol, "error": error(r), "cpu": cpu})
+            print(f"  IDA {label} rtol {rtol:g}: error {rows[-1]['error']:.2e}, {cpu:.3f} s", flush=True)
+    for method in ("LSODA", "RK45", "DOP853", "Radau", "BDF"):
+        run(method, 1e-6, 1e-3)  # compiled before timing
+        for rtol in rtols:
+            r, cpu = run(method, rtol)
+            rows.append({"label": method, "rtol": rtol, "error": error(r), "cpu": cpu})
+            print(f"  {method} rtol {rtol:g}: error {rows[-1]['error']:.2e}, {cpu:.2f} s"
+                  + ("" if r.success else f" FAILED {r.message[:60]}"), flush=True)
+            if cpu > budget:
+                print(f"  {method}: over {budget:g} s, tighter tolerances not run", flush=True)
+                break
+    print(f"\n16-link chain, {t_end:g} s runs; error over [0, {window:g}] s against the reference; CPU s\n")
+    print("| IDA | rtol | error | CPU | fastest scipy run with error <= IDA's | its error | its CPU | ratio |")
+    print("|---|---|---|---|---|---|---|---|")
+    scipy = [r for r in rows if not r["label"].startswith("IDA") and math.isfinite(r["error"])]
+    for row in (r for r in rows if r["label"].startswith("IDA")):
+        head_cells = f"| {row['label'][4:]} | {row['rtol']:.0e} | {row['error']:.2e} | {row['cpu']:.3f} s"
+        rivals = [r for r in scipy if r["error"] <= row["error"]]
+        if not rivals:
+            print(head_cells + " | none ran that accurate | | | |")
+            continue
+        best = min(rivals, key=lambda r: r["cpu"])
+        print(f"{head_cells} | {best['label']} rtol {best['rtol']:.0e} | {best['error']:.2e} | {best['cpu']:.2f} s "
+              f"| {best['cpu'] / row['cpu']:.1f}x |", flush=True)
+
+
 def _sizes(text: str) -> list[int]:
     try:
         sizes = [int(s) for s in text.split(",") if s.strip()]
@@ -297,6 +382,11 @@ def main() -> None:
     parser.add_argument("--old-max", type=int, default=0, help="with --trees: run OLD only up to this N (0: all)")
     parser.add_argument("--flat", type=_sizes, help="this tree's sizes interleaved (e.g. 16,64,128)")
     parser.add_argument("--accuracy", action="store_true", help="the equal-accuracy study instead")
+    parser.add_argument("--chain-accuracy", action="store_true",
+                        help="the 16-link chain's whole --t-end run at equal accuracy (errors over --window)")
+    parser.add_argument("--window", type=float, default=0.03, help="with --chain-accuracy: error window, s (0.03)")
+    parser.add_argument("--budget", type=float, default=120.0,
+                        help="with --chain-accuracy: a scipy method slower than this (s) stops tightening (120)")
     parser.add_argument("--write-doc", action="store_true", help="write the table into docs/performance.md")
     args = parser.parse_args()
     if args.t_end <= 0 or args.repeats < 1:
@@ -305,6 +395,9 @@ def main() -> None:
           "are noisy; compare ratios of interleaved calls)")
     if args.accuracy:
         accuracy(args.repeats)
+        return
+    if args.chain_accuracy:
+        chain_run_accuracy(args.t_end, args.window, [1e-5, 1e-6, 1e-7, 1e-8], args.repeats, args.budget)
         return
     if args.flat:
         flat(args.flat, args.t_end, args.repeats)

@@ -4,8 +4,11 @@ The run driver hands a :class:`Recorder` the reported points chunk by chunk, eac
 vector of its segment, and their steps, events and segments. IDA's points come without channels
 and, kept in memory, as IDA left them: the run's `Result` makes their multipliers and yp consistent
 and computes the channels at the first read (:class:`~daeclear.results.lazy_channels.LazyChannels`).
-Streamed (``stream_to``), each chunk is appended to the file and dropped, so the run's memory does
-not grow with its length and the file holds what was computed whatever stops the run. Either way
+In memory, a run of several chunks is kept in :class:`~daeclear.solvers.row_store.RowStore` columns
+that grow in place, so each point is copied once, into the Result's own arrays (joining the chunks at
+the end copied it twice, into fresh pages each time). Streamed (``stream_to``), each chunk is appended
+to the file and dropped, so the run's memory does not grow with its length and the file holds what
+was computed whatever stops the run. Either way
 the physics checks read the few rows of :func:`daeclear.assembly.physics.key_rows`.
 """
 
