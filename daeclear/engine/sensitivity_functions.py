@@ -5,8 +5,10 @@ For F(t, y, y', P) = 0 and parameters p with dP/dp (``dP``, n_P x W), S = dy/dp 
 directional derivative (CasADi ``jtimes``) of a function of :class:`DAEFunctions`: the residual, each
 switchable term (its own parameters p_k, e.g. the latched approach speed, get their sensitivities
 ``Sk``) and any extra; the roots' Jacobian blocks give the event time's sensitivity.
-:func:`augmented_functions` stacks [y; S] into one DAE (a slow reference: IDA then factors the (1 + W) n
-system, where the compiled loop will reuse the state's factorisation).
+:func:`augmented_functions` stacks [y; S] into one DAE: with ``block`` its Jacobian is the state's n x n
+iteration matrix, which the session factors once and applies to each of the 1 + W blocks (what
+``simulate`` runs); without, the (1 + W) n matrix itself (the reference the tests and
+benchmarks/bench_sensitivity.py compare with).
 """
 
 from __future__ import annotations
@@ -136,15 +138,21 @@ def sensitivity_functions(funcs: DAEFunctions, width: int, extras: Sequence[int]
                                 curvature, fwd, tuple(int(k) for k in extras))
 
 
-def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False) -> DAEFunctions:
+def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, block: bool = False) -> DAEFunctions:
     """The DAE of [y; S_1; ...; S_width] as one :class:`DAEFunctions` (what IDA integrates for
-    ``simulate(..., sensitivities=...)``, never the fast path): parameters [P; vec(dP)], term k's
-    parameters [p_k; vec(Sk)], the roots those of y, no extras.
+    ``simulate(..., sensitivities=...)``): parameters [P; vec(dP)], term k's parameters [p_k; vec(Sk)],
+    the roots those of y, no extras.
 
-    Its Jacobian: the state's iteration matrix on every diagonal block, nothing else (IDAS' simultaneous
-    corrector: a modified Newton that converges since S's equations are linear in S); ``coupled``: the
-    exact Jacobian of the stacked residual, block lower triangular, whose blocks (F_yy S) blow up where a
-    force has no second derivative (Hertz's delta^1.5 at onset: Newton then fails at the restart)."""
+    Its Newton matrix: the state's iteration matrix on every diagonal block, nothing else (IDAS'
+    simultaneous corrector: a modified Newton that converges since S's equations are linear in S).
+    ``block``: the Jacobian functions give that n x n matrix once (``blocks = 1 + width``: the session
+    factors it once and solves every block with it); else the (1 + width) n matrix itself, the reference.
+    ``coupled`` (not with ``block``): the exact Jacobian of the stacked residual, block lower triangular,
+    whose blocks (F_yy S) blow up where a force has no second derivative (Hertz's delta^1.5 at onset:
+    Newton then fails at the restart)."""
+    if coupled and block:
+        raise ValueError("augmented_functions: coupled=True, must be False with block=True (the block "
+                         "Newton matrix is the state's iteration matrix alone).")
     n, n_P = int(funcs.n), int(funcs.n_parameters)
     res = _with_parameters(funcs.residual, 3, n_P)
     sym: Any = casadi.SX if res.is_a("SXFunction") else casadi.MX  # one kind at run time
@@ -162,8 +170,8 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False) 
     def jacobian(r: Any) -> Any:
         if coupled:
             return casadi.jacobian(r, Y) + cj * casadi.jacobian(r, Yp)
-        block = casadi.jacobian(r[:n], y) + cj * casadi.jacobian(r[:n], yp)
-        return casadi.diagcat(*([block] * (1 + width)))
+        state = casadi.jacobian(r[:n], y) + cj * casadi.jacobian(r[:n], yp)
+        return state if block else casadi.diagcat(*([state] * (1 + width)))
 
     r = stacked(res(t, y, yp, P), sens.res(t, y, yp, P, S, Sp, dP))
     residual = casadi.Function("residual", [t, Y, Yp, PA], [r], ["t", "y", "yp", "P"], ["r"])
@@ -183,4 +191,5 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False) 
         roots = casadi.Function("roots", [t, Y, Yp, PA], [g(t, y, yp, P)], ["t", "y", "yp", "P"], ["g"])
     return DAEFunctions(n=n * (1 + width), residual=residual, jacobian=jac, term_residuals=tuple(term_res),
                         term_jacobians=tuple(term_jac), roots=roots, n_parameters=n_P * (1 + width),
-                        name=f"{funcs.name}_sens{width}{'c' if coupled else ''}")
+                        name=f"{funcs.name}_sens{width}{'c' if coupled else 'b' if block else ''}",
+                        blocks=1 + width if block else 1)

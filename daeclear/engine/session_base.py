@@ -43,7 +43,10 @@ class DAEFunctions:
     extras[k]: functions with vector inputs, P last, and one output, evaluated over many points by
     :meth:`Session.eval_extra` (output channels, consistent restarts); never called by IDA.
     ``P``: the ``n_parameters`` run-time parameters (values given to :func:`open_session`); with
-    ``n_parameters == 0`` the functions may leave it out. A value: what a process compiles of it is
+    ``n_parameters == 0`` the functions may leave it out. ``blocks`` > 1: the Newton matrix is block
+    diagonal, ``blocks`` copies of the (n / blocks)-square matrix the Jacobian functions return (the
+    stacked forward sensitivities [y; S_1; ...], IDAS' simultaneous corrector): one factorisation
+    of that block solves them all. A value: what a process compiles of it is
     kept by a :class:`~daeclear.engine.compiled.CompiledDAE`.
     """
 
@@ -56,6 +59,7 @@ class DAEFunctions:
     name: str = "model"
     extras: tuple[casadi.Function, ...] = ()
     n_parameters: int = 0
+    blocks: int = 1
 
 
 @dataclass(frozen=True)
@@ -194,6 +198,10 @@ class Session(Protocol):
 
     def set_layout(self, layout: StateLayout) -> bool:
         """Let the loop make states consistent itself; whether it does (compiled backend)."""
+        ...
+
+    def set_kinematic_rows(self, n_kinematic: int) -> bool:
+        """The reduced solver's eliminated position rows without a layout; whether it applies (compiled)."""
         ...
 
     def set_auto_events(self, pairs: Sequence[tuple[int, int, int, bool, float]], *, storms: Sequence[Storm],
@@ -362,6 +370,10 @@ class SessionBase:
 
     def set_layout(self, layout: StateLayout) -> bool:
         """Only the compiled backend makes states consistent in C; returns False here."""
+        return False
+
+    def set_kinematic_rows(self, n_kinematic: int) -> bool:
+        """Only the compiled backend has the reduced solver; returns False here."""
         return False
 
     def pair_states(self) -> list[PairState]:

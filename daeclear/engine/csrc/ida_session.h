@@ -95,6 +95,10 @@ typedef struct {
   SUNLinearSolver LS; /* IDA's solver: dcls_sun_create's wrapper of lin */
   dc_linsol* lin;     /* the factorisation IDA's setup makes and every solve uses (dc_linsol.h) */
   int n, n_terms, n_roots;
+  /* The Newton matrix: blocks diagonal copies of the nj x nj iteration matrix the Jacobian functions
+   * give (n = blocks nj). blocks 1: an ordinary model. blocks > 1: the forward sensitivities' stacked
+   * [y; S_1; ...] (IDAS' simultaneous corrector), factored once at nj and solved block by block. */
+  int nj, blocks;
   /* CasADi work memory, sized for the largest function */
   const double** arg;
   double** res;
