@@ -65,6 +65,8 @@ class NormalizedModel:
     extras: tuple[casadi.Function, ...] = ()
     n_parameters: int = 0
     blocks: int = 1  # the Newton matrix: blocks diagonal copies of the nj x nj iteration matrix
+    cpl: casadi.Function | None = None  # (1, n, n, 1, n_P, nj) -> n - nj: the blocks below, times dy0
+    term_cpl: tuple[casadi.Function, ...] = ()  # (1, n, n, p_k, 1, n_P, nj) -> n - nj
 
     @property
     def n_jac(self) -> int:
@@ -173,8 +175,19 @@ def normalize_model(funcs: Any) -> NormalizedModel:
         if sizes[-1] != n_P:
             raise AssemblyError(f"extras[{k}] ({f.name()}) must take the {n_P} run-time parameters as its last input")
         extras.append(_wrap(f, f"dc_extra{k}", sizes, (f.numel_out(0), 1), keep_sparsity=True))
+    cpl, tcpl = None, []
+    coupling = getattr(funcs, "coupling", None)
+    if coupling is not None:
+        if blocks == 1 or len(funcs.term_couplings) != len(n_params):
+            raise AssemblyError(f"DAEFunctions.coupling needs blocks > 1 (blocks={blocks}) and one term coupling "
+                                f"per term ({len(funcs.term_couplings)} for {len(n_params)} terms)")
+        _check(coupling, "coupling", [1, n, n, 1, n_P, nj], n - nj)
+        cpl = _wrap(coupling, "dc_cpl", [1, n, n, 1, n_P, nj], (n - nj, 1))
+        for k, (fc, p) in enumerate(zip(funcs.term_couplings, n_params)):
+            _check(fc, f"term_couplings[{k}]", [1, n, n, p, 1, n_P, nj], n - nj)
+            tcpl.append(_wrap(fc, f"dc_term{k}_cpl", [1, n, n, p, 1, n_P, nj], (n - nj, 1)))
     return NormalizedModel(n, str(getattr(funcs, "name", "model")), res, jac, tuple(tres), tuple(tjac), roots,
-                           tuple(n_params), n_roots, tuple(extras), n_P, blocks)
+                           tuple(n_params), n_roots, tuple(extras), n_P, blocks, cpl, tuple(tcpl))
 
 
 def _c_string(s: str) -> str:
@@ -216,12 +229,16 @@ def generate_source(model: NormalizedModel, sensitivity: Any = None) -> str:
     funs = [model.res, model.jac, *model.term_res, *model.term_jac, *model.extras]
     if model.roots is not None:
         funs.append(model.roots)
+    if model.cpl is not None:
+        funs += [model.cpl, *model.term_cpl]
     sens = _sensitivity_functions(sensitivity) if sensitivity is not None else {}
     src = _code_generator("dc_model_gen.c", funs + [_column_inputs(f, name) for name, f in sens.items()])
     nt = len(model.term_res)
     lines = ["", "/* ---------------------------------------------------------------- daeclear table */",
              '#include "dc_model.h"',
-             *_term_tables("dc_", model.n_params, {"term_res_tab": "dc_term{}_res", "term_jac_tab": "dc_term{}_jac"})]
+             *_term_tables("dc_", model.n_params, {"term_res_tab": "dc_term{}_res", "term_jac_tab": "dc_term{}_jac"}),
+             *(_term_tables("dc_cpl_", model.n_params, {"term_tab": "dc_term{}_cpl"})[1:] if model.cpl is not None
+               else [])]
     plan_lines, plan_ref = plan_source(plan_of_model(model))
     lines += plan_lines
     roots_entry = _fun_entry("dc_roots") if model.roots is not None else _NO_FUN
@@ -231,7 +248,9 @@ def generate_source(model: NormalizedModel, sensitivity: Any = None) -> str:
               "const dc_model_t dc_model = {", f"  {model.n}, {nt}, {model.n_roots}, {model.n_parameters},",
               f"  {'dc_n_params_tab' if nt else '0'},", f"  {_fun_entry('dc_res')},", f"  {_fun_entry('dc_jac')},",
               f"  {roots_entry},", f"  {'dc_term_res_tab' if nt else '0'},", f"  {'dc_term_jac_tab' if nt else '0'},",
-              f"  {plan_ref},", f"  {_c_string(model.name)}", "};", ""]
+              f"  {plan_ref},", f"  {_c_string(model.name)},",
+              f"  {_fun_entry('dc_cpl') if model.cpl is not None else _NO_FUN},",
+              f"  {'dc_cpl_term_tab' if model.cpl is not None and nt else '0'}", "};", ""]
     if sensitivity is not None:
         lines += _sensitivity_table(sensitivity)
     return src + "\n".join(lines)

@@ -147,12 +147,11 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, 
     simultaneous corrector: a modified Newton that converges since S's equations are linear in S).
     ``block``: the Jacobian functions give that n x n matrix once (``blocks = 1 + width``: the session
     factors it once and solves every block with it); else the (1 + width) n matrix itself, the reference.
-    ``coupled`` (not with ``block``): the exact Jacobian of the stacked residual, block lower triangular,
-    whose blocks (F_yy S) blow up where a force has no second derivative (Hertz's delta^1.5 at onset:
-    Newton then fails at the restart)."""
-    if coupled and block:
-        raise ValueError("augmented_functions: coupled=True, must be False with block=True (the block "
-                         "Newton matrix is the state's iteration matrix alone).")
+    ``coupled``: the exact Newton matrix, block lower triangular: with ``block`` its blocks below the
+    diagonal C_i = d(F_y S_i + F_y' S_i' + F_P dP_i)/dy + cj d(...)/dy' as directional derivatives
+    (``DAEFunctions.coupling``: C dy0 for the block forward substitution); without, the whole (1 + width) n
+    matrix. Where a force has no second derivative (Hertz's delta^1.5 at onset: delta^-0.5) C is not
+    finite: the compiled session then drops it for that solve; the whole matrix fails."""
     n, n_P = int(funcs.n), int(funcs.n_parameters)
     res = _with_parameters(funcs.residual, 3, n_P)
     sym: Any = casadi.SX if res.is_a("SXFunction") else casadi.MX  # one kind at run time
@@ -167,8 +166,15 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, 
     def stacked(value: Any, derivative: Any) -> Any:
         return casadi.vertcat(value, casadi.vec(derivative))
 
+    dy0 = sym.sym("dy0", n)
+    seed = casadi.vertcat(dy0, casadi.DM.zeros(n * width, 1), cj * dy0, casadi.DM.zeros(n * width, 1))
+
+    def below(r: Any) -> Any:
+        """C dy0: the sensitivity rows' derivative in y (and y' = cj y) along the first block's solution."""
+        return casadi.jtimes(r[n:], casadi.vertcat(Y, Yp), seed)
+
     def jacobian(r: Any) -> Any:
-        if coupled:
+        if coupled and not block:
             return casadi.jacobian(r, Y) + cj * casadi.jacobian(r, Yp)
         state = casadi.jacobian(r[:n], y) + cj * casadi.jacobian(r[:n], yp)
         return state if block else casadi.diagcat(*([state] * (1 + width)))
@@ -176,7 +182,10 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, 
     r = stacked(res(t, y, yp, P), sens.res(t, y, yp, P, S, Sp, dP))
     residual = casadi.Function("residual", [t, Y, Yp, PA], [r], ["t", "y", "yp", "P"], ["r"])
     jac = casadi.Function("jacobian", [t, Y, Yp, cj, PA], [jacobian(r)], ["t", "y", "yp", "cj", "P"], ["J"])
-    term_res, term_jac = [], []
+    with_coupling = coupled and block
+    coupling = casadi.Function("coupling", [t, Y, Yp, cj, PA, dy0], [below(r)],
+                               ["t", "y", "yp", "cj", "P", "dy0"], ["Cdy0"]) if with_coupling else None
+    term_res, term_jac, term_cpl = [], [], []
     for k, (fk, npk) in enumerate(zip(funcs.term_residuals, sens.n_params)):
         fk = _with_parameters(fk, 4, n_P)
         pa = sym.sym("p", npk * (1 + width))
@@ -185,11 +194,14 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, 
         term_res.append(casadi.Function(f"term{k}_res", [t, Y, Yp, pa, PA], [rk], ["t", "y", "yp", "p", "P"], ["r"]))
         term_jac.append(casadi.Function(f"term{k}_jac", [t, Y, Yp, pa, cj, PA], [jacobian(rk)],
                                         ["t", "y", "yp", "p", "cj", "P"], ["J"]))
+        if with_coupling:
+            term_cpl.append(casadi.Function(f"term{k}_cpl", [t, Y, Yp, pa, cj, PA, dy0], [below(rk)],
+                                            ["t", "y", "yp", "p", "cj", "P", "dy0"], ["Cdy0"]))
     roots = None
     if funcs.roots is not None:
         g = _with_parameters(funcs.roots, 3, n_P)
         roots = casadi.Function("roots", [t, Y, Yp, PA], [g(t, y, yp, P)], ["t", "y", "yp", "P"], ["g"])
     return DAEFunctions(n=n * (1 + width), residual=residual, jacobian=jac, term_residuals=tuple(term_res),
                         term_jacobians=tuple(term_jac), roots=roots, n_parameters=n_P * (1 + width),
-                        name=f"{funcs.name}_sens{width}{'c' if coupled else 'b' if block else ''}",
-                        blocks=1 + width if block else 1)
+                        name=f"{funcs.name}_sens{width}{'c' if coupled else ''}{'b' if block else ''}",
+                        blocks=1 + width if block else 1, coupling=coupling, term_couplings=tuple(term_cpl))

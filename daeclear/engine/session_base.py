@@ -45,9 +45,12 @@ class DAEFunctions:
     ``P``: the ``n_parameters`` run-time parameters (values given to :func:`open_session`); with
     ``n_parameters == 0`` the functions may leave it out. ``blocks`` > 1: the Newton matrix is block
     diagonal, ``blocks`` copies of the (n / blocks)-square matrix the Jacobian functions return (the
-    stacked forward sensitivities [y; S_1; ...], IDAS' simultaneous corrector): one factorisation
-    of that block solves them all. A value: what a process compiles of it is
-    kept by a :class:`~daeclear.engine.compiled.CompiledDAE`.
+    stacked forward sensitivities [y; S_1; ...]): one factorisation of that block solves them all.
+    ``coupling`` (with ``blocks`` > 1): (t, y, yp, cj, P, dy0) -> C dy0 (n - n / blocks), the Newton
+    matrix's blocks below its first block column times the first block's solution; ``term_couplings[k]``
+    (t, y, yp, p_k, cj, P, dy0) the same of term k: the solve is then the block forward substitution of
+    the block lower-triangular matrix, else the block-diagonal part (IDAS' simultaneous corrector).
+    A value: what a process compiles of it is kept by a :class:`~daeclear.engine.compiled.CompiledDAE`.
     """
 
     n: int
@@ -60,6 +63,8 @@ class DAEFunctions:
     extras: tuple[casadi.Function, ...] = ()
     n_parameters: int = 0
     blocks: int = 1
+    coupling: casadi.Function | None = None
+    term_couplings: tuple[casadi.Function, ...] = ()
 
 
 @dataclass(frozen=True)

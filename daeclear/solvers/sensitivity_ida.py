@@ -79,6 +79,7 @@ class SensitivityIntegrator:
     fixed_step: float | None = None
     session: Session | None = None  # the model's own functions serve the driver (the stacked session is S's)
     stacked_factorisation = False  # True: the reference path of stacked_reference()
+    coupling = True  # the compiled session's block forward substitution with the blocks below the diagonal
 
     def __init__(self, model: DAEModel, t_end: float, output: Output, settings: SolverOptions,
                  names: list[str]) -> None:
@@ -92,7 +93,8 @@ class SensitivityIntegrator:
         pbar = parameter_scales(model, self.sens.names)
         block = not self.stacked_factorisation
         self.stacked = open_session(
-            augmented_functions(model.functions, W, block=block), backend=settings.backend, rtol=rtol,
+            augmented_functions(model.functions, W, coupled=block and self.coupling, block=block),
+            backend=settings.backend, rtol=rtol,
             atol=np.concatenate([atol, *(atol / p for p in pbar)]), max_step=settings.max_step,
             max_steps=settings.max_steps,
             parameters=np.concatenate([model.parameter_values, self.sens.ms.dP.ravel(order="F")]),

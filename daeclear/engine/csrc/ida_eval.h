@@ -176,6 +176,36 @@ static dc_int jac_first_nonfinite(const dc_session* s, const double* Jd) {
   return -1;
 }
 
+/* The block lower-triangular solve's coupling (dcls_sun_set_coupling): x[nj:] -= C x[:nj], C the blocks
+ * below the first block column at the last Jacobian's point (base and active terms, dc_model.cpl). Where C
+ * is not finite (a force without a second derivative there: Hertz's delta^1.5 at onset) or its evaluation
+ * fails, that solve keeps the block-diagonal part (IDAS' simultaneous corrector), as IDA's modified Newton
+ * may. The generated SX functions keep no state between calls (memory 0, as the extras). */
+static void couple_cb(void* data, double* x) {
+  dc_session* s = (dc_session*)data;
+  const dc_model_t* M = &dc_model;
+  const int m = s->n - s->nj;
+  point_args(s, &s->cpl_t, s->cpl_y, s->cpl_yp);
+  s->arg[3] = &s->cpl_cj;
+  s->arg[4] = s->P;
+  s->arg[5] = x;
+  s->res[0] = s->cpl_out;
+  if (M->cpl.eval(s->arg, s->res, s->iw, s->w, 0)) return;
+  for (int k = 0; k < s->n_terms; ++k) {
+    if (!s->active[k]) continue;
+    point_args(s, &s->cpl_t, s->cpl_y, s->cpl_yp);
+    s->arg[3] = s->params + s->param_off[k];
+    s->arg[4] = &s->cpl_cj;
+    s->arg[5] = s->P;
+    s->arg[6] = x;
+    s->res[0] = s->cpl_tmp;
+    if (M->term_cpl[k].eval(s->arg, s->res, s->iw, s->w, 0)) return;
+    for (int i = 0; i < m; ++i) s->cpl_out[i] += s->cpl_tmp[i];
+  }
+  if (dc_first_nonfinite(s->cpl_out, m) >= 0) return;
+  for (int i = 0; i < m; ++i) x[s->nj + i] -= s->cpl_out[i];
+}
+
 static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vector rr,
                   SUNMatrix J, void* data, N_Vector t1, N_Vector t2, N_Vector t3) {
   dc_session* s = (dc_session*)data;
@@ -201,6 +231,12 @@ static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vec
     return 1;
   }
   s->lin->cj = cj; /* IDA factors this matrix next */
+  if (s->coupled) { /* the coupling's point: the same modified Newton matrix */
+    s->cpl_t = t;
+    s->cpl_cj = cj;
+    memcpy(s->cpl_y, N_VGetArrayPointer(yy), sizeof(double) * (size_t)s->n);
+    memcpy(s->cpl_yp, N_VGetArrayPointer(yp), sizeof(double) * (size_t)s->n);
+  }
   return 0;
 }
 

@@ -153,6 +153,10 @@ DC_API void dc_free(void* sp) {
   free(s->w);
   free(s->mem_term_res);
   free(s->mem_term_jac);
+  free(s->cpl_y);
+  free(s->cpl_yp);
+  free(s->cpl_out);
+  free(s->cpl_tmp);
   free(s->active);
   free(s->params);
   free(s->param_off);
@@ -240,6 +244,10 @@ static int open_work_memory(dc_session* s, char* err, int errlen) {
   for (int k = 0; k < M->n_terms; ++k) {
     work_max(&M->term_res[k], &sa, &sr, &si, &sw);
     work_max(&M->term_jac[k], &sa, &sr, &si, &sw);
+  }
+  if (M->cpl.eval) {
+    work_max(&M->cpl, &sa, &sr, &si, &sw);
+    for (int k = 0; k < M->n_terms; ++k) work_max(&M->term_cpl[k], &sa, &sr, &si, &sw);
   }
   s->arg = (const double**)xcalloc((size_t)sa, sizeof(double*));
   s->res = (double**)xcalloc((size_t)sr, sizeof(double*));
@@ -373,6 +381,16 @@ static int open_linear_solver(dc_session* s, char* err, int errlen) {
   if (!s->lin) OPEN_FAIL("the linear solver could not be created (out of memory)");
   s->LS = dcls_sun_create(s->lin, jac_storage(s, s->A), s->blocks, s->ctx);
   if (!s->LS) OPEN_FAIL("the linear solver could not be created (out of memory)");
+  if (s->blocks > 1 && dc_model.cpl.eval) {
+    const size_t m = (size_t)(s->n - s->nj);
+    s->cpl_y = (double*)xcalloc((size_t)s->n, sizeof(double));
+    s->cpl_yp = (double*)xcalloc((size_t)s->n, sizeof(double));
+    s->cpl_out = (double*)xcalloc(m, sizeof(double));
+    s->cpl_tmp = (double*)xcalloc(m, sizeof(double));
+    if (!s->cpl_y || !s->cpl_yp || !s->cpl_out || !s->cpl_tmp) OPEN_FAIL("out of memory");
+    s->coupled = 1;
+    dcls_sun_set_coupling(s->LS, couple_cb, s);
+  }
   return 0;
 }
 
