@@ -84,7 +84,8 @@ class CSession(SessionBase):
         self._clib = clib
         self._lib = clib.lib
         self._build = build
-        self._linear_solver = _resolve_linear_solver(opts.linear_solver, n, clib.build_info.has_sparse,
+        self._nj = model.n_jac  # the iteration matrix's size (n / blocks: the stacked sensitivities')
+        self._linear_solver = _resolve_linear_solver(opts.linear_solver, self._nj, clib.build_info.has_sparse,
                                                      clib.sparse_plan[0])
         hd = take_pooled(self._pool_key(), opts)
         if hd is None:
@@ -200,6 +201,15 @@ class CSession(SessionBase):
                                  recent=tuple(recent[offset:offset + n_recent[p]].tolist())))
             offset += storm.events
         return out
+
+    def set_kinematic_rows(self, n_kinematic: int) -> bool:
+        """The reduced solver's eliminated position rows without a state layout (the stacked
+        sensitivities' session factors the state's iteration matrix as the state's run does)."""
+        self._check_open()
+        if self._lib.dc_set_kinematic_rows(self._h, int(n_kinematic)) != 0:
+            raise DaeclearError(f"set_kinematic_rows: n_kinematic={n_kinematic!r}, must be >= 0 and below the "
+                                f"iteration matrix's {self._nj} rows.")
+        return True
 
     def set_layout(self, layout: StateLayout) -> bool:
         """The model's state layout and extras, so that C makes states consistent itself: restarts
@@ -493,7 +503,7 @@ class CSession(SessionBase):
         inactive terms), whatever the session's linear solver."""
         self._check_open()
         y, yp = self._vec(y, "y"), self._vec(yp, "yp")
-        colptr = np.empty(self._n + 1, dtype=np.int64)
+        colptr = np.empty(self._nj + 1, dtype=np.int64)
         rowind = np.empty(max(self._jac_nnz, 1), dtype=np.int64)
         data = np.empty(max(self._jac_nnz, 1))
         self._lib.dc_jac_pattern(self._h, colptr.ctypes.data, rowind.ctypes.data)
@@ -506,7 +516,7 @@ class CSession(SessionBase):
     def jacobian(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray:
         self._check_open()
         y, yp = self._vec(y, "y"), self._vec(yp, "yp")
-        out = np.empty((self._n, self._n), order="F")
+        out = np.empty((self._nj, self._nj), order="F")
         self._sync_terms()
         if self._lib.dc_eval_jacobian(self._h, float(t), y.ctypes.data, yp.ctypes.data, float(cj),
                                       out.ctypes.data):
@@ -523,11 +533,12 @@ class CSession(SessionBase):
         self._check_open()
         y, yp = self._vec(y, "y"), self._vec(yp, "yp")
         B = np.array(b, dtype=float, order="F")
-        if B.shape[0] != self._n or B.ndim > 2:
-            raise ValueError(f"solve_linear: b has shape {B.shape}, must be ({self._n},) or ({self._n}, k)")
+        nj = self._nj
+        if B.shape[0] != nj or B.ndim > 2:
+            raise ValueError(f"solve_linear: b has shape {B.shape}, must be ({nj},) or ({nj}, k)")
         A = None if matrix is None else np.asfortranarray(matrix, dtype=float)
-        if A is not None and A.shape != (self._n, self._n):
-            raise ValueError(f"solve_linear: matrix has shape {A.shape}, must be ({self._n}, {self._n})")
+        if A is not None and A.shape != (nj, nj):
+            raise ValueError(f"solve_linear: matrix has shape {A.shape}, must be ({nj}, {nj})")
         if solver not in ("dense", "reduced", "sparse"):
             raise ValueError(f"solve_linear: solver={solver!r}, must be 'dense', 'reduced' or 'sparse'")
         self._sync_terms()
