@@ -77,11 +77,23 @@ def test_a_session_is_not_rearmed_for_another_structure_or_the_python_backend():
 
 def test_blocks_in_one_session_equal_blocks_each_in_its_own(monkeypatch):
     """simulate_wear's blocks run in one re-armed session; each block in a session of its own (the
-    driver's) gives the same history bit for bit: depth, sliding work and peak force."""
+    driver's) gives the same history bit for bit: depth, sliding work, peak force and each block's last
+    state (made consistent in the shared session; ``Result.state(-1)`` in its own)."""
     worn = slider_crank("revolute", friction=0.1).with_values(
         {"clearance.wear": ArchardWear(coefficient=1e-12, length=0.02)})
+    states: list[list[np.ndarray]] = [[], []]  # each block's last state (the next start, the file's y)
+    real_row = study.WearRow
+
+    def row(**kwargs):
+        if kwargs["y"] is not None:  # not the unworn start's row
+            states[phase[0]].append(kwargs["y"])
+        return real_row(**kwargs)
+
+    opened: list[int] = []
+    phase = [0]
+    monkeypatch.setattr(study, "WearRow", row)
     shared = simulate_wear(worn, 3)
-    opened = []
+    phase[0] = 1
 
     def own_session(self, solver, model, t_end, save, settings):
         opened.append(1)
@@ -90,6 +102,9 @@ def test_blocks_in_one_session_equal_blocks_each_in_its_own(monkeypatch):
     monkeypatch.setattr(BlockRuns, "integrator", own_session)
     alone = simulate_wear(worn, 3)
     assert len(opened) == 3
+    assert len(states[0]) == len(states[1]) == 3
+    for mine, own in zip(*states):
+        np.testing.assert_array_equal(mine, own)
     for field in ("depth", "sliding_work", "peak_force", "volume"):
         np.testing.assert_array_equal(getattr(shared, field), getattr(alone, field))
     assert shared.max_depth[-1] > 0

@@ -28,8 +28,8 @@ from ..model.scene import RevoluteClearance, Scene
 from ..core import options as opts
 from ..core.progress import Progress
 from ..results.outputs import check_file
-from ..core.values import to_plain
-from ..results.channel_eval import RunChannels
+from ..core.values import readonly, to_plain
+from ..results.channel_eval import ModelEvaluator, RunChannels
 from ..results.result import Result
 from ..solvers import driver
 from ..solvers.base import DrivenSolver
@@ -266,7 +266,7 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
                 depth = {s: depth[s] + extrapolate * increment[s] for s in depth}
                 done += update_every * extrapolate
                 work += extrapolate * block_work
-                t0, y0 = float(result.t[-1]), result.state(-1)
+                t0, y0 = float(result.t[-1]), last_state(result, model, backend, runs.session)
                 peak = float(np.max(channels[f"{name}.normal_force"]))
                 rows.append(WearRow(cycles=done, depth=depth, work=work, block_peak=peak, t=t0, y=y0))
                 if store is not None:  # a Ctrl-C meanwhile arrives once the row is written whole
@@ -328,6 +328,18 @@ class BlockRuns:
         if self.open is not None:
             self.open.close()
             self.open = None
+
+
+def last_state(result: Result, model: DAEModel, backend: str, session: Session | None) -> NDArray[np.float64]:
+    """``result.state(-1)`` (the state the next block starts from: its last row made consistent alone),
+    in ``session`` (an open one of ``model``'s, the run's) instead of a session opened for it."""
+    source = result.channel_source
+    if session is None or source is None or not source.raw or not source.t.size:
+        return result.state(-1)
+    last = slice(source.t.size - 1, source.t.size)
+    y, _ = ModelEvaluator(model, backend, session).consistent(source.t[last], source.stored_y[last],
+                                                              source.switch[last])
+    return readonly(y[0])
 
 
 def worn_model(model: DAEModel, joint: str, depth: Any) -> DAEModel:
