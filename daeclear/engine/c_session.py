@@ -39,7 +39,6 @@ from .session_base import (
     SessionBase,
     SessionOptions,
     StateLayout,
-    check_options,
     output_rows,
 )
 from .sundials import SPARSE_LIBS
@@ -101,23 +100,6 @@ class CSession(SessionBase):
         self._extra_meta = hd.extra_meta
         self._poff = list(itertools.accumulate(model.n_params, initial=0))
         self._auto_storms: tuple[Storm, ...] = ()  # the storm constants of the pairs C decides (set_auto_events)
-
-    def rearm(self, *, atol: np.ndarray, parameters: np.ndarray) -> None:
-        """Ready the open session for another run as a new session of this library with these absolute
-        tolerances and run-time parameters (its other options kept) would start: ``dc_reset``, what a
-        pooled session gets, without closing and opening it (its buffers kept; a study running models of
-        one structure one after another, as the wear study's blocks). Hints, stall guard, layout and
-        events are set again as after opening."""
-        self._check_open()
-        o = self._opts
-        opts = check_options(self._model, o.rtol, atol, o.max_step, o.max_order, o.max_steps, o.root_directions,
-                             o.buffer_steps, parameters, o.linear_solver)
-        if self._lib.dc_reset(self._h, opts.rtol, address(opts.atol), opts.max_step, opts.max_steps,
-                              pointer(opts.root_directions), pointer(opts.parameters)) != 0:
-            raise DaeclearError(f"re-arming the compiled IDA session failed: {self._lib.dc_message(self._h).decode()}")
-        self._opts = opts
-        self._new_run()
-        self._auto_storms = ()
 
     def _pool_key(self) -> tuple[int, str, int, int]:
         """What a pooled handle must share with this session: library, linear solver, max_order, buffer_steps."""

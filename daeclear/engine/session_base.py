@@ -312,22 +312,18 @@ class SessionBase:
         self._opts = opts
         self._n = model.n
         self._nt = len(model.term_res)
+        self._ready = False
         self._closed = False
-        self._new_run()
+        self._t = 0.0
+        self._y = np.zeros(model.n)
+        self._yp = np.zeros(model.n)
+        self._active = np.zeros(self._nt, dtype=np.int32)
+        self._params = [np.zeros(p) for p in model.n_params]
+        self._stall = StallGuard()
+        self._solve_time = 0.0
         # the compiled library and its session handle: CSession's only (set_stall uses them)
         self._lib: Any
         self._h: Any
-
-    def _new_run(self) -> None:
-        """The state of a session no run has used yet (a new or a re-armed one)."""
-        self._ready = False
-        self._t = 0.0
-        self._y = np.zeros(self._n)
-        self._yp = np.zeros(self._n)
-        self._active = np.zeros(self._nt, dtype=np.int32)
-        self._params = [np.zeros(p) for p in self._model.n_params]
-        self._stall = StallGuard()
-        self._solve_time = 0.0
 
     @property
     def max_steps(self) -> int:

@@ -26,21 +26,14 @@ __all__ = ["ModelEvaluator", "RunChannels", "evaluator_from_parameters", "rebuil
 
 class ModelEvaluator:
     """A model's channels and derivatives at stored rows, each call in a session of ``backend`` opened
-    for it alone (the run's library, loaded once per process), or in ``session``, an open one of the
-    model (with its numbers), left open."""
+    for it alone (the run's library, loaded once per process)."""
 
-    def __init__(self, model: DAEModel, backend: str, session: Any = None) -> None:
-        self.model, self.backend, self.given = model, backend, session
+    def __init__(self, model: DAEModel, backend: str) -> None:
+        self.model, self.backend = model, backend
 
     def _session(self) -> Any:
-        if self.given is not None:
-            return self.given
         return open_session(self.model.compiled, backend=self.backend, rtol=1e-6, atol=1.0,
                             parameters=self.model.parameter_values)
-
-    def _close(self, session: Any) -> None:
-        if session is not self.given:
-            session.close()
 
     def channels(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray,
                  names: Sequence[str] | None = None) -> Mapping[str, NDArray]:
@@ -54,7 +47,7 @@ class ModelEvaluator:
             column = self.model.channel_names.index
             return {name: np.ascontiguousarray(values[:, column(name)]) for name in names}
         finally:
-            self._close(session)
+            session.close()
 
     def consistent(self, t: NDArray, y: NDArray, switch: NDArray) -> tuple[NDArray, NDArray]:
         """(y, yp) at the rows by the run's own consistency pass: multipliers and accelerations from q
@@ -66,7 +59,7 @@ class ModelEvaluator:
                 return y_out, yp_out
             return model.consistent_state(t, y, model.term_forces_rows(t, y, switch, session), session)
         finally:
-            self._close(session)
+            session.close()
 
 
 class RunChannels:
@@ -92,11 +85,9 @@ class RunChannels:
         self._y = np.array(self.outputs.jac_sparsity(0, 1), dtype=bool)[rows]  # which states each one reads
         self._reads_yp = bool(np.array(self.outputs.jac_sparsity(0, 2), dtype=bool)[rows].any())
 
-    def __call__(self, result: Result, model: DAEModel, backend: str = "auto", session: Any = None
-                 ) -> dict[str, NDArray]:
+    def __call__(self, result: Result, model: DAEModel, backend: str = "auto") -> dict[str, NDArray]:
         """The channels of ``result``, a run of ``model`` in ``backend`` (the run's: its parameters'
-        ``simulate.backend``); ``session``: an open session of ``model`` to evaluate them in (else one is
-        opened for the call)."""
+        ``simulate.backend``)."""
         if model.outputs is not self.outputs:
             raise SceneError(f"RunChannels: model '{model.scene_name}' is of another structure than the one the "
                              "channels were chosen for; make a RunChannels for it.")
@@ -105,7 +96,7 @@ class RunChannels:
             return {name: np.asarray(result[name]) for name in self.names}
         y = source.y if self._y[:, source.recomputed].any() else source.stored_y
         yp = source.yp if self._reads_yp else np.zeros(model.n_states)
-        values = ModelEvaluator(model, backend, session).channels(source.t, y, yp, source.switch, self.names)
+        values = ModelEvaluator(model, backend).channels(source.t, y, yp, source.switch, self.names)
         return {name: readonly(values[name]) for name in self.names}
 
 

@@ -53,15 +53,14 @@ Observer = Callable[[Jump], None]
 
 def run(solver: Driven, scene: Scene | DAEModel, t_end: float, t0: float, y0: NDArray | None, save: Output,
         settings: SolverOptions, on_failure: str, progress: bool, observers: Sequence[Observer] = (), *,
-        checks: bool = True, integrator: Integrator | None = None) -> Result:
+        checks: bool = True) -> Result:
     """Integrate ``scene`` (a Scene is assembled with ``settings.formulation`` or the solver's own) from
     ``t0`` to ``t_end`` with the solver's integrator (the :class:`daeclear.solvers.base.Solver` contract's
     ``run``); ``observers`` see every :class:`Jump`. An integrator that carries a quantity beside the
     states (:class:`~daeclear.solvers.integrator.Carried`: the sensitivities) has it jump at every event.
     ``checks=False``: a run that reaches its end is not checked (no warnings, no ``max_constraint_drift``;
     a caller judging each run itself, as the wear study's blocks); a failed or interrupted one is, for its
-    message. ``integrator``: an open one of ``scene``'s model (a model), ready for this run (a re-armed
-    :class:`~daeclear.solvers.ida.IDAIntegrator`), which the caller closes: left open at the end."""
+    message."""
     setup_start = time.perf_counter()
     if isinstance(scene, DAEModel):
         model = scene
@@ -70,9 +69,7 @@ def run(solver: Driven, scene: Scene | DAEModel, t_end: float, t0: float, y0: ND
     y0 = None if y0 is None else opts.state(y0, model.n_states)
     save.check_size(step=settings.step, n_states=model.n_states,
                     n_channels=len(model.channel_names))  # before the integrator: nothing compiled or run
-    owned = integrator is None
-    if integrator is None:
-        integrator = solver.integrator(model, t_end, save, settings)
+    integrator = solver.integrator(model, t_end, save, settings)
     carried = integrator if isinstance(integrator, Carried) else None
     from_state = y0 is not None
     try:
@@ -90,12 +87,11 @@ def run(solver: Driven, scene: Scene | DAEModel, t_end: float, t0: float, y0: ND
         rec = Recorder(model, parameters={**model.parameters, "simulate": record}, method=solver.name,
                        stream_to=save.stream_to, keep_data=save.keep_data, lazy_rows=integrator.lazy_rows)
     except BaseException:
-        if owned:
-            integrator.close()
+        integrator.close()
         raise
     declared = start if record["start"] == "declared" else None  # the start checks concern a declared state
     driver = Driver(model, integrator, rec, save, t_end, progress, observers, carried)
-    driver.checks, driver.owns_integrator = checks, owned
+    driver.checks = checks
     return driver.run(t0, start, start_yp, declared, from_state, on_failure, time.perf_counter() - setup_start)
 
 
@@ -177,7 +173,6 @@ class Driver:
         self.last_event_t = -math.inf
         self.interrupted = False
         self.checks = True  # False: a successful run's physics checks are left out (run's ``checks``)
-        self.owns_integrator = True  # False: the caller's, left open at the end (run's ``integrator``)
 
     # ---------------------------------------------------------------- the run
     def run(self, t0: float, y0: NDArray, yp0: NDArray, declared: NDArray | None, from_state: bool,
@@ -200,8 +195,7 @@ class Driver:
         except BaseException as exc:  # anything else: a streamed file keeps what it holds, then the error goes on
             self.progress_line.close()
             self.rec.abort(exc)
-            if self.owns_integrator:
-                self.integrator.close()
+            self.integrator.close()
             raise
         if not math.isnan(self.seg_start):  # stopped inside a segment: it ends where the run stopped
             self.segments.append((self.seg_start, self.t, dict(self.modes)))
@@ -482,8 +476,7 @@ class Driver:
             return found
         finally:
             rec.session = None  # the session closes: later channels open their own
-            if self.owns_integrator:
-                integrator.close()
+            integrator.close()
 
 
 def _same_terms(a: Terms, b: Terms) -> bool:

@@ -79,47 +79,28 @@ class IDAIntegrator:
     def __init__(self, model: DAEModel, t_end: float, output: Output, settings: SolverOptions) -> None:
         rtol = settings.rtol
         self.model, self.t_end, self.times, self.store_steps = model, t_end, output.times, output.steps
-        self.settings = settings
         self.session: Session = open_session(
             model.compiled, backend=settings.backend, rtol=rtol,
             atol=tolerance_vector(model, rtol, settings.atol_value()), max_step=settings.max_step,
             parameters=model.parameter_values, max_steps=settings.max_steps, linear_solver=settings.linear_solver)
+        session = self.session
         try:
-            self._configure()
+            session.set_hints(jacobian_refresh=JACOBIAN_REFRESH,
+                              first_step=FIRST_STEP_ESTIMATE and model.formulation == "ggl")
+            if model.formulation == "ggl" and model.n_constraints:  # without constraints GGL is index-1
+                # never ask Newton for corrections below round-off: coef * rtol >= 1e-13
+                session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / rtol)))
+            session.set_stall(STALL_STEP, STALL_COUNT)
         except BaseException:
-            self.session.close()
+            session.close()
             raise
-        self.backend = self.session.backend
-
-    def _configure(self) -> None:
-        """The session's hints and stall guard, the run's own state: as opened."""
-        model, session = self.model, self.session
-        session.set_hints(jacobian_refresh=JACOBIAN_REFRESH,
-                          first_step=FIRST_STEP_ESTIMATE and model.formulation == "ggl")
-        if model.formulation == "ggl" and model.n_constraints:  # without constraints GGL is index-1
-            # never ask Newton for corrections below round-off: coef * rtol >= 1e-13
-            session.set_hints(nonlin_conv_coef=min(0.33, max(GGL_NEWTON_COEF, 1e-13 / self.settings.rtol)))
-        session.set_stall(STALL_STEP, STALL_COUNT)
+        self.backend = session.backend
         self.missed: list[tuple[float, float, str]] = []
         self.t_start = 0.0
         self.i_eval = 0  # the next output time
         self.c_layout = False  # the compiled loop makes the points consistent itself
         self.decides = False  # the compiled loop decides every contact switch itself
         self.auto: list[AutoPair] = []
-
-    def rearm(self, model: DAEModel, t_end: float, output: Output) -> bool:
-        """Ready the open session for another run, of ``model`` (this one's structure, other numbers) to
-        ``t_end`` with the same settings, as a new integrator would start it (the compiled session's
-        :meth:`~daeclear.engine.c_session.CSession.rearm`). False: the session cannot (the python
-        backend) or the model is of another structure; open a new integrator."""
-        rearm = getattr(self.session, "rearm", None)
-        if rearm is None or model.compiled is not self.model.compiled:
-            return False
-        rearm(atol=tolerance_vector(model, self.settings.rtol, self.settings.atol_value()),
-              parameters=model.parameter_values)
-        self.model, self.t_end, self.times, self.store_steps = model, t_end, output.times, output.steps
-        self._configure()
-        return True
 
     def start(self, t: float, y: NDArray, yp: NDArray, terms: Terms, state: ContactState) -> None:
         """Start IDA; let the compiled loop make states consistent and decide simple pairs' switches."""

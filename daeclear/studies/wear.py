@@ -28,15 +28,13 @@ from ..model.scene import RevoluteClearance, Scene
 from ..core import options as opts
 from ..core.progress import Progress
 from ..results.outputs import check_file
-from ..core.values import readonly, to_plain
-from ..results.channel_eval import ModelEvaluator, RunChannels
+from ..core.values import to_plain
+from ..results.channel_eval import RunChannels
 from ..results.result import Result
 from ..solvers import driver
 from ..solvers.base import DrivenSolver
 from ..solvers.registry import solver_class
-from ..engine.session_base import Session
-from ..solvers.ida import IDAIntegrator
-from ..solvers.save_at import Output, save_value
+from ..solvers.save_at import save_value
 from ..solvers.solver_options import SolverOptions
 from ..solvers.dispatch import simulate
 from .poincare import crank_period
@@ -233,8 +231,6 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
     name, radius, clearance = element.name, float(element.bearing_radius), element.radial_clearance
     history_of = joint_channels(model, name)
     backend = (options or SolverOptions()).backend  # the runs' (resolved alike by every session)
-    settings = options or SolverOptions()  # one object: the blocks' runs share their session
-    runs = BlockRuns()
     message = ""
     try:
         with warnings.catch_warnings():  # a block beyond its contact law is judged below, once
@@ -246,13 +242,13 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
                                f"{MAX_DEPTH_FRACTION:g} of the bearing radius {radius:g} m, where the gap's "
                                "small-slope model no longer holds; a smaller wear coefficient, or fewer cycles.")
                     break
-                model = worn_model(model, name, _depth_value(depth, wear.surfaces))
+                model = model.with_parameters({f"{name}.wear_depth": _depth_value(depth, wear.surfaces)})
                 try:
-                    result = block_run(model, t0, t0 + update_every * period, y0, settings, runs)
+                    result = block_run(model, t0, t0 + update_every * period, y0, options)
                 except (SolveError, AssemblyError) as exc:  # the history so far is the result (and in the file)
                     message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
                     break
-                channels = history_of(result, model, backend, runs.session)
+                channels = history_of(result, model, backend)
                 deepest_run = float(np.max(channels[f"{name}.penetration"]))
                 if deepest_run > clearance:
                     message = (f"stopped at {done:g} cycles: the next block's run left joint '{name}' "
@@ -266,7 +262,7 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
                 depth = {s: depth[s] + extrapolate * increment[s] for s in depth}
                 done += update_every * extrapolate
                 work += extrapolate * block_work
-                t0, y0 = float(result.t[-1]), last_state(result, model, backend, runs.session)
+                t0, y0 = float(result.t[-1]), result.state(-1)
                 peak = float(np.max(channels[f"{name}.normal_force"]))
                 rows.append(WearRow(cycles=done, depth=depth, work=work, block_peak=peak, t=t0, y=y0))
                 if store is not None:  # a Ctrl-C meanwhile arrives once the row is written whole
@@ -275,82 +271,22 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
     except KeyboardInterrupt:  # Ctrl-C: the history so far is kept (and in the file)
         return _history(rows, wear, radius, f"interrupted at {done:g} cycles"), True
     finally:
-        runs.close()
         bar.close()
     return _history(rows, wear, radius, message), False
 
 
 def block_run(model: DAEModel, t0: float, t_end: float, y0: NDArray[np.float64] | None,
-              options: SolverOptions | None, runs: BlockRuns | None = None) -> Result:
+               options: SolverOptions | None) -> Result:
     """One block's run: ``simulate(model, t_end, t0=t0, y0=y0, options=options)`` without the physics
     checks of a run that reaches its end (the block judges its penetration itself; their warnings were
-    ignored), 5-10 % of a block; with ``runs``, in the IDA session the blocks before it ran in."""
+    ignored), 5-10 % of a block."""
     settings = options or SolverOptions()
     opts.step_within(settings.step, t0, t_end)  # as simulate checks it
     solver = solver_class(settings.method)()
     if not isinstance(solver, DrivenSolver):  # a solver class of the user's: its own run, checked
         return simulate(model, t_end, t0=t0, y0=y0, options=options)
-    save = save_value(None).plan(t0, t_end)
-    integrator = None if runs is None else runs.integrator(solver, model, t_end, save, settings)
-    return driver.run(solver, model, t_end, t0, y0, save, settings, "raise", False, checks=False,
-                      integrator=integrator)
-
-
-class BlockRuns:
-    """The IDA session a history's blocks run in, one after another: each block's run starts in it as in
-    a new one (:meth:`IDAIntegrator.rearm`: its numbers, tolerances and run state reset, so the same
-    steps), and nothing is opened or closed between blocks. Closed by :meth:`close`."""
-
-    def __init__(self) -> None:
-        self.open: IDAIntegrator | None = None
-
-    def integrator(self, solver: DrivenSolver, model: DAEModel, t_end: float, save: Output,
-                   settings: SolverOptions) -> IDAIntegrator | None:
-        """The open integrator ready for the next block's run (None: the driver's own, for a method
-        other than IDA or a session that cannot be re-armed)."""
-        if self.open is not None and self.open.settings is settings and self.open.rearm(model, t_end, save):
-            return self.open
-        self.close()
-        made = solver.integrator(model, t_end, save, settings)
-        if not isinstance(made, IDAIntegrator):
-            made.close()
-            return None
-        self.open = made
-        return made
-
-    @property
-    def session(self) -> Session | None:
-        """The open session, with the numbers of the last block's model (its channels are read in it)."""
-        return None if self.open is None else self.open.session
-
-    def close(self) -> None:
-        """Close the session (it goes back to the pool)."""
-        if self.open is not None:
-            self.open.close()
-            self.open = None
-
-
-def last_state(result: Result, model: DAEModel, backend: str, session: Session | None) -> NDArray[np.float64]:
-    """``result.state(-1)`` (the state the next block starts from: its last row made consistent alone),
-    in ``session`` (an open one of ``model``'s, the run's) instead of a session opened for it."""
-    source = result.channel_source
-    if session is None or source is None or not source.raw or not source.t.size:
-        return result.state(-1)
-    last = slice(source.t.size - 1, source.t.size)
-    y, _ = ModelEvaluator(model, backend, session).consistent(source.t[last], source.stored_y[last],
-                                                              source.switch[last])
-    return readonly(y[0])
-
-
-def worn_model(model: DAEModel, joint: str, depth: Any) -> DAEModel:
-    """``model`` with joint ``joint``'s worn profile ``depth`` (its ``wear_depth`` value): the scene's
-    new value assembled (nothing compiled), as ``model.with_parameters({"<joint>.wear_depth": depth})``
-    makes it, without that call's check of the name."""
-    assert model.scene is not None
-    scene = model.scene.with_values({f"{joint}.wear_depth": depth})
-    if model.formulation == "index1":
-        return assemble(scene, model.formulation, alpha=model.alpha, beta=model.beta, track_work=model.track_work)
-    return assemble(scene, model.formulation, track_work=model.track_work)
+    return driver.run(solver, model, t_end, t0, y0, save_value(None).plan(t0, t_end), settings, "raise", False,
+                      checks=False)
 
 
 def _checked_period(scene: Scene, period: float | None) -> float:
