@@ -233,40 +233,41 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
     backend = (options or SolverOptions()).backend  # the runs' (resolved alike by every session)
     message = ""
     try:
-        while done < cycles:
-            deepest = max(float(d.max()) for d in depth.values())
-            if deepest > MAX_DEPTH_FRACTION * radius:
-                message = (f"stopped at {done:g} cycles: the worn depth {deepest:.3g} m exceeds "
-                           f"{MAX_DEPTH_FRACTION:g} of the bearing radius {radius:g} m, where the gap's small-slope "
-                           "model no longer holds; a smaller wear coefficient, or fewer cycles.")
-                break
-            model = model.with_parameters({f"{name}.wear_depth": _depth_value(depth, wear.surfaces)})
-            try:
-                with warnings.catch_warnings():  # a block beyond its contact law is judged below, once
-                    warnings.simplefilter("ignore", PhysicsWarning)
+        with warnings.catch_warnings():  # a block beyond its contact law is judged below, once
+            warnings.simplefilter("ignore", PhysicsWarning)
+            while done < cycles:
+                deepest = max(float(d.max()) for d in depth.values())
+                if deepest > MAX_DEPTH_FRACTION * radius:
+                    message = (f"stopped at {done:g} cycles: the worn depth {deepest:.3g} m exceeds "
+                               f"{MAX_DEPTH_FRACTION:g} of the bearing radius {radius:g} m, where the gap's "
+                               "small-slope model no longer holds; a smaller wear coefficient, or fewer cycles.")
+                    break
+                model = model.with_parameters({f"{name}.wear_depth": _depth_value(depth, wear.surfaces)})
+                try:
                     result = block_run(model, t0, t0 + update_every * period, y0, options)
-            except (SolveError, AssemblyError) as exc:  # the history so far is the result (and in the file)
-                message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
-                break
-            channels = history_of(result, model, backend)
-            deepest_run = float(np.max(channels[f"{name}.penetration"]))
-            if deepest_run > clearance:
-                message = (f"stopped at {done:g} cycles: the next block's run left joint '{name}' {deepest_run:.3g} m "
-                           f"inside its wall, more than its clearance {clearance:g} m (beyond what its contact law "
-                           "describes); its wear is not taken. A tighter rtol, or a smaller wear coefficient.")
-                break
-            increment, block_work = wear_increment(wear, history_arrays(result.t, channels, name),
-                                                   bearing_radius=radius, clearance=clearance,
-                                                   effective_modulus=modulus)
-            depth = {s: depth[s] + extrapolate * increment[s] for s in depth}
-            done += update_every * extrapolate
-            work += extrapolate * block_work
-            t0, y0 = float(result.t[-1]), result.state(-1)
-            peak = float(np.max(channels[f"{name}.normal_force"]))
-            rows.append(WearRow(cycles=done, depth=depth, work=work, block_peak=peak, t=t0, y=y0))
-            if store is not None:  # a Ctrl-C meanwhile arrives once the row is written whole
-                store.append(rows[-1], model.n_states)
-            bar.update(min(done, cycles), f"max depth {max(float(d.max()) for d in depth.values()):.3g} m")
+                except (SolveError, AssemblyError) as exc:  # the history so far is the result (and in the file)
+                    message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
+                    break
+                channels = history_of(result, model, backend)
+                deepest_run = float(np.max(channels[f"{name}.penetration"]))
+                if deepest_run > clearance:
+                    message = (f"stopped at {done:g} cycles: the next block's run left joint '{name}' "
+                               f"{deepest_run:.3g} m inside its wall, more than its clearance {clearance:g} m (beyond "
+                               "what its contact law describes); its wear is not taken. A tighter rtol, or a smaller "
+                               "wear coefficient.")
+                    break
+                increment, block_work = wear_increment(wear, history_arrays(result.t, channels, name),
+                                                       bearing_radius=radius, clearance=clearance,
+                                                       effective_modulus=modulus)
+                depth = {s: depth[s] + extrapolate * increment[s] for s in depth}
+                done += update_every * extrapolate
+                work += extrapolate * block_work
+                t0, y0 = float(result.t[-1]), result.state(-1)
+                peak = float(np.max(channels[f"{name}.normal_force"]))
+                rows.append(WearRow(cycles=done, depth=depth, work=work, block_peak=peak, t=t0, y=y0))
+                if store is not None:  # a Ctrl-C meanwhile arrives once the row is written whole
+                    store.append(rows[-1], model.n_states)
+                bar.update(min(done, cycles), f"max depth {max(float(d.max()) for d in depth.values()):.3g} m")
     except KeyboardInterrupt:  # Ctrl-C: the history so far is kept (and in the file)
         return _history(rows, wear, radius, f"interrupted at {done:g} cycles"), True
     finally:
