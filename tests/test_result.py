@@ -592,7 +592,9 @@ STATES_ONLY = {"/switch", "/channel_names", "/channel_units"}
 #: items of a run with sensitivities only (simulate(..., sensitivities=...))
 SENSITIVITIES = {"/sensitivities", "/sensitivities/names", "/sensitivities/states", "/sensitivities/channel_names",
                  "/sensitivities/channels", "/sensitivities/events", "/sensitivities/events/t",
-                 "/sensitivities/events/pair", "/sensitivities/events/kind", "/sensitivities/events/dt_dp"}
+                 "/sensitivities/events/pair", "/sensitivities/events/kind", "/sensitivities/events/dt_dp",
+                 "/sensitivities/sides", *(f"/sensitivities/sides/{name}" for name in ("t", "y", "values", "states",
+                                                                                      "channels"))}
 
 
 def _documented_items() -> list[tuple[str, bool]]:

@@ -27,7 +27,8 @@ from .hdf5_stream import STREAM_RUNNING, ResultWriter
 from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, save_result, write_result_group
 from .lazy_channels import LazyChannels
 from .result_checks import checked_fields
-from .sensitivities import Sensitivities
+from .objectives import Gradient, Objective, evaluate
+from .sensitivities import RunTrajectory, Sensitivities
 from ..core.values import readonly, time_window, to_plain
 
 if TYPE_CHECKING:  # h5py, pandas and xarray are imported lazily, only where they are used
@@ -236,6 +237,16 @@ class Result:
             raise KeyError("Result.sensitivity: this run has no sensitivities; run "
                            "simulate(..., sensitivities=[names from model.parameter_names]).")
         return self.sensitivities.of(name, parameter)
+
+    def gradient(self, of: Objective) -> Gradient:
+        """The objective ``of`` (``dc.Final``, ``dc.Integral``, ``dc.Peak``, ``dc.EventTime``) on this run and
+        its gradient w.r.t. :attr:`sensitivity_names`, as ``dc.gradient`` computes it: a run's result or a
+        loaded one alike (the file keeps each event's rows). An Integral or a Peak reads the output rows:
+        give the run enough of them (``SaveAt(times=...)``)."""
+        if self.sensitivities is None:
+            raise KeyError("Result.gradient: this run has no sensitivities; run "
+                           "simulate(..., sensitivities=[names from model.parameter_names]).")
+        return evaluate(of, RunTrajectory(self.t, self.__getitem__, self.sensitivities))
 
     def state(self, i: int) -> NDArray[np.float64]:
         """Row ``i`` of :attr:`y` (e.g. -1: the state to continue a run from), without making every row
