@@ -245,4 +245,4 @@ def test_a_loaded_result_gives_the_same_objectives(scene: dc.Scene, tmp_path) ->
         run.gradient(dc.Integral("clearance.normal_force", window=(0.05, 0.12))).value, rel=1e-9)  # end nodes one-sided
     assert run.slice(0.05, 0.12).sensitivities.sides.t.size == 2
     with pytest.raises(KeyError, match="Result.gradient: this run has no sensitivities"):
-        dc.Result(t=[0.0], y=[[0.0]], yp=None, state_names=["x"], channels={}, units={}).gradient(dc.Final("x"))
+        dc.Result(t=[0.0], y=[[0.0]], yp=[[0.0]], state_names=["x"], channels={}, units={}).gradient(dc.Final("x"))

@@ -108,6 +108,73 @@ def test_saved_and_loaded_with_the_result(kv_model, tmp_path: Path) -> None:
     assert np.array_equal(sliced.sensitivity("journal.x"), window.sensitivity("journal.x"))
 
 
+STREAM_TIMES = np.linspace(0.0, T, 51)
+
+
+def _same_sensitivities(a: dc.Result, b: dc.Result, rows: int | None = None) -> None:
+    """b's rows (its first ``rows``) and events' sensitivities are a's, to the bit."""
+    sa, sb = a.sensitivities, b.sensitivities
+    k = a.n_times if rows is None else rows
+    assert sa is not None and sb is not None and sa.names == sb.names
+    assert np.array_equal(a.t, b.t[:k]) and np.array_equal(sa.states, sb.states[:k], equal_nan=True)
+    assert np.array_equal(sa.channels, sb.channels[:k], equal_nan=True)
+    assert [(e.t, e.pair, e.kind) for e in sa.events] == [(e.t, e.pair, e.kind) for e in sb.events][:len(sa.events)]
+    dt_a, dt_b = (np.array([e.dt_dp for e in s.events]) for s in (sa, sb))
+    assert np.array_equal(dt_a, dt_b[:len(sa.events)])
+    assert sa.sides is not None and sb.sides is not None
+    j = sa.sides.t.size
+    for name in ("t", "y", "values", "states", "channels"):
+        assert np.array_equal(getattr(sa.sides, name), getattr(sb.sides, name)[:j], equal_nan=True)
+
+
+def test_a_streamed_run_writes_them_as_it_goes(kv_model, tmp_path: Path) -> None:
+    """SaveAt(stream_to=...): the file holds S of the states and channels at every row, the events' dt*/dp and
+    their rows, exactly the run in memory's; dc.load reads them and Result.gradient gives the same objectives;
+    keep_data=False returns the outcome alone and the file holds the rest."""
+    memory = kv_run(kv_model, save=dc.SaveAt(times=STREAM_TIMES))
+    streamed = kv_run(kv_model, save=dc.SaveAt(times=STREAM_TIMES, stream_to=tmp_path / "run.h5"))
+    back = dc.load(tmp_path / "run.h5")
+    for result in (streamed, back):
+        _same_sensitivities(memory, result)
+        assert result.n_times == memory.n_times == STREAM_TIMES.size
+    assert streamed.sensitivities.sides.t.size == 4  # onset and separation, before and after each
+    of = dc.Integral("clearance.normal_force")
+    assert back.gradient(of) == memory.gradient(of)
+    want = complex_step(kelvin_voigt_radial, P0)
+    assert back.sensitivity("journal.x")[-1] == pytest.approx(want[0], rel=1e-6)
+    outcome = kv_run(kv_model, save=dc.SaveAt(times=STREAM_TIMES, stream_to=tmp_path / "alone.h5", keep_data=False))
+    assert outcome.n_times == 0 and outcome.sensitivities is None
+    _same_sensitivities(memory, dc.load(tmp_path / "alone.h5"))
+
+
+def test_an_interrupted_streamed_run_keeps_what_it_computed(kv_model, tmp_path: Path,
+                                                           monkeypatch: pytest.MonkeyPatch) -> None:
+    """Ctrl-C as the run reaches its separation root, before deciding it (the progress line's second update: the
+    run restarts at each of its two events): the file holds the rows before it with their S, the onset's dt*/dp
+    and rows, those of the complete run; the Interrupted's result is the file's."""
+    from daeclear.core.errors import Interrupted
+    from daeclear.core.progress import Progress
+
+    full = kv_run(kv_model, save=dc.SaveAt(times=STREAM_TIMES))
+    calls, original = [0], Progress.update
+
+    def update(self: Progress, t: float, note: str = "") -> None:
+        calls[0] += 1
+        if calls[0] == 2:
+            raise KeyboardInterrupt
+        original(self, t, note)
+
+    monkeypatch.setattr(Progress, "update", update)
+    with pytest.raises(Interrupted) as info:
+        kv_run(kv_model, save=dc.SaveAt(times=STREAM_TIMES, stream_to=tmp_path / "run.h5"))
+    partial = dc.load(tmp_path / "run.h5")
+    assert not partial.success and "interrupted" in partial.message
+    assert 0 < partial.n_times < full.n_times and partial.t[-1] < 0.1316 < partial.t[-1] + T / 50
+    assert [e.kind for e in partial.sensitivities.events] == ["onset"] and partial.sensitivities.sides.t.size == 2
+    _same_sensitivities(partial, full, rows=partial.n_times)
+    _same_sensitivities(partial, info.value.result)
+
+
 def test_a_run_without_sensitivities_says_how_to_get_them(kv_model) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", dc.DaeclearWarning)
@@ -148,16 +215,13 @@ def test_a_scene_is_assembled_to_check_the_names(monkeypatch: pytest.MonkeyPatch
         dc.simulate(radial_scene(dcc.KelvinVoigt(stiffness=K, damping=D)), T, sensitivities=["clearance.stiffness"])
 
 
-def test_runs_that_cannot_carry_them_are_refused(kv_model, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+def test_runs_that_cannot_carry_them_are_refused(kv_model, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(driver, "run", _no_run)
     with pytest.raises(dc.SceneError, match=r"sensitivities=\['clearance.clearance'\], must be None with "
                                             r"method='RK45': only method='ida' carries sensitivities"):
         dc.simulate(kv_model, T, method="RK45", sensitivities=["clearance.clearance"])
     with pytest.raises(dc.SceneError, match=r"must be None when y0 is given"):
         dc.simulate(kv_model, T, y0=np.zeros(kv_model.n_states), sensitivities=["clearance.clearance"])
-    with pytest.raises(dc.SceneError, match=r"must be None with SaveAt\(stream_to=...\)"):
-        dc.simulate(kv_model, T, save=dc.SaveAt(stream_to=tmp_path / "run.h5"), sensitivities=["clearance.clearance"])
-    assert not (tmp_path / "run.h5").exists()
 
 
 def _no_run(*args: object, **keywords: object) -> None:
