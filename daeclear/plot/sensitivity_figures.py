@@ -4,13 +4,13 @@
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..core.options import fail, number
-from ..results.sensitivity_growth import finite_time_lyapunov, predictability_horizon
+from ..results.sensitivity_growth import SensitivityHorizon, finite_time_lyapunov, predictability_horizon
 from . import style
 
 if TYPE_CHECKING:  # matplotlib is imported only when a figure is drawn
@@ -19,13 +19,23 @@ if TYPE_CHECKING:  # matplotlib is imported only when a figure is drawn
 __all__ = ["plot_sensitivity_horizon"]
 
 
-def plot_sensitivity_horizon(t: ArrayLike, growth: ArrayLike, rtol: float, *, ax: Axes | None = None,
+def plot_sensitivity_horizon(t: ArrayLike | SensitivityHorizon | Any, growth: ArrayLike | None = None,
+                             rtol: float | None = None, *, ax: Axes | None = None,
                              label: str = "largest relative sensitivity") -> Axes:
     """The growth G(t) of a run's sensitivities (log scale; ``relative_growth`` of
     :mod:`daeclear.results.sensitivity_growth`) with its least-squares exponential (the finite-time Lyapunov
     estimate lambda, dashed), the level 1/rtol (errors of the run's ``rtol`` grown to 1) and the predictability
     horizon t0 + ln(1/rtol)/lambda (a vertical line, when it is finite). Returns the Axes (a new figure when
-    ``ax`` is None)."""
+    ``ax`` is None). ``t`` may be a run's Result with sensitivities or its ``sensitivity_horizon`` alone
+    (``growth`` and ``rtol`` then theirs)."""
+    given: Any = t.sensitivity_horizon if hasattr(t, "sensitivity_horizon") else t  # a Result: its horizon
+    if isinstance(given, SensitivityHorizon):
+        if growth is not None or rtol is not None:
+            fail("plot_sensitivity_horizon", "growth", growth, "None with a Result or a SensitivityHorizon (theirs)")
+        t, growth, rtol = given.t, given.growth, given.rtol
+    if growth is None or rtol is None:
+        fail("plot_sensitivity_horizon", "rtol" if growth is not None else "growth", rtol if growth is not None
+             else growth, "given with the times t (or pass a Result with sensitivities)")
     times, values = np.asarray(t, dtype=float), np.asarray(growth, dtype=float)
     if times.ndim != 1 or values.shape != times.shape or times.size < 2:
         fail("plot_sensitivity_horizon", "growth", f"shape {values.shape}", f"one value per time ({times.size} times)")

@@ -185,7 +185,8 @@ def _read(r: _Reader) -> dict[str, Any]:
             parameters_s, tuple(state_names), tuple(r.strings("sensitivities/channel_names")),
             r.array("sensitivities/states", points), r.array("sensitivities/channels", points),
             sensitivity_events([float(ev_t[i]) for i in inside], [pairs[i] for i in inside],
-                               [kinds[i] for i in inside], dt_dp[inside]), _sides(r))
+                               [kinds[i] for i in inside], dt_dp[inside]), _sides(r),
+            r.array("sensitivities/values") if r.has("sensitivities/values") else None)
     return dict(t=t, y=y, yp=yp, state_names=state_names, channels=channels, units=units, events=events,
                 sensitivities=sensitivities,
                 segments=segments, stats=r.json("stats_json"), success=bool(r.attr("success")),

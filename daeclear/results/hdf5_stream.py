@@ -91,13 +91,15 @@ class ResultWriter:
             f.close()
             raise
 
-    def sensitivities(self, names: Sequence[str], channel_names: Sequence[str]) -> None:
-        """Add the empty ``/sensitivities`` group of a run with sensitivities (docs/hdf5_layout.md), which
+    def sensitivities(self, names: Sequence[str], channel_names: Sequence[str], values: ArrayLike) -> None:
+        """Add the ``/sensitivities`` group of a run with sensitivities (docs/hdf5_layout.md; the parameters'
+        ``names`` and ``values``, the arrays empty), which
         :meth:`stage_sensitivities` fills as the run goes."""
         import h5py
 
         g = self._f.create_group("sensitivities")
         string_dataset(g, "names", list(names))
+        g.create_dataset("values", data=np.asarray(values, dtype=np.float64))
         string_dataset(g, "channel_names", list(channel_names))
         width, n_ch, text = len(names), len(channel_names), h5py.string_dtype()
         self._grow(g, "states", np.float64, (self._n, width))

@@ -159,6 +159,8 @@ def _write_sensitivities(group: h5py.Group, s: Sensitivities) -> None:
     """A run's forward sensitivities (``simulate(..., sensitivities=[...])``): names, S of the states and
     the channels at every output time, each event time's sensitivity, the rows at each event."""
     string_dataset(group, "names", s.names)
+    if s.values is not None:
+        _dataset(group, "values", np.asarray(s.values, dtype=np.float64))
     _dataset(group, "states", np.asarray(s.states, dtype=np.float64))
     string_dataset(group, "channel_names", s.channel_names)
     _dataset(group, "channels", np.asarray(s.channels, dtype=np.float64))

@@ -29,6 +29,7 @@ from .lazy_channels import LazyChannels
 from .result_checks import checked_fields
 from .objectives import Gradient, Objective, evaluate
 from .sensitivities import RunTrajectory, Sensitivities
+from .sensitivity_growth import SensitivityHorizon, sensitivity_horizon
 from ..core.values import readonly, time_window, to_plain
 
 if TYPE_CHECKING:  # h5py, pandas and xarray are imported lazily, only where they are used
@@ -237,6 +238,23 @@ class Result:
             raise KeyError("Result.sensitivity: this run has no sensitivities; run "
                            "simulate(..., sensitivities=[names from model.parameter_names]).")
         return self.sensitivities.of(name, parameter)
+
+    @property
+    def sensitivity_horizon(self) -> SensitivityHorizon:
+        """How fast the run's sensitivities grow: G(t), the largest |dy_i/dp_j| |p_j| / max|y_i| over the states
+        and parameters, its finite-time Lyapunov estimate (the slope of ln G) and the predictability horizon
+        t0 + ln(1/rtol)/lambda at the run's rtol, past which a derivative means nothing (docs/sensitivities.md,
+        "Chaos"). Drawn by ``daeclear.plot.plot_sensitivity_horizon(result)``."""
+        if self.sensitivities is None:
+            raise KeyError("Result.sensitivity_horizon: this run has no sensitivities; run "
+                           "simulate(..., sensitivities=[names from model.parameter_names]).")
+        s = self.sensitivities
+        rtol = float(self.parameters.get("simulate", {}).get("rtol", math.nan))
+        if not 0.0 < rtol < 1.0:
+            raise KeyError("Result.sensitivity_horizon: the result does not record its run's rtol "
+                           "(parameters['simulate']['rtol']).")
+        values = np.ones(len(s.names)) if s.values is None else s.values  # an older file: relative to 1
+        return sensitivity_horizon(self.t, self.y, s.states, values, rtol)
 
     def gradient(self, of: Objective) -> Gradient:
         """The objective ``of`` (``dc.Final``, ``dc.Integral``, ``dc.Peak``, ``dc.EventTime``) on this run and

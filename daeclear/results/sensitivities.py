@@ -49,7 +49,8 @@ class EventSides:
 class Sensitivities:
     """``names`` (the parameters), ``states`` (n_times, n_states, Ns) and ``channels`` (n_times,
     n_channels, Ns) in the order of ``state_names`` and ``channel_names``, ``events``; ``sides``: the rows
-    before and after each event (kept in the file too; None in a file written before they were)."""
+    before and after each event; ``values``: the parameters' values in the run (None in a file written
+    before either was kept)."""
 
     names: tuple[str, ...]
     state_names: tuple[str, ...]
@@ -58,6 +59,7 @@ class Sensitivities:
     channels: NDArray[np.float64]
     events: tuple[SensitivityEvent, ...] = ()
     sides: EventSides | None = None
+    values: NDArray[np.float64] | None = None
 
     def of(self, name: str, parameter: str | None = None) -> NDArray[np.float64]:
         """d(name)/d(parameter) at every output time, (n_times,); every parameter (n_times, Ns) without one."""
@@ -79,7 +81,7 @@ class Sensitivities:
         """The rows ``rows`` and the events in [lo, hi] (a window of the result)."""
         return Sensitivities(self.names, self.state_names, self.channel_names, self.states[rows],
                              self.channels[rows], tuple(e for e in self.events if lo <= e.t <= hi),
-                             None if self.sides is None else self.sides.within(lo, hi))
+                             None if self.sides is None else self.sides.within(lo, hi), self.values)
 
 
 def sensitivity_events(t: Sequence[float], pairs: Sequence[str], kinds: Sequence[str],

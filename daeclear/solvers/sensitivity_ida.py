@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from ..assembly.contact_state import ContactState
 from ..assembly.dae_model import DAEModel
-from ..assembly.sensitivity import initial_sensitivities
+from ..assembly.sensitivity import initial_sensitivities, parameter_value
 from ..core.automaton import PairState
 from ..engine.ida_session import open_session
 from ..engine.sensitivity_functions import augmented_functions
@@ -70,6 +70,7 @@ class SensitivityIntegrator:
         atol = tolerance_vector(model, rtol, settings.atol_value())
         self.sens = SensitivityCarrier(model, names, rtol, atol)
         self.names = self.sens.names
+        self.values = np.array([parameter_value(model, name) for name in self.names])  # the run's parameters
         W = self.sens.width
         pbar = parameter_scales(model, self.sens.names)
         self.stacked = open_session(
@@ -171,7 +172,7 @@ class SensitivityIntegrator:
         driver appends next), then dropped: the run's memory does not grow with its length."""
         c = self.sens
         if not self.streamed:
-            writer.sensitivities(c.names, self.model.channel_names)
+            writer.sensitivities(c.names, self.model.channel_names, self.values)
             self.streamed = True
         writer.stage_sensitivities(self.collected(min(len(c.rows_S), len(c.rows_channel_S))))
         for kept in (c.rows_t, c.rows_S, c.rows_channel_S, c.rows_channels, c.events, c.event_t, c.event_rows):
@@ -189,4 +190,4 @@ class SensitivityIntegrator:
             np.stack([row[i] for row in c.event_rows]) if k else np.zeros(empty)
             for i, empty in ((0, (0, model.n_states)), (3, (0, n_ch)), (1, shape[0]), (2, shape[1]))))
         return Sensitivities(c.names, tuple(model.state_names), tuple(model.channel_names),
-                             states, channels, tuple(c.events), sides)
+                             states, channels, tuple(c.events), sides, self.values)
