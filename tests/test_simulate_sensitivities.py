@@ -266,3 +266,36 @@ def test_slider_crank_clearance_by_its_taylor_remainder(formulation: str) -> Non
         assert np.linalg.norm(error[n // 2:]) < 0.01 * np.linalg.norm(h * S[n // 2:])
     ratios = np.array(remainders[:-1]) / np.array(remainders[1:])
     assert ratios == pytest.approx(4.0, rel=0.1), ratios
+
+
+def test_handed_to_pandas_and_xarray(kv_model) -> None:
+    """to_pandas(sensitivities=True): a column d(name)/d(parameter) per state or channel and parameter; to_xarray:
+    S over (t, state, parameter), each channel's over (t, parameter), the events' dt*/dp; both hold the closed
+    form's derivatives at T and the separation's."""
+    pytest.importorskip("pandas")
+    pytest.importorskip("xarray")
+    result = kv_run(kv_model, save=dc.SaveAt(times=[0.0, 0.05, T_CONTACT, T]))
+    want = complex_step(kelvin_voigt_radial, P0)  # rows x(T), vx(T), t_sep; columns K, D, z0
+    df = result.to_pandas(states=True, sensitivities=True)
+    for j, parameter in enumerate(NAMES):
+        column = df[f"d(journal.x)/d({parameter})"].to_numpy()
+        assert np.array_equal(column, result.sensitivity("journal.x", parameter))
+        assert column[-1] == pytest.approx(want[0, j], rel=1e-6)
+        assert np.array_equal(df[f"d(clearance.normal_force)/d({parameter})"].to_numpy(),
+                              result.sensitivity("clearance.normal_force", parameter))
+    assert df.attrs["units"]["d(journal.x)/d(clearance.clearance)"] == "m per unit of clearance.clearance"
+    assert not any(c.startswith("d(") for c in result.to_pandas().columns)
+    ds = result.to_xarray()
+    assert list(ds["parameter"].values) == NAMES and ds["parameter_value"].values == pytest.approx(P0, rel=1e-15)
+    vx = ds["sensitivity_y"].sel(state="journal.vx").values[-1]
+    assert vx == pytest.approx(want[1], rel=1e-6, abs=1e-9)
+    assert np.array_equal(ds["sensitivity_clearance.normal_force"].values, result.sensitivity("clearance.normal_force"))
+    assert list(ds["sensitivity_event_kind"].values) == ["onset", "separation"]
+    assert ds["sensitivity_event_dt_dp"].values[1] == pytest.approx(want[2], rel=1e-6)
+    assert "sensitivity_y" not in result.to_xarray(sensitivities=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", dc.DaeclearWarning)
+        plain = dc.simulate(kv_model, 0.01, options=dc.SolverOptions(start="declared"))
+    assert "parameter" not in plain.to_xarray().coords
+    with pytest.raises(dc.SceneError, match=r"Result.to_pandas: sensitivities=True, must be False for a run without"):
+        plain.to_pandas(sensitivities=True)

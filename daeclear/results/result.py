@@ -475,16 +475,17 @@ class Result:
 
     # ------------------------------------------------------------------ hand-off to pandas and xarray
 
-    def to_pandas(self, *, states: bool = False) -> pd.DataFrame:
+    def to_pandas(self, *, states: bool = False, sensitivities: bool = False) -> pd.DataFrame:
         """The channels as a pandas DataFrame (copies), one column per channel, indexed by time ``"t"``.
 
         An event time may appear twice (before and after a restart); a channel of shape (n_times, k)
         becomes the columns ``"name[0]"`` ... ``"name[k-1]"``; ``states=True`` adds the states that
         are not channels. ``df.attrs`` holds ``"units"`` (per column and ``"t"``), scene_name, method,
-        formulation, success, status and message. MissingDependencyError (an ImportError) without
-        pandas: ``pip install "daeclear[data]"``.
+        formulation, success, status and message. ``sensitivities=True`` (a run with them) adds the column
+        ``"d(name)/d(parameter)"`` of each channel (and state) and parameter. MissingDependencyError (an
+        ImportError) without pandas: ``pip install "daeclear[data]"``.
         """
-        return export.to_pandas(self, states=states)
+        return export.to_pandas(self, states=states, sensitivities=sensitivities)
 
     def events_frame(self, *, states: bool = False) -> pd.DataFrame:
         """The contact events as a pandas DataFrame in time order: ``t`` (s), ``pair``, ``kind`` and
@@ -492,7 +493,7 @@ class Result:
         ``df.attrs["units"]``. MissingDependencyError (an ImportError) without pandas."""
         return export.events_frame(self, states=states)
 
-    def to_xarray(self, *, states: bool = True) -> xr.Dataset:
+    def to_xarray(self, *, states: bool = True, sensitivities: bool = True) -> xr.Dataset:
         """The result as an xarray Dataset: channels over ``t``, events over ``event``.
 
         Each channel is a variable over ``t`` (more dimensions named ``"<channel>_dim_1"``, ...) with
@@ -501,10 +502,13 @@ class Result:
         ``event_y`` with states) over ``event``; the segments ``segment_t_start``, ``segment_t_end``,
         ``segment_modes`` (JSON) over ``segment``. Attributes are netCDF-safe (success as 0/1, each
         scalar statistic as ``stats.<name>``, ``stats_json``, ``parameters_json``). ``states=True``
-        adds ``y`` and ``yp`` over (``t``, ``state``). MissingDependencyError (an ImportError) without
-        xarray: ``pip install "daeclear[data]"``.
+        adds ``y`` and ``yp`` over (``t``, ``state``). A run with sensitivities (``sensitivities=True``) adds
+        ``sensitivity_<channel>`` over (``t``, ``parameter``), with states ``sensitivity_y`` over (``t``, ``state``,
+        ``parameter``), and its events' ``sensitivity_event_t``, ``_pair``, ``_kind``, ``_dt_dp``; coordinates
+        ``parameter`` and ``parameter_value``. MissingDependencyError (an ImportError) without xarray:
+        ``pip install "daeclear[data]"``.
         """
-        return export.to_xarray(self, states=states)
+        return export.to_xarray(self, states=states, sensitivities=sensitivities)
 
     # ------------------------------------------------------------------ HDF5
 
