@@ -3,7 +3,7 @@
     python benchmarks/compare_outputs.py OLD NEW [--examples revolute_fig4_15 ...] [--rtol 1e-10]
 
 OLD and NEW are two checkouts (e.g. ``git worktree add /tmp/base <rev>`` and this one). Every example
-script of NEW's ``examples/`` (or those named) runs with ``--quick`` in each tree's own package and its
+script of NEW's ``examples/`` that takes ``--quick`` (or those named) runs with it in each tree's own package and its
 own copy of the script, each in a fresh working folder (``--out`` into it where the script takes one) with
 its own fresh compile cache.
 Then every ``.h5`` file both wrote is read back by each tree's own ``daeclear.load`` (in its own
@@ -94,6 +94,15 @@ def equal(a: np.ndarray, b: np.ndarray, rtol: float = 0.0) -> bool:
     return a.shape == b.shape and bool(np.array_equal(a, b))
 
 
+def takes_quick(tree: Path, script: Path) -> bool:
+    """Whether the example script of ``tree`` lists ``--quick`` in its help (the others write figures or
+    animations only)."""
+    env = {**os.environ, "PYTHONPATH": f"{tree}{os.pathsep}{tree / 'examples'}", "MPLBACKEND": "Agg"}
+    done = subprocess.run([sys.executable, str(script), "--help"], env=env, capture_output=True, text=True,
+                          check=False)
+    return "--quick" in done.stdout
+
+
 def run_example(tree: Path, script: Path, folder: Path, cache: Path) -> bool:
     """``script`` of ``tree`` with --quick in ``folder`` (its --out there), libraries built into ``cache``;
     whether it exited 0."""
@@ -163,6 +172,9 @@ def main() -> int:
             script = new / "examples" / f"{name}.py"
             if not (old / "examples" / script.name).is_file():
                 print(f"{name}: not in {old} (an example of the new tree alone)")
+                continue
+            if not takes_quick(new, script):
+                print(f"{name}: skipped (takes no --quick: a figure or animation only)")
                 continue
             folders = {tree: Path(tmp) / f"{label}-{name}" for label, tree in (("old", old), ("new", new))}
             ran = True

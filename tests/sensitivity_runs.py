@@ -1,8 +1,9 @@
 """A run with forward sensitivities through ``dc.simulate(..., sensitivities=...)`` as the sensitivity tests read
 it (what the reference run of the stacked [y; S] gave them before the run driver carried sensitivities): the
 times, states, S of states and channels, the events with their dt*/dp, and a run without the jumps (the
-driver's carrier with ``jumps=False``: S carried through each event as it is, the latched values' dt*/dp
-term dropped), a wrong answer that shows the tests see the jumps.
+carrier's jump formulas replaced: S carried through each event as it is, the latched values' dt*/dp
+term dropped), a wrong answer that shows the tests see the jumps. The run without them is a test double: the
+carrier's two jump formulas replaced for the run's duration, the production code left with no switch.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-from daeclear.solvers.sensitivity_ida import SensitivityIntegrator
+from daeclear.solvers import sensitivity_carrier
 
 
 class StackedRun:
@@ -43,13 +44,14 @@ def forward_sensitivities(model: dc.DAEModel, t_end: float, names: Sequence[str]
     with pytest.MonkeyPatch.context() as patch, warnings.catch_warnings():
         warnings.simplefilter("ignore", dc.DaeclearWarning)  # the runs' physics notes, atol at round-off
         if not jumps:
-            original = SensitivityIntegrator.__init__
+            latched = sensitivity_carrier.latched_sensitivity
 
-            def without_jumps(self: SensitivityIntegrator, *args: object, **keywords: object) -> None:
-                original(self, *args, **keywords)  # type: ignore[arg-type]
-                self.sens.jumps = False
+            def latched_without_dt(rate_p: np.ndarray, rate_rate: float, dt_dp: np.ndarray, *,
+                                   floored: bool) -> np.ndarray:
+                return latched(rate_p, rate_rate, np.zeros_like(dt_dp), floored=floored)
 
-            patch.setattr(SensitivityIntegrator, "__init__", without_jumps)
+            patch.setattr(sensitivity_carrier, "state_jump", lambda S_m, *rest: S_m)
+            patch.setattr(sensitivity_carrier, "latched_sensitivity", latched_without_dt)
         result = dc.simulate(model, t_end, rtol=rtol, options=dc.SolverOptions(start=start, backend=backend),
                              save=dc.SaveAt(times=times, steps=False), sensitivities=list(names),
                              on_failure="return")

@@ -387,18 +387,21 @@ def test_event_blocks_read_as_the_events_they_hold() -> None:
     assert rec.n_events == 4
 
 
-def test_event_from_solver_equals_the_checked_constructor() -> None:
-    """The contact logic's fast path builds the same event as the constructor: equal fields, a
+def test_events_of_the_compiled_loop_equal_the_checked_constructor() -> None:
+    """The compiled loop's columns of events make the same events as the constructor: equal fields, a
     float time and speed, and a state that cannot be changed through the event."""
-    y = np.array([1.0, 2.0, 3.0])
-    fast = ContactEvent.from_solver(np.float64(0.25), "C", "onset", np.float64(0.5), y.copy())
-    checked = ContactEvent(t=0.25, pair="C", kind="onset", approach_speed=0.5, y=y)
-    assert fast == checked and repr(fast) == repr(checked)
-    assert type(fast.t) is float and type(fast.approach_speed) is float
+    from daeclear.core.events import EventRows
+
+    y = np.array([[1.0, 2.0, 3.0]])
+    y.flags.writeable = False
+    (made,) = EventRows([np.float64(0.25)], ["C"], ["onset"], [np.float64(0.5)], y)
+    checked = ContactEvent(t=0.25, pair="C", kind="onset", approach_speed=0.5, y=y[0].copy())
+    assert made == checked and repr(made) == repr(checked)
+    assert type(made.t) is float and type(made.approach_speed) is float
     with pytest.raises(ValueError, match="read-only"):
-        fast.y[0] = 9.0
+        made.y[0] = 9.0
     with pytest.raises(AttributeError):
-        fast.t = 1.0  # type: ignore[misc]
+        made.t = 1.0  # type: ignore[misc]
 
 
 def test_result_events_of_pair() -> None:

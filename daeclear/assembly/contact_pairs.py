@@ -141,7 +141,7 @@ def pair_event(pair: str, t: float, y: NDArray, rate: float, decision: Decision)
     """The event a pair's decision makes (none for NONE)."""
     if decision.kind == NONE:
         return []
-    return [ContactEvent.from_solver(t, pair, EVENT_KINDS[decision.kind], rate, np.array(y, dtype=float))]
+    return [ContactEvent(t, pair, EVENT_KINDS[decision.kind], rate, np.array(y, dtype=float))]
 
 
 @dataclass(frozen=True)

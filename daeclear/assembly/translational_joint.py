@@ -105,7 +105,7 @@ class SliderGuideLogic(PairLogic):
             if on != was:
                 a, b = self.face_corners[f]
                 speed = 0.5 * (after[a].latched + after[b].latched) if on else float("nan")
-                events.append(ContactEvent.from_solver(t, self.face_names[f], "onset" if on else "separation", speed,
+                events.append(ContactEvent(t, self.face_names[f], "onset" if on else "separation", speed,
                                                        np.array(y, dtype=float)))
         return after, events
 

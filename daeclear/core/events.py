@@ -17,7 +17,7 @@ from .values import readonly
 __all__ = ["EVENT_KINDS", "ContactEvent", "EventKind", "EventList", "EventRows", "flatten"]
 
 EventKind = Literal["onset", "separation"]
-EVENT_KINDS: tuple[str, ...] = ("onset", "separation")
+EVENT_KINDS: tuple[EventKind, ...] = ("onset", "separation")
 
 
 def _same_float(a: float, b: float) -> bool:
@@ -63,24 +63,6 @@ class ContactEvent:
         object.__setattr__(self, "approach_speed", float(self.approach_speed))
         object.__setattr__(self, "y", readonly(y))
 
-    @classmethod
-    def from_solver(cls, t: float, pair: str, kind: str, approach_speed: float,
-                    y: NDArray[np.float64]) -> ContactEvent:
-        """An event the contact logic records at every switch, without the checks of the constructor:
-        ``kind`` is one of EVENT_KINDS and ``y`` a 1-D float64 state the event may own (made read-only)."""
-        y.flags.writeable = False
-        return cls.of_readonly_row(float(t), pair, kind, float(approach_speed), y)
-
-    @classmethod
-    def of_readonly_row(cls, t: float, pair: str, kind: str, approach_speed: float,
-                        y: NDArray[np.float64]) -> ContactEvent:
-        """:meth:`from_solver` for floats and a read-only row (of a block made read-only once: the
-        compiled loop's tens of events a run, half the time of setting each row's flags)."""
-        event = object.__new__(cls)
-        object.__setattr__(event, "__dict__", {"t": t, "pair": pair, "kind": kind, "approach_speed": approach_speed,
-                                               "y": y})
-        return event
-
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, ContactEvent):
             return NotImplemented
@@ -101,14 +83,14 @@ class EventRows(Sequence[ContactEvent]):
 
     __slots__ = ("_columns", "_made")
 
-    def __init__(self, t: list[float], pair: list[str], kind: list[str], approach_speed: list[float],
+    def __init__(self, t: list[float], pair: list[str], kind: list[EventKind], approach_speed: list[float],
                  y: NDArray[np.float64]) -> None:
         self._columns = (t, pair, kind, approach_speed, y)
         self._made: tuple[ContactEvent, ...] | None = None
 
     def _events(self) -> tuple[ContactEvent, ...]:
         if self._made is None:
-            self._made = tuple(map(ContactEvent.of_readonly_row, *self._columns))
+            self._made = tuple(map(ContactEvent, *self._columns))
         return self._made
 
     def __len__(self) -> int:

@@ -36,14 +36,12 @@ def parameter_scales(model: DAEModel, names: Sequence[str]) -> NDArray[np.float6
 
 class SensitivityCarrier:
     """S of one run between events: its contact mode, the latched values' sensitivities, the poisoned
-    parameters; the rows and events it gave (``rows_t``, ``rows_S``, ``rows_channel_S``, ``events``).
-    ``jumps=False`` leaves the jumps out (a wrong answer, kept to show that tests see the jump)."""
+    parameters; the rows and events it gave (``rows_t``, ``rows_S``, ``rows_channel_S``, ``events``)."""
 
-    def __init__(self, model: DAEModel, names: Sequence[str], rtol: float, atol: NDArray, *,
-                 jumps: bool = True) -> None:
+    def __init__(self, model: DAEModel, names: Sequence[str], rtol: float, atol: NDArray) -> None:
         self.ms = ModelSensitivity(model, names)
         self.model, self.names, self.width = model, self.ms.names, self.ms.width
-        self.rtol, self.atol, self.jumps = rtol, atol, jumps
+        self.rtol, self.atol = rtol, atol
         self.differential = np.array([kind != KIND_MULTIPLIER for kind in model.state_kinds])
         self.state: contact_state.ContactState = ()
         self.active: list[bool] = []
@@ -162,13 +160,13 @@ class SensitivityCarrier:
                     if e.kind == "onset" and logic.needs_approach and logic.pair_name(root) == e.pair:
                         speed, rate_p, rate_rate = ms.approach_rate(root, y_m, yp_m, S_m)
                         new_latched[i][logic.pair_index(root)] = latched_sensitivity(
-                            rate_p, rate_rate, dt if self.jumps else np.zeros(W),
+                            rate_p, rate_rate, dt,
                             floored=speed <= logic.min_approach_speed)
                 self.events.append(SensitivityEvent(t, e.pair, e.kind, dt_dps[-len(owners)]))
         dt_dp = np.zeros(W)
         if dt_dps:
             dt_dp = dt_dps[0] if same_event_times(dt_dps, rtol) else np.full(W, np.nan)
-        S_p = state_jump(S_m, yp_m, yp_p, dt_dp, self.differential) if self.jumps else S_m
+        S_p = state_jump(S_m, yp_m, yp_p, dt_dp, self.differential)
         if projected:
             S_p = ms.projected(t, y_p, S_p)
         self.latched = new_latched
