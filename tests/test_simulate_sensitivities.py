@@ -361,3 +361,68 @@ def test_output_times_at_the_events_report_the_row_before_the_switch(kv_model) -
     assert r.sensitivity("journal.x")[-1] == pytest.approx(complex_step(kelvin_voigt_radial, P0)[0], rel=1e-6)
     for of in (dc.EventTime("clearance", "separation"), dc.Final("journal.vx")):
         assert r.gradient(of).gradient == pytest.approx(first.gradient(of).gradient, rel=1e-9, abs=1e-12)
+
+
+def _worn_scene() -> dc.Scene:
+    """A free journal flying obliquely (0.5 rad) under gravity into a bearing whose worn profile has 4 modes
+    (unworn: every mode 0), Lankarani-Nikravesh: one impact and its separation."""
+    from daeclear.contact.wear import ArchardWear
+
+    scene = dc.Scene("worn", gravity=(0.0, -2.0))
+    journal = scene.add(dc.Body("journal", mass=1.0, inertia=1.0, velocity=(np.cos(0.5), np.sin(0.5))))
+    scene.add(dc.RevoluteClearance("clearance", scene.ground, journal, at=(0, 0), bearing_radius=1.0, clearance=0.1,
+                                   law=dcc.LankaraniNikravesh(restitution=0.8, stiffness=1e7),
+                                   wear=ArchardWear(coefficient=1e-12, length=0.02, nodes=36, modes=4)))
+    return scene
+
+
+@pytest.mark.parametrize("name", ["clearance.wear.bearing_cos[1]", "clearance.wear.bearing_sin[1]"])
+def test_a_worn_profile_mode_by_its_taylor_remainder(name: str) -> None:
+    """A worn profile's mode (element k of the parameter table's vector entry, "<key>[k]") as a sensitivity
+    parameter: d(position and velocity at T)/d(mode) against separate runs at rtol 1e-12 with the mode moved by h
+    (4, 2, 1, 0.5 mm of depth): the first-order prediction's error quarters when h halves, the same events."""
+    from daeclear.assembly.sensitivity import moved_parameter
+
+    model, t_end = dc.assemble(_worn_scene()), 0.2
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", dc.DaeclearWarning)
+        result = dc.simulate(model, t_end, rtol=1e-10, options=dc.SolverOptions(start="declared"),
+                             save=dc.SaveAt(times=[0.0, t_end]), sensitivities=[name])
+    assert [e.kind for e in result.sensitivities.events] == ["onset", "separation"]
+    assert result.sensitivities.values.tolist() == [0.0]  # unworn
+    S = result.sensitivities.states[-1, :6, 0]
+
+    def final(value: float) -> np.ndarray:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", dc.DaeclearWarning)
+            run = dc.simulate(moved_parameter(model, name, value), t_end, rtol=1e-12, save=dc.SaveAt(
+                times=[0.0, t_end], steps=False), options=dc.SolverOptions(start="declared"))
+        assert len(run.events) == 2
+        return run.y[-1, :6]
+
+    base = final(0.0)
+    remainders = []
+    for h in (4e-3, 2e-3, 1e-3, 5e-4):
+        error = final(h) - base - h * S
+        remainders.append([np.linalg.norm(error[:3]), np.linalg.norm(error[3:])])
+    assert remainders[-1][1] < 0.02 * np.linalg.norm(5e-4 * S[3:])
+    ratios = np.array(remainders[:-1]) / np.array(remainders[1:])
+    assert ratios == pytest.approx(4.0, rel=0.1), ratios
+
+
+def test_a_worn_profile_mode_moves_the_onset_as_the_clearance() -> None:
+    """Flying along x the journal meets the bearing at angle 0, where a cos mode adds its own value to the gap
+    and a sine mode nothing: dt_onset/d(cos_k) = dt_onset/dc = 1/u, dt_onset/d(sin_k) = 0; an element beyond the
+    entry's size is refused before any run, naming the entry form."""
+    from daeclear.contact.wear import ArchardWear
+
+    scene = radial_scene(dcc.LankaraniNikravesh(restitution=0.8, stiffness=1e7)).with_values(
+        {"clearance.wear": ArchardWear(coefficient=1e-12, length=0.02, nodes=36, modes=4)})
+    names = ["clearance.clearance", "clearance.wear.bearing_cos[0]", "clearance.wear.bearing_cos[2]",
+             "clearance.wear.bearing_sin[1]"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", dc.DaeclearWarning)
+        r = dc.simulate(scene, 0.11, rtol=1e-10, options=dc.SolverOptions(start="declared"), sensitivities=names)
+    assert r.sensitivities.events[0].dt_dp == pytest.approx([1.0, 1.0, 1.0, 0.0], rel=1e-9, abs=1e-9)
+    with pytest.raises(dc.SceneError, match=r"sensitivities='clearance.wear.bearing_cos\[9\]', must be one of"):
+        dc.simulate(scene, 0.11, sensitivities=["clearance.wear.bearing_cos[9]"])

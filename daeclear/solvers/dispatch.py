@@ -18,7 +18,7 @@ from .base import Solver
 from .registry import solver_class
 from .ida import IDA
 from .sensitivity_ida import SensitivityIDA
-from ..assembly.sensitivity import parameter_value
+from ..assembly.sensitivity import parameter_value, table_entry
 
 DEFAULTS = SolverOptions()
 
@@ -148,10 +148,11 @@ def checked_sensitivities(value: object, solver: Solver, y0: object) -> list[str
 
 
 def parameter_names(model: DAEModel, names: list[str]) -> None:
-    """Each name one of ``model.parameter_names`` and one finite number (SceneError naming it otherwise)."""
+    """Each name one of ``model.parameter_names`` (or an element ``"<key>[k]"`` of a vector entry of the parameter
+    table, a worn profile's mode) and one finite number (SceneError naming it otherwise)."""
     known = model.parameter_names
     for name in names:
-        if name not in known:
+        if name not in known and table_entry(model, name) is None:
             close = opts.close_matches(name, known)
             hint = f"close matches: {', '.join(map(repr, close))}" if close else (
                 f"e.g. {', '.join(map(repr, list(known)[:4]))}")
