@@ -84,14 +84,15 @@ class CSession(SessionBase):
         self._clib = clib
         self._lib = clib.lib
         self._build = build
-        self._linear_solver = _resolve_linear_solver(opts.linear_solver, n, clib.build_info.has_sparse,
+        self._nj = model.n_jac  # the iteration matrix's size (n / blocks: the stacked sensitivities')
+        self._linear_solver = _resolve_linear_solver(opts.linear_solver, self._nj, clib.build_info.has_sparse,
                                                      clib.sparse_plan[0])
         hd = take_pooled(self._pool_key(), opts)
         if hd is None:
             hd = self._open(opts, n, nr)  # "auto" may fall back from the sparse LU to the reduced one
         self._hd = hd
         self._h, self._jac_nnz, self._cap, self._cap_times = hd.h, hd.jac_nnz, hd.cap, hd.cap_times
-        self._st, self._sy, self._syp, self._sh, self._sord = hd.st, hd.sy, hd.syp, hd.sh, hd.sord
+        self._st, self._sh, self._sord = hd.st, hd.sh, hd.sord
         self._yout, self._ypout, self._roots, self._statbuf = hd.yout, hd.ypout, hd.roots, hd.statbuf
         self._i_eval, self._n_stored, self._t_out, self._flag = hd.i_eval, hd.n_stored, hd.t_out, hd.flag
         self._y0b, self._yp0b, self._actb, self._rdb, self._pcat = hd.y0b, hd.yp0b, hd.actb, hd.rdb, hd.pcat
@@ -200,6 +201,15 @@ class CSession(SessionBase):
                                  recent=tuple(recent[offset:offset + n_recent[p]].tolist())))
             offset += storm.events
         return out
+
+    def set_kinematic_rows(self, n_kinematic: int) -> bool:
+        """The reduced solver's eliminated position rows without a state layout (the stacked
+        sensitivities' session factors the state's iteration matrix as the state's run does)."""
+        self._check_open()
+        if self._lib.dc_set_kinematic_rows(self._h, int(n_kinematic)) != 0:
+            raise DaeclearError(f"set_kinematic_rows: n_kinematic={n_kinematic!r}, must be >= 0 and below the "
+                                f"iteration matrix's {self._nj} rows.")
+        return True
 
     def set_layout(self, layout: StateLayout) -> bool:
         """The model's state layout and extras, so that C makes states consistent itself: restarts
@@ -380,9 +390,6 @@ class CSession(SessionBase):
         chunks: list[tuple[Any, ...]] = []  # step times, y, yp (None unless store_yp), sizes, orders
         auto_events: list[AutoEvents] = []
         store = (STORE_TIMES | (STORE_STATES if store_states else 0)) if store_steps else 0
-        if store & STORE_STATES and self._sy is None:  # kept by the handle for the sessions after this one
-            self._sy, self._syp = self._hd.sy, self._hd.syp = np.empty((self._cap, n)), np.empty((self._cap, n))
-            A["sy"], A["syp"] = address(self._sy), address(self._syp)
         # times only: the long buffers; without any steps cap counts IDA calls (a streamed run hands
         # its events over every buffer_steps calls, so its memory does not grow with its length)
         cap = self._cap_times if store == STORE_TIMES else self._cap
@@ -391,15 +398,16 @@ class CSession(SessionBase):
         interrupted = False
         try:
             while True:
+                sy, syp = self._state_buffers(store & STORE_STATES, store_yp)
+                sy_p, syp_p = (None if b is None else address(b) for b in (sy, syp))
                 rc = lib.dc_advance(h, t_stop, te_p, m, A["i_eval"], evy_p, evyp_p,
-                                    store, cap, A["st"], A["sy"], A["syp"], A["sh"], A["sord"],
+                                    store, cap, A["st"], sy_p, syp_p, A["sh"], A["sord"],
                                     A["n_stored"], A["t_out"], A["yout"], A["ypout"], A["roots"],
                                     A["flag"])
                 k = self._n_stored.value
+                states = (self._state_rows(sy, k, "sy"), self._state_rows(syp, k, "syp")) if sy is not None \
+                    else (np.empty((0, n)), np.empty((0, n)) if store_yp else None)
                 if k:
-                    sy, syp = self._sy, self._syp
-                    states = (sy[:k].copy(), syp[:k].copy() if store_yp else None) \
-                        if sy is not None and syp is not None and store_states else (np.empty((0, n)),) * 2
                     chunks.append((self._st[:k].copy(), *states, self._sh[:k].copy(), self._sord[:k].copy()))
                 taken = self._take_auto_events()  # drained at every chunk: the C buffer never overflows
                 if taken is not None:
@@ -456,6 +464,28 @@ class CSession(SessionBase):
         adv.message = msg
         return adv
 
+    def _state_buffers(self, states: int, store_yp: bool) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """The buffers the next dc_advance writes the steps' y (and yp when ``store_yp``) into: the handle's
+        spare ones, else new ones (the C loop writes each row once; :meth:`_state_rows` hands them on)."""
+        if not states:
+            return None, None
+        hd, shape = self._hd, (self._cap, self._n)
+        sy = hd.sy if hd.sy is not None else np.empty(shape)
+        syp = (hd.syp if hd.syp is not None else np.empty(shape)) if store_yp else None
+        hd.sy = hd.syp = None  # taken; given back by _state_rows when only a few rows were written
+        return sy, syp
+
+    def _state_rows(self, buf: np.ndarray | None, k: int, spare: str) -> np.ndarray | None:
+        """The ``k`` rows the C loop wrote into ``buf``: a view of it when they fill half of it or more (no
+        copy: the buffer is the rows' now), else a copy, and the buffer kept for the next call (so a view
+        never holds more than twice its rows' memory)."""
+        if buf is None:
+            return None
+        if k and 2 * k >= buf.shape[0]:
+            return buf[:k]
+        setattr(self._hd, spare, buf)
+        return buf[:k].copy()
+
     # ---------------------------------------------------------------- model evaluation
     def residual(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
         self._check_open()
@@ -473,7 +503,7 @@ class CSession(SessionBase):
         inactive terms), whatever the session's linear solver."""
         self._check_open()
         y, yp = self._vec(y, "y"), self._vec(yp, "yp")
-        colptr = np.empty(self._n + 1, dtype=np.int64)
+        colptr = np.empty(self._nj + 1, dtype=np.int64)
         rowind = np.empty(max(self._jac_nnz, 1), dtype=np.int64)
         data = np.empty(max(self._jac_nnz, 1))
         self._lib.dc_jac_pattern(self._h, colptr.ctypes.data, rowind.ctypes.data)
@@ -486,7 +516,7 @@ class CSession(SessionBase):
     def jacobian(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray:
         self._check_open()
         y, yp = self._vec(y, "y"), self._vec(yp, "yp")
-        out = np.empty((self._n, self._n), order="F")
+        out = np.empty((self._nj, self._nj), order="F")
         self._sync_terms()
         if self._lib.dc_eval_jacobian(self._h, float(t), y.ctypes.data, yp.ctypes.data, float(cj),
                                       out.ctypes.data):
@@ -503,11 +533,12 @@ class CSession(SessionBase):
         self._check_open()
         y, yp = self._vec(y, "y"), self._vec(yp, "yp")
         B = np.array(b, dtype=float, order="F")
-        if B.shape[0] != self._n or B.ndim > 2:
-            raise ValueError(f"solve_linear: b has shape {B.shape}, must be ({self._n},) or ({self._n}, k)")
+        nj = self._nj
+        if B.shape[0] != nj or B.ndim > 2:
+            raise ValueError(f"solve_linear: b has shape {B.shape}, must be ({nj},) or ({nj}, k)")
         A = None if matrix is None else np.asfortranarray(matrix, dtype=float)
-        if A is not None and A.shape != (self._n, self._n):
-            raise ValueError(f"solve_linear: matrix has shape {A.shape}, must be ({self._n}, {self._n})")
+        if A is not None and A.shape != (nj, nj):
+            raise ValueError(f"solve_linear: matrix has shape {A.shape}, must be ({nj}, {nj})")
         if solver not in ("dense", "reduced", "sparse"):
             raise ValueError(f"solve_linear: solver={solver!r}, must be 'dense', 'reduced' or 'sparse'")
         self._sync_terms()

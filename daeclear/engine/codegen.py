@@ -47,8 +47,8 @@ CFLAGS = (f"-DDC_ABI_VERSION={DRIVER_ABI}", "-O2", "-fPIC", "-shared", "-fvisibi
 class NormalizedModel:
     """The model's functions with column-vector inputs, the run-time parameters ``P`` last.
 
-    Signatures (sizes): ``res (1, n, n, n_P) -> n``; ``jac (1, n, n, 1, n_P) -> n x n``;
-    ``term_res[k] (1, n, n, p_k, n_P) -> n``; ``term_jac[k] (1, n, n, p_k, 1, n_P) -> n x n``;
+    Signatures (sizes, nj = n / blocks): ``res (1, n, n, n_P) -> n``; ``jac (1, n, n, 1, n_P) -> nj x nj``;
+    ``term_res[k] (1, n, n, p_k, n_P) -> n``; ``term_jac[k] (1, n, n, p_k, 1, n_P) -> nj x nj``;
     ``roots (1, n, n, n_P) -> n_roots`` or None; ``extras[k] (..., n_P) -> vector``. The residual and
     the roots have dense outputs; the others keep their sparsity (the generated code grows with the
     nonzeros, not with n^2)."""
@@ -64,6 +64,14 @@ class NormalizedModel:
     n_roots: int
     extras: tuple[casadi.Function, ...] = ()
     n_parameters: int = 0
+    blocks: int = 1  # the Newton matrix: blocks diagonal copies of the nj x nj iteration matrix
+    cpl: casadi.Function | None = None  # (1, n, n, 1, n_P, nj) -> n - nj: the blocks below, times dy0
+    term_cpl: tuple[casadi.Function, ...] = ()  # (1, n, n, p_k, 1, n_P, nj) -> n - nj
+
+    @property
+    def n_jac(self) -> int:
+        """The iteration matrix's size nj = n / blocks."""
+        return self.n // self.blocks
 
 
 def densified(f: casadi.Function) -> casadi.Function:
@@ -130,22 +138,26 @@ def normalize_model(funcs: Any) -> NormalizedModel:
     if n < 1:
         raise AssemblyError(f"DAEFunctions.n must be >= 1, got {n}")
     n_P = int(getattr(funcs, "n_parameters", 0))
+    blocks = int(getattr(funcs, "blocks", 1))
+    if blocks < 1 or n % blocks:
+        raise AssemblyError(f"DAEFunctions.blocks={blocks}, must be an integer >= 1 dividing n={n}")
+    nj = n // blocks
     residual = _with_parameters(funcs.residual, 3, n_P)
     jacobian = _with_parameters(funcs.jacobian, 4, n_P)
     _check(residual, "residual", [1, n, n, n_P], n)
-    _check(jacobian, "jacobian", [1, n, n, 1, n_P], n * n)
+    _check(jacobian, "jacobian", [1, n, n, 1, n_P], nj * nj)
     if len(funcs.term_residuals) != len(funcs.term_jacobians):
         raise AssemblyError(f"{len(funcs.term_residuals)} term residuals but {len(funcs.term_jacobians)} "
                             "term Jacobians")
     res = _wrap(residual, "dc_res", [1, n, n, n_P], (n, 1))
-    jac = _wrap(jacobian, "dc_jac", [1, n, n, 1, n_P], (n, n), keep_sparsity=True)
+    jac = _wrap(jacobian, "dc_jac", [1, n, n, 1, n_P], (nj, nj), keep_sparsity=True)
     tres, tjac, n_params = [], [], []
     for k, (fr, fj) in enumerate(zip(funcs.term_residuals, funcs.term_jacobians)):
         fr, fj = _with_parameters(fr, 4, n_P), _with_parameters(fj, 5, n_P)
         p = _check(fr, f"term_residuals[{k}]", [1, n, n, None, n_P], n)[3]
-        _check(fj, f"term_jacobians[{k}]", [1, n, n, p, 1, n_P], n * n)
+        _check(fj, f"term_jacobians[{k}]", [1, n, n, p, 1, n_P], nj * nj)
         tres.append(_wrap(fr, f"dc_term{k}_res", [1, n, n, p, n_P], (n, 1), keep_sparsity=True))
-        tjac.append(_wrap(fj, f"dc_term{k}_jac", [1, n, n, p, 1, n_P], (n, n), keep_sparsity=True))
+        tjac.append(_wrap(fj, f"dc_term{k}_jac", [1, n, n, p, 1, n_P], (nj, nj), keep_sparsity=True))
         n_params.append(p)
     roots = None
     n_roots = 0
@@ -163,8 +175,19 @@ def normalize_model(funcs: Any) -> NormalizedModel:
         if sizes[-1] != n_P:
             raise AssemblyError(f"extras[{k}] ({f.name()}) must take the {n_P} run-time parameters as its last input")
         extras.append(_wrap(f, f"dc_extra{k}", sizes, (f.numel_out(0), 1), keep_sparsity=True))
+    cpl, tcpl = None, []
+    coupling = getattr(funcs, "coupling", None)
+    if coupling is not None:
+        if blocks == 1 or len(funcs.term_couplings) != len(n_params):
+            raise AssemblyError(f"DAEFunctions.coupling needs blocks > 1 (blocks={blocks}) and one term coupling "
+                                f"per term ({len(funcs.term_couplings)} for {len(n_params)} terms)")
+        _check(coupling, "coupling", [1, n, n, 1, n_P, nj], n - nj)
+        cpl = _wrap(coupling, "dc_cpl", [1, n, n, 1, n_P, nj], (n - nj, 1))
+        for k, (fc, p) in enumerate(zip(funcs.term_couplings, n_params)):
+            _check(fc, f"term_couplings[{k}]", [1, n, n, p, 1, n_P, nj], n - nj)
+            tcpl.append(_wrap(fc, f"dc_term{k}_cpl", [1, n, n, p, 1, n_P, nj], (n - nj, 1)))
     return NormalizedModel(n, str(getattr(funcs, "name", "model")), res, jac, tuple(tres), tuple(tjac), roots,
-                           tuple(n_params), n_roots, tuple(extras), n_P)
+                           tuple(n_params), n_roots, tuple(extras), n_P, blocks, cpl, tuple(tcpl))
 
 
 def _c_string(s: str) -> str:
@@ -206,12 +229,16 @@ def generate_source(model: NormalizedModel, sensitivity: Any = None) -> str:
     funs = [model.res, model.jac, *model.term_res, *model.term_jac, *model.extras]
     if model.roots is not None:
         funs.append(model.roots)
+    if model.cpl is not None:
+        funs += [model.cpl, *model.term_cpl]
     sens = _sensitivity_functions(sensitivity) if sensitivity is not None else {}
     src = _code_generator("dc_model_gen.c", funs + [_column_inputs(f, name) for name, f in sens.items()])
     nt = len(model.term_res)
     lines = ["", "/* ---------------------------------------------------------------- daeclear table */",
              '#include "dc_model.h"',
-             *_term_tables("dc_", model.n_params, {"term_res_tab": "dc_term{}_res", "term_jac_tab": "dc_term{}_jac"})]
+             *_term_tables("dc_", model.n_params, {"term_res_tab": "dc_term{}_res", "term_jac_tab": "dc_term{}_jac"}),
+             *(_term_tables("dc_cpl_", model.n_params, {"term_tab": "dc_term{}_cpl"})[1:] if model.cpl is not None
+               else [])]
     plan_lines, plan_ref = plan_source(plan_of_model(model))
     lines += plan_lines
     roots_entry = _fun_entry("dc_roots") if model.roots is not None else _NO_FUN
@@ -221,7 +248,9 @@ def generate_source(model: NormalizedModel, sensitivity: Any = None) -> str:
               "const dc_model_t dc_model = {", f"  {model.n}, {nt}, {model.n_roots}, {model.n_parameters},",
               f"  {'dc_n_params_tab' if nt else '0'},", f"  {_fun_entry('dc_res')},", f"  {_fun_entry('dc_jac')},",
               f"  {roots_entry},", f"  {'dc_term_res_tab' if nt else '0'},", f"  {'dc_term_jac_tab' if nt else '0'},",
-              f"  {plan_ref},", f"  {_c_string(model.name)}", "};", ""]
+              f"  {plan_ref},", f"  {_c_string(model.name)},",
+              f"  {_fun_entry('dc_cpl') if model.cpl is not None else _NO_FUN},",
+              f"  {'dc_cpl_term_tab' if model.cpl is not None and nt else '0'}", "};", ""]
     if sensitivity is not None:
         lines += _sensitivity_table(sensitivity)
     return src + "\n".join(lines)

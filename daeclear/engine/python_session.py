@@ -94,7 +94,8 @@ class PythonSession(SessionBase):
     def _eval_jac(self, t: float, y: np.ndarray, yp: np.ndarray, cj: float) -> np.ndarray:
         self._at(t, y, yp)
         self._a_cj[0] = cj
-        return self._with_terms(self._jac, self._tjac).reshape(self._n, self._n, order="F")
+        nj = self._model.n_jac
+        return self._with_terms(self._jac, self._tjac).reshape(nj, nj, order="F")
 
     def _eval_roots(self, t: float, y: np.ndarray, yp: np.ndarray) -> np.ndarray:
         self._at(t, y, yp)
@@ -110,6 +111,7 @@ class PythonSession(SessionBase):
         count = self._count
         eval_res, eval_jac, eval_roots = self._eval_res, self._eval_jac, self._eval_roots
         isfinite = math.isfinite
+        blocks, nj = self._model.blocks, self._model.n_jac
 
         def resfn(t, y, yp, res):
             count["res"] += 1
@@ -124,7 +126,12 @@ class PythonSession(SessionBase):
             J = eval_jac(t, y, yp, cj)
             if not isfinite(float(J.sum())):
                 raise _ModelError(f"the Jacobian has non-finite entries at t={t!r}")
-            JJ[:, :] = J
+            if blocks == 1:
+                JJ[:, :] = J
+            else:  # the block-diagonal Newton matrix, factored whole by scikit-sundae's dense LU (slow path)
+                JJ[:, :] = 0.0
+                for b in range(blocks):
+                    JJ[b * nj:(b + 1) * nj, b * nj:(b + 1) * nj] = J
 
         options: dict[str, Any] = dict(
             rtol=self._opts.rtol, atol=self._opts.atol.copy(), max_step=self._opts.max_step,

@@ -5,8 +5,10 @@ For F(t, y, y', P) = 0 and parameters p with dP/dp (``dP``, n_P x W), S = dy/dp 
 directional derivative (CasADi ``jtimes``) of a function of :class:`DAEFunctions`: the residual, each
 switchable term (its own parameters p_k, e.g. the latched approach speed, get their sensitivities
 ``Sk``) and any extra; the roots' Jacobian blocks give the event time's sensitivity.
-:func:`augmented_functions` stacks [y; S] into one DAE (a slow reference: IDA then factors the (1 + W) n
-system, where the compiled loop will reuse the state's factorisation).
+:func:`augmented_functions` stacks [y; S] into one DAE: with ``block`` its Jacobian is the state's n x n
+iteration matrix, which the session factors once and applies to each of the 1 + W blocks (what
+``simulate`` runs); without, the (1 + W) n matrix itself (the reference the tests and
+benchmarks/bench_sensitivity.py compare with).
 """
 
 from __future__ import annotations
@@ -136,15 +138,20 @@ def sensitivity_functions(funcs: DAEFunctions, width: int, extras: Sequence[int]
                                 curvature, fwd, tuple(int(k) for k in extras))
 
 
-def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False) -> DAEFunctions:
+def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, block: bool = False) -> DAEFunctions:
     """The DAE of [y; S_1; ...; S_width] as one :class:`DAEFunctions` (what IDA integrates for
-    ``simulate(..., sensitivities=...)``, never the fast path): parameters [P; vec(dP)], term k's
-    parameters [p_k; vec(Sk)], the roots those of y, no extras.
+    ``simulate(..., sensitivities=...)``): parameters [P; vec(dP)], term k's parameters [p_k; vec(Sk)],
+    the roots those of y, no extras.
 
-    Its Jacobian: the state's iteration matrix on every diagonal block, nothing else (IDAS' simultaneous
-    corrector: a modified Newton that converges since S's equations are linear in S); ``coupled``: the
-    exact Jacobian of the stacked residual, block lower triangular, whose blocks (F_yy S) blow up where a
-    force has no second derivative (Hertz's delta^1.5 at onset: Newton then fails at the restart)."""
+    Its Newton matrix: the state's iteration matrix on every diagonal block, nothing else (IDAS'
+    simultaneous corrector: a modified Newton that converges since S's equations are linear in S).
+    ``block``: the Jacobian functions give that n x n matrix once (``blocks = 1 + width``: the session
+    factors it once and solves every block with it); else the (1 + width) n matrix itself, the reference.
+    ``coupled``: the exact Newton matrix, block lower triangular: with ``block`` its blocks below the
+    diagonal C_i = d(F_y S_i + F_y' S_i' + F_P dP_i)/dy + cj d(...)/dy' as directional derivatives
+    (``DAEFunctions.coupling``: C dy0 for the block forward substitution); without, the whole (1 + width) n
+    matrix. Where a force has no second derivative (Hertz's delta^1.5 at onset: delta^-0.5) C is not
+    finite: the compiled session then drops it for that solve; the whole matrix fails."""
     n, n_P = int(funcs.n), int(funcs.n_parameters)
     res = _with_parameters(funcs.residual, 3, n_P)
     sym: Any = casadi.SX if res.is_a("SXFunction") else casadi.MX  # one kind at run time
@@ -159,16 +166,26 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False) 
     def stacked(value: Any, derivative: Any) -> Any:
         return casadi.vertcat(value, casadi.vec(derivative))
 
+    dy0 = sym.sym("dy0", n)
+    seed = casadi.vertcat(dy0, casadi.DM.zeros(n * width, 1), cj * dy0, casadi.DM.zeros(n * width, 1))
+
+    def below(r: Any) -> Any:
+        """C dy0: the sensitivity rows' derivative in y (and y' = cj y) along the first block's solution."""
+        return casadi.jtimes(r[n:], casadi.vertcat(Y, Yp), seed)
+
     def jacobian(r: Any) -> Any:
-        if coupled:
+        if coupled and not block:
             return casadi.jacobian(r, Y) + cj * casadi.jacobian(r, Yp)
-        block = casadi.jacobian(r[:n], y) + cj * casadi.jacobian(r[:n], yp)
-        return casadi.diagcat(*([block] * (1 + width)))
+        state = casadi.jacobian(r[:n], y) + cj * casadi.jacobian(r[:n], yp)
+        return state if block else casadi.diagcat(*([state] * (1 + width)))
 
     r = stacked(res(t, y, yp, P), sens.res(t, y, yp, P, S, Sp, dP))
     residual = casadi.Function("residual", [t, Y, Yp, PA], [r], ["t", "y", "yp", "P"], ["r"])
     jac = casadi.Function("jacobian", [t, Y, Yp, cj, PA], [jacobian(r)], ["t", "y", "yp", "cj", "P"], ["J"])
-    term_res, term_jac = [], []
+    with_coupling = coupled and block
+    coupling = casadi.Function("coupling", [t, Y, Yp, cj, PA, dy0], [below(r)],
+                               ["t", "y", "yp", "cj", "P", "dy0"], ["Cdy0"]) if with_coupling else None
+    term_res, term_jac, term_cpl = [], [], []
     for k, (fk, npk) in enumerate(zip(funcs.term_residuals, sens.n_params)):
         fk = _with_parameters(fk, 4, n_P)
         pa = sym.sym("p", npk * (1 + width))
@@ -177,10 +194,14 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False) 
         term_res.append(casadi.Function(f"term{k}_res", [t, Y, Yp, pa, PA], [rk], ["t", "y", "yp", "p", "P"], ["r"]))
         term_jac.append(casadi.Function(f"term{k}_jac", [t, Y, Yp, pa, cj, PA], [jacobian(rk)],
                                         ["t", "y", "yp", "p", "cj", "P"], ["J"]))
+        if with_coupling:
+            term_cpl.append(casadi.Function(f"term{k}_cpl", [t, Y, Yp, pa, cj, PA, dy0], [below(rk)],
+                                            ["t", "y", "yp", "p", "cj", "P", "dy0"], ["Cdy0"]))
     roots = None
     if funcs.roots is not None:
         g = _with_parameters(funcs.roots, 3, n_P)
         roots = casadi.Function("roots", [t, Y, Yp, PA], [g(t, y, yp, P)], ["t", "y", "yp", "P"], ["g"])
     return DAEFunctions(n=n * (1 + width), residual=residual, jacobian=jac, term_residuals=tuple(term_res),
                         term_jacobians=tuple(term_jac), roots=roots, n_parameters=n_P * (1 + width),
-                        name=f"{funcs.name}_sens{width}{'c' if coupled else ''}")
+                        name=f"{funcs.name}_sens{width}{'c' if coupled else ''}{'b' if block else ''}",
+                        blocks=1 + width if block else 1, coupling=coupling, term_couplings=tuple(term_cpl))

@@ -43,8 +43,14 @@ class DAEFunctions:
     extras[k]: functions with vector inputs, P last, and one output, evaluated over many points by
     :meth:`Session.eval_extra` (output channels, consistent restarts); never called by IDA.
     ``P``: the ``n_parameters`` run-time parameters (values given to :func:`open_session`); with
-    ``n_parameters == 0`` the functions may leave it out. A value: what a process compiles of it is
-    kept by a :class:`~daeclear.engine.compiled.CompiledDAE`.
+    ``n_parameters == 0`` the functions may leave it out. ``blocks`` > 1: the Newton matrix is block
+    diagonal, ``blocks`` copies of the (n / blocks)-square matrix the Jacobian functions return (the
+    stacked forward sensitivities [y; S_1; ...]): one factorisation of that block solves them all.
+    ``coupling`` (with ``blocks`` > 1): (t, y, yp, cj, P, dy0) -> C dy0 (n - n / blocks), the Newton
+    matrix's blocks below its first block column times the first block's solution; ``term_couplings[k]``
+    (t, y, yp, p_k, cj, P, dy0) the same of term k: the solve is then the block forward substitution of
+    the block lower-triangular matrix, else the block-diagonal part (IDAS' simultaneous corrector).
+    A value: what a process compiles of it is kept by a :class:`~daeclear.engine.compiled.CompiledDAE`.
     """
 
     n: int
@@ -56,6 +62,9 @@ class DAEFunctions:
     name: str = "model"
     extras: tuple[casadi.Function, ...] = ()
     n_parameters: int = 0
+    blocks: int = 1
+    coupling: casadi.Function | None = None
+    term_couplings: tuple[casadi.Function, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -194,6 +203,10 @@ class Session(Protocol):
 
     def set_layout(self, layout: StateLayout) -> bool:
         """Let the loop make states consistent itself; whether it does (compiled backend)."""
+        ...
+
+    def set_kinematic_rows(self, n_kinematic: int) -> bool:
+        """The reduced solver's eliminated position rows without a layout; whether it applies (compiled)."""
         ...
 
     def set_auto_events(self, pairs: Sequence[tuple[int, int, int, bool, float]], *, storms: Sequence[Storm],
@@ -362,6 +375,10 @@ class SessionBase:
 
     def set_layout(self, layout: StateLayout) -> bool:
         """Only the compiled backend makes states consistent in C; returns False here."""
+        return False
+
+    def set_kinematic_rows(self, n_kinematic: int) -> bool:
+        """Only the compiled backend has the reduced solver; returns False here."""
         return False
 
     def pair_states(self) -> list[PairState]:

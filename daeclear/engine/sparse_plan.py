@@ -227,8 +227,8 @@ def make_plan(n: int, colptr: Sequence[int] | np.ndarray, rowind: Sequence[int] 
 
 def plan_of_model(model: NormalizedModel) -> SparsePlan:
     """The plan of a model's Newton matrix (its base and term Jacobians)."""
-    colptr, rowind = union_pattern(model.n, [f.sparsity_out(0) for f in (model.jac, *model.term_jac)])
-    return make_plan(model.n, colptr, rowind)
+    colptr, rowind = union_pattern(model.n_jac, [f.sparsity_out(0) for f in (model.jac, *model.term_jac)])
+    return make_plan(model.n_jac, colptr, rowind)
 
 
 def _c_array(name: str, values: np.ndarray) -> str:

@@ -27,6 +27,7 @@ from ..core.events import EventRows, flatten
 from ..results.lazy_channels import LazyChannels
 from ..core.events import ContactEvent
 from ..results.result import Result, ResultWriter, load
+from .row_store import RowStore
 
 #: a chunk of points: t, y, yp (None: IDA's raw points), switch rows, the channels when the solver computed them
 Points = tuple[NDArray, NDArray, NDArray | None, NDArray, dict[str, NDArray] | None]
@@ -67,7 +68,9 @@ class Recorder:
         self._rebuildable: bool | None = None
         self.writer = None if stream_to is None else ResultWriter(
             stream_to, **self._header, channel_names=list(model.channel_names) if self.rebuildable() else None)
-        self._points: list[Points] = []
+        self._points: list[Points] = []  # the first chunk kept as given; from the second, in self._store
+        self._store: tuple[RowStore, ...] = ()  # t, y, switch (and yp when the chunks have it): each row stored once
+        self._channels: list[dict[str, NDArray] | None] = []  # the chunks' channels, when in self._store
         self._steps: list[tuple[NDArray, NDArray, NDArray]] = []
         n = model.n_states
         self._key: tuple[NDArray, NDArray, dict[str, NDArray]] = (np.zeros(0), np.zeros((0, n)), {})
@@ -101,8 +104,10 @@ class Recorder:
                 channels = self._evaluated(t, y, yp, switch)
             self._keep_key_rows(t, y, self._checked(t, y, switch, channels))
             self.writer.append(t=t, y=y, yp=yp, switch=switch, channels=None if self.rebuildable() else channels)
-        else:
+        elif not self._points and not self._store:
             self._points.append((t, y, yp, switch, channels))
+        else:
+            self._stored((t, y, yp, switch, channels))
 
     def add_steps(self, t: NDArray, h: NDArray, order: NDArray) -> None:
         """The integrator's steps: time, size and order of each."""
@@ -148,22 +153,36 @@ class Recorder:
         out = ModelEvaluator(self.model, self._backend).channels(t, y, yp, switch)
         return {name: np.ascontiguousarray(out[name]) for name in self.model.channel_names}
 
+    def _stored(self, chunk: Points) -> None:
+        """Append a chunk of points to the stores (made at the second chunk, with the first)."""
+        if not self._store:
+            first = self._points.pop()
+            t, y, yp, switch, _ = first
+            columns = (t, y, switch) if yp is None else (t, y, switch, yp)
+            self._store = tuple(RowStore(c.shape[1:], c.dtype) for c in columns)
+            self._stored(first)
+        t, y, yp, switch, channels = chunk
+        for store, column in zip(self._store, (t, y, switch) if yp is None else (t, y, switch, yp)):
+            store.append(column)
+        self._channels.append(channels)
+
     def _joined(self) -> tuple[NDArray, NDArray, NDArray | None, NDArray, dict[str, NDArray] | None]:
         """The points kept in memory as one chunk, with their channels when the solver gave them (else
         None: the Result computes them when they are first read)."""
         n = self.model.n_states
         points = self._points
         channels: dict[str, NDArray] | None
-        if len(points) == 1:  # one chunk (a short run): nothing to join
-            t, y, yp, switch, channels = points[0]
-        elif points:
-            t, y, switch = (np.concatenate([p[k] for p in points]) for k in (0, 1, 3))
-            yp = None if points[0][2] is None else np.concatenate([p[2] for p in points])
-            given = [p[4] for p in points]
+        if self._store:  # several chunks: stored once, as they came
+            t, y, switch, *rest = (store.array() for store in self._store)
+            yp = rest[0] if rest else None
+            given = self._channels
             channels = None
             if all(g is not None for g in given):
                 chunks = [g for g in given if g is not None]
                 channels = {c: np.concatenate([g[c] for g in chunks]) for c in chunks[0]}
+            self._store, self._channels = (), []
+        elif points:  # one chunk (a short run): nothing to join
+            t, y, yp, switch, channels = points[0]
         else:
             n_switch = self.model.outputs.size1_in(3)
             t, y, yp, switch = np.zeros(0), np.zeros((0, n)), np.zeros((0, n)), np.zeros((0, n_switch))

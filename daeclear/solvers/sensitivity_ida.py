@@ -1,8 +1,11 @@
 """IDA on the stacked DAE [y; S] as the run driver's integrator (``simulate(..., sensitivities=[...])``).
 
 :class:`SensitivityIntegrator` integrates the states and S = dy/dp together (the sensitivity residual of
-:func:`daeclear.engine.sensitivity_functions.augmented_functions`: IDA factors the (1 + Ns) n system, a
-reference path, not the fast one) and reports the states' rows to the driver; S's rows, made consistent
+:func:`daeclear.engine.sensitivity_functions.augmented_functions`; IDAS' simultaneous corrector: its
+Newton matrix is the state's iteration matrix on each of the 1 + Ns diagonal blocks, factored once at
+n x n by the solver the state's run would use and applied block by block; :func:`stacked_reference`
+makes IDA factor the (1 + Ns) n matrix instead, the reference of the tests and
+benchmarks/bench_sensitivity.py) and reports the states' rows to the driver; S's rows, made consistent
 in their mode with the channels' sensitivities, go to its :class:`SensitivityCarrier`. The driver decides
 every root and calls the carrier's jump at every event (:meth:`daeclear.solvers.driver.Driver.jump`); a
 restart then begins from the carrier's S. It restarts at every root (as the reference run did) and
@@ -12,6 +15,8 @@ decides no switch itself. Error control: S in the test, scaled by each parameter
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -35,7 +40,7 @@ from .tolerances import tolerance_vector
 if TYPE_CHECKING:
     from .solver_options import SolverOptions
 
-__all__ = ["SensitivityIDA", "SensitivityIntegrator"]
+__all__ = ["SensitivityIDA", "SensitivityIntegrator", "stacked_reference"]
 
 
 class SensitivityIDA(ida.IDA):
@@ -51,6 +56,18 @@ class SensitivityIDA(ida.IDA):
         return SensitivityIntegrator(model, t_end, output, settings, self.names)
 
 
+@contextmanager
+def stacked_reference() -> Iterator[None]:
+    """Runs with sensitivities started inside factor the (1 + Ns) n block-diagonal Newton matrix whole
+    (the path before the state's factorisation was reused): a reference for tests and benchmarks only."""
+    before = SensitivityIntegrator.stacked_factorisation
+    SensitivityIntegrator.stacked_factorisation = True
+    try:
+        yield
+    finally:
+        SensitivityIntegrator.stacked_factorisation = before
+
+
 class SensitivityIntegrator:
     """One run's IDA session on [y; S] as the driver's :class:`~daeclear.solvers.integrator.Integrator`."""
 
@@ -61,6 +78,8 @@ class SensitivityIntegrator:
     order = 0
     fixed_step: float | None = None
     session: Session | None = None  # the model's own functions serve the driver (the stacked session is S's)
+    stacked_factorisation = False  # True: the reference path of stacked_reference()
+    coupling = True  # the compiled session's block forward substitution with the blocks below the diagonal
 
     def __init__(self, model: DAEModel, t_end: float, output: Output, settings: SolverOptions,
                  names: list[str]) -> None:
@@ -73,12 +92,17 @@ class SensitivityIntegrator:
         self.values = np.array([parameter_value(model, name) for name in self.names])  # the run's parameters
         W = self.sens.width
         pbar = parameter_scales(model, self.sens.names)
+        block = not self.stacked_factorisation
         self.stacked = open_session(
-            augmented_functions(model.functions, W), backend=settings.backend, rtol=rtol,
+            augmented_functions(model.functions, W, coupled=block and self.coupling, block=block),
+            backend=settings.backend, rtol=rtol,
             atol=np.concatenate([atol, *(atol / p for p in pbar)]), max_step=settings.max_step,
             max_steps=settings.max_steps,
-            parameters=np.concatenate([model.parameter_values, self.sens.ms.dP.ravel(order="F")]))
+            parameters=np.concatenate([model.parameter_values, self.sens.ms.dP.ravel(order="F")]),
+            linear_solver=settings.linear_solver if block else "auto")
         try:
+            if block:  # the reduced LU eliminates the position rows, as in the state's run (its layout)
+                self.stacked.set_kinematic_rows(model.n_q)
             # GGL's tight Newton coefficient left out: S's corrections converge linearly (the reference run's rule)
             self.stacked.set_hints(jacobian_refresh=ida.JACOBIAN_REFRESH,
                                    first_step=ida.FIRST_STEP_ESTIMATE and model.formulation == "ggl")

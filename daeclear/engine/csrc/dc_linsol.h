@@ -113,6 +113,11 @@ static dc_linsol* dcls_dense_create(int kind, int n) {
 /* ------------------------------------------------------------------ IDA's SUNLinearSolver */
 typedef struct {
   dc_linsol* ls;  /* not owned */
+  int blocks;     /* the Newton matrix: blocks diagonal copies of ls's matrix (n = blocks ls->n) */
+  /* a block lower-triangular Newton matrix: x[ls->n:] -= C x[:ls->n] after the first block's solve (NULL:
+   * block diagonal) */
+  void (*couple)(void* ctx, double* x);
+  void* couple_ctx;
   double* values; /* the matrix storage IDA's Jacobian callback fills (stable for the session) */
   sunindextype last_flag;
 } dcls_sun;
@@ -149,8 +154,16 @@ static int dcls_sun_solve(SUNLinearSolver S, SUNMatrix A, N_Vector x, N_Vector b
   double* xx = N_VGetArrayPointer(x);
   (void)A;
   (void)tol;
-  if (x != b) memcpy(xx, N_VGetArrayPointer(b), sizeof(double) * (size_t)c->ls->n);
-  c->ls->solve(c->ls, xx);
+  if (x != b) memcpy(xx, N_VGetArrayPointer(b), sizeof(double) * (size_t)c->blocks * (size_t)c->ls->n);
+  if (c->blocks == 1) {
+    c->ls->solve(c->ls, xx);
+  } else if (!c->couple) {
+    c->ls->solve_many(c->ls, xx, c->blocks, c->ls->n);
+  } else { /* block forward substitution: x0 = J^-1 b0, then x_i = J^-1 (b_i - C_i x0) */
+    c->ls->solve(c->ls, xx);
+    c->couple(c->couple_ctx, xx);
+    c->ls->solve_many(c->ls, xx + c->ls->n, c->blocks - 1, c->ls->n);
+  }
   c->last_flag = 0;
   return SUN_SUCCESS;
 }
@@ -165,8 +178,10 @@ static SUNErrCode dcls_sun_free(SUNLinearSolver S) {
   return SUN_SUCCESS;
 }
 
-/* The SUNLinearSolver IDA calls: setup factors ls on values, solve solves with it. */
-static SUNLinearSolver dcls_sun_create(dc_linsol* ls, double* values, SUNContext ctx) {
+/* The SUNLinearSolver IDA calls: setup factors ls on values, solve solves with it, each of the
+ * Newton matrix's blocks diagonal blocks (the stacked forward sensitivities, IDAS' simultaneous
+ * corrector: one factorisation of the n x n iteration matrix for all 1 + Ns blocks). */
+static SUNLinearSolver dcls_sun_create(dc_linsol* ls, double* values, int blocks, SUNContext ctx) {
   SUNLinearSolver S = SUNLinSolNewEmpty(ctx);
   if (!S) return NULL;
   dcls_sun* c = (dcls_sun*)calloc(1, sizeof(dcls_sun));
@@ -175,6 +190,7 @@ static SUNLinearSolver dcls_sun_create(dc_linsol* ls, double* values, SUNContext
     return NULL;
   }
   c->ls = ls;
+  c->blocks = blocks;
   c->values = values;
   S->content = c;
   S->ops->gettype = dcls_sun_gettype;
@@ -185,6 +201,13 @@ static SUNLinearSolver dcls_sun_create(dc_linsol* ls, double* values, SUNContext
   S->ops->lastflag = dcls_sun_lastflag;
   S->ops->free = dcls_sun_free;
   return S;
+}
+
+/* Make the solver of dcls_sun_create block lower triangular: couple(ctx, x) subtracts the blocks below the
+ * first block column times x's first block from the rest of x. */
+static void dcls_sun_set_coupling(SUNLinearSolver S, void (*couple)(void*, double*), void* ctx) {
+  DCLS_SUN(S)->couple = couple;
+  DCLS_SUN(S)->couple_ctx = ctx;
 }
 
 #undef DCLS_SUN

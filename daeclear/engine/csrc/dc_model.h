@@ -61,6 +61,11 @@ typedef struct {
   const dc_fun_t* term_jac;   /* [n_terms] (t, y, yp, p, cj, P) -> J_k (sparse, n x n) */
   const dc_lu_plan* lu;       /* the sparse LU's plan, NULL when its static pivots are structurally singular */
   const char* name;
+  /* a Newton matrix of blocks (jac nj x nj, n = blocks nj: the stacked sensitivities) that is block lower
+   * triangular: (t, y, yp, cj, P, dy0) -> C dy0 [n - nj], its blocks below the first block column times
+   * the first block's solution; eval == 0: none (the block-diagonal part is solved) */
+  dc_fun_t cpl;
+  const dc_fun_t* term_cpl;   /* [n_terms] (t, y, yp, p, cj, P, dy0) -> the same of term k */
 } dc_model_t;
 
 extern const dc_model_t dc_model;

@@ -62,7 +62,7 @@ static void adv_record(dc_session* s, dc_adv* a, double tret, double h, int orde
     a->st[k] = tret;
     if (a->store_steps & DC_STORE_STATES) {
       memcpy(a->sy + (size_t)k * n, N_VGetArrayPointer(s->yy), sizeof(double) * (size_t)n);
-      memcpy(a->syp + (size_t)k * n, N_VGetArrayPointer(s->yp), sizeof(double) * (size_t)n);
+      if (a->syp) memcpy(a->syp + (size_t)k * n, N_VGetArrayPointer(s->yp), sizeof(double) * (size_t)n);
     }
     a->sh[k] = h;
     a->sord[k] = order;
@@ -249,9 +249,9 @@ static int adv_full(const dc_adv* a) {
  * t_eval[*i_eval .. n_eval) are the requested output times, sorted, all > current time; each
  * one reached is written (y via IDAGetDky k=0, yp via k=1 unless eval_yp is NULL) to
  * eval_y/eval_yp row *i_eval and *i_eval advances. If store_steps (DC_STORE_TIMES, with
- * DC_STORE_STATES also y and yp), every return point of IDA (the end of each internal step; on
- * a root return the root point; duplicates skipped) is written to the step buffers, at most cap
- * rows; *n_stored rows were written.
+ * DC_STORE_STATES also y and, unless syp is NULL, yp), every return point of IDA (the end of each
+ * internal step; on a root return the root point; duplicates skipped) is written to the step
+ * buffers, at most cap rows; *n_stored rows were written.
  *
  * Returns DC_CHUNK when cap rows were written (store_steps), cap IDA calls were made
  * (otherwise), or a step filled the last of the n_eval output rows (so that a caller can hand

@@ -143,7 +143,7 @@ DC_API int dc_eval_jacobian_sparse(void* sp, double t, const double* y, const do
 DC_API int dc_solve_linear(void* sp, int kind, int nk, double t, const double* y, const double* yp, double cj,
                            const double* A, double* B, int nrhs, long long* info) {
   dc_session* s = (dc_session*)sp;
-  const int n = s->n;
+  const int n = s->nj;
   const int dense = kind != DC_LS_SPARSE;
   const size_t len = dense ? (size_t)n * (size_t)n : (size_t)(s->jp_nnz ? s->jp_nnz : 1);
   dc_linsol* ls = NULL;
@@ -195,7 +195,7 @@ DC_API int dc_linear_solver(void* sp) { return ((dc_session*)sp)->lin_kind; }
 /* The union pattern as 64-bit CSC arrays: colptr[n + 1], rowind[dc_jac_nnz]. */
 DC_API void dc_jac_pattern(void* sp, long long* colptr, long long* rowind) {
   dc_session* s = (dc_session*)sp;
-  for (int c = 0; c <= s->n; ++c) colptr[c] = (long long)s->jp_colptr[c];
+  for (int c = 0; c <= s->nj; ++c) colptr[c] = (long long)s->jp_colptr[c];
   for (dc_int k = 0; k < s->jp_nnz; ++k) rowind[k] = (long long)s->jp_rowind[k];
 }
 

@@ -66,7 +66,7 @@ static const dc_fun_t* jac_part(int p) { return p == 0 ? &dc_model.jac : &dc_mod
  * the data array of the union pattern, through the precomputed positions (no search per entry). */
 static void add_part(const dc_session* s, int p, const double* nz, double* out, int sparse) {
   if (!sparse) {
-    dc_sp_scatter(jac_part(p)->sparsity_out(0), nz, out, s->n, 1);
+    dc_sp_scatter(jac_part(p)->sparsity_out(0), nz, out, s->nj, 1);
     return;
   }
   const dc_int* map = s->jmap + s->jmap_off[p];
@@ -76,7 +76,7 @@ static void add_part(const dc_session* s, int p, const double* nz, double* out, 
 
 /* Entries of the Jacobian (out): n * n dense, or jp_nnz in the union pattern. */
 static dc_int jac_len(const dc_session* s, int sparse) {
-  return sparse ? s->jp_nnz : (dc_int)s->n * (dc_int)s->n;
+  return sparse ? s->jp_nnz : (dc_int)s->nj * (dc_int)s->nj;
 }
 
 /* J = base Jacobian + active terms' Jacobians, into out (layout: see add_part); zeroed: J is
@@ -139,12 +139,12 @@ static int res_cb(sunrealtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* da
 /* Row and column of entry i of the Jacobian's storage (for messages). */
 static void entry_position(const dc_session* s, dc_int i, int sparse, int* row, int* col) {
   if (!sparse) {
-    *row = (int)(i % s->n);
-    *col = (int)(i / s->n);
+    *row = (int)(i % s->nj);
+    *col = (int)(i / s->nj);
     return;
   }
   int c = 0;
-  while (c < s->n && (dc_int)s->jp_colptr[c + 1] <= i) ++c;
+  while (c < s->nj && (dc_int)s->jp_colptr[c + 1] <= i) ++c;
   *row = (int)s->jp_rowind[i];
   *col = c;
 }
@@ -156,7 +156,7 @@ static double* jac_storage(dc_session* s, SUNMatrix J) {
   if (s->lin_kind == DC_LS_SPARSE) return dcls_values_data(J);
 #if DC_HAVE_SPARSE
   if (s->lin_kind == DC_LS_SUPERLU) {
-    memcpy(SUNSparseMatrix_IndexPointers(J), s->jp_colptr, sizeof(sunindextype) * ((size_t)s->n + 1));
+    memcpy(SUNSparseMatrix_IndexPointers(J), s->jp_colptr, sizeof(sunindextype) * ((size_t)s->nj + 1));
     memcpy(SUNSparseMatrix_IndexValues(J), s->jp_rowind, sizeof(sunindextype) * (size_t)s->jp_nnz);
     return SUNSparseMatrix_Data(J);
   }
@@ -170,10 +170,40 @@ static dc_int jac_first_nonfinite(const dc_session* s, const double* Jd) {
   if (LIN_UNION(s)) return dc_first_nonfinite(Jd, (int)s->jp_nnz);
   for (int p = 0; p <= s->n_terms; ++p) {
     if (p > 0 && !s->active[p - 1]) continue;
-    const dc_int i = dc_sp_first_nonfinite(jac_part(p)->sparsity_out(0), Jd, s->n);
+    const dc_int i = dc_sp_first_nonfinite(jac_part(p)->sparsity_out(0), Jd, s->nj);
     if (i >= 0) return i;
   }
   return -1;
+}
+
+/* The block lower-triangular solve's coupling (dcls_sun_set_coupling): x[nj:] -= C x[:nj], C the blocks
+ * below the first block column at the last Jacobian's point (base and active terms, dc_model.cpl). Where C
+ * is not finite (a force without a second derivative there: Hertz's delta^1.5 at onset) or its evaluation
+ * fails, that solve keeps the block-diagonal part (IDAS' simultaneous corrector), as IDA's modified Newton
+ * may. The generated SX functions keep no state between calls (memory 0, as the extras). */
+static void couple_cb(void* data, double* x) {
+  dc_session* s = (dc_session*)data;
+  const dc_model_t* M = &dc_model;
+  const int m = s->n - s->nj;
+  point_args(s, &s->cpl_t, s->cpl_y, s->cpl_yp);
+  s->arg[3] = &s->cpl_cj;
+  s->arg[4] = s->P;
+  s->arg[5] = x;
+  s->res[0] = s->cpl_out;
+  if (M->cpl.eval(s->arg, s->res, s->iw, s->w, 0)) return;
+  for (int k = 0; k < s->n_terms; ++k) {
+    if (!s->active[k]) continue;
+    point_args(s, &s->cpl_t, s->cpl_y, s->cpl_yp);
+    s->arg[3] = s->params + s->param_off[k];
+    s->arg[4] = &s->cpl_cj;
+    s->arg[5] = s->P;
+    s->arg[6] = x;
+    s->res[0] = s->cpl_tmp;
+    if (M->term_cpl[k].eval(s->arg, s->res, s->iw, s->w, 0)) return;
+    for (int i = 0; i < m; ++i) s->cpl_out[i] += s->cpl_tmp[i];
+  }
+  if (dc_first_nonfinite(s->cpl_out, m) >= 0) return;
+  for (int i = 0; i < m; ++i) x[s->nj + i] -= s->cpl_out[i];
 }
 
 static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vector rr,
@@ -201,6 +231,12 @@ static int jac_cb(sunrealtype t, sunrealtype cj, N_Vector yy, N_Vector yp, N_Vec
     return 1;
   }
   s->lin->cj = cj; /* IDA factors this matrix next */
+  if (s->coupled) { /* the coupling's point: the same modified Newton matrix */
+    s->cpl_t = t;
+    s->cpl_cj = cj;
+    memcpy(s->cpl_y, N_VGetArrayPointer(yy), sizeof(double) * (size_t)s->n);
+    memcpy(s->cpl_yp, N_VGetArrayPointer(yp), sizeof(double) * (size_t)s->n);
+  }
   return 0;
 }
 
@@ -226,9 +262,9 @@ static int cmp_index(const void* a, const void* b) {
 /* The union of the CSC patterns of all Jacobian parts (base and every term), rows sorted within
  * each column as SUNSparseMatrix and SuperLU_MT expect, and each part's nonzero -> position map.
  * Once per session, O(nonzeros log): a row marker per column, no n x n scratch. Returns 0, or -1
- * out of memory, -2 a pattern that is not n x n, -3 too many nonzeros for sunindextype. */
+ * out of memory, -2 a pattern that is not nj x nj, -3 too many nonzeros for sunindextype. */
 static int build_jac_pattern(dc_session* s) {
-  const int n = s->n, parts = s->n_terms + 1;
+  const int n = s->nj, parts = s->n_terms + 1;
   dc_int total = 0;
   s->jmap_off = (dc_int*)xcalloc((size_t)parts + 1, sizeof(dc_int));
   if (!s->jmap_off) return -1;

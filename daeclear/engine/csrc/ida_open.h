@@ -99,13 +99,13 @@ static void superlu_destroy(dc_linsol* ls) {
 /* SuperLU_MT on s->A (a SUNSparseMatrix of the union pattern), initialized once; NULL on failure. */
 static dc_linsol* superlu_create(dc_session* s) {
   dcls_superlu* c = (dcls_superlu*)calloc(1, sizeof(dcls_superlu));
-  dc_linsol* ls = c ? dcls_new(DC_LS_SUPERLU, s->n, c, superlu_factor, superlu_solve, superlu_destroy) : NULL;
+  dc_linsol* ls = c ? dcls_new(DC_LS_SUPERLU, s->nj, c, superlu_factor, superlu_solve, superlu_destroy) : NULL;
   if (!ls) {
     free(c);
     return NULL;
   }
   c->s = s;
-  c->v = N_VMake_Serial(s->n, N_VGetArrayPointer(s->yy), s->ctx);
+  c->v = N_VMake_Serial(s->nj, N_VGetArrayPointer(s->yy), s->ctx);
   c->sl = c->v ? SUNLinSol_SuperLUMT(s->yy, s->A, 1, s->ctx) : NULL;
   if (!c->sl || SUNLinSolInitialize(c->sl) != 0) {
     if (c->sl) c->factored = 1; /* never factor the identity into a solver that did not initialize */
@@ -153,6 +153,10 @@ DC_API void dc_free(void* sp) {
   free(s->w);
   free(s->mem_term_res);
   free(s->mem_term_jac);
+  free(s->cpl_y);
+  free(s->cpl_yp);
+  free(s->cpl_out);
+  free(s->cpl_tmp);
   free(s->active);
   free(s->params);
   free(s->param_off);
@@ -241,6 +245,10 @@ static int open_work_memory(dc_session* s, char* err, int errlen) {
     work_max(&M->term_res[k], &sa, &sr, &si, &sw);
     work_max(&M->term_jac[k], &sa, &sr, &si, &sw);
   }
+  if (M->cpl.eval) {
+    work_max(&M->cpl, &sa, &sr, &si, &sw);
+    for (int k = 0; k < M->n_terms; ++k) work_max(&M->term_cpl[k], &sa, &sr, &si, &sw);
+  }
   s->arg = (const double**)xcalloc((size_t)sa, sizeof(double*));
   s->res = (double**)xcalloc((size_t)sr, sizeof(double*));
   s->iw = (dc_int*)xcalloc((size_t)si, sizeof(dc_int));
@@ -304,7 +312,7 @@ static int open_run_arrays(dc_session* s, const int* rootdir, const double* P, c
 /* The Jacobian pattern (always built: small, and dc_eval_jacobian_sparse works in any session),
  * the choice of linear solver, the SUNDIALS context with our error handler, and the vectors. */
 static int open_vectors(dc_session* s, const double* atol, int linear_solver, char* err, int errlen) {
-  const int n = s->n;
+  const int n = s->nj;
   int rc = build_jac_pattern(s);
   if (rc == -1) OPEN_FAIL("out of memory");
   if (rc == -2) OPEN_FAIL("a generated Jacobian is not %d x %d", n, n);
@@ -330,17 +338,17 @@ static int open_vectors(dc_session* s, const double* atol, int linear_solver, ch
     OPEN_FAIL("SUNContext_Create failed");
   SUNContext_ClearErrHandlers(s->ctx); /* IDA must not print; we build our own messages */
   SUNContext_PushErrHandler(s->ctx, err_handler, s);
-  s->yy = N_VNew_Serial(n, s->ctx);
-  s->yp = N_VNew_Serial(n, s->ctx);
-  s->atol = N_VNew_Serial(n, s->ctx);
-  s->dky = N_VNew_Serial(n, s->ctx);
+  s->yy = N_VNew_Serial(s->n, s->ctx);
+  s->yp = N_VNew_Serial(s->n, s->ctx);
+  s->atol = N_VNew_Serial(s->n, s->ctx);
+  s->dky = N_VNew_Serial(s->n, s->ctx);
   if (!s->yy || !s->yp || !s->atol || !s->dky) OPEN_FAIL("N_VNew_Serial failed");
   /* IDA clones its vectors from yy: with fused operations its predictor, corrector and error
    * norms make one pass (N_VLinearCombination, ...) instead of one call per term */
   if (N_VEnableFusedOps_Serial(s->yy, SUNTRUE) != SUN_SUCCESS) OPEN_FAIL("N_VEnableFusedOps_Serial failed");
-  memset(N_VGetArrayPointer(s->yy), 0, sizeof(double) * (size_t)n);
-  memset(N_VGetArrayPointer(s->yp), 0, sizeof(double) * (size_t)n);
-  memcpy(N_VGetArrayPointer(s->atol), atol, sizeof(double) * (size_t)n);
+  memset(N_VGetArrayPointer(s->yy), 0, sizeof(double) * (size_t)s->n);
+  memset(N_VGetArrayPointer(s->yp), 0, sizeof(double) * (size_t)s->n);
+  memcpy(N_VGetArrayPointer(s->atol), atol, sizeof(double) * (size_t)s->n);
   return 0;
 }
 
@@ -348,7 +356,7 @@ static int open_vectors(dc_session* s, const double* atol, int linear_solver, ch
  * the union values, SuperLU_MT on a SUNSparseMatrix of the union pattern (one thread), else a dense
  * matrix with the reduced or the plain dense LU. */
 static int open_linear_solver(dc_session* s, char* err, int errlen) {
-  const int n = s->n;
+  const int n = s->nj; /* the iteration matrix's size: blocks of them make the Newton matrix */
   if (s->lin_kind == DC_LS_SPARSE) {
     s->A = dcls_values_create((size_t)s->jp_nnz, s->ctx);
     if (!s->A) OPEN_FAIL("the sparse LU's matrix could not be allocated (nnz=%lld)", (long long)s->jp_nnz);
@@ -371,8 +379,18 @@ static int open_linear_solver(dc_session* s, char* err, int errlen) {
     s->lin = s->lin_kind == DC_LS_REDUCED ? rls_create(DC_LS_REDUCED, n) : dcls_dense_create(DC_LS_DENSE, n);
   }
   if (!s->lin) OPEN_FAIL("the linear solver could not be created (out of memory)");
-  s->LS = dcls_sun_create(s->lin, jac_storage(s, s->A), s->ctx);
+  s->LS = dcls_sun_create(s->lin, jac_storage(s, s->A), s->blocks, s->ctx);
   if (!s->LS) OPEN_FAIL("the linear solver could not be created (out of memory)");
+  if (s->blocks > 1 && dc_model.cpl.eval) {
+    const size_t m = (size_t)(s->n - s->nj);
+    s->cpl_y = (double*)xcalloc((size_t)s->n, sizeof(double));
+    s->cpl_yp = (double*)xcalloc((size_t)s->n, sizeof(double));
+    s->cpl_out = (double*)xcalloc(m, sizeof(double));
+    s->cpl_tmp = (double*)xcalloc(m, sizeof(double));
+    if (!s->cpl_y || !s->cpl_yp || !s->cpl_out || !s->cpl_tmp) OPEN_FAIL("out of memory");
+    s->coupled = 1;
+    dcls_sun_set_coupling(s->LS, couple_cb, s);
+  }
   return 0;
 }
 
@@ -420,6 +438,13 @@ DC_API void* dc_open(double rtol, const double* atol, double max_step, int max_o
     return NULL;
   }
   s->n = M->n;
+  s->nj = (int)M->jac.sparsity_out(0)[0];
+  s->blocks = s->nj > 0 && M->n % s->nj == 0 ? M->n / s->nj : 0;
+  if (s->blocks < 1) {
+    if (err && errlen > 0) snprintf(err, errlen, "the generated Jacobian has %d rows, must divide n=%d", s->nj, M->n);
+    free(s);
+    return NULL;
+  }
   s->n_terms = M->n_terms;
   s->n_roots = M->n_roots;
   s->max_steps = max_steps;
@@ -503,6 +528,16 @@ DC_API int dc_set_stall(void* sp, double stall_step, int count) {
 DC_API int dc_set_first_step(void* sp, int on) {
   ((dc_session*)sp)->first_step_on = on != 0;
   return 0;
+}
+
+/* The reduced solver's eliminated kinematic rows (the q rows, 0 <= nk < nj) without a state layout:
+ * a session on the stacked sensitivities [y; S] factors the state's iteration matrix as the state's
+ * own run does (dc_set_layout sets them there). 0 done (also for another solver: nothing to do),
+ * -1 out of range or out of memory. */
+DC_API int dc_set_kinematic_rows(void* sp, int nk) {
+  dc_session* s = (dc_session*)sp;
+  if (s->lin_kind != DC_LS_REDUCED) return 0;
+  return nk >= 0 && nk < s->nj && rls_set_kinematic_rows(s->lin, nk) == 0 ? 0 : -1;
 }
 
 /* (Re)start IDA at (t0, y0, yp0) with fresh BDF history; set active terms, their parameters

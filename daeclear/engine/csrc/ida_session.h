@@ -95,6 +95,18 @@ typedef struct {
   SUNLinearSolver LS; /* IDA's solver: dcls_sun_create's wrapper of lin */
   dc_linsol* lin;     /* the factorisation IDA's setup makes and every solve uses (dc_linsol.h) */
   int n, n_terms, n_roots;
+  /* The Newton matrix: blocks diagonal copies of the nj x nj iteration matrix the Jacobian functions
+   * give (n = blocks nj). blocks 1: an ordinary model. blocks > 1: the forward sensitivities' stacked
+   * [y; S_1; ...] (IDAS' simultaneous corrector), factored once at nj and solved block by block. */
+  int nj, blocks;
+  /* blocks > 1 with dc_model.cpl: the Newton matrix is block lower triangular, its blocks below the first
+   * block column applied by dc_model.cpl at the point of the last Jacobian (a modified Newton's matrix) */
+  int coupled;
+  double cpl_t, cpl_cj;
+  double* cpl_y;    /* [n] y and y' of the last Jacobian */
+  double* cpl_yp;   /* [n] */
+  double* cpl_out;  /* [n - nj] C dy0 */
+  double* cpl_tmp;  /* [n - nj] a term's part of it */
   /* CasADi work memory, sized for the largest function */
   const double** arg;
   double** res;
