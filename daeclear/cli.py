@@ -142,9 +142,7 @@ def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
     study.add_argument("--repeats", type=int, default=3, help="timed repeats per run, best kept (default %(default)s)")
     study.add_argument("--out", type=Path, default=Path("results/study"), help="output directory (default %(default)s)")
     _add_sweep_parser(sub, epilog)
-    from .plot import animate_command  # the parser of its subcommand
-
-    animate_command.add_parser(sub)
+    _add_animate_parser(sub)
     return parser
 
 
@@ -572,6 +570,27 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_animate_parser(sub: Any) -> None:
+    animate = sub.add_parser(
+        "animate", help="animated GIF (or MP4 with ffmpeg) of a saved result",
+        description="Draw the mechanism of a saved result moving, each clearance joint magnified in a panel, and "
+                    "a time plot with a moving cursor. Frames: round(duration x slow motion x fps), at least 2.")
+    animate.add_argument("result", type=Path, help="result file (.h5) written by daeclear run or Result.save")
+    animate.add_argument("--out", type=Path, help="animation file, .gif or .mp4 (default: RESULT with .gif)")
+    animate.add_argument("--fps", type=float, default=25.0, help="frames per second (default %(default)g)")
+    animate.add_argument("--window", type=float, nargs=2, metavar=("T0", "T1"),
+                         help="simulated time shown, s (default: the whole run)")
+    animate.add_argument("--slow-motion", type=float,
+                         help="times slower than real time (default: the window plays in 5 s)")
+    size = (720, 450)
+    animate.add_argument("--size", type=int, nargs=2, default=size, metavar=("WIDTH", "HEIGHT"),
+                         help=f"pixels (default {size[0]} {size[1]})")
+    animate.add_argument("--channel", help="channel of the time plot (default: the driver's moment)")
+    animate.add_argument("--magnify", type=float,
+                         help="magnification of a slider's offset and tilt in its guide (default: automatic)")
+    animate.add_argument("--quiet", action="store_true", help="no progress line")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="daeclear: %(message)s")
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -589,9 +608,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "sweep":
             return _sweep(args)
         if args.command == "animate":
-            from .plot import animate_command
+            from .plot.animate_command import run as animate  # loads the figures' libraries
 
-            return animate_command.run(args)
+            return animate(args)
     except SolveError as exc:
         print(f"daeclear: {exc}", file=sys.stderr)
         return 1
