@@ -115,6 +115,9 @@ def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
                           "is found (default %(default)s)")
     run.add_argument("--out", type=Path, default=Path("results"), help="output directory (default ./%(default)s)")
     run.add_argument("--name", help="base name of the output files (default: the scene name)")
+    run.add_argument("--sensitivity", action="append", default=[], metavar="NAME",
+                     help="integrate d(states)/d(NAME) too, NAME from model.parameter_names (repeatable): saved in "
+                          "the file, drawn in BASE_sensitivities.png (IDA; small models, short spans)")
     run.add_argument("--no-figure", action="store_true", help="write the HDF5 result only")
     run.add_argument("--window", type=float, nargs=2, metavar=("T0", "T1"),
                      help="the figure shows this time window, s (default: the whole run, min-max decimated to "
@@ -216,7 +219,8 @@ def _run(args: argparse.Namespace) -> int:
         named = "" if args.name is not None else ", as it names the output files (or give --name)"
         options.fail(where if args.name is not None else f"{where} {args.target}", field, base,
                      f"a plain file name without a directory (e.g. run1){named}")
-    check_directory(args.out, "--out", files=[f"{base}.h5", f"{base}.png"])  # before any work
+    figures = [f"{base}.png", *([f"{base}_sensitivities.png"] if args.sensitivity else [])]
+    check_directory(args.out, "--out", files=[f"{base}.h5", *figures])  # before any work
     if args.window is not None:  # the figure's window, inside the run
         lo, hi = args.window
         if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 <= lo < hi and lo < t_end):
@@ -240,7 +244,7 @@ def _run(args: argparse.Namespace) -> int:
         with warnings.catch_warnings():  # shown once, from the result, after the run
             warnings.simplefilter("ignore", PhysicsWarning)
             outcome = simulate(scene, t_end, rtol=rtol, options=solver, save=save, progress=not args.quiet,
-                               on_failure="return")
+                               on_failure="return", sensitivities=args.sensitivity or None)  # names checked first
         shown_from, result = _read_back(h5)
     except Interrupted as exc:
         message = exc.result.message if exc.result is not None else "interrupted"
@@ -291,6 +295,9 @@ def _run_figure(args: argparse.Namespace, result: Any, scene: Any, reference_sce
     png = save_run_figure(result, args.out / f"{base}.png", reference=reference,
                           window=tuple(args.window) if args.window else None, max_points=CLI_FIGURE_POINTS)
     print(f"wrote {png}")
+    if result.sensitivities is not None:  # --sensitivity: their growth and horizon too
+        from .plot import save_sensitivity_figure
+        print(f"wrote {save_sensitivity_figure(result, args.out / f'{base}_sensitivities.png')}")
 
 
 def _read_back(h5: Path) -> tuple[float | None, Any]:
@@ -584,22 +591,6 @@ def _add_animate_parser(sub: Any) -> None:
     animate.add_argument("--quiet", action="store_true", help="no progress line")
 
 
-def _animate(args: argparse.Namespace) -> int:
-    from .plot.animate import CLI_FIELDS, render
-    from .results.result import load
-
-    if not args.result.is_file():
-        raise DaeclearError(f"animate: no result file '{args.result}'; give a .h5 file written by daeclear run or "
-                            "Result.save.")
-    out = args.out if args.out is not None else args.result.with_suffix(".gif")
-    result = load(args.result)
-    path = render(result, out, fps=args.fps, window=tuple(args.window) if args.window else None,
-                  slow_motion=args.slow_motion, size=tuple(args.size), channel=args.channel, magnify=args.magnify,
-                  progress=not args.quiet, fields=CLI_FIELDS)
-    print(f"wrote {path}")
-    return 0
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="daeclear: %(message)s")
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -617,7 +608,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "sweep":
             return _sweep(args)
         if args.command == "animate":
-            return _animate(args)
+            from .plot.animate_command import run as animate  # loads the figures' libraries
+
+            return animate(args)
     except SolveError as exc:
         print(f"daeclear: {exc}", file=sys.stderr)
         return 1

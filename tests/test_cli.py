@@ -173,3 +173,33 @@ def test_scene_file_clearance_law_errors_name_the_table(tmp_path, capsys):
     path.write_text(clearance_toml().replace('name = "lankarani-nikravesh"', 'name = "spring"'))
     assert main(["run", str(path), "--out", str(tmp_path)]) == 2
     assert "[[revolute_clearance]] #1" in capsys.readouterr().err
+
+
+def test_run_with_sensitivities_writes_them_and_their_figure(tmp_path, capsys):
+    """--sensitivity (repeatable): the streamed file holds S of every state and channel, those of the same run
+    through the API; BASE_sensitivities.png draws one panel per parameter and the horizon."""
+    import matplotlib.image
+
+    names = ["clearance.clearance", "clearance.law.restitution"]
+    argv = ["run", "slider_crank", "--joint", "revolute", "--t-end", "0.4e-3", "--out", str(tmp_path), "--quiet"]
+    assert main(argv + [a for name in names for a in ("--sensitivity", name)]) == 0
+    out = capsys.readouterr().out
+    back = dc.load(tmp_path / "slider_crank_revolute.h5")
+    assert back.sensitivity_names == tuple(names) and back.parameters["simulate"]["sensitivities"] == names
+    step = back.t[1] - back.t[0]
+    api = dc.simulate(dc.mechanisms.slider_crank("revolute"), 0.4e-3, rtol=1e-6, sensitivities=names,
+                      save=dc.SaveAt(every=step, steps=False))
+    assert np.array_equal(back.t, api.t) and len(back.sensitivities.events) == len(api.sensitivities.events) >= 2
+    for name in ("slider.x", "crank.omega", "drive.moment"):
+        assert back.sensitivity(name) == pytest.approx(api.sensitivity(name), rel=1e-9, abs=1e-12)
+    png = tmp_path / "slider_crank_revolute_sensitivities.png"
+    assert f"wrote {png}" in out and matplotlib.image.imread(png).shape[0] > 3 * 300  # three panels of 3 in
+
+
+def test_run_refuses_an_unknown_sensitivity_before_any_run(tmp_path, capsys):
+    argv = ["run", "slider_crank", "--joint", "revolute", "--t-end", "0.4e-3", "--out", str(tmp_path), "--quiet"]
+    assert main(argv + ["--sensitivity", "clearance.clearence"]) == 2
+    err = capsys.readouterr().err
+    assert "sensitivities='clearance.clearence', must be one of model.parameter_names" in err
+    assert "close matches: 'clearance.clearance'" in err
+    assert not (tmp_path / "slider_crank_revolute.h5").exists()

@@ -593,9 +593,12 @@ LAYOUT_DOC = Path(__file__).resolve().parents[1] / "docs" / "hdf5_layout.md"
 #: items of a run's file only: each point's switch vector and the names of the channels computed when read
 STATES_ONLY = {"/switch", "/channel_names", "/channel_units"}
 #: items of a run with sensitivities only (simulate(..., sensitivities=...))
-SENSITIVITIES = {"/sensitivities", "/sensitivities/names", "/sensitivities/states", "/sensitivities/channel_names",
+SENSITIVITIES = {"/sensitivities", "/sensitivities/names", "/sensitivities/values",
+                 "/sensitivities/states", "/sensitivities/channel_names",
                  "/sensitivities/channels", "/sensitivities/events", "/sensitivities/events/t",
-                 "/sensitivities/events/pair", "/sensitivities/events/kind", "/sensitivities/events/dt_dp"}
+                 "/sensitivities/events/pair", "/sensitivities/events/kind", "/sensitivities/events/dt_dp",
+                 "/sensitivities/sides", *(f"/sensitivities/sides/{name}" for name in ("t", "y", "values", "states",
+                                                                                      "channels"))}
 
 
 def _documented_items() -> list[tuple[str, bool]]:

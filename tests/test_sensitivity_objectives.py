@@ -217,3 +217,32 @@ def test_bad_gradient_calls(scene: dc.Scene) -> None:
         grad(scene, dc.Final("journal.z"))
     with pytest.raises(dc.SceneError, match=r"EventTime: index=3, must be within the run's 1 onset event"):
         grad(scene, dc.EventTime("clearance", index=3))
+
+
+def test_a_loaded_result_gives_the_same_objectives(scene: dc.Scene, tmp_path) -> None:
+    """The file keeps each event's rows before and after its switch: Result.gradient on the loaded result equals
+    the run's (the impulse's onset jump term and the peak need them), and both equal the closed form; a window
+    keeps the rows of its events."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", dc.DaeclearWarning)
+        run = dc.simulate(scene, T, rtol=1e-10, options=dc.SolverOptions(start="declared"),
+                          save=dc.SaveAt(times=np.linspace(0.0, T, 2001), steps=False), sensitivities=NAMES)
+    back = dc.load(run.save(tmp_path / "run.h5"))
+    assert back.sensitivities.sides is not None and back.sensitivities.sides.t.size == 4  # onset, separation
+    for of in (dc.Integral("clearance.normal_force"), dc.Peak("clearance.normal_force"), dc.Final("journal.x"),
+               dc.EventTime("clearance", "separation")):
+        here, there = run.gradient(of), back.gradient(of)
+        assert there.value == pytest.approx(here.value, rel=1e-12, abs=1e-15)
+        assert vector(there) == pytest.approx(vector(here), rel=1e-10, abs=1e-12)
+    impulse = back.gradient(dc.Integral("clearance.normal_force"))
+    assert impulse.value == pytest.approx(M * (U + np.real(separation(P0)[2])), rel=1e-5)
+    assert abs(vector(impulse)[2]) < 2e-2 * P0[1] * U  # the onset's jump term read from the file: else 20
+    peak = back.gradient(dc.Peak("clearance.normal_force"))
+    assert vector(peak)[:2] == pytest.approx(complex_step(peak_force, P0)[0, :2], rel=1e-6)
+    window = dc.load(tmp_path / "run.h5", 0.05, 0.12)  # the onset (0.1 s) inside, the separation outside
+    assert window.sensitivities.sides.t == pytest.approx([P0[2] / U] * 2, rel=1e-12)
+    assert window.gradient(dc.Integral("clearance.normal_force", window=(0.05, 0.12))).value == pytest.approx(
+        run.gradient(dc.Integral("clearance.normal_force", window=(0.05, 0.12))).value, rel=1e-9)  # end nodes one-sided
+    assert run.slice(0.05, 0.12).sensitivities.sides.t.size == 2
+    with pytest.raises(KeyError, match="Result.gradient: this run has no sensitivities"):
+        dc.Result(t=[0.0], y=[[0.0]], yp=[[0.0]], state_names=["x"], channels={}, units={}).gradient(dc.Final("x"))

@@ -26,7 +26,7 @@ from ..core.options import close_matches
 from ..engine.sensitivity_functions import SensitivityFunctions, directional, jacobian_blocks
 from .dae_model import EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_TERM0, DAEModel
 
-__all__ = ["parameter_value", "moved_parameter", "parameter_directions", "initial_sensitivities",
+__all__ = ["parameter_value", "moved_parameter", "table_entry", "parameter_directions", "initial_sensitivities",
            "model_sensitivity_functions",
            "ModelSensitivity", "RootTerms", "STEP_BITS"]
 
@@ -35,10 +35,28 @@ __all__ = ["parameter_value", "moved_parameter", "parameter_directions", "initia
 STEP_BITS = 10
 
 
+def table_entry(model: DAEModel, name: str) -> int | None:
+    """The index in P of ``"<key>[k]"``, element k of the parameter table's vector entry ``key`` (a worn
+    profile's modes, ``"clearance.wear.bearing_cos[1]"``); None for any other name."""
+    key, bracket, rest = name.rpartition("[")
+    if not bracket or not rest.endswith("]") or not rest[:-1].isdigit():
+        return None
+    k = int(rest[:-1])
+    offset = 0
+    for entry, size in model.parameter_layout:
+        if entry == key:
+            return offset + k if k < size else None
+        offset += size
+    return None
+
+
 def parameter_value(model: DAEModel, name: str) -> float:
     """The number a sensitivity parameter ``name`` stands for: a scene value (``"<element>.<field>..."``),
-    ``"baumgarte.alpha"``/``"beta"``, or an entry of the parameter table; SceneError unless one scalar."""
+    ``"baumgarte.alpha"``/``"beta"``, an entry of the parameter table, or element k of a vector entry
+    (``"<key>[k]"``, :func:`table_entry`); SceneError unless one scalar."""
     where = "sensitivities"
+    if isinstance(name, str) and (index := table_entry(model, name)) is not None:
+        return float(model.parameter_values[index])
     if not isinstance(name, str) or name not in model.parameter_names:
         close = close_matches(str(name), model.parameter_names)
         hint = f" Close matches: {', '.join(map(repr, close))}." if close else ""
@@ -50,7 +68,8 @@ def parameter_value(model: DAEModel, name: str) -> float:
     array = np.asarray(value, dtype=float)
     if array.size != 1 or not math.isfinite(float(array.ravel()[0])):
         raise SceneError(f"{where}: parameter={name!r} is {array.tolist()!r}, must be one finite number "
-                         "(a vector value such as a point has no single derivative; name a scalar value).")
+                         "(a vector value such as a point has no single derivative; name a scalar value, or an "
+                         "element '<key>[k]' of a vector entry of model.parameter_layout).")
     return float(array.ravel()[0])
 
 
@@ -81,6 +100,10 @@ def _step(p: float) -> float:
 
 def moved_parameter(model: DAEModel, name: str, value: float) -> DAEModel:
     """``model`` with the parameter ``name`` at ``value`` (the scene's number, or the table entry itself)."""
+    if (index := table_entry(model, name)) is not None:  # an element of a vector entry: that number alone
+        P = model.parameter_values.copy()
+        P[index] = value
+        return dataclasses.replace(model, parameter_values=P)
     if _scene_value(model, name) is not None:
         try:
             return model.with_parameters({name: value})

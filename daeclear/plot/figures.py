@@ -15,7 +15,7 @@ from .joint_figures import (plot_cases, plot_journal_orbit, plot_phase_portrait,
                             plot_slider_path, plot_step_sizes, plot_translational_response)
 from .run_panels import (RESPONSE_CHANNELS, Window, plot_channel, plot_force_penetration, plot_force_time,
                          save_figure, save_response_figure, set_run_title)
-from .sensitivity_figures import plot_sensitivity_horizon
+from .sensitivity_figures import plot_sensitivities, plot_sensitivity_horizon, save_sensitivity_figure
 from .study_figures import (MOTION_COLORS, plot_bifurcation, plot_motion_map, plot_poincare_section,
                             plot_work_precision)
 
@@ -25,9 +25,9 @@ if TYPE_CHECKING:
 __all__ = ["CLEARANCE_PANELS", "MAX_PANELS_PER_ROW", "MOTION_COLORS", "RESPONSE_CHANNELS", "Window", "clearance_joints",
            "default_channels", "plot_bifurcation", "plot_cases", "plot_channel", "plot_force_penetration",
            "plot_force_time", "plot_journal_orbit", "plot_motion_map", "plot_phase_portrait", "plot_poincare_section",
-           "plot_revolute_response", "plot_run", "plot_sensitivity_horizon", "plot_slider_path", "plot_step_sizes",
-           "plot_translational_response",
-           "plot_work_precision", "save_figure", "save_response_figure", "save_run_figure"]
+           "plot_revolute_response", "plot_run", "plot_sensitivities", "plot_sensitivity_horizon", "plot_slider_path",
+           "plot_step_sizes", "plot_translational_response", "plot_work_precision", "save_figure",
+           "save_response_figure", "save_run_figure", "save_sensitivity_figure"]
 
 #: Joint panels per row of :func:`plot_run` (a chain of many links gets several rows).
 MAX_PANELS_PER_ROW = 4

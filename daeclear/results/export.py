@@ -20,10 +20,12 @@ if TYPE_CHECKING:  # pandas and xarray are imported lazily, only where they are 
 __all__ = ["events_frame", "to_pandas", "to_xarray"]
 
 
-def to_pandas(r: Result, *, states: bool = False) -> pd.DataFrame:
+def to_pandas(r: Result, *, states: bool = False, sensitivities: bool = False) -> pd.DataFrame:
     """The channels of ``r`` as a DataFrame indexed by time: :meth:`Result.to_pandas`."""
     pd = _optional("pandas", "Result.to_pandas")
     cols, units = _columns(r, states)
+    if sensitivities:
+        cols, units = _sensitivity_columns(r, cols, units)
     index = pd.Index(np.array(r.t), name="t")
     df = pd.DataFrame({name: np.array(arr) for name, arr in cols.items()}, index=index)
     df.attrs["units"] = {"t": "s", **units}
@@ -52,7 +54,7 @@ def events_frame(r: Result, *, states: bool = False) -> pd.DataFrame:
     return df
 
 
-def to_xarray(r: Result, *, states: bool = True) -> xr.Dataset:
+def to_xarray(r: Result, *, states: bool = True, sensitivities: bool = True) -> xr.Dataset:
     """``r`` as an xarray Dataset, channels over ``t``, events over ``event``: :meth:`Result.to_xarray`."""
     xr = _optional("xarray", "Result.to_xarray")
     variables: dict[str, Any] = {}
@@ -80,6 +82,8 @@ def to_xarray(r: Result, *, states: bool = True) -> xr.Dataset:
                                                      attrs={"units": "s"})
     variables["segment_modes"] = xr.Variable(
         "segment", np.array([json.dumps(s[2], ensure_ascii=False) for s in r.segments], dtype=object))
+    if sensitivities and r.sensitivities is not None:
+        coords.update(_sensitivity_variables(r, variables, states))
     attrs: dict[str, Any] = {**_metadata(r), "success": int(r.success)}
     for key, value in r.stats.items():
         if isinstance(value, bool):
@@ -109,6 +113,50 @@ def _columns(r: Result, states: bool) -> tuple[dict[str, np.ndarray], dict[str, 
             if name not in cols:  # a channel of the same name wins, as in result[name]
                 cols[name], units[name] = r.y[:, j], r.units[name]
     return cols, units
+
+
+def _sensitivity_columns(r: Result, cols: dict[str, np.ndarray], units: dict[str, str]
+                         ) -> tuple[dict[str, np.ndarray], dict[str, str]]:
+    """``cols`` followed by d(column)/d(parameter) of each one-dimensional channel or state among them."""
+    s = r.sensitivities
+    if s is None:
+        from ..core.options import fail
+
+        fail("Result.to_pandas", "sensitivities", True, "False for a run without sensitivities (run "
+             "simulate(..., sensitivities=[...]))")
+    out, out_units = dict(cols), dict(units)
+    for name in cols:
+        if name in s.state_names or name in s.channel_names:
+            S = s.of(name)
+            for j, parameter in enumerate(s.names):
+                out[f"d({name})/d({parameter})"] = S[:, j]
+                out_units[f"d({name})/d({parameter})"] = f"{units[name]} per unit of {parameter}".strip()
+    return out, out_units
+
+
+def _sensitivity_variables(r: Result, variables: dict[str, Any], states: bool) -> dict[str, Any]:
+    """The sensitivities of ``r`` added to ``variables``; return their coordinates."""
+    import xarray as xr
+
+    s = r.sensitivities
+    assert s is not None
+    for i, name in enumerate(s.channel_names):
+        if name in variables and variables[name].ndim == 1:
+            variables[f"sensitivity_{name}"] = xr.Variable(("t", "parameter"), np.array(s.channels[:, i, :]),
+                                                           attrs={"units": f"{r.units[name]} per unit of parameter"})
+    if states:
+        variables["sensitivity_y"] = xr.Variable(("t", "state", "parameter"), np.array(s.states))
+    variables["sensitivity_event_t"] = xr.Variable("sensitivity_event", np.array([e.t for e in s.events], dtype=float),
+                                                   attrs={"units": "s"})
+    variables["sensitivity_event_pair"] = xr.Variable("sensitivity_event", np.array([e.pair for e in s.events],
+                                                                                   dtype=object))
+    variables["sensitivity_event_kind"] = xr.Variable("sensitivity_event", np.array([e.kind for e in s.events],
+                                                                                   dtype=object))
+    variables["sensitivity_event_dt_dp"] = xr.Variable(("sensitivity_event", "parameter"), np.array(
+        [e.dt_dp for e in s.events], dtype=float).reshape(len(s.events), len(s.names)), attrs={"units": "s per unit"})
+    values = np.full(len(s.names), np.nan) if s.values is None else np.asarray(s.values, dtype=float)
+    return {"parameter": xr.Variable("parameter", np.array(s.names, dtype=object)),
+            "parameter_value": xr.Variable("parameter", values)}
 
 
 def _metadata(r: Result) -> dict[str, Any]:

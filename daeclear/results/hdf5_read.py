@@ -14,9 +14,9 @@ import numpy as np
 
 from ..core.errors import DaeclearError, SceneError
 from ..core.events import ContactEvent
-from .hdf5_write import FORMAT_NAME, FORMAT_VERSION
+from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, SIDES
 from .lazy_channels import LazyChannels, rebuilt_evaluator
-from .sensitivities import Sensitivities, sensitivity_events
+from .sensitivities import EventSides, Sensitivities, sensitivity_events
 from ..core.values import time_window
 
 if TYPE_CHECKING:  # h5py is imported lazily, only where a file is read
@@ -185,7 +185,8 @@ def _read(r: _Reader) -> dict[str, Any]:
             parameters_s, tuple(state_names), tuple(r.strings("sensitivities/channel_names")),
             r.array("sensitivities/states", points), r.array("sensitivities/channels", points),
             sensitivity_events([float(ev_t[i]) for i in inside], [pairs[i] for i in inside],
-                               [kinds[i] for i in inside], dt_dp[inside]))
+                               [kinds[i] for i in inside], dt_dp[inside]), _sides(r),
+            r.array("sensitivities/values") if r.has("sensitivities/values") else None)
     return dict(t=t, y=y, yp=yp, state_names=state_names, channels=channels, units=units, events=events,
                 sensitivities=sensitivities,
                 segments=segments, stats=r.json("stats_json"), success=bool(r.attr("success")),
@@ -194,6 +195,16 @@ def _read(r: _Reader) -> dict[str, Any]:
                 formulation=str(r.attr("formulation")),
                 warnings=r.json("warnings_json") if r.has("warnings_json") else [],  # older files: no warnings
                 **steps)
+
+
+def _sides(r: _Reader) -> EventSides | None:
+    """The rows at each event inside the window (None in a file written before they were kept)."""
+    if not r.has("sensitivities/sides"):
+        return None
+    t = r.array("sensitivities/sides/t")
+    lo, hi = r.window
+    rows = (t >= lo) & (t <= hi)
+    return EventSides(*(r.array(f"sensitivities/sides/{name}")[rows] for name in SIDES))
 
 
 def read_group(group: h5py.Group, path: Path) -> dict[str, Any]:

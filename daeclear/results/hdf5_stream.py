@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, json_dataset, mirror, string_dataset
+from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, SIDES, json_dataset, mirror, string_dataset
 from .run_file import STREAM_ROWS, append_rows, extendable
 from ..core.values import to_plain
 
@@ -22,6 +22,7 @@ if TYPE_CHECKING:  # h5py is imported lazily, only where a file is written
     import h5py
 
     from ..core.events import ContactEvent
+    from .sensitivities import Sensitivities
 
 __all__ = ["STREAM_RUNNING", "ResultWriter"]
 
@@ -51,6 +52,7 @@ class ResultWriter:
         self.path = Path(path)
         self._units = dict(units)
         self._n = len(state_names)
+        self._staged: list[NDArray[np.float64]] = []  # the sensitivities of rows not yet appended (states, channels)
         self._f = f = h5py.File(self.path, "w")
         try:
             f.attrs["format"] = FORMAT_NAME
@@ -88,6 +90,45 @@ class ResultWriter:
         except BaseException:
             f.close()
             raise
+
+    def sensitivities(self, names: Sequence[str], channel_names: Sequence[str], values: ArrayLike) -> None:
+        """Add the ``/sensitivities`` group of a run with sensitivities (docs/hdf5_layout.md; the parameters'
+        ``names`` and ``values``, the arrays empty), which
+        :meth:`stage_sensitivities` fills as the run goes."""
+        import h5py
+
+        g = self._f.create_group("sensitivities")
+        string_dataset(g, "names", list(names))
+        g.create_dataset("values", data=np.asarray(values, dtype=np.float64))
+        string_dataset(g, "channel_names", list(channel_names))
+        width, n_ch, text = len(names), len(channel_names), h5py.string_dtype()
+        self._grow(g, "states", np.float64, (self._n, width))
+        self._grow(g, "channels", np.float64, (n_ch, width))
+        for group, columns in (("events", {"t": (np.float64, ()), "pair": (text, ()), "kind": (text, ()),
+                                           "dt_dp": (np.float64, (width,))}),
+                               ("sides", {"t": (np.float64, ()), "y": (np.float64, (self._n,)),
+                                          "values": (np.float64, (n_ch,)), "states": (np.float64, (self._n, width)),
+                                          "channels": (np.float64, (n_ch, width))})):
+            sub = g.create_group(group)
+            for name, (dtype, rest) in columns.items():
+                self._grow(sub, name, dtype, rest, rows=_LIST_ROWS)
+        self._f.flush()
+        self._staged = [np.zeros((0, self._n, width)), np.zeros((0, n_ch, width))]
+
+    def stage_sensitivities(self, s: Sensitivities) -> None:
+        """The sensitivities carried since the last call: the events and their rows appended now; S of the
+        states and channels (``s.states``, ``s.channels``, one row per output row) appended with the output
+        rows of the next :meth:`append`, in the same change (the file's rows of ``/t`` and of S never differ)."""
+        self._staged = [np.concatenate([self._staged[0], s.states]), np.concatenate([self._staged[1], s.channels])]
+        g = self._f["sensitivities"]
+        items = [(g["events/t"], np.array([e.t for e in s.events], dtype=np.float64)),
+                 (g["events/pair"], np.array([e.pair for e in s.events], dtype=object)),
+                 (g["events/kind"], np.array([e.kind for e in s.events], dtype=object)),
+                 (g["events/dt_dp"], np.array([e.dt_dp for e in s.events], dtype=np.float64).reshape(
+                     len(s.events), len(s.names)))]
+        if s.sides is not None:
+            items += [(g[f"sides/{name}"], getattr(s.sides, name)) for name in SIDES]
+        append_rows(self._f, items, path=self.path, what="stream_to")
 
     @staticmethod
     def _grow(group: h5py.Group, name: str, dtype: Any, rest: tuple[int, ...] = (),
@@ -134,6 +175,13 @@ class ResultWriter:
         items: list[tuple[h5py.Dataset, Any]] = [(f["t"], t_arr), (f["y"], np.asarray(y, dtype=np.float64))]
         if "yp" in f:
             items.append((f["yp"], np.asarray(yp, dtype=np.float64)))
+        if self._staged:  # a run with sensitivities: S of these rows (NaN for a row the run did not give S)
+            k = t_arr.size
+            for dataset, staged in zip((f["sensitivities/states"], f["sensitivities/channels"]), self._staged):
+                rows = staged[:k] if staged.shape[0] >= k else np.concatenate(
+                    [staged, np.full((k - staged.shape[0], *staged.shape[1:]), np.nan)])
+                items.append((dataset, rows))
+            self._staged = [staged[k:] for staged in self._staged]
         rows = np.asarray(switch if switch is not None else np.zeros((t_arr.size, 0)), dtype=np.float64)
         if rows.shape[1:] != (0,):  # one row per point, repeated over a segment: gzip makes it small
             if "switch" not in f:

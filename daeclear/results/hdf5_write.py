@@ -22,7 +22,7 @@ if TYPE_CHECKING:  # h5py is imported lazily, only where a file is written
     from .result import Result
     from .sensitivities import Sensitivities
 
-__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "json_dataset", "mirror", "save_result", "stores_states_only",
+__all__ = ["SIDES", "FORMAT_NAME", "FORMAT_VERSION", "json_dataset", "mirror", "save_result", "stores_states_only",
            "string_dataset", "write_result_group"]
 
 FORMAT_NAME = "daeclear-result"
@@ -31,6 +31,9 @@ FORMAT_NAME = "daeclear-result"
 FORMAT_VERSION = 2
 """Version of the HDF5 layout written by this daeclear; `load` reads versions <= this (version 1: every
 channel stored, no ``/switch``)."""
+
+SIDES: tuple[str, ...] = ("t", "y", "values", "states", "channels")
+"""The datasets of ``/sensitivities/sides``: the fields of :class:`daeclear.results.sensitivities.EventSides`."""
 
 _COMPRESS_MIN_SIZE = 16384  # values; smaller arrays are stored contiguous, uncompressed
 _MIRROR_ATTR_MAX_LEN = 1024  # longer lists become datasets (HDF5 attributes are limited to 64 KiB)
@@ -154,8 +157,10 @@ def _write(f: h5py.File | h5py.Group, r: Result, channels: bool = False) -> None
 
 def _write_sensitivities(group: h5py.Group, s: Sensitivities) -> None:
     """A run's forward sensitivities (``simulate(..., sensitivities=[...])``): names, S of the states and
-    the channels at every output time, each event time's sensitivity."""
+    the channels at every output time, each event time's sensitivity, the rows at each event."""
     string_dataset(group, "names", s.names)
+    if s.values is not None:
+        _dataset(group, "values", np.asarray(s.values, dtype=np.float64))
     _dataset(group, "states", np.asarray(s.states, dtype=np.float64))
     string_dataset(group, "channel_names", s.channel_names)
     _dataset(group, "channels", np.asarray(s.channels, dtype=np.float64))
@@ -164,6 +169,10 @@ def _write_sensitivities(group: h5py.Group, s: Sensitivities) -> None:
     string_dataset(events, "pair", [e.pair for e in s.events])
     string_dataset(events, "kind", [e.kind for e in s.events])
     _dataset(events, "dt_dp", np.array([e.dt_dp for e in s.events], dtype=np.float64).reshape(-1, len(s.names)))
+    if s.sides is not None:  # each event's rows before and after its switch (the objectives read them)
+        sides = group.create_group("sides")
+        for name in SIDES:
+            _dataset(sides, name, np.asarray(getattr(s.sides, name), dtype=np.float64))
 
 
 def stores_states_only(r: Result) -> bool:

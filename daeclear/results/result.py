@@ -27,7 +27,9 @@ from .hdf5_stream import STREAM_RUNNING, ResultWriter
 from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, save_result, write_result_group
 from .lazy_channels import LazyChannels
 from .result_checks import checked_fields
-from .sensitivities import Sensitivities
+from .objectives import Gradient, Objective, evaluate
+from .sensitivities import RunTrajectory, Sensitivities
+from .sensitivity_growth import SensitivityHorizon, sensitivity_horizon
 from ..core.values import readonly, time_window, to_plain
 
 if TYPE_CHECKING:  # h5py, pandas and xarray are imported lazily, only where they are used
@@ -236,6 +238,33 @@ class Result:
             raise KeyError("Result.sensitivity: this run has no sensitivities; run "
                            "simulate(..., sensitivities=[names from model.parameter_names]).")
         return self.sensitivities.of(name, parameter)
+
+    @property
+    def sensitivity_horizon(self) -> SensitivityHorizon:
+        """How fast the run's sensitivities grow: G(t), the largest |dy_i/dp_j| |p_j| / max|y_i| over the states
+        and parameters, its finite-time Lyapunov estimate (the slope of ln G) and the predictability horizon
+        t0 + ln(1/rtol)/lambda at the run's rtol, past which a derivative means nothing (docs/sensitivities.md,
+        "Chaos"). Drawn by ``daeclear.plot.plot_sensitivity_horizon(result)``."""
+        if self.sensitivities is None:
+            raise KeyError("Result.sensitivity_horizon: this run has no sensitivities; run "
+                           "simulate(..., sensitivities=[names from model.parameter_names]).")
+        s = self.sensitivities
+        rtol = float(self.parameters.get("simulate", {}).get("rtol", math.nan))
+        if not 0.0 < rtol < 1.0:
+            raise KeyError("Result.sensitivity_horizon: the result does not record its run's rtol "
+                           "(parameters['simulate']['rtol']).")
+        values = np.ones(len(s.names)) if s.values is None else s.values  # an older file: relative to 1
+        return sensitivity_horizon(self.t, self.y, s.states, values, rtol)
+
+    def gradient(self, of: Objective) -> Gradient:
+        """The objective ``of`` (``dc.Final``, ``dc.Integral``, ``dc.Peak``, ``dc.EventTime``) on this run and
+        its gradient w.r.t. :attr:`sensitivity_names`, as ``dc.gradient`` computes it: a run's result or a
+        loaded one alike (the file keeps each event's rows). An Integral or a Peak reads the output rows:
+        give the run enough of them (``SaveAt(times=...)``)."""
+        if self.sensitivities is None:
+            raise KeyError("Result.gradient: this run has no sensitivities; run "
+                           "simulate(..., sensitivities=[names from model.parameter_names]).")
+        return evaluate(of, RunTrajectory(self.t, self.__getitem__, self.sensitivities))
 
     def state(self, i: int) -> NDArray[np.float64]:
         """Row ``i`` of :attr:`y` (e.g. -1: the state to continue a run from), without making every row
@@ -446,16 +475,17 @@ class Result:
 
     # ------------------------------------------------------------------ hand-off to pandas and xarray
 
-    def to_pandas(self, *, states: bool = False) -> pd.DataFrame:
+    def to_pandas(self, *, states: bool = False, sensitivities: bool = False) -> pd.DataFrame:
         """The channels as a pandas DataFrame (copies), one column per channel, indexed by time ``"t"``.
 
         An event time may appear twice (before and after a restart); a channel of shape (n_times, k)
         becomes the columns ``"name[0]"`` ... ``"name[k-1]"``; ``states=True`` adds the states that
         are not channels. ``df.attrs`` holds ``"units"`` (per column and ``"t"``), scene_name, method,
-        formulation, success, status and message. MissingDependencyError (an ImportError) without
-        pandas: ``pip install "daeclear[data]"``.
+        formulation, success, status and message. ``sensitivities=True`` (a run with them) adds the column
+        ``"d(name)/d(parameter)"`` of each channel (and state) and parameter. MissingDependencyError (an
+        ImportError) without pandas: ``pip install "daeclear[data]"``.
         """
-        return export.to_pandas(self, states=states)
+        return export.to_pandas(self, states=states, sensitivities=sensitivities)
 
     def events_frame(self, *, states: bool = False) -> pd.DataFrame:
         """The contact events as a pandas DataFrame in time order: ``t`` (s), ``pair``, ``kind`` and
@@ -463,7 +493,7 @@ class Result:
         ``df.attrs["units"]``. MissingDependencyError (an ImportError) without pandas."""
         return export.events_frame(self, states=states)
 
-    def to_xarray(self, *, states: bool = True) -> xr.Dataset:
+    def to_xarray(self, *, states: bool = True, sensitivities: bool = True) -> xr.Dataset:
         """The result as an xarray Dataset: channels over ``t``, events over ``event``.
 
         Each channel is a variable over ``t`` (more dimensions named ``"<channel>_dim_1"``, ...) with
@@ -472,10 +502,13 @@ class Result:
         ``event_y`` with states) over ``event``; the segments ``segment_t_start``, ``segment_t_end``,
         ``segment_modes`` (JSON) over ``segment``. Attributes are netCDF-safe (success as 0/1, each
         scalar statistic as ``stats.<name>``, ``stats_json``, ``parameters_json``). ``states=True``
-        adds ``y`` and ``yp`` over (``t``, ``state``). MissingDependencyError (an ImportError) without
-        xarray: ``pip install "daeclear[data]"``.
+        adds ``y`` and ``yp`` over (``t``, ``state``). A run with sensitivities (``sensitivities=True``) adds
+        ``sensitivity_<channel>`` over (``t``, ``parameter``), with states ``sensitivity_y`` over (``t``, ``state``,
+        ``parameter``), and its events' ``sensitivity_event_t``, ``_pair``, ``_kind``, ``_dt_dp``; coordinates
+        ``parameter`` and ``parameter_value``. MissingDependencyError (an ImportError) without xarray:
+        ``pip install "daeclear[data]"``.
         """
-        return export.to_xarray(self, states=states)
+        return export.to_xarray(self, states=states, sensitivities=sensitivities)
 
     # ------------------------------------------------------------------ HDF5
 

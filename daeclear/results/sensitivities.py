@@ -39,12 +39,18 @@ class EventSides:
     states: NDArray[np.float64]
     channels: NDArray[np.float64]
 
+    def within(self, lo: float, hi: float) -> EventSides:
+        """The rows of the events in [lo, hi] (a window of the result)."""
+        rows = (self.t >= lo) & (self.t <= hi)
+        return EventSides(self.t[rows], self.y[rows], self.values[rows], self.states[rows], self.channels[rows])
+
 
 @dataclass(frozen=True)
 class Sensitivities:
     """``names`` (the parameters), ``states`` (n_times, n_states, Ns) and ``channels`` (n_times,
     n_channels, Ns) in the order of ``state_names`` and ``channel_names``, ``events``; ``sides``: the rows
-    before and after each event (a run's, in memory; a file does not keep them)."""
+    before and after each event; ``values``: the parameters' values in the run (None in a file written
+    before either was kept)."""
 
     names: tuple[str, ...]
     state_names: tuple[str, ...]
@@ -53,6 +59,7 @@ class Sensitivities:
     channels: NDArray[np.float64]
     events: tuple[SensitivityEvent, ...] = ()
     sides: EventSides | None = None
+    values: NDArray[np.float64] | None = None
 
     def of(self, name: str, parameter: str | None = None) -> NDArray[np.float64]:
         """d(name)/d(parameter) at every output time, (n_times,); every parameter (n_times, Ns) without one."""
@@ -73,7 +80,8 @@ class Sensitivities:
     def take(self, rows: NDArray[np.bool_], lo: float, hi: float) -> Sensitivities:
         """The rows ``rows`` and the events in [lo, hi] (a window of the result)."""
         return Sensitivities(self.names, self.state_names, self.channel_names, self.states[rows],
-                             self.channels[rows], tuple(e for e in self.events if lo <= e.t <= hi))  # sides: none
+                             self.channels[rows], tuple(e for e in self.events if lo <= e.t <= hi),
+                             None if self.sides is None else self.sides.within(lo, hi), self.values)
 
 
 def sensitivity_events(t: Sequence[float], pairs: Sequence[str], kinds: Sequence[str],
@@ -91,7 +99,8 @@ class RunTrajectory:
 
     def __init__(self, t: NDArray[np.float64], read: Callable[[str], NDArray[np.float64]], sens: Sensitivities) -> None:
         if sens.sides is None:
-            raise ValueError("RunTrajectory: the sensitivities have no rows at the events (a loaded file's)")
+            raise ValueError("RunTrajectory: the sensitivities have no rows at the events (a file written before "
+                             "they were saved: run it again)")
         self.sides, self.sens, self.read = sens.sides, sens, read
         self.keep = ~np.isin(t, self.sides.t)
         joined = np.concatenate([t[self.keep], self.sides.t])

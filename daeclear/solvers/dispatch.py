@@ -18,8 +18,7 @@ from .base import Solver
 from .registry import solver_class
 from .ida import IDA
 from .sensitivity_ida import SensitivityIDA
-from .save_at import Output
-from ..assembly.sensitivity import parameter_value
+from ..assembly.sensitivity import parameter_value, table_entry
 
 DEFAULTS = SolverOptions()
 
@@ -72,8 +71,9 @@ def simulate(
         New numbers for this run by name (:meth:`DAEModel.with_parameters`); nothing is compiled.
     sensitivities : list of str or None
         Names from ``model.parameter_names``: IDA integrates S = dy/dp with the states, with the jumps at
-        every event (:meth:`Result.sensitivity`, docs/sensitivities.md). IDA only; not with ``y0`` or a
-        streamed output. None (the default): no cost.
+        every event (:meth:`Result.sensitivity`, docs/sensitivities.md); a streamed output
+        (``SaveAt(stream_to=...)``) writes them as the run goes. IDA only; not with ``y0``. None (the
+        default): no cost.
 
     Returns
     -------
@@ -114,7 +114,7 @@ def simulate(
             scene = assemble(scene, settings.formulation or solver.formulation, track_work=settings.track_work)
         scene = scene.with_parameters(parameters)
     if sensitivities is not None:
-        names = checked_sensitivities(sensitivities, solver, y0, out)
+        names = checked_sensitivities(sensitivities, solver, y0)
         if isinstance(scene, Scene):  # the names are the model's: assembled first
             scene = assemble(scene, settings.formulation or solver.formulation, track_work=settings.track_work)
         parameter_names(scene, names)
@@ -126,9 +126,9 @@ def simulate(
     return result
 
 
-def checked_sensitivities(value: object, solver: Solver, y0: object, out: Output) -> list[str]:
+def checked_sensitivities(value: object, solver: Solver, y0: object) -> list[str]:
     """``simulate``'s ``sensitivities``: a non-empty list of distinct names, for a run that can carry them
-    (IDA, from its own start, kept in memory); checked before any work."""
+    (IDA, from its own start); checked before any work."""
     if isinstance(value, str) or not isinstance(value, Sequence) or not value:
         opts.fail("simulate", "sensitivities", value, "None or a non-empty list of names from "
                   "model.parameter_names, e.g. ['clearance.clearance']")
@@ -144,17 +144,15 @@ def checked_sensitivities(value: object, solver: Solver, y0: object, out: Output
     if y0 is not None:
         opts.fail("simulate", "sensitivities", value, "None when y0 is given: S starts as dy0/dp of the run's "
                   "own start (options.start), and a given state has none")
-    if out.stream_to is not None:
-        opts.fail("simulate", "sensitivities", value, "None with SaveAt(stream_to=...): a streamed file does not "
-                  "hold sensitivities yet; run in memory and save the result (result.save)")
     return names
 
 
 def parameter_names(model: DAEModel, names: list[str]) -> None:
-    """Each name one of ``model.parameter_names`` and one finite number (SceneError naming it otherwise)."""
+    """Each name one of ``model.parameter_names`` (or an element ``"<key>[k]"`` of a vector entry of the parameter
+    table, a worn profile's mode) and one finite number (SceneError naming it otherwise)."""
     known = model.parameter_names
     for name in names:
-        if name not in known:
+        if name not in known and table_entry(model, name) is None:
             close = opts.close_matches(name, known)
             hint = f"close matches: {', '.join(map(repr, close))}" if close else (
                 f"e.g. {', '.join(map(repr, list(known)[:4]))}")

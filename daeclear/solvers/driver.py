@@ -391,6 +391,8 @@ class Driver:
         incomplete are completed first (multipliers and accelerations from q and v), unless a result in
         memory makes its IDA rows consistent when they are first read."""
         raw = self.raw
+        if self.carried is not None and self.rec.writer is not None:  # streamed: S goes with its rows
+            self.carried.stream(self.rec.writer)
         if self.rec.consistent_when_read:  # as the integrator left them, joined once (by the recorder)
             for t, y, switch in raw:
                 self.rec.add_points(t, y, None, switch)

@@ -73,8 +73,8 @@ class Jump:
 class Carried(Protocol):
     """An integrator that carries a quantity beside a run's states, which jumps at its events (the
     sensitivities of :mod:`daeclear.solvers.sensitivity_ida`, its parameters ``names``): the driver
-    calls :meth:`jump` at every event, before the integrator restarts, and :meth:`attach` with the
-    finished Result."""
+    calls :meth:`jump` at every event, before the integrator restarts, :meth:`stream` before it hands rows
+    to a streamed file, and :meth:`attach` with the finished Result."""
 
     names: tuple[str, ...]
 
@@ -84,6 +84,11 @@ class Carried(Protocol):
 
     def attach(self, result: Any) -> None:
         """Put what was carried on the run's Result."""
+        ...
+
+    def stream(self, writer: Any) -> None:
+        """A streamed run: what was carried since the last call to the run's file (its ResultWriter), before
+        the driver appends the rows it goes with."""
         ...
 
 

@@ -24,14 +24,14 @@ from numpy.typing import NDArray
 
 from ..assembly.contact_state import ContactState
 from ..assembly.dae_model import DAEModel
-from ..assembly.sensitivity import initial_sensitivities
+from ..assembly.sensitivity import initial_sensitivities, parameter_value
 from ..core.automaton import PairState
 from ..engine.ida_session import open_session
 from ..engine.sensitivity_functions import augmented_functions
 from ..engine.session_base import Advance, Session
 from . import ida
 from .integrator import Jump, Terms
-from ..results.result import Result
+from ..results.result import Result, ResultWriter
 from ..results.sensitivities import EventSides, Sensitivities
 from .save_at import Output
 from .sensitivity_carrier import SensitivityCarrier, parameter_scales
@@ -89,6 +89,7 @@ class SensitivityIntegrator:
         atol = tolerance_vector(model, rtol, settings.atol_value())
         self.sens = SensitivityCarrier(model, names, rtol, atol)
         self.names = self.sens.names
+        self.values = np.array([parameter_value(model, name) for name in self.names])  # the run's parameters
         W = self.sens.width
         pbar = parameter_scales(model, self.sens.names)
         block = not self.stacked_factorisation
@@ -184,16 +185,33 @@ class SensitivityIntegrator:
 
     def attach(self, result: Result) -> None:
         """The rows' and events' sensitivities onto the run's Result (the rows it kept: after a MemoryError
-        the driver drops its last unrecorded rows)."""
-        c, model, n = self.sens, self.model, result.n_times
+        the driver drops its last unrecorded rows); a streamed run's file holds them (read back with it)."""
+        if not self.streamed:
+            result.sensitivities = self.collected(result.n_times)
+
+    streamed = False  # the run streams its sensitivities to its file (stream)
+
+    def stream(self, writer: ResultWriter) -> None:
+        """A streamed run's sensitivities carried since the last call to its file (S with the output rows the
+        driver appends next), then dropped: the run's memory does not grow with its length."""
+        c = self.sens
+        if not self.streamed:
+            writer.sensitivities(c.names, self.model.channel_names, self.values)
+            self.streamed = True
+        writer.stage_sensitivities(self.collected(min(len(c.rows_S), len(c.rows_channel_S))))
+        for kept in (c.rows_t, c.rows_S, c.rows_channel_S, c.rows_channels, c.events, c.event_t, c.event_rows):
+            kept.clear()
+
+    def collected(self, n: int) -> Sensitivities:
+        """The first ``n`` rows carried, every event and its rows."""
+        c, model = self.sens, self.model
         shape = (0, model.n_states, c.width), (0, len(model.channel_names), c.width)
         states = np.stack(c.rows_S[:n]) if n else np.zeros(shape[0])
         channels = np.stack(c.rows_channel_S[:n]) if n else np.zeros(shape[1])
-        k = len(c.event_t)
+        k = len(c.event_rows)
         n_ch = len(model.channel_names)
-        sides = EventSides(np.array(c.event_t), *(
+        sides = EventSides(np.array(c.event_t[:k]), *(
             np.stack([row[i] for row in c.event_rows]) if k else np.zeros(empty)
             for i, empty in ((0, (0, model.n_states)), (3, (0, n_ch)), (1, shape[0]), (2, shape[1]))))
-        result.sensitivities = Sensitivities(c.names, tuple(model.state_names), tuple(model.channel_names),
-                                             states, channels, tuple(c.events), sides)
-
+        return Sensitivities(c.names, tuple(model.state_names), tuple(model.channel_names),
+                             states, channels, tuple(c.events), sides, self.values)

@@ -20,8 +20,8 @@ from ..assembly.sensitivity import moved_parameter, parameter_value
 from ..core import options
 from ..core.errors import SolveError
 from ..model.scene import Scene
-from ..results.objectives import EventTime, Final, Gradient, Integral, Objective, Peak, evaluate
-from ..results.sensitivities import RunTrajectory
+from ..results.objectives import EventTime, Final, Gradient, Integral, Objective, Peak
+from ..results.result import Result
 from ..solvers.dispatch import simulate
 from ..solvers.save_at import SaveAt
 from ..solvers.solver_options import SolverOptions
@@ -70,21 +70,20 @@ def gradient(scene_or_model: Scene | DAEModel, t_end: float, *, of: Objective, p
     settings = SolverOptions(rtol=tol, atol=atol, start=start, backend=backend)
     save = SaveAt(times=times, steps=False)
 
-    def run(m: DAEModel, wanted: Sequence[str]) -> RunTrajectory:
+    def run(m: DAEModel, wanted: Sequence[str]) -> Result:
         out = simulate(m, end, options=settings, save=save, sensitivities=wanted, on_failure="return")
         if not out.success:
             raise SolveError(f"gradient: the run failed at t={out.t[-1] if out.t.size else 0.0:.6g} s "
                              f"({out.message}).", out)
-        assert out.sensitivities is not None
-        return RunTrajectory(out.t, out.__getitem__, out.sensitivities)
+        return out
 
     if chosen == "sensitivities":
-        return evaluate(of, run(model, names))
-    base = evaluate(of, run(model, names[:1])).value
+        return run(model, names).gradient(of)
+    base = run(model, names[:1]).gradient(of).value
     grad: dict[str, float] = {}
     for name, p in values.items():
         h = tol ** (1.0 / 3.0) * (abs(p) or 1.0)
-        plus, minus = (evaluate(of, run(moved_parameter(model, name, p + s * h), names[:1])).value for s in (1, -1))
+        plus, minus = (run(moved_parameter(model, name, p + s * h), names[:1]).gradient(of).value for s in (1, -1))
         grad[name] = (plus - minus) / (2.0 * h)
     return Gradient(of, base, grad, "fd")
 
