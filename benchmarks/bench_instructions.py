@@ -60,19 +60,18 @@ for k in range(2, 2 + rounds):
 TOTAL = re.compile(r"^(?:summary|totals):\s+(\d+)", re.MULTILINE)
 
 
-def worker(tree: Path, cache: Path, kind: str, rounds: int, out: Path | None = None) -> None:
-    """The worker in ``tree``'s package, under callgrind when ``out`` is given (its output file)."""
+def callgrind(tree: Path, cache: Path, code: str, argv: list[str], out: Path | None = None) -> int:
+    """Run the worker ``code`` with ``argv`` in ``tree``'s package, under callgrind when ``out`` is given (its
+    output file): the instructions it counts for the whole process, or 0 without ``out`` (a plain run, e.g.
+    one that compiles into the cache)."""
     env = {**tree_env(tree, cache), "PYTHONHASHSEED": "0", "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     tool = [] if out is None else ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}"]
-    done = subprocess.run([*tool, sys.executable, "-c", WORKER, kind, str(rounds)], cwd=tree, env=env,
+    done = subprocess.run([*tool, sys.executable, "-c", code, *argv], cwd=tree, env=env,
                           capture_output=True, text=True, check=False)
     if done.returncode != 0:
         raise SystemExit(f"{tree}: the worker failed ({done.returncode}):\n{done.stderr[-2000:]}")
-
-
-def instructions(tree: Path, cache: Path, kind: str, rounds: int, out: Path) -> int:
-    """Instructions callgrind counts for the worker in ``tree``'s package (the whole process)."""
-    worker(tree, cache, kind, rounds, out)
+    if out is None:
+        return 0
     found = TOTAL.search(out.read_text())
     if found is None:
         raise SystemExit(f"{out}: no total in callgrind's output")
@@ -93,9 +92,9 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for label, tree in (("old", args.old.resolve()), ("new", args.new.resolve())):
             cache = Path(tmp) / label
-            worker(tree, cache, args.call, 0)  # compiles into the tree's cache, without callgrind
-            warm = instructions(tree, cache, args.call, 0, Path(tmp) / f"{label}.warm.out")
-            full = instructions(tree, cache, args.call, args.rounds, Path(tmp) / f"{label}.full.out")
+            callgrind(tree, cache, WORKER, [args.call, "0"])  # compiles into the tree's cache, without callgrind
+            warm = callgrind(tree, cache, WORKER, [args.call, "0"], Path(tmp) / f"{label}.warm.out")
+            full = callgrind(tree, cache, WORKER, [args.call, str(args.rounds)], Path(tmp) / f"{label}.full.out")
             measured[label] = full - warm
             print(f"{label}: {measured[label]:,} instructions in {calls} calls ({measured[label] / calls:,.0f} a call; "
                   f"warm-up {warm:,})", flush=True)

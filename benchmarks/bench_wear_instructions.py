@@ -17,12 +17,10 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import tempfile
 from pathlib import Path
 
-from bench_instructions import TOTAL
-from bench_trees import tree_env
+from bench_instructions import callgrind
 
 #: the worker: argv = cycles (0: the warm-up alone)
 WORKER = r"""
@@ -39,25 +37,6 @@ if cycles:
 """
 
 
-def instructions(tree: Path, cache: Path, cycles: int, out: Path | None) -> int:
-    """Instructions callgrind counts for the worker in ``tree``'s package (the whole process); without
-    ``out`` the worker runs alone (compiling into the cache) and 0 is returned."""
-    import subprocess
-
-    env = {**tree_env(tree, cache), "PYTHONHASHSEED": "0", "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
-    tool = [] if out is None else ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}"]
-    done = subprocess.run([*tool, sys.executable, "-c", WORKER, str(cycles)], cwd=tree, env=env,
-                          capture_output=True, text=True, check=False)
-    if done.returncode != 0:
-        raise SystemExit(f"{tree}: the worker failed ({done.returncode}):\n{done.stderr[-2000:]}")
-    if out is None:
-        return 0
-    found = TOTAL.search(out.read_text())
-    if found is None:
-        raise SystemExit(f"{out}: no total in callgrind's output")
-    return int(found.group(1))
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("old", type=Path)
@@ -70,9 +49,9 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for label, tree in (("old", args.old.resolve()), ("new", args.new.resolve())):
             cache = Path(tmp) / label
-            instructions(tree, cache, 0, None)  # compiles into the tree's cache, without callgrind
-            warm = instructions(tree, cache, 0, Path(tmp) / f"{label}.warm.out")
-            full = instructions(tree, cache, args.cycles, Path(tmp) / f"{label}.full.out")
+            callgrind(tree, cache, WORKER, ["0"])  # compiles into the tree's cache, without callgrind
+            warm = callgrind(tree, cache, WORKER, ["0"], Path(tmp) / f"{label}.warm.out")
+            full = callgrind(tree, cache, WORKER, [str(args.cycles)], Path(tmp) / f"{label}.full.out")
             measured[label] = (full - warm) / args.cycles
             print(f"{label}: {measured[label]:,.0f} instructions a simulated cycle ({args.cycles} cycles; "
                   f"warm-up {warm:,})", flush=True)
