@@ -78,6 +78,18 @@ def callgrind(tree: Path, cache: Path, code: str, argv: list[str], out: Path | N
     return int(found.group(1))
 
 
+def work_instructions(tree: Path, folder: Path, label: str, code: str, args: list[str], units: int
+                      ) -> tuple[int, int]:
+    """(instructions of ``units`` units of the worker's work, those of its warm-up) in ``tree``'s package:
+    the worker run once to compile into its own cache under ``folder``, then with 0 and ``units`` units
+    (its last argument) under callgrind; the work is the difference, set-up and imports cancelled."""
+    cache = folder / label
+    callgrind(tree, cache, code, [*args, "0"])  # compiles into the tree's cache, without callgrind
+    warm = callgrind(tree, cache, code, [*args, "0"], folder / f"{label}.warm.out")
+    full = callgrind(tree, cache, code, [*args, str(units)], folder / f"{label}.full.out")
+    return full - warm, warm
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("old", type=Path)
@@ -91,11 +103,7 @@ def main() -> None:
     measured = {}
     with tempfile.TemporaryDirectory() as tmp:
         for label, tree in (("old", args.old.resolve()), ("new", args.new.resolve())):
-            cache = Path(tmp) / label
-            callgrind(tree, cache, WORKER, [args.call, "0"])  # compiles into the tree's cache, without callgrind
-            warm = callgrind(tree, cache, WORKER, [args.call, "0"], Path(tmp) / f"{label}.warm.out")
-            full = callgrind(tree, cache, WORKER, [args.call, str(args.rounds)], Path(tmp) / f"{label}.full.out")
-            measured[label] = full - warm
+            measured[label], warm = work_instructions(tree, Path(tmp), label, WORKER, [args.call], args.rounds)
             print(f"{label}: {measured[label]:,} instructions in {calls} calls ({measured[label] / calls:,.0f} a call; "
                   f"warm-up {warm:,})", flush=True)
     print(f"new / old: {measured['new'] / measured['old']:.4f}")

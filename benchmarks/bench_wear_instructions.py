@@ -20,7 +20,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from bench_instructions import callgrind
+from bench_instructions import work_instructions
 
 #: the worker: argv = cycles (0: the warm-up alone)
 WORKER = r"""
@@ -48,11 +48,8 @@ def main() -> None:
     measured = {}
     with tempfile.TemporaryDirectory() as tmp:
         for label, tree in (("old", args.old.resolve()), ("new", args.new.resolve())):
-            cache = Path(tmp) / label
-            callgrind(tree, cache, WORKER, ["0"])  # compiles into the tree's cache, without callgrind
-            warm = callgrind(tree, cache, WORKER, ["0"], Path(tmp) / f"{label}.warm.out")
-            full = callgrind(tree, cache, WORKER, [str(args.cycles)], Path(tmp) / f"{label}.full.out")
-            measured[label] = (full - warm) / args.cycles
+            work, warm = work_instructions(tree, Path(tmp), label, WORKER, [], args.cycles)
+            measured[label] = work / args.cycles
             print(f"{label}: {measured[label]:,.0f} instructions a simulated cycle ({args.cycles} cycles; "
                   f"warm-up {warm:,})", flush=True)
     print(f"new / old: {measured['new'] / measured['old']:.4f} (old / new: {measured['old'] / measured['new']:.3f})")
