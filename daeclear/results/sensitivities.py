@@ -8,8 +8,8 @@ sensitivity dt*/dp. Read through :meth:`daeclear.Result.sensitivity`; saved and 
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,7 +50,8 @@ class Sensitivities:
     """``names`` (the parameters), ``states`` (n_times, n_states, Ns) and ``channels`` (n_times,
     n_channels, Ns) in the order of ``state_names`` and ``channel_names``, ``events``; ``sides``: the rows
     before and after each event; ``values``: the parameters' values in the run (None in a file written
-    before either was kept)."""
+    before either was kept); ``integrals``: {channel: (Q (n_times,), dQ/dp (n_times, Ns))}, the integrals
+    from the run's start integrated as states under error control (``simulate(..., integrals=[...])``)."""
 
     names: tuple[str, ...]
     state_names: tuple[str, ...]
@@ -60,6 +61,7 @@ class Sensitivities:
     events: tuple[SensitivityEvent, ...] = ()
     sides: EventSides | None = None
     values: NDArray[np.float64] | None = None
+    integrals: Mapping[str, tuple[NDArray[np.float64], NDArray[np.float64]]] = field(default_factory=dict)
 
     def of(self, name: str, parameter: str | None = None) -> NDArray[np.float64]:
         """d(name)/d(parameter) at every output time, (n_times,); every parameter (n_times, Ns) without one."""
@@ -81,7 +83,8 @@ class Sensitivities:
         """The rows ``rows`` and the events in [lo, hi] (a window of the result)."""
         return Sensitivities(self.names, self.state_names, self.channel_names, self.states[rows],
                              self.channels[rows], tuple(e for e in self.events if lo <= e.t <= hi),
-                             None if self.sides is None else self.sides.within(lo, hi), self.values)
+                             None if self.sides is None else self.sides.within(lo, hi), self.values,
+                             {c: (Q[rows], dQ[rows]) for c, (Q, dQ) in self.integrals.items()})
 
 
 def sensitivity_events(t: Sequence[float], pairs: Sequence[str], kinds: Sequence[str],
@@ -101,13 +104,21 @@ class RunTrajectory:
         if sens.sides is None:
             raise ValueError("RunTrajectory: the sensitivities have no rows at the events (a file written before "
                              "they were saved: run it again)")
-        self.sides, self.sens, self.read = sens.sides, sens, read
+        self.sides, self.sens, self.read, self.rows_t = sens.sides, sens, read, t
         self.keep = ~np.isin(t, self.sides.t)
         joined = np.concatenate([t[self.keep], self.sides.t])
         self.order = np.argsort(joined, kind="stable")  # an event's two rows stay in their order
         self.t = joined[self.order]
         self.names, self.events = sens.names, sens.events
         self.state_names, self.channel_names = sens.state_names, sens.channel_names
+
+    def quadrature(self, name: str) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]] | None:
+        """The run's integral of channel ``name`` from its start at the output rows: (t, Q, dQ/dp), or None
+        when the run did not integrate it (``simulate(..., integrals=[...])``)."""
+        if name not in self.sens.integrals:
+            return None
+        Q, dQ = self.sens.integrals[name]
+        return self.rows_t, Q, dQ
 
     def _joined(self, rows: NDArray, at_events: NDArray) -> NDArray[np.float64]:
         return np.concatenate([rows[self.keep], at_events])[self.order]

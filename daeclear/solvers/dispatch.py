@@ -18,6 +18,7 @@ from .base import Solver
 from .registry import solver_class
 from .ida import IDA
 from .sensitivity_ida import SensitivityIDA
+from .sensitivity_quadrature import checked_integrals
 from ..assembly.sensitivity import parameter_value, table_entry
 
 DEFAULTS = SolverOptions()
@@ -38,6 +39,7 @@ def simulate(
     progress: bool = False,
     parameters: Mapping[str, Any] | None = None,
     sensitivities: Sequence[str] | None = None,
+    integrals: Sequence[str] | None = None,
 ) -> Result:
     """Integrate a scene (or an assembled model) from ``t0`` to ``t_end``.
 
@@ -74,6 +76,10 @@ def simulate(
         every event (:meth:`Result.sensitivity`, docs/sensitivities.md); a streamed output
         (``SaveAt(stream_to=...)``) writes them as the run goes. IDA only; not with ``y0``. None (the
         default): no cost.
+    integrals : list of str or None
+        Channel names (``model.channel_names``) whose integrals from ``t0`` IDA integrates as states under
+        its error control, with their sensitivities (``result.sensitivities.integrals``; ``dc.Integral``
+        reads them). With ``sensitivities`` only, not streamed (docs/sensitivities.md, section 7).
 
     Returns
     -------
@@ -118,7 +124,16 @@ def simulate(
         if isinstance(scene, Scene):  # the names are the model's: assembled first
             scene = assemble(scene, settings.formulation or solver.formulation, track_work=settings.track_work)
         parameter_names(scene, names)
-        solver = SensitivityIDA(names)
+        chosen = None
+        if integrals is not None:
+            if out.stream_to is not None:
+                opts.fail("simulate", "integrals", integrals, "None with a streamed output (SaveAt(stream_to=...)): "
+                          "the integrals are kept in memory only")
+            chosen = checked_integrals(integrals, scene)
+        solver = SensitivityIDA(names, chosen)
+    elif integrals is not None:
+        opts.fail("simulate", "integrals", integrals, "None without sensitivities: the integrals are states of "
+                  "the run with sensitivities (simulate(..., sensitivities=[...], integrals=[...]))")
     result = solver.run(scene, t_end, t0, y0, out, settings, on_failure, progress)
     if not isinstance(result, Result):  # a solver class of the user's: its contract checked where it is used
         opts.fail("simulate", "method", settings.method, "a solver whose run() returns a daeclear.Result "

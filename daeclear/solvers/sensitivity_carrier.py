@@ -13,7 +13,8 @@ every event (:meth:`daeclear.solvers.driver.Driver.jump`); the integrator of the
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,12 +27,24 @@ from ..core.events import ContactEvent
 from ..results.sensitivities import SensitivityEvent
 from .sensitivity_jumps import event_time_sensitivity, latched_sensitivity, same_event_times, state_jump
 
-__all__ = ["SensitivityCarrier", "parameter_scales"]
+__all__ = ["SensitivityCarrier", "onset_limit", "parameter_scales"]
 
 
 def parameter_scales(model: DAEModel, names: Sequence[str]) -> NDArray[np.float64]:
     """|p| of each parameter (1 at 0): S's absolute tolerance is atol / |p| (IDAS' ``pbar``)."""
     return np.array([abs(parameter_value(model, name)) or 1.0 for name in names])
+
+
+#: The step along the motion (in s, times 1 + |t|) at which an onset's forces are read from inside the contact.
+ONSET_STEP = 1e-12
+
+
+def onset_limit(forces: Callable[[float], Any], t: float) -> NDArray:
+    """The forces' limit from inside a contact that begins at ``t``, from ``forces(s)`` read a step s along the
+    motion, extrapolated linearly to s = 0: 2 F(s) - F(2 s). A law gated at delta > 0 (Kelvin-Voigt) reads 0
+    when the root lands exactly on delta = 0, which would drop its jump D u from y'+ and so from S+."""
+    s = ONSET_STEP * (1.0 + abs(t))
+    return 2.0 * np.asarray(forces(s)) - np.asarray(forces(2.0 * s))
 
 
 class SensitivityCarrier:
@@ -50,6 +63,7 @@ class SensitivityCarrier:
         self.S_params: list[NDArray] = []
         self.S = self.Sp = np.zeros((model.n_states, self.width))
         self.poisoned = np.zeros(self.width, dtype=bool)  # NaN from a grazing event on
+        self.dt_dp = np.zeros(self.width)  # the last event's time sensitivity (the quadratures' jump reads it)
         self.events: list[SensitivityEvent] = []
         self.rows_t: list[float] = []
         self.rows_S: list[NDArray] = []
@@ -133,7 +147,10 @@ class SensitivityCarrier:
         new_active, new_params = contact_state.switches(model, new_state)
         y_m, yp_m = model.consistent_state(t, y, model.term_forces(t, y, self.active, self.params))
         S_m, Sp_m = ms.consistent(t, y_m, S, self.active, self.params, self.S_params)
-        yp_p = model.consistent_state(t, y_p, model.term_forces(t, y_p, new_active, new_params))[1]
+        forces = model.term_forces(t, y_p, new_active, new_params)
+        if forces is not None and any(e.kind == "onset" for e in events):  # y'+ read inside the contact
+            forces = onset_limit(lambda s: model.term_forces(t + s, y_p + s * yp_m, new_active, new_params), t)
+        yp_p = model.consistent_state(t, y_p, forces)[1]
         new_latched = [[value.copy() for value in per_pair] for per_pair in self.latched]
         dt_dps: list[NDArray] = []
         if events and found is not None:
@@ -166,6 +183,7 @@ class SensitivityCarrier:
         dt_dp = np.zeros(W)
         if dt_dps:
             dt_dp = dt_dps[0] if same_event_times(dt_dps, rtol) else np.full(W, np.nan)
+        self.dt_dp = dt_dp
         S_p = state_jump(S_m, yp_m, yp_p, dt_dp, self.differential)
         if projected:
             S_p = ms.projected(t, y_p, S_p)

@@ -34,7 +34,8 @@ from .integrator import Jump, Terms
 from ..results.result import Result, ResultWriter
 from ..results.sensitivities import EventSides, Sensitivities
 from .save_at import Output
-from .sensitivity_carrier import SensitivityCarrier, parameter_scales
+from .sensitivity_carrier import SensitivityCarrier, onset_limit, parameter_scales
+from .sensitivity_quadrature import Quadratures
 from .tolerances import tolerance_vector
 
 if TYPE_CHECKING:
@@ -47,13 +48,14 @@ class SensitivityIDA(ida.IDA):
     """The "ida" method of a run with sensitivities (``simulate(..., sensitivities=names)``): its
     integrator is IDA on [y; S]."""
 
-    def __init__(self, names: list[str]) -> None:
+    def __init__(self, names: list[str], integrals: list[str] | None = None) -> None:
         self.names = list(names)
+        self.integrals = list(integrals or [])
 
     def integrator(self, model: DAEModel, t_end: float, output: Output,  # type: ignore[override]
                    settings: SolverOptions) -> SensitivityIntegrator:
         """The run's IDA session on [y; S], open with the run's settings."""
-        return SensitivityIntegrator(model, t_end, output, settings, self.names)
+        return SensitivityIntegrator(model, t_end, output, settings, self.names, self.integrals)
 
 
 @contextmanager
@@ -82,7 +84,7 @@ class SensitivityIntegrator:
     coupling = True  # the compiled session's block forward substitution with the blocks below the diagonal
 
     def __init__(self, model: DAEModel, t_end: float, output: Output, settings: SolverOptions,
-                 names: list[str]) -> None:
+                 names: list[str], integrals: list[str] | None = None) -> None:
         rtol = settings.rtol
         self.model, self.t_end, self.times, self.store_steps = model, t_end, output.times, output.steps
         self.settings = settings
@@ -93,8 +95,14 @@ class SensitivityIntegrator:
         W = self.sens.width
         pbar = parameter_scales(model, self.sens.names)
         block = not self.stacked_factorisation
+        # the integrals of channels as states after y in every block (dc.Integral under error control)
+        self.quad = Quadratures(model, integrals, W) if integrals else None
+        funcs = model.functions if self.quad is None else self.quad.functions(model.functions)
+        self.n_block = int(funcs.n)
+        if self.quad is not None:
+            atol = np.concatenate([atol, self.quad.atol(rtol)])
         self.stacked = open_session(
-            augmented_functions(model.functions, W, coupled=block and self.coupling, block=block),
+            augmented_functions(funcs, W, coupled=block and self.coupling, block=block),
             backend=settings.backend, rtol=rtol,
             atol=np.concatenate([atol, *(atol / p for p in pbar)]), max_step=settings.max_step,
             max_steps=settings.max_steps,
@@ -123,6 +131,8 @@ class SensitivityIntegrator:
         self.t_start = t
         if self.times is None or self.times.window(0, 1)[0] == t:  # the driver reports the start point
             self.sens.row(t, y, self.sens.S)
+            if self.quad is not None:
+                self.quad.row(self.quad.Q, self.quad.dQ, self.sens.poisoned)
             self.i_eval = int(self.times is not None)
         self.restart(t, y, yp, terms)
 
@@ -130,8 +140,14 @@ class SensitivityIntegrator:
         """The sensitivities' jump at an event the driver decided (before it restarts this integrator)."""
         n, W = self.model.n_states, self.sens.width
         assert jump.y_plus is not None and jump.state is not None  # the driver decides every switch here
-        S = self.root_S.reshape(n, W, order="F")
+        S = self.root_S.reshape(self.n_block, W, order="F")[:n]
         self.sens.jump(jump.t, jump.y_minus, S, jump.found, jump.state, jump.events, jump.y_plus, jump.projected)
+        if self.quad is not None:  # the event's rows before and after its switch: the channels' jump
+            before, after = self.sens.event_rows[-2][3], self.sens.event_rows[-1][3]
+            if jump.yp_minus is not None and any(e.kind == "onset" for e in jump.events):  # read inside the contact
+                y_p, yp_m, c = jump.y_plus, jump.yp_minus, self.sens
+                after = onset_limit(lambda s: c.evaluate(jump.t + s, y_p + s * yp_m, c.S)[3], jump.t)
+            self.quad.jump(before, after, self.sens.dt_dp)
 
     def consistent(self, t: float, y: NDArray, terms: Terms) -> tuple[NDArray, NDArray]:
         """q and v of ``y`` kept, multipliers and derivatives in the mode of ``terms``."""
@@ -140,13 +156,23 @@ class SensitivityIntegrator:
 
     def restart(self, t: float, y: NDArray, yp: NDArray, terms: Terms) -> None:
         """IDA re-initialised at ``(y, yp)`` and the carrier's S, S' (after its jump)."""
-        c = self.sens
-        self.stacked.reinit(t, np.concatenate([y, c.S.ravel(order="F")]), np.concatenate([yp, c.Sp.ravel(order="F")]),
-                            terms.active, c.terms_stacked(), terms.directions)
+        c, quad = self.sens, self.quad
+        if quad is None:
+            self.stacked.reinit(t, np.concatenate([y, c.S.ravel(order="F")]),
+                                np.concatenate([yp, c.Sp.ravel(order="F")]), terms.active, c.terms_stacked(),
+                                terms.directions)
+            return
+        _, _, channel_S, values = c.evaluate(t, y, c.S)
+        rate, rate_S = quad.rates(values, channel_S)
+        switch = self.model.switch_vector(c.active, c.params)
+        extra = quad.term(switch, c.ms.switch_sensitivity(c.S_params))
+        self.stacked.reinit(t, np.concatenate([y, quad.Q, np.vstack([c.S, quad.dQ]).ravel(order="F")]),
+                            np.concatenate([yp, rate, np.vstack([c.Sp, rate_S]).ravel(order="F")]),
+                            [*terms.active, *(True for _ in extra)], [*c.terms_stacked(), *extra], terms.directions)
 
     def advance(self) -> Advance:
         """Integrate [y; S] to the end or a root; the states' rows to the driver, S's rows to the carrier."""
-        n, W, times = self.model.n_states, self.sens.width, self.times
+        n, W, times, nb, quad = self.model.n_states, self.sens.width, self.times, self.n_block, self.quad
         window = None if times is None else times.window(self.i_eval, times.size)
         adv = self.stacked.advance(self.t_end, window, self.store_steps, store_states=times is None,
                                    store_yp=False)
@@ -154,8 +180,13 @@ class SensitivityIntegrator:
         if times is not None:
             self.i_eval += adv.eval_t.size
         for k, t in enumerate(rows_t.tolist()):
-            self.sens.row(t, rows_y[k, :n], rows_y[k, n:].reshape(n, W, order="F"))
-        self.root_S = adv.y[n:]
+            S = rows_y[k, nb:].reshape(nb, W, order="F")
+            self.sens.row(t, rows_y[k, :n], S[:n])
+            if quad is not None:
+                quad.row(rows_y[k, n:nb], S[n:], self.sens.poisoned)
+        self.root_S = adv.y[nb:]
+        if quad is not None:
+            quad.Q, quad.dQ = adv.y[n:nb].copy(), self.root_S.reshape(nb, W, order="F")[n:].copy()
         adv.y, adv.yp = adv.y[:n], adv.yp[:n]
         adv.step_y = adv.step_y[:, :n] if adv.step_y.ndim == 2 else adv.step_y
         adv.eval_y = adv.eval_y[:, :n] if adv.eval_y.ndim == 2 else adv.eval_y
@@ -213,5 +244,6 @@ class SensitivityIntegrator:
         sides = EventSides(np.array(c.event_t[:k]), *(
             np.stack([row[i] for row in c.event_rows]) if k else np.zeros(empty)
             for i, empty in ((0, (0, model.n_states)), (3, (0, n_ch)), (1, shape[0]), (2, shape[1]))))
+        integrals = {} if self.quad is None else self.quad.collected(n)
         return Sensitivities(c.names, tuple(model.state_names), tuple(model.channel_names),
-                             states, channels, tuple(c.events), sides, self.values)
+                             states, channels, tuple(c.events), sides, self.values, integrals)

@@ -70,8 +70,11 @@ def gradient(scene_or_model: Scene | DAEModel, t_end: float, *, of: Objective, p
     settings = SolverOptions(rtol=tol, atol=atol, start=start, backend=backend)
     save = SaveAt(times=times, steps=False)
 
+    integrals = [of.channel] if isinstance(of, Integral) else None  # a quadrature state under error control
+
     def run(m: DAEModel, wanted: Sequence[str]) -> Result:
-        out = simulate(m, end, options=settings, save=save, sensitivities=wanted, on_failure="return")
+        out = simulate(m, end, options=settings, save=save, sensitivities=wanted, integrals=integrals,
+                       on_failure="return")
         if not out.success:
             raise SolveError(f"gradient: the run failed at t={out.t[-1] if out.t.size else 0.0:.6g} s "
                              f"({out.message}).", out)
