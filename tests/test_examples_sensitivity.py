@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import math
 from pathlib import Path
 
 import pytest
@@ -22,3 +23,9 @@ def test_sensitivity_study_quick(tmp_path: Path) -> None:
     got = json.loads((tmp_path / "gradients.json").read_text())["gradients"]
     for name, value in got["sensitivities"].items():
         assert value == pytest.approx(got["fd"][name], rel=1e-4), name
+    horizons = json.loads((tmp_path / "gradients.json").read_text())["horizons"]
+    assert sorted(horizons) == ["0.1 mm", "0.5 mm"]
+    for h in horizons.values():  # result.sensitivity_horizon's: t0 + ln(1/rtol) / lambda at the run's rtol 1e-8
+        if h["lyapunov (1/s)"] > 0:
+            assert h["horizon (s)"] == pytest.approx(math.log(1e8) / h["lyapunov (1/s)"], rel=1e-12)
+        assert h["predictable"] == (h["horizon (s)"] > 2e-3)
