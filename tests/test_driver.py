@@ -137,8 +137,8 @@ def test_every_list_of_method_names_comes_from_the_one_table():
 def test_both_sessions_have_every_member_the_protocol_declares():
     members = {name for name in vars(Session) if not name.startswith("_")} | set(Session.__annotations__)
     assert members == {"backend", "max_steps", "eval_from", "reinit", "advance", "roots", "eval_extra", "stats",
-                       "set_hints", "set_stall", "set_layout", "set_kinematic_rows", "set_auto_events", "pair_states",
-                       "report", "close"}
+                       "set_hints", "set_stall", "set_layout", "set_kinematic_rows", "set_newton_tolerances",
+                       "set_auto_events", "pair_states", "report", "close"}
     for cls in (CSession, PythonSession):
         assert all(hasattr(cls, name) for name in members), cls
 

@@ -145,6 +145,7 @@ IDA_GROUPS: Final = _table(
         "int dc_set_first_step(void* sp, int on)",
         "double dc_first_step(void* sp)",
         "int dc_set_kinematic_rows(void* sp, int nk)",
+        "int dc_set_newton_atol(void* sp, const double* atol)",
         "int dc_set_layout(void* sp, int nq, int m, int ggl, int track_work, int accel_extra, int force_extra0, "
         "int kin_extra, int outputs_extra, int project, double tol, int max_iter)",
         "int dc_reinit(void* sp, double t0, const double* y0, const double* yp0, const int* active, "

@@ -211,6 +211,19 @@ class CSession(SessionBase):
                                 f"iteration matrix's {self._nj} rows.")
         return True
 
+    def set_newton_tolerances(self, atol: np.ndarray | None) -> bool:
+        """Newton's own convergence-test weights 1/(rtol |y| + atol) on the rows with ``atol > 0`` (a run's
+        sensitivities out of IDA's error test, kept in Newton's: csrc/ida_newton.h); None: IDA's weights."""
+        self._check_open()
+        given = None
+        if atol is not None:
+            given = np.ascontiguousarray(atol, dtype=float)
+            if given.shape != (self._n,):
+                raise DaeclearError(f"set_newton_tolerances: atol of shape {given.shape}, must be ({self._n},)")
+        if self._lib.dc_set_newton_atol(self._h, None if given is None else address(given)) != 0:
+            raise DaeclearError(f"set_newton_tolerances failed: {self._lib.dc_message(self._h).decode()}")
+        return True
+
     def set_layout(self, layout: StateLayout) -> bool:
         """The model's state layout and extras, so that C makes states consistent itself: restarts
         after the switches it decides (GGL: projected on the constraint manifold) and :meth:`report`."""

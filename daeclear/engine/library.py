@@ -26,7 +26,7 @@ __all__ = ["DRIVER_ABI", "ODE_DRIVER_ABI", "Prototypes", "StaleLibrary", "open_l
 #: Version of the ctypes interface of csrc/ida_driver.c, handed to the compiler (-DDC_ABI_VERSION)
 #: and checked when a library is loaded: bump it when a dc_* signature (c_api.py) or what a dc_* call writes
 #: changes.
-DRIVER_ABI = 9
+DRIVER_ABI = 10
 #: The same for csrc/ode_driver.c (-DDCO_ABI_VERSION).
 ODE_DRIVER_ABI = 3
 

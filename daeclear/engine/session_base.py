@@ -209,6 +209,12 @@ class Session(Protocol):
         """The reduced solver's eliminated position rows without a layout; whether it applies (compiled)."""
         ...
 
+    def set_newton_tolerances(self, atol: np.ndarray | None) -> bool:
+        """Newton's convergence test weighs the rows with ``atol > 0`` by 1/(rtol |y| + atol), whatever the error
+        test's tolerances (rows out of the error test kept in Newton's; None: the error test's weights
+        everywhere); whether the backend does (compiled)."""
+        ...
+
     def set_auto_events(self, pairs: Sequence[tuple[int, int, int, bool, float]], *, storms: Sequence[Storm],
                         states: Sequence[PairState], capacity: int = 256) -> bool:
         """Let the loop decide these pairs' switches itself; whether it does (compiled backend)."""
@@ -379,6 +385,10 @@ class SessionBase:
 
     def set_kinematic_rows(self, n_kinematic: int) -> bool:
         """Only the compiled backend has the reduced solver; returns False here."""
+        return False
+
+    def set_newton_tolerances(self, atol: np.ndarray | None) -> bool:
+        """Only the compiled backend has Newton weights of its own; returns False here."""
         return False
 
     def pair_states(self) -> list[PairState]:

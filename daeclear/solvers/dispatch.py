@@ -121,6 +121,9 @@ def simulate(
         scene = scene.with_parameters(parameters)
     if sensitivities is not None:
         names = checked_sensitivities(sensitivities, solver, y0)
+        if not settings.sensitivity_error_test and settings.backend == "python":
+            opts.fail("simulate", "options.sensitivity_error_test", False, "True with backend='python': S out of "
+                      "IDA's error test needs the compiled session's own Newton test (backend='c' or 'auto')")
         if isinstance(scene, Scene):  # the names are the model's: assembled first
             scene = assemble(scene, settings.formulation or solver.formulation, track_work=settings.track_work)
         parameter_names(scene, names)

@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 from ..assembly.contact_state import ContactState
 from ..assembly.dae_model import DAEModel
 from ..assembly.sensitivity import initial_sensitivities, parameter_value
+from ..core.errors import SceneError
 from ..core.automaton import PairState
 from ..engine.ida_session import open_session
 from ..engine.sensitivity_functions import augmented_functions
@@ -41,7 +42,11 @@ from .tolerances import tolerance_vector
 if TYPE_CHECKING:
     from .solver_options import SolverOptions
 
-__all__ = ["SensitivityIDA", "SensitivityIntegrator", "stacked_reference"]
+__all__ = ["SensitivityIDA", "SensitivityIntegrator", "stacked_reference", "OUT_OF_ERROR_TEST"]
+
+#: S's absolute tolerance in IDA's error test with ``SolverOptions(sensitivity_error_test=False)``: its weight
+#: 1/(rtol |S| + 1e100) leaves it out (its Newton test keeps the weights of atol / |p|: csrc/ida_newton.h).
+OUT_OF_ERROR_TEST = 1e100
 
 
 class SensitivityIDA(ida.IDA):
@@ -101,16 +106,23 @@ class SensitivityIntegrator:
         self.n_block = int(funcs.n)
         if self.quad is not None:
             atol = np.concatenate([atol, self.quad.atol(rtol)])
+        atol_S = np.concatenate([atol / p for p in pbar])  # IDAS' pbar: S |p| held to the states' atol
+        tested = settings.sensitivity_error_test
         self.stacked = open_session(
             augmented_functions(funcs, W, coupled=block and self.coupling, block=block),
             backend=settings.backend, rtol=rtol,
-            atol=np.concatenate([atol, *(atol / p for p in pbar)]), max_step=settings.max_step,
+            atol=np.concatenate([atol, atol_S if tested else np.full(atol_S.size, OUT_OF_ERROR_TEST)]),
+            max_step=settings.max_step,
             max_steps=settings.max_steps,
             parameters=np.concatenate([model.parameter_values, self.sens.ms.dP.ravel(order="F")]),
             linear_solver=settings.linear_solver if block else "auto")
         try:
             if block:  # the reduced LU eliminates the position rows, as in the state's run (its layout)
                 self.stacked.set_kinematic_rows(model.n_q)
+            if not tested and not self.stacked.set_newton_tolerances(np.concatenate([np.zeros(atol.size), atol_S])):
+                raise SceneError("simulate: options.sensitivity_error_test=False, must be True with the python "
+                                 "backend (S out of IDA's error test needs the compiled session's Newton test; "
+                                 "backend='c')")
             # GGL's tight Newton coefficient left out: S's corrections converge linearly (the reference run's rule)
             self.stacked.set_hints(jacobian_refresh=ida.JACOBIAN_REFRESH,
                                    first_step=ida.FIRST_STEP_ESTIMATE and model.formulation == "ggl")

@@ -70,6 +70,11 @@ class SolverOptions:
         Start even deeper in a wall than the physics checks allow (:mod:`daeclear.assembly.physics`).
     track_work : bool
         IDA only: integrate the work of drivers and contact forces (channel ``energy.work``).
+    sensitivity_error_test : bool
+        A run with sensitivities (``simulate(..., sensitivities=...)``): True holds S in IDA's error test,
+        each parameter's columns scaled by its magnitude; False leaves S out of the error test and in the
+        Newton convergence test only (IDAS' errconS = False; the compiled backend: docs/sensitivities.md,
+        section 2): fewer steps, S only as accurate as the states' steps make it.
     """
 
     method: str = "ida"
@@ -84,6 +89,7 @@ class SolverOptions:
     start: str = "ideal"
     allow_penetration: bool = False
     track_work: bool = False
+    sensitivity_error_test: bool = True
     #: who the settings were given to, for the messages (not stored): "simulate" for its keywords
     where: dataclasses.InitVar[str] = WHERE
 
@@ -162,6 +168,8 @@ def checked(values: Mapping[str, Any], *, where: str) -> dict[str, Any]:
         "start": options.start(values["start"], where=where),
         "allow_penetration": options.flag(values["allow_penetration"], where=where, field="allow_penetration"),
         "track_work": options.flag(values["track_work"], where=where, field="track_work"),
+        "sensitivity_error_test": options.flag(values["sensitivity_error_test"], where=where,
+                                               field="sensitivity_error_test"),
     }
 
 

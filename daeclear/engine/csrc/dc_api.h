@@ -44,6 +44,7 @@ DC_API int dc_set_stall(void* sp, double stall_step, int count);
 DC_API int dc_set_first_step(void* sp, int on);
 DC_API double dc_first_step(void* sp);
 DC_API int dc_set_kinematic_rows(void* sp, int nk);
+DC_API int dc_set_newton_atol(void* sp, const double* atol);
 DC_API int dc_set_layout(void* sp, int nq, int m, int ggl, int track_work, int accel_extra, int force_extra0,
                          int kin_extra, int outputs_extra, int project, double tol, int max_iter);
 DC_API int dc_reinit(void* sp, double t0, const double* y0, const double* yp0, const int* active,

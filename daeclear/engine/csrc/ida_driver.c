@@ -36,6 +36,7 @@
 #include "ida_session.h"
 #include "ida_automaton.h"
 #include "ida_eval.h"
+#include "ida_newton.h"
 #include "ida_open.h"
 #include "ida_consistent.h"
 #include "ida_events.h"

@@ -138,6 +138,7 @@ DC_API void dc_free(void* sp) {
   dc_session* s = (dc_session*)sp;
   if (!s) return;
   if (s->ida) IDAFree(&s->ida);
+  nls_release(s); /* IDA does not own the Newton wrapper (ida_newton.h) */
   if (s->LS) SUNLinSolFree(s->LS);
   dcls_free(s->lin);
   if (s->A) SUNMatDestroy(s->A);
@@ -489,6 +490,7 @@ DC_API int dc_reset(void* sp, double rtol, const double* atol, double max_step, 
   s->max_steps = max_steps;
   for (int i = 0; i < s->n_roots; ++i) s->rootdir_default[i] = rootdir ? rootdir[i] : 0;
   clear_run_state(s);
+  s->nls_on = 0; /* IDA's own weights in the Newton test (dc_set_newton_atol) */
   memcpy(N_VGetArrayPointer(s->atol), atol, sizeof(double) * (size_t)s->n);
   flag = IDASVtolerances(s->ida, rtol, s->atol);
   if (flag >= 0) flag = IDASetMaxStep(s->ida, max_step);

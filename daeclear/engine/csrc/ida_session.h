@@ -189,6 +189,13 @@ typedef struct {
   double* xw;
   double* xnz;        /* the nonzeros of a sparse extra's output, before extra_dense scatters them */
   int* lay_on;        /* [n_terms] */
+  /* Newton's own weights (ida_newton.h, dc_set_newton_atol): rows out of IDA's error test kept in its
+   * Newton convergence test (a run's sensitivities, as IDAS' errconS = false) */
+  SUNNonlinearSolver nls;       /* the wrapper IDA calls; NULL until dc_set_newton_atol */
+  SUNNonlinearSolver nls_inner; /* SUNDIALS' Newton solver it delegates to */
+  N_Vector nls_w;               /* [n] the weights it passes on */
+  double* nls_atol;             /* [n] > 0: that row's Newton weight is 1/(rtol |y| + atol); else IDA's */
+  int nls_on;                   /* 0: the wrapper passes IDA's weights on unchanged */
 } dc_session;
 
 static void err_handler(int line, const char* func, const char* file, const char* msg,
