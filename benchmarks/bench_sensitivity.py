@@ -19,6 +19,14 @@ N output times (fewer rows: what each row costs beside the integration shows).
 Cases: the chapter's slider-crank (Fig. 4.15: revolute clearance, c = 0.5 mm, GGL; its first 2 ms, the
 impacts of the start) and a driven chain of 10 links with a clearance at every pin
 (``dc.mechanisms.chain(10, rpm=300)``, 63 states: the sparse LU's size; 2 ms).
+
+    python benchmarks/bench_sensitivity.py --table [--repeats 3] [--accuracy 1e-3] [--widths 1 2 4 8 16]
+        [--table-cases fig415-2ms fig415-2rev chain16]
+
+The issue's table (``--table``, :mod:`bench_sensitivity_table`): Ns = 1, 2, 4, 8, 16 on the Fig. 4.15 scene
+(2 ms and two revolutions) and a 16-link chain, whole calls on the assembled model against the plain run and
+against central differences (2 Ns + 1 runs) at equal accuracy: each method's cheapest setting (the run's
+rtol; for central differences rtol and step) whose S(t_end) is within ``--accuracy`` of a tight reference.
 """
 
 from __future__ import annotations
@@ -31,6 +39,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+import bench_sensitivity_table
 import daeclear as dc
 from daeclear.solvers.sensitivity_ida import stacked_reference
 
@@ -99,11 +108,22 @@ def main() -> None:
     parser.add_argument("--rtol", type=float, default=1e-6)
     parser.add_argument("--times", type=int, default=0)
     parser.add_argument("--cases", nargs="+", choices=sorted(CASES), default=list(CASES))
+    parser.add_argument("--table", action="store_true", help="the issue's table against central differences")
+    parser.add_argument("--accuracy", type=float, default=1e-3, help="--table: the error both methods reach")
+    parser.add_argument("--widths", type=int, nargs="+", default=list(bench_sensitivity_table.WIDTHS))
+    parser.add_argument("--table-cases", nargs="+", choices=sorted(bench_sensitivity_table.CASES),
+                        default=list(bench_sensitivity_table.CASES))
     args = parser.parse_args()
     if args.repeats < 1:
         parser.error(f"--repeats must be at least 1, got {args.repeats}")
     if args.times < 0 or args.times == 1:
         parser.error(f"--times must be 0 (every step) or at least 2, got {args.times}")
+    if args.table:
+        if not 0.0 < args.accuracy < 1.0 or any(not 1 <= k <= 16 for k in args.widths):
+            parser.error("--accuracy must be in (0, 1) and --widths between 1 and 16")
+        for case in args.table_cases:
+            bench_sensitivity_table.table(case, sorted(set(args.widths)), args.accuracy, args.repeats)
+        return
     for case in args.cases:
         bench(case, args.repeats, args.rtol, args.times)
 
