@@ -2,16 +2,17 @@
 at equal accuracy (``python benchmarks/bench_sensitivity.py --table``; the cases and the rule below).
 
 For each case a reference S_ref(t_end) of every position and velocity is computed once, by a run with all 16
-sensitivities at ``REFERENCE_RTOL``. An error is then the largest relative sensitivity of the difference,
-max_ij |S_ij - S_ref,ij| |p_j| / scale_i (scale_i: the state's largest magnitude over the reference run's
-rows), over the same of S_ref, for each parameter j, and the largest over j: the error relative to the
-response's largest amplification of a relative change of that parameter. Equal accuracy: each method's
-cheapest setting whose error for the first Ns parameters is below ``accuracy``: the sensitivities' loosest rtol of ``SENSITIVITY_RTOLS``; central differences' loosest
-rtol of ``FD_RTOLS`` with any relative step h of ``FD_STEPS`` (p +- h |p|, |p| = 1 at 0). Then ``repeats``
-rounds time, interleaved, whole ``simulate`` calls on the assembled model (sessions opened, dy0/dp, the jumps
-and the output rows included; the libraries compiled in an untimed first call): the plain run at the
-sensitivities' rtol, the run with Ns sensitivities, and the 2 Ns + 1 runs of central differences (the base
-run and each parameter moved both ways, ``moved_parameter``). Medians; a shared machine: ratios only.
+sensitivities at ``REFERENCE_RTOL``. An error is then the largest relative sensitivity of the difference, max_ij
+|S_ij - S_ref,ij| |p_j| / scale_i (scale_i: the state's largest magnitude over the reference run's rows), over
+the same of S_ref, for each parameter j, and the largest over j: the error relative to the response's largest
+amplification of a relative change of that parameter. Equal accuracy: each method's cheapest setting whose error
+for the first Ns parameters is below ``accuracy``: the sensitivities' loosest rtol of ``SENSITIVITY_RTOLS``;
+central differences' loosest rtol of ``FD_RTOLS`` with any relative step h of ``FD_STEPS`` (p +- h |p|, |p| = 1
+at 0). Then ``repeats`` rounds time, interleaved, whole ``simulate`` calls on the assembled model (sessions
+opened, dy0/dp, the jumps and the output rows included; the libraries compiled in an untimed first call): the
+plain run at the sensitivities' rtol, the run with Ns sensitivities, and the 2 Ns + 1 runs of central
+differences (the base run and each parameter moved both ways, ``moved_parameter``). Medians; a shared machine:
+ratios only.
 """
 
 from __future__ import annotations
