@@ -214,7 +214,7 @@ def test_every_definition_is_its_table_entry(driver: str) -> None:
 def test_each_driver_has_its_own_prefix() -> None:
     assert all(e.name.startswith("dc_") for e in c_api.IDA_ENTRY_POINTS)
     assert all(e.name.startswith("dco_") for e in c_api.ODE_ENTRY_POINTS)
-    assert len(c_api.IDA_ENTRY_POINTS) == len(library.MODEL_PROTOTYPES) == 40
+    assert len(c_api.IDA_ENTRY_POINTS) == len(library.MODEL_PROTOTYPES) == 41
     assert len(c_api.ODE_ENTRY_POINTS) == len(library.ODE_PROTOTYPES) == 16
 
 
