@@ -61,7 +61,7 @@ REV = 60.0 / 5000.0
 RTOL = 1e-8
 SOURCE = Path(__file__).resolve().parent / "bound_main.c"
 #: the driver interface bound_main.c is written for (its BOUND_ABI)
-BOUND_ABI = 9
+BOUND_ABI = 10
 N_STATS = len(STAT_KEYS)  # the counters dc_stats writes
 #: simulate's stored steps and the C program's may differ by this fraction (they are expected equal)
 STEPS_TOLERANCE = 0.02

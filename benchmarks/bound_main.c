@@ -17,7 +17,7 @@
  * the stored steps, events, IDA's counters and the end state. bound_run() is the same run for a
  * caller in the same process (bench_bound.py, through ctypes).
  *
- * Written for the driver interface DC_ABI_VERSION 9 (daeclear.engine.library.DRIVER_ABI); the
+ * Written for the driver interface DC_ABI_VERSION 10 (daeclear.engine.library.DRIVER_ABI); the
  * program refuses a library of another one.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -30,7 +30,7 @@
 #include "dc_abi.h" /* DC_CHUNK, DC_TSTOP, DC_ST_N: generated from daeclear/engine/abi.py (csrc on -I) */
 #include "dc_api.h" /* the dc_* declarations: generated from daeclear/engine/c_api.py */
 
-#define BOUND_ABI 9
+#define BOUND_ABI 10
 
 /* the driver's entry points, as dlsym returns them: pointers of the types dc_api.h declares */
 typedef struct {
@@ -194,7 +194,7 @@ static int load_driver(const char* lib_path, driver_t* D, char* err, int errlen)
   SYM(message, "dc_message");
   SYM(free_, "dc_free");
 #undef SYM
-  if (D->abi_version() != BOUND_ABI) return fail(err, errlen, "the library has another driver ABI than 9", lib_path);
+  if (D->abi_version() != BOUND_ABI) return fail(err, errlen, "the library has another driver ABI than 10", lib_path);
   return 0;
 }
 
