@@ -296,3 +296,19 @@ def test_a_loaded_result_gives_the_same_objectives(scene: dc.Scene, tmp_path) ->
     assert run.slice(0.05, 0.12).sensitivities.sides.t.size == 2
     with pytest.raises(KeyError, match="Result.gradient: this run has no sensitivities"):
         dc.Result(t=[0.0], y=[[0.0]], yp=[[0.0]], state_names=["x"], channels={}, units={}).gradient(dc.Final("x"))
+
+
+def test_integral_without_contact_terms() -> None:
+    """A model without contact terms (ideal joints: no switch vector) has the quadrature row in its residual:
+    the driven crank's angle phi = phi0 + w t integrates to phi0 T + w T^2/2, its derivative in w is T^2/2."""
+    model = dc.assemble(dc.mechanisms.slider_crank())
+    end = 2e-3
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", dc.DaeclearWarning)
+        r = dc.simulate(model, end, rtol=1e-8, options=dc.SolverOptions(backend="python"),
+                        save=dc.SaveAt(times=[0.0, end], steps=False), sensitivities=["drive.speed"],
+                        integrals=["crank.phi"])
+    w = r.sensitivities.values[0]
+    Q, dQ = r.sensitivities.integrals["crank.phi"]
+    assert Q[-1] == pytest.approx(r["crank.phi"][0] * end + w * end ** 2 / 2, rel=1e-8, abs=0.0)
+    assert dQ[-1, 0] == pytest.approx(end ** 2 / 2, rel=1e-8, abs=0.0)
