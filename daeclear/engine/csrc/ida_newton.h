@@ -12,8 +12,7 @@
 #ifndef DAECLEAR_IDA_NEWTON_H
 #define DAECLEAR_IDA_NEWTON_H
 
-/* SUNDIALS' Newton nonlinear solver (in the IDA library; its header is not vendored). */
-SUNDIALS_EXPORT SUNNonlinearSolver SUNNonlinSol_Newton(N_Vector y, SUNContext sunctx);
+#include <sunnonlinsol/sunnonlinsol_newton.h> /* SUNDIALS' Newton solver (its code is in the IDA library) */
 
 static dc_session* nls_session(SUNNonlinearSolver NLS) { return (dc_session*)NLS->content; }
 
