@@ -309,7 +309,7 @@ def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction
     v_T = ca.dot(bj.world_point_velocity(Q_j) - bi.world_point_velocity(Q_i), t_vec)
     n_params = 1 if law_numeric.needs_approach_speed else 0
     p = ca.SX.sym("p", n_params)
-    F_N = law.force(delta, delta_dot, p[0] if n_params else None)
+    F_N = law.contact_force(delta, delta_dot, p[0] if n_params else None)
     F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
     worn_angles = None
     if worn_jacobian is not None:  # the contact direction's angle in each body's frame: atan2 of A(phi)^T n
