@@ -189,6 +189,28 @@ def model_sensitivity_functions(model: DAEModel, width: int) -> SensitivityFunct
 
 
 @dataclass(frozen=True)
+class Shared:
+    """An input of :func:`mapped` that is the same at every point."""
+
+    value: Any
+
+
+def mapped(f: Any, N: int, *inputs: Any) -> NDArray[np.float64]:
+    """``f`` (one matrix output) at N points in one call: each input either :class:`Shared` or stacked per
+    point along its first axis ((N,) for a scalar, (N, r) for a vector, (N, r, c) for a matrix); returns
+    (N, rows, cols) of the output. One point calls ``f`` itself (a map costs ~0.1 ms to build)."""
+    cols = []
+    for x in inputs:
+        if isinstance(x, Shared):
+            cols.append(np.asarray(x.value, dtype=float))
+            continue
+        a = np.asarray(x, dtype=float).reshape(N, x.shape[1] if np.ndim(x) > 1 else 1, -1)
+        cols.append(a.transpose(1, 0, 2).reshape(a.shape[1], -1))  # point k's block in columns k c ... (k + 1) c
+    out = np.array((f if N == 1 else f.map(N))(*cols), dtype=float)
+    return out.reshape(out.shape[0], N, -1).transpose(1, 0, 2)
+
+
+@dataclass(frozen=True)
 class RootTerms:
     """The pieces of the jump at the model's roots (each (n_roots,) but ``g_p``): the root's sensitivity
     ``g_p`` = g_y S + g_y' S' + g_P dP (n_roots, Ns); its ``rate`` g_t + g_y y'; the magnitude of that rate's
@@ -239,27 +261,36 @@ class ModelSensitivity:
         ``S_params``): S_q and S_v kept, the multipliers' and the derivatives' sensitivities the derivative
         of :meth:`DAEModel.consistent_state` (its accelerations' solve) in the direction (S_q, S_v, dP);
         GGL's mu has sensitivity 0 (mu is 0 on the solution for every p)."""
+        S_out, Sp = self.consistent_rows(np.array([t], dtype=float), np.asarray(y, dtype=float)[None],
+                                         np.asarray(S, dtype=float)[None], active, params, S_params)
+        return S_out[0], Sp[0]
+
+    def consistent_rows(self, t: NDArray, y: NDArray, S: NDArray, active: Sequence[bool], params: Sequence[NDArray],
+                        S_params: Sequence[NDArray]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """:meth:`consistent` at N points of one mode at once: ``t`` (N,), ``y`` (N, n_states), ``S``
+        (N, n_states, Ns) -> (S, S'), each (N, n_states, Ns); one mapped call per function for all rows."""
         model, P, dP, W = self.model, self.model.parameter_values, self.dP, self.width
         n, m = model.n_q, model.n_constraints
-        q, v = y[:n], y[n:2 * n]
-        Sq, Sv = S[:n], S[n:2 * n]
+        N = t.size
+        q, v = y[:, :n], y[:, n:2 * n]
+        Sq, Sv = S[:, :n], S[:, n:2 * n]
         zero_t = np.zeros((1, W))
-        forces = model.term_forces(t, y, active, params)
-        Qc = np.zeros(n) if forces is None else forces
-        dQc = np.zeros((n, W))
+        forces = model.term_forces(t if N > 1 else t[0], y if N > 1 else y[0], active, params)
+        Qc = np.zeros((N, n)) if forces is None else np.asarray(forces, dtype=float).reshape(N, n)
+        dQc = np.zeros((N, n, W))
         for k, on in enumerate(active):
             if on:
-                dQc += np.array(self._extra[EXTRA_TERM0 + k](t, q, v, params[k], P, zero_t, Sq, Sv,
-                                                             S_params[k].reshape(-1, W), dP))
-        d = np.array(self._extra[EXTRA_ACCEL](t, q, v, Qc, P, zero_t, Sq, Sv, dQc, dP))
-        S_out, Sp = np.array(S, dtype=float), np.zeros((model.n_states, W))
-        S_out[2 * n:2 * n + m] = d[n:n + m]
+                dQc += mapped(self._extra[EXTRA_TERM0 + k], N, t, q, v, Shared(params[k]), Shared(P),
+                              Shared(zero_t), Sq, Sv, Shared(S_params[k].reshape(-1, W)), Shared(dP))
+        d = mapped(self._extra[EXTRA_ACCEL], N, t, q, v, Qc, Shared(P), Shared(zero_t), Sq, Sv, dQc, Shared(dP))
+        S_out, Sp = np.array(S, dtype=float), np.zeros((N, model.n_states, W))
+        S_out[:, 2 * n:2 * n + m] = d[:, n:n + m]
         if model.formulation == "ggl":
-            S_out[2 * n + m:2 * n + 2 * m] = 0.0
-        Sp[:n] = Sv
-        Sp[n:2 * n] = d[:n]
+            S_out[:, 2 * n + m:2 * n + 2 * m] = 0.0
+        Sp[:, :n] = Sv
+        Sp[:, n:2 * n] = d[:, :n]
         if model.track_work:
-            Sp[-1] = d[n + m]
+            Sp[:, -1] = d[:, n + m]
         return S_out, Sp
 
     def switch_sensitivity(self, S_params: Sequence[NDArray]) -> NDArray[np.float64]:
@@ -275,11 +306,23 @@ class ModelSensitivity:
                  S_switch: NDArray) -> NDArray[np.float64]:
         """Every output channel's sensitivity at one point, (n_channels, Ns): d ch/dy S + d ch/dy' S'
         + d ch/d switch S_switch + d ch/dP dP (the chain rule through the channels' functions)."""
+        return self.channels_rows(np.array([t], dtype=float), y[None], yp[None], S[None], Sp[None], switch,
+                                  S_switch)[0]
+
+    def channels_rows(self, t: NDArray, y: NDArray, yp: NDArray, S: NDArray, Sp: NDArray, switch: NDArray,
+                      S_switch: NDArray) -> NDArray[np.float64]:
+        """:meth:`channels` at N points of one mode (``switch``, ``S_switch``) at once, (N, n_channels, Ns)."""
         if self._outputs is None:
             self._outputs = directional(self.model.functions.extras[EXTRA_OUTPUTS], self.width, (1, 2, 3, 4),
                                         "sens_outputs")
         P = self.model.parameter_values
-        return np.array(self._outputs(t, y, yp, switch, P, S, Sp, S_switch, self.dP))
+        return mapped(self._outputs, t.size, t, y, yp, Shared(switch), Shared(P), S, Sp, Shared(S_switch),
+                      Shared(self.dP))
+
+    def outputs_rows(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> NDArray[np.float64]:
+        """The channels' values at N points of one mode at once, (N, n_channels)."""
+        f = self.model.functions.extras[EXTRA_OUTPUTS]
+        return mapped(f, t.size, t, y, yp, Shared(switch), Shared(self.model.parameter_values))[:, :, 0]
 
     def projected(self, t: float, y: NDArray, S: NDArray) -> NDArray[np.float64]:
         """S with S_q and S_v moved (least norm) onto the linearised constraints, d Phi = Phi_q S_q + Phi_P dP

@@ -153,8 +153,8 @@ class SensitivityIntegrator:
         rows_t, rows_y = (adv.step_t, adv.step_y) if times is None else (adv.eval_t, adv.eval_y)
         if times is not None:
             self.i_eval += adv.eval_t.size
-        for k, t in enumerate(rows_t.tolist()):
-            self.sens.row(t, rows_y[k, :n], rows_y[k, n:].reshape(n, W, order="F"))
+        if rows_t.size:  # every row of this advance is in one mode: one mapped evaluation for all
+            self.sens.rows(rows_t, rows_y[:, :n], rows_y[:, n:].reshape(-1, W, n).transpose(0, 2, 1))
         self.root_S = adv.y[n:]
         adv.y, adv.yp = adv.y[:n], adv.yp[:n]
         adv.step_y = adv.step_y[:, :n] if adv.step_y.ndim == 2 else adv.step_y
