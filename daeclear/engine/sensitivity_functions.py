@@ -138,10 +138,39 @@ def sensitivity_functions(funcs: DAEFunctions, width: int, extras: Sequence[int]
                                 curvature, fwd, tuple(int(k) for k in extras))
 
 
-def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, block: bool = False) -> DAEFunctions:
+def stacked_extras(funcs: DAEFunctions, width: int, derivatives: Sequence[int]) -> tuple[casadi.Function, ...]:
+    """The extras of the stacked DAE, whose parameter input is [P; vec(dP)]: the model's extras (same index,
+    P taken from it), then the directional derivative (:func:`directional` in every input) of
+    ``funcs.extras[k]`` for each k of ``derivatives``, at index ``len(funcs.extras) + i``, with inputs (the
+    extra's inputs but P, their seeds but dP's, [P; vec(dP)]). A run with sensitivities evaluates its rows and
+    events with them in the stacked session (the same functions, in C in a compiled session)."""
+    n_P = int(funcs.n_parameters)
+    out = []
+    for f in funcs.extras:
+        xs = _symbols(f, [f.numel_in(k) for k in range(f.n_in())], [f.name_in(k) for k in range(f.n_in())])
+        PA = _symbols(f, [n_P * (1 + width)], ["P"])[0]
+        out.append(casadi.Function(f"{f.name()}_stacked", [*xs[:-1], PA], f.call([*xs[:-1], PA[:n_P]]),
+                                   [*(f.name_in(k) for k in range(f.n_in() - 1)), "P"], [f.name_out(0)]))
+    for k in derivatives:
+        d = directional(funcs.extras[k], width, None, f"sens_d{k}")
+        m = funcs.extras[k].n_in()  # d's inputs: m values (P last), m seeds (dP last)
+        xs = _symbols(d, [d.numel_in(j) for j in range(2 * m)], [d.name_in(j) for j in range(2 * m)])
+        PA = _symbols(d, [n_P * (1 + width)], ["P"])[0]
+        dP = casadi.reshape(PA[n_P:], n_P, width)
+        shaped = [casadi.reshape(x, d.size_in(j)) for j, x in enumerate(xs)]  # an extra's inputs are vectors
+        value = d.call([*shaped[:m - 1], PA[:n_P], *shaped[m:2 * m - 1], dP])
+        out.append(casadi.Function(f"sens_extra{k}", [*xs[:m - 1], *xs[m:2 * m - 1], PA], value,
+                                   [*(d.name_in(j) for j in (*range(m - 1), *range(m, 2 * m - 1))), "P"],
+                                   [d.name_out(0)]))
+    return tuple(out)
+
+
+def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, block: bool = False,
+                        derivatives: Sequence[int] | None = None) -> DAEFunctions:
     """The DAE of [y; S_1; ...; S_width] as one :class:`DAEFunctions` (what IDA integrates for
     ``simulate(..., sensitivities=...)``): parameters [P; vec(dP)], term k's parameters [p_k; vec(Sk)],
-    the roots those of y, no extras.
+    the roots those of y; with ``derivatives`` (indices of ``funcs.extras``) the extras of
+    :func:`stacked_extras`, else none.
 
     Its Newton matrix: the state's iteration matrix on every diagonal block, nothing else (IDAS'
     simultaneous corrector: a modified Newton that converges since S's equations are linear in S).
@@ -204,4 +233,5 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, 
     return DAEFunctions(n=n * (1 + width), residual=residual, jacobian=jac, term_residuals=tuple(term_res),
                         term_jacobians=tuple(term_jac), roots=roots, n_parameters=n_P * (1 + width),
                         name=f"{funcs.name}_sens{width}{'c' if coupled else ''}{'b' if block else ''}",
-                        blocks=1 + width if block else 1, coupling=coupling, term_couplings=tuple(term_cpl))
+                        blocks=1 + width if block else 1, coupling=coupling, term_couplings=tuple(term_cpl),
+                        extras=() if derivatives is None else stacked_extras(funcs, width, derivatives))

@@ -116,15 +116,15 @@ def consistent_restart(model: DAEModel, integrator: Integrator, t: float, y: NDA
     for the switches it decides itself. The flag: whether the state was projected (sensitivities follow it)."""
     if model.formulation != "ggl":
         return (*integrator.consistent(t, y, terms), False)
-    session = integrator.session
-    forces = model.term_forces(t, y, terms.active, terms.params, session)
-    projected = model.consistent_state(t, y, forces, session, project=True)
+    session, extras = integrator.session, integrator.extras
+    forces = model.term_forces(t, y, terms.active, terms.params, extras)
+    projected = model.consistent_state(t, y, forces, extras, project=True)
     if not model.gap_names:
         return (*projected, True)
     g0, g1 = _roots(model, session, t, y, yp), _roots(model, session, t, projected[0], yp)
     quiet = np.zeros(g0.shape, bool) if found is None else np.asarray(found).ravel() == 0
     if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
-        return (*model.consistent_state(t, y, forces, session, project=False), False)
+        return (*model.consistent_state(t, y, forces, extras, project=False), False)
     return (*projected, True)
 
 

@@ -118,8 +118,9 @@ class SensitivityCarrier:
         values), each with N rows first; nothing poisoned."""
         model, ms = self.model, self.ms
         single = t.size == 1
-        forces = model.term_forces(t[0] if single else t, y[0] if single else y, self.active, self.params)
-        y, yp = model.consistent_state(t[0] if single else t, y[0] if single else y, forces)
+        session = ms.session
+        forces = model.term_forces(t[0] if single else t, y[0] if single else y, self.active, self.params, session)
+        y, yp = model.consistent_state(t[0] if single else t, y[0] if single else y, forces, session)
         y, yp = np.atleast_2d(y), np.atleast_2d(yp)
         S, Sp = ms.consistent_rows(t, y, S, self.active, self.params, self.S_params)
         switch = model.switch_vector(self.active, self.params)
@@ -148,7 +149,8 @@ class SensitivityCarrier:
         model, ms, W, rtol = self.model, self.ms, self.width, self.rtol
         y_m, yp_m, S_m, Sp_m = self.event_row(t, y, S)
         new_active, new_params = contact_state.switches(model, new_state)
-        yp_p = model.consistent_state(t, y_p, model.term_forces(t, y_p, new_active, new_params))[1]
+        session = ms.session
+        yp_p = model.consistent_state(t, y_p, model.term_forces(t, y_p, new_active, new_params, session), session)[1]
         new_latched = [[value.copy() for value in per_pair] for per_pair in self.latched]
         dt_dps: list[NDArray] = []
         if events and found is not None:

@@ -27,7 +27,6 @@ from ..assembly.dae_model import DAEModel
 from ..assembly.sensitivity import initial_sensitivities, parameter_value
 from ..core.automaton import PairState
 from ..engine.ida_session import open_session
-from ..engine.sensitivity_functions import augmented_functions
 from ..engine.session_base import Advance, Session
 from . import ida
 from .integrator import Jump, Terms
@@ -77,7 +76,7 @@ class SensitivityIntegrator:
     decides = False
     order = 0
     fixed_step: float | None = None
-    session: Session | None = None  # the model's own functions serve the driver (the stacked session is S's)
+    session: Session | None = None  # the model's own roots serve the driver (the stacked session is S's)
     stacked_factorisation = False  # True: the reference path of stacked_reference()
     coupling = True  # the compiled session's block forward substitution with the blocks below the diagonal
 
@@ -94,12 +93,13 @@ class SensitivityIntegrator:
         pbar = parameter_scales(model, self.sens.names)
         block = not self.stacked_factorisation
         self.stacked = open_session(
-            augmented_functions(model.functions, W, coupled=block and self.coupling, block=block),
+            model.compiled.stacked(W, block and self.coupling, block, self.sens.ms.row_derivatives(model)),
             backend=settings.backend, rtol=rtol,
             atol=np.concatenate([atol, *(atol / p for p in pbar)]), max_step=settings.max_step,
             max_steps=settings.max_steps,
             parameters=np.concatenate([model.parameter_values, self.sens.ms.dP.ravel(order="F")]),
             linear_solver=settings.linear_solver if block else "auto")
+        self.sens.ms.session = self.stacked  # the rows' and events' pieces in its C (its extras)
         try:
             if block:  # the reduced LU eliminates the position rows, as in the state's run (its layout)
                 self.stacked.set_kinematic_rows(model.n_q)
@@ -111,6 +111,7 @@ class SensitivityIntegrator:
             self.stacked.close()
             raise
         self.backend = self.stacked.backend
+        self.extras = self.stacked  # its extras begin with the model's (stacked_extras): the driver's restarts
         self.missed: list[tuple[float, float, str]] = []
         self.i_eval = 0
         self.t_start = 0.0
@@ -118,7 +119,8 @@ class SensitivityIntegrator:
     def start(self, t: float, y: NDArray, yp: NDArray, terms: Terms, state: ContactState) -> None:
         """S at the start (dy0/dp of the run's start), consistent in the start's mode; IDA started."""
         settings, model = self.settings, self.model
-        S0 = initial_sensitivities(model, self.sens.names, settings.start, settings.allow_penetration)
+        S0 = initial_sensitivities(model, self.sens.names, settings.start, settings.allow_penetration,
+                                   self.sens.ms.moved)
         self.sens.start(t, y, yp, state, S0)
         self.t_start = t
         if self.times is None or self.times.window(0, 1)[0] == t:  # the driver reports the start point
@@ -135,8 +137,8 @@ class SensitivityIntegrator:
 
     def consistent(self, t: float, y: NDArray, terms: Terms) -> tuple[NDArray, NDArray]:
         """q and v of ``y`` kept, multipliers and derivatives in the mode of ``terms``."""
-        model = self.model
-        return model.consistent_state(t, y, model.term_forces(t, y, terms.active, terms.params))
+        model, extras = self.model, self.stacked
+        return model.consistent_state(t, y, model.term_forces(t, y, terms.active, terms.params, extras), extras)
 
     def restart(self, t: float, y: NDArray, yp: NDArray, terms: Terms) -> None:
         """IDA re-initialised at ``(y, yp)`` and the carrier's S, S' (after its jump)."""
