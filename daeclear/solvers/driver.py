@@ -203,7 +203,7 @@ class Driver:
 
     def begin(self, t0: float, y0: NDArray, yp0: NDArray) -> None:
         """The contact modes from the state at ``t0``, the start recorded, the integrator started."""
-        model, session = self.model, self.integrator.session
+        model = self.model
         self.set_state(contact_state.start_state(model, t0, y0))
         self.last_terms = {name: (t0, contact_state.pair_state(model, self.state, root).term_on)
                            for root, name in enumerate(model.gap_names)}
@@ -215,7 +215,7 @@ class Driver:
             self.rec.add_steps(np.array([t0]), np.array([0.0]), np.array([self.integrator.order]))
         if self.times is None or self.times.window(0, 1)[0] == t0:  # the start point is reported
             self.raw.append((np.array([t0]), y[None, :], self.switch[None, :]))
-        self.rec.session = session  # the checked channels in the run's library while it is open
+        self.rec.session = self.integrator.extras  # the checked channels in the run's library while it is open
         self.y, self.yp = y, yp
         self.integrator.start(t0, y, yp, self.terms(), self.state)
 
@@ -471,7 +471,7 @@ class Driver:
                 return []
             key_t, key_y, key_channels = rec.key_rows()
             self.checked_rows = (key_t, key_y)  # the failure message reads the deepest pair's gap there
-            found = physics.check_run(model, key_t, key_y, key_channels, self.y0, stats, integrator.session,
+            found = physics.check_run(model, key_t, key_y, key_channels, self.y0, stats, integrator.extras,
                                       from_state=self.from_state)
             if self.kept_events is not None and integrator.fixed_step is not None:
                 found += physics.check_fixed_steps(model, self.kept_events, integrator.fixed_step, integrator.missed)
