@@ -399,7 +399,13 @@ class ModelSensitivity:
         if f is None or self.functions.root_curvature is None:
             raise ValueError("ModelSensitivity.roots: the model has no roots")
         P = model.parameter_values
-        J = np.array(f(t, y, yp, P))
+        n_roots = f.size_out(0)[0]
+        # in the stacked session (its last two extras: stacked_extras), else CasADi's
+        index = len(model.functions.extras) + len(self.row_derivatives(model))
+        if self.session is not None:
+            J = self.session.eval_extra(index, [np.array([t]), y, yp], 1)[0].reshape(-1, n_roots).T
+        else:
+            J = np.array(f(t, y, yp, P))
         g_t, g_y, g_yp, g_P = J[:, :1], J[:, 1:1 + n], J[:, 1 + n:1 + 2 * n], J[:, 1 + 2 * n:]
         if np.any(g_yp != 0.0):
             raise ValueError("ModelSensitivity.roots: a root reads y' (its rate would need y''): not supported")
@@ -408,7 +414,9 @@ class ModelSensitivity:
         tolerance = (np.zeros(n) if atol is None else np.asarray(atol, dtype=float)) + rtol * np.abs(y)
         return RootTerms(g_p=g_y @ S + g_yp @ Sp + g_P @ self.dP, rate=g_t[:, 0] + g_y @ yp,
                          scale=np.abs(g_t[:, 0]) + np.abs(g_y) @ np.abs(yp),
-                         curvature=np.array(self.functions.root_curvature(t, y, yp, ypp, P)).ravel(),
+                         curvature=(self.session.eval_extra(index + 1, [np.array([t]), y, yp, ypp], 1)[0]
+                                    if self.session is not None else
+                                    np.array(self.functions.root_curvature(t, y, yp, ypp, P)).ravel()),
                          error=np.abs(g_y) @ tolerance)
 
     def approach_rate(self, root: int, y: NDArray, yp: NDArray, S: NDArray
