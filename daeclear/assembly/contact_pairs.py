@@ -55,6 +55,11 @@ class PairLogic:
         """Indices of the gaps (roots) of this element."""
         return range(self.first_root, self.first_root + len(self.pairs))
 
+    @property
+    def n_states(self) -> int:
+        """How many pair states this element's part of a run's contact state holds."""
+        return len(self.pairs)
+
     def pair_index(self, root: int) -> int:
         """The pair (index in this element's states) of gap ``root``."""
         return root - self.first_root
