@@ -365,3 +365,31 @@ def test_a_thousand_cycles_at_k_1e_12_every_one_simulated_finish():
     joint = next(e for e in scene.elements if e.name == "clearance")
     mean_depth = history.volume[-1] / (2 * math.pi * joint.bearing_radius * 0.02)  # the volume spread evenly
     assert 2 * mean_depth < history.max_depth[-1] < MAX_DEPTH_FRACTION * joint.bearing_radius  # a worn spot
+
+
+@pytest.mark.parametrize("surface", ["bearing", "journal", "both"])
+def test_the_worn_depth_s_written_out_gradient_is_its_derivative(surface):
+    """worn_depths writes the profile's gradient out (the polynomial's derivative in z = c + i s); it must
+    be CasADi's derivative of the depth itself, in contact (a unit direction) and off it (shorter, and
+    zero: the centred journal), for random profiles and body angles."""
+    import casadi as ca
+    from types import SimpleNamespace
+
+    from daeclear.assembly.contact_pairs import worn_depths
+
+    modes = 12
+    q = ca.SX.sym("q", 4)  # the two bodies' angles, the direction's two components
+    symbols = {f"wear.{s}_{k}": ca.SX.sym(f"{s}_{k}", modes + 1 if k == "cos" else modes)
+               for s in ("bearing", "journal") for k in ("cos", "sin")}
+    ctx = SimpleNamespace(q=q, p=lambda name, key: symbols[key])
+    joint = SimpleNamespace(name="j", wear=ArchardWear(coefficient=1e-13, length=0.02, modes=modes, surface=surface))
+    bi, bj = SimpleNamespace(phi=q[0]), SimpleNamespace(phi=q[1])
+    h_bearing, h_journal, gradient = worn_depths(ctx, joint, q[2:], bi, bj)
+    p = ca.vertcat(*symbols.values())
+    f = ca.Function("f", [q, p], [gradient, ca.jacobian(h_bearing + h_journal, q)])
+    rng = np.random.default_rng(7)
+    for direction in ([0.6, 0.8], [0.21, -0.13], [0.0, 0.0]):
+        x = np.concatenate([rng.uniform(-3, 3, 2), direction])
+        written, derived = (np.array(v).ravel() for v in f(x, rng.normal(0.0, 1e-5, p.numel())))
+        assert np.max(np.abs(derived)) > 0
+        np.testing.assert_allclose(written, derived, rtol=1e-12, atol=1e-12 * np.max(np.abs(derived)))
