@@ -16,15 +16,12 @@ for each tree, new / old of both, and each tree's IDA step count (equal: the sam
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import statistics
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
-from bench_trees import tree_env
+from bench_trees import ask, start_worker, stop_workers
 
 #: one call a line on stdin ("formulation rtol t_end"), its wall time and steps as JSON on stdout
 WORKER = r"""
@@ -51,23 +48,6 @@ CALLS = [(window, t_end, formulation, rtol)
          for rtol in ("1e-5", "1e-6", "1e-7", "1e-8", "1e-9")]
 
 
-def start_worker(tree: Path, cache: Path) -> subprocess.Popen[str]:
-    """A worker in ``tree``'s package (its own compile cache)."""
-    return subprocess.Popen([sys.executable, "-c", WORKER], cwd=tree, env=tree_env(tree, cache), stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, text=True)
-
-
-def ask(worker: subprocess.Popen[str], formulation: str, rtol: str, t_end: float) -> dict[str, float]:
-    """One call in ``worker``: its wall time and IDA steps."""
-    assert worker.stdin is not None and worker.stdout is not None
-    worker.stdin.write(f"{formulation} {rtol} {t_end!r}\n")
-    worker.stdin.flush()
-    line = worker.stdout.readline()
-    if not line:
-        raise SystemExit(f"a worker stopped (exit code {worker.wait()})")
-    return json.loads(line)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("old", type=Path)
@@ -77,7 +57,7 @@ def main() -> None:
     if args.calls < 1:
         parser.error(f"--calls must be at least 1, got {args.calls}")
     with tempfile.TemporaryDirectory() as tmp:
-        workers = {label: start_worker(tree.resolve(), Path(tmp) / label)
+        workers = {label: start_worker(tree.resolve(), Path(tmp) / label, WORKER)
                    for label, tree in (("old", args.old), ("new", args.new))}
         print("| call | old best | new best | new / old (best) | old median | new median | "
               "new / old (median) | steps old / new |\n|---|---:|---:|---:|---:|---:|---:|---:|")
@@ -85,12 +65,12 @@ def main() -> None:
         try:
             for window, t_end, formulation, rtol in CALLS:
                 for label in workers:  # the first call compiles or loads the model: not counted
-                    ask(workers[label], formulation, rtol, t_end)
+                    ask(workers[label], f"{formulation} {rtol} {t_end!r}")
                 walls: dict[str, list[float]] = {"old": [], "new": []}
                 steps = {}
                 for k in range(args.calls):
                     for label in (("old", "new") if k % 2 == 0 else ("new", "old")):
-                        out = ask(workers[label], formulation, rtol, t_end)
+                        out = ask(workers[label], f"{formulation} {rtol} {t_end!r}")
                         walls[label].append(out["wall"])
                         steps[label] = out["steps"]
                 best = {label: min(w) for label, w in walls.items()}
@@ -101,10 +81,7 @@ def main() -> None:
                       f"{median['new'] * 1e3:.2f} ms | {median['new'] / median['old']:.3f} | "
                       f"{steps['old']} / {steps['new']} |", flush=True)
         finally:
-            for worker in workers.values():
-                if worker.stdin is not None:
-                    worker.stdin.close()
-                worker.wait()
+            stop_workers(workers.values())
     mean = math.exp(sum(math.log(r) for r in ratios) / len(ratios))
     print(f"\n{len(ratios)} calls, {args.calls} each a tree: geometric mean of new / old (median) {mean:.3f}, "
           f"range {min(ratios):.3f}-{max(ratios):.3f}")

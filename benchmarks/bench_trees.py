@@ -17,6 +17,7 @@ and new / old; then the geometric mean and the largest ratio.
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 import re
@@ -24,7 +25,9 @@ import subprocess
 import sys
 import tempfile
 from collections import defaultdict
+from collections.abc import Iterable
 from pathlib import Path
+from typing import Any
 
 #: every run of bench_work_precision.py's study, its wall time (the script prints the fastest rival's alone)
 WORK_PRECISION = r"""
@@ -69,6 +72,33 @@ def times_by_line(output: str) -> dict[tuple[str, int], list[float]]:
 def tree_env(tree: Path, cache: Path) -> dict[str, str]:
     """The environment of a process that imports ``tree``'s package, with its own compile cache."""
     return {**os.environ, "PYTHONPATH": str(tree), "DAECLEAR_CACHE_DIR": str(cache), "MPLBACKEND": "Agg"}
+
+
+def start_worker(tree: Path, cache: Path, code: str) -> subprocess.Popen[str]:
+    """A worker process running ``code`` in ``tree``'s package (its own compile cache): it reads one
+    request a line on stdin and answers each with one line of JSON on stdout."""
+    return subprocess.Popen([sys.executable, "-c", code], cwd=tree, env=tree_env(tree, cache), stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True)
+
+
+def ask(worker: subprocess.Popen[str], request: str) -> dict[str, Any]:
+    """One request to ``worker`` (a line) and its JSON answer."""
+    assert worker.stdin is not None and worker.stdout is not None
+    worker.stdin.write(request + "\n")
+    worker.stdin.flush()
+    line = worker.stdout.readline()
+    if not line:
+        raise SystemExit(f"a worker stopped (exit code {worker.wait()}) at {request!r}")
+    answer: dict[str, Any] = json.loads(line)
+    return answer
+
+
+def stop_workers(workers: Iterable[subprocess.Popen[str]]) -> None:
+    """Close each worker's input and wait for it to end."""
+    for worker in workers:
+        if worker.stdin is not None:
+            worker.stdin.close()
+        worker.wait()
 
 
 def run(tree: Path, script: str, args: list[str], cache: Path) -> str:

@@ -15,14 +15,11 @@ largest depth (the same physics: equal to a few digits).
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
-from bench_trees import tree_env
+from bench_trees import ask, start_worker, stop_workers
 
 #: one call a line on stdin ("cycles path-or-none"), its wall and CPU time and the final largest depth on stdout
 WORKER = r"""
@@ -41,23 +38,6 @@ for line in sys.stdin:
 """
 
 
-def start_worker(tree: Path, cache: Path) -> subprocess.Popen[str]:
-    """A worker in ``tree``'s package (its own compile cache)."""
-    return subprocess.Popen([sys.executable, "-c", WORKER], cwd=tree, env=tree_env(tree, cache), stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, text=True)
-
-
-def ask(worker: subprocess.Popen[str], cycles: int, path: str) -> dict[str, float]:
-    """One call in ``worker``: its wall time and final largest depth."""
-    assert worker.stdin is not None and worker.stdout is not None
-    worker.stdin.write(f"{cycles} {path}\n")
-    worker.stdin.flush()
-    line = worker.stdout.readline()
-    if not line:
-        raise SystemExit(f"a worker stopped (exit code {worker.wait()})")
-    return json.loads(line)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("old", type=Path)
@@ -69,26 +49,23 @@ def main() -> None:
     if args.calls < 1 or args.cycles < 1:
         parser.error("--calls and --cycles must be at least 1")
     with tempfile.TemporaryDirectory() as tmp:
-        workers = {label: start_worker(tree.resolve(), Path(tmp) / label)
+        workers = {label: start_worker(tree.resolve(), Path(tmp) / label, WORKER)
                    for label, tree in (("old", args.old), ("new", args.new))}
         walls: dict[str, list[float]] = {"old": [], "new": []}
         cpus: dict[str, list[float]] = {"old": [], "new": []}
         depth = {}
         try:
             for label in workers:  # the first call compiles or loads the model: not counted
-                ask(workers[label], 2, "-")
+                ask(workers[label], "2 -")
             for k in range(args.calls):
                 for label in (("old", "new") if k % 2 == 0 else ("new", "old")):
                     path = str(Path(tmp) / f"{label}{k}.h5") if args.path else "-"
-                    out = ask(workers[label], args.cycles, path)
+                    out = ask(workers[label], f"{args.cycles} {path}")
                     walls[label].append(out["wall"])
                     cpus[label].append(out["cpu"])
                     depth[label] = out["depth"]
         finally:
-            for worker in workers.values():
-                if worker.stdin is not None:
-                    worker.stdin.close()
-                worker.wait()
+            stop_workers(workers.values())
     rate = {label: (args.cycles / min(w), args.cycles / statistics.median(w)) for label, w in walls.items()}
     cpu_rate = {label: args.cycles / statistics.median(c) for label, c in cpus.items()}
     print(f"simulate_wear, {args.cycles} cycles every one simulated{', with a file' if args.path else ''}, "
