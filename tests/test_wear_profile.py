@@ -393,3 +393,24 @@ def test_the_worn_depth_s_written_out_gradient_is_its_derivative(surface):
         written, derived = (np.array(v).ravel() for v in f(x, rng.normal(0.0, 1e-5, p.numel())))
         assert np.max(np.abs(derived)) > 0
         np.testing.assert_allclose(written, derived, rtol=1e-12, atol=1e-12 * np.max(np.abs(derived)))
+
+
+def test_a_carried_pair_keeps_its_state_only_where_its_gap_agrees(worn_crank):
+    """continued_state: a pair carried in contact keeps its latched speed where the start's gap is in
+    contact; where the gap is open (new numbers moved it) it starts from its gap, as any run."""
+    from daeclear.assembly import contact_state
+    from daeclear.core.automaton import PairState
+
+    model = assemble(worn_crank)
+    run = block_run(model, 0.0, 0.0115, None, None)
+    rows = {mode: next(i for i, t in enumerate(run.t) if any(a < t < b and m["clearance"] == mode
+                                                                for a, b, m in run.segments))
+            for mode in ("contact", "free")}
+    carried = ((PairState(contact=True, latched=0.37, recent=(0.001,)),),)
+    t, y = run.t[rows["contact"]], run.state(rows["contact"])
+    assert contact_state.continued_state(model, t, y, carried) == carried
+    t, y = run.t[rows["free"]], run.state(rows["free"])
+    assert contact_state.continued_state(model, t, y, carried) == contact_state.start_state(model, t, y)
+    assert not contact_state.start_state(model, t, y)[0][0].contact
+    shape = contact_state.state_shape(model)
+    assert contact_state.array_state(contact_state.state_array(carried, shape), carried) == carried
