@@ -137,7 +137,8 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
 
     Each block runs ``update_every`` cycles with the current profile; its Archard wear times
     ``extrapolate`` is added to the profile (counting ``update_every * extrapolate`` cycles), and the
-    next block continues from its last state with the new profile (nothing is compiled).
+    next block continues from its last state and contact state (a contact going on across the boundary
+    keeps its impact's approach speed) with the new profile (nothing is compiled).
 
     Parameters
     ----------
