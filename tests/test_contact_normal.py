@@ -358,3 +358,16 @@ def test_resolve_and_evaluation_errors() -> None:
         ln.with_stiffness(1e10).force(1e-6, 0.0)
     with pytest.raises(TypeError, match="penetration_rate"):
         ln.with_stiffness(1e10).force(1e-6)
+
+
+def test_contact_force_is_the_limit_from_inside_the_contact() -> None:
+    """A term on at its onset root (delta = 0) reads the force's limit from inside: Kelvin-Voigt's jump D delta_dot
+    (the law's own value there is 0, as out of contact); a law continuous at delta = 0 reads its force."""
+    kv = KelvinVoigt(stiffness=1e9, damping=1e4)
+    assert kv.force(0.0, 5.0) == 0.0 and kv.contact_force(0.0, 5.0) == 1e4 * 5.0
+    assert kv.contact_force(1e-9, -5.0) == 0.0 and kv.contact_force(-1e-9, 5.0) == 0.0  # clamped; outside
+    assert kv.contact_force(2e-6, 1.0) == kv.force(2e-6, 1.0) == pytest.approx(1e9 * 2e-6 + 1e4)
+    for law in [Hertz(stiffness=K_BENCH), LankaraniNikravesh(restitution=0.9, stiffness=K_BENCH),
+                LankaraniPlane(stiffness=6e9)]:
+        delta = np.array([-1e-9, 0.0, 1e-6])
+        assert np.array_equal(law.contact_force(delta, 5.0, 1.0), law.force(delta, 5.0, 1.0))

@@ -332,9 +332,9 @@ def test_track_work_carries_the_work_state_and_keeps_the_derivatives() -> None:
 
 
 def test_track_work_through_a_force_that_jumps_at_onset() -> None:
-    """With track_work IDA's onset root lands exactly on delta = 0, where Kelvin-Voigt's force reads 0 (the
-    law's delta > 0 guard): the jump reads y'+ from inside the contact (onset_limit), else it misses D u and
-    dx/dz0 comes out 3.51 (the jumpless value) instead of 1.74."""
+    """With track_work IDA's onset root lands exactly on delta = 0: the term reads Kelvin-Voigt's force there from
+    inside the contact (``contact_force``: D u, not the law's 0 out of contact), so the jump's y'+ has it (before the
+    fix dx/dz0 came out 3.51, the jumpless value, instead of 1.74)."""
     r = _work_run(dcc.KelvinVoigt(stiffness=K, damping=D), True)
     assert r.sensitivity("journal.x")[-1] == pytest.approx(complex_step(kelvin_voigt_radial, P0)[0], rel=1e-6)
 

@@ -123,7 +123,7 @@ def test_a_file_of_the_former_layout_or_another_kind_is_refused(worn, tmp_path, 
     result = dc.simulate(dc.mechanisms.slider_crank("revolute"), 0.001).save(tmp_path / "run.h5")
     monkeypatch.setattr(study, "assemble", lambda *a, **k: pytest.fail("assembled before the file was checked"))
     with pytest.raises(SceneError, match=r"is a daeclear-wear file of layout version 1 \(none written\), which this "
-                                         r"daeclear does not resume \(it writes and resumes version 2\); the file is "
+                                         r"daeclear does not resume \(it writes and resumes version 3\); the file is "
                                          r"left as it is; give a new path"):
         simulate_wear(worn, 2, path=former)
     with pytest.raises(SceneError, match=r"is not a daeclear-wear file \(its format is 'daeclear-result'\)"):

@@ -16,7 +16,9 @@ import daeclear.contact as dcc
 from daeclear.contact.wear import MAX_DEPTH_FRACTION, ArchardWear, profile_coefficients, profile_depth
 from daeclear.core.errors import SceneError
 from daeclear.model.scene import RevoluteClearance
-from daeclear.studies.wear import simulate_wear
+from daeclear.assembly.assemble import assemble
+from daeclear.solvers.driver import Continuation
+from daeclear.studies.wear import block_run, simulate_wear
 
 NODES, MODES = 360, 48
 THETA = 2.0 * np.pi * np.arange(NODES) / NODES
@@ -197,6 +199,45 @@ def test_a_stopped_history_resumes_where_it_stopped(worn_crank, tmp_path):
         simulate_wear(worn_crank, 4, path=path, update_every=2)
 
 
+def _continued(model: dc.DAEModel, t_end: float, t_split: float):
+    """The run of ``model`` from its start to ``t_end`` whole, and split at ``t_split`` into two block runs,
+    the second from the first's last state and contact state."""
+    whole = block_run(model, 0.0, t_end, None, None)
+    carry = Continuation()
+    first = block_run(model, 0.0, t_split, None, None, carry)
+    latched = carry.state[0][0].latched
+    return whole, first, latched, block_run(model, t_split, t_end, first.state(-1), None, carry)
+
+
+def test_a_block_boundary_inside_a_contact_keeps_the_impact_s_approach_speed(worn_crank):
+    """A block that starts inside an ongoing contact (the slider-crank's rod-slider journal stays in
+    contact from 7.2 ms on) goes on with the approach speed its impact latched (Lankarani-Nikravesh's
+    damping divides by it), as the unsplit run does: its normal force is the unsplit run's to
+    integration accuracy (measured 1.5e-3 of the peak at rtol 1e-6, shrinking with rtol). Re-latched
+    from the penetration rate at the block's start, as every block did before, it was 18 % off."""
+    model = assemble(worn_crank)
+    whole, first, latched, second = _continued(model, 0.0115, 0.009)
+    segment = next(s for s in whole.segments if s[0] < 0.009 < s[1])
+    assert segment[2]["clearance"] == "contact" and segment[0] < 0.0085  # the boundary is inside a contact
+    onset = [e for e in first.events.of("clearance", kind="onset")][-1]
+    assert latched == onset.approach_speed > 0.0  # the impact's, carried to the next block
+    force = second["clearance.normal_force"]
+    reference = np.interp(second.t, whole.t, whole["clearance.normal_force"])
+    assert np.max(force) > 5e3 and np.max(np.abs(force - reference)) < 5e-3 * np.max(reference)
+
+
+def test_blocks_split_inside_a_contact_wear_as_one_run():
+    """simulate_wear's block boundaries (each turn of the crank, inside the journal's long contact) do not
+    change the physics: two one-cycle blocks give the sliding work of one two-cycle block (k so small
+    that the profile does not act) to integration accuracy (measured 3e-5; with each block's approach
+    speed re-latched at its start, 8.5e-3)."""
+    scene = dc.mechanisms.slider_crank("revolute", friction=0.1).with_values(
+        {"clearance.wear": ArchardWear(coefficient=1e-20, length=0.02)})
+    split, whole = (simulate_wear(scene, 2, update_every=every) for every in (1, 2))
+    assert whole.sliding_work[-1] > 50.0
+    assert split.sliding_work[-1] == pytest.approx(whole.sliding_work[-1], rel=3e-4)
+
+
 def test_simulate_wear_input_is_checked(worn_crank):
     for kwargs, word in ((dict(update_every=0), "update_every=0"), (dict(extrapolate=1.5), "extrapolate=1.5"),
                          (dict(joint="C"), "joint='C'"), (dict(period=-1.0), "period=-1.0")):
@@ -324,3 +365,52 @@ def test_a_thousand_cycles_at_k_1e_12_every_one_simulated_finish():
     joint = next(e for e in scene.elements if e.name == "clearance")
     mean_depth = history.volume[-1] / (2 * math.pi * joint.bearing_radius * 0.02)  # the volume spread evenly
     assert 2 * mean_depth < history.max_depth[-1] < MAX_DEPTH_FRACTION * joint.bearing_radius  # a worn spot
+
+
+@pytest.mark.parametrize("surface", ["bearing", "journal", "both"])
+def test_the_worn_depth_s_written_out_gradient_is_its_derivative(surface):
+    """worn_depths writes the profile's gradient out (the polynomial's derivative in z = c + i s); it must
+    be CasADi's derivative of the depth itself, in contact (a unit direction) and off it (shorter, and
+    zero: the centred journal), for random profiles and body angles."""
+    import casadi as ca
+    from types import SimpleNamespace
+
+    from daeclear.assembly.contact_pairs import worn_depths
+
+    modes = 12
+    q = ca.SX.sym("q", 4)  # the two bodies' angles, the direction's two components
+    symbols = {f"wear.{s}_{k}": ca.SX.sym(f"{s}_{k}", modes + 1 if k == "cos" else modes)
+               for s in ("bearing", "journal") for k in ("cos", "sin")}
+    ctx = SimpleNamespace(q=q, p=lambda name, key: symbols[key])
+    joint = SimpleNamespace(name="j", wear=ArchardWear(coefficient=1e-13, length=0.02, modes=modes, surface=surface))
+    bi, bj = SimpleNamespace(phi=q[0]), SimpleNamespace(phi=q[1])
+    h_bearing, h_journal, gradient = worn_depths(ctx, joint, q[2:], bi, bj)
+    p = ca.vertcat(*symbols.values())
+    f = ca.Function("f", [q, p], [gradient, ca.jacobian(h_bearing + h_journal, q)])
+    rng = np.random.default_rng(7)
+    for direction in ([0.6, 0.8], [0.21, -0.13], [0.0, 0.0]):
+        x = np.concatenate([rng.uniform(-3, 3, 2), direction])
+        written, derived = (np.array(v).ravel() for v in f(x, rng.normal(0.0, 1e-5, p.numel())))
+        assert np.max(np.abs(derived)) > 0
+        np.testing.assert_allclose(written, derived, rtol=1e-12, atol=1e-12 * np.max(np.abs(derived)))
+
+
+def test_a_carried_pair_keeps_its_state_only_where_its_gap_agrees(worn_crank):
+    """continued_state: a pair carried in contact keeps its latched speed where the start's gap is in
+    contact; where the gap is open (new numbers moved it) it starts from its gap, as any run."""
+    from daeclear.assembly import contact_state
+    from daeclear.core.automaton import PairState
+
+    model = assemble(worn_crank)
+    run = block_run(model, 0.0, 0.0115, None, None)
+    rows = {mode: next(i for i, t in enumerate(run.t) if any(a < t < b and m["clearance"] == mode
+                                                                for a, b, m in run.segments))
+            for mode in ("contact", "free")}
+    carried = ((PairState(contact=True, latched=0.37, recent=(0.001,)),),)
+    t, y = run.t[rows["contact"]], run.state(rows["contact"])
+    assert contact_state.continued_state(model, t, y, carried) == carried
+    t, y = run.t[rows["free"]], run.state(rows["free"])
+    assert contact_state.continued_state(model, t, y, carried) == contact_state.start_state(model, t, y)
+    assert not contact_state.start_state(model, t, y)[0][0].contact
+    shape = contact_state.state_shape(model)
+    assert contact_state.array_state(contact_state.state_array(carried, shape), carried) == carried

@@ -55,6 +55,11 @@ class PairLogic:
         """Indices of the gaps (roots) of this element."""
         return range(self.first_root, self.first_root + len(self.pairs))
 
+    @property
+    def n_states(self) -> int:
+        """How many pair states this element's part of a run's contact state holds."""
+        return len(self.pairs)
+
     def pair_index(self, root: int) -> int:
         """The pair (index in this element's states) of gap ``root``."""
         return root - self.first_root
@@ -254,11 +259,19 @@ def journal_parameters(ref: Reference, joint: Any, law: Any, friction: Any, film
     return values
 
 
-def worn_depths(ctx: AssemblyContext, joint: Any, direction: Any, bi: Any, bj: Any) -> tuple[Any, Any]:
+def worn_depths(ctx: AssemblyContext, joint: Any, direction: Any, bi: Any, bj: Any) -> tuple[Any, Any, Any]:
     """The worn depths of the bearing and of the journal along the unit ``direction`` (world frame):
-    each surface's profile (parameters ``<joint>.wear.<surface>_cos/_sin``), 0 if it does not wear."""
+    each surface's profile (parameters ``<joint>.wear.<surface>_cos/_sin``), 0 if it does not wear; and
+    the sum's gradient in the positions (None without wear).
+
+    A profile is a polynomial in ``z = c + i s``, the direction's cosine and sine in the body's frame:
+    ``h = a_0 + Re sum (a_m - i b_m) z^m`` (the angle-sum rule, no atan2: regular at e = 0). Its
+    gradient is written out, ``dh = Re sum m (a_m - i b_m) z^(m-1) dz`` with the powers the depth
+    already made, rather than differentiated through the powers' recurrence: the same numbers, and
+    the contact's Jacobian then differentiates the powers once, not their derivative again."""
     wear = getattr(joint, "wear", None)
     out: list[Any] = [0.0, 0.0]
+    gradient: Any = None
     for k, (surface, frame) in enumerate((("bearing", bi), ("journal", bj))):
         if wear is None or surface not in wear.surfaces:
             continue
@@ -266,12 +279,17 @@ def worn_depths(ctx: AssemblyContext, joint: Any, direction: Any, bi: Any, bj: A
         c1 = ca.cos(frame.phi) * direction[0] + ca.sin(frame.phi) * direction[1]
         s1 = -ca.sin(frame.phi) * direction[0] + ca.cos(frame.phi) * direction[1]
         a, b = ctx.p(joint.name, f"wear.{surface}_cos"), ctx.p(joint.name, f"wear.{surface}_sin")
-        depth, cm, sm = a[0], c1, s1
-        for m in range(wear.modes):  # cos/sin of (m + 1) theta by the angle-sum rule: no atan2 (regular at e = 0)
-            depth = depth + a[m + 1] * cm + b[m] * sm
+        depth, d_c, d_s = a[0], 0.0, 0.0
+        cm, sm = 1.0, 0.0  # Re and Im of z^m, from m = 0
+        for m in range(1, wear.modes + 1):
+            d_c = d_c + m * (a[m] * cm + b[m - 1] * sm)  # dh/dc: Re m (a_m - i b_m) z^(m-1)
+            d_s = d_s + m * (b[m - 1] * cm - a[m] * sm)  # dh/ds = i dh/dc's real part
             cm, sm = cm * c1 - sm * s1, sm * c1 + cm * s1
+            depth = depth + a[m] * cm + b[m - 1] * sm
         out[k] = depth
-    return out[0], out[1]
+        part = d_c * ca.jacobian(c1, ctx.q) + d_s * ca.jacobian(s1, ctx.q)
+        gradient = part if gradient is None else gradient + part
+    return out[0], out[1], gradient
 
 
 def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction_numeric: Any,
@@ -293,11 +311,10 @@ def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction
     n = e / e_norm  # (4.4)
     # the direction of e, regular at e = 0 (where the gap is far from closing): exactly n in contact
     clearance = ctx.p(name, "clearance")
-    worn = worn_depths(ctx, joint, e / ca.fmax(e_norm, 0.5 * clearance), bi, bj)  # 0 without wear
+    *worn, worn_jacobian = worn_depths(ctx, joint, e / ca.fmax(e_norm, 0.5 * clearance), bi, bj)  # 0 without wear
     c_worn = worn[0] + worn[1]
     c = clearance + c_worn  # the clearance along n, worn surfaces included
     delta = e_norm - c  # (4.5)
-    worn_jacobian = ca.jacobian(c_worn, ctx.q) if isinstance(c_worn, ca.SX) else None
     worn_rate = ca.mtimes(worn_jacobian, ctx.v) if worn_jacobian is not None else 0.0
     # (4.8): v_N = d|e|/dt, less the worn depth's change as the contact moves along the profile and the
     # worn bodies turn (the gap's own rate: a contact is left only when its gap closes)
@@ -309,7 +326,7 @@ def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction
     v_T = ca.dot(bj.world_point_velocity(Q_j) - bi.world_point_velocity(Q_i), t_vec)
     n_params = 1 if law_numeric.needs_approach_speed else 0
     p = ca.SX.sym("p", n_params)
-    F_N = law.force(delta, delta_dot, p[0] if n_params else None)
+    F_N = law.contact_force(delta, delta_dot, p[0] if n_params else None)
     F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
     worn_angles = None
     if worn_jacobian is not None:  # the contact direction's angle in each body's frame: atan2 of A(phi)^T n

@@ -85,3 +85,50 @@ def with_pairs(model: DAEModel, state: ContactState, pairs: Mapping[int, PairSta
             if root in pairs:
                 new[k][logic.pair_index(root)] = pairs[root]
     return tuple(tuple(states) for states in new)
+
+
+def continued_state(model: DAEModel, t: float, y: NDArray, carried: ContactState) -> ContactState:
+    """Every pair's state at the start of a run that continues another (``carried``: the pairs' states
+    where it ended): each pair keeps its carried state (its latched approach speed, its history) when
+    its mode is the one its gap gives at ``(t, y)``; a pair whose mode the start's gap contradicts (new
+    numbers moved its gap across zero) starts as :func:`start_state` starts it."""
+    fresh = start_state(model, t, y)
+    return tuple(tuple(old if old.contact == new.contact else new for old, new in zip(olds, news))
+                 for olds, news in zip(carried, fresh))
+
+
+#: The numbers of one pair's state in :func:`state_array`'s rows before its switch times.
+PAIR_FIELDS = ("contact", "held", "free_since", "latched")
+
+
+def state_array(state: ContactState, shape: tuple[int, int]) -> NDArray:
+    """The state as numbers, one row per pair in model order: :data:`PAIR_FIELDS`, then the last switch
+    times (oldest first), NaN up to the columns of ``shape`` (:func:`state_shape`; to keep it in a file)."""
+    pairs = [pair for states in state for pair in states]
+    out = np.full(shape, np.nan)
+    for row, pair in zip(out, pairs):
+        row[:4] = (float(pair.contact), float(pair.held), pair.free_since, pair.latched)
+        row[4:4 + len(pair.recent)] = pair.recent
+    return out
+
+
+def array_state(values: NDArray, like: ContactState) -> ContactState:
+    """The state :func:`state_array` wrote, in the structure of ``like`` (a state of the same model)."""
+    rows = iter(np.asarray(values, dtype=float))
+    out = []
+    for states in like:
+        element = []
+        for _ in states:
+            row = next(rows)
+            recent = row[4:]
+            element.append(PairState(contact=bool(row[0]), held=bool(row[1]), free_since=float(row[2]),
+                                     latched=float(row[3]), recent=tuple(recent[~np.isnan(recent)].tolist())))
+        out.append(tuple(element))
+    return tuple(out)
+
+
+def state_shape(model: DAEModel) -> tuple[int, int]:
+    """The shape of :func:`state_array` for any state of ``model``: its pairs, and the fields and the
+    longest switch history."""
+    return (sum(logic.n_states for logic in model.contacts),
+            len(PAIR_FIELDS) + max((logic.storm.events for logic in model.contacts), default=0))

@@ -122,6 +122,10 @@ class LubricatedLogic(PairLogic):
     def roots(self) -> range:
         return range(self.first_root, self.first_root + 3)
 
+    @property
+    def n_states(self) -> int:
+        return 2  # the regime and the dry contact
+
     def pair_index(self, root: int) -> int:
         return 0 if root < self.first_root + 2 else 1
 

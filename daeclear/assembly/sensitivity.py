@@ -124,10 +124,26 @@ def _offsets(model: DAEModel) -> list[tuple[str, int]]:
     return out
 
 
+#: The moved values of a parameter p whose differences :func:`_richardson` combines: p + h, p - h, p + h/2, p - h/2.
+STEPS = (1.0, -1.0, 0.5, -0.5)
+
+#: A parameter's value p, its step h and the model at each of p + STEPS h: what the central differences of the
+#: scene-to-P map and of the start both difference (made once per parameter by :func:`moved_models`).
+Moved = tuple[float, float, list[DAEModel]]
+
+
+def moved_models(model: DAEModel, name: str) -> Moved:
+    """``model`` with the parameter ``name`` at each of p + STEPS h (:data:`Moved`)."""
+    p = parameter_value(model, name)
+    h = _step(p)
+    return p, h, [moved_parameter(model, name, p + s * h) for s in STEPS]
+
+
 def _richardson(f: Any, p: float, h: float) -> NDArray[np.float64]:
     """(4 D(h/2) - D(h)) / 3 of central differences D of ``f`` at ``p``, with the exact 0 and 1 of values
-    that do not move or move as ``p`` itself (an entry of P that is the parameter)."""
-    plus, minus, plus2, minus2 = (np.asarray(f(p + s), dtype=float) for s in (h, -h, h / 2, -h / 2))
+    that do not move or move as ``p`` itself (an entry of P that is the parameter); ``f`` is given the index
+    of each moved value in :data:`STEPS`."""
+    plus, minus, plus2, minus2 = (np.asarray(f(k), dtype=float) for k in range(len(STEPS)))
     d1, d2 = (plus - minus) / (2 * h), (plus2 - minus2) / h
     out = (4.0 * d2 - d1) / 3.0
     still = (plus == minus) & (plus2 == minus2)
@@ -137,15 +153,20 @@ def _richardson(f: Any, p: float, h: float) -> NDArray[np.float64]:
     return out
 
 
-def parameter_directions(model: DAEModel, names: Sequence[str]) -> NDArray[np.float64]:
+def parameter_directions(model: DAEModel, names: Sequence[str], moved: dict[str, Moved] | None = None
+                         ) -> NDArray[np.float64]:
     """dP/dp, (n_P, Ns): how the run-time vector P moves with each named parameter (column j for
     ``names[j]``); exact 1 and 0 where P holds the number itself or not at all, else the derivative of
-    the numbers derived from it (central differences with Richardson's extrapolation, ``STEP_BITS``)."""
+    the numbers derived from it (central differences with Richardson's extrapolation, ``STEP_BITS``).
+    ``moved``: the moved models by name (:func:`moved_models`), made here for the names it lacks."""
     names = _checked_names(names)
+    moved = {} if moved is None else moved
     columns = []
     for name in names:
-        p = parameter_value(model, name)
-        columns.append(_richardson(lambda x, name=name: moved_parameter(model, name, x).parameter_values, p, _step(p)))
+        if name not in moved:
+            moved[name] = moved_models(model, name)
+        p, h, models = moved[name]
+        columns.append(_richardson(lambda k, models=models: models[k].parameter_values, p, h))
     return np.stack(columns, axis=1) if columns else np.zeros((model.parameter_values.size, 0))
 
 
@@ -161,21 +182,26 @@ def _checked_names(names: Any) -> tuple[str, ...]:
 
 
 def initial_sensitivities(model: DAEModel, names: Sequence[str], start: str = "ideal",
-                          allow_penetration: bool = False) -> NDArray[np.float64]:
+                          allow_penetration: bool = False, moved: dict[str, Moved] | None = None
+                          ) -> NDArray[np.float64]:
     """dy0/dp of the start ``model.initial_state(start=...)``, (n_states, Ns): central differences with
     Richardson's extrapolation over models with the parameter moved (the start is a Newton solution
-    from the declared state, not a formula); the algebraic rows are made consistent afterwards."""
+    from the declared state, not a formula); the algebraic rows are made consistent afterwards.
+    ``moved``: the moved models by name (:func:`moved_models`; those of :func:`parameter_directions`), made
+    here for the names it lacks (CasADi evaluates them: a session's extras read its own parameters)."""
     names = _checked_names(names)
+    moved = {} if moved is None else moved
     columns = []
     for name in names:
-        p = parameter_value(model, name)
+        if name not in moved:
+            moved[name] = moved_models(model, name)
+        p, h, models = moved[name]
 
-        def start_at(x: float, name: str = name) -> NDArray[np.float64]:
+        def start_at(k: int, models: list[DAEModel] = models) -> NDArray[np.float64]:
             with warnings.catch_warnings():  # the start's notes were given for the run itself
                 warnings.simplefilter("ignore")
-                moved = moved_parameter(model, name, x)
-                return moved.initial_state(start=start, allow_penetration=allow_penetration)[0]
-        columns.append(_richardson(start_at, p, _step(p)))
+                return models[k].initial_state(start=start, allow_penetration=allow_penetration)[0]
+        columns.append(_richardson(start_at, p, h))
     return np.stack(columns, axis=1)
 
 
@@ -186,6 +212,28 @@ def model_sensitivity_functions(model: DAEModel, width: int) -> SensitivityFunct
     extras = (EXTRA_ACCEL, EXTRA_KINEMATICS, *(EXTRA_TERM0 + k for k in range(len(model.terms))),
               *(extra for _, _, extra, _, _ in model.auto_pairs))
     return model.compiled.sensitivity(width, extras)
+
+
+@dataclass(frozen=True)
+class Shared:
+    """An input of :func:`mapped` that is the same at every point."""
+
+    value: Any
+
+
+def mapped(f: Any, N: int, *inputs: Any) -> NDArray[np.float64]:
+    """``f`` (one matrix output) at N points in one call: each input either :class:`Shared` or stacked per
+    point along its first axis ((N,) for a scalar, (N, r) for a vector, (N, r, c) for a matrix); returns
+    (N, rows, cols) of the output. One point calls ``f`` itself (a map costs ~0.1 ms to build)."""
+    cols = []
+    for x in inputs:
+        if isinstance(x, Shared):
+            cols.append(np.asarray(x.value, dtype=float))
+            continue
+        a = np.asarray(x, dtype=float).reshape(N, x.shape[1] if np.ndim(x) > 1 else 1, -1)
+        cols.append(a.transpose(1, 0, 2).reshape(a.shape[1], -1))  # point k's block in columns k c ... (k + 1) c
+    out = np.array((f if N == 1 else f.map(N))(*cols), dtype=float)
+    return out.reshape(out.shape[0], N, -1).transpose(1, 0, 2)
 
 
 @dataclass(frozen=True)
@@ -208,16 +256,25 @@ class ModelSensitivity:
     says which roots make its events and how its terms' parameters follow its pairs' latched speeds
     (``event_roots``, ``term_sensitivities`` of :class:`~daeclear.assembly.contact_pairs.PairLogic`)."""
 
+    #: The extras whose directional derivatives a run's rows and events evaluate (consistent S, the channels'
+    #: S): in a stacked session they follow the model's extras in this order (``stacked_extras``).
+    @staticmethod
+    def row_derivatives(model: DAEModel) -> tuple[int, ...]:
+        return (EXTRA_ACCEL, *(EXTRA_TERM0 + k for k in range(len(model.terms))), EXTRA_OUTPUTS, EXTRA_KINEMATICS)
+
     def __init__(self, model: DAEModel, names: Sequence[str]) -> None:
         self.model = model
         self.names = _checked_names(names)
-        self.dP = parameter_directions(model, self.names)
+        #: the models with each parameter moved: differenced for dP here, for the start's S by initial_sensitivities
+        self.moved: dict[str, Moved] = {}
+        self.dP = parameter_directions(model, self.names, self.moved)
         self.functions = model_sensitivity_functions(model, len(self.names))
         self._extra = {k: f for k, f in zip(self.functions.extra_index, self.functions.extras)}
+        #: the stacked session whose extras (:meth:`row_derivatives`) evaluate the rows (None: CasADi here)
+        self.session: Any = None
         # each contact element's gap rates' Jacobian [r_q | r_v | r_P]: the latched approach speed's derivative
         self._rate_jacobians = [jacobian_blocks(logic.rate.function, f"rate_jacobian{i}", out=logic.rate_output)
                                 for i, logic in enumerate(model.contacts)]
-        self._outputs: Any = None  # the channels' directional derivative, made when first asked for
 
     @property
     def width(self) -> int:
@@ -239,27 +296,36 @@ class ModelSensitivity:
         ``S_params``): S_q and S_v kept, the multipliers' and the derivatives' sensitivities the derivative
         of :meth:`DAEModel.consistent_state` (its accelerations' solve) in the direction (S_q, S_v, dP);
         GGL's mu has sensitivity 0 (mu is 0 on the solution for every p)."""
-        model, P, dP, W = self.model, self.model.parameter_values, self.dP, self.width
+        S_out, Sp = self.consistent_rows(np.array([t], dtype=float), np.asarray(y, dtype=float)[None],
+                                         np.asarray(S, dtype=float)[None], active, params, S_params)
+        return S_out[0], Sp[0]
+
+    def consistent_rows(self, t: NDArray, y: NDArray, S: NDArray, active: Sequence[bool], params: Sequence[NDArray],
+                        S_params: Sequence[NDArray]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """:meth:`consistent` at N points of one mode at once: ``t`` (N,), ``y`` (N, n_states), ``S``
+        (N, n_states, Ns) -> (S, S'), each (N, n_states, Ns); one mapped call per function for all rows."""
+        model, W = self.model, self.width
         n, m = model.n_q, model.n_constraints
-        q, v = y[:n], y[n:2 * n]
-        Sq, Sv = S[:n], S[n:2 * n]
-        zero_t = np.zeros((1, W))
-        forces = model.term_forces(t, y, active, params)
-        Qc = np.zeros(n) if forces is None else forces
-        dQc = np.zeros((n, W))
+        N = t.size
+        q, v = y[:, :n], y[:, n:2 * n]
+        Sq, Sv = S[:, :n], S[:, n:2 * n]
+        zero_t = Shared(np.zeros((1, W)))
+        forces = model.term_forces(t if N > 1 else t[0], y if N > 1 else y[0], active, params, self.session)
+        Qc = np.zeros((N, n)) if forces is None else np.asarray(forces, dtype=float).reshape(N, n)
+        dQc = np.zeros((N, n, W))
         for k, on in enumerate(active):
             if on:
-                dQc += np.array(self._extra[EXTRA_TERM0 + k](t, q, v, params[k], P, zero_t, Sq, Sv,
-                                                             S_params[k].reshape(-1, W), dP))
-        d = np.array(self._extra[EXTRA_ACCEL](t, q, v, Qc, P, zero_t, Sq, Sv, dQc, dP))
-        S_out, Sp = np.array(S, dtype=float), np.zeros((model.n_states, W))
-        S_out[2 * n:2 * n + m] = d[n:n + m]
+                dQc += self.derivative(EXTRA_TERM0 + k, N, [t, q, v, Shared(params[k])],
+                                       [zero_t, Sq, Sv, Shared(S_params[k].reshape(-1, W))])
+        d = self.derivative(EXTRA_ACCEL, N, [t, q, v, Qc], [zero_t, Sq, Sv, dQc])
+        S_out, Sp = np.array(S, dtype=float), np.zeros((N, model.n_states, W))
+        S_out[:, 2 * n:2 * n + m] = d[:, n:n + m]
         if model.formulation == "ggl":
-            S_out[2 * n + m:2 * n + 2 * m] = 0.0
-        Sp[:n] = Sv
-        Sp[n:2 * n] = d[:n]
+            S_out[:, 2 * n + m:2 * n + 2 * m] = 0.0
+        Sp[:, :n] = Sv
+        Sp[:, n:2 * n] = d[:, :n]
         if model.track_work:
-            Sp[-1] = d[n + m]
+            Sp[:, -1] = d[:, n + m]
         return S_out, Sp
 
     def switch_sensitivity(self, S_params: Sequence[NDArray]) -> NDArray[np.float64]:
@@ -275,27 +341,52 @@ class ModelSensitivity:
                  S_switch: NDArray) -> NDArray[np.float64]:
         """Every output channel's sensitivity at one point, (n_channels, Ns): d ch/dy S + d ch/dy' S'
         + d ch/d switch S_switch + d ch/dP dP (the chain rule through the channels' functions)."""
-        if self._outputs is None:
-            self._outputs = directional(self.model.functions.extras[EXTRA_OUTPUTS], self.width, (1, 2, 3, 4),
-                                        "sens_outputs")
-        P = self.model.parameter_values
-        return np.array(self._outputs(t, y, yp, switch, P, S, Sp, S_switch, self.dP))
+        return self.channels_rows(np.array([t], dtype=float), y[None], yp[None], S[None], Sp[None], switch,
+                                  S_switch)[0]
+
+    def channels_rows(self, t: NDArray, y: NDArray, yp: NDArray, S: NDArray, Sp: NDArray, switch: NDArray,
+                      S_switch: NDArray) -> NDArray[np.float64]:
+        """:meth:`channels` at N points of one mode (``switch``, ``S_switch``) at once, (N, n_channels, Ns)."""
+        return self.derivative(EXTRA_OUTPUTS, t.size, [t, y, yp, Shared(switch)],
+                               [Shared(np.zeros((1, self.width))), S, Sp, Shared(S_switch)])
+
+    def outputs_rows(self, t: NDArray, y: NDArray, yp: NDArray, switch: NDArray) -> NDArray[np.float64]:
+        """The channels' values at N points of one mode at once, (N, n_channels)."""
+        N = t.size
+        return self.model.evaluate(EXTRA_OUTPUTS, [t.reshape(N, 1), y, yp, switch], N, self.session)
+
+    def derivative(self, k: int, N: int, values: Sequence[Any], seeds: Sequence[Any]) -> NDArray[np.float64]:
+        """The directional derivative of the model's extra ``k`` at N points, (N, numel_out, Ns): ``values`` its
+        inputs but P, ``seeds`` their directions but dP's (each :class:`Shared` or stacked per point); in the
+        stacked session's C when there is one (:meth:`row_derivatives`), else in CasADi."""
+        if self.session is None:
+            if k not in self._extra:  # the channels': made when first asked for
+                self._extra[k] = directional(self.model.functions.extras[k], self.width, None, f"sens_extra{k}")
+            P, dP = Shared(self.model.parameter_values), Shared(self.dP)
+            return mapped(self._extra[k], N, *values, P, *seeds, dP)
+        index = len(self.model.functions.extras) + self.row_derivatives(self.model).index(k)
+        flat = [np.asarray(x.value, dtype=float).ravel(order="F") if isinstance(x, Shared) else
+                np.asarray(x, dtype=float).reshape(N, x.shape[1] if np.ndim(x) > 1 else 1, -1).transpose(0, 2, 1
+                                                                                                   ).reshape(N, -1)
+                for x in (*values, *seeds)]  # column-major per point, as CasADi's matrices
+        out = self.session.eval_extra(index, flat, N)
+        return out.reshape(N, self.width, -1).transpose(0, 2, 1)
 
     def projected(self, t: float, y: NDArray, S: NDArray) -> NDArray[np.float64]:
         """S with S_q and S_v moved (least norm) onto the linearised constraints, d Phi = Phi_q S_q + Phi_P dP
         = 0 and d(Phi_q v + Phi_t) = 0: what :meth:`DAEModel.consistent_state` with ``project`` does to q and v
         at a GGL restart (IDA's S holds them only to its tolerance; GGL's index-2 rows need them exact)."""
-        model, P, W = self.model, self.model.parameter_values, self.width
+        model, W = self.model, self.width
         n, m = model.n_q, model.n_constraints
         if not m:
             return np.array(S, dtype=float)
         S = np.array(S, dtype=float)
         q, v = y[:n], y[n:2 * n]
-        kinematics = self._extra[EXTRA_KINEMATICS]
-        Phi_q = np.array(model.functions.extras[EXTRA_KINEMATICS](q, v, t, P)).ravel()[m:m + m * n].reshape(n, m).T
-        zero_t = np.zeros((1, W))
+        Phi_q = model.constraints(q, v, t, self.session)[1]
+        zero_t = Shared(np.zeros((1, W)))
         for rows, level in ((slice(0, n), slice(0, m)), (slice(n, 2 * n), slice(m + m * n, 2 * m + m * n))):
-            d = np.array(kinematics(q, v, t, P, S[:n], S[n:2 * n], zero_t, self.dP))[level]
+            d = self.derivative(EXTRA_KINEMATICS, 1, [q[None], v[None], np.array([t])], [S[None, :n], S[None, n:2 * n],
+                                                                                          zero_t])[0][level]
             S[rows] -= np.linalg.lstsq(Phi_q, d, rcond=None)[0]
         return S
 
@@ -308,7 +399,13 @@ class ModelSensitivity:
         if f is None or self.functions.root_curvature is None:
             raise ValueError("ModelSensitivity.roots: the model has no roots")
         P = model.parameter_values
-        J = np.array(f(t, y, yp, P))
+        n_roots = f.size_out(0)[0]
+        # in the stacked session (its last two extras: stacked_extras), else CasADi's
+        index = len(model.functions.extras) + len(self.row_derivatives(model))
+        if self.session is not None:
+            J = self.session.eval_extra(index, [np.array([t]), y, yp], 1)[0].reshape(-1, n_roots).T
+        else:
+            J = np.array(f(t, y, yp, P))
         g_t, g_y, g_yp, g_P = J[:, :1], J[:, 1:1 + n], J[:, 1 + n:1 + 2 * n], J[:, 1 + 2 * n:]
         if np.any(g_yp != 0.0):
             raise ValueError("ModelSensitivity.roots: a root reads y' (its rate would need y''): not supported")
@@ -317,7 +414,9 @@ class ModelSensitivity:
         tolerance = (np.zeros(n) if atol is None else np.asarray(atol, dtype=float)) + rtol * np.abs(y)
         return RootTerms(g_p=g_y @ S + g_yp @ Sp + g_P @ self.dP, rate=g_t[:, 0] + g_y @ yp,
                          scale=np.abs(g_t[:, 0]) + np.abs(g_y) @ np.abs(yp),
-                         curvature=np.array(self.functions.root_curvature(t, y, yp, ypp, P)).ravel(),
+                         curvature=(self.session.eval_extra(index + 1, [np.array([t]), y, yp, ypp], 1)[0]
+                                    if self.session is not None else
+                                    np.array(self.functions.root_curvature(t, y, yp, ypp, P)).ravel()),
                          error=np.abs(g_y) @ tolerance)
 
     def approach_rate(self, root: int, y: NDArray, yp: NDArray, S: NDArray

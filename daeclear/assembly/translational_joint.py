@@ -207,7 +207,7 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         """The term of ``law_``'s force on the slider at ``point_slider`` (and friction), its opposite
         on the guide at ``point_guide``, (4.22)-(4.25)."""
         p = ca.SX.sym("p", n_p)
-        F_N = law_.force(d, d_dot, p[0] if n_p else None)
+        F_N = law_.contact_force(d, d_dot, p[0] if n_p else None)
         n_in = -side[surface] * n_vec  # surface normal pointing into the guide
         v_T = ca.dot(slider.world_point_velocity(point_guide) - guide.world_point_velocity(point_guide), t_vec)
         F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)

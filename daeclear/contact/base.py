@@ -120,22 +120,40 @@ class NormalLaw(abc.ABC):
         TypeError
             If a required rate or approach speed is missing.
         """
+        return self._evaluate("force", self._force, penetration, penetration_rate, approach_speed)
+
+    def contact_force(self, penetration: Any, penetration_rate: Any = None, approach_speed: Any = None) -> Any:
+        """The force inside a contact, what a contact term reads while it is on: :meth:`force`, but at
+        ``penetration`` 0 its one-sided limit from inside the contact (same arguments).
+
+        At an onset root the penetration is 0 and the term switches on: a law whose force jumps at onset
+        (Kelvin-Voigt's ``D delta_dot``) gives the jump there, which the restart's accelerations and the
+        sensitivities' jump (docs/sensitivities.md, section 4) need; :meth:`force`, the law's value, is 0
+        there as out of contact. For a law continuous at ``delta = 0`` the two are the same."""
+        return self._evaluate("contact_force", self._contact_force, penetration, penetration_rate, approach_speed)
+
+    def _evaluate(self, method: str, law: Any, penetration: Any, penetration_rate: Any, approach_speed: Any) -> Any:
+        """``law(delta, delta_dot, v_minus)`` on the arguments checked and made numeric (or symbolic)."""
         if not self.is_resolved:
             raise SceneError(f"{type(self).__name__}: some parameters are None (not resolved); give them "
                              "explicitly or call .resolve(kind, radii=..., materials=...) first.")
         if penetration_rate is None and self.dissipative:
-            raise TypeError(f"{type(self).__name__}.force needs penetration_rate (the law is dissipative).")
+            raise TypeError(f"{type(self).__name__}.{method} needs penetration_rate (the law is dissipative).")
         if approach_speed is None and self.needs_approach_speed:
-            raise TypeError(f"{type(self).__name__}.force needs approach_speed (initial impact velocity).")
+            raise TypeError(f"{type(self).__name__}.{method} needs approach_speed (initial impact velocity).")
         scalar, (delta, delta_dot, v_minus) = B.as_numeric(penetration, penetration_rate, approach_speed)
         delta_dot = 0.0 if delta_dot is None else delta_dot
         v_minus = 0.0 if v_minus is None else v_minus
-        out = self._force(delta, delta_dot, v_minus)
+        out = law(delta, delta_dot, v_minus)
         return float(out) if scalar else out
 
     @abc.abstractmethod
     def _force(self, delta: Any, delta_dot: Any, v_minus: Any) -> Any:
         """The law, written once with ``daeclear.contact._backend`` functions."""
+
+    def _contact_force(self, delta: Any, delta_dot: Any, v_minus: Any) -> Any:
+        """The law inside a contact, continued to ``delta = 0`` from inside: ``_force`` unless it jumps there."""
+        return self._force(delta, delta_dot, v_minus)
 
     def check_penetration(self, penetration: Any, *, warn: bool = True) -> bool:
         """True if every penetration (e.g. of a result's channel) is inside the law's valid range; else

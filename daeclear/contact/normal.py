@@ -283,7 +283,8 @@ class KelvinVoigt(_FaceLaw):
     Notes
     -----
     For comparison only (it "does not represent the overall nonlinear nature of impact"). The
-    force jumps to ``D delta_dot_minus`` at first contact and is clamped at 0 near separation.
+    force jumps to ``D delta_dot_minus`` at first contact and is clamped at 0 near separation:
+    :meth:`force` is 0 at ``delta = 0``, :meth:`contact_force` (what a contact term reads) the jump.
     """
 
     damping: float = 0.0
@@ -301,6 +302,9 @@ class KelvinVoigt(_FaceLaw):
         return self.damping > 0.0
 
     def _force(self, delta: Any, delta_dot: Any, v_minus: Any) -> Any:
-        linear = B.fmax(self.stiffness * delta + self.damping * delta_dot, 0.0)
-        return B.if_else(delta > 0.0, linear, 0.0)
+        return B.if_else(delta > 0.0, self._contact_force(delta, delta_dot, v_minus), 0.0)
+
+    def _contact_force(self, delta: Any, delta_dot: Any, v_minus: Any) -> Any:
+        # inside a contact (at its onset, delta = 0, too): the jump to D delta_dot, clamped at 0
+        return B.if_else(delta >= 0.0, B.fmax(self.stiffness * delta + self.damping * delta_dot, 0.0), 0.0)
 

@@ -19,7 +19,7 @@ from pathlib import Path
 from .build import BuildResult
 from .codegen import NormalizedModel, OdeSpec, build_model_library, normalize_model
 from .library import ModelLibrary, OdeLibrary, StaleLibrary
-from .sensitivity_functions import SensitivityFunctions, sensitivity_functions
+from .sensitivity_functions import SensitivityFunctions, augmented_functions, sensitivity_functions
 from .session_base import DAEFunctions
 from .sundials import SundialsMismatch
 
@@ -36,13 +36,14 @@ class CompiledDAE:
     them from the model. Not a value: one object per owner, whose parts its sessions share.
     """
 
-    __slots__ = ("functions", "_normalized", "_loaded", "_sensitivity", "ode_spec", "ode_library")
+    __slots__ = ("functions", "_normalized", "_loaded", "_sensitivity", "_stacked", "ode_spec", "ode_library")
 
     def __init__(self, functions: DAEFunctions) -> None:
         self.functions = functions
         self._normalized: NormalizedModel | None = None
         self._loaded: tuple[ModelLibrary, BuildResult] | None = None
         self._sensitivity: dict[tuple[int, tuple[int, ...]], SensitivityFunctions] = {}
+        self._stacked: dict[tuple[int, bool, bool, tuple[int, ...]], CompiledDAE] = {}
         #: the index-1 equations as an ODE (numbers symbolic), made by the non-IDA methods
         self.ode_spec: OdeSpec | None = None
         #: the ODE library loaded for ``ode_spec`` and how it was built
@@ -72,6 +73,17 @@ class CompiledDAE:
         if key not in self._sensitivity:
             self._sensitivity[key] = sensitivity_functions(self.functions, width, extras)
         return self._sensitivity[key]
+
+    def stacked(self, width: int, coupled: bool, block: bool, derivatives: tuple[int, ...]) -> CompiledDAE:
+        """The compiled object of the stacked DAE [y; S] for ``width`` parameters
+        (:func:`~daeclear.engine.sensitivity_functions.augmented_functions` with these arguments), made at the
+        first call for them, then kept with what its sessions load: a run with sensitivities opens it without
+        building its functions and generating its source again (most of such a call's set-up)."""
+        key = (width, coupled, block, derivatives)
+        if key not in self._stacked:
+            self._stacked[key] = CompiledDAE(augmented_functions(self.functions, width, coupled=coupled, block=block,
+                                                                 derivatives=derivatives))
+        return self._stacked[key]
 
     def __repr__(self) -> str:
         made = [name for name, part in (("normalized", self._normalized), ("library", self._loaded),

@@ -113,6 +113,15 @@ def _with_parameters(f: casadi.Function, n_base: int, n_parameters: int) -> casa
                            [f.name_out(k) for k in range(f.n_out())])
 
 
+def root_functions(funcs: DAEFunctions) -> tuple[casadi.Function, casadi.Function] | None:
+    """The roots' Jacobian (t, y, yp, P) -> [g_t | g_y | g_y' | g_P] and curvature (t, y, yp, ypp, P) ->
+    d^2 g/dt^2 of the model's roots g (None without roots): the event's pieces (docs/sensitivities.md, section 4)."""
+    if funcs.roots is None or funcs.roots.numel_out(0) == 0:
+        return None
+    g = _with_parameters(funcs.roots, 3, int(funcs.n_parameters))
+    return jacobian_blocks(g, "sens_root_jacobian"), curvature_along(g, "sens_root_curvature")
+
+
 def sensitivity_functions(funcs: DAEFunctions, width: int, extras: Sequence[int] = ()) -> SensitivityFunctions:
     """The sensitivity functions of ``funcs`` for ``width`` directions at once, with the directional
     derivatives of ``funcs.extras[k]`` for k in ``extras``."""
@@ -124,11 +133,8 @@ def sensitivity_functions(funcs: DAEFunctions, width: int, extras: Sequence[int]
         fk = _with_parameters(fk, 4, n_P)
         term_res.append(directional(fk, width, (1, 2, 3, 4), f"sens_term{k}_res"))
         n_params.append(int(fk.numel_in(3)))
-    roots, curvature, n_roots = None, None, 0
-    if funcs.roots is not None and funcs.roots.numel_out(0) > 0:
-        g = _with_parameters(funcs.roots, 3, n_P)
-        n_roots = int(g.numel_out(0))
-        roots, curvature = jacobian_blocks(g, "sens_root_jacobian"), curvature_along(g, "sens_root_curvature")
+    roots, curvature = root_functions(funcs) or (None, None)
+    n_roots = 0 if roots is None else int(roots.size_out(0)[0])
     bad = [k for k in extras if not 0 <= k < len(funcs.extras)]
     if bad:
         raise ValueError(f"sensitivity_functions: extras={list(extras)!r}, must be indices below "
@@ -138,10 +144,43 @@ def sensitivity_functions(funcs: DAEFunctions, width: int, extras: Sequence[int]
                                 curvature, fwd, tuple(int(k) for k in extras))
 
 
-def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, block: bool = False) -> DAEFunctions:
+def stacked_extras(funcs: DAEFunctions, width: int, derivatives: Sequence[int]) -> tuple[casadi.Function, ...]:
+    """The extras of the stacked DAE, whose parameter input is [P; vec(dP)]: the model's extras (same index,
+    P taken from it), then the directional derivative (:func:`directional` in every input) of
+    ``funcs.extras[k]`` for each k of ``derivatives``, at index ``len(funcs.extras) + i``, with inputs (the
+    extra's inputs but P, their seeds but dP's, [P; vec(dP)]), then the roots' Jacobian and curvature
+    (:func:`root_functions`) when the model has roots. A run with sensitivities evaluates its rows and events
+    with them in the stacked session (the same functions, in C in a compiled session)."""
+    n_P = int(funcs.n_parameters)
+
+    def stacked(f: casadi.Function) -> casadi.Function:
+        """``f`` (vector inputs, P last, one output) with [P; vec(dP)] for P."""
+        xs = _symbols(f, [f.numel_in(k) for k in range(f.n_in())], [f.name_in(k) for k in range(f.n_in())])
+        PA = _symbols(f, [n_P * (1 + width)], ["P"])[0]
+        return casadi.Function(f"{f.name()}_stacked", [*xs[:-1], PA], f.call([*xs[:-1], PA[:n_P]]),
+                               [*(f.name_in(k) for k in range(f.n_in() - 1)), "P"], [f.name_out(0)])
+
+    out = [stacked(f) for f in funcs.extras]
+    for k in derivatives:
+        d = directional(funcs.extras[k], width, None, f"sens_d{k}")
+        m = funcs.extras[k].n_in()  # d's inputs: m values (P last), m seeds (dP last)
+        xs = _symbols(d, [d.numel_in(j) for j in range(2 * m)], [d.name_in(j) for j in range(2 * m)])
+        PA = _symbols(d, [n_P * (1 + width)], ["P"])[0]
+        dP = casadi.reshape(PA[n_P:], n_P, width)
+        shaped = [casadi.reshape(x, d.size_in(j)) for j, x in enumerate(xs)]  # an extra's inputs are vectors
+        value = d.call([*shaped[:m - 1], PA[:n_P], *shaped[m:2 * m - 1], dP])
+        out.append(casadi.Function(f"sens_extra{k}", [*xs[:m - 1], *xs[m:2 * m - 1], PA], value,
+                                   [*(d.name_in(j) for j in (*range(m - 1), *range(m, 2 * m - 1))), "P"],
+                                   [d.name_out(0)]))
+    return (*out, *(stacked(f) for f in root_functions(funcs) or ()))
+
+
+def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, block: bool = False,
+                        derivatives: Sequence[int] | None = None) -> DAEFunctions:
     """The DAE of [y; S_1; ...; S_width] as one :class:`DAEFunctions` (what IDA integrates for
     ``simulate(..., sensitivities=...)``): parameters [P; vec(dP)], term k's parameters [p_k; vec(Sk)],
-    the roots those of y, no extras.
+    the roots those of y; with ``derivatives`` (indices of ``funcs.extras``) the extras of
+    :func:`stacked_extras`, else none.
 
     Its Newton matrix: the state's iteration matrix on every diagonal block, nothing else (IDAS'
     simultaneous corrector: a modified Newton that converges since S's equations are linear in S).
@@ -204,4 +243,5 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, 
     return DAEFunctions(n=n * (1 + width), residual=residual, jacobian=jac, term_residuals=tuple(term_res),
                         term_jacobians=tuple(term_jac), roots=roots, n_parameters=n_P * (1 + width),
                         name=f"{funcs.name}_sens{width}{'c' if coupled else ''}{'b' if block else ''}",
-                        blocks=1 + width if block else 1, coupling=coupling, term_couplings=tuple(term_cpl))
+                        blocks=1 + width if block else 1, coupling=coupling, term_couplings=tuple(term_cpl),
+                        extras=() if derivatives is None else stacked_extras(funcs, width, derivatives))

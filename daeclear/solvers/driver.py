@@ -42,7 +42,7 @@ if TYPE_CHECKING:
     from .save_at import Output
     from .solver_options import SolverOptions
 
-__all__ = ["STALL_EVENTS", "Driver", "consistent_restart", "consistent_start", "run"]
+__all__ = ["STALL_EVENTS", "Continuation", "Driver", "consistent_restart", "consistent_start", "run"]
 
 #: a run whose restarts produce STALL_EVENTS events without the time advancing fails (the event loop is stuck)
 STALL_EVENTS = 50
@@ -51,16 +51,28 @@ STALL_EVENTS = 50
 Observer = Callable[[Jump], None]
 
 
+class Continuation:
+    """The contact state carried from one run into the next that starts at its last state (the wear
+    study's blocks): ``state`` is what the next run's pairs start in (None: from the start's gaps, each
+    rate latched anew, as any run from a state) and, once a run ends, what its pairs ended in. A
+    contact that goes on across the runs keeps its impact's approach speed, as in one run."""
+
+    def __init__(self, state: contact_state.ContactState | None = None) -> None:
+        self.state = state
+
+
 def run(solver: Driven, scene: Scene | DAEModel, t_end: float, t0: float, y0: NDArray | None, save: Output,
         settings: SolverOptions, on_failure: str, progress: bool, observers: Sequence[Observer] = (), *,
-        checks: bool = True) -> Result:
+        checks: bool = True, carry: Continuation | None = None) -> Result:
     """Integrate ``scene`` (a Scene is assembled with ``settings.formulation`` or the solver's own) from
     ``t0`` to ``t_end`` with the solver's integrator (the :class:`daeclear.solvers.base.Solver` contract's
     ``run``); ``observers`` see every :class:`Jump`. An integrator that carries a quantity beside the
     states (:class:`~daeclear.solvers.integrator.Carried`: the sensitivities) has it jump at every event.
     ``checks=False``: a run that reaches its end is not checked (no warnings, no ``max_constraint_drift``;
     a caller judging each run itself, as the wear study's blocks); a failed or interrupted one is, for its
-    message."""
+    message. ``carry``: a run that continues another from its last state (``y0``) starts its pairs in
+    ``carry.state`` (:func:`~daeclear.assembly.contact_state.continued_state`: each keeps its latched approach
+    speed) and leaves the state they end in there."""
     setup_start = time.perf_counter()
     if isinstance(scene, DAEModel):
         model = scene
@@ -92,6 +104,7 @@ def run(solver: Driven, scene: Scene | DAEModel, t_end: float, t0: float, y0: ND
     declared = start if record["start"] == "declared" else None  # the start checks concern a declared state
     driver = Driver(model, integrator, rec, save, t_end, progress, observers, carried)
     driver.checks = checks
+    driver.carry = carry
     return driver.run(t0, start, start_yp, declared, from_state, on_failure, time.perf_counter() - setup_start)
 
 
@@ -116,15 +129,15 @@ def consistent_restart(model: DAEModel, integrator: Integrator, t: float, y: NDA
     for the switches it decides itself. The flag: whether the state was projected (sensitivities follow it)."""
     if model.formulation != "ggl":
         return (*integrator.consistent(t, y, terms), False)
-    session = integrator.session
-    forces = model.term_forces(t, y, terms.active, terms.params, session)
-    projected = model.consistent_state(t, y, forces, session, project=True)
+    session, extras = integrator.session, integrator.extras
+    forces = model.term_forces(t, y, terms.active, terms.params, extras)
+    projected = model.consistent_state(t, y, forces, extras, project=True)
     if not model.gap_names:
         return (*projected, True)
     g0, g1 = _roots(model, session, t, y, yp), _roots(model, session, t, projected[0], yp)
     quiet = np.zeros(g0.shape, bool) if found is None else np.asarray(found).ravel() == 0
     if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
-        return (*model.consistent_state(t, y, forces, session, project=False), False)
+        return (*model.consistent_state(t, y, forces, extras, project=False), False)
     return (*projected, True)
 
 
@@ -173,6 +186,7 @@ class Driver:
         self.last_event_t = -math.inf
         self.interrupted = False
         self.checks = True  # False: a successful run's physics checks are left out (run's ``checks``)
+        self.carry: Continuation | None = None  # the contact state to start in and to leave (run's ``carry``)
 
     # ---------------------------------------------------------------- the run
     def run(self, t0: float, y0: NDArray, yp0: NDArray, declared: NDArray | None, from_state: bool,
@@ -199,12 +213,16 @@ class Driver:
             raise
         if not math.isnan(self.seg_start):  # stopped inside a segment: it ends where the run stopped
             self.segments.append((self.seg_start, self.t, dict(self.modes)))
+        if self.carry is not None:
+            self.carry.state = self.state
         return self.finish(on_failure, setup_time)
 
     def begin(self, t0: float, y0: NDArray, yp0: NDArray) -> None:
         """The contact modes from the state at ``t0``, the start recorded, the integrator started."""
-        model, session = self.model, self.integrator.session
-        self.set_state(contact_state.start_state(model, t0, y0))
+        model = self.model
+        carried = None if self.carry is None else self.carry.state
+        self.set_state(contact_state.start_state(model, t0, y0) if carried is None
+                       else contact_state.continued_state(model, t0, y0, carried))
         self.last_terms = {name: (t0, contact_state.pair_state(model, self.state, root).term_on)
                            for root, name in enumerate(model.gap_names)}
         y, yp = y0, yp0
@@ -215,7 +233,7 @@ class Driver:
             self.rec.add_steps(np.array([t0]), np.array([0.0]), np.array([self.integrator.order]))
         if self.times is None or self.times.window(0, 1)[0] == t0:  # the start point is reported
             self.raw.append((np.array([t0]), y[None, :], self.switch[None, :]))
-        self.rec.session = session  # the checked channels in the run's library while it is open
+        self.rec.session = self.integrator.extras  # the checked channels in the run's library while it is open
         self.y, self.yp = y, yp
         self.integrator.start(t0, y, yp, self.terms(), self.state)
 
@@ -471,7 +489,7 @@ class Driver:
                 return []
             key_t, key_y, key_channels = rec.key_rows()
             self.checked_rows = (key_t, key_y)  # the failure message reads the deepest pair's gap there
-            found = physics.check_run(model, key_t, key_y, key_channels, self.y0, stats, integrator.session,
+            found = physics.check_run(model, key_t, key_y, key_channels, self.y0, stats, integrator.extras,
                                       from_state=self.from_state)
             if self.kept_events is not None and integrator.fixed_step is not None:
                 found += physics.check_fixed_steps(model, self.kept_events, integrator.fixed_step, integrator.missed)

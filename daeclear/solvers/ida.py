@@ -76,6 +76,11 @@ class IDAIntegrator:
     order = 0  # the start's row; IDA reports each step's own order
     fixed_step: float | None = None
 
+    @property
+    def extras(self) -> Session:
+        """The session evaluates the model's extras."""
+        return self.session
+
     def __init__(self, model: DAEModel, t_end: float, output: Output, settings: SolverOptions) -> None:
         rtol = settings.rtol
         self.model, self.t_end, self.times, self.store_steps = model, t_end, output.times, output.steps

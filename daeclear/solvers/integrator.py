@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 
 from ..assembly.contact_pairs import PairLogic
 from ..assembly.contact_state import ContactState
+from ..assembly.dae_model import ExtrasEvaluator
 from ..core.automaton import PairState
 from ..core.events import ContactEvent
 from ..engine.session_base import Advance, Session
@@ -131,6 +132,12 @@ class Integrator(Protocol):
     @property
     def session(self) -> Session | None:
         """The run's open IDA session (the model's functions in C for the checks and restarts), or None."""
+        ...
+
+    @property
+    def extras(self) -> ExtrasEvaluator | None:
+        """What evaluates the model's extras in C for the driver's restarts: the session, or (a run with
+        sensitivities) the stacked session, whose extras begin with the model's; None: CasADi's."""
         ...
 
     @property

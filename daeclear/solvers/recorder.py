@@ -22,8 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..assembly import physics
-from ..assembly.dae_model import DAEModel
-from ..engine.session_base import Session
+from ..assembly.dae_model import DAEModel, ExtrasEvaluator
 from ..results.channel_eval import ModelEvaluator, rebuildable
 from ..core.errors import OutputError
 from ..core.events import EventRows, flatten
@@ -59,7 +58,7 @@ class Recorder:
         self._header: dict[str, Any] = dict(state_names=list(model.state_names), units=dict(model.channel_units),
                             parameters=parameters, scene_name=model.scene_name, method=method,
                             formulation=model.formulation)
-        self.session: Session | None = None
+        self.session: ExtrasEvaluator | None = None  # the run's extras in C while it is open
         #: ``lazy_rows``: the integrator's points are the DAE's own states (IDA's, its multipliers not
         #: converged), their channels made again from them alone (the model's output function): kept in
         #: memory as they are, the Result makes them consistent when first read; a file stores consistent points

@@ -109,33 +109,51 @@ class SensitivityCarrier:
         """Each term's parameters followed by their sensitivities: the stacked system's term parameters."""
         return [np.concatenate([p, s.ravel(order="F")]) for p, s in zip(self.params, self.S_params)]
 
-    def row(self, t: float, y: NDArray, S: NDArray) -> NDArray:
-        """Keep an output row at ``t`` (S of the state ``y`` in the current mode, made consistent there,
-        and the channels' sensitivities); NaN where poisoned. Return the consistent y."""
-        y, S, channel_S, values = self.evaluate(t, y, S)
-        self.rows_t.append(t)
-        self.rows_S.append(S)
-        self.rows_channel_S.append(channel_S)
-        self.rows_channels.append(values)
-        return y
+    def rows(self, t: NDArray, y: NDArray, S: NDArray) -> None:
+        """Keep output rows at ``t`` (N,) of the current mode: S of the states ``y`` (N, n) made consistent
+        there (``S`` (N, n, Ns)) and the channels' sensitivities, all rows at once; NaN where poisoned."""
+        if not t.size:
+            return
+        _, _, S, _, channel_S, values = self.evaluate_rows(t, y, S)
+        S[:, :, self.poisoned] = np.nan
+        channel_S[:, :, self.poisoned] = np.nan
+        self.rows_t.extend(t.tolist())
+        self.rows_S.extend(S)
+        self.rows_channel_S.extend(channel_S)
+        self.rows_channels.extend(values)
 
-    def evaluate(self, t: float, y: NDArray, S: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
-        """A row at ``t`` made consistent in the current mode: (y, S, the channels' S, the channels' values)."""
+    def row(self, t: float, y: NDArray, S: NDArray) -> None:
+        """Keep one output row at ``t`` (:meth:`rows`)."""
+        self.rows(np.array([t], dtype=float), y[None], S[None])
+
+    def evaluate_rows(self, t: NDArray, y: NDArray, S: NDArray
+                      ) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray, NDArray]:
+        """Rows at ``t`` (N,) made consistent in the current mode: (y, y', S, S', the channels' S, the channels'
+        values), each with N rows first; nothing poisoned."""
         model, ms = self.model, self.ms
-        y, yp = model.consistent_state(t, y, model.term_forces(t, y, self.active, self.params))
-        S, Sp = ms.consistent(t, y, S, self.active, self.params, self.S_params)
+        single = t.size == 1
+        session = ms.session
+        forces = model.term_forces(t[0] if single else t, y[0] if single else y, self.active, self.params, session)
+        y, yp = model.consistent_state(t[0] if single else t, y[0] if single else y, forces, session)
+        y, yp = np.atleast_2d(y), np.atleast_2d(yp)
+        S, Sp = ms.consistent_rows(t, y, S, self.active, self.params, self.S_params)
         switch = model.switch_vector(self.active, self.params)
-        channel_S = ms.channels(t, y, yp, S, Sp, switch, ms.switch_sensitivity(self.S_params))
-        values = np.array(model.outputs(t, y, yp, switch, model.parameter_values), dtype=float).ravel()
-        S[:, self.poisoned] = np.nan
-        channel_S[:, self.poisoned] = np.nan
-        return y, S, channel_S, values
+        channel_S = ms.channels_rows(t, y, yp, S, Sp, switch, ms.switch_sensitivity(self.S_params))
+        values = ms.outputs_rows(t, y, yp, switch)
+        return y, yp, S, Sp, channel_S, values
 
-    def event_row(self, t: float, y: NDArray, S: NDArray) -> None:
+    def event_row(self, t: float, y: NDArray, S: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
         """Keep a row at an event's time (before its switch, then after): what an objective integrating or
-        peaking across the event reads (:mod:`daeclear.results.objectives`)."""
-        self.event_rows.append(self.evaluate(t, y, S))
+        peaking across the event reads (:mod:`daeclear.results.objectives`). Return (y, y', S, S') consistent
+        in the current mode (nothing poisoned)."""
+        y_c, yp, S_c, Sp, channel_S, values = (a[0] for a in self.evaluate_rows(np.array([t], dtype=float), y[None],
+                                                                                 S[None]))
+        S_row, channel_row = S_c.copy(), channel_S.copy()
+        S_row[:, self.poisoned] = np.nan
+        channel_row[:, self.poisoned] = np.nan
+        self.event_rows.append((y_c, S_row, channel_row, values))
         self.event_t.append(t)
+        return y_c, yp, S_c, Sp
 
     def jump(self, t: float, y: NDArray, S: NDArray, found: NDArray | None, new_state: contact_state.ContactState,
              events: Sequence[ContactEvent], y_p: NDArray, projected: bool) -> None:
@@ -143,14 +161,10 @@ class SensitivityCarrier:
         contact ``events`` decided there into ``new_state``; ``y_p`` the consistent state the run restarts
         from (``projected``: onto GGL's constraint manifold). Leaves S and S' consistent in the new mode."""
         model, ms, W, rtol = self.model, self.ms, self.width, self.rtol
-        self.event_row(t, y, S.copy())
+        y_m, yp_m, S_m, Sp_m = self.event_row(t, y, S)
         new_active, new_params = contact_state.switches(model, new_state)
-        y_m, yp_m = model.consistent_state(t, y, model.term_forces(t, y, self.active, self.params))
-        S_m, Sp_m = ms.consistent(t, y_m, S, self.active, self.params, self.S_params)
-        forces = model.term_forces(t, y_p, new_active, new_params)
-        if forces is not None and any(e.kind == "onset" for e in events):  # y'+ read inside the contact
-            forces = onset_limit(lambda s: model.term_forces(t + s, y_p + s * yp_m, new_active, new_params), t)
-        yp_p = model.consistent_state(t, y_p, forces)[1]
+        session = ms.session
+        yp_p = model.consistent_state(t, y_p, model.term_forces(t, y_p, new_active, new_params, session), session)[1]
         new_latched = [[value.copy() for value in per_pair] for per_pair in self.latched]
         dt_dps: list[NDArray] = []
         if events and found is not None:

@@ -15,6 +15,7 @@ decides no switch itself. Error control: S in the test, scaled by each parameter
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
@@ -27,8 +28,9 @@ from ..assembly.dae_model import DAEModel
 from ..assembly.sensitivity import initial_sensitivities, parameter_value
 from ..core.errors import SceneError
 from ..core.automaton import PairState
+from ..engine.compiled import CompiledDAE
 from ..engine.ida_session import open_session
-from ..engine.sensitivity_functions import augmented_functions
+from ..engine.sensitivity_functions import augmented_functions, stacked_extras
 from ..engine.session_base import Advance, Session
 from . import ida
 from .integrator import Jump, Terms
@@ -84,7 +86,7 @@ class SensitivityIntegrator:
     decides = False
     order = 0
     fixed_step: float | None = None
-    session: Session | None = None  # the model's own functions serve the driver (the stacked session is S's)
+    session: Session | None = None  # the model's own roots serve the driver (the stacked session is S's)
     stacked_factorisation = False  # True: the reference path of stacked_reference()
     coupling = True  # the compiled session's block forward substitution with the blocks below the diagonal
 
@@ -108,14 +110,22 @@ class SensitivityIntegrator:
             atol = np.concatenate([atol, self.quad.atol(rtol)])
         atol_S = np.concatenate([atol / p for p in pbar])  # IDAS' pbar: S |p| held to the states' atol
         tested = settings.sensitivity_error_test
+        derivatives = self.sens.ms.row_derivatives(model)
+        if self.quad is None:
+            stacked_functions = model.compiled.stacked(W, block and self.coupling, block, derivatives)
+        else:  # the DAE with the quadratures; the extras (rows, events) the model's, of its y
+            stacked = augmented_functions(funcs, W, coupled=block and self.coupling, block=block)
+            stacked_functions = CompiledDAE(dataclasses.replace(
+                stacked, extras=stacked_extras(model.functions, W, derivatives), name=f"{stacked.name}x"))
         self.stacked = open_session(
-            augmented_functions(funcs, W, coupled=block and self.coupling, block=block),
+            stacked_functions,
             backend=settings.backend, rtol=rtol,
             atol=np.concatenate([atol, atol_S if tested else np.full(atol_S.size, OUT_OF_ERROR_TEST)]),
             max_step=settings.max_step,
             max_steps=settings.max_steps,
             parameters=np.concatenate([model.parameter_values, self.sens.ms.dP.ravel(order="F")]),
             linear_solver=settings.linear_solver if block else "auto")
+        self.sens.ms.session = self.stacked  # the rows' and events' pieces in its C (its extras)
         try:
             if block:  # the reduced LU eliminates the position rows, as in the state's run (its layout)
                 self.stacked.set_kinematic_rows(model.n_q)
@@ -131,6 +141,7 @@ class SensitivityIntegrator:
             self.stacked.close()
             raise
         self.backend = self.stacked.backend
+        self.extras = self.stacked  # its extras begin with the model's (stacked_extras): the driver's restarts
         self.missed: list[tuple[float, float, str]] = []
         self.i_eval = 0
         self.t_start = 0.0
@@ -138,7 +149,8 @@ class SensitivityIntegrator:
     def start(self, t: float, y: NDArray, yp: NDArray, terms: Terms, state: ContactState) -> None:
         """S at the start (dy0/dp of the run's start), consistent in the start's mode; IDA started."""
         settings, model = self.settings, self.model
-        S0 = initial_sensitivities(model, self.sens.names, settings.start, settings.allow_penetration)
+        S0 = initial_sensitivities(model, self.sens.names, settings.start, settings.allow_penetration,
+                                   self.sens.ms.moved)
         self.sens.start(t, y, yp, state, S0)
         self.t_start = t
         if self.times is None or self.times.window(0, 1)[0] == t:  # the driver reports the start point
@@ -158,13 +170,14 @@ class SensitivityIntegrator:
             before, after = self.sens.event_rows[-2][3], self.sens.event_rows[-1][3]
             if jump.yp_minus is not None and any(e.kind == "onset" for e in jump.events):  # read inside the contact
                 y_p, yp_m, c = jump.y_plus, jump.yp_minus, self.sens
-                after = onset_limit(lambda s: c.evaluate(jump.t + s, y_p + s * yp_m, c.S)[3], jump.t)
+                after = onset_limit(lambda s: c.evaluate_rows(np.array([jump.t + s]), (y_p + s * yp_m)[None],
+                                                              c.S[None])[5][0], jump.t)
             self.quad.jump(before, after, self.sens.dt_dp)
 
     def consistent(self, t: float, y: NDArray, terms: Terms) -> tuple[NDArray, NDArray]:
         """q and v of ``y`` kept, multipliers and derivatives in the mode of ``terms``."""
-        model = self.model
-        return model.consistent_state(t, y, model.term_forces(t, y, terms.active, terms.params))
+        model, extras = self.model, self.stacked
+        return model.consistent_state(t, y, model.term_forces(t, y, terms.active, terms.params, extras), extras)
 
     def restart(self, t: float, y: NDArray, yp: NDArray, terms: Terms) -> None:
         """IDA re-initialised at ``(y, yp)`` and the carrier's S, S' (after its jump)."""
@@ -174,7 +187,7 @@ class SensitivityIntegrator:
                                 np.concatenate([yp, c.Sp.ravel(order="F")]), terms.active, c.terms_stacked(),
                                 terms.directions)
             return
-        _, _, channel_S, values = c.evaluate(t, y, c.S)
+        channel_S, values = (a[0] for a in c.evaluate_rows(np.array([t], dtype=float), y[None], c.S[None])[4:])
         rate, rate_S = quad.rates(values, channel_S)
         switch = self.model.switch_vector(c.active, c.params)
         extra = quad.term(switch, c.ms.switch_sensitivity(c.S_params))
@@ -191,11 +204,12 @@ class SensitivityIntegrator:
         rows_t, rows_y = (adv.step_t, adv.step_y) if times is None else (adv.eval_t, adv.eval_y)
         if times is not None:
             self.i_eval += adv.eval_t.size
-        for k, t in enumerate(rows_t.tolist()):
-            S = rows_y[k, nb:].reshape(nb, W, order="F")
-            self.sens.row(t, rows_y[k, :n], S[:n])
+        if rows_t.size:  # every row of this advance is in one mode: one mapped evaluation for all
+            S = rows_y[:, nb:].reshape(-1, W, nb).transpose(0, 2, 1)  # (rows, nb, W)
+            self.sens.rows(rows_t, rows_y[:, :n], S[:, :n])
             if quad is not None:
-                quad.row(rows_y[k, n:nb], S[n:], self.sens.poisoned)
+                for k in range(rows_t.size):
+                    quad.row(rows_y[k, n:nb], S[k, n:], self.sens.poisoned)
         self.root_S = adv.y[nb:]
         if quad is not None:
             quad.Q, quad.dQ = adv.y[n:nb].copy(), self.root_S.reshape(nb, W, order="F")[n:].copy()

@@ -89,7 +89,8 @@ def quadrature_functions(funcs: DAEFunctions, outputs: casadi.Function, channels
         roots = casadi.Function("roots", [t, Y, Yp, P], [funcs.roots(t, y, yp, P)], ["t", "y", "yp", "P"], ["g"])
     tag = "_".join(str(int(c)) for c in channels)
     return DAEFunctions(n=n + nQ, residual=residual, jacobian=jac, term_residuals=tuple(term_res),
-                        term_jacobians=tuple(term_jac), roots=roots, n_parameters=nP, name=f"{funcs.name}_q{tag}")
+                        term_jacobians=tuple(term_jac), roots=roots, n_parameters=nP, name=f"{funcs.name}_q{tag}",
+                        extras=funcs.extras)  # the model's own: the stacked session evaluates the rows with them
 
 
 class Quadratures:

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..assembly import contact_state
 from ..assembly.assemble import assemble
 from ..assembly.dae_model import DAEModel
 from ..contact.geometry import sigma_sum
@@ -33,6 +34,7 @@ from ..results.channel_eval import RunChannels
 from ..results.result import Result
 from ..solvers import driver
 from ..solvers.base import DrivenSolver
+from ..solvers.driver import Continuation
 from ..solvers.registry import solver_class
 from ..solvers.save_at import save_value
 from ..solvers.solver_options import SolverOptions
@@ -135,7 +137,8 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
 
     Each block runs ``update_every`` cycles with the current profile; its Archard wear times
     ``extrapolate`` is added to the profile (counting ``update_every * extrapolate`` cycles), and the
-    next block continues from its last state with the new profile (nothing is compiled).
+    next block continues from its last state and contact state (a contact going on across the boundary
+    keeps its impact's approach speed) with the new profile (nothing is compiled).
 
     Parameters
     ----------
@@ -201,9 +204,10 @@ def simulate_wear(scene: Scene | DAEModel, cycles: float, *, joint: str | None =
         rows = store.open() if store is not None else None  # checked against the settings before any work
         model = assemble(scene) if model is None else model
         if rows is None:
-            rows = [WearRow(cycles=0.0, depth=element.worn_profiles(), work=0.0, block_peak=math.nan, t=0.0, y=None)]
+            rows = [WearRow(cycles=0.0, depth=element.worn_profiles(), work=0.0, block_peak=math.nan, t=0.0, y=None,
+                            contact=None)]
             if store is not None:
-                store.append(rows[0], model.n_states)
+                store.append(rows[0], model.n_states, contact_state.state_shape(model))
         history, interrupted = _blocks(model, rows, store, element, cycles, (update_every, extrapolate, period),
                                        options, progress)
     if interrupted:  # Ctrl-C: the history so far is kept (and in the file), then the caller stops
@@ -227,6 +231,10 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
     modulus = effective_modulus(element) if wear.distribution == "hertz" else None
     last = rows[-1]
     depth, done, work, t0, y0 = last.depth, last.cycles, last.work, last.t, last.y
+    # the pairs' contact states carried from block to block (a resumed history: the file's last row's)
+    carry = Continuation(None if y0 is None or last.contact is None else
+                         contact_state.array_state(last.contact, contact_state.start_state(model, t0, y0)))
+    shape = contact_state.state_shape(model)
     bar = Progress(float(cycles), unit="cycles", desc="wear", enabled=progress)
     name, radius, clearance = element.name, float(element.bearing_radius), element.radial_clearance
     history_of = joint_channels(model, name)
@@ -244,7 +252,7 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
                     break
                 model = model.with_parameters({f"{name}.wear_depth": _depth_value(depth, wear.surfaces)})
                 try:
-                    result = block_run(model, t0, t0 + update_every * period, y0, options)
+                    result = block_run(model, t0, t0 + update_every * period, y0, options, carry)
                 except (SolveError, AssemblyError) as exc:  # the history so far is the result (and in the file)
                     message = f"stopped at {done:g} cycles: the run of the next block failed: {exc}"
                     break
@@ -264,9 +272,11 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
                 work += extrapolate * block_work
                 t0, y0 = float(result.t[-1]), result.state(-1)
                 peak = float(np.max(channels[f"{name}.normal_force"]))
-                rows.append(WearRow(cycles=done, depth=depth, work=work, block_peak=peak, t=t0, y=y0))
+                rows.append(WearRow(cycles=done, depth=depth, work=work, block_peak=peak, t=t0, y=y0,
+                                    contact=None if carry.state is None else
+                                    contact_state.state_array(carry.state, shape)))
                 if store is not None:  # a Ctrl-C meanwhile arrives once the row is written whole
-                    store.append(rows[-1], model.n_states)
+                    store.append(rows[-1], model.n_states, shape)
                 bar.update(min(done, cycles), f"max depth {max(float(d.max()) for d in depth.values()):.3g} m")
     except KeyboardInterrupt:  # Ctrl-C: the history so far is kept (and in the file)
         return _history(rows, wear, radius, f"interrupted at {done:g} cycles"), True
@@ -276,17 +286,21 @@ def _blocks(model: DAEModel, rows: list[WearRow], store: WearFile | None, elemen
 
 
 def block_run(model: DAEModel, t0: float, t_end: float, y0: NDArray[np.float64] | None,
-               options: SolverOptions | None) -> Result:
+              options: SolverOptions | None, carry: Continuation | None = None) -> Result:
     """One block's run: ``simulate(model, t_end, t0=t0, y0=y0, options=options)`` without the physics
     checks of a run that reaches its end (the block judges its penetration itself; their warnings were
-    ignored), 5-10 % of a block."""
+    ignored), 5-10 % of a block; its pairs start in ``carry``'s contact state (the previous block's end:
+    a contact that goes on across the blocks keeps its impact's approach speed, as in one run) and
+    leave theirs there (:class:`~daeclear.solvers.driver.Continuation`)."""
     settings = options or SolverOptions()
     opts.step_within(settings.step, t0, t_end)  # as simulate checks it
     solver = solver_class(settings.method)()
-    if not isinstance(solver, DrivenSolver):  # a solver class of the user's: its own run, checked
+    if not isinstance(solver, DrivenSolver):  # a solver class of the user's: its own run, checked, from the gaps
+        if carry is not None:
+            carry.state = None
         return simulate(model, t_end, t0=t0, y0=y0, options=options)
     return driver.run(solver, model, t_end, t0, y0, save_value(None).plan(t0, t_end), settings, "raise", False,
-                      checks=False)
+                      checks=False, carry=carry)
 
 
 def _checked_period(scene: Scene, period: float | None) -> float:
