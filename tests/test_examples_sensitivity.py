@@ -33,8 +33,10 @@ def test_sensitivity_study_quick(tmp_path: Path) -> None:
         for name, relative in got["relative"].items():  # d ln(peak)/d ln p, the figure's bars
             assert relative == pytest.approx(got["sensitivities"][name] * got["values"][name] / peak, rel=1e-12)
     # the dry and the worn joint's gradients go through an impact (its onset's jump of S), the oil film holds
-    assert variants["dry, friction 0.05"]["events"]["onset"] >= 1 and variants["worn bearing"]["events"]["onset"] >= 1
-    assert variants["worn bearing"]["values"]["clearance.wear.bearing_cos[1]"] == pytest.approx(20e-6, rel=1e-9)
+    for label in ("dry, friction 0.05", "worn bearing"):
+        assert variants[label]["events"]["onset"] >= 1, label
+    mode = variants["worn bearing"]["values"]["clearance.wear.bearing_cos[1]"]  # 20 um (1 + cos theta)'s first mode
+    assert mode == pytest.approx(20e-6, rel=1e-9, abs=0.0)
     horizons = json.loads((tmp_path / "gradients.json").read_text())["horizons"]
     assert sorted(horizons) == ["0.1 mm", "0.5 mm"]
     for h in horizons.values():  # result.sensitivity_horizon's: t0 + ln(1/rtol) / lambda at the run's rtol 1e-8

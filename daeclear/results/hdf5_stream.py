@@ -132,7 +132,8 @@ class ResultWriter:
         dQ/dp (``s.integrals``, in the order given to :meth:`sensitivities`) appended with the output rows of
         the next :meth:`append`, in the same change (the file's rows of ``/t`` and of S never differ)."""
         _, Q, dQ = integral_arrays(s, len(s.states))
-        self._staged = [np.concatenate([staged, rows]) for staged, rows in zip(self._staged, (s.states, s.channels, Q, dQ))]
+        self._staged = [np.concatenate([staged, rows])
+                        for staged, rows in zip(self._staged, (s.states, s.channels, Q, dQ))]
         g = self._f["sensitivities"]
         items = [(g["events/t"], np.array([e.t for e in s.events], dtype=np.float64)),
                  (g["events/pair"], np.array([e.pair for e in s.events], dtype=object)),

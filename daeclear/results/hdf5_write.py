@@ -22,8 +22,8 @@ if TYPE_CHECKING:  # h5py is imported lazily, only where a file is written
     from .result import Result
     from .sensitivities import Sensitivities
 
-__all__ = ["SIDES", "FORMAT_NAME", "FORMAT_VERSION", "integral_arrays", "json_dataset", "mirror", "save_result", "stores_states_only",
-           "string_dataset", "write_result_group"]
+__all__ = ["SIDES", "FORMAT_NAME", "FORMAT_VERSION", "integral_arrays", "json_dataset", "mirror", "save_result",
+           "stores_states_only", "string_dataset", "write_result_group"]
 
 FORMAT_NAME = "daeclear-result"
 """Value of the root ``format`` attribute of every file written by `Result.save`."""
