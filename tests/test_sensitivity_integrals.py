@@ -143,3 +143,27 @@ def test_a_tighter_quadrature_atol_tightens_the_integral(scene: dc.Scene) -> Non
         errors[atol] = abs(r.sensitivities.integrals["journal.x"][0][-1] - want) / abs(want)
     assert errors[1e-12] < errors[1e-3] / 10, errors
     assert errors[1e-12] < 10 * 1e-6 and errors[None] < 10 * 1e-6, errors
+
+
+def test_an_interrupted_streamed_run_keeps_its_integrals(scene: dc.Scene, memory: dc.Result, tmp_path: Path,
+                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    """Ctrl-C at the progress line's second update (the run restarts at each of its two events): the file holds
+    the rows before it with their integrals, the complete run's, and the Interrupted's result is the file's."""
+    from daeclear.core.errors import Interrupted
+    from daeclear.core.progress import Progress
+
+    calls, original = [0], Progress.update
+
+    def update(self: Progress, t: float, note: str = "") -> None:
+        calls[0] += 1
+        if calls[0] == 2:
+            raise KeyboardInterrupt
+        original(self, t, note)
+
+    monkeypatch.setattr(Progress, "update", update)
+    with pytest.raises(Interrupted) as info:
+        run(scene, dc.SaveAt(times=TIMES, steps=False, stream_to=tmp_path / "run.h5"))
+    partial = dc.load(tmp_path / "run.h5")
+    assert not partial.success and 0 < partial.n_times < TIMES.size
+    same_integrals(memory, partial, slice(0, partial.n_times))
+    same_integrals(partial, info.value.result)
