@@ -167,3 +167,14 @@ def test_an_interrupted_streamed_run_keeps_its_integrals(scene: dc.Scene, memory
     assert not partial.success and 0 < partial.n_times < TIMES.size
     same_integrals(memory, partial, slice(0, partial.n_times))
     same_integrals(partial, info.value.result)
+
+
+def test_a_file_written_before_the_integrals_were_kept(memory: dc.Result, tmp_path: Path) -> None:
+    """A file without /sensitivities/integrals (written before they were kept) loads with no integrals, its
+    sensitivities otherwise whole."""
+    path = memory.save(tmp_path / "old.h5")
+    with h5py.File(path, "r+") as f:
+        del f["sensitivities/integrals"]
+    back = dc.load(path)
+    assert dict(back.sensitivities.integrals) == {}
+    assert np.array_equal(back.sensitivities.states, memory.sensitivities.states)
