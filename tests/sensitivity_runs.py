@@ -20,7 +20,7 @@ from daeclear.solvers import sensitivity_carrier
 
 class StackedRun:
     """A Result with sensitivities, read as arrays: ``y`` (n_times, n_states), ``S`` (n_times, n_states, Ns),
-    ``channel_S`` (n_times, n_channels, Ns), ``events`` with ``dt_dp``."""
+    ``channel_S`` (n_times, n_channels, Ns), the contact ``events`` with ``dt_dp``, the friction ``kinks``."""
 
     def __init__(self, result: dc.Result) -> None:
         sens = result.sensitivities
@@ -28,7 +28,8 @@ class StackedRun:
         self.result = result
         self.names, self.state_names, self.channel_names = sens.names, sens.state_names, sens.channel_names
         self.t, self.y, self.S, self.channel_S = result.t, result.y, sens.states, sens.channels
-        self.events = list(sens.events)
+        self.events = [e for e in sens.events if e.kind != "kink"]  # the contact events
+        self.kinks = [e for e in sens.events if e.kind == "kink"]  # the friction kinks crossed (restarts, no jump)
         self.success, self.message = result.success, result.message
 
     def sensitivity(self, name: str, parameter: str | None = None) -> np.ndarray:

@@ -172,6 +172,8 @@ class Structure:
     logic: tuple[Callable[[NDArray[np.float64]], list[PairLogic]], ...]
     # (root, term, gap-rate extra, needs approach speed, index of the contact logic) of simple pairs
     auto_pairs: tuple[tuple[int, int, int, bool, int], ...]
+    # the term of each friction kink (``DAEFunctions.kinks``: roots of a run with sensitivities only)
+    kink_terms: tuple[int, ...] = ()
     compiled: CompiledDAE = field(init=False, repr=False)  # made empty here, filled by the engine when used
     starts: StartMemo = field(default_factory=dict, repr=False)  # bounded: START_MEMO_LIMIT
 
@@ -450,12 +452,15 @@ class _TemplateBuilder:
 
     def contact_terms(self) -> None:
         """Each contact term's residual and Jacobian, switch inputs, channels and power; the gaps (roots)."""
-        t, q, v, P, n, n_y, y, yp, cj = self.t, self.q, self.v, self.P, self.n, self.n_y, self.y, self.yp, self.cj
+        t, q, v, P, y, yp, cj = self.t, self.q, self.v, self.P, self.y, self.yp, self.cj
         self.terms: list[Term] = []
         self.term_res: list[ca.Function] = []
         self.term_jac: list[ca.Function] = []
         gaps: list[Any] = []
         self.gap_names: list[str] = []
+        kinks: list[Any] = []
+        self.kink_terms: list[int] = []
+        self.locked_res: list[ca.Function | None] = []  # per term: its residual on one friction piece (Term.locked)
         self.contact_channels: list[Channel] = []
         self.switch_syms: list[Any] = []  # per term: on/off flag and parameters, inputs of the outputs
         self.power_channels: list[Any] = []
@@ -474,12 +479,12 @@ class _TemplateBuilder:
                 self.power_channels.append(power)
             for term in build.terms:
                 p = ca.SX.sym("p", term.n_params)
-                Qk = term.force(t, q, v, p, P)
-                # the term's share of the work rate: its own power and the driver power it causes
-                work_row = ([-(ca.dot(Qk, v) + ca.substitute(self.drive_power_of, self.Fc, ca.densify(Qk))
-                               - self.drive_power_base)] if self.track_work else [])
-                r_k = ca.vertcat(ca.SX(n, 1), -Qk, ca.SX(n_y - 2 * n - len(work_row), 1), *work_row)  # structural zeros
+                r_k = self.term_residual(term.force(t, q, v, p, P))
                 ident = _c_identifier(term.name)  # term names may hold dots (channel names); C may not
+                p_locked = ca.SX.sym("p", term.n_params + 1)  # [p; piece]
+                self.locked_res.append(None if term.locked is None else ca.Function(
+                    f"{ident}_locked_res", [t, y, yp, p_locked, P],
+                    [self.term_residual(term.locked(t, q, v, p_locked, P))], ["t", "y", "yp", "p", "P"], ["r"]))
                 self.term_res.append(ca.Function(f"{ident}_res", [t, y, yp, p, P], [r_k],
                                                  ["t", "y", "yp", "p", "P"], ["r"]))
                 j_k = ca.jacobian(r_k, y) + cj * ca.jacobian(r_k, yp)
@@ -488,9 +493,22 @@ class _TemplateBuilder:
                 self.terms.append(term)
             gaps.extend(build.gaps)
             self.gap_names.extend(build.gap_names)
+            kinks.extend(build.kinks)
+            self.kink_terms.extend(len(self.terms) - len(build.terms) + k for k in build.kink_terms)
         self.roots = None
         if gaps:
             self.roots = ca.Function("roots", [t, y, yp, P], [ca.vertcat(*gaps)], ["t", "y", "yp", "P"], ["g"])
+        self.kinks = None
+        if kinks:
+            self.kinks = ca.Function("kinks", [t, y, yp, P], [ca.vertcat(*kinks)], ["t", "y", "yp", "P"], ["g"])
+
+    def term_residual(self, Qk: Any) -> Any:
+        """A term's residual rows from its generalized force: -Qk in the velocity rows, its work rate's row."""
+        n, v = self.n, self.v
+        # the term's share of the work rate: its own power and the driver power it causes
+        work_row = ([-(ca.dot(Qk, v) + ca.substitute(self.drive_power_of, self.Fc, ca.densify(Qk))
+                       - self.drive_power_base)] if self.track_work else [])
+        return ca.vertcat(ca.SX(n, 1), -Qk, ca.SX(self.n_y - 2 * n - len(work_row), 1), *work_row)  # structural zeros
 
     def output_channels(self) -> None:
         """The output channels: bodies, drivers, energy, constraints, contacts, loads, joints."""
@@ -580,7 +598,8 @@ class _TemplateBuilder:
         functions = DAEFunctions(
             n=self.n_y, residual=self.residual, jacobian=self.jacobian, term_residuals=tuple(self.term_res),
             term_jacobians=tuple(self.term_jac), roots=self.roots, name=library_name, extras=tuple(extras),
-            n_parameters=int(P.numel()),
+            n_parameters=int(P.numel()), kinks=self.kinks,
+            locked_residuals=tuple(self.locked_res) if self.kinks is not None else (),
         )
         return Structure(
             key=self.key, formulation=self.formulation, track_work=self.track_work, functions=functions,
@@ -592,7 +611,8 @@ class _TemplateBuilder:
             channel_units=MappingProxyType({c.name: c.unit for c in channels}), outputs=outputs,
             kinematics=self.kinematics, base_force=self.base_force, layout=self.table.layout,
             start_parameters=start_parameters(functions), logic=logic_makers,
-            auto_pairs=tuple(auto_pairs))  # numbers are bound per scene (Structure.bind)
+            auto_pairs=tuple(auto_pairs),
+            kink_terms=tuple(self.kink_terms))  # numbers are bound per scene (Structure.bind)
 
 
 def _c_identifier(name: str) -> str:

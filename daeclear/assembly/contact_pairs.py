@@ -8,7 +8,7 @@ guard included, is :mod:`daeclear.core.automaton`'s (docs/user_guide.md, "Contac
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 from collections.abc import Callable, Sequence
 
@@ -162,6 +162,10 @@ class ContactBuild:
     # the constraints of the ideal joint it stands for (the chapter's start), with their names
     ideal: list[Any]
     ideal_names: list[str]
+    # the friction laws' kinks as roots (friction_kinks) and the term of each: what a run with sensitivities
+    # watches besides the gaps (docs/sensitivities.md, "Kinks")
+    kinks: list[Any] = field(default_factory=list)
+    kink_terms: list[int] = field(default_factory=list)  # the index in ``terms`` of each kink's term
 
 
 def approach_floor(ctx: AssemblyContext, law: Any, prefix: str) -> Callable[[NDArray[np.float64]], float]:
@@ -198,6 +202,10 @@ class JournalContact:
     worn_rate: Any = 0.0
     # a worn joint's contact direction in the bearing's and the journal's frame (rad), for the wear study
     worn_angles: tuple[Any, Any] | None = None
+    # the friction law's kinks as roots (friction_kinks; none frictionless or for a smooth law) and the force
+    # on one piece of the law (Term.locked)
+    kinks: tuple[Any, ...] = ()
+    locked: ca.Function | None = None
 
     @property
     def penetration_rate(self) -> Any:
@@ -332,10 +340,37 @@ def journal_contact(ctx: AssemblyContext, joint: Any, law_numeric: Any, friction
     if worn_jacobian is not None:  # the contact direction's angle in each body's frame: atan2 of A(phi)^T n
         worn_angles = tuple(ca.atan2(-ca.sin(f.phi) * e[0] + ca.cos(f.phi) * e[1],
                                      ca.cos(f.phi) * e[0] + ca.sin(f.phi) * e[1]) for f in (bi, bj))
-    f_journal = -F_N * n + F_T * t_vec  # force on the journal (body j); the bearing gets the opposite
-    Q = ctx.generalized_force([(joint.body_j, f_journal, Q_j), (joint.body_i, -f_journal, Q_i)])
-    if worn_jacobian is not None:  # the normal force along the gap's gradient: -F_N d(delta)/dq, delta's worn part
-        Q = Q + F_N * worn_jacobian.T
-    force = ca.Function(f"{name}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P], [Q], ["t", "q", "v", "p", "P"], ["Q"])
+
+    def generalized(F_T: Any) -> Any:
+        f_journal = -F_N * n + F_T * t_vec  # force on the journal (body j); the bearing gets the opposite
+        Q = ctx.generalized_force([(joint.body_j, f_journal, Q_j), (joint.body_i, -f_journal, Q_i)])
+        if worn_jacobian is not None:  # the normal force along the gap's gradient: -F_N d(delta)/dq, delta's worn part
+            Q = Q + F_N * worn_jacobian.T
+        return Q
+    force = ca.Function(f"{name}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P], [generalized(F_T)],
+                        ["t", "q", "v", "p", "P"], ["Q"])
+    kinks: tuple[Any, ...] = ()
+    locked = None
+    if not friction_numeric.frictionless and friction_numeric.kinks:
+        # v_T with n regular at e = 0 (a root is evaluated in free flight too): exactly v_T in contact
+        n_r = e / ca.fmax(e_norm, 0.5 * clearance)
+        v_T_r = ca.dot(bj.world_point_velocity(P_j + (R_j - worn[1]) * n_r)
+                       - bi.world_point_velocity(P_i + (R_i + worn[0]) * n_r), perpendicular(n_r))
+        kinks = friction_kinks(friction, v_T_r)
+        locked = locked_force(f"{name}_locked", ctx, p, lambda piece: generalized(friction.piece(F_N, v_T, piece)))
     return JournalContact(e, e_dot, ee, e_norm, c, bi, bj, P_i, P_j, F_N, F_T, v_T, p, n_params, force, worn_rate,
-                          worn_angles)
+                          worn_angles, kinks, locked)
+
+
+def friction_kinks(friction: Any, v_T: Any) -> tuple[Any, ...]:
+    """The roots v_T - b of the friction law's kinks (``FrictionLaw.breakpoints``, ascending): the piece of
+    the law v_T is on is the number of them that are positive."""
+    return tuple(v_T - b for b in friction.breakpoints)
+
+
+def locked_force(label: str, ctx: AssemblyContext, p: Any, force: Callable[[Any], Any]) -> ca.Function:
+    """(t, q, v, [p; piece], P) -> ``force(piece)``: a term's force on one piece of its friction law
+    (``Term.locked``)."""
+    piece = ca.SX.sym("piece")
+    return ca.Function(label, [ctx.t, ctx.q, ctx.v, ca.vertcat(p, piece), ctx.P], [force(piece)],
+                       ["t", "q", "v", "p", "P"], ["Q"])

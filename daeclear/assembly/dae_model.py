@@ -206,6 +206,16 @@ class DAEModel:
         return self.structure.gap_names
 
     @property
+    def kink_terms(self) -> tuple[int, ...]:
+        """The term of each friction kink, the roots a run with sensitivities watches after the gaps."""
+        return self.structure.kink_terms
+
+    @property
+    def kink_pairs(self) -> tuple[str, ...]:
+        """The pair (or face) of each friction kink: its term's name."""
+        return tuple(self.structure.terms[k].name for k in self.structure.kink_terms)
+
+    @property
     def channel_names(self) -> tuple[str, ...]:
         return self.structure.channel_names
 

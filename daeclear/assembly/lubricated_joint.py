@@ -101,9 +101,11 @@ def build_lubricated_revolute(ctx: AssemblyContext, joint: RevoluteClearance, fi
             Channel(f"{name}.film_dissipation", "W", film_on * dissipation),
         ]
 
-    return ContactBuild(terms=[Term(name, jc.force, jc.n_params), Term(f"{name}.film", film_fn, 0)], gaps=gaps,
+    terms = [Term(name, jc.force, jc.n_params, jc.locked), Term(f"{name}.film", film_fn, 0)]
+    return ContactBuild(terms=terms, gaps=gaps,
                         gap_names=[f"{name}.film_break", f"{name}.film_reform", name], channels=channels,
-                        logic=logic, ideal=[e[0], e[1]], ideal_names=[f"{name}.x", f"{name}.y"])
+                        logic=logic, ideal=[e[0], e[1]], ideal_names=[f"{name}.x", f"{name}.y"],
+                        kinks=list(jc.kinks), kink_terms=[0] * len(jc.kinks))
 
 
 @dataclass(frozen=True)

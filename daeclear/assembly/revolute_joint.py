@@ -57,8 +57,9 @@ def build_dry_journal(ctx: AssemblyContext, joint: RevoluteClearance, first_term
         on, p_sym = switches[0]
         return jc.channels(name, on, p_sym, friction_numeric.frictionless)
 
-    return ContactBuild(terms=[Term(name, jc.force, jc.n_params)], gaps=[gap], gap_names=[name],
-                        channels=channels, logic=logic, ideal=[e[0], e[1]], ideal_names=[f"{name}.x", f"{name}.y"])
+    return ContactBuild(terms=[Term(name, jc.force, jc.n_params, jc.locked)], gaps=[gap], gap_names=[name],
+                        channels=channels, logic=logic, ideal=[e[0], e[1]], ideal_names=[f"{name}.x", f"{name}.y"],
+                        kinks=list(jc.kinks), kink_terms=[0] * len(jc.kinks))
 
 
 #: A revolute clearance joint's law's ``journal_model`` -> (parameter function, builder): a normal law makes

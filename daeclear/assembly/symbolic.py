@@ -68,6 +68,9 @@ class Term:
     name: str
     force: ca.Function
     n_params: int
+    # (t, q, v, [p; piece], P) -> the force with its friction law's piece ``piece`` (FrictionLaw.piece), for a
+    # friction law with kinks: what a run with sensitivities integrates between two kinks; else None
+    locked: ca.Function | None = None
 
 
 @dataclass(frozen=True)

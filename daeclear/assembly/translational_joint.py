@@ -31,7 +31,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from .contact_pairs import ContactBuild, PairLogic, PairStates, TermSwitch, approach_floor
+from .contact_pairs import ContactBuild, PairLogic, PairStates, TermSwitch, approach_floor, friction_kinks, locked_force
 from .parameters import law_structure, law_values, symbolic_law
 from ..core.events import ContactEvent
 from ..model.scene import TranslationalClearance
@@ -211,10 +211,18 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         n_in = -side[surface] * n_vec  # surface normal pointing into the guide
         v_T = ca.dot(slider.world_point_velocity(point_guide) - guide.world_point_velocity(point_guide), t_vec)
         F_T = 0.0 if friction_numeric.frictionless else friction.friction_force(F_N, v_T)
-        f_slider = F_N * n_in + F_T * t_vec
-        Q = ctx.generalized_force([(joint.body_j, f_slider, point_slider), (joint.body_i, -f_slider, point_guide)])
+
+        def generalized(F_T: Any) -> Any:
+            f_slider = F_N * n_in + F_T * t_vec
+            return ctx.generalized_force([(joint.body_j, f_slider, point_slider),
+                                          (joint.body_i, -f_slider, point_guide)])
+        locked = None
+        if not friction_numeric.frictionless and friction_numeric.kinks:
+            locked = locked_force(f"{ident}_{label}_locked", ctx, p,
+                                  lambda piece: generalized(friction.piece(F_N, v_T, piece)))
         terms.append(Term(f"{name}.{label}", ca.Function(f"{ident}_{label}_force", [ctx.t, ctx.q, ctx.v, p, ctx.P],
-                                                          [Q], ["t", "q", "v", "p", "P"], ["Q"]), n_p))
+                                                          [generalized(F_T)], ["t", "q", "v", "p", "P"], ["Q"]), n_p,
+                          locked))
         forces.append((F_N, F_T, v_T, p))
 
     corner_s, corner_d, corner_gap, corner_rate = [], [], [], []
@@ -332,5 +340,9 @@ def build_translational_clearance(ctx: AssemblyContext, joint: TranslationalClea
         ]
         return out
 
+    # each term's friction kinks (a corner's or a face's)
+    kinks = [(k, g) for k, (term, force) in enumerate(zip(terms, forces)) if term.locked is not None
+             for g in friction_kinks(friction, force[2])]
     return ContactBuild(terms=terms, gaps=corner_gap, gap_names=pair_names, channels=channels, logic=logic,
-                        ideal=[y_centre, tilt], ideal_names=[f"{name}.lateral", f"{name}.angle"])
+                        ideal=[y_centre, tilt], ideal_names=[f"{name}.lateral", f"{name}.angle"],
+                        kinks=[g for _, g in kinks], kink_terms=[k for k, _ in kinks])

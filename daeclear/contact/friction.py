@@ -31,6 +31,25 @@ class FrictionLaw(abc.ABC):
         """True if the law never produces a force (the assembly may skip it)."""
         return False
 
+    @property
+    def kinks(self) -> tuple[Any, ...]:
+        """The sliding speeds |v_T| (m/s), ascending, where the force is continuous but its slope in v_T
+        jumps (a piecewise law's breaks; none for a smooth law). A run with sensitivities stops IDA at each
+        and integrates S with the piece of the law it is on (:meth:`piece`): S' jumps there with F_y
+        (docs/sensitivities.md, "Kinks")."""
+        return ()
+
+    @property
+    def breakpoints(self) -> tuple[Any, ...]:
+        """The signed sliding speeds of the kinks, ascending: -kinks reversed, then kinks. Piece ``r`` of
+        :meth:`piece` lies above ``r`` of them."""
+        return (*(-k for k in reversed(self.kinks)), *self.kinks)
+
+    def piece(self, normal_force: Any, sliding_velocity: Any, region: Any) -> Any:
+        """The formula of the law on piece ``region`` (0 ... len(breakpoints)), continued past its ends: the
+        force a run with sensitivities integrates between two kinks. Without kinks, the law itself."""
+        return self._force(normal_force, sliding_velocity)
+
     def friction_force(self, normal_force: Any, sliding_velocity: Any) -> Any:
         """Signed tangential force ``F_T`` (N), ``F_T * v_T <= 0``, from ``F_N >= 0`` (N) and the sliding
         velocity ``v_T`` (m/s), on floats, numpy arrays or CasADi symbols."""
@@ -117,6 +136,19 @@ class ModifiedCoulomb(FrictionLaw):
         set_field(self, "v1", check_number("ModifiedCoulomb", "v1", self.v1, low=0.0, unit="m/s"))
         if self.v1 <= self.v0:
             raise SceneError(f"ModifiedCoulomb: v1={self.v1:g} m/s, must be > v0={self.v0:g} m/s.")
+
+    @property
+    def kinks(self) -> tuple[Any, ...]:
+        """c_d's breaks: |v_T| = v0 and v1."""
+        return (self.v0, self.v1)
+
+    def piece(self, normal_force: Any, sliding_velocity: Any, region: Any) -> Any:
+        """c_d sign(v_T) on the pieces below -v1, up to -v0, up to v0, up to v1, above: -1, the ramp
+        (v_T + v0)/(v1 - v0), 0, (v_T - v0)/(v1 - v0), 1 (``region`` 0 ... 4, a number or a symbol)."""
+        v, width = sliding_velocity, self.v1 - self.v0
+        factors = (-1.0, (v + self.v0) / width, 0.0, (v - self.v0) / width, 1.0)
+        factor = sum((region == j) * f for j, f in enumerate(factors))
+        return -self.coefficient * normal_force * factor
 
     def correction(self, sliding_velocity: Any) -> Any:
         """Dynamic correction coefficient ``c_d(|v_T|)`` in [0, 1], any backend."""

@@ -113,12 +113,25 @@ def _with_parameters(f: casadi.Function, n_base: int, n_parameters: int) -> casa
                            [f.name_out(k) for k in range(f.n_out())])
 
 
+def event_roots(funcs: DAEFunctions) -> casadi.Function | None:
+    """The roots a run with sensitivities watches, (t, y, yp, P) -> [g; k]: the model's roots g (the gaps),
+    then its kinks k (``DAEFunctions.kinks``: where S' jumps, a restart without a jump; docs/sensitivities.md,
+    "Kinks"); None without either."""
+    parts = [_with_parameters(f, 3, int(funcs.n_parameters)) for f in (funcs.roots, funcs.kinks)
+             if f is not None and f.numel_out(0) > 0]
+    if len(parts) < 2:
+        return parts[0] if parts else None
+    xs = _symbols(parts[0], [parts[0].sparsity_in(k).shape for k in range(4)], ["t", "y", "yp", "P"])
+    return casadi.Function("roots", xs, [casadi.vertcat(*(f(*xs) for f in parts))], ["t", "y", "yp", "P"], ["g"])
+
+
 def root_functions(funcs: DAEFunctions) -> tuple[casadi.Function, casadi.Function] | None:
     """The roots' Jacobian (t, y, yp, P) -> [g_t | g_y | g_y' | g_P] and curvature (t, y, yp, ypp, P) ->
-    d^2 g/dt^2 of the model's roots g (None without roots): the event's pieces (docs/sensitivities.md, section 4)."""
-    if funcs.roots is None or funcs.roots.numel_out(0) == 0:
+    d^2 g/dt^2 of the roots g of :func:`event_roots` (None without roots): the event's pieces
+    (docs/sensitivities.md, section 4)."""
+    g = event_roots(funcs)
+    if g is None:
         return None
-    g = _with_parameters(funcs.roots, 3, int(funcs.n_parameters))
     return jacobian_blocks(g, "sens_root_jacobian"), curvature_along(g, "sens_root_curvature")
 
 
@@ -225,11 +238,19 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, 
     coupling = casadi.Function("coupling", [t, Y, Yp, cj, PA, dy0], [below(r)],
                                ["t", "y", "yp", "cj", "P", "dy0"], ["Cdy0"]) if with_coupling else None
     term_res, term_jac, term_cpl = [], [], []
+    locked = funcs.locked_residuals
     for k, (fk, npk) in enumerate(zip(funcs.term_residuals, sens.n_params)):
         fk = _with_parameters(fk, 4, n_P)
-        pa = sym.sym("p", npk * (1 + width))
-        Sk = casadi.reshape(pa[npk:], npk, width)
-        rk = stacked(fk(t, y, yp, pa[:npk], P), sens.term_res[k](t, y, yp, pa[:npk], P, S, Sp, Sk, dP))
+        lk = locked[k] if k < len(locked) else None
+        nl = 0 if lk is None else 1  # [p_k; piece; vec(Sk)]: S integrated on the friction law's piece
+        pa = sym.sym("p", npk * (1 + width) + nl)
+        Sk = casadi.reshape(pa[npk + nl:], npk, width)
+        if lk is None:
+            dk = sens.term_res[k](t, y, yp, pa[:npk], P, S, Sp, Sk, dP)
+        else:  # the piece is a constant: its seed 0
+            dlk = directional(_with_parameters(lk, 4, n_P), width, (1, 2, 3, 4), f"sens_term{k}_locked")
+            dk = dlk(t, y, yp, pa[:npk + 1], P, S, Sp, casadi.vertcat(Sk, casadi.DM.zeros(1, width)), dP)
+        rk = stacked(fk(t, y, yp, pa[:npk], P), dk)
         term_res.append(casadi.Function(f"term{k}_res", [t, Y, Yp, pa, PA], [rk], ["t", "y", "yp", "p", "P"], ["r"]))
         term_jac.append(casadi.Function(f"term{k}_jac", [t, Y, Yp, pa, cj, PA], [jacobian(rk)],
                                         ["t", "y", "yp", "p", "cj", "P"], ["J"]))
@@ -237,8 +258,8 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, 
             term_cpl.append(casadi.Function(f"term{k}_cpl", [t, Y, Yp, pa, cj, PA, dy0], [below(rk)],
                                             ["t", "y", "yp", "p", "cj", "P", "dy0"], ["Cdy0"]))
     roots = None
-    if funcs.roots is not None:
-        g = _with_parameters(funcs.roots, 3, n_P)
+    g = event_roots(funcs)  # the gaps and the kinks: a run with sensitivities restarts at both
+    if g is not None:
         roots = casadi.Function("roots", [t, Y, Yp, PA], [g(t, y, yp, P)], ["t", "y", "yp", "P"], ["g"])
     return DAEFunctions(n=n * (1 + width), residual=residual, jacobian=jac, term_residuals=tuple(term_res),
                         term_jacobians=tuple(term_jac), roots=roots, n_parameters=n_P * (1 + width),

@@ -50,6 +50,10 @@ class DAEFunctions:
     matrix's blocks below its first block column times the first block's solution; ``term_couplings[k]``
     (t, y, yp, p_k, cj, P, dy0) the same of term k: the solve is then the block forward substitution of
     the block lower-triangular matrix, else the block-diagonal part (IDAS' simultaneous corrector).
+    ``kinks``: (t, y, yp, P) -> k[n_kinks], where a force's slope jumps (friction laws' ``kinks``), or None:
+    not roots of this DAE; the stacked DAE of a run with sensitivities appends them to its roots and
+    integrates S with ``locked_residuals[k]`` (t, y, yp, [p_k; piece], P), term k's residual on one piece of
+    its friction law (None for a term without kinks; empty without kinks).
     A value: what a process compiles of it is kept by a :class:`~daeclear.engine.compiled.CompiledDAE`.
     """
 
@@ -65,6 +69,8 @@ class DAEFunctions:
     blocks: int = 1
     coupling: casadi.Function | None = None
     term_couplings: tuple[casadi.Function, ...] = ()
+    kinks: casadi.Function | None = None
+    locked_residuals: tuple[casadi.Function | None, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -135,7 +135,7 @@ def consistent_restart(model: DAEModel, integrator: Integrator, t: float, y: NDA
     if not model.gap_names:
         return (*projected, True)
     g0, g1 = _roots(model, session, t, y, yp), _roots(model, session, t, projected[0], yp)
-    quiet = np.zeros(g0.shape, bool) if found is None else np.asarray(found).ravel() == 0
+    quiet = np.zeros(g0.shape, bool) if found is None else np.asarray(found).ravel()[:g0.size] == 0  # kinks after
     if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
         return (*model.consistent_state(t, y, forces, extras, project=False), False)
     return (*projected, True)

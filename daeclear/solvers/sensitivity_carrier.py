@@ -61,6 +61,11 @@ class SensitivityCarrier:
         self.params: list[NDArray] = []
         self.latched: list[list[NDArray]] = []
         self.S_params: list[NDArray] = []
+        self.pieces: dict[int, int] = {}  # term -> the piece of its friction law S is integrated on (Term.locked)
+        # the direction to watch each kink root in: both at first, then back across the last crossing (never
+        # the round-off of the root just left)
+        self.kink_watch = np.zeros(len(model.kink_terms), dtype=np.int32)
+        self.n_kinks = 0  # the kinks crossed (the run's stats)
         self.S = self.Sp = np.zeros((model.n_states, self.width))
         self.poisoned = np.zeros(self.width, dtype=bool)  # NaN from a grazing event on
         self.dt_dp = np.zeros(self.width)  # the last event's time sensitivity (the quadratures' jump reads it)
@@ -95,7 +100,25 @@ class SensitivityCarrier:
         if any(self.active):
             y, yp = model.consistent_state(t, y, model.term_forces(t, y, self.active, self.params))
         self.S, self.Sp = ms.consistent(t, y, S0, self.active, self.params, self.S_params)
+        self.pieces = self.pieces_at(t, y, yp, None)
         return y, yp
+
+    def pieces_at(self, t: float, y: NDArray, yp: NDArray, found: NDArray | None) -> dict[int, int]:
+        """The piece of its friction law each term with kinks is on at ``(t, y)``: how many of its kink roots
+        (v_T - b, b its law's breakpoints) are positive; a root ``found`` at ``t`` on the side it crossed to."""
+        model = self.model
+        if not model.kink_terms:
+            return {}
+        kinks = model.functions.kinks
+        assert kinks is not None  # a model with kink terms has their roots
+        g = np.array(kinks(t, y, yp, model.parameter_values), dtype=float).ravel() > 0.0
+        if found is not None:
+            crossed = np.ravel(found)[len(model.gap_names):]
+            g = np.where(crossed != 0, crossed > 0, g)
+        out: dict[int, int] = {}
+        for term, positive in zip(model.kink_terms, g.tolist()):
+            out[term] = out.get(term, 0) + int(positive)
+        return out
 
     def term_sensitivities(self, state: contact_state.ContactState, latched: list[list[NDArray]]) -> list[NDArray]:
         """Each term's parameters' sensitivity (n_params_k, Ns) in ``state``, from the pairs' ``latched``."""
@@ -106,8 +129,11 @@ class SensitivityCarrier:
         return out
 
     def terms_stacked(self) -> list[NDArray]:
-        """Each term's parameters followed by their sensitivities: the stacked system's term parameters."""
-        return [np.concatenate([p, s.ravel(order="F")]) for p, s in zip(self.params, self.S_params)]
+        """Each term's parameters (then the piece of its friction law, for a term with kinks) followed by their
+        sensitivities: the stacked system's term parameters."""
+        pieces = self.pieces
+        return [np.concatenate([p, [float(pieces[k])] if k in pieces else [], s.ravel(order="F")])
+                for k, (p, s) in enumerate(zip(self.params, self.S_params))]
 
     def rows(self, t: NDArray, y: NDArray, S: NDArray) -> None:
         """Keep output rows at ``t`` (N,) of the current mode: S of the states ``y`` (N, n) made consistent
@@ -141,6 +167,27 @@ class SensitivityCarrier:
         channel_S = ms.channels_rows(t, y, yp, S, Sp, switch, ms.switch_sensitivity(self.S_params))
         values = ms.outputs_rows(t, y, yp, switch)
         return y, yp, S, Sp, channel_S, values
+
+    def kinks_found(self, found: NDArray | None) -> NDArray[np.intp]:
+        """The friction kinks (roots after the gaps) among the roots ``found``."""
+        n_gaps, n_kinks = len(self.model.gap_names), len(self.model.kink_pairs)
+        if found is None or not n_kinks:
+            return np.zeros(0, dtype=np.intp)
+        return n_gaps + np.flatnonzero(np.ravel(found)[n_gaps:n_gaps + n_kinks])
+
+    def kink_events(self, t: float, found: NDArray | None, at: Any) -> None:
+        """Record each friction kink crossed at ``t`` (kind ``"kink"``, docs/sensitivities.md, "Kinks"): the
+        force's slope jumps there, not the force, so S goes on continuous (S+ = S-, S' re-solved in the
+        restart); its time's sensitivity -(g_y S + g_p) / g' is reported, NaN where the rate is 0."""
+        n_gaps = len(self.model.gap_names)
+        crossed = self.kinks_found(found)
+        if found is not None and crossed.size:
+            self.kink_watch[crossed - n_gaps] = -np.sign(np.ravel(found)[crossed])
+            self.n_kinks += crossed.size
+        for root in crossed:
+            rate = float(at.rate[root])
+            dt = -at.g_p[root] / rate if rate != 0.0 else np.full(self.width, np.nan)
+            self.events.append(SensitivityEvent(t, self.model.kink_pairs[root - n_gaps], "kink", dt))
 
     def event_row(self, t: float, y: NDArray, S: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
         """Keep a row at an event's time (before its switch, then after): what an objective integrating or
@@ -194,6 +241,7 @@ class SensitivityCarrier:
                             rate_p, rate_rate, dt,
                             floored=speed <= logic.min_approach_speed)
                 self.events.append(SensitivityEvent(t, e.pair, e.kind, dt_dps[-len(owners)]))
+        self.kink_events(t, found, ms.roots(t, y_m, yp_m, S_m, Sp_m) if self.kinks_found(found).size else None)
         dt_dp = np.zeros(W)
         if dt_dps:
             dt_dp = dt_dps[0] if same_event_times(dt_dps, rtol) else np.full(W, np.nan)
@@ -203,7 +251,12 @@ class SensitivityCarrier:
             S_p = ms.projected(t, y_p, S_p)
         self.latched = new_latched
         self.set_state(new_state)
-        S_p, Sp_p = ms.consistent(t, y_p, S_p, self.active, self.params, self.S_params)
+        self.pieces = self.pieces_at(t, y_p, yp_p, found)
+        if self.kinks_found(found).size:  # S' on the piece the run goes on with: read a step along the motion
+            S_p, Sp_p = (np.asarray(a) for a in onset_limit(lambda s: np.stack(ms.consistent(
+                t + s, y_p + s * yp_p, S_p, self.active, self.params, self.S_params)), t))
+        else:
+            S_p, Sp_p = ms.consistent(t, y_p, S_p, self.active, self.params, self.S_params)
         self.poisoned |= ~np.all(np.isfinite(S_p), axis=0)
         S_p[:, self.poisoned] = 0.0  # integrated as zeros, reported as NaN
         Sp_p[:, self.poisoned] = 0.0

@@ -180,12 +180,17 @@ class SensitivityIntegrator:
         return model.consistent_state(t, y, model.term_forces(t, y, terms.active, terms.params, extras), extras)
 
     def restart(self, t: float, y: NDArray, yp: NDArray, terms: Terms) -> None:
-        """IDA re-initialised at ``(y, yp)`` and the carrier's S, S' (after its jump)."""
+        """IDA re-initialised at ``(y, yp)`` and the carrier's S, S' (after its jump); the friction kinks,
+        roots after the gaps, watched as the carrier says."""
         c, quad = self.sens, self.quad
+        directions = terms.directions
+        if self.model.kink_terms:
+            gaps = np.zeros(len(self.model.gap_names), dtype=np.int32) if directions is None else directions
+            directions = np.concatenate([gaps, c.kink_watch])
         if quad is None:
             self.stacked.reinit(t, np.concatenate([y, c.S.ravel(order="F")]),
                                 np.concatenate([yp, c.Sp.ravel(order="F")]), terms.active, c.terms_stacked(),
-                                terms.directions)
+                                directions)
             return
         channel_S, values = (a[0] for a in c.evaluate_rows(np.array([t], dtype=float), y[None], c.S[None])[4:])
         rate, rate_S = quad.rates(values, channel_S)
@@ -193,7 +198,7 @@ class SensitivityIntegrator:
         extra = quad.term(switch, c.ms.switch_sensitivity(c.S_params))
         self.stacked.reinit(t, np.concatenate([y, quad.Q, np.vstack([c.S, quad.dQ]).ravel(order="F")]),
                             np.concatenate([yp, rate, np.vstack([c.Sp, rate_S]).ravel(order="F")]),
-                            [*terms.active, *(True for _ in extra)], [*c.terms_stacked(), *extra], terms.directions)
+                            [*terms.active, *(True for _ in extra)], [*c.terms_stacked(), *extra], directions)
 
     def advance(self) -> Advance:
         """Integrate [y; S] to the end or a root; the states' rows to the driver, S's rows to the carrier."""
@@ -235,7 +240,8 @@ class SensitivityIntegrator:
         return "Try a smaller rtol, or fewer sensitivities."
 
     def stats(self) -> dict[str, Any]:
-        return dict(self.stacked.stats())
+        """The stacked session's counters, and the friction kinks crossed (``n_kinks``: each a restart)."""
+        return {**self.stacked.stats(), "n_kinks": self.sens.n_kinks}
 
     def close(self) -> None:
         self.stacked.close()

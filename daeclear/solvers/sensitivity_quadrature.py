@@ -85,13 +85,20 @@ def quadrature_functions(funcs: DAEFunctions, outputs: casadi.Function, channels
                                         ["t", "y", "yp", "p", "P"], ["r"]))
         term_jac.append(casadi.Function("quadrature_jac", [t, Y, Yp, switch, cj, P], [jacobian(rq)],
                                         ["t", "y", "yp", "p", "cj", "P"], ["J"]))
-    roots = None
-    if funcs.roots is not None:
-        roots = casadi.Function("roots", [t, Y, Yp, P], [funcs.roots(t, y, yp, P)], ["t", "y", "yp", "P"], ["g"])
+    roots, kinks = (None if f is None else casadi.Function(f.name(), [t, Y, Yp, P], [f(t, y, yp, P)],
+                                                            ["t", "y", "yp", "P"], ["g"])
+                    for f in (funcs.roots, funcs.kinks))
+    locked: list[casadi.Function | None] = []
+    for lk in funcs.locked_residuals:
+        pl = sym.sym("p", 0 if lk is None else lk.numel_in(3))
+        locked.append(None if lk is None else casadi.Function(
+            lk.name(), [t, Y, Yp, pl, P], [casadi.vertcat(lk(t, y, yp, pl, P), sym(nQ, 1))], ["t", "y", "yp", "p", "P"],
+            ["r"]))
     tag = "_".join(str(int(c)) for c in channels)
     return DAEFunctions(n=n + nQ, residual=residual, jacobian=jac, term_residuals=tuple(term_res),
                         term_jacobians=tuple(term_jac), roots=roots, n_parameters=nP, name=f"{funcs.name}_q{tag}",
-                        extras=funcs.extras)  # the model's own: the stacked session evaluates the rows with them
+                        # the model's own extras: the stacked session evaluates the rows with them
+                        extras=funcs.extras, kinks=kinks, locked_residuals=tuple(locked))
 
 
 class Quadratures:
