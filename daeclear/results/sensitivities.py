@@ -19,7 +19,8 @@ __all__ = ["EventSides", "RunTrajectory", "Sensitivities", "SensitivityEvent", "
 
 @dataclass(frozen=True)
 class SensitivityEvent:
-    """One contact switch: time, pair, kind and the event time's sensitivity to each parameter (Ns,)."""
+    """One contact switch (kind "onset" or "separation") or friction kink crossed ("kink": a restart without a
+    jump, docs/sensitivities.md): time, pair, kind and the event time's sensitivity to each parameter (Ns,)."""
 
     t: float
     pair: str
