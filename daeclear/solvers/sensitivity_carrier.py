@@ -62,8 +62,8 @@ class SensitivityCarrier:
         self.latched: list[list[NDArray]] = []
         self.S_params: list[NDArray] = []
         self.pieces: dict[int, int] = {}  # term -> the piece of its friction law S is integrated on (Term.locked)
-        # the direction to watch each kink root in: both at first, then back across the last crossing (never
-        # the round-off of the root just left)
+        # the direction to watch each kink root in after a restart: back across a root crossed there (never the
+        # round-off of the root just left), both ways for the others
         self.kink_watch = np.zeros(len(model.kink_terms), dtype=np.int32)
         self.n_kinks = 0  # the kinks crossed (the run's stats)
         self.S = self.Sp = np.zeros((model.n_states, self.width))
@@ -181,6 +181,7 @@ class SensitivityCarrier:
         restart); its time's sensitivity -(g_y S + g_p) / g' is reported, NaN where the rate is 0."""
         n_gaps = len(self.model.gap_names)
         crossed = self.kinks_found(found)
+        self.kink_watch[:] = 0  # away from their roots: either way
         if found is not None and crossed.size:
             self.kink_watch[crossed - n_gaps] = -np.sign(np.ravel(found)[crossed])
             self.n_kinks += crossed.size

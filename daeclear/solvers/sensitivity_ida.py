@@ -219,9 +219,23 @@ class SensitivityIntegrator:
         if quad is not None:
             quad.Q, quad.dQ = adv.y[n:nb].copy(), self.root_S.reshape(nb, W, order="F")[n:].copy()
         adv.y, adv.yp = adv.y[:n], adv.yp[:n]
+        if adv.status == "root" and self.free_kinks_only(adv.roots_found):
+            adv.status = "chunk"  # a kink of a term that is off: nothing to do there, IDA goes on (no restart)
         adv.step_y = adv.step_y[:, :n] if adv.step_y.ndim == 2 else adv.step_y
         adv.eval_y = adv.eval_y[:, :n] if adv.eval_y.ndim == 2 else adv.eval_y
         return adv
+
+    def free_kinks_only(self, found: NDArray | None) -> bool:
+        """Whether the roots ``found`` are all friction kinks of terms that are off (a pair in free flight,
+        where its law's pieces do not matter: the onset's restart reads the piece it begins on)."""
+        model = self.model
+        if found is None or not model.kink_terms:
+            return False
+        found = np.ravel(found)
+        n_gaps = len(model.gap_names)
+        kinks = found[n_gaps:n_gaps + len(model.kink_terms)]
+        return (not np.any(found[:n_gaps]) and bool(np.any(kinks))
+                and not any(self.sens.active[k] for k, hit in zip(model.kink_terms, kinks) if hit))
 
     def pair_states(self) -> dict[int, PairState]:
         return {}
