@@ -97,6 +97,25 @@ class SensitivityCarrier:
         self.S, self.Sp = ms.consistent(t, y, S0, self.active, self.params, self.S_params)
         return y, yp
 
+    def restarted_poisoned(self, t: float, y: NDArray, S: NDArray, Sp: NDArray) -> tuple[NDArray, NDArray]:
+        """(S, S') with the poisoned columns (reported NaN from here on) restarted from S_q = S_v = 0 (GGL: moved
+        onto the linearised constraints) and no latched sensitivity, their multipliers' and derivatives'
+        sensitivities consistent with that (the response to dP from here on): zeros alone are no solution of
+        F_y S + F_y' S' + F_P dP = 0 where F_P dP is not zero (a driven joint's speed), and IDA's error test then
+        fails at every step size (docs/sensitivities.md, section 2)."""
+        for per_pair in self.latched:
+            for value in per_pair:
+                value[self.poisoned] = 0.0
+        self.S_params = self.term_sensitivities(self.state, self.latched)
+        S = S.copy()
+        S[:, self.poisoned] = 0.0
+        if self.model.formulation == "ggl":
+            S[:, self.poisoned] = self.ms.projected(t, y, S)[:, self.poisoned]
+        S_zero, Sp_zero = self.ms.consistent(t, y, S, self.active, self.params, self.S_params)
+        Sp = Sp.copy()
+        S[:, self.poisoned], Sp[:, self.poisoned] = S_zero[:, self.poisoned], Sp_zero[:, self.poisoned]
+        return S, Sp
+
     def term_sensitivities(self, state: contact_state.ContactState, latched: list[list[NDArray]]) -> list[NDArray]:
         """Each term's parameters' sensitivity (n_params_k, Ns) in ``state``, from the pairs' ``latched``."""
         out = [np.zeros((term.n_params, self.width)) for term in self.model.terms]
@@ -148,12 +167,27 @@ class SensitivityCarrier:
         in the current mode (nothing poisoned)."""
         y_c, yp, S_c, Sp, channel_S, values = (a[0] for a in self.evaluate_rows(np.array([t], dtype=float), y[None],
                                                                                  S[None]))
-        S_row, channel_row = S_c.copy(), channel_S.copy()
+        self.keep_event_row(t, y_c, S_c, channel_S, values)
+        return y_c, yp, S_c, Sp
+
+    def consistent_event_row(self, t: float, y: NDArray, yp: NDArray, S: NDArray, Sp: NDArray) -> None:
+        """:meth:`event_row` of a point already consistent in the current mode (``y``, ``yp`` of
+        :meth:`DAEModel.consistent_state`, ``S``, ``Sp`` of :meth:`ModelSensitivity.consistent`): the
+        channels and their sensitivities only."""
+        ms, model = self.ms, self.model
+        T = np.array([t], dtype=float)
+        switch = model.switch_vector(self.active, self.params)
+        channel_S = ms.channels_rows(T, y[None], yp[None], S[None], Sp[None], switch,
+                                     ms.switch_sensitivity(self.S_params))[0]
+        self.keep_event_row(t, y, S, channel_S, ms.outputs_rows(T, y[None], yp[None], switch)[0])
+
+    def keep_event_row(self, t: float, y: NDArray, S: NDArray, channel_S: NDArray, values: NDArray) -> None:
+        """Keep an event's row (y, S, the channels' S and values; S's NaN where poisoned)."""
+        S_row, channel_row = S.copy(), channel_S.copy()
         S_row[:, self.poisoned] = np.nan
         channel_row[:, self.poisoned] = np.nan
-        self.event_rows.append((y_c, S_row, channel_row, values))
+        self.event_rows.append((y, S_row, channel_row, values))
         self.event_t.append(t)
-        return y_c, yp, S_c, Sp
 
     def jump(self, t: float, y: NDArray, S: NDArray, found: NDArray | None, new_state: contact_state.ContactState,
              events: Sequence[ContactEvent], y_p: NDArray, projected: bool) -> None:
@@ -164,7 +198,7 @@ class SensitivityCarrier:
         y_m, yp_m, S_m, Sp_m = self.event_row(t, y, S)
         new_active, new_params = contact_state.switches(model, new_state)
         session = ms.session
-        yp_p = model.consistent_state(t, y_p, model.term_forces(t, y_p, new_active, new_params, session), session)[1]
+        y_c, yp_p = model.consistent_state(t, y_p, model.term_forces(t, y_p, new_active, new_params, session), session)
         new_latched = [[value.copy() for value in per_pair] for per_pair in self.latched]
         dt_dps: list[NDArray] = []
         if events and found is not None:
@@ -205,11 +239,7 @@ class SensitivityCarrier:
         self.set_state(new_state)
         S_p, Sp_p = ms.consistent(t, y_p, S_p, self.active, self.params, self.S_params)
         self.poisoned |= ~np.all(np.isfinite(S_p), axis=0)
-        S_p[:, self.poisoned] = 0.0  # integrated as zeros, reported as NaN
-        Sp_p[:, self.poisoned] = 0.0
-        for per_pair in self.latched:
-            for value in per_pair:
-                value[self.poisoned] = 0.0
-        self.S_params = self.term_sensitivities(self.state, self.latched)
+        if self.poisoned.any():
+            S_p, Sp_p = self.restarted_poisoned(t, y_p, S_p, Sp_p)
         self.S, self.Sp = S_p, Sp_p
-        self.event_row(t, y_p, S_p.copy())
+        self.consistent_event_row(t, y_c, yp_p, S_p, Sp_p)  # y_c: y_p with its multipliers of this mode
