@@ -97,23 +97,23 @@ class SensitivityCarrier:
         self.S, self.Sp = ms.consistent(t, y, S0, self.active, self.params, self.S_params)
         return y, yp
 
-    def restarted_poisoned(self, t: float, y: NDArray, S: NDArray, Sp: NDArray) -> tuple[NDArray, NDArray]:
-        """(S, S') with the poisoned columns (reported NaN from here on) restarted from S_q = S_v = 0 (GGL: moved
-        onto the linearised constraints) and no latched sensitivity, their multipliers' and derivatives'
-        sensitivities consistent with that (the response to dP from here on): zeros alone are no solution of
-        F_y S + F_y' S' + F_P dP = 0 where F_P dP is not zero (a driven joint's speed), and IDA's error test then
-        fails at every step size (docs/sensitivities.md, section 2)."""
+    def restarted(self, t: float, y: NDArray, S: NDArray, Sp: NDArray, bad: NDArray) -> tuple[NDArray, NDArray]:
+        """(S, S') with the ``bad`` columns (poisoned: reported NaN from here on) restarted from S_q = S_v = 0
+        (GGL: moved onto the linearised constraints) and no latched sensitivity, their multipliers' and
+        derivatives' sensitivities consistent with that (the response to dP from here on): zeros alone are no
+        solution of F_y S + F_y' S' + F_P dP = 0 where F_P dP is not zero (a driven joint's speed), and IDA's
+        error test then fails at every step size (docs/sensitivities.md, section 4)."""
         for per_pair in self.latched:
             for value in per_pair:
-                value[self.poisoned] = 0.0
+                value[bad] = 0.0
         self.S_params = self.term_sensitivities(self.state, self.latched)
         S = S.copy()
-        S[:, self.poisoned] = 0.0
+        S[:, bad] = 0.0
         if self.model.formulation == "ggl":
-            S[:, self.poisoned] = self.ms.projected(t, y, S)[:, self.poisoned]
+            S[:, bad] = self.ms.projected(t, y, S)[:, bad]
         S_zero, Sp_zero = self.ms.consistent(t, y, S, self.active, self.params, self.S_params)
         Sp = Sp.copy()
-        S[:, self.poisoned], Sp[:, self.poisoned] = S_zero[:, self.poisoned], Sp_zero[:, self.poisoned]
+        S[:, bad], Sp[:, bad] = S_zero[:, bad], Sp_zero[:, bad]
         return S, Sp
 
     def term_sensitivities(self, state: contact_state.ContactState, latched: list[list[NDArray]]) -> list[NDArray]:
@@ -238,8 +238,12 @@ class SensitivityCarrier:
         self.latched = new_latched
         self.set_state(new_state)
         S_p, Sp_p = ms.consistent(t, y_p, S_p, self.active, self.params, self.S_params)
-        self.poisoned |= ~np.all(np.isfinite(S_p), axis=0)
-        if self.poisoned.any():
-            S_p, Sp_p = self.restarted_poisoned(t, y_p, S_p, Sp_p)
+        bad = ~np.all(np.isfinite(S_p), axis=0)  # NaN from this event (a poisoned column's S is finite until then)
+        for per_pair in self.latched:
+            for value in per_pair:
+                bad |= ~np.isfinite(value)
+        self.poisoned |= bad
+        if bad.any():
+            S_p, Sp_p = self.restarted(t, y_p, S_p, Sp_p, bad)
         self.S, self.Sp = S_p, Sp_p
         self.consistent_event_row(t, y_c, yp_p, S_p, Sp_p)  # y_c: y_p with its multipliers of this mode

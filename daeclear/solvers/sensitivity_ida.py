@@ -77,6 +77,21 @@ def stacked_reference() -> Iterator[None]:
         SensitivityIntegrator.stacked_factorisation = before
 
 
+class StackedRoots:
+    """The model's roots at a point of its state y in the stacked session's C: its roots are those of y
+    (:func:`~daeclear.engine.sensitivity_functions.augmented_functions`), so S's rows are given as zeros."""
+
+    def __init__(self, stacked: Session, n: int, size: int) -> None:
+        self.stacked = stacked
+        self.Y, self.Yp = np.zeros(size), np.zeros(size)  # y in the first n of the stacked session's size rows
+        self.n = n
+
+    def roots(self, t: float, y: NDArray, yp: NDArray) -> NDArray:
+        """The model's root functions at (t, y, yp)."""
+        self.Y[:self.n], self.Yp[:self.n] = y, yp
+        return self.stacked.roots(t, self.Y, self.Yp)
+
+
 class SensitivityIntegrator:
     """One run's IDA session on [y; S] as the driver's :class:`~daeclear.solvers.integrator.Integrator`."""
 
@@ -142,6 +157,7 @@ class SensitivityIntegrator:
             raise
         self.backend = self.stacked.backend
         self.extras = self.stacked  # its extras begin with the model's (stacked_extras): the driver's restarts
+        self.root_evaluator = StackedRoots(self.stacked, model.n_states, self.n_block * (1 + W))
         self.missed: list[tuple[float, float, str]] = []
         self.i_eval = 0
         self.t_start = 0.0
