@@ -13,8 +13,7 @@ import pytest
 
 import daeclear as dc
 import daeclear.contact as dcc
-from daeclear.assembly.sensitivity import (ModelSensitivity, constrained_start_sensitivities, initial_sensitivities,
-                                           parameter_directions, start_sensitivities)
+from daeclear.assembly.sensitivity import ModelSensitivity, initial_sensitivities, parameter_directions
 from daeclear.core.errors import SceneError
 
 
@@ -263,8 +262,7 @@ def test_constrained_start_sensitivities_against_differences(formulation, index1
     the drive's speed, joint offsets and the crank's length (which move it) and a mass and the clearance
     (which do not: exactly 0, the ideal start centres the journal)."""
     model = ggl if formulation == "ggl" else index1
-    dP = parameter_directions(model, START_MOVERS)
-    S = constrained_start_sensitivities(model, dP)
+    S = ModelSensitivity(model, START_MOVERS).constrained_start()
     assert S is not None
     want = initial_sensitivities(model, START_MOVERS)
     n = 2 * model.n_q
@@ -282,10 +280,9 @@ def test_start_sensitivities_difference_a_start_its_constraints_do_not_fix() -> 
     run's dy0/dp is then the central differences'."""
     chain = dc.assemble(dc.mechanisms.chain(3, rpm=300.0))
     names = ["pin2.clearance", "link2.mass"]
-    dP = parameter_directions(chain, names)
-    assert len(chain.start_constraint_names) < chain.n_q and constrained_start_sensitivities(chain, dP) is None
-    np.testing.assert_array_equal(start_sensitivities(chain, names, dP), initial_sensitivities(chain, names))
+    ms = ModelSensitivity(chain, names)
+    assert len(chain.start_constraint_names) < chain.n_q and ms.constrained_start() is None
+    np.testing.assert_array_equal(ms.start(), initial_sensitivities(chain, names))
     crank = dc.assemble(dc.mechanisms.slider_crank("revolute"))
-    dP = parameter_directions(crank, ["drive.speed"])
-    np.testing.assert_array_equal(start_sensitivities(crank, ["drive.speed"], dP, start="declared"),
+    np.testing.assert_array_equal(ModelSensitivity(crank, ["drive.speed"]).start("declared"),
                                   initial_sensitivities(crank, ["drive.speed"], start="declared"))

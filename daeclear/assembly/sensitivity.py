@@ -28,7 +28,7 @@ from .dae_model import (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_STAR
                         DAEModel)
 
 __all__ = ["parameter_value", "moved_parameter", "table_entry", "parameter_directions", "initial_sensitivities",
-           "start_sensitivities", "constrained_start_sensitivities", "model_sensitivity_functions",
+           "model_sensitivity_functions",
            "ModelSensitivity", "RootTerms", "STEP_BITS"]
 
 #: Central differences of the scene-to-P map and of the start use the step 2**-STEP_BITS |p| (a power of
@@ -206,47 +206,6 @@ def initial_sensitivities(model: DAEModel, names: Sequence[str], start: str = "i
     return np.stack(columns, axis=1)
 
 
-def start_sensitivities(model: DAEModel, names: Sequence[str], dP: NDArray, start: str = "ideal",
-                        allow_penetration: bool = False, moved: dict[str, Moved] | None = None
-                        ) -> NDArray[np.float64]:
-    """dy0/dp of the start ``model.initial_state(start=...)``, (n_states, Ns), for the parameters ``names``
-    whose dP/dp is ``dP``: :func:`constrained_start_sensitivities` where the start's constraints fix it,
-    else :func:`initial_sensitivities` (central differences of moved starts)."""
-    S0 = constrained_start_sensitivities(model, dP) if start == "ideal" else None
-    return initial_sensitivities(model, names, start, allow_penetration, moved) if S0 is None else S0
-
-
-def constrained_start_sensitivities(model: DAEModel, dP: NDArray) -> NDArray[np.float64] | None:
-    """dy0/dp of the chapter's start (``start="ideal"``) along dP/dp ``dP`` (n_P, Ns), where its constraints
-    fix it: as many independent constraints (the clearance joints ideal) as coordinates. Then the assembled q
-    solves Phi(q, P) = 0 and v solves Phi_q v + Phi_t = 0 whatever the guess, and differentiating them,
-
-        Phi_q S_q = -Phi_P dP,    Phi_q S_v = -(d(Phi_q v + Phi_t)/dq S_q + d(Phi_q v + Phi_t)/dP dP)
-
-    (one directional derivative of the start's kinematics each). None where they do not fix it (fewer
-    constraints than coordinates: an open chain; or dependent ones): the start is then the Newton path's end
-    from the guess, differenced instead. The multipliers' rows are 0: made consistent afterwards."""
-    n, m, W = model.n_q, len(model.start_constraint_names), dP.shape[1]
-    if m != n or n == 0:
-        return None
-    with warnings.catch_warnings():  # the start's notes were given for the run itself
-        warnings.simplefilter("ignore")
-        y0 = model.initial_state(start="ideal")[0]
-    q, v, t = y0[:n], y0[n:2 * n], np.zeros(1)
-    Phi_q = model.constraints(q, v, 0.0, ideal=True)[1]
-    singular = np.linalg.svd(Phi_q, compute_uv=False)
-    if not singular[-1] > RANK_TOL * singular[0]:
-        return None
-    f = directional(model.functions.extras[EXTRA_START_KINEMATICS], W, None, "sens_start_kinematics")
-    P, zero = model.parameter_values, np.zeros((n, W))
-    d_P = np.array(f(q, v, t, P, zero, zero, np.zeros((1, W)), dP))  # along dP alone: Phi_P dP, ...
-    S = np.zeros((model.n_states, W))
-    S[:n] = -np.linalg.solve(Phi_q, d_P[:m])
-    d_qP = np.array(f(q, v, t, P, S[:n], zero, np.zeros((1, W)), dP))  # along (S_q, dP): d(Phi_q v + Phi_t)
-    S[n:2 * n] = -np.linalg.solve(Phi_q, d_qP[m + m * n:])
-    return S
-
-
 def model_sensitivity_functions(model: DAEModel, width: int) -> SensitivityFunctions:
     """The model's sensitivity functions for ``width`` parameters, with the directional derivatives of
     the accelerations, the constraints, each term's force and the simple pairs' gap rates (built once per
@@ -302,7 +261,8 @@ class ModelSensitivity:
     #: S): in a stacked session they follow the model's extras in this order (``stacked_extras``).
     @staticmethod
     def row_derivatives(model: DAEModel) -> tuple[int, ...]:
-        return (EXTRA_ACCEL, *(EXTRA_TERM0 + k for k in range(len(model.terms))), EXTRA_OUTPUTS, EXTRA_KINEMATICS)
+        return (EXTRA_ACCEL, *(EXTRA_TERM0 + k for k in range(len(model.terms))), EXTRA_OUTPUTS, EXTRA_KINEMATICS,
+                EXTRA_START_KINEMATICS)
 
     def __init__(self, model: DAEModel, names: Sequence[str]) -> None:
         self.model = model
@@ -413,6 +373,45 @@ class ModelSensitivity:
                 for x in (*values, *seeds)]  # column-major per point, as CasADi's matrices
         out = self.session.eval_extra(index, flat, N)
         return out.reshape(N, self.width, -1).transpose(0, 2, 1)
+
+    def start(self, start: str = "ideal", allow_penetration: bool = False) -> NDArray[np.float64]:
+        """dy0/dp of the start ``model.initial_state(start=...)``, (n_states, Ns): :meth:`constrained_start`
+        where the start's constraints fix it, else :func:`initial_sensitivities` (central differences of the
+        moved models' starts)."""
+        S0 = self.constrained_start(allow_penetration) if start == "ideal" else None
+        if S0 is None:
+            return initial_sensitivities(self.model, self.names, start, allow_penetration, self.moved)
+        return S0
+
+    def constrained_start(self, allow_penetration: bool = False) -> NDArray[np.float64] | None:
+        """dy0/dp of the chapter's start (``start="ideal"``) where its constraints fix it: as many independent
+        constraints (the clearance joints ideal) as coordinates. Then the assembled q solves Phi(q, P) = 0 and
+        v solves Phi_q v + Phi_t = 0 whatever the guess, and differentiating them,
+
+            Phi_q S_q = -Phi_P dP,    Phi_q S_v = -(d(Phi_q v + Phi_t)/dq S_q + d(Phi_q v + Phi_t)/dP dP)
+
+        (one directional derivative of the start's kinematics each). None where they do not fix it (fewer
+        constraints than coordinates: an open chain; or dependent ones): the start is then the end of the
+        Newton path from the guess, differenced instead. The multipliers' rows are 0: made consistent after."""
+        model, W = self.model, self.width
+        n, m = model.n_q, len(model.start_constraint_names)
+        if m != n or n == 0:
+            return None
+        with warnings.catch_warnings():  # the run's own start (kept by the structure); its notes were given
+            warnings.simplefilter("ignore")
+            y0 = model.initial_state(start="ideal", allow_penetration=allow_penetration)[0]
+        q, v, t = y0[None, :n], y0[None, n:2 * n], np.zeros(1)
+        Phi_q = model.constraints(q[0], v[0], 0.0, self.session, ideal=True)[1]
+        singular = np.linalg.svd(Phi_q, compute_uv=False)
+        if not singular[-1] > RANK_TOL * singular[0]:
+            return None
+        zero, zero_t = np.zeros((1, n, W)), Shared(np.zeros((1, W)))
+        S = np.zeros((model.n_states, W))
+        d_P = self.derivative(EXTRA_START_KINEMATICS, 1, [q, v, t], [zero, zero, zero_t])[0]  # along dP: Phi_P dP
+        S[:n] = -np.linalg.solve(Phi_q, d_P[:m])
+        d_qP = self.derivative(EXTRA_START_KINEMATICS, 1, [q, v, t], [S[None, :n], zero, zero_t])[0]
+        S[n:2 * n] = -np.linalg.solve(Phi_q, d_qP[m + m * n:])  # along (S_q, dP): d(Phi_q v + Phi_t)
+        return S
 
     def projected(self, t: float, y: NDArray, S: NDArray) -> NDArray[np.float64]:
         """S with S_q and S_v moved (least norm) onto the linearised constraints, d Phi = Phi_q S_q + Phi_P dP

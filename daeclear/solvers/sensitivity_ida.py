@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from ..assembly.contact_state import ContactState
 from ..assembly.dae_model import DAEModel
-from ..assembly.sensitivity import parameter_value, start_sensitivities
+from ..assembly.sensitivity import parameter_value
 from ..core.errors import SceneError
 from ..core.automaton import PairState
 from ..engine.compiled import CompiledDAE
@@ -164,9 +164,8 @@ class SensitivityIntegrator:
 
     def start(self, t: float, y: NDArray, yp: NDArray, terms: Terms, state: ContactState) -> None:
         """S at the start (dy0/dp of the run's start), consistent in the start's mode; IDA started."""
-        settings, model = self.settings, self.model
-        S0 = start_sensitivities(model, self.sens.names, self.sens.ms.dP, settings.start, settings.allow_penetration,
-                                 self.sens.ms.moved)
+        settings = self.settings
+        S0 = self.sens.ms.start(settings.start, settings.allow_penetration)
         self.sens.start(t, y, yp, state, S0)
         self.t_start = t
         if self.times is None or self.times.window(0, 1)[0] == t:  # the driver reports the start point
