@@ -598,7 +598,8 @@ SENSITIVITIES = {"/sensitivities", "/sensitivities/names", "/sensitivities/value
                  "/sensitivities/channels", "/sensitivities/events", "/sensitivities/events/t",
                  "/sensitivities/events/pair", "/sensitivities/events/kind", "/sensitivities/events/dt_dp",
                  "/sensitivities/sides", *(f"/sensitivities/sides/{name}" for name in ("t", "y", "values", "states",
-                                                                                      "channels"))}
+                                                                                      "channels")),
+                 "/sensitivities/integrals", *(f"/sensitivities/integrals/{name}" for name in ("names", "Q", "dQ"))}
 
 
 def _documented_items() -> list[tuple[str, bool]]:

@@ -186,7 +186,7 @@ def _read(r: _Reader) -> dict[str, Any]:
             r.array("sensitivities/states", points), r.array("sensitivities/channels", points),
             sensitivity_events([float(ev_t[i]) for i in inside], [pairs[i] for i in inside],
                                [kinds[i] for i in inside], dt_dp[inside]), _sides(r),
-            r.array("sensitivities/values") if r.has("sensitivities/values") else None)
+            r.array("sensitivities/values") if r.has("sensitivities/values") else None, _integrals(r, points))
     return dict(t=t, y=y, yp=yp, state_names=state_names, channels=channels, units=units, events=events,
                 sensitivities=sensitivities,
                 segments=segments, stats=r.json("stats_json"), success=bool(r.attr("success")),
@@ -205,6 +205,17 @@ def _sides(r: _Reader) -> EventSides | None:
     lo, hi = r.window
     rows = (t >= lo) & (t <= hi)
     return EventSides(*(r.array(f"sensitivities/sides/{name}")[rows] for name in SIDES))
+
+
+def _integrals(r: _Reader, points: slice) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """The integrals integrated as states at the window's rows (none in a file written before they were kept)."""
+    if not r.has("sensitivities/integrals"):
+        return {}
+    names = r.strings("sensitivities/integrals/names")
+    if not names:  # none integrated (a streamed file's empty arrays have no rows either)
+        return {}
+    Q, dQ = r.array("sensitivities/integrals/Q", points), r.array("sensitivities/integrals/dQ", points)
+    return {name: (Q[:, i], dQ[:, i, :]) for i, name in enumerate(names)}
 
 
 def read_group(group: h5py.Group, path: Path) -> dict[str, Any]:

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, SIDES, json_dataset, mirror, string_dataset
+from .hdf5_write import FORMAT_NAME, FORMAT_VERSION, SIDES, integral_arrays, json_dataset, mirror, string_dataset
 from .run_file import STREAM_ROWS, append_rows, extendable
 from ..core.values import to_plain
 
@@ -26,6 +26,8 @@ if TYPE_CHECKING:  # h5py is imported lazily, only where a file is written
 
 __all__ = ["STREAM_RUNNING", "ResultWriter"]
 
+#: The datasets of ``/sensitivities`` whose rows go with the output rows, in the order of ``_staged``.
+_STAGED = ("states", "channels", "integrals/Q", "integrals/dQ")
 #: Rows per chunk of the events and segments: a run has tens of them, and a chunk is written whole.
 _LIST_ROWS = 64
 #: Root message of a streamed file while its run goes on; a file left so was stopped without a word
@@ -91,9 +93,10 @@ class ResultWriter:
             f.close()
             raise
 
-    def sensitivities(self, names: Sequence[str], channel_names: Sequence[str], values: ArrayLike) -> None:
+    def sensitivities(self, names: Sequence[str], channel_names: Sequence[str], values: ArrayLike,
+                      integrals: Sequence[str] = ()) -> None:
         """Add the ``/sensitivities`` group of a run with sensitivities (docs/hdf5_layout.md; the parameters'
-        ``names`` and ``values``, the arrays empty), which
+        ``names`` and ``values``, the ``integrals``' channels, the arrays empty), which
         :meth:`stage_sensitivities` fills as the run goes."""
         import h5py
 
@@ -112,14 +115,25 @@ class ResultWriter:
             sub = g.create_group(group)
             for name, (dtype, rest) in columns.items():
                 self._grow(sub, name, dtype, rest, rows=_LIST_ROWS)
+        sub = g.create_group("integrals")
+        string_dataset(sub, "names", list(integrals))
+        for name, rest in (("Q", (len(integrals),)), ("dQ", (len(integrals), width))):
+            if integrals:
+                self._grow(sub, name, np.float64, rest)
+            else:  # no column: HDF5 cannot chunk it, and no append adds to it
+                sub.create_dataset(name, shape=(0, *rest), dtype=np.float64)
         self._f.flush()
-        self._staged = [np.zeros((0, self._n, width)), np.zeros((0, n_ch, width))]
+        self._staged = [np.zeros((0, self._n, width)), np.zeros((0, n_ch, width)),
+                        np.zeros((0, len(integrals))), np.zeros((0, len(integrals), width))]
 
     def stage_sensitivities(self, s: Sensitivities) -> None:
         """The sensitivities carried since the last call: the events and their rows appended now; S of the
-        states and channels (``s.states``, ``s.channels``, one row per output row) appended with the output
-        rows of the next :meth:`append`, in the same change (the file's rows of ``/t`` and of S never differ)."""
-        self._staged = [np.concatenate([self._staged[0], s.states]), np.concatenate([self._staged[1], s.channels])]
+        states and channels (``s.states``, ``s.channels``, one row per output row) and the integrals' Q and
+        dQ/dp (``s.integrals``, in the order given to :meth:`sensitivities`) appended with the output rows of
+        the next :meth:`append`, in the same change (the file's rows of ``/t`` and of S never differ)."""
+        _, Q, dQ = integral_arrays(s, len(s.states))
+        self._staged = [np.concatenate([staged, rows])
+                        for staged, rows in zip(self._staged, (s.states, s.channels, Q, dQ))]
         g = self._f["sensitivities"]
         items = [(g["events/t"], np.array([e.t for e in s.events], dtype=np.float64)),
                  (g["events/pair"], np.array([e.pair for e in s.events], dtype=object)),
@@ -177,10 +191,12 @@ class ResultWriter:
             items.append((f["yp"], np.asarray(yp, dtype=np.float64)))
         if self._staged:  # a run with sensitivities: S of these rows (NaN for a row the run did not give S)
             k = t_arr.size
-            for dataset, staged in zip((f["sensitivities/states"], f["sensitivities/channels"]), self._staged):
+            for name, staged in zip(_STAGED, self._staged):
+                if not staged.shape[1]:  # no integral: the empty dataset stays
+                    continue
                 rows = staged[:k] if staged.shape[0] >= k else np.concatenate(
                     [staged, np.full((k - staged.shape[0], *staged.shape[1:]), np.nan)])
-                items.append((dataset, rows))
+                items.append((f[f"sensitivities/{name}"], rows))
             self._staged = [staged[k:] for staged in self._staged]
         rows = np.asarray(switch if switch is not None else np.zeros((t_arr.size, 0)), dtype=np.float64)
         if rows.shape[1:] != (0,):  # one row per point, repeated over a segment: gzip makes it small

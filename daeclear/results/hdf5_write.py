@@ -22,8 +22,8 @@ if TYPE_CHECKING:  # h5py is imported lazily, only where a file is written
     from .result import Result
     from .sensitivities import Sensitivities
 
-__all__ = ["SIDES", "FORMAT_NAME", "FORMAT_VERSION", "json_dataset", "mirror", "save_result", "stores_states_only",
-           "string_dataset", "write_result_group"]
+__all__ = ["SIDES", "FORMAT_NAME", "FORMAT_VERSION", "integral_arrays", "json_dataset", "mirror", "save_result",
+           "stores_states_only", "string_dataset", "write_result_group"]
 
 FORMAT_NAME = "daeclear-result"
 """Value of the root ``format`` attribute of every file written by `Result.save`."""
@@ -157,7 +157,8 @@ def _write(f: h5py.File | h5py.Group, r: Result, channels: bool = False) -> None
 
 def _write_sensitivities(group: h5py.Group, s: Sensitivities) -> None:
     """A run's forward sensitivities (``simulate(..., sensitivities=[...])``): names, S of the states and
-    the channels at every output time, each event time's sensitivity, the rows at each event."""
+    the channels at every output time, each event time's sensitivity, the rows at each event, the integrals
+    integrated as states with their sensitivities at every output time."""
     string_dataset(group, "names", s.names)
     if s.values is not None:
         _dataset(group, "values", np.asarray(s.values, dtype=np.float64))
@@ -173,6 +174,22 @@ def _write_sensitivities(group: h5py.Group, s: Sensitivities) -> None:
         sides = group.create_group("sides")
         for name in SIDES:
             _dataset(sides, name, np.asarray(getattr(s.sides, name), dtype=np.float64))
+    names, Q, dQ = integral_arrays(s, len(s.states))
+    integrals = group.create_group("integrals")  # (simulate(..., integrals=[...]); none: empty)
+    string_dataset(integrals, "names", names)
+    _dataset(integrals, "Q", Q)
+    _dataset(integrals, "dQ", dQ)
+
+
+def integral_arrays(s: Sensitivities, n: int) -> tuple[list[str], np.ndarray, np.ndarray]:
+    """The integrals of ``s`` as the file keeps them: their channels' names, Q (n, n_integrals) and dQ/dp
+    (n, n_integrals, Ns), one row per output row (``n`` rows: none integrated, empty columns)."""
+    names = list(s.integrals)
+    Q = np.zeros((n, len(names)))
+    dQ = np.zeros((n, len(names), len(s.names)))
+    for i, name in enumerate(names):
+        Q[:, i], dQ[:, i, :] = s.integrals[name]
+    return names, Q, dQ
 
 
 def stores_states_only(r: Result) -> bool:

@@ -79,7 +79,7 @@ def simulate(
     integrals : list of str or None
         Channel names (``model.channel_names``) whose integrals from ``t0`` IDA integrates as states under
         its error control, with their sensitivities (``result.sensitivities.integrals``; ``dc.Integral``
-        reads them). With ``sensitivities`` only, not streamed (docs/sensitivities.md, section 7).
+        reads them). With ``sensitivities`` only; saved and streamed with them (docs/sensitivities.md, section 7).
 
     Returns
     -------
@@ -129,9 +129,6 @@ def simulate(
         parameter_names(scene, names)
         chosen = None
         if integrals is not None:
-            if out.stream_to is not None:
-                opts.fail("simulate", "integrals", integrals, "None with a streamed output (SaveAt(stream_to=...)): "
-                          "the integrals are kept in memory only")
             chosen = checked_integrals(integrals, scene)
         solver = SensitivityIDA(names, chosen)
     elif integrals is not None:

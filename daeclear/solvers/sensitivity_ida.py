@@ -122,7 +122,7 @@ class SensitivityIntegrator:
         funcs = model.functions if self.quad is None else self.quad.functions(model.functions)
         self.n_block = int(funcs.n)
         if self.quad is not None:
-            atol = np.concatenate([atol, self.quad.atol(rtol)])
+            atol = np.concatenate([atol, self.quad.atol(rtol, settings.quadrature_atol)])
         atol_S = np.concatenate([atol / p for p in pbar])  # IDAS' pbar: S |p| held to the states' atol
         tested = settings.sensitivity_error_test
         derivatives = self.sens.ms.row_derivatives(model)
@@ -268,10 +268,12 @@ class SensitivityIntegrator:
         driver appends next), then dropped: the run's memory does not grow with its length."""
         c = self.sens
         if not self.streamed:
-            writer.sensitivities(c.names, self.model.channel_names, self.values)
+            writer.sensitivities(c.names, self.model.channel_names, self.values,
+                                 () if self.quad is None else self.quad.channels)
             self.streamed = True
         writer.stage_sensitivities(self.collected(min(len(c.rows_S), len(c.rows_channel_S))))
-        for kept in (c.rows_t, c.rows_S, c.rows_channel_S, c.rows_channels, c.events, c.event_t, c.event_rows):
+        for kept in (c.rows_t, c.rows_S, c.rows_channel_S, c.rows_channels, c.events, c.event_t, c.event_rows,
+                     *(() if self.quad is None else (self.quad.rows_Q, self.quad.rows_dQ))):
             kept.clear()
 
     def collected(self, n: int) -> Sensitivities:

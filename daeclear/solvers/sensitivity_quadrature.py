@@ -25,8 +25,9 @@ from ..engine.session_base import DAEFunctions
 
 __all__ = ["QUADRATURE_ATOL", "Quadratures", "quadrature_functions", "checked_integrals"]
 
-#: The quadratures' absolute tolerance per unit of rtol (in the channel's unit times s): an integral below
-#: it in magnitude is held to this absolute error, above it to rtol relative.
+#: The quadratures' default absolute tolerance per unit of rtol (in the channel's unit times s): an integral
+#: below it in magnitude is held to this absolute error, above it to rtol relative
+#: (``SolverOptions.quadrature_atol`` sets another).
 QUADRATURE_ATOL = 1e-3
 
 
@@ -111,9 +112,10 @@ class Quadratures:
         """The model's functions with the quadrature states appended."""
         return quadrature_functions(funcs, self.model.functions.extras[EXTRA_OUTPUTS], self.index)
 
-    def atol(self, rtol: float) -> NDArray[np.float64]:
-        """The quadratures' absolute tolerances at ``rtol``."""
-        return np.full(self.size, QUADRATURE_ATOL * rtol)
+    def atol(self, rtol: float, given: float | None = None) -> NDArray[np.float64]:
+        """The quadratures' absolute tolerances: ``given`` (``SolverOptions.quadrature_atol``), or
+        :data:`QUADRATURE_ATOL` times ``rtol`` when None."""
+        return np.full(self.size, QUADRATURE_ATOL * rtol if given is None else given)
 
     def term(self, switch: NDArray, S_switch: NDArray) -> list[NDArray]:
         """The quadrature term's stacked parameters (none without contact terms): the switch vector and its

@@ -75,6 +75,10 @@ class SolverOptions:
         each parameter's columns scaled by its magnitude; False leaves S out of the error test and in the
         Newton convergence test only (IDAS' errconS = False; the compiled backend: docs/sensitivities.md,
         section 2): fewer steps, S only as accurate as the states' steps make it.
+    quadrature_atol : float or None
+        A run with integrals (``simulate(..., integrals=[...])``, ``dc.Integral``): the absolute tolerance
+        of each integral Q, in the channel's unit times s (an integral below it in magnitude is held to
+        this absolute error, above it to rtol relative); dQ/dp's is it over |p|. None: 1e-3 rtol.
     """
 
     method: str = "ida"
@@ -90,6 +94,7 @@ class SolverOptions:
     allow_penetration: bool = False
     track_work: bool = False
     sensitivity_error_test: bool = True
+    quadrature_atol: float | None = None
     #: who the settings were given to, for the messages (not stored): "simulate" for its keywords
     where: dataclasses.InitVar[str] = WHERE
 
@@ -170,7 +175,18 @@ def checked(values: Mapping[str, Any], *, where: str) -> dict[str, Any]:
         "track_work": options.flag(values["track_work"], where=where, field="track_work"),
         "sensitivity_error_test": options.flag(values["sensitivity_error_test"], where=where,
                                                field="sensitivity_error_test"),
+        "quadrature_atol": _quadrature_atol(values["quadrature_atol"], where),
     }
+
+
+def _quadrature_atol(value: Any, where: str) -> float | None:
+    """None, or a finite number > 0: the integrals' absolute tolerance (the channel's unit times s)."""
+    if value is None:
+        return None
+    if not (options.is_real(value) and np.isfinite(float(value)) and float(value) > 0.0):
+        fail(where, "quadrature_atol", value, "None or a finite number > 0 (the integrals' absolute tolerance, in "
+             "the channel's unit times s)")
+    return float(value)
 
 
 def _check_names(values: Mapping[str, Any], where: str) -> None:

@@ -36,15 +36,19 @@ DEFAULT_SAMPLES = 2000
 
 def gradient(scene_or_model: Scene | DAEModel, t_end: float, *, of: Objective, parameters: Sequence[str],
              method: str = "sensitivities", rtol: float = 1e-8, atol: Any = None, start: str = "ideal",
-             formulation: str | None = None, samples: int = DEFAULT_SAMPLES, backend: str = "auto") -> Gradient:
+             formulation: str | None = None, samples: int = DEFAULT_SAMPLES, backend: str = "auto",
+             quadrature_atol: float | None = None) -> Gradient:
     """The value of the objective ``of`` over a run to ``t_end`` and its gradient {name: d value/d name} w.r.t.
     ``parameters`` (names of ``model.parameter_names``).
 
     ``samples``: output intervals for an Integral or a Peak (trapezoidal rule, parabolic peak: errors
-    O(1/samples^2)); ``rtol``, ``atol``, ``start``, ``formulation``, ``backend`` as ``simulate``'s. ``method="fd"``:
+    O(1/samples^2)); ``rtol``, ``atol``, ``start``, ``formulation``, ``backend`` as ``simulate``'s;
+    ``quadrature_atol``: an Integral's absolute tolerance (``SolverOptions.quadrature_atol``). ``method="fd"``:
     central differences with the step rtol^(1/3) |p| (|p| = 1 at 0), 2 Ns + 1 runs. A run that fails raises
     :class:`~daeclear.core.errors.SolveError`."""
     where = "gradient"
+    settings = SolverOptions(rtol=1e-8, atol=atol, start=start, backend=backend, quadrature_atol=quadrature_atol,
+                             where=where)  # checked before any work (rtol: below)
     if not isinstance(of, (Final, Integral, Peak, EventTime)):
         options.fail(where, "of", of, "an objective: dc.Final, dc.Integral, dc.Peak or dc.EventTime")
     end = options.t_end(t_end, where=where)
@@ -67,7 +71,7 @@ def gradient(scene_or_model: Scene | DAEModel, t_end: float, *, of: Objective, p
     values = {name: parameter_value(model, name) for name in names}  # checks each name before any run
     times = _output_times(of, end, count)
 
-    settings = SolverOptions(rtol=tol, atol=atol, start=start, backend=backend)
+    settings = settings.replace(rtol=tol)
     save = SaveAt(times=times, steps=False)
 
     integrals = [of.channel] if isinstance(of, Integral) else None  # a quadrature state under error control
