@@ -2,6 +2,7 @@
 plain run, and the state's factorisation against the (1 + Ns) n reference, side by side in one process.
 
     python benchmarks/bench_sensitivity.py [--repeats 5] [--rtol 1e-6] [--times 0] [--cases slider-crank chain]
+        [--fresh-starts]
 
 Each call is a whole user call, set-up included (the Scene assembled, the sessions opened, the start's
 dy0/dp): ``simulate(scene, t_end, rtol=..., sensitivities=names)`` with Ns = 0 (the plain run), 1, 3 and
@@ -13,8 +14,13 @@ that every variant sees the same machine. Printed per case: the median and best 
 variant, its ratio to the plain run's median, and the reference's ratio to the state's factorisation; the
 same for the time inside IDA's advances (``stats["solve_time"]``: the integration of [y; S] in C, where the
 linear algebra is; the rest of a call is set-up, the jumps at events and the output rows, in Python).
+"NaN S rows": the share of the first call's output rows whose S is NaN (from a grazing event on: the run
+goes on, those columns are integrated but mean nothing; docs/sensitivities.md, section 4).
 ``--times 0`` (the default): every step an output row, as ``simulate``'s default ``SaveAt``; ``--times N``:
-N output times (fewer rows: what each row costs beside the integration shows).
+N output times (fewer rows: what each row costs beside the integration shows). ``--fresh-starts``: the
+structure's kept starts dropped before every call (plain and with sensitivities alike), as a call with new
+parameter values (a sweep, a gradient's next point) finds them: each start, and the moved models' starts
+of dy0/dp where they are differenced, assembled again.
 
 Cases: the chapter's slider-crank (Fig. 4.15: revolute clearance, c = 0.5 mm, GGL; its first 2 ms, the
 impacts of the start) and a driven chain of 10 links with a clearance at every pin
@@ -54,9 +60,12 @@ WIDTHS = (1, 3, 5)
 
 
 def call(scene: dc.Scene, t_end: float, rtol: float, names: list[str] | None, reference: bool,
-         times: int) -> tuple[float, int, float]:
-    """One whole simulate call: its wall time, the IDA steps and the time inside IDA's advances."""
+         times: int, fresh: bool = False) -> tuple[float, int, float, float]:
+    """One whole simulate call: its wall time, the IDA steps, the time inside IDA's advances and the share of
+    its S rows that are NaN (a grazing event's; ``fresh``: the kept starts dropped first)."""
     save = dc.SaveAt() if times == 0 else dc.SaveAt(times=np.linspace(0.0, t_end, times), steps=False)
+    if fresh:
+        dc.assemble(scene).structure.starts.clear()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", dc.DaeclearWarning)
         start = time.perf_counter()
@@ -68,38 +77,44 @@ def call(scene: dc.Scene, t_end: float, rtol: float, names: list[str] | None, re
         wall = time.perf_counter() - start
     if not result.success:
         raise SystemExit(f"bench_sensitivity: a run failed: {result.message}")
-    return wall, int(result.stats["n_steps"]), float(result.stats["solve_time"])
+    S = None if result.sensitivities is None else np.asarray(result.sensitivities.states)
+    nan = 0.0 if S is None else float(np.isnan(S).any(axis=(1, 2)).mean())
+    return wall, int(result.stats["n_steps"]), float(result.stats["solve_time"]), nan
 
 
-def bench(case: str, repeats: int, rtol: float, times: int) -> None:
+def bench(case: str, repeats: int, rtol: float, times: int, fresh: bool = False) -> None:
     """Every variant of one case, interleaved; the table of medians, bests and ratios."""
     make, t_end, names = CASES[case]
     scene = make()
     variants: list[tuple[str, list[str] | None, bool]] = [("plain", None, False)]
     for k in WIDTHS:
         variants += [(f"Ns={k} state", names[:k], False), (f"Ns={k} stacked", names[:k], True)]
-    steps = {label: call(scene, t_end, rtol, sens, ref, times)[1] for label, sens, ref in variants}  # compiles
+    first = {label: call(scene, t_end, rtol, sens, ref, times) for label, sens, ref in variants}  # compiles
+    steps = {label: c[1] for label, c in first.items()}
     walls: dict[str, list[float]] = {label: [] for label, _, _ in variants}
     solves: dict[str, list[float]] = {label: [] for label, _, _ in variants}
     for r in range(repeats):
         order = variants[r % len(variants):] + variants[:r % len(variants)]
         for label, sens, ref in order:
-            wall, _, solve = call(scene, t_end, rtol, sens, ref, times)
+            wall, _, solve, _ = call(scene, t_end, rtol, sens, ref, times, fresh)
             walls[label].append(wall)
             solves[label].append(solve)
     med = {label: statistics.median(w) for label, w in walls.items()}
     ida = {label: statistics.median(w) for label, w in solves.items()}
     rows = "every step" if times == 0 else f"{times} output times"
-    print(f"\n{case}: t_end {t_end * 1e3:g} ms, rtol {rtol:g}, {rows}, {repeats} rounds (shared machine: ratios only)")
+    starts = ", fresh starts" if fresh else ""
+    print(f"\n{case}: t_end {t_end * 1e3:g} ms, rtol {rtol:g}, {rows}{starts}, {repeats} rounds (shared machine: "
+          "ratios only)")
     print(f"{'variant':<16} {'median s':>9} {'best s':>9} {'/ plain':>8} {'steps':>7} {'stacked/state':>14} "
-          f"{'IDA s':>8} {'IDA / plain':>12} {'IDA stacked/state':>18}")
+          f"{'IDA s':>8} {'IDA / plain':>12} {'IDA stacked/state':>18} {'NaN S rows':>11}")
     for label, _, _ in variants:
         other = label.replace("stacked", "state")
         stacked = label.endswith("stacked")
         vs = f"{med[label] / med[other]:14.2f}" if stacked else " " * 14
-        ida_vs = f"{ida[label] / ida[other]:18.2f}" if stacked else ""
+        ida_vs = f"{ida[label] / ida[other]:18.2f}" if stacked else " " * 18
         print(f"{label:<16} {med[label]:9.4f} {min(walls[label]):9.4f} {med[label] / med['plain']:8.2f} "
-              f"{steps[label]:7d} {vs} {ida[label]:8.4f} {ida[label] / ida['plain']:12.2f} {ida_vs}")
+              f"{steps[label]:7d} {vs} {ida[label]:8.4f} {ida[label] / ida['plain']:12.2f} {ida_vs} "
+              f"{first[label][3]:11.2f}")
 
 
 def main() -> None:
@@ -108,6 +123,7 @@ def main() -> None:
     parser.add_argument("--rtol", type=float, default=1e-6)
     parser.add_argument("--times", type=int, default=0)
     parser.add_argument("--cases", nargs="+", choices=sorted(CASES), default=list(CASES))
+    parser.add_argument("--fresh-starts", action="store_true", help="drop the kept starts before every call")
     parser.add_argument("--table", action="store_true", help="the issue's table against central differences")
     parser.add_argument("--accuracy", type=float, default=1e-3, help="--table: the error both methods reach")
     parser.add_argument("--widths", type=int, nargs="+", default=list(bench_sensitivity_table.WIDTHS))
@@ -125,7 +141,7 @@ def main() -> None:
             bench_sensitivity_table.table(case, sorted(set(args.widths)), args.accuracy, args.repeats)
         return
     for case in args.cases:
-        bench(case, args.repeats, args.rtol, args.times)
+        bench(case, args.repeats, args.rtol, args.times, args.fresh_starts)
 
 
 if __name__ == "__main__":

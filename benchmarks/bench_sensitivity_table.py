@@ -6,7 +6,8 @@ sensitivities at ``REFERENCE_RTOL``. An error is then the largest relative sensi
 |S_ij - S_ref,ij| |p_j| / scale_i (scale_i: the state's largest magnitude over the reference run's rows), over
 the same of S_ref, for each parameter j, and the largest over j: the error relative to the response's largest
 amplification of a relative change of that parameter. Equal accuracy: each method's cheapest setting whose error
-for the first Ns parameters is below ``accuracy``: the sensitivities' loosest rtol of ``SENSITIVITY_RTOLS``;
+for the first Ns parameters is below ``accuracy``: the sensitivities' loosest rtol of ``SENSITIVITY_RTOLS``, with S
+in IDA's error test (the default) and out of it (``SolverOptions(sensitivity_error_test=False)``), each reported;
 central differences' loosest rtol of ``FD_RTOLS`` with any relative step h of ``FD_STEPS`` (p +- h |p|, |p| = 1
 at 0). Then ``repeats`` rounds time, interleaved, whole ``simulate`` calls on the assembled model (sessions
 opened, dy0/dp, the jumps and the output rows included; the libraries compiled in an untimed first call): the
@@ -47,14 +48,16 @@ FD_STEPS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 
 
 def final(model: dc.DAEModel, t_end: float, rtol: float, names: list[str] | None,
-          times: int = 2, may_fail: bool = False) -> tuple[dc.Result, float]:
-    """One whole simulate call and its wall time (a failed run: SystemExit, or returned with ``may_fail``)."""
+          times: int = 2, may_fail: bool = False, tested: bool = True) -> tuple[dc.Result, float]:
+    """One whole simulate call and its wall time (a failed run: SystemExit, or returned with ``may_fail``);
+    ``tested=False``: S out of IDA's error test (``SolverOptions(sensitivity_error_test=False)``)."""
+    options = None if tested else dc.SolverOptions(sensitivity_error_test=False)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", dc.DaeclearWarning)
         start = time.perf_counter()
         result = dc.simulate(model, t_end, rtol=rtol, save=dc.SaveAt(times=np.linspace(0.0, t_end, times),
                                                                     steps=False), sensitivities=names,
-                             on_failure="return")
+                             on_failure="return", options=options)
         wall = time.perf_counter() - start
     if not result.success and not may_fail:
         raise SystemExit(f"bench_sensitivity --table: a run failed: {result.message}")
@@ -107,39 +110,51 @@ def table(case: str, widths: list[int], accuracy: float, repeats: int) -> None:
     model = make()
     errors = Errors(model, t_end, names)
     top = max(widths)
-    sens_err = {}
+    sens_err: dict[tuple[float, bool], np.ndarray] = {}
     for rtol in SENSITIVITY_RTOLS:  # a run that fails at a loose rtol reaches nothing: error inf
-        result = final(model, t_end, rtol, names[:top], may_fail=True)[0]
-        sens_err[rtol] = end_sensitivities(result, errors.n) if result.success else np.full((errors.n, top), np.nan)
+        for tested in (True, False):
+            result = final(model, t_end, rtol, names[:top], may_fail=True, tested=tested)[0]
+            sens_err[rtol, tested] = (end_sensitivities(result, errors.n) if result.success
+                                      else np.full((errors.n, top), np.nan))
     fd = {(rtol, h): fd_derivatives(model, t_end, names[:top], rtol, h, errors.n)
           for rtol in FD_RTOLS for h in FD_STEPS}
     print(f"\n{case}: t_end {t_end * 1e3:g} ms, accuracy {accuracy:g} (against S at rtol {REFERENCE_RTOL:g}), "
-          f"{repeats} rounds, medians (shared machine: ratios only)")
-    print(f"{'Ns':>3} {'rtol':>7} {'error':>8} {'plain s':>9} {'sens s':>9} {'/ plain':>8} {'1+Ns/2':>7} "
+          f"{repeats} rounds, medians (shared machine: ratios only); S test: S in IDA's error test (the default) "
+          "or out (SolverOptions(sensitivity_error_test=False)); / plain: against the plain run at the same rtol")
+    print(f"{'Ns':>3} {'S test':>6} {'rtol':>7} {'error':>8} {'plain s':>9} {'sens s':>9} {'/ plain':>8} {'1+Ns/2':>7} "
           f"{'fd rtol':>8} {'fd h':>6} {'fd error':>9} {'fd s':>9} {'fd / sens':>10}")
     for width in widths:
-        s_rtol = next((r for r in SENSITIVITY_RTOLS if errors.of(sens_err[r], width) <= accuracy), None)
+        picks = {tested: next((r for r in SENSITIVITY_RTOLS if errors.of(sens_err[r, tested], width) <= accuracy),
+                              None) for tested in (True, False)}
         fd_pick = next(((r, h) for r in FD_RTOLS for h in FD_STEPS if errors.of(fd[r, h], width) <= accuracy), None)
-        if s_rtol is None:
-            print(f"{width:3d} sensitivities do not reach {accuracy:g} at rtol {SENSITIVITY_RTOLS[-1]:g}")
-            continue
         chosen = names[:width]
-        final(model, t_end, s_rtol, chosen)  # compiles this width's library: untimed
-        walls: dict[str, list[float]] = {"plain": [], "sens": [], "fd": []}
-        for _ in range(repeats):
-            walls["plain"].append(final(model, t_end, s_rtol, None)[1])
-            walls["sens"].append(final(model, t_end, s_rtol, chosen)[1])
+        for tested, pick in picks.items():
+            if pick is not None:
+                final(model, t_end, pick, chosen, tested=tested)  # compiles this width's library: untimed
+        walls: dict[tuple[str, object], list[float]] = {("fd", None): []}
+        walls.update({key: [] for tested, pick in picks.items() for key in (("plain", pick), ("sens", tested))})
+        for _ in range(repeats):  # interleaved: the plain run at each pick's rtol, each pick, central differences
+            for tested, pick in picks.items():
+                if pick is not None:
+                    walls["plain", pick].append(final(model, t_end, pick, None)[1])
+                    walls["sens", tested].append(final(model, t_end, pick, chosen, tested=tested)[1])
             if fd_pick is not None:
                 start = time.perf_counter()
                 final(model, t_end, fd_pick[0], None)
                 fd_derivatives(model, t_end, chosen, fd_pick[0], fd_pick[1], errors.n)
-                walls["fd"].append(time.perf_counter() - start)
-        plain, sens = statistics.median(walls["plain"]), statistics.median(walls["sens"])
-        row = (f"{width:3d} {s_rtol:7.0e} {errors.of(sens_err[s_rtol], width):8.1e} {plain:9.4f} {sens:9.4f} "
-               f"{sens / plain:8.1f} {1 + 0.5 * width:7.1f}")
-        if fd_pick is None:
-            print(f"{row} {'central differences do not reach it':>45}")
-            continue
-        fd_s = statistics.median(walls["fd"])
-        print(f"{row} {fd_pick[0]:8.0e} {fd_pick[1]:6.0e} {errors.of(fd[fd_pick], width):9.1e} {fd_s:9.4f} "
-              f"{fd_s / sens:10.2f}")
+                walls["fd", None].append(time.perf_counter() - start)
+        for tested, pick in picks.items():
+            label = "in" if tested else "out"
+            if pick is None:
+                print(f"{width:3d} {label:>6} sensitivities do not reach {accuracy:g} at rtol "
+                      f"{SENSITIVITY_RTOLS[-1]:g}")
+                continue
+            plain, sens = statistics.median(walls["plain", pick]), statistics.median(walls["sens", tested])
+            row = (f"{width:3d} {label:>6} {pick:7.0e} {errors.of(sens_err[pick, tested], width):8.1e} {plain:9.4f} "
+                   f"{sens:9.4f} {sens / plain:8.1f} {1 + 0.5 * width:7.1f}")
+            if fd_pick is None:
+                print(f"{row} {'central differences do not reach it':>45}")
+                continue
+            fd_s = statistics.median(walls["fd", None])
+            print(f"{row} {fd_pick[0]:8.0e} {fd_pick[1]:6.0e} {errors.of(fd[fd_pick], width):9.1e} {fd_s:9.4f} "
+                  f"{fd_s / sens:10.2f}")

@@ -249,3 +249,40 @@ def test_face_and_film_rules_of_the_latched_sensitivities() -> None:
     assert lub.event_roots("bearing.regime", found) == [lub.first_root + 1]
     assert lub.event_roots("bearing", found) == []
     assert (lub.rate_output, lub.rate_index(lub.first_root + 2)) == (3, 0)
+
+
+START_MOVERS = ["drive.speed", "B.s_i[0]", "A.s_j[0]", "clearance.s_i[1]", "D.s_i[1]", "rod.mass",
+                "clearance.clearance"]
+
+
+@pytest.mark.parametrize("formulation", ["index1", "ggl"])
+def test_constrained_start_sensitivities_against_differences(formulation, index1, ggl) -> None:
+    """The chapter's start of the slider-crank is fixed by its constraints (9 of them, 9 coordinates): its
+    dy0/dp from the differentiated constraints equals the central differences of moved starts it replaces, for
+    the drive's speed, joint offsets and the crank's length (which move it) and a mass and the clearance
+    (which do not: exactly 0, the ideal start centres the journal)."""
+    model = ggl if formulation == "ggl" else index1
+    S = ModelSensitivity(model, START_MOVERS).constrained_start()
+    assert S is not None
+    want = initial_sensitivities(model, START_MOVERS)
+    n = 2 * model.n_q
+    for j, name in enumerate(START_MOVERS):
+        scale = np.abs(want[:n, j]).max()
+        assert np.abs(S[:n, j] - want[:n, j]).max() <= 1e-9 * max(scale, 1.0), name
+    assert np.all(S[:, -2:] == 0.0) and np.all(S[n:] == 0.0)
+    w = model.parameter("drive.speed")[0]
+    y0 = model.initial_state()[0]
+    assert S[model.n_q:n, 0] == pytest.approx(y0[model.n_q:n] / w, rel=1e-12, abs=1e-15)  # v0 proportional to w
+
+
+def test_start_sensitivities_difference_a_start_its_constraints_do_not_fix() -> None:
+    """An open chain (21 constraints, 30 coordinates) and a declared start: no constrained derivative; the
+    run's dy0/dp is then the central differences'."""
+    chain = dc.assemble(dc.mechanisms.chain(3, rpm=300.0))
+    names = ["pin2.clearance", "link2.mass"]
+    ms = ModelSensitivity(chain, names)
+    assert len(chain.start_constraint_names) < chain.n_q and ms.constrained_start() is None
+    np.testing.assert_array_equal(ms.start(), initial_sensitivities(chain, names))
+    crank = dc.assemble(dc.mechanisms.slider_crank("revolute"))
+    np.testing.assert_array_equal(ModelSensitivity(crank, ["drive.speed"]).start("declared"),
+                                  initial_sensitivities(crank, ["drive.speed"], start="declared"))

@@ -24,7 +24,8 @@ from numpy.typing import NDArray
 from ..core.errors import SceneError
 from ..core.options import close_matches
 from ..engine.sensitivity_functions import SensitivityFunctions, directional, jacobian_blocks
-from .dae_model import EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_TERM0, DAEModel
+from .dae_model import (EXTRA_ACCEL, EXTRA_KINEMATICS, EXTRA_OUTPUTS, EXTRA_START_KINEMATICS, EXTRA_TERM0, RANK_TOL,
+                        DAEModel)
 
 __all__ = ["parameter_value", "moved_parameter", "table_entry", "parameter_directions", "initial_sensitivities",
            "model_sensitivity_functions",
@@ -260,7 +261,8 @@ class ModelSensitivity:
     #: S): in a stacked session they follow the model's extras in this order (``stacked_extras``).
     @staticmethod
     def row_derivatives(model: DAEModel) -> tuple[int, ...]:
-        return (EXTRA_ACCEL, *(EXTRA_TERM0 + k for k in range(len(model.terms))), EXTRA_OUTPUTS, EXTRA_KINEMATICS)
+        return (EXTRA_ACCEL, *(EXTRA_TERM0 + k for k in range(len(model.terms))), EXTRA_OUTPUTS, EXTRA_KINEMATICS,
+                EXTRA_START_KINEMATICS)
 
     def __init__(self, model: DAEModel, names: Sequence[str]) -> None:
         self.model = model
@@ -371,6 +373,45 @@ class ModelSensitivity:
                 for x in (*values, *seeds)]  # column-major per point, as CasADi's matrices
         out = self.session.eval_extra(index, flat, N)
         return out.reshape(N, self.width, -1).transpose(0, 2, 1)
+
+    def start(self, start: str = "ideal", allow_penetration: bool = False) -> NDArray[np.float64]:
+        """dy0/dp of the start ``model.initial_state(start=...)``, (n_states, Ns): :meth:`constrained_start`
+        where the start's constraints fix it, else :func:`initial_sensitivities` (central differences of the
+        moved models' starts)."""
+        S0 = self.constrained_start(allow_penetration) if start == "ideal" else None
+        if S0 is None:
+            return initial_sensitivities(self.model, self.names, start, allow_penetration, self.moved)
+        return S0
+
+    def constrained_start(self, allow_penetration: bool = False) -> NDArray[np.float64] | None:
+        """dy0/dp of the chapter's start (``start="ideal"``) where its constraints fix it: as many independent
+        constraints (the clearance joints ideal) as coordinates. Then the assembled q solves Phi(q, P) = 0 and
+        v solves Phi_q v + Phi_t = 0 whatever the guess, and differentiating them,
+
+            Phi_q S_q = -Phi_P dP,    Phi_q S_v = -(d(Phi_q v + Phi_t)/dq S_q + d(Phi_q v + Phi_t)/dP dP)
+
+        (one directional derivative of the start's kinematics each). None where they do not fix it (fewer
+        constraints than coordinates: an open chain; or dependent ones): the start is then the end of the
+        Newton path from the guess, differenced instead. The multipliers' rows are 0: made consistent after."""
+        model, W = self.model, self.width
+        n, m = model.n_q, len(model.start_constraint_names)
+        if m != n or n == 0:
+            return None
+        with warnings.catch_warnings():  # the run's own start (kept by the structure); its notes were given
+            warnings.simplefilter("ignore")
+            y0 = model.initial_state(start="ideal", allow_penetration=allow_penetration)[0]
+        q, v, t = y0[None, :n], y0[None, n:2 * n], np.zeros(1)
+        Phi_q = model.constraints(q[0], v[0], 0.0, self.session, ideal=True)[1]
+        singular = np.linalg.svd(Phi_q, compute_uv=False)
+        if not singular[-1] > RANK_TOL * singular[0]:
+            return None
+        zero, zero_t = np.zeros((1, n, W)), Shared(np.zeros((1, W)))
+        S = np.zeros((model.n_states, W))
+        d_P = self.derivative(EXTRA_START_KINEMATICS, 1, [q, v, t], [zero, zero, zero_t])[0]  # along dP: Phi_P dP
+        S[:n] = -np.linalg.solve(Phi_q, d_P[:m])
+        d_qP = self.derivative(EXTRA_START_KINEMATICS, 1, [q, v, t], [S[None, :n], zero, zero_t])[0]
+        S[n:2 * n] = -np.linalg.solve(Phi_q, d_qP[m + m * n:])  # along (S_q, dP): d(Phi_q v + Phi_t)
+        return S
 
     def projected(self, t: float, y: NDArray, S: NDArray) -> NDArray[np.float64]:
         """S with S_q and S_v moved (least norm) onto the linearised constraints, d Phi = Phi_q S_q + Phi_P dP

@@ -32,7 +32,7 @@ from ..core.events import ContactEvent, EventRows
 from ..core.progress import Progress
 from ..engine.abi import DC_EV_CONTACT, DC_EV_HELD, DC_EV_KIND
 from ..engine.session_base import Advance, AutoEvents, Session
-from .integrator import Carried, Driven, Integrator, Jump, Terms, auto_pairs
+from .integrator import Carried, Driven, Integrator, Jump, RootEvaluator, Terms, auto_pairs
 from .recorder import Recorder, out_of_memory
 from .tolerances import atol_record
 from ..results.result import Result
@@ -129,20 +129,23 @@ def consistent_restart(model: DAEModel, integrator: Integrator, t: float, y: NDA
     for the switches it decides itself. The flag: whether the state was projected (sensitivities follow it)."""
     if model.formulation != "ggl":
         return (*integrator.consistent(t, y, terms), False)
-    session, extras = integrator.session, integrator.extras
+    extras = integrator.extras
     forces = model.term_forces(t, y, terms.active, terms.params, extras)
     projected = model.consistent_state(t, y, forces, extras, project=True)
     if not model.gap_names:
         return (*projected, True)
-    g0, g1 = _roots(model, session, t, y, yp), _roots(model, session, t, projected[0], yp)
-    quiet = np.zeros(g0.shape, bool) if found is None else np.asarray(found).ravel()[:g0.size] == 0  # kinks after
+    roots = integrator.root_evaluator
+    g0, g1 = _roots(model, roots, t, y, yp), _roots(model, roots, t, projected[0], yp)
+    # found: the gaps, then (a run with sensitivities) its kinks, which the stacked session's roots hold too
+    quiet = np.zeros(g0.shape, bool) if found is None else np.asarray(found).ravel()[:g0.size] == 0
     if np.any(quiet & (g0 != 0) & ((g0 > 0) != (g1 > 0))):
         return (*model.consistent_state(t, y, forces, extras, project=False), False)
     return (*projected, True)
 
 
-def _roots(model: DAEModel, session: Session | None, t: float, y: NDArray, yp: NDArray) -> NDArray:
-    """The root functions at one point: in the session's library, else CasADi's."""
+def _roots(model: DAEModel, session: RootEvaluator | None, t: float, y: NDArray, yp: NDArray) -> NDArray:
+    """The root functions at one point: in the integrator's library (:attr:`Integrator.root_evaluator`), else
+    CasADi's."""
     if session is not None:
         return session.roots(t, y, yp)
     roots = model.functions.roots

@@ -81,6 +81,11 @@ class IDAIntegrator:
         """The session evaluates the model's extras."""
         return self.session
 
+    @property
+    def root_evaluator(self) -> Session:
+        """The session evaluates the model's roots."""
+        return self.session
+
     def __init__(self, model: DAEModel, t_end: float, output: Output, settings: SolverOptions) -> None:
         rtol = settings.rtol
         self.model, self.t_end, self.times, self.store_steps = model, t_end, output.times, output.steps

@@ -113,6 +113,15 @@ def auto_pairs(model: DAEModel) -> list[AutoPair]:
             for root, term, _, needs, _ in model.auto_pairs]
 
 
+class RootEvaluator(Protocol):
+    """Evaluates the model's root functions at one point in C (a session, or the stacked session of a run
+    with sensitivities through its states' rows)."""
+
+    def roots(self, t: float, y: NDArray, yp: NDArray) -> NDArray:
+        """The root functions at (t, y, yp) of the model's state y."""
+        ...
+
+
 class Integrator(Protocol):
     """An integrator of one run (made by :meth:`Driven.integrator`), between restarts.
 
@@ -132,6 +141,12 @@ class Integrator(Protocol):
     @property
     def session(self) -> Session | None:
         """The run's open IDA session (the model's functions in C for the checks and restarts), or None."""
+        ...
+
+    @property
+    def root_evaluator(self) -> RootEvaluator | None:
+        """What evaluates the model's roots in C at the driver's restarts: the session, or (a run with
+        sensitivities) the stacked session through its states' rows; None: CasADi's."""
         ...
 
     @property

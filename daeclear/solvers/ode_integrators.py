@@ -56,6 +56,7 @@ class ODEIntegrator:
     resumes_at_roots = False
     decides = False
     session = None
+    root_evaluator = None  # the driver's restarts evaluate the roots in CasADi
     extras = None
     fixed_step: float | None = None
     takes_jacobian = False  # the scheme takes the generated Jacobian

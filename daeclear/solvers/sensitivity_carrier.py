@@ -120,6 +120,25 @@ class SensitivityCarrier:
             out[term] = out.get(term, 0) + int(positive)
         return out
 
+    def restarted(self, t: float, y: NDArray, S: NDArray, Sp: NDArray, bad: NDArray) -> tuple[NDArray, NDArray]:
+        """(S, S') with the ``bad`` columns (poisoned: reported NaN from here on) restarted from S_q = S_v = 0
+        (GGL: moved onto the linearised constraints) and no latched sensitivity, their multipliers' and
+        derivatives' sensitivities consistent with that (the response to dP from here on): zeros alone are no
+        solution of F_y S + F_y' S' + F_P dP = 0 where F_P dP is not zero (a driven joint's speed), and IDA's
+        error test then fails at every step size (docs/sensitivities.md, section 4)."""
+        for per_pair in self.latched:
+            for value in per_pair:
+                value[bad] = 0.0
+        self.S_params = self.term_sensitivities(self.state, self.latched)
+        S = S.copy()
+        S[:, bad] = 0.0
+        if self.model.formulation == "ggl":
+            S[:, bad] = self.ms.projected(t, y, S)[:, bad]
+        S_zero, Sp_zero = self.ms.consistent(t, y, S, self.active, self.params, self.S_params)
+        Sp = Sp.copy()
+        S[:, bad], Sp[:, bad] = S_zero[:, bad], Sp_zero[:, bad]
+        return S, Sp
+
     def term_sensitivities(self, state: contact_state.ContactState, latched: list[list[NDArray]]) -> list[NDArray]:
         """Each term's parameters' sensitivity (n_params_k, Ns) in ``state``, from the pairs' ``latched``."""
         out = [np.zeros((term.n_params, self.width)) for term in self.model.terms]
@@ -196,12 +215,27 @@ class SensitivityCarrier:
         in the current mode (nothing poisoned)."""
         y_c, yp, S_c, Sp, channel_S, values = (a[0] for a in self.evaluate_rows(np.array([t], dtype=float), y[None],
                                                                                  S[None]))
-        S_row, channel_row = S_c.copy(), channel_S.copy()
+        self.keep_event_row(t, y_c, S_c, channel_S, values)
+        return y_c, yp, S_c, Sp
+
+    def consistent_event_row(self, t: float, y: NDArray, yp: NDArray, S: NDArray, Sp: NDArray) -> None:
+        """:meth:`event_row` of a point already consistent in the current mode (``y``, ``yp`` of
+        :meth:`DAEModel.consistent_state`, ``S``, ``Sp`` of :meth:`ModelSensitivity.consistent`): the
+        channels and their sensitivities only."""
+        ms, model = self.ms, self.model
+        T = np.array([t], dtype=float)
+        switch = model.switch_vector(self.active, self.params)
+        channel_S = ms.channels_rows(T, y[None], yp[None], S[None], Sp[None], switch,
+                                     ms.switch_sensitivity(self.S_params))[0]
+        self.keep_event_row(t, y, S, channel_S, ms.outputs_rows(T, y[None], yp[None], switch)[0])
+
+    def keep_event_row(self, t: float, y: NDArray, S: NDArray, channel_S: NDArray, values: NDArray) -> None:
+        """Keep an event's row (y, S, the channels' S and values; S's NaN where poisoned)."""
+        S_row, channel_row = S.copy(), channel_S.copy()
         S_row[:, self.poisoned] = np.nan
         channel_row[:, self.poisoned] = np.nan
-        self.event_rows.append((y_c, S_row, channel_row, values))
+        self.event_rows.append((y, S_row, channel_row, values))
         self.event_t.append(t)
-        return y_c, yp, S_c, Sp
 
     def jump(self, t: float, y: NDArray, S: NDArray, found: NDArray | None, new_state: contact_state.ContactState,
              events: Sequence[ContactEvent], y_p: NDArray, projected: bool) -> None:
@@ -212,7 +246,7 @@ class SensitivityCarrier:
         y_m, yp_m, S_m, Sp_m = self.event_row(t, y, S)
         new_active, new_params = contact_state.switches(model, new_state)
         session = ms.session
-        yp_p = model.consistent_state(t, y_p, model.term_forces(t, y_p, new_active, new_params, session), session)[1]
+        y_c, yp_p = model.consistent_state(t, y_p, model.term_forces(t, y_p, new_active, new_params, session), session)
         new_latched = [[value.copy() for value in per_pair] for per_pair in self.latched]
         dt_dps: list[NDArray] = []
         if events and found is not None:
@@ -258,12 +292,12 @@ class SensitivityCarrier:
                 t + s, y_p + s * yp_p, S_p, self.active, self.params, self.S_params)), t))
         else:
             S_p, Sp_p = ms.consistent(t, y_p, S_p, self.active, self.params, self.S_params)
-        self.poisoned |= ~np.all(np.isfinite(S_p), axis=0)
-        S_p[:, self.poisoned] = 0.0  # integrated as zeros, reported as NaN
-        Sp_p[:, self.poisoned] = 0.0
+        bad = ~np.all(np.isfinite(S_p), axis=0)  # NaN from this event (a poisoned column's S is finite until then)
         for per_pair in self.latched:
             for value in per_pair:
-                value[self.poisoned] = 0.0
-        self.S_params = self.term_sensitivities(self.state, self.latched)
+                bad |= ~np.isfinite(value)
+        self.poisoned |= bad
+        if bad.any():
+            S_p, Sp_p = self.restarted(t, y_p, S_p, Sp_p, bad)
         self.S, self.Sp = S_p, Sp_p
-        self.event_row(t, y_p, S_p.copy())
+        self.consistent_event_row(t, y_c, yp_p, S_p, Sp_p)  # y_c: y_p with its multipliers of this mode

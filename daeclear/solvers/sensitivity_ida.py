@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from ..assembly.contact_state import ContactState
 from ..assembly.dae_model import DAEModel
-from ..assembly.sensitivity import initial_sensitivities, parameter_value
+from ..assembly.sensitivity import parameter_value
 from ..core.errors import SceneError
 from ..core.automaton import PairState
 from ..engine.compiled import CompiledDAE
@@ -75,6 +75,21 @@ def stacked_reference() -> Iterator[None]:
         yield
     finally:
         SensitivityIntegrator.stacked_factorisation = before
+
+
+class StackedRoots:
+    """The model's roots at a point of its state y in the stacked session's C: its roots are those of y
+    (:func:`~daeclear.engine.sensitivity_functions.augmented_functions`), so S's rows are given as zeros."""
+
+    def __init__(self, stacked: Session, n: int, size: int) -> None:
+        self.stacked = stacked
+        self.Y, self.Yp = np.zeros(size), np.zeros(size)  # y in the first n of the stacked session's size rows
+        self.n = n
+
+    def roots(self, t: float, y: NDArray, yp: NDArray) -> NDArray:
+        """The model's root functions at (t, y, yp)."""
+        self.Y[:self.n], self.Yp[:self.n] = y, yp
+        return self.stacked.roots(t, self.Y, self.Yp)
 
 
 class SensitivityIntegrator:
@@ -142,15 +157,15 @@ class SensitivityIntegrator:
             raise
         self.backend = self.stacked.backend
         self.extras = self.stacked  # its extras begin with the model's (stacked_extras): the driver's restarts
+        self.root_evaluator = StackedRoots(self.stacked, model.n_states, self.n_block * (1 + W))
         self.missed: list[tuple[float, float, str]] = []
         self.i_eval = 0
         self.t_start = 0.0
 
     def start(self, t: float, y: NDArray, yp: NDArray, terms: Terms, state: ContactState) -> None:
         """S at the start (dy0/dp of the run's start), consistent in the start's mode; IDA started."""
-        settings, model = self.settings, self.model
-        S0 = initial_sensitivities(model, self.sens.names, settings.start, settings.allow_penetration,
-                                   self.sens.ms.moved)
+        settings = self.settings
+        S0 = self.sens.ms.start(settings.start, settings.allow_penetration)
         self.sens.start(t, y, yp, state, S0)
         self.t_start = t
         if self.times is None or self.times.window(0, 1)[0] == t:  # the driver reports the start point
