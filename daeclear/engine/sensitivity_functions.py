@@ -250,7 +250,9 @@ def augmented_functions(funcs: DAEFunctions, width: int, coupled: bool = False, 
         else:  # the piece is a constant: its seed 0
             dlk = directional(_with_parameters(lk, 4, n_P), width, (1, 2, 3, 4), f"sens_term{k}_locked")
             dk = dlk(t, y, yp, pa[:npk + 1], P, S, Sp, casadi.vertcat(Sk, casadi.DM.zeros(1, width)), dP)
-        rk = stacked(fk(t, y, yp, pa[:npk], P), dk)
+        # y's rows on the piece too: the whole residual smooth within a segment (the piece is the law there)
+        yk = fk(t, y, yp, pa[:npk], P) if lk is None else _with_parameters(lk, 4, n_P)(t, y, yp, pa[:npk + 1], P)
+        rk = stacked(yk, dk)
         term_res.append(casadi.Function(f"term{k}_res", [t, Y, Yp, pa, PA], [rk], ["t", "y", "yp", "p", "P"], ["r"]))
         term_jac.append(casadi.Function(f"term{k}_jac", [t, Y, Yp, pa, cj, PA], [jacobian(rk)],
                                         ["t", "y", "yp", "p", "cj", "P"], ["J"]))
