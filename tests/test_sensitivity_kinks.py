@@ -175,3 +175,12 @@ def test_fig415_with_friction_through_six_reversals() -> None:
         inside += e.kind == "kink" and contact
     assert inside >= 24 and inside == len(run.kinks) == run.result.stats["n_kinks"]
     assert np.all(np.isfinite(run.S[-1]))
+
+
+def test_fig415_with_friction_past_the_reversal_at_rtol_1e_12() -> None:
+    """With only S's rows on the law's piece (y's on the law itself) the run failed at the reversal at rtol 1e-12
+    (IDA_CONV_FAIL at 0.7255 ms): the whole term on the piece passes it."""
+    model = dc.assemble(dc.mechanisms.slider_crank("revolute", friction=0.05))
+    run = forward_sensitivities(model, 0.8e-3, FIG415[1:], rtol=1e-12, backend="c")
+    assert run.success, run.message
+    assert len(run.kinks) == 4 and all(0.7255e-3 < e.t < 0.7256e-3 for e in run.kinks)
