@@ -45,6 +45,29 @@ def plain_ida(monkeypatch: pytest.MonkeyPatch) -> str:
 
 
 @pytest.fixture
+def ctrl_c_at_update(monkeypatch: pytest.MonkeyPatch):
+    """``ctrl_c_at_update(n)``: the n-th progress update of a run raises KeyboardInterrupt (a Ctrl-C there);
+    returns the count of updates so far (a one-element list)."""
+    from daeclear.core.progress import Progress
+
+    original = Progress.update
+
+    def arm(n: int) -> list[int]:
+        calls = [0]
+
+        def update(self: Progress, t: float, note: str = "") -> None:
+            calls[0] += 1
+            if calls[0] == n:
+                raise KeyboardInterrupt
+            original(self, t, note)
+
+        monkeypatch.setattr(Progress, "update", update)
+        return calls
+
+    return arm
+
+
+@pytest.fixture
 def sigint_as_a_terminal_sends_it():
     """Ctrl-C handled as Python does at a terminal, also when the suite was started in the background
     (``cmd &`` in a script: SIGINT ignored, which the child processes of these tests would inherit)."""

@@ -32,28 +32,13 @@ T_END = 0.006
 pytestmark = pytest.mark.usefixtures("sigint_as_a_terminal_sends_it")  # tests/conftest.py
 
 @pytest.fixture
-def ctrl_c_after(monkeypatch):
-    """``ctrl_c_after(n)``: the n-th progress update of a run raises KeyboardInterrupt (a Ctrl-C there)."""
+def ctrl_c_after(monkeypatch, ctrl_c_at_update):
+    """``ctrl_c_after(n)``: the n-th progress update of a run raises KeyboardInterrupt (a Ctrl-C there), the
+    session's buffer small (64 steps) so that a short run flushes rows before it."""
     import daeclear.solvers.ida as solve
 
     monkeypatch.setattr(solve, "open_session", functools.partial(solve.open_session, buffer_steps=64))
-    from daeclear.core.progress import Progress
-
-    original = Progress.update
-
-    def arm(n: int) -> list[int]:
-        calls = [0]
-
-        def update(self, t, note=""):
-            calls[0] += 1
-            if calls[0] == n:
-                raise KeyboardInterrupt
-            return original(self, t, note)
-
-        monkeypatch.setattr(Progress, "update", update)
-        return calls
-
-    return arm
+    return ctrl_c_at_update
 
 
 def test_ctrl_c_stops_a_loop_of_runs_that_catches_failures(ctrl_c_after):

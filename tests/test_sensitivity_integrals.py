@@ -16,8 +16,7 @@ import numpy as np
 import pytest
 
 import daeclear as dc
-import daeclear.contact as dcc
-from test_sensitivity_objectives import M, NAMES, P0, T, U, complex_step, separation, x_integral
+from test_sensitivity_objectives import M, NAMES, P0, T, U, complex_step, radial_scene, separation, x_integral
 
 CHANNELS = ["journal.x", "clearance.normal_force"]
 TIMES = np.linspace(0.0, T, 26)
@@ -34,11 +33,7 @@ def run(scene: dc.Scene, save: dc.SaveAt, channels: list[str] = CHANNELS, rtol: 
 @pytest.fixture(scope="module")
 def scene() -> dc.Scene:
     """The radial impact of tests/test_sensitivity_objectives.py."""
-    scene = dc.Scene("radial", gravity=(0.0, 0.0))
-    journal = scene.add(dc.Body("journal", mass=M, inertia=1.0, velocity=(U, 0.0)))
-    scene.add(dc.RevoluteClearance("clearance", scene.ground, journal, at=(0, 0), bearing_radius=1.0,
-                                   clearance=P0[2], law=dcc.KelvinVoigt(stiffness=P0[0], damping=P0[1])))
-    return scene
+    return radial_scene()
 
 
 @pytest.fixture(scope="module")
@@ -146,21 +141,11 @@ def test_a_tighter_quadrature_atol_tightens_the_integral(scene: dc.Scene) -> Non
 
 
 def test_an_interrupted_streamed_run_keeps_its_integrals(scene: dc.Scene, memory: dc.Result, tmp_path: Path,
-                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+                                                         ctrl_c_at_update) -> None:
     """Ctrl-C at the progress line's second update (the run restarts at each of its two events): the file holds
     the rows before it with their integrals, the complete run's, and the Interrupted's result is the file's."""
     from daeclear.core.errors import Interrupted
-    from daeclear.core.progress import Progress
-
-    calls, original = [0], Progress.update
-
-    def update(self: Progress, t: float, note: str = "") -> None:
-        calls[0] += 1
-        if calls[0] == 2:
-            raise KeyboardInterrupt
-        original(self, t, note)
-
-    monkeypatch.setattr(Progress, "update", update)
+    ctrl_c_at_update(2)
     with pytest.raises(Interrupted) as info:
         run(scene, dc.SaveAt(times=TIMES, steps=False, stream_to=tmp_path / "run.h5"))
     partial = dc.load(tmp_path / "run.h5")

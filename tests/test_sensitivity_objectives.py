@@ -71,13 +71,18 @@ def complex_step(f, p: np.ndarray) -> np.ndarray:
     return np.stack([np.imag(f(p + 1j * steps[j] * np.eye(p.size)[j])) / steps[j] for j in range(p.size)], axis=1)
 
 
-@pytest.fixture(scope="module")
-def scene() -> dc.Scene:
+def radial_scene() -> dc.Scene:
+    """Issue 43's radial impact: a free journal from the bearing's centre at U along x, Kelvin-Voigt (P0)."""
     scene = dc.Scene("radial", gravity=(0.0, 0.0))
     journal = scene.add(dc.Body("journal", mass=M, inertia=1.0, velocity=(U, 0.0)))
     scene.add(dc.RevoluteClearance("clearance", scene.ground, journal, at=(0, 0), bearing_radius=1.0,
                                    clearance=P0[2], law=dcc.KelvinVoigt(stiffness=P0[0], damping=P0[1])))
     return scene
+
+
+@pytest.fixture(scope="module")
+def scene() -> dc.Scene:
+    return radial_scene()
 
 
 def grad(scene: dc.Scene, of: object, **kw: object) -> Gradient:

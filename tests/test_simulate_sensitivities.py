@@ -147,24 +147,14 @@ def test_a_streamed_run_writes_them_as_it_goes(kv_model, tmp_path: Path) -> None
     _same_sensitivities(memory, dc.load(tmp_path / "alone.h5"))
 
 
-def test_an_interrupted_streamed_run_keeps_what_it_computed(kv_model, tmp_path: Path,
-                                                           monkeypatch: pytest.MonkeyPatch) -> None:
+def test_an_interrupted_streamed_run_keeps_what_it_computed(kv_model, tmp_path: Path, ctrl_c_at_update) -> None:
     """Ctrl-C as the run reaches its separation root, before deciding it (the progress line's second update: the
     run restarts at each of its two events): the file holds the rows before it with their S, the onset's dt*/dp
     and rows, those of the complete run; the Interrupted's result is the file's."""
     from daeclear.core.errors import Interrupted
-    from daeclear.core.progress import Progress
 
     full = kv_run(kv_model, save=dc.SaveAt(times=STREAM_TIMES))
-    calls, original = [0], Progress.update
-
-    def update(self: Progress, t: float, note: str = "") -> None:
-        calls[0] += 1
-        if calls[0] == 2:
-            raise KeyboardInterrupt
-        original(self, t, note)
-
-    monkeypatch.setattr(Progress, "update", update)
+    ctrl_c_at_update(2)
     with pytest.raises(Interrupted) as info:
         kv_run(kv_model, save=dc.SaveAt(times=STREAM_TIMES, stream_to=tmp_path / "run.h5"))
     partial = dc.load(tmp_path / "run.h5")
